@@ -1,0 +1,39 @@
+"""Shared fixtures: MPI-safe teardown and the paper's problems."""
+
+from __future__ import annotations
+
+import gc
+import os
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+from mpi4py import MPI
+
+import pytest
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(autouse=True)
+def _collective_teardown():
+    """Run collective PETSc destructors together on every rank (dolfinx conftest)."""
+    yield
+    gc.collect()
+    MPI.COMM_WORLD.Barrier()
+
+
+def run_mpi(script: str | Path, nprocs: int, *args: str, timeout: float = 600) -> str:
+    """Run ``python script args`` under the venv's mpiexec; return stdout, raise on failure."""
+    mpiexec = shutil.which("mpiexec", path=str(Path(sys.executable).parent)) or "mpiexec"
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    proc = subprocess.run(
+        [mpiexec, "-n", str(nprocs), sys.executable, str(script), *args],
+        capture_output=True, text=True, timeout=timeout, env=env, cwd=ROOT,
+    )
+    if proc.returncode != 0:
+        raise AssertionError(
+            f"mpiexec -n {nprocs} {script} failed ({proc.returncode}):\n{proc.stdout}\n{proc.stderr}"
+        )
+    return proc.stdout

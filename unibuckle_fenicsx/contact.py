@@ -1,0 +1,132 @@
+"""Contact-node manager: obstacle zone -> constrained w-DOFs; candidate set -> removed DOFs.
+
+The constrained set I holds the mesh nodes of the closed zone whose deflection is free
+(nodes already fixed by an edge support are recorded but not counted). Nodes are numbered
+0..i-1 in lexicographic (y, x) order of their coordinates, so a contact set, a sorted int64
+array of these numbers, means the same nodes on every rank and for every partition.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.config import ObstacleSpec
+from unibuckle_fenicsx.plate.model import PlateModel
+
+__all__ = ["ContactSetManager", "EmptyZoneError"]
+
+
+class EmptyZoneError(ValueError):
+    """The obstacle zone holds no free mesh node."""
+
+
+@dataclass(frozen=True)
+class _Owned:
+    positions: npt.NDArray[np.int64]  # position k in 0..i-1 of each owned constrained node
+    local_dofs: npt.NDArray[np.int32]  # W local dof of each
+    global_dofs: npt.NDArray[np.int64]  # W global dof of each
+
+
+class ContactSetManager:
+    """Constrained w-DOFs of an obstacle zone, and candidate sets as removed DOFs.
+
+    Args:
+        model: The assembled plate pencil.
+        obstacle: The obstacle zone.
+
+    Attributes:
+        coordinates: (i, 2) coordinates of the constrained nodes, same on all ranks.
+        num_edge_fixed: Nodes of the zone already fixed (w = 0) by edge supports.
+
+    Note:
+        Construction is collective. Raises :class:`EmptyZoneError` if the zone holds no
+        free mesh node.
+    """
+
+    def __init__(self, model: PlateModel, obstacle: ObstacleSpec) -> None:
+        self.model = model
+        self.obstacle = obstacle
+        comm = model.mesh.comm
+        W, Vw = model.W, model.Vw
+        size = max(model.plate.length, model.plate.width)
+        dofs_W, dofs_Vw = dolfinx.fem.locate_dofs_geometrical(
+            (W.sub(0), Vw), lambda x: obstacle.contains(x, size)
+        )
+        n_owned = model.num_owned_dofs
+        owned = dofs_W < n_owned
+        dofs_W, dofs_Vw = dofs_W[owned], dofs_Vw[owned]
+        fixed = np.isin(dofs_W, model.bc_dofs)
+        self.num_edge_fixed = int(comm.allreduce(int(fixed.sum()), op=MPI.SUM))
+        dofs_W, dofs_Vw = dofs_W[~fixed], dofs_Vw[~fixed]
+        xy = Vw.tabulate_dof_coordinates()[dofs_Vw, :2]
+
+        gathered = comm.allgather(xy)
+        all_xy = np.vstack(gathered) if gathered else np.empty((0, 2))
+        # Quantise before sorting: equal nodes must sort alike on every partition.
+        keys = np.round(all_xy / (1e-9 * size)).astype(np.int64)
+        order = np.lexsort((keys[:, 0], keys[:, 1]))
+        self.coordinates: npt.NDArray[np.float64] = all_xy[order]
+        if self.coordinates.shape[0] == 0:
+            nx = model.mesh.topology.index_map(0).size_global
+            raise EmptyZoneError(
+                f"obstacle zone {obstacle.describe()} holds no free mesh node "
+                f"({self.num_edge_fixed} zone nodes are fixed by edge supports; the mesh "
+                f"has {nx} vertices, spacing about {self._spacing():.3g} m): enlarge the "
+                "zone or refine the mesh"
+            )
+        offset = int(sum(len(g) for g in gathered[: comm.rank]))
+        rank_pos = np.empty(len(order), dtype=np.int64)
+        rank_pos[order] = np.arange(len(order), dtype=np.int64)
+        positions = rank_pos[offset : offset + len(dofs_W)]
+        self._owned = _Owned(positions, dofs_W.astype(np.int32), model.global_dofs(dofs_W))
+
+    def _spacing(self) -> float:
+        msh = self.model.mesh
+        h = msh.h(msh.topology.dim, np.arange(msh.topology.index_map(2).size_local, dtype=np.int32))
+        return float(msh.comm.allreduce(h.max() if h.size else 0.0, op=MPI.MAX))
+
+    @property
+    def size(self) -> int:
+        """Number i of constrained nodes."""
+        return int(self.coordinates.shape[0])
+
+    def removed_rows(self, active: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
+        """Global W rows owned by this rank of the nodes ``active`` (node numbers)."""
+        mask = np.isin(self._owned.positions, active)
+        return self._owned.global_dofs[mask]
+
+    def values(self, u: PETSc.Vec) -> npt.NDArray[np.float64]:  # type: ignore[name-defined]
+        """Entries of the W-vector ``u`` at the constrained nodes, (i,), same on all ranks.
+
+        Note:
+            Collective.
+        """
+        local = np.zeros(self.size)
+        local[self._owned.positions] = u.array_r[self._owned.local_dofs]
+        self.model.mesh.comm.Allreduce(MPI.IN_PLACE, local, op=MPI.SUM)
+        return local
+
+    def indicator(self) -> dolfinx.fem.Function:
+        """Function on the w-space: 1 at the constrained nodes, 0 elsewhere (for output)."""
+        return self.node_function(np.arange(self.size, dtype=np.int64), "obstacle_zone")
+
+    def node_function(
+        self, active: npt.NDArray[np.int64], name: str = "contact"
+    ) -> dolfinx.fem.Function:
+        """Function on the w-space: 1 at the nodes ``active``, 0 elsewhere."""
+        f = dolfinx.fem.Function(self.model.Vw, name=name)
+        inverse = np.full(self.model.num_owned_dofs, -1, dtype=np.int64)
+        n_owned_w = self.model.Vw.dofmap.index_map.size_local
+        inverse[self.model.w_dofs[:n_owned_w]] = np.arange(n_owned_w)
+        mask = np.isin(self._owned.positions, active)
+        f.x.array[inverse[self._owned.local_dofs[mask]]] = 1.0
+        f.x.scatter_forward()
+        return f

@@ -1,0 +1,101 @@
+"""Plate meshes and edge markers."""
+
+from __future__ import annotations
+
+from mpi4py import MPI
+
+import dolfinx
+
+import numpy as np
+
+from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, MeshSpec, PlateSpec
+
+__all__ = ["create_plate_mesh", "edge_normal_axis", "edge_tag"]
+
+
+def create_plate_mesh(
+    plate: PlateSpec, spec: MeshSpec, comm: MPI.Comm = MPI.COMM_WORLD
+) -> tuple[dolfinx.mesh.Mesh, dolfinx.mesh.MeshTags]:
+    """Structured quadrilateral mesh of the rectangle with tagged edges.
+
+    Args:
+        plate: Geometry; edges named as in :data:`EDGE_NAMES`.
+        spec: Cells along x and y.
+        comm: Communicator (``MPI.COMM_SELF`` for a serial copy per rank).
+
+    Returns:
+        The mesh and facet tags 1..4 for left, right, bottom, top.
+
+    Note:
+        Collective on ``comm``.
+    """
+    (x0, y0), (x1, y1) = plate.corners
+    msh = dolfinx.mesh.create_rectangle(
+        comm,
+        [np.array([x0, y0]), np.array([x1, y1])],
+        [spec.nx, spec.ny],
+        dolfinx.mesh.CellType.quadrilateral,
+    )
+    tol = 1e-10 * max(plate.length, plate.width)
+    markers = (
+        lambda x: np.isclose(x[0], x0, atol=tol),
+        lambda x: np.isclose(x[0], x1, atol=tol),
+        lambda x: np.isclose(x[1], y0, atol=tol),
+        lambda x: np.isclose(x[1], y1, atol=tol),
+    )
+    fdim = msh.topology.dim - 1
+    facets, values = [], []
+    for tag, marker in enumerate(markers, start=1):
+        f = dolfinx.mesh.locate_entities_boundary(msh, fdim, marker)
+        facets.append(f)
+        values.append(np.full_like(f, tag))
+    order_facets = np.concatenate(facets)
+    order = np.argsort(order_facets, kind="stable")
+    tags = dolfinx.mesh.meshtags(
+        msh,
+        fdim,
+        order_facets[order].astype(np.int32),
+        np.concatenate(values)[order].astype(np.int32),
+    )
+    assert len(EDGE_NAMES) == 4
+    return msh, tags
+
+
+def edge_tag(plate: PlateSpec, edge: EdgeSpec) -> int:
+    """Facet tag of ``edge``: its ``tag`` if set, else its position in :data:`EDGE_NAMES` + 1."""
+    if edge.tag is not None:
+        return edge.tag
+    if edge.name not in EDGE_NAMES:
+        raise ValueError(f"edge {edge.name!r} has no tag; rectangle edges are named {EDGE_NAMES}")
+    return EDGE_NAMES.index(edge.name) + 1
+
+
+def edge_normal_axis(
+    msh: dolfinx.mesh.Mesh, facet_tags: dolfinx.mesh.MeshTags, tag: int, name: str
+) -> int:
+    """Axis (0: x, 1: y) normal to the straight, axis-aligned edge with facet tag ``tag``.
+
+    Raises ``ValueError`` for an edge that is not parallel to a coordinate axis, where
+    a tangential/normal condition would need a rotated constraint.
+
+    Note:
+        Collective.
+    """
+    fdim = msh.topology.dim - 1
+    facets = facet_tags.find(tag)
+    msh.topology.create_connectivity(fdim, 0)
+    vertices = np.unique(dolfinx.mesh.entities_to_geometry(msh, fdim, facets).ravel())
+    x = msh.geometry.x[vertices, :2]
+    lo = np.min(msh.comm.allgather(x.min(axis=0) if vertices.size else np.full(2, np.inf)), axis=0)
+    hi = np.max(msh.comm.allgather(x.max(axis=0) if vertices.size else np.full(2, -np.inf)), axis=0)
+    if not np.all(np.isfinite(lo)):
+        raise ValueError(f"edge {name!r} (facet tag {tag}) holds no facet of the mesh")
+    extent = hi - lo
+    if extent[0] <= 1e-10 * extent.max():
+        return 0
+    if extent[1] <= 1e-10 * extent.max():
+        return 1
+    raise ValueError(
+        f"edge {name!r} is not parallel to a coordinate axis: hard simple support and "
+        "in-plane rollers need axis-aligned edges"
+    )

@@ -1,0 +1,5 @@
+"""Reissner-Mindlin plate: spaces, MITC shear interpolation, UFL forms, assembled pencil."""
+
+from unibuckle_fenicsx.plate.model import PlateModel
+
+__all__ = ["PlateModel"]

@@ -1,0 +1,172 @@
+"""The assembled buckling pencil (A, B) of a Reissner-Mindlin plate with its edge conditions."""
+
+from __future__ import annotations
+
+from petsc4py import PETSc
+
+import dolfinx
+import dolfinx.fem.petsc
+import ufl
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.config import Material, PlateSpec
+from unibuckle_fenicsx.materials import bending_voigt, shear_stiffness
+from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tag
+from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_form
+from unibuckle_fenicsx.plate.spaces import (
+    create_plate_space,
+    create_shear_space,
+    mitc_shear_operator,
+)
+from unibuckle_fenicsx.prestress import Prestress
+
+__all__ = ["PlateModel"]
+
+
+class PlateModel:
+    r"""Reissner-Mindlin plate with the assembled matrices A (stiffness) and B (geometric).
+
+    A is the bending stiffness plus the MITC shear stiffness :math:`P^T M_s P`
+    (:func:`~unibuckle_fenicsx.plate.spaces.mitc_shear_operator`); B is
+    :math:`-\int N^0\nabla w\cdot\nabla z`. Edge-constrained DOFs have zero rows and
+    columns with diagonal 1 in A and 0 in B, so they map to :math:`\lambda = \infty`.
+    Both matrices are assembled once, here.
+
+    Args:
+        msh: Quadrilateral plate mesh.
+        facet_tags: Edge markers.
+        plate: Thickness and edge conditions.
+        material: Elastic constants.
+        prestress: Membrane force per unit load.
+        shear: "mitc" (locking-free) or "full" (plain full integration, locks).
+
+    Note:
+        Construction and :meth:`destroy` are collective.
+    """
+
+    def __init__(
+        self,
+        msh: dolfinx.mesh.Mesh,
+        facet_tags: dolfinx.mesh.MeshTags,
+        plate: PlateSpec,
+        material: Material,
+        prestress: Prestress,
+        shear: str = "mitc",
+    ) -> None:
+        if msh.topology.cell_type != dolfinx.mesh.CellType.quadrilateral:
+            raise ValueError("the MITC plate element needs a quadrilateral mesh")
+        self.mesh = msh
+        self.plate = plate
+        self.material = material
+        self.prestress = prestress
+        self.W = create_plate_space(msh)
+        self.Vw, map_w = self.W.sub(0).collapse()
+        self.w_dofs = np.asarray(map_w[0], dtype=np.int32)  # Vw local dof -> W local dof
+        self.bcs = self._edge_bcs(facet_tags)
+        self.bc_dofs = np.unique(
+            np.concatenate([bc.dof_indices()[0] for bc in self.bcs] or [np.empty(0, np.int32)])
+        ).astype(np.int32)
+
+        u, v = ufl.TrialFunction(self.W), ufl.TestFunction(self.W)
+        D = bending_voigt(material, plate.thickness)
+        ks = shear_stiffness(material, plate.thickness)
+        a = bending_form(u, v, D)
+        if shear == "full":
+            a = a + shear_form(u, v, ks)
+        elif shear != "mitc":
+            raise ValueError(f'shear must be "mitc" or "full", got {shear!r}')
+        self.a_form = dolfinx.fem.form(a)
+        self.b_form = dolfinx.fem.form(geometric_form(u, v, prestress.N0))
+
+        self.A = dolfinx.fem.petsc.assemble_matrix(self.a_form, bcs=self.bcs, diag=1.0)
+        self.A.assemble()
+        if shear == "mitc":
+            S = self._mitc_shear_matrix(ks)
+            self.A.axpy(1.0, S, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[attr-defined]
+            S.destroy()
+        self.B = dolfinx.fem.petsc.assemble_matrix(self.b_form, bcs=self.bcs, diag=0.0)
+        self.B.assemble()
+        self.A.setOption(PETSc.Mat.Option.SPD, True)  # type: ignore[attr-defined]
+        self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[attr-defined]
+        self.B.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[attr-defined]
+
+    def _edge_bcs(self, facet_tags: dolfinx.mesh.MeshTags) -> list[dolfinx.fem.DirichletBC]:
+        """Zero Dirichlet conditions of the edge supports (hard SS: w and tangential theta)."""
+        msh, W = self.mesh, self.W
+        fdim = msh.topology.dim - 1
+        bcs = []
+        for e in self.plate.edges:
+            if e.support == "free":
+                continue
+            tag = edge_tag(self.plate, e)
+            facets = facet_tags.find(tag)
+            subs = [(0,)]
+            if e.support == "clamped":
+                subs += [(1, 0), (1, 1)]
+            elif e.support == "simply_supported":
+                # theta . s = 0: the rotation component along the edge direction.
+                normal = edge_normal_axis(msh, facet_tags, tag, e.name)
+                subs.append((1, 1 - normal))
+            for path in subs:
+                sub = W
+                for i in path:
+                    sub = sub.sub(i)
+                Vc, _ = sub.collapse()
+                dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
+                bcs.append(dolfinx.fem.dirichletbc(PETSc.ScalarType(0), dofs[0], sub))
+        return bcs
+
+    def _mitc_shear_matrix(self, ks: float) -> PETSc.Mat:  # type: ignore[name-defined]
+        """:math:`P^T M_s P` with P's columns of edge-constrained DOFs zeroed."""
+        Vs = create_shear_space(self.mesh)
+        g, d = ufl.TrialFunction(Vs), ufl.TestFunction(Vs)
+        Ms = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(ks * ufl.inner(g, d) * ufl.dx))
+        Ms.assemble()
+        P = mitc_shear_operator(self.W, Vs)
+        keep = P.createVecRight()
+        keep.set(1.0)
+        n_owned = self.W.dofmap.index_map.size_local * self.W.dofmap.index_map_bs
+        owned_bc = self.bc_dofs[self.bc_dofs < n_owned]
+        keep.array[owned_bc] = 0.0
+        P.diagonalScale(R=keep)
+        S = Ms.PtAP(P)
+        for obj in (Ms, P, keep):
+            obj.destroy()
+        return S
+
+    @property
+    def num_owned_dofs(self) -> int:
+        """Owned DOFs of W on this rank."""
+        return self.W.dofmap.index_map.size_local * self.W.dofmap.index_map_bs
+
+    @property
+    def num_dofs(self) -> int:
+        """Global DOF count of W."""
+        return self.W.dofmap.index_map.size_global * self.W.dofmap.index_map_bs
+
+    def global_dofs(self, local: npt.NDArray[np.int32]) -> npt.NDArray[np.int64]:
+        """Global (PETSc) indices of the local W DOFs ``local``."""
+        im, bs = self.W.dofmap.index_map, self.W.dofmap.index_map_bs
+        local = np.ascontiguousarray(local, dtype=np.int32)
+        return im.local_to_global(local // bs) * bs + local % bs
+
+    def split(self, u: dolfinx.fem.Function) -> tuple[dolfinx.fem.Function, dolfinx.fem.Function]:
+        """Deflection and rotation of ``u`` as Functions on collapsed spaces."""
+        w = u.sub(0).collapse()
+        w.name = "w"
+        theta = u.sub(1).collapse()
+        theta.name = "theta"
+        return w, theta
+
+    def destroy(self) -> None:
+        """Destroy A and B (collective)."""
+        for name in ("A", "B"):
+            mat = getattr(self, name, None)
+            if mat is not None:
+                mat.destroy()
+                setattr(self, name, None)
+
+    def __del__(self) -> None:
+        self.destroy()

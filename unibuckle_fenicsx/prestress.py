@@ -1,0 +1,272 @@
+r"""Plane-elasticity prestress solve (paper eq. [1]) giving the membrane force :math:`N^0`.
+
+The in-plane displacement :math:`u^p` solves
+
+.. math::
+
+    \int_\omega N(u^p) : \varepsilon(v) \,dx
+    = \int_{\gamma_1} t\,(\sigma_n n + \tau_s s)\cdot v\,ds,
+
+with :math:`N = C_m \varepsilon` the membrane stress resultant (N/m) per unit load.
+The actual prestress is :math:`\lambda N^0`; compression makes :math:`N^0` negative.
+When no edge holds the plate in its plane, the three rigid motions are pinned at two
+mesh nodes, which leaves :math:`N^0` unchanged for a self-equilibrated load.
+"""
+
+from __future__ import annotations
+
+import logging
+from dataclasses import dataclass
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import basix.ufl
+import dolfinx
+import dolfinx.fem.petsc
+import ufl
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.config import EdgeSpec, Material, PlateSpec
+from unibuckle_fenicsx.materials import membrane_voigt
+from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tag
+
+__all__ = ["DIRECT_LU", "Prestress", "membrane_force", "solve_prestress"]
+
+logger = logging.getLogger(__name__)
+
+#: Linear solver options for the prestress (options prefix ``unibuckle_prestress_``).
+DIRECT_LU: dict[str, str | bool] = {
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+    "ksp_error_if_not_converged": True,
+}
+
+
+def voigt_to_ufl(C: npt.NDArray[np.float64], eps: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
+    """Apply a 3x3 Voigt stiffness to a symmetric 2x2 UFL tensor, returning a tensor."""
+    e = ufl.as_vector([eps[0, 0], eps[1, 1], 2.0 * eps[0, 1]])
+    s = ufl.as_matrix(C.tolist()) * e
+    return ufl.as_matrix([[s[0], s[2]], [s[2], s[1]]])
+
+
+def membrane_force(
+    u: dolfinx.fem.Function | ufl.Argument, material: Material, thickness: float
+) -> ufl.core.expr.Expr:
+    r"""Membrane stress resultant :math:`N = C_m \varepsilon(u)` (N/m) as a UFL tensor."""
+    return voigt_to_ufl(membrane_voigt(material, thickness), ufl.sym(ufl.grad(u)))
+
+
+@dataclass
+class Prestress:
+    r"""Result of the prestress solve.
+
+    Attributes:
+        displacement: In-plane displacement per unit load.
+        N0: Membrane force tensor per unit load (UFL expression of ``displacement``).
+        max_compression: Largest compressive principal membrane force over the
+            quadrature points, :math:`\max(-\min \mathrm{eig}\, N^0)` (N/m).
+        max_tension: Largest tensile principal membrane force (N/m).
+        pinned_rigid_motions: Whether rigid motions were removed by point pins.
+    """
+
+    displacement: dolfinx.fem.Function
+    N0: ufl.core.expr.Expr
+    max_compression: float
+    max_tension: float
+    pinned_rigid_motions: bool
+
+    @property
+    def indefinite(self) -> bool:
+        """Whether the geometric form b is indefinite (tension somewhere)."""
+        return self.max_tension > 1e-10 * self.max_compression
+
+
+def _nearest_vertex(
+    msh: dolfinx.mesh.Mesh, point: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]:
+    """Coordinates of the mesh node nearest ``point`` (collective, same on all ranks)."""
+    x = msh.geometry.x
+    d = np.linalg.norm(x[:, :2] - point[:2], axis=1)
+    k = int(np.argmin(d)) if d.size else -1
+    best = (float(d[k]) if d.size else np.inf, msh.comm.rank)
+    _, owner = msh.comm.allreduce(best, op=MPI.MINLOC)
+    return np.asarray(msh.comm.bcast(x[k].copy() if msh.comm.rank == owner else None, root=owner))
+
+
+def _pin_dofs(
+    V: dolfinx.fem.FunctionSpace, msh: dolfinx.mesh.Mesh
+) -> list[dolfinx.fem.DirichletBC]:
+    """Point constraints removing the three in-plane rigid motions."""
+    x = msh.geometry.x
+    local = np.vstack([x.min(axis=0), x.max(axis=0)]) if x.shape[0] else np.zeros((2, 3))
+    lo = np.min(msh.comm.allgather(local[0]), axis=0)
+    hi = np.max(msh.comm.allgather(local[1]), axis=0)
+    p1 = _nearest_vertex(msh, 0.5 * (lo + hi))
+    p2 = _nearest_vertex(msh, np.array([hi[0], p1[1], 0.0]))
+    if np.linalg.norm(p2 - p1) == 0.0:
+        p2 = _nearest_vertex(msh, np.array([p1[0], hi[1], 0.0]))
+    size = float(np.linalg.norm(hi - lo))
+    tol = 1e-12 * size
+    bcs = []
+    # p1: both components; p2: the component normal to p2 - p1.
+    comps = (0, 1)
+    axis = 1 if abs(p2[0] - p1[0]) >= abs(p2[1] - p1[1]) else 0
+    for point, components in ((p1, comps), (p2, (axis,))):
+        for c in components:
+            Vc, _ = V.sub(c).collapse()
+            dofs = dolfinx.fem.locate_dofs_geometrical(
+                (V.sub(c), Vc), lambda y, p=point: np.linalg.norm(y[:2].T - p[:2], axis=1) < tol
+            )
+            bcs.append(dolfinx.fem.dirichletbc(PETSc.ScalarType(0), dofs[0], V.sub(c)))
+    return bcs
+
+
+def solve_prestress(
+    msh: dolfinx.mesh.Mesh,
+    facet_tags: dolfinx.mesh.MeshTags,
+    plate: PlateSpec,
+    material: Material,
+    degree: int = 1,
+    petsc_options: dict[str, str | bool] | None = None,
+) -> Prestress:
+    """Solve the membrane problem under the unit load and return :math:`N^0`.
+
+    Args:
+        msh: Plate mesh.
+        facet_tags: Edge markers (:func:`unibuckle_fenicsx.mesh.edge_tag`).
+        plate: Thickness and edge conditions (in-plane supports and tractions).
+        material: Membrane stiffness.
+        degree: Lagrange degree of the in-plane displacement.
+        petsc_options: KSP options (default :data:`DIRECT_LU`), prefix
+            ``unibuckle_prestress_``.
+
+    Returns:
+        The prestress; raises ``ValueError`` if no edge is loaded, if the load is not
+        self-equilibrated on a plate held by no in-plane support, or if the plate is
+        in tension everywhere (no buckling under a positive load).
+
+    Note:
+        Collective.
+    """
+    t = plate.thickness
+    loaded = [e for e in plate.edges if e.loaded]
+    if not loaded:
+        raise ValueError(
+            "no edge is loaded: give at least one edge a non-zero normal_stress or shear_stress"
+        )
+    cell = msh.basix_cell()
+    V = dolfinx.fem.functionspace(msh, basix.ufl.element("Lagrange", cell.name, degree, shape=(2,)))
+    u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
+    ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
+    n = ufl.FacetNormal(msh)
+    s = ufl.as_vector([-n[1], n[0]])
+
+    a = ufl.inner(membrane_force(u, material, t), ufl.sym(ufl.grad(v))) * ufl.dx
+    L = sum(
+        (
+            t
+            * (e.normal_stress * ufl.dot(n, v) + e.shear_stress * ufl.dot(s, v))
+            * ds(edge_tag(plate, e))
+            for e in loaded
+        ),
+        start=dolfinx.fem.Constant(msh, PETSc.ScalarType(0)) * v[0] * ufl.dx,
+    )
+
+    bcs: list[dolfinx.fem.DirichletBC] = []
+    fdim = msh.topology.dim - 1
+    for e in plate.edges:
+        if e.inplane == "free":
+            continue
+        facets = facet_tags.find(edge_tag(plate, e))
+        components: tuple[int, ...] = (0, 1)
+        if e.inplane == "roller":
+            components = (edge_normal_axis(msh, facet_tags, edge_tag(plate, e), e.name),)
+        for c in components:
+            Vc, _ = V.sub(c).collapse()
+            dofs = dolfinx.fem.locate_dofs_topological((V.sub(c), Vc), fdim, facets)
+            bcs.append(dolfinx.fem.dirichletbc(PETSc.ScalarType(0), dofs[0], V.sub(c)))
+    pinned = not bcs
+    if pinned:
+        _check_self_equilibrated(msh, ds, n, s, plate, loaded)
+        bcs = _pin_dofs(V, msh)
+
+    problem = dolfinx.fem.petsc.LinearProblem(
+        a,
+        L,
+        bcs=bcs,
+        petsc_options=DIRECT_LU if petsc_options is None else petsc_options,
+        petsc_options_prefix="unibuckle_prestress_",
+    )
+    uh = problem.solve()
+    assert isinstance(uh, dolfinx.fem.Function)
+    uh.name = "prestress_displacement"
+    del problem
+
+    N0 = membrane_force(uh, material, t)
+    max_compression, max_tension = _principal_extremes(msh, N0, degree)
+    logger.info(
+        "prestress: max compression %.6g N/m, max tension %.6g N/m per unit load",
+        max_compression,
+        max_tension,
+    )
+    scale = max(max_compression, max_tension)
+    if max_compression <= 1e-10 * scale:
+        raise ValueError(
+            "the load puts the plate in tension everywhere (largest compressive membrane "
+            f"force {max_compression:.3g} N/m against tension {max_tension:.3g} N/m): no "
+            "buckling under a positive load; reverse the sign of normal_stress"
+        )
+    return Prestress(uh, N0, max_compression, max_tension, pinned)
+
+
+def _check_self_equilibrated(
+    msh: dolfinx.mesh.Mesh,
+    ds: ufl.Measure,
+    n: ufl.core.expr.Expr,
+    s: ufl.core.expr.Expr,
+    plate: PlateSpec,
+    loaded: list[EdgeSpec],
+) -> None:
+    x = ufl.SpatialCoordinate(msh)
+    force = [0.0, 0.0]
+    moment = 0.0
+    total = 0.0
+    for e in loaded:
+        tr = e.normal_stress * n + e.shear_stress * s
+        m = ds(edge_tag(plate, e))
+        for c in range(2):
+            force[c] += dolfinx.fem.assemble_scalar(dolfinx.fem.form(tr[c] * m))
+        moment += dolfinx.fem.assemble_scalar(dolfinx.fem.form((x[0] * tr[1] - x[1] * tr[0]) * m))
+        total += dolfinx.fem.assemble_scalar(dolfinx.fem.form(ufl.sqrt(ufl.dot(tr, tr)) * m))
+    force = [msh.comm.allreduce(f, op=MPI.SUM) for f in force]
+    moment = msh.comm.allreduce(moment, op=MPI.SUM)
+    total = msh.comm.allreduce(total, op=MPI.SUM)
+    size = max(plate.length, plate.width)
+    if max(abs(force[0]), abs(force[1]), abs(moment) / size) > 1e-10 * total:
+        raise ValueError(
+            'every edge is free in its plane (inplane = "free") but the load is not '
+            f"self-equilibrated (resultant force {force}, moment {moment:.3g} per unit "
+            'thickness): set inplane = "clamped" or "roller" on some edge'
+        )
+
+
+def _principal_extremes(
+    msh: dolfinx.mesh.Mesh, N0: ufl.core.expr.Expr, degree: int
+) -> tuple[float, float]:
+    """Largest compressive and tensile principal value of N0 over quadrature points."""
+    points, _ = basix.make_quadrature(msh.basix_cell(), max(2, 2 * degree))
+    expr = dolfinx.fem.Expression(N0, points)
+    cells = np.arange(msh.topology.index_map(msh.topology.dim).size_local, dtype=np.int32)
+    values = expr.eval(msh, cells).reshape(-1, 2, 2)
+    if values.size:
+        eig = np.linalg.eigvalsh(values)
+        local = (float(-eig[:, 0].min()), float(eig[:, 1].max()))
+    else:
+        local = (-np.inf, -np.inf)
+    comp = msh.comm.allreduce(local[0], op=MPI.MAX)
+    tens = msh.comm.allreduce(local[1], op=MPI.MAX)
+    return max(comp, 0.0), max(tens, 0.0)
