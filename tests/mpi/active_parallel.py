@@ -1,0 +1,28 @@
+"""Active-set solve of a paper case on a mesh distributed over the ranks; JSON on rank 0.
+
+Usage: mpiexec -n 2 python active_parallel.py CASE NX NY
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+
+from mpi4py import MPI
+
+from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+from unibuckle_fenicsx.cases import paper_case
+from unibuckle_fenicsx.problem import BucklingProblem
+
+case, nx, ny = sys.argv[1], int(sys.argv[2]), int(sys.argv[3])
+problem = BucklingProblem(paper_case(case, nx, ny), MPI.COMM_WORLD)
+sol = solve_active_set(problem)
+assert problem.contact is not None
+coords = problem.contact.coordinates[sol.active].tolist()
+# Every rank must hold the same answer.
+assert (
+    MPI.COMM_WORLD.allgather(sol.active.tolist()).count(sol.active.tolist()) == MPI.COMM_WORLD.size
+)
+if MPI.COMM_WORLD.rank == 0:
+    print(json.dumps({"load": sol.load, "coordinates": coords, "kkt": sol.details["kkt"]}))
+problem.destroy()

@@ -1,0 +1,342 @@
+r"""Active-set method (algorithms/active_set.py) against independent computations.
+
+- A randomised, seeded family of small problems (random plates of aspect 1-3, random
+  box zones, coarse meshes, i <= 12): the exhaustive minimum over all 2^i contact sets,
+  computed here with dense numpy (the pencil condensed onto w by a Schur complement,
+  every subset's reduced pencil solved with ``numpy.linalg.eigh``), must equal the
+  active-set load to 1e-8 and its contact set.
+- The paper's zones: a certified KKT point; the interlacing order of the zones
+  (c2 within c1 within c3) orders the loads; multilevel equals single-level.
+- The lattice lower bound is valid, and closes on small problems.
+- ``mpiexec -n 2``: the distributed result equals the serial one.
+- ``-m convergence``: the unilateral load of each zone converges at rate h^2 (20x10 ..
+  160x80), with a Richardson-extrapolated value.
+"""
+
+from __future__ import annotations
+
+import itertools
+import json
+import math
+from pathlib import Path
+
+from mpi4py import MPI
+
+import numpy as np
+import pytest
+from conftest import run_mpi
+
+from unibuckle_fenicsx.algorithms.active_set import prolong_contact_set, solve_active_set
+from unibuckle_fenicsx.cases import paper_case
+from unibuckle_fenicsx.config import (
+    Material,
+    MeshSpec,
+    ObstacleSpec,
+    PlateSpec,
+    ProblemSpec,
+    SolverSpec,
+)
+from unibuckle_fenicsx.problem import BucklingProblem
+
+HERE = Path(__file__).resolve().parent
+#: Agreement required by the issue (relative load).
+RTOL = 1e-8
+serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
+
+
+# -- independent exhaustive reference ---------------------------------------------------
+def _dense(mat) -> np.ndarray:
+    n = mat.getSize()[0]
+    idx = np.arange(n, dtype=np.int32)
+    return np.asarray(mat.getValues(idx, idx))
+
+
+def exhaustive_minimum(problem: BucklingProblem) -> tuple[float, list[tuple[int, ...]], int]:
+    r"""Smallest feasible :math:`\lambda(Z)` over all Z in 2^I, by dense linear algebra.
+
+    The rotations are condensed out: :math:`S = A_{ww} - A_{w\theta} A_{\theta\theta}^{-1}
+    A_{\theta w}` on the free w-DOFs; removing the w-DOFs of Z from (A, B) and condensing
+    equals taking the principal submatrices of (S, B_ww). The largest eigenvalue mu of
+    :math:`B_{ff} x = \mu S_{ff} x` gives :math:`\lambda = 1/\mu`; a mode is feasible
+    when, for one sign, :math:`w_k \le \tau \max|w|` on :math:`I \setminus Z`.
+
+    Returns:
+        (lambda_min, every Z with a feasible mode and lambda within RTOL of the minimum,
+        number of feasible sets).
+    """
+    A, B = _dense(problem.model.A), _dense(problem.model.B)
+    n = A.shape[0]
+    bc = problem.model.bc_dofs
+    w_all = problem.model.w_dofs
+    w = np.setdiff1d(w_all, bc)  # free w-DOFs (serial: local == global)
+    th = np.setdiff1d(np.setdiff1d(np.arange(n), w_all), bc)
+    Ath = A[np.ix_(th, th)]
+    S = A[np.ix_(w, w)] - A[np.ix_(w, th)] @ np.linalg.solve(Ath, A[np.ix_(th, w)])
+    Bw = B[np.ix_(w, w)]
+    contact = problem.contact
+    i = contact.size
+    node_pos = np.searchsorted(w, [int(contact.removed_rows(np.array([k]))[0]) for k in range(i)])
+    tau = problem.tau
+    loads: list[tuple[float, tuple[int, ...]]] = []
+    for p in range(i + 1):
+        combos = list(itertools.combinations(range(i), p))
+        keep = np.ones((len(combos), len(w)), dtype=bool)
+        for c, z in enumerate(combos):
+            keep[c, node_pos[list(z)]] = False
+        idx = np.array([np.flatnonzero(k) for k in keep])  # (C, m)
+        if idx.shape[1] == 0:
+            continue  # every w-DOF removed: no finite load
+        Sz = S[idx[:, :, None], idx[:, None, :]]
+        Bz = Bw[idx[:, :, None], idx[:, None, :]]
+        L = np.linalg.cholesky(Sz)
+        Li = np.linalg.inv(L)
+        C = Li @ Bz @ np.swapaxes(Li, 1, 2)
+        mu, Y = np.linalg.eigh(0.5 * (C + np.swapaxes(C, 1, 2)))
+        X = np.swapaxes(Li, 1, 2) @ Y[:, :, -1:]  # w at the free w-DOFs
+        for c, z in enumerate(combos):
+            if mu[c, -1] <= 0.0:
+                continue
+            x = np.zeros(len(w))
+            x[idx[c]] = X[c, :, 0]
+            x /= np.abs(x).max()
+            rest = np.setdiff1d(np.arange(i), z)
+            vals = x[node_pos[rest]]
+            if rest.size == 0 or vals.max() <= tau or (-vals).max() <= tau:
+                loads.append((1.0 / mu[c, -1], z))
+    best = min(v for v, _ in loads)
+    minimisers = [z for v, z in loads if v <= best * (1 + RTOL)]
+    return best, minimisers, len(loads)
+
+
+# -- random family ----------------------------------------------------------------------
+def _interior_nodes_in_box(nx, ny, length, width, box) -> int:
+    xs = np.linspace(0, length, nx + 1)[1:-1]
+    ys = np.linspace(0, width, ny + 1)[1:-1]
+    X, Y = np.meshgrid(xs, ys)
+    tol = 1e-8 * length
+    (x0, x1), (y0, y1) = box
+    inside = (X >= x0 - tol) & (X <= x1 + tol) & (Y >= y0 - tol) & (Y <= y1 + tol)
+    return int(inside.sum())
+
+
+def random_specs(seed: int = 20240605, min_nodes: int = 3, max_nodes: int = 12):
+    """Endless seeded stream of random plates with random box zones.
+
+    Aspect 1-3, width 0.1 m, t = 6 mm; the zones hold ``min_nodes`` to ``max_nodes``
+    free mesh nodes.
+    """
+    rng = np.random.default_rng(seed)
+    count = 0
+    while True:
+        aspect = rng.uniform(1.0, 3.0)
+        length, width = 0.1 * aspect, 0.1
+        ny = int(rng.integers(2, 5))
+        nx = max(2, round(aspect * ny) + int(rng.integers(-1, 2)))
+        xa, xb = np.sort(rng.uniform(0, length, 2))
+        ya, yb = np.sort(rng.uniform(0, width, 2))
+        if rng.random() < 0.3:  # zones spanning the width, like the paper's c1
+            ya, yb = 0.0, width
+        box = ((float(xa), float(xb)), (float(ya), float(yb)))
+        i = _interior_nodes_in_box(nx, ny, length, width, box)
+        if not min_nodes <= i <= max_nodes:
+            continue
+        yield ProblemSpec(
+            name=f"random{count}",
+            plate=PlateSpec(corners=((0.0, 0.0), (length, width)), thickness=0.006),
+            material=Material(E=1.0e9, nu=0.3),
+            mesh=MeshSpec(nx, ny),
+            obstacle=ObstacleSpec(zone=box),
+            solver=SolverSpec(method="active-set"),
+        )
+        count += 1
+
+
+def active_family(count: int = 50) -> tuple[list[ProblemSpec], int]:
+    """The first ``count`` random problems whose obstacle is active.
+
+    Active: the free mode violates it for both signs. Also returns how many inactive
+    problems were skipped.
+    """
+    family, skipped = [], 0
+    for spec in random_specs():
+        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        problem.solve_free()
+        v = problem.contact.values(problem.free_mode.x.petsc_vec)
+        v = v / np.abs(v).max()
+        problem.destroy()
+        if min(v.max(), (-v).max()) > 1e-6:
+            family.append(spec)
+        else:
+            skipped += 1
+        if len(family) == count:
+            return family, skipped
+    raise AssertionError("unreachable")
+
+
+@pytest.fixture(scope="module")
+def family() -> list[ProblemSpec]:
+    return active_family()[0]
+
+
+#: Problems of the family where the iteration (all seeds) stops at a KKT point that is
+#: not the global minimum (checked against the exhaustive list: e.g. random29 has KKT
+#: points Z = (0, 1) at 23.646 MPa and the global Z = (1, 2) at 23.142 MPa). A local
+#: method cannot exclude this (the problem is NP-hard); the lattice search recovers it.
+KNOWN_LOCAL_MINIMA = {"random29"}
+
+
+@serial
+def test_random_family_matches_exhaustive_enumeration(family):
+    """Same load (1e-8) and contact set as the dense exhaustive minimum, 50 problems.
+
+    The iteration alone (``bound_budget=0``) agrees except on :data:`KNOWN_LOCAL_MINIMA`,
+    where it returns a certified, non-global KKT point (an upper bound); with the lattice
+    search those are solved and proven optimal too.
+    """
+    report = []
+    disagreements = {}
+    for spec in family:
+        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        problem.solve_free()
+        sol = solve_active_set(problem, bound_budget=0)
+        best, minimisers, _ = exhaustive_minimum(problem)
+        z = tuple(int(k) for k in sol.active)
+        rel = abs(sol.load - best) / best
+        report.append((spec.name, problem.num_constrained, rel, len(minimisers)))
+        assert best > sol.details["free_load"] * (1 + RTOL)  # the obstacle is active
+        assert sol.details["kkt"], (spec.name, sol.details.get("warning"))
+        assert sol.load >= best * (1 - RTOL)  # a feasible load is an upper bound
+        assert sol.lower_bound <= best * (1 + RTOL)
+        if rel > RTOL or z not in minimisers:
+            disagreements[spec.name] = (
+                f"{spec.name} {spec.mesh} zone {spec.obstacle.zone}: active-set "
+                f"{sol.load:.12g} Z={z}, exhaustive {best:.12g} Z={minimisers}"
+            )
+            full = solve_active_set(problem, bound_budget=2**problem.num_constrained)
+            assert abs(full.load - best) <= RTOL * best
+            assert tuple(int(k) for k in full.active) in minimisers
+            assert full.global_optimum_proven
+        problem.destroy()
+    assert set(disagreements) <= KNOWN_LOCAL_MINIMA, "\n".join(disagreements.values())
+    # Large zones are represented; ties (several minimisers) are the exception.
+    assert sum(n >= 8 for _, n, _, _ in report) >= 5, report
+    assert sum(m == 1 for *_, m in report) >= 40, report
+
+
+@serial
+def test_lattice_bound_is_valid_and_closes(family):
+    """Lower bound <= exhaustive minimum; proven optimum equals it (first 8 problems)."""
+    proven = 0
+    for spec in family[:8]:
+        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        sol = solve_active_set(problem, bound_budget=512)
+        best, _, _ = exhaustive_minimum(problem)
+        assert sol.lower_bound <= best * (1 + 1e-10)
+        assert sol.lower_bound >= sol.details["free_load"] * (1 - 1e-10)
+        assert abs(sol.load - best) <= RTOL * best
+        if sol.details["bound_search_complete"]:
+            assert sol.global_optimum_proven
+        proven += sol.global_optimum_proven
+        problem.destroy()
+    assert proven >= 4
+
+
+# -- the paper's zones --------------------------------------------------------------------
+@pytest.fixture(scope="module")
+def paper_loads() -> dict[str, float]:
+    """Active-set loads of the paper's zones at 20x10 (certificate checked on each)."""
+    loads = {}
+    for case in ("c1", "c2", "c3"):
+        problem = BucklingProblem(paper_case(case, 20, 10))
+        free = problem.solve_free().value
+        sol = solve_active_set(problem)
+        cert = problem.certify(sol.load, sol.active)
+        assert cert.kkt, (case, cert)
+        assert sol.details["kkt"]
+        assert free <= sol.lower_bound <= sol.load
+        loads[case] = sol.load
+        loads["free"] = free
+        problem.destroy()
+    return loads
+
+
+def test_paper_zones_certified_and_ordered(paper_loads):
+    """Zones c2 within c1 within c3: interlacing of the cones orders the loads."""
+    lam = paper_loads
+    assert lam["free"] < lam["c2"] <= lam["c1"] * (1 + RTOL)
+    assert lam["c1"] <= lam["c3"] * (1 + RTOL)
+    # The obstacle raises the paper's plate load noticeably (paper, section 6: about
+    # 13 % here, since the m = 2 mode must change).
+    assert lam["c1"] / lam["free"] > 1.05
+
+
+def test_multilevel_equals_single_level():
+    """Seeding on 20x10 and polishing gives the single-level multi-seed answer (40x20)."""
+    for case in ("c1", "c2"):
+        problem = BucklingProblem(paper_case(case, 40, 20))
+        problem.solve_free()
+        multi = solve_active_set(problem, bound_budget=0)
+        single = solve_active_set(problem, multilevel=False, bound_budget=0)
+        assert multi.details["levels"], "expected a coarse level"
+        assert abs(multi.load - single.load) <= RTOL * single.load
+        assert np.array_equal(multi.active, single.active)
+        assert multi.details["fine_eigensolves"] < single.details["fine_eigensolves"]
+        problem.destroy()
+
+
+def test_prolongation_includes_midway_nodes():
+    """Coarse contact at x = 0.5, 1 (h = 0.5, 4 x 2 cells) marks fine 0.5, 0.75, 1 only."""
+    coarse = np.array([[0.5, 0.5], [1.0, 0.5], [1.5, 0.5]])
+    fine = np.array([[x, 0.5] for x in (0.25, 0.5, 0.75, 1.0, 1.25, 1.5, 1.75)])
+    z = prolong_contact_set(np.array([0, 1]), coarse, fine, (0.0, 0.0), (0.5, 0.5), (4, 2))
+    # 0.25 lies between the edge node x = 0 (abstains) and contact node 0.5: in contact.
+    assert z.tolist() == [0, 1, 2, 3]
+
+
+def test_bad_options_raise_before_work():
+    problem = BucklingProblem(paper_case("c2", 4, 2))
+    with pytest.raises(ValueError, match="max_iterations"):
+        solve_active_set(problem, max_iterations=0)
+    with pytest.raises(ValueError, match="bound_budget"):
+        solve_active_set(problem, bound_budget=-1)
+    with pytest.raises(ValueError, match="refine_margin"):
+        solve_active_set(problem, refine_margin=math.nan)
+    assert problem.solver.solves == 0
+    problem.destroy()
+    free = BucklingProblem(paper_case("free", 4, 2))
+    with pytest.raises(ValueError, match="obstacle"):
+        solve_active_set(free)
+    free.destroy()
+
+
+# -- MPI ----------------------------------------------------------------------------------
+@serial
+def test_distributed_equals_serial():
+    """Mpiexec -n 2 on a distributed 40x20 mesh (multilevel) gives the serial answer."""
+    out = run_mpi(HERE / "mpi" / "active_parallel.py", 2, "c1", "40", "20")
+    par = json.loads(out.strip().splitlines()[-1])
+    problem = BucklingProblem(paper_case("c1", 40, 20), MPI.COMM_SELF)
+    sol = solve_active_set(problem)
+    assert abs(par["load"] - sol.load) <= RTOL * sol.load
+    assert np.allclose(par["coordinates"], problem.contact.coordinates[sol.active], atol=1e-12)
+    problem.destroy()
+
+
+# -- convergence ------------------------------------------------------------------------
+@pytest.mark.convergence
+@pytest.mark.parametrize("case", ["c1", "c2", "c3"])
+def test_unilateral_load_converges(case):
+    """Loads at 20x10 .. 160x80 decrease monotonically at an observed rate near 2."""
+    loads = []
+    for n in (20, 40, 80, 160):
+        problem = BucklingProblem(paper_case(case, n, n // 2))
+        sol = solve_active_set(problem, bound_budget=0)
+        assert sol.details["kkt"]
+        loads.append(sol.load)
+        problem.destroy()
+    diffs = -np.diff(loads)
+    assert np.all(diffs > 0), loads
+    rates = np.log2(diffs[:-1] / diffs[1:])
+    richardson = loads[-1] - diffs[-1] / (2 ** rates[-1] - 1)
+    print(f"{case}: loads {loads}, rates {rates}, Richardson {richardson:.8g}")
+    assert np.all((rates > 1.8) & (rates < 2.2)), rates
