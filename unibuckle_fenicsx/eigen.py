@@ -94,7 +94,7 @@ class GEPSolver:
         B: PETSc.Mat,  # type: ignore[name-defined]
         *,
         indefinite: bool = False,
-        prefix: str = "unibuckle_eps_",
+        prefix: str = "unibuckle_",
         tol: float = 1e-10,
         options: dict[str, str | float | int] | None = None,
     ) -> None:

@@ -111,7 +111,8 @@ class BucklingProblem:
         spec: The problem.
         comm: Communicator of the mesh (``MPI.COMM_SELF`` gives each rank its own
             serial copy, for candidate-parallel enumeration).
-        eps_options: Extra EPS options under the prefix ``unibuckle_eps_``.
+        eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
+            is ``-unibuckle_eps_view``).
 
     Note:
         Construction and :meth:`destroy` are collective on ``comm``.
@@ -265,7 +266,9 @@ class BucklingProblem:
         free[active] = False
         margin = float(u_I[free].max()) if free.any() else -np.inf
         force = float(r_I[active].max() / au_inf) if len(active) else -np.inf
-        feasible = margin <= self.tau
+        # Contact means u_k = 0 on Z: a mode that still penetrates there (penalty) fails.
+        on_z = float(u_I[active].max()) if len(active) else -np.inf
+        feasible = margin <= self.tau and on_z <= self.tau
         kkt = feasible and force <= self.tau and residual <= np.sqrt(self.tau)
         return Certificate(
             feasible=bool(feasible),

@@ -73,7 +73,8 @@ def solve(
         comm: Communicator. By default the mesh is distributed over it.
         candidate_parallel: Instead, give every rank a serial copy of the problem and
             split the enumeration's candidate sets over ``comm`` (method "enumerate").
-        eps_options: Extra options under the prefix ``unibuckle_eps_``.
+        eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
+            is ``-unibuckle_eps_view``).
 
     Returns:
         The result and the set-up problem (holding the mode in ``problem.u``; the

@@ -1,0 +1,471 @@
+r"""The penalty method (for comparison with the paper's direct method).
+
+The unilateral condition :math:`w_k \le 0` on the constrained nodes I is relaxed into
+a spring of stiffness :math:`\rho` at every node that penetrates the obstacle:
+
+.. math::
+
+    \lambda(\rho) = \min_{v \ne 0} R_\rho(v), \qquad
+    R_\rho(v) = \frac{a(v, v) + \rho \sum_{k \in I} \max(0, v_k)^2}{b(v, v)}.
+
+For v in the cone the penalty term vanishes, so :math:`\lambda(\rho) \le \lambda_c`;
+:math:`R_\rho` grows pointwise with :math:`\rho`, so :math:`\lambda(\rho)` is
+non-decreasing, and :math:`\lambda(\rho) \to \lambda_c` as :math:`\rho \to \infty`.
+
+:math:`R_\rho` is piecewise quadratic. On the set S of penetrating nodes it is the
+Rayleigh quotient of :math:`A_S = A + \rho \sum_{k \in S} e_k e_k^T`, so the method
+iterates on S (a semismooth Newton step): solve the smallest eigenpair of
+:math:`(A_S, B)`, orient the mode (its sign is free) to minimise the penetration, and
+take as the next S the nodes with :math:`v_k > 0` (when both orientations penetrate
+alike, as the antisymmetric free mode of the paper's symmetric plate does, the tie is
+broken deterministically, see :data:`TIE_RTOL`). A fixed point (S repeats) is a
+stationary point of :math:`R_\rho`; a set that reappears after more than one step is a
+cycle, which is reported (the iterate with the smallest :math:`R_\rho` is returned).
+
+The stationary point found is not proven to be the global minimum of :math:`R_\rho`,
+and its mode penetrates the obstacle by :math:`O(1/\rho)`: the result is neither a
+proven bound nor an admissible mode. The lower bound reported is :math:`\lambda_{free}`
+(interlacing). ``rho`` is given relative to the largest diagonal entry of A:
+:math:`\rho_{abs} = \rho \max_j A_{jj}`.
+
+A is assembled once (by :class:`~unibuckle_fenicsx.plate.model.PlateModel`); the
+springs are added on the diagonal of a private copy :math:`A_{pen}`, which has its
+own :class:`~unibuckle_fenicsx.eigen.GEPSolver` with the options prefix
+``unibuckle_penalty_``.
+
+Note:
+    Everything here is collective on the problem's communicator.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass
+
+from petsc4py import PETSc
+from slepc4py import SLEPc
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, GEPSolver
+
+__all__ = [
+    "CONDITION_OPTIONS",
+    "PENALTY_PREFIX",
+    "TIE_RTOL",
+    "PenaltySolver",
+    "PenaltyStep",
+    "solve_penalty",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Options prefix of the penalty eigen solver.
+PENALTY_PREFIX = "unibuckle_penalty_"
+
+#: Relative tie tolerance of the two orientations' penetration energies. The free mode
+#: of a symmetric problem ties exactly; computed with an EPS tolerance of 1e-10 its two
+#: energies differ by about that, so 1e-6 leaves four orders of margin either way.
+TIE_RTOL = 1e-6
+
+#: Options prefix of the extreme-eigenvalue solvers of :meth:`PenaltySolver.condition_number`.
+CONDITION_PREFIX = "unibuckle_penalty_cond_"
+
+#: Default options of the extreme-eigenvalue solvers (pushed under :data:`CONDITION_PREFIX`).
+CONDITION_OPTIONS: dict[str, str | float | int] = {
+    "eps_type": "krylovschur",
+    "eps_max_it": 2000,
+    "st_ksp_type": "preonly",
+    "st_pc_type": "lu",
+    "st_pc_factor_mat_solver_type": "mumps",
+}
+
+
+@dataclass(frozen=True)
+class PenaltyStep:
+    r"""One eigen solve of the iteration on the penetrating set.
+
+    Attributes:
+        springs: Sorted node numbers carrying a spring in this solve (the set S).
+        load: Smallest eigenvalue :math:`\lambda_S` of :math:`(A_S, B)`.
+        quotient: :math:`R_\rho` of the oriented mode (equals ``load`` at a fixed point).
+        penetration: Largest oriented :math:`w_k/\max|w|` over I (0 if none penetrates).
+        penetrating: Sorted node numbers with :math:`w_k > ` threshold: the next S.
+    """
+
+    springs: npt.NDArray[np.int64]
+    load: float
+    quotient: float
+    penetration: float
+    penetrating: npt.NDArray[np.int64]
+
+
+def _key(nodes: npt.NDArray[np.int64]) -> tuple[int, ...]:
+    return tuple(int(k) for k in nodes)
+
+
+class PenaltySolver:
+    r"""Penalised pencil :math:`(A + \rho_{abs} \sum_{k\in S} e_k e_k^T, B)` of a problem.
+
+    Args:
+        problem: A :class:`~unibuckle_fenicsx.problem.BucklingProblem` with an obstacle.
+        prefix: Options prefix of the eigen solver (``-<prefix>eps_view`` etc. apply).
+        eps_options: Extra EPS options under ``prefix`` (merged into
+            :data:`~unibuckle_fenicsx.eigen.EIGEN_OPTIONS`).
+
+    Attributes:
+        max_diag: :math:`\max_j A_{jj}`, the unit of the relative penalty.
+        solves: Eigen solves performed by this object (the condition estimates excluded).
+
+    Note:
+        Construction, every method and :meth:`destroy` are collective. The caller owns
+        the object and must :meth:`destroy` it.
+    """
+
+    def __init__(
+        self,
+        problem: object,
+        prefix: str = PENALTY_PREFIX,
+        eps_options: dict[str, str | float | int] | None = None,
+    ) -> None:
+        from unibuckle_fenicsx.problem import BucklingProblem
+
+        if not isinstance(problem, BucklingProblem):
+            raise ValueError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
+        if problem.contact is None:
+            raise ValueError("the penalty method needs an obstacle (problem.spec.obstacle is None)")
+        self.problem = problem
+        A = problem.model.A
+        diag = A.getDiagonal()
+        self.max_diag = float(diag.max()[1])
+        diag.destroy()
+        self.A_pen = A.duplicate(copy=True)
+        self._springs = A.createVecLeft()
+        self._work = A.createVecLeft()
+        self._Av = A.createVecLeft()
+        self._Bv = A.createVecLeft()
+        self._rho_abs = 0.0
+        self._active = np.empty(0, dtype=np.int64)
+        options = {**EIGEN_OPTIONS, **(eps_options or {})}
+        self.gep = GEPSolver(
+            self.A_pen,
+            problem.model.B,
+            indefinite=problem.prestress.indefinite,
+            prefix=prefix,
+            tol=problem.spec.solver.eps_tol,
+            options=options,
+        )
+        self.solves = 0
+
+    # -- the penalised operator ---------------------------------------------------------
+    def set_springs(self, rho_abs: float, active: npt.NDArray[np.int64]) -> None:
+        r""":math:`A_{pen} = A + \rho_{abs}\sum_{k \in S} e_k e_k^T` (S = ``active``), in place."""
+        assert self.problem.contact is not None
+        same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN  # type: ignore[attr-defined]
+        self.problem.model.A.copy(self.A_pen, structure=same)
+        self._springs.zeroEntries()
+        rows = self.problem.contact.removed_rows(active).astype(PETSc.IntType)  # type: ignore[attr-defined]
+        self._springs.setValues(rows, np.full(len(rows), rho_abs))
+        self._springs.assemble()
+        self.A_pen.setDiagonal(self._springs, addv=PETSc.InsertMode.ADD_VALUES)  # type: ignore[attr-defined]
+        self._rho_abs = rho_abs
+        self._active = np.asarray(active, dtype=np.int64)
+
+    def quotient(self, vec: PETSc.Vec, rho_abs: float) -> float:  # type: ignore[name-defined]
+        r""":math:`R_\rho(v) = (v^TAv + \rho_{abs}\sum_I \max(0, v_k)^2) / v^TBv`."""
+        assert self.problem.contact is not None
+        self.problem.model.A.mult(vec, self._Av)
+        self.problem.model.B.mult(vec, self._Bv)
+        vals = self.problem.contact.values(vec)
+        num = vec.dot(self._Av) + rho_abs * float(np.sum(np.maximum(vals, 0.0) ** 2))
+        den = vec.dot(self._Bv)
+        return float(num / den) if den > 0.0 else math.inf
+
+    def condition_number(self) -> tuple[float, float]:
+        r"""Extreme eigenvalues of the current :math:`A_{pen}` restricted to the free DOFs.
+
+        The edge-constrained rows (diagonal 1, decoupled) are left out, so this is the
+        spectrum of the operator that actually carries the physics. The 2-norm condition
+        number of this SPD matrix is the ratio of the two values. Computed with SLEPc
+        (Krylov-Schur: largest real eigenvalue plainly, smallest by shift-and-invert at 0
+        with MUMPS), options prefix ``unibuckle_penalty_cond_``.
+
+        Returns:
+            (smallest, largest) eigenvalue.
+        """
+        model = self.problem.model
+        n_owned = model.num_owned_dofs
+        owned_bc = model.bc_dofs[model.bc_dofs < n_owned]
+        keep = np.setdiff1d(np.arange(n_owned, dtype=np.int32), owned_bc)
+        rows = model.global_dofs(keep).astype(PETSc.IntType)  # type: ignore[attr-defined]
+        iset = PETSc.IS().createGeneral(rows, comm=self.A_pen.comm)  # type: ignore[attr-defined]
+        sub = self.A_pen.createSubMatrix(iset, iset)
+        iset.destroy()
+        values = []
+        for which in ("largest", "smallest"):
+            eps = SLEPc.EPS().create(sub.comm)  # type: ignore[attr-defined]
+            eps.setOptionsPrefix(CONDITION_PREFIX)
+            eps.setOperators(sub)
+            eps.setProblemType(SLEPc.EPS.ProblemType.HEP)  # type: ignore[attr-defined]
+            eps.setDimensions(1)
+            eps.setTolerances(1e-8)
+            if which == "largest":
+                eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)  # type: ignore[attr-defined]
+                opts_used = {"eps_type": CONDITION_OPTIONS["eps_type"]}
+            else:
+                eps.setTarget(0.0)
+                eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)  # type: ignore[attr-defined]
+                eps.getST().setType(SLEPc.ST.Type.SINVERT)  # type: ignore[attr-defined]
+                opts_used = dict(CONDITION_OPTIONS)
+            opts = PETSc.Options()  # type: ignore[attr-defined]
+            opts.prefixPush(CONDITION_PREFIX)
+            for key, value in opts_used.items():
+                opts[key] = value
+            opts.prefixPop()
+            eps.setFromOptions()
+            opts.prefixPush(CONDITION_PREFIX)
+            for key in opts_used:
+                del opts[key]
+            opts.prefixPop()
+            eps.solve()
+            if eps.getConverged() < 1:
+                eps.destroy()
+                sub.destroy()
+                raise RuntimeError(f"condition estimate: the {which} eigenvalue did not converge")
+            values.append(float(eps.getEigenvalue(0).real))
+            eps.destroy()
+        sub.destroy()
+        return values[1], values[0]
+
+    # -- the iteration ----------------------------------------------------------------
+    def solve(
+        self,
+        rho: float,
+        *,
+        initial_active: npt.NDArray[np.int64] | None = None,
+        max_iterations: int = 100,
+        threshold: float = 0.0,
+        condition: bool = False,
+        lower_bound: float | None = None,
+        tie_rtol: float = TIE_RTOL,
+    ) -> UnilateralSolution:
+        r"""Iterate on the penetrating set for one penalty; the mode is left in ``problem.u``.
+
+        Args:
+            rho: Penalty relative to :math:`\max_j A_{jj}`, finite and > 0.
+            initial_active: Starting spring set S_0 (node numbers; default empty, whose
+                first solve is the free plate). For a sequence of penalties, pass the
+                previous penalty's set (continuation).
+            max_iterations: Eigen solves allowed, >= 1.
+            threshold: A node penetrates when :math:`w_k > ` threshold * max|w|; in
+                [0, 1e-2].
+            condition: Also estimate the condition number of the final :math:`A_{pen}`
+                (:meth:`condition_number`, two extra SLEPc solves).
+            lower_bound: :math:`\lambda_{free}` if known; else taken from the first solve
+                when S_0 is empty, or computed with one extra solve.
+            tie_rtol: The two orientations of a mode tie when their penalty energies
+                :math:`\sum \max(0, \pm v_k)^2` differ by at most this, relatively; a
+                tie is broken by the lexicographically smaller penetrating set. In
+                [0, 1); 0 leaves ties to rounding (for studying its effect).
+
+        Returns:
+            The solution: ``load`` = :math:`R_\rho` of the returned mode (a stationary
+            value of the penalised quotient; <= the critical load if it is the global
+            minimum, which is not proven), ``active`` = its penetrating set (where the
+            springs act), ``lower_bound`` = :math:`\lambda_{free}`,
+            ``global_optimum_proven`` False, and ``details`` (see the code).
+        """
+        problem = self.problem
+        contact = problem.contact
+        assert contact is not None
+        if not (isinstance(rho, int | float) and math.isfinite(rho) and rho > 0.0):
+            raise ValueError(f"rho (relative penalty) must be finite and > 0, got {rho!r}")
+        if int(max_iterations) != max_iterations or max_iterations < 1:
+            raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+        if not 0.0 <= tie_rtol < 1.0:
+            raise ValueError(f"tie_rtol must lie in [0, 1), got {tie_rtol!r}")
+        if not 0.0 <= threshold <= 1e-2:
+            raise ValueError(f"threshold must lie in [0, 1e-2], got {threshold!r}")
+        i = contact.size
+        active = np.unique(np.asarray([] if initial_active is None else initial_active, np.int64))
+        if active.size and (active.min() < 0 or active.max() >= i):
+            raise ValueError(f"initial_active must hold node numbers in [0, {i}), got {active}")
+        rho_abs = float(rho) * self.max_diag
+        solves0 = self.solves
+
+        vec = self._work
+        best: PETSc.Vec | None = None  # type: ignore[name-defined]
+        best_q = math.inf
+        best_step = -1
+        previous: PETSc.Vec | None = None  # type: ignore[name-defined]
+        seen: dict[tuple[int, ...], int] = {}
+        steps: list[PenaltyStep] = []
+        status = "max_iterations"
+        cycle_length = 0
+        ties = 0
+        for it in range(int(max_iterations)):
+            seen[_key(active)] = it
+            self.set_springs(rho_abs, active)
+            pair = self.gep.solve(out=vec, initial=previous)
+            self.solves += 1
+            if lower_bound is None and not active.size:
+                lower_bound = pair.value
+            wmax = problem.max_abs_w(vec)
+            vals = contact.values(vec) / wmax
+            up = float(np.sum(np.maximum(vals, 0.0) ** 2))
+            down = float(np.sum(np.maximum(-vals, 0.0) ** 2))
+            if abs(up - down) > tie_rtol * (up + down):
+                sign = 1.0 if up < down else -1.0
+            else:
+                # Tie (e.g. the antisymmetric free mode under a zone symmetric about x = 0:
+                # both orientations penetrate alike, and the two unilateral modes are
+                # mirror images with equal loads). Decided by rounding, the choice would
+                # flip with tiny changes of rho; take the lexicographically smaller
+                # penetrating set instead (the enumeration's tie rule).
+                plus = _key(np.flatnonzero(vals > threshold))
+                minus = _key(np.flatnonzero(-vals > threshold))
+                sign = 1.0 if plus <= minus else -1.0
+                ties += 1
+            vec.scale(sign / wmax)
+            vals = sign * vals
+            q = self.quotient(vec, rho_abs)
+            penetrating = np.flatnonzero(vals > threshold).astype(np.int64)
+            steps.append(
+                PenaltyStep(active, pair.value, q, max(float(vals.max()), 0.0), penetrating)
+            )
+            logger.debug(
+                "penalty rho=%.3g it %d: |S|=%d lambda_S=%.10g R=%.10g penetration %.3g",
+                rho, it, active.size, pair.value, q, steps[-1].penetration,
+            )  # fmt: skip
+            if q < best_q:
+                best_q, best_step = q, it
+                if best is None:
+                    best = vec.copy()
+                else:
+                    vec.copy(best)
+            if previous is None:
+                previous = vec.copy()
+            else:
+                vec.copy(previous)
+            key = _key(penetrating)
+            if key == _key(active):
+                status = "converged"
+                break
+            if key in seen:
+                status = "cycle"
+                cycle_length = it + 1 - seen[key]
+                logger.warning(
+                    "penalty rho=%.3g: the penetrating set cycles (length %d) after %d solves; "
+                    "returning the iterate with the smallest penalised quotient",
+                    rho, cycle_length, it + 1,
+                )  # fmt: skip
+                break
+            active = penetrating
+        if status == "max_iterations":
+            logger.warning(
+                "penalty rho=%.3g: no fixed point after %d solves (-max_iterations)",
+                rho, max_iterations,
+            )  # fmt: skip
+        if previous is not None:
+            previous.destroy()
+        assert best is not None
+        best.copy(problem.u.x.petsc_vec)
+        problem.u.x.scatter_forward()
+        best.destroy()
+        step = steps[best_step]
+        if status != "converged":
+            # Leave A_pen with the springs of the returned mode, for condition().
+            self.set_springs(rho_abs, step.springs)
+        if lower_bound is None:
+            lower_bound = problem.solver.solve().value
+            self.solves += 1
+        details: dict[str, object] = {
+            "penalty_rho": float(rho),
+            "penalty_rho_abs": rho_abs,
+            "penalty_max_diag_A": self.max_diag,
+            "penalty_status": status,
+            "penalty_cycle_length": cycle_length,
+            "penalty_iterations": len(steps),
+            "penalty_orientation_ties": ties,
+            "penalty_max_penetration": step.penetration,
+            "penalty_penetrating_set": [int(k) for k in step.penetrating],
+            "penalty_springs": [int(k) for k in step.springs],
+            "penalty_eigenvalue": step.load,
+            "penalty_history": [s.quotient for s in steps],
+        }
+        if condition:
+            lo, hi = self.condition_number()
+            details["penalty_eig_min_A_pen"] = lo
+            details["penalty_eig_max_A_pen"] = hi
+            details["penalty_condition_number"] = hi / lo
+        return UnilateralSolution(
+            load=step.quotient,
+            active=step.penetrating,
+            eigensolves=self.solves - solves0,
+            lower_bound=float(lower_bound),
+            global_optimum_proven=False,
+            details=details,
+        )
+
+    def destroy(self) -> None:
+        """Destroy the eigen solver, A_pen and the work vectors (collective)."""
+        gep = getattr(self, "gep", None)
+        if gep is not None:
+            gep.destroy()
+            self.gep = None  # type: ignore[assignment]
+        for name in ("A_pen", "_springs", "_work", "_Av", "_Bv"):
+            obj = getattr(self, name, None)
+            if obj is not None:
+                obj.destroy()
+                setattr(self, name, None)
+
+    def __del__(self) -> None:
+        self.destroy()
+
+
+def solve_penalty(
+    problem: object,
+    rho: float,
+    *,
+    initial_active: npt.NDArray[np.int64] | None = None,
+    max_iterations: int = 100,
+    threshold: float = 0.0,
+    condition: bool = False,
+    tie_rtol: float = TIE_RTOL,
+    eps_options: dict[str, str | float | int] | None = None,
+) -> UnilateralSolution:
+    r"""Penalty method for one relative penalty ``rho`` (see the module docstring).
+
+    Args:
+        problem: A :class:`~unibuckle_fenicsx.problem.BucklingProblem` with an obstacle.
+        rho: Penalty relative to the largest diagonal entry of A, finite and > 0.
+        initial_active: Starting spring set (default empty).
+        max_iterations: Eigen solves allowed, >= 1.
+        threshold: Relative penetration that counts, in [0, 1e-2].
+        condition: Also estimate the condition number of the penalised operator.
+        tie_rtol: Tie tolerance of the two orientations (see :meth:`PenaltySolver.solve`).
+        eps_options: Extra options under ``unibuckle_penalty_``.
+
+    Returns:
+        The solution, mode left in ``problem.u``; see :meth:`PenaltySolver.solve`.
+
+    Note:
+        Collective.
+    """
+    if not (isinstance(rho, int | float) and math.isfinite(rho) and rho > 0.0):
+        raise ValueError(f"rho (relative penalty) must be finite and > 0, got {rho!r}")
+    solver = PenaltySolver(problem, eps_options=eps_options)
+    try:
+        return solver.solve(
+            rho,
+            initial_active=initial_active,
+            max_iterations=max_iterations,
+            threshold=threshold,
+            condition=condition,
+            tie_rtol=tie_rtol,
+        )
+    finally:
+        solver.destroy()

@@ -1,0 +1,611 @@
+r"""Figures of buckling modes, sections, contact sets and mesh convergence (PNG).
+
+pyvista and matplotlib are imported inside the functions that need them (install the
+``demo`` extra), so importing this module is cheap. Every writer returns the path it
+wrote. 3-D figures render off screen; without a display, VTK's EGL window is selected
+so that no X server is needed (set ``VTK_DEFAULT_OPENGL_WINDOW`` to override).
+
+Data helpers (:func:`nodal_deflection`, :func:`section`) are collective on the mesh
+communicator and return the same arrays on every rank; the writers draw on rank 0 only
+(3-D figures need a serial problem, ``comm.size == 1``).
+
+Sign convention: the obstacle lies just above the plate, the admissible deflection in
+the zone is :math:`w \le 0`, so figures draw the obstacle at :math:`w = 0^+`.
+"""
+
+from __future__ import annotations
+
+import os
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import TYPE_CHECKING, Any
+
+import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:  # pragma: no cover
+    import dolfinx
+
+    from unibuckle_fenicsx.config import ProblemSpec
+    from unibuckle_fenicsx.problem import BucklingProblem
+
+__all__ = [
+    "THEME",
+    "mirror_to_match",
+    "nodal_deflection",
+    "plot_contact_set",
+    "plot_convergence",
+    "plot_mode_3d",
+    "plot_section",
+    "section",
+    "zone_box",
+]
+
+#: The one theme of every figure (overridable module constant).
+THEME: dict[str, Any] = {
+    "window_size": (1400, 900),  # pyvista, pixels
+    "font_size": 18,  # pyvista text
+    "cmap": "coolwarm",
+    "figsize": (9.0, 5.0),  # matplotlib, inches
+    "dpi": 130,
+    "mpl_font_size": 12,
+    "warp": 0.035,  # 3-D height (m) of |w| = 1 (plate 0.2 m x 0.1 m)
+    "obstacle_color": "dimgray",
+    "contact_color": "black",
+    "free_color": "tab:blue",
+    "unilateral_color": "tab:red",
+}
+
+
+# -- lazy imports ----------------------------------------------------------------------
+def _pyvista() -> Any:
+    if not os.environ.get("DISPLAY") and "VTK_DEFAULT_OPENGL_WINDOW" not in os.environ:
+        # Off-screen without X: ask VTK for EGL up front (avoids the X connection warning).
+        os.environ["VTK_DEFAULT_OPENGL_WINDOW"] = "vtkEGLRenderWindow"
+    try:
+        import pyvista as pv
+    except ImportError as err:  # pragma: no cover
+        raise ImportError(
+            "3-D figures need pyvista: pip install 'unibuckle_fenicsx[demo]'"
+        ) from err
+    pv.OFF_SCREEN = True
+    return pv
+
+
+def _font_file() -> str | None:
+    """A TrueType font with Greek letters for VTK text (matplotlib's DejaVu Sans)."""
+    try:
+        import matplotlib as mpl
+    except ImportError:  # pragma: no cover
+        return None
+    path = Path(mpl.get_data_path()) / "fonts" / "ttf" / "DejaVuSans.ttf"
+    return str(path) if path.exists() else None
+
+
+_VTK_FONT_FILE = 4  # vtkTextProperty font family "VTK_FONT_FILE"
+
+
+def _pyplot() -> Any:
+    try:
+        import matplotlib as mpl
+    except ImportError as err:  # pragma: no cover
+        raise ImportError("figures need matplotlib: pip install 'unibuckle_fenicsx[demo]'") from err
+    mpl.use("Agg")
+    import matplotlib.pyplot as plt
+
+    plt.rcParams.update({"font.size": THEME["mpl_font_size"]})
+    return plt
+
+
+def _prepare(path: str | Path) -> Path:
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+# -- data ------------------------------------------------------------------------------
+def zone_box(
+    spec: ProblemSpec, constrained: npt.NDArray[np.float64] | None = None
+) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    """Obstacle zone of ``spec`` as ``((xmin, xmax), (ymin, ymax))``; ``None`` without one.
+
+    Args:
+        spec: The problem.
+        constrained: Coordinates of the constrained nodes (needed for a predicate
+            zone, whose bounding box is returned).
+    """
+    obstacle = spec.obstacle
+    if obstacle is None:
+        return None
+    if isinstance(obstacle.zone, str):
+        (x0, y0), (x1, y1) = spec.plate.corners
+        return (x0, x1), (y0, y1)
+    if callable(obstacle.zone):
+        if constrained is None or len(constrained) == 0:
+            return None
+        lo, hi = constrained.min(axis=0), constrained.max(axis=0)
+        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
+    (x0, x1), (y0, y1) = obstacle.zone
+    return (x0, x1), (y0, y1)
+
+
+def _problem_zone(
+    problem: BucklingProblem,
+) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    coords = problem.contact.coordinates if problem.contact is not None else None
+    return zone_box(problem.spec, coords)
+
+
+def nodal_deflection(
+    problem: BucklingProblem, u: dolfinx.fem.Function | None = None
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Node coordinates (n, 2) and deflection w (n,) of ``u`` (default ``problem.u``).
+
+    Gathered over the mesh communicator (owned w-DOFs of every rank), same on all ranks.
+
+    Note:
+        Collective.
+    """
+    w, _ = problem.model.split(problem.u if u is None else u)
+    Vw = w.function_space
+    n_owned = Vw.dofmap.index_map.size_local
+    xy = Vw.tabulate_dof_coordinates()[:n_owned, :2]
+    values = w.x.array[:n_owned].real
+    comm = problem.comm
+    all_xy = np.vstack(comm.allgather(xy))
+    all_w = np.concatenate(comm.allgather(values))
+    return all_xy, all_w
+
+
+def section(
+    problem: BucklingProblem,
+    u: dolfinx.fem.Function | None = None,
+    y: float = 0.0,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Section of the deflection along the line y = ``y`` ("section A" for y = 0).
+
+    Returns the nodal values when the line is a row of mesh nodes, and the values at
+    the nodes' x positions interpolated linearly between the two nearest rows otherwise
+    (exact for the bilinear element).
+
+    Returns:
+        x (sorted) and w at those points.
+
+    Note:
+        Collective.
+    """
+    xy, w = nodal_deflection(problem, u)
+    scale = max(problem.spec.plate.length, problem.spec.plate.width)
+    keys = np.round(xy / (1e-9 * scale)).astype(np.int64)
+    _, first = np.unique(keys, axis=0, return_index=True)
+    xy, w = xy[first], w[first]  # drop duplicates (none in serial)
+    rows = np.unique(np.round(xy[:, 1] / (1e-9 * scale))) * 1e-9 * scale
+    if y < rows[0] - 1e-9 * scale or y > rows[-1] + 1e-9 * scale:
+        raise ValueError(f"section: y = {y} lies outside the plate [{rows[0]}, {rows[-1]}]")
+    below = rows[rows <= y + 1e-9 * scale].max()
+    above = rows[rows >= y - 1e-9 * scale].min()
+
+    def row(yr: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        mask = np.abs(xy[:, 1] - yr) <= 1e-9 * scale
+        order = np.argsort(xy[mask, 0])
+        return xy[mask, 0][order], w[mask][order]
+
+    x0, w0 = row(below)
+    if above - below <= 1e-9 * scale:
+        return x0, w0
+    x1, w1 = row(above)
+    s = (y - below) / (above - below)
+    return x0, (1 - s) * w0 + s * np.interp(x0, x1, w1)
+
+
+def mirror_to_match(
+    x_ref: npt.ArrayLike,
+    w_ref: npt.ArrayLike,
+    x: npt.ArrayLike,
+    w: npt.ArrayLike,
+    center: float = 0.0,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], bool]:
+    """Reflect a section about x = ``center`` if its mirror image matches ``w_ref`` better.
+
+    The paper's plate and zones are symmetric about x = 0, so a mode and its mirror
+    image have the same load; solvers may return either. Drawing twins on the same side
+    makes sections comparable.
+
+    Returns:
+        The (possibly reflected, re-sorted) abscissae and values, and whether it was
+        reflected.
+    """
+    x_ref, w_ref = np.asarray(x_ref, dtype=float), np.asarray(w_ref, dtype=float)
+    x, w = np.asarray(x, dtype=float), np.asarray(w, dtype=float)
+    direct = np.dot(np.interp(x_ref, x, w), w_ref)
+    xm = 2 * center - x[::-1]
+    wm = w[::-1]
+    mirrored = np.dot(np.interp(x_ref, xm, wm), w_ref)
+    if mirrored > direct:
+        return xm, wm, True
+    return x, w, False
+
+
+# -- 3-D mode ----------------------------------------------------------------------------
+def plot_mode_3d(
+    problem: BucklingProblem,
+    path: str | Path,
+    *,
+    contact_coordinates: npt.ArrayLike | None = None,
+    u: dolfinx.fem.Function | None = None,
+    title: str = "",
+    show_zone: bool = True,
+) -> Path:
+    """Warped 3-D surface of the mode, with the obstacle zone and the contact nodes.
+
+    The surface is coloured by w / max|w|; the obstacle is a translucent grey plane just
+    above w = 0 over its zone, outlined in black; contact nodes (|Z|) are black spheres.
+
+    Args:
+        problem: The solved problem (serial).
+        path: PNG to write.
+        contact_coordinates: (|Z|, 2) coordinates of the contact set.
+        u: Mode to draw (default ``problem.u``), scaled to max|w| = 1 by the caller.
+        title: Text at the top left.
+        show_zone: Draw the obstacle zone (if the problem has one).
+
+    Returns:
+        The written path.
+    """
+    if problem.comm.size != 1:
+        raise RuntimeError("plot_mode_3d draws serial problems only (comm.size == 1)")
+    pv = _pyvista()
+    import dolfinx.plot
+
+    path = _prepare(path)
+    w, _ = problem.model.split(problem.u if u is None else u)
+    wmax = float(np.abs(w.x.array).max()) or 1.0
+    grid = pv.UnstructuredGrid(*dolfinx.plot.vtk_mesh(w.function_space))  # type: ignore[arg-type]
+    grid.point_data["w / max|w|"] = w.x.array.real / wmax
+    grid.set_active_scalars("w / max|w|")
+    warp = THEME["warp"]
+    warped = grid.warp_by_scalar("w / max|w|", factor=warp)
+
+    font = _font_file()
+    plotter = pv.Plotter(off_screen=True, window_size=THEME["window_size"])
+    plotter.set_background("white")
+    plotter.add_mesh(
+        warped,
+        scalars="w / max|w|",
+        cmap=THEME["cmap"],
+        clim=(-1.0, 1.0),
+        show_edges=grid.n_cells <= 2500,
+        edge_color="gray",
+        line_width=0.5,
+        show_scalar_bar=False,
+    )
+    bar = plotter.add_scalar_bar(
+        title="w (normalised)",
+        vertical=True,
+        position_x=0.87,
+        position_y=0.2,
+        height=0.6,
+        width=0.06,
+        title_font_size=THEME["font_size"],
+        label_font_size=THEME["font_size"] - 2,
+        color="black",
+        fmt="%.1f",
+        n_labels=5,
+    )
+    if font is not None:
+        for prop in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
+            prop.SetFontFamily(_VTK_FONT_FILE)
+            prop.SetFontFile(font)
+    # Flat reference outline of the plate at w = 0.
+    (px0, py0), (px1, py1) = problem.spec.plate.corners
+    plate_outline = pv.Rectangle([[px0, py0, 0.0], [px1, py0, 0.0], [px1, py1, 0.0]])
+    plotter.add_mesh(plate_outline.extract_feature_edges(), color="gray", line_width=1.5)
+    box = _problem_zone(problem) if show_zone else None
+    lift = 0.02 * warp
+    legend: list[tuple[str, str]] = []
+    if box is not None:
+        (x0, x1), (y0, y1) = box
+        plane = pv.Rectangle([[x0, y0, lift], [x1, y0, lift], [x1, y1, lift]])
+        plotter.add_mesh(plane, color=THEME["obstacle_color"], opacity=0.2)
+        plotter.add_mesh(plane.extract_feature_edges(), color="black", line_width=4)
+        legend.append(("obstacle zone (w <= 0 there)", "#303030"))
+    cxy = np.asarray(contact_coordinates if contact_coordinates is not None else [], dtype=float)
+    cxy = cxy.reshape(-1, 2)
+    if len(cxy):
+        pts = np.column_stack([cxy[:, 0], cxy[:, 1], np.full(len(cxy), 0.5 * lift)])
+        plotter.add_points(
+            pts, color=THEME["contact_color"], point_size=12, render_points_as_spheres=True
+        )
+    if box is not None:
+        legend.append((f"contact nodes: {len(cxy)}", "black"))
+    if legend:
+        plotter.add_legend(
+            labels=[[label, color] for label, color in legend],
+            bcolor="white",
+            border=True,
+            size=(0.3, 0.1),
+            loc="lower left",
+            face="rectangle",
+        )
+    if title:
+        plotter.add_text(
+            title,
+            position="upper_left",
+            font_size=THEME["font_size"] - 2,
+            color="black",
+            font_file=font,
+        )
+    plotter.add_axes(
+        xlabel="x", ylabel="y", zlabel="w", color="black", viewport=(0.72, 0.0, 0.86, 0.18)
+    )
+    plotter.camera_position = [
+        (px0 - 0.12, py0 - 0.28, 0.22),
+        (0.5 * (px0 + px1) + 0.01 * (px1 - px0), 0.5 * (py0 + py1), -0.005),
+        (0.0, 0.0, 1.0),
+    ]
+    plotter.camera.zoom(1.18)
+    plotter.screenshot(str(path))
+    plotter.close()
+    return path
+
+
+# -- section A -------------------------------------------------------------------------
+def plot_section(
+    path: str | Path,
+    x_free: npt.ArrayLike,
+    w_free: npt.ArrayLike,
+    x_unilateral: npt.ArrayLike,
+    w_unilateral: npt.ArrayLike,
+    *,
+    zone_x: tuple[float, float] | None,
+    title: str = "",
+    extra: Sequence[tuple[npt.ArrayLike, npt.ArrayLike, str]] = (),
+    labels: tuple[str, str] = ("free mode (no obstacle)", "unilateral mode"),
+) -> Path:
+    """Section A (y = 0) of the free mode, the unilateral mode and the obstacle.
+
+    Args:
+        path: PNG to write.
+        x_free: Abscissae of the free mode.
+        w_free: Free mode along the section (normalised by the caller).
+        x_unilateral: Abscissae of the unilateral mode.
+        w_unilateral: Unilateral mode along the section.
+        zone_x: x-extent of the obstacle on the section (``None``: no obstacle).
+        title: Axes title.
+        extra: More curves ``(x, w, label)``, drawn dashed.
+        labels: Legend labels of the two modes.
+
+    Returns:
+        The written path.
+    """
+    plt = _pyplot()
+    path = _prepare(path)
+    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    ax.axhline(0.0, color="lightgray", lw=1.0, zorder=0)
+    ax.plot(x_free, w_free, "-o", ms=3.5, color=THEME["free_color"], label=labels[0])
+    ax.plot(
+        x_unilateral, w_unilateral, "-s", ms=3.5, color=THEME["unilateral_color"], label=labels[1]
+    )
+    styles = (("--", "darkred"), ("-.", "tab:purple"), (":", "tab:green"), ("--", "tab:olive"))
+    for k, (xe, we, label) in enumerate(extra):
+        ls, color = styles[k % len(styles)]
+        ax.plot(xe, we, ls, lw=1.8, color=color, label=label)
+    if zone_x is not None:
+        x0, x1 = zone_x
+        ax.fill_between(
+            [x0, x1],
+            [0.0, 0.0],
+            [0.25, 0.25],
+            facecolor="lightgray",
+            edgecolor=THEME["obstacle_color"],
+            hatch="///",
+            lw=0.0,
+            label="obstacle (section A)",
+        )
+        ax.plot([x0, x1], [0.0, 0.0], color="black", lw=3.0)
+    ax.set_xlabel("x (m)   [section A: y = 0]")
+    ax.set_ylabel("w / max|w|")
+    ax.set_ylim(-1.15, 1.15)
+    ax.grid(True, alpha=0.3)
+    if title:
+        ax.set_title(title)
+    ax.legend(loc="best", fontsize=THEME["mpl_font_size"] - 2, framealpha=0.9)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+# -- contact set -----------------------------------------------------------------------
+def plot_contact_set(
+    problem: BucklingProblem,
+    path: str | Path,
+    contact_coordinates: npt.ArrayLike,
+    *,
+    title: str = "",
+) -> Path:
+    """Top view: mode contours, constrained nodes (I) and the contact set (Z).
+
+    Args:
+        problem: The solved problem, mode in ``problem.u``.
+        path: PNG to write (rank 0).
+        contact_coordinates: (|Z|, 2) coordinates of the contact set.
+        title: Axes title.
+
+    Returns:
+        The path (written on rank 0).
+
+    Note:
+        Collective (gathers the mode).
+    """
+    xy, w = nodal_deflection(problem)
+    path = Path(path)
+    if problem.comm.rank != 0:
+        return path
+    plt = _pyplot()
+    path = _prepare(path)
+    wmax = float(np.abs(w).max()) or 1.0
+    (px0, py0), (px1, py1) = problem.spec.plate.corners
+    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    levels = np.linspace(-1.0, 1.0, 21)
+    cs = ax.tricontourf(xy[:, 0], xy[:, 1], w / wmax, levels=levels, cmap=THEME["cmap"])
+    cbar = fig.colorbar(cs, ax=ax, shrink=0.8, ticks=np.linspace(-1, 1, 5))
+    cbar.set_label("w / max|w|")
+    box = _problem_zone(problem)
+    if box is not None:
+        (x0, x1), (y0, y1) = box
+        ax.add_patch(
+            plt.Rectangle(
+                (x0, y0),
+                x1 - x0,
+                y1 - y0,
+                fill=False,
+                ec="black",
+                lw=2.5,
+                ls="--",
+                label="obstacle zone",
+            )
+        )
+    if problem.contact is not None:
+        cxy = problem.contact.coordinates
+        dense = len(cxy) > 1500
+        ax.plot(
+            cxy[:, 0],
+            cxy[:, 1],
+            ".",
+            ms=1.2 if dense else 2.5,
+            color="dimgray",
+            alpha=0.6 if dense else 1.0,
+            label=f"constrained nodes I ({len(cxy)})",
+        )
+    z = np.atleast_2d(np.asarray(contact_coordinates, dtype=float))
+    nz = z.shape[0] if z.size else 0
+    if nz:
+        ax.plot(
+            z[:, 0],
+            z[:, 1],
+            "o",
+            ms=5 if nz < 500 else 3,
+            mfc="black",
+            mec="white",
+            mew=0.5,
+            label=f"contact set Z ({nz})",
+        )
+    ax.set_xlim(px0, px1)
+    ax.set_ylim(py0, py1)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    if title:
+        ax.set_title(title)
+    ax.legend(
+        loc="upper center",
+        bbox_to_anchor=(0.5, -0.18),
+        ncol=3,
+        fontsize=THEME["mpl_font_size"] - 2,
+        frameon=False,
+    )
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+# -- convergence -----------------------------------------------------------------------
+def plot_convergence(
+    path: str | Path,
+    studies: Mapping[str, Sequence[tuple[int, int, float]]],
+    *,
+    reference: float | None = None,
+    reference_label: str = "analytic",
+    title: str = "",
+) -> Path:
+    r"""Critical load against mesh refinement for one or several cases.
+
+    Left: :math:`\lambda` (MPa) against the number of cells along x. Right: the relative
+    difference to the finest mesh of each study (and, for ``reference``, the error
+    against it), on log axes with an :math:`h^2` slope for comparison.
+
+    Args:
+        path: PNG to write.
+        studies: ``{label: [(nx, ny, load_Pa), ...]}``.
+        reference: A known limit (e.g. the analytic free load), drawn dashed.
+        reference_label: Its legend label.
+        title: Figure title.
+
+    Returns:
+        The written path.
+    """
+    plt = _pyplot()
+    path = _prepare(path)
+    fig, (ax0, ax1) = plt.subplots(
+        1, 2, figsize=(THEME["figsize"][0] * 1.3, THEME["figsize"][1]), dpi=THEME["dpi"]
+    )
+    markers = "osD^v<>"
+    # Cases may nearly coincide: alternate open/filled markers of decreasing size.
+    style = [
+        {
+            "marker": markers[k % len(markers)],
+            "ms": max(10.0 - 1.5 * k, 4.0),
+            "mfc": "none" if k % 2 else None,
+            "color": f"C{k}",
+        }
+        for k in range(len(studies))
+    ]
+    for k, (label, rows) in enumerate(studies.items()):
+        rows = sorted(rows)
+        nx = np.array([r[0] for r in rows], dtype=float)
+        lam = np.array([r[2] for r in rows], dtype=float)
+        ax0.plot(nx, lam / 1e6, "-", label=label, **style[k])
+        if len(rows) >= 2:
+            diff = np.abs(lam[:-1] - lam[-1]) / lam[-1]
+            ok = diff > 0
+            ax1.loglog(
+                nx[:-1][ok],
+                diff[ok],
+                "-",
+                label=f"{label}: |λ_h − λ_finest| / λ_finest",
+                **style[k],
+            )
+    if reference is not None:
+        ax0.axhline(reference / 1e6, color="k", ls="--", lw=1.0, label=reference_label)
+        for k, (label, rows) in enumerate(studies.items()):
+            if label.startswith("free"):
+                rows = sorted(rows)
+                nx = np.array([r[0] for r in rows], dtype=float)
+                err = np.abs(np.array([r[2] for r in rows]) - reference) / reference
+                ax1.loglog(
+                    nx,
+                    err,
+                    ":",
+                    marker=markers[k % len(markers)],
+                    color=f"C{k}",
+                    mfc="none",
+                    label=f"{label}: error vs {reference_label}",
+                )
+    all_nx = sorted({r[0] for rows in studies.values() for r in rows})
+    ny_of = {r[0]: r[1] for rows in studies.values() for r in rows}
+    ticks = [f"{n}×{ny_of[n]}" for n in all_nx]
+    if len(all_nx) >= 2:
+        n0 = float(all_nx[0])
+        guide = np.array([n0, float(all_nx[-1])])
+        ymax = max((line.get_ydata().max() for line in ax1.get_lines()), default=1e-2)
+        ax1.loglog(guide, ymax * (guide / n0) ** -2, "k-", lw=0.8, alpha=0.6, label="slope h²")
+    ax0.set_xscale("log", base=2)
+    ax0.set_xticks(all_nx, ticks)
+    ax0.set_xlabel("mesh (quadrilaterals nx × ny)")
+    ax0.set_ylabel("critical load λ (MPa)")
+    ax0.grid(True, alpha=0.3)
+    ax0.legend(fontsize=THEME["mpl_font_size"] - 2)
+    ax1.set_xscale("log", base=2)
+    ax1.set_xticks(all_nx, ticks)
+    ax1.set_xlabel("mesh (quadrilaterals nx × ny)")
+    ax1.set_ylabel("relative difference")
+    ax1.grid(True, which="both", alpha=0.3)
+    ax1.legend(fontsize=THEME["mpl_font_size"] - 3)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
