@@ -30,10 +30,15 @@ def run_mpi(script: str | Path, nprocs: int, *args: str, timeout: float = 600) -
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
     proc = subprocess.run(
         [mpiexec, "-n", str(nprocs), sys.executable, str(script), *args],
-        capture_output=True, text=True, timeout=timeout, env=env, cwd=ROOT,
+        capture_output=True,
+        text=True,
+        timeout=timeout,
+        env=env,
+        cwd=ROOT,
     )
     if proc.returncode != 0:
         raise AssertionError(
-            f"mpiexec -n {nprocs} {script} failed ({proc.returncode}):\n{proc.stdout}\n{proc.stderr}"
+            f"mpiexec -n {nprocs} {script} failed ({proc.returncode}):\n"
+            f"{proc.stdout}\n{proc.stderr}"
         )
     return proc.stdout

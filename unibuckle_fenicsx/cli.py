@@ -106,7 +106,10 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         spec = paper_case(args.case) if args.case else load_toml(args.config)
         if args.nx is not None or args.ny is not None:
-            spec = spec.with_mesh(args.nx or spec.mesh.nx, args.ny or spec.mesh.ny)
+            spec = spec.with_mesh(
+                spec.mesh.nx if args.nx is None else args.nx,
+                spec.mesh.ny if args.ny is None else args.ny,
+            )
         changes = {
             "method": args.method,
             "max_candidates": args.max_candidates,

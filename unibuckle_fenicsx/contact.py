@@ -77,7 +77,7 @@ class ContactSetManager:
         if self.coordinates.shape[0] == 0:
             nx = model.mesh.topology.index_map(0).size_global
             raise EmptyZoneError(
-                f"obstacle zone {obstacle.describe()} holds no free mesh node "
+                f"obstacle.zone {obstacle.describe()} holds no free mesh node "
                 f"({self.num_edge_fixed} zone nodes are fixed by edge supports; the mesh "
                 f"has {nx} vertices, spacing about {self._spacing():.3g} m): enlarge the "
                 "zone or refine the mesh"

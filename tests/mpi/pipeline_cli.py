@@ -1,0 +1,54 @@
+"""The command line under mpiexec: JSON written once (rank 0), VTX written collectively.
+
+``mpiexec -n P python tests/mpi/pipeline_cli.py OUTDIR -- CLI ARGS...`` runs
+``unibuckle solve CLI ARGS --json OUTDIR/result.json --output OUTDIR/vtx`` with
+:func:`unibuckle_fenicsx.results.write_json` and :func:`unibuckle_fenicsx.solver.write_vtx`
+wrapped to count their calls per rank, and prints on rank 0 a JSON line
+``{"status": [...], "json_writes": [...], "vtx_calls": [...]}`` (one entry per rank).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+
+from mpi4py import MPI
+
+import unibuckle_fenicsx.results as results
+import unibuckle_fenicsx.solver as solver
+from unibuckle_fenicsx.cli import main as cli_main
+
+
+def main() -> None:
+    outdir = Path(sys.argv[1])
+    args = sys.argv[sys.argv.index("--") + 1 :]
+    comm = MPI.COMM_WORLD
+    counts = {"json": 0, "vtx": 0}
+    write_json, write_vtx = results.write_json, solver.write_vtx
+
+    def counting_json(*a, **k):
+        counts["json"] += 1
+        return write_json(*a, **k)
+
+    def counting_vtx(*a, **k):
+        counts["vtx"] += 1
+        return write_vtx(*a, **k)
+
+    results.write_json = counting_json
+    solver.write_vtx = counting_vtx
+    status = cli_main(
+        ["solve", *args, "--json", str(outdir / "result.json"), "--output", str(outdir / "vtx")]
+    )
+    sys.stdout.flush()
+    report = {
+        "status": comm.allgather(status),
+        "json_writes": comm.allgather(counts["json"]),
+        "vtx_calls": comm.allgather(counts["vtx"]),
+    }
+    if comm.rank == 0:
+        print(json.dumps(report))
+
+
+if __name__ == "__main__":
+    main()

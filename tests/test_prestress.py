@@ -1,0 +1,139 @@
+r"""Plane-elasticity prestress (paper eq. [1]): N0 of the paper's case and equilibrium.
+
+Helpers shared with the MPI scripts (``tests/mpi/pipeline_*.py``) live in
+:func:`n0_at_quadrature_points` and :func:`strip_average`.
+"""
+
+from __future__ import annotations
+
+from mpi4py import MPI
+
+import basix
+import dolfinx
+import ufl
+
+import numpy as np
+import pytest
+
+from unibuckle_fenicsx.cases import paper_case
+from unibuckle_fenicsx.config import EdgeSpec, Material, MeshSpec, PlateSpec
+from unibuckle_fenicsx.mesh import create_plate_mesh
+from unibuckle_fenicsx.prestress import solve_prestress
+
+T = 0.006
+MATERIAL = Material(E=1.0e9, nu=0.3)
+
+
+def n0_at_quadrature_points(msh, N0, degree=4):
+    """N0 (n, 2, 2) at the owned cells' quadrature points of a degree-``degree`` rule."""
+    points, _ = basix.make_quadrature(msh.basix_cell(), degree)
+    cells = np.arange(msh.topology.index_map(msh.topology.dim).size_local, dtype=np.int32)
+    return dolfinx.fem.Expression(N0, points).eval(msh, cells).reshape(-1, 2, 2)
+
+
+def strip_average(msh, N0, x1, x2, component=(0, 0)):
+    r""":math:`\int_{x_1<x<x_2} N^0_{ij}\,dx / (x_2 - x_1)`, summed over ranks.
+
+    For mesh lines x1 < x2 this is :math:`a(u, (\varphi, 0))` (or :math:`(0, \varphi)`
+    for the shear component) with the Q1 ramp :math:`\varphi` = 0 left of x1, 1 right of
+    x2, so discrete equilibrium makes it equal the load's resultant beyond x2.
+    """
+    chi = dolfinx.fem.Function(dolfinx.fem.functionspace(msh, ("DG", 0)))
+    chi.interpolate(lambda x: ((x[0] > x1) & (x[0] < x2)).astype(np.float64))
+    i, j = component
+    local = dolfinx.fem.assemble_scalar(dolfinx.fem.form(N0[i, j] * chi * ufl.dx))
+    return msh.comm.allreduce(local, op=MPI.SUM) / (x2 - x1)
+
+
+def clamped_left_plate(thickness=T):
+    """Paper's plate held in its plane on the left edge, pushed on the right edge only."""
+    edges = (
+        EdgeSpec("left", inplane="clamped"),
+        EdgeSpec("right", normal_stress=-1.0),
+        EdgeSpec("bottom"),
+        EdgeSpec("top"),
+    )
+    return PlateSpec(thickness=thickness, edges=edges)
+
+
+@pytest.mark.parametrize("degree", [1, 2])
+def test_paper_case_is_uniaxial(degree):
+    """Free lateral expansion under unit compression on x = +-0.1: N0 = diag(-t, 0) exactly."""
+    spec = paper_case("free", 10, 6)
+    msh, tags = create_plate_mesh(spec.plate, spec.mesh, MPI.COMM_WORLD)
+    ps = solve_prestress(msh, tags, spec.plate, spec.material, degree=degree)
+    values = n0_at_quadrature_points(msh, ps.N0)
+    exact = np.array([[-T, 0.0], [0.0, 0.0]])
+    # MUMPS on a well-conditioned 2D elasticity matrix: relative error near 1e-13.
+    err = np.abs(values - exact).max() / T
+    assert err < 1e-10, err
+    assert ps.pinned_rigid_motions
+    assert not ps.indefinite
+    assert ps.max_compression == pytest.approx(T, rel=1e-10)
+    assert ps.max_tension < 1e-10 * T
+
+
+def test_clamped_edge_prestress_is_non_uniform_but_in_equilibrium():
+    """Left edge clamped in plane, unit compression on the right edge only.
+
+    Equilibrium of the discrete problem with the test function (phi(x), 0), phi the Q1
+    ramp across the band x1 < x < x2 of mesh columns (phi = 0 on the clamped edge, 1 on
+    the loaded one), gives the band average of N0_xx = the applied force per unit load,
+    -t * width, to solver precision; (0, phi) gives zero for N0_xy.
+    """
+    plate = clamped_left_plate()
+    msh, tags = create_plate_mesh(plate, MeshSpec(20, 10), MPI.COMM_WORLD)
+    ps = solve_prestress(msh, tags, plate, MATERIAL)
+    assert not ps.pinned_rigid_motions
+    values = n0_at_quadrature_points(msh, ps.N0)
+    # Non-uniform: the clamp blocks the Poisson expansion, so N0_yy != 0 and N0_xx varies.
+    nxx, nyy = values[:, 0, 0], values[:, 1, 1]
+    assert nxx.max() - nxx.min() > 0.1 * T
+    assert np.abs(nyy).max() > 0.1 * T
+    force = -T * plate.width
+    h = plate.length / 20
+    for k1, k2 in [(0, 1), (0, 20), (5, 10), (13, 14), (19, 20)]:
+        x1, x2 = -0.1 + k1 * h, -0.1 + k2 * h
+        avg = strip_average(msh, ps.N0, x1, x2)
+        assert avg == pytest.approx(force, rel=1e-12), (x1, x2, avg)
+        shear = strip_average(msh, ps.N0, x1, x2, (0, 1))
+        assert abs(shear) < 1e-12 * abs(force), (x1, x2, shear)
+
+
+def test_clamped_edge_prestress_is_indefinite():
+    """With the clamp, corners near the loaded edge see a small tension (B indefinite)."""
+    plate = clamped_left_plate()
+    msh, tags = create_plate_mesh(plate, MeshSpec(20, 10), MPI.COMM_WORLD)
+    ps = solve_prestress(msh, tags, plate, MATERIAL)
+    assert ps.max_compression > T
+    assert ps.max_tension > 0.0 and ps.indefinite
+
+
+def test_tensile_load_is_refused():
+    """normal_stress = +1 on left and right pulls the plate: no buckling under lambda > 0."""
+    edges = (
+        EdgeSpec("left", normal_stress=1.0),
+        EdgeSpec("right", normal_stress=1.0),
+        EdgeSpec("bottom"),
+        EdgeSpec("top"),
+    )
+    plate = PlateSpec(edges=edges)
+    msh, tags = create_plate_mesh(plate, MeshSpec(6, 4), MPI.COMM_WORLD)
+    with pytest.raises(ValueError, match=r"tension everywhere.*normal_stress"):
+        solve_prestress(msh, tags, plate, MATERIAL)
+
+
+def test_unloaded_plate_is_refused():
+    plate = PlateSpec(edges=tuple(EdgeSpec(n) for n in ("left", "right", "bottom", "top")))
+    msh, tags = create_plate_mesh(plate, MeshSpec(4, 2), MPI.COMM_WORLD)
+    with pytest.raises(ValueError, match="no edge is loaded"):
+        solve_prestress(msh, tags, plate, MATERIAL)
+
+
+def test_unbalanced_load_on_free_plate_is_refused():
+    """Every edge free in plane and a load on one edge only: no equilibrium, clear error."""
+    edges = (EdgeSpec("left", normal_stress=-1.0), EdgeSpec("right"), EdgeSpec("bottom"))
+    plate = PlateSpec(edges=(*edges, EdgeSpec("top")))
+    msh, tags = create_plate_mesh(plate, MeshSpec(4, 2), MPI.COMM_WORLD)
+    with pytest.raises(ValueError, match=r"not self-equilibrated.*inplane"):
+        solve_prestress(msh, tags, plate, MATERIAL)
