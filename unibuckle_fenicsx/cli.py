@@ -43,13 +43,19 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument(
         "--method",
         choices=["auto", "enumerate", "active-set", "penalty"],
-        help="unilateral algorithm (default auto: enumerate if 2^i <= --max-candidates, "
-        "else active-set)",
+        help="unilateral algorithm (default auto: exact enumeration if 2^i <= "
+        "--max-candidates, else active-set; enumerate alone = the paper's stopping rule)",
     )
     s.add_argument(
         "--complete",
         action="store_true",
         help="enumerate: visit every subset (checks the paper's monotonicity)",
+    )
+    s.add_argument(
+        "--until-proven",
+        action="store_true",
+        help="enumerate: go past the paper's stopping size p* until the interlacing bound "
+        "proves the best set optimal (exact; implied by --method auto)",
     )
     s.add_argument(
         "--max-candidates",
@@ -119,6 +125,8 @@ def main(argv: Sequence[str] | None = None) -> int:
         changes = {k: v for k, v in changes.items() if v is not None}
         if args.complete:
             changes["complete"] = True
+        if args.until_proven:
+            changes["until_proven"] = True
         spec = spec.with_solver(**changes)
     except (ValueError, OSError) as err:
         if comm.rank == 0:

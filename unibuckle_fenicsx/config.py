@@ -306,13 +306,17 @@ class SolverSpec:
     """Solver options.
 
     Args:
-        method: One of :data:`METHODS`; "auto" enumerates when the candidate count is
-            at most ``max_candidates`` and uses the active-set method otherwise.
+        method: One of :data:`METHODS`; "auto" enumerates (with ``until_proven``) when
+            the candidate count 2^i is at most ``max_candidates`` and uses the
+            active-set method otherwise.
         tau: Relative feasibility/contact tolerance (DESIGN.md section 4), in (0, 1e-2].
         eps_tol: SLEPc convergence tolerance, in (0, 1e-4].
         max_candidates: Largest candidate count the enumeration accepts, >= 1.
         complete: Enumerate every subset instead of stopping after the first
             feasible size p (to check the paper's monotonicity).
+        until_proven: Enumerate past the paper's stopping size p* until the
+            interlacing bound proves the best feasible set optimal (exact; the
+            paper's rule is not, see the README).
         penalty: Penalty stiffness rho for ``method="penalty"`` (relative to the
             largest diagonal entry of A), > 0.
         prestress_degree: Lagrange degree of the in-plane displacement, >= 1.
@@ -325,6 +329,7 @@ class SolverSpec:
     eps_tol: float = 1e-10
     max_candidates: int = 100_000
     complete: bool = False
+    until_proven: bool = False
     penalty: float = 1e3
     prestress_degree: int = 1
     shear: str = "mitc"

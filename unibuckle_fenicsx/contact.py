@@ -21,11 +21,28 @@ import numpy.typing as npt
 from unibuckle_fenicsx.config import ObstacleSpec
 from unibuckle_fenicsx.plate.model import PlateModel
 
-__all__ = ["ContactSetManager", "EmptyZoneError"]
+__all__ = ["ContactSetManager", "EmptyZoneError", "check_zone_has_nodes"]
 
 
 class EmptyZoneError(ValueError):
     """The obstacle zone holds no free mesh node."""
+
+
+def check_zone_has_nodes(msh: dolfinx.mesh.Mesh, obstacle: ObstacleSpec, size: float) -> None:
+    """Raise :class:`EmptyZoneError` if no mesh node lies in the closed zone (cheap pre-check).
+
+    Note:
+        Collective.
+    """
+    x = msh.geometry.x
+    n_owned = msh.geometry.index_map().size_local
+    inside = int(np.count_nonzero(obstacle.contains(x[:n_owned].T, size)))
+    if msh.comm.allreduce(inside, op=MPI.SUM) == 0:
+        raise EmptyZoneError(
+            f"obstacle.zone {obstacle.describe()} holds no free mesh node: none of the "
+            f"{msh.geometry.index_map().size_global} mesh nodes lies in it; enlarge the zone "
+            "or refine the mesh"
+        )
 
 
 @dataclass(frozen=True)
@@ -69,7 +86,8 @@ class ContactSetManager:
         xy = Vw.tabulate_dof_coordinates()[dofs_Vw, :2]
 
         gathered = comm.allgather(xy)
-        all_xy = np.vstack(gathered) if gathered else np.empty((0, 2))
+        # Round away partition-dependent last bits (0.0 vs 9e-19), and -0.0.
+        all_xy = np.round(np.vstack(gathered), 12) + 0.0
         # Quantise before sorting: equal nodes must sort alike on every partition.
         keys = np.round(all_xy / (1e-9 * size)).astype(np.int64)
         order = np.lexsort((keys[:, 0], keys[:, 1]))

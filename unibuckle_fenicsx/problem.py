@@ -21,7 +21,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.contact import ContactSetManager
+from unibuckle_fenicsx.contact import ContactSetManager, check_zone_has_nodes
 from unibuckle_fenicsx.eigen import EigenPair, GEPSolver
 from unibuckle_fenicsx.materials import bending_stiffness
 from unibuckle_fenicsx.mesh import create_plate_mesh
@@ -129,6 +129,9 @@ class BucklingProblem:
         self.comm = comm
         self.timings: dict[str, float] = {}
         self.mesh, self.facet_tags = create_plate_mesh(spec.plate, spec.mesh, comm)
+        if spec.obstacle is not None:
+            size = max(spec.plate.length, spec.plate.width)
+            check_zone_has_nodes(self.mesh, spec.obstacle, size)
         self.prestress = solve_prestress(
             self.mesh, self.facet_tags, spec.plate, spec.material, spec.solver.prestress_degree
         )

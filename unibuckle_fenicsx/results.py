@@ -73,10 +73,11 @@ class BucklingResult:
         """One line for the terminal."""
         z = ""
         if self.constrained_nodes:
-            proven = (self.certificate or {}).get("global_optimum_proven")
+            cert = self.certificate or {}
             z = (
                 f"  i={self.constrained_nodes} |Z|={self.contact_nodes}"
-                f"  proven={'yes' if proven else 'no'}"
+                f"  KKT={'yes' if cert.get('kkt') else 'NO'}"
+                f"  proven={'yes' if cert.get('global_optimum_proven') else 'no'}"
             )
         return (
             f"{self.case}: lambda_c = {self.critical_load_Pa:.6e} Pa "

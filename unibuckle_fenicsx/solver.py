@@ -30,7 +30,11 @@ def candidate_count(i: int) -> int:
 
 
 def choose_method(spec: ProblemSpec, i: int) -> str:
-    """The method "auto" resolves to: enumeration when 2^i <= max_candidates."""
+    """The method "auto" resolves to: enumeration when 2^i <= max_candidates.
+
+    "auto" enumerates with ``until_proven`` (exact), "enumerate" alone follows the
+    paper's stopping rule.
+    """
     if spec.solver.method != "auto":
         return spec.solver.method
     return "enumerate" if candidate_count(i) <= spec.solver.max_candidates else "active-set"
@@ -42,11 +46,14 @@ def _run_method(
     if method == "enumerate":
         from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 
+        options = problem.spec.solver
         return enumerate_contact_sets(
             problem,
-            complete=problem.spec.solver.complete,
-            max_candidates=problem.spec.solver.max_candidates,
+            complete=options.complete,
+            max_candidates=options.max_candidates,
             candidate_comm=candidate_comm,
+            # "auto" must be exact: the paper's stopping rule is not (README).
+            until_proven=options.until_proven or options.method == "auto",
         )
     if method == "active-set":
         from unibuckle_fenicsx.algorithms.active_set import solve_active_set

@@ -1,0 +1,340 @@
+r"""The paper's direct method (Ayadi, section 5.3): enumerate the contact sets by size.
+
+For p = 0, 1, ..., i (i = number of constrained nodes) and every subset Z of I with
+|Z| = p, in the lexicographic order of :func:`itertools.combinations`, compute the
+smallest eigenpair of the pencil with the w-DOFs of Z removed
+(:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`). The mode is *feasible*
+when, suitably oriented, it is negative on :math:`I \setminus Z` (tolerance tau). Keep
+the smallest feasible load and stop after the first p that produced a feasible mode
+(:math:`p^*`), or visit every p (``complete=True``) to check the paper's observation
+that :math:`\lambda(p) \le \lambda(q)` for :math:`p \le q`, with :math:`\lambda(p)` the
+smallest feasible load among the sets of size p.
+
+That observation does not hold in general (e.g. the zone c1 on the 8 x 4 mesh:
+:math:`\lambda(2) > \lambda(3)`, the optimum being a full column of contact nodes), and
+then the paper's stopping rule returns an admissible mode whose load is above the
+critical one. Every result therefore carries a proven lower bound:
+
+Optimality. The critical state's contact set Z has a feasible reduced first mode
+(Lemma 5.1), so it is one of the feasible sets. Removing more DOFs never lowers the
+smallest eigenvalue (interlacing, DESIGN.md section 1), so a set Z with :math:`|Z| > q`
+has :math:`\lambda(Z) \ge \max_{S \subset Z, |S| = q} \lambda(S)`, a maximum over at
+least q + 1 distinct sets of size q; it is therefore at least :math:`\mu_q`, the
+(q+1)-th smallest :math:`\lambda(S)` over *all* sets of size q (feasible or not). After
+visiting the sizes 0..q the critical load is bounded below by the smaller of
+:math:`\mu_q` and the best feasible load found; the result is proven optimal when the
+two agree. (The cruder bound :math:`\min_{|S| = p^*} \lambda(S)` is also reported.)
+``until_proven=True`` keeps enumerating past :math:`p^*` until the bound proves the
+best feasible load optimal (exact, usually far fewer sets than ``complete``). The
+complete mode is exhaustive. These arguments assume, as the paper does, that the
+reduced first eigenvalue is simple.
+
+Ties (mirror-symmetric sets have equal loads up to rounding) are broken
+deterministically: the smallest load, and among loads within :data:`TIE_RTOL` of it
+the lexicographically smallest set. Every candidate solve starts from the same
+pseudo-random vector (seeded, indexed by global DOF), so that a set's load does not
+depend on which sets were solved before on the same rank.
+
+Candidate-parallel runs (``candidate_comm``): every rank holds its own serial copy of
+the problem and evaluates the candidates of each p round-robin; the per-p results are
+reduced on all ranks, which therefore stop at the same p and pick the same set.
+"""
+
+from __future__ import annotations
+
+import itertools
+import logging
+import math
+import time
+from dataclasses import dataclass
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import numpy as np
+
+from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.problem import BucklingProblem
+
+__all__ = ["PROOF_RTOL", "TIE_RTOL", "LevelSummary", "candidate_count", "enumerate_contact_sets"]
+
+logger = logging.getLogger(__name__)
+
+#: Loads within this relative distance of the smallest are ties (lexicographic pick).
+TIE_RTOL = 1e-10
+#: Relative tolerance for "lower bound equals load" (global optimum proven).
+PROOF_RTOL = 1e-10
+#: Seed of the start vector shared by all candidate solves.
+START_SEED = 20240503
+
+
+def candidate_count(i: int) -> int:
+    r"""Candidate sets the enumeration may visit: :math:`\sum_{p=0}^{i} C(i, p) = 2^i`.
+
+    Early stopping cannot know :math:`p^*` in advance, so the worst case is the count.
+    """
+    return 2**i
+
+
+@dataclass(frozen=True)
+class LevelSummary:
+    """Reduced (over candidate ranks) results for one contact-set size p.
+
+    Attributes:
+        p: Contact-set size.
+        candidates: C(i, p), the sets evaluated.
+        feasible: Number of sets with a feasible mode.
+        load_min: Smallest load over all sets of size p (feasible or not).
+        load_kth: The (p+1)-th smallest load over all sets of size p (``inf`` if fewer).
+        best_load: Smallest feasible load (``inf`` if none).
+        best_set: The set giving it (ties: lexicographically smallest), or None.
+        wall_s: Wall time of this level (max over ranks).
+    """
+
+    p: int
+    candidates: int
+    feasible: int
+    load_min: float
+    load_kth: float
+    best_load: float
+    best_set: tuple[int, ...] | None
+    wall_s: float
+
+
+def _start_vector(problem: BucklingProblem) -> PETSc.Vec:
+    """Seeded pseudo-random vector of the W layout, partition independent (caller destroys)."""
+    vec = problem.u.x.petsc_vec.duplicate()
+    lo, hi = vec.getOwnershipRange()
+    rng = np.random.default_rng(START_SEED)
+    vec.array_w[:] = rng.standard_normal(vec.getSize())[lo:hi]
+    vec.assemble()
+    return vec
+
+
+def _pick(entries: list[tuple[float, tuple[int, ...]]]) -> tuple[float, tuple[int, ...] | None]:
+    """Smallest load, then lexicographically smallest set among loads within TIE_RTOL."""
+    if not entries:
+        return math.inf, None
+    best = min(load for load, _ in entries)
+    ties = [(s, load) for load, s in entries if load <= best * (1.0 + TIE_RTOL)]
+    s, load = min(ties)
+    return load, s
+
+
+def _reduce_level(
+    p: int,
+    n: int,
+    loads: list[float],
+    feasible: list[tuple[float, tuple[int, ...]]],
+    wall: float,
+    comm: MPI.Comm,
+) -> LevelSummary:
+    """Combine the candidate ranks' results for size p (collective on ``comm``)."""
+    k = p + 1
+    smallest = sorted(loads)[:k]
+    merged = sorted(x for part in comm.allgather(smallest) for x in part)
+    load_kth = merged[k - 1] if len(merged) >= k else math.inf
+    load_min = merged[0] if merged else math.inf
+    n_feasible = comm.allreduce(len(feasible), op=MPI.SUM)
+    # Global minimum first, then each rank offers its lexicographic pick within the ties.
+    local_min = min((load for load, _ in feasible), default=math.inf)
+    global_min = comm.allreduce(local_min, op=MPI.MIN)
+    offers = [(load, s) for load, s in feasible if load <= global_min * (1.0 + TIE_RTOL)]
+    local_offer = min(offers, key=lambda e: e[1]) if offers else None
+    picks = [e for e in comm.allgather(local_offer) if e is not None]
+    best_load, best_set = _pick(picks)
+    return LevelSummary(
+        p=p,
+        candidates=n,
+        feasible=int(n_feasible),
+        load_min=float(load_min),
+        load_kth=float(load_kth),
+        best_load=float(best_load),
+        best_set=best_set,
+        wall_s=float(comm.allreduce(wall, op=MPI.MAX)),
+    )
+
+
+def _monotonicity(levels: list[LevelSummary]) -> tuple[bool, list[list[int]]]:
+    r"""Check :math:`\lambda(p) \le \lambda(q)` for p <= q over the sizes with a feasible mode."""
+    feasible = [lv for lv in levels if lv.best_set is not None]
+    violations = [
+        [a.p, b.p]
+        for a, b in itertools.combinations(feasible, 2)
+        if a.best_load > b.best_load * (1.0 + TIE_RTOL)
+    ]
+    return not violations, violations
+
+
+def _finite_or_none(value: float) -> float | None:
+    return value if math.isfinite(value) else None
+
+
+def enumerate_contact_sets(
+    problem: BucklingProblem,
+    *,
+    complete: bool = False,
+    max_candidates: int = 100_000,
+    candidate_comm: MPI.Comm | None = None,
+    until_proven: bool = False,
+) -> UnilateralSolution:
+    r"""Critical load by the paper's enumeration of contact sets (section 5.3).
+
+    Args:
+        problem: A set-up problem with an obstacle.
+        complete: Visit every size p = 0..i instead of stopping after the first p with
+            a feasible mode; reports :math:`\lambda(p)` per p and whether it is
+            monotone, and proves the global optimum.
+        max_candidates: Refuse (``ValueError``, before any solve) when the number of
+            candidate sets that may be visited, :math:`2^i`, exceeds this.
+        candidate_comm: Split the candidate sets of each p round-robin over this
+            communicator's ranks; every rank must hold its own serial copy of the
+            problem (``problem.comm`` of size 1). ``None``: evaluate every candidate
+            on ``problem.comm`` (which may distribute the mesh).
+        until_proven: Do not stop at :math:`p^*` (the paper's rule) but after the first
+            size q at which the interlacing bound proves the best feasible load found
+            globally optimal (see the module docstring).
+
+    Returns:
+        The solution; its mode is left in ``problem.u`` (on every rank). ``eigensolves``
+        counts the solves of all candidate ranks, including the final re-evaluation of
+        the winning set. ``details`` holds, per visited p, the candidates, the feasible
+        count, :math:`\lambda(p)` (``lambda_by_p``) and the smallest load of any set
+        (``lambda_min_by_p``); ``monotone`` (complete mode; ``None`` otherwise).
+
+    Raises:
+        ValueError: No obstacle, bad ``max_candidates``, too many candidates, or a
+            distributed problem with ``candidate_comm``.
+        RuntimeError: No contact set gives a feasible mode.
+
+    Note:
+        Collective on ``problem.comm`` and on ``candidate_comm``.
+    """
+    if problem.contact is None:
+        raise ValueError("enumerate_contact_sets needs a problem with an obstacle")
+    if (
+        isinstance(max_candidates, bool)
+        or int(max_candidates) != max_candidates
+        or max_candidates < 1
+    ):
+        raise ValueError(f"max_candidates must be an integer >= 1, got {max_candidates!r}")
+    ccomm = MPI.COMM_SELF if candidate_comm is None else candidate_comm
+    if ccomm.size > 1 and problem.comm.size > 1:
+        raise ValueError(
+            "candidate_comm needs a serial copy of the problem on every rank "
+            f"(problem.comm has {problem.comm.size} ranks): build it on MPI.COMM_SELF, "
+            "e.g. solver.solve(..., candidate_parallel=True)"
+        )
+    i = problem.contact.size
+    count = candidate_count(i)
+    if count > max_candidates:
+        raise ValueError(
+            f"enumeration may need {count} candidate sets (2^{i}, i = {i} constrained "
+            f"nodes), above max_candidates = {max_candidates}: use --method active-set "
+            "(or a coarser mesh, a smaller zone, or a larger --max-candidates)"
+        )
+
+    rank, size = ccomm.rank, ccomm.size
+    t_start = time.perf_counter()
+    solves0 = problem.solver.solves
+    start = _start_vector(problem)
+    levels: list[LevelSummary] = []
+    try:
+        for p in range(i + 1):
+            t0 = time.perf_counter()
+            loads: list[float] = []
+            feasible: list[tuple[float, tuple[int, ...]]] = []
+            n = 0
+            for j, combo in enumerate(itertools.combinations(range(i), p)):
+                n += 1
+                if j % size != rank:
+                    continue
+                cand = problem.evaluate(np.asarray(combo, dtype=np.int64), initial=start)
+                loads.append(cand.load)
+                if cand.feasible:
+                    feasible.append((cand.load, combo))
+            level = _reduce_level(p, n, loads, feasible, time.perf_counter() - t0, ccomm)
+            levels.append(level)
+            logger.info(
+                "p = %d: %d sets, %d feasible, lambda(p) = %.9e, min lambda = %.9e (%.2f s)",
+                p,
+                n,
+                level.feasible,
+                level.best_load,
+                level.load_min,
+                level.wall_s,
+            )
+            if complete:
+                continue
+            if until_proven:
+                found = min((lv.best_load for lv in levels), default=math.inf)
+                if math.isfinite(found) and level.load_kth >= found * (1.0 - PROOF_RTOL):
+                    break
+            elif level.best_set is not None:
+                break
+
+        with_feasible = [lv for lv in levels if lv.best_set is not None]
+        if not with_feasible:
+            raise RuntimeError(
+                f"no contact set of the {i} constrained nodes gives a feasible mode "
+                f"(tau = {problem.tau:g}): the problem has no admissible buckling mode"
+            )
+        p_star = with_feasible[0].p
+        load, chosen = _pick([(lv.best_load, lv.best_set) for lv in with_feasible])  # type: ignore[misc]
+        assert chosen is not None
+        last = levels[-1]
+        # Sets larger than the last size visited: >= its (p+1)-th smallest load.
+        lower = load if last.p == i else min(load, last.load_kth)
+        proven = lower >= load * (1.0 - PROOF_RTOL)
+
+        active = np.asarray(chosen, dtype=np.int64)
+        final = problem.evaluate(active, initial=start)
+        if not final.feasible or abs(final.load - load) > TIE_RTOL * load:
+            logger.warning(
+                "re-evaluating the winning set gave load %.12e (feasible %s), expected %.12e",
+                final.load,
+                final.feasible,
+                load,
+            )
+    finally:
+        start.destroy()
+    eigensolves = int(ccomm.allreduce(problem.solver.solves - solves0, op=MPI.SUM))
+
+    monotone, violations = _monotonicity(levels) if complete else (None, [])
+    details = {
+        "constrained_nodes": i,
+        "candidate_count": count,
+        "candidates_evaluated": sum(lv.candidates for lv in levels),
+        "candidate_ranks": size,
+        "complete": complete,
+        "until_proven": until_proven,
+        "p_optimum": len(active),
+        "lambda_by_p": [_finite_or_none(lv.best_load) for lv in levels],
+        "feasible_by_p": [lv.feasible for lv in levels],
+        "candidates_by_p": [lv.candidates for lv in levels],
+        "lambda_min_by_p": [_finite_or_none(lv.load_min) for lv in levels],
+        "wall_by_p_s": [lv.wall_s for lv in levels],
+        "monotone": monotone,
+        "monotone_violations": violations,
+        "lower_bound_interlacing": with_feasible[0].load_min,
+        "enumeration_wall_s": time.perf_counter() - t_start,
+    }
+    if problem.comm.rank == 0 and rank == 0:
+        logger.info(
+            "enumeration: lambda = %.9e, |Z| = %d, p* = %d, lower bound %.9e (%s), %d eigen solves",
+            load,
+            len(active),
+            p_star,
+            lower,
+            "proven" if proven else "not proven",
+            eigensolves,
+        )
+    return UnilateralSolution(
+        load=float(load),
+        active=active,
+        eigensolves=eigensolves,
+        lower_bound=float(lower),
+        global_optimum_proven=bool(proven),
+        p_star=p_star,
+        details=details,
+    )
