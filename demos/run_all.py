@@ -24,7 +24,13 @@ from pathlib import Path
 from typing import Any
 
 ROOT = Path(__file__).resolve().parents[1]
-DEMOS = ("demo_free_plate.py", "demo_obstacle_c1.py", "demo_obstacle_c2.py", "demo_obstacle_c3.py")
+DEMOS = (
+    "demo_free_plate.py",
+    "demo_obstacle_c1.py",
+    "demo_obstacle_c2.py",
+    "demo_obstacle_c3.py",
+    "study_penalty.py",  # figures/penalty_*.png; no row in the table
+)
 CASES = ("free", "c1", "c2", "c3")
 COLUMNS = (
     "case",
@@ -97,7 +103,7 @@ def main(argv: list[str] | None = None) -> int:
         cmd = [sys.executable, str(ROOT / "demos" / demo), "--figures", str(figures)]
         if args.coarse:
             cmd.append("--coarse")
-        if args.output is not None:
+        if args.output is not None and demo.startswith("demo_"):
             cmd += ["--output", str(args.output.resolve())]
         t0 = time.perf_counter()
         proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
