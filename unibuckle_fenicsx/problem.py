@@ -113,6 +113,10 @@ class BucklingProblem:
             serial copy, for candidate-parallel enumeration).
         eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
             is ``-unibuckle_eps_view``).
+        mesh: A quadrilateral DOLFINx mesh to use instead of ``spec.mesh`` (the
+            rectangle); ``spec.plate.corners`` should then be its bounding box (used for
+            tolerances and the buckling coefficient's width).
+        facet_tags: Edge markers of ``mesh``, matched by :class:`EdgeSpec` ``tag``.
 
     Note:
         Construction and :meth:`destroy` are collective on ``comm``.
@@ -123,12 +127,28 @@ class BucklingProblem:
         spec: ProblemSpec,
         comm: MPI.Comm = MPI.COMM_WORLD,
         eps_options: dict[str, str | float | int] | None = None,
+        *,
+        mesh: dolfinx.mesh.Mesh | None = None,
+        facet_tags: dolfinx.mesh.MeshTags | None = None,
     ) -> None:
         t0 = time.perf_counter()
         self.spec = spec
-        self.comm = comm
         self.timings: dict[str, float] = {}
-        self.mesh, self.facet_tags = create_plate_mesh(spec.plate, spec.mesh, comm)
+        #: The mesh came from the user (not spec.mesh): no coarse copies can be made.
+        self.custom_mesh = mesh is not None
+        if mesh is not None:
+            if facet_tags is None:
+                raise ValueError(
+                    "facet_tags: a user mesh needs its edge facet tags (EdgeSpec.tag, or "
+                    "tags 1..4 for edges named left, right, bottom, top)"
+                )
+            if mesh.topology.cell_type != dolfinx.mesh.CellType.quadrilateral:
+                raise ValueError("mesh: the MITC plate element needs a quadrilateral mesh")
+            self.mesh, self.facet_tags = mesh, facet_tags
+            comm = mesh.comm
+        else:
+            self.mesh, self.facet_tags = create_plate_mesh(spec.plate, spec.mesh, comm)
+        self.comm = comm
         if spec.obstacle is not None:
             size = max(spec.plate.length, spec.plate.width)
             check_zone_has_nodes(self.mesh, spec.obstacle, size)

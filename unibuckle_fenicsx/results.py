@@ -25,7 +25,7 @@ class BucklingResult:
         critical_force_N_per_m: N = t lambda.
         buckling_coefficient_k: k = N b^2 / (pi^2 D), b = plate width.
         dofs: Global DOF count of (w, theta).
-        mesh: [nx, ny].
+        mesh: [nx, ny] (a user-supplied mesh: [number of cells]).
         eigensolves: Linear eigen solves, including the free one.
         wall_time_s: Wall time of the whole solve (set-up included).
         constrained_nodes: i, nodes in the closed obstacle zone with free deflection.

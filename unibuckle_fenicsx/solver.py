@@ -72,6 +72,8 @@ def solve(
     *,
     candidate_parallel: bool = False,
     eps_options: dict[str, str | float | int] | None = None,
+    mesh: dolfinx.mesh.Mesh | None = None,
+    facet_tags: dolfinx.mesh.MeshTags | None = None,
 ) -> tuple[BucklingResult, BucklingProblem]:
     """Critical load and mode of ``spec``.
 
@@ -80,6 +82,9 @@ def solve(
         comm: Communicator. By default the mesh is distributed over it.
         candidate_parallel: Instead, give every rank a serial copy of the problem and
             split the enumeration's candidate sets over ``comm`` (method "enumerate").
+        mesh: Optional quadrilateral mesh replacing ``spec.mesh`` (with ``facet_tags``;
+            see :class:`~unibuckle_fenicsx.problem.BucklingProblem`).
+        facet_tags: Edge markers of ``mesh``.
         eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
             is ``-unibuckle_eps_view``).
 
@@ -91,7 +96,15 @@ def solve(
         Collective on ``comm``.
     """
     t0 = time.perf_counter()
-    problem = BucklingProblem(spec, MPI.COMM_SELF if candidate_parallel else comm, eps_options)
+    if mesh is not None and candidate_parallel:
+        raise ValueError("candidate_parallel builds its own serial meshes: pass no mesh")
+    problem = BucklingProblem(
+        spec,
+        MPI.COMM_SELF if candidate_parallel else comm,
+        eps_options,
+        mesh=mesh,
+        facet_tags=facet_tags,
+    )
     free = problem.solve_free()
     i = problem.num_constrained
     method = "free"
@@ -117,7 +130,11 @@ def solve(
         critical_force_N_per_m=t * load,
         buckling_coefficient_k=problem.buckling_coefficient(load),
         dofs=problem.model.num_dofs,
-        mesh=[spec.mesh.nx, spec.mesh.ny],
+        mesh=(
+            [problem.mesh.topology.index_map(2).size_global]
+            if problem.custom_mesh
+            else [spec.mesh.nx, spec.mesh.ny]
+        ),
         eigensolves=1 + (0 if solution is None else solution.eigensolves),
         wall_time_s=wall,
         timings={**problem.timings, "total_s": wall},

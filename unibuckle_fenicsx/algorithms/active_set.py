@@ -507,7 +507,8 @@ def solve_active_set(
         free_load = _free_load(problem)
     spec = problem.spec
     details: dict[str, Any] = {"free_load": free_load}
-    levels = _mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if multilevel else []
+    structured = multilevel and not problem.custom_mesh  # coarse copies need spec.mesh
+    levels = _mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
     coarse_solves = 0
     level_log: list[dict[str, Any]] = []
 
