@@ -7,6 +7,7 @@ from dataclasses import replace
 from mpi4py import MPI
 
 import dolfinx
+
 import numpy as np
 import pytest
 
@@ -18,8 +19,10 @@ from unibuckle_fenicsx.solver import solve
 
 
 def test_user_mesh_with_own_tags_matches_rectangle():
-    """Any quadrilateral mesh with facet tags: the same plate, tagged 11..14, gives the
-    same free load as the built-in rectangle (identical discretisation, so to 1e-10)."""
+    """A user mesh with its own facet tags gives the built-in rectangle's results.
+
+    The same plate, tagged 11..14: identical discretisation, so equal to 1e-10.
+    """
     spec = paper_case("c2", 8, 4)
     reference, problem = solve(spec)
     problem.destroy()
@@ -45,8 +48,11 @@ def test_user_mesh_needs_facet_tags():
 
 
 def test_swapped_pencil_equals_ghep():
-    """B x = mu A x for the largest mu (the indefinite-B path) gives lambda = 1/mu equal
-    to the shift-invert GHEP solve of the same pencil, to the eigen tolerance."""
+    """The swapped pencil (indefinite-B path) gives the GHEP load.
+
+    B x = mu A x for the largest mu gives lambda = 1/mu, equal to the shift-invert GHEP
+    solve of the same pencil to the eigen tolerance.
+    """
     problem = BucklingProblem(paper_case("free", 20, 10))
     ghep = problem.solve_free().value
     swapped = GEPSolver(problem.model.A, problem.model.B, indefinite=True, prefix="swapped_")
@@ -59,9 +65,12 @@ def test_swapped_pencil_equals_ghep():
 
 
 def test_indefinite_prestress_uses_swapped_pencil():
-    """Left edge clamped in plane, right edge compressed: Poisson's effect puts part of
-    the plate in tension, so B is indefinite; the smallest positive load must still be the
-    one GHEP shift-invert finds on the same pencil (checked with the swapped solver)."""
+    """An indefinite B (tension somewhere) selects the swapped pencil.
+
+    Left edge clamped in plane, right edge compressed: Poisson's effect puts part of the
+    plate in tension. The load found must be the one GHEP shift-invert finds on the same
+    pencil here.
+    """
     edges = (
         EdgeSpec("left", inplane="clamped"),
         EdgeSpec("right", normal_stress=-1.0),
