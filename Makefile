@@ -1,5 +1,5 @@
 # make demo : set up .venv (first time) and reproduce the paper's cases, writing figures/
-# make test : set up .venv (first time) and run the test suite (lint + pytest)
+# make test : set up .venv (first time) and run the test suite (ruff, mypy, pytest)
 VENV ?= .venv
 PY := $(VENV)/bin/python
 export PYVISTA_OFF_SCREEN := true
@@ -22,6 +22,7 @@ test-all: setup
 lint: setup
 	$(VENV)/bin/ruff check unibuckle_fenicsx tests demos bench
 	$(VENV)/bin/ruff format --check unibuckle_fenicsx tests demos bench
+	$(VENV)/bin/mypy unibuckle_fenicsx
 
 bench: setup
 	$(PY) bench/bench_unilateral.py

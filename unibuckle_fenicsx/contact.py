@@ -121,7 +121,7 @@ class ContactSetManager:
         mask = np.isin(self._owned.positions, active)
         return self._owned.global_dofs[mask]
 
-    def values(self, u: PETSc.Vec) -> npt.NDArray[np.float64]:  # type: ignore[name-defined]
+    def values(self, u: PETSc.Vec) -> npt.NDArray[np.float64]:
         """Entries of the W-vector ``u`` at the constrained nodes, (i,), same on all ranks.
 
         Note:

@@ -68,9 +68,9 @@ class EigenPair:
     converged: int
 
 
-def _is_zero(B: PETSc.Mat) -> bool:  # type: ignore[name-defined]
+def _is_zero(B: PETSc.Mat) -> bool:
     """Whether B has no non-zero entry (collective)."""
-    return bool(B.norm(PETSc.NormType.INFINITY) == 0.0)  # type: ignore[attr-defined]
+    return bool(B.norm(PETSc.NormType.INFINITY) == 0.0)  # type: ignore[arg-type]
 
 
 class GEPSolver:
@@ -90,8 +90,8 @@ class GEPSolver:
 
     def __init__(
         self,
-        A: PETSc.Mat,  # type: ignore[name-defined]
-        B: PETSc.Mat,  # type: ignore[name-defined]
+        A: PETSc.Mat,
+        B: PETSc.Mat,
         *,
         indefinite: bool = False,
         prefix: str = "unibuckle_",
@@ -103,55 +103,55 @@ class GEPSolver:
         self.A, self.B = A, B
         self.indefinite = indefinite
         self.prefix = prefix
-        self._Aw: PETSc.Mat | None = None  # type: ignore[name-defined]
-        self._Bw: PETSc.Mat | None = None  # type: ignore[name-defined]
+        self._Aw: PETSc.Mat | None = None
+        self._Bw: PETSc.Mat | None = None
         self.solves = 0
 
-        eps = SLEPc.EPS().create(A.comm)  # type: ignore[attr-defined]
+        eps = SLEPc.EPS().create(A.comm)
         eps.setOptionsPrefix(prefix)
-        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)  # type: ignore[attr-defined]
+        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
         eps.setDimensions(1)
         eps.setTolerances(tol)
         st = eps.getST()
         if indefinite:
-            eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)  # type: ignore[attr-defined]
-            st.setType(SLEPc.ST.Type.SHIFT)  # type: ignore[attr-defined]
+            eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)
+            st.setType(SLEPc.ST.Type.SHIFT)
             st.setShift(0.0)
         else:
             eps.setTarget(0.0)
-            eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)  # type: ignore[attr-defined]
-            st.setType(SLEPc.ST.Type.SINVERT)  # type: ignore[attr-defined]
-        opts = PETSc.Options()  # type: ignore[attr-defined]
+            eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
+            st.setType(SLEPc.ST.Type.SINVERT)
+        opts = PETSc.Options()
         opts.prefixPush(prefix)
         for key, value in (EIGEN_OPTIONS if options is None else options).items():
-            opts[key] = value
+            opts.setValue(key, value)
         opts.prefixPop()
         eps.setFromOptions()
         opts.prefixPush(prefix)
         for key in EIGEN_OPTIONS if options is None else options:
-            del opts[key]
+            opts.delValue(key)
         opts.prefixPop()
         self.eps = eps
 
-    def _work(self, removed: npt.NDArray[np.int64]) -> tuple[PETSc.Mat, PETSc.Mat]:  # type: ignore[name-defined]
-        same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN  # type: ignore[attr-defined]
+    def _work(self, removed: npt.NDArray[np.int64]) -> tuple[PETSc.Mat, PETSc.Mat]:
+        same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
         if self._Aw is None:
             self._Aw = self.A.duplicate(copy=True)
             self._Bw = self.B.duplicate(copy=True)
         else:
-            self.A.copy(self._Aw, structure=same)
-            self.B.copy(self._Bw, structure=same)
+            self.A.copy(self._Aw, structure=same)  # type: ignore[arg-type]
+            self.B.copy(self._Bw, structure=same)  # type: ignore[arg-type]
         assert self._Bw is not None
-        rows = np.ascontiguousarray(removed, dtype=PETSc.IntType)  # type: ignore[attr-defined]
-        self._Aw.zeroRowsColumns(rows, diag=1.0)
-        self._Bw.zeroRowsColumns(rows, diag=0.0)
+        rows = np.ascontiguousarray(removed, dtype=PETSc.IntType)
+        self._Aw.zeroRowsColumns(rows, diag=1.0)  # type: ignore[arg-type]
+        self._Bw.zeroRowsColumns(rows, diag=0.0)  # type: ignore[arg-type]
         return self._Aw, self._Bw
 
     def solve(
         self,
         removed: npt.NDArray[np.int64] | None = None,
-        out: PETSc.Vec | None = None,  # type: ignore[name-defined]
-        initial: PETSc.Vec | None = None,  # type: ignore[name-defined]
+        out: PETSc.Vec | None = None,
+        initial: PETSc.Vec | None = None,
     ) -> EigenPair:
         """Smallest eigenpair with the DOFs ``removed`` set to zero.
 

@@ -19,7 +19,6 @@ import logging
 from dataclasses import dataclass
 
 from mpi4py import MPI
-from petsc4py import PETSc
 
 import basix.ufl
 import dolfinx
@@ -121,7 +120,7 @@ def _pin_dofs(
             dofs = dolfinx.fem.locate_dofs_geometrical(
                 (V.sub(c), Vc), lambda y, p=point: np.linalg.norm(y[:2].T - p[:2], axis=1) < tol
             )
-            bcs.append(dolfinx.fem.dirichletbc(PETSc.ScalarType(0), dofs[0], V.sub(c)))
+            bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
     return bcs
 
 
@@ -166,15 +165,15 @@ def solve_prestress(
     s = ufl.as_vector([-n[1], n[0]])
 
     a = ufl.inner(membrane_force(u, material, t), ufl.sym(ufl.grad(v))) * ufl.dx
-    L = sum(
-        (
-            t
-            * (e.normal_stress * ufl.dot(n, v) + e.shear_stress * ufl.dot(s, v))
-            * ds(edge_tag(plate, e))
-            for e in loaded
-        ),
-        start=dolfinx.fem.Constant(msh, PETSc.ScalarType(0)) * v[0] * ufl.dx,
-    )
+    terms = [
+        t
+        * (e.normal_stress * ufl.dot(n, v) + e.shear_stress * ufl.dot(s, v))
+        * ds(edge_tag(plate, e))
+        for e in loaded
+    ]
+    L = terms[0]
+    for term in terms[1:]:
+        L = L + term
 
     bcs: list[dolfinx.fem.DirichletBC] = []
     fdim = msh.topology.dim - 1
@@ -188,7 +187,7 @@ def solve_prestress(
         for c in components:
             Vc, _ = V.sub(c).collapse()
             dofs = dolfinx.fem.locate_dofs_topological((V.sub(c), Vc), fdim, facets)
-            bcs.append(dolfinx.fem.dirichletbc(PETSc.ScalarType(0), dofs[0], V.sub(c)))
+            bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
     pinned = not bcs
     if pinned:
         _check_self_equilibrated(msh, ds, n, s, plate, loaded)
@@ -239,9 +238,9 @@ def _check_self_equilibrated(
         tr = e.normal_stress * n + e.shear_stress * s
         m = ds(edge_tag(plate, e))
         for c in range(2):
-            force[c] += dolfinx.fem.assemble_scalar(dolfinx.fem.form(tr[c] * m))
-        moment += dolfinx.fem.assemble_scalar(dolfinx.fem.form((x[0] * tr[1] - x[1] * tr[0]) * m))
-        total += dolfinx.fem.assemble_scalar(dolfinx.fem.form(ufl.sqrt(ufl.dot(tr, tr)) * m))
+            force[c] += _scalar(tr[c] * m)
+        moment += _scalar((x[0] * tr[1] - x[1] * tr[0]) * m)
+        total += _scalar(ufl.sqrt(ufl.dot(tr, tr)) * m)
     force = [msh.comm.allreduce(f, op=MPI.SUM) for f in force]
     moment = msh.comm.allreduce(moment, op=MPI.SUM)
     total = msh.comm.allreduce(total, op=MPI.SUM)
@@ -254,12 +253,17 @@ def _check_self_equilibrated(
         )
 
 
+def _scalar(integrand: ufl.Form) -> float:
+    """Process-local value of a scalar form (the caller reduces over ranks)."""
+    return float(np.real(dolfinx.fem.assemble_scalar(dolfinx.fem.form(integrand))))
+
+
 def _principal_extremes(
     msh: dolfinx.mesh.Mesh, N0: ufl.core.expr.Expr, degree: int
 ) -> tuple[float, float]:
     """Largest compressive and tensile principal value of N0 over quadrature points."""
     points, _ = basix.make_quadrature(msh.basix_cell(), max(2, 2 * degree))
-    expr = dolfinx.fem.Expression(N0, points)
+    expr = dolfinx.fem.Expression(N0, np.asarray(points, dtype=np.float64))
     cells = np.arange(msh.topology.index_map(msh.topology.dim).size_local, dtype=np.int32)
     values = expr.eval(msh, cells).reshape(-1, 2, 2)
     if values.size:

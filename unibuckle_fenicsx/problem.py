@@ -190,7 +190,7 @@ class BucklingProblem:
         """i, the number of constrained nodes (0 without obstacle)."""
         return 0 if self.contact is None else self.contact.size
 
-    def max_abs_w(self, u: PETSc.Vec | None = None) -> float:  # type: ignore[name-defined]
+    def max_abs_w(self, u: PETSc.Vec | None = None) -> float:
         """Max |w| over the plate of the W-vector ``u`` (default: the current mode)."""
         arr = (self.u.x.petsc_vec if u is None else u).array_r
         local = float(np.abs(arr[self._w_owned]).max()) if self._w_owned.size else 0.0
@@ -212,7 +212,7 @@ class BucklingProblem:
     def evaluate(
         self,
         active: npt.NDArray[np.int64],
-        initial: PETSc.Vec | None = None,  # type: ignore[name-defined]
+        initial: PETSc.Vec | None = None,
     ) -> Candidate:
         """Smallest eigenpair with the nodes ``active`` removed; mode left in :attr:`u`.
 
@@ -253,7 +253,7 @@ class BucklingProblem:
         self,
         load: float,
         active: npt.NDArray[np.int64],
-        u: PETSc.Vec | None = None,  # type: ignore[name-defined]
+        u: PETSc.Vec | None = None,
         *,
         smallest_of_reduced: bool = True,
         global_optimum_proven: bool = False,
@@ -276,11 +276,11 @@ class BucklingProblem:
         wmax = self.max_abs_w(vec)
         u_I = self.contact.values(vec) / wmax
         r_I = self.contact.values(r)
-        au_inf = Au.norm(PETSc.NormType.INFINITY)  # type: ignore[attr-defined]
+        au_inf = Au.norm(PETSc.NormType.INFINITY)
         au_2 = Au.norm()
         # Residual off Z: zero the rows of Z.
         rows = self.contact.removed_rows(active)
-        r.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))  # type: ignore[attr-defined]
+        r.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))
         r.assemble()
         residual = r.norm() / au_2
         for v in (Au, Bu, r):

@@ -121,7 +121,7 @@ class _Evaluator:
         self._Au = vec.duplicate()
         self._Bu = vec.duplicate()
         self._start = vec.duplicate()
-        self.saved: dict[bytes, PETSc.Vec] = {}  # type: ignore[name-defined]
+        self.saved: dict[bytes, PETSc.Vec] = {}
         self.calls = 0
 
     def mask(self, active: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:
@@ -132,7 +132,7 @@ class _Evaluator:
     def __call__(
         self,
         active: npt.NDArray[np.int64],
-        initial: PETSc.Vec | None = None,  # type: ignore[name-defined]
+        initial: PETSc.Vec | None = None,
         save: bool = True,
     ) -> _State:
         """Evaluate Z = ``active``; the oriented mode is left in ``problem.u``."""
@@ -152,8 +152,9 @@ class _Evaluator:
         A, B = problem.model.A, problem.model.B
         A.mult(vec, self._Au)
         B.mult(vec, self._Bu)
-        scale = self._Au.norm(PETSc.NormType.INFINITY)  # type: ignore[attr-defined]
+        scale = self._Au.norm(PETSc.NormType.INFINITY)
         self._Au.axpy(-cand.load, self._Bu)
+        assert problem.contact is not None
         r = problem.contact.values(self._Au) / scale
         u = np.array(cand.values)
         free_u = u[~inz]
@@ -194,7 +195,7 @@ def _pdas(
     ev: _Evaluator,
     seed: str,
     start: npt.NDArray[np.int64],
-    initial: PETSc.Vec | None,  # type: ignore[name-defined]
+    initial: PETSc.Vec | None,
     max_iterations: int,
     greedy: bool = False,
 ) -> _Run:
@@ -274,7 +275,11 @@ def _seeds(
             z = np.arange(n)
         elif name in ("greedy+", "greedy-"):
             v = free_values if name == "greedy+" else -free_values
-            z = np.flatnonzero(v >= v.max() * (1.0 - 1e-9)) if v.max() > tau * scale else v[:0]
+            z = (
+                np.flatnonzero(v >= v.max() * (1.0 - 1e-9))
+                if v.max() > tau * scale
+                else np.empty(0, np.intp)
+            )
         else:
             a, b = windows[name]
             c = xy[:, axis]
@@ -371,7 +376,7 @@ def _distinct_kkt(runs: list[_Run]) -> list[_State]:
 def _multi_seed(
     ev: _Evaluator,
     free_values: npt.NDArray[np.float64],
-    free_vec: PETSc.Vec | None,  # type: ignore[name-defined]
+    free_vec: PETSc.Vec | None,
     max_iterations: int,
 ) -> list[_Run]:
     runs = []

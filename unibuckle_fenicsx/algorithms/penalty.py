@@ -164,24 +164,26 @@ class PenaltySolver:
     def set_springs(self, rho_abs: float, active: npt.NDArray[np.int64]) -> None:
         r""":math:`A_{pen} = A + \rho_{abs}\sum_{k \in S} e_k e_k^T` (S = ``active``), in place."""
         assert self.problem.contact is not None
-        same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN  # type: ignore[attr-defined]
+        same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
         self.problem.model.A.copy(self.A_pen, structure=same)
         self._springs.zeroEntries()
-        rows = self.problem.contact.removed_rows(active).astype(PETSc.IntType)  # type: ignore[attr-defined]
+        rows = self.problem.contact.removed_rows(active).astype(PETSc.IntType)
         self._springs.setValues(rows, np.full(len(rows), rho_abs))
         self._springs.assemble()
-        self.A_pen.setDiagonal(self._springs, addv=PETSc.InsertMode.ADD_VALUES)  # type: ignore[attr-defined]
+        self.A_pen.setDiagonal(self._springs, addv=PETSc.InsertMode.ADD_VALUES)
         self._rho_abs = rho_abs
         self._active = np.asarray(active, dtype=np.int64)
 
-    def quotient(self, vec: PETSc.Vec, rho_abs: float) -> float:  # type: ignore[name-defined]
+    def quotient(self, vec: PETSc.Vec, rho_abs: float) -> float:
         r""":math:`R_\rho(v) = (v^TAv + \rho_{abs}\sum_I \max(0, v_k)^2) / v^TBv`."""
         assert self.problem.contact is not None
         self.problem.model.A.mult(vec, self._Av)
         self.problem.model.B.mult(vec, self._Bv)
         vals = self.problem.contact.values(vec)
-        num = vec.dot(self._Av) + rho_abs * float(np.sum(np.maximum(vals, 0.0) ** 2))
-        den = vec.dot(self._Bv)
+        num = float(np.real(vec.dot(self._Av))) + rho_abs * float(
+            np.sum(np.maximum(vals, 0.0) ** 2)
+        )
+        den = float(np.real(vec.dot(self._Bv)))
         return float(num / den) if den > 0.0 else math.inf
 
     def condition_number(self) -> tuple[float, float]:
@@ -200,35 +202,35 @@ class PenaltySolver:
         n_owned = model.num_owned_dofs
         owned_bc = model.bc_dofs[model.bc_dofs < n_owned]
         keep = np.setdiff1d(np.arange(n_owned, dtype=np.int32), owned_bc)
-        rows = model.global_dofs(keep).astype(PETSc.IntType)  # type: ignore[attr-defined]
-        iset = PETSc.IS().createGeneral(rows, comm=self.A_pen.comm)  # type: ignore[attr-defined]
+        rows = model.global_dofs(keep).astype(PETSc.IntType)
+        iset = PETSc.IS().createGeneral(rows, comm=self.A_pen.comm)  # type: ignore[arg-type]
         sub = self.A_pen.createSubMatrix(iset, iset)
         iset.destroy()
         values = []
         for which in ("largest", "smallest"):
-            eps = SLEPc.EPS().create(sub.comm)  # type: ignore[attr-defined]
+            eps = SLEPc.EPS().create(sub.comm)
             eps.setOptionsPrefix(CONDITION_PREFIX)
             eps.setOperators(sub)
-            eps.setProblemType(SLEPc.EPS.ProblemType.HEP)  # type: ignore[attr-defined]
+            eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
             eps.setDimensions(1)
             eps.setTolerances(1e-8)
             if which == "largest":
-                eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)  # type: ignore[attr-defined]
+                eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)
                 opts_used = {"eps_type": CONDITION_OPTIONS["eps_type"]}
             else:
                 eps.setTarget(0.0)
-                eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)  # type: ignore[attr-defined]
-                eps.getST().setType(SLEPc.ST.Type.SINVERT)  # type: ignore[attr-defined]
+                eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
+                eps.getST().setType(SLEPc.ST.Type.SINVERT)
                 opts_used = dict(CONDITION_OPTIONS)
-            opts = PETSc.Options()  # type: ignore[attr-defined]
+            opts = PETSc.Options()
             opts.prefixPush(CONDITION_PREFIX)
             for key, value in opts_used.items():
-                opts[key] = value
+                opts.setValue(key, value)
             opts.prefixPop()
             eps.setFromOptions()
             opts.prefixPush(CONDITION_PREFIX)
             for key in opts_used:
-                del opts[key]
+                opts.delValue(key)
             opts.prefixPop()
             eps.solve()
             if eps.getConverged() < 1:
@@ -297,10 +299,10 @@ class PenaltySolver:
         solves0 = self.solves
 
         vec = self._work
-        best: PETSc.Vec | None = None  # type: ignore[name-defined]
+        best: PETSc.Vec | None = None
         best_q = math.inf
         best_step = -1
-        previous: PETSc.Vec | None = None  # type: ignore[name-defined]
+        previous: PETSc.Vec | None = None
         seen: dict[tuple[int, ...], int] = {}
         steps: list[PenaltyStep] = []
         status = "max_iterations"

@@ -84,13 +84,13 @@ class PlateModel:
         self.A.assemble()
         if shear == "mitc":
             S = self._mitc_shear_matrix(ks)
-            self.A.axpy(1.0, S, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[attr-defined]
+            self.A.axpy(1.0, S, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
             S.destroy()
         self.B = dolfinx.fem.petsc.assemble_matrix(self.b_form, bcs=self.bcs, diag=0.0)
         self.B.assemble()
-        self.A.setOption(PETSc.Mat.Option.SPD, True)  # type: ignore[attr-defined]
-        self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[attr-defined]
-        self.B.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[attr-defined]
+        self.A.setOption(PETSc.Mat.Option.SPD, True)
+        self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        self.B.setOption(PETSc.Mat.Option.SYMMETRIC, True)
 
     def _edge_bcs(self, facet_tags: dolfinx.mesh.MeshTags) -> list[dolfinx.fem.DirichletBC]:
         """Zero Dirichlet conditions of the edge supports (hard SS: w and tangential theta)."""
@@ -102,7 +102,7 @@ class PlateModel:
                 continue
             tag = edge_tag(self.plate, e)
             facets = facet_tags.find(tag)
-            subs = [(0,)]
+            subs: list[tuple[int, ...]] = [(0,)]
             if e.support == "clamped":
                 subs += [(1, 0), (1, 1)]
             elif e.support == "simply_supported":
@@ -115,10 +115,10 @@ class PlateModel:
                     sub = sub.sub(i)
                 Vc, _ = sub.collapse()
                 dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
-                bcs.append(dolfinx.fem.dirichletbc(PETSc.ScalarType(0), dofs[0], sub))
+                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
         return bcs
 
-    def _mitc_shear_matrix(self, ks: float) -> PETSc.Mat:  # type: ignore[name-defined]
+    def _mitc_shear_matrix(self, ks: float) -> PETSc.Mat:
         """:math:`P^T M_s P` with P's columns of edge-constrained DOFs zeroed."""
         Vs = create_shear_space(self.mesh)
         g, d = ufl.TrialFunction(Vs), ufl.TestFunction(Vs)

@@ -39,19 +39,19 @@ def create_shear_space(msh: dolfinx.mesh.Mesh) -> dolfinx.fem.FunctionSpace:
 
 def _restriction(
     W: dolfinx.fem.FunctionSpace, Vc: dolfinx.fem.FunctionSpace, parent: npt.NDArray[np.int32]
-) -> PETSc.Mat:  # type: ignore[name-defined]
+) -> PETSc.Mat:
     """0/1 matrix R with (R u)_i = u[parent[i]], from W to its collapsed sub-space Vc."""
     imW, bsW = W.dofmap.index_map, W.dofmap.index_map_bs
     imc, bsc = Vc.dofmap.index_map, Vc.dofmap.index_map_bs
     n_rows = imc.size_local * bsc
     local = np.ascontiguousarray(parent[:n_rows], dtype=np.int32)
     cols = imW.local_to_global(local // bsW) * bsW + local % bsW
-    R = PETSc.Mat().createAIJ(  # type: ignore[attr-defined]
-        ((n_rows, None), (imW.size_local * bsW, None)),
-        csr=(
-            np.arange(n_rows + 1, dtype=PETSc.IntType),  # type: ignore[attr-defined]
-            cols.astype(PETSc.IntType),  # type: ignore[attr-defined]
-            np.ones(n_rows, dtype=PETSc.ScalarType),  # type: ignore[attr-defined]
+    R = PETSc.Mat().createAIJ(
+        ((n_rows, None), (imW.size_local * bsW, None)),  # type: ignore[arg-type]
+        csr=(  # type: ignore[arg-type]
+            np.arange(n_rows + 1, dtype=PETSc.IntType),
+            cols.astype(PETSc.IntType),
+            np.ones(n_rows, dtype=PETSc.ScalarType),
         ),
         comm=W.mesh.comm,
     )
@@ -59,7 +59,7 @@ def _restriction(
     return R
 
 
-def mitc_shear_operator(W: dolfinx.fem.FunctionSpace, Vs: dolfinx.fem.FunctionSpace) -> PETSc.Mat:  # type: ignore[name-defined]
+def mitc_shear_operator(W: dolfinx.fem.FunctionSpace, Vs: dolfinx.fem.FunctionSpace) -> PETSc.Mat:
     r"""Matrix P with :math:`\gamma_h = P u = \Pi \nabla w - \Pi \theta`.
 
     Args:
@@ -82,7 +82,7 @@ def mitc_shear_operator(W: dolfinx.fem.FunctionSpace, Vs: dolfinx.fem.FunctionSp
     Rt = _restriction(W, Vt, np.asarray(map_t[0], dtype=np.int32))
     P = G.matMult(Rw)
     It = I.matMult(Rt)
-    P.axpy(-1.0, It, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[attr-defined]
+    P.axpy(-1.0, It, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
     for m in (G, I, Rw, Rt, It):
         m.destroy()
     return P
