@@ -179,6 +179,8 @@ class BucklingProblem:
         )
         self.u = dolfinx.fem.Function(self.model.W, name="mode")
         self.free_mode: dolfinx.fem.Function | None = None
+        self._r: PETSc.Vec | None = None  # work vectors of residual()
+        self._Bu: PETSc.Vec | None = None
         self.tau = spec.solver.tau
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         self._w_owned = self.model.w_dofs[:n_owned_w]
@@ -249,6 +251,35 @@ class BucklingProblem:
         return Candidate(active, pair.value, sign * values, feasible, sign, pair)
 
     # -- certificate ----------------------------------------------------------------
+    def residual(
+        self,
+        load: float,
+        u: PETSc.Vec | None = None,
+    ) -> tuple[PETSc.Vec, float, float]:
+        r"""Residual :math:`r = A u - \lambda B u` with the edge-constrained pencil.
+
+        Args:
+            load: :math:`\lambda`.
+            u: W-vector (default: the current mode :attr:`u`).
+
+        Returns:
+            r in a work vector owned by the problem (valid until the next call), and
+            :math:`\|Au\|_\infty`, :math:`\|Au\|_2` for scaling.
+
+        Note:
+            Collective.
+        """
+        vec = self.u.x.petsc_vec if u is None else u
+        if self._r is None:
+            self._r, self._Bu = vec.duplicate(), vec.duplicate()
+        assert self._Bu is not None
+        self.model.A.mult(vec, self._r)
+        au_inf = self._r.norm(PETSc.NormType.INFINITY)  # type: ignore[arg-type]
+        au_2 = self._r.norm()
+        self.model.B.mult(vec, self._Bu)
+        self._r.axpy(-load, self._Bu)
+        return self._r, float(au_inf), float(au_2)  # type: ignore[arg-type]
+
     def certify(
         self,
         load: float,
@@ -266,25 +297,15 @@ class BucklingProblem:
         """
         assert self.contact is not None
         vec = self.u.x.petsc_vec if u is None else u
-        A, B = self.model.A, self.model.B
-        Au = A.createVecLeft()
-        A.mult(vec, Au)
-        Bu = B.createVecLeft()
-        B.mult(vec, Bu)
-        r = Au.copy()
-        r.axpy(-load, Bu)
+        r, au_inf, au_2 = self.residual(load, vec)
         wmax = self.max_abs_w(vec)
         u_I = self.contact.values(vec) / wmax
         r_I = self.contact.values(r)
-        au_inf = Au.norm(PETSc.NormType.INFINITY)
-        au_2 = Au.norm()
         # Residual off Z: zero the rows of Z.
         rows = self.contact.removed_rows(active)
-        r.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))
+        r.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))  # type: ignore[arg-type]
         r.assemble()
-        residual = r.norm() / au_2
-        for v in (Au, Bu, r):
-            v.destroy()
+        residual = float(r.norm()) / au_2  # type: ignore[arg-type]
         free = np.ones(u_I.size, dtype=bool)
         free[active] = False
         margin = float(u_I[free].max()) if free.any() else -np.inf
@@ -314,5 +335,9 @@ class BucklingProblem:
 
     def destroy(self) -> None:
         """Destroy the PETSc/SLEPc objects (collective)."""
+        for v in (self._r, self._Bu):
+            if v is not None:
+                v.destroy()
+        self._r = self._Bu = None
         self.solver.destroy()
         self.model.destroy()

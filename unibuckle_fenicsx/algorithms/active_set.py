@@ -110,7 +110,7 @@ class _Run:
 class _Evaluator:
     """Reduced eigen solves on one problem, with multipliers and mode snapshots.
 
-    Owns two work vectors, a start vector and the saved modes; :meth:`destroy` them.
+    Owns a start vector and the saved modes; :meth:`destroy` them.
     """
 
     def __init__(self, problem: BucklingProblem) -> None:
@@ -118,8 +118,6 @@ class _Evaluator:
         self.tau = problem.tau
         self.n = problem.num_constrained
         vec = problem.u.x.petsc_vec
-        self._Au = vec.duplicate()
-        self._Bu = vec.duplicate()
         self._start = vec.duplicate()
         self.saved: dict[bytes, PETSc.Vec] = {}
         self.calls = 0
@@ -149,13 +147,9 @@ class _Evaluator:
             zeros = np.zeros(self.n)
             return _State(active, math.inf, zeros, zeros, False, False, math.inf, math.inf)
         vec = problem.u.x.petsc_vec
-        A, B = problem.model.A, problem.model.B
-        A.mult(vec, self._Au)
-        B.mult(vec, self._Bu)
-        scale = self._Au.norm(PETSc.NormType.INFINITY)
-        self._Au.axpy(-cand.load, self._Bu)
+        residual, scale, _ = problem.residual(cand.load, vec)
         assert problem.contact is not None
-        r = problem.contact.values(self._Au) / scale
+        r = problem.contact.values(residual) / scale
         u = np.array(cand.values)
         free_u = u[~inz]
         force = float(r[inz].max()) if inz.any() else -math.inf
@@ -186,7 +180,7 @@ class _Evaluator:
         return True
 
     def destroy(self) -> None:
-        for v in (self._Au, self._Bu, self._start, *self.saved.values()):
+        for v in (self._start, *self.saved.values()):
             v.destroy()
         self.saved = {}
 
@@ -437,6 +431,27 @@ def _lattice_bound(
     return lower, evaluations, better, not frontier or frontier[0][0] >= upper * (1 - PROOF_RTOL)
 
 
+def _polish(
+    ev: _Evaluator,
+    candidates: list[npt.NDArray[np.int64]],
+    prev: tuple[BucklingProblem, tuple[int, int]],
+    max_iterations: int,
+) -> list[_Run]:
+    """Prolong the contact sets of the coarser level ``prev`` to ``ev``'s mesh; iterate."""
+    coarse, (nx, ny) = prev
+    target = ev.problem
+    assert coarse.contact is not None and target.contact is not None
+    plate = target.spec.plate
+    h = (plate.length / nx, plate.width / ny)
+    runs = []
+    for k, z in enumerate(candidates):
+        zf = prolong_contact_set(
+            z, coarse.contact.coordinates, target.contact.coordinates, plate.corners[0], h, (nx, ny)
+        )
+        runs.append(_pdas(ev, f"candidate{k}", zf, None, max_iterations))
+    return runs
+
+
 def _free_load(problem: BucklingProblem) -> float:
     """Rayleigh quotient of the stored free mode (its eigenvalue to solver accuracy)."""
     assert problem.free_mode is not None
@@ -536,15 +551,8 @@ def solve_active_set(
             coarse_runs = _multi_seed(cev, fvals, cp.free_mode.x.petsc_vec, max_iterations)
             runs = coarse_runs
         else:
-            assert prev is not None and prev[0].contact is not None and cp.contact is not None
-            origin = spec.plate.corners[0]
-            h = (spec.plate.length / prev[1][0], spec.plate.width / prev[1][1])
-            runs = []
-            for k, z in enumerate(candidates):
-                zf = prolong_contact_set(
-                    z, prev[0].contact.coordinates, cp.contact.coordinates, origin, h, prev[1]
-                )
-                runs.append(_pdas(cev, f"candidate{k}", zf, None, max_iterations))
+            assert prev is not None
+            runs = _polish(cev, candidates, prev, max_iterations)
         kkt = _distinct_kkt(runs)
         groups = _twin_groups(kkt)
         if groups:
@@ -573,15 +581,7 @@ def solve_active_set(
     ev = _Evaluator(problem)
     assert problem.free_mode is not None
     if candidates is not None and prev is not None:
-        assert prev[0].contact is not None
-        origin = spec.plate.corners[0]
-        h = (spec.plate.length / prev[1][0], spec.plate.width / prev[1][1])
-        runs = []
-        for k, z in enumerate(candidates):
-            zf = prolong_contact_set(
-                z, prev[0].contact.coordinates, problem.contact.coordinates, origin, h, prev[1]
-            )
-            runs.append(_pdas(ev, f"candidate{k}", zf, None, max_iterations))
+        runs = _polish(ev, candidates, prev, max_iterations)
         details["seeded_on"] = list(prev[1])
     else:
         fvals = problem.contact.values(problem.free_mode.x.petsc_vec)
