@@ -32,8 +32,8 @@ def worker(case: str, nx: int, ny: int, method: str) -> None:
     """One run under mpiexec; rank 0 prints a JSON line."""
     from mpi4py import MPI
 
+    from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.cases import paper_case
-    from unibuckle_fenicsx.solver import solve
 
     comm = MPI.COMM_WORLD
     spec = paper_case(case, nx, ny)
@@ -41,10 +41,10 @@ def worker(case: str, nx: int, ny: int, method: str) -> None:
         spec = spec.with_solver(method=method)
     comm.Barrier()
     t0 = time.perf_counter()
-    result, problem = solve(spec, comm)
+    with solve(spec, comm) as analysis:
+        result = analysis.result
     comm.Barrier()
     total = time.perf_counter() - t0
-    problem.destroy()
     rss_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024.0  # Linux: KiB
     setup = result.timings.get("setup_s", float("nan"))
     report = {

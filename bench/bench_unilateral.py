@@ -54,7 +54,7 @@ def main() -> None:
                 print(
                     f"{case:5} {f'{nx}x{ny}':>8} {problem.model.num_dofs:7d} {t_free:9.2f} "
                     f"{t_uni:11.2f} {t_uni / t_free:6.2f} {solves:>11} {peak / 1024:8.0f} "
-                    f"{sol.load:14.6f} {len(sol.active):5d} {d['kkt']}",
+                    f"{sol.load:14.6f} {len(sol.active):5d} {sol.candidate.kkt}",
                     flush=True,
                 )
             problem.destroy()

@@ -23,7 +23,8 @@
 #
 # This demo illustrates how to:
 #
-# - set up the paper's free plate with `paper_case` and solve it with `solver.solve`;
+# - set up the paper's free plate with `paper_case` and solve it on a sequence of meshes
+#   (`study.mesh_study`, which calls `solve` on each);
 # - compare the critical load with the analytic Navier value and measure the rate of
 #   convergence under mesh refinement;
 # - draw the mode (paper figure 3) and the convergence of λ, and write ParaView files.
@@ -31,19 +32,14 @@
 # %%
 from __future__ import annotations
 
-import argparse
-import json
-import os
 import warnings
-from pathlib import Path
 
 from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx import paper_case, plotting
+from unibuckle_fenicsx import paper_case, study
 from unibuckle_fenicsx.materials import navier_load_mindlin
-from unibuckle_fenicsx.solver import solve, write_vtx
 
 warnings.filterwarnings("error")  # demos run warning-free
 
@@ -56,18 +52,10 @@ warnings.filterwarnings("error")  # demos run warning-free
 # runs tiny meshes for the test suite. Unknown options go to PETSc.
 
 # %%
-parser = argparse.ArgumentParser(description="Free plate vs the Navier solution.")
-parser.add_argument(
-    "--coarse", action="store_true", default=os.environ.get("UNIBUCKLE_DEMO_COARSE") == "1"
-)
-parser.add_argument("--figures", type=Path, default=Path("figures"), help="PNG directory")
-parser.add_argument("--output", type=Path, default=None, help="VTX (ParaView) directory")
-args, _ = parser.parse_known_args()
-
+args = study.demo_arguments("Free plate vs the Navier solution.")
 CASE = "free"
-MESHES = [(4, 4), (8, 8), (16, 16)] if args.coarse else [(10, 10), (20, 20), (40, 40), (80, 80)]
-PAPER_MESH = MESHES[1]  # 20 x 20 (8 x 8 when coarse)
-REFINED_MESH = MESHES[-1]
+MESHES = study.COARSE_MESHES if args.coarse else study.PAPER_MESHES
+PAPER_MESH, REFINED_MESH = MESHES[1], MESHES[-1]  # 20 x 20 and 80 x 80
 comm = MPI.COMM_WORLD
 figures = args.figures / CASE
 
@@ -82,32 +70,23 @@ if comm.rank == 0:
 # %% [markdown]
 # ## Solve on each mesh
 #
-# `solve` returns a `BucklingResult` (load, buckling coefficient k, timings, …) and the
-# set-up problem, whose `u` holds the mode scaled to max |w| = 1.
+# Each solve returns an `Analysis`: the `BucklingResult` (load, buckling coefficient k,
+# timings, …), the mode scaled to max |w| = 1, and the set-up problem.
 
 # %%
-rows = []
-for nx, ny in MESHES:
-    result, problem = solve(paper_case(CASE, nx, ny), comm)
-    if comm.rank == 0:
-        print(result.summary())
-    rows.append(result)
-    if (nx, ny) in (PAPER_MESH, REFINED_MESH) and comm.size == 1:
-        plotting.plot_mode_3d(
-            problem,
-            figures / f"mode_{nx}x{ny}.png",
-            title=f"free plate, {nx}x{ny} mesh: λ = {result.critical_load_Pa / 1e6:.4f} MPa",
-            show_zone=False,
-        )
-    if args.output is not None:
-        write_vtx(problem, result, args.output / CASE / f"{nx}x{ny}")
-    problem.destroy()
+series = study.mesh_study(
+    [paper_case(CASE, nx, ny) for nx, ny in MESHES],
+    comm=comm,
+    figures=figures,
+    keep=[PAPER_MESH, REFINED_MESH],
+    output=args.output,
+)
 
 # %% [markdown]
 # ## Convergence against the Navier value
 
 # %%
-loads = np.array([r.critical_load_Pa for r in rows])
+loads = np.array([r.critical_load_Pa for r in series.results])
 nxs = np.array([m[0] for m in MESHES], dtype=float)
 errors = np.abs(loads - lambda_rm) / lambda_rm
 rates = np.log(errors[:-1] / errors[1:]) / np.log(nxs[1:] / nxs[:-1])
@@ -115,22 +94,20 @@ if comm.rank == 0:
     for (nx, ny), lam, err in zip(MESHES, loads, errors, strict=True):
         print(f"  {nx:3d} x {ny:<3d}  lambda = {lam:.6e} Pa   relative error {err:.3e}")
     print("  observed rates:", np.array2string(rates, precision=3))
-    plotting.plot_convergence(
+    series.plot_convergence(
         figures / "convergence.png",
-        {"free": [(nx, ny, lam) for (nx, ny), lam in zip(MESHES, loads, strict=True)]},
         reference=lambda_rm,
         reference_label="λ_RM (Navier)",
         title="Free plate: convergence of the critical load",
     )
-    summary = {
-        "case": CASE,
-        "paper_mesh": list(PAPER_MESH),
-        "refined_mesh": list(REFINED_MESH),
-        "reference_Pa": lambda_rm,
-        "results": [r.as_dict() for r in rows],
-    }
-    figures.mkdir(parents=True, exist_ok=True)
-    (figures / "results.json").write_text(json.dumps(summary, indent=2) + "\n")
+    x, w = series.at(PAPER_MESH).section
+    series.write_json(
+        figures / "results.json",
+        paper_mesh=list(PAPER_MESH),
+        refined_mesh=list(REFINED_MESH),
+        reference_Pa=lambda_rm,
+        section_A={"x": x.tolist(), "w": w.tolist()},
+    )
 
 # %% [markdown]
 # ## Checks
@@ -139,8 +116,8 @@ if comm.rank == 0:
 #   here) and converges to it at rate h²: the observed rate of the two finest meshes
 #   lies in (1.8, 2.2).
 # - On the paper's 20 × 20 mesh the error is below 1 % (measured 0.54 %); on the
-#   refined 80 × 80 mesh below 0.05 % (measured 0.034 %; DESIGN.md §3 quotes 2e-4
-#   at 160 × 80).
+#   refined 80 × 80 mesh below 0.05 % (measured 0.034 %; about 2e-4 at 160 × 80, see
+#   the README's verification section).
 
 # %%
 assert np.all(loads > lambda_rm), loads

@@ -7,8 +7,12 @@ Usage::
 Each demo (``demos/demo_*.py``) runs in its own process, writes its figures and a
 ``results.json`` under ``DIR/<case>/`` and ends with its own assertions. This script
 collects the JSON files, prints one table (paper's mesh and refined mesh of every case),
-writes it as Markdown to ``DIR/results.md`` and draws ``DIR/convergence.png``.
-It exits non-zero if a demo fails. ``make demo`` runs it with the default (paper) sizes;
+writes it as Markdown to ``DIR/results.md``, draws ``DIR/convergence.png`` and
+``DIR/sections_A.png`` (section A of every case on the paper's mesh), and checks the
+paper's comparisons between the cases: the zones are nested (c2 within c1 within c3),
+so their loads are ordered, and "the noticeable changing of the obstacle [c1 to c2] has
+slightly affected [...] the buckling critical load" (we require below 2 %).
+It exits non-zero if a demo or a check fails. ``make demo`` runs it with the default (paper) sizes;
 ``--coarse`` (or ``UNIBUCKLE_DEMO_COARSE=1``) runs tiny meshes for the tests.
 """
 
@@ -22,6 +26,8 @@ import sys
 import time
 from pathlib import Path
 from typing import Any
+
+import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 DEMOS = (
@@ -82,6 +88,54 @@ def _table(rows: list[list[str]]) -> tuple[str, str]:
     return "\n".join(lines), "\n".join(md)
 
 
+def _compare_cases(paper: dict[str, dict[str, Any]], figures: Path) -> list[str]:
+    """Section A of every case on the paper's mesh, and the paper's comparisons."""
+    from unibuckle_fenicsx import plotting
+    from unibuckle_fenicsx.cases import paper_case
+    from unibuckle_fenicsx.fields import mirror_to_match, zone_box
+
+    load = {}
+    for case, data in paper.items():
+        mesh = data["paper_mesh"]
+        load[case] = next(r for r in data["results"] if r["mesh"] == mesh)["critical_load_Pa"]
+    x1, w1 = (np.asarray(paper["c1"]["section_A"][k]) for k in ("x", "w"))
+    extra = []
+    for case in ("c2", "c3"):
+        x, w, flipped = mirror_to_match(
+            x1, w1, paper[case]["section_A"]["x"], paper[case]["section_A"]["w"]
+        )
+        extra.append((x, w, f"unilateral mode, {case}" + (" (mirrored)" if flipped else "")))
+    xf, wf = (np.asarray(paper["free"]["section_A"][k]) for k in ("x", "w"))
+    sign = 1.0 if np.dot(np.interp(x1, xf, wf), w1) >= 0 else -1.0
+    mesh = "x".join(str(n) for n in paper["c1"]["paper_mesh"])
+    plotting.plot_section(
+        figures / "sections_A.png",
+        xf,
+        sign * wf,
+        x1,
+        w1,
+        zone_x=zone_box(paper_case("c1"))[0],  # type: ignore[index]
+        title=f"Section A (y = 0) of every case, {mesh} mesh (obstacle of c1, c2 drawn)",
+        extra=extra,
+        labels=("free mode (no obstacle)", "unilateral mode, c1"),
+    )
+    change = load["c2"] / load["c1"] - 1
+    print(
+        f"\npaper's mesh: lambda_c2/lambda_c1 - 1 = {change:.2e}, "
+        f"lambda_c3/lambda_c1 - 1 = {load['c3'] / load['c1'] - 1:.2e}"
+    )
+    rtol = 1e-8
+    checks = {
+        "free <= c2 <= c1 <= c3 (nested zones)": load["free"] <= load["c2"] * (1 + rtol)
+        and load["c2"] <= load["c1"] * (1 + rtol)
+        and load["c1"] <= load["c3"] * (1 + rtol),
+        "c1 -> c2 changes the load slightly (< 2 %)": abs(change) < 2e-2,
+    }
+    for name, ok in checks.items():
+        print(f"check {name}: {'ok' if ok else 'FAILED'}")
+    return [name for name, ok in checks.items() if not ok]
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the demos; return the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -114,7 +168,7 @@ def main(argv: list[str] | None = None) -> int:
             failed.append(demo)
             print(proc.stdout[-4000:], proc.stderr[-4000:], sep="\n", file=sys.stderr)
 
-    rows, studies = [], {}
+    rows, studies, paper = [], {}, {}
     for case in CASES:
         path = figures / case / "results.json"
         if not path.exists():
@@ -124,6 +178,7 @@ def main(argv: list[str] | None = None) -> int:
         keep = [tuple(data["paper_mesh"]), tuple(data["refined_mesh"])]
         rows += [_row(r) for r in results if tuple(r["mesh"]) in keep]
         studies[case] = [(*r["mesh"], r["critical_load_Pa"]) for r in results]
+        paper[case] = data
     if rows:
         text, md = _table(rows)
         print()
@@ -145,6 +200,8 @@ def main(argv: list[str] | None = None) -> int:
             title="Critical load under mesh refinement, all cases",
         )
         print(f"\nwrote {path.relative_to(figures.parent) if path.is_relative_to(ROOT) else path}")
+    if set(paper) == set(CASES):
+        failed += _compare_cases(paper, figures)
     print(f"total {time.perf_counter() - t_all:.1f} s")
     if failed:
         print(f"failed demos: {', '.join(failed)}", file=sys.stderr)

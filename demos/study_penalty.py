@@ -22,9 +22,10 @@
 #
 # This study illustrates how to:
 #
-# - compute an exact reference for the unilateral critical load on small meshes: the
-#   minimum over all contact sets Z with a feasible reduced first mode, by exhaustive
-#   depth-first enumeration pruned with interlacing (λ(Z) ≤ λ(Z′) for Z ⊂ Z′);
+# - compute an exact reference for the unilateral critical load on small meshes with the
+#   package's exhaustive search: the active-set method with an unlimited budget for its
+#   lattice search, which visits the contact sets best-first, prunes with interlacing
+#   (λ(Z) ≤ λ(Z′) for Z ⊂ Z′) and proves the minimum over all feasible sets;
 # - sweep ρ over 22 decades and record λ(ρ), the penetration, the condition number of
 #   the penalised operator, the number of eigen solves and the change of the mode,
 #   each against the reference;
@@ -42,8 +43,11 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx import paper_case, plotting
+from unibuckle_fenicsx import fields, paper_case
+from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver
+from unibuckle_fenicsx.certify import certify
 from unibuckle_fenicsx.problem import BucklingProblem
 
 # %% [markdown]
@@ -82,36 +86,20 @@ def log(*a: object) -> None:
 # ## Exact reference (the direct method, made exhaustive)
 #
 # The critical load is the smallest λ(Z) over the contact sets Z whose reduced first
-# mode is feasible (DESIGN.md §1, Lemma 5.1). Depth-first over the subsets of I in
-# lexicographic order, a subset whose λ(Z) is not below the best feasible load found
-# so far is cut with all its descendants (they are supersets: interlacing). The
-# search starts from an upper bound (the load of any feasible set) and ends with the
-# global minimum, proven. The paper's own stopping rule (stop at the first size p
-# with a feasible set) is run too, for comparison.
-
+# mode is feasible (paper, Lemma 5.1). The lattice search of the active-set method
+# (`algorithms.bounds`) visits the subsets of I best-first; a subset whose λ(Z) is not
+# below the best feasible load found so far is cut with all its supersets
+# (interlacing), and the search ends with the global minimum, proven. The paper's own
+# stopping rule (stop at the first size p with a feasible set) is run too, for
+# comparison.
 
 # %%
-def exact_reference(problem: BucklingProblem, upper: float) -> tuple[float, np.ndarray, int]:
-    """Global minimum of lambda(Z) over feasible Z, by pruned exhaustive search."""
-    assert problem.contact is not None
-    i = problem.contact.size
-    best, best_set, evals = upper, None, 0
-    stack: list[tuple[tuple[int, ...], int]] = [((), 0)]
-    while stack:
-        Z, start = stack.pop()
-        cand = problem.evaluate(np.array(Z, dtype=np.int64))
-        evals += 1
-        if cand.load >= best * (1.0 - 1e-12):
-            continue
-        if cand.feasible:
-            best, best_set = cand.load, cand.active
-        stack.extend(((*Z, k), k + 1) for k in range(i - 1, start - 1, -1))
-    return best, best_set, evals
+EXHAUSTIVE = 10**7  # lattice budget: never reached on these meshes
 
 
-def deflection(problem: BucklingProblem) -> np.ndarray:
-    """Nodal w of the mode in problem.u (scaled to max|w| = 1, oriented)."""
-    _, w = plotting.nodal_deflection(problem, problem.u)
+def deflection(mode) -> np.ndarray:
+    """Nodal w of a mode (scaled to max|w| = 1, oriented)."""
+    _, w = fields.nodal_deflection(problem, mode)
     return w
 
 
@@ -135,27 +123,15 @@ results: dict[str, dict[str, object]] = {}
 for zone, (nx, ny) in ZONES.items():
     t0 = time.perf_counter()
     problem = BucklingProblem(paper_case(zone, nx, ny), comm)
-    free = problem.solve_free().value
+    free = problem.solve_free().load
+    exact = solve_active_set(problem, multilevel=False, bound_budget=EXHAUSTIVE)
+    cert = certify(problem, exact)
+    assert cert.kkt and cert.global_optimum_proven, cert
+    ref, lam_ref = exact.candidate, exact.load
+    evals = exact.details["bound_evaluations"]
+    w_ref = deflection(ref.mode)
+    paper_rule = enumerate_contact_sets(problem, max_candidates=2**62)
     pen = PenaltySolver(problem)
-    # Upper bound for the search: the penalty's limit set, if its mode is feasible.
-    trial = pen.solve(1e8)
-    cand = problem.evaluate(trial.active)
-    upper = cand.load if cand.feasible else np.inf
-    lam_ref, z_ref, evals = exact_reference(problem, upper)
-    if z_ref is None:  # the upper bound itself was optimal
-        z_ref = cand.active
-    ref = problem.evaluate(z_ref)
-    cert = problem.certify(ref.load, ref.active)
-    assert ref.feasible and cert.kkt and abs(ref.load - lam_ref) <= 1e-10 * lam_ref
-    w_ref = deflection(problem)
-    paper_rule = None
-    try:
-        from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
-
-        paper_rule = enumerate_contact_sets(problem, max_candidates=2**62)
-    except ImportError:  # pragma: no cover
-        pass
-    pen.set_springs(0.0, np.empty(0, np.int64))
     kappa_A = np.divide(*pen.condition_number()[::-1])
 
     rows = []
@@ -163,15 +139,15 @@ for zone, (nx, ny) in ZONES.items():
     for rho in RHOS:
         warm = pen.solve(rho, initial_active=prev_set, lower_bound=free)
         prev_set = warm.active
-        w_warm = deflection(problem)
+        w_warm = deflection(warm.candidate.mode)
         slight = pen.solve(rho * PERTURBATION, lower_bound=free)
-        w_slight = deflection(problem)
+        w_slight = deflection(slight.candidate.mode)
         naive = pen.solve(rho, lower_bound=free, tie_rtol=0.0)
-        w_naive = deflection(problem)
+        w_naive = deflection(naive.candidate.mode)
         naive_slight = pen.solve(rho * PERTURBATION, lower_bound=free, tie_rtol=0.0)
-        w_naive_slight = deflection(problem)
+        w_naive_slight = deflection(naive_slight.candidate.mode)
         cold = pen.solve(rho, condition=True, lower_bound=free)
-        w = deflection(problem)
+        w = deflection(cold.candidate.mode)
         d = cold.details
         rows.append(
             {
@@ -356,10 +332,8 @@ problem.solve_free()
 sections = []
 pen = PenaltySolver(problem)
 for rho in (1e-6, 1e-3, 1e-2, 1e0, 1e8):
-    pen.solve(rho)
-    sections.append((rho, *plotting.section(problem)))
-problem.evaluate(results["c1"]["ref_set"])
-x_ref, w_ref_sec = plotting.section(problem)
+    sections.append((rho, *fields.section(problem, pen.solve(rho).candidate.mode)))
+x_ref, w_ref_sec = fields.section(problem, problem.evaluate(results["c1"]["ref_set"]).mode)
 pen.destroy()
 problem.destroy()
 if comm.rank == 0:

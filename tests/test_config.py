@@ -24,8 +24,8 @@ from unibuckle_fenicsx.config import (
     problem_from_dict,
 )
 
-# The schema example of issue 2, verbatim.
-ISSUE_TOML = """\
+# A problem file in the README's schema ("Problem files"): the paper's case c1.
+SCHEMA_TOML = """\
 [plate]
 corners = [[-0.1, -0.05], [0.1, 0.05]]
 thickness = 0.006
@@ -144,9 +144,9 @@ def test_specs_are_frozen():
 
 
 # -- TOML ---------------------------------------------------------------------------------
-def test_issue_schema_example_loads(tmp_path):
+def test_schema_example_loads(tmp_path):
     path = tmp_path / "plate.toml"
-    path.write_text(ISSUE_TOML)
+    path.write_text(SCHEMA_TOML)
     spec = load_toml(path)
     assert spec.name == "plate"  # the file's stem
     assert spec.plate.corners == ((-0.1, -0.05), (0.1, 0.05))
@@ -214,25 +214,18 @@ def test_toml_bad_input_names_parameter(data, match):
 
 def test_toml_unknown_key_from_file(tmp_path):
     path = tmp_path / "bad.toml"
-    path.write_text(ISSUE_TOML.replace("thickness = 0.006", "thickness = 0.006\ncolour = 1"))
+    path.write_text(SCHEMA_TOML.replace("thickness = 0.006", "thickness = 0.006\ncolour = 1"))
     with pytest.raises(ValueError, match=r"'colour'.*\[plate\]"):
         load_toml(path)
 
 
 # -- the paper's cases as data --------------------------------------------------------
-def test_paper_cases():
-    """Zones of DESIGN.md section 2."""
-    assert CASES["free"] is None
-    assert CASES["c1"].zone == ((-0.04, 0.04), (-0.05, 0.05))
-    assert CASES["c2"].zone == ((-0.04, 0.04), (-0.02, 0.02))
-    assert CASES["c3"].zone == "all"
-    spec = paper_case("c2")
-    assert (spec.mesh.nx, spec.mesh.ny) == (20, 20)  # the paper's mesh
-    assert (spec.plate.length, spec.plate.width, spec.plate.thickness) == (0.2, 0.1, 0.006)
-    assert [e.normal_stress for e in spec.plate.edges] == [-1.0, -1.0, 0.0, 0.0]
-    assert all(e.support == "simply_supported" and e.inplane == "free" for e in spec.plate.edges)
-    with pytest.raises(ValueError, match="case"):
+def test_paper_case_names():
+    """An unknown case is refused with the list of the known ones; the mesh is settable."""
+    with pytest.raises(ValueError, match=r"case must be one of \['free', 'c1', 'c2', 'c3'\]"):
         paper_case("c4")
+    spec = paper_case("c2", 8, 4)
+    assert (spec.mesh.nx, spec.mesh.ny, spec.obstacle) == (8, 4, CASES["c2"])
 
 
 def test_with_mesh_and_solver_copies():

@@ -29,7 +29,7 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
     dpi = THEME["dpi"]
     line = (round(fh * dpi), round(fw * dpi))
     conv = (round(fh * dpi), round(1.3 * fw * dpi))
-    pngs = {"convergence.png": conv, "free/convergence.png": conv}
+    pngs = {"convergence.png": conv, "free/convergence.png": conv, "sections_A.png": line}
     for mesh in COARSE:
         pngs[f"free/mode_{mesh}.png"] = (h3, w3)
     for case in CASES[1:]:
@@ -62,6 +62,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     for demo in ("demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3"):
         assert f"{demo}.py: ok" in proc.stdout
     assert "lambda/lambda_free" in proc.stdout and "eigen solves" in proc.stdout
+    assert "check free <= c2 <= c1 <= c3 (nested zones): ok" in proc.stdout
     table = (figures / "results.md").read_text().splitlines()
     assert len(table) == 2 + 2 * len(CASES)  # header, rule, paper + refined mesh per case
 
@@ -78,7 +79,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     for case in CASES:
         data = json.loads((figures / case / "results.json").read_text())
         for r in data["results"]:
-            # Lower bound of DESIGN.md section 1: the obstacle never lowers the load.
+            # Interlacing: the obstacle never lowers the load (README, "The problem").
             assert r["critical_load_Pa"] >= r["free_load_Pa"] * (1 - 1e-8)
         for mesh in COARSE:
             assert (vtx / case / mesh / f"{case}_w.bp").exists()
@@ -90,19 +91,16 @@ def test_section_of_free_mode_is_the_navier_shape():
     """Section A of the free 20 x 20 mode against the Navier mode sin(2 pi (x + a/2) / a).
 
     The free mode of the simply supported plate is sin(m pi x'/a) sin(pi y'/b), m = 2
-    (DESIGN.md section 3), so along y = 0 and scaled to max |w| = 1 it is +-sin(2 pi x'/a).
-    The MITC4 mode's nodal values on the paper's mesh match it within 2 % of max |w|.
+    (Navier, Timoshenko & Gere, Theory of Elastic Stability, section 9.2), so along y = 0
+    and scaled to max |w| = 1 it is +-sin(2 pi x'/a). The MITC4 mode's nodal values on the
+    paper's mesh match it within 2 % of max |w|.
     """
-    from unibuckle_fenicsx import paper_case, plotting
+    from unibuckle_fenicsx import fields, paper_case
     from unibuckle_fenicsx.problem import BucklingProblem
 
     spec = paper_case("free", 20, 20)
-    problem = BucklingProblem(spec, MPI.COMM_WORLD)
-    try:
-        problem.solve_free()
-        x, w = plotting.section(problem)
-    finally:
-        problem.destroy()
+    with BucklingProblem(spec, MPI.COMM_WORLD) as problem:
+        x, w = fields.section(problem, problem.solve_free().function)
     a = spec.plate.length
     assert x.shape == (21,) and np.allclose(np.diff(x), a / 20)
     exact = np.sin(2 * np.pi * (x - x[0]) / a)
@@ -111,9 +109,9 @@ def test_section_of_free_mode_is_the_navier_shape():
 
 
 def test_zone_box_of_the_paper_cases():
-    """zone_box returns the zones of DESIGN.md section 2 (and the plate for c3)."""
+    """zone_box returns the paper's zones (section 6), and the plate for "all" (c3)."""
     from unibuckle_fenicsx import paper_case
-    from unibuckle_fenicsx.plotting import zone_box
+    from unibuckle_fenicsx.fields import zone_box
 
     assert zone_box(paper_case("free")) is None
     assert zone_box(paper_case("c1")) == ((-0.04, 0.04), (-0.05, 0.05))

@@ -1,4 +1,4 @@
-"""Distributed runs (issue 7): the mesh distributed by DOLFINx over 2 and 3 ranks.
+"""Distributed runs: the mesh distributed by DOLFINx over 2 and 3 ranks.
 
 Each test launches ``mpiexec -n P`` on a helper under ``tests/mpi/`` and compares with
 the same computation in this (serial) process: free and candidate loads to 1e-8
@@ -20,11 +20,14 @@ import pytest
 from conftest import run_mpi
 
 from unibuckle_fenicsx.cli import main as cli_main
+from unibuckle_fenicsx.materials import navier_load_mindlin
 
 HERE = Path(__file__).resolve().parent
 STEPS = HERE / "mpi" / "pipeline_steps.py"
 CLI = HERE / "mpi" / "pipeline_cli.py"
-#: Relative agreement of loads between partitions (issue 7).
+#: Relative agreement of loads between partitions: the eigen solves converge to a relative
+#: residual of eps_tol = 1e-10, so two partitions' loads differ by about that; 1e-8 leaves
+#: a margin of 100.
 LOAD_RTOL = 1e-8
 #: Mode values at contact nodes (scaled to max|w| = 1): eigenvector accuracy at eps_tol 1e-10.
 VALUE_ATOL = 1e-7
@@ -151,12 +154,17 @@ def _compare_results(ser, par, nprocs):
 
 
 def test_cli_free_plate_two_ranks(tmp_path):
-    """Issue 2: mpiexec -n 2 gives the serial free load (20x10: 12930136.835 Pa)."""
+    """Mpiexec -n 2 gives the serial free load, near the Navier value.
+
+    20x10: the MITC4 error against lambda_RM is 1.4 % there (README, "Verification"),
+    so within 2 %.
+    """
     args = ["--case", "free", "--nx", "20", "--ny", "10"]
     ser = _cli_serial(tmp_path, args)
     par, outdir = _cli_parallel(tmp_path, args, 2)
     _compare_results(ser, par, 2)
-    assert par["critical_load_Pa"] == pytest.approx(12930136.835, rel=1e-9)
+    exact, _ = navier_load_mindlin(1.0e9, 0.3, 0.006, 0.2, 0.1)
+    assert par["critical_load_Pa"] == pytest.approx(exact, rel=2e-2)
     # The VTX metadata names the fields written (mode and free mode).
     meta = (outdir / "vtx" / "free_w.bp" / "md.0").read_bytes()
     assert b"w_free" in meta
@@ -168,7 +176,6 @@ def test_cli_enumerate_distributed(tmp_path):
     i = 3, two mirror-image feasible sets at p = 1 with equal loads: the tie-break must
     not depend on the ranks.
     """
-    pytest.importorskip("unibuckle_fenicsx.algorithms.enumeration")
     args = ["--case", "c2", "--nx", "8", "--ny", "4", "--method", "enumerate"]
     ser = _cli_serial(tmp_path, args)
     par, outdir = _cli_parallel(tmp_path, args, 2)
@@ -185,7 +192,6 @@ def test_cli_active_set_distributed(tmp_path):
 
     Same path (eigensolve count), contact set and load as the serial run.
     """
-    pytest.importorskip("unibuckle_fenicsx.algorithms.active_set")
     args = ["--case", "c1", "--nx", "20", "--ny", "10", "--method", "active-set"]
     ser = _cli_serial(tmp_path, args)
     par, _ = _cli_parallel(tmp_path, args, 2)

@@ -11,6 +11,7 @@ import pytest
 
 from unibuckle_fenicsx import paper_case
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, solve_penalty
+from unibuckle_fenicsx.certify import certify
 from unibuckle_fenicsx.problem import BucklingProblem
 
 #: Eigenvalues are solved to a relative residual of 1e-10 (SolverSpec.eps_tol), so loads
@@ -24,10 +25,10 @@ def c1_small():
 
     The reference is computed independently of the penalty code: the minimum of
     lambda(Z) over the 2^9 = 512 contact sets Z whose reduced first mode is feasible
-    (problem.evaluate), which is the critical load (DESIGN.md section 1, Lemma 5.1).
+    (problem.evaluate), which is the critical load (paper, Lemma 5.1).
     """
     problem = BucklingProblem(paper_case("c1", 8, 4), MPI.COMM_WORLD)
-    free = problem.solve_free().value
+    free = problem.solve_free().load
     i = problem.num_constrained
     assert i == 9
     best = np.inf
@@ -81,7 +82,7 @@ def test_penalty_limit_set_is_the_exact_contact_set(c1_small):
     cand = problem.evaluate(sol.active)
     assert cand.feasible
     assert cand.load == pytest.approx(exact, rel=LOAD_RTOL)
-    assert problem.certify(cand.load, cand.active).kkt
+    assert certify(problem, cand).kkt
 
 
 def test_certificate_rejects_a_penetrating_penalty_mode(c1_small):
@@ -89,7 +90,7 @@ def test_certificate_rejects_a_penetrating_penalty_mode(c1_small):
     problem, _, _ = c1_small
     sol = solve_penalty(problem, 1.0)
     assert sol.details["penalty_max_penetration"] > 1e-4
-    assert not problem.certify(sol.load, sol.active).feasible
+    assert not certify(problem, sol).feasible
 
 
 def test_condition_number_matches_dense_eigenvalues():
@@ -163,24 +164,27 @@ def test_penalty_needs_an_obstacle():
         problem.destroy()
 
 
-def test_cli_penalty_end_to_end(tmp_path, capsys):
-    """`unibuckle solve --method penalty --penalty RHO` writes the penalty's details.
+def test_cli_penalty_end_to_end(tmp_path, capsys, c1_small):
+    """`unibuckle solve --method penalty --penalty RHO`: a valid bracket, no upper bound.
 
-    The load at rho = 1e6 is within 1e-8 of the exhaustive minimum (1/rho law, above).
+    The penalised mode penetrates, so its load is not an upper bound: the JSON gives none,
+    and the lower bound (the free load) lies below the exhaustive minimum of the fixture.
+    The load at rho = 1e6 is within 1e-8 below that minimum (1/rho law, above).
     """
     from unibuckle_fenicsx.cli import main
 
+    _, _, exact = c1_small
     out = tmp_path / "p.json"
     args = ["solve", "--case", "c1", "--nx", "8", "--ny", "4", "--method", "penalty"]
     assert main([*args, "--penalty", "1e6", "--json", str(out)]) == 0
     if MPI.COMM_WORLD.rank == 0:
         data = json.loads(out.read_text())
         assert data["method"] == "penalty"
-        assert data["details"]["penalty_rho"] == 1e6
         assert data["details"]["penalty_status"] == "converged"
         assert data["certificate"]["global_optimum_proven"] is False
-        assert data["lower_bound_Pa"] == pytest.approx(data["free_load_Pa"], rel=LOAD_RTOL)
-        assert data["contact_indices"] == data["details"]["penalty_penetrating_set"]
+        assert data["upper_bound_Pa"] is None
+        assert data["lower_bound_Pa"] <= exact
+        assert 0.0 <= (exact - data["critical_load_Pa"]) / exact < 1e-8
     assert main([*args, "--penalty", "-1"]) == 2
     if MPI.COMM_WORLD.rank == 0:  # errors are printed on rank 0
         assert "penalty" in capsys.readouterr().err

@@ -1,8 +1,11 @@
 """unibuckle_fenicsx: unilateral buckling of thin plates with FEniCSx.
 
-Importing the package does not import PETSc, SLEPc, DOLFINx or pyvista; import
-:mod:`unibuckle_fenicsx.solver` (``solve``) for the computations.
+Importing the package does not import PETSc, SLEPc, DOLFINx or pyvista:
+``unibuckle_fenicsx.solve`` (:func:`unibuckle_fenicsx.analysis.solve`) imports them on
+first use.
 """
+
+from typing import Any
 
 from unibuckle_fenicsx.cases import CASES, paper_case
 from unibuckle_fenicsx.config import (
@@ -30,4 +33,14 @@ __all__ = [
     "__version__",
     "load_toml",
     "paper_case",
+    "solve",
 ]
+
+
+def __getattr__(name: str) -> Any:
+    """Lazy ``solve``: the computations import DOLFINx, PETSc and SLEPc."""
+    if name == "solve":
+        from unibuckle_fenicsx.analysis import solve
+
+        return solve
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

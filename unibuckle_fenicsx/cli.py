@@ -99,10 +99,10 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     petsc4py.init([sys.argv[0], *rest])
 
+    from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.cases import paper_case
     from unibuckle_fenicsx.config import load_toml
-    from unibuckle_fenicsx.results import write_json
-    from unibuckle_fenicsx.solver import solve, write_vtx
+    from unibuckle_fenicsx.results import write_json, write_vtx
 
     comm = MPI.COMM_WORLD
     logging.basicConfig(
@@ -133,18 +133,18 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"unibuckle: error: {err}", file=sys.stderr)
         return 2
     try:
-        result, problem = solve(spec, comm, candidate_parallel=args.candidate_parallel)
+        analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
     except ValueError as err:
         if comm.rank == 0:
             print(f"unibuckle: error: {err}", file=sys.stderr)
         return 2
-    if args.output:
-        write_vtx(problem, result, args.output)
-    problem.destroy()
+    with analysis:
+        if args.output:
+            write_vtx(analysis, args.output)
     if comm.rank == 0:
-        print(result.summary())
+        print(analysis.result.summary())
         if args.json:
-            write_json(result, args.json)
+            write_json(analysis.result, args.json)
     return 0
 
 

@@ -309,7 +309,7 @@ class SolverSpec:
         method: One of :data:`METHODS`; "auto" enumerates (with ``until_proven``) when
             the candidate count 2^i is at most ``max_candidates`` and uses the
             active-set method otherwise.
-        tau: Relative feasibility/contact tolerance (DESIGN.md section 4), in (0, 1e-2].
+        tau: Relative feasibility/contact tolerance (README, "The problem"), in (0, 1e-2].
         eps_tol: SLEPc convergence tolerance, in (0, 1e-4].
         max_candidates: Largest candidate count the enumeration accepts, >= 1.
         complete: Enumerate every subset instead of stopping after the first

@@ -21,7 +21,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.config import ObstacleSpec
 from unibuckle_fenicsx.plate.model import PlateModel
 
-__all__ = ["ContactSetManager", "EmptyZoneError", "check_zone_has_nodes"]
+__all__ = ["ContactSetManager", "EmptyZoneError", "check_zone_has_nodes", "orientation"]
 
 
 class EmptyZoneError(ValueError):
@@ -43,6 +43,45 @@ def check_zone_has_nodes(msh: dolfinx.mesh.Mesh, obstacle: ObstacleSpec, size: f
             f"{msh.geometry.index_map().size_global} mesh nodes lies in it; enlarge the zone "
             "or refine the mesh"
         )
+
+
+def orientation(
+    values: npt.NDArray[np.float64],
+    forces: npt.NDArray[np.float64],
+    active: npt.NDArray[np.int64],
+    tau: float,
+) -> float:
+    r"""Sign (+1 or -1) that puts a reduced mode on the admissible side of the obstacle.
+
+    A mode's sign is free; the admissible side has :math:`s u_k \le \tau` on
+    :math:`I \setminus Z`. If only one side is admissible it is chosen; if neither,
+    the side with the smaller violation (for reporting); if both (the mode vanishes on
+    :math:`I \setminus Z`, e.g. Z = I), the side on which the obstacle pushes
+    (:math:`s r_k \le \tau` on Z), + when both push or both pull.
+
+    Args:
+        values: Mode at the constrained nodes, relative to max |w| (unoriented).
+        forces: :math:`r = Au - \lambda Bu` at the constrained nodes, relative to
+            :math:`\|Au\|_\infty`, of the same (unoriented) mode.
+        active: The contact set Z (node numbers).
+        tau: Feasibility tolerance.
+
+    Returns:
+        The sign to apply to the mode.
+    """
+    free = np.ones(values.size, dtype=bool)
+    free[active] = False
+    up = float(values[free].max()) if free.any() else -np.inf
+    down = float(-values[free].min()) if free.any() else -np.inf
+    if up <= tau and down <= tau:
+        pull = float(forces[~free].max()) if (~free).any() else -np.inf
+        push = float(-forces[~free].min()) if (~free).any() else -np.inf
+        return -1.0 if pull > tau and push < pull else 1.0
+    if up <= tau:
+        return 1.0
+    if down <= tau:
+        return -1.0
+    return 1.0 if up <= down else -1.0
 
 
 @dataclass(frozen=True)

@@ -1,4 +1,4 @@
-r"""Smallest eigenpair of the buckling pencil with a set of DOFs removed (SLEPc).
+r"""PETSc/SLEPc solvers: the buckling pencil's smallest eigenpair, extreme eigenvalues, LDLᵀ.
 
 :math:`A u = \lambda B u`, A SPD (after the edge conditions), B the geometric
 stiffness. Removed DOFs (an active contact set) get zero rows and columns with
@@ -11,15 +11,22 @@ they map to :math:`\lambda = \infty`.
   for the largest real :math:`\mu`, :math:`\lambda = 1/\mu`; the smallest positive
   :math:`\lambda` whatever the negative ones.
 
+Every solver object here has a non-empty options prefix: options are pushed under it
+by :func:`set_options` (the one place that touches the global options database), so
+``-<prefix>eps_view`` and friends work from the command line.
+
 Note:
-    Every object here is collective on the matrices' communicator; :meth:`GEPSolver.destroy`
-    is collective.
+    Every object here is collective on its matrices' communicator; ``destroy()`` is
+    collective.
 """
 
 from __future__ import annotations
 
 import logging
+from collections.abc import Mapping
 from dataclasses import dataclass
+from types import TracebackType
+from typing import Any
 
 import numpy as np
 import numpy.typing as npt
@@ -33,18 +40,114 @@ except ImportError as err:  # pragma: no cover
         "the 'fenics' extra: pip install 'unibuckle_fenicsx[fenics]'"
     ) from err
 
-__all__ = ["EIGEN_OPTIONS", "EigenPair", "EigenSolveError", "GEPSolver"]
+__all__ = [
+    "EIGEN_OPTIONS",
+    "EXTREME_OPTIONS",
+    "LDL_OPTIONS",
+    "EigenPair",
+    "EigenSolveError",
+    "GEPSolver",
+    "Owner",
+    "SymmetricFactorization",
+    "extreme_eigenvalues",
+    "release",
+    "set_options",
+]
 
 logger = logging.getLogger(__name__)
 
-#: Default EPS options (overridable per solver or on the command line under the prefix).
-EIGEN_OPTIONS: dict[str, str | float | int] = {
+Options = Mapping[str, str | float | int | bool]
+
+#: Default EPS options of :class:`GEPSolver` (overridable per solver or on the command
+#: line under the prefix).
+EIGEN_OPTIONS: dict[str, str | float | int | bool] = {
     "eps_type": "krylovschur",
     "st_ksp_type": "preonly",
     "st_pc_type": "lu",
     "st_pc_factor_mat_solver_type": "mumps",
     "eps_max_it": 500,
 }
+
+#: Default options of :func:`extreme_eigenvalues` (the smallest eigenvalue uses them all;
+#: the largest only ``eps_type`` and ``eps_max_it``).
+EXTREME_OPTIONS: dict[str, str | float | int | bool] = {
+    "eps_type": "krylovschur",
+    "eps_max_it": 2000,
+    "st_ksp_type": "preonly",
+    "st_pc_type": "lu",
+    "st_pc_factor_mat_solver_type": "mumps",
+}
+
+#: Default options of :class:`SymmetricFactorization`: a MUMPS LDLᵀ (symmetric
+#: indefinite), with the settings MUMPS needs to report the inertia in parallel
+#: (ICNTL(13) = 1) and the null pivots (ICNTL(24) = 1).
+LDL_OPTIONS: dict[str, str | float | int | bool] = {
+    "ksp_type": "preonly",
+    "pc_type": "cholesky",
+    "pc_factor_mat_solver_type": "mumps",
+    "mat_mumps_icntl_13": 1,
+    "mat_mumps_icntl_24": 1,
+}
+
+
+def release(owner: object, *names: str) -> None:
+    """Destroy the PETSc/SLEPc objects held in ``owner``'s attributes ``names`` (collective).
+
+    Each is set to None afterwards, so a second call (or ``__del__`` after ``destroy``)
+    does nothing.
+    """
+    for name in names:
+        obj = getattr(owner, name, None)
+        if obj is not None:
+            obj.destroy()
+            setattr(owner, name, None)
+
+
+class Owner:
+    """A holder of PETSc/SLEPc objects: ``destroy()`` them, or use it in a ``with`` block."""
+
+    def destroy(self) -> None:
+        """Destroy the objects held (collective)."""
+        raise NotImplementedError
+
+    def __enter__(self) -> Any:
+        return self
+
+    def __exit__(
+        self,
+        exc_type: type[BaseException] | None,
+        exc: BaseException | None,
+        tb: TracebackType | None,
+    ) -> None:
+        self.destroy()
+
+
+def set_options(obj: Any, prefix: str, options: Options) -> None:
+    """Set the options prefix of ``obj`` and default ``options``; then ``setFromOptions``.
+
+    An option already in the database under ``prefix`` (from the command line, e.g.
+    ``-unibuckle_eps_max_it 1000``) wins over the default given here; the defaults are
+    removed again afterwards, so nothing leaks into other objects.
+
+    Args:
+        obj: A PETSc/SLEPc object with ``setOptionsPrefix`` and ``setFromOptions``.
+        prefix: Non-empty options prefix.
+        options: Option names (without prefix) and default values.
+    """
+    if not prefix:
+        raise ValueError("PETSc/SLEPc objects need a non-empty options prefix")
+    obj.setOptionsPrefix(prefix)
+    opts = PETSc.Options()
+    opts.prefixPush(prefix)
+    pushed = [key for key in options if not opts.hasName(key)]
+    for key in pushed:
+        opts.setValue(key, options[key])
+    opts.prefixPop()
+    obj.setFromOptions()
+    opts.prefixPush(prefix)
+    for key in pushed:
+        opts.delValue(key)
+    opts.prefixPop()
 
 
 class EigenSolveError(RuntimeError):
@@ -53,7 +156,7 @@ class EigenSolveError(RuntimeError):
 
 @dataclass(frozen=True)
 class EigenPair:
-    r"""Smallest eigenpair of a (reduced) pencil.
+    r"""Smallest eigenpair of a (reduced) pencil (the vector is written to the caller's).
 
     Attributes:
         value: :math:`\lambda`.
@@ -73,7 +176,7 @@ def _is_zero(B: PETSc.Mat) -> bool:
     return bool(B.norm(PETSc.NormType.INFINITY) == 0.0)  # type: ignore[arg-type]
 
 
-class GEPSolver:
+class GEPSolver(Owner):
     """Smallest eigenpair of :math:`(A, B)` with optional removed DOFs.
 
     Args:
@@ -84,8 +187,11 @@ class GEPSolver:
         tol: EPS tolerance.
         options: Options pushed under ``prefix`` (default :data:`EIGEN_OPTIONS`).
 
+    Attributes:
+        solves: Eigen solves performed so far.
+
     Note:
-        Collective on ``A.comm``.
+        Collective on ``A.comm``. The owner must :meth:`destroy` it.
     """
 
     def __init__(
@@ -96,7 +202,7 @@ class GEPSolver:
         indefinite: bool = False,
         prefix: str = "unibuckle_",
         tol: float = 1e-10,
-        options: dict[str, str | float | int] | None = None,
+        options: Options | None = None,
     ) -> None:
         if not prefix:
             raise ValueError("GEPSolver needs a non-empty options prefix")
@@ -108,7 +214,6 @@ class GEPSolver:
         self.solves = 0
 
         eps = SLEPc.EPS().create(A.comm)
-        eps.setOptionsPrefix(prefix)
         eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
         eps.setDimensions(1)
         eps.setTolerances(tol)
@@ -121,19 +226,17 @@ class GEPSolver:
             eps.setTarget(0.0)
             eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
             st.setType(SLEPc.ST.Type.SINVERT)
-        opts = PETSc.Options()
-        opts.prefixPush(prefix)
-        for key, value in (EIGEN_OPTIONS if options is None else options).items():
-            opts.setValue(key, value)
-        opts.prefixPop()
-        eps.setFromOptions()
-        opts.prefixPush(prefix)
-        for key in EIGEN_OPTIONS if options is None else options:
-            opts.delValue(key)
-        opts.prefixPop()
+        set_options(eps, prefix, EIGEN_OPTIONS if options is None else options)
         self.eps = eps
 
-    def _work(self, removed: npt.NDArray[np.int64]) -> tuple[PETSc.Mat, PETSc.Mat]:
+    def reduced(self, removed: npt.NDArray[np.int64]) -> tuple[PETSc.Mat, PETSc.Mat]:
+        """The pencil with the global rows ``removed`` zeroed (diagonal 1 in A, 0 in B).
+
+        Returns work matrices owned by the solver, valid until the next call.
+
+        Note:
+            Collective; every rank passes its owned rows (possibly none).
+        """
         same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
         if self._Aw is None:
             self._Aw = self.A.duplicate(copy=True)
@@ -163,8 +266,8 @@ class GEPSolver:
 
         Returns:
             The eigenpair, with value ``inf`` when the removed DOFs leave no geometric
-            stiffness (no finite load); raises :class:`EigenSolveError` if SLEPc converged no pair
-            or returned a non-positive or non-finite load.
+            stiffness (no finite load); raises :class:`EigenSolveError` if SLEPc
+            converged no pair or returned a non-positive or non-finite load.
 
         Note:
             Collective.
@@ -172,7 +275,7 @@ class GEPSolver:
         n_removed = self.A.comm.tompi4py().allreduce(0 if removed is None else len(removed))
         if n_removed:
             assert removed is not None
-            A, B = self._work(removed)
+            A, B = self.reduced(removed)
         else:
             A, B = self.A, self.B
         if _is_zero(B):
@@ -211,11 +314,101 @@ class GEPSolver:
 
     def destroy(self) -> None:
         """Destroy the EPS and work matrices (collective)."""
-        for name in ("eps", "_Aw", "_Bw"):
-            obj = getattr(self, name, None)
-            if obj is not None:
-                obj.destroy()
-                setattr(self, name, None)
+        release(self, "eps", "_Aw", "_Bw")
+
+    def __del__(self) -> None:
+        self.destroy()
+
+
+def extreme_eigenvalues(
+    mat: PETSc.Mat, prefix: str, options: Options | None = None, tol: float = 1e-8
+) -> tuple[float, float]:
+    """Smallest and largest eigenvalue of the symmetric matrix ``mat`` (SLEPc, HEP).
+
+    The largest by plain Krylov-Schur, the smallest by shift-and-invert at 0 (a MUMPS
+    LU of ``mat``, which must be nonsingular); both under the options prefix ``prefix``.
+
+    Args:
+        mat: Symmetric matrix (not modified).
+        prefix: Options prefix of both solves.
+        options: Options pushed under ``prefix`` (default :data:`EXTREME_OPTIONS`).
+        tol: EPS tolerance.
+
+    Returns:
+        (smallest, largest).
+
+    Raises:
+        EigenSolveError: One of the two does not converge.
+
+    Note:
+        Collective.
+    """
+    options = EXTREME_OPTIONS if options is None else options
+    values = []
+    for which in ("smallest", "largest"):
+        eps = SLEPc.EPS().create(mat.comm)
+        try:
+            eps.setOperators(mat)
+            eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
+            eps.setDimensions(1)
+            eps.setTolerances(tol)
+            if which == "largest":
+                eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)
+                used = {k: v for k, v in options.items() if k.startswith("eps_")}
+            else:
+                eps.setTarget(0.0)
+                eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
+                eps.getST().setType(SLEPc.ST.Type.SINVERT)
+                used = dict(options)
+            set_options(eps, prefix, used)
+            eps.solve()
+            if eps.getConverged() < 1:
+                raise EigenSolveError(f"SLEPc ({prefix}): the {which} eigenvalue did not converge")
+            values.append(float(eps.getEigenvalue(0).real))
+        finally:
+            eps.destroy()
+    return values[0], values[1]
+
+
+class SymmetricFactorization(Owner):
+    r"""Sparse :math:`LDL^T` factorisation of a symmetric (indefinite) matrix, with inertia.
+
+    A KSP ``preonly`` + PC ``cholesky`` with MUMPS (:data:`LDL_OPTIONS`); the matrix
+    must not carry PETSc's SPD flag (MUMPS would then assume a positive definite
+    matrix). Used by the global-optimality certificate: the inertia of
+    :math:`A - \lambda B` counts the pencil's eigenvalues below :math:`\lambda`.
+
+    Args:
+        mat: Symmetric matrix (referenced, not copied; keep it alive).
+        prefix: Options prefix, e.g. ``unibuckle_certify_`` (so
+            ``-unibuckle_certify_ksp_view`` works).
+        options: Options pushed under ``prefix`` (default :data:`LDL_OPTIONS`).
+
+    Note:
+        Collective. The owner must :meth:`destroy` it.
+    """
+
+    def __init__(self, mat: PETSc.Mat, prefix: str, options: Options | None = None) -> None:
+        mat.setOption(PETSc.Mat.Option.SPD, False)  # type: ignore[arg-type]
+        mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
+        self.ksp = PETSc.KSP().create(mat.comm)
+        self.ksp.setOperators(mat)
+        set_options(self.ksp, prefix, LDL_OPTIONS if options is None else options)
+        self.ksp.setUp()
+        self.prefix = prefix
+
+    def inertia(self) -> tuple[int, int, int]:
+        """(negative, zero, positive) eigenvalue counts of the factorised matrix."""
+        nneg, nzero, npos = self.ksp.getPC().getFactorMatrix().getInertia()
+        return int(nneg), int(nzero), int(npos)
+
+    def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
+        """Solve M x = b for x (collective)."""
+        self.ksp.solve(b, x)
+
+    def destroy(self) -> None:
+        """Destroy the KSP and its factor (collective)."""
+        release(self, "ksp")
 
     def __del__(self) -> None:
         self.destroy()

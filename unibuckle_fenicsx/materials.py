@@ -83,7 +83,7 @@ def navier_load_mindlin(
     r"""Reissner-Mindlin critical stress, hard simple support (Navier series, n = 1).
 
     :math:`\sigma_m = \sigma_K(m) / (1 + \pi^2 D (m^2/a^2 + 1/b^2)/(\kappa G t))`,
-    minimised over m (DESIGN.md section 3).
+    minimised over m (hard simple support: w = 0 and tangential rotation = 0).
 
     Returns:
         The critical stress (Pa) and the minimising m.

@@ -5,9 +5,11 @@ pyvista and matplotlib are imported inside the functions that need them (install
 wrote. 3-D figures render off screen; without a display, VTK's EGL window is selected
 so that no X server is needed (set ``VTK_DEFAULT_OPENGL_WINDOW`` to override).
 
-Data helpers (:func:`nodal_deflection`, :func:`section`) are collective on the mesh
-communicator and return the same arrays on every rank; the writers draw on rank 0 only
-(3-D figures need a serial problem, ``comm.size == 1``).
+This module only draws. The data (nodal deflections, sections, the zone's box) come from
+:mod:`unibuckle_fenicsx.fields`, whose functions are collective; the writers here are
+called on one rank (3-D figures need a serial problem, ``comm.size == 1``). Deflections
+within the feasibility tolerance of zero are drawn as zero (``tau``), so that rounding on a
+flat contact region does not read as penetration.
 
 Sign convention: the obstacle lies just above the plate, the admissible deflection in
 the zone is :math:`w \le 0`, so figures draw the obstacle at :math:`w = 0^+`.
@@ -23,23 +25,14 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.fields import problem_zone
+
 if TYPE_CHECKING:  # pragma: no cover
     import dolfinx
 
-    from unibuckle_fenicsx.config import ProblemSpec
     from unibuckle_fenicsx.problem import BucklingProblem
 
-__all__ = [
-    "THEME",
-    "mirror_to_match",
-    "nodal_deflection",
-    "plot_contact_set",
-    "plot_convergence",
-    "plot_mode_3d",
-    "plot_section",
-    "section",
-    "zone_box",
-]
+__all__ = ["THEME", "plot_contact_set", "plot_convergence", "plot_mode_3d", "plot_section"]
 
 #: The one theme of every figure (overridable module constant).
 THEME: dict[str, Any] = {
@@ -103,138 +96,24 @@ def _prepare(path: str | Path) -> Path:
     return path
 
 
-# -- data ------------------------------------------------------------------------------
-def zone_box(
-    spec: ProblemSpec, constrained: npt.NDArray[np.float64] | None = None
-) -> tuple[tuple[float, float], tuple[float, float]] | None:
-    """Obstacle zone of ``spec`` as ``((xmin, xmax), (ymin, ymax))``; ``None`` without one.
-
-    Args:
-        spec: The problem.
-        constrained: Coordinates of the constrained nodes (needed for a predicate
-            zone, whose bounding box is returned).
-    """
-    obstacle = spec.obstacle
-    if obstacle is None:
-        return None
-    if isinstance(obstacle.zone, str):
-        (x0, y0), (x1, y1) = spec.plate.corners
-        return (x0, x1), (y0, y1)
-    if callable(obstacle.zone):
-        if constrained is None or len(constrained) == 0:
-            return None
-        lo, hi = constrained.min(axis=0), constrained.max(axis=0)
-        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
-    (x0, x1), (y0, y1) = obstacle.zone
-    return (x0, x1), (y0, y1)
-
-
-def _problem_zone(
-    problem: BucklingProblem,
-) -> tuple[tuple[float, float], tuple[float, float]] | None:
-    coords = problem.contact.coordinates if problem.contact is not None else None
-    return zone_box(problem.spec, coords)
-
-
-def nodal_deflection(
-    problem: BucklingProblem, u: dolfinx.fem.Function | None = None
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """Node coordinates (n, 2) and deflection w (n,) of ``u`` (default ``problem.u``).
-
-    Gathered over the mesh communicator (owned w-DOFs of every rank), same on all ranks.
-
-    Note:
-        Collective.
-    """
-    w, _ = problem.model.split(problem.u if u is None else u)
-    Vw = w.function_space
-    n_owned = Vw.dofmap.index_map.size_local
-    xy = Vw.tabulate_dof_coordinates()[:n_owned, :2]
-    values = w.x.array[:n_owned].real
-    comm = problem.comm
-    all_xy = np.vstack(comm.allgather(xy))
-    all_w = np.concatenate(comm.allgather(values))
-    return all_xy, all_w
-
-
-def section(
-    problem: BucklingProblem,
-    u: dolfinx.fem.Function | None = None,
-    y: float = 0.0,
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-    """Section of the deflection along the line y = ``y`` ("section A" for y = 0).
-
-    Returns the nodal values when the line is a row of mesh nodes, and the values at
-    the nodes' x positions interpolated linearly between the two nearest rows otherwise
-    (exact for the bilinear element).
-
-    Returns:
-        x (sorted) and w at those points.
-
-    Note:
-        Collective.
-    """
-    xy, w = nodal_deflection(problem, u)
-    scale = max(problem.spec.plate.length, problem.spec.plate.width)
-    keys = np.round(xy / (1e-9 * scale)).astype(np.int64)
-    _, first = np.unique(keys, axis=0, return_index=True)
-    xy, w = xy[first], w[first]  # drop duplicates (none in serial)
-    rows = np.unique(np.round(xy[:, 1] / (1e-9 * scale))) * 1e-9 * scale
-    if y < rows[0] - 1e-9 * scale or y > rows[-1] + 1e-9 * scale:
-        raise ValueError(f"section: y = {y} lies outside the plate [{rows[0]}, {rows[-1]}]")
-    below = rows[rows <= y + 1e-9 * scale].max()
-    above = rows[rows >= y - 1e-9 * scale].min()
-
-    def row(yr: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-        mask = np.abs(xy[:, 1] - yr) <= 1e-9 * scale
-        order = np.argsort(xy[mask, 0])
-        return xy[mask, 0][order], w[mask][order]
-
-    x0, w0 = row(below)
-    if above - below <= 1e-9 * scale:
-        return x0, w0
-    x1, w1 = row(above)
-    s = (y - below) / (above - below)
-    return x0, (1 - s) * w0 + s * np.interp(x0, x1, w1)
-
-
-def mirror_to_match(
-    x_ref: npt.ArrayLike,
-    w_ref: npt.ArrayLike,
-    x: npt.ArrayLike,
-    w: npt.ArrayLike,
-    center: float = 0.0,
-) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], bool]:
-    """Reflect a section about x = ``center`` if its mirror image matches ``w_ref`` better.
-
-    The paper's plate and zones are symmetric about x = 0, so a mode and its mirror
-    image have the same load; solvers may return either. Drawing twins on the same side
-    makes sections comparable.
-
-    Returns:
-        The (possibly reflected, re-sorted) abscissae and values, and whether it was
-        reflected.
-    """
-    x_ref, w_ref = np.asarray(x_ref, dtype=float), np.asarray(w_ref, dtype=float)
-    x, w = np.asarray(x, dtype=float), np.asarray(w, dtype=float)
-    direct = np.dot(np.interp(x_ref, x, w), w_ref)
-    xm = 2 * center - x[::-1]
-    wm = w[::-1]
-    mirrored = np.dot(np.interp(x_ref, xm, wm), w_ref)
-    if mirrored > direct:
-        return xm, wm, True
-    return x, w, False
+def _normalised(w: npt.NDArray[np.float64], tau: float) -> npt.NDArray[np.float64]:
+    """Deflection divided by max |w|, values within ``tau`` of zero set to zero."""
+    wmax = float(np.abs(w).max()) or 1.0
+    out = np.asarray(w, dtype=float) / wmax
+    out[np.abs(out) <= tau] = 0.0
+    return out
 
 
 # -- 3-D mode ----------------------------------------------------------------------------
 def plot_mode_3d(
     problem: BucklingProblem,
+    mode: dolfinx.fem.Function,
     path: str | Path,
     *,
     contact_coordinates: npt.ArrayLike | None = None,
-    u: dolfinx.fem.Function | None = None,
     title: str = "",
     show_zone: bool = True,
+    tau: float = 0.0,
 ) -> Path:
     """Warped 3-D surface of the mode, with the obstacle zone and the contact nodes.
 
@@ -243,11 +122,12 @@ def plot_mode_3d(
 
     Args:
         problem: The solved problem (serial).
+        mode: The mode (w, theta) to draw.
         path: PNG to write.
         contact_coordinates: (|Z|, 2) coordinates of the contact set.
-        u: Mode to draw (default ``problem.u``), scaled to max|w| = 1 by the caller.
         title: Text at the top left.
         show_zone: Draw the obstacle zone (if the problem has one).
+        tau: Relative deflections below this are drawn as zero.
 
     Returns:
         The written path.
@@ -258,10 +138,9 @@ def plot_mode_3d(
     import dolfinx.plot
 
     path = _prepare(path)
-    w, _ = problem.model.split(problem.u if u is None else u)
-    wmax = float(np.abs(w.x.array).max()) or 1.0
+    w, _ = problem.model.split(mode)
     grid = pv.UnstructuredGrid(*dolfinx.plot.vtk_mesh(w.function_space))  # type: ignore[arg-type]
-    grid.point_data["w / max|w|"] = w.x.array.real / wmax
+    grid.point_data["w / max|w|"] = _normalised(w.x.array.real, tau)
     grid.set_active_scalars("w / max|w|")
     warp = THEME["warp"]
     warped = grid.warp_by_scalar("w / max|w|", factor=warp)
@@ -300,7 +179,7 @@ def plot_mode_3d(
     (px0, py0), (px1, py1) = problem.spec.plate.corners
     plate_outline = pv.Rectangle([[px0, py0, 0.0], [px1, py0, 0.0], [px1, py1, 0.0]])
     plotter.add_mesh(plate_outline.extract_feature_edges(), color="gray", line_width=1.5)
-    box = _problem_zone(problem) if show_zone else None
+    box = problem_zone(problem) if show_zone else None
     lift = 0.02 * warp
     legend: list[tuple[str, str]] = []
     if box is not None:
@@ -418,42 +297,46 @@ def plot_section(
 
 # -- contact set -----------------------------------------------------------------------
 def plot_contact_set(
-    problem: BucklingProblem,
     path: str | Path,
-    contact_coordinates: npt.ArrayLike,
+    xy: npt.ArrayLike,
+    w: npt.ArrayLike,
     *,
+    corners: tuple[tuple[float, float], tuple[float, float]],
+    zone: tuple[tuple[float, float], tuple[float, float]] | None,
+    constrained: npt.ArrayLike,
+    contact_coordinates: npt.ArrayLike,
     title: str = "",
+    tau: float = 0.0,
 ) -> Path:
     """Top view: mode contours, constrained nodes (I) and the contact set (Z).
 
     Args:
-        problem: The solved problem, mode in ``problem.u``.
-        path: PNG to write (rank 0).
+        path: PNG to write.
+        xy: (n, 2) node coordinates (:func:`~unibuckle_fenicsx.fields.nodal_deflection`).
+        w: (n,) deflection of the mode at those nodes.
+        corners: The plate's corners.
+        zone: The obstacle zone's box (:func:`~unibuckle_fenicsx.fields.zone_box`).
+        constrained: (i, 2) coordinates of the constrained nodes I.
         contact_coordinates: (|Z|, 2) coordinates of the contact set.
         title: Axes title.
+        tau: Relative deflections below this are drawn as zero.
 
     Returns:
-        The path (written on rank 0).
-
-    Note:
-        Collective (gathers the mode).
+        The written path.
     """
-    xy, w = nodal_deflection(problem)
-    path = Path(path)
-    if problem.comm.rank != 0:
-        return path
     plt = _pyplot()
     path = _prepare(path)
-    wmax = float(np.abs(w).max()) or 1.0
-    (px0, py0), (px1, py1) = problem.spec.plate.corners
+    xy = np.asarray(xy, dtype=float)
+    (px0, py0), (px1, py1) = corners
     fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
-    levels = np.linspace(-1.0, 1.0, 21)
-    cs = ax.tricontourf(xy[:, 0], xy[:, 1], w / wmax, levels=levels, cmap=THEME["cmap"])
+    levels = np.linspace(-1.05, 1.05, 22)  # bands centred on 0, ±0.1, ...: 0 is neutral
+    cs = ax.tricontourf(
+        xy[:, 0], xy[:, 1], _normalised(np.asarray(w), tau), levels=levels, cmap=THEME["cmap"]
+    )
     cbar = fig.colorbar(cs, ax=ax, shrink=0.8, ticks=np.linspace(-1, 1, 5))
     cbar.set_label("w / max|w|")
-    box = _problem_zone(problem)
-    if box is not None:
-        (x0, x1), (y0, y1) = box
+    if zone is not None:
+        (x0, x1), (y0, y1) = zone
         ax.add_patch(
             plt.Rectangle(
                 (x0, y0),
@@ -466,8 +349,8 @@ def plot_contact_set(
                 label="obstacle zone",
             )
         )
-    if problem.contact is not None:
-        cxy = problem.contact.coordinates
+    cxy = np.asarray(constrained, dtype=float).reshape(-1, 2)
+    if len(cxy):
         dense = len(cxy) > 1500
         ax.plot(
             cxy[:, 0],

@@ -1,16 +1,24 @@
-"""A set-up buckling problem: mesh, prestress, pencil, eigen solver and contact manager.
+r"""A set-up buckling problem: mesh, prestress, pencil, eigen solver and contact manager.
 
 :class:`BucklingProblem` is what the algorithms work on. Its primitive is
-:meth:`BucklingProblem.evaluate`: the smallest eigenpair with a candidate contact set
-removed, and whether that mode respects the obstacle. :meth:`BucklingProblem.certify`
-checks a result against the optimality conditions of DESIGN.md section 1.
+:meth:`BucklingProblem.evaluate`: the smallest eigenpair of the pencil with a candidate
+contact set Z removed, returned as a :class:`Candidate` that owns its mode, oriented
+towards the admissible side of the obstacle, with its values and contact forces at the
+constrained nodes. Nothing here keeps a "current" mode: whoever holds a candidate holds
+its mode.
+
+The discrete critical state (README, "The problem"): the smallest :math:`\lambda` and
+:math:`u \ne 0` with :math:`u_k \le 0` on the constrained nodes I, :math:`r = Au -
+\lambda Bu = 0` off the contact set Z, :math:`u_k < 0` on :math:`I \setminus Z`,
+:math:`r_k \le 0` on Z, and :math:`\lambda` the smallest eigenvalue of the pencil with Z
+removed (paper, Lemma 5.1).
 """
 
 from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -21,90 +29,78 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.contact import ContactSetManager, check_zone_has_nodes
-from unibuckle_fenicsx.eigen import EigenPair, GEPSolver
+from unibuckle_fenicsx.contact import ContactSetManager, check_zone_has_nodes, orientation
+from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, EigenPair, GEPSolver, Owner, release
 from unibuckle_fenicsx.materials import bending_stiffness
 from unibuckle_fenicsx.mesh import create_plate_mesh
 from unibuckle_fenicsx.plate.model import PlateModel
 from unibuckle_fenicsx.prestress import solve_prestress
 
-__all__ = ["BucklingProblem", "Candidate", "Certificate"]
+__all__ = ["BucklingProblem", "Candidate", "Mode"]
 
 logger = logging.getLogger(__name__)
 
 
 @dataclass(frozen=True)
-class Candidate:
-    r"""Smallest eigenpair of the pencil with the contact set ``active`` removed.
+class Mode:
+    r"""The smallest eigenpair of the pencil without obstacle (the free plate).
 
     Attributes:
-        active: Sorted node numbers of the removed (contact) set Z.
+        load: :math:`\lambda_{free}`.
+        function: The mode (w, theta), scaled to max |w| = 1.
+        eigen: SLEPc's report.
+    """
+
+    load: float
+    function: dolfinx.fem.Function
+    eigen: EigenPair
+
+
+@dataclass(frozen=True)
+class Candidate:
+    r"""The smallest eigenpair of the pencil with the contact set ``active`` removed.
+
+    Built by :meth:`BucklingProblem.evaluate` (or :meth:`BucklingProblem.candidate` for
+    a mode from elsewhere, e.g. the penalty method). The candidate owns its mode.
+
+    Attributes:
+        active: Sorted node numbers of the contact set Z.
         load: :math:`\lambda(Z)` (``inf`` when no geometric stiffness is left).
-        values: Mode at the constrained nodes, oriented (sign) for feasibility when
-            possible, scaled by the mode's max |w| over the whole plate.
-        feasible: The oriented mode satisfies w <= tau max|w| on I \ Z.
-        sign: Orientation applied to the raw eigenvector (+1 or -1).
-        pair: The raw SLEPc result.
+        mode: The mode (w, theta), oriented (see
+            :func:`~unibuckle_fenicsx.contact.orientation`) and scaled to max |w| = 1.
+        values: The mode at the constrained nodes (max |w| = 1 over the plate).
+        forces: :math:`r = Au - \lambda Bu` at the constrained nodes, relative to
+            :math:`\|Au\|_\infty` (positive: the node pulls the obstacle).
+        margin: Largest value on :math:`I \setminus Z` (``-inf`` if Z = I); negative
+            when the mode lies strictly below the obstacle there.
+        feasible: :math:`u_k \le \tau` on every constrained node.
+        max_force: Largest force on Z (``-inf`` if Z is empty).
+        tau: The tolerance used.
+        eigen: SLEPc's report (None for a mode not computed by an eigen solve).
     """
 
     active: npt.NDArray[np.int64]
     load: float
+    mode: dolfinx.fem.Function
     values: npt.NDArray[np.float64]
+    forces: npt.NDArray[np.float64]
+    margin: float
     feasible: bool
-    sign: float
-    pair: EigenPair
+    max_force: float
+    tau: float
+    eigen: EigenPair | None = None
 
     @property
-    def violation(self) -> float:
-        r"""Largest oriented value on I \ Z (relative to max|w|); <= tau when feasible."""
-        free = np.ones(self.values.size, dtype=bool)
-        free[self.active] = False
-        return float(self.values[free].max()) if free.any() else -np.inf
+    def kkt(self) -> bool:
+        r"""Feasible and the obstacle only pushes: :math:`r_k \le \tau` on Z."""
+        return self.feasible and self.max_force <= self.tau
+
+    def key(self) -> bytes:
+        """Hashable identity of the contact set."""
+        return self.active.tobytes()
 
 
-@dataclass(frozen=True)
-class Certificate:
-    r"""Optimality conditions of DESIGN.md section 1 for a mode u and load lambda.
-
-    Attributes:
-        feasible: u_k <= tau max|w| on every constrained node.
-        feasibility_margin: max over I \ Z of u_k / max|w| (negative: strictly inside).
-        max_contact_force: max over Z of r_k / ||A u||_inf, r = A u - lambda B u; must be
-            <= tau (the obstacle only pushes); ``-inf`` when Z is empty.
-        relative_residual: ||r off Z||_2 / ||A u||_2.
-        tolerance: tau.
-        kkt: All three conditions hold within tau (and the residual within sqrt(tau)).
-        smallest_of_reduced: lambda is the smallest eigenvalue of the pencil with Z
-            removed (true by construction for loads from a target-0 shift-invert solve).
-        global_optimum_proven: The algorithm proved no admissible mode has a lower load.
-    """
-
-    feasible: bool
-    feasibility_margin: float
-    max_contact_force: float
-    relative_residual: float
-    tolerance: float
-    kkt: bool
-    smallest_of_reduced: bool
-    global_optimum_proven: bool = False
-    notes: tuple[str, ...] = field(default_factory=tuple)
-
-    def as_dict(self) -> dict[str, object]:
-        """JSON-ready mapping."""
-        return {
-            "feasible": self.feasible,
-            "feasibility_margin": self.feasibility_margin,
-            "max_contact_force": self.max_contact_force,
-            "relative_residual": self.relative_residual,
-            "tolerance": self.tolerance,
-            "kkt": self.kkt,
-            "smallest_of_reduced": self.smallest_of_reduced,
-            "global_optimum_proven": self.global_optimum_proven,
-            "notes": list(self.notes),
-        }
-
-
-class BucklingProblem:
+class BucklingProblem(Owner):
     """Everything an algorithm needs, set up once.
 
     Args:
@@ -118,8 +114,15 @@ class BucklingProblem:
             tolerances and the buckling coefficient's width).
         facet_tags: Edge markers of ``mesh``, matched by :class:`EdgeSpec` ``tag``.
 
+    Attributes:
+        eigensolver: The :class:`~unibuckle_fenicsx.eigen.GEPSolver` of the pencil.
+        contact: The :class:`~unibuckle_fenicsx.contact.ContactSetManager` (None
+            without obstacle).
+        free: The free mode, once :meth:`solve_free` has run.
+
     Note:
-        Construction and :meth:`destroy` are collective on ``comm``.
+        Construction and :meth:`destroy` are collective on ``comm``; the problem is a
+        context manager that destroys itself on exit.
     """
 
     def __init__(
@@ -162,23 +165,17 @@ class BucklingProblem:
         )
         t2 = time.perf_counter()
         self.timings["assembly_s"] = t2 - t1
-        options = None
-        if eps_options:
-            from unibuckle_fenicsx.eigen import EIGEN_OPTIONS
-
-            options = {**EIGEN_OPTIONS, **eps_options}
-        self.solver = GEPSolver(
+        self.eigensolver = GEPSolver(
             self.model.A,
             self.model.B,
             indefinite=self.prestress.indefinite,
             tol=spec.solver.eps_tol,
-            options=options,
+            options={**EIGEN_OPTIONS, **(eps_options or {})},
         )
         self.contact = (
             ContactSetManager(self.model, spec.obstacle) if spec.obstacle is not None else None
         )
-        self.u = dolfinx.fem.Function(self.model.W, name="mode")
-        self.free_mode: dolfinx.fem.Function | None = None
+        self.free: Mode | None = None
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
         self.tau = spec.solver.tau
@@ -186,81 +183,114 @@ class BucklingProblem:
         self._w_owned = self.model.w_dofs[:n_owned_w]
         self.timings["setup_s"] = time.perf_counter() - t0
 
-    # -- primitive -----------------------------------------------------------------
+    # -- primitives ----------------------------------------------------------------
     @property
     def num_constrained(self) -> int:
         """i, the number of constrained nodes (0 without obstacle)."""
         return 0 if self.contact is None else self.contact.size
 
-    def max_abs_w(self, u: PETSc.Vec | None = None) -> float:
-        """Max |w| over the plate of the W-vector ``u`` (default: the current mode)."""
-        arr = (self.u.x.petsc_vec if u is None else u).array_r
+    def new_mode(self, name: str = "mode") -> dolfinx.fem.Function:
+        """A zero function on the (w, theta) space."""
+        return dolfinx.fem.Function(self.model.W, name=name)
+
+    def max_abs_w(self, u: PETSc.Vec) -> float:
+        """Max |w| over the plate of the W-vector ``u`` (collective)."""
+        arr = u.array_r
         local = float(np.abs(arr[self._w_owned]).max()) if self._w_owned.size else 0.0
         return float(self.comm.allreduce(local, op=MPI.MAX))
 
-    def solve_free(self) -> EigenPair:
-        """Smallest eigenpair without obstacle.
+    def solve_free(self) -> Mode:
+        """Smallest eigenpair without obstacle (computed once, then :attr:`free`).
 
-        The mode, scaled to max |w| = 1, is left in :attr:`u` and copied to
-        :attr:`free_mode`.
+        Note:
+            Collective.
         """
-        pair = self.solver.solve(out=self.u.x.petsc_vec)
-        self.u.x.petsc_vec.scale(1.0 / self.max_abs_w())
-        self.u.x.scatter_forward()
-        self.free_mode = self.u.copy()
-        self.free_mode.name = "free_mode"
-        return pair
+        if self.free is None:
+            u = self.new_mode("free_mode")
+            pair = self.eigensolver.solve(out=u.x.petsc_vec)
+            u.x.petsc_vec.scale(1.0 / self.max_abs_w(u.x.petsc_vec))
+            u.x.scatter_forward()
+            self.free = Mode(pair.value, u, pair)
+        return self.free
 
     def evaluate(
         self,
         active: npt.NDArray[np.int64],
         initial: PETSc.Vec | None = None,
     ) -> Candidate:
-        """Smallest eigenpair with the nodes ``active`` removed; mode left in :attr:`u`.
+        """Smallest eigenpair with the nodes ``active`` removed, as a :class:`Candidate`.
 
-        The mode is oriented (its sign is free) so that it lies on the side away from
-        the obstacle where possible, and scaled to max |w| = 1.
+        Args:
+            active: Contact set Z (node numbers, any order).
+            initial: Optional start vector of the eigen solve (e.g. a previous mode).
 
         Note:
             Collective; ``active`` must be the same on every rank.
         """
         assert self.contact is not None, "evaluate() needs an obstacle"
         active = np.unique(np.asarray(active, dtype=np.int64))
-        vec = self.u.x.petsc_vec
-        pair = self.solver.solve(self.contact.removed_rows(active), out=vec, initial=initial)
-        if not np.isfinite(pair.value):
-            values = np.zeros(self.contact.size)
-            return Candidate(active, pair.value, values, False, 1.0, pair)
+        u = self.new_mode()
+        pair = self.eigensolver.solve(
+            self.contact.removed_rows(active), out=u.x.petsc_vec, initial=initial
+        )
+        return self.candidate(u, pair.value, active, eigen=pair)
+
+    def candidate(
+        self,
+        u: dolfinx.fem.Function,
+        load: float,
+        active: npt.NDArray[np.int64],
+        *,
+        eigen: EigenPair | None = None,
+        sign: float | None = None,
+    ) -> Candidate:
+        r"""Make ``u`` a :class:`Candidate`: orient, scale, values and forces at I.
+
+        The one place where a mode's orientation, feasibility and contact forces are
+        computed. ``u`` is modified in place (scaled to max |w| = 1, oriented) and
+        becomes the candidate's mode.
+
+        Args:
+            u: A mode (the candidate takes ownership).
+            load: Its load (an eigenvalue, or a Rayleigh quotient).
+            active: Sorted contact set Z claimed for it.
+            eigen: SLEPc's report, if ``u`` is an eigenvector.
+            sign: Orientation to apply instead of
+                :func:`~unibuckle_fenicsx.contact.orientation`'s.
+
+        Note:
+            Collective.
+        """
+        assert self.contact is not None
+        n = self.contact.size
+        vec = u.x.petsc_vec
+        if not np.isfinite(load):
+            zeros = np.zeros(n)
+            return Candidate(active, load, u, zeros, zeros, np.inf, False, np.inf, self.tau, eigen)
         scale = self.max_abs_w(vec)
         values = self.contact.values(vec) / scale
-        free = np.ones(values.size, dtype=bool)
-        free[active] = False
-        sign = 1.0
-        feasible = True
-        if free.any():
-            if values[free].max() <= self.tau:
-                sign = 1.0
-            elif -values[free].min() <= self.tau:
-                sign = -1.0
-            else:
-                feasible = False
-                # Orient towards the smaller violation, for reporting.
-                sign = 1.0 if values[free].max() <= -values[free].min() else -1.0
+        r, au_inf, _ = self.residual(load, vec)
+        forces = self.contact.values(r) / au_inf
+        if sign is None:
+            sign = orientation(values, forces, active, self.tau)
         vec.scale(sign / scale)
-        self.u.x.scatter_forward()
-        return Candidate(active, pair.value, sign * values, feasible, sign, pair)
+        u.x.scatter_forward()
+        values, forces = sign * values, sign * forces
+        free = np.ones(n, dtype=bool)
+        free[active] = False
+        margin = float(values[free].max()) if free.any() else -np.inf
+        max_force = float(forces[active].max()) if active.size else -np.inf
+        feasible = bool(values.max() <= self.tau)
+        return Candidate(
+            active, float(load), u, values, forces, margin, feasible, max_force, self.tau, eigen
+        )
 
-    # -- certificate ----------------------------------------------------------------
-    def residual(
-        self,
-        load: float,
-        u: PETSc.Vec | None = None,
-    ) -> tuple[PETSc.Vec, float, float]:
+    def residual(self, load: float, u: PETSc.Vec) -> tuple[PETSc.Vec, float, float]:
         r"""Residual :math:`r = A u - \lambda B u` with the edge-constrained pencil.
 
         Args:
             load: :math:`\lambda`.
-            u: W-vector (default: the current mode :attr:`u`).
+            u: W-vector.
 
         Returns:
             r in a work vector owned by the problem (valid until the next call), and
@@ -269,62 +299,15 @@ class BucklingProblem:
         Note:
             Collective.
         """
-        vec = self.u.x.petsc_vec if u is None else u
         if self._r is None:
-            self._r, self._Bu = vec.duplicate(), vec.duplicate()
+            self._r, self._Bu = u.duplicate(), u.duplicate()
         assert self._Bu is not None
-        self.model.A.mult(vec, self._r)
+        self.model.A.mult(u, self._r)
         au_inf = self._r.norm(PETSc.NormType.INFINITY)  # type: ignore[arg-type]
         au_2 = self._r.norm()
-        self.model.B.mult(vec, self._Bu)
+        self.model.B.mult(u, self._Bu)
         self._r.axpy(-load, self._Bu)
         return self._r, float(au_inf), float(au_2)  # type: ignore[arg-type]
-
-    def certify(
-        self,
-        load: float,
-        active: npt.NDArray[np.int64],
-        u: PETSc.Vec | None = None,
-        *,
-        smallest_of_reduced: bool = True,
-        global_optimum_proven: bool = False,
-        notes: tuple[str, ...] = (),
-    ) -> Certificate:
-        """Check (load, u, Z = active) against DESIGN.md section 1.
-
-        Note:
-            Collective.
-        """
-        assert self.contact is not None
-        vec = self.u.x.petsc_vec if u is None else u
-        r, au_inf, au_2 = self.residual(load, vec)
-        wmax = self.max_abs_w(vec)
-        u_I = self.contact.values(vec) / wmax
-        r_I = self.contact.values(r)
-        # Residual off Z: zero the rows of Z.
-        rows = self.contact.removed_rows(active)
-        r.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))  # type: ignore[arg-type]
-        r.assemble()
-        residual = float(r.norm()) / au_2  # type: ignore[arg-type]
-        free = np.ones(u_I.size, dtype=bool)
-        free[active] = False
-        margin = float(u_I[free].max()) if free.any() else -np.inf
-        force = float(r_I[active].max() / au_inf) if len(active) else -np.inf
-        # Contact means u_k = 0 on Z: a mode that still penetrates there (penalty) fails.
-        on_z = float(u_I[active].max()) if len(active) else -np.inf
-        feasible = margin <= self.tau and on_z <= self.tau
-        kkt = feasible and force <= self.tau and residual <= np.sqrt(self.tau)
-        return Certificate(
-            feasible=bool(feasible),
-            feasibility_margin=margin,
-            max_contact_force=force,
-            relative_residual=float(residual),
-            tolerance=self.tau,
-            kkt=bool(kkt),
-            smallest_of_reduced=smallest_of_reduced,
-            global_optimum_proven=global_optimum_proven,
-            notes=notes,
-        )
 
     # -- reporting ------------------------------------------------------------------
     def buckling_coefficient(self, load: float) -> float:
@@ -335,9 +318,6 @@ class BucklingProblem:
 
     def destroy(self) -> None:
         """Destroy the PETSc/SLEPc objects (collective)."""
-        for v in (self._r, self._Bu):
-            if v is not None:
-                v.destroy()
-        self._r = self._Bu = None
-        self.solver.destroy()
+        release(self, "_r", "_Bu")
+        self.eigensolver.destroy()
         self.model.destroy()

@@ -3,13 +3,20 @@
 from __future__ import annotations
 
 import json
+import math
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-__all__ = ["BucklingResult", "write_json"]
+if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.algorithms import UnilateralSolution
+    from unibuckle_fenicsx.analysis import Analysis
+    from unibuckle_fenicsx.certify import Certificate
+    from unibuckle_fenicsx.problem import BucklingProblem, Mode
+
+__all__ = ["BucklingResult", "write_json", "write_vtx"]
 
 
 @dataclass
@@ -34,8 +41,9 @@ class BucklingResult:
         contact_coordinates: Coordinates of Z, (|Z|, 2).
         contact_indices: Node numbers of Z (lexicographic (y, x) order of the zone).
         contact_dofs: Global W DOF indices of Z (partition-dependent numbering).
-        lower_bound_Pa / upper_bound_Pa: Optimality bracket.
-        certificate: :class:`~unibuckle_fenicsx.problem.Certificate` as a dict.
+        lower_bound_Pa / upper_bound_Pa: Verified bracket of the critical load (the upper
+            bound is the load of an admissible mode; None if the method found none).
+        certificate: :class:`~unibuckle_fenicsx.certify.Certificate` as a dict.
         details: Method-specific information.
         timings: Seconds per phase.
         mpi_size: Ranks used.
@@ -64,6 +72,71 @@ class BucklingResult:
     details: dict[str, Any] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
     mpi_size: int = 1
+
+    @classmethod
+    def from_solution(
+        cls,
+        problem: BucklingProblem,
+        free: Mode,
+        solution: UnilateralSolution | None,
+        certificate: Certificate | None,
+        *,
+        method: str,
+        wall_time_s: float,
+        mpi_size: int,
+    ) -> BucklingResult:
+        """Assemble the result of ``problem``'s free mode and unilateral ``solution``.
+
+        Note:
+            Collective on the problem's communicator (gathers the contact DOFs).
+        """
+        spec = problem.spec
+        load = free.load if solution is None else solution.load
+        result = cls(
+            case=spec.name,
+            method=method,
+            critical_load_Pa=load,
+            free_load_Pa=free.load,
+            ratio_to_free=load / free.load,
+            critical_force_N_per_m=spec.plate.thickness * load,
+            buckling_coefficient_k=problem.buckling_coefficient(load),
+            dofs=problem.model.num_dofs,
+            mesh=(
+                [problem.mesh.topology.index_map(2).size_global]
+                if problem.custom_mesh
+                else [spec.mesh.nx, spec.mesh.ny]
+            ),
+            eigensolves=1 + (0 if solution is None else solution.eigensolves),
+            wall_time_s=wall_time_s,
+            timings={**problem.timings, "total_s": wall_time_s},
+            mpi_size=mpi_size,
+            details={
+                "free_eigen_error": free.eigen.error,
+                "free_eigen_iterations": free.eigen.iterations,
+            },
+        )
+        if solution is None or certificate is None:
+            result.lower_bound_Pa = result.upper_bound_Pa = free.load
+            return result
+        contact = problem.contact
+        assert contact is not None
+        active = solution.active
+        rows = contact.removed_rows(active)
+        result.constrained_nodes = problem.num_constrained
+        result.contact_nodes = len(active)
+        result.p_star = solution.p_star
+        result.contact_indices = [int(k) for k in active]
+        result.contact_coordinates = contact.coordinates[active].tolist()
+        result.contact_dofs = sorted(
+            int(r) for part in problem.comm.allgather(rows.tolist()) for r in part
+        )
+        result.lower_bound_Pa = certificate.lower_bound
+        result.upper_bound_Pa = (
+            certificate.upper_bound if math.isfinite(certificate.upper_bound) else None
+        )
+        result.certificate = certificate.as_dict()
+        result.details.update(solution.details)
+        return result
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready mapping (non-finite floats become strings)."""
@@ -108,3 +181,34 @@ def write_json(result: BucklingResult, path: str | Path) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     path.write_text(json.dumps(result.as_dict(), indent=2) + "\n")
     return path
+
+
+def write_vtx(analysis: Analysis, directory: str | Path) -> list[Path]:
+    """Write the mode, the free mode, the obstacle zone and the contact set as VTX (.bp).
+
+    Files: ``<case>_w.bp`` (w, free w, obstacle indicator, contact indicator on the Q1
+    space) and ``<case>_theta.bp`` (rotation). Open them in ParaView (ADIOS2VTXReader).
+
+    Note:
+        Collective on the mesh communicator.
+    """
+    import dolfinx.io
+
+    problem = analysis.problem
+    directory = Path(directory)
+    if problem.comm.rank == 0:
+        directory.mkdir(parents=True, exist_ok=True)
+    problem.comm.barrier()
+    w, theta = problem.model.split(analysis.mode)
+    w_free, _ = problem.model.split(analysis.free_mode)
+    w_free.name = "w_free"
+    fields = [w, w_free]
+    if problem.contact is not None and analysis.solution is not None:
+        fields.append(problem.contact.indicator())
+        fields.append(problem.contact.node_function(analysis.solution.active))
+    case = analysis.result.case
+    paths = [directory / f"{case}_w.bp", directory / f"{case}_theta.bp"]
+    for path, funcs in ((paths[0], fields), (paths[1], [theta])):
+        with dolfinx.io.VTXWriter(problem.comm, path, funcs, engine="BP4") as writer:
+            writer.write(0.0)
+    return paths

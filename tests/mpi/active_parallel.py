@@ -24,5 +24,5 @@ assert (
     MPI.COMM_WORLD.allgather(sol.active.tolist()).count(sol.active.tolist()) == MPI.COMM_WORLD.size
 )
 if MPI.COMM_WORLD.rank == 0:
-    print(json.dumps({"load": sol.load, "coordinates": coords, "kkt": sol.details["kkt"]}))
+    print(json.dumps({"load": sol.load, "coordinates": coords, "kkt": sol.candidate.kkt}))
 problem.destroy()

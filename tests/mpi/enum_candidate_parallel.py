@@ -15,19 +15,19 @@ from mpi4py import MPI
 
 import numpy as np
 
+from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.solver import solve
 
 
 def run(case: str, nx: int, ny: int, complete: bool, candidate_parallel: bool) -> dict:
     comm = MPI.COMM_WORLD
     spec = paper_case(case, nx, ny).with_solver(method="enumerate", complete=complete)
-    result, problem = solve(spec, comm, candidate_parallel=candidate_parallel)
-    assert problem.contact is not None
-    values = problem.contact.values(problem.u.x.petsc_vec) / problem.max_abs_w()
+    with solve(spec, comm, candidate_parallel=candidate_parallel) as analysis:
+        result = analysis.result
+        assert analysis.solution is not None
+        values = analysis.solution.candidate.values
     spread = max(float(np.abs(v - values).max()) for v in comm.allgather(values))
     actives = comm.allgather(list(result.contact_indices))
-    problem.destroy()
     return {
         "load": result.critical_load_Pa,
         "active": result.contact_indices,

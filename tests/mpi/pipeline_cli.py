@@ -2,7 +2,7 @@
 
 ``mpiexec -n P python tests/mpi/pipeline_cli.py OUTDIR -- CLI ARGS...`` runs
 ``unibuckle solve CLI ARGS --json OUTDIR/result.json --output OUTDIR/vtx`` with
-:func:`unibuckle_fenicsx.results.write_json` and :func:`unibuckle_fenicsx.solver.write_vtx`
+:func:`unibuckle_fenicsx.results.write_json` and :func:`unibuckle_fenicsx.results.write_vtx`
 wrapped to count their calls per rank, and prints on rank 0 a JSON line
 ``{"status": [...], "json_writes": [...], "vtx_calls": [...]}`` (one entry per rank).
 """
@@ -16,7 +16,6 @@ from pathlib import Path
 from mpi4py import MPI
 
 import unibuckle_fenicsx.results as results
-import unibuckle_fenicsx.solver as solver
 from unibuckle_fenicsx.cli import main as cli_main
 
 
@@ -25,7 +24,7 @@ def main() -> None:
     args = sys.argv[sys.argv.index("--") + 1 :]
     comm = MPI.COMM_WORLD
     counts = {"json": 0, "vtx": 0}
-    write_json, write_vtx = results.write_json, solver.write_vtx
+    write_json, write_vtx = results.write_json, results.write_vtx
 
     def counting_json(*a, **k):
         counts["json"] += 1
@@ -36,7 +35,7 @@ def main() -> None:
         return write_vtx(*a, **k)
 
     results.write_json = counting_json
-    solver.write_vtx = counting_vtx
+    results.write_vtx = counting_vtx
     status = cli_main(
         ["solve", *args, "--json", str(outdir / "result.json"), "--output", str(outdir / "vtx")]
     )

@@ -1,22 +1,35 @@
 """Unilateral critical-state algorithms.
 
 Each takes a :class:`~unibuckle_fenicsx.problem.BucklingProblem` with an obstacle and
-returns a :class:`UnilateralSolution`, leaving the final mode in ``problem.u``:
+returns a :class:`UnilateralSolution` holding the chosen
+:class:`~unibuckle_fenicsx.problem.Candidate` (load, contact set and its own mode):
 
-- :mod:`.enumeration`: the paper's direct method (section 5.3), exact, 2^i candidates;
-- :mod:`.active_set`: primal-dual active-set iteration from several seeds, with bounds;
+- :mod:`.enumeration`: the paper's direct method (section 5.3), 2^i candidate sets;
+- :mod:`.active_set`: primal-dual active-set iteration from several seeds
+  (:mod:`.multilevel` carries it over a mesh hierarchy, :mod:`.bounds` brackets it);
 - :mod:`.penalty`: the penalty method the paper rejects, for comparison.
 """
 
 from __future__ import annotations
 
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["UnilateralSolution"]
+if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.problem import Candidate
+
+__all__ = ["UnilateralSolution", "candidate_count"]
+
+
+def candidate_count(i: int) -> int:
+    r"""Contact sets the paper's enumeration may visit: :math:`\sum_{p=0}^{i} C(i, p) = 2^i`.
+
+    Early stopping cannot know the stopping size in advance, so the worst case is the count.
+    """
+    return 2**i
 
 
 @dataclass
@@ -24,21 +37,37 @@ class UnilateralSolution:
     """What an algorithm found.
 
     Attributes:
-        load: Critical load lambda (upper bound: the load of a feasible mode).
-        active: Sorted node numbers of the contact set Z of the returned mode.
-        eigensolves: Linear eigen solves performed (on this rank's share for
-            candidate-parallel runs: summed over ranks).
-        lower_bound: A proven lower bound on the critical load.
-        global_optimum_proven: ``lower_bound`` equals ``load`` (within tolerance), or
-            the method is exhaustive.
+        candidate: The returned critical state: load, contact set Z and mode.
+        method: Name of the algorithm.
+        eigensolves: Linear eigen solves performed (all levels; for candidate-parallel
+            runs summed over ranks).
+        lower_bound: A lower bound on the critical load proven by the algorithm
+            (interlacing, lattice search), at least the free load.
+        global_optimum_proven: ``lower_bound`` reaches the load (within the algorithm's
+            tolerance), or the search was exhaustive.
+        upper_bound: The load of an admissible mode (``inf`` if the method found none,
+            e.g. the penalty method, whose modes penetrate).
+        kkt_points: Other KKT points met (distinct contact sets), for the certificate.
         p_star: Size of the contact set at which enumeration stopped (None otherwise).
         details: Method-specific, JSON-ready information.
     """
 
-    load: float
-    active: npt.NDArray[np.int64]
+    candidate: Candidate
+    method: str
     eigensolves: int
     lower_bound: float
     global_optimum_proven: bool
+    upper_bound: float
+    kkt_points: list[Candidate] = field(default_factory=list)
     p_star: int | None = None
     details: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def load(self) -> float:
+        """The returned load."""
+        return self.candidate.load
+
+    @property
+    def active(self) -> npt.NDArray[np.int64]:
+        """The returned contact set."""
+        return self.candidate.active

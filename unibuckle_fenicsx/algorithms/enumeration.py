@@ -17,7 +17,7 @@ critical one. Every result therefore carries a proven lower bound:
 
 Optimality. The critical state's contact set Z has a feasible reduced first mode
 (Lemma 5.1), so it is one of the feasible sets. Removing more DOFs never lowers the
-smallest eigenvalue (interlacing, DESIGN.md section 1), so a set Z with :math:`|Z| > q`
+smallest eigenvalue (interlacing, README "The problem"), so a set Z with :math:`|Z| > q`
 has :math:`\lambda(Z) \ge \max_{S \subset Z, |S| = q} \lambda(S)`, a maximum over at
 least q + 1 distinct sets of size q; it is therefore at least :math:`\mu_q`, the
 (q+1)-th smallest :math:`\lambda(S)` over *all* sets of size q (feasible or not). After
@@ -37,7 +37,8 @@ depend on which sets were solved before on the same rank.
 
 Candidate-parallel runs (``candidate_comm``): every rank holds its own serial copy of
 the problem and evaluates the candidates of each p round-robin; the per-p results are
-reduced on all ranks, which therefore stop at the same p and pick the same set.
+reduced on all ranks, which therefore stop at the same p and pick the same set; the
+rank that evaluated the winning set broadcasts its mode.
 """
 
 from __future__ import annotations
@@ -53,10 +54,10 @@ from petsc4py import PETSc
 
 import numpy as np
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
+from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 
-__all__ = ["PROOF_RTOL", "TIE_RTOL", "LevelSummary", "candidate_count", "enumerate_contact_sets"]
+__all__ = ["PROOF_RTOL", "TIE_RTOL", "LevelSummary", "enumerate_contact_sets"]
 
 logger = logging.getLogger(__name__)
 
@@ -66,14 +67,6 @@ TIE_RTOL = 1e-10
 PROOF_RTOL = 1e-10
 #: Seed of the start vector shared by all candidate solves.
 START_SEED = 20240503
-
-
-def candidate_count(i: int) -> int:
-    r"""Candidate sets the enumeration may visit: :math:`\sum_{p=0}^{i} C(i, p) = 2^i`.
-
-    Early stopping cannot know :math:`p^*` in advance, so the worst case is the count.
-    """
-    return 2**i
 
 
 @dataclass(frozen=True)
@@ -103,7 +96,7 @@ class LevelSummary:
 
 def _start_vector(problem: BucklingProblem) -> PETSc.Vec:
     """Seeded pseudo-random vector of the W layout, partition independent (caller destroys)."""
-    vec = problem.u.x.petsc_vec.duplicate()
+    vec = problem.model.A.createVecRight()
     lo, hi = vec.getOwnershipRange()
     rng = np.random.default_rng(START_SEED)
     vec.array_w[:] = rng.standard_normal(vec.getSize())[lo:hi]
@@ -166,6 +159,34 @@ def _monotonicity(levels: list[LevelSummary]) -> tuple[bool, list[list[int]]]:
     return not violations, violations
 
 
+def _keep_ties(ties: list[Candidate], cand: Candidate) -> list[Candidate]:
+    """Add ``cand`` to the feasible candidates within TIE_RTOL of the smallest load."""
+    best = min([c.load for c in ties] + [cand.load])
+    return [c for c in [*ties, cand] if c.load <= best * (1.0 + TIE_RTOL)]
+
+
+def _share(problem: BucklingProblem, mine: Candidate | None, ccomm: MPI.Comm) -> Candidate:
+    """The winning candidate on every candidate rank: its evaluator broadcasts the mode.
+
+    Every rank holds a serial copy of the same mesh, so the DOF layouts agree.
+    """
+    owner = ccomm.allreduce(ccomm.rank if mine is not None else ccomm.size, op=MPI.MIN)
+    if ccomm.size == 1:
+        assert mine is not None
+        return mine
+    payload = None
+    if ccomm.rank == owner:
+        assert mine is not None
+        payload = (mine.mode.x.array.copy(), mine.load, mine.active, mine.eigen)
+    array, load, active, eigen = ccomm.bcast(payload, root=owner)
+    if ccomm.rank == owner:
+        assert mine is not None
+        return mine
+    u = problem.new_mode()
+    u.x.array[:] = array
+    return problem.candidate(u, load, active, eigen=eigen)
+
+
 def _finite_or_none(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
@@ -196,9 +217,8 @@ def enumerate_contact_sets(
             globally optimal (see the module docstring).
 
     Returns:
-        The solution; its mode is left in ``problem.u`` (on every rank). ``eigensolves``
-        counts the solves of all candidate ranks, including the final re-evaluation of
-        the winning set. ``details`` holds, per visited p, the candidates, the feasible
+        The solution, its candidate on every rank. ``eigensolves`` counts the solves of
+        all candidate ranks. ``details`` holds, per visited p, the candidates, the feasible
         count, :math:`\lambda(p)` (``lambda_by_p``) and the smallest load of any set
         (``lambda_min_by_p``); ``monotone`` (complete mode; ``None`` otherwise).
 
@@ -223,7 +243,7 @@ def enumerate_contact_sets(
         raise ValueError(
             "candidate_comm needs a serial copy of the problem on every rank "
             f"(problem.comm has {problem.comm.size} ranks): build it on MPI.COMM_SELF, "
-            "e.g. solver.solve(..., candidate_parallel=True)"
+            "e.g. analysis.solve(..., candidate_parallel=True)"
         )
     i = problem.contact.size
     count = candidate_count(i)
@@ -236,14 +256,16 @@ def enumerate_contact_sets(
 
     rank, size = ccomm.rank, ccomm.size
     t_start = time.perf_counter()
-    solves0 = problem.solver.solves
+    solves0 = problem.eigensolver.solves
     start = _start_vector(problem)
     levels: list[LevelSummary] = []
+    kept: list[Candidate | None] = []  # per level: this rank's candidate of its best set
     try:
         for p in range(i + 1):
             t0 = time.perf_counter()
             loads: list[float] = []
             feasible: list[tuple[float, tuple[int, ...]]] = []
+            ties: list[Candidate] = []  # feasible candidates within TIE_RTOL of the best
             n = 0
             for j, combo in enumerate(itertools.combinations(range(i), p)):
                 n += 1
@@ -253,8 +275,14 @@ def enumerate_contact_sets(
                 loads.append(cand.load)
                 if cand.feasible:
                     feasible.append((cand.load, combo))
+                    ties = _keep_ties(ties, cand)
             level = _reduce_level(p, n, loads, feasible, time.perf_counter() - t0, ccomm)
             levels.append(level)
+            kept.append(
+                next((c for c in ties if tuple(c.active) == level.best_set), None)
+                if level.best_set is not None
+                else None
+            )
             logger.info(
                 "p = %d: %d sets, %d feasible, lambda(p) = %.9e, min lambda = %.9e (%.2f s)",
                 p,
@@ -272,33 +300,25 @@ def enumerate_contact_sets(
                     break
             elif level.best_set is not None:
                 break
-
-        with_feasible = [lv for lv in levels if lv.best_set is not None]
-        if not with_feasible:
-            raise RuntimeError(
-                f"no contact set of the {i} constrained nodes gives a feasible mode "
-                f"(tau = {problem.tau:g}): the problem has no admissible buckling mode"
-            )
-        p_star = with_feasible[0].p
-        load, chosen = _pick([(lv.best_load, lv.best_set) for lv in with_feasible])  # type: ignore[misc]
-        assert chosen is not None
-        last = levels[-1]
-        # Sets larger than the last size visited: >= its (p+1)-th smallest load.
-        lower = load if last.p == i else min(load, last.load_kth)
-        proven = lower >= load * (1.0 - PROOF_RTOL)
-
-        active = np.asarray(chosen, dtype=np.int64)
-        final = problem.evaluate(active, initial=start)
-        if not final.feasible or abs(final.load - load) > TIE_RTOL * load:
-            logger.warning(
-                "re-evaluating the winning set gave load %.12e (feasible %s), expected %.12e",
-                final.load,
-                final.feasible,
-                load,
-            )
     finally:
         start.destroy()
-    eigensolves = int(ccomm.allreduce(problem.solver.solves - solves0, op=MPI.SUM))
+
+    with_feasible = [lv for lv in levels if lv.best_set is not None]
+    if not with_feasible:
+        raise RuntimeError(
+            f"no contact set of the {i} constrained nodes gives a feasible mode "
+            f"(tau = {problem.tau:g}): the problem has no admissible buckling mode"
+        )
+    p_star = with_feasible[0].p
+    load, chosen = _pick([(lv.best_load, lv.best_set) for lv in with_feasible])  # type: ignore[misc]
+    assert chosen is not None
+    last = levels[-1]
+    # Sets larger than the last size visited: >= its (p+1)-th smallest load.
+    lower = load if last.p == i else min(load, last.load_kth)
+    proven = lower >= load * (1.0 - PROOF_RTOL)
+    level_of = next(k for k, lv in enumerate(levels) if lv.best_set == chosen)
+    candidate = _share(problem, kept[level_of], ccomm)
+    eigensolves = int(ccomm.allreduce(problem.eigensolver.solves - solves0, op=MPI.SUM))
 
     monotone, violations = _monotonicity(levels) if complete else (None, [])
     details = {
@@ -308,7 +328,7 @@ def enumerate_contact_sets(
         "candidate_ranks": size,
         "complete": complete,
         "until_proven": until_proven,
-        "p_optimum": len(active),
+        "p_optimum": len(chosen),
         "lambda_by_p": [_finite_or_none(lv.best_load) for lv in levels],
         "feasible_by_p": [lv.feasible for lv in levels],
         "candidates_by_p": [lv.candidates for lv in levels],
@@ -317,24 +337,26 @@ def enumerate_contact_sets(
         "monotone": monotone,
         "monotone_violations": violations,
         "lower_bound_interlacing": with_feasible[0].load_min,
+        "lower_bound_by": "enumeration",
         "enumeration_wall_s": time.perf_counter() - t_start,
     }
     if problem.comm.rank == 0 and rank == 0:
         logger.info(
             "enumeration: lambda = %.9e, |Z| = %d, p* = %d, lower bound %.9e (%s), %d eigen solves",
             load,
-            len(active),
+            len(chosen),
             p_star,
             lower,
             "proven" if proven else "not proven",
             eigensolves,
         )
     return UnilateralSolution(
-        load=float(load),
-        active=active,
+        candidate=candidate,
+        method="enumerate",
         eigensolves=eigensolves,
         lower_bound=float(lower),
         global_optimum_proven=bool(proven),
+        upper_bound=float(load),
         p_star=p_star,
         details=details,
     )

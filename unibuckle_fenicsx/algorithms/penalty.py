@@ -24,7 +24,8 @@ cycle, which is reported (the iterate with the smallest :math:`R_\rho` is return
 
 The stationary point found is not proven to be the global minimum of :math:`R_\rho`,
 and its mode penetrates the obstacle by :math:`O(1/\rho)`: the result is neither a
-proven bound nor an admissible mode. The lower bound reported is :math:`\lambda_{free}`
+proven bound nor an admissible mode, so it gives no upper bound (only the load of an
+admissible mode is one). The lower bound reported is :math:`\lambda_{free}`
 (interlacing). ``rho`` is given relative to the largest diagonal entry of A:
 :math:`\rho_{abs} = \rho \max_j A_{jj}`.
 
@@ -44,16 +45,23 @@ import math
 from dataclasses import dataclass
 
 from petsc4py import PETSc
-from slepc4py import SLEPc
 
 import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
-from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, GEPSolver
+from unibuckle_fenicsx.eigen import (
+    EIGEN_OPTIONS,
+    EXTREME_OPTIONS,
+    GEPSolver,
+    Owner,
+    extreme_eigenvalues,
+    release,
+)
+from unibuckle_fenicsx.problem import BucklingProblem
 
 __all__ = [
-    "CONDITION_OPTIONS",
+    "CONDITION_PREFIX",
     "PENALTY_PREFIX",
     "TIE_RTOL",
     "PenaltySolver",
@@ -73,15 +81,6 @@ TIE_RTOL = 1e-6
 
 #: Options prefix of the extreme-eigenvalue solvers of :meth:`PenaltySolver.condition_number`.
 CONDITION_PREFIX = "unibuckle_penalty_cond_"
-
-#: Default options of the extreme-eigenvalue solvers (pushed under :data:`CONDITION_PREFIX`).
-CONDITION_OPTIONS: dict[str, str | float | int] = {
-    "eps_type": "krylovschur",
-    "eps_max_it": 2000,
-    "st_ksp_type": "preonly",
-    "st_pc_type": "lu",
-    "st_pc_factor_mat_solver_type": "mumps",
-}
 
 
 @dataclass(frozen=True)
@@ -107,7 +106,7 @@ def _key(nodes: npt.NDArray[np.int64]) -> tuple[int, ...]:
     return tuple(int(k) for k in nodes)
 
 
-class PenaltySolver:
+class PenaltySolver(Owner):
     r"""Penalised pencil :math:`(A + \rho_{abs} \sum_{k\in S} e_k e_k^T, B)` of a problem.
 
     Args:
@@ -127,12 +126,10 @@ class PenaltySolver:
 
     def __init__(
         self,
-        problem: object,
+        problem: BucklingProblem,
         prefix: str = PENALTY_PREFIX,
         eps_options: dict[str, str | float | int] | None = None,
     ) -> None:
-        from unibuckle_fenicsx.problem import BucklingProblem
-
         if not isinstance(problem, BucklingProblem):
             raise ValueError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
         if problem.contact is None:
@@ -190,10 +187,10 @@ class PenaltySolver:
         r"""Extreme eigenvalues of the current :math:`A_{pen}` restricted to the free DOFs.
 
         The edge-constrained rows (diagonal 1, decoupled) are left out, so this is the
-        spectrum of the operator that actually carries the physics. The 2-norm condition
-        number of this SPD matrix is the ratio of the two values. Computed with SLEPc
-        (Krylov-Schur: largest real eigenvalue plainly, smallest by shift-and-invert at 0
-        with MUMPS), options prefix ``unibuckle_penalty_cond_``.
+        spectrum of the operator that actually carries the physics; the 2-norm condition
+        number of this SPD matrix is the ratio of the two values
+        (:func:`~unibuckle_fenicsx.eigen.extreme_eigenvalues`, options prefix
+        ``unibuckle_penalty_cond_``).
 
         Returns:
             (smallest, largest) eigenvalue.
@@ -206,41 +203,10 @@ class PenaltySolver:
         iset = PETSc.IS().createGeneral(rows, comm=self.A_pen.comm)  # type: ignore[arg-type]
         sub = self.A_pen.createSubMatrix(iset, iset)
         iset.destroy()
-        values = []
-        for which in ("largest", "smallest"):
-            eps = SLEPc.EPS().create(sub.comm)
-            eps.setOptionsPrefix(CONDITION_PREFIX)
-            eps.setOperators(sub)
-            eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
-            eps.setDimensions(1)
-            eps.setTolerances(1e-8)
-            if which == "largest":
-                eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)
-                opts_used = {"eps_type": CONDITION_OPTIONS["eps_type"]}
-            else:
-                eps.setTarget(0.0)
-                eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
-                eps.getST().setType(SLEPc.ST.Type.SINVERT)
-                opts_used = dict(CONDITION_OPTIONS)
-            opts = PETSc.Options()
-            opts.prefixPush(CONDITION_PREFIX)
-            for key, value in opts_used.items():
-                opts.setValue(key, value)
-            opts.prefixPop()
-            eps.setFromOptions()
-            opts.prefixPush(CONDITION_PREFIX)
-            for key in opts_used:
-                opts.delValue(key)
-            opts.prefixPop()
-            eps.solve()
-            if eps.getConverged() < 1:
-                eps.destroy()
-                sub.destroy()
-                raise RuntimeError(f"condition estimate: the {which} eigenvalue did not converge")
-            values.append(float(eps.getEigenvalue(0).real))
-            eps.destroy()
-        sub.destroy()
-        return values[1], values[0]
+        try:
+            return extreme_eigenvalues(sub, CONDITION_PREFIX, EXTREME_OPTIONS)
+        finally:
+            sub.destroy()
 
     # -- the iteration ----------------------------------------------------------------
     def solve(
@@ -254,7 +220,7 @@ class PenaltySolver:
         lower_bound: float | None = None,
         tie_rtol: float = TIE_RTOL,
     ) -> UnilateralSolution:
-        r"""Iterate on the penetrating set for one penalty; the mode is left in ``problem.u``.
+        r"""Iterate on the penetrating set for one penalty.
 
         Args:
             rho: Penalty relative to :math:`\max_j A_{jj}`, finite and > 0.
@@ -274,11 +240,12 @@ class PenaltySolver:
                 [0, 1); 0 leaves ties to rounding (for studying its effect).
 
         Returns:
-            The solution: ``load`` = :math:`R_\rho` of the returned mode (a stationary
-            value of the penalised quotient; <= the critical load if it is the global
-            minimum, which is not proven), ``active`` = its penetrating set (where the
-            springs act), ``lower_bound`` = :math:`\lambda_{free}`,
-            ``global_optimum_proven`` False, and ``details`` (see the code).
+            The solution: its candidate's ``load`` is :math:`R_\rho` of the returned mode
+            (a stationary value of the penalised quotient; <= the critical load if it is
+            the global minimum, which is not proven), its ``active`` set the penetrating
+            set (where the springs act); ``lower_bound`` = :math:`\lambda_{free}`,
+            ``upper_bound`` = inf (the mode penetrates), ``global_optimum_proven``
+            False, and ``details`` (see the code).
         """
         problem = self.problem
         contact = problem.contact
@@ -374,16 +341,20 @@ class PenaltySolver:
         if previous is not None:
             previous.destroy()
         assert best is not None
-        best.copy(problem.u.x.petsc_vec)
-        problem.u.x.scatter_forward()
+        u = problem.new_mode()
+        best.copy(u.x.petsc_vec)
+        u.x.scatter_forward()
         best.destroy()
         step = steps[best_step]
+        # Oriented and scaled above: the penalty's own orientation minimises R_rho.
+        candidate = problem.candidate(u, step.quotient, step.penetrating, sign=1.0)
         if status != "converged":
             # Leave A_pen with the springs of the returned mode, for condition().
             self.set_springs(rho_abs, step.springs)
         if lower_bound is None:
-            lower_bound = problem.solver.solve().value
-            self.solves += 1
+            fresh = problem.free is None
+            lower_bound = problem.solve_free().load
+            self.solves += int(fresh)
         details: dict[str, object] = {
             "penalty_rho": float(rho),
             "penalty_rho_abs": rho_abs,
@@ -404,32 +375,25 @@ class PenaltySolver:
             details["penalty_eig_max_A_pen"] = hi
             details["penalty_condition_number"] = hi / lo
         return UnilateralSolution(
-            load=step.quotient,
-            active=step.penetrating,
+            candidate=candidate,
+            method="penalty",
             eigensolves=self.solves - solves0,
             lower_bound=float(lower_bound),
             global_optimum_proven=False,
+            upper_bound=math.inf,
             details=details,
         )
 
     def destroy(self) -> None:
         """Destroy the eigen solver, A_pen and the work vectors (collective)."""
-        gep = getattr(self, "gep", None)
-        if gep is not None:
-            gep.destroy()
-            self.gep = None  # type: ignore[assignment]
-        for name in ("A_pen", "_springs", "_work", "_Av", "_Bv"):
-            obj = getattr(self, name, None)
-            if obj is not None:
-                obj.destroy()
-                setattr(self, name, None)
+        release(self, "gep", "A_pen", "_springs", "_work", "_Av", "_Bv")
 
     def __del__(self) -> None:
         self.destroy()
 
 
 def solve_penalty(
-    problem: object,
+    problem: BucklingProblem,
     rho: float,
     *,
     initial_active: npt.NDArray[np.int64] | None = None,
@@ -452,7 +416,7 @@ def solve_penalty(
         eps_options: Extra options under ``unibuckle_penalty_``.
 
     Returns:
-        The solution, mode left in ``problem.u``; see :meth:`PenaltySolver.solve`.
+        The solution; see :meth:`PenaltySolver.solve`.
 
     Note:
         Collective.

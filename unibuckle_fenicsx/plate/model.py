@@ -12,6 +12,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import Material, PlateSpec
+from unibuckle_fenicsx.eigen import Owner, release
 from unibuckle_fenicsx.materials import bending_voigt, shear_stiffness
 from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tag
 from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_form
@@ -25,7 +26,7 @@ from unibuckle_fenicsx.prestress import Prestress
 __all__ = ["PlateModel"]
 
 
-class PlateModel:
+class PlateModel(Owner):
     r"""Reissner-Mindlin plate with the assembled matrices A (stiffness) and B (geometric).
 
     A is the bending stiffness plus the MITC shear stiffness :math:`P^T M_s P`
@@ -162,11 +163,7 @@ class PlateModel:
 
     def destroy(self) -> None:
         """Destroy A and B (collective)."""
-        for name in ("A", "B"):
-            mat = getattr(self, name, None)
-            if mat is not None:
-                mat.destroy()
-                setattr(self, name, None)
+        release(self, "A", "B")
 
     def __del__(self) -> None:
         self.destroy()

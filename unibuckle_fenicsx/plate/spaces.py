@@ -5,7 +5,8 @@ in one mixed space :math:`W = Q_1 \times Q_1^2`. The transverse shear strain is 
 :math:`\nabla w - \theta` but its interpolant
 :math:`\gamma_h = \Pi(\nabla w - \theta)` into the lowest-order N1curl space
 (tangential components at edge midpoints: MacNeal's / Bathe-Dvorkin's assumed shear
-strain), which removes shear locking without hourglass modes (DESIGN.md section 4).
+strain; Bathe & Dvorkin, Int. J. Numer. Meth. Engng 21, 1985), which removes shear
+locking without hourglass modes.
 :math:`\Pi \nabla w` is exactly the discrete gradient and :math:`\Pi \theta` the
 interpolation matrix, so :math:`\gamma_h = P u` with a sparse matrix P.
 """

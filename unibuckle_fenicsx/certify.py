@@ -1,0 +1,209 @@
+r"""Certificates of a unilateral critical state: local (KKT) and global (lower bound).
+
+Local. A candidate (:math:`\lambda`, u, Z) is a critical state of the discrete problem
+when (README, "The problem"; paper, Lemma 5.1)
+
+- :math:`r = Au - \lambda Bu` vanishes off Z (relative residual below :math:`\sqrt\tau`),
+- :math:`u_k \le \tau \max|w|` on I (the mode does not cross the obstacle),
+- :math:`r_k \le \tau \|Au\|_\infty` on Z (the obstacle only pushes),
+- :math:`\lambda` is the smallest eigenvalue of the pencil with Z removed: checked by the
+  inertia of :math:`A_Z - \lambda(1 - \delta) B_Z` (Sylvester: its negative eigenvalues
+  count the reduced pencil's eigenvalues in :math:`(0, \lambda(1-\delta))`), with
+  :math:`\delta = 10^3` ``eps_tol`` (one sparse :math:`LDL^T`).
+
+Global. The algorithms bracket the critical load: any admissible mode's load is an upper
+bound; interlacing, the lattice search and exhaustive enumeration give lower bounds. The
+result is *proven* globally optimal when the verified bracket closes to
+:data:`PROOF_GAP`.
+
+Every check here is collective on the problem's communicator.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+from dataclasses import dataclass, field
+from typing import Any
+
+from petsc4py import PETSc
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.eigen import SymmetricFactorization
+from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+
+__all__ = ["CERTIFY_PREFIX", "PROOF_GAP", "Certificate", "certify", "reduced_inertia"]
+
+logger = logging.getLogger(__name__)
+
+#: Options prefix of the certificate's factorisations (``-unibuckle_certify_ksp_view``).
+CERTIFY_PREFIX = "unibuckle_certify_"
+#: Relative gap (upper - lower)/upper below which the global optimum counts as proven.
+PROOF_GAP = 1e-6
+#: The smallest-eigenvalue check looks below lambda (1 - SMALLEST_RTOL_FACTOR eps_tol).
+SMALLEST_RTOL_FACTOR = 1e3
+
+
+@dataclass(frozen=True)
+class Certificate:
+    r"""What was verified about a returned critical state.
+
+    Attributes:
+        feasible: :math:`u_k \le \tau \max|w|` on every constrained node.
+        feasibility_margin: :math:`\max_{I \setminus Z} u_k / \max|w|` (negative: strictly
+            below the obstacle; ``-inf`` when Z = I).
+        max_contact_force: :math:`\max_Z r_k / \|Au\|_\infty` (``-inf`` when Z is empty).
+        relative_residual: :math:`\|r\ \text{off}\ Z\|_2 / \|Au\|_2`.
+        tolerance: :math:`\tau`.
+        kkt: Feasible, forces at most :math:`\tau`, residual at most :math:`\sqrt\tau`.
+        smallest_of_reduced: :math:`\lambda` is the smallest eigenvalue of the reduced
+            pencil (inertia check); ``None`` when not checked.
+        lower_bound: Verified lower bound on the critical load.
+        upper_bound: Load of an admissible mode (``inf`` if the mode is not admissible).
+        relative_gap: (upper - lower) / upper.
+        global_optimum_proven: The gap is at most :data:`PROOF_GAP`.
+        proven_by: What gave the lower bound ("interlacing", "lattice", "enumeration").
+        notes: Anything that failed or was skipped, in words.
+    """
+
+    feasible: bool
+    feasibility_margin: float
+    max_contact_force: float
+    relative_residual: float
+    tolerance: float
+    kkt: bool
+    smallest_of_reduced: bool | None
+    lower_bound: float
+    upper_bound: float
+    relative_gap: float
+    global_optimum_proven: bool
+    proven_by: str
+    notes: tuple[str, ...] = field(default_factory=tuple)
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready mapping."""
+        return {
+            "feasible": self.feasible,
+            "feasibility_margin": self.feasibility_margin,
+            "max_contact_force": self.max_contact_force,
+            "relative_residual": self.relative_residual,
+            "tolerance": self.tolerance,
+            "kkt": self.kkt,
+            "smallest_of_reduced": self.smallest_of_reduced,
+            "lower_bound_Pa": self.lower_bound,
+            "upper_bound_Pa": self.upper_bound,
+            "relative_gap": self.relative_gap,
+            "global_optimum_proven": self.global_optimum_proven,
+            "proven_by": self.proven_by,
+            "notes": list(self.notes),
+        }
+
+
+def reduced_inertia(
+    problem: BucklingProblem, active: npt.NDArray[np.int64], sigma: float
+) -> tuple[int, int, int]:
+    r"""Inertia of :math:`A_Z - \sigma B_Z`, the pencil with the contact set Z removed.
+
+    Its negative count is the number of eigenvalues of the reduced pencil in
+    :math:`(0, \sigma)` (Sylvester's law of inertia, A SPD).
+
+    Note:
+        Collective.
+    """
+    assert problem.contact is not None
+    A_Z, B_Z = problem.eigensolver.reduced(problem.contact.removed_rows(active))
+    K = A_Z.duplicate(copy=True)
+    K.axpy(-sigma, B_Z, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
+    factor = SymmetricFactorization(K, CERTIFY_PREFIX)
+    try:
+        return factor.inertia()
+    finally:
+        factor.destroy()
+        K.destroy()
+
+
+def _residual_off_contact(problem: BucklingProblem, candidate: Candidate) -> float:
+    r""":math:`\|r\|_2 / \|Au\|_2` with the rows of Z left out."""
+    assert problem.contact is not None
+    r, _, au_2 = problem.residual(candidate.load, candidate.mode.x.petsc_vec)
+    rows = problem.contact.removed_rows(candidate.active)
+    r.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))  # type: ignore[arg-type]
+    r.assemble()
+    return float(r.norm()) / au_2  # type: ignore[arg-type]
+
+
+def certify(
+    problem: BucklingProblem,
+    solution: UnilateralSolution | Candidate,
+    *,
+    check_smallest: bool = True,
+) -> Certificate:
+    r"""Certify ``solution`` (its candidate and its bracket) on ``problem``.
+
+    Args:
+        problem: The problem the solution was computed on.
+        solution: An algorithm's result, or a bare candidate (whose bracket is then
+            :math:`[\lambda_{free}, \lambda]`, by interlacing).
+        check_smallest: Verify by inertia that the load is the smallest eigenvalue of
+            the reduced pencil (one sparse factorisation).
+
+    Note:
+        Collective.
+    """
+    if isinstance(solution, Candidate):
+        solution = UnilateralSolution(
+            candidate=solution,
+            method="candidate",
+            eigensolves=0,
+            lower_bound=problem.solve_free().load,
+            global_optimum_proven=False,
+            upper_bound=solution.load if solution.feasible else math.inf,
+        )
+    cand = solution.candidate
+    tau = problem.tau
+    notes: list[str] = []
+    if not math.isfinite(cand.load):
+        raise ValueError("certify: the candidate has no finite load")
+    residual = _residual_off_contact(problem, cand)
+    kkt = cand.feasible and cand.max_force <= tau and residual <= math.sqrt(tau)
+    smallest: bool | None = None
+    if check_smallest and cand.eigen is not None:
+        sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
+        neg, _, _ = reduced_inertia(problem, cand.active, sigma)
+        smallest = neg == 0
+        if not smallest:
+            notes.append(
+                f"the reduced pencil has {neg} eigenvalue(s) below the returned load: "
+                "not its smallest eigenpair"
+            )
+    elif cand.eigen is None:
+        notes.append("the mode is not an eigenvector of a reduced pencil (not checked)")
+    # Only the eigenvalue of a reduced pencil whose mode is admissible bounds the critical
+    # load from above (a penalised quotient lies below it).
+    upper = solution.upper_bound
+    if cand.eigen is not None and cand.feasible:
+        upper = min(upper, cand.load)
+    elif not cand.feasible:
+        notes.append("the mode crosses the obstacle: its load is not an upper bound")
+    lower = min(solution.lower_bound, upper)
+    gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
+    proven = bool(solution.global_optimum_proven and kkt and gap <= PROOF_GAP)
+    proven_by = str(solution.details.get("lower_bound_by", "interlacing"))
+    return Certificate(
+        feasible=cand.feasible,
+        feasibility_margin=cand.margin,
+        max_contact_force=cand.max_force,
+        relative_residual=residual,
+        tolerance=tau,
+        kkt=bool(kkt),
+        smallest_of_reduced=smallest,
+        lower_bound=lower,
+        upper_bound=upper,
+        relative_gap=gap,
+        global_optimum_proven=proven,
+        proven_by=proven_by,
+        notes=tuple(notes),
+    )

@@ -1,0 +1,144 @@
+"""Data of a solved problem for figures: nodal deflections, sections, the zone's box.
+
+Kept apart from :mod:`unibuckle_fenicsx.plotting` (which only draws): the functions that
+read a mode are collective on the mesh communicator and return the same arrays on every
+rank, so that drawing can happen on rank 0 alone.
+"""
+
+from __future__ import annotations
+
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+if TYPE_CHECKING:  # pragma: no cover
+    import dolfinx
+
+    from unibuckle_fenicsx.config import ProblemSpec
+    from unibuckle_fenicsx.problem import BucklingProblem
+
+__all__ = ["mirror_to_match", "nodal_deflection", "problem_zone", "section", "zone_box"]
+
+
+def zone_box(
+    spec: ProblemSpec, constrained: npt.NDArray[np.float64] | None = None
+) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    """Obstacle zone of ``spec`` as ``((xmin, xmax), (ymin, ymax))``; ``None`` without one.
+
+    Args:
+        spec: The problem.
+        constrained: Coordinates of the constrained nodes (needed for a predicate
+            zone, whose bounding box is returned).
+    """
+    obstacle = spec.obstacle
+    if obstacle is None:
+        return None
+    if isinstance(obstacle.zone, str):
+        (x0, y0), (x1, y1) = spec.plate.corners
+        return (x0, x1), (y0, y1)
+    if callable(obstacle.zone):
+        if constrained is None or len(constrained) == 0:
+            return None
+        lo, hi = constrained.min(axis=0), constrained.max(axis=0)
+        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
+    (x0, x1), (y0, y1) = obstacle.zone
+    return (x0, x1), (y0, y1)
+
+
+def problem_zone(
+    problem: BucklingProblem,
+) -> tuple[tuple[float, float], tuple[float, float]] | None:
+    """:func:`zone_box` of a set-up problem (a predicate zone: its nodes' bounding box)."""
+    coords = problem.contact.coordinates if problem.contact is not None else None
+    return zone_box(problem.spec, coords)
+
+
+def nodal_deflection(
+    problem: BucklingProblem, u: dolfinx.fem.Function
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Node coordinates (n, 2) and deflection w (n,) of the mode ``u``.
+
+    Gathered over the mesh communicator (owned w-DOFs of every rank), same on all ranks.
+
+    Note:
+        Collective.
+    """
+    w, _ = problem.model.split(u)
+    Vw = w.function_space
+    n_owned = Vw.dofmap.index_map.size_local
+    xy = Vw.tabulate_dof_coordinates()[:n_owned, :2]
+    values = w.x.array[:n_owned].real
+    comm = problem.comm
+    all_xy = np.vstack(comm.allgather(xy))
+    all_w = np.concatenate(comm.allgather(values))
+    return all_xy, all_w
+
+
+def section(
+    problem: BucklingProblem,
+    u: dolfinx.fem.Function,
+    y: float = 0.0,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Section of the deflection along the line y = ``y`` ("section A" for y = 0).
+
+    Returns the nodal values when the line is a row of mesh nodes, and the values at
+    the nodes' x positions interpolated linearly between the two nearest rows otherwise
+    (exact for the bilinear element).
+
+    Returns:
+        x (sorted) and w at those points.
+
+    Note:
+        Collective.
+    """
+    xy, w = nodal_deflection(problem, u)
+    scale = max(problem.spec.plate.length, problem.spec.plate.width)
+    keys = np.round(xy / (1e-9 * scale)).astype(np.int64)
+    _, first = np.unique(keys, axis=0, return_index=True)
+    xy, w = xy[first], w[first]  # drop duplicates (none in serial)
+    rows = np.unique(np.round(xy[:, 1] / (1e-9 * scale))) * 1e-9 * scale
+    if y < rows[0] - 1e-9 * scale or y > rows[-1] + 1e-9 * scale:
+        raise ValueError(f"section: y = {y} lies outside the plate [{rows[0]}, {rows[-1]}]")
+    below = rows[rows <= y + 1e-9 * scale].max()
+    above = rows[rows >= y - 1e-9 * scale].min()
+
+    def row(yr: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+        mask = np.abs(xy[:, 1] - yr) <= 1e-9 * scale
+        order = np.argsort(xy[mask, 0])
+        return xy[mask, 0][order], w[mask][order]
+
+    x0, w0 = row(below)
+    if above - below <= 1e-9 * scale:
+        return x0, w0
+    x1, w1 = row(above)
+    s = (y - below) / (above - below)
+    return x0, (1 - s) * w0 + s * np.interp(x0, x1, w1)
+
+
+def mirror_to_match(
+    x_ref: npt.ArrayLike,
+    w_ref: npt.ArrayLike,
+    x: npt.ArrayLike,
+    w: npt.ArrayLike,
+    center: float = 0.0,
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], bool]:
+    """Reflect a section about x = ``center`` if its mirror image matches ``w_ref`` better.
+
+    The paper's plate and zones are symmetric about x = 0, so a mode and its mirror
+    image have the same load; solvers may return either. Drawing twins on the same side
+    makes sections comparable.
+
+    Returns:
+        The (possibly reflected, re-sorted) abscissae and values, and whether it was
+        reflected.
+    """
+    x_ref, w_ref = np.asarray(x_ref, dtype=float), np.asarray(w_ref, dtype=float)
+    x, w = np.asarray(x, dtype=float), np.asarray(w, dtype=float)
+    direct = np.dot(np.interp(x_ref, x, w), w_ref)
+    xm = 2 * center - x[::-1]
+    wm = w[::-1]
+    mirrored = np.dot(np.interp(x_ref, xm, wm), w_ref)
+    if mirrored > direct:
+        return xm, wm, True
+    return x, w, False

@@ -1,0 +1,318 @@
+"""Mesh-refinement study of one problem: solve on each mesh, draw, record.
+
+:func:`mesh_study` is the loop every demo of the paper's cases runs: solve the problem on
+a sequence of meshes, print each result, keep section A (y = 0) of the free and critical
+modes on the meshes asked for, draw their 3-D modes and the contact set, and write
+ParaView files. :class:`MeshStudy` then draws section A and the convergence of the load
+and writes the results as JSON (the demos' ``results.json``).
+
+Note:
+    :func:`mesh_study` is collective on ``comm``; figures are drawn on rank 0 (the 3-D
+    figures only in serial runs).
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+from mpi4py import MPI
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx import fields, plotting
+from unibuckle_fenicsx.analysis import Analysis, solve
+from unibuckle_fenicsx.config import ProblemSpec
+from unibuckle_fenicsx.results import BucklingResult, write_vtx
+
+__all__ = [
+    "COARSE_MESHES",
+    "PAPER_MESHES",
+    "MeshStudy",
+    "StudyPoint",
+    "all_constrained_load",
+    "check_certified",
+    "demo_arguments",
+    "mesh_study",
+]
+
+#: The meshes of the paper's cases in the demos: 20 x 20 is the paper's, 80 x 80 refined.
+PAPER_MESHES = [(10, 10), (20, 20), (40, 40), (80, 80)]
+#: Their tiny stand-ins for the test suite (``--coarse``).
+COARSE_MESHES = [(4, 4), (8, 8), (16, 16)]
+
+Section = tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]
+
+
+@dataclass
+class StudyPoint:
+    """One mesh of a study.
+
+    Attributes:
+        mesh: (nx, ny).
+        result: The solve's result.
+        section: Section A of the critical mode (kept meshes only).
+        free_section: Section A of the free mode (kept meshes only).
+        extra: What the study's ``at_each`` hook returned for this mesh.
+    """
+
+    mesh: tuple[int, int]
+    result: BucklingResult
+    section: Section | None = None
+    free_section: Section | None = None
+    extra: dict[str, Any] = field(default_factory=dict)
+
+    @property
+    def label(self) -> str:
+        """The mesh as in the file names, e.g. 20x20."""
+        return f"{self.mesh[0]}x{self.mesh[1]}"
+
+
+@dataclass
+class MeshStudy:
+    """The results of :func:`mesh_study`.
+
+    Attributes:
+        name: The problem's name (a paper case: "free", "c1", ...).
+        points: One per mesh, coarsest first.
+        zone: The obstacle zone's box, or None.
+    """
+
+    name: str
+    points: list[StudyPoint]
+    zone: tuple[tuple[float, float], tuple[float, float]] | None
+
+    @property
+    def results(self) -> list[BucklingResult]:
+        """The results, coarsest mesh first."""
+        return [p.result for p in self.points]
+
+    def at(self, mesh: tuple[int, int]) -> StudyPoint:
+        """The point of ``mesh``."""
+        return next(p for p in self.points if p.mesh == tuple(mesh))
+
+    def plot_section(
+        self,
+        path: Path,
+        mesh: tuple[int, int],
+        *,
+        title: str,
+        others: Sequence[tuple[tuple[int, int], str]] = (),
+    ) -> Path:
+        """Section A of the free and critical modes on ``mesh``, plus other meshes' modes.
+
+        The critical mode lies below the obstacle; the free mode is drawn with the sign
+        that matches it. The paper's plate and zones are symmetric about x = 0, so a mode
+        and its mirror image have the same load and a solver may return either: the
+        other curves are reflected onto the side of this one if that matches better
+        (and labelled so).
+        """
+        point = self.at(mesh)
+        assert point.section is not None and point.free_section is not None
+        (xf, wf), (xu, wu) = point.free_section, point.section
+        sign = 1.0 if np.dot(wf, wu) >= 0 else -1.0
+        extra = []
+        for other, label in others:
+            section = self.at(other).section
+            assert section is not None
+            x, w, flipped = fields.mirror_to_match(xu, wu, *section)
+            extra.append((x, w, label + (" (mirrored)" if flipped else "")))
+        return plotting.plot_section(
+            path,
+            xf,
+            sign * wf,
+            xu,
+            wu,
+            zone_x=None if self.zone is None else self.zone[0],
+            title=title,
+            extra=extra,
+        )
+
+    def plot_convergence(self, path: Path, *, title: str, reference: float | None = None,
+                         reference_label: str = "analytic") -> Path:  # fmt: skip
+        """The critical load (and the free load, with an obstacle) against the mesh."""
+        studies = {}
+        if self.zone is not None:
+            studies["free"] = [(*p.mesh, p.result.free_load_Pa) for p in self.points]
+        studies[self.name] = [(*p.mesh, p.result.critical_load_Pa) for p in self.points]
+        return plotting.plot_convergence(
+            path, studies, reference=reference, reference_label=reference_label, title=title
+        )
+
+    def write_json(self, path: Path, **extra: Any) -> Path:
+        """``{"case", "results": [...], **extra}`` as JSON (call on one rank)."""
+        path.parent.mkdir(parents=True, exist_ok=True)
+        summary = {"case": self.name, **extra, "results": [r.as_dict() for r in self.results]}
+        path.write_text(json.dumps(summary, indent=2) + "\n")
+        return path
+
+    def finish(
+        self,
+        figures: Path,
+        paper_mesh: tuple[int, int],
+        refined_mesh: tuple[int, int],
+        title: str,
+        **extra: Any,
+    ) -> None:
+        """Section A and convergence figures, and ``results.json``, of a paper case.
+
+        Section A is drawn on the paper's mesh with the refined mesh's mode; the JSON
+        holds both meshes, section A on the paper's mesh and ``extra``. Call on rank 0.
+        """
+        refined = "x".join(str(n) for n in refined_mesh)
+        self.plot_section(
+            figures / "section_A.png",
+            paper_mesh,
+            title=f"{title}, section A (y = 0), {'x'.join(str(n) for n in paper_mesh)} mesh",
+            others=[(refined_mesh, f"unilateral mode, {refined} mesh")],
+        )
+        self.plot_convergence(
+            figures / "convergence.png", title=f"{title}: convergence of the critical load"
+        )
+        x, w = self.at(paper_mesh).section  # type: ignore[misc]
+        self.write_json(
+            figures / "results.json",
+            paper_mesh=list(paper_mesh),
+            refined_mesh=list(refined_mesh),
+            section_A={"x": x.tolist(), "w": w.tolist()},
+            **extra,
+        )
+
+
+def mesh_study(
+    specs: Sequence[ProblemSpec],
+    *,
+    comm: MPI.Comm,
+    figures: Path,
+    keep: Sequence[tuple[int, int]],
+    output: Path | None = None,
+    contact_mesh: tuple[int, int] | None = None,
+    at_each: Callable[[Analysis], dict[str, Any]] | None = None,
+) -> MeshStudy:
+    """Solve the same problem on each mesh of ``specs`` (see the module docstring).
+
+    Args:
+        specs: The problem on each mesh (same name and zone), coarsest first.
+        comm: Communicator (the mesh is distributed over it).
+        figures: Directory of the PNGs (``mode_<nx>x<ny>.png``, ``contact_set.png``).
+        keep: Meshes whose sections and 3-D modes are kept and drawn.
+        output: Directory of ParaView (VTX) files, per mesh; None writes none.
+        contact_mesh: Mesh whose contact set is drawn (default: the last one).
+        at_each: Called with each solved analysis (before it is destroyed); its dict is
+            stored in the point's ``extra``.
+
+    Returns:
+        The study.
+
+    Note:
+        Collective on ``comm``.
+    """
+    name = specs[0].name
+    contact_mesh = (specs[-1].mesh.nx, specs[-1].mesh.ny) if contact_mesh is None else contact_mesh
+    points: list[StudyPoint] = []
+    zone = None
+    for spec in specs:
+        mesh = (spec.mesh.nx, spec.mesh.ny)
+        with solve(spec, comm) as analysis:
+            problem, result = analysis.problem, analysis.result
+            zone = fields.problem_zone(problem)
+            if comm.rank == 0:
+                print(result.summary(), flush=True)
+            point = StudyPoint(mesh, result)
+            if mesh in keep:
+                point.section = fields.section(problem, analysis.mode)
+                point.free_section = fields.section(problem, analysis.free_mode)
+                if comm.size == 1:
+                    ratio = "" if zone is None else f" = {result.ratio_to_free:.3f} λ_free"
+                    plotting.plot_mode_3d(
+                        problem,
+                        analysis.mode,
+                        figures / f"mode_{point.label}.png",
+                        contact_coordinates=result.contact_coordinates,
+                        title=f"{_title(name)}, {point.label} mesh: "
+                        f"λ = {result.critical_load_Pa / 1e6:.4f} MPa{ratio}",
+                        show_zone=zone is not None,
+                        tau=problem.tau,
+                    )
+            if zone is not None and mesh == contact_mesh:
+                xy, w = fields.nodal_deflection(problem, analysis.mode)
+                assert problem.contact is not None
+                if comm.rank == 0:
+                    plotting.plot_contact_set(
+                        figures / "contact_set.png",
+                        xy,
+                        w,
+                        corners=spec.plate.corners,
+                        zone=zone,
+                        constrained=problem.contact.coordinates,
+                        contact_coordinates=result.contact_coordinates,
+                        title=f"{_title(name)}: contact set on the {point.label} mesh",
+                        tau=problem.tau,
+                    )
+            if output is not None:
+                write_vtx(analysis, output / name / point.label)
+            if at_each is not None:
+                point.extra = at_each(analysis)
+        points.append(point)
+    return MeshStudy(name, points, zone)
+
+
+def _title(name: str) -> str:
+    return "free plate" if name == "free" else f"obstacle {name}"
+
+
+def demo_arguments(description: str) -> argparse.Namespace:
+    """The demos' command line: ``--coarse``, ``--figures DIR``, ``--output DIR``.
+
+    Unknown arguments are left for PETSc. ``UNIBUCKLE_DEMO_COARSE=1`` also selects the
+    coarse meshes (for the test suite).
+    """
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument(
+        "--coarse",
+        action="store_true",
+        default=os.environ.get("UNIBUCKLE_DEMO_COARSE") == "1",
+        help="tiny meshes (for the tests)",
+    )
+    parser.add_argument("--figures", type=Path, default=Path("figures"), help="PNG directory")
+    parser.add_argument("--output", type=Path, default=None, help="VTX (ParaView) directory")
+    args, _ = parser.parse_known_args()
+    return args
+
+
+def all_constrained_load(mesh: tuple[int, int]) -> Callable[[Analysis], dict[str, float]]:
+    """An ``at_each`` hook: on ``mesh``, λ(Z = I), every constrained node held at w = 0.
+
+    By interlacing (removing DOFs never lowers the smallest eigenvalue) it bounds the
+    unilateral load from above.
+    """
+
+    def hook(analysis: Analysis) -> dict[str, float]:
+        problem = analysis.problem
+        if (problem.spec.mesh.nx, problem.spec.mesh.ny) != tuple(mesh):
+            return {}
+        everything = np.arange(problem.num_constrained, dtype=np.int64)
+        return {"upper_bound_all_constrained_Pa": problem.evaluate(everything).load}
+
+    return hook
+
+
+def check_certified(results: Sequence[BucklingResult], rtol: float) -> None:
+    """Assert every result's certificate: KKT, smallest eigenvalue, a valid bracket.
+
+    Raises:
+        AssertionError: A result is not certified, or its load lies below the free load
+            (the obstacle never lowers it: interlacing) by more than ``rtol``.
+    """
+    for r in results:
+        cert = r.certificate
+        assert cert is not None and cert["kkt"], f"{r.mesh}: certificate fails: {cert}"
+        assert cert["smallest_of_reduced"], f"{r.mesh}: not the smallest eigenvalue: {cert}"
+        assert r.critical_load_Pa >= r.free_load_Pa * (1 - rtol), (r.mesh, r.ratio_to_free)
+        assert r.lower_bound_Pa is not None and r.lower_bound_Pa >= r.free_load_Pa * (1 - rtol)
