@@ -111,7 +111,7 @@ if comm.rank == 0:
         REFINED_MESH,
         "Obstacle c2",
         upper_bound_all_constrained_Pa=upper_bound,
-        stop_rule_8x8={name: r.as_dict() for name, r in stop_rule.items()},
+        stop_rule_8x8={name: r.as_dict(timings=False) for name, r in stop_rule.items()},
     )
 
 # %% [markdown]

@@ -48,7 +48,6 @@ COLUMNS = (
     "|Z|",
     "method",
     "eigen solves",
-    "wall time (s)",
     "certificate",
 )
 
@@ -59,7 +58,7 @@ def _row(r: dict[str, Any]) -> list[str]:
         verdict = "-"
     else:
         verdict = ("KKT" if cert.get("kkt") else "FAILS") + (
-            ", proven" if cert.get("global_optimum_proven") else ""
+            f", proven ({cert.get('proven_by')})" if cert.get("global_optimum_proven") else ""
         )
     return [
         r["case"],
@@ -71,7 +70,6 @@ def _row(r: dict[str, Any]) -> list[str]:
         str(r["contact_nodes"]),
         r["method"],
         str(r["eigensolves"]),
-        f"{r['wall_time_s']:.2f}",
         verdict,
     ]
 

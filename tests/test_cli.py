@@ -6,7 +6,6 @@ kind of exit checks the installed console script itself.
 
 from __future__ import annotations
 
-import argparse
 import json
 import math
 import os
@@ -15,9 +14,10 @@ import subprocess
 import sys
 from pathlib import Path
 
+import numpy as np
 import pytest
 
-from unibuckle_fenicsx.cli import _parser, main
+from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED, EXIT_OK, _parser, main
 from unibuckle_fenicsx.materials import navier_load_mindlin
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
@@ -75,13 +75,19 @@ def test_help(tmp_path):
         "--json",
         "--output",
         "--verbose",
+        "--quiet",
+        "--no-certify",
+        "--max-iterations",
+        "--bound-budget",
+        "--enumeration-budget",
     )
     for flag in flags:
         assert flag in sub.stdout, flag
+    # The exit statuses are documented.
+    for status in (EXIT_OK, EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED):
+        assert f"\n  {status}  " in sub.stdout
     # Every flag is explained: each option of the sub-command carries a help text.
-    solve_parser = next(
-        a for a in _parser()._actions if isinstance(a, argparse._SubParsersAction)
-    ).choices["solve"]
+    _, solve_parser = _parser()
     for action in solve_parser._actions:
         assert action.help, action.option_strings
 
@@ -90,7 +96,10 @@ def test_solve_free_case_writes_json(tmp_path, capsys):
     out = tmp_path / "sub" / "free.json"
     assert main(["solve", "--case", "free", "--nx", "20", "--ny", "10", "--json", str(out)]) == 0
     stdout = capsys.readouterr().out.strip().splitlines()
-    assert len(stdout) == 1 and stdout[0].startswith("free: lambda_c = ")
+    assert len(stdout) == 2 and stdout[0].startswith("free: lambda_c = ")
+    assert (
+        stdout[1] == "  edge stress per unit lambda (tension > 0): left normal -1; right normal -1"
+    )
     data = json.loads(out.read_text())
     for key in REQUIRED:
         assert key in data, key
@@ -198,6 +207,13 @@ def test_usage_errors_exit_2(args, capsys):
     assert "usage: unibuckle" in capsys.readouterr().err
 
 
+def test_unknown_flag_after_solve_shows_the_solve_usage(capsys):
+    with pytest.raises(SystemExit):
+        main(["solve", "--case", "free", "--no-such-flag"])
+    err = capsys.readouterr().err
+    assert "usage: unibuckle solve" in err and "--no-such-flag" in err
+
+
 def test_console_script_exit_status(tmp_path):
     """The installed script: 2 with the message on stderr for bad input, 0 otherwise."""
     path = tmp_path / "bad.toml"
@@ -208,4 +224,147 @@ def test_console_script_exit_status(tmp_path):
     good = run_script("solve", "--case", "free", "--nx", "8", "--ny", "4", cwd=tmp_path)
     assert good.returncode == 0, good.stderr
     assert good.stdout.startswith("free: lambda_c = ")
+    assert "Traceback" not in bad.stderr + good.stderr
     assert list(tmp_path.iterdir()) == [path]  # no stray files in the working directory
+
+
+# -- input a user can trust: refused early, with the parameter or file named --------------
+@pytest.fixture
+def no_solve(monkeypatch):
+    """Fail the test if a solve starts: bad input must be refused before any work."""
+    import unibuckle_fenicsx.analysis
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the solve started")
+
+    monkeypatch.setattr(unibuckle_fenicsx.analysis, "solve", refuse)
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ('[solver]\ncomplete = "false"\n', r"solver\.complete must be true or false"),
+        ('[material]\nE = "abc"\nnu = 0.3\n', r"material\.E must be a number, got 'abc'"),
+        ('[plate]\nthickness = "thin"\n', r"plate\.thickness must be a number"),
+        ('[solver]\nmax_candidates = "many"\n', r"solver\.max_candidates must be an integer"),
+        ("[plate\n", r"invalid TOML"),
+        ("[obstacle]\n", r"\[obstacle\] needs zone"),
+    ],
+)
+def test_bad_file_exits_2_naming_key_and_file(tmp_path, capsys, no_solve, text, match):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    assert main(["solve", "--config", str(path)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert re.search(match, err) and str(path) in err, err
+    assert "Traceback" not in err
+
+
+@pytest.mark.parametrize("flag", ["--json", "--output"])
+def test_unwritable_output_is_refused_before_solving(tmp_path, capsys, no_solve, flag):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    target = blocker / "sub" / ("out.json" if flag == "--json" else "vtx")
+    assert main(["solve", "--case", "c1", flag, str(target)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"{flag}: {blocker} is not a directory" in err, err
+
+
+def test_one_cell_and_huge_meshes_are_refused(capsys, monkeypatch):
+    """--nx 1 names mesh.nx; a 100000 x 100000 mesh is refused with its memory estimate."""
+    import unibuckle_fenicsx.problem as problem_module
+
+    assert main(["solve", "--case", "free", "--nx", "1"]) == EXIT_BAD_INPUT
+    assert "mesh.nx must be an integer >= 2" in capsys.readouterr().err
+
+    def no_mesh(*args, **kwargs):
+        raise AssertionError("the mesh was built")
+
+    monkeypatch.setattr(problem_module, "create_plate_mesh", no_mesh)
+    assert main(["solve", "--case", "free", "--nx", "100000", "--ny", "100000"]) == 2
+    err = capsys.readouterr().err
+    assert "30,000,600,003 DOFs" in err and "GB" in err and "available" in err, err
+
+
+def test_plate_far_from_the_origin(tmp_path, capsys):
+    """Translation invariance: the plate at (1000, 2000) m has the load of the one at 0."""
+    loads = []
+    for corners in ("[[1000.0, 2000.0], [1000.2, 2000.1]]", "[[0.0, 0.0], [0.2, 0.1]]"):
+        path = tmp_path / "plate.toml"
+        path.write_text(f"[plate]\ncorners = {corners}\n[mesh]\nnx = 20\nny = 10\n")
+        out = tmp_path / "out.json"
+        assert main(["solve", "--config", str(path), "--json", str(out)]) == EXIT_OK
+        loads.append(json.loads(out.read_text())["critical_load_Pa"])
+    assert loads[0] == pytest.approx(loads[1], rel=1e-9)
+
+
+def test_mm_file_prints_mpa_and_solves_the_same_problem(tmp_path, capsys):
+    path = tmp_path / "mm.toml"
+    path.write_text(
+        'units = "mm-N-MPa"\n[plate]\ncorners = [[-100.0, -50.0], [100.0, 50.0]]\n'
+        "thickness = 6.0\n[material]\nE = 1000.0\nnu = 0.3\n[mesh]\nnx = 8\nny = 4\n"
+    )
+    out_mm, out_si = tmp_path / "mm.json", tmp_path / "si.json"
+    assert main(["solve", "--config", str(path), "--json", str(out_mm)]) == EXIT_OK
+    line = capsys.readouterr().out.splitlines()[0]
+    assert re.search(r"lambda_c = 1\.\d+e\+01 MPa", line), line
+    assert main(["solve", "--case", "free", "--nx", "8", "--ny", "4", "--json", str(out_si)]) == 0
+    mm, si = (json.loads(p.read_text()) for p in (out_mm, out_si))
+    assert mm["units"] == "mm-N-MPa" and mm["input"]["units"] == "SI"
+    assert mm["critical_load_Pa"] == pytest.approx(si["critical_load_Pa"], rel=1e-12)
+
+
+def test_options_that_do_not_apply_are_named(capsys):
+    args = ["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--method", "active-set"]
+    assert main([*args, "--complete", "--until-proven", "--penalty", "5"]) == EXIT_OK
+    err = capsys.readouterr().err
+    for flag in ("--complete", "--until-proven", "--penalty"):
+        assert re.search(rf"warning: {flag} \(applies to --method \w+\) is ignored", err), err
+
+
+def test_candidate_parallel_under_auto_enumerates(capsys):
+    """--candidate-parallel with no method: auto runs the enumeration (i = 3 here)."""
+    assert main(["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--candidate-parallel"]) == 0
+    assert "method enumerate" in capsys.readouterr().out
+    assert main(["solve", "--case", "c1", "--candidate-parallel"]) == EXIT_BAD_INPUT
+    assert "--candidate-parallel runs the enumeration" in capsys.readouterr().err
+
+
+def test_progress_lines_and_quiet(capsys):
+    """Enumeration reports each size p on stderr; -q keeps stderr empty."""
+    args = ["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--method", "enumerate"]
+    assert main([*args, "--until-proven"]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert "enumeration p = 0 done: 1 sets" in err and "enumeration p = 1 done: 3 sets" in err
+    assert main([*args, "--until-proven", "-q"]) == EXIT_OK
+    assert capsys.readouterr().err == ""
+
+
+def test_json_says_what_it_solved_and_reruns(tmp_path, capsys):
+    """The JSON holds input, versions and why auto chose; --config on it gives the same load."""
+    out, again = tmp_path / "c2.json", tmp_path / "again.json"
+    assert main(["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["input"]["mesh"] == {"nx": 8, "ny": 4}
+    assert data["input"]["obstacle"] == {"zone": [[-0.04, 0.04], [-0.02, 0.02]]}
+    assert data["input"]["solver"]["tau"] == 1e-8  # defaults included
+    for key in ("unibuckle_fenicsx", "dolfinx", "PETSc", "SLEPc", "python"):
+        assert key in data["versions"], key
+    assert data["method"] == "enumerate"
+    assert data["method_chosen_by"].startswith("auto: 2^3 = 8 candidate sets")
+    assert main(["solve", "--config", str(out), "--json", str(again)]) == EXIT_OK
+    rerun = json.loads(again.read_text())
+    assert rerun["critical_load_Pa"] == data["critical_load_Pa"]
+    assert rerun["contact_indices"] == data["contact_indices"]
+
+
+def test_output_is_readable_by_pyvista(tmp_path, capsys):
+    """--output writes VTK (.pvd) next to the VTX (.bp) files; pyvista reads the fields."""
+    pv = pytest.importorskip("pyvista")
+    args = ["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--output", str(tmp_path / "o")]
+    assert main(args) == EXIT_OK
+    mesh = pv.read(tmp_path / "o" / "c2.pvd")
+    block = mesh[0] if isinstance(mesh, pv.MultiBlock) else mesh
+    for name in ("w", "w_free", "obstacle_zone", "contact", "theta"):
+        assert name in block.point_data, name
+    assert np.abs(block.point_data["w"]).max() == pytest.approx(1.0)

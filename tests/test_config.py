@@ -9,10 +9,12 @@ from __future__ import annotations
 import math
 from dataclasses import FrozenInstanceError
 
+import numpy as np
 import pytest
 
 from unibuckle_fenicsx.cases import CASES, paper_case
 from unibuckle_fenicsx.config import (
+    EDGE_NAMES,
     EdgeSpec,
     Material,
     MeshSpec,
@@ -22,6 +24,7 @@ from unibuckle_fenicsx.config import (
     SolverSpec,
     load_toml,
     problem_from_dict,
+    problem_to_dict,
 )
 
 # A problem file in the README's schema ("Problem files"): the paper's case c1.
@@ -99,9 +102,10 @@ def test_bad_edge(kwargs, name):
         EdgeSpec("left", **kwargs)
 
 
-@pytest.mark.parametrize("n", [0, -3, 2.5, True])
+@pytest.mark.parametrize("n", [0, 1, -3, 2.5, True, "8"])
 def test_bad_mesh(n):
-    with pytest.raises(ValueError, match=r"mesh\.nx"):
+    """At least two cells a side: one cell cannot carry a buckle (w = 0 on its edges)."""
+    with pytest.raises(ValueError, match=r"mesh\.nx must be an integer >= 2"):
         MeshSpec(nx=n, ny=4)
 
 
@@ -116,6 +120,13 @@ def test_bad_mesh(n):
         ({"penalty": -1.0}, r"solver\.penalty"),
         ({"prestress_degree": 0}, r"solver\.prestress_degree"),
         ({"shear": "reduced"}, r"solver\.shear"),
+        ({"complete": "false"}, r"solver\.complete must be true or false, got 'false'"),
+        ({"max_candidates": "many"}, r"solver\.max_candidates must be an integer"),
+        ({"tau": "1e-8"}, r"solver\.tau must be a number, got '1e-8'"),
+        ({"max_iterations": 0}, r"solver\.max_iterations"),
+        ({"bound_budget": -1}, r"solver\.bound_budget"),
+        ({"enumeration_budget_s": 0.0}, r"solver\.enumeration_budget_s"),
+        ({"certify": 1}, r"solver\.certify must be true or false"),
     ],
 )
 def test_bad_solver_option(kwargs, name):
@@ -178,7 +189,8 @@ def test_toml_all_zone_edges_and_solver(tmp_path):
     assert spec.obstacle == ObstacleSpec(zone="all")
     left = spec.plate.edge("left")
     assert (left.support, left.inplane, left.loaded) == ("clamped", "clamped", False)
-    assert spec.plate.edge("right").normal_stress == -1.0  # paper default kept
+    # The file sets a load on the left edge (zero): no other edge is loaded either.
+    assert spec.plate.edge("right").normal_stress == 0.0
     assert spec.plate.edge("top").support == "free"
     assert (spec.solver.method, spec.solver.tau, spec.solver.shear) == ("active-set", 1e-6, "full")
 
@@ -243,3 +255,75 @@ def test_obstacle_box_contains_closed_zone():
     zone = ObstacleSpec(zone=((-0.04, 0.04), (-0.02, 0.02)))
     x = np.array([[-0.04, 0.04, 0.0, 0.0400001, 0.0], [0.02, -0.02, 0.0, 0.0, -0.0200001], [0] * 5])
     assert zone.contains(x, 0.2).tolist() == [True, True, True, False, False]
+
+
+# -- types, units and the load rule of problem files --------------------------------------
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ('[material]\nE = "abc"\nnu = 0.3\n', r"material\.E must be a number, got 'abc'"),
+        ('[plate]\nthickness = "thin"\n', r"plate\.thickness must be a number, got 'thin'"),
+        ('[solver]\ncomplete = "false"\n', r"solver\.complete must be true or false"),
+        ('[solver]\nmax_candidates = "many"\n', r"solver\.max_candidates must be an integer"),
+        ("[mesh]\nnx = 8.0\n", r"mesh\.nx must be an integer"),
+        ('[edges.left]\nnormal_stress = "-1"\n', r"edges\.left\.normal_stress must be a number"),
+        ('[obstacle]\nzone = [["a", 1], [0, 1]]\n', r"obstacle\.zone must be a number"),
+        ("[obstacle]\ntolerance = 1e-9\n", r"\[obstacle\] needs zone"),
+        ("name = 3\n", r"name must be a string"),
+        ('units = "inch"\n', r"units must be one of \('SI', 'mm-N-MPa'\)"),
+    ],
+)
+def test_toml_types_are_checked_and_the_file_named(tmp_path, text, match):
+    path = tmp_path / "typed.toml"
+    path.write_text(text)
+    with pytest.raises(ValueError, match=match) as err:
+        load_toml(path)
+    assert str(err.value).startswith(f"{path}: ")
+
+
+def test_toml_syntax_error_and_binary_file_name_the_file(tmp_path):
+    bad = tmp_path / "broken.toml"
+    bad.write_text("[plate\nthickness = 0.006\n")
+    with pytest.raises(ValueError, match=rf"{bad}: invalid TOML"):
+        load_toml(bad)
+    binary = tmp_path / "latin1.toml"
+    binary.write_bytes('name = "pl\u00e4te"\n'.encode("latin-1"))
+    with pytest.raises(ValueError, match=rf"{binary}: not a UTF-8 text file"):
+        load_toml(binary)
+
+
+def test_mm_units_convert_to_si(tmp_path):
+    """The paper's c1 in mm, N and MPa reads as the same SI problem (and prints MPa)."""
+    path = tmp_path / "mm.toml"
+    path.write_text(
+        'units = "mm-N-MPa"\n'
+        "[plate]\ncorners = [[-100.0, -50.0], [100.0, 50.0]]\nthickness = 6.0\n"
+        "[material]\nE = 1000.0\nnu = 0.3\n"
+        "[obstacle]\nzone = [[-40.0, 40.0], [-50.0, 50.0]]\ntolerance = 1e-6\n"
+    )
+    spec = load_toml(path)
+    si = paper_case("c1")
+    assert spec.units == "mm-N-MPa" and spec.stress_unit == (1e6, "MPa")
+    np.testing.assert_allclose(spec.plate.corners, si.plate.corners, rtol=1e-15)
+    assert spec.plate.thickness == pytest.approx(si.plate.thickness, rel=1e-15)
+    assert spec.material.E == pytest.approx(si.material.E, rel=1e-15)
+    np.testing.assert_allclose(spec.obstacle.zone, si.obstacle.zone, rtol=1e-15)
+    assert spec.obstacle.tolerance == pytest.approx(1e-9, rel=1e-15)
+
+
+def test_edge_loads_default_to_zero_once_a_file_sets_one():
+    """A file that loads one edge loads only the edges it names (README, "Problem files")."""
+    shear = {"edges": {e: {"shear_stress": 1.0, "normal_stress": 0.0} for e in EDGE_NAMES}}
+    spec = problem_from_dict({"material": {"E": 1e9, "nu": 0.3}, **shear})
+    assert [e.normal_stress for e in spec.plate.edges] == [0.0] * 4
+    only_left = problem_from_dict({"edges": {"left": {"shear_stress": 1.0}}})
+    assert only_left.plate.edge("right").normal_stress == 0.0
+    assert only_left.plate.edge("left").normal_stress == 0.0
+    supports_only = problem_from_dict({"edges": {"top": {"support": "clamped"}}})
+    assert [e.normal_stress for e in supports_only.plate.edges] == [-1.0, -1.0, 0.0, 0.0]
+
+
+def test_problem_to_dict_round_trip():
+    """problem_from_dict(problem_to_dict(spec)) gives spec back, defaults included."""
+    for spec in (paper_case("c2", 12, 6), paper_case("free").with_solver(method="penalty")):
+        assert problem_from_dict(problem_to_dict(spec)) == spec

@@ -23,15 +23,54 @@ __all__ = ["Analysis", "choose_method", "solve"]
 logger = logging.getLogger(__name__)
 
 
-def choose_method(spec: ProblemSpec, i: int) -> str:
-    """The method "auto" resolves to: enumeration when 2^i <= max_candidates.
+def choose_method(
+    spec: ProblemSpec, i: int, solve_time_s: float, *, candidate_parallel: bool = False
+) -> tuple[str, str]:
+    """The method to run, and why ("auto" decides by estimated cost).
 
-    "auto" enumerates with ``until_proven`` (exact), "enumerate" alone follows the
-    paper's stopping rule.
+    "auto" enumerates (with ``until_proven``: exact) when the 2^i candidate sets are at
+    most ``max_candidates`` and their estimated time, 2^i times ``solve_time_s`` (the
+    measured time of one eigen solve), is at most ``enumeration_budget_s``; otherwise it
+    runs the active-set method. "enumerate" alone follows the paper's stopping rule.
+
+    Raises:
+        ValueError: ``candidate_parallel`` with a method other than enumeration, or with
+            more candidate sets than ``max_candidates``.
     """
-    if spec.solver.method != "auto":
-        return spec.solver.method
-    return "enumerate" if candidate_count(i) <= spec.solver.max_candidates else "active-set"
+    options = spec.solver
+    count = candidate_count(i)
+    estimate = count * solve_time_s
+    if candidate_parallel:
+        if options.method not in ("auto", "enumerate"):
+            raise ValueError(
+                f"--candidate-parallel splits the enumeration's candidate sets: it needs "
+                f'method "enumerate" or "auto", not {options.method!r}'
+            )
+        if count > options.max_candidates:
+            raise ValueError(
+                f"--candidate-parallel runs the enumeration, but i = {i} constrained nodes "
+                f"give 2^{i} = {count} candidate sets, above max_candidates = "
+                f"{options.max_candidates}: drop --candidate-parallel (the active-set "
+                "method distributes the mesh instead)"
+            )
+        return "enumerate", f"--candidate-parallel: 2^{i} = {count} candidate sets"
+    if options.method != "auto":
+        return options.method, "given"
+    if count > options.max_candidates:
+        return "active-set", (
+            f"auto: 2^{i} = {count} candidate sets exceed max_candidates = {options.max_candidates}"
+        )
+    if estimate > options.enumeration_budget_s:
+        return "active-set", (
+            f"auto: enumerating 2^{i} = {count} sets would take about {estimate:.3g} s "
+            f"({solve_time_s:.3g} s per eigen solve), above enumeration_budget_s = "
+            f"{options.enumeration_budget_s:g}"
+        )
+    return "enumerate", (
+        f"auto: 2^{i} = {count} candidate sets, about {estimate:.3g} s "
+        f"({solve_time_s:.3g} s per eigen solve), within enumeration_budget_s = "
+        f"{options.enumeration_budget_s:g}"
+    )
 
 
 def _run_method(
@@ -52,7 +91,10 @@ def _run_method(
     if method == "active-set":
         from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 
-        return solve_active_set(problem)
+        options = problem.spec.solver
+        return solve_active_set(
+            problem, max_iterations=options.max_iterations, bound_budget=options.bound_budget
+        )
     if method == "penalty":
         from unibuckle_fenicsx.algorithms.penalty import solve_penalty
 
@@ -135,18 +177,19 @@ def solve(
         mesh=mesh,
         facet_tags=facet_tags,
     )
+    t_free = time.perf_counter()
     free = problem.solve_free()
+    t_free = comm.allreduce(time.perf_counter() - t_free, op=MPI.MAX)
     solution: UnilateralSolution | None = None
     certificate: Certificate | None = None
-    method = "free"
+    method, reason = "free", "no obstacle"
     if problem.contact is not None:
-        method = choose_method(spec, problem.num_constrained)
-        if candidate_parallel and method != "enumerate":
-            raise ValueError(
-                'candidate_parallel runs need method "enumerate"; distribute the mesh '
-                "for the other methods"
-            )
-        logger.info("i = %d constrained nodes; method %s", problem.num_constrained, method)
+        method, reason = choose_method(
+            spec, problem.num_constrained, t_free, candidate_parallel=candidate_parallel
+        )
+        logger.info(
+            "i = %d constrained nodes; method %s (%s)", problem.num_constrained, method, reason
+        )
         solution = _run_method(method, problem, comm if candidate_parallel else None)
         if not math.isfinite(solution.load):
             raise RuntimeError(f"{spec.name}: no finite critical load was found")
@@ -162,4 +205,5 @@ def solve(
         wall_time_s=time.perf_counter() - t0,
         mpi_size=comm.size,
     )
+    result.method_chosen_by = reason
     return Analysis(result, problem, solution, certificate)

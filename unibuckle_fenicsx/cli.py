@@ -8,13 +8,36 @@ from __future__ import annotations
 
 import argparse
 import logging
+import os
 import sys
 from collections.abc import Sequence
+from pathlib import Path
+from typing import Any
 
-__all__ = ["main"]
+__all__ = ["EXIT_BAD_INPUT", "EXIT_NOT_CERTIFIED", "EXIT_OK", "main"]
+
+#: A certified critical state was found.
+EXIT_OK = 0
+#: The input was refused (the message names the parameter); nothing was solved.
+EXIT_BAD_INPUT = 2
+#: A numerical difficulty: no certified critical state (the JSON holds what was found).
+EXIT_NOT_CERTIFIED = 3
+
+EPILOG = f"""\
+exit status:
+  {EXIT_OK}  a critical state satisfying its certificate (KKT) was found
+  {EXIT_BAD_INPUT}  bad input (the message names the parameter and the allowed range);
+     nothing was computed
+  {EXIT_NOT_CERTIFIED}  a numerical difficulty: no certified critical state; the JSON (--json)
+     still holds the best admissible load found (an upper bound), the lower bound and a
+     certificate saying what failed
+
+Single-dash options that argparse does not know go to PETSc/SLEPc under the package's
+prefixes, e.g. -unibuckle_eps_view, -unibuckle_eps_tol 1e-12, -unibuckle_certify_ksp_view.
+"""
 
 
-def _parser() -> argparse.ArgumentParser:
+def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     parser = argparse.ArgumentParser(
         prog="unibuckle",
         description=(
@@ -29,6 +52,8 @@ def _parser() -> argparse.ArgumentParser:
         "solve",
         help="solve one problem (a paper case or a TOML file)",
         description="Compute the critical load of one problem and print a one-line summary.",
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     src = s.add_mutually_exclusive_group(required=True)
     src.add_argument(
@@ -37,14 +62,19 @@ def _parser() -> argparse.ArgumentParser:
         help="the paper's plate: free (no obstacle), c1 = [-0.04,0.04]x[-0.05,0.05], "
         "c2 = [-0.04,0.04]x[-0.02,0.02], c3 = whole plate",
     )
-    src.add_argument("--config", metavar="TOML", help="problem file (schema in the README)")
-    s.add_argument("--nx", type=int, help="cells along x (default: paper 20, or the TOML's)")
-    s.add_argument("--ny", type=int, help="cells along y (default: paper 20, or the TOML's)")
+    src.add_argument(
+        "--config",
+        metavar="FILE",
+        help="problem file: TOML (schema in the README), or a result JSON to re-run its input",
+    )
+    s.add_argument("--nx", type=int, help="cells along x, >= 2 (default: paper 20, or the TOML's)")
+    s.add_argument("--ny", type=int, help="cells along y, >= 2 (default: paper 20, or the TOML's)")
     s.add_argument(
         "--method",
         choices=["auto", "enumerate", "active-set", "penalty"],
-        help="unilateral algorithm (default auto: exact enumeration if 2^i <= "
-        "--max-candidates, else active-set; enumerate alone = the paper's stopping rule)",
+        help="unilateral algorithm (default auto: exact enumeration when 2^i <= "
+        "--max-candidates and its estimated time fits --enumeration-budget, else "
+        "active-set; enumerate alone = the paper's stopping rule)",
     )
     s.add_argument(
         "--complete",
@@ -64,6 +94,29 @@ def _parser() -> argparse.ArgumentParser:
         help="enumerate: refuse above N candidate sets (default 100000)",
     )
     s.add_argument(
+        "--enumeration-budget",
+        type=float,
+        metavar="SECONDS",
+        help="auto: enumerate only if the estimated time is below this (default 60)",
+    )
+    s.add_argument(
+        "--max-iterations",
+        type=int,
+        metavar="N",
+        help="active-set: iterates per seed and mesh level (default 100)",
+    )
+    s.add_argument(
+        "--bound-budget",
+        type=int,
+        metavar="N",
+        help="active-set: eigen solves for the lattice lower bound (default 64)",
+    )
+    s.add_argument(
+        "--no-certify",
+        action="store_true",
+        help="skip the global-optimality certificate (for speed studies; KKT is still checked)",
+    )
+    s.add_argument(
         "--penalty",
         type=float,
         metavar="RHO",
@@ -80,19 +133,93 @@ def _parser() -> argparse.ArgumentParser:
     s.add_argument(
         "--output",
         metavar="DIR",
-        help="write the mode, obstacle zone and contact set as VTX (.bp) for ParaView",
+        help="write the mode, obstacle zone and contact set for ParaView (VTX .bp) and "
+        "as VTK (.pvd/.vtu, readable by pyvista.read)",
     )
     s.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
-    return parser
+    s.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
+    return parser, s
+
+
+#: Flags that matter only for some methods: flag -> (methods, SolverSpec field).
+_METHOD_FLAGS = {
+    "--complete": (("enumerate",), "complete"),
+    "--until-proven": (("enumerate",), "until_proven"),
+    "--max-candidates": (("enumerate", "auto"), "max_candidates"),
+    "--enumeration-budget": (("auto",), "enumeration_budget_s"),
+    "--max-iterations": (("active-set", "auto"), "max_iterations"),
+    "--bound-budget": (("active-set", "auto"), "bound_budget"),
+    "--penalty": (("penalty",), "penalty"),
+}
+
+
+def _solver_changes(args: argparse.Namespace) -> tuple[dict[str, Any], list[str]]:
+    """SolverSpec changes from the flags, and the flags that do not apply to the method."""
+    values = {
+        "--complete": args.complete or None,
+        "--until-proven": args.until_proven or None,
+        "--max-candidates": args.max_candidates,
+        "--enumeration-budget": args.enumeration_budget,
+        "--max-iterations": args.max_iterations,
+        "--bound-budget": args.bound_budget,
+        "--penalty": args.penalty,
+    }
+    changes: dict[str, Any] = {
+        k: v for k, v in {"method": args.method, "tau": args.tau}.items() if v is not None
+    }
+    if args.no_certify:
+        changes["certify"] = False
+    ignored = []
+    method = args.method or "auto"
+    for flag, value in values.items():
+        if value is None:
+            continue
+        methods, name = _METHOD_FLAGS[flag]
+        changes[name] = value
+        if method not in methods and not (method == "auto" and "enumerate" in methods):
+            ignored.append(f"{flag} (applies to --method {' or '.join(methods)})")
+    return changes, ignored
+
+
+def _check_writable(args: argparse.Namespace) -> str | None:
+    """Why --json or --output cannot be written, or None (before any solve)."""
+    targets = []
+    if args.json:
+        targets.append(("--json", Path(args.json).parent))
+    if args.output:
+        targets.append(("--output", Path(args.output)))
+    for flag, directory in targets:
+        existing = directory
+        while not existing.exists() and existing != existing.parent:
+            existing = existing.parent
+        if not existing.is_dir():
+            return f"{flag}: {existing} is not a directory"
+        if not os.access(existing, os.W_OK | os.X_OK):
+            return f"{flag}: cannot write in {existing} (permission denied)"
+    if args.json and Path(args.json).is_dir():
+        return f"--json: {args.json} is a directory"
+    return None
+
+
+def _logging(verbose: int, quiet: bool, rank: int) -> None:
+    handler = logging.StreamHandler(sys.stderr)
+    handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    root = logging.getLogger()
+    root.handlers[:] = [handler]
+    root.setLevel([logging.WARNING, logging.INFO, logging.DEBUG][min(verbose, 2)])
+    progress = logging.getLogger("unibuckle_fenicsx.progress")
+    quiet = quiet or rank != 0
+    progress.setLevel(logging.WARNING if quiet else min(root.level, logging.INFO))
 
 
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    args, rest = _parser().parse_known_args(argv)
+    parser, solve_parser = _parser()
+    args, rest = parser.parse_known_args(argv)
     unknown = [a for a in rest if a.startswith("--")]
     if unknown:
-        _parser().error(f"unrecognized arguments: {' '.join(unknown)}")
+        solve_parser.error(f"unrecognized arguments: {' '.join(unknown)}")
 
     import petsc4py
     from mpi4py import MPI  # before petsc4py: loads libmpi
@@ -101,51 +228,63 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.cases import paper_case
-    from unibuckle_fenicsx.config import load_toml
-    from unibuckle_fenicsx.results import write_json, write_vtx
+    from unibuckle_fenicsx.config import load_problem
+    from unibuckle_fenicsx.eigen import EigenSolveError
+    from unibuckle_fenicsx.results import write_fields, write_json
 
     comm = MPI.COMM_WORLD
-    logging.basicConfig(
-        level=[logging.WARNING, logging.INFO, logging.DEBUG][min(args.verbose, 2)],
-        format="%(levelname)s %(name)s: %(message)s",
-    )
+    _logging(args.verbose, args.quiet, comm.rank)
+
+    def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
+        if comm.rank == 0:
+            print(f"unibuckle: error: {message}", file=sys.stderr)
+        return status
+
+    problem = comm.bcast(_check_writable(args) if comm.rank == 0 else None, root=0)
+    if problem is not None:
+        return fail(problem)
     try:
-        spec = paper_case(args.case) if args.case else load_toml(args.config)
+        spec = paper_case(args.case) if args.case else load_problem(args.config)
         if args.nx is not None or args.ny is not None:
             spec = spec.with_mesh(
                 spec.mesh.nx if args.nx is None else args.nx,
                 spec.mesh.ny if args.ny is None else args.ny,
             )
-        changes = {
-            "method": args.method,
-            "max_candidates": args.max_candidates,
-            "penalty": args.penalty,
-            "tau": args.tau,
-        }
-        changes = {k: v for k, v in changes.items() if v is not None}
-        if args.complete:
-            changes["complete"] = True
-        if args.until_proven:
-            changes["until_proven"] = True
+        changes, ignored = _solver_changes(args)
         spec = spec.with_solver(**changes)
     except (ValueError, OSError) as err:
-        if comm.rank == 0:
-            print(f"unibuckle: error: {err}", file=sys.stderr)
-        return 2
+        return fail(str(err))
+    if ignored and comm.rank == 0:
+        method = spec.solver.method
+        for flag in ignored:
+            print(f"unibuckle: warning: {flag} is ignored with --method {method}", file=sys.stderr)
     try:
         analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
     except ValueError as err:
-        if comm.rank == 0:
-            print(f"unibuckle: error: {err}", file=sys.stderr)
-        return 2
+        return fail(str(err))
+    except EigenSolveError as err:
+        return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
     with analysis:
         if args.output:
-            write_vtx(analysis, args.output)
+            write_fields(analysis, args.output)
+    result = analysis.result
+    status = EXIT_OK
+    certificate = result.certificate
+    if certificate is not None and not certificate["kkt"]:
+        status = EXIT_NOT_CERTIFIED
     if comm.rank == 0:
-        print(analysis.result.summary())
         if args.json:
-            write_json(analysis.result, args.json)
-    return 0
+            write_json(result, args.json)
+        print(result.summary(), flush=True)
+        if status != EXIT_OK:
+            notes = "; ".join((certificate or {}).get("notes", [])) or "see the certificate"
+            print(
+                f"unibuckle: error: no certified critical state ({notes}); the bracket "
+                f"[{result.lower_bound_Pa}, {result.upper_bound_Pa}] Pa is "
+                + (f"in {args.json}" if args.json else "above"),
+                file=sys.stderr,
+            )
+    return status
 
 
 if __name__ == "__main__":

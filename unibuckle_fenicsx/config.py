@@ -1,16 +1,20 @@
 r"""Problem description: frozen dataclasses and the TOML loader.
 
-Every quantity is in SI units. The load is *one* scalar :math:`\lambda`: the
-membrane traction on a loaded edge is :math:`\lambda\, t\, (\sigma_n n + \tau_s s)`
-with :math:`(\sigma_n, \tau_s)` the edge stress per unit load given here, so that
-:math:`\lambda` is a stress in Pa (for the paper's plate, the compressive stress).
+The computation is in SI units (m, N, Pa). The load is *one* scalar :math:`\lambda`: the
+membrane traction on a loaded edge is :math:`\lambda\, t\, (\sigma_n n + \tau_s s)` with
+:math:`(\sigma_n, \tau_s)` the edge stress per unit load given here, so that
+:math:`\lambda` is a stress in Pa (for the paper's plate, the compressive stress). A TOML
+file may be written in another consistent system (``units``, :data:`UNITS`); it is
+converted to SI when read, and results are printed in its stress unit.
 
-Validation happens in ``__post_init__``: a bad value raises ``ValueError`` naming
-the parameter and the allowed range before any mesh or matrix is built.
+Validation happens in ``__post_init__``: a bad value (wrong type included) raises
+``ValueError`` naming the parameter and the allowed range before any mesh or matrix is
+built.
 """
 
 from __future__ import annotations
 
+import json
 import math
 import tomllib
 from collections.abc import Callable, Mapping
@@ -26,6 +30,7 @@ __all__ = [
     "EDGE_NAMES",
     "INPLANE_SUPPORTS",
     "METHODS",
+    "UNITS",
     "EdgeSpec",
     "Material",
     "MeshSpec",
@@ -33,8 +38,10 @@ __all__ = [
     "PlateSpec",
     "ProblemSpec",
     "SolverSpec",
+    "load_problem",
     "load_toml",
     "problem_from_dict",
+    "problem_to_dict",
 ]
 
 #: Edge names of a rectangular plate, in facet-tag order 1..4.
@@ -46,14 +53,41 @@ BENDING_SUPPORTS = ("simply_supported", "simply_supported_soft", "clamped", "fre
 INPLANE_SUPPORTS = ("free", "clamped", "roller")
 #: Unilateral solution methods.
 METHODS = ("auto", "enumerate", "active-set", "penalty")
+#: Unit systems of a problem file: name -> (metres per length unit, pascals per stress
+#: unit, stress unit's name). Forces follow (N for both).
+UNITS: dict[str, tuple[float, float, str]] = {
+    "SI": (1.0, 1.0, "Pa"),
+    "mm-N-MPa": (1e-3, 1e6, "MPa"),
+}
 
 Predicate = Callable[[npt.NDArray[np.float64]], npt.NDArray[np.bool_]]
 
 
-def _finite(name: str, value: float) -> float:
+def _number(name: str, value: Any) -> float:
+    """``value`` as a finite float; a string, a boolean or NaN/inf is refused."""
+    if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
+        raise ValueError(f"{name} must be a number, got {value!r} ({type(value).__name__})")
     value = float(value)
     if not math.isfinite(value):
         raise ValueError(f"{name} must be a finite number, got {value!r}")
+    return value
+
+
+def _integer(name: str, value: Any, minimum: int) -> int:
+    if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
+        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+    return int(value)
+
+
+def _boolean(name: str, value: Any) -> bool:
+    if not isinstance(value, bool | np.bool_):
+        raise ValueError(f"{name} must be true or false, got {value!r} ({type(value).__name__})")
+    return bool(value)
+
+
+def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
+    if not isinstance(value, str) or value not in choices:
+        raise ValueError(f"{name} must be one of {choices}, got {value!r}")
     return value
 
 
@@ -83,13 +117,13 @@ class Material:
     bending_voigt: tuple[tuple[float, ...], ...] | None = None
 
     def __post_init__(self) -> None:
-        if not _finite("material.E", self.E) > 0.0:
+        if not _number("material.E", self.E) > 0.0:
             raise ValueError(f"material.E (Young's modulus) must be > 0 Pa, got {self.E!r}")
-        if not -1.0 < _finite("material.nu", self.nu) < 0.5:
+        if not -1.0 < _number("material.nu", self.nu) < 0.5:
             raise ValueError(
                 f"material.nu (Poisson's ratio) must lie in (-1, 0.5), got {self.nu!r}"
             )
-        if not _finite("material.shear_correction", self.shear_correction) > 0.0:
+        if not _number("material.shear_correction", self.shear_correction) > 0.0:
             raise ValueError(
                 f"material.shear_correction must be > 0, got {self.shear_correction!r}"
             )
@@ -97,14 +131,21 @@ class Material:
             value = getattr(self, name)
             if value is None:
                 continue
-            mat = np.asarray(value, dtype=float)
-            if mat.shape != (3, 3) or not np.all(np.isfinite(mat)):
+            try:
+                mat = np.array(
+                    [[_number(f"material.{name}", c) for c in row] for row in value], dtype=float
+                )
+            except TypeError:
+                raise ValueError(f"material.{name} must be a 3x3 matrix, got {value!r}") from None
+            if mat.shape != (3, 3):
                 raise ValueError(f"material.{name} must be a finite 3x3 matrix, got {value!r}")
             if not np.allclose(mat, mat.T, rtol=1e-12, atol=0.0):
                 raise ValueError(f"material.{name} must be symmetric")
             if np.linalg.eigvalsh(mat).min() <= 0.0:
                 raise ValueError(f"material.{name} must be positive definite")
             object.__setattr__(self, name, tuple(tuple(float(c) for c in row) for row in mat))
+        for name in ("E", "nu", "shear_correction"):
+            object.__setattr__(self, name, float(getattr(self, name)))
 
 
 @dataclass(frozen=True)
@@ -132,16 +173,13 @@ class EdgeSpec:
     tag: int | None = None
 
     def __post_init__(self) -> None:
-        if self.support not in BENDING_SUPPORTS:
-            raise ValueError(
-                f"edges.{self.name}.support must be one of {BENDING_SUPPORTS}, got {self.support!r}"
-            )
-        if self.inplane not in INPLANE_SUPPORTS:
-            raise ValueError(
-                f"edges.{self.name}.inplane must be one of {INPLANE_SUPPORTS}, got {self.inplane!r}"
-            )
-        _finite(f"edges.{self.name}.normal_stress", self.normal_stress)
-        _finite(f"edges.{self.name}.shear_stress", self.shear_stress)
+        where = f"edges.{self.name}"
+        _choice(f"{where}.support", self.support, BENDING_SUPPORTS)
+        _choice(f"{where}.inplane", self.inplane, INPLANE_SUPPORTS)
+        for name in ("normal_stress", "shear_stress"):
+            object.__setattr__(self, name, _number(f"{where}.{name}", getattr(self, name)))
+        if self.tag is not None:
+            _integer(f"{where}.tag", self.tag, 0)
 
     @property
     def loaded(self) -> bool:
@@ -174,18 +212,19 @@ class PlateSpec:
     edges: tuple[EdgeSpec, ...] = field(default_factory=paper_edges)
 
     def __post_init__(self) -> None:
-        if not _finite("plate.thickness", self.thickness) > 0.0:
+        if not _number("plate.thickness", self.thickness) > 0.0:
             raise ValueError(f"plate.thickness must be > 0 m, got {self.thickness!r}")
+        object.__setattr__(self, "thickness", float(self.thickness))
         try:
             (x0, y0), (x1, y1) = self.corners
-            corners = (
-                (_finite("plate.corners", x0), _finite("plate.corners", y0)),
-                (_finite("plate.corners", x1), _finite("plate.corners", y1)),
-            )
-        except (TypeError, ValueError) as err:
+        except (TypeError, ValueError):
             raise ValueError(
-                f"plate.corners must be [[x0, y0], [x1, y1]] with finite numbers: {err}"
+                f"plate.corners must be [[x0, y0], [x1, y1]], got {self.corners!r}"
             ) from None
+        corners = (
+            (_number("plate.corners", x0), _number("plate.corners", y0)),
+            (_number("plate.corners", x1), _number("plate.corners", y1)),
+        )
         object.__setattr__(self, "corners", corners)
         if not (corners[1][0] > corners[0][0] and corners[1][1] > corners[0][1]):
             raise ValueError(
@@ -220,8 +259,8 @@ class MeshSpec:
     """Structured quadrilateral mesh of the rectangle.
 
     Args:
-        nx: Cells along x, >= 1.
-        ny: Cells along y, >= 1.
+        nx: Cells along x, >= 2 (one cell cannot carry a buckle).
+        ny: Cells along y, >= 2.
     """
 
     nx: int = 20
@@ -229,9 +268,12 @@ class MeshSpec:
 
     def __post_init__(self) -> None:
         for name in ("nx", "ny"):
-            value = getattr(self, name)
-            if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < 1:
-                raise ValueError(f"mesh.{name} must be an integer >= 1, got {value!r}")
+            object.__setattr__(self, name, _integer(f"mesh.{name}", getattr(self, name), 2))
+
+    @property
+    def num_dofs(self) -> int:
+        """DOFs of (w, theta) on this mesh: 3 per node."""
+        return 3 * (self.nx + 1) * (self.ny + 1)
 
 
 @dataclass(frozen=True)
@@ -261,19 +303,20 @@ class ObstacleSpec:
         elif not callable(self.zone):
             try:
                 (x0, x1), (y0, y1) = self.zone
-                box = ((float(x0), float(x1)), (float(y0), float(y1)))
             except (TypeError, ValueError):
                 raise ValueError(
                     f"obstacle.zone must be [[xmin, xmax], [ymin, ymax]], got {self.zone!r}"
                 ) from None
-            if not all(math.isfinite(c) for pair in box for c in pair):
-                raise ValueError(f"obstacle.zone must hold finite numbers, got {self.zone!r}")
+            box = (
+                (_number("obstacle.zone", x0), _number("obstacle.zone", x1)),
+                (_number("obstacle.zone", y0), _number("obstacle.zone", y1)),
+            )
             if box[0][0] > box[0][1] or box[1][0] > box[1][1]:
                 raise ValueError(
                     f"obstacle.zone needs xmin <= xmax and ymin <= ymax, got {self.zone!r}"
                 )
             object.__setattr__(self, "zone", box)
-        if self.tolerance is not None and not _finite("obstacle.tolerance", self.tolerance) >= 0:
+        if self.tolerance is not None and not _number("obstacle.tolerance", self.tolerance) >= 0:
             raise ValueError(f"obstacle.tolerance must be >= 0 m, got {self.tolerance!r}")
 
     def describe(self) -> str:
@@ -307,16 +350,24 @@ class SolverSpec:
 
     Args:
         method: One of :data:`METHODS`; "auto" enumerates (with ``until_proven``) when
-            the candidate count 2^i is at most ``max_candidates`` and uses the
+            the candidate count 2^i is at most ``max_candidates`` and the estimated
+            enumeration time is within ``enumeration_budget_s``, and uses the
             active-set method otherwise.
         tau: Relative feasibility/contact tolerance (README, "The problem"), in (0, 1e-2].
         eps_tol: SLEPc convergence tolerance, in (0, 1e-4].
         max_candidates: Largest candidate count the enumeration accepts, >= 1.
+        enumeration_budget_s: "auto" enumerates only if the estimate (2^i times the
+            time of one eigen solve) is at most this many seconds, > 0.
         complete: Enumerate every subset instead of stopping after the first
             feasible size p (to check the paper's monotonicity).
         until_proven: Enumerate past the paper's stopping size p* until the
             interlacing bound proves the best feasible set optimal (exact; the
             paper's rule is not, see the README).
+        max_iterations: Active-set iterates per seed and mesh level, >= 1.
+        bound_budget: Eigen solves allowed for the active set's lattice lower bound,
+            >= 0 (it runs when the budget covers the i singletons).
+        certify: Verify the result's global optimality (README, "Proving the global
+            minimum"); off for speed studies.
         penalty: Penalty stiffness rho for ``method="penalty"`` (relative to the
             largest diagonal entry of A), > 0.
         prestress_degree: Lagrange degree of the in-plane displacement, >= 1.
@@ -328,36 +379,45 @@ class SolverSpec:
     tau: float = 1e-8
     eps_tol: float = 1e-10
     max_candidates: int = 100_000
+    enumeration_budget_s: float = 60.0
     complete: bool = False
     until_proven: bool = False
+    max_iterations: int = 100
+    bound_budget: int = 64
+    certify: bool = True
     penalty: float = 1e3
     prestress_degree: int = 1
     shear: str = "mitc"
 
     def __post_init__(self) -> None:
-        if self.method not in METHODS:
-            raise ValueError(f"solver.method must be one of {METHODS}, got {self.method!r}")
-        if not 0.0 < _finite("solver.tau", self.tau) <= 1e-2:
+        _choice("solver.method", self.method, METHODS)
+        _choice("solver.shear", self.shear, ("mitc", "full"))
+        if not 0.0 < _number("solver.tau", self.tau) <= 1e-2:
             raise ValueError(f"solver.tau must lie in (0, 1e-2], got {self.tau!r}")
-        if not 0.0 < _finite("solver.eps_tol", self.eps_tol) <= 1e-4:
+        if not 0.0 < _number("solver.eps_tol", self.eps_tol) <= 1e-4:
             raise ValueError(f"solver.eps_tol must lie in (0, 1e-4], got {self.eps_tol!r}")
-        if int(self.max_candidates) != self.max_candidates or self.max_candidates < 1:
+        if not _number("solver.enumeration_budget_s", self.enumeration_budget_s) > 0.0:
             raise ValueError(
-                f"solver.max_candidates must be an integer >= 1, got {self.max_candidates!r}"
+                f"solver.enumeration_budget_s must be > 0 s, got {self.enumeration_budget_s!r}"
             )
-        if not _finite("solver.penalty", self.penalty) > 0.0:
+        if not _number("solver.penalty", self.penalty) > 0.0:
             raise ValueError(f"solver.penalty must be > 0, got {self.penalty!r}")
-        if int(self.prestress_degree) != self.prestress_degree or self.prestress_degree < 1:
-            raise ValueError(
-                f"solver.prestress_degree must be an integer >= 1, got {self.prestress_degree!r}"
-            )
-        if self.shear not in ("mitc", "full"):
-            raise ValueError(f'solver.shear must be "mitc" or "full", got {self.shear!r}')
+        for name, minimum in (
+            ("max_candidates", 1),
+            ("max_iterations", 1),
+            ("bound_budget", 0),
+            ("prestress_degree", 1),
+        ):
+            object.__setattr__(self, name, _integer(f"solver.{name}", getattr(self, name), minimum))
+        for name in ("complete", "until_proven", "certify"):
+            object.__setattr__(self, name, _boolean(f"solver.{name}", getattr(self, name)))
+        for name in ("tau", "eps_tol", "enumeration_budget_s", "penalty"):
+            object.__setattr__(self, name, float(getattr(self, name)))
 
 
 @dataclass(frozen=True)
 class ProblemSpec:
-    """A complete unilateral buckling problem.
+    """A complete unilateral buckling problem (in SI units).
 
     Args:
         name: Label used in output.
@@ -366,6 +426,8 @@ class ProblemSpec:
         mesh: Mesh resolution.
         obstacle: Obstacle zone, or ``None`` for the free (bilateral) plate.
         solver: Solver options.
+        units: The unit system results are printed in (one of :data:`UNITS`; the
+            numbers here are SI whatever it is).
     """
 
     name: str = "plate"
@@ -374,6 +436,12 @@ class ProblemSpec:
     mesh: MeshSpec = field(default_factory=MeshSpec)
     obstacle: ObstacleSpec | None = None
     solver: SolverSpec = field(default_factory=SolverSpec)
+    units: str = "SI"
+
+    def __post_init__(self) -> None:
+        if not isinstance(self.name, str):
+            raise ValueError(f"name must be a string, got {self.name!r}")
+        _choice("units", self.units, tuple(UNITS))
 
     def with_mesh(self, nx: int, ny: int) -> ProblemSpec:
         """Copy with another mesh resolution."""
@@ -382,6 +450,12 @@ class ProblemSpec:
     def with_solver(self, **changes: Any) -> ProblemSpec:
         """Copy with changed solver options."""
         return replace(self, solver=replace(self.solver, **changes))
+
+    @property
+    def stress_unit(self) -> tuple[float, str]:
+        """(pascals per unit, name) of the stress unit results are printed in."""
+        _, stress, name = UNITS[self.units]
+        return stress, name
 
 
 def _take(table: Mapping[str, Any], allowed: tuple[str, ...], where: str) -> dict[str, Any]:
@@ -397,19 +471,69 @@ def _names(cls: type) -> tuple[str, ...]:
     return tuple(f.name for f in fields(cls))
 
 
+def _scaled(value: Any, factor: float, name: str) -> Any:
+    """``value`` (a number or nested lists of numbers) times ``factor``, types checked."""
+    if isinstance(value, list | tuple):
+        return [_scaled(v, factor, name) for v in value]
+    return _number(name, value) * factor
+
+
+#: Keys converted to SI by a file's ``units``: (table, key) -> powers of (length, stress).
+_DIMENSIONS: dict[tuple[str, str], tuple[int, int]] = {
+    ("plate", "corners"): (1, 0),
+    ("plate", "thickness"): (1, 0),
+    ("material", "E"): (0, 1),
+    ("material", "membrane_voigt"): (1, 1),  # N/m = Pa m
+    ("material", "bending_voigt"): (3, 1),  # N m = Pa m^3
+    ("obstacle", "tolerance"): (1, 0),
+}
+
+
+def _to_si(top: dict[str, Any], units: str) -> dict[str, Any]:
+    """Convert the dimensional values of a TOML-shaped mapping from ``units`` to SI."""
+    length, stress, _ = UNITS[units]
+    if units == "SI":
+        return top
+    out = {k: dict(v) if isinstance(v, Mapping) else v for k, v in top.items()}
+    for (table, key), (pl, ps) in _DIMENSIONS.items():
+        if isinstance(out.get(table), dict) and key in out[table]:
+            out[table][key] = _scaled(out[table][key], length**pl * stress**ps, f"{table}.{key}")
+    obstacle = out.get("obstacle")
+    if isinstance(obstacle, dict) and isinstance(obstacle.get("zone"), list):
+        obstacle["zone"] = _scaled(obstacle["zone"], length, "obstacle.zone")
+    return out
+
+
 def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSpec:
-    """Build a :class:`ProblemSpec` from a TOML-shaped mapping.
+    """Build a :class:`ProblemSpec` from a TOML-shaped mapping (schema: README).
 
     Tables: ``[plate]`` (corners, thickness), ``[material]`` (E, nu, shear_correction,
     membrane_voigt, bending_voigt), ``[edges.<name>]`` (support, inplane,
     normal_stress, shear_stress), ``[mesh]`` (nx, ny), ``[obstacle]`` (zone,
-    tolerance; absent = free plate), ``[solver]`` (the :class:`SolverSpec` fields).
-    Unknown tables or keys raise ``ValueError``. Missing values take the paper's.
+    tolerance; absent = free plate), ``[solver]`` (the :class:`SolverSpec` fields);
+    top-level ``name`` and ``units``. Unknown tables or keys raise ``ValueError``.
+
+    Missing values take the paper's, with one exception for the load: if any edge table
+    gives ``normal_stress`` or ``shear_stress``, the edges that give neither carry no load
+    (the paper's unit compression of the short edges applies only to a file that sets
+    no edge load at all).
     """
-    top = _take(data, ("name", "plate", "material", "edges", "mesh", "obstacle", "solver"), "top")
+    top = _take(
+        data, ("name", "units", "plate", "material", "edges", "mesh", "obstacle", "solver"), "top"
+    )
+    units = _choice("units", top.get("units", "SI"), tuple(UNITS))
+    top = _to_si(top, units)
     plate_kw = _take(top.get("plate", {}), ("corners", "thickness"), "plate")
+    edge_tables = _take(top.get("edges", {}), EDGE_NAMES, "edges")
     edges = {e.name: e for e in paper_edges()}
-    for edge_name, edge_table in _take(top.get("edges", {}), EDGE_NAMES, "edges").items():
+    load_keys = ("normal_stress", "shear_stress")
+    loads_given = any(
+        key in table for table in edge_tables.values() if isinstance(table, Mapping)
+        for key in load_keys
+    )  # fmt: skip
+    if loads_given:
+        edges = {n: replace(e, normal_stress=0.0, shear_stress=0.0) for n, e in edges.items()}
+    for edge_name, edge_table in edge_tables.items():
         kw = _take(edge_table, _names(EdgeSpec)[1:-1], f"edges.{edge_name}")
         edges[edge_name] = replace(edges[edge_name], **kw)
     plate = PlateSpec(**plate_kw, edges=tuple(edges.values()))
@@ -421,21 +545,111 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     mesh = MeshSpec(**_take(top.get("mesh", {}), _names(MeshSpec), "mesh"))
     obstacle = None
     if "obstacle" in top:
-        obstacle = ObstacleSpec(**_take(top["obstacle"], ("zone", "tolerance"), "obstacle"))
+        obstacle_kw = _take(top["obstacle"], ("zone", "tolerance"), "obstacle")
+        if "zone" not in obstacle_kw:
+            raise ValueError(
+                '[obstacle] needs zone = "all" (the whole plate) or [[xmin, xmax], [ymin, ymax]]'
+            )
+        obstacle = ObstacleSpec(**obstacle_kw)
     solver = SolverSpec(**_take(top.get("solver", {}), _names(SolverSpec), "solver"))
+    label = top.get("name", name)
+    if not isinstance(label, str):
+        raise ValueError(f"name must be a string, got {label!r}")
     return ProblemSpec(
-        name=str(top.get("name", name)),
+        name=label,
         plate=plate,
         material=material,
         mesh=mesh,
         obstacle=obstacle,
         solver=solver,
+        units=units,
     )
 
 
+def problem_to_dict(spec: ProblemSpec) -> dict[str, Any]:
+    """The TOML-shaped mapping of ``spec``, every key with the value used (in SI).
+
+    ``problem_from_dict(problem_to_dict(spec)) == spec`` for a spec with a box or
+    "all" zone on the rectangle (a predicate zone cannot be written; it raises).
+    """
+    plate = spec.plate
+    out: dict[str, Any] = {
+        "name": spec.name,
+        "units": "SI",
+        "plate": {"corners": [list(c) for c in plate.corners], "thickness": plate.thickness},
+        "material": {
+            k: v for k, v in vars(spec.material).items() if v is not None
+        },  # tuples become lists in JSON/TOML
+        "edges": {
+            e.name: {
+                "support": e.support,
+                "inplane": e.inplane,
+                "normal_stress": e.normal_stress,
+                "shear_stress": e.shear_stress,
+            }
+            for e in plate.edges
+        },
+        "mesh": {"nx": spec.mesh.nx, "ny": spec.mesh.ny},
+        "solver": dict(vars(spec.solver)),
+    }
+    if spec.obstacle is not None:
+        zone = spec.obstacle.zone
+        if callable(zone):
+            raise ValueError("problem_to_dict: a predicate obstacle zone cannot be written")
+        obstacle: dict[str, Any] = {
+            "zone": zone if isinstance(zone, str) else [list(z) for z in zone]
+        }
+        if spec.obstacle.tolerance is not None:
+            obstacle["tolerance"] = spec.obstacle.tolerance
+        out["obstacle"] = obstacle
+    for key in ("membrane_voigt", "bending_voigt"):
+        if key in out["material"]:
+            out["material"][key] = [list(row) for row in out["material"][key]]
+    return out
+
+
 def load_toml(path: str | Path) -> ProblemSpec:
-    """Read a :class:`ProblemSpec` from a TOML file (schema: :func:`problem_from_dict`)."""
+    """Read a :class:`ProblemSpec` from a TOML file (schema: :func:`problem_from_dict`).
+
+    Raises:
+        ValueError: The file is not UTF-8 TOML, or describes an invalid problem; the
+            message names the file.
+        OSError: The file cannot be read.
+    """
     path = Path(path)
-    with path.open("rb") as f:
-        data = tomllib.load(f)
-    return problem_from_dict(data, name=path.stem)
+    try:
+        data = tomllib.loads(path.read_bytes().decode("utf-8"))
+    except UnicodeDecodeError as err:
+        raise ValueError(
+            f"{path}: not a UTF-8 text file ({err.reason} at byte {err.start})"
+        ) from None
+    except tomllib.TOMLDecodeError as err:
+        raise ValueError(f"{path}: invalid TOML: {err}") from None
+    try:
+        return problem_from_dict(data, name=path.stem)
+    except ValueError as err:
+        raise ValueError(f"{path}: {err}") from None
+
+
+def load_problem(path: str | Path) -> ProblemSpec:
+    """A problem file: TOML, or the JSON of a result (its ``input``, which re-runs it).
+
+    Raises:
+        ValueError: An invalid file or problem; the message names the file.
+        OSError: The file cannot be read.
+    """
+    path = Path(path)
+    if path.suffix.lower() != ".json":
+        return load_toml(path)
+    try:
+        data = json.loads(path.read_bytes().decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise ValueError(f"{path}: not a JSON result or problem file: {err}") from None
+    if isinstance(data, dict) and "input" in data:
+        data = data["input"]
+        if data is None:
+            raise ValueError(f"{path}: this result's problem has no file form (a predicate zone)")
+    try:
+        return problem_from_dict(data, name=path.stem)
+    except ValueError as err:
+        raise ValueError(f"{path}: {err}") from None

@@ -36,12 +36,16 @@ def create_plate_mesh(
         [spec.nx, spec.ny],
         dolfinx.mesh.CellType.quadrilateral,
     )
-    tol = 1e-10 * max(plate.length, plate.width)
+    # Absolute tolerance from the plate's size and the coordinates' magnitude (rounding
+    # of x0 + i h); no relative tolerance, which would grow with the distance to 0.
+    tol = 1e-10 * max(plate.length, plate.width) + 64 * np.finfo(float).eps * max(
+        abs(x0), abs(x1), abs(y0), abs(y1)
+    )
     markers = (
-        lambda x: np.isclose(x[0], x0, atol=tol),
-        lambda x: np.isclose(x[0], x1, atol=tol),
-        lambda x: np.isclose(x[1], y0, atol=tol),
-        lambda x: np.isclose(x[1], y1, atol=tol),
+        lambda x: np.isclose(x[0], x0, rtol=0.0, atol=tol),
+        lambda x: np.isclose(x[0], x1, rtol=0.0, atol=tol),
+        lambda x: np.isclose(x[1], y0, rtol=0.0, atol=tol),
+        lambda x: np.isclose(x[1], y1, rtol=0.0, atol=tol),
     )
     fdim = msh.topology.dim - 1
     facets, values = [], []

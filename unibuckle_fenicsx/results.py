@@ -10,13 +10,15 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from unibuckle_fenicsx.config import UNITS, ProblemSpec, problem_to_dict
+
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution
     from unibuckle_fenicsx.analysis import Analysis
     from unibuckle_fenicsx.certify import Certificate
     from unibuckle_fenicsx.problem import BucklingProblem, Mode
 
-__all__ = ["BucklingResult", "write_json", "write_vtx"]
+__all__ = ["BucklingResult", "versions", "write_fields", "write_json"]
 
 
 @dataclass
@@ -47,6 +49,12 @@ class BucklingResult:
         details: Method-specific information.
         timings: Seconds per phase.
         mpi_size: Ranks used.
+        method_chosen_by: Why this method ran ("given", or the "auto" rule's reason).
+        edge_loads: Per edge, its normal and shear stress per unit load (tension > 0).
+        units: The unit system the summary prints in (the numbers here are SI).
+        input: The problem solved, every key with the value used, in SI
+            (:func:`~unibuckle_fenicsx.config.problem_to_dict`; None for a predicate zone).
+        versions: Versions of the package, DOLFINx, PETSc, SLEPc, Python and NumPy.
     """
 
     case: str
@@ -72,6 +80,11 @@ class BucklingResult:
     details: dict[str, Any] = field(default_factory=dict)
     timings: dict[str, float] = field(default_factory=dict)
     mpi_size: int = 1
+    method_chosen_by: str = ""
+    edge_loads: dict[str, dict[str, float]] = field(default_factory=dict)
+    units: str = "SI"
+    input: dict[str, Any] | None = None
+    versions: dict[str, str] = field(default_factory=dict)
 
     @classmethod
     def from_solution(
@@ -114,6 +127,13 @@ class BucklingResult:
                 "free_eigen_error": free.eigen.error,
                 "free_eigen_iterations": free.eigen.iterations,
             },
+            edge_loads={
+                e.name: {"normal_stress": e.normal_stress, "shear_stress": e.shear_stress}
+                for e in spec.plate.edges
+            },
+            units=spec.units,
+            input=_input(spec),
+            versions=versions(),
         )
         if solution is None or certificate is None:
             result.lower_bound_Pa = result.upper_bound_Pa = free.load
@@ -138,26 +158,96 @@ class BucklingResult:
         result.details.update(solution.details)
         return result
 
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready mapping (non-finite floats become strings)."""
-        return _jsonable(asdict(self))
+    def as_dict(self, timings: bool = True) -> dict[str, Any]:
+        """JSON-ready mapping (non-finite floats become strings).
+
+        Args:
+            timings: Keep the wall times (``*_s`` keys, ``timings``) and the "auto" rule's
+                reason, which quotes a measured time; without them the mapping is the same
+                on every run (for files kept under version control).
+        """
+        data = _jsonable(asdict(self))
+        return data if timings else _without_timings(data)
 
     def summary(self) -> str:
-        """One line for the terminal."""
+        """Two lines for the terminal: the result, and the load it is a multiple of."""
+        scale, unit = UNITS[self.units][1:]
         z = ""
         if self.constrained_nodes:
             cert = self.certificate or {}
+            proven = "no"
+            if cert.get("global_optimum_proven"):
+                proven = f"yes ({cert.get('proven_by')}, gap {cert.get('relative_gap', 0):.1e})"
             z = (
                 f"  i={self.constrained_nodes} |Z|={self.contact_nodes}"
-                f"  KKT={'yes' if cert.get('kkt') else 'NO'}"
-                f"  proven={'yes' if cert.get('global_optimum_proven') else 'no'}"
+                f"  KKT={'yes' if cert.get('kkt') else 'NO'}  proven={proven}"
             )
+        loaded = [
+            f"{name} {_load_text(load)}"
+            for name, load in self.edge_loads.items()
+            if load["normal_stress"] or load["shear_stress"]
+        ]
         return (
-            f"{self.case}: lambda_c = {self.critical_load_Pa:.6e} Pa "
-            f"({self.critical_load_Pa / self.free_load_Pa:.4f} x free {self.free_load_Pa:.6e} Pa), "
+            f"{self.case}: lambda_c = {self.critical_load_Pa / scale:.6e} {unit} "
+            f"({self.critical_load_Pa / self.free_load_Pa:.4f} x free "
+            f"{self.free_load_Pa / scale:.6e} {unit}), "
             f"k = {self.buckling_coefficient_k:.4f}, method {self.method}{z}, "
-            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s"
+            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s\n"
+            f"  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}"
         )
+
+
+def _load_text(load: dict[str, float]) -> str:
+    parts = []
+    if load["normal_stress"]:
+        parts.append(f"normal {load['normal_stress']:g}")
+    if load["shear_stress"]:
+        parts.append(f"shear {load['shear_stress']:g}")
+    return ", ".join(parts)
+
+
+def _input(spec: ProblemSpec) -> dict[str, Any] | None:
+    try:
+        return problem_to_dict(spec)
+    except ValueError:  # a predicate zone
+        return None
+
+
+def versions() -> dict[str, str]:
+    """Versions of the package and of the libraries that computed the result."""
+    import platform
+    from importlib.metadata import PackageNotFoundError, version
+
+    out = {"python": platform.python_version(), "numpy": np.__version__}
+    for dist in ("unibuckle_fenicsx", "fenics-dolfinx", "petsc4py", "slepc4py", "fenics-basix"):
+        try:
+            out[dist] = version(dist)
+        except PackageNotFoundError:
+            pass
+    try:
+        from petsc4py import PETSc
+        from slepc4py import SLEPc
+
+        import dolfinx
+
+        out["dolfinx"] = dolfinx.__version__
+        out["PETSc"] = ".".join(str(v) for v in PETSc.Sys.getVersion())
+        out["SLEPc"] = ".".join(str(v) for v in SLEPc.Sys.getVersion())
+    except ImportError:  # pragma: no cover
+        pass
+    return out
+
+
+def _without_timings(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {
+            k: _without_timings(v)
+            for k, v in obj.items()
+            if not (k.endswith("_s") or k in ("timings", "method_chosen_by"))
+        }
+    if isinstance(obj, list):
+        return [_without_timings(v) for v in obj]
+    return obj
 
 
 def _jsonable(obj: Any) -> Any:
@@ -183,11 +273,16 @@ def write_json(result: BucklingResult, path: str | Path) -> Path:
     return path
 
 
-def write_vtx(analysis: Analysis, directory: str | Path) -> list[Path]:
-    """Write the mode, the free mode, the obstacle zone and the contact set as VTX (.bp).
+def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
+    """Write the mode, the free mode, the obstacle zone and the contact set for viewing.
 
-    Files: ``<case>_w.bp`` (w, free w, obstacle indicator, contact indicator on the Q1
-    space) and ``<case>_theta.bp`` (rotation). Open them in ParaView (ADIOS2VTXReader).
+    Files, for ParaView (ADIOS2 VTX reader): ``<case>_w.bp`` (w, w_free, obstacle_zone,
+    contact on the Q1 space) and ``<case>_theta.bp`` (the rotation); and the same fields
+    as VTK, ``<case>.pvd`` (with ``.pvtu``/``.vtu`` pieces), which ParaView and
+    ``pyvista.read`` open without ADIOS2.
+
+    Returns:
+        The paths of the two ``.bp`` directories and of the ``.pvd`` file.
 
     Note:
         Collective on the mesh communicator.
@@ -211,4 +306,7 @@ def write_vtx(analysis: Analysis, directory: str | Path) -> list[Path]:
     for path, funcs in ((paths[0], fields), (paths[1], [theta])):
         with dolfinx.io.VTXWriter(problem.comm, path, funcs, engine="BP4") as writer:
             writer.write(0.0)
+    paths.append(directory / f"{case}.pvd")
+    with dolfinx.io.VTKFile(problem.comm, paths[-1], "w") as vtk:
+        vtk.write_function([*fields, theta], 0.0)
     return paths

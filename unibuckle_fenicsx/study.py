@@ -29,7 +29,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx import fields, plotting
 from unibuckle_fenicsx.analysis import Analysis, solve
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.results import BucklingResult, write_vtx
+from unibuckle_fenicsx.results import BucklingResult, write_fields
 
 __all__ = [
     "COARSE_MESHES",
@@ -146,9 +146,14 @@ class MeshStudy:
         )
 
     def write_json(self, path: Path, **extra: Any) -> Path:
-        """``{"case", "results": [...], **extra}`` as JSON (call on one rank)."""
+        """``{"case", "results": [...], **extra}`` as JSON, without wall times (rank 0).
+
+        The file is the same on every run of the same problem, so that it can be kept
+        under version control (the figures directory); the times are printed instead.
+        """
         path.parent.mkdir(parents=True, exist_ok=True)
-        summary = {"case": self.name, **extra, "results": [r.as_dict() for r in self.results]}
+        results = [r.as_dict(timings=False) for r in self.results]
+        summary = {"case": self.name, **extra, "results": results}
         path.write_text(json.dumps(summary, indent=2) + "\n")
         return path
 
@@ -256,7 +261,7 @@ def mesh_study(
                         tau=problem.tau,
                     )
             if output is not None:
-                write_vtx(analysis, output / name / point.label)
+                write_fields(analysis, output / name / point.label)
             if at_each is not None:
                 point.extra = at_each(analysis)
         points.append(point)

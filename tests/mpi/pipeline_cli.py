@@ -2,7 +2,7 @@
 
 ``mpiexec -n P python tests/mpi/pipeline_cli.py OUTDIR -- CLI ARGS...`` runs
 ``unibuckle solve CLI ARGS --json OUTDIR/result.json --output OUTDIR/vtx`` with
-:func:`unibuckle_fenicsx.results.write_json` and :func:`unibuckle_fenicsx.results.write_vtx`
+:func:`unibuckle_fenicsx.results.write_json` and :func:`unibuckle_fenicsx.results.write_fields`
 wrapped to count their calls per rank, and prints on rank 0 a JSON line
 ``{"status": [...], "json_writes": [...], "vtx_calls": [...]}`` (one entry per rank).
 """
@@ -24,7 +24,7 @@ def main() -> None:
     args = sys.argv[sys.argv.index("--") + 1 :]
     comm = MPI.COMM_WORLD
     counts = {"json": 0, "vtx": 0}
-    write_json, write_vtx = results.write_json, results.write_vtx
+    write_json, write_fields = results.write_json, results.write_fields
 
     def counting_json(*a, **k):
         counts["json"] += 1
@@ -32,10 +32,10 @@ def main() -> None:
 
     def counting_vtx(*a, **k):
         counts["vtx"] += 1
-        return write_vtx(*a, **k)
+        return write_fields(*a, **k)
 
     results.write_json = counting_json
-    results.write_vtx = counting_vtx
+    results.write_fields = counting_vtx
     status = cli_main(
         ["solve", *args, "--json", str(outdir / "result.json"), "--output", str(outdir / "vtx")]
     )

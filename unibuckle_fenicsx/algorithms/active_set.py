@@ -59,6 +59,7 @@ from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.contact import EmptyZoneError
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 
 __all__ = ["SEED_NAMES", "TWIN_RTOL", "solve_active_set"]
 
@@ -261,6 +262,14 @@ def solve_active_set(
                 "kkt_loads": [s.load for s in kkt],
             }
         )
+        if problem.comm.rank == 0:
+            PROGRESS.info(
+                "active set, level %dx%d (i = %d): %d runs, %d KKT point(s)%s, %d eigen solves, "
+                "%.2f s",
+                nx, ny, cp.num_constrained, len(runs), len(kkt),
+                f", best lambda = {kkt[0].load:.9e}" if kkt else "",
+                cp.eigensolver.solves, time.perf_counter() - tl,
+            )  # fmt: skip
         coarse_solves += cp.eigensolver.solves
         if prev is not None:
             prev.destroy()

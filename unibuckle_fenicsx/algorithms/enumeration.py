@@ -56,6 +56,8 @@ import numpy as np
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+from unibuckle_fenicsx.progress import Progress
 
 __all__ = ["PROOF_RTOL", "TIE_RTOL", "LevelSummary", "enumerate_contact_sets"]
 
@@ -260,6 +262,7 @@ def enumerate_contact_sets(
     start = _start_vector(problem)
     levels: list[LevelSummary] = []
     kept: list[Candidate | None] = []  # per level: this rank's candidate of its best set
+    talk = rank == 0 and problem.comm.rank == 0
     try:
         for p in range(i + 1):
             t0 = time.perf_counter()
@@ -267,8 +270,10 @@ def enumerate_contact_sets(
             feasible: list[tuple[float, tuple[int, ...]]] = []
             ties: list[Candidate] = []  # feasible candidates within TIE_RTOL of the best
             n = 0
+            progress = Progress(f"enumeration p = {p}", math.comb(i, p), enabled=talk)
             for j, combo in enumerate(itertools.combinations(range(i), p)):
                 n += 1
+                progress.update(j)
                 if j % size != rank:
                     continue
                 cand = problem.evaluate(np.asarray(combo, dtype=np.int64), initial=start)
@@ -283,15 +288,19 @@ def enumerate_contact_sets(
                 if level.best_set is not None
                 else None
             )
-            logger.info(
-                "p = %d: %d sets, %d feasible, lambda(p) = %.9e, min lambda = %.9e (%.2f s)",
-                p,
-                n,
-                level.feasible,
-                level.best_load,
-                level.load_min,
-                level.wall_s,
-            )
+            if talk:
+                PROGRESS.info(
+                    "enumeration p = %d done: %d sets, %d feasible, lambda(p) = %.9e, "
+                    "min lambda = %.9e (%.2f s); %d of %d sets visited",
+                    p,
+                    n,
+                    level.feasible,
+                    level.best_load,
+                    level.load_min,
+                    level.wall_s,
+                    sum(lv.candidates for lv in levels),
+                    count,
+                )
             if complete:
                 continue
             if until_proven:
