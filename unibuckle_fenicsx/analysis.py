@@ -39,7 +39,7 @@ def choose_method(
     """
     options = spec.solver
     count = candidate_count(i)
-    estimate = count * solve_time_s
+    estimate = math.inf if i > 1000 else count * solve_time_s
     if candidate_parallel:
         if options.method not in ("auto", "enumerate"):
             raise ValueError(
@@ -180,6 +180,7 @@ def solve(
     t_free = time.perf_counter()
     free = problem.solve_free()
     t_free = comm.allreduce(time.perf_counter() - t_free, op=MPI.MAX)
+    problem.timings["free_solve_s"] = t_free
     solution: UnilateralSolution | None = None
     certificate: Certificate | None = None
     method, reason = "free", "no obstacle"
@@ -190,10 +191,14 @@ def solve(
         logger.info(
             "i = %d constrained nodes; method %s (%s)", problem.num_constrained, method, reason
         )
+        t1 = time.perf_counter()
         solution = _run_method(method, problem, comm if candidate_parallel else None)
+        problem.timings["unilateral_s"] = time.perf_counter() - t1
         if not math.isfinite(solution.load):
             raise RuntimeError(f"{spec.name}: no finite critical load was found")
+        t1 = time.perf_counter()
         certificate = certify(problem, solution)
+        problem.timings["certify_s"] = time.perf_counter() - t1
         if not certificate.kkt:
             logger.warning("the %s result fails its certificate: %s", method, certificate)
     result = BucklingResult.from_solution(

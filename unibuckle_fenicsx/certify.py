@@ -12,9 +12,13 @@ when (README, "The problem"; paper, Lemma 5.1)
   :math:`\delta = 10^3` ``eps_tol`` (one sparse :math:`LDL^T`).
 
 Global. The algorithms bracket the critical load: any admissible mode's load is an upper
-bound; interlacing, the lattice search and exhaustive enumeration give lower bounds. The
-result is *proven* globally optimal when the verified bracket closes to
-:data:`PROOF_GAP`.
+bound; interlacing, the lattice search and exhaustive enumeration give lower bounds, and
+:mod:`unibuckle_fenicsx.copositivity` proves one just below a KKT point's load when
+:math:`A - \lambda B` is copositive on the cone there (a rank-2 certificate that costs one
+sparse :math:`LDL^T`, or a semidefinite program for small i). The result is *proven*
+globally optimal when the verified bracket closes to :data:`PROOF_GAP`. When it is proven,
+the smallest-eigenvalue check is not run (the proof says more: no admissible mode at all
+has a lower load).
 
 Every check here is collective on the problem's communicator.
 """
@@ -32,6 +36,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.copositivity import CERTIFY_PREFIX, BoundOptions, copositivity_bound
 from unibuckle_fenicsx.eigen import SymmetricFactorization
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 
@@ -39,8 +44,6 @@ __all__ = ["CERTIFY_PREFIX", "PROOF_GAP", "Certificate", "certify", "reduced_ine
 
 logger = logging.getLogger(__name__)
 
-#: Options prefix of the certificate's factorisations (``-unibuckle_certify_ksp_view``).
-CERTIFY_PREFIX = "unibuckle_certify_"
 #: Relative gap (upper - lower)/upper below which the global optimum counts as proven.
 PROOF_GAP = 1e-6
 #: The smallest-eigenvalue check looks below lambda (1 - SMALLEST_RTOL_FACTOR eps_tol).
@@ -60,12 +63,17 @@ class Certificate:
         tolerance: :math:`\tau`.
         kkt: Feasible, forces at most :math:`\tau`, residual at most :math:`\sqrt\tau`.
         smallest_of_reduced: :math:`\lambda` is the smallest eigenvalue of the reduced
-            pencil (inertia check); ``None`` when not checked.
+            pencil (inertia check); ``None`` when not checked (the global proof makes
+            it moot, or certification is off).
         lower_bound: Verified lower bound on the critical load.
         upper_bound: Load of an admissible mode (``inf`` if the mode is not admissible).
         relative_gap: (upper - lower) / upper.
         global_optimum_proven: The gap is at most :data:`PROOF_GAP`.
-        proven_by: What gave the lower bound ("interlacing", "lattice", "enumeration").
+        proven_by: What gave the lower bound: "interlacing" (the free load),
+            "lattice", "enumeration", or a copositivity route ("rank2-spn", "sdp-spn",
+            "sdp-sectors", "psd").
+        copositivity: The copositivity certificate's record (route, delta, verified
+            margins, factorisations, solves, seconds), or None if it did not run.
         notes: Anything that failed or was skipped, in words.
     """
 
@@ -81,6 +89,7 @@ class Certificate:
     relative_gap: float
     global_optimum_proven: bool
     proven_by: str
+    copositivity: dict[str, Any] | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
 
     def as_dict(self) -> dict[str, Any]:
@@ -98,6 +107,7 @@ class Certificate:
             "relative_gap": self.relative_gap,
             "global_optimum_proven": self.global_optimum_proven,
             "proven_by": self.proven_by,
+            "copositivity": self.copositivity,
             "notes": list(self.notes),
         }
 
@@ -139,7 +149,9 @@ def certify(
     problem: BucklingProblem,
     solution: UnilateralSolution | Candidate,
     *,
+    global_bound: bool | None = None,
     check_smallest: bool = True,
+    options: BoundOptions | None = None,
 ) -> Certificate:
     r"""Certify ``solution`` (its candidate and its bracket) on ``problem``.
 
@@ -147,8 +159,11 @@ def certify(
         problem: The problem the solution was computed on.
         solution: An algorithm's result, or a bare candidate (whose bracket is then
             :math:`[\lambda_{free}, \lambda]`, by interlacing).
-        check_smallest: Verify by inertia that the load is the smallest eigenvalue of
-            the reduced pencil (one sparse factorisation).
+        global_bound: Try the copositivity certificate of global optimality (default:
+            ``problem.spec.solver.certify``), unless the algorithm proved it already.
+        check_smallest: When the optimum is not proven, verify by inertia that the load
+            is the smallest eigenvalue of the reduced pencil (one sparse factorisation).
+        options: Settings of the copositivity certificate.
 
     Note:
         Collective.
@@ -162,6 +177,8 @@ def certify(
             global_optimum_proven=False,
             upper_bound=solution.load if solution.feasible else math.inf,
         )
+    if global_bound is None:
+        global_bound = problem.spec.solver.certify
     cand = solution.candidate
     tau = problem.tau
     notes: list[str] = []
@@ -169,8 +186,37 @@ def certify(
         raise ValueError("certify: the candidate has no finite load")
     residual = _residual_off_contact(problem, cand)
     kkt = cand.feasible and cand.max_force <= tau and residual <= math.sqrt(tau)
+    # Only the eigenvalue of a reduced pencil whose mode is admissible bounds the critical
+    # load from above (a penalised quotient lies below it).
+    upper = solution.upper_bound
+    if cand.eigen is not None and cand.feasible:
+        upper = min(upper, cand.load)
+    elif not cand.feasible:
+        notes.append("the mode crosses the obstacle: its load is not an upper bound")
+    lower = min(solution.lower_bound, upper)
+    proven_by = str(solution.details.get("lower_bound_by", "interlacing"))
+    algorithm_proof = solution.global_optimum_proven
+    record: dict[str, Any] | None = None
+    if not algorithm_proof and global_bound and kkt and cand.eigen is not None:
+        bound = copositivity_bound(problem, cand, solution.kkt_points, options)
+        record = {
+            "method": bound.method,
+            "delta": bound.delta,
+            "margins": bound.margins,
+            **{k: bound.timings[k] for k in ("factorisations", "solves")},
+            "time_s": bound.timings["total_s"],
+        }
+        notes += list(bound.notes)
+        if bound.value is not None and bound.value > lower:
+            lower, proven_by = min(bound.value, upper), bound.method
+    elif not algorithm_proof and not global_bound:
+        notes.append("global certification skipped (solver.certify = false)")
+    gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
+    proven = bool(kkt and gap <= PROOF_GAP and (algorithm_proof or proven_by != "interlacing"))
     smallest: bool | None = None
-    if check_smallest and cand.eigen is not None:
+    if proven:
+        pass  # the global bound says more than the reduced pencil's inertia would
+    elif check_smallest and global_bound and cand.eigen is not None:
         sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
         neg, _, _ = reduced_inertia(problem, cand.active, sigma)
         smallest = neg == 0
@@ -181,17 +227,6 @@ def certify(
             )
     elif cand.eigen is None:
         notes.append("the mode is not an eigenvector of a reduced pencil (not checked)")
-    # Only the eigenvalue of a reduced pencil whose mode is admissible bounds the critical
-    # load from above (a penalised quotient lies below it).
-    upper = solution.upper_bound
-    if cand.eigen is not None and cand.feasible:
-        upper = min(upper, cand.load)
-    elif not cand.feasible:
-        notes.append("the mode crosses the obstacle: its load is not an upper bound")
-    lower = min(solution.lower_bound, upper)
-    gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
-    proven = bool(solution.global_optimum_proven and kkt and gap <= PROOF_GAP)
-    proven_by = str(solution.details.get("lower_bound_by", "interlacing"))
     return Certificate(
         feasible=cand.feasible,
         feasibility_margin=cand.margin,
@@ -205,5 +240,6 @@ def certify(
         relative_gap=gap,
         global_optimum_proven=proven,
         proven_by=proven_by,
+        copositivity=record,
         notes=tuple(notes),
     )

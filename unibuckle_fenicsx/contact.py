@@ -171,6 +171,24 @@ class ContactSetManager:
         self.model.mesh.comm.Allreduce(MPI.IN_PLACE, local, op=MPI.SUM)
         return local
 
+    def scatter(self, values: npt.NDArray[np.float64], u: PETSc.Vec) -> PETSc.Vec:
+        """Set the W-vector ``u`` to ``values`` (i,) at the constrained nodes, zero elsewhere.
+
+        The inverse of :meth:`values` for a vector supported on I. Not collective.
+        """
+        u.zeroEntries()
+        u.array[self._owned.local_dofs] = values[self._owned.positions]
+        return u
+
+    def global_rows(self) -> npt.NDArray[np.int64]:
+        """Global W row of every constrained node, (i,), same on all ranks (collective)."""
+        comm = self.model.mesh.comm
+        positions = np.concatenate(comm.allgather(self._owned.positions))
+        dofs = np.concatenate(comm.allgather(self._owned.global_dofs))
+        rows = np.empty(self.size, dtype=np.int64)
+        rows[positions] = dofs
+        return rows
+
     def indicator(self) -> dolfinx.fem.Function:
         """Function on the w-space: 1 at the constrained nodes, 0 elsewhere (for output)."""
         return self.node_function(np.arange(self.size, dtype=np.int64), "obstacle_zone")
