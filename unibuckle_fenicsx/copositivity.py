@@ -541,10 +541,10 @@ def copositivity_bound(
                 if route.get("unavailable") or route.get("too_large"):
                     break
     finally:
-        timings = {
-            "total_s": time.perf_counter() - t0,
-            "factor_s": matrix.factor_s,
-            "solve_s": matrix.solve_s,
+        timings = {  # the slowest rank's, so that the record is the same on every rank
+            "total_s": problem.comm.allreduce(time.perf_counter() - t0, op=MPI.MAX),
+            "factor_s": problem.comm.allreduce(matrix.factor_s, op=MPI.MAX),
+            "solve_s": problem.comm.allreduce(matrix.solve_s, op=MPI.MAX),
             "factorisations": matrix.factorisations,
             "solves": matrix.solves,
         }

@@ -99,7 +99,7 @@ def _psd_plus_nonnegative(
             program.solve(**SDP_SOLVER)
     except cp.error.SolverError as err:
         return -math.inf, -math.inf, np.zeros((n, n)), f"solver failed: {err}"
-    if N.value is None:
+    if N.value is None or t.value is None:
         return -math.inf, -math.inf, np.zeros((n, n)), str(program.status)
     Nv = np.maximum(0.5 * (N.value + N.value.T), 0.0)
     eig_min = float(np.linalg.eigvalsh(Hs - Nv).min())
