@@ -17,7 +17,7 @@ test: setup lint
 	$(PY) -m pytest tests
 
 test-all: setup
-	$(PY) -m pytest tests -m "convergence or not convergence"
+	$(PY) -m pytest tests -m "convergence or stress or not (convergence or stress)"
 
 lint: setup
 	$(VENV)/bin/ruff check unibuckle_fenicsx tests demos bench

@@ -15,7 +15,6 @@ r"""Active-set method (algorithms/active_set.py) against independent computation
 
 from __future__ import annotations
 
-import itertools
 import json
 import math
 from pathlib import Path
@@ -25,156 +24,21 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 from conftest import run_mpi
+from exhaustive import RTOL, exhaustive_minimum
+from families import active_family
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.multilevel import prolong_contact_set
 from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certify import certify
-from unibuckle_fenicsx.config import (
-    Material,
-    MeshSpec,
-    ObstacleSpec,
-    PlateSpec,
-    ProblemSpec,
-    SolverSpec,
-)
+from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.problem import BucklingProblem
 
 HERE = Path(__file__).resolve().parent
-#: Relative agreement of loads: SLEPc converges to a relative residual of eps_tol = 1e-10
-#: and LAPACK to about 1e-13 here, so 1e-8 leaves a margin of 100.
-RTOL = 1e-8
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 
 
-# -- independent exhaustive reference ---------------------------------------------------
-def _dense(mat) -> np.ndarray:
-    n = mat.getSize()[0]
-    idx = np.arange(n, dtype=np.int32)
-    return np.asarray(mat.getValues(idx, idx))
-
-
-def exhaustive_minimum(problem: BucklingProblem) -> tuple[float, list[tuple[int, ...]], int]:
-    r"""Smallest feasible :math:`\lambda(Z)` over all Z in 2^I, by dense linear algebra.
-
-    The rotations are condensed out: :math:`S = A_{ww} - A_{w\theta} A_{\theta\theta}^{-1}
-    A_{\theta w}` on the free w-DOFs; removing the w-DOFs of Z from (A, B) and condensing
-    equals taking the principal submatrices of (S, B_ww). The largest eigenvalue mu of
-    :math:`B_{ff} x = \mu S_{ff} x` gives :math:`\lambda = 1/\mu`; a mode is feasible
-    when, for one sign, :math:`w_k \le \tau \max|w|` on :math:`I \setminus Z`.
-
-    Returns:
-        (lambda_min, every Z with a feasible mode and lambda within RTOL of the minimum,
-        number of feasible sets).
-    """
-    A, B = _dense(problem.model.A), _dense(problem.model.B)
-    n = A.shape[0]
-    bc = problem.model.bc_dofs
-    w_all = problem.model.w_dofs
-    w = np.setdiff1d(w_all, bc)  # free w-DOFs (serial: local == global)
-    th = np.setdiff1d(np.setdiff1d(np.arange(n), w_all), bc)
-    Ath = A[np.ix_(th, th)]
-    S = A[np.ix_(w, w)] - A[np.ix_(w, th)] @ np.linalg.solve(Ath, A[np.ix_(th, w)])
-    Bw = B[np.ix_(w, w)]
-    contact = problem.contact
-    i = contact.size
-    node_pos = np.searchsorted(w, [int(contact.removed_rows(np.array([k]))[0]) for k in range(i)])
-    tau = problem.tau
-    loads: list[tuple[float, tuple[int, ...]]] = []
-    for p in range(i + 1):
-        combos = list(itertools.combinations(range(i), p))
-        keep = np.ones((len(combos), len(w)), dtype=bool)
-        for c, z in enumerate(combos):
-            keep[c, node_pos[list(z)]] = False
-        idx = np.array([np.flatnonzero(k) for k in keep])  # (C, m)
-        if idx.shape[1] == 0:
-            continue  # every w-DOF removed: no finite load
-        Sz = S[idx[:, :, None], idx[:, None, :]]
-        Bz = Bw[idx[:, :, None], idx[:, None, :]]
-        L = np.linalg.cholesky(Sz)
-        Li = np.linalg.inv(L)
-        C = Li @ Bz @ np.swapaxes(Li, 1, 2)
-        mu, Y = np.linalg.eigh(0.5 * (C + np.swapaxes(C, 1, 2)))
-        X = np.swapaxes(Li, 1, 2) @ Y[:, :, -1:]  # w at the free w-DOFs
-        for c, z in enumerate(combos):
-            if mu[c, -1] <= 0.0:
-                continue
-            x = np.zeros(len(w))
-            x[idx[c]] = X[c, :, 0]
-            x /= np.abs(x).max()
-            rest = np.setdiff1d(np.arange(i), z)
-            vals = x[node_pos[rest]]
-            if rest.size == 0 or vals.max() <= tau or (-vals).max() <= tau:
-                loads.append((1.0 / mu[c, -1], z))
-    best = min(v for v, _ in loads)
-    minimisers = [z for v, z in loads if v <= best * (1 + RTOL)]
-    return best, minimisers, len(loads)
-
-
 # -- random family ----------------------------------------------------------------------
-def _interior_nodes_in_box(nx, ny, length, width, box) -> int:
-    xs = np.linspace(0, length, nx + 1)[1:-1]
-    ys = np.linspace(0, width, ny + 1)[1:-1]
-    X, Y = np.meshgrid(xs, ys)
-    tol = 1e-8 * length
-    (x0, x1), (y0, y1) = box
-    inside = (X >= x0 - tol) & (X <= x1 + tol) & (Y >= y0 - tol) & (Y <= y1 + tol)
-    return int(inside.sum())
-
-
-def random_specs(seed: int = 20240605, min_nodes: int = 3, max_nodes: int = 12):
-    """Endless seeded stream of random plates with random box zones.
-
-    Aspect 1-3, width 0.1 m, t = 6 mm; the zones hold ``min_nodes`` to ``max_nodes``
-    free mesh nodes.
-    """
-    rng = np.random.default_rng(seed)
-    count = 0
-    while True:
-        aspect = rng.uniform(1.0, 3.0)
-        length, width = 0.1 * aspect, 0.1
-        ny = int(rng.integers(2, 5))
-        nx = max(2, round(aspect * ny) + int(rng.integers(-1, 2)))
-        xa, xb = np.sort(rng.uniform(0, length, 2))
-        ya, yb = np.sort(rng.uniform(0, width, 2))
-        if rng.random() < 0.3:  # zones spanning the width, like the paper's c1
-            ya, yb = 0.0, width
-        box = ((float(xa), float(xb)), (float(ya), float(yb)))
-        i = _interior_nodes_in_box(nx, ny, length, width, box)
-        if not min_nodes <= i <= max_nodes:
-            continue
-        yield ProblemSpec(
-            name=f"random{count}",
-            plate=PlateSpec(corners=((0.0, 0.0), (length, width)), thickness=0.006),
-            material=Material(E=1.0e9, nu=0.3),
-            mesh=MeshSpec(nx, ny),
-            obstacle=ObstacleSpec(zone=box),
-            solver=SolverSpec(method="active-set"),
-        )
-        count += 1
-
-
-def active_family(count: int = 50) -> tuple[list[ProblemSpec], int]:
-    """The first ``count`` random problems whose obstacle is active.
-
-    Active: the free mode violates it for both signs. Also returns how many inactive
-    problems were skipped.
-    """
-    family, skipped = [], 0
-    for spec in random_specs():
-        problem = BucklingProblem(spec, MPI.COMM_SELF)
-        v = problem.contact.values(problem.solve_free().function.x.petsc_vec)
-        v = v / np.abs(v).max()
-        problem.destroy()
-        if min(v.max(), (-v).max()) > 1e-6:
-            family.append(spec)
-        else:
-            skipped += 1
-        if len(family) == count:
-            return family, skipped
-    raise AssertionError("unreachable")
-
-
 @pytest.fixture(scope="module")
 def family() -> list[ProblemSpec]:
     return active_family()[0]

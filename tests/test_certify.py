@@ -1,7 +1,7 @@
 r"""The global-optimality certificate (copositivity of A - lambda B on the cone).
 
 Soundness is checked against independent exhaustive minima (dense numpy over all 2^i
-contact sets, ``test_active_set.exhaustive_minimum``): a verified lower bound may never
+contact sets, ``tests/exhaustive.py``): a verified lower bound may never
 exceed the true critical load, and a KKT point that is not the global minimum may never
 be proven. Completeness where the theory says so: below the second pencil eigenvalue the
 rank-2 certificate exists (README, "Proving the global minimum"), so the paper's cases are
@@ -16,7 +16,8 @@ from mpi4py import MPI
 
 import numpy as np
 import pytest
-from test_active_set import active_family, exhaustive_minimum
+from exhaustive import exhaustive_minimum
+from families import active_family
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.analysis import solve

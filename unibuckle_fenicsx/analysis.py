@@ -11,7 +11,11 @@ from mpi4py import MPI
 
 import dolfinx
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
+from unibuckle_fenicsx.algorithms import (
+    NoAdmissibleModeError,
+    UnilateralSolution,
+    candidate_count,
+)
 from unibuckle_fenicsx.certify import Certificate, certify
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner
@@ -39,6 +43,8 @@ def choose_method(
     """
     options = spec.solver
     count = candidate_count(i)
+    # 2^i in words a reader can take in (2^2581 has 777 digits).
+    shown = str(count) if i <= 64 else f"10^{int(i * math.log10(2))}"
     estimate = math.inf if i > 1000 else count * solve_time_s
     if candidate_parallel:
         if options.method not in ("auto", "enumerate"):
@@ -49,25 +55,25 @@ def choose_method(
         if count > options.max_candidates:
             raise ValueError(
                 f"--candidate-parallel runs the enumeration, but i = {i} constrained nodes "
-                f"give 2^{i} = {count} candidate sets, above max_candidates = "
+                f"give 2^{i} = {shown} candidate sets, above max_candidates = "
                 f"{options.max_candidates}: drop --candidate-parallel (the active-set "
                 "method distributes the mesh instead)"
             )
-        return "enumerate", f"--candidate-parallel: 2^{i} = {count} candidate sets"
+        return "enumerate", f"--candidate-parallel: 2^{i} = {shown} candidate sets"
     if options.method != "auto":
         return options.method, "given"
     if count > options.max_candidates:
         return "active-set", (
-            f"auto: 2^{i} = {count} candidate sets exceed max_candidates = {options.max_candidates}"
+            f"auto: 2^{i} = {shown} candidate sets exceed max_candidates = {options.max_candidates}"
         )
     if estimate > options.enumeration_budget_s:
         return "active-set", (
-            f"auto: enumerating 2^{i} = {count} sets would take about {estimate:.3g} s "
+            f"auto: enumerating 2^{i} = {shown} sets would take about {estimate:.3g} s "
             f"({solve_time_s:.3g} s per eigen solve), above enumeration_budget_s = "
             f"{options.enumeration_budget_s:g}"
         )
     return "enumerate", (
-        f"auto: 2^{i} = {count} candidate sets, about {estimate:.3g} s "
+        f"auto: 2^{i} = {shown} candidate sets, about {estimate:.3g} s "
         f"({solve_time_s:.3g} s per eigen solve), within enumeration_budget_s = "
         f"{options.enumeration_budget_s:g}"
     )
@@ -195,7 +201,10 @@ def solve(
         solution = _run_method(method, problem, comm if candidate_parallel else None)
         problem.timings["unilateral_s"] = time.perf_counter() - t1
         if not math.isfinite(solution.load):
-            raise RuntimeError(f"{spec.name}: no finite critical load was found")
+            raise NoAdmissibleModeError(
+                f"{spec.name}: no admissible mode with a finite load was found; lower bound "
+                f"lambda_free = {free.load!r} Pa"
+            )
         t1 = time.perf_counter()
         certificate = certify(problem, solution)
         problem.timings["certify_s"] = time.perf_counter() - t1

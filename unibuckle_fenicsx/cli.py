@@ -30,7 +30,8 @@ exit status:
      nothing was computed
   {EXIT_NOT_CERTIFIED}  a numerical difficulty: no certified critical state; the JSON (--json)
      still holds the best admissible load found (an upper bound), the lower bound and a
-     certificate saying what failed
+     certificate saying what failed; when no admissible mode with a finite load
+     exists (or none was found), the message gives the lower bound and no JSON is written
 
 Single-dash options that argparse does not know go to PETSc/SLEPc under the package's
 prefixes, e.g. -unibuckle_eps_view, -unibuckle_eps_tol 1e-12, -unibuckle_certify_ksp_view.
@@ -226,6 +227,7 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     petsc4py.init([sys.argv[0], *rest])
 
+    from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
     from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.cases import paper_case
     from unibuckle_fenicsx.config import load_problem
@@ -262,7 +264,7 @@ def main(argv: Sequence[str] | None = None) -> int:
         analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
     except ValueError as err:
         return fail(str(err))
-    except EigenSolveError as err:
+    except (EigenSolveError, NoAdmissibleModeError) as err:
         return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
     with analysis:
         if args.output:

@@ -208,6 +208,9 @@ class GEPSolver(Owner):
             raise ValueError("GEPSolver needs a non-empty options prefix")
         self.A, self.B = A, B
         self.indefinite = indefinite
+        self._norm_ratio: float | None = None
+        self._radius: float | None = None
+        self._Bx: PETSc.Vec | None = None
         self.prefix = prefix
         self._Aw: PETSc.Mat | None = None
         self._Bw: PETSc.Mat | None = None
@@ -265,9 +268,10 @@ class GEPSolver(Owner):
             initial: Optional start vector (e.g. the previous mode).
 
         Returns:
-            The eigenpair, with value ``inf`` when the removed DOFs leave no geometric
-            stiffness (no finite load); raises :class:`EigenSolveError` if SLEPc
-            converged no pair or returned a non-positive or non-finite load.
+            The eigenpair, with value ``inf`` when no finite load exists (the removed DOFs
+            leave no geometric stiffness, or it is nowhere positive); raises
+            :class:`EigenSolveError` if SLEPc converged no pair or returned a non-positive
+            or non-finite load.
 
         Note:
             Collective.
@@ -287,12 +291,16 @@ class GEPSolver(Owner):
             self.eps.setOperators(B, A)
         else:
             self.eps.setOperators(A, B)
-        if initial is not None:
+        if initial is not None and self._useful_start(initial, B):
             self.eps.setInitialSpace([initial])
         self.eps.solve()
         self.solves += 1
         nconv = self.eps.getConverged()
         its = self.eps.getIterationNumber()
+        if nconv < 1 and self.indefinite and self._negligible_spectrum():
+            if out is not None:
+                out.zeroEntries()
+            return EigenPair(float("inf"), 0.0, int(its), 0)
         if nconv < 1:
             reason = self.eps.getConvergedReason()
             raise EigenSolveError(
@@ -301,6 +309,12 @@ class GEPSolver(Owner):
                 f"-{self.prefix}eps_max_it or a looser -{self.prefix}eps_tol"
             )
         theta = self.eps.getEigenvalue(0).real
+        if self.indefinite and self._is_roundoff(theta):
+            # No eigenvalue of B x = theta A x is distinguishable from zero above it: the
+            # geometric stiffness is nowhere positive on this space, no finite load.
+            if out is not None:
+                out.zeroEntries()
+            return EigenPair(float("inf"), 0.0, int(its), int(nconv))
         value = 1.0 / theta if self.indefinite else theta
         if not np.isfinite(value) or value <= 0.0:
             raise EigenSolveError(
@@ -312,9 +326,103 @@ class GEPSolver(Owner):
         error = self.eps.computeError(0)
         return EigenPair(float(value), float(error), int(its), int(nconv))
 
+    def operators_changed(self) -> None:
+        """Forget the scales cached from A and B (call after changing them in place)."""
+        self._norm_ratio = None
+        self._radius = None
+
+    def _useful_start(self, initial: PETSc.Vec, B: PETSc.Mat) -> bool:
+        """Whether ``initial`` has a component SLEPc can start from (B x != 0).
+
+        A start vector that the pencil's B annihilates (the zero mode of a set with no
+        finite load, or a mode living on removed DOFs only) is refused by SLEPc
+        ("initial vector is zero"); the solve then starts from its default vector.
+        Collective.
+        """
+        if self._Bx is None:
+            self._Bx = B.createVecLeft()
+        B.mult(initial, self._Bx)
+        return bool(self._Bx.norm() > 0.0)  # type: ignore[operator]
+
+    def _negligible_spectrum(self) -> bool:
+        """After a failed solve of B x = theta A x: is every positive theta round-off?
+
+        A relative tolerance cannot be met by eigenvalues that are round-off (a load that
+        does not buckle the plate on this mesh); a fresh solve with an absolute tolerance
+        (1e-12 of the spectral radius) tells. Collective.
+        """
+        B, A = self.eps.getOperators()
+        theta = self._swapped_extreme(
+            A,
+            B,
+            SLEPc.EPS.Which.LARGEST_REAL,
+            1e-12 * self._spectral_radius(),
+            "abs_",
+            SLEPc.EPS.Conv.ABS,
+        )
+        self.solves += 1
+        return theta is not None and self._is_roundoff(theta)
+
+    def _swapped_extreme(
+        self, A: PETSc.Mat, B: PETSc.Mat, which: Any, tol: float, suffix: str, conv: Any
+    ) -> float | None:
+        """One extreme theta of B x = theta A x to ``tol`` by test ``conv`` (None if none).
+
+        Its own EPS under the prefix ``<prefix><suffix>``, destroyed here. Collective.
+        """
+        eps = SLEPc.EPS().create(A.comm)
+        try:
+            eps.setOperators(B, A)
+            eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+            eps.setDimensions(1)
+            eps.setWhichEigenpairs(which)
+            eps.setConvergenceTest(conv)
+            eps.setTolerances(tol)
+            eps.getST().setType(SLEPc.ST.Type.SHIFT)
+            set_options(eps, self.prefix + suffix, EIGEN_OPTIONS)
+            eps.solve()
+            return eps.getEigenvalue(0).real if eps.getConverged() >= 1 else None
+        finally:
+            eps.destroy()
+
+    def _is_roundoff(self, theta: float) -> bool:
+        """Whether theta (= 1/lambda) is at most 1e-10 of the spectral radius of A^-1 B.
+
+        Round-off in theta is about 1e-16 of that radius. Only values below 1e-4 of
+        ||B||/||A|| (the order of 1/lambda for a plate with t/b <= 0.1 is far above) pay
+        for the radius (one eigen solve, then cached). Collective.
+        """
+        if self._norm_ratio is None:
+            inf = PETSc.NormType.INFINITY
+            b_norm = float(self.B.norm(inf))  # type: ignore[arg-type]
+            a_norm = float(self.A.norm(inf))  # type: ignore[arg-type]
+            self._norm_ratio = b_norm / a_norm
+        if theta > 1e-4 * self._norm_ratio:
+            return False
+        return theta <= 1e-10 * self._spectral_radius()
+
+    def _spectral_radius(self) -> float:
+        """The largest |theta| of B x = theta A x (relative 1e-6; cached). Collective."""
+        if self._radius is None:
+            theta = self._swapped_extreme(
+                self.A,
+                self.B,
+                SLEPc.EPS.Which.LARGEST_MAGNITUDE,
+                1e-6,
+                "radius_",
+                SLEPc.EPS.Conv.REL,
+            )
+            if theta is None:
+                raise EigenSolveError(
+                    f"SLEPc ({self.prefix}radius_): the spectral radius of the pencil did "
+                    "not converge"
+                )
+            self._radius = abs(theta)
+        return self._radius
+
     def destroy(self) -> None:
         """Destroy the EPS and work matrices (collective)."""
-        release(self, "eps", "_Aw", "_Bw")
+        release(self, "eps", "_Aw", "_Bw", "_Bx")
 
     def __del__(self) -> None:
         self.destroy()

@@ -241,8 +241,10 @@ class BucklingProblem(Owner):
             pair = self.eigensolver.solve(out=u.x.petsc_vec)
             if not np.isfinite(pair.value):
                 raise ValueError(
-                    "the edge supports fix every deflection DOF of the mesh (no geometric "
-                    "stiffness is left): refine the mesh or free an edge"
+                    "the plate has no positive buckling load on this mesh: the geometric "
+                    "stiffness b(w, w) is nowhere positive on the free deflections (edge "
+                    "loads in tension, or the supports fix every deflection DOF); check the "
+                    "edge loads, refine the mesh or free an edge"
                 )
             u.x.petsc_vec.scale(1.0 / self.max_abs_w(u.x.petsc_vec))
             u.x.scatter_forward()

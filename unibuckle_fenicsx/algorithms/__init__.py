@@ -21,7 +21,11 @@ import numpy.typing as npt
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.problem import Candidate
 
-__all__ = ["UnilateralSolution", "candidate_count"]
+__all__ = ["NoAdmissibleModeError", "UnilateralSolution", "candidate_count"]
+
+
+class NoAdmissibleModeError(RuntimeError):
+    """No admissible mode with a finite load was found (the message gives the bracket)."""
 
 
 def candidate_count(i: int) -> int:

@@ -53,8 +53,9 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import PROOF_RTOL, lattice_bound
+from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.contact import EmptyZoneError
@@ -67,6 +68,9 @@ logger = logging.getLogger(__name__)
 
 #: Loads within this relative distance are equal-load twins.
 TWIN_RTOL = 1e-8
+#: Iterates allowed when polishing a prolonged contact set (it needs one to three when
+#: the coarser level predicts the fine one; more means it stalls: the fallback takes over).
+POLISH_ITERATIONS = 25
 #: Seeds run on the coarsest level, in this order.
 SEED_NAMES = ("free+", "free-", "all", "end-low", "middle", "end-high", "greedy+", "greedy-")
 
@@ -164,6 +168,15 @@ def _distinct_kkt(runs: list[Run]) -> list[Candidate]:
     return sorted(found.values(), key=lambda s: (s.load, len(s.active), tuple(s.active)))
 
 
+def _best_attempt(runs: list[Run]) -> Candidate | None:
+    """The best state met: the lowest feasible load, else the smallest violation."""
+    feasible = [r.best_feasible for r in runs if r.best_feasible is not None]
+    if feasible:
+        return min(feasible, key=lambda c: c.load)
+    finals = [r.final for r in runs if r.final is not None and math.isfinite(r.final.load)]
+    return min(finals, key=lambda c: c.margin) if finals else None
+
+
 def _prune(problem: BucklingProblem, cand: Candidate) -> Candidate:
     """Release the contact nodes with (near) zero multiplier if the KKT point stays."""
     slack = cand.forces[cand.active] >= -problem.tau
@@ -245,7 +258,7 @@ def solve_active_set(
             runs = coarse_runs
         else:
             assert prev is not None
-            runs = _polish(cp, prev, candidates, max_iterations)
+            runs = _polish(cp, prev, candidates, min(max_iterations, POLISH_ITERATIONS))
         kkt = _distinct_kkt(runs)
         groups = _twin_groups(kkt)
         if groups:
@@ -279,7 +292,7 @@ def solve_active_set(
             candidates = None
     # -- finest level -------------------------------------------------------------
     if candidates is not None and prev is not None:
-        runs = _polish(problem, prev, candidates, max_iterations)
+        runs = _polish(problem, prev, candidates, min(max_iterations, POLISH_ITERATIONS))
         details["seeded_on"] = [prev.spec.mesh.nx, prev.spec.mesh.ny]
     else:
         runs = _multi_seed(problem, max_iterations)
@@ -288,8 +301,23 @@ def solve_active_set(
         prev.destroy()
 
     kkt = _distinct_kkt(runs)
-    feasible = [r.best_feasible for r in runs if r.best_feasible is not None]
     warnings: list[str] = []
+    if not kkt:
+        # The iteration stalled on this mesh: penalty continuation from the best set met.
+        # (From the free plate: a stalled set is a poor start, measured on thin plates.)
+        run, penalty_solves = penalty_continuation(problem, None, max_iterations=200)
+        runs.append(run)
+        kkt = _distinct_kkt(runs)
+        details["fallback"] = {
+            "method": "penalty continuation",
+            "penalty_eigensolves": penalty_solves,
+            "status": run.status,
+        }
+        warnings.append(
+            f"the active-set iteration stalled; penalty continuation ({penalty_solves} "
+            f"eigen solves) ended {'at a KKT point' if run.status == 'kkt' else run.status}"
+        )
+    feasible = [r.best_feasible for r in runs if r.best_feasible is not None]
     cycles = [r.seed for r in runs + coarse_runs if r.status == "cycle"]
     if cycles:
         warnings.append(f"active-set iteration cycled from seed(s) {cycles}")
@@ -306,8 +334,16 @@ def solve_active_set(
         chosen = min(feasible, key=lambda s: s.load)
         warnings.append("no seed reached a KKT point; returning the best feasible mode")
     else:
-        raise RuntimeError(
-            f"active-set: no seed produced a feasible mode (runs: {[r.summary() for r in runs]})"
+        attempt = _best_attempt(runs)
+        if attempt is None:
+            raise NoAdmissibleModeError(
+                "no admissible mode with a finite load was found (the load grows without "
+                "bound as the obstacle is enforced: it may prevent buckling on this mesh; "
+                f"refine it); lower bound lambda_free = {problem.solve_free().load!r} Pa"
+            )
+        chosen = attempt
+        warnings.append(
+            "no admissible mode was found; returning the least violating one (no upper bound)"
         )
     if chosen.kkt:
         chosen = _prune(problem, chosen)
@@ -351,7 +387,7 @@ def solve_active_set(
         eigensolves=problem.eigensolver.solves - solves0 + coarse_solves,
         lower_bound=min(lower, chosen.load),
         global_optimum_proven=proven,
-        upper_bound=chosen.load,
+        upper_bound=chosen.load if chosen.feasible else math.inf,
         kkt_points=kkt,
         details=details,
     )

@@ -168,6 +168,7 @@ class PenaltySolver(Owner):
         self._springs.setValues(rows, np.full(len(rows), rho_abs))
         self._springs.assemble()
         self.A_pen.setDiagonal(self._springs, addv=PETSc.InsertMode.ADD_VALUES)
+        self.gep.operators_changed()
         self._rho_abs = rho_abs
         self._active = np.asarray(active, dtype=np.int64)
 
@@ -338,9 +339,13 @@ class PenaltySolver(Owner):
                 "penalty rho=%.3g: no fixed point after %d solves (-max_iterations)",
                 rho, max_iterations,
             )  # fmt: skip
+        if best is None:
+            # Every iterate had b(v, v) <= 0 (an infinite penalised quotient): the load
+            # grows without bound with rho, no admissible mode buckles. Keep the last.
+            best, best_step = vec.copy(), len(steps) - 1
+            status = "no-finite-load"
         if previous is not None:
             previous.destroy()
-        assert best is not None
         u = problem.new_mode()
         best.copy(u.x.petsc_vec)
         u.x.scatter_forward()

@@ -1,0 +1,99 @@
+"""Independent reference for small problems: the exhaustive minimum by dense linear algebra.
+
+Used by the tests of the active-set method and of the random stress family: nothing here
+calls the package's algorithms, only its assembled matrices A and B.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+import numpy as np
+import scipy.linalg
+
+from unibuckle_fenicsx.problem import BucklingProblem
+
+#: Relative agreement of loads: SLEPc converges to a relative residual of eps_tol = 1e-10
+#: and LAPACK to about 1e-13 here, so 1e-8 leaves a margin of 100.
+RTOL = 1e-8
+
+
+def _dense(mat) -> np.ndarray:
+    n = mat.getSize()[0]
+    idx = np.arange(n, dtype=np.int32)
+    return np.asarray(mat.getValues(idx, idx))
+
+
+def exhaustive_minimum(
+    problem: BucklingProblem, rtol: float = RTOL
+) -> tuple[float, list[tuple[int, ...]], int]:
+    r"""Smallest feasible :math:`\lambda(Z)` over all Z in 2^I, by dense linear algebra.
+
+    The rotations are condensed out: :math:`S = A_{ww} - A_{w\theta} A_{\theta\theta}^{-1}
+    A_{\theta w}` on the free w-DOFs; removing the w-DOFs of Z from (A, B) and condensing
+    equals taking the principal submatrices of (S, B_ww). The largest eigenvalue mu of
+    :math:`B_{ff} x = \mu S_{ff} x` gives :math:`\lambda = 1/\mu`; a mode is feasible
+    when, for one sign, :math:`w_k \le \tau \max|w|` on :math:`I \setminus Z`.
+
+    Returns:
+        (lambda_min, or inf if no subset has a positive load; every Z with a feasible
+        mode and lambda within ``rtol`` of the minimum; number of feasible sets).
+    """
+    A, B = _dense(problem.model.A), _dense(problem.model.B)
+    n = A.shape[0]
+    bc = problem.model.bc_dofs
+    w_all = problem.model.w_dofs
+    w = np.setdiff1d(w_all, bc)  # free w-DOFs (serial: local == global)
+    th = np.setdiff1d(np.setdiff1d(np.arange(n), w_all), bc)
+    Ath = A[np.ix_(th, th)]
+    S = A[np.ix_(w, w)] - A[np.ix_(w, th)] @ np.linalg.solve(Ath, A[np.ix_(th, w)])
+    Bw = B[np.ix_(w, w)]
+    contact = problem.contact
+    i = contact.size
+    node_pos = np.searchsorted(w, [int(contact.removed_rows(np.array([k]))[0]) for k in range(i)])
+    tau = problem.tau
+    loads: list[tuple[float, tuple[int, ...]]] = []
+    for p in range(i + 1):
+        combos = list(itertools.combinations(range(i), p))
+        keep = np.ones((len(combos), len(w)), dtype=bool)
+        for c, z in enumerate(combos):
+            keep[c, node_pos[list(z)]] = False
+        idx = np.array([np.flatnonzero(k) for k in keep])  # (C, m)
+        if idx.shape[1] == 0:
+            continue  # every w-DOF removed: no finite load
+        Sz = S[idx[:, :, None], idx[:, None, :]]
+        Bz = Bw[idx[:, :, None], idx[:, None, :]]
+        L = np.linalg.cholesky(Sz)
+        Li = np.linalg.inv(L)
+        C = Li @ Bz @ np.swapaxes(Li, 1, 2)
+        mu, Y = np.linalg.eigh(0.5 * (C + np.swapaxes(C, 1, 2)))
+        X = np.swapaxes(Li, 1, 2) @ Y[:, :, -1:]  # w at the free w-DOFs
+        for c, z in enumerate(combos):
+            if mu[c, -1] <= 0.0:
+                continue
+            x = np.zeros(len(w))
+            x[idx[c]] = X[c, :, 0]
+            x /= np.abs(x).max()
+            rest = np.setdiff1d(np.arange(i), z)
+            vals = x[node_pos[rest]]
+            if rest.size == 0 or vals.max() <= tau or (-vals).max() <= tau:
+                loads.append((1.0 / mu[c, -1], z))
+    if not loads:  # no subset has a positive load: the plate does not buckle
+        return math.inf, [], 0
+    best = min(v for v, _ in loads)
+    minimisers = [z for v, z in loads if v <= best * (1 + rtol)]
+    return best, minimisers, len(loads)
+
+
+def dense_free_load(problem: BucklingProblem) -> float:
+    """Smallest positive load of the whole pencil by LAPACK (``scipy.linalg.eigh``, inf if none).
+
+    theta = 1/lambda below 1e-10 of the largest |theta| is round-off, not a load (LAPACK's
+    generalized solver is accurate to about 1e-16 of it; e.g. a pure-shear plate with one
+    row of free nodes, where b(w, w) vanishes identically by symmetry).
+    """
+    A, B = _dense(problem.model.A), _dense(problem.model.B)
+    theta = scipy.linalg.eigh(B, A, eigvals_only=True)
+    top = theta[-1]
+    return 1.0 / top if top > 1e-10 * np.abs(theta).max() else math.inf
