@@ -19,7 +19,7 @@ from unibuckle_fenicsx.problem import BucklingProblem
 RTOL = 1e-8
 
 
-def _dense(mat) -> np.ndarray:
+def dense(mat) -> np.ndarray:
     n = mat.getSize()[0]
     idx = np.arange(n, dtype=np.int32)
     return np.asarray(mat.getValues(idx, idx))
@@ -40,7 +40,7 @@ def exhaustive_minimum(
         (lambda_min, or inf if no subset has a positive load; every Z with a feasible
         mode and lambda within ``rtol`` of the minimum; number of feasible sets).
     """
-    A, B = _dense(problem.model.A), _dense(problem.model.B)
+    A, B = dense(problem.model.A), dense(problem.model.B)
     n = A.shape[0]
     bc = problem.model.bc_dofs
     w_all = problem.model.w_dofs
@@ -93,7 +93,26 @@ def dense_free_load(problem: BucklingProblem) -> float:
     generalized solver is accurate to about 1e-16 of it; e.g. a pure-shear plate with one
     row of free nodes, where b(w, w) vanishes identically by symmetry).
     """
-    A, B = _dense(problem.model.A), _dense(problem.model.B)
+    A, B = dense(problem.model.A), dense(problem.model.B)
     theta = scipy.linalg.eigh(B, A, eigvals_only=True)
     top = theta[-1]
     return 1.0 / top if top > 1e-10 * np.abs(theta).max() else math.inf
+
+
+def dense_reduced_load(problem: BucklingProblem, active: tuple[int, ...]) -> float:
+    """lambda(Z) of the pencil with the edge DOFs and the w-DOFs of Z removed, by LAPACK.
+
+    No condensation (the Schur complement of :func:`exhaustive_minimum` cancels digits on
+    thin plates, where cond(A) reaches 1e11): the reference value of one contact set.
+    """
+    A, B = dense(problem.model.A), dense(problem.model.B)
+    removed = np.union1d(problem.model.bc_dofs, problem.contact.removed_rows(np.array(active)))
+    keep = np.setdiff1d(np.arange(A.shape[0]), removed)
+    theta = scipy.linalg.eigh(B[np.ix_(keep, keep)], A[np.ix_(keep, keep)], eigvals_only=True)
+    return 1.0 / theta[-1] if theta[-1] > 1e-10 * np.abs(theta).max() else math.inf
+
+
+def membrane_force_scale(spec) -> float:
+    """T times the largest edge stress of ``spec`` (N/m per unit load): the size of N0."""
+    stresses = [abs(v) for e in spec.plate.edges for v in (e.normal_stress, e.shear_stress)]
+    return spec.plate.thickness * max(stresses)

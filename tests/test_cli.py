@@ -368,3 +368,74 @@ def test_output_is_readable_by_pyvista(tmp_path, capsys):
     for name in ("w", "w_free", "obstacle_zone", "contact", "theta"):
         assert name in block.point_data, name
     assert np.abs(block.point_data["w"]).max() == pytest.approx(1.0)
+
+
+#: Pure shear on a mesh with one row of free nodes (clamped bottom and top, ny = 2): the
+#: contributions of b(w, w) above and below the row cancel, B vanishes identically.
+NO_BUCKLING_TOML = """\
+name = "shear_one_row"
+[plate]
+corners = [[0.0, 0.0], [0.3, 0.1]]
+thickness = 1e-3
+[edges.left]
+shear_stress = 1.0
+[edges.right]
+shear_stress = 1.0
+[edges.bottom]
+support = "clamped"
+shear_stress = -1.0
+[edges.top]
+support = "clamped"
+shear_stress = -1.0
+[mesh]
+nx = 6
+ny = 2
+"""
+
+#: Compression along x, tension along y, whole-plate obstacle on a 6x3 mesh: every
+#: contact set's mode crosses the obstacle (checked by enumerating all 2^10 sets).
+BLOCKED_TOML = """\
+name = "blocked"
+[plate]
+corners = [[0.0, 0.0], [0.5, 0.1]]
+thickness = 7.4e-5
+[material]
+E = 1.0e9
+nu = 0.44
+[edges.left]
+normal_stress = -0.5
+[edges.right]
+normal_stress = -0.5
+[edges.bottom]
+support = "clamped"
+normal_stress = 0.3
+[edges.top]
+support = "simply_supported_soft"
+normal_stress = 0.3
+[mesh]
+nx = 6
+ny = 3
+[obstacle]
+zone = "all"
+"""
+
+
+def test_no_buckling_load_exits_2(tmp_path, capsys):
+    """A load that buckles nothing on this mesh: refused, not 1/round-off as a load."""
+    path = tmp_path / "p.toml"
+    path.write_text(NO_BUCKLING_TOML)
+    assert main(["solve", "--config", str(path)]) == EXIT_BAD_INPUT
+    assert "no positive buckling load" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("method", ["enumerate", "active-set"])
+def test_no_admissible_mode_exits_3(method, tmp_path, capsys):
+    """No contact set has an admissible mode: exit 3 with the lower bound, no traceback."""
+    path = tmp_path / "p.toml"
+    path.write_text(BLOCKED_TOML)
+    out = tmp_path / "r.json"
+    args = ["solve", "--config", str(path), "--method", method, "--json", str(out)]
+    assert main(args) == EXIT_NOT_CERTIFIED
+    err = capsys.readouterr().err
+    assert "no admissible mode with a finite load" in err and "lambda_free" in err
+    assert not out.exists()

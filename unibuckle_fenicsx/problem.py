@@ -196,6 +196,7 @@ class BucklingProblem(Owner):
         )
         t2 = time.perf_counter()
         self.timings["assembly_s"] = t2 - t1
+        self._check_geometric_stiffness()
         self.eigensolver = GEPSolver(
             self.model.A,
             self.model.B,
@@ -213,6 +214,24 @@ class BucklingProblem(Owner):
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         self._w_owned = self.model.w_dofs[:n_owned_w]
         self.timings["setup_s"] = time.perf_counter() - t0
+
+    def _check_geometric_stiffness(self) -> None:
+        """Refuse a B that is round-off (collective).
+
+        Its entries are of the order of the membrane force |N0| (a Q1 stiffness integral
+        is O(1)); at 1e-10 of it, b(w, w) vanishes identically on the free deflections,
+        e.g. pure shear on a mesh with a single row of free nodes (the contributions
+        above and below the row cancel), and no load buckles the plate.
+        """
+        scale = max(self.prestress.max_compression, self.prestress.max_tension)
+        b_norm = float(self.model.B.norm(PETSc.NormType.INFINITY))
+        if b_norm <= 1e-10 * scale:
+            self.model.destroy()
+            raise ValueError(
+                "the plate has no positive buckling load on this mesh: the geometric "
+                f"stiffness b(w, w) vanishes on the free deflections (|B| = {b_norm:.3g} "
+                f"against |N0| = {scale:.3g} N/m); refine the mesh or check the edge loads"
+            )
 
     # -- primitives ----------------------------------------------------------------
     @property

@@ -54,7 +54,11 @@ from petsc4py import PETSc
 
 import numpy as np
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
+from unibuckle_fenicsx.algorithms import (
+    NoAdmissibleModeError,
+    UnilateralSolution,
+    candidate_count,
+)
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.progress import Progress
@@ -227,7 +231,7 @@ def enumerate_contact_sets(
     Raises:
         ValueError: No obstacle, bad ``max_candidates``, too many candidates, or a
             distributed problem with ``candidate_comm``.
-        RuntimeError: No contact set gives a feasible mode.
+        NoAdmissibleModeError: No contact set gives a feasible mode.
 
     Note:
         Collective on ``problem.comm`` and on ``candidate_comm``.
@@ -314,9 +318,10 @@ def enumerate_contact_sets(
 
     with_feasible = [lv for lv in levels if lv.best_set is not None]
     if not with_feasible:
-        raise RuntimeError(
-            f"no contact set of the {i} constrained nodes gives a feasible mode "
-            f"(tau = {problem.tau:g}): the problem has no admissible buckling mode"
+        raise NoAdmissibleModeError(
+            f"no admissible mode with a finite load: no contact set of the {i} constrained "
+            f"nodes gives a feasible mode (tau = {problem.tau:g}), so the obstacle prevents "
+            f"buckling on this mesh; lower bound lambda_free = {problem.solve_free().load!r} Pa"
         )
     p_star = with_feasible[0].p
     load, chosen = _pick([(lv.best_load, lv.best_set) for lv in with_feasible])  # type: ignore[misc]
