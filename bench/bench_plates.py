@@ -5,7 +5,7 @@ under every edge condition and under shear: the cases on which a contact set wit
 lobes makes the active-set iteration hard. For each case and mesh, ``solve`` runs the
 whole process (free solve, unilateral algorithm, certificate) and the table gives the
 unilateral and certificate time over the free solve's, the eigen solves, the route that
-gave the answer (``fallback`` when the multilevel active set stalled and penalty
+gave the answer ("+ penalty continuation" when the multilevel active set stalled and penalty
 continuation took over), whether the result is a KKT point and whether it is proven
 globally optimal, and the buckling coefficient k = lambda b^2 t / (pi^2 D).
 
@@ -41,7 +41,13 @@ def main() -> None:
     args, _ = parser.parse_known_args()
     comm = MPI.COMM_WORLD
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
-    rows = []
+    if comm.rank == 0:
+        print(f"MPI ranks: {comm.size}; plate {LENGTH} x {WIDTH} m, t = {THICKNESS} m, zone all")
+        print(
+            "| case | edges | load | t/b | mesh | i | \\|Z\\| | eigen solves | route "
+            "| free solve (s) | ratio | total (s) | KKT | proven | k | lambda_c (Pa) |"
+        )
+        print("|" + "---|" * 16, flush=True)
     for nx, ny in meshes:
         for name in args.cases.split(","):
             supports, load, edges = CASES[name]
@@ -63,39 +69,31 @@ def main() -> None:
                 assert sol is not None and cert is not None
                 t = r.timings
                 fallback = sol.details.get("fallback")
-                route = "fallback" if fallback else r.method
-                rows.append(
-                    (
-                        name,
-                        edges,
-                        load,
-                        THICKNESS / WIDTH,
-                        f"{nx}x{ny}",
-                        r.constrained_nodes,
-                        r.contact_nodes,
-                        r.eigensolves,
-                        route,
-                        t["free_solve_s"],
-                        (t["unilateral_s"] + t["certify_s"]) / t["free_solve_s"],
-                        total,
-                        "yes" if cert.kkt else "no",
-                        cert.proven_by if cert.global_optimum_proven else "no",
-                        analysis.problem.buckling_coefficient(r.critical_load_Pa),
-                        r.critical_load_Pa,
-                    )
+                route = f"{r.method} + penalty continuation" if fallback else r.method
+                row = (
+                    name,
+                    edges,
+                    load,
+                    THICKNESS / WIDTH,
+                    f"{nx}x{ny}",
+                    r.constrained_nodes,
+                    r.contact_nodes,
+                    r.eigensolves,
+                    route,
+                    t["free_solve_s"],
+                    (t["unilateral_s"] + t["certify_s"]) / t["free_solve_s"],
+                    total,
+                    "yes" if cert.kkt else "no",
+                    cert.proven_by if cert.global_optimum_proven else "no",
+                    analysis.problem.buckling_coefficient(r.critical_load_Pa),
+                    r.critical_load_Pa,
                 )
-    if comm.rank == 0:
-        print(f"MPI ranks: {comm.size}; plate {LENGTH} x {WIDTH} m, t = {THICKNESS} m, zone all")
-        print(
-            "| case | edges | load | t/b | mesh | i | \\|Z\\| | eigen solves | route "
-            "| free solve (s) | ratio | total (s) | KKT | proven | k | lambda_c (Pa) |"
-        )
-        print("|" + "---|" * 16)
-        for row in rows:
-            print(
-                "| {} | {} | {} | {:.0e} | {} | {} | {} | {} | {} | {:.2f} | **{:.1f}** "
-                "| {:.1f} | {} | {} | {:.4f} | {:.6f} |".format(*row)
-            )
+            if comm.rank == 0:  # one row at a time: a long run shows its progress
+                print(
+                    "| {} | {} | {} | {:.0e} | {} | {} | {} | {} | {} | {:.2f} | **{:.1f}** "
+                    "| {:.1f} | {} | {} | {:.4f} | {:.6f} |".format(*row),
+                    flush=True,
+                )
 
 
 if __name__ == "__main__":
