@@ -27,7 +27,7 @@ EPILOG = f"""\
 exit status:
   {EXIT_OK}  a critical state satisfying its certificate (KKT) was found
   {EXIT_BAD_INPUT}  bad input (the message names the parameter and the allowed range);
-     nothing was computed
+     no result was computed
   {EXIT_NOT_CERTIFIED}  a numerical difficulty: no certified critical state; the JSON (--json)
      still holds the best admissible load found (an upper bound), the lower bound and a
      certificate saying what failed; when no admissible mode with a finite load
