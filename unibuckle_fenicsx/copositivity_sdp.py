@@ -155,34 +155,29 @@ def spn_certificate(problem: BucklingProblem, matrix: ShiftedMatrix, lam: float)
 def _lowest_modes(problem: BucklingProblem, nev: int) -> list[PETSc.Vec]:
     """The nev lowest pencil modes with a positive load (for the sector rows).
 
-    Solved as the swapped pencil B x = (1/lambda) A x (A positive definite, B possibly
-    indefinite), largest first. The caller destroys the vectors. Collective.
+    Lowest load first; the caller destroys the vectors. Collective.
     """
     from slepc4py import SLEPc
 
-    from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, set_options
+    from unibuckle_fenicsx.eigen import swapped_eigenpairs
 
-    eps = SLEPc.EPS().create(problem.comm)
-    try:
-        eps.setOperators(problem.model.B, problem.model.A)
-        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-        eps.setDimensions(nev)
-        eps.setWhichEigenpairs(SLEPc.EPS.Which.LARGEST_REAL)
-        eps.setTolerances(1e-12)
-        eps.getST().setType(SLEPc.ST.Type.SHIFT)
-        set_options(eps, CERTIFY_PREFIX + "modes_", EIGEN_OPTIONS)
-        eps.solve()
-        pairs = []
-        for k in range(min(nev, eps.getConverged())):
-            v = problem.model.A.createVecRight()
-            theta = eps.getEigenpair(k, v).real
-            if theta > 0.0:
-                pairs.append((theta, v))
-            else:
-                v.destroy()
-    finally:
-        eps.destroy()
-    return [v for _, v in sorted(pairs, key=lambda p: -p[0])]
+    pairs = swapped_eigenpairs(
+        problem.model.A,
+        problem.model.B,
+        CERTIFY_PREFIX + "modes_",
+        which=SLEPc.EPS.Which.LARGEST_REAL,
+        nev=nev,
+        tol=1e-12,
+        vectors=True,
+    )
+    modes = []
+    for theta, v in sorted(pairs, key=lambda p: -p[0]):
+        assert v is not None
+        if theta > 0.0:
+            modes.append(v)
+        else:
+            v.destroy()
+    return modes
 
 
 def sector_certificate(

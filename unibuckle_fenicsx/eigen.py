@@ -52,6 +52,7 @@ __all__ = [
     "extreme_eigenvalues",
     "release",
     "set_options",
+    "swapped_eigenpairs",
 ]
 
 logger = logging.getLogger(__name__)
@@ -352,38 +353,16 @@ class GEPSolver(Owner):
         (1e-12 of the spectral radius) tells. Collective.
         """
         B, A = self.eps.getOperators()
-        theta = self._swapped_extreme(
+        pairs = swapped_eigenpairs(
             A,
             B,
-            SLEPc.EPS.Which.LARGEST_REAL,
-            1e-12 * self._spectral_radius(),
-            "abs_",
-            SLEPc.EPS.Conv.ABS,
+            self.prefix + "abs_",
+            which=SLEPc.EPS.Which.LARGEST_REAL,
+            tol=1e-12 * self._spectral_radius(),
+            conv=SLEPc.EPS.Conv.ABS,
         )
         self.solves += 1
-        return theta is not None and self._is_roundoff(theta)
-
-    def _swapped_extreme(
-        self, A: PETSc.Mat, B: PETSc.Mat, which: Any, tol: float, suffix: str, conv: Any
-    ) -> float | None:
-        """One extreme theta of B x = theta A x to ``tol`` by test ``conv`` (None if none).
-
-        Its own EPS under the prefix ``<prefix><suffix>``, destroyed here. Collective.
-        """
-        eps = SLEPc.EPS().create(A.comm)
-        try:
-            eps.setOperators(B, A)
-            eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-            eps.setDimensions(1)
-            eps.setWhichEigenpairs(which)
-            eps.setConvergenceTest(conv)
-            eps.setTolerances(tol)
-            eps.getST().setType(SLEPc.ST.Type.SHIFT)
-            set_options(eps, self.prefix + suffix, EIGEN_OPTIONS)
-            eps.solve()
-            return eps.getEigenvalue(0).real if eps.getConverged() >= 1 else None
-        finally:
-            eps.destroy()
+        return bool(pairs) and self._is_roundoff(pairs[0][0])
 
     def _is_roundoff(self, theta: float) -> bool:
         """Whether theta (= 1/lambda) is at most 1e-10 of the spectral radius of A^-1 B.
@@ -404,20 +383,16 @@ class GEPSolver(Owner):
     def _spectral_radius(self) -> float:
         """The largest |theta| of B x = theta A x (relative 1e-6; cached). Collective."""
         if self._radius is None:
-            theta = self._swapped_extreme(
-                self.A,
-                self.B,
-                SLEPc.EPS.Which.LARGEST_MAGNITUDE,
-                1e-6,
-                "radius_",
-                SLEPc.EPS.Conv.REL,
+            pairs = swapped_eigenpairs(
+                self.A, self.B, self.prefix + "radius_", which=SLEPc.EPS.Which.LARGEST_MAGNITUDE
             )
-            if theta is None:
+            self.solves += 1
+            if not pairs:
                 raise EigenSolveError(
                     f"SLEPc ({self.prefix}radius_): the spectral radius of the pencil did "
                     "not converge"
                 )
-            self._radius = abs(theta)
+            self._radius = abs(pairs[0][0])
         return self._radius
 
     def destroy(self) -> None:
@@ -426,6 +401,60 @@ class GEPSolver(Owner):
 
     def __del__(self) -> None:
         self.destroy()
+
+
+def swapped_eigenpairs(
+    A: PETSc.Mat,
+    B: PETSc.Mat,
+    prefix: str,
+    *,
+    which: Any,
+    nev: int = 1,
+    tol: float = 1e-6,
+    conv: Any = None,
+    vectors: bool = False,
+) -> list[tuple[float, PETSc.Vec | None]]:
+    """Extreme eigenpairs theta of the swapped pencil B x = theta A x (theta = 1/lambda).
+
+    A is positive definite and B may be indefinite (tension somewhere), so this is the
+    form every solve with an indefinite B uses: a GHEP with A in the inner-product slot,
+    spectral transformation "shift" (one MUMPS LU of A). Its own EPS under ``prefix``,
+    destroyed here.
+
+    Args:
+        A: Bending stiffness (SPD; not modified).
+        B: Geometric stiffness (not modified).
+        prefix: Options prefix.
+        which: SLEPc ``EPS.Which`` (e.g. ``LARGEST_REAL`` for the lowest positive loads).
+        nev: Pairs wanted.
+        tol: Tolerance.
+        conv: SLEPc ``EPS.Conv`` convergence test (default relative).
+        vectors: Also return the eigenvectors (the caller destroys them).
+
+    Returns:
+        The converged pairs (theta, vector or None), at most ``nev``, in SLEPc's order.
+
+    Note:
+        Collective.
+    """
+    eps = SLEPc.EPS().create(A.comm)
+    try:
+        eps.setOperators(B, A)
+        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+        eps.setDimensions(nev)
+        eps.setWhichEigenpairs(which)
+        eps.setConvergenceTest(SLEPc.EPS.Conv.REL if conv is None else conv)
+        eps.setTolerances(tol)
+        eps.getST().setType(SLEPc.ST.Type.SHIFT)
+        set_options(eps, prefix, EIGEN_OPTIONS)
+        eps.solve()
+        pairs: list[tuple[float, PETSc.Vec | None]] = []
+        for k in range(min(nev, eps.getConverged())):
+            v = A.createVecRight() if vectors else None
+            pairs.append((float(eps.getEigenpair(k, v).real), v))
+        return pairs
+    finally:
+        eps.destroy()
 
 
 def extreme_eigenvalues(

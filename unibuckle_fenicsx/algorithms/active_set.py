@@ -168,11 +168,8 @@ def _distinct_kkt(runs: list[Run]) -> list[Candidate]:
     return sorted(found.values(), key=lambda s: (s.load, len(s.active), tuple(s.active)))
 
 
-def _best_attempt(runs: list[Run]) -> Candidate | None:
-    """The best state met: the lowest feasible load, else the smallest violation."""
-    feasible = [r.best_feasible for r in runs if r.best_feasible is not None]
-    if feasible:
-        return min(feasible, key=lambda c: c.load)
+def _least_violating(runs: list[Run]) -> Candidate | None:
+    """The final state with a finite load that crosses the obstacle least (or None)."""
     finals = [r.final for r in runs if r.final is not None and math.isfinite(r.final.load)]
     return min(finals, key=lambda c: c.margin) if finals else None
 
@@ -303,8 +300,8 @@ def solve_active_set(
     kkt = _distinct_kkt(runs)
     warnings: list[str] = []
     if not kkt:
-        # The iteration stalled on this mesh: penalty continuation from the best set met.
-        # (From the free plate: a stalled set is a poor start, measured on thin plates.)
+        # The iteration stalled on this mesh: penalty continuation, started from the free
+        # plate (a stalled contact set is a poorer start, measured on thin plates).
         run, penalty_solves = penalty_continuation(problem, None, max_iterations=200)
         runs.append(run)
         kkt = _distinct_kkt(runs)
@@ -334,7 +331,7 @@ def solve_active_set(
         chosen = min(feasible, key=lambda s: s.load)
         warnings.append("no seed reached a KKT point; returning the best feasible mode")
     else:
-        attempt = _best_attempt(runs)
+        attempt = _least_violating(runs)
         if attempt is None:
             raise NoAdmissibleModeError(
                 "no admissible mode with a finite load was found (the load grows without "
