@@ -35,6 +35,7 @@ DEMOS = (
     "demo_obstacle_c1.py",
     "demo_obstacle_c2.py",
     "demo_obstacle_c3.py",
+    "demo_garland.py",  # figures/garland/; no row in the table
     "study_penalty.py",  # figures/penalty_*.png; no row in the table
 )
 CASES = ("free", "c1", "c2", "c3")

@@ -41,6 +41,6 @@ if [ ! -x "$venv/bin/python" ]; then
   "$py" -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip
-"$venv/bin/python" -m pip install --quiet -e '.[fenics,demo,test,lint,sdp]'
+"$venv/bin/python" -m pip install --quiet -e '.[fenics,demo,test,lint,sdp,progress]'
 touch "$stamp"
 echo "setup: $venv ready ($("$venv/bin/python" --version))"

@@ -38,6 +38,8 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
         pngs[f"{case}/contact_set.png"] = line
         for mesh in COARSE:
             pngs[f"{case}/mode_{mesh}.png"] = (h3, w3)
+    for name in ("ssss", "loaded_edges_clamped"):  # charts.plot_sweep: 7.5 x 5 in at 150 dpi
+        pngs[f"garland/garland_{name}.png"] = (750, 1125)
     return pngs
 
 
@@ -59,7 +61,10 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     cmd += ["--figures", str(figures), "--output", str(vtx)]
     proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env, cwd=ROOT)
     assert proc.returncode == 0, proc.stdout + proc.stderr
-    for demo in ("demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3"):
+    for demo in (
+        "demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3",
+        "demo_garland",
+    ):  # fmt: skip
         assert f"{demo}.py: ok" in proc.stdout
     assert "lambda/lambda_free" in proc.stdout and "eigen solves" in proc.stdout
     assert "check free <= c2 <= c1 <= c3 (nested zones): ok" in proc.stdout

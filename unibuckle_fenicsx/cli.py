@@ -1,4 +1,7 @@
-"""Command line: ``unibuckle solve --case c1 --nx 20 --ny 20 --json out.json``.
+"""Command line: ``unibuckle solve`` (one problem) and ``unibuckle sweep`` (a grid of them).
+
+``unibuckle solve --case c1 --nx 20 --ny 20 --json out.json``;
+``unibuckle sweep --config base.toml --vary plate.length=0.1:0.4:7 --json out.jsonl``.
 
 Unrecognised ``-prefix_option value`` pairs are passed to PETSc, e.g.
 ``-unibuckle_eps_view`` or ``-unibuckle_prestress_ksp_view``.
@@ -35,6 +38,28 @@ exit status:
 
 Single-dash options that argparse does not know go to PETSc/SLEPc under the package's
 prefixes, e.g. -unibuckle_eps_view, -unibuckle_eps_tol 1e-12, -unibuckle_certify_ksp_view.
+"""
+
+
+SWEEP_EPILOG = f"""\
+--vary PATH=START:STOP:N gives N values from START to STOP (ends included);
+--vary PATH=V1,V2,... gives a list. PATH is the dotted path of a number of the
+problem file, list entries by index: plate.thickness, material.nu,
+edges.left.normal_stress, plate.corners.1.0 (x1), obstacle.zone.0.1, mesh.size;
+plate.length and plate.width set x1 = x0 + value and y1 = y0 + value. Several
+--vary make a grid (the first varies slowest). Values are in the file's units. Give
+[mesh] size = h in the file for a cell count that follows the plate's size.
+
+Each finished point appends one JSON line to --json: index, point, status and the keys
+of 'unibuckle solve --json' (without wall times). Re-running the same command resumes:
+points already in the file are skipped. Under mpiexec -n P the points are shared among
+P/R groups of --ranks-per-point R ranks.
+
+exit status:
+  {EXIT_OK}  every point has a certified critical state
+  {EXIT_BAD_INPUT}  bad input (a --vary, the base file, a point the schema refuses);
+     nothing was solved
+  {EXIT_NOT_CERTIFIED}  some points have no certified critical state (their lines say why)
 """
 
 
@@ -139,6 +164,44 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     )
     s.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
     s.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
+
+    w = sub.add_parser(
+        "sweep",
+        help="solve a problem file over a grid of values of some of its numbers",
+        description="Solve the problem of --config at every point of the --vary grid, "
+        "writing one JSON line per point (resumable), and optionally a chart of k.",
+        epilog=SWEEP_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    w.add_argument("--config", metavar="FILE", required=True, help="the base problem (TOML)")
+    w.add_argument(
+        "--vary",
+        metavar="PATH=VALUES",
+        action="append",
+        required=True,
+        help="a number to vary: PATH=START:STOP:N or PATH=V1,V2,... (repeat for a grid)",
+    )
+    w.add_argument(
+        "--json",
+        metavar="PATH",
+        required=True,
+        help="JSON-lines output; an existing file of the same sweep is resumed",
+    )
+    w.add_argument(
+        "--plot",
+        metavar="PNG",
+        help="draw k against the first --vary (bilateral and unilateral, with the "
+        "exact curves where they exist)",
+    )
+    w.add_argument(
+        "--ranks-per-point",
+        type=int,
+        default=1,
+        metavar="R",
+        help="under mpiexec: ranks of each point's mesh (default 1: one point per rank)",
+    )
+    w.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
+    w.add_argument("-q", "--quiet", action="store_true", help="no progress bar or lines")
     return parser, s
 
 
@@ -220,7 +283,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     args, rest = parser.parse_known_args(argv)
     unknown = [a for a in rest if a.startswith("--")]
     if unknown:
-        solve_parser.error(f"unrecognized arguments: {' '.join(unknown)}")
+        sub = solve_parser if args.command == "solve" else parser
+        sub.error(f"unrecognized arguments: {' '.join(unknown)}")
 
     import petsc4py
     from mpi4py import MPI  # before petsc4py: loads libmpi
@@ -236,6 +300,8 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     comm = MPI.COMM_WORLD
     _logging(args.verbose, args.quiet, comm.rank)
+    if args.command == "sweep":
+        return _sweep(args, comm)
 
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
         if comm.rank == 0:
@@ -287,6 +353,61 @@ def main(argv: Sequence[str] | None = None) -> int:
                 file=sys.stderr,
             )
     return status
+
+
+def _sweep(args: argparse.Namespace, comm: Any) -> int:
+    """``unibuckle sweep``: the grid, the JSON lines, the chart."""
+    from unibuckle_fenicsx.sweep import base_mapping, parse_variation, run_sweep
+
+    def fail(message: str) -> int:
+        if comm.rank == 0:
+            print(f"unibuckle: error: {message}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+
+    args.output = None
+    problem = comm.bcast(_check_writable(args) if comm.rank == 0 else None, root=0)
+    if problem is not None:
+        return fail(problem)
+    if args.plot and comm.rank == 0:
+        try:
+            import matplotlib as mpl  # noqa: F401
+        except ImportError:
+            return fail("--plot needs matplotlib: pip install 'unibuckle_fenicsx[demo]'")
+    # Each point's own progress lines and warnings would interleave with the sweep's
+    # (the warnings are in the point's JSON line, under details).
+    if args.verbose == 0:
+        logging.getLogger("unibuckle_fenicsx").setLevel(logging.ERROR)
+        logging.getLogger("unibuckle_fenicsx.progress").setLevel(logging.ERROR)
+        sweep_lines = logging.getLogger("unibuckle_fenicsx.progress.sweep")
+        sweep_lines.setLevel(logging.ERROR if args.quiet or comm.rank else logging.INFO)
+    try:
+        variations = [parse_variation(v) for v in args.vary]
+        base = base_mapping(args.config)
+        lines = run_sweep(
+            base,
+            variations,
+            args.json,
+            comm,
+            ranks_per_point=args.ranks_per_point,
+            progress=not args.quiet,
+        )
+    except (ValueError, OSError) as err:
+        return fail(str(err))
+    if comm.rank == 0:
+        from collections import Counter
+
+        counts = Counter(line["status"] for line in lines)
+        print(
+            f"sweep: {len(lines)} points in {args.json}: "
+            + ", ".join(f"{n} {status}" for status, n in sorted(counts.items())),
+            flush=True,
+        )
+        if args.plot:
+            from unibuckle_fenicsx.charts import plot_sweep
+
+            print(f"sweep: chart {plot_sweep(lines, variations, base, args.plot)}")
+    ok = all(line["status"] == "ok" for line in lines)
+    return EXIT_OK if ok else EXIT_NOT_CERTIFIED
 
 
 if __name__ == "__main__":

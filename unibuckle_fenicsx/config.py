@@ -261,14 +261,32 @@ class MeshSpec:
     Args:
         nx: Cells along x, >= 2 (one cell cannot carry a buckle).
         ny: Cells along y, >= 2.
+        size: The cell size the file asked for (m), or None when it gave nx and ny;
+            nx and ny are then :meth:`cells_for` of the plate (recorded so that a file
+            written back, e.g. a sweep point, keeps asking for the size).
     """
 
     nx: int = 20
     ny: int = 20
+    size: float | None = None
 
     def __post_init__(self) -> None:
         for name in ("nx", "ny"):
             object.__setattr__(self, name, _integer(f"mesh.{name}", getattr(self, name), 2))
+        if self.size is not None:
+            if not _number("mesh.size", self.size) > 0.0:
+                raise ValueError(f"mesh.size must be > 0 m, got {self.size!r}")
+            object.__setattr__(self, "size", float(self.size))
+
+    @staticmethod
+    def cells_for(length: float, width: float, size: float) -> tuple[int, int]:
+        """Cells (nx, ny) of side at most ``size`` on a ``length`` x ``width`` plate (>= 2)."""
+        if not _number("mesh.size", size) > 0.0:
+            raise ValueError(f"mesh.size must be > 0 m, got {size!r}")
+        # 1e-9: a size that divides the side exactly gives that many cells, not one more.
+        return tuple(  # type: ignore[return-value]
+            max(2, math.ceil(side / size * (1.0 - 1e-9))) for side in (length, width)
+        )
 
     @property
     def num_dofs(self) -> int:
@@ -486,21 +504,27 @@ _DIMENSIONS: dict[tuple[str, str], tuple[int, int]] = {
     ("material", "membrane_voigt"): (1, 1),  # N/m = Pa m
     ("material", "bending_voigt"): (3, 1),  # N m = Pa m^3
     ("obstacle", "tolerance"): (1, 0),
+    ("mesh", "size"): (1, 0),
 }
 
 
-def _to_si(top: dict[str, Any], units: str) -> dict[str, Any]:
-    """Convert the dimensional values of a TOML-shaped mapping from ``units`` to SI."""
+def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, Any]:
+    """Convert the dimensional values of a TOML-shaped mapping between ``units`` and SI.
+
+    From ``units`` to SI, or from SI to ``units`` with ``inverse``.
+    """
     length, stress, _ = UNITS[units]
     if units == "SI":
         return top
+    sign = -1 if inverse else 1
     out = {k: dict(v) if isinstance(v, Mapping) else v for k, v in top.items()}
     for (table, key), (pl, ps) in _DIMENSIONS.items():
         if isinstance(out.get(table), dict) and key in out[table]:
-            out[table][key] = _scaled(out[table][key], length**pl * stress**ps, f"{table}.{key}")
+            factor = (length**pl * stress**ps) ** sign
+            out[table][key] = _scaled(out[table][key], factor, f"{table}.{key}")
     obstacle = out.get("obstacle")
     if isinstance(obstacle, dict) and isinstance(obstacle.get("zone"), list):
-        obstacle["zone"] = _scaled(obstacle["zone"], length, "obstacle.zone")
+        obstacle["zone"] = _scaled(obstacle["zone"], length**sign, "obstacle.zone")
     return out
 
 
@@ -509,7 +533,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
 
     Tables: ``[plate]`` (corners, thickness), ``[material]`` (E, nu, shear_correction,
     membrane_voigt, bending_voigt), ``[edges.<name>]`` (support, inplane,
-    normal_stress, shear_stress), ``[mesh]`` (nx, ny), ``[obstacle]`` (zone,
+    normal_stress, shear_stress), ``[mesh]`` (nx, ny; or size, a cell size), ``[obstacle]`` (zone,
     tolerance; absent = free plate), ``[solver]`` (the :class:`SolverSpec` fields);
     top-level ``name`` and ``units``. Unknown tables or keys raise ``ValueError``.
 
@@ -542,7 +566,14 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         if key not in material_kw:
             raise ValueError(f"[material] needs {key!r}")
     material = Material(**material_kw)
-    mesh = MeshSpec(**_take(top.get("mesh", {}), _names(MeshSpec), "mesh"))
+    mesh_kw = _take(top.get("mesh", {}), _names(MeshSpec), "mesh")
+    if "size" in mesh_kw:
+        if "nx" in mesh_kw or "ny" in mesh_kw:
+            raise ValueError("[mesh]: give size (a cell size) or nx and ny, not both")
+        mesh_kw["nx"], mesh_kw["ny"] = MeshSpec.cells_for(
+            plate.length, plate.width, mesh_kw["size"]
+        )
+    mesh = MeshSpec(**mesh_kw)
     obstacle = None
     if "obstacle" in top:
         obstacle_kw = _take(top["obstacle"], ("zone", "tolerance"), "obstacle")
@@ -566,13 +597,20 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     )
 
 
-def problem_to_dict(spec: ProblemSpec) -> dict[str, Any]:
-    """The TOML-shaped mapping of ``spec``, every key with the value used (in SI).
+def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
+    """The TOML-shaped mapping of ``spec``, every key with the value used.
 
     ``problem_from_dict(problem_to_dict(spec)) == spec`` for a spec with a box or
     "all" zone on the rectangle (a predicate zone cannot be written; it raises).
+
+    Args:
+        spec: The problem.
+        units: Unit system of the numbers written (one of :data:`UNITS`); the mapping's
+            ``units`` key says which.
     """
+    _choice("units", units, tuple(UNITS))
     plate = spec.plate
+    mesh = spec.mesh
     out: dict[str, Any] = {
         "name": spec.name,
         "units": "SI",
@@ -589,7 +627,7 @@ def problem_to_dict(spec: ProblemSpec) -> dict[str, Any]:
             }
             for e in plate.edges
         },
-        "mesh": {"nx": spec.mesh.nx, "ny": spec.mesh.ny},
+        "mesh": {"nx": mesh.nx, "ny": mesh.ny} if mesh.size is None else {"size": mesh.size},
         "solver": dict(vars(spec.solver)),
     }
     if spec.obstacle is not None:
@@ -605,6 +643,9 @@ def problem_to_dict(spec: ProblemSpec) -> dict[str, Any]:
     for key in ("membrane_voigt", "bending_voigt"):
         if key in out["material"]:
             out["material"][key] = [list(row) for row in out["material"][key]]
+    if units != "SI":
+        out = _to_si(out, units, inverse=True)
+        out["units"] = units
     return out
 
 

@@ -23,9 +23,18 @@ class Progress:
         total: Items in the loop.
         interval: Seconds between lines.
         enabled: Log at all (e.g. only on rank 0).
+        logger: Where to log (default :data:`LOGGER`).
     """
 
-    def __init__(self, label: str, total: int, interval: float = 5.0, enabled: bool = True) -> None:
+    def __init__(
+        self,
+        label: str,
+        total: int,
+        interval: float = 5.0,
+        enabled: bool = True,
+        logger: logging.Logger = LOGGER,
+    ) -> None:
+        self.logger = logger
         self.label = label
         self.total = total
         self.interval = interval
@@ -41,7 +50,7 @@ class Progress:
         self._last = now
         elapsed = now - self.start
         left = elapsed * (self.total - done) / done
-        LOGGER.info(
+        self.logger.info(
             "%s: %d/%d (%.0f %%), %.0f s elapsed, about %.0f s left%s",
             self.label,
             done,

@@ -1,0 +1,186 @@
+r"""Design charts of a sweep (matplotlib): k against the swept number.
+
+One figure, :func:`plot_sweep`: the buckling coefficient :math:`k = N b^2/(\pi^2 D)`
+of the plate without obstacle (bilateral, the free load) and with it (unilateral), one
+curve per combination of the other swept numbers. Unilateral points are marked by their
+certificate: filled = proven globally optimal, open = KKT point only, cross = not
+certified. When the sweep varies ``plate.length`` or ``plate.width`` the abscissa is the
+aspect ratio a/b.
+
+Exact thin-plate curves are drawn where they exist (:func:`reference_k`):
+
+- SSSS plate, uniform compression of the short edges x = const, no obstacle:
+  :math:`k = \min_m (m/\phi + \phi/m)^2`, :math:`\phi = a/b` (Timoshenko and Gere,
+  *Theory of Elastic Stability*, 1961, section 9.2);
+- the same plate with the obstacle over the whole plate: the single buckle
+  :math:`(\phi + 1/\phi)^2` up to :math:`\phi = \sqrt 2`, where it reaches 4.5, and 4.5
+  beyond (README, "Every plate the schema describes": a buckle against the loaded edge
+  that touches down, f = 2 sin t (1 + cos t), has k = 9/2);
+- loaded edges clamped, unloaded simply supported, whole-plate obstacle: the long-plate
+  value 16/3 (an interior buckle between two touch-downs, f = cos³(px)).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Mapping, Sequence
+from pathlib import Path
+from typing import Any
+
+import numpy as np
+
+from unibuckle_fenicsx.config import UNITS, ProblemSpec
+from unibuckle_fenicsx.sweep import Variation, point_problem
+
+__all__ = ["plot_sweep", "reference_k"]
+
+_SS = ("simply_supported", "simply_supported_soft")
+
+
+def _uniaxial_x(spec: ProblemSpec) -> bool:
+    """Uniform compression of the edges x = const only."""
+    e = {edge.name: edge for edge in spec.plate.edges}
+    return (
+        e["left"].normal_stress < 0
+        and e["left"].normal_stress == e["right"].normal_stress
+        and e["bottom"].normal_stress == 0 == e["top"].normal_stress
+        and all(edge.shear_stress == 0 for edge in e.values())
+    )
+
+
+def reference_k(spec: ProblemSpec) -> tuple[float | None, float | None, str]:
+    """Exact thin-plate k of ``spec`` without and with the obstacle, where known.
+
+    Returns:
+        (bilateral k or None, unilateral k or None, what the unilateral value is).
+    """
+    if not _uniaxial_x(spec):
+        return None, None, ""
+    supports = {edge.name: edge.support for edge in spec.plate.edges}
+    phi = spec.plate.length / spec.plate.width
+    whole = spec.obstacle is not None and spec.obstacle.zone == "all"
+    if all(s in _SS for s in supports.values()):
+        m_max = max(1, math.ceil(phi)) + 1
+        bilateral = min((m / phi + phi / m) ** 2 for m in range(1, m_max + 1))
+        unilateral = ((phi + 1 / phi) ** 2 if phi <= math.sqrt(2) else 4.5) if whole else None
+        return bilateral, unilateral, "exact"
+    clamped_loaded = supports["left"] == supports["right"] == "clamped"
+    if clamped_loaded and supports["bottom"] in _SS and supports["top"] in _SS and whole:
+        return None, 16 / 3, "long-plate limit"
+    return None, None, ""
+
+
+def _unit(path: str, units: str) -> str:
+    length = "mm" if units == "mm-N-MPa" else "m"
+    stress = UNITS[units][2]
+    if path in ("plate.length", "plate.width", "mesh.size", "plate.thickness"):
+        return length
+    if path.startswith(("plate.corners", "obstacle.zone", "obstacle.tolerance")):
+        return length
+    if path == "material.E":
+        return stress
+    return "-"
+
+
+def _group_key(line: Mapping[str, Any], others: Sequence[str]) -> tuple[float, ...]:
+    return tuple(line["point"][p] for p in others)
+
+
+def plot_sweep(
+    lines: Sequence[Mapping[str, Any]],
+    variations: Sequence[Variation],
+    base: Mapping[str, Any],
+    path: str | Path,
+    *,
+    title: str | None = None,
+) -> Path:
+    """Draw k against the first variation (see the module docstring); returns ``path``."""
+    import matplotlib as mpl
+
+    mpl.use("Agg")
+    import matplotlib.pyplot as plt
+
+    first = variations[0]
+    others = [v.path for v in variations[1:]]
+    aspect = first.path in ("plate.length", "plate.width")
+    units = str(base.get("units", "SI"))
+
+    def abscissa(spec: ProblemSpec, value: float) -> float:
+        return spec.plate.length / spec.plate.width if aspect else value
+
+    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    groups: dict[tuple[float, ...], list[Mapping[str, Any]]] = {}
+    for line in lines:
+        groups.setdefault(_group_key(line, others), []).append(line)
+    for g, (key, members) in enumerate(sorted(groups.items())):
+        colour = colours[g % len(colours)]
+        label = ", ".join(f"{p} = {v:g}" for p, v in zip(others, key, strict=True))
+        suffix = f" ({label})" if label else ""
+        solved = [m for m in members if "buckling_coefficient_k" in m]
+        specs = [point_problem(base, m["point"]) for m in solved]
+        x = np.array(
+            [abscissa(s, m["point"][first.path]) for s, m in zip(specs, solved, strict=True)]
+        )
+        k = np.array([m["buckling_coefficient_k"] for m in solved], dtype=float)
+        k_free = k * np.array([m["free_load_Pa"] / m["critical_load_Pa"] for m in solved])
+        order = np.argsort(x)
+        ax.plot(x[order], k_free[order], "-", color=colour, lw=1.0, marker=".",
+                label=f"bilateral{suffix}")  # fmt: skip
+        unilateral = [m.get("certificate") is not None for m in solved]
+        if any(unilateral):
+            idx = [int(i) for i in order if unilateral[i]]
+            ax.plot(x[idx], k[idx], "--", color=colour, lw=1.0, label=f"unilateral{suffix}")
+            for i in idx:
+                cert = solved[i]["certificate"]
+                if not cert.get("kkt"):
+                    ax.plot(x[i], k[i], "x", color=colour, ms=7)
+                elif cert.get("global_optimum_proven"):
+                    ax.plot(x[i], k[i], "o", color=colour, ms=6)
+                else:
+                    ax.plot(x[i], k[i], "o", mfc="white", color=colour, ms=6)
+        # Exact curves on a fine grid of the swept number.
+        dense = np.linspace(min(first.values), max(first.values), 400)
+        refs: list[tuple[float, float | None, float | None]] = []
+        kind = ""
+        for value in dense:
+            point = {first.path: float(value), **dict(zip(others, key, strict=True))}
+            try:
+                spec = point_problem(base, point)
+            except ValueError:
+                continue
+            bil, uni, what = reference_k(spec)
+            kind = what or kind
+            refs.append((abscissa(spec, float(value)), bil, uni))
+        for col, style, name in ((1, ":", "bilateral"), (2, "-.", "unilateral")):
+            pts = [(r[0], r[col]) for r in refs if r[col] is not None]
+            if pts:
+                xs, ys = np.array(pts).T
+                o = np.argsort(xs)
+                what = kind if col == 2 else "exact"
+                label = f"{name}, thin plate ({what}){suffix}"
+                ax.plot(xs[o], ys[o], style, color="0.35", lw=1.2, label=label)
+    # Legend entries for the certificate markers.
+    for style, mfc, text in (("o", "0.2", "proven optimal"), ("o", "white", "KKT only"),
+                             ("x", "0.2", "not certified")):  # fmt: skip
+        ax.plot([], [], style, color="0.2", mfc=mfc, label=text)
+    # Keep the interesting range readable: very short plates have large k.
+    solved_lines = [m for m in lines if "buckling_coefficient_k" in m]
+    shown = [float(m["buckling_coefficient_k"]) for m in solved_lines] + [
+        float(m["buckling_coefficient_k"]) * m["free_load_Pa"] / m["critical_load_Pa"]
+        for m in solved_lines
+    ]
+    if shown:
+        low, high = min(shown), max(shown)
+        ax.set_ylim(0.9 * low, min(1.05 * high, 2.5 * low))
+    ax.set_xlabel("aspect ratio a/b" if aspect else f"{first.path} ({_unit(first.path, units)})")
+    ax.set_ylabel(r"buckling coefficient $k = N b^2 / (\pi^2 D)$")
+    ax.set_title(title or f"{base.get('name', 'plate')}: k against {first.path}")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+    return path

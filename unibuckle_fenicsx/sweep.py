@@ -1,0 +1,412 @@
+r"""Parametric sweeps: one problem file, some of its numbers varied over a grid.
+
+``unibuckle sweep --config base.toml --vary plate.length=0.05:0.5:46 --json out.jsonl``
+solves the base problem at every point of the grid of the ``--vary`` values (the first
+``--vary`` varies slowest), each with the normal method and certificate, and writes one
+JSON line per point as soon as it is done:
+
+.. code-block:: json
+
+    {"index": 0, "point": {"plate.length": 0.05}, "status": "ok",
+     "critical_load_Pa": ..., "buckling_coefficient_k": ..., ...}
+
+with the keys of ``unibuckle solve --json`` (without the wall times, so that a line
+does not depend on the run). ``status`` is "ok" (a certified critical state),
+"not-certified" (the result fails its KKT certificate; the line still holds the
+bracket), "refused" (the problem was refused once its mesh existed, e.g. an obstacle
+zone that holds no node or a load that buckles nothing), "no-admissible-mode" (no
+admissible mode with a finite load was found) or "eigen-failure" (an eigen solve did
+not converge); the last three lines hold ``error`` instead of the results.
+
+**Paths** name any number of the TOML schema (README, "Problem files") by its dotted
+path, list entries by index: ``plate.thickness``, ``material.nu``,
+``edges.left.normal_stress``, ``plate.corners.1.0`` (x1), ``obstacle.zone.0.1``,
+``mesh.size``. Two shortcuts move a corner: ``plate.length`` sets x1 = x0 + value and
+``plate.width`` sets y1 = y0 + value. Values are in the base file's ``units``. Write
+``[mesh] size = h`` in the base file so that the cell count follows the plate's size.
+
+**Resume.** Each line is appended with one ``write`` of the whole line and flushed to
+disk, so a killed sweep leaves complete lines (and at most one truncated last line,
+which is dropped). Run the same command again: the points already in the file are
+skipped, the rest solved; at the end the file is rewritten (atomically) in point order,
+so an interrupted and resumed sweep leaves the same file as an uninterrupted one.
+
+**Distribution.** Under ``mpiexec -n P`` with ``ranks_per_point = R`` (P divisible by
+R), the ranks form P/R sub-communicators of R ranks; each solves every (P/R)-th of the
+remaining points with its mesh distributed over its R ranks, and its first rank appends
+the lines. With R = 1 every point is a serial solve, so the lines are those of a serial
+sweep.
+
+Note:
+    :func:`run_sweep` is collective on its communicator.
+"""
+
+from __future__ import annotations
+
+import copy
+import itertools
+import json
+import logging
+import math
+import os
+import re
+import time
+from collections.abc import Callable, Mapping, Sequence
+from dataclasses import dataclass
+from pathlib import Path
+from typing import Any
+
+from mpi4py import MPI
+
+from unibuckle_fenicsx.config import ProblemSpec, load_problem, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.progress import Progress
+
+__all__ = [
+    "STATUSES",
+    "Variation",
+    "base_mapping",
+    "parse_variation",
+    "point_problem",
+    "read_lines",
+    "run_sweep",
+    "set_value",
+    "sweep_points",
+]
+
+logger = logging.getLogger(__name__)
+#: The sweep's progress lines (a child of the package's progress logger, so that the
+#: command line can show them while it hides the progress lines of each point's solve).
+PROGRESS = logging.getLogger("unibuckle_fenicsx.progress.sweep")
+
+#: Status of a sweep line, see the module docstring.
+STATUSES = ("ok", "not-certified", "refused", "no-admissible-mode", "eigen-failure")
+#: Shortcut paths: name -> (corner coordinate it sets, the coordinate it is relative to).
+SHORTCUTS = {"plate.length": (0, "x"), "plate.width": (1, "y")}
+_RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+)\s*$")
+
+
+@dataclass(frozen=True)
+class Variation:
+    """The values of one varied number.
+
+    Attributes:
+        path: Dotted path of the number in the problem file (see the module docstring).
+        values: The values, in the order they are solved.
+    """
+
+    path: str
+    values: tuple[float, ...]
+
+
+def _float(text: str, what: str) -> float:
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"--vary {what}: {text.strip()!r} is not a number") from None
+    if not math.isfinite(value):
+        raise ValueError(f"--vary {what}: {text.strip()!r} is not a finite number")
+    return value
+
+
+def parse_variation(text: str) -> Variation:
+    """``PATH=START:STOP:N`` (N values, ends included) or ``PATH=V1,V2,...``.
+
+    Raises:
+        ValueError: A malformed argument (the message quotes it).
+    """
+    path, sep, spec = text.partition("=")
+    path = path.strip()
+    if not sep or not path or not spec.strip():
+        raise ValueError(f"--vary {text!r}: expected PATH=START:STOP:N or PATH=V1,V2,...")
+    match = _RANGE.match(spec)
+    if match:
+        start, stop = _float(match[1], text), _float(match[2], text)
+        try:
+            count = int(match[3])
+        except ValueError:
+            count = 0
+        if count < 1 or str(count) != match[3].strip():
+            raise ValueError(f"--vary {text!r}: N must be an integer >= 1, got {match[3]!r}")
+        if count == 1:
+            values: tuple[float, ...] = (start,)
+        else:
+            values = tuple(start + (stop - start) * k / (count - 1) for k in range(count))
+    elif ":" in spec:
+        raise ValueError(f"--vary {text!r}: a range is START:STOP:N (three numbers)")
+    else:
+        values = tuple(_float(v, text) for v in spec.split(","))
+    return Variation(path, values)
+
+
+def sweep_points(variations: Sequence[Variation]) -> list[dict[str, float]]:
+    """The grid of points (the first variation varies slowest).
+
+    Raises:
+        ValueError: No variation, or a path given twice.
+    """
+    if not variations:
+        raise ValueError("a sweep needs at least one --vary")
+    paths = [v.path for v in variations]
+    if len(set(paths)) != len(paths):
+        raise ValueError(f"--vary: a path is given twice: {paths}")
+    return [dict(zip(paths, combo, strict=True)) for combo in itertools.product(
+        *(v.values for v in variations)
+    )]  # fmt: skip
+
+
+def base_mapping(path: str | Path) -> dict[str, Any]:
+    """The problem file ``path`` as a mapping with every key and the value used.
+
+    In the file's own ``units``, and with ``[mesh] size`` kept if the file gives it.
+
+    Raises:
+        ValueError: An invalid problem file (the message names it).
+        OSError: It cannot be read.
+    """
+    spec = load_problem(path)
+    return problem_to_dict(spec, units=spec.units)
+
+
+def _is_number(value: Any) -> bool:
+    return isinstance(value, int | float) and not isinstance(value, bool)
+
+
+def set_value(data: dict[str, Any], path: str, value: float) -> None:
+    """Set the number at the dotted ``path`` of the problem mapping ``data``, in place.
+
+    Raises:
+        ValueError: ``path`` does not name a number of ``data`` (the message lists what
+            is there), or ``value`` is not an integer where one is needed.
+    """
+    if path in SHORTCUTS:
+        axis, _ = SHORTCUTS[path]
+        corners = data.get("plate", {}).get("corners")
+        if not isinstance(corners, list):
+            raise ValueError(f"--vary {path}: the problem has no plate.corners")
+        corners[1][axis] = corners[0][axis] + value
+        return
+    keys = path.split(".")
+    node: Any = data
+    for depth, key in enumerate(keys):
+        where = ".".join(keys[:depth]) or "the problem file"
+        if isinstance(node, Mapping):
+            if key not in node:
+                raise ValueError(
+                    f"--vary {path}: {where} has no key {key!r} (keys: {sorted(node)}; "
+                    f"shortcuts: {sorted(SHORTCUTS)})"
+                )
+        elif isinstance(node, list):
+            if not (key.isdigit() and int(key) < len(node)):
+                raise ValueError(
+                    f"--vary {path}: {where} is a list of {len(node)}; {key!r} is not an "
+                    f"index in [0, {len(node) - 1}]"
+                )
+        else:
+            raise ValueError(f"--vary {path}: {where} = {node!r} is not a table or a list")
+        if depth < len(keys) - 1:
+            node = node[key] if isinstance(node, Mapping) else node[int(key)]
+    leaf = keys[-1]
+    index: Any = leaf if isinstance(node, Mapping) else int(leaf)
+    current = node[index]
+    if not _is_number(current):
+        raise ValueError(f"--vary {path}: the value there, {current!r}, is not a number")
+    if isinstance(current, int):
+        if value != int(value):
+            raise ValueError(f"--vary {path}: must be an integer, got {value!r}")
+        value = int(value)
+    node[index] = value
+
+
+def point_problem(base: Mapping[str, Any], point: Mapping[str, float]) -> ProblemSpec:
+    """The problem of one sweep point: ``base`` with the point's values set.
+
+    Raises:
+        ValueError: A bad path, or a value the schema refuses (the message names both).
+    """
+    data = copy.deepcopy(dict(base))
+    for path, value in point.items():
+        set_value(data, path, value)
+    try:
+        return problem_from_dict(data, name=str(base.get("name", "plate")))
+    except ValueError as err:
+        raise ValueError(f"sweep point {dict(point)}: {err}") from None
+
+
+def read_lines(path: str | Path) -> list[dict[str, Any]]:
+    """The complete JSON lines of a sweep file (a truncated or foreign line is dropped)."""
+    out = []
+    for text in Path(path).read_text().splitlines():
+        try:
+            line = json.loads(text)
+        except json.JSONDecodeError:
+            continue
+        if isinstance(line, dict) and isinstance(line.get("index"), int) and "point" in line:
+            out.append(line)
+    return out
+
+
+def _write_atomically(path: Path, lines: list[dict[str, Any]]) -> None:
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text("".join(json.dumps(line) + "\n" for line in lines))
+    os.replace(tmp, path)
+
+
+def _append(path: Path, line: dict[str, Any]) -> None:
+    """Append one line with a single write, and flush it to disk."""
+    data = (json.dumps(line) + "\n").encode()
+    fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
+    try:
+        written = os.write(fd, data)
+        while written < len(data):  # a short write (never seen on a regular file)
+            written += os.write(fd, data[written:])
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _done_points(path: Path, points: list[dict[str, float]]) -> dict[int, dict[str, Any]]:
+    """The lines already in ``path`` (checked against ``points``), the file cleaned up."""
+    if not path.exists():
+        return {}
+    lines = read_lines(path)
+    done: dict[int, dict[str, Any]] = {}
+    for line in lines:
+        k = line["index"]
+        if not 0 <= k < len(points) or line["point"] != points[k]:
+            raise ValueError(
+                f"--json {path}: holds a point of another sweep (line index {k}, point "
+                f"{line['point']}); give another file or delete it"
+            )
+        done.setdefault(k, line)
+    _write_atomically(path, [done[k] for k in sorted(done)])  # drop a truncated last line
+    return done
+
+
+def _solve_point(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
+    """Solve one point; the JSON-ready line body (results, or the error)."""
+    from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
+    from unibuckle_fenicsx.analysis import solve
+    from unibuckle_fenicsx.eigen import EigenSolveError
+
+    try:
+        with solve(spec, comm) as analysis:
+            result = analysis.result
+    except ValueError as err:
+        return {"status": "refused", "error": str(err)}
+    except NoAdmissibleModeError as err:
+        return {"status": "no-admissible-mode", "error": str(err)}
+    except EigenSolveError as err:
+        return {"status": "eigen-failure", "error": str(err)}
+    cert = result.certificate
+    status = "not-certified" if cert is not None and not cert["kkt"] else "ok"
+    return {"status": status, **result.as_dict(timings=False)}
+
+
+def _tqdm(total: int, initial: int, enabled: bool) -> Any:
+    """A tqdm bar, or None (with a note naming the extra) if tqdm is not installed."""
+    if not enabled:
+        return None
+    try:
+        from tqdm import tqdm
+    except ImportError:
+        PROGRESS.info(
+            "sweep: install the 'progress' extra (pip install 'unibuckle_fenicsx[progress]') "
+            "for a progress bar; progress lines follow instead"
+        )
+        return None
+    return tqdm(total=total, initial=initial, unit="point", desc="sweep", dynamic_ncols=True)
+
+
+def run_sweep(
+    base: Mapping[str, Any],
+    variations: Sequence[Variation],
+    out: str | Path,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    *,
+    ranks_per_point: int = 1,
+    progress: bool = True,
+    edit: Callable[[ProblemSpec], ProblemSpec] | None = None,
+) -> list[dict[str, Any]]:
+    """Solve every point of the grid of ``variations`` and write ``out`` (JSON lines).
+
+    Args:
+        base: The base problem (:func:`base_mapping`).
+        variations: The varied numbers (:func:`parse_variation`).
+        out: The JSON-lines file; points already in it are skipped (resume).
+        comm: Communicator shared among the points.
+        ranks_per_point: Ranks of each point's mesh, >= 1, dividing ``comm.size``.
+        progress: Show a progress bar (tqdm, the 'progress' extra) or progress lines,
+            on rank 0.
+        edit: Applied to each point's problem (e.g. solver options of the command line).
+
+    Returns:
+        The lines of the whole sweep in point order (on every rank).
+
+    Raises:
+        ValueError: Bad ``variations`` or ``ranks_per_point``, a point the schema
+            refuses, or an ``out`` holding another sweep: before anything is solved.
+
+    Note:
+        Collective on ``comm``.
+    """
+    if int(ranks_per_point) != ranks_per_point or ranks_per_point < 1:
+        raise ValueError(f"ranks_per_point must be an integer >= 1, got {ranks_per_point!r}")
+    if comm.size % ranks_per_point:
+        raise ValueError(
+            f"ranks_per_point = {ranks_per_point} must divide the number of ranks ({comm.size})"
+        )
+    points = sweep_points(variations)
+    specs = [point_problem(base, p) for p in points]  # every point checked before solving
+    if edit is not None:
+        specs = [edit(s) for s in specs]
+    path = Path(out)
+    error = None
+    done: dict[int, dict[str, Any]] = {}
+    if comm.rank == 0:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            done = _done_points(path, points)
+        except (ValueError, OSError) as err:
+            error = str(err)
+    error, done = comm.bcast((error, done), root=0)
+    if error is not None:
+        raise ValueError(error)
+    todo = [k for k in range(len(points)) if k not in done]
+    groups = comm.size // ranks_per_point
+    color = comm.rank // ranks_per_point
+    sub = comm.Split(color, comm.rank)
+    try:
+        mine = todo[color::groups]
+        show = progress and comm.rank == 0
+        if show and done:
+            PROGRESS.info("sweep: %d of %d points already in %s", len(done), len(points), path)
+        bar = _tqdm(len(points), len(done), show)
+        lines = Progress(
+            "sweep", len(todo), interval=0.0, enabled=show and bar is None, logger=PROGRESS
+        )
+        t0 = time.perf_counter()
+        for count, k in enumerate(mine, start=1):
+            body = _solve_point(specs[k], sub)
+            if sub.rank == 0:
+                _append(path, {"index": k, "point": points[k], **body})
+            if comm.rank == 0:
+                finished = len(read_lines(path)) - len(done)
+                if bar is not None:
+                    bar.update(len(done) + finished - bar.n)
+                lines.update(
+                    finished,
+                    f"point {k} {points[k]}: {body['status']} "
+                    f"({time.perf_counter() - t0:.1f} s for {count} point(s) on this rank)",
+                )
+        comm.Barrier()
+        if bar is not None:
+            bar.update(len(points) - bar.n)
+            bar.close()
+    finally:
+        sub.Free()
+    final = None
+    if comm.rank == 0:
+        everything = {line["index"]: line for line in read_lines(path)}
+        final = [everything[k] for k in sorted(everything)]
+        _write_atomically(path, final)
+    return comm.bcast(final, root=0)
