@@ -94,13 +94,16 @@ def plate(name: str, loaded_edges: str) -> dict:
 # here (run again, `run_sweep` would resume it and solve only what is missing).
 
 # %%
+bases = {
+    "ssss": plate("ssss", "simply_supported"),
+    "loaded_edges_clamped": plate("loaded_edges_clamped", "clamped"),
+}
 lines = {}
-for name, edges in (("ssss", "simply_supported"), ("loaded_edges_clamped", "clamped")):
+for name, base in bases.items():
     out = figures / f"{name}.jsonl"
     if comm.rank == 0:
         out.unlink(missing_ok=True)
     comm.Barrier()
-    base = plate(name, edges)
     lines[name] = run_sweep(base, [VARY], out, comm, progress=False)
     title = {
         "ssss": "SSSS plate under uniaxial compression",
@@ -118,9 +121,8 @@ for name, edges in (("ssss", "simply_supported"), ("loaded_edges_clamped", "clam
 # %%
 rows = []
 for name, points in lines.items():
-    base = plate(name, "simply_supported" if name == "ssss" else "clamped")
     for line in points:
-        spec = point_problem(base, line["point"])
+        spec = point_problem(bases[name], line["point"])
         phi = spec.plate.length / spec.plate.width
         k = line["buckling_coefficient_k"]
         k_free = k * line["free_load_Pa"] / line["critical_load_Pa"]

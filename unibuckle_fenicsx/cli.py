@@ -250,7 +250,7 @@ def _check_writable(args: argparse.Namespace) -> str | None:
     targets = []
     if args.json:
         targets.append(("--json", Path(args.json).parent))
-    if args.output:
+    if getattr(args, "output", None):  # solve only
         targets.append(("--output", Path(args.output)))
     for flag, directory in targets:
         existing = directory
@@ -364,7 +364,6 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
             print(f"unibuckle: error: {message}", file=sys.stderr)
         return EXIT_BAD_INPUT
 
-    args.output = None
     problem = comm.bcast(_check_writable(args) if comm.rank == 0 else None, root=0)
     if problem is not None:
         return fail(problem)

@@ -51,7 +51,7 @@ import math
 import os
 import re
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -73,15 +73,14 @@ __all__ = [
     "sweep_points",
 ]
 
-logger = logging.getLogger(__name__)
 #: The sweep's progress lines (a child of the package's progress logger, so that the
 #: command line can show them while it hides the progress lines of each point's solve).
 PROGRESS = logging.getLogger("unibuckle_fenicsx.progress.sweep")
 
 #: Status of a sweep line, see the module docstring.
 STATUSES = ("ok", "not-certified", "refused", "no-admissible-mode", "eigen-failure")
-#: Shortcut paths: name -> (corner coordinate it sets, the coordinate it is relative to).
-SHORTCUTS = {"plate.length": (0, "x"), "plate.width": (1, "y")}
+#: Shortcut paths: name -> the coordinate (0: x, 1: y) of the second corner they set.
+SHORTCUTS = {"plate.length": 0, "plate.width": 1}
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+)\s*$")
 
 
@@ -179,7 +178,7 @@ def set_value(data: dict[str, Any], path: str, value: float) -> None:
             is there), or ``value`` is not an integer where one is needed.
     """
     if path in SHORTCUTS:
-        axis, _ = SHORTCUTS[path]
+        axis = SHORTCUTS[path]
         corners = data.get("plate", {}).get("corners")
         if not isinstance(corners, list):
             raise ValueError(f"--vary {path}: the problem has no plate.corners")
@@ -325,7 +324,6 @@ def run_sweep(
     *,
     ranks_per_point: int = 1,
     progress: bool = True,
-    edit: Callable[[ProblemSpec], ProblemSpec] | None = None,
 ) -> list[dict[str, Any]]:
     """Solve every point of the grid of ``variations`` and write ``out`` (JSON lines).
 
@@ -337,7 +335,6 @@ def run_sweep(
         ranks_per_point: Ranks of each point's mesh, >= 1, dividing ``comm.size``.
         progress: Show a progress bar (tqdm, the 'progress' extra) or progress lines,
             on rank 0.
-        edit: Applied to each point's problem (e.g. solver options of the command line).
 
     Returns:
         The lines of the whole sweep in point order (on every rank).
@@ -357,8 +354,6 @@ def run_sweep(
         )
     points = sweep_points(variations)
     specs = [point_problem(base, p) for p in points]  # every point checked before solving
-    if edit is not None:
-        specs = [edit(s) for s in specs]
     path = Path(out)
     error = None
     done: dict[int, dict[str, Any]] = {}
@@ -390,7 +385,8 @@ def run_sweep(
             if sub.rank == 0:
                 _append(path, {"index": k, "point": points[k], **body})
             if comm.rank == 0:
-                finished = len(read_lines(path)) - len(done)
+                # Lines on disk, every group's (a newline ends each complete line).
+                finished = path.read_bytes().count(b"\n") - len(done)
                 if bar is not None:
                     bar.update(len(done) + finished - bar.n)
                 lines.update(
