@@ -4,10 +4,11 @@ Thin plates (t = 1e-4 m, 0.3 x 0.1 m, t/b = 1e-3) with the obstacle over the who
 under every edge condition and under shear: the cases on which a contact set with several
 lobes makes the active-set iteration hard. For each case and mesh, ``solve`` runs the
 whole process (free solve, unilateral algorithm, certificate) and the table gives the
-unilateral and certificate time over the free solve's, the eigen solves, the route that
-gave the answer ("+ penalty continuation" when the multilevel active set stalled and penalty
-continuation took over), whether the result is a KKT point and whether it is proven
-globally optimal, and the buckling coefficient k = lambda b^2 t / (pi^2 D).
+unilateral and certificate time over the free solve's, the eigen solves (all levels and
+links), the route that gave the answer ("+ penalty continuation" when the multilevel active
+set stalled and penalty continuation took over, "+ feasible descent" when that stalled
+too), whether the result is a KKT point and whether it is proven globally optimal, and the
+buckling coefficient k = lambda b^2 t / (pi^2 D).
 
 Usage: python bench/bench_plates.py [--meshes 90x30,180x60] [--cases ssss,cs,sc,cccc,shear]
 """
@@ -69,7 +70,11 @@ def main() -> None:
                 assert sol is not None and cert is not None
                 t = r.timings
                 fallback = sol.details.get("fallback")
-                route = f"{r.method} + penalty continuation" if fallback else r.method
+                route = r.method
+                if fallback:
+                    route += " + penalty continuation"
+                    if "descent" in fallback:
+                        route += " + feasible descent"
                 row = (
                     name,
                     edges,

@@ -31,6 +31,10 @@ side has fewer than ``coarse_min_cells`` cells); the best KKT sets (within
 and polished by the same iteration, which then needs a couple of iterates per level.
 The answer is always a KKT point of the *fine* problem.
 
+**Fallbacks.** When the finest level reaches no KKT point: penalty continuation
+(:mod:`.continuation`), then, if that stalls too, the feasible descent
+(:mod:`.descent`), which cannot cycle, from the best admissible mode met.
+
 **Bounds** (:mod:`.bounds`). Upper: the returned feasible load. Lower:
 :math:`\lambda_{free}`, and, when the budget allows (``bound_budget`` evaluations, at
 least i), the best-first search over the subset lattice, which closes the bracket
@@ -56,6 +60,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import PROOF_RTOL, lattice_bound
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
+from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.contact import EmptyZoneError
@@ -71,6 +76,8 @@ TWIN_RTOL = 1e-8
 #: Iterates allowed when polishing a prolonged contact set (it needs one to three when
 #: the coarser level predicts the fine one; more means it stalls: the fallback takes over).
 POLISH_ITERATIONS = 25
+#: Eigen solves allowed to the feasible descent, per ``max_iterations``.
+DESCENT_BUDGET = 10
 #: Seeds run on the coarsest level, in this order.
 SEED_NAMES = ("free+", "free-", "all", "end-low", "middle", "end-high", "greedy+", "greedy-")
 
@@ -174,6 +181,29 @@ def _least_violating(runs: list[Run]) -> Candidate | None:
     return min(finals, key=lambda c: c.margin) if finals else None
 
 
+def _descent(
+    problem: BucklingProblem, runs: list[Run], max_steps: int
+) -> tuple[Run | None, dict[str, int]]:
+    """Feasible descent from the best admissible mode of ``runs`` (or one made admissible).
+
+    Returns (None, {}) when no admissible mode with a finite load can be made.
+    """
+    feasible = [r.best_feasible for r in runs if r.best_feasible is not None]
+    if feasible:
+        start: Candidate | None = min(feasible, key=lambda s: s.load)
+        used = 0
+    else:
+        attempt = _least_violating(runs)
+        if attempt is None:
+            return None, {}
+        start, used = admissible_start(problem, attempt, max_steps)
+    if start is None:
+        return None, {}
+    run, steps = descend(problem, start, max(max_steps - used, 1))
+    run.iterations += used
+    return run, steps
+
+
 def _prune(problem: BucklingProblem, cand: Candidate) -> Candidate:
     """Release the contact nodes with (near) zero multiplier if the KKT point stays."""
     slack = cand.forces[cand.active] >= -problem.tau
@@ -237,6 +267,7 @@ def solve_active_set(
     structured = multilevel and not problem.custom_mesh  # coarse copies need spec.mesh
     levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
     coarse_solves = 0
+    penalty_solves = 0  # the penalty solver has its own eigen solver
     level_log: list[dict[str, Any]] = []
 
     # -- coarse levels: seeds on the coarsest, then polish upwards --------------------
@@ -314,6 +345,22 @@ def solve_active_set(
             f"the active-set iteration stalled; penalty continuation ({penalty_solves} "
             f"eigen solves) ended {'at a KKT point' if run.status == 'kkt' else run.status}"
         )
+    if not kkt:
+        # Both stalled: the feasible descent cannot cycle (README, "Every plate the
+        # schema describes").
+        last, steps = _descent(problem, runs, DESCENT_BUDGET * max_iterations)
+        if last is not None:
+            runs.append(last)
+            kkt = _distinct_kkt(runs)
+            details["fallback"]["descent"] = {
+                "eigensolves": last.iterations,
+                "status": last.status,
+                "steps": steps,
+            }
+            warnings.append(
+                f"feasible descent ({last.iterations} eigen solves) ended "
+                f"{'at a KKT point' if last.status == 'kkt' else last.status}"
+            )
     feasible = [r.best_feasible for r in runs if r.best_feasible is not None]
     cycles = [r.seed for r in runs + coarse_runs if r.status == "cycle"]
     if cycles:
@@ -368,6 +415,7 @@ def solve_active_set(
             "coarse_kkt_loads": [s.load for s in coarse_kkt],
             "fine_eigensolves": problem.eigensolver.solves - solves0,
             "coarse_eigensolves": coarse_solves,
+            "penalty_eigensolves": penalty_solves,
             "bound_evaluations": bound_evals,
             "bound_search_complete": complete,
             "lower_bound_by": "lattice" if bound_evals else "interlacing",
@@ -381,7 +429,7 @@ def solve_active_set(
     return UnilateralSolution(
         candidate=chosen,
         method="active-set",
-        eigensolves=problem.eigensolver.solves - solves0 + coarse_solves,
+        eigensolves=problem.eigensolver.solves - solves0 + coarse_solves + penalty_solves,
         lower_bound=min(lower, chosen.load),
         global_optimum_proven=proven,
         upper_bound=chosen.load if chosen.feasible else math.inf,

@@ -1,0 +1,285 @@
+r"""Feasible descent on the cone: a monotone route to a KKT point when the others stall.
+
+The primal-dual iteration (:mod:`.pdas`) and the penalty continuation
+(:mod:`.continuation`) jump between contact sets and can wander for ever on plates whose
+buckle may sit almost anywhere at nearly the same load. This is the classical active-set
+method of nonlinear programming applied to the Rayleigh quotient
+:math:`R(u) = a(u,u)/b(u,u)` on the cone :math:`C = \{u: u_k \le 0,\ k \in I\}`: it keeps
+an *admissible* vector u and a working set :math:`W \subseteq \{k \in I: u_k = 0\}`, and
+never lets R increase.
+
+One step: release the nodes :math:`R_\ell \subseteq W` that pull (none at the start),
+solve the pencil with :math:`W' = W \setminus R_\ell` removed for its smallest eigenvector
+v, and move from u towards v on the arc of span{u, v}
+
+.. math::
+
+    x(\varphi) = \cos\varphi\, e_1 + \sin\varphi\, e_2, \qquad
+    e_1 = u/\|u\|_A,\quad e_2 \perp_A e_1,\quad v \propto x(\varphi_v),\ 0 \le \varphi_v \le \pi/2.
+
+On span{u, v}, v maximises :math:`b/a` (it minimises R on the larger space of W'), and
+:math:`b(x(\varphi))` is :math:`c + \rho\cos 2(\varphi - \varphi_v)`, so R decreases
+monotonically along the arc. The step stops at the first node of :math:`I \setminus W'`
+that reaches the obstacle (those nodes join W) or at v itself. At v, an eigenvector of
+W, the point is KKT when no node of W pulls (:math:`r_k \le \tau`); otherwise the pulling
+nodes are released at the next step. Released nodes that would cross the obstacle at
+once (a zero step) stay in W and the others are released.
+
+R strictly decreases on every non-zero step and a zero step shrinks the release set, so
+the iteration cannot cycle: it ends at a KKT point, or at its step budget with an
+admissible mode (an upper bound) that is never worse than its start. Each step is one
+eigen solve; the price of monotonicity is that a contact line moves by about one node
+layer per step, so this is the last link of the chain, not the first.
+
+Note:
+    Decisions use values reduced over the ranks; collective on the problem's communicator.
+"""
+
+from __future__ import annotations
+
+import math
+
+from petsc4py import PETSc
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.algorithms.pdas import Run
+from unibuckle_fenicsx.eigen import set_options
+from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+
+__all__ = ["admissible_start", "descend"]
+
+#: Options of the gradient release's solve (prefix ``unibuckle_descent_``).
+GRADIENT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+#: A blocking angle below this fraction of the step's full angle is a zero step (the node
+#: is at the obstacle up to round-off).
+ZERO_STEP = 1e-9
+
+
+def admissible_start(
+    problem: BucklingProblem, start: Candidate, max_iterations: int
+) -> tuple[Candidate | None, int]:
+    r"""An admissible eigen mode from ``start``, by adding the violating nodes to Z.
+
+    Z only grows, so this ends in at most i iterates: at an admissible mode, or with no
+    finite load (None) when the obstacle leaves no geometric stiffness.
+
+    Returns:
+        The admissible candidate (or None) and the eigen solves used.
+
+    Note:
+        Collective.
+    """
+    cand, solves = start, 0
+    while not cand.feasible and solves < max_iterations:
+        grow = np.union1d(cand.active, np.flatnonzero(cand.values > problem.tau))
+        cand = problem.evaluate(grow, initial=cand.mode.x.petsc_vec)
+        solves += 1
+        if not math.isfinite(cand.load):
+            return None, solves
+    return (cand if cand.feasible else None), solves
+
+
+class _Arc:
+    r"""The arc from u towards d on which R decreases.
+
+    :math:`e_1 = u/\|u\|_A`, :math:`e_2` the A-orthogonal part of d (unit, with the sign on
+    which :math:`b` increases from u); on the unit A-circle :math:`b(\varphi) = b_{11}\cos^2
+    + 2 b_{12}\cos\sin + b_{22}\sin^2` is :math:`c + \rho\cos 2(\varphi - \varphi_m)`, so it
+    increases (R decreases) on :math:`[0, \varphi_m]`. For d an eigenvector of a space
+    holding u, :math:`x(\varphi_m)` is d.
+    """
+
+    def __init__(
+        self, A: PETSc.Mat, B: PETSc.Mat, u: PETSc.Vec, d: PETSc.Vec, work: PETSc.Vec
+    ) -> None:
+        def form(M: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> float:
+            M.mult(y, work)
+            return float(x.dot(work).real)
+
+        self.e1 = u.copy()
+        self.e1.scale(1.0 / math.sqrt(form(A, u, u)))
+        self.e2 = d.copy()
+        self.e2.axpy(-form(A, d, self.e1), self.e1)
+        s = math.sqrt(max(form(A, self.e2, self.e2), 0.0))
+        self.phi_max = 0.0
+        if s > 1e-12 * math.sqrt(form(A, d, d)):
+            self.e2.scale(1.0 / s)
+            b11, b12 = form(B, self.e1, self.e1), form(B, self.e1, self.e2)
+            b22 = form(B, self.e2, self.e2)
+            if b12 < 0.0:
+                self.e2.scale(-1.0)
+                b12 = -b12
+            self.phi_max = 0.5 * math.atan2(2.0 * b12, b11 - b22)
+
+    def point(self, phi: float) -> PETSc.Vec:
+        """x(phi), a new vector."""
+        x = self.e1.copy()
+        x.scale(math.cos(phi))
+        x.axpy(math.sin(phi), self.e2)
+        return x
+
+    def destroy(self) -> None:
+        self.e1.destroy()
+        self.e2.destroy()
+
+
+class _Gradient:
+    r"""Descent direction :math:`g = -A_{W'}^{-1} r` with :math:`r = Au - R(u)Bu`.
+
+    On a node k released from W (:math:`u_k = 0`, :math:`r_k > 0`) alone,
+    :math:`g_k = -r_k (A_{W'}^{-1})_{kk} < 0`: g leaves the obstacle there, and
+    :math:`r \cdot g < 0` makes it a descent direction of R. Used when every eigen step
+    towards a release is a zero step (on a 4th-order operator the reduced eigenvector
+    need not leave the obstacle where the multiplier pulls).
+    """
+
+    PREFIX = "unibuckle_descent_"
+
+    def __init__(self, problem: BucklingProblem) -> None:
+        self.problem = problem
+        self.ksp = PETSc.KSP().create(problem.model.A.comm)
+        set_options(self.ksp, self.PREFIX, GRADIENT_OPTIONS)
+
+    def direction(self, u: PETSc.Vec, working: npt.NDArray[np.int64]) -> PETSc.Vec:
+        """The direction g for the working set ``working`` (a new vector)."""
+        problem = self.problem
+        assert problem.contact is not None
+        A, B = problem.model.A, problem.model.B
+        rows = np.asarray(problem.contact.removed_rows(working), dtype=PETSc.IntType)
+        Aw, _ = problem.eigensolver.reduced(rows)
+        au, bu = u.duplicate(), u.duplicate()
+        A.mult(u, au)
+        B.mult(u, bu)
+        rhs = au.copy()
+        rhs.axpy(-u.dot(au).real / u.dot(bu).real, bu)
+        rhs.scale(-1.0)
+        rhs.setValues(rows, np.zeros(len(rows)))  # type: ignore[arg-type]
+        rhs.assemble()
+        g = u.duplicate()
+        self.ksp.setOperators(Aw)
+        self.ksp.solve(rhs, g)
+        for v in (au, bu, rhs):
+            v.destroy()
+        return g
+
+    def destroy(self) -> None:
+        self.ksp.destroy()
+
+
+def descend(
+    problem: BucklingProblem, start: Candidate, max_steps: int
+) -> tuple[Run, dict[str, int]]:
+    """Monotone feasible descent from the admissible eigen mode ``start``.
+
+    Args:
+        problem: The problem (with an obstacle).
+        start: An admissible candidate (``start.feasible``); its contact set is the
+            first working set.
+        max_steps: Solves allowed (eigen and gradient), >= 1.
+
+    Returns:
+        A run named "descent" (status "kkt" at a KKT point, else "max-iterations" or
+        "stalled"; ``best_feasible`` is the last admissible eigen mode met: R never
+        increases, so it is also the lowest) and the number of steps of each kind.
+
+    Note:
+        Collective.
+    """
+    assert problem.contact is not None and start.feasible
+    n, tau = problem.contact.size, problem.tau
+    A, B = problem.model.A, problem.model.B
+    run = Run("descent", best_feasible=start, final=start)
+    u = start.mode.x.petsc_vec.copy()
+    work = u.duplicate()
+    gradient = _Gradient(problem)
+    working = start.active
+    release = _pulling(start, n, tau)
+    by_gradient = False
+    steps = {"full": 0, "partial": 0, "zero": 0, "gradient": 0}
+    try:
+        for step in range(max_steps):
+            run.iterations = step + 1
+            trial = np.setdiff1d(working, release)
+            cand: Candidate | None = None
+            if by_gradient:
+                steps["gradient"] += 1
+                d = gradient.direction(u, trial)
+            else:
+                cand = problem.evaluate(trial, initial=u)
+                d = cand.mode.x.petsc_vec.copy()
+            arc = _Arc(A, B, u, d, work)
+            d.destroy()
+            free = np.ones(n, dtype=bool)
+            free[trial] = False
+            e1 = problem.contact.values(arc.e1)
+            e2 = problem.contact.values(arc.e2) if arc.phi_max > 0.0 else np.zeros(n)
+            # Nodes that the end of the arc puts above the obstacle beyond the tolerance.
+            end = math.cos(arc.phi_max) * e1 + math.sin(arc.phi_max) * e2
+            target = arc.point(arc.phi_max)
+            scale = problem.max_abs_w(target) or 1.0
+            target.destroy()
+            rising = free & (e2 > 0.0) & (end > tau * scale)
+            angle = np.full(n, np.inf)
+            angle[rising] = np.arctan2(np.maximum(-e1[rising], 0.0), e2[rising])
+            phi_b = float(angle.min()) if rising.any() else math.inf
+            zero = ZERO_STEP * arc.phi_max
+            blocked = np.flatnonzero(rising & (angle <= max(phi_b, zero)))
+            if phi_b <= zero:
+                # Zero step: released nodes that would cross at once stay in W, nodes
+                # already at the obstacle join it; the others are released. When every
+                # eigen step towards a release is a zero step, release the most pulling
+                # node along the gradient instead (which leaves the obstacle there).
+                arc.destroy()
+                steps["zero"] += 1
+                had = release.size > 0
+                working = np.union1d(working, blocked)
+                release = np.setdiff1d(release, blocked)
+                if had and release.size == 0:
+                    if by_gradient:
+                        run.status = "stalled"
+                        break
+                    release, by_gradient = _pulling(run.final, n, tau, largest=True), True
+                continue
+            full = phi_b >= arc.phi_max
+            u.destroy()
+            if full and cand is not None:
+                # u = v, an eigenvector of the working set.
+                arc.destroy()
+                steps["full"] += 1
+                u = cand.mode.x.petsc_vec.copy()
+                working, by_gradient = trial, False
+                run.final = cand
+                run.history.append((len(trial), cand.load, cand.feasible))
+                if cand.feasible:
+                    run.best_feasible = cand
+                if cand.kkt:
+                    run.status = "kkt"
+                    break
+                release = _pulling(cand, n, tau)
+                continue
+            steps["partial"] += 1
+            u = arc.point(arc.phi_max if full else phi_b)
+            arc.destroy()
+            working = trial if full else np.union1d(trial, blocked)
+            release = np.empty(0, dtype=np.int64)
+            by_gradient = False
+    finally:
+        u.destroy()
+        work.destroy()
+        gradient.destroy()
+    return run, steps
+
+
+def _pulling(
+    cand: Candidate | None, n: int, tau: float, largest: bool = False
+) -> npt.NDArray[np.int64]:
+    """Nodes of the candidate's contact set whose force pulls (r_k > tau)."""
+    if cand is None or cand.active.size == 0:
+        return np.empty(0, dtype=np.int64)
+    forces = cand.forces[cand.active]
+    pull = forces > tau
+    if largest and pull.any():
+        pull &= forces >= forces[pull].max() * (1.0 - 1e-9)
+    return cand.active[pull].astype(np.int64)
