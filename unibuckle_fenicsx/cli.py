@@ -129,7 +129,8 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
         "--max-iterations",
         type=int,
         metavar="N",
-        help="active-set: iterates per seed and mesh level (default 100)",
+        help="active-set: iterates per seed and mesh level (default 100; the feasible "
+        "descent, the last fallback, may use 10x as many solves)",
     )
     s.add_argument(
         "--bound-budget",

@@ -381,7 +381,8 @@ class SolverSpec:
         until_proven: Enumerate past the paper's stopping size p* until the
             interlacing bound proves the best feasible set optimal (exact; the
             paper's rule is not, see the README).
-        max_iterations: Active-set iterates per seed and mesh level, >= 1.
+        max_iterations: Active-set iterates per seed and mesh level, >= 1 (the feasible
+            descent, the chain's last link, may use ten times as many solves).
         bound_budget: Eigen solves allowed for the active set's lattice lower bound,
             >= 0 (it runs when the budget covers the i singletons).
         certify: Verify the result's global optimality (README, "Proving the global
