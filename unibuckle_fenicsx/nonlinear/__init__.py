@@ -17,6 +17,7 @@ from unibuckle_fenicsx.nonlinear.path import (
     inflection_load,
     solve_nonlinear,
     southwell_load,
+    southwell_window,
 )
 
 __all__ = [
@@ -31,4 +32,5 @@ __all__ = [
     "inflection_load",
     "solve_nonlinear",
     "southwell_load",
+    "southwell_window",
 ]

@@ -74,6 +74,7 @@ __all__ = [
     "inflection_load",
     "solve_nonlinear",
     "southwell_load",
+    "southwell_window",
 ]
 
 logger = logging.getLogger(__name__)
@@ -183,6 +184,26 @@ class PathPoint:
     newton_iterations: int
 
 
+def southwell_window(
+    loads: npt.ArrayLike,
+    max_w: npt.ArrayLike,
+    initial: float,
+    knee: float,
+    thickness: float,
+) -> npt.NDArray[np.bool_]:
+    r"""The path points Southwell's fit uses.
+
+    Those with :math:`\lambda` within :data:`SOUTHWELL_WINDOW` times ``knee`` and an
+    additional deflection :math:`0 < \delta_w = \max|w| - w_0 \le`
+    :data:`SOUTHWELL_MAX_DEFLECTION` t.
+    """
+    lam = np.asarray(loads, dtype=float)
+    dw = np.asarray(max_w, dtype=float) - initial
+    lo, hi = SOUTHWELL_WINDOW
+    mask = (lam >= lo * knee) & (lam <= hi * knee) & (dw > 0.0)
+    return np.asarray(mask & (dw <= SOUTHWELL_MAX_DEFLECTION * thickness), dtype=bool)
+
+
 def southwell_load(
     loads: npt.ArrayLike,
     max_w: npt.ArrayLike,
@@ -192,10 +213,8 @@ def southwell_load(
 ) -> tuple[float | None, int]:
     r"""Southwell's estimate of the critical load from a path below its knee.
 
-    Fits :math:`\delta_w/\lambda = a + \delta_w/\lambda_S` (least squares) on the points
-    with :math:`\lambda` in :data:`SOUTHWELL_WINDOW` times ``knee`` and
-    :math:`0 < \delta_w \le` :data:`SOUTHWELL_MAX_DEFLECTION` t, where
-    :math:`\delta_w = \max|w| - w_0`.
+    Fits :math:`\delta_w/\lambda = a + \delta_w/\lambda_S` (least squares) on the
+    points of :func:`southwell_window`, where :math:`\delta_w = \max|w| - w_0`.
 
     Args:
         loads: :math:`\lambda` along the path.
@@ -210,9 +229,7 @@ def southwell_load(
     """
     lam = np.asarray(loads, dtype=float)
     dw = np.asarray(max_w, dtype=float) - initial
-    lo, hi = SOUTHWELL_WINDOW
-    mask = (lam >= lo * knee) & (lam <= hi * knee) & (dw > 0.0)
-    mask &= dw <= SOUTHWELL_MAX_DEFLECTION * thickness
+    mask = southwell_window(lam, max_w, initial, knee, thickness)
     count = int(mask.sum())
     if count < 3:
         return None, count
