@@ -6,7 +6,7 @@ Where the numbers come from:
   linear amplification w = w0 / (1 - lambda/lambda_c) (Southwell, Proc. R. Soc. A 135,
   1932) and the one-mode model of a stable symmetric bifurcation,
   (1 - mu) xi + C xi^3 = mu xi0 (Thompson and Hunt, *A General Theory of Elastic
-  Stability*, 1973, ch. 3), whose steepest point is located here by dense sampling of
+  Stability*, 1973), whose steepest point is located here by dense sampling of
   its exact derivative;
 - the loads read off the nonlinear path are compared with the linear critical loads of
   the package's *linear eigen* solver on the same mesh (the unilateral load with the
@@ -120,7 +120,9 @@ def test_inconsistent_requests_are_refused_before_any_solve(monkeypatch):
     with pytest.raises(ValueError, match='shape = "unilateral" needs a problem with an obstacle'):
         solve_nonlinear(paper_case("free", 8, 4), NonlinearOptions(shape="unilateral"))
     with pytest.raises(ValueError, match="uniaxial compression"):
-        shear = plate_case("shear", length=0.2, width=0.1, thickness=0.006, load="shear", nx=8, ny=4)
+        shear = plate_case(
+            "shear", length=0.2, width=0.1, thickness=0.006, load="shear", nx=8, ny=4
+        )
         solve_nonlinear(shear, NonlinearOptions(control="displacement"))
 
 

@@ -2,9 +2,10 @@ r"""The von Kármán Reissner–Mindlin plate: mixed space, energy, MITC shear a
 
 Unknowns :math:`x = (u, w, \theta)` in one mixed space :math:`Q_k^2 \times Q_1 \times Q_1^2`
 (in-plane displacement, deflection, rotation), from a stress-free imperfect shape
-:math:`x_0 = (0, w_0, \theta_0)`. The energy (von Kármán kinematics; e.g. Timoshenko and
-Woinowsky-Krieger, *Theory of Plates and Shells*, 1959, §96; Reissner–Mindlin bending and
-shear) is
+:math:`x_0 = (0, w_0, \theta_0)`. The energy (the von Kármán plate: T. von Kármán,
+*Festigkeitsprobleme im Maschinenbau*, Encyklopädie der mathematischen Wissenschaften IV/4,
+1910; Timoshenko and Woinowsky-Krieger, *Theory of Plates and Shells*, 1959, ch. 13; here
+with Reissner–Mindlin bending and shear) is
 
 .. math::
 
@@ -25,9 +26,13 @@ and the edge loads are those of the same :class:`~unibuckle_fenicsx.config.Probl
 The obstacle (:math:`w \le 0` at the zone's nodes, the nodes of
 :class:`~unibuckle_fenicsx.contact.ContactSetManager`) enters as variable bounds of PETSc's
 reduced-space VI Newton method (``vinewtonrsls``); the other bounds are
-``PETSc.INFINITY``. Unknowns are scaled, :math:`\hat u = u/t`, :math:`\hat w = w/t`, and the
-energy by :math:`D_{11}`, so that PETSc's absolute active-set tolerance (1e-8) means
-1e-8 t, not 1e-8 m.
+``PETSc.INFINITY``. DOLFINx's ``NonlinearProblem`` takes no bounds and assembles forms
+only (the MITC shear is a matrix), so the SNES is wired here, with the same assembly
+calls (``assemble_vector``, ``apply_lifting``, ``set_bc``, ``assemble_matrix``) and the
+Jacobian by ``ufl.derivative``. Unknowns are scaled, :math:`\hat u = u/t`,
+:math:`\hat w = w/t`, and the energy by :math:`D_{11}`, so that the absolute tolerances
+with which the VI method decides that a bound is active act in units of t, not of metres
+(w is 1e-7 m at the smallest imperfections).
 
 Two controls: the load :math:`\lambda` (edge tractions), or the end shortening
 (prescribed normal displacement of the loaded edges, :math:`\lambda` from their reactions).
