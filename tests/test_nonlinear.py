@@ -219,6 +219,23 @@ def test_contact_conditions_of_a_converged_state():
         assert check["max_zone_w_m"] <= 0.0 and check["max_contact_force"] <= 0.0
 
 
+def test_contact_set_below_the_knee_is_the_linear_one():
+    """At 0.9 lambda_c the plate rests on exactly the linear critical contact set Z.
+
+    The imperfection is the unilateral mode (zero on Z) pushed 1 % off the obstacle;
+    which nodes touch down under load is decided by the VI solver alone. Z comes from
+    the linear solver's certified critical state (5 nodes on 12 x 6).
+    """
+    options = NonlinearOptions(imperfection=1e-3, max_load=0.9)
+    with solve_nonlinear(paper_case("c1", 12, 6), options) as analysis:
+        plate, linear = analysis.plate, analysis.linear.result
+        assert linear.certificate["kkt"] and linear.contact_nodes > 0
+        touching = plate.contact.coordinates[plate.contact_nodes()]
+        np.testing.assert_allclose(
+            touching, np.asarray(linear.contact_coordinates), rtol=0, atol=1e-12
+        )
+
+
 def test_end_shortening_control_on_the_free_plate():
     """End-shortening control: lambda from the edge reactions, knee at lambda_free.
 

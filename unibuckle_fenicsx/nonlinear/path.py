@@ -693,6 +693,14 @@ def solve_nonlinear(
             f"solver.prestress_degree = {degree} sets the in-plane displacement degree of "
             "the nonlinear model, which must be 1 or 2: give degree"
         )
+    if linear is not None:
+        if obstacle and linear.problem.contact is None:
+            raise ValueError(
+                "linear: the analysis given was solved without the obstacle; pass one of "
+                "the problem with its obstacle (or obstacle = false)"
+            )
+        if linear.problem.spec.mesh != spec.mesh or linear.problem.spec.plate != spec.plate:
+            raise ValueError("linear: the analysis given is of another plate or mesh")
     owns_linear = linear is None
     if linear is None:
         linear = solve_linear(spec if obstacle else replace(spec, obstacle=None), comm)
