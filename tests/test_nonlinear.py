@@ -236,6 +236,18 @@ def test_contact_set_below_the_knee_is_the_linear_one():
         )
 
 
+def test_quadratic_in_plane_displacement():
+    """Q2 in-plane displacement (degree = 2): the same knee, within 1 % of lambda_c."""
+    options = NonlinearOptions(imperfection=1e-3, degree=2, max_load=1.1)
+    with solve_nonlinear(paper_case("c1", 12, 6), options) as analysis:
+        result = analysis.result
+    assert result.options["degree"] == 2 and result.completed
+    assert result.contact_check["satisfied"]
+    reference = result.linear_critical_load_Pa
+    assert result.southwell_load_Pa == pytest.approx(reference, rel=KNEE_RTOL)
+    assert result.inflection_load_Pa == pytest.approx(reference, rel=KNEE_RTOL)
+
+
 def test_end_shortening_control_on_the_free_plate():
     """End-shortening control: lambda from the edge reactions, knee at lambda_free.
 
