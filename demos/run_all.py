@@ -37,6 +37,7 @@ DEMOS = (
     "demo_obstacle_c3.py",
     "demo_garland.py",  # figures/garland/; no row in the table
     "study_penalty.py",  # figures/penalty_*.png; no row in the table
+    "demo_nonlinear.py",  # figures/nonlinear/; no row in the table
 )
 CASES = ("free", "c1", "c2", "c3")
 COLUMNS = (

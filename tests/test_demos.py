@@ -40,6 +40,11 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
             pngs[f"{case}/mode_{mesh}.png"] = (h3, w3)
     for name in ("ssss", "loaded_edges_clamped"):  # charts.plot_sweep: 7.5 x 5 in at 150 dpi
         pngs[f"garland/garland_{name}.png"] = (750, 1125)
+    # demo_nonlinear: plotting.plot_load_paths is 1.6 x 1.1 times the line figure.
+    pngs["nonlinear/load_paths.png"] = (round(1.1 * fh * dpi), round(1.6 * fw * dpi))
+    pngs["nonlinear/southwell.png"] = line
+    pngs["nonlinear/section_c1.png"] = line
+    pngs["nonlinear/deformed_c1.png"] = (h3, w3)
     return pngs
 
 
@@ -63,7 +68,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for demo in (
         "demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3",
-        "demo_garland",
+        "demo_garland", "demo_nonlinear",
     ):  # fmt: skip
         assert f"{demo}.py: ok" in proc.stdout
     assert "lambda/lambda_free" in proc.stdout and "eigen solves" in proc.stdout

@@ -1,7 +1,10 @@
-"""Command line: ``unibuckle solve`` (one problem) and ``unibuckle sweep`` (a grid of them).
+"""Command line: ``unibuckle solve``, ``unibuckle sweep`` and ``unibuckle nonlinear``.
+
+One problem, a grid of them, and the load path of the imperfect plate:
 
 ``unibuckle solve --case c1 --nx 20 --ny 20 --json out.json``;
-``unibuckle sweep --config base.toml --vary plate.length=0.1:0.4:7 --json out.jsonl``.
+``unibuckle sweep --config base.toml --vary plate.length=0.1:0.4:7 --json out.jsonl``;
+``unibuckle nonlinear --case c1 --nx 20 --ny 20 --imperfection 1e-3 --json out.json``.
 
 Unrecognised ``-prefix_option value`` pairs are passed to PETSc, e.g.
 ``-unibuckle_eps_view`` or ``-unibuckle_prestress_ksp_view``.
@@ -60,6 +63,30 @@ exit status:
   {EXIT_BAD_INPUT}  bad input (a --vary, the base file, a point the schema refuses);
      nothing was solved
   {EXIT_NOT_CERTIFIED}  some points have no certified critical state (their lines say why)
+"""
+
+
+NONLINEAR_EPILOG = f"""\
+The linear critical load and mode come first (as 'unibuckle solve'); the von Karman
+plate, given the imperfection delta t times that mode (the unilateral mode with the
+obstacle, the free mode without), is loaded step by step against the obstacle (PETSc
+SNES vinewtonrsls); the JSON holds the path (load_Pa, max_w_m, contact_nodes,
+end_shortening_m per step), southwell_load_Pa, inflection_load_Pa and
+linear_critical_load_Pa. A progress line per load step goes to stderr (-q hides it).
+
+exit status:
+  {EXIT_OK}  the path reached --max-load, both loads were read off it and the last state
+     satisfies the contact conditions
+  {EXIT_BAD_INPUT}  bad input (the message names the parameter and the allowed range);
+     nothing was solved
+  {EXIT_NOT_CERTIFIED}  a numerical difficulty: the path stopped early (SNES did not converge
+     at the smallest step; the JSON holds the path up to there and stop_reason), the
+     knee was not passed, or the contact conditions fail; when no load step converged
+     or the linear solve failed, the message says why and no JSON is written
+
+Single-dash options go to PETSc under the prefixes unibuckle_nl_ (the SNES, its KSP:
+-unibuckle_nl_snes_monitor, -unibuckle_nl_snes_view), unibuckle_ (the linear eigen
+solves) and unibuckle_prestress_.
 """
 
 
@@ -203,7 +230,68 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     )
     w.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
     w.add_argument("-q", "--quiet", action="store_true", help="no progress bar or lines")
+    _nonlinear_parser(sub)
     return parser, s
+
+
+def _nonlinear_parser(sub: Any) -> None:
+    """The ``nonlinear`` subcommand's arguments."""
+    n = sub.add_parser(
+        "nonlinear",
+        help="validate the critical load by the load path of the imperfect plate "
+        "(von Karman, against the obstacle)",
+        description="Follow the load path of the imperfect von Karman plate against the "
+        "obstacle and read the buckling load off it (Southwell, steepest rise), next to "
+        "the linear critical load.",
+        epilog=NONLINEAR_EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
+    )
+    src = n.add_mutually_exclusive_group(required=True)
+    src.add_argument(
+        "--case", choices=["free", "c1", "c2", "c3"], help="the paper's plate (as for solve)"
+    )
+    src.add_argument("--config", metavar="FILE", help="problem file (TOML or a result JSON)")
+    n.add_argument("--nx", type=int, help="cells along x, >= 2")
+    n.add_argument("--ny", type=int, help="cells along y, >= 2")
+    n.add_argument(
+        "--imperfection",
+        type=float,
+        default=1e-3,
+        metavar="DELTA",
+        help="imperfection amplitude max|w0| / thickness, in (0, 1] (default 1e-3)",
+    )
+    n.add_argument(
+        "--shape",
+        choices=["auto", "free", "unilateral"],
+        default="auto",
+        help="imperfection shape: the linear free or unilateral mode (default auto: "
+        "unilateral with the obstacle, free without)",
+    )
+    n.add_argument(
+        "--control",
+        choices=["load", "displacement"],
+        default="load",
+        help="load control (edge traction, adaptive steps) or displacement control (end "
+        "shortening of the loaded edges; uniaxial compression only)",
+    )
+    n.add_argument("--no-obstacle", action="store_true", help="the same plate without its obstacle")
+    n.add_argument(
+        "--max-load",
+        type=float,
+        default=1.2,
+        metavar="RATIO",
+        help="stop at RATIO times the linear critical load, in (0, 5] (default 1.2)",
+    )
+    n.add_argument(
+        "--max-step",
+        type=float,
+        default=0.05,
+        metavar="FRACTION",
+        help="largest load step, relative to the linear critical load (default 0.05)",
+    )
+    n.add_argument("--json", metavar="PATH", help="write the result as JSON")
+    n.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
+    n.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
 
 
 #: Flags that matter only for some methods: flag -> (methods, SolverSpec field).
@@ -303,6 +391,8 @@ def main(argv: Sequence[str] | None = None) -> int:
     _logging(args.verbose, args.quiet, comm.rank)
     if args.command == "sweep":
         return _sweep(args, comm)
+    if args.command == "nonlinear":
+        return _nonlinear(args, comm)
 
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
         if comm.rank == 0:
@@ -354,6 +444,76 @@ def main(argv: Sequence[str] | None = None) -> int:
                 file=sys.stderr,
             )
     return status
+
+
+def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
+    """``unibuckle nonlinear``: the load path, the Southwell and inflection loads."""
+    import json
+
+    from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
+    from unibuckle_fenicsx.cases import paper_case
+    from unibuckle_fenicsx.config import load_problem
+    from unibuckle_fenicsx.eigen import EigenSolveError
+    from unibuckle_fenicsx.nonlinear import NonlinearError, NonlinearOptions, solve_nonlinear
+
+    def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
+        if comm.rank == 0:
+            print(f"unibuckle: error: {message}", file=sys.stderr)
+        return status
+
+    problem = comm.bcast(_check_writable(args) if comm.rank == 0 else None, root=0)
+    if problem is not None:
+        return fail(problem)
+    try:
+        options = NonlinearOptions(
+            imperfection=args.imperfection,
+            shape=args.shape,
+            control=args.control,
+            obstacle=not args.no_obstacle,
+            max_load=args.max_load,
+            max_step=args.max_step,
+            min_step=min(1e-5, args.max_step),
+        )
+        spec = paper_case(args.case) if args.case else load_problem(args.config)
+        if args.nx is not None or args.ny is not None:
+            spec = spec.with_mesh(
+                spec.mesh.nx if args.nx is None else args.nx,
+                spec.mesh.ny if args.ny is None else args.ny,
+            )
+    except (ValueError, OSError) as err:
+        message = str(err)
+        for name in _NONLINEAR_FLAGS:  # name the flag, not the option
+            if message.startswith(name):
+                message = "--" + name.replace("_", "-") + message[len(name) :]
+        return fail(message)
+    try:
+        analysis = solve_nonlinear(spec, options, comm)
+    except ValueError as err:
+        return fail(str(err))
+    except (EigenSolveError, NoAdmissibleModeError, NonlinearError) as err:
+        return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
+    with analysis:
+        result = analysis.result
+    if comm.rank == 0:
+        if args.json:
+            path = Path(args.json)
+            path.parent.mkdir(parents=True, exist_ok=True)
+            path.write_text(json.dumps(result.as_dict(), indent=2) + "\n")
+        print(result.summary(), flush=True)
+        if not result.ok:
+            print(
+                f"unibuckle: error: the path does not validate the critical state "
+                f"({result.stop_reason}; Southwell {result.southwell_load_Pa}, inflection "
+                f"{result.inflection_load_Pa}, contact conditions "
+                f"{'hold' if result.contact_check.get('satisfied') else 'FAIL'})"
+                + (f"; what was obtained is in {args.json}" if args.json else ""),
+                file=sys.stderr,
+            )
+    return EXIT_OK if result.ok else EXIT_NOT_CERTIFIED
+
+
+#: Option names of the nonlinear analysis that are also command-line flags.
+_NONLINEAR_FLAGS = ("imperfection", "shape", "control", "max_load", "max_step")
 
 
 def _sweep(args: argparse.Namespace, comm: Any) -> int:

@@ -9,6 +9,7 @@ array of these numbers, means the same nodes on every rank and for every partiti
 from __future__ import annotations
 
 from dataclasses import dataclass
+from typing import Protocol
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -18,10 +19,44 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import ObstacleSpec
-from unibuckle_fenicsx.plate.model import PlateModel
+from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec
 
-__all__ = ["ContactSetManager", "EmptyZoneError", "check_zone_has_nodes", "orientation"]
+__all__ = [
+    "ContactSetManager",
+    "EmptyZoneError",
+    "PlateDofs",
+    "check_zone_has_nodes",
+    "orientation",
+]
+
+
+class PlateDofs(Protocol):
+    """What :class:`ContactSetManager` needs of a plate model: its w-DOFs and supports.
+
+    :class:`~unibuckle_fenicsx.plate.model.PlateModel` (the (w, theta) space) and the
+    von Karman model (u, w, theta) both provide it.
+    """
+
+    mesh: dolfinx.mesh.Mesh
+    plate: PlateSpec
+    W: dolfinx.fem.FunctionSpace
+    Vw: dolfinx.fem.FunctionSpace
+    w_dofs: npt.NDArray[np.int32]
+    bc_dofs: npt.NDArray[np.int32]
+
+    @property
+    def w_subspace(self) -> dolfinx.fem.FunctionSpace:
+        """The sub-space of W holding w."""
+        ...
+
+    @property
+    def num_owned_dofs(self) -> int:
+        """Owned DOFs of W on this rank."""
+        ...
+
+    def global_dofs(self, local: npt.NDArray[np.int32]) -> npt.NDArray[np.int64]:
+        """Global (PETSc) indices of local W DOFs."""
+        ...
 
 
 class EmptyZoneError(ValueError):
@@ -95,7 +130,7 @@ class ContactSetManager:
     """Constrained w-DOFs of an obstacle zone, and candidate sets as removed DOFs.
 
     Args:
-        model: The assembled plate pencil.
+        model: The plate model (the assembled pencil, or any :class:`PlateDofs`).
         obstacle: The obstacle zone.
 
     Attributes:
@@ -107,14 +142,14 @@ class ContactSetManager:
         free mesh node.
     """
 
-    def __init__(self, model: PlateModel, obstacle: ObstacleSpec) -> None:
+    def __init__(self, model: PlateDofs, obstacle: ObstacleSpec) -> None:
         self.model = model
         self.obstacle = obstacle
         comm = model.mesh.comm
-        W, Vw = model.W, model.Vw
+        Vw = model.Vw
         size = max(model.plate.length, model.plate.width)
         dofs_W, dofs_Vw = dolfinx.fem.locate_dofs_geometrical(
-            (W.sub(0), Vw), lambda x: obstacle.contains(x, size)
+            (model.w_subspace, Vw), lambda x: obstacle.contains(x, size)
         )
         n_owned = model.num_owned_dofs
         owned = dofs_W < n_owned

@@ -32,7 +32,15 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from unibuckle_fenicsx.problem import BucklingProblem
 
-__all__ = ["THEME", "plot_contact_set", "plot_convergence", "plot_mode_3d", "plot_section"]
+__all__ = [
+    "THEME",
+    "plot_contact_set",
+    "plot_convergence",
+    "plot_load_paths",
+    "plot_mode_3d",
+    "plot_section",
+    "plot_southwell",
+]
 
 #: The one theme of every figure (overridable module constant).
 THEME: dict[str, Any] = {
@@ -488,6 +496,110 @@ def plot_convergence(
     ax1.legend(fontsize=THEME["mpl_font_size"] - 3)
     if title:
         fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+# -- nonlinear load paths ----------------------------------------------------------------
+#: One curve of :func:`plot_load_paths`: loads (Pa), max |w| (m), label, colour, line style.
+PathCurve = tuple[npt.ArrayLike, npt.ArrayLike, str, str, str]
+
+
+def plot_load_paths(
+    path: str | Path,
+    curves: Sequence[PathCurve],
+    *,
+    thickness: float,
+    marks: Mapping[str, tuple[float, str]],
+    title: str = "",
+) -> Path:
+    """Max |w| / t against the load for several nonlinear paths.
+
+    Left: linear axes (the knees); right: log deflection axis (the small imperfections'
+    amplification below the knee). Vertical lines mark reference loads.
+
+    Args:
+        path: PNG to write.
+        curves: ``(loads_Pa, max_w_m, label, colour, line style)`` per path.
+        thickness: t (m), the deflection's scale.
+        marks: ``{label: (load_Pa, colour)}`` drawn as vertical dotted lines.
+        title: Figure title.
+
+    Returns:
+        The written path.
+    """
+    plt = _pyplot()
+    path = _prepare(path)
+    fw, fh = THEME["figsize"]
+    fig, axes = plt.subplots(1, 2, figsize=(1.6 * fw, 1.1 * fh), dpi=THEME["dpi"])
+    for ax in axes:
+        for loads, max_w, label, color, style in curves:
+            lam = np.asarray(loads, dtype=float) / 1e6
+            ax.plot(lam, np.asarray(max_w, dtype=float) / thickness, style, color=color,
+                    lw=1.6, label=label)  # fmt: skip
+        for label, (load, color) in marks.items():
+            ax.axvline(load / 1e6, color=color, ls=":", lw=1.5, label=label)
+        ax.set_xlabel("load λ (MPa)")
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].set_ylabel("max |w| / t")
+    axes[1].set_yscale("log")
+    axes[1].set_ylabel("max |w| / t (log scale)")
+    axes[0].legend(fontsize=THEME["mpl_font_size"] - 3, loc="upper left", framealpha=0.9)
+    if title:
+        fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+#: One series of :func:`plot_southwell`: additional deflection (m), loads (Pa), mask of
+#: the fitted points, Southwell load (Pa), label, colour.
+SouthwellSeries = tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike, float, str, str]
+
+
+def plot_southwell(
+    path: str | Path, series: Sequence[SouthwellSeries], *, thickness: float, title: str = ""
+) -> Path:
+    r"""Southwell plot: :math:`\delta_w/\lambda` against :math:`\delta_w` with the fitted lines.
+
+    The fitted points are filled, the others open; a line of slope
+    :math:`1/\lambda_S` through the fitted points' mean.
+
+    Args:
+        path: PNG to write.
+        series: ``(delta_w_m, loads_Pa, fitted_mask, southwell_Pa, label, colour)``.
+        thickness: t (m), the deflection's scale.
+        title: Axes title.
+
+    Returns:
+        The written path.
+    """
+    plt = _pyplot()
+    path = _prepare(path)
+    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    for dw, loads, mask, southwell, label, color in series:
+        x = np.asarray(dw, dtype=float) / thickness
+        lam = np.asarray(loads, dtype=float) / 1e6
+        keep = (lam > 0) & (x > 0)
+        fit = np.asarray(mask, dtype=bool) & keep
+        shown = keep & (x <= 2.0 * x[fit].max()) if fit.any() else keep
+        ax.plot(x[shown & ~fit], x[shown & ~fit] / lam[shown & ~fit], "o", mfc="none",
+                color=color, ms=5)  # fmt: skip
+        ax.plot(x[fit], x[fit] / lam[fit], "o", color=color, ms=5,
+                label=f"{label}: λ_S = {southwell / 1e6:.4f} MPa")  # fmt: skip
+        if fit.any():
+            xm, ym = x[fit].mean(), (x[fit] / lam[fit]).mean()
+            xs = np.array([0.0, x[shown].max()])
+            ax.plot(xs, ym + (xs - xm) / (southwell / 1e6), "-", color=color, lw=1.0)
+    ax.set_xlabel("additional deflection δ_w / t = (max |w| − δ t) / t")
+    ax.set_ylabel("(δ_w / t) / λ  (1/MPa)")
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=THEME["mpl_font_size"] - 2, loc="upper left")
+    if title:
+        ax.set_title(title)
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)

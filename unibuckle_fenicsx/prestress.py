@@ -32,7 +32,14 @@ from unibuckle_fenicsx.config import EdgeSpec, Material, PlateSpec
 from unibuckle_fenicsx.materials import membrane_voigt
 from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tag
 
-__all__ = ["DIRECT_LU", "Prestress", "membrane_force", "solve_prestress"]
+__all__ = [
+    "DIRECT_LU",
+    "Prestress",
+    "membrane_force",
+    "pin_rigid_motions",
+    "solve_prestress",
+    "voigt_to_ufl",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -96,10 +103,18 @@ def _nearest_vertex(
     return np.asarray(msh.comm.bcast(x[k].copy() if msh.comm.rank == owner else None, root=owner))
 
 
-def _pin_dofs(
-    V: dolfinx.fem.FunctionSpace, msh: dolfinx.mesh.Mesh
+def pin_rigid_motions(
+    V: dolfinx.fem.FunctionSpace, msh: dolfinx.mesh.Mesh, only: int | None = None
 ) -> list[dolfinx.fem.DirichletBC]:
-    """Point constraints removing the three in-plane rigid motions."""
+    """Point constraints removing the three in-plane rigid motions of the vector space V.
+
+    Both components at the node nearest the plate's centre, and the component normal to
+    the line joining it to a second node. ``only``: just that component at the centre
+    node (a translation, when the other motions are held by edge conditions).
+
+    Note:
+        Collective.
+    """
     x = msh.geometry.x
     local = np.vstack([x.min(axis=0), x.max(axis=0)]) if x.shape[0] else np.zeros((2, 3))
     lo = np.min(msh.comm.allgather(local[0]), axis=0)
@@ -113,9 +128,9 @@ def _pin_dofs(
     tol = 1e-10 * size + 64 * np.finfo(float).eps * float(np.abs(np.vstack([lo, hi])).max())
     bcs = []
     # p1: both components; p2: the component normal to p2 - p1.
-    comps = (0, 1)
     axis = 1 if abs(p2[0] - p1[0]) >= abs(p2[1] - p1[1]) else 0
-    for point, components in ((p1, comps), (p2, (axis,))):
+    pins = [(p1, (0, 1)), (p2, (axis,))] if only is None else [(p1, (only,))]
+    for point, components in pins:
         for c in components:
             Vc, _ = V.sub(c).collapse()
             dofs = dolfinx.fem.locate_dofs_geometrical(
@@ -192,7 +207,7 @@ def solve_prestress(
     pinned = not bcs
     if pinned:
         _check_self_equilibrated(msh, ds, n, s, plate, loaded)
-        bcs = _pin_dofs(V, msh)
+        bcs = pin_rigid_motions(V, msh)
 
     problem = dolfinx.fem.petsc.LinearProblem(
         a,

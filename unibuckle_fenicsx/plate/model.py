@@ -23,7 +23,7 @@ from unibuckle_fenicsx.plate.spaces import (
 )
 from unibuckle_fenicsx.prestress import Prestress
 
-__all__ = ["PlateModel"]
+__all__ = ["PlateModel", "edge_support_bcs", "mitc_shear_matrix"]
 
 
 class PlateModel(Owner):
@@ -95,47 +95,16 @@ class PlateModel(Owner):
 
     def _edge_bcs(self, facet_tags: dolfinx.mesh.MeshTags) -> list[dolfinx.fem.DirichletBC]:
         """Zero Dirichlet conditions of the edge supports (hard SS: w and tangential theta)."""
-        msh, W = self.mesh, self.W
-        fdim = msh.topology.dim - 1
-        bcs = []
-        for e in self.plate.edges:
-            if e.support == "free":
-                continue
-            tag = edge_tag(self.plate, e)
-            facets = facet_tags.find(tag)
-            subs: list[tuple[int, ...]] = [(0,)]
-            if e.support == "clamped":
-                subs += [(1, 0), (1, 1)]
-            elif e.support == "simply_supported":
-                # theta . s = 0: the rotation component along the edge direction.
-                normal = edge_normal_axis(msh, facet_tags, tag, e.name)
-                subs.append((1, 1 - normal))
-            for path in subs:
-                sub = W
-                for i in path:
-                    sub = sub.sub(i)
-                Vc, _ = sub.collapse()
-                dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
-                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
-        return bcs
+        return edge_support_bcs(self.W, facet_tags, self.plate)
 
     def _mitc_shear_matrix(self, ks: float) -> PETSc.Mat:
         """:math:`P^T M_s P` with P's columns of edge-constrained DOFs zeroed."""
-        Vs = create_shear_space(self.mesh)
-        g, d = ufl.TrialFunction(Vs), ufl.TestFunction(Vs)
-        Ms = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(ks * ufl.inner(g, d) * ufl.dx))
-        Ms.assemble()
-        P = mitc_shear_operator(self.W, Vs)
-        keep = P.createVecRight()
-        keep.set(1.0)
-        n_owned = self.W.dofmap.index_map.size_local * self.W.dofmap.index_map_bs
-        owned_bc = self.bc_dofs[self.bc_dofs < n_owned]
-        keep.array[owned_bc] = 0.0
-        P.diagonalScale(R=keep)
-        S = Ms.PtAP(P)
-        for obj in (Ms, P, keep):
-            obj.destroy()
-        return S
+        return mitc_shear_matrix(self.W, self.bc_dofs, ks)
+
+    @property
+    def w_subspace(self) -> dolfinx.fem.FunctionSpace:
+        """The sub-space of W holding w."""
+        return self.W.sub(0)
 
     @property
     def num_owned_dofs(self) -> int:
@@ -167,3 +136,100 @@ class PlateModel(Owner):
 
     def __del__(self) -> None:
         self.destroy()
+
+
+def edge_support_bcs(
+    W: dolfinx.fem.FunctionSpace,
+    facet_tags: dolfinx.mesh.MeshTags,
+    plate: PlateSpec,
+    *,
+    w_sub: int = 0,
+    theta_sub: int = 1,
+) -> list[dolfinx.fem.DirichletBC]:
+    """Zero Dirichlet conditions of the edge supports on w and theta.
+
+    Hard simple support: w and the tangential rotation; soft: w; clamped: w and theta.
+
+    Args:
+        W: Mixed space holding w and theta.
+        facet_tags: Edge markers.
+        plate: The edge conditions.
+        w_sub: Sub-space of W holding w.
+        theta_sub: Sub-space of W holding theta.
+
+    Note:
+        Collective.
+    """
+    msh = W.mesh
+    fdim = msh.topology.dim - 1
+    bcs = []
+    for e in plate.edges:
+        if e.support == "free":
+            continue
+        tag = edge_tag(plate, e)
+        facets = facet_tags.find(tag)
+        subs: list[tuple[int, ...]] = [(w_sub,)]
+        if e.support == "clamped":
+            subs += [(theta_sub, 0), (theta_sub, 1)]
+        elif e.support == "simply_supported":
+            # theta . s = 0: the rotation component along the edge direction.
+            normal = edge_normal_axis(msh, facet_tags, tag, e.name)
+            subs.append((theta_sub, 1 - normal))
+        for path in subs:
+            sub = W
+            for i in path:
+                sub = sub.sub(i)
+            Vc, _ = sub.collapse()
+            dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
+            bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
+    return bcs
+
+
+def mitc_shear_matrix(
+    W: dolfinx.fem.FunctionSpace,
+    bc_dofs: npt.NDArray[np.int32],
+    ks: float,
+    *,
+    w_sub: int = 0,
+    theta_sub: int = 1,
+    column_scale: PETSc.Vec | None = None,
+) -> PETSc.Mat:
+    r"""MITC shear stiffness :math:`P^T M_s P`, P's columns of ``bc_dofs`` zeroed.
+
+    Zeroed columns give zero rows and columns at the edge-constrained DOFs (whose
+    values are zero), so the matrix can be added to an operator assembled with
+    ``diag=1`` there.
+
+    Args:
+        W: Mixed space holding w and theta.
+        bc_dofs: Local W DOFs fixed by the edge supports.
+        ks: Shear stiffness :math:`\kappa_s G t` (N/m).
+        w_sub: Sub-space of W holding w.
+        theta_sub: Sub-space of W holding theta.
+        column_scale: Optional W-vector D: the matrix becomes :math:`D P^T M_s P D`
+            (for scaled unknowns).
+
+    Returns:
+        The matrix; the caller must destroy it.
+
+    Note:
+        Collective.
+    """
+    Vs = create_shear_space(W.mesh)
+    g, d = ufl.TrialFunction(Vs), ufl.TestFunction(Vs)
+    Ms = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(ks * ufl.inner(g, d) * ufl.dx))
+    Ms.assemble()
+    P = mitc_shear_operator(W, Vs, w_sub=w_sub, theta_sub=theta_sub)
+    keep = P.createVecRight()
+    if column_scale is None:
+        keep.set(1.0)
+    else:
+        column_scale.copy(keep)
+    n_owned = W.dofmap.index_map.size_local * W.dofmap.index_map_bs
+    owned_bc = bc_dofs[bc_dofs < n_owned]
+    keep.array[owned_bc] = 0.0
+    P.diagonalScale(R=keep)
+    S = Ms.PtAP(P)
+    for obj in (Ms, P, keep):
+        obj.destroy()
+    return S

@@ -60,12 +60,21 @@ def _restriction(
     return R
 
 
-def mitc_shear_operator(W: dolfinx.fem.FunctionSpace, Vs: dolfinx.fem.FunctionSpace) -> PETSc.Mat:
+def mitc_shear_operator(
+    W: dolfinx.fem.FunctionSpace,
+    Vs: dolfinx.fem.FunctionSpace,
+    *,
+    w_sub: int = 0,
+    theta_sub: int = 1,
+) -> PETSc.Mat:
     r"""Matrix P with :math:`\gamma_h = P u = \Pi \nabla w - \Pi \theta`.
 
     Args:
-        W: Mixed (w, theta) space from :func:`create_plate_space`.
+        W: Mixed space holding w (Q1) and theta (Q1^2), e.g. the (w, theta) space of
+            :func:`create_plate_space`.
         Vs: N1curl space from :func:`create_shear_space`.
+        w_sub: Sub-space of W holding w.
+        theta_sub: Sub-space of W holding theta.
 
     Returns:
         P of size dim(Vs) x dim(W). The caller must destroy it.
@@ -73,8 +82,8 @@ def mitc_shear_operator(W: dolfinx.fem.FunctionSpace, Vs: dolfinx.fem.FunctionSp
     Note:
         Collective.
     """
-    Vw, map_w = W.sub(0).collapse()
-    Vt, map_t = W.sub(1).collapse()
+    Vw, map_w = W.sub(w_sub).collapse()
+    Vt, map_t = W.sub(theta_sub).collapse()
     G = dolfinx.fem.petsc.discrete_gradient(Vw, Vs)
     G.assemble()
     I = dolfinx.fem.petsc.interpolation_matrix(Vt, Vs)  # noqa: E741

@@ -1,0 +1,587 @@
+r"""The von Kármán Reissner–Mindlin plate: mixed space, energy, MITC shear and a SNES VI solver.
+
+Unknowns :math:`x = (u, w, \theta)` in one mixed space :math:`Q_k^2 \times Q_1 \times Q_1^2`
+(in-plane displacement, deflection, rotation), from a stress-free imperfect shape
+:math:`x_0 = (0, w_0, \theta_0)`. The energy (the von Kármán plate: T. von Kármán,
+*Festigkeitsprobleme im Maschinenbau*, Encyklopädie der mathematischen Wissenschaften IV/4,
+1910; Timoshenko and Woinowsky-Krieger, *Theory of Plates and Shells*, 1959, ch. 13; here
+with Reissner–Mindlin bending and shear) is
+
+.. math::
+
+    \Pi(x) = \tfrac12\int_\omega N(e):e\,dx + \tfrac12\int_\omega M(\kappa):\kappa\,dx
+           + \tfrac12 (x - x_0)^T K_s (x - x_0)
+           - \lambda \int_{\gamma_1} t\,(\sigma_n n + \tau_s s)\cdot u\,ds,
+
+    e = \mathrm{sym}\nabla u + \tfrac12(\nabla w\otimes\nabla w
+        - \nabla w_0\otimes\nabla w_0), \qquad
+    \kappa = \mathrm{sym}\nabla(\theta - \theta_0),
+
+with the membrane and bending stiffnesses of the linear model and :math:`K_s = P^T M_s P`
+its MITC shear stiffness (:func:`~unibuckle_fenicsx.plate.model.mitc_shear_matrix`):
+the shear energy is quadratic, so :math:`K_s` is assembled once and adds
+:math:`K_s(x - x_0)` to the residual and :math:`K_s` to the Jacobian. The edge supports
+and the edge loads are those of the same :class:`~unibuckle_fenicsx.config.ProblemSpec`.
+
+The obstacle (:math:`w \le 0` at the zone's nodes, the nodes of
+:class:`~unibuckle_fenicsx.contact.ContactSetManager`) enters as variable bounds of PETSc's
+reduced-space VI Newton method (``vinewtonrsls``); the other bounds are
+``PETSc.INFINITY``. DOLFINx's ``NonlinearProblem`` takes no bounds and assembles forms
+only (the MITC shear is a matrix), so the SNES is wired here, with the same assembly
+calls (``assemble_vector``, ``apply_lifting``, ``set_bc``, ``assemble_matrix``) and the
+Jacobian by ``ufl.derivative``. Unknowns are scaled, :math:`\hat u = u/t`,
+:math:`\hat w = w/t`, and the energy by :math:`D_{11}`, so that the absolute tolerances
+with which the VI method decides that a bound is active act in units of t, not of metres
+(w is 1e-7 m at the smallest imperfections).
+
+Two controls: the load :math:`\lambda` (edge tractions), or the end shortening
+(prescribed normal displacement of the loaded edges, :math:`\lambda` from their reactions).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Any
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import basix.ufl
+import dolfinx
+import dolfinx.fem.petsc
+import ufl
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
+from unibuckle_fenicsx.contact import ContactSetManager
+from unibuckle_fenicsx.eigen import Owner, release
+from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, shear_stiffness
+from unibuckle_fenicsx.mesh import create_plate_mesh, edge_normal_axis, edge_tag
+from unibuckle_fenicsx.plate.model import edge_support_bcs, mitc_shear_matrix
+from unibuckle_fenicsx.prestress import pin_rigid_motions, voigt_to_ufl
+
+__all__ = [
+    "CONTROLS",
+    "SNES_OPTIONS",
+    "StepReport",
+    "VonKarmanPlate",
+    "apply_options",
+    "displacement_axis",
+]
+
+#: Path controls: the edge load, or the end shortening of the loaded edges.
+CONTROLS = ("load", "displacement")
+
+#: Default SNES options (prefix ``unibuckle_nl_``): Newton with MUMPS LU; the VI type is
+#: set when the plate has an obstacle. Tolerances act on the scaled residual.
+SNES_OPTIONS: dict[str, str | float | int | bool] = {
+    "snes_rtol": 1e-10,
+    "snes_stol": 0.0,
+    "snes_max_it": 25,
+    "ksp_type": "preonly",
+    "pc_type": "lu",
+    "pc_factor_mat_solver_type": "mumps",
+}
+
+# Sub-spaces of the mixed space.
+U_SUB, W_SUB, THETA_SUB = 0, 1, 2
+
+
+@dataclass(frozen=True)
+class StepReport:
+    """Outcome of one nonlinear solve.
+
+    Attributes:
+        converged: SNES converged (reason > 0).
+        reason: SNES converged reason (negative: diverged).
+        iterations: Newton iterations.
+    """
+
+    converged: bool
+    reason: int
+    iterations: int
+
+
+def displacement_axis(plate: PlateSpec, control: str) -> int | None:
+    """Axis of the compression under end-shortening control (None under load control).
+
+    Raises:
+        ValueError: ``control`` unknown, or "displacement" for a load that is not a
+            uniaxial compression of opposite rectangle edges (checked before any work).
+    """
+    if control not in CONTROLS:
+        raise ValueError(f"control must be one of {CONTROLS}, got {control!r}")
+    if control != "displacement":
+        return None
+    loaded = [e for e in plate.edges if e.loaded]
+    problem = None
+    if not loaded:
+        problem = "no edge is loaded"
+    elif any(e.shear_stress != 0.0 or e.normal_stress >= 0.0 for e in loaded):
+        problem = "its loaded edges must carry compression only (no shear, no tension)"
+    elif len({e.normal_stress for e in loaded}) != 1:
+        problem = "its loaded edges must carry the same normal stress"
+    elif any(e.name not in EDGE_NAMES or e.tag is not None for e in loaded):
+        problem = "its loaded edges must be edges of the rectangle (left, right, bottom, top)"
+    elif len({0 if e.name in ("left", "right") else 1 for e in loaded}) != 1:
+        problem = "its loaded edges must be opposite edges"
+    if problem is not None:
+        raise ValueError(
+            'control = "displacement" (end shortening) needs a uniaxial compression: '
+            f'{problem}; use control = "load"'
+        )
+    return 0 if loaded[0].name in ("left", "right") else 1
+
+
+def apply_options(obj: Any, prefix: str, defaults: Mapping[str, Any]) -> None:
+    """Give ``obj`` the options prefix and default options, then ``setFromOptions``.
+
+    A default is used only when the database holds no value for ``prefix + key`` (an
+    option from the command line wins), and removed again afterwards. Safe for SNES and
+    KSP objects, which read every option here in ``setFromOptions``.
+
+    Args:
+        obj: A PETSc object with ``setOptionsPrefix`` and ``setFromOptions``.
+        prefix: Non-empty options prefix.
+        defaults: Option names (without prefix) and default values.
+    """
+    if not prefix:
+        raise ValueError("PETSc objects need a non-empty options prefix")
+    obj.setOptionsPrefix(prefix)
+    opts = PETSc.Options(prefix)
+    pushed = [key for key in defaults if not opts.hasName(key)]
+    for key in pushed:
+        opts.setValue(key, defaults[key])
+    try:
+        obj.setFromOptions()
+    finally:
+        for key in pushed:
+            opts.delValue(key)
+
+
+def _add_ghosts(vec: PETSc.Vec) -> None:
+    """Sum the ghost contributions into their owners (after assembly)."""
+    vec.ghostUpdate(addv=True, mode="reverse")  # ADD_VALUES, SCATTER_REVERSE
+
+
+def _update_ghosts(vec: PETSc.Vec) -> None:
+    """Copy the owned values to the ghosts."""
+    vec.ghostUpdate(addv=False, mode="forward")  # INSERT_VALUES, SCATTER_FORWARD
+
+
+def _scalar(form: dolfinx.fem.Form, comm: MPI.Comm) -> float:
+    return float(comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM))
+
+
+class VonKarmanPlate(Owner):
+    r"""Geometrically nonlinear (von Kármán) plate with the linear model's edges and loads.
+
+    Args:
+        spec: The problem (plate, material, edges, loads, mesh, obstacle).
+        comm: Communicator of the mesh.
+        control: "load" or "displacement" (:data:`CONTROLS`).
+        obstacle: Impose the obstacle of ``spec`` (False: the same plate without it).
+        degree: Lagrange degree of the in-plane displacement (1 or 2).
+        snes_options: SNES options pushed under the prefix ``unibuckle_nl_`` (default
+            :data:`SNES_OPTIONS`).
+        mesh: The mesh to use (e.g. the linear problem's, to share its functions);
+            default: ``spec.mesh``'s rectangle.
+        facet_tags: Edge markers of ``mesh``.
+
+    Attributes:
+        x: The current state :math:`(u/t, w/t, \theta)` (scaled, see the module note).
+        x0: The imperfect, stress-free shape :math:`(0, w_0/t, \theta_0)`.
+        load: :math:`\lambda` (Pa) under load control.
+        contact: The zone's nodes (None without obstacle).
+
+    Note:
+        Construction, :meth:`solve` and :meth:`destroy` are collective.
+    """
+
+    def __init__(
+        self,
+        spec: ProblemSpec,
+        comm: MPI.Comm = MPI.COMM_WORLD,
+        *,
+        control: str = "load",
+        obstacle: bool = True,
+        degree: int = 1,
+        snes_options: Mapping[str, str | float | int | bool] | None = None,
+        mesh: dolfinx.mesh.Mesh | None = None,
+        facet_tags: dolfinx.mesh.MeshTags | None = None,
+    ) -> None:
+        if degree not in (1, 2):
+            raise ValueError(f"degree (in-plane displacement) must be 1 or 2, got {degree!r}")
+        self.spec = spec
+        self.plate = spec.plate
+        self.control = control
+        self.thickness = t = spec.plate.thickness
+        loaded = [e for e in spec.plate.edges if e.loaded]
+        if not loaded:
+            raise ValueError(
+                "no edge is loaded: give at least one edge a non-zero normal_stress or shear_stress"
+            )
+        self._displacement_axis = displacement_axis(spec.plate, control)
+
+        if mesh is None or facet_tags is None:
+            mesh, facet_tags = create_plate_mesh(spec.plate, spec.mesh, comm)
+        self.mesh, self.facet_tags = mesh, facet_tags
+        msh = self.mesh
+        self.comm = msh.comm
+        cell = msh.basix_cell().name
+        elements = [
+            basix.ufl.element("Lagrange", cell, degree, shape=(2,)),
+            basix.ufl.element("Lagrange", cell, 1),
+            basix.ufl.element("Lagrange", cell, 1, shape=(2,)),
+        ]
+        self.W = dolfinx.fem.functionspace(msh, basix.ufl.mixed_element(elements))
+        self.Vw, map_w = self.W.sub(W_SUB).collapse()
+        self.w_dofs = np.asarray(map_w[0], dtype=np.int32)  # Vw dof -> W dof
+        self.bending_bcs = edge_support_bcs(
+            self.W, self.facet_tags, spec.plate, w_sub=W_SUB, theta_sub=THETA_SUB
+        )
+        self.bc_dofs = np.unique(
+            np.concatenate(
+                [bc.dof_indices()[0] for bc in self.bending_bcs] or [np.empty(0, np.int32)]
+            )
+        ).astype(np.int32)
+        self._edge_values: list[tuple[dolfinx.fem.Constant, float]] = []
+        self.bcs = self.bending_bcs + self._inplane_bcs()
+
+        self.x = dolfinx.fem.Function(self.W, name="state")
+        self.x0 = dolfinx.fem.Function(self.W, name="imperfection")
+        self.load = dolfinx.fem.Constant(msh, 0.0)
+        D = bending_voigt(spec.material, t)
+        self.energy_scale = float(D[0, 0])  # N m
+        Cm = membrane_voigt(spec.material, t)
+        self._compliance = np.linalg.inv(Cm)
+
+        u_h, w_h, theta_h = ufl.split(self.x)
+        _, w0_h, theta0_h = ufl.split(self.x0)
+        u, w, w0 = t * u_h, t * w_h, t * w0_h
+        e = ufl.sym(ufl.grad(u)) + 0.5 * (
+            ufl.outer(ufl.grad(w), ufl.grad(w)) - ufl.outer(ufl.grad(w0), ufl.grad(w0))
+        )
+        kappa = ufl.sym(ufl.grad(theta_h - theta0_h))
+        energy = 0.5 * ufl.inner(voigt_to_ufl(Cm, e), e) + 0.5 * ufl.inner(
+            voigt_to_ufl(D, kappa), kappa
+        )
+        ks = shear_stiffness(spec.material, t)
+        if spec.solver.shear == "full":
+            gamma = ufl.grad(w - w0) - (theta_h - theta0_h)
+            energy = energy + 0.5 * ks * ufl.inner(gamma, gamma)
+        Pi = energy / self.energy_scale * ufl.dx
+        ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
+        n = ufl.FacetNormal(msh)
+        s = ufl.as_vector([-n[1], n[0]])
+        if control == "load":
+            for edge in loaded:
+                traction = edge.normal_stress * n + edge.shear_stress * s
+                Pi = Pi - (self.load * t / self.energy_scale) * ufl.inner(traction, u) * ds(
+                    edge_tag(spec.plate, edge)
+                )
+        v, dx_ = ufl.TestFunction(self.W), ufl.TrialFunction(self.W)
+        # The edge loads' vector per unit lambda: the scale of the residual.
+        unit_load = sum(
+            (t / self.energy_scale)
+            * ufl.inner(e.normal_stress * n + e.shear_stress * s, ufl.split(v)[U_SUB])
+            * ds(edge_tag(spec.plate, e))
+            for e in loaded
+        )
+        f = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(unit_load))
+        _add_ghosts(f)
+        #: 2-norm of the scaled load vector per unit lambda (Pa).
+        self.unit_load_norm = float(f.norm())  # type: ignore[arg-type]
+        #: Its largest entry.
+        self.unit_load_inf = float(f.norm(PETSc.NormType.INFINITY))  # type: ignore[arg-type]
+        f.destroy()
+        F = ufl.derivative(Pi, self.x, v)
+        J = ufl.derivative(F, self.x, dx_)
+        self.F_form = dolfinx.fem.form(F)
+        self.J_form = dolfinx.fem.form(J)
+        # End shortening: -(mean normal displacement) summed over the loaded edges.
+        self._edge_forms = [
+            (
+                dolfinx.fem.form(
+                    t * ufl.inner(ufl.split(self.x)[U_SUB], n) * ds(edge_tag(spec.plate, e))
+                ),
+                _scalar(dolfinx.fem.form(1.0 * ds(edge_tag(spec.plate, e))), self.comm),
+                e,
+            )
+            for e in loaded
+        ]
+
+        scale = dolfinx.fem.Function(self.W)
+        scale.x.array[:] = 1.0
+        scale.x.array[self.w_dofs] = t
+        self.Ks: PETSc.Mat | None = None
+        if spec.solver.shear == "mitc":
+            Ks = mitc_shear_matrix(
+                self.W,
+                self.bc_dofs,
+                ks / self.energy_scale,
+                w_sub=W_SUB,
+                theta_sub=THETA_SUB,
+                column_scale=scale.x.petsc_vec,
+            )
+            self.Ks = Ks
+        self.J: PETSc.Mat | None = dolfinx.fem.petsc.create_matrix(self.J_form)
+        self._merged = False
+        self.b: PETSc.Vec | None = dolfinx.fem.petsc.create_vector(self.W)
+        self._xs: PETSc.Vec | None = dolfinx.fem.petsc.create_vector(self.W)
+        self._d: PETSc.Vec | None = self._xs.duplicate()
+        self._Kd: PETSc.Vec | None = self._xs.duplicate()
+
+        self.contact = (
+            ContactSetManager(self, spec.obstacle)
+            if obstacle and spec.obstacle is not None
+            else None
+        )
+        snes = PETSc.SNES().create(self.comm)
+        snes.setFunction(self._residual, self.b)
+        snes.setJacobian(self._jacobian, self.J)
+        options = dict(SNES_OPTIONS if snes_options is None else snes_options)
+        self._lower: PETSc.Vec | None = None
+        self._upper: PETSc.Vec | None = None
+        if self.contact is not None:
+            options.setdefault("snes_type", "vinewtonrsls")
+            self._lower = self._xs.duplicate()
+            self._upper = self._xs.duplicate()
+            self._lower.set(PETSc.NINFINITY)
+            self._upper.set(PETSc.INFINITY)
+            rows = self.contact.global_rows()
+            lo, hi = self._upper.getOwnershipRange()
+            mine = rows[(rows >= lo) & (rows < hi)]
+            self._upper.array[mine - lo] = 0.0
+            snes.setVariableBounds(self._lower, self._upper)
+        else:
+            options.setdefault("snes_type", "newtonls")
+        apply_options(snes, "unibuckle_nl_", options)
+        self.snes: PETSc.SNES | None = snes
+
+    # -- set-up helpers ------------------------------------------------------------
+    def _inplane_bcs(self) -> list[dolfinx.fem.DirichletBC]:
+        """In-plane edge conditions, prescribed shortening, and rigid-motion pins."""
+        msh, W, plate = self.mesh, self.W, self.plate
+        fdim = msh.topology.dim - 1
+        U = W.sub(U_SUB)
+        bcs: list[dolfinx.fem.DirichletBC] = []
+        held = {0: False, 1: False}  # a component held along an edge (no translation)
+
+        def fix(edge: EdgeSpec, c: int, value: float | dolfinx.fem.Constant) -> None:
+            Vc, _ = U.sub(c).collapse()
+            facets = self.facet_tags.find(edge_tag(plate, edge))
+            dofs = dolfinx.fem.locate_dofs_topological((U.sub(c), Vc), fdim, facets)
+            bcs.append(dolfinx.fem.dirichletbc(value, dofs[0], U.sub(c)))
+
+        axis = self._displacement_axis
+        loaded = [e for e in plate.edges if e.loaded]
+        for e in plate.edges:
+            if axis is not None and e.loaded:
+                # u . n = -shortening per loaded edge (outward normal +-axis).
+                sign = 1.0 if e.name in ("right", "top") else -1.0
+                value = dolfinx.fem.Constant(msh, 0.0)
+                self._edge_values.append((value, -sign / len(loaded)))
+                fix(e, axis, value)
+                held[axis] = True
+                continue
+            if e.inplane == "free":
+                continue
+            components: tuple[int, ...] = (0, 1)
+            if e.inplane == "roller":
+                components = (edge_normal_axis(msh, self.facet_tags, edge_tag(plate, e), e.name),)
+            for c in components:
+                fix(e, c, 0.0)
+                held[c] = True
+        if axis is None and not bcs:
+            bcs += pin_rigid_motions(U, msh)
+        elif axis is not None and not held[1 - axis]:
+            bcs += pin_rigid_motions(U, msh, only=1 - axis)
+        return bcs
+
+    # -- PlateDofs (for ContactSetManager) -------------------------------------------
+    @property
+    def w_subspace(self) -> dolfinx.fem.FunctionSpace:
+        """The sub-space holding w."""
+        return self.W.sub(W_SUB)
+
+    @property
+    def num_owned_dofs(self) -> int:
+        """Owned DOFs of the mixed space on this rank."""
+        return self.W.dofmap.index_map.size_local * self.W.dofmap.index_map_bs
+
+    @property
+    def num_dofs(self) -> int:
+        """Global DOF count of the mixed space."""
+        return self.W.dofmap.index_map.size_global * self.W.dofmap.index_map_bs
+
+    def global_dofs(self, local: npt.NDArray[np.int32]) -> npt.NDArray[np.int64]:
+        """Global (PETSc) indices of the local DOFs ``local``."""
+        im, bs = self.W.dofmap.index_map, self.W.dofmap.index_map_bs
+        local = np.ascontiguousarray(local, dtype=np.int32)
+        return im.local_to_global(local // bs) * bs + local % bs
+
+    # -- SNES callbacks ------------------------------------------------------------
+    def _assign(self, x: PETSc.Vec) -> None:
+        """State function <- the (owned part of the) vector ``x``, ghosts updated."""
+        _update_ghosts(x)  # x is used with its ghosts by the lifting
+        self.x.x.array[: self.num_owned_dofs] = x.array_r
+        self.x.x.scatter_forward()
+
+    def _to_vector(self, x: PETSc.Vec) -> None:
+        """Vector ``x`` <- the state function (owned part)."""
+        x.array[:] = self.x.x.array[: self.num_owned_dofs]
+        _update_ghosts(x)
+
+    def _residual(self, _snes: PETSc.SNES | None, x: PETSc.Vec, b: PETSc.Vec) -> None:
+        """SNES function: the scaled residual F(x) with the edge conditions lifted."""
+        self._assign(x)
+        with b.localForm() as local:
+            local.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(b, self.F_form)  # type: ignore[arg-type]
+        dolfinx.fem.petsc.apply_lifting(b, [self.J_form], bcs=[self.bcs], x0=[x], alpha=-1.0)
+        _add_ghosts(b)
+        if self.Ks is not None:
+            assert self._d is not None and self._Kd is not None
+            x.copy(self._d)
+            self._d.axpy(-1.0, self.x0.x.petsc_vec)
+            self.Ks.mult(self._d, self._Kd)
+            b.axpy(1.0, self._Kd)
+        dolfinx.fem.petsc.set_bc(b, self.bcs, x0=x, alpha=-1.0)
+
+    def _jacobian(self, _snes: PETSc.SNES, x: PETSc.Vec, J: PETSc.Mat, _P: PETSc.Mat) -> None:
+        """SNES Jacobian: the assembled derivative of F plus K_s (diagonal 1 on edge DOFs)."""
+        self._assign(x)
+        J.zeroEntries()
+        dolfinx.fem.petsc.assemble_matrix(J, self.J_form, self.bcs, diag=1.0)  # type: ignore[arg-type, misc]
+        J.assemble()
+        if self.Ks is not None:
+            # K_s has structural zeros outside J's cell pattern (the N1curl interpolation
+            # rows hold every dof of a cell): merge the patterns once.
+            structure = (
+                PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
+                if self._merged
+                else PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
+            )
+            J.axpy(1.0, self.Ks, structure=structure)  # type: ignore[arg-type]
+            self._merged = True
+
+    # -- solving -------------------------------------------------------------------
+    def set_control(self, value: float) -> None:
+        r"""Set the load :math:`\lambda` (Pa), or the end shortening (m) (displacement control)."""
+        if self.control == "load":
+            self.load.value = value  # type: ignore[assignment]
+        else:
+            for constant, factor in self._edge_values:
+                constant.value = factor * value / self.thickness  # type: ignore[assignment]
+
+    def project(self) -> None:
+        """Clip the state onto the obstacle (w <= 0 at the zone's nodes); not collective."""
+        if self.contact is None:
+            return
+        assert self._upper is not None
+        arr = self.x.x.petsc_vec.array
+        np.minimum(arr, self._upper.array, out=arr)
+        self.x.x.scatter_forward()
+
+    def solve(self) -> StepReport:
+        """Solve for the current control from the current state (the initial guess).
+
+        On convergence the state is updated; otherwise it is left as it was.
+
+        Note:
+            Collective.
+        """
+        assert self.snes is not None and self._xs is not None
+        self._to_vector(self._xs)
+        self.snes.solve(None, self._xs)
+        reason = int(self.snes.getConvergedReason())  # type: ignore[call-overload]
+        its = int(self.snes.getIterationNumber())
+        if reason > 0:
+            self._assign(self._xs)
+        return StepReport(reason > 0, reason, its)
+
+    # -- measures (collective) -------------------------------------------------------
+    def max_abs_w(self, x: dolfinx.fem.Function | None = None) -> float:
+        """The largest |w| over the plate (m)."""
+        x = self.x if x is None else x
+        n_owned = self.Vw.dofmap.index_map.size_local
+        values = x.x.array[self.w_dofs[:n_owned]]
+        local = float(np.abs(values).max()) if values.size else 0.0
+        return self.thickness * float(self.comm.allreduce(local, op=MPI.MAX))
+
+    def zone_deflection(self) -> npt.NDArray[np.float64]:
+        """Deflection (m) at the zone's nodes, (i,), same on every rank (empty without obstacle)."""
+        if self.contact is None:
+            return np.empty(0)
+        return self.thickness * self.contact.values(self.x.x.petsc_vec)
+
+    def contact_nodes(self, rtol: float = 1e-9) -> npt.NDArray[np.int64]:
+        """Zone nodes on the obstacle: w >= -rtol t (the VI keeps them at w = 0)."""
+        w = self.zone_deflection()
+        return np.flatnonzero(w >= -rtol * self.thickness).astype(np.int64)
+
+    def end_shortening(self) -> float:
+        """Mean inward normal displacement of the loaded edges, summed over them (m)."""
+        total = 0.0
+        for form, length, _ in self._edge_forms:
+            total -= _scalar(form, self.comm) / length
+        return total
+
+    def residual_vector(self) -> PETSc.Vec:
+        """The scaled residual at the current state, edge-constrained rows zero.
+
+        Returns a work vector owned by the plate (valid until the next call).
+        """
+        assert self.b is not None and self._xs is not None
+        self._to_vector(self._xs)
+        self._residual(None, self._xs, self.b)
+        dolfinx.fem.petsc.set_bc(self.b, self.bcs, alpha=0.0)
+        return self.b
+
+    def edge_reaction_load(self) -> float:
+        r""":math:`\lambda` (Pa) from the reactions on the loaded edges (displacement control).
+
+        The support's normal force on each loaded edge, divided by t, its length and its
+        normal stress per unit load; the mean over the loaded edges.
+        """
+        assert self._displacement_axis is not None and self.b is not None
+        axis = self._displacement_axis
+        b = self.b
+        with b.localForm() as local:
+            local.set(0.0)
+        dolfinx.fem.petsc.assemble_vector(b, self.F_form)  # type: ignore[arg-type]
+        _add_ghosts(b)
+        n_owned = self.num_owned_dofs
+        fdim = self.mesh.topology.dim - 1
+        U = self.W.sub(U_SUB).sub(axis)
+        Vc, _ = U.collapse()
+        loads = []
+        for _, length, edge in self._edge_forms:
+            facets = self.facet_tags.find(edge_tag(self.plate, edge))
+            dofs = dolfinx.fem.locate_dofs_topological((U, Vc), fdim, facets)[0]
+            dofs = dofs[dofs < n_owned]
+            sign = 1.0 if edge.name in ("right", "top") else -1.0
+            force = float(self.comm.allreduce(float(b.array[dofs].sum()), op=MPI.SUM))
+            # Scaled residual -> N: times D11 / t.
+            force *= sign * self.energy_scale / self.thickness
+            loads.append(force / (self.thickness * length * edge.normal_stress))
+        return float(np.mean(loads))
+
+    def flat_shortening(self, load: float) -> float:
+        """End shortening (m) of the flat plate under ``load`` (linear membrane estimate)."""
+        axis = self._displacement_axis if self._displacement_axis is not None else 0
+        stress = max(abs(e.normal_stress) for e in self.plate.edges if e.loaded)
+        strain = float(self._compliance[axis, axis]) * load * self.thickness * stress
+        length = self.plate.length if axis == 0 else self.plate.width
+        return strain * length
+
+    def destroy(self) -> None:
+        """Destroy the PETSc objects (collective)."""
+        release(self, "snes", "J", "Ks", "b", "_xs", "_d", "_Kd", "_lower", "_upper")
+
+    def __del__(self) -> None:
+        self.destroy()
