@@ -90,3 +90,41 @@ def test_indefinite_prestress_uses_swapped_pencil():
     # Both pick the smallest positive eigenvalue here (the negative ones, from the tension
     # zone, lie far from 0): identical to the eigen tolerance.
     assert value == pytest.approx(check, rel=1e-8)
+
+
+def test_command_line_option_wins_and_defaults_do_not_leak():
+    """README, "Command line": an option under a package prefix wins over its default.
+
+    The defaults pushed for one object are removed afterwards (no leak into the next
+    object with that prefix), and with ``setup=True`` options read only at set-up (MUMPS
+    ICNTL(13) and ICNTL(24), which make the inertia count reliable in parallel) reach the
+    factorisation: the inertia of diag(-1, 1, 2) is (1, 0, 2).
+    """
+    from petsc4py import PETSc
+
+    from unibuckle_fenicsx.eigen import LDL_OPTIONS, SymmetricFactorization, set_options
+
+    opts = PETSc.Options()
+    opts.setValue("unibuckle_test_ksp_type", "gmres")  # as if given on the command line
+    try:
+        ksp = PETSc.KSP().create(MPI.COMM_SELF)
+        set_options(ksp, "unibuckle_test_", {"ksp_type": "preonly", "pc_type": "jacobi"})
+        assert ksp.getType() == "gmres"  # the user's value
+        assert ksp.getPC().getType() == "jacobi"  # the default
+        assert not opts.hasName("unibuckle_test_pc_type")  # removed again
+        ksp.destroy()
+    finally:
+        opts.delValue("unibuckle_test_ksp_type")
+
+    mat = PETSc.Mat().createAIJ((3, 3), nnz=1, comm=MPI.COMM_SELF)
+    for k, value in enumerate((-1.0, 1.0, 2.0)):
+        mat.setValue(k, k, value)
+    mat.assemble()
+    ldl = SymmetricFactorization(mat, "unibuckle_test_ldl_")
+    factor = ldl.ksp.getPC().getFactorMatrix()
+    assert factor.getMumpsIcntl(13) == LDL_OPTIONS["mat_mumps_icntl_13"]
+    assert factor.getMumpsIcntl(24) == LDL_OPTIONS["mat_mumps_icntl_24"]
+    assert ldl.inertia() == (1, 0, 2)
+    assert not opts.hasName("unibuckle_test_ldl_mat_mumps_icntl_13")
+    ldl.destroy()
+    mat.destroy()

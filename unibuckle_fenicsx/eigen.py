@@ -123,32 +123,35 @@ class Owner:
         self.destroy()
 
 
-def set_options(obj: Any, prefix: str, options: Options) -> None:
+def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False) -> None:
     """Set the options prefix of ``obj`` and default ``options``; then ``setFromOptions``.
 
-    An option already in the database under ``prefix`` (from the command line, e.g.
-    ``-unibuckle_eps_max_it 1000``) wins over the default given here; the defaults are
-    removed again afterwards, so nothing leaks into other objects.
+    A default is used only when the database holds no value for ``prefix + key`` (an
+    option from the command line, e.g. ``-unibuckle_eps_max_it 1000``, wins), and it is
+    removed again afterwards, so nothing leaks into other objects. Options read only when
+    the object is set up (MUMPS ICNTL settings are read at the symbolic factorisation)
+    need ``setup=True``: ``obj.setUp()`` then runs before the defaults are removed.
 
     Args:
         obj: A PETSc/SLEPc object with ``setOptionsPrefix`` and ``setFromOptions``.
         prefix: Non-empty options prefix.
         options: Option names (without prefix) and default values.
+        setup: Call ``obj.setUp()`` (its operators must be set) while the defaults are in.
     """
     if not prefix:
         raise ValueError("PETSc/SLEPc objects need a non-empty options prefix")
     obj.setOptionsPrefix(prefix)
-    opts = PETSc.Options()
-    opts.prefixPush(prefix)
+    opts = PETSc.Options(prefix)  # names below are relative to the prefix
     pushed = [key for key in options if not opts.hasName(key)]
     for key in pushed:
         opts.setValue(key, options[key])
-    opts.prefixPop()
-    obj.setFromOptions()
-    opts.prefixPush(prefix)
-    for key in pushed:
-        opts.delValue(key)
-    opts.prefixPop()
+    try:
+        obj.setFromOptions()
+        if setup:
+            obj.setUp()
+    finally:
+        for key in pushed:
+            opts.delValue(key)
 
 
 class EigenSolveError(RuntimeError):
@@ -530,8 +533,7 @@ class SymmetricFactorization(Owner):
         mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
         self.ksp = PETSc.KSP().create(mat.comm)
         self.ksp.setOperators(mat)
-        set_options(self.ksp, prefix, LDL_OPTIONS if options is None else options)
-        self.ksp.setUp()
+        set_options(self.ksp, prefix, LDL_OPTIONS if options is None else options, setup=True)
         self.prefix = prefix
 
     def inertia(self) -> tuple[int, int, int]:

@@ -42,7 +42,6 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Any
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -57,7 +56,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
 from unibuckle_fenicsx.contact import ContactSetManager
-from unibuckle_fenicsx.eigen import Owner, release
+from unibuckle_fenicsx.eigen import Owner, release, set_options
 from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, shear_stiffness
 from unibuckle_fenicsx.mesh import create_plate_mesh, edge_normal_axis, edge_tag
 from unibuckle_fenicsx.plate.model import edge_support_bcs, mitc_shear_matrix
@@ -68,7 +67,6 @@ __all__ = [
     "SNES_OPTIONS",
     "StepReport",
     "VonKarmanPlate",
-    "apply_options",
     "displacement_axis",
 ]
 
@@ -134,32 +132,6 @@ def displacement_axis(plate: PlateSpec, control: str) -> int | None:
             f'{problem}; use control = "load"'
         )
     return 0 if loaded[0].name in ("left", "right") else 1
-
-
-def apply_options(obj: Any, prefix: str, defaults: Mapping[str, Any]) -> None:
-    """Give ``obj`` the options prefix and default options, then ``setFromOptions``.
-
-    A default is used only when the database holds no value for ``prefix + key`` (an
-    option from the command line wins), and removed again afterwards. Safe for SNES and
-    KSP objects, which read every option here in ``setFromOptions``.
-
-    Args:
-        obj: A PETSc object with ``setOptionsPrefix`` and ``setFromOptions``.
-        prefix: Non-empty options prefix.
-        defaults: Option names (without prefix) and default values.
-    """
-    if not prefix:
-        raise ValueError("PETSc objects need a non-empty options prefix")
-    obj.setOptionsPrefix(prefix)
-    opts = PETSc.Options(prefix)
-    pushed = [key for key in defaults if not opts.hasName(key)]
-    for key in pushed:
-        opts.setValue(key, defaults[key])
-    try:
-        obj.setFromOptions()
-    finally:
-        for key in pushed:
-            opts.delValue(key)
 
 
 def _add_ghosts(vec: PETSc.Vec) -> None:
@@ -359,7 +331,7 @@ class VonKarmanPlate(Owner):
             snes.setVariableBounds(self._lower, self._upper)
         else:
             options.setdefault("snes_type", "newtonls")
-        apply_options(snes, "unibuckle_nl_", options)
+        set_options(snes, "unibuckle_nl_", options)
         self.snes: PETSc.SNES | None = snes
 
     # -- set-up helpers ------------------------------------------------------------

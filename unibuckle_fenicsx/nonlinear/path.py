@@ -50,12 +50,11 @@ import numpy.typing as npt
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
 from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
-from unibuckle_fenicsx.eigen import Owner
+from unibuckle_fenicsx.eigen import Owner, set_options
 from unibuckle_fenicsx.nonlinear.model import (
     CONTROLS,
     THETA_SUB,
     VonKarmanPlate,
-    apply_options,
     displacement_axis,
 )
 from unibuckle_fenicsx.problem import BucklingProblem
@@ -445,7 +444,7 @@ def _pressure_shape(problem: BucklingProblem) -> dolfinx.fem.Function:
     dolfinx.fem.petsc.set_bc(f, model.bcs)
     ksp = PETSc.KSP().create(problem.comm)  # type: ignore[arg-type]
     ksp.setOperators(model.A)
-    apply_options(ksp, "unibuckle_nl_shape_", SHAPE_LU)
+    set_options(ksp, "unibuckle_nl_shape_", SHAPE_LU)
     p = dolfinx.fem.Function(model.W, name="pressure_shape")
     try:
         ksp.solve(f, p.x.petsc_vec)
