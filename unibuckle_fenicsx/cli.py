@@ -18,7 +18,10 @@ import os
 import sys
 from collections.abc import Sequence
 from pathlib import Path
-from typing import Any
+from typing import TYPE_CHECKING, Any
+
+if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.config import ProblemSpec
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_NOT_CERTIFIED", "EXIT_OK", "main"]
 
@@ -382,8 +385,6 @@ def main(argv: Sequence[str] | None = None) -> int:
 
     from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
     from unibuckle_fenicsx.analysis import solve
-    from unibuckle_fenicsx.cases import paper_case
-    from unibuckle_fenicsx.config import load_problem
     from unibuckle_fenicsx.eigen import EigenSolveError
     from unibuckle_fenicsx.results import write_fields, write_json
 
@@ -395,20 +396,13 @@ def main(argv: Sequence[str] | None = None) -> int:
         return _nonlinear(args, comm)
 
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
-        if comm.rank == 0:
-            print(f"unibuckle: error: {message}", file=sys.stderr)
-        return status
+        return _fail(comm, message, status)
 
     problem = comm.bcast(_check_writable(args) if comm.rank == 0 else None, root=0)
     if problem is not None:
         return fail(problem)
     try:
-        spec = paper_case(args.case) if args.case else load_problem(args.config)
-        if args.nx is not None or args.ny is not None:
-            spec = spec.with_mesh(
-                spec.mesh.nx if args.nx is None else args.nx,
-                spec.mesh.ny if args.ny is None else args.ny,
-            )
+        spec = _spec_from_args(args)
         changes, ignored = _solver_changes(args)
         spec = spec.with_solver(**changes)
     except (ValueError, OSError) as err:
@@ -451,15 +445,11 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
     import json
 
     from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
-    from unibuckle_fenicsx.cases import paper_case
-    from unibuckle_fenicsx.config import load_problem
     from unibuckle_fenicsx.eigen import EigenSolveError
     from unibuckle_fenicsx.nonlinear import NonlinearError, NonlinearOptions, solve_nonlinear
 
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
-        if comm.rank == 0:
-            print(f"unibuckle: error: {message}", file=sys.stderr)
-        return status
+        return _fail(comm, message, status)
 
     problem = comm.bcast(_check_writable(args) if comm.rank == 0 else None, root=0)
     if problem is not None:
@@ -474,12 +464,7 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
             max_step=args.max_step,
             min_step=min(1e-5, args.max_step),
         )
-        spec = paper_case(args.case) if args.case else load_problem(args.config)
-        if args.nx is not None or args.ny is not None:
-            spec = spec.with_mesh(
-                spec.mesh.nx if args.nx is None else args.nx,
-                spec.mesh.ny if args.ny is None else args.ny,
-            )
+        spec = _spec_from_args(args)
     except (ValueError, OSError) as err:
         message = str(err)
         for name in _NONLINEAR_FLAGS:  # name the flag, not the option
@@ -510,6 +495,27 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
                 file=sys.stderr,
             )
     return EXIT_OK if result.ok else EXIT_NOT_CERTIFIED
+
+
+def _fail(comm: Any, message: str, status: int = EXIT_BAD_INPUT) -> int:
+    """Print the error on rank 0 and return the exit status."""
+    if comm.rank == 0:
+        print(f"unibuckle: error: {message}", file=sys.stderr)
+    return status
+
+
+def _spec_from_args(args: argparse.Namespace) -> ProblemSpec:
+    """The problem of --case or --config, with --nx/--ny applied."""
+    from unibuckle_fenicsx.cases import paper_case
+    from unibuckle_fenicsx.config import load_problem
+
+    spec = paper_case(args.case) if args.case else load_problem(args.config)
+    if args.nx is not None or args.ny is not None:
+        spec = spec.with_mesh(
+            spec.mesh.nx if args.nx is None else args.nx,
+            spec.mesh.ny if args.ny is None else args.ny,
+        )
+    return spec
 
 
 #: Option names of the nonlinear analysis that are also command-line flags.

@@ -60,6 +60,7 @@ from unibuckle_fenicsx.eigen import Owner, release, set_options
 from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, shear_stiffness
 from unibuckle_fenicsx.mesh import create_plate_mesh, edge_normal_axis, edge_tag
 from unibuckle_fenicsx.plate.model import edge_support_bcs, mitc_shear_matrix
+from unibuckle_fenicsx.plate.spaces import MixedDofs
 from unibuckle_fenicsx.prestress import pin_rigid_motions, voigt_to_ufl
 
 __all__ = [
@@ -148,7 +149,7 @@ def _scalar(form: dolfinx.fem.Form, comm: MPI.Comm) -> float:
     return float(comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM))
 
 
-class VonKarmanPlate(Owner):
+class VonKarmanPlate(MixedDofs, Owner):
     r"""Geometrically nonlinear (von Kármán) plate with the linear model's edges and loads.
 
     Args:
@@ -379,22 +380,6 @@ class VonKarmanPlate(Owner):
     def w_subspace(self) -> dolfinx.fem.FunctionSpace:
         """The sub-space holding w."""
         return self.W.sub(W_SUB)
-
-    @property
-    def num_owned_dofs(self) -> int:
-        """Owned DOFs of the mixed space on this rank."""
-        return self.W.dofmap.index_map.size_local * self.W.dofmap.index_map_bs
-
-    @property
-    def num_dofs(self) -> int:
-        """Global DOF count of the mixed space."""
-        return self.W.dofmap.index_map.size_global * self.W.dofmap.index_map_bs
-
-    def global_dofs(self, local: npt.NDArray[np.int32]) -> npt.NDArray[np.int64]:
-        """Global (PETSc) indices of the local DOFs ``local``."""
-        im, bs = self.W.dofmap.index_map, self.W.dofmap.index_map_bs
-        local = np.ascontiguousarray(local, dtype=np.int32)
-        return im.local_to_global(local // bs) * bs + local % bs
 
     # -- SNES callbacks ------------------------------------------------------------
     def _assign(self, x: PETSc.Vec) -> None:

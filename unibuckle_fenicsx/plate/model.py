@@ -17,6 +17,7 @@ from unibuckle_fenicsx.materials import bending_voigt, shear_stiffness
 from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tag
 from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_form
 from unibuckle_fenicsx.plate.spaces import (
+    MixedDofs,
     create_plate_space,
     create_shear_space,
     mitc_shear_operator,
@@ -26,7 +27,7 @@ from unibuckle_fenicsx.prestress import Prestress
 __all__ = ["PlateModel", "edge_support_bcs", "mitc_shear_matrix"]
 
 
-class PlateModel(Owner):
+class PlateModel(MixedDofs, Owner):
     r"""Reissner-Mindlin plate with the assembled matrices A (stiffness) and B (geometric).
 
     A is the bending stiffness plus the MITC shear stiffness :math:`P^T M_s P`
@@ -105,22 +106,6 @@ class PlateModel(Owner):
     def w_subspace(self) -> dolfinx.fem.FunctionSpace:
         """The sub-space of W holding w."""
         return self.W.sub(0)
-
-    @property
-    def num_owned_dofs(self) -> int:
-        """Owned DOFs of W on this rank."""
-        return self.W.dofmap.index_map.size_local * self.W.dofmap.index_map_bs
-
-    @property
-    def num_dofs(self) -> int:
-        """Global DOF count of W."""
-        return self.W.dofmap.index_map.size_global * self.W.dofmap.index_map_bs
-
-    def global_dofs(self, local: npt.NDArray[np.int32]) -> npt.NDArray[np.int64]:
-        """Global (PETSc) indices of the local W DOFs ``local``."""
-        im, bs = self.W.dofmap.index_map, self.W.dofmap.index_map_bs
-        local = np.ascontiguousarray(local, dtype=np.int32)
-        return im.local_to_global(local // bs) * bs + local % bs
 
     def split(self, u: dolfinx.fem.Function) -> tuple[dolfinx.fem.Function, dolfinx.fem.Function]:
         """Deflection and rotation of ``u`` as Functions on collapsed spaces."""

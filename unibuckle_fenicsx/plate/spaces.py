@@ -22,7 +22,7 @@ import dolfinx.fem.petsc
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["create_plate_space", "create_shear_space", "mitc_shear_operator"]
+__all__ = ["MixedDofs", "create_plate_space", "create_shear_space", "mitc_shear_operator"]
 
 
 def create_plate_space(msh: dolfinx.mesh.Mesh) -> dolfinx.fem.FunctionSpace:
@@ -96,3 +96,25 @@ def mitc_shear_operator(
     for m in (G, I, Rw, Rt, It):
         m.destroy()
     return P
+
+
+class MixedDofs:
+    """DOF counts and global indices of a mixed space ``self.W`` (for the plate models)."""
+
+    W: dolfinx.fem.FunctionSpace
+
+    @property
+    def num_owned_dofs(self) -> int:
+        """Owned DOFs of W on this rank."""
+        return self.W.dofmap.index_map.size_local * self.W.dofmap.index_map_bs
+
+    @property
+    def num_dofs(self) -> int:
+        """Global DOF count of W."""
+        return self.W.dofmap.index_map.size_global * self.W.dofmap.index_map_bs
+
+    def global_dofs(self, local: npt.NDArray[np.int32]) -> npt.NDArray[np.int64]:
+        """Global (PETSc) indices of the local W DOFs ``local``."""
+        im, bs = self.W.dofmap.index_map, self.W.dofmap.index_map_bs
+        local = np.ascontiguousarray(local, dtype=np.int32)
+        return im.local_to_global(local // bs) * bs + local % bs
