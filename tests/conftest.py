@@ -1,4 +1,4 @@
-"""Shared fixtures: MPI-safe teardown and the paper's problems."""
+"""Shared fixtures: MPI-safe teardown, the random family of active problems; mpiexec."""
 
 from __future__ import annotations
 
@@ -22,6 +22,14 @@ def _collective_teardown():
     yield
     gc.collect()
     MPI.COMM_WORLD.Barrier()
+
+
+@pytest.fixture(scope="session")
+def active_specs():
+    """The seeded random problems whose obstacle is active (families.active_family)."""
+    from families import active_family
+
+    return active_family()[0]
 
 
 def run_mpi(script: str | Path, nprocs: int, *args: str, timeout: float = 600) -> str:

@@ -25,7 +25,6 @@ import numpy as np
 import pytest
 from conftest import run_mpi
 from exhaustive import RTOL, exhaustive_minimum
-from families import active_family
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.multilevel import prolong_contact_set
@@ -40,8 +39,8 @@ serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is 
 
 # -- random family ----------------------------------------------------------------------
 @pytest.fixture(scope="module")
-def family() -> list[ProblemSpec]:
-    return active_family()[0]
+def family(active_specs) -> list[ProblemSpec]:
+    return active_specs
 
 
 #: Problems of the family where the iteration (all seeds) stops at a KKT point that is

@@ -17,7 +17,6 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 from exhaustive import exhaustive_minimum
-from families import active_family
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.analysis import solve
@@ -53,12 +52,12 @@ def test_paper_cases_are_proven(case):
 
 
 @serial
-def test_lower_bound_never_exceeds_the_exhaustive_minimum():
+def test_lower_bound_never_exceeds_the_exhaustive_minimum(active_specs):
     """50 random small problems: the verified bound <= the dense exhaustive minimum.
 
     And every proof is right: a proven load is the exhaustive minimum (to 1e-8).
     """
-    family, _ = active_family()
+    family = active_specs
     proven = 0
     for spec in family:
         with BucklingProblem(spec, MPI.COMM_SELF) as problem:
@@ -75,13 +74,13 @@ def test_lower_bound_never_exceeds_the_exhaustive_minimum():
 
 
 @serial
-def test_a_wrong_kkt_point_is_never_proven():
+def test_a_wrong_kkt_point_is_never_proven(active_specs):
     """random29: every seed stops at the KKT point 23.646 MPa, the minimum is 23.142 MPa.
 
     Also a claimed load slightly above the true minimum (the true KKT point with its load
     raised by 1e-6 and 1e-4 relative) is never proven.
     """
-    family, _ = active_family()
+    family = active_specs
     spec = next(s for s in family if s.name == "random29")
     with BucklingProblem(spec, MPI.COMM_SELF) as problem:
         sol = solve_active_set(problem, bound_budget=0)

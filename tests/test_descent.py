@@ -1,14 +1,15 @@
 r"""Feasible descent (algorithms/descent.py): monotone, and it ends at KKT points.
 
-- On the random family of small problems (:func:`families.active_family`), started from
-  an admissible mode, the loads it meets never increase and it stops at a point that
-  satisfies the KKT conditions (README, "The problem") checked here with dense numpy on
-  the assembled matrices, whose load LAPACK reproduces for its contact set
-  (:func:`exhaustive.dense_reduced_load`), and which is never below the exhaustive minimum.
+- On random small problems (:func:`families.active_family`; all 200 of the stress family
+  with ``-m stress``), started from an admissible mode, the loads it meets never increase
+  and it stops at a point that satisfies the KKT conditions (README, "The problem")
+  checked here with dense numpy on the assembled matrices, whose load LAPACK reproduces
+  for its contact set (:func:`exhaustive.dense_reduced_load`), and which is never below
+  the exhaustive minimum.
 - On a thin long plate with the loaded edges clamped against a whole-plate obstacle,
   where the primal-dual iteration and the penalty continuation both stall, the solver's
   chain ends at a certified KKT point through the descent, and ``mpiexec -n 2`` ends at
-  the same point.
+  the same point or its mirror image.
 - The gradient direction g = -A_W'^{-1} r of a node released from the contact set leaves
   the obstacle there and lowers the Rayleigh quotient (first-order: r . g < 0).
 """
@@ -24,9 +25,10 @@ from mpi4py import MPI
 
 import numpy as np
 import pytest
+import scipy.linalg
 from conftest import run_mpi
 from exhaustive import RTOL, dense, dense_reduced_load, exhaustive_minimum
-from families import active_family
+from test_stress_family import FAMILY, _reference
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.descent import _Gradient, admissible_start, descend
@@ -39,51 +41,113 @@ HERE = Path(__file__).resolve().parent
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 
 
-def dense_kkt(problem: BucklingProblem, cand) -> bool:
-    """The KKT conditions of the returned mode, from the dense matrices alone."""
+def dense_kkt(problem: BucklingProblem, active) -> bool:
+    """The KKT conditions of the contact set ``active``, by LAPACK alone.
+
+    The smallest positive eigenpair of the dense pencil with the edge DOFs and the w-DOFs
+    of Z removed (``scipy.linalg.eigh``, no condensation), oriented to the obstacle's
+    side: it must lie below the obstacle off Z and the obstacle must only push on Z
+    (README, "The problem"), both to the solver's tolerance tau.
+    """
     A, B = dense(problem.model.A), dense(problem.model.B)
-    u = cand.mode.x.petsc_vec.array_r.copy()
-    r = A @ u - cand.load * (B @ u)
     rows = problem.contact.global_rows()
-    w = u[problem.model.w_dofs]
-    scale, force = np.abs(w).max(), np.abs(A @ u).max()
-    tau = problem.tau
+    removed = np.union1d(problem.model.bc_dofs, rows[np.asarray(active, dtype=int)])
+    keep = np.setdiff1d(np.arange(A.shape[0]), removed)
+    theta, X = scipy.linalg.eigh(B[np.ix_(keep, keep)], A[np.ix_(keep, keep)])
+    load = 1.0 / theta[-1]
+    u = np.zeros(A.shape[0])
+    u[keep] = X[:, -1]
+    u /= np.abs(u[problem.model.w_dofs]).max()
     on_z = np.zeros(problem.num_constrained, dtype=bool)
-    on_z[cand.active] = True
-    off_z = np.setdiff1d(np.arange(len(u)), np.union1d(rows[on_z], problem.model.bc_dofs))
-    return bool(
-        np.abs(r[off_z]).max() <= 1e-6 * force  # eigen residual off Z (SLEPc tol 1e-10)
-        and np.abs(u[rows[on_z]]).max(initial=0.0) == 0.0  # Z is removed
-        and u[rows].max() <= tau * scale  # below the obstacle
-        and r[rows[on_z]].max(initial=-1.0) <= tau * force  # the obstacle only pushes
-    )
+    on_z[np.asarray(active, dtype=int)] = True
+    tau = problem.tau
+    for sign in (1.0, -1.0):
+        v = sign * u
+        r = A @ v - load * (B @ v)
+        if (
+            v[rows[~on_z]].max(initial=-1.0) <= tau  # below the obstacle
+            and r[rows[on_z]].max(initial=-1.0) <= tau * np.abs(A @ v).max()  # only pushes
+        ):
+            return True
+    return False
+
+
+def _descend_from_free(problem: BucklingProblem):
+    """Descent from the free mode's violating set (either sign) made admissible."""
+    free = problem.solve_free()  # may refuse the plate (b nowhere positive)
+    v = problem.contact.values(free.function.x.petsc_vec)
+    for violated in (np.flatnonzero(v > 0), np.flatnonzero(v < 0)):
+        start, _ = admissible_start(problem, problem.evaluate(violated), 100)
+        if start is not None:
+            return start, *descend(problem, start, 300)
+    return None, None, None
+
+
+def _check_descent(problem: BucklingProblem, start, run, steps, rtol: float = RTOL) -> None:
+    """Monotone, ends at a dense-checked KKT point whose load LAPACK reproduces."""
+    name = problem.spec.name
+    loads = [start.load] + [load for _, load, _ in run.history]
+    assert all(b <= a * (1 + 1e-10) for a, b in itertools.pairwise(loads)), (name, loads)
+    assert run.status == "kkt", (name, run.status, steps)
+    end = run.final
+    assert end is not None and end.kkt and dense_kkt(problem, end.active), name
+    reference = dense_reduced_load(problem, tuple(int(k) for k in end.active))
+    assert abs(end.load - reference) <= rtol * reference, name
 
 
 @serial
-def test_descent_is_monotone_and_ends_at_kkt_points():
-    """20 random problems: loads never increase; the end is KKT, >= the global minimum.
+def test_descent_is_monotone_and_ends_at_kkt_points(active_specs):
+    """10 random problems: loads never increase; the end is KKT, >= the global minimum.
 
-    A local method from one start: 9 of the 20 end at the global minimum (measured), the
-    others at genuine KKT points above it (the solver's chain runs it from its best
-    admissible mode, and the lattice search brackets what it returns).
+    A local method from one start: on the first 20 of this family 9 end at the global
+    minimum (measured), the others at genuine KKT points above it (the solver's chain
+    runs it from its best admissible mode, and the lattice search brackets what it
+    returns).
     """
-    for spec in active_family(20)[0]:
+    for spec in active_specs[:10]:
         problem = BucklingProblem(spec, MPI.COMM_SELF)
-        free = problem.solve_free()
-        violated = np.flatnonzero(problem.contact.values(free.function.x.petsc_vec) > 0)
-        start, _ = admissible_start(problem, problem.evaluate(violated), 100)
+        start, run, steps = _descend_from_free(problem)
         assert start is not None, spec.name
-        run, steps = descend(problem, start, 200)
-        loads = [start.load] + [load for _, load, _ in run.history]
-        assert all(b <= a * (1 + 1e-10) for a, b in itertools.pairwise(loads)), (spec.name, loads)
-        assert run.status == "kkt", (spec.name, run.status, steps)
-        end = run.final
-        assert end is not None and end.kkt and dense_kkt(problem, end), spec.name
-        reference = dense_reduced_load(problem, tuple(int(k) for k in end.active))
-        assert abs(end.load - reference) <= RTOL * reference, spec.name
+        _check_descent(problem, start, run, steps)
         best, _, _ = exhaustive_minimum(problem)
-        assert end.load >= best * (1 - RTOL), spec.name
+        assert run.final.load >= best * (1 - RTOL), spec.name
         problem.destroy()
+
+
+@serial
+@pytest.mark.stress
+@pytest.mark.parametrize(("spec", "kind", "i"), FAMILY, ids=[s.name for s, *_ in FAMILY])
+def test_descent_on_the_stress_family(spec, kind, i):
+    """Every plate of the stress family (``-m stress``): KKT wherever an admissible mode exists.
+
+    Measured: KKT on all 185 problems that have an admissible mode, 151 of them at
+    the exhaustive minimum; 13 are refused (b vanishes or is nowhere positive) and 2 have
+    no admissible mode (as the solver's own family test finds). The load is compared with
+    LAPACK's for the final contact set at the family's tolerance, except for
+    :data:`WARM_START_ROUNDOFF`.
+    """
+    try:
+        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        start, run, steps = _descend_from_free(problem)
+    except ValueError as err:  # refused (b vanishes or is nowhere positive): family test
+        assert "no positive buckling load" in str(err), err
+        return
+    best, _, rtol = _reference(spec, i)
+    if start is None:  # no admissible mode: the exhaustive search must agree
+        assert not math.isfinite(best), (spec.name, best)
+    else:
+        _check_descent(problem, start, run, steps, WARM_START_ROUNDOFF.get(spec.name, rtol))
+        assert run.final.load >= best * (1 - rtol), spec.name
+    problem.destroy()
+
+
+#: Problems where the descent's last (warm-started) eigen solve agrees with LAPACK less
+#: closely than the family's tolerance (ten times the spread of independent solves of the
+#: plain pencil), and the bound it is held to instead. stress28 (t/b = 3e-4, tension and
+#: shear, cond(A) ~ 1e11): at its KKT point Z = (1,) SLEPc's Lanczos in the A-inner
+#: product, started from the previous iterate, ends 1.4e-7 from LAPACK (started from
+#: random, 4e-12; the Ritz value is only as accurate as the A-orthogonality it keeps).
+WARM_START_ROUNDOFF = {"stress28": 1e-6}
 
 
 def long_clamped_spec(nx: int = 24, ny: int = 6):
@@ -126,33 +190,36 @@ def test_descent_answers_where_the_iterations_stall(long_clamped):
     k = problem.buckling_coefficient(sol.load)
     assert 16 / 3 < k < 16 / 3 * 1.10, k
     if problem.comm.size == 1:
-        assert dense_kkt(problem, sol.candidate)
+        assert dense_kkt(problem, sol.active)
 
 
 @serial
 @pytest.mark.mpi
-def test_descent_distributed_equals_serial(long_clamped, tmp_path):
-    """Mpiexec -n 2: the chain ends in the descent at the serial KKT point or its mirror.
+def test_descent_distributed_equals_serial(tmp_path):
+    """Mpiexec -n 2 takes the serial descent's path: same steps, load (1e-8), contact set.
 
-    The plate is symmetric about x = a/2, so a KKT point and its mirror image have the
-    same load; the penalty continuation before the descent cycles along a path that
-    round-off (the number of ranks) decides, and -n 2 was measured to end at the mirror
-    image of the serial point (same load to 1e-11).
+    The plate of :func:`long_clamped_spec` with cells of b/6, from the left half of the
+    plate in contact made admissible (a start that does not depend on the sign SLEPc
+    gives a mode; the descent alone: the penalty continuation before it in the solver's
+    chain cycles along a round-off-dependent path and may end at the mirror image).
     """
-    problem, sol = long_clamped
+    spec = long_clamped_spec()
+    with BucklingProblem(spec, MPI.COMM_SELF) as problem:
+        left = np.flatnonzero(problem.contact.coordinates[:, 0] <= 2.0)
+        start, _ = admissible_start(problem, problem.evaluate(left), 100)
+        assert start is not None
+        run, steps = descend(problem, start, 300)
+        assert run.status == "kkt" and run.final is not None
+        serial_xy = _sorted(problem.contact.coordinates[run.final.active])
+        load = run.final.load
     path = tmp_path / "long-clamped.json"
-    path.write_text(json.dumps(problem_to_dict(problem.spec)))
-    out = run_mpi(HERE / "mpi" / "active_parallel.py", 2, str(path))
+    path.write_text(json.dumps(problem_to_dict(spec)))
+    out = run_mpi(HERE / "mpi" / "descent_parallel.py", 2, str(path))
     par = json.loads(out.strip().splitlines()[-1])
-    assert par["kkt"] and par["fallback"]["descent"]["status"] == "kkt"
-    assert abs(par["load"] - sol.load) <= RTOL * sol.load
-    serial_xy = problem.contact.coordinates[sol.active]
-    mirror_xy = np.column_stack([4.0 - serial_xy[:, 0], serial_xy[:, 1]])
+    assert par["status"] == "kkt" and par["steps"] == steps
+    assert abs(par["load"] - load) <= RTOL * load
     par_xy = _sorted(np.asarray(par["coordinates"]))
-    assert any(
-        par_xy.shape == xy.shape and np.allclose(par_xy, _sorted(xy), atol=1e-9)
-        for xy in (serial_xy, mirror_xy)
-    )
+    assert par_xy.shape == serial_xy.shape and np.allclose(par_xy, serial_xy, atol=1e-9)
 
 
 def _sorted(xy: np.ndarray) -> np.ndarray:
@@ -161,9 +228,9 @@ def _sorted(xy: np.ndarray) -> np.ndarray:
 
 
 @serial
-def test_gradient_direction_leaves_the_obstacle_and_descends():
+def test_gradient_direction_leaves_the_obstacle_and_descends(active_specs):
     """g_k < 0 at the released node, g = 0 on the rest of Z, and R(u + eps g) < R(u)."""
-    spec = active_family(1)[0][0]
+    spec = active_specs[0]
     with BucklingProblem(spec, MPI.COMM_SELF) as problem:
         n = problem.num_constrained
         # A contact set with a pulling node: the first of these (deterministic).

@@ -52,6 +52,9 @@ __all__ = ["admissible_start", "descend"]
 
 #: Options of the gradient release's solve (prefix ``unibuckle_descent_``).
 GRADIENT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
+#: d within this angle of u is u (an eigenvector is accurate to about the eigen solver's
+#: tolerance, 1e-10, over the spectral gap; a smaller threshold makes round-off a step).
+SAME_DIRECTION = 1e-8
 #: A blocking angle below this fraction of the step's full angle is a zero step (the node
 #: is at the obstacle up to round-off).
 ZERO_STEP = 1e-9
@@ -104,7 +107,7 @@ class _Arc:
         self.e2.axpy(-form(A, d, self.e1), self.e1)
         s = math.sqrt(max(form(A, self.e2, self.e2), 0.0))
         self.phi_max = 0.0
-        if s > 1e-12 * math.sqrt(form(A, d, d)):
+        if s > SAME_DIRECTION * math.sqrt(form(A, d, d)):
             self.e2.scale(1.0 / s)
             b11, b12 = form(B, self.e1, self.e1), form(B, self.e1, self.e2)
             b22 = form(B, self.e2, self.e2)
@@ -191,6 +194,9 @@ def descend(
     n, tau = problem.contact.size, problem.tau
     A, B = problem.model.A, problem.model.B
     run = Run("descent", best_feasible=start, final=start)
+    if start.kkt:
+        run.status = "kkt"
+        return run, {"full": 0, "partial": 0, "zero": 0, "gradient": 0}
     u = start.mode.x.petsc_vec.copy()
     work = u.duplicate()
     gradient = _Gradient(problem)
