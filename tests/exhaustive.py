@@ -114,5 +114,5 @@ def dense_reduced_load(problem: BucklingProblem, active: tuple[int, ...]) -> flo
 
 def membrane_force_scale(spec) -> float:
     """T times the largest edge stress of ``spec`` (N/m per unit load): the size of N0."""
-    stresses = [abs(v) for e in spec.plate.edges for v in (e.normal_stress, e.shear_stress)]
+    stresses = [e.max_stress() for e in spec.plate.edges]
     return spec.plate.thickness * max(stresses)

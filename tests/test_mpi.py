@@ -212,3 +212,25 @@ def test_cli_bad_input_distributed(tmp_path):
     report = json.loads(run_mpi(CLI, 2, str(outdir), "--", "--config", str(path)).splitlines()[-1])
     assert report == {"status": [2, 2], "json_writes": [0, 0], "vtx_calls": [0, 0]}
     assert not outdir.exists()
+
+
+def test_cli_stress_gradient_distributed(tmp_path):
+    """In-plane bending (normal_stress = [1, -1]) against a whole-plate obstacle on 2 ranks.
+
+    a/b = 4/3, 16x12: the linear edge stress, the prestress and the active set give the
+    serial load, contact set and certificate.
+    """
+    path = tmp_path / "bending.toml"
+    path.write_text(
+        "[plate]\ncorners = [[0.0, 0.0], [0.4, 0.3]]\nthickness = 0.003\n"
+        "[edges.left]\nnormal_stress = [1.0, -1.0]\n"
+        "[edges.right]\nnormal_stress = [1.0, -1.0]\n"
+        "[mesh]\nnx = 16\nny = 12\n"
+        '[obstacle]\nzone = "all"\n[solver]\nmethod = "active-set"\n'
+    )
+    args = ["--config", str(path)]
+    ser = _cli_serial(tmp_path, args)
+    par, _ = _cli_parallel(tmp_path, args, 2)
+    _compare_results(ser, par, 2)
+    assert ser["certificate"]["kkt"] and ser["ratio_to_free"] > 1.05
+    assert par["edge_loads"]["left"]["normal_stress"] == [1.0, -1.0]

@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from unibuckle_fenicsx.config import UNITS, ProblemSpec
+from unibuckle_fenicsx.config import EDGE_NAMES, UNITS, ProblemSpec
 from unibuckle_fenicsx.sweep import Variation, point_problem
 
 __all__ = ["plot_sweep", "reference_k"]
@@ -40,11 +40,15 @@ _SS = ("simply_supported", "simply_supported_soft")
 def _uniaxial_x(spec: ProblemSpec) -> bool:
     """Uniform compression of the edges x = const only."""
     e = {edge.name: edge for edge in spec.plate.edges}
+    if set(e) != set(EDGE_NAMES) or not all(edge.uniform for edge in e.values()):
+        return False
+    left, right = e["left"].normal_ends[0], e["right"].normal_ends[0]
     return (
-        e["left"].normal_stress < 0
-        and e["left"].normal_stress == e["right"].normal_stress
-        and e["bottom"].normal_stress == 0 == e["top"].normal_stress
-        and all(edge.shear_stress == 0 for edge in e.values())
+        left < 0
+        and left == right
+        and not e["bottom"].loaded
+        and not e["top"].loaded
+        and all(edge.shear_ends[0] == 0 for edge in e.values())
     )
 
 

@@ -42,6 +42,8 @@ __all__ = [
     "load_toml",
     "problem_from_dict",
     "problem_to_dict",
+    "stress_ends",
+    "stress_value",
 ]
 
 #: Edge names of a rectangular plate, in facet-tag order 1..4.
@@ -83,6 +85,25 @@ def _boolean(name: str, value: Any) -> bool:
     if not isinstance(value, bool | np.bool_):
         raise ValueError(f"{name} must be true or false, got {value!r} ({type(value).__name__})")
     return bool(value)
+
+
+def _stress(name: str, value: Any) -> float | tuple[float, float]:
+    """An edge stress: a number, or a pair ``[start, end]`` of numbers (linear along the edge)."""
+    if isinstance(value, list | tuple):
+        if len(value) != 2:
+            raise ValueError(
+                f"{name} must be a number or a pair [start, end] (linear along the edge), "
+                f"got {value!r}"
+            )
+        return (_number(name, value[0]), _number(name, value[1]))
+    return _number(name, value)
+
+
+def stress_ends(value: float | tuple[float, float]) -> tuple[float, float]:
+    """(start, end) of an edge stress: the pair itself, or the number twice."""
+    if isinstance(value, tuple):
+        return value
+    return (value, value)
 
 
 def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
@@ -150,7 +171,7 @@ class Material:
 
 @dataclass(frozen=True)
 class EdgeSpec:
-    """Conditions on one edge part.
+    r"""Conditions on one edge part.
 
     Args:
         name: Edge name; for the rectangle one of :data:`EDGE_NAMES`.
@@ -158,9 +179,12 @@ class EdgeSpec:
         inplane: In-plane condition for the prestress, one of :data:`INPLANE_SUPPORTS`
             ("roller" fixes the normal displacement only).
         normal_stress: Normal edge stress per unit load (Pa/Pa), tension positive;
-            the paper's compressed edges have -1.
+            the paper's compressed edges have -1. A pair ``(start, end)`` varies
+            linearly along the edge (:func:`~unibuckle_fenicsx.mesh.edge_lines` gives
+            the direction): in-plane bending is ``(1, -1)``, the stress-gradient ratio
+            of design codes is :math:`\psi` = end/start.
         shear_stress: Tangential edge stress per unit load (Pa/Pa), along the
-            counter-clockwise tangent.
+            counter-clockwise tangent; a number or a pair, as ``normal_stress``.
         tag: Facet tag of this edge in a user-supplied mesh; ``None`` for the
             rectangle (tags 1..4 in :data:`EDGE_NAMES` order).
     """
@@ -168,8 +192,8 @@ class EdgeSpec:
     name: str
     support: str = "simply_supported"
     inplane: str = "free"
-    normal_stress: float = 0.0
-    shear_stress: float = 0.0
+    normal_stress: float | tuple[float, float] = 0.0
+    shear_stress: float | tuple[float, float] = 0.0
     tag: int | None = None
 
     def __post_init__(self) -> None:
@@ -177,14 +201,33 @@ class EdgeSpec:
         _choice(f"{where}.support", self.support, BENDING_SUPPORTS)
         _choice(f"{where}.inplane", self.inplane, INPLANE_SUPPORTS)
         for name in ("normal_stress", "shear_stress"):
-            object.__setattr__(self, name, _number(f"{where}.{name}", getattr(self, name)))
+            object.__setattr__(self, name, _stress(f"{where}.{name}", getattr(self, name)))
         if self.tag is not None:
             _integer(f"{where}.tag", self.tag, 0)
 
     @property
     def loaded(self) -> bool:
         r"""Whether this edge carries a traction (belongs to :math:`\gamma_1`)."""
-        return self.normal_stress != 0.0 or self.shear_stress != 0.0
+        return any(v != 0.0 for v in (*self.normal_ends, *self.shear_ends))
+
+    @property
+    def normal_ends(self) -> tuple[float, float]:
+        """Normal stress per unit load at the start and the end of the edge."""
+        return stress_ends(self.normal_stress)
+
+    @property
+    def shear_ends(self) -> tuple[float, float]:
+        """Shear stress per unit load at the start and the end of the edge."""
+        return stress_ends(self.shear_stress)
+
+    @property
+    def uniform(self) -> bool:
+        """Whether both stresses are constant along the edge."""
+        return all(a == b for a, b in (self.normal_ends, self.shear_ends))
+
+    def max_stress(self) -> float:
+        """The largest absolute edge stress per unit load (normal or shear, either end)."""
+        return max(abs(v) for v in (*self.normal_ends, *self.shear_ends))
 
 
 def paper_edges() -> tuple[EdgeSpec, ...]:
@@ -623,8 +666,8 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
             e.name: {
                 "support": e.support,
                 "inplane": e.inplane,
-                "normal_stress": e.normal_stress,
-                "shear_stress": e.shear_stress,
+                "normal_stress": stress_value(e.normal_stress),
+                "shear_stress": stress_value(e.shear_stress),
             }
             for e in plate.edges
         },
@@ -648,6 +691,11 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         out = _to_si(out, units, inverse=True)
         out["units"] = units
     return out
+
+
+def stress_value(value: float | tuple[float, float]) -> float | list[float]:
+    """An edge stress as written in a file: a number or ``[start, end]``."""
+    return list(value) if isinstance(value, tuple) else value
 
 
 def load_toml(path: str | Path) -> ProblemSpec:

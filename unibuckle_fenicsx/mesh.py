@@ -7,10 +7,11 @@ from mpi4py import MPI
 import dolfinx
 
 import numpy as np
+import numpy.typing as npt
 
 from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, MeshSpec, PlateSpec
 
-__all__ = ["create_plate_mesh", "edge_normal_axis", "edge_tag"]
+__all__ = ["create_plate_mesh", "edge_line", "edge_normal_axis", "edge_tag"]
 
 
 def create_plate_mesh(
@@ -103,3 +104,50 @@ def edge_normal_axis(
         f"edge {name!r} is not parallel to a coordinate axis: hard simple support and "
         "in-plane rollers need axis-aligned edges"
     )
+
+
+def edge_line(
+    msh: dolfinx.mesh.Mesh, facet_tags: dolfinx.mesh.MeshTags, plate: PlateSpec, edge: EdgeSpec
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
+    """Start and end point of a straight edge: the direction of a linearly varying stress.
+
+    A rectangle edge runs from its end with the smaller coordinate to the larger (y for
+    left and right, x for bottom and top). An edge given by a facet tag of a user mesh
+    runs the same way along the coordinate in which it extends most (its extreme mesh
+    nodes along that coordinate).
+
+    Note:
+        Collective (for an edge given by a tag).
+    """
+    if edge.tag is None and edge.name in EDGE_NAMES:
+        (x0, y0), (x1, y1) = plate.corners
+        ends = {
+            "left": ((x0, y0), (x0, y1)),
+            "right": ((x1, y0), (x1, y1)),
+            "bottom": ((x0, y0), (x1, y0)),
+            "top": ((x0, y1), (x1, y1)),
+        }[edge.name]
+        return np.array(ends[0], dtype=float), np.array(ends[1], dtype=float)
+    tag = edge_tag(plate, edge)
+    fdim = msh.topology.dim - 1
+    msh.topology.create_connectivity(fdim, 0)
+    facets = facet_tags.find(tag)
+    nodes = np.unique(dolfinx.mesh.entities_to_geometry(msh, fdim, facets).ravel())
+    x = msh.geometry.x[nodes, :2]
+    lo = np.min(msh.comm.allgather(x.min(axis=0) if nodes.size else np.full(2, np.inf)), axis=0)
+    hi = np.max(msh.comm.allgather(x.max(axis=0) if nodes.size else np.full(2, -np.inf)), axis=0)
+    if not np.all(np.isfinite(lo)):
+        raise ValueError(f"edge {edge.name!r} (facet tag {tag}) holds no facet of the mesh")
+    axis = int(np.argmax(hi - lo))
+    # The extreme nodes along that axis (same on every rank).
+    candidates = []
+    for pick, better in ((np.argmin, np.less), (np.argmax, np.greater)):
+        k = int(pick(x[:, axis])) if nodes.size else -1
+        local = x[k] if nodes.size else None
+        points = [p for p in msh.comm.allgather(local) if p is not None]
+        best = points[0]
+        for p in points[1:]:
+            if better(p[axis], best[axis]):
+                best = p
+        candidates.append(np.asarray(best, dtype=float))
+    return candidates[0], candidates[1]

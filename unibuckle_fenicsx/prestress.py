@@ -30,11 +30,12 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.config import EdgeSpec, Material, PlateSpec
 from unibuckle_fenicsx.materials import membrane_voigt
-from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tag
+from unibuckle_fenicsx.mesh import edge_line, edge_normal_axis, edge_tag
 
 __all__ = [
     "DIRECT_LU",
     "Prestress",
+    "edge_traction",
     "membrane_force",
     "pin_rigid_motions",
     "solve_prestress",
@@ -64,6 +65,34 @@ def membrane_force(
 ) -> ufl.core.expr.Expr:
     r"""Membrane stress resultant :math:`N = C_m \varepsilon(u)` (N/m) as a UFL tensor."""
     return voigt_to_ufl(membrane_voigt(material, thickness), ufl.sym(ufl.grad(u)))
+
+
+def edge_traction(
+    msh: dolfinx.mesh.Mesh,
+    facet_tags: dolfinx.mesh.MeshTags,
+    plate: PlateSpec,
+    edge: EdgeSpec,
+) -> ufl.core.expr.Expr:
+    r"""Edge stress vector per unit load, :math:`\sigma_n n + \tau_s s` (Pa/Pa), in UFL.
+
+    n is the outward normal, :math:`s = (-n_y, n_x)` the counter-clockwise tangent. A
+    stress given as a pair (start, end) varies linearly with the position
+    :math:`\xi = (x - P)\cdot(Q - P)/|Q - P|^2` between the edge's start P and end Q
+    (:func:`~unibuckle_fenicsx.mesh.edge_line`).
+
+    Note:
+        Collective for an edge given by a facet tag.
+    """
+    n = ufl.FacetNormal(msh)
+    s = ufl.as_vector([-n[1], n[0]])
+    if edge.uniform:
+        return edge.normal_ends[0] * n + edge.shear_ends[0] * s
+    start, end = edge_line(msh, facet_tags, plate, edge)
+    d = end - start
+    x = ufl.SpatialCoordinate(msh)
+    xi = ufl.dot(x - ufl.as_vector(start.tolist()), ufl.as_vector(d.tolist())) / float(d @ d)
+    (n0, n1), (s0, s1) = edge.normal_ends, edge.shear_ends
+    return (n0 + (n1 - n0) * xi) * n + (s0 + (s1 - s0) * xi) * s
 
 
 @dataclass
@@ -177,14 +206,10 @@ def solve_prestress(
     V = dolfinx.fem.functionspace(msh, basix.ufl.element("Lagrange", cell.name, degree, shape=(2,)))
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
-    n = ufl.FacetNormal(msh)
-    s = ufl.as_vector([-n[1], n[0]])
 
     a = ufl.inner(membrane_force(u, material, t), ufl.sym(ufl.grad(v))) * ufl.dx
     terms = [
-        t
-        * (e.normal_stress * ufl.dot(n, v) + e.shear_stress * ufl.dot(s, v))
-        * ds(edge_tag(plate, e))
+        t * ufl.dot(edge_traction(msh, facet_tags, plate, e), v) * ds(edge_tag(plate, e))
         for e in loaded
     ]
     L = terms[0]
@@ -206,7 +231,7 @@ def solve_prestress(
             bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
     pinned = not bcs
     if pinned:
-        _check_self_equilibrated(msh, ds, n, s, plate, loaded)
+        _check_self_equilibrated(msh, facet_tags, ds, plate, loaded)
         bcs = pin_rigid_motions(V, msh)
 
     problem = dolfinx.fem.petsc.LinearProblem(
@@ -240,9 +265,8 @@ def solve_prestress(
 
 def _check_self_equilibrated(
     msh: dolfinx.mesh.Mesh,
+    facet_tags: dolfinx.mesh.MeshTags,
     ds: ufl.Measure,
-    n: ufl.core.expr.Expr,
-    s: ufl.core.expr.Expr,
     plate: PlateSpec,
     loaded: list[EdgeSpec],
 ) -> None:
@@ -253,7 +277,7 @@ def _check_self_equilibrated(
     moment = 0.0
     total = 0.0
     for e in loaded:
-        tr = e.normal_stress * n + e.shear_stress * s
+        tr = edge_traction(msh, facet_tags, plate, e)
         m = ds(edge_tag(plate, e))
         for c in range(2):
             force[c] += _scalar(tr[c] * m)

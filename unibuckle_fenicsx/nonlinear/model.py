@@ -61,7 +61,7 @@ from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, shear_sti
 from unibuckle_fenicsx.mesh import create_plate_mesh, edge_normal_axis, edge_tag
 from unibuckle_fenicsx.plate.model import edge_support_bcs, mitc_shear_matrix
 from unibuckle_fenicsx.plate.spaces import MixedDofs
-from unibuckle_fenicsx.prestress import pin_rigid_motions, voigt_to_ufl
+from unibuckle_fenicsx.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
 
 __all__ = [
     "CONTROLS",
@@ -119,9 +119,11 @@ def displacement_axis(plate: PlateSpec, control: str) -> int | None:
     problem = None
     if not loaded:
         problem = "no edge is loaded"
-    elif any(e.shear_stress != 0.0 or e.normal_stress >= 0.0 for e in loaded):
+    elif not all(e.uniform for e in loaded):
+        problem = "its loaded edges must carry a uniform stress (not a [start, end] pair)"
+    elif any(e.shear_ends[0] != 0.0 or e.normal_ends[0] >= 0.0 for e in loaded):
         problem = "its loaded edges must carry compression only (no shear, no tension)"
-    elif len({e.normal_stress for e in loaded}) != 1:
+    elif len({e.normal_ends[0] for e in loaded}) != 1:
         problem = "its loaded edges must carry the same normal stress"
     elif any(e.name not in EDGE_NAMES or e.tag is not None for e in loaded):
         problem = "its loaded edges must be edges of the rectangle (left, right, bottom, top)"
@@ -249,10 +251,9 @@ class VonKarmanPlate(MixedDofs, Owner):
         Pi = energy / self.energy_scale * ufl.dx
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
         n = ufl.FacetNormal(msh)
-        s = ufl.as_vector([-n[1], n[0]])
+        tractions = [edge_traction(msh, self.facet_tags, spec.plate, e) for e in loaded]
         if control == "load":
-            for edge in loaded:
-                traction = edge.normal_stress * n + edge.shear_stress * s
+            for edge, traction in zip(loaded, tractions, strict=True):
                 Pi = Pi - (self.load * t / self.energy_scale) * ufl.inner(traction, u) * ds(
                     edge_tag(spec.plate, edge)
                 )
@@ -260,9 +261,9 @@ class VonKarmanPlate(MixedDofs, Owner):
         # The edge loads' vector per unit lambda: the scale of the residual.
         unit_load = sum(
             (t / self.energy_scale)
-            * ufl.inner(e.normal_stress * n + e.shear_stress * s, ufl.split(v)[U_SUB])
+            * ufl.inner(traction, ufl.split(v)[U_SUB])
             * ds(edge_tag(spec.plate, e))
-            for e in loaded
+            for e, traction in zip(loaded, tractions, strict=True)
         )
         f = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(unit_load))
         _add_ghosts(f)
@@ -525,13 +526,13 @@ class VonKarmanPlate(MixedDofs, Owner):
             force = float(self.comm.allreduce(float(b.array[dofs].sum()), op=MPI.SUM))
             # Scaled residual -> N: times D11 / t.
             force *= sign * self.energy_scale / self.thickness
-            loads.append(force / (self.thickness * length * edge.normal_stress))
+            loads.append(force / (self.thickness * length * edge.normal_ends[0]))
         return float(np.mean(loads))
 
     def flat_shortening(self, load: float) -> float:
         """End shortening (m) of the flat plate under ``load`` (linear membrane estimate)."""
         axis = self._displacement_axis if self._displacement_axis is not None else 0
-        stress = max(abs(e.normal_stress) for e in self.plate.edges if e.loaded)
+        stress = max(abs(v) for e in self.plate.edges if e.loaded for v in e.normal_ends)
         strain = float(self._compliance[axis, axis]) * load * self.thickness * stress
         length = self.plate.length if axis == 0 else self.plate.width
         return strain * length
