@@ -234,3 +234,23 @@ def test_cli_stress_gradient_distributed(tmp_path):
     _compare_results(ser, par, 2)
     assert ser["certificate"]["kkt"] and ser["ratio_to_free"] > 1.05
     assert par["edge_loads"]["left"]["normal_stress"] == [1.0, -1.0]
+
+
+def test_cli_several_obstacles_distributed(tmp_path):
+    """A polygon zone above the plate and a circle below it, on 2 ranks (c1's plate, 16x8).
+
+    The oriented values (w <= 0 above, w >= 0 below) and the union of the zones' nodes
+    are decided on values reduced over the ranks: same load, contact set and certificate.
+    """
+    path = tmp_path / "two.toml"
+    path.write_text(
+        "[mesh]\nnx = 16\nny = 8\n"
+        "[[obstacles]]\npolygon = [[-0.1, -0.05], [-0.01, -0.05], [-0.01, 0.05], [-0.06, 0.05]]\n"
+        '[[obstacles]]\ncircle = {center = [0.05, 0.0], radius = 0.03}\nside = "below"\n'
+        '[solver]\nmethod = "active-set"\n'
+    )
+    args = ["--config", str(path)]
+    ser = _cli_serial(tmp_path, args)
+    par, _ = _cli_parallel(tmp_path, args, 2)
+    _compare_results(ser, par, 2)
+    assert ser["certificate"]["kkt"] and ser["constrained_nodes"] > 20

@@ -62,7 +62,7 @@ def reference_k(spec: ProblemSpec) -> tuple[float | None, float | None, str]:
         return None, None, ""
     supports = {edge.name: edge.support for edge in spec.plate.edges}
     phi = spec.plate.length / spec.plate.width
-    whole = spec.obstacle is not None and spec.obstacle.zone == "all"
+    whole = len(spec.all_obstacles) == 1 and spec.all_obstacles[0].zone == "all"
     if all(s in _SS for s in supports.values()):
         m_max = max(1, math.ceil(phi)) + 1
         bilateral = min((m / phi + phi / m) ** 2 for m in range(1, m_max + 1))

@@ -25,17 +25,27 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.geometry import (
+    is_simple,
+    points_in_circle,
+    points_in_polygon,
+    polygon_area,
+)
+
 __all__ = [
     "BENDING_SUPPORTS",
     "EDGE_NAMES",
     "INPLANE_SUPPORTS",
     "METHODS",
+    "SIDES",
     "UNITS",
+    "Circle",
     "EdgeSpec",
     "Material",
     "MeshSpec",
     "ObstacleSpec",
     "PlateSpec",
+    "Polygon",
     "ProblemSpec",
     "SolverSpec",
     "load_problem",
@@ -338,21 +348,81 @@ class MeshSpec:
 
 
 @dataclass(frozen=True)
-class ObstacleSpec:
-    """Rigid flat obstacle just above the plate over a contact zone.
+class Circle:
+    """A circular zone: the closed disc of ``radius`` about ``center`` (m)."""
 
-    The deflection must satisfy w <= 0 at every mesh node of the closed zone.
+    center: tuple[float, float]
+    radius: float
+
+    def __post_init__(self) -> None:
+        try:
+            cx, cy = self.center
+        except (TypeError, ValueError):
+            raise ValueError(f"circle.center must be [x, y], got {self.center!r}") from None
+        object.__setattr__(
+            self, "center", (_number("circle.center", cx), _number("circle.center", cy))
+        )
+        if not _number("circle.radius", self.radius) > 0.0:
+            raise ValueError(f"circle.radius must be > 0 m, got {self.radius!r}")
+        object.__setattr__(self, "radius", float(self.radius))
+
+
+@dataclass(frozen=True)
+class Polygon:
+    """A polygonal zone: the closed simple polygon of ``vertices`` (m), at least three."""
+
+    vertices: tuple[tuple[float, float], ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "vertices", _polygon("polygon", self.vertices))
+
+
+def _polygon(name: str, value: Any) -> tuple[tuple[float, float], ...]:
+    """A simple polygon of at least three vertices [[x, y], ...] with a non-zero area."""
+    if not isinstance(value, list | tuple) or len(value) < 3:
+        raise ValueError(f"{name} must be a list of at least 3 points [[x, y], ...], got {value!r}")
+    vertices = []
+    for point in value:
+        if not isinstance(point, list | tuple) or len(point) != 2:
+            raise ValueError(f"{name}: each vertex must be a point [x, y], got {point!r}")
+        vertices.append((_number(name, point[0]), _number(name, point[1])))
+    if not is_simple(vertices):
+        raise ValueError(
+            f"{name} must be a simple polygon (no repeated vertex, no self-intersection), "
+            f"got {value!r}"
+        )
+    size = float(np.ptp(np.asarray(vertices), axis=0).max())
+    if abs(polygon_area(vertices)) <= 1e-12 * size * size:
+        raise ValueError(f"{name} has no area (collinear vertices), got {value!r}")
+    return tuple(vertices)
+
+
+#: Sides of an obstacle: "above" (on the +w side: w <= 0 in its zone), "below" (w >= 0).
+SIDES = ("above", "below")
+
+Box = tuple[tuple[float, float], tuple[float, float]]
+
+
+@dataclass(frozen=True)
+class ObstacleSpec:
+    """Rigid flat obstacle on one side of the plate over a contact zone.
+
+    With ``side = "above"`` the deflection must satisfy w <= 0 at every mesh node of the
+    closed zone; with ``"below"``, w >= 0.
 
     Args:
-        zone: ``"all"`` (the whole closed plate), a box
-            ``((xmin, xmax), (ymin, ymax))``, or a predicate
-            ``f(x) -> bool array`` on coordinates of shape (3, n).
-        tolerance: Geometric tolerance (m) for a node to count as inside a box;
-            ``None`` uses 1e-8 times the plate size.
+        zone: ``"all"`` (the whole closed plate), a box ``((xmin, xmax), (ymin, ymax))``,
+            a :class:`Polygon`, a :class:`Circle`, or a predicate ``f(x) -> bool array``
+            on coordinates of shape (3, n).
+        tolerance: Geometric tolerance (m) for a node to count as inside a box, polygon
+            or circle; ``None`` uses 1e-8 times the plate size.
+        side: One of :data:`SIDES`: where the obstacle lies (w, the deflection, is
+            positive towards "above").
     """
 
-    zone: Literal["all"] | tuple[tuple[float, float], tuple[float, float]] | Predicate = "all"
+    zone: Literal["all"] | Box | Polygon | Circle | Predicate = "all"
     tolerance: float | None = None
+    side: str = "above"
 
     def __post_init__(self) -> None:
         if isinstance(self.zone, str):
@@ -361,6 +431,8 @@ class ObstacleSpec:
                     f'obstacle.zone must be "all", [[xmin, xmax], [ymin, ymax]] or a '
                     f"callable, got {self.zone!r}"
                 )
+        elif isinstance(self.zone, Polygon | Circle):
+            pass
         elif not callable(self.zone):
             try:
                 (x0, x1), (y0, y1) = self.zone
@@ -379,11 +451,29 @@ class ObstacleSpec:
             object.__setattr__(self, "zone", box)
         if self.tolerance is not None and not _number("obstacle.tolerance", self.tolerance) >= 0:
             raise ValueError(f"obstacle.tolerance must be >= 0 m, got {self.tolerance!r}")
+        if self.side == "both":
+            raise ValueError(
+                'obstacle.side = "both": a rigid obstacle on both sides of the plate is a '
+                "bilateral support (w = 0 in the zone), not an obstacle; give an edge its "
+                '[edges.NAME] support (e.g. support = "simply_supported"), or one side '
+                f"{SIDES}"
+            )
+        _choice("obstacle.side", self.side, SIDES)
+
+    @property
+    def sign(self) -> float:
+        """+1 for an obstacle above (w <= 0 admissible), -1 below (w >= 0)."""
+        return 1.0 if self.side == "above" else -1.0
 
     def describe(self) -> str:
         """Short human-readable description of the zone."""
         if isinstance(self.zone, str):
             return "whole plate"
+        if isinstance(self.zone, Polygon):
+            return f"polygon of {len(self.zone.vertices)} vertices"
+        if isinstance(self.zone, Circle):
+            (cx, cy), r = self.zone.center, self.zone.radius
+            return f"circle about ({cx:g}, {cy:g}) of radius {r:g}"
         if callable(self.zone):
             return f"predicate {getattr(self.zone, '__name__', 'zone')}"
         (x0, x1), (y0, y1) = self.zone
@@ -398,11 +488,19 @@ class ObstacleSpec:
         """
         if isinstance(self.zone, str):
             return np.ones(x.shape[1], dtype=bool)
+        tol = 1e-8 * size if self.tolerance is None else self.tolerance
+        if isinstance(self.zone, Polygon):
+            return points_in_polygon(x[:2].T, self.zone.vertices, tol)
+        if isinstance(self.zone, Circle):
+            return points_in_circle(x[:2].T, self.zone.center, self.zone.radius, tol)
         if callable(self.zone):
             return np.asarray(self.zone(x), dtype=bool)
-        tol = 1e-8 * size if self.tolerance is None else self.tolerance
         (x0, x1), (y0, y1) = self.zone
         return (x[0] >= x0 - tol) & (x[0] <= x1 + tol) & (x[1] >= y0 - tol) & (x[1] <= y1 + tol)
+
+    def same_zone(self, other: ObstacleSpec) -> bool:
+        """Whether ``other`` has the same zone (a predicate only when it is the same one)."""
+        return self.zone is other.zone or (not callable(self.zone) and self.zone == other.zone)
 
 
 @dataclass(frozen=True)
@@ -490,6 +588,8 @@ class ProblemSpec:
         solver: Solver options.
         units: The unit system results are printed in (one of :data:`UNITS`; the
             numbers here are SI whatever it is).
+        obstacles: Several obstacles (the file's ``[[obstacles]]`` tables), instead of
+            ``obstacle``; their constrained nodes are the union of their zones'.
     """
 
     name: str = "plate"
@@ -499,11 +599,42 @@ class ProblemSpec:
     obstacle: ObstacleSpec | None = None
     solver: SolverSpec = field(default_factory=SolverSpec)
     units: str = "SI"
+    obstacles: tuple[ObstacleSpec, ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
             raise ValueError(f"name must be a string, got {self.name!r}")
         _choice("units", self.units, tuple(UNITS))
+        object.__setattr__(self, "obstacles", tuple(self.obstacles))
+        if self.obstacle is not None and self.obstacles:
+            raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
+        for k, o in enumerate(self.obstacles):
+            if not isinstance(o, ObstacleSpec):
+                raise ValueError(f"obstacles[{k}] must be an ObstacleSpec, got {o!r}")
+        found = self.all_obstacles
+        for j, first in enumerate(found):
+            for k in range(j + 1, len(found)):
+                second = found[k]
+                if first.same_zone(second) and first.side != second.side:
+                    raise ValueError(
+                        f"{self.obstacle_label(j)} and {self.obstacle_label(k)} give the same "
+                        "zone on both sides of the plate: that is a bilateral support (w = 0 "
+                        "there), not an obstacle; give an edge its [edges.NAME] support "
+                        '(e.g. support = "simply_supported"), or keep one side'
+                    )
+
+    @property
+    def all_obstacles(self) -> tuple[ObstacleSpec, ...]:
+        """Every obstacle: ``(obstacle,)`` or ``obstacles`` (empty for the free plate)."""
+        return (self.obstacle,) if self.obstacle is not None else self.obstacles
+
+    def obstacle_label(self, k: int) -> str:
+        """How the file names obstacle k of :attr:`all_obstacles` (for messages)."""
+        return "obstacle" if self.obstacle is not None else f"obstacles[{k}]"
+
+    def without_obstacles(self) -> ProblemSpec:
+        """Copy of the free plate (no obstacle)."""
+        return replace(self, obstacle=None, obstacles=())
 
     def with_mesh(self, nx: int, ny: int) -> ProblemSpec:
         """Copy with another mesh resolution."""
@@ -547,7 +678,6 @@ _DIMENSIONS: dict[tuple[str, str], tuple[int, int]] = {
     ("material", "E"): (0, 1),
     ("material", "membrane_voigt"): (1, 1),  # N/m = Pa m
     ("material", "bending_voigt"): (3, 1),  # N m = Pa m^3
-    ("obstacle", "tolerance"): (1, 0),
     ("mesh", "size"): (1, 0),
 }
 
@@ -566,9 +696,80 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
         if isinstance(out.get(table), dict) and key in out[table]:
             factor = (length**pl * stress**ps) ** sign
             out[table][key] = _scaled(out[table][key], factor, f"{table}.{key}")
-    obstacle = out.get("obstacle")
-    if isinstance(obstacle, dict) and isinstance(obstacle.get("zone"), list):
-        obstacle["zone"] = _scaled(obstacle["zone"], length**sign, "obstacle.zone")
+    if isinstance(out.get("obstacle"), dict):
+        out["obstacle"] = _obstacle_to_si(out["obstacle"], "obstacle", length**sign)
+    if isinstance(out.get("obstacles"), list):
+        out["obstacles"] = [
+            _obstacle_to_si(t, f"obstacles[{k}]", length**sign) if isinstance(t, Mapping) else t
+            for k, t in enumerate(out["obstacles"])
+        ]
+    return out
+
+
+def _obstacle_to_si(table: Mapping[str, Any], where: str, length: float) -> dict[str, Any]:
+    """An obstacle table with its lengths times ``length``."""
+    out = dict(table)
+    for key in ("polygon", "tolerance"):
+        if key in out:
+            out[key] = _scaled(out[key], length, f"{where}.{key}")
+    if isinstance(out.get("zone"), list):
+        out["zone"] = _scaled(out["zone"], length, f"{where}.zone")
+    if isinstance(out.get("circle"), Mapping):
+        circle = dict(out["circle"])
+        for key in ("center", "radius"):
+            if key in circle:
+                circle[key] = _scaled(circle[key], length, f"{where}.circle.{key}")
+        out["circle"] = circle
+    return out
+
+
+#: Keys of an ``[obstacle]`` or ``[[obstacles]]`` table.
+OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "tolerance")
+
+
+def _obstacle_from_table(table: Any, where: str) -> ObstacleSpec:
+    """An :class:`ObstacleSpec` from its table; messages name ``where`` (e.g. obstacles[1])."""
+    kw = _take(table, OBSTACLE_KEYS, where)
+    given = [key for key in ("zone", "polygon", "circle") if key in kw]
+    if len(given) != 1:
+        raise ValueError(
+            f'[{where}] needs zone = "all" (the whole plate) or [[xmin, xmax], [ymin, ymax]], '
+            "or polygon = [[x, y], ...], or circle = {center = [x, y], radius = r}: exactly "
+            f"one of them; got {given or 'none'}"
+        )
+    try:
+        if "polygon" in kw:
+            kw["zone"] = Polygon(_polygon(f"{where}.polygon", kw.pop("polygon")))
+        elif "circle" in kw:
+            circle = _take(kw.pop("circle"), ("center", "radius"), f"{where}.circle")
+            if set(circle) != {"center", "radius"}:
+                raise ValueError(f"{where}.circle needs center = [x, y] and radius = r")
+            kw["zone"] = Circle(**circle)
+        return ObstacleSpec(**kw)
+    except ValueError as err:
+        message = str(err)
+        if message.startswith("obstacle."):
+            message = where + message[len("obstacle") :]
+        elif message.startswith("circle."):
+            message = f"{where}.{message}"
+        raise ValueError(message) from None
+
+
+def _obstacle_table(obstacle: ObstacleSpec) -> dict[str, Any]:
+    """The file form of an obstacle (every key with the value used)."""
+    zone = obstacle.zone
+    out: dict[str, Any] = {}
+    if isinstance(zone, Polygon):
+        out["polygon"] = [list(v) for v in zone.vertices]
+    elif isinstance(zone, Circle):
+        out["circle"] = {"center": list(zone.center), "radius": zone.radius}
+    elif callable(zone):
+        raise ValueError("problem_to_dict: a predicate obstacle zone cannot be written")
+    else:
+        out["zone"] = zone if isinstance(zone, str) else [list(z) for z in zone]
+    out["side"] = obstacle.side
+    if obstacle.tolerance is not None:
+        out["tolerance"] = obstacle.tolerance
     return out
 
 
@@ -578,7 +779,8 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     Tables: ``[plate]`` (corners, thickness), ``[material]`` (E, nu, shear_correction,
     membrane_voigt, bending_voigt), ``[edges.<name>]`` (support, inplane,
     normal_stress, shear_stress), ``[mesh]`` (nx, ny; or size, a cell size), ``[obstacle]`` (zone,
-    tolerance; absent = free plate), ``[solver]`` (the :class:`SolverSpec` fields);
+    polygon or circle, side, tolerance; absent = free plate) or several ``[[obstacles]]``
+    with the same keys, ``[solver]`` (the :class:`SolverSpec` fields);
     top-level ``name`` and ``units``. Unknown tables or keys raise ``ValueError``.
 
     Missing values take the paper's, with one exception for the load: if any edge table
@@ -587,7 +789,9 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     no edge load at all).
     """
     top = _take(
-        data, ("name", "units", "plate", "material", "edges", "mesh", "obstacle", "solver"), "top"
+        data,
+        ("name", "units", "plate", "material", "edges", "mesh", "obstacle", "obstacles", "solver"),
+        "top",
     )
     units = _choice("units", top.get("units", "SI"), tuple(UNITS))
     top = _to_si(top, units)
@@ -620,12 +824,18 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     mesh = MeshSpec(**mesh_kw)
     obstacle = None
     if "obstacle" in top:
-        obstacle_kw = _take(top["obstacle"], ("zone", "tolerance"), "obstacle")
-        if "zone" not in obstacle_kw:
+        obstacle = _obstacle_from_table(top["obstacle"], "obstacle")
+    obstacles: list[ObstacleSpec] = []
+    if "obstacles" in top:
+        tables = top["obstacles"]
+        if not isinstance(tables, list) or not tables:
             raise ValueError(
-                '[obstacle] needs zone = "all" (the whole plate) or [[xmin, xmax], [ymin, ymax]]'
+                "obstacles must be a list of tables ([[obstacles]] in TOML), at least one, "
+                f"got {tables!r}"
             )
-        obstacle = ObstacleSpec(**obstacle_kw)
+        if obstacle is not None:
+            raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
+        obstacles = [_obstacle_from_table(t, f"obstacles[{k}]") for k, t in enumerate(tables)]
     solver = SolverSpec(**_take(top.get("solver", {}), _names(SolverSpec), "solver"))
     label = top.get("name", name)
     if not isinstance(label, str):
@@ -638,6 +848,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         obstacle=obstacle,
         solver=solver,
         units=units,
+        obstacles=tuple(obstacles),
     )
 
 
@@ -675,15 +886,9 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         "solver": dict(vars(spec.solver)),
     }
     if spec.obstacle is not None:
-        zone = spec.obstacle.zone
-        if callable(zone):
-            raise ValueError("problem_to_dict: a predicate obstacle zone cannot be written")
-        obstacle: dict[str, Any] = {
-            "zone": zone if isinstance(zone, str) else [list(z) for z in zone]
-        }
-        if spec.obstacle.tolerance is not None:
-            obstacle["tolerance"] = spec.obstacle.tolerance
-        out["obstacle"] = obstacle
+        out["obstacle"] = _obstacle_table(spec.obstacle)
+    if spec.obstacles:
+        out["obstacles"] = [_obstacle_table(o) for o in spec.obstacles]
     for key in ("membrane_voigt", "bending_voigt"):
         if key in out["material"]:
             out["material"][key] = [list(row) for row in out["material"][key]]

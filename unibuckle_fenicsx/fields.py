@@ -18,7 +18,14 @@ if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.config import ProblemSpec
     from unibuckle_fenicsx.problem import BucklingProblem
 
-__all__ = ["mirror_to_match", "nodal_deflection", "problem_zone", "section", "zone_box"]
+__all__ = [
+    "mirror_to_match",
+    "nodal_deflection",
+    "problem_zone",
+    "section",
+    "zone_box",
+    "zone_outlines",
+]
 
 
 def zone_box(
@@ -26,24 +33,50 @@ def zone_box(
 ) -> tuple[tuple[float, float], tuple[float, float]] | None:
     """Obstacle zone of ``spec`` as ``((xmin, xmax), (ymin, ymax))``; ``None`` without one.
 
+    A polygon or circle gives its bounding box; several obstacles the box around all.
+
     Args:
         spec: The problem.
         constrained: Coordinates of the constrained nodes (needed for a predicate
             zone, whose bounding box is returned).
     """
-    obstacle = spec.obstacle
-    if obstacle is None:
+    outlines = zone_outlines(spec)
+    if not outlines:
+        if spec.all_obstacles and constrained is not None and len(constrained):
+            lo, hi = constrained.min(axis=0), constrained.max(axis=0)
+            return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
         return None
-    if isinstance(obstacle.zone, str):
-        (x0, y0), (x1, y1) = spec.plate.corners
-        return (x0, x1), (y0, y1)
-    if callable(obstacle.zone):
-        if constrained is None or len(constrained) == 0:
-            return None
-        lo, hi = constrained.min(axis=0), constrained.max(axis=0)
-        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
-    (x0, x1), (y0, y1) = obstacle.zone
-    return (x0, x1), (y0, y1)
+    points = np.vstack([xy for xy, _ in outlines])
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
+
+
+def zone_outlines(spec: ProblemSpec) -> list[tuple[npt.NDArray[np.float64], str]]:
+    """Outline (n, 2), closed implicitly, and side of every obstacle zone, for drawing.
+
+    "all" gives the plate's outline (its bounding box), a circle 96 points; a predicate
+    zone has no outline and is left out.
+    """
+    from unibuckle_fenicsx.config import Circle, Polygon
+    from unibuckle_fenicsx.geometry import circle_points
+
+    out = []
+    for obstacle in spec.all_obstacles:
+        zone = obstacle.zone
+        if isinstance(zone, str):
+            (x0, y0), (x1, y1) = spec.plate.corners
+            xy = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float)
+        elif isinstance(zone, Polygon):
+            xy = np.asarray(zone.vertices, dtype=float)
+        elif isinstance(zone, Circle):
+            xy = circle_points(zone.center, zone.radius)
+        elif callable(zone):
+            continue
+        else:
+            (x0, x1), (y0, y1) = zone
+            xy = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float)
+        out.append((xy, obstacle.side))
+    return out
 
 
 def problem_zone(

@@ -183,9 +183,11 @@ class BucklingProblem(Owner):
             _check_memory(spec, comm)
             self.mesh, self.facet_tags = create_plate_mesh(spec.plate, spec.mesh, comm)
         self.comm = comm
-        if spec.obstacle is not None:
+        obstacles = spec.all_obstacles
+        if obstacles:
             size = max(spec.plate.length, spec.plate.width)
-            check_zone_has_nodes(self.mesh, spec.obstacle, size)
+            labels = [spec.obstacle_label(k) for k in range(len(obstacles))]
+            check_zone_has_nodes(self.mesh, obstacles, size, labels)
         self.prestress = solve_prestress(
             self.mesh, self.facet_tags, spec.plate, spec.material, spec.solver.prestress_degree
         )
@@ -204,9 +206,7 @@ class BucklingProblem(Owner):
             tol=spec.solver.eps_tol,
             options={**EIGEN_OPTIONS, **(eps_options or {})},
         )
-        self.contact = (
-            ContactSetManager(self.model, spec.obstacle) if spec.obstacle is not None else None
-        )
+        self.contact = ContactSetManager(self.model, obstacles) if obstacles else None
         self.free: Mode | None = None
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None

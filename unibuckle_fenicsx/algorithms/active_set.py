@@ -249,7 +249,7 @@ def solve_active_set(
         Collective on ``problem.comm``.
     """
     if problem.contact is None:
-        raise ValueError("solve_active_set needs a problem with an obstacle (spec.obstacle)")
+        raise ValueError("solve_active_set needs a problem with an obstacle")
     if int(max_iterations) != max_iterations or max_iterations < 1:
         raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
     if int(coarse_min_cells) != coarse_min_cells or coarse_min_cells < 2:

@@ -133,7 +133,7 @@ class PenaltySolver(Owner):
         if not isinstance(problem, BucklingProblem):
             raise ValueError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
         if problem.contact is None:
-            raise ValueError("the penalty method needs an obstacle (problem.spec.obstacle is None)")
+            raise ValueError("the penalty method needs an obstacle (the problem has none)")
         self.problem = problem
         A = problem.model.A
         diag = A.getDiagonal()

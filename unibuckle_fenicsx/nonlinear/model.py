@@ -310,9 +310,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         self._Kd: PETSc.Vec | None = self._xs.duplicate()
 
         self.contact = (
-            ContactSetManager(self, spec.obstacle)
-            if obstacle and spec.obstacle is not None
-            else None
+            ContactSetManager(self, spec.all_obstacles) if obstacle and spec.all_obstacles else None
         )
         snes = PETSc.SNES().create(self.comm)
         snes.setFunction(self._residual, self.b)
@@ -326,10 +324,14 @@ class VonKarmanPlate(MixedDofs, Owner):
             self._upper = self._xs.duplicate()
             self._lower.set(PETSc.NINFINITY)
             self._upper.set(PETSc.INFINITY)
+            # Obstacle above: w <= 0 (upper bound); below: w >= 0 (lower bound).
             rows = self.contact.global_rows()
             lo, hi = self._upper.getOwnershipRange()
-            mine = rows[(rows >= lo) & (rows < hi)]
-            self._upper.array[mine - lo] = 0.0
+            mine = (rows >= lo) & (rows < hi)
+            above = mine & (self.contact.signs > 0)
+            below = mine & (self.contact.signs < 0)
+            self._upper.array[rows[above] - lo] = 0.0
+            self._lower.array[rows[below] - lo] = 0.0
             snes.setVariableBounds(self._lower, self._upper)
         else:
             options.setdefault("snes_type", "newtonls")
@@ -437,12 +439,13 @@ class VonKarmanPlate(MixedDofs, Owner):
                 constant.value = factor * value / self.thickness  # type: ignore[assignment]
 
     def project(self) -> None:
-        """Clip the state onto the obstacle (w <= 0 at the zone's nodes); not collective."""
+        """Clip the state onto the obstacles (w <= 0 above, >= 0 below); not collective."""
         if self.contact is None:
             return
-        assert self._upper is not None
+        assert self._upper is not None and self._lower is not None
         arr = self.x.x.petsc_vec.array
         np.minimum(arr, self._upper.array, out=arr)
+        np.maximum(arr, self._lower.array, out=arr)
         self.x.x.scatter_forward()
 
     def solve(self) -> StepReport:
@@ -472,7 +475,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         return self.thickness * float(self.comm.allreduce(local, op=MPI.MAX))
 
     def zone_deflection(self) -> npt.NDArray[np.float64]:
-        """Deflection (m) at the zone's nodes, (i,), same on every rank (empty without obstacle)."""
+        """Deflection (m) towards the obstacles at the zone nodes, s_k w_k (empty without one)."""
         if self.contact is None:
             return np.empty(0)
         return self.thickness * self.contact.values(self.x.x.petsc_vec)
