@@ -254,3 +254,29 @@ def test_cli_several_obstacles_distributed(tmp_path):
     par, _ = _cli_parallel(tmp_path, args, 2)
     _compare_results(ser, par, 2)
     assert ser["certificate"]["kkt"] and ser["constrained_nodes"] > 20
+
+
+@pytest.mark.parametrize("side", ["above", "both"])
+def test_cli_foundation_distributed(tmp_path, side):
+    """A tensionless (side above) and a bilateral (side both) Winkler foundation on 2 ranks.
+
+    0.3 x 0.1 m plate, loaded edges clamped, 24x8: the spring-set iteration takes the
+    serial path (same load, pressing nodes and certificate); the bilateral springs are
+    part of the stiffness (a free-plate solve).
+    """
+    path = tmp_path / f"foundation_{side}.toml"
+    path.write_text(
+        "[plate]\ncorners = [[0.0, 0.0], [0.3, 0.1]]\nthickness = 0.001\n"
+        '[edges.left]\nsupport = "clamped"\nnormal_stress = -1.0\n'
+        '[edges.right]\nsupport = "clamped"\nnormal_stress = -1.0\n'
+        "[mesh]\nnx = 24\nny = 8\n"
+        f'[obstacle]\nzone = "all"\nside = "{side}"\nfoundation_stiffness = 2.0e7\n'
+    )
+    args = ["--config", str(path)]
+    ser = _cli_serial(tmp_path, args)
+    par, _ = _cli_parallel(tmp_path, args, 2)
+    _compare_results(ser, par, 2)
+    assert ser["method"] == ("foundation" if side == "above" else "free")
+    if side == "above":
+        assert ser["certificate"]["kkt"] and ser["contact_nodes"] > 0
+        assert par["details"]["foundation_start"] == ser["details"]["foundation_start"]

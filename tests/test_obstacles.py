@@ -36,7 +36,9 @@ from unibuckle_fenicsx.problem import BucklingProblem
 def test_side_defaults_to_above_and_is_checked():
     assert ObstacleSpec("all").side == "above" and ObstacleSpec("all").sign == 1.0
     assert ObstacleSpec("all", side="below").sign == -1.0
-    with pytest.raises(ValueError, match=r"obstacle\.side must be one of \('above', 'below'\)"):
+    with pytest.raises(
+        ValueError, match=r"obstacle\.side must be one of \('above', 'below', 'both'\)"
+    ):
         ObstacleSpec("all", side="up")
 
 

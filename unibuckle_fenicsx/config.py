@@ -397,18 +397,23 @@ def _polygon(name: str, value: Any) -> tuple[tuple[float, float], ...]:
     return tuple(vertices)
 
 
-#: Sides of an obstacle: "above" (on the +w side: w <= 0 in its zone), "below" (w >= 0).
-SIDES = ("above", "below")
+#: Sides of an obstacle: "above" (on the +w side: w <= 0 in its zone), "below" (w >= 0);
+#: "both" only for a foundation (a bilateral Winkler foundation, springs everywhere).
+SIDES = ("above", "below", "both")
 
 Box = tuple[tuple[float, float], tuple[float, float]]
 
 
 @dataclass(frozen=True)
 class ObstacleSpec:
-    """Rigid flat obstacle on one side of the plate over a contact zone.
+    r"""Rigid flat obstacle, or Winkler foundation, on one side of the plate over a zone.
 
     With ``side = "above"`` the deflection must satisfy w <= 0 at every mesh node of the
-    closed zone; with ``"below"``, w >= 0.
+    closed zone; with ``"below"``, w >= 0. With a ``foundation_stiffness`` :math:`k_f`
+    the obstacle is a tensionless (compression-only) Winkler foundation instead: the
+    plate may press into it, against a pressure :math:`k_f w` (above; :math:`-k_f w`
+    below), and lift off it freely; :math:`k_f \to \infty` is the rigid obstacle.
+    ``side = "both"`` is then a bilateral foundation (springs in tension too).
 
     Args:
         zone: ``"all"`` (the whole closed plate), a box ``((xmin, xmax), (ymin, ymax))``,
@@ -417,12 +422,16 @@ class ObstacleSpec:
         tolerance: Geometric tolerance (m) for a node to count as inside a box, polygon
             or circle; ``None`` uses 1e-8 times the plate size.
         side: One of :data:`SIDES`: where the obstacle lies (w, the deflection, is
-            positive towards "above").
+            positive towards "above"); "both" only with a foundation.
+        foundation_stiffness: Winkler modulus :math:`k_f` (N/m^3, Pa/m), > 0; ``None``
+            for a rigid obstacle. The springs are lumped at the zone's nodes: node k
+            carries :math:`k_f \int \varphi_k\,dx` (its tributary area).
     """
 
     zone: Literal["all"] | Box | Polygon | Circle | Predicate = "all"
     tolerance: float | None = None
     side: str = "above"
+    foundation_stiffness: float | None = None
 
     def __post_init__(self) -> None:
         if isinstance(self.zone, str):
@@ -451,19 +460,33 @@ class ObstacleSpec:
             object.__setattr__(self, "zone", box)
         if self.tolerance is not None and not _number("obstacle.tolerance", self.tolerance) >= 0:
             raise ValueError(f"obstacle.tolerance must be >= 0 m, got {self.tolerance!r}")
-        if self.side == "both":
+        if self.foundation_stiffness is not None:
+            if not _number("obstacle.foundation_stiffness", self.foundation_stiffness) > 0.0:
+                raise ValueError(
+                    "obstacle.foundation_stiffness (Winkler modulus) must be > 0 N/m^3, got "
+                    f"{self.foundation_stiffness!r}; leave it out for a rigid obstacle"
+                )
+            object.__setattr__(self, "foundation_stiffness", float(self.foundation_stiffness))
+        if self.side == "both" and self.foundation_stiffness is None:
             raise ValueError(
                 'obstacle.side = "both": a rigid obstacle on both sides of the plate is a '
                 "bilateral support (w = 0 in the zone), not an obstacle; give an edge its "
                 '[edges.NAME] support (e.g. support = "simply_supported"), or one side '
-                f"{SIDES}"
+                '("above" or "below"); "both" is for a foundation (foundation_stiffness)'
             )
         _choice("obstacle.side", self.side, SIDES)
 
     @property
     def sign(self) -> float:
-        """+1 for an obstacle above (w <= 0 admissible), -1 below (w >= 0)."""
-        return 1.0 if self.side == "above" else -1.0
+        """+1 for an obstacle above (w <= 0 admissible), -1 below (w >= 0), 0 for both."""
+        return {"above": 1.0, "below": -1.0}.get(self.side, 0.0)
+
+    @property
+    def kind(self) -> str:
+        """Kind: "rigid", "tensionless" (one-sided foundation) or "bilateral" (foundation)."""
+        if self.foundation_stiffness is None:
+            return "rigid"
+        return "bilateral" if self.side == "both" else "tensionless"
 
     def describe(self) -> str:
         """Short human-readable description of the zone."""
@@ -612,16 +635,52 @@ class ProblemSpec:
             if not isinstance(o, ObstacleSpec):
                 raise ValueError(f"obstacles[{k}] must be an ObstacleSpec, got {o!r}")
         found = self.all_obstacles
+        kinds = {o.kind for o in found}
+        if {"rigid", "tensionless"} <= kinds:
+            raise ValueError(
+                "rigid obstacles and tensionless foundations in one problem are not "
+                "supported: give every one-sided obstacle a foundation_stiffness, or none "
+                '(a bilateral foundation, side = "both", goes with either)'
+            )
+        if "tensionless" in kinds and self.solver.method != "auto":
+            raise ValueError(
+                f'solver.method = "{self.solver.method}": a tensionless foundation is solved '
+                'by its own spring-set iteration; use method = "auto"'
+            )
         for j, first in enumerate(found):
             for k in range(j + 1, len(found)):
                 second = found[k]
-                if first.same_zone(second) and first.side != second.side:
+                if not (
+                    first.same_zone(second) and {first.side, second.side} == {"above", "below"}
+                ):
+                    continue
+                label = f"{self.obstacle_label(j)} and {self.obstacle_label(k)}"
+                if first.kind == second.kind == "tensionless":
                     raise ValueError(
-                        f"{self.obstacle_label(j)} and {self.obstacle_label(k)} give the same "
-                        "zone on both sides of the plate: that is a bilateral support (w = 0 "
-                        "there), not an obstacle; give an edge its [edges.NAME] support "
-                        '(e.g. support = "simply_supported"), or keep one side'
+                        f"{label} give the same foundation zone on both sides of the plate: "
+                        'write it once with side = "both" (a bilateral foundation)'
                     )
+                raise ValueError(
+                    f"{label} give the same zone on both sides of the plate: that is a "
+                    "bilateral support (w = 0 there), not an obstacle; give an edge its "
+                    '[edges.NAME] support (e.g. support = "simply_supported"), or keep one '
+                    "side"
+                )
+
+    @property
+    def unilateral_obstacles(self) -> tuple[ObstacleSpec, ...]:
+        """The one-sided obstacles (rigid or tensionless foundations): the contact nodes'."""
+        return tuple(o for o in self.all_obstacles if o.kind != "bilateral")
+
+    @property
+    def bilateral_foundations(self) -> tuple[ObstacleSpec, ...]:
+        """The bilateral foundations (``side = "both"``): springs added to the stiffness."""
+        return tuple(o for o in self.all_obstacles if o.kind == "bilateral")
+
+    @property
+    def tensionless(self) -> bool:
+        """Whether the one-sided obstacles are tensionless foundations."""
+        return any(o.kind == "tensionless" for o in self.all_obstacles)
 
     @property
     def all_obstacles(self) -> tuple[ObstacleSpec, ...]:
@@ -697,21 +756,29 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
             factor = (length**pl * stress**ps) ** sign
             out[table][key] = _scaled(out[table][key], factor, f"{table}.{key}")
     if isinstance(out.get("obstacle"), dict):
-        out["obstacle"] = _obstacle_to_si(out["obstacle"], "obstacle", length**sign)
+        out["obstacle"] = _obstacle_to_si(out["obstacle"], "obstacle", length**sign, stress**sign)
     if isinstance(out.get("obstacles"), list):
         out["obstacles"] = [
-            _obstacle_to_si(t, f"obstacles[{k}]", length**sign) if isinstance(t, Mapping) else t
+            _obstacle_to_si(t, f"obstacles[{k}]", length**sign, stress**sign)
+            if isinstance(t, Mapping)
+            else t
             for k, t in enumerate(out["obstacles"])
         ]
     return out
 
 
-def _obstacle_to_si(table: Mapping[str, Any], where: str, length: float) -> dict[str, Any]:
-    """An obstacle table with its lengths times ``length``."""
+def _obstacle_to_si(
+    table: Mapping[str, Any], where: str, length: float, stress: float
+) -> dict[str, Any]:
+    """An obstacle table with its lengths times ``length`` and stresses times ``stress``."""
     out = dict(table)
     for key in ("polygon", "tolerance"):
         if key in out:
             out[key] = _scaled(out[key], length, f"{where}.{key}")
+    if "foundation_stiffness" in out:  # N/m^3 = Pa/m
+        out["foundation_stiffness"] = _scaled(
+            out["foundation_stiffness"], stress / length, f"{where}.foundation_stiffness"
+        )
     if isinstance(out.get("zone"), list):
         out["zone"] = _scaled(out["zone"], length, f"{where}.zone")
     if isinstance(out.get("circle"), Mapping):
@@ -724,7 +791,7 @@ def _obstacle_to_si(table: Mapping[str, Any], where: str, length: float) -> dict
 
 
 #: Keys of an ``[obstacle]`` or ``[[obstacles]]`` table.
-OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "tolerance")
+OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "foundation_stiffness", "tolerance")
 
 
 def _obstacle_from_table(table: Any, where: str) -> ObstacleSpec:
@@ -768,6 +835,8 @@ def _obstacle_table(obstacle: ObstacleSpec) -> dict[str, Any]:
     else:
         out["zone"] = zone if isinstance(zone, str) else [list(z) for z in zone]
     out["side"] = obstacle.side
+    if obstacle.foundation_stiffness is not None:
+        out["foundation_stiffness"] = obstacle.foundation_stiffness
     if obstacle.tolerance is not None:
         out["tolerance"] = obstacle.tolerance
     return out

@@ -16,6 +16,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 import dolfinx
+import dolfinx.la
+import ufl
 
 import numpy as np
 import numpy.typing as npt
@@ -28,7 +30,9 @@ __all__ = [
     "EmptyZoneError",
     "PlateDofs",
     "check_zone_has_nodes",
+    "foundation_springs",
     "orientation",
+    "tributary_areas",
 ]
 
 
@@ -121,7 +125,7 @@ def check_zone_has_nodes(
     for o, mask in zip(found, inside, strict=True):
         if o.side == "above":
             above |= mask
-        else:
+        elif o.side == "below":
             below |= mask
     both = np.flatnonzero(above & below)
     local = x[both[0], :2].tolist() if both.size else None
@@ -131,10 +135,14 @@ def check_zone_has_nodes(
         raise BilateralZoneError(
             f"obstacle zones on both sides of the plate share mesh nodes, e.g. "
             f"({shared[0][0]:.6g}, {shared[0][1]:.6g}) ({', '.join(names)}: "
-            f"{', '.join(f'{o.describe()} ({o.side})' for o in found)}): a node held on "
-            "both sides is a "
-            "bilateral support (w = 0), not an obstacle; give an edge its [edges.NAME] "
-            "support, or make the zones disjoint"
+            f"{', '.join(f'{o.describe()} ({o.side})' for o in found)}): "
+            + (
+                'a foundation on both sides is one zone with side = "both" (a bilateral '
+                "foundation); make the zones disjoint"
+                if any(o.kind == "tensionless" for o in found)
+                else "a node held on both sides is a bilateral support (w = 0), not an "
+                "obstacle; give an edge its [edges.NAME] support, or make the zones disjoint"
+            )
         )
 
 
@@ -184,6 +192,58 @@ class _Owned:
     global_dofs: npt.NDArray[np.int64]  # W global dof of each
 
 
+def tributary_areas(model: PlateDofs) -> dolfinx.la.Vector:
+    r"""Lumped areas :math:`\int \varphi_k\,dx` of the w-space's nodes (owned and ghosts).
+
+    The row sums of the Q1 mass matrix: a lumped Winkler foundation puts the spring
+    :math:`k_f \int \varphi_k\,dx` at node k.
+
+    Note:
+        Collective.
+    """
+    v = ufl.TestFunction(model.Vw)
+    areas = dolfinx.fem.assemble_vector(dolfinx.fem.form(v * ufl.dx))
+    areas.scatter_reverse(dolfinx.la.InsertMode.add)
+    areas.scatter_forward()
+    return areas
+
+
+def _zone_dofs(
+    model: PlateDofs, obstacle: ObstacleSpec, size: float
+) -> tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]:
+    """(W dofs, Vw dofs) of the w-DOFs of the zone's nodes, ghosts included (not collective)."""
+    dofs_W, dofs_Vw = dolfinx.fem.locate_dofs_geometrical(
+        (model.w_subspace, model.Vw), lambda x: obstacle.contains(x, size)
+    )
+    return np.asarray(dofs_W, dtype=np.int32), np.asarray(dofs_Vw, dtype=np.int32)
+
+
+def foundation_springs(
+    model: PlateDofs, foundations: Sequence[ObstacleSpec]
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]:
+    r"""Global W rows owned by this rank and lumped spring stiffnesses of ``foundations``.
+
+    Node k of a zone gets :math:`k_f \int \varphi_k\,dx` (N/m), summed over the zones
+    holding it; nodes fixed by edge supports are left out.
+
+    Note:
+        Collective.
+    """
+    size = max(model.plate.length, model.plate.width)
+    areas = tributary_areas(model).array
+    springs: dict[int, float] = {}
+    for o in foundations:
+        assert o.foundation_stiffness is not None
+        dofs_W, dofs_Vw = _zone_dofs(model, o, size)
+        for dw, dv in zip(dofs_W.tolist(), dofs_Vw.tolist(), strict=True):
+            springs[dw] = springs.get(dw, 0.0) + o.foundation_stiffness * float(areas[dv])
+    local = np.array(sorted(springs), dtype=np.int32)
+    keep = (local < model.num_owned_dofs) & ~np.isin(local, model.bc_dofs)
+    local = local[keep]
+    values = np.array([springs[d] for d in local.tolist()], dtype=float)
+    return model.global_dofs(local), values
+
+
 class ContactSetManager:
     r"""Constrained w-DOFs of the obstacle zones, and candidate sets as removed DOFs.
 
@@ -200,6 +260,9 @@ class ContactSetManager:
     Attributes:
         coordinates: (i, 2) coordinates of the constrained nodes, same on all ranks.
         signs: (i,) :math:`s_k`, same on all ranks.
+        stiffness: (i,) lumped spring stiffness (N/m) of each node, same on all ranks,
+            for tensionless foundations (:func:`foundation_springs`); None for rigid
+            obstacles.
         num_edge_fixed: Nodes of the zones already fixed (w = 0) by edge supports.
 
     Note:
@@ -212,18 +275,28 @@ class ContactSetManager:
         self.obstacles = _as_tuple(obstacles)
         if not self.obstacles:
             raise ValueError("ContactSetManager needs at least one obstacle")
+        kinds = {o.kind for o in self.obstacles}
+        if "bilateral" in kinds or len(kinds) != 1:
+            raise ValueError(
+                "ContactSetManager takes one-sided obstacles of one kind: all rigid or all "
+                f"tensionless foundations, got {sorted(kinds)}"
+            )
         comm = model.mesh.comm
         Vw = model.Vw
         size = max(model.plate.length, model.plate.width)
+        tensionless = kinds == {"tensionless"}
+        areas = tributary_areas(model).array if tensionless else None
         found: dict[int, tuple[int, float]] = {}  # W dof -> (Vw dof, sign)
+        spring: dict[int, float] = {}  # W dof -> stiffness (foundations)
         conflict = False
         for o in self.obstacles:
-            dofs_W, dofs_Vw = dolfinx.fem.locate_dofs_geometrical(
-                (model.w_subspace, Vw), lambda x, o=o: o.contains(x, size)
-            )
+            dofs_W, dofs_Vw = _zone_dofs(model, o, size)
             for dw, dv in zip(dofs_W.tolist(), dofs_Vw.tolist(), strict=True):
                 conflict |= dw in found and found[dw][1] != o.sign
                 found[dw] = (dv, o.sign)
+                if areas is not None:
+                    assert o.foundation_stiffness is not None
+                    spring[dw] = spring.get(dw, 0.0) + o.foundation_stiffness * float(areas[dv])
         if comm.allreduce(conflict, op=MPI.LOR):
             raise BilateralZoneError(
                 "obstacle zones on both sides of the plate share a mesh node: a bilateral "
@@ -234,12 +307,13 @@ class ContactSetManager:
         dofs_W = order_W
         dofs_Vw = np.array([found[d][0] for d in order_W.tolist()], dtype=np.int32)
         signs = np.array([found[d][1] for d in order_W.tolist()], dtype=float)
+        springs = np.array([spring.get(d, 0.0) for d in order_W.tolist()], dtype=float)
         n_owned = model.num_owned_dofs
-        owned = dofs_W < n_owned
-        dofs_W, dofs_Vw, signs = dofs_W[owned], dofs_Vw[owned], signs[owned]
+        keep = dofs_W < n_owned
         fixed = np.isin(dofs_W, model.bc_dofs)
-        self.num_edge_fixed = int(comm.allreduce(int(fixed.sum()), op=MPI.SUM))
-        dofs_W, dofs_Vw, signs = dofs_W[~fixed], dofs_Vw[~fixed], signs[~fixed]
+        self.num_edge_fixed = int(comm.allreduce(int((fixed & keep).sum()), op=MPI.SUM))
+        keep &= ~fixed
+        dofs_W, dofs_Vw, signs, springs = dofs_W[keep], dofs_Vw[keep], signs[keep], springs[keep]
         xy = Vw.tabulate_dof_coordinates()[dofs_Vw, :2]
 
         gathered = comm.allgather(xy)
@@ -250,6 +324,9 @@ class ContactSetManager:
         order = np.lexsort((keys[:, 0], keys[:, 1]))
         self.coordinates: npt.NDArray[np.float64] = all_xy[order]
         self.signs: npt.NDArray[np.float64] = np.concatenate(comm.allgather(signs))[order]
+        self.stiffness: npt.NDArray[np.float64] | None = (
+            np.concatenate(comm.allgather(springs))[order] if tensionless else None
+        )
         if self.coordinates.shape[0] == 0:
             nx = model.mesh.topology.index_map(0).size_global
             zones = "; ".join(o.describe() for o in self.obstacles)
@@ -284,6 +361,13 @@ class ContactSetManager:
         """Global W rows owned by this rank of the nodes ``active`` (node numbers)."""
         mask = np.isin(self._owned.positions, active)
         return self._owned.global_dofs[mask]
+
+    def node_rows(
+        self, active: npt.NDArray[np.int64]
+    ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """(global W rows, node numbers) owned by this rank of the nodes ``active``."""
+        mask = np.isin(self._owned.positions, active)
+        return self._owned.global_dofs[mask], self._owned.positions[mask]
 
     def values(self, u: PETSc.Vec) -> npt.NDArray[np.float64]:
         """Oriented entries :math:`s_k u_k` of the W-vector ``u`` at the constrained nodes.

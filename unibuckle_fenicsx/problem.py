@@ -29,7 +29,12 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.contact import ContactSetManager, check_zone_has_nodes, orientation
+from unibuckle_fenicsx.contact import (
+    ContactSetManager,
+    check_zone_has_nodes,
+    foundation_springs,
+    orientation,
+)
 from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, EigenPair, GEPSolver, Owner, release
 from unibuckle_fenicsx.materials import bending_stiffness
 from unibuckle_fenicsx.mesh import create_plate_mesh
@@ -196,6 +201,8 @@ class BucklingProblem(Owner):
         self.model = PlateModel(
             self.mesh, self.facet_tags, spec.plate, spec.material, self.prestress, spec.solver.shear
         )
+        if spec.bilateral_foundations:
+            self.model.add_springs(*foundation_springs(self.model, spec.bilateral_foundations))
         t2 = time.perf_counter()
         self.timings["assembly_s"] = t2 - t1
         self._check_geometric_stiffness()
@@ -206,7 +213,8 @@ class BucklingProblem(Owner):
             tol=spec.solver.eps_tol,
             options={**EIGEN_OPTIONS, **(eps_options or {})},
         )
-        self.contact = ContactSetManager(self.model, obstacles) if obstacles else None
+        unilateral = spec.unilateral_obstacles
+        self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
         self.free: Mode | None = None
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
@@ -234,6 +242,11 @@ class BucklingProblem(Owner):
             )
 
     # -- primitives ----------------------------------------------------------------
+    @property
+    def tensionless(self) -> bool:
+        """Whether the contact nodes carry a tensionless foundation (springs), not obstacles."""
+        return self.contact is not None and self.contact.stiffness is not None
+
     @property
     def num_constrained(self) -> int:
         """i, the number of constrained nodes (0 without obstacle)."""

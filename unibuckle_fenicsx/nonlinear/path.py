@@ -690,6 +690,11 @@ def solve_nonlinear(
     """
     t0 = time.perf_counter()
     options = NonlinearOptions() if options is None else options
+    if any(o.foundation_stiffness is not None for o in spec.all_obstacles):
+        raise ValueError(
+            "the nonlinear analysis models rigid obstacles only, not Winkler foundations "
+            "(foundation_stiffness)"
+        )
     obstacle = options.obstacle and bool(spec.all_obstacles)
     if obstacle and len({o.side for o in spec.all_obstacles}) > 1:
         raise ValueError(

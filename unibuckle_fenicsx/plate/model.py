@@ -102,6 +102,25 @@ class PlateModel(MixedDofs, Owner):
         """:math:`P^T M_s P` with P's columns of edge-constrained DOFs zeroed."""
         return mitc_shear_matrix(self.W, self.bc_dofs, ks)
 
+    def add_springs(self, rows: npt.NDArray[np.int64], stiffness: npt.NDArray[np.float64]) -> None:
+        r"""Add nodal springs to A: :math:`A_{kk} \mathrel{+}= k_k` at the global ``rows``.
+
+        A bilateral Winkler foundation (lumped springs at the w-DOFs, see
+        :func:`~unibuckle_fenicsx.contact.foundation_springs`); A stays SPD.
+
+        Args:
+            rows: Global W rows owned by this rank (free w-DOFs).
+            stiffness: Spring stiffness (N/m) of each.
+
+        Note:
+            Collective.
+        """
+        diag = self.A.createVecLeft()
+        diag.setValues(rows.astype(PETSc.IntType), stiffness)
+        diag.assemble()
+        self.A.setDiagonal(diag, addv=PETSc.InsertMode.ADD_VALUES)
+        diag.destroy()
+
     @property
     def w_subspace(self) -> dolfinx.fem.FunctionSpace:
         """The sub-space of W holding w."""
