@@ -280,3 +280,31 @@ def test_cli_foundation_distributed(tmp_path, side):
     if side == "above":
         assert ser["certificate"]["kkt"] and ser["contact_nodes"] > 0
         assert par["details"]["foundation_start"] == ser["details"]["foundation_start"]
+
+
+def test_cli_gmsh_plate_distributed(tmp_path):
+    """A plate meshed by gmsh on rank 0 and distributed over 2 ranks.
+
+    An outline with a circular and a polygonal hole, a segment pushed with a stress
+    gradient against one held in its plane, an obstacle below.
+
+    Same mesh (cells), load, contact nodes (as coordinates) and certificate as serially.
+    """
+    pytest.importorskip("gmsh")
+    path = tmp_path / "holes.toml"
+    path.write_text(
+        "[plate]\noutline = [[0, 0], [0.4, 0], [0.4, 0.2], [0.25, 0.2], [0, 0.2]]\n"
+        "thickness = 0.004\n"
+        "[[plate.holes]]\ncenter = [0.1, 0.1]\nradius = 0.04\n"
+        "[[plate.holes]]\noutline = [[0.25, 0.06], [0.33, 0.06], [0.33, 0.14], [0.25, 0.14]]\n"
+        "[edges.pushed]\nsegments = [1]\nnormal_stress = [-1.0, -0.5]\n"
+        '[edges.held]\nsegments = [4]\ninplane = "clamped"\n'
+        "[edges.sides]\nsegments = [0, 2, 3]\n"
+        "[mesh]\nsize = 0.025\n"
+        '[obstacle]\nzone = "all"\nside = "below"\n[solver]\nmethod = "active-set"\n'
+    )
+    args = ["--config", str(path)]
+    ser = _cli_serial(tmp_path, args)
+    par, _ = _cli_parallel(tmp_path, args, 2)
+    _compare_results(ser, par, 2)
+    assert ser["certificate"]["kkt"] and len(ser["mesh"]) == 1

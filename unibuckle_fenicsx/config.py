@@ -26,15 +26,20 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.geometry import (
+    circle_points,
+    distance_to_polygon,
     is_simple,
     points_in_circle,
     points_in_polygon,
     polygon_area,
+    polygon_inside,
+    polygons_disjoint,
 )
 
 __all__ = [
     "BENDING_SUPPORTS",
     "EDGE_NAMES",
+    "HOLES",
     "INPLANE_SUPPORTS",
     "METHODS",
     "SIDES",
@@ -180,6 +185,56 @@ class Material:
 
 
 @dataclass(frozen=True)
+class Circle:
+    """A circular zone: the closed disc of ``radius`` about ``center`` (m)."""
+
+    center: tuple[float, float]
+    radius: float
+
+    def __post_init__(self) -> None:
+        try:
+            cx, cy = self.center
+        except (TypeError, ValueError):
+            raise ValueError(f"circle.center must be [x, y], got {self.center!r}") from None
+        object.__setattr__(
+            self, "center", (_number("circle.center", cx), _number("circle.center", cy))
+        )
+        if not _number("circle.radius", self.radius) > 0.0:
+            raise ValueError(f"circle.radius must be > 0 m, got {self.radius!r}")
+        object.__setattr__(self, "radius", float(self.radius))
+
+
+@dataclass(frozen=True)
+class Polygon:
+    """A polygonal zone: the closed simple polygon of ``vertices`` (m), at least three."""
+
+    vertices: tuple[tuple[float, float], ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "vertices", _polygon("polygon", self.vertices))
+
+
+def _polygon(name: str, value: Any) -> tuple[tuple[float, float], ...]:
+    """A simple polygon of at least three vertices [[x, y], ...] with a non-zero area."""
+    if not isinstance(value, list | tuple) or len(value) < 3:
+        raise ValueError(f"{name} must be a list of at least 3 points [[x, y], ...], got {value!r}")
+    vertices = []
+    for point in value:
+        if not isinstance(point, list | tuple) or len(point) != 2:
+            raise ValueError(f"{name}: each vertex must be a point [x, y], got {point!r}")
+        vertices.append((_number(name, point[0]), _number(name, point[1])))
+    if not is_simple(vertices):
+        raise ValueError(
+            f"{name} must be a simple polygon (no repeated vertex, no self-intersection), "
+            f"got {value!r}"
+        )
+    size = float(np.ptp(np.asarray(vertices), axis=0).max())
+    if abs(polygon_area(vertices)) <= 1e-12 * size * size:
+        raise ValueError(f"{name} has no area (collinear vertices), got {value!r}")
+    return tuple(vertices)
+
+
+@dataclass(frozen=True)
 class EdgeSpec:
     r"""Conditions on one edge part.
 
@@ -197,6 +252,8 @@ class EdgeSpec:
             counter-clockwise tangent; a number or a pair, as ``normal_stress``.
         tag: Facet tag of this edge in a user-supplied mesh; ``None`` for the
             rectangle (tags 1..4 in :data:`EDGE_NAMES` order).
+        segments: The outline segments forming this boundary part (segment k runs from
+            vertex k to vertex k + 1), for a plate given by its ``outline``.
     """
 
     name: str
@@ -205,15 +262,28 @@ class EdgeSpec:
     normal_stress: float | tuple[float, float] = 0.0
     shear_stress: float | tuple[float, float] = 0.0
     tag: int | None = None
+    segments: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         where = f"edges.{self.name}"
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"edge names must be non-empty strings, got {self.name!r}")
         _choice(f"{where}.support", self.support, BENDING_SUPPORTS)
         _choice(f"{where}.inplane", self.inplane, INPLANE_SUPPORTS)
         for name in ("normal_stress", "shear_stress"):
             object.__setattr__(self, name, _stress(f"{where}.{name}", getattr(self, name)))
         if self.tag is not None:
             _integer(f"{where}.tag", self.tag, 0)
+        if self.segments is not None:
+            if not isinstance(self.segments, list | tuple) or not self.segments:
+                raise ValueError(
+                    f"{where}.segments must be a non-empty list of outline segment numbers "
+                    f"[k, ...], got {self.segments!r}"
+                )
+            segments = tuple(_integer(f"{where}.segments", k, 0) for k in self.segments)
+            if len(set(segments)) != len(segments):
+                raise ValueError(f"{where}.segments repeats a segment: {list(segments)}")
+            object.__setattr__(self, "segments", segments)
 
     @property
     def loaded(self) -> bool:
@@ -254,20 +324,45 @@ def paper_edges() -> tuple[EdgeSpec, ...]:
 class PlateSpec:
     """Geometry and edge conditions of the plate.
 
+    The plate is the rectangle of ``corners`` (a structured mesh), or, meshed by gmsh
+    with quadrilaterals, the polygon ``outline``, the rectangle or the outline with
+    ``holes``, or the plate of a gmsh ``file``.
+
     Args:
-        corners: Opposite corners ``((x0, y0), (x1, y1))`` of the rectangle (m).
+        corners: Opposite corners ``((x0, y0), (x1, y1))`` of the rectangle (m); for an
+            outline, its bounding box (set from it); for a file, its bounding box once
+            meshed.
         thickness: Plate thickness t = 2 epsilon (m), > 0.
-        edges: One :class:`EdgeSpec` per edge part.
+        edges: One :class:`EdgeSpec` per edge part: the rectangle's are named as in
+            :data:`EDGE_NAMES`, an outline's parts by their ``segments``, a file's by
+            its physical groups of dimension 1; the part ``holes`` is the holes'
+            boundary. Boundary parts not named are free.
+        outline: A simple polygon [(x, y), ...] (m), at least three vertices; segment k
+            runs from vertex k to vertex k + 1 (the last back to the first).
+        holes: :class:`Circle` or :class:`Polygon` holes inside the plate, disjoint.
+        file: A gmsh ``.geo`` (meshed with quadrilaterals) or ``.msh`` (its
+            quadrilaterals) file with a physical surface and named physical curves.
     """
 
     corners: tuple[tuple[float, float], tuple[float, float]] = ((-0.1, -0.05), (0.1, 0.05))
     thickness: float = 0.006
     edges: tuple[EdgeSpec, ...] = field(default_factory=paper_edges)
+    outline: tuple[tuple[float, float], ...] | None = None
+    holes: tuple[Circle | Polygon, ...] = ()
+    file: str | None = None
 
     def __post_init__(self) -> None:
         if not _number("plate.thickness", self.thickness) > 0.0:
             raise ValueError(f"plate.thickness must be > 0 m, got {self.thickness!r}")
         object.__setattr__(self, "thickness", float(self.thickness))
+        if self.outline is not None:
+            outline = _polygon("plate.outline", self.outline)
+            object.__setattr__(self, "outline", outline)
+            v = np.asarray(outline)
+            lo, hi = v.min(axis=0), v.max(axis=0)
+            object.__setattr__(
+                self, "corners", ((float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1])))
+            )
         try:
             (x0, y0), (x1, y1) = self.corners
         except (TypeError, ValueError):
@@ -288,6 +383,111 @@ class PlateSpec:
         names = [e.name for e in self.edges]
         if len(set(names)) != len(names):
             raise ValueError(f"plate.edges: duplicate edge names {names}")
+        self._check_file()
+        self._check_holes()
+        self._check_edges()
+
+    def _check_file(self) -> None:
+        if self.file is None:
+            return
+        if not isinstance(self.file, str) or Path(self.file).suffix.lower() not in (
+            ".geo",
+            ".msh",
+        ):
+            raise ValueError(f"plate.file must be a gmsh .geo or .msh file, got {self.file!r}")
+        if self.outline is not None or self.holes:
+            raise ValueError("plate.file: give a file, or an outline and holes, not both")
+        if not Path(self.file).is_file():
+            raise ValueError(f"plate.file: no such file {self.file!r}")
+
+    def _check_holes(self) -> None:
+        holes = tuple(self.holes)
+        object.__setattr__(self, "holes", holes)
+        outer = self.boundary
+        for k, hole in enumerate(holes):
+            where = f"plate.holes[{k}]"
+            if isinstance(hole, Circle):
+                center = np.array([hole.center])
+                inside = (
+                    bool(points_in_polygon(center, outer)[0])
+                    and float(distance_to_polygon(center, outer)[0]) > hole.radius
+                )
+            elif isinstance(hole, Polygon):
+                inside = polygon_inside(hole.vertices, outer)
+            else:
+                raise ValueError(f"{where} must be a Circle or a Polygon, got {hole!r}")
+            if not inside:
+                raise ValueError(f"{where} must lie inside the plate, without touching its edge")
+            for j in range(k):
+                if not _disjoint(holes[j], hole):
+                    raise ValueError(f"plate.holes[{j}] and {where} overlap or touch")
+
+    def _check_edges(self) -> None:
+        count = len(self.outline) if self.outline is not None else 0
+        used: dict[int, str] = {}
+        for e in self.edges:
+            where = f"edges.{e.name}"
+            if e.name == HOLES and e.tag is None:
+                if not self.holes:
+                    raise ValueError(f"{where}: the plate has no holes (plate.holes)")
+                if e.segments is not None:
+                    raise ValueError(f"{where}: the holes' boundary takes no segments")
+                if not e.uniform:
+                    raise ValueError(
+                        f"{where}: a linear [start, end] stress needs a straight edge; give "
+                        "the holes a number"
+                    )
+                continue
+            if e.segments is not None:
+                if self.outline is None:
+                    raise ValueError(
+                        f"{where}.segments names segments of plate.outline, which this "
+                        "plate does not have"
+                    )
+                for k in e.segments:
+                    if k >= count:
+                        raise ValueError(
+                            f"{where}.segments: {k} is not a segment of the outline (0 to "
+                            f"{count - 1}: segment k runs from vertex k to vertex k + 1)"
+                        )
+                    if k in used:
+                        raise ValueError(
+                            f"{where}.segments: segment {k} is already in edges.{used[k]}"
+                        )
+                    used[k] = e.name
+            elif self.outline is not None and e.tag is None:
+                raise ValueError(
+                    f"{where}: a plate given by its outline names its boundary parts by "
+                    f"segments = [k, ...] (outline segments 0 to {count - 1}), or "
+                    f"{HOLES!r} for the holes"
+                )
+
+    @property
+    def meshed_by_gmsh(self) -> bool:
+        """Whether gmsh meshes the plate (an outline, holes or a file)."""
+        return self.outline is not None or bool(self.holes) or self.file is not None
+
+    @property
+    def boundary(self) -> tuple[tuple[float, float], ...]:
+        """The outer boundary as a polygon: the outline, or the rectangle's four corners.
+
+        For a file, the bounding box.
+        """
+        if self.outline is not None:
+            return self.outline
+        (x0, y0), (x1, y1) = self.corners
+        return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+
+    @property
+    def area(self) -> float:
+        """The plate's area (m^2): the outer boundary's less the holes' (a file: its box)."""
+        total = abs(polygon_area(self.boundary))
+        for hole in self.holes:
+            if isinstance(hole, Circle):
+                total -= math.pi * hole.radius**2
+            else:
+                total -= abs(polygon_area(hole.vertices))
+        return total
 
     @property
     def length(self) -> float:
@@ -347,54 +547,22 @@ class MeshSpec:
         return 3 * (self.nx + 1) * (self.ny + 1)
 
 
-@dataclass(frozen=True)
-class Circle:
-    """A circular zone: the closed disc of ``radius`` about ``center`` (m)."""
-
-    center: tuple[float, float]
-    radius: float
-
-    def __post_init__(self) -> None:
-        try:
-            cx, cy = self.center
-        except (TypeError, ValueError):
-            raise ValueError(f"circle.center must be [x, y], got {self.center!r}") from None
-        object.__setattr__(
-            self, "center", (_number("circle.center", cx), _number("circle.center", cy))
-        )
-        if not _number("circle.radius", self.radius) > 0.0:
-            raise ValueError(f"circle.radius must be > 0 m, got {self.radius!r}")
-        object.__setattr__(self, "radius", float(self.radius))
+def _disjoint(a: Circle | Polygon, b: Circle | Polygon) -> bool:
+    """Whether two holes neither overlap nor touch (a circle as a 256-gon, to 1e-4 r)."""
+    if isinstance(a, Circle) and isinstance(b, Circle):
+        return math.dist(a.center, b.center) > a.radius + b.radius
+    pa, pb = (_hole_polygon(h) for h in (a, b))
+    return polygons_disjoint(pa, pb)
 
 
-@dataclass(frozen=True)
-class Polygon:
-    """A polygonal zone: the closed simple polygon of ``vertices`` (m), at least three."""
-
-    vertices: tuple[tuple[float, float], ...]
-
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "vertices", _polygon("polygon", self.vertices))
+def _hole_polygon(hole: Circle | Polygon) -> npt.NDArray[np.float64]:
+    if isinstance(hole, Circle):
+        return circle_points(hole.center, hole.radius, 256)
+    return np.asarray(hole.vertices, dtype=float)
 
 
-def _polygon(name: str, value: Any) -> tuple[tuple[float, float], ...]:
-    """A simple polygon of at least three vertices [[x, y], ...] with a non-zero area."""
-    if not isinstance(value, list | tuple) or len(value) < 3:
-        raise ValueError(f"{name} must be a list of at least 3 points [[x, y], ...], got {value!r}")
-    vertices = []
-    for point in value:
-        if not isinstance(point, list | tuple) or len(point) != 2:
-            raise ValueError(f"{name}: each vertex must be a point [x, y], got {point!r}")
-        vertices.append((_number(name, point[0]), _number(name, point[1])))
-    if not is_simple(vertices):
-        raise ValueError(
-            f"{name} must be a simple polygon (no repeated vertex, no self-intersection), "
-            f"got {value!r}"
-        )
-    size = float(np.ptp(np.asarray(vertices), axis=0).max())
-    if abs(polygon_area(vertices)) <= 1e-12 * size * size:
-        raise ValueError(f"{name} has no area (collinear vertices), got {value!r}")
-    return tuple(vertices)
+#: Name of the holes' boundary part in ``[edges.*]``.
+HOLES = "holes"
 
 
 #: Sides of an obstacle: "above" (on the +w side: w <= 0 in its zone), "below" (w >= 0);
@@ -629,6 +797,15 @@ class ProblemSpec:
             raise ValueError(f"name must be a string, got {self.name!r}")
         _choice("units", self.units, tuple(UNITS))
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
+        plate = self.plate
+        if plate.meshed_by_gmsh and self.mesh.size is None:
+            if plate.file is None:
+                raise ValueError(
+                    "mesh.size: a plate meshed by gmsh (outline or holes) needs [mesh] size = "
+                    "h, the characteristic cell size (m)"
+                )
+        if plate.file is not None and plate.file.lower().endswith(".msh") and self.mesh.size:
+            raise ValueError("mesh.size: a .msh file is meshed already; leave size out")
         if self.obstacle is not None and self.obstacles:
             raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
         for k, o in enumerate(self.obstacles):
@@ -696,7 +873,12 @@ class ProblemSpec:
         return replace(self, obstacle=None, obstacles=())
 
     def with_mesh(self, nx: int, ny: int) -> ProblemSpec:
-        """Copy with another mesh resolution."""
+        """Copy with another mesh resolution (the structured rectangle only)."""
+        if self.plate.meshed_by_gmsh:
+            raise ValueError(
+                "nx, ny (--nx, --ny) set the structured rectangle's cells; a plate meshed by "
+                "gmsh takes [mesh] size = h"
+            )
         return replace(self, mesh=MeshSpec(nx, ny))
 
     def with_solver(self, **changes: Any) -> ProblemSpec:
@@ -755,6 +937,22 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
         if isinstance(out.get(table), dict) and key in out[table]:
             factor = (length**pl * stress**ps) ** sign
             out[table][key] = _scaled(out[table][key], factor, f"{table}.{key}")
+    plate = out.get("plate")
+    if isinstance(plate, dict):
+        if "outline" in plate:
+            plate["outline"] = _scaled(plate["outline"], length**sign, "plate.outline")
+        if isinstance(plate.get("holes"), list):
+            plate["holes"] = [
+                {
+                    k: _scaled(v, length**sign, f"plate.holes[{j}].{k}")
+                    if k in ("center", "radius", "outline")
+                    else v
+                    for k, v in hole.items()
+                }
+                if isinstance(hole, Mapping)
+                else hole
+                for j, hole in enumerate(plate["holes"])
+            ]
     if isinstance(out.get("obstacle"), dict):
         out["obstacle"] = _obstacle_to_si(out["obstacle"], "obstacle", length**sign, stress**sign)
     if isinstance(out.get("obstacles"), list):
@@ -794,6 +992,29 @@ def _obstacle_to_si(
 OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "foundation_stiffness", "tolerance")
 
 
+def _holes(tables: Any) -> tuple[Circle | Polygon, ...]:
+    """``[[plate.holes]]`` tables: center and radius (a circle) or outline (a polygon)."""
+    if not isinstance(tables, list):
+        raise ValueError(f"plate.holes must be a list of tables ([[plate.holes]]), got {tables!r}")
+    holes: list[Circle | Polygon] = []
+    for k, table in enumerate(tables):
+        where = f"plate.holes[{k}]"
+        kw = _take(table, ("center", "radius", "outline"), where)
+        if set(kw) == {"outline"}:
+            holes.append(Polygon(_polygon(f"{where}.outline", kw["outline"])))
+        elif set(kw) == {"center", "radius"}:
+            try:
+                holes.append(Circle(kw["center"], kw["radius"]))
+            except ValueError as err:
+                raise ValueError(f"{where}.{err}") from None
+        else:
+            raise ValueError(
+                f"[{where}] needs center = [x, y] and radius = r (a circle), or outline = "
+                f"[[x, y], ...] (a polygon); got {sorted(kw)}"
+            )
+    return tuple(holes)
+
+
 def _obstacle_from_table(table: Any, where: str) -> ObstacleSpec:
     """An :class:`ObstacleSpec` from its table; messages name ``where`` (e.g. obstacles[1])."""
     kw = _take(table, OBSTACLE_KEYS, where)
@@ -820,6 +1041,26 @@ def _obstacle_from_table(table: Any, where: str) -> ObstacleSpec:
         elif message.startswith("circle."):
             message = f"{where}.{message}"
         raise ValueError(message) from None
+
+
+def _plate_table(plate: PlateSpec) -> dict[str, Any]:
+    """The file form of the plate."""
+    out: dict[str, Any] = {"thickness": plate.thickness}
+    if plate.file is not None:
+        out["file"] = plate.file
+    elif plate.outline is not None:
+        out["outline"] = [list(v) for v in plate.outline]
+    else:
+        out["corners"] = [list(c) for c in plate.corners]
+    holes: list[dict[str, Any]] = []
+    for hole in plate.holes:
+        if isinstance(hole, Circle):
+            holes.append({"center": list(hole.center), "radius": hole.radius})
+        else:
+            holes.append({"outline": [list(v) for v in hole.vertices]})
+    if holes:
+        out["holes"] = holes
+    return out
 
 
 def _obstacle_table(obstacle: ObstacleSpec) -> dict[str, Any]:
@@ -864,9 +1105,24 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     )
     units = _choice("units", top.get("units", "SI"), tuple(UNITS))
     top = _to_si(top, units)
-    plate_kw = _take(top.get("plate", {}), ("corners", "thickness"), "plate")
-    edge_tables = _take(top.get("edges", {}), EDGE_NAMES, "edges")
-    edges = {e.name: e for e in paper_edges()}
+    plate_kw = _take(
+        top.get("plate", {}), ("corners", "thickness", "outline", "holes", "file"), "plate"
+    )
+    gmsh_plate = any(key in plate_kw for key in ("outline", "file"))
+    if gmsh_plate and "corners" in plate_kw:
+        raise ValueError(
+            "[plate]: give corners (a rectangle), or outline (a polygon) or file (a gmsh "
+            "file), not both"
+        )
+    if "holes" in plate_kw:
+        plate_kw["holes"] = _holes(plate_kw["holes"])
+    given = top.get("edges", {})
+    if gmsh_plate:  # a file's or an outline's part names are checked by PlateSpec
+        names = tuple(given) if isinstance(given, Mapping) else ()
+    else:
+        names = (*EDGE_NAMES, HOLES) if "holes" in plate_kw else EDGE_NAMES
+    edge_tables = _take(given, names, "edges")
+    edges = {} if gmsh_plate else {e.name: e for e in paper_edges()}
     load_keys = ("normal_stress", "shear_stress")
     loads_given = any(
         key in table for table in edge_tables.values() if isinstance(table, Mapping)
@@ -874,9 +1130,11 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     )  # fmt: skip
     if loads_given:
         edges = {n: replace(e, normal_stress=0.0, shear_stress=0.0) for n, e in edges.items()}
+    edge_keys = ("support", "inplane", "normal_stress", "shear_stress", "segments")
     for edge_name, edge_table in edge_tables.items():
-        kw = _take(edge_table, _names(EdgeSpec)[1:-1], f"edges.{edge_name}")
-        edges[edge_name] = replace(edges[edge_name], **kw)
+        kw = _take(edge_table, edge_keys, f"edges.{edge_name}")
+        edge = edges.get(edge_name, EdgeSpec(edge_name))
+        edges[edge_name] = replace(edge, **kw)
     plate = PlateSpec(**plate_kw, edges=tuple(edges.values()))
     material_kw = _take(top.get("material", {"E": 1.0e9, "nu": 0.3}), _names(Material), "material")
     for key in ("E", "nu"):
@@ -884,7 +1142,13 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
             raise ValueError(f"[material] needs {key!r}")
     material = Material(**material_kw)
     mesh_kw = _take(top.get("mesh", {}), _names(MeshSpec), "mesh")
-    if "size" in mesh_kw:
+    if plate.meshed_by_gmsh:
+        if "nx" in mesh_kw or "ny" in mesh_kw:
+            raise ValueError(
+                "[mesh]: a plate meshed by gmsh (outline, holes or file) takes size = h (the "
+                "characteristic cell size), not nx and ny"
+            )
+    elif "size" in mesh_kw:
         if "nx" in mesh_kw or "ny" in mesh_kw:
             raise ValueError("[mesh]: give size (a cell size) or nx and ny, not both")
         mesh_kw["nx"], mesh_kw["ny"] = MeshSpec.cells_for(
@@ -938,7 +1202,7 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
     out: dict[str, Any] = {
         "name": spec.name,
         "units": "SI",
-        "plate": {"corners": [list(c) for c in plate.corners], "thickness": plate.thickness},
+        "plate": _plate_table(plate),
         "material": {
             k: v for k, v in vars(spec.material).items() if v is not None
         },  # tuples become lists in JSON/TOML
@@ -949,9 +1213,16 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
                 "normal_stress": stress_value(e.normal_stress),
                 "shear_stress": stress_value(e.shear_stress),
             }
+            | ({} if e.segments is None else {"segments": list(e.segments)})
             for e in plate.edges
         },
-        "mesh": {"nx": mesh.nx, "ny": mesh.ny} if mesh.size is None else {"size": mesh.size},
+        "mesh": (
+            {"size": mesh.size}
+            if mesh.size is not None
+            else {}
+            if plate.meshed_by_gmsh
+            else {"nx": mesh.nx, "ny": mesh.ny}
+        ),
         "solver": dict(vars(spec.solver)),
     }
     if spec.obstacle is not None:
@@ -989,6 +1260,10 @@ def load_toml(path: str | Path) -> ProblemSpec:
         ) from None
     except tomllib.TOMLDecodeError as err:
         raise ValueError(f"{path}: invalid TOML: {err}") from None
+    plate = data.get("plate")
+    if isinstance(plate, dict) and isinstance(plate.get("file"), str):
+        # A gmsh file is found next to the problem file.
+        plate["file"] = str((path.parent / plate["file"]).resolve())
     try:
         return problem_from_dict(data, name=path.stem)
     except ValueError as err:

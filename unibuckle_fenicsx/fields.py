@@ -54,8 +54,8 @@ def zone_box(
 def zone_outlines(spec: ProblemSpec) -> list[tuple[npt.NDArray[np.float64], str]]:
     """Outline (n, 2), closed implicitly, and side of every obstacle zone, for drawing.
 
-    "all" gives the plate's outline (its bounding box), a circle 96 points; a predicate
-    zone has no outline and is left out.
+    "all" gives the plate's outer boundary (its outline, or its bounding box), a circle
+    96 points; a predicate zone has no outline and is left out.
     """
     from unibuckle_fenicsx.config import Circle, Polygon
     from unibuckle_fenicsx.geometry import circle_points
@@ -64,8 +64,7 @@ def zone_outlines(spec: ProblemSpec) -> list[tuple[npt.NDArray[np.float64], str]
     for obstacle in spec.all_obstacles:
         zone = obstacle.zone
         if isinstance(zone, str):
-            (x0, y0), (x1, y1) = spec.plate.corners
-            xy = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float)
+            xy = np.asarray(spec.plate.boundary, dtype=float)
         elif isinstance(zone, Polygon):
             xy = np.asarray(zone.vertices, dtype=float)
         elif isinstance(zone, Circle):

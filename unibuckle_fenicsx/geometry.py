@@ -19,6 +19,7 @@ __all__ = [
     "points_in_polygon",
     "polygon_area",
     "polygon_inside",
+    "polygons_disjoint",
 ]
 
 Vertices = Sequence[Sequence[float]] | npt.NDArray[np.float64]
@@ -149,3 +150,18 @@ def circle_points(center: Sequence[float], radius: float, n: int = 96) -> npt.ND
     """``n`` points on the circle (counter-clockwise), for drawing."""
     phi = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
     return np.column_stack([center[0] + radius * np.cos(phi), center[1] + radius * np.sin(phi)])
+
+
+def polygons_disjoint(a: Vertices, b: Vertices) -> bool:
+    """Whether two polygons neither overlap, nor touch, nor contain one another."""
+    pa, pb = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    size = float(max(np.ptp(pa, axis=0).max(), np.ptp(pb, axis=0).max()))
+    if points_in_polygon(pa, pb).any() or points_in_polygon(pb, pa).any():
+        return False
+    for k in range(len(pa)):
+        for j in range(len(pb)):
+            if _segments_cross(
+                pa[k], pa[(k + 1) % len(pa)], pb[j], pb[(j + 1) % len(pb)], 1e-12 * size
+            ):
+                return False
+    return True

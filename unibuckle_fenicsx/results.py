@@ -34,7 +34,7 @@ class BucklingResult:
         critical_force_N_per_m: N = t lambda.
         buckling_coefficient_k: k = N b^2 / (pi^2 D), b = plate width.
         dofs: Global DOF count of (w, theta).
-        mesh: [nx, ny] (a user-supplied mesh: [number of cells]).
+        mesh: [nx, ny] (a user-supplied or gmsh mesh: [number of cells]).
         eigensolves: Linear eigen solves, including the free one.
         wall_time_s: Wall time of the whole solve (set-up included).
         constrained_nodes: i, nodes in the closed obstacle zone with free deflection.
@@ -116,7 +116,7 @@ class BucklingResult:
             dofs=problem.model.num_dofs,
             mesh=(
                 [problem.mesh.topology.index_map(2).size_global]
-                if problem.custom_mesh
+                if not problem.structured
                 else [spec.mesh.nx, spec.mesh.ny]
             ),
             eigensolves=1 + (0 if solution is None else solution.eigensolves),

@@ -264,7 +264,7 @@ def solve_active_set(
     free_load = problem.solve_free().load
     spec = problem.spec
     details: dict[str, Any] = {"free_load": free_load}
-    structured = multilevel and not problem.custom_mesh  # coarse copies need spec.mesh
+    structured = multilevel and problem.structured  # coarse copies need spec.mesh
     levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
     coarse_solves = 0
     penalty_solves = 0  # the penalty solver has its own eigen solver
@@ -324,7 +324,7 @@ def solve_active_set(
         details["seeded_on"] = [prev.spec.mesh.nx, prev.spec.mesh.ny]
     else:
         runs = _multi_seed(problem, max_iterations)
-        details["seeded_on"] = [spec.mesh.nx, spec.mesh.ny]
+        details["seeded_on"] = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
     if prev is not None:
         prev.destroy()
 

@@ -58,7 +58,13 @@ from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpe
 from unibuckle_fenicsx.contact import ContactSetManager
 from unibuckle_fenicsx.eigen import Owner, release, set_options
 from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, shear_stiffness
-from unibuckle_fenicsx.mesh import create_plate_mesh, edge_normal_axis, edge_tag
+from unibuckle_fenicsx.mesh import (
+    build_plate_mesh,
+    edge_facets,
+    edge_normal_axis,
+    edge_tag,
+    edge_tags,
+)
 from unibuckle_fenicsx.plate.model import edge_support_bcs, mitc_shear_matrix
 from unibuckle_fenicsx.plate.spaces import MixedDofs
 from unibuckle_fenicsx.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
@@ -202,7 +208,8 @@ class VonKarmanPlate(MixedDofs, Owner):
         self._displacement_axis = displacement_axis(spec.plate, control)
 
         if mesh is None or facet_tags is None:
-            mesh, facet_tags = create_plate_mesh(spec.plate, spec.mesh, comm)
+            mesh, facet_tags, plate = build_plate_mesh(spec.plate, spec.mesh, comm)
+            self.plate = plate
         self.mesh, self.facet_tags = mesh, facet_tags
         msh = self.mesh
         self.comm = msh.comm
@@ -216,7 +223,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         self.Vw, map_w = self.W.sub(W_SUB).collapse()
         self.w_dofs = np.asarray(map_w[0], dtype=np.int32)  # Vw dof -> W dof
         self.bending_bcs = edge_support_bcs(
-            self.W, self.facet_tags, spec.plate, w_sub=W_SUB, theta_sub=THETA_SUB
+            self.W, self.facet_tags, self.plate, w_sub=W_SUB, theta_sub=THETA_SUB
         )
         self.bc_dofs = np.unique(
             np.concatenate(
@@ -251,19 +258,19 @@ class VonKarmanPlate(MixedDofs, Owner):
         Pi = energy / self.energy_scale * ufl.dx
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
         n = ufl.FacetNormal(msh)
-        tractions = [edge_traction(msh, self.facet_tags, spec.plate, e) for e in loaded]
+        tractions = [
+            (edge_traction(msh, self.facet_tags, self.plate, e, tag), tag)
+            for e in loaded
+            for tag in edge_tags(self.plate, e)
+        ]
         if control == "load":
-            for edge, traction in zip(loaded, tractions, strict=True):
-                Pi = Pi - (self.load * t / self.energy_scale) * ufl.inner(traction, u) * ds(
-                    edge_tag(spec.plate, edge)
-                )
+            for traction, tag in tractions:
+                Pi = Pi - (self.load * t / self.energy_scale) * ufl.inner(traction, u) * ds(tag)
         v, dx_ = ufl.TestFunction(self.W), ufl.TrialFunction(self.W)
         # The edge loads' vector per unit lambda: the scale of the residual.
         unit_load = sum(
-            (t / self.energy_scale)
-            * ufl.inner(traction, ufl.split(v)[U_SUB])
-            * ds(edge_tag(spec.plate, e))
-            for e, traction in zip(loaded, tractions, strict=True)
+            (t / self.energy_scale) * ufl.inner(traction, ufl.split(v)[U_SUB]) * ds(tag)
+            for traction, tag in tractions
         )
         f = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(unit_load))
         _add_ghosts(f)
@@ -280,9 +287,9 @@ class VonKarmanPlate(MixedDofs, Owner):
         self._edge_forms = [
             (
                 dolfinx.fem.form(
-                    t * ufl.inner(ufl.split(self.x)[U_SUB], n) * ds(edge_tag(spec.plate, e))
+                    t * ufl.inner(ufl.split(self.x)[U_SUB], n) * ds(edge_tags(self.plate, e))
                 ),
-                _scalar(dolfinx.fem.form(1.0 * ds(edge_tag(spec.plate, e))), self.comm),
+                _scalar(dolfinx.fem.form(1.0 * ds(edge_tags(self.plate, e))), self.comm),
                 e,
             )
             for e in loaded
@@ -347,9 +354,12 @@ class VonKarmanPlate(MixedDofs, Owner):
         bcs: list[dolfinx.fem.DirichletBC] = []
         held = {0: False, 1: False}  # a component held along an edge (no translation)
 
-        def fix(edge: EdgeSpec, c: int, value: float | dolfinx.fem.Constant) -> None:
+        def fix(
+            edge: EdgeSpec, c: int, value: float | dolfinx.fem.Constant, tag: int | None = None
+        ) -> None:
             Vc, _ = U.sub(c).collapse()
-            facets = self.facet_tags.find(edge_tag(plate, edge))
+            tags = edge_tags(plate, edge) if tag is None else (tag,)
+            facets = edge_facets(self.facet_tags, tags)
             dofs = dolfinx.fem.locate_dofs_topological((U.sub(c), Vc), fdim, facets)
             bcs.append(dolfinx.fem.dirichletbc(value, dofs[0], U.sub(c)))
 
@@ -366,12 +376,13 @@ class VonKarmanPlate(MixedDofs, Owner):
                 continue
             if e.inplane == "free":
                 continue
-            components: tuple[int, ...] = (0, 1)
-            if e.inplane == "roller":
-                components = (edge_normal_axis(msh, self.facet_tags, edge_tag(plate, e), e.name),)
-            for c in components:
-                fix(e, c, 0.0)
-                held[c] = True
+            for tag in edge_tags(plate, e):
+                components: tuple[int, ...] = (0, 1)
+                if e.inplane == "roller":
+                    components = (edge_normal_axis(msh, self.facet_tags, tag, e.name),)
+                for c in components:
+                    fix(e, c, 0.0, tag)
+                    held[c] = True
         if axis is None and not bcs:
             bcs += pin_rigid_motions(U, msh)
         elif axis is not None and not held[1 - axis]:

@@ -14,7 +14,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.config import Material, PlateSpec
 from unibuckle_fenicsx.eigen import Owner, release
 from unibuckle_fenicsx.materials import bending_voigt, shear_stiffness
-from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tag
+from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tags
 from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_form
 from unibuckle_fenicsx.plate.spaces import (
     MixedDofs,
@@ -170,22 +170,22 @@ def edge_support_bcs(
     for e in plate.edges:
         if e.support == "free":
             continue
-        tag = edge_tag(plate, e)
-        facets = facet_tags.find(tag)
-        subs: list[tuple[int, ...]] = [(w_sub,)]
-        if e.support == "clamped":
-            subs += [(theta_sub, 0), (theta_sub, 1)]
-        elif e.support == "simply_supported":
-            # theta . s = 0: the rotation component along the edge direction.
-            normal = edge_normal_axis(msh, facet_tags, tag, e.name)
-            subs.append((theta_sub, 1 - normal))
-        for path in subs:
-            sub = W
-            for i in path:
-                sub = sub.sub(i)
-            Vc, _ = sub.collapse()
-            dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
-            bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
+        for tag in edge_tags(plate, e):
+            facets = facet_tags.find(tag)
+            subs: list[tuple[int, ...]] = [(w_sub,)]
+            if e.support == "clamped":
+                subs += [(theta_sub, 0), (theta_sub, 1)]
+            elif e.support == "simply_supported":
+                # theta . s = 0: the rotation component along the edge (each segment's).
+                normal = edge_normal_axis(msh, facet_tags, tag, e.name)
+                subs.append((theta_sub, 1 - normal))
+            for path in subs:
+                sub = W
+                for i in path:
+                    sub = sub.sub(i)
+                Vc, _ = sub.collapse()
+                dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
+                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
     return bcs
 
 
