@@ -19,6 +19,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.problem import BucklingProblem
 
 __all__ = [
+    "mesh_triangles",
     "mirror_to_match",
     "nodal_deflection",
     "problem_zone",
@@ -174,3 +175,23 @@ def mirror_to_match(
     if mirrored > direct:
         return xm, wm, True
     return x, w, False
+
+
+def mesh_triangles(
+    problem: BucklingProblem, u: dolfinx.fem.Function
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.int32]]:
+    """Node coordinates (n, 2), deflection (n,) and triangles (2 per quadrilateral, (m, 3)).
+
+    The plate's own cells, split along a diagonal, for contour plots that leave holes and
+    re-entrant corners empty (a triangulation of the nodes alone would fill them).
+    Serial problems only (``comm.size == 1``).
+    """
+    if problem.comm.size != 1:
+        raise RuntimeError("mesh_triangles draws serial problems only (comm.size == 1)")
+    w, _ = problem.model.split(u)
+    Vw = w.function_space
+    xy = Vw.tabulate_dof_coordinates()[:, :2]
+    cells = Vw.dofmap.list  # Q1 on quadrilaterals: DOLFINx's tensor order 0, 1, 2, 3
+    quads = cells[:, [0, 1, 3, 2]]  # counter-clockwise
+    triangles = np.vstack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]]).astype(np.int32)
+    return xy, w.x.array.real.copy(), triangles
