@@ -280,7 +280,7 @@ def test_one_cell_and_huge_meshes_are_refused(capsys, monkeypatch):
     def no_mesh(*args, **kwargs):
         raise AssertionError("the mesh was built")
 
-    monkeypatch.setattr(problem_module, "create_plate_mesh", no_mesh)
+    monkeypatch.setattr(problem_module, "build_plate_mesh", no_mesh)
     assert main(["solve", "--case", "free", "--nx", "100000", "--ny", "100000"]) == 2
     err = capsys.readouterr().err
     assert "30,000,600,003 DOFs" in err and "GB" in err and "available" in err, err

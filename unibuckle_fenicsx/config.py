@@ -1086,10 +1086,12 @@ def _obstacle_table(obstacle: ObstacleSpec) -> dict[str, Any]:
 def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSpec:
     """Build a :class:`ProblemSpec` from a TOML-shaped mapping (schema: README).
 
-    Tables: ``[plate]`` (corners, thickness), ``[material]`` (E, nu, shear_correction,
+    Tables: ``[plate]`` (corners, or outline, or file; thickness; ``[[plate.holes]]``
+    with center and radius, or outline), ``[material]`` (E, nu, shear_correction,
     membrane_voigt, bending_voigt), ``[edges.<name>]`` (support, inplane,
-    normal_stress, shear_stress), ``[mesh]`` (nx, ny; or size, a cell size), ``[obstacle]`` (zone,
-    polygon or circle, side, tolerance; absent = free plate) or several ``[[obstacles]]``
+    normal_stress, shear_stress, segments), ``[mesh]`` (nx, ny; or size, a cell size),
+    ``[obstacle]`` (zone, polygon or circle, side, foundation_stiffness, tolerance;
+    absent = free plate) or several ``[[obstacles]]``
     with the same keys, ``[solver]`` (the :class:`SolverSpec` fields);
     top-level ``name`` and ``units``. Unknown tables or keys raise ``ValueError``.
 
