@@ -38,6 +38,7 @@ DEMOS = (
     "demo_garland.py",  # figures/garland/; no row in the table
     "study_penalty.py",  # figures/penalty_*.png; no row in the table
     "demo_nonlinear.py",  # figures/nonlinear/; no row in the table
+    "demo_realistic.py",  # figures/realistic/; no row in the table
 )
 CASES = ("free", "c1", "c2", "c3")
 COLUMNS = (

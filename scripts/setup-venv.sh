@@ -41,6 +41,13 @@ if [ ! -x "$venv/bin/python" ]; then
   "$py" -m venv "$venv"
 fi
 "$venv/bin/python" -m pip install --quiet --upgrade pip
-"$venv/bin/python" -m pip install --quiet -e '.[fenics,demo,test,lint,sdp,progress]'
+"$venv/bin/python" -m pip install --quiet -e '.[fenics,demo,test,lint,sdp,progress,gmsh]'
+if ! err=$("$venv/bin/python" -c 'import gmsh' 2>&1); then
+  # The gmsh wheel links the system's OpenGL/X11 client libraries (not X itself).
+  echo "setup: gmsh is installed but does not load: ${err##*$'\n'}" >&2
+  echo "setup: install its system libraries, e.g. 'apt-get install libglu1-mesa libxcursor1" >&2
+  echo "setup: libxft2 libxinerama1 libgl1', then rerun; plates meshed by gmsh need it" >&2
+  exit 1
+fi
 touch "$stamp"
 echo "setup: $venv ready ($("$venv/bin/python" --version))"

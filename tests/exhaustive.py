@@ -34,7 +34,8 @@ def exhaustive_minimum(
     A_{\theta w}` on the free w-DOFs; removing the w-DOFs of Z from (A, B) and condensing
     equals taking the principal submatrices of (S, B_ww). The largest eigenvalue mu of
     :math:`B_{ff} x = \mu S_{ff} x` gives :math:`\lambda = 1/\mu`; a mode is feasible
-    when, for one sign, :math:`w_k \le \tau \max|w|` on :math:`I \setminus Z`.
+    when, for one sign, :math:`s_k w_k \le \tau \max|w|` on :math:`I \setminus Z`
+    (:math:`s_k` = +1 under an obstacle above, -1 below).
 
     Returns:
         (lambda_min, or inf if no subset has a positive load; every Z with a feasible
@@ -76,7 +77,7 @@ def exhaustive_minimum(
             x[idx[c]] = X[c, :, 0]
             x /= np.abs(x).max()
             rest = np.setdiff1d(np.arange(i), z)
-            vals = x[node_pos[rest]]
+            vals = contact.signs[rest] * x[node_pos[rest]]  # oriented: <= 0 is admissible
             if rest.size == 0 or vals.max() <= tau or (-vals).max() <= tau:
                 loads.append((1.0 / mu[c, -1], z))
     if not loads:  # no subset has a positive load: the plate does not buckle
@@ -114,5 +115,5 @@ def dense_reduced_load(problem: BucklingProblem, active: tuple[int, ...]) -> flo
 
 def membrane_force_scale(spec) -> float:
     """T times the largest edge stress of ``spec`` (N/m per unit load): the size of N0."""
-    stresses = [abs(v) for e in spec.plate.edges for v in (e.normal_stress, e.shear_stress)]
+    stresses = [e.max_stress() for e in spec.plate.edges]
     return spec.plate.thickness * max(stresses)

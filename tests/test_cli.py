@@ -280,7 +280,7 @@ def test_one_cell_and_huge_meshes_are_refused(capsys, monkeypatch):
     def no_mesh(*args, **kwargs):
         raise AssertionError("the mesh was built")
 
-    monkeypatch.setattr(problem_module, "create_plate_mesh", no_mesh)
+    monkeypatch.setattr(problem_module, "build_plate_mesh", no_mesh)
     assert main(["solve", "--case", "free", "--nx", "100000", "--ny", "100000"]) == 2
     err = capsys.readouterr().err
     assert "30,000,600,003 DOFs" in err and "GB" in err and "available" in err, err
@@ -346,7 +346,7 @@ def test_json_says_what_it_solved_and_reruns(tmp_path, capsys):
     assert main(["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--json", str(out)]) == 0
     data = json.loads(out.read_text())
     assert data["input"]["mesh"] == {"nx": 8, "ny": 4}
-    assert data["input"]["obstacle"] == {"zone": [[-0.04, 0.04], [-0.02, 0.02]]}
+    assert data["input"]["obstacle"] == {"zone": [[-0.04, 0.04], [-0.02, 0.02]], "side": "above"}
     assert data["input"]["solver"]["tau"] == 1e-8  # defaults included
     for key in ("unibuckle_fenicsx", "dolfinx", "PETSc", "SLEPc", "python"):
         assert key in data["versions"], key

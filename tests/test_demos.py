@@ -45,6 +45,8 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
     pngs["nonlinear/southwell.png"] = line
     pngs["nonlinear/section_c1.png"] = line
     pngs["nonlinear/deformed_c1.png"] = (h3, w3)
+    pngs["realistic/mode.png"] = (h3, w3)  # demo_realistic
+    pngs["realistic/contact_map.png"] = line
     return pngs
 
 
@@ -68,7 +70,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for demo in (
         "demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3",
-        "demo_garland", "demo_nonlinear",
+        "demo_garland", "demo_nonlinear", "demo_realistic",
     ):  # fmt: skip
         assert f"{demo}.py: ok" in proc.stdout
     assert "lambda/lambda_free" in proc.stdout and "eigen solves" in proc.stdout

@@ -16,7 +16,7 @@ from unibuckle_fenicsx.algorithms import (
     UnilateralSolution,
     candidate_count,
 )
-from unibuckle_fenicsx.certify import Certificate, certify
+from unibuckle_fenicsx.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner
 from unibuckle_fenicsx.problem import BucklingProblem
@@ -42,6 +42,13 @@ def choose_method(
             more candidate sets than ``max_candidates``.
     """
     options = spec.solver
+    if spec.tensionless:
+        if candidate_parallel:
+            raise ValueError(
+                "--candidate-parallel splits the enumeration's candidate sets; a tensionless "
+                "foundation is solved by its spring-set iteration: drop --candidate-parallel"
+            )
+        return "foundation", "tensionless foundation: spring-set iteration"
     count = candidate_count(i)
     # 2^i in words a reader can take in (2^2581 has 777 digits).
     shown = str(count) if i <= 64 else f"10^{int(i * math.log10(2))}"
@@ -105,6 +112,10 @@ def _run_method(
         from unibuckle_fenicsx.algorithms.penalty import solve_penalty
 
         return solve_penalty(problem, problem.spec.solver.penalty)
+    if method == "foundation":
+        from unibuckle_fenicsx.algorithms.foundation import solve_foundation
+
+        return solve_foundation(problem, max_iterations=problem.spec.solver.max_iterations)
     raise ValueError(f"unknown method {method!r}")
 
 
@@ -206,7 +217,10 @@ def solve(
                 f"lambda_free = {free.load!r} Pa"
             )
         t1 = time.perf_counter()
-        certificate = certify(problem, solution)
+        if method == "foundation":
+            certificate = certify_foundation(problem, solution)
+        else:
+            certificate = certify(problem, solution)
         problem.timings["certify_s"] = time.perf_counter() - t1
         if not certificate.kkt:
             logger.warning("the %s result fails its certificate: %s", method, certificate)

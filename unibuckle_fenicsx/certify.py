@@ -40,7 +40,14 @@ from unibuckle_fenicsx.copositivity import CERTIFY_PREFIX, BoundOptions, coposit
 from unibuckle_fenicsx.eigen import SymmetricFactorization
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 
-__all__ = ["CERTIFY_PREFIX", "PROOF_GAP", "Certificate", "certify", "reduced_inertia"]
+__all__ = [
+    "CERTIFY_PREFIX",
+    "PROOF_GAP",
+    "Certificate",
+    "certify",
+    "certify_foundation",
+    "reduced_inertia",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -243,3 +250,103 @@ def certify(
         copositivity=record,
         notes=tuple(notes),
     )
+
+
+def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -> Certificate:
+    r"""Certify a critical state on a tensionless foundation (:mod:`.algorithms.foundation`).
+
+    With :math:`z_k = s_k u_k` the oriented mode at the foundation's nodes and
+    :math:`S = \{k: z_k > 0\}` the nodes pressing it, the quotient
+    :math:`R_f = (a + \sum \rho_k \max(0, z_k)^2)/b` is stationary at u when
+
+    - :math:`r_f = Au + \sum_k \rho_k \max(0, z_k) s_k e_k - \lambda Bu` vanishes
+      (relative residual :math:`\|r_f\|_2/\|Au\|_2 \le \sqrt\tau`: ``kkt``);
+    - and :math:`\lambda` is the smallest eigenvalue of the pencil
+      :math:`(A + \sum_{k\in S}\rho_k e_k e_k^T, B)` (inertia, ``smallest_of_reduced``).
+
+    Every mode is admissible on a foundation (``feasible``); ``feasibility_margin`` is
+    the largest :math:`z_k/\max|w|` (how deep the plate presses the springs) and springs
+    cannot pull (``max_contact_force`` = -inf). Bracket: :math:`[\lambda_{free}, \lambda]`;
+    proven only when it closes.
+
+    Note:
+        Collective.
+    """
+    contact = problem.contact
+    assert contact is not None and contact.stiffness is not None
+    cand = solution.candidate
+    tau = problem.tau
+    notes: list[str] = []
+    if not math.isfinite(cand.load):
+        raise ValueError("certify_foundation: the candidate has no finite load")
+    u = cand.mode.x.petsc_vec
+    z = contact.values(u) / problem.max_abs_w(u)
+    pressing = np.flatnonzero(z > 0.0).astype(np.int64)
+    r, _, au_2 = problem.residual(cand.load, u)
+    spring = u.duplicate()
+    try:
+        scale = problem.max_abs_w(u)
+        contact.scatter(contact.stiffness * np.maximum(z, 0.0) * scale, spring)
+        r.axpy(1.0, spring)
+    finally:
+        spring.destroy()
+    residual = float(r.norm()) / au_2  # type: ignore[arg-type]
+    status = solution.details.get("foundation_status", "converged")
+    kkt = residual <= math.sqrt(tau) and status == "converged"
+    if status != "converged":
+        notes.append(f"the spring-set iteration did not converge ({status})")
+    lower = min(solution.lower_bound, cand.load)
+    upper = cand.load
+    gap = (upper - lower) / upper
+    proven = bool(kkt and solution.global_optimum_proven and gap <= PROOF_GAP)
+    smallest: bool | None = None
+    if not proven:
+        sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
+        neg, _, _ = _spring_inertia(problem, pressing, sigma)
+        smallest = neg == 0
+        if not smallest:
+            notes.append(
+                f"the pencil with the springs of the pressing nodes has {neg} eigenvalue(s) "
+                "below the returned load"
+            )
+        notes.append(
+            f"tensionless foundation: {pressing.size} of {contact.size} nodes press it; a "
+            "stationary point of the spring quotient, global optimality not proven"
+        )
+    return Certificate(
+        feasible=True,
+        feasibility_margin=float(z.max()),
+        max_contact_force=-math.inf,
+        relative_residual=residual,
+        tolerance=tau,
+        kkt=bool(kkt),
+        smallest_of_reduced=smallest,
+        lower_bound=lower,
+        upper_bound=upper,
+        relative_gap=gap,
+        global_optimum_proven=proven,
+        proven_by="interlacing",
+        notes=tuple(notes),
+    )
+
+
+def _spring_inertia(
+    problem: BucklingProblem, pressing: npt.NDArray[np.int64], sigma: float
+) -> tuple[int, int, int]:
+    r"""Inertia of :math:`A + \sum_{k \in S} \rho_k e_k e_k^T - \sigma B` (collective)."""
+    contact = problem.contact
+    assert contact is not None and contact.stiffness is not None
+    K = problem.model.A.duplicate(copy=True)
+    diag = K.createVecLeft()
+    rows, nodes = contact.node_rows(pressing)
+    diag.setValues(rows.astype(PETSc.IntType), contact.stiffness[nodes])
+    diag.assemble()
+    K.setDiagonal(diag, addv=PETSc.InsertMode.ADD_VALUES)
+    diag.destroy()
+    K.axpy(-sigma, problem.model.B, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
+    factor = SymmetricFactorization(K, CERTIFY_PREFIX)
+    try:
+        return factor.inertia()
+    finally:
+        factor.destroy()
+        K.destroy()

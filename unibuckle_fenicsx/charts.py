@@ -29,7 +29,7 @@ from typing import Any
 
 import numpy as np
 
-from unibuckle_fenicsx.config import UNITS, ProblemSpec
+from unibuckle_fenicsx.config import EDGE_NAMES, UNITS, ProblemSpec
 from unibuckle_fenicsx.sweep import Variation, point_problem
 
 __all__ = ["plot_sweep", "reference_k"]
@@ -40,11 +40,15 @@ _SS = ("simply_supported", "simply_supported_soft")
 def _uniaxial_x(spec: ProblemSpec) -> bool:
     """Uniform compression of the edges x = const only."""
     e = {edge.name: edge for edge in spec.plate.edges}
+    if set(e) != set(EDGE_NAMES) or not all(edge.uniform for edge in e.values()):
+        return False
+    left, right = e["left"].normal_ends[0], e["right"].normal_ends[0]
     return (
-        e["left"].normal_stress < 0
-        and e["left"].normal_stress == e["right"].normal_stress
-        and e["bottom"].normal_stress == 0 == e["top"].normal_stress
-        and all(edge.shear_stress == 0 for edge in e.values())
+        left < 0
+        and left == right
+        and not e["bottom"].loaded
+        and not e["top"].loaded
+        and all(edge.shear_ends[0] == 0 for edge in e.values())
     )
 
 
@@ -58,7 +62,7 @@ def reference_k(spec: ProblemSpec) -> tuple[float | None, float | None, str]:
         return None, None, ""
     supports = {edge.name: edge.support for edge in spec.plate.edges}
     phi = spec.plate.length / spec.plate.width
-    whole = spec.obstacle is not None and spec.obstacle.zone == "all"
+    whole = len(spec.all_obstacles) == 1 and spec.all_obstacles[0].zone == "all"
     if all(s in _SS for s in supports.values()):
         m_max = max(1, math.ceil(phi)) + 1
         bilateral = min((m / phi + phi / m) ** 2 for m in range(1, m_max + 1))

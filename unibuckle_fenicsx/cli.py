@@ -413,7 +413,7 @@ def main(argv: Sequence[str] | None = None) -> int:
             print(f"unibuckle: warning: {flag} is ignored with --method {method}", file=sys.stderr)
     try:
         analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
-    except ValueError as err:
+    except (ValueError, ImportError) as err:  # ImportError: an extra is missing (gmsh)
         return fail(str(err))
     except (EigenSolveError, NoAdmissibleModeError) as err:
         return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
@@ -473,7 +473,7 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
         return fail(message)
     try:
         analysis = solve_nonlinear(spec, options, comm)
-    except ValueError as err:
+    except (ValueError, ImportError) as err:
         return fail(str(err))
     except (EigenSolveError, NoAdmissibleModeError, NonlinearError) as err:
         return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
@@ -557,7 +557,7 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
             ranks_per_point=args.ranks_per_point,
             progress=not args.quiet,
         )
-    except (ValueError, OSError) as err:
+    except (ValueError, OSError, ImportError) as err:
         return fail(str(err))
     if comm.rank == 0:
         from collections import Counter

@@ -25,23 +25,40 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.geometry import (
+    circle_points,
+    distance_to_polygon,
+    is_simple,
+    points_in_circle,
+    points_in_polygon,
+    polygon_area,
+    polygon_inside,
+    polygons_disjoint,
+)
+
 __all__ = [
     "BENDING_SUPPORTS",
     "EDGE_NAMES",
+    "HOLES",
     "INPLANE_SUPPORTS",
     "METHODS",
+    "SIDES",
     "UNITS",
+    "Circle",
     "EdgeSpec",
     "Material",
     "MeshSpec",
     "ObstacleSpec",
     "PlateSpec",
+    "Polygon",
     "ProblemSpec",
     "SolverSpec",
     "load_problem",
     "load_toml",
     "problem_from_dict",
     "problem_to_dict",
+    "stress_ends",
+    "stress_value",
 ]
 
 #: Edge names of a rectangular plate, in facet-tag order 1..4.
@@ -83,6 +100,25 @@ def _boolean(name: str, value: Any) -> bool:
     if not isinstance(value, bool | np.bool_):
         raise ValueError(f"{name} must be true or false, got {value!r} ({type(value).__name__})")
     return bool(value)
+
+
+def _stress(name: str, value: Any) -> float | tuple[float, float]:
+    """An edge stress: a number, or a pair ``[start, end]`` of numbers (linear along the edge)."""
+    if isinstance(value, list | tuple):
+        if len(value) != 2:
+            raise ValueError(
+                f"{name} must be a number or a pair [start, end] (linear along the edge), "
+                f"got {value!r}"
+            )
+        return (_number(name, value[0]), _number(name, value[1]))
+    return _number(name, value)
+
+
+def stress_ends(value: float | tuple[float, float]) -> tuple[float, float]:
+    """(start, end) of an edge stress: the pair itself, or the number twice."""
+    if isinstance(value, tuple):
+        return value
+    return (value, value)
 
 
 def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
@@ -149,8 +185,58 @@ class Material:
 
 
 @dataclass(frozen=True)
+class Circle:
+    """A circular zone: the closed disc of ``radius`` about ``center`` (m)."""
+
+    center: tuple[float, float]
+    radius: float
+
+    def __post_init__(self) -> None:
+        try:
+            cx, cy = self.center
+        except (TypeError, ValueError):
+            raise ValueError(f"circle.center must be [x, y], got {self.center!r}") from None
+        object.__setattr__(
+            self, "center", (_number("circle.center", cx), _number("circle.center", cy))
+        )
+        if not _number("circle.radius", self.radius) > 0.0:
+            raise ValueError(f"circle.radius must be > 0 m, got {self.radius!r}")
+        object.__setattr__(self, "radius", float(self.radius))
+
+
+@dataclass(frozen=True)
+class Polygon:
+    """A polygonal zone: the closed simple polygon of ``vertices`` (m), at least three."""
+
+    vertices: tuple[tuple[float, float], ...]
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "vertices", _polygon("polygon", self.vertices))
+
+
+def _polygon(name: str, value: Any) -> tuple[tuple[float, float], ...]:
+    """A simple polygon of at least three vertices [[x, y], ...] with a non-zero area."""
+    if not isinstance(value, list | tuple) or len(value) < 3:
+        raise ValueError(f"{name} must be a list of at least 3 points [[x, y], ...], got {value!r}")
+    vertices = []
+    for point in value:
+        if not isinstance(point, list | tuple) or len(point) != 2:
+            raise ValueError(f"{name}: each vertex must be a point [x, y], got {point!r}")
+        vertices.append((_number(name, point[0]), _number(name, point[1])))
+    if not is_simple(vertices):
+        raise ValueError(
+            f"{name} must be a simple polygon (no repeated vertex, no self-intersection), "
+            f"got {value!r}"
+        )
+    size = float(np.ptp(np.asarray(vertices), axis=0).max())
+    if abs(polygon_area(vertices)) <= 1e-12 * size * size:
+        raise ValueError(f"{name} has no area (collinear vertices), got {value!r}")
+    return tuple(vertices)
+
+
+@dataclass(frozen=True)
 class EdgeSpec:
-    """Conditions on one edge part.
+    r"""Conditions on one edge part.
 
     Args:
         name: Edge name; for the rectangle one of :data:`EDGE_NAMES`.
@@ -158,33 +244,70 @@ class EdgeSpec:
         inplane: In-plane condition for the prestress, one of :data:`INPLANE_SUPPORTS`
             ("roller" fixes the normal displacement only).
         normal_stress: Normal edge stress per unit load (Pa/Pa), tension positive;
-            the paper's compressed edges have -1.
+            the paper's compressed edges have -1. A pair ``(start, end)`` varies
+            linearly along the edge (:func:`~unibuckle_fenicsx.mesh.edge_lines` gives
+            the direction): in-plane bending is ``(1, -1)``, the stress-gradient ratio
+            of design codes is :math:`\psi` = end/start.
         shear_stress: Tangential edge stress per unit load (Pa/Pa), along the
-            counter-clockwise tangent.
+            counter-clockwise tangent; a number or a pair, as ``normal_stress``.
         tag: Facet tag of this edge in a user-supplied mesh; ``None`` for the
             rectangle (tags 1..4 in :data:`EDGE_NAMES` order).
+        segments: The outline segments forming this boundary part (segment k runs from
+            vertex k to vertex k + 1), for a plate given by its ``outline``.
     """
 
     name: str
     support: str = "simply_supported"
     inplane: str = "free"
-    normal_stress: float = 0.0
-    shear_stress: float = 0.0
+    normal_stress: float | tuple[float, float] = 0.0
+    shear_stress: float | tuple[float, float] = 0.0
     tag: int | None = None
+    segments: tuple[int, ...] | None = None
 
     def __post_init__(self) -> None:
         where = f"edges.{self.name}"
+        if not isinstance(self.name, str) or not self.name:
+            raise ValueError(f"edge names must be non-empty strings, got {self.name!r}")
         _choice(f"{where}.support", self.support, BENDING_SUPPORTS)
         _choice(f"{where}.inplane", self.inplane, INPLANE_SUPPORTS)
         for name in ("normal_stress", "shear_stress"):
-            object.__setattr__(self, name, _number(f"{where}.{name}", getattr(self, name)))
+            object.__setattr__(self, name, _stress(f"{where}.{name}", getattr(self, name)))
         if self.tag is not None:
             _integer(f"{where}.tag", self.tag, 0)
+        if self.segments is not None:
+            if not isinstance(self.segments, list | tuple) or not self.segments:
+                raise ValueError(
+                    f"{where}.segments must be a non-empty list of outline segment numbers "
+                    f"[k, ...], got {self.segments!r}"
+                )
+            segments = tuple(_integer(f"{where}.segments", k, 0) for k in self.segments)
+            if len(set(segments)) != len(segments):
+                raise ValueError(f"{where}.segments repeats a segment: {list(segments)}")
+            object.__setattr__(self, "segments", segments)
 
     @property
     def loaded(self) -> bool:
         r"""Whether this edge carries a traction (belongs to :math:`\gamma_1`)."""
-        return self.normal_stress != 0.0 or self.shear_stress != 0.0
+        return any(v != 0.0 for v in (*self.normal_ends, *self.shear_ends))
+
+    @property
+    def normal_ends(self) -> tuple[float, float]:
+        """Normal stress per unit load at the start and the end of the edge."""
+        return stress_ends(self.normal_stress)
+
+    @property
+    def shear_ends(self) -> tuple[float, float]:
+        """Shear stress per unit load at the start and the end of the edge."""
+        return stress_ends(self.shear_stress)
+
+    @property
+    def uniform(self) -> bool:
+        """Whether both stresses are constant along the edge."""
+        return all(a == b for a, b in (self.normal_ends, self.shear_ends))
+
+    def max_stress(self) -> float:
+        """The largest absolute edge stress per unit load (normal or shear, either end)."""
+        return max(abs(v) for v in (*self.normal_ends, *self.shear_ends))
 
 
 def paper_edges() -> tuple[EdgeSpec, ...]:
@@ -201,20 +324,45 @@ def paper_edges() -> tuple[EdgeSpec, ...]:
 class PlateSpec:
     """Geometry and edge conditions of the plate.
 
+    The plate is the rectangle of ``corners`` (a structured mesh), or, meshed by gmsh
+    with quadrilaterals, the polygon ``outline``, the rectangle or the outline with
+    ``holes``, or the plate of a gmsh ``file``.
+
     Args:
-        corners: Opposite corners ``((x0, y0), (x1, y1))`` of the rectangle (m).
+        corners: Opposite corners ``((x0, y0), (x1, y1))`` of the rectangle (m); for an
+            outline, its bounding box (set from it); for a file, its bounding box once
+            meshed.
         thickness: Plate thickness t = 2 epsilon (m), > 0.
-        edges: One :class:`EdgeSpec` per edge part.
+        edges: One :class:`EdgeSpec` per edge part: the rectangle's are named as in
+            :data:`EDGE_NAMES`, an outline's parts by their ``segments``, a file's by
+            its physical groups of dimension 1; the part ``holes`` is the holes'
+            boundary. Boundary parts not named are free.
+        outline: A simple polygon [(x, y), ...] (m), at least three vertices; segment k
+            runs from vertex k to vertex k + 1 (the last back to the first).
+        holes: :class:`Circle` or :class:`Polygon` holes inside the plate, disjoint.
+        file: A gmsh ``.geo`` (meshed with quadrilaterals) or ``.msh`` (its
+            quadrilaterals) file with a physical surface and named physical curves.
     """
 
     corners: tuple[tuple[float, float], tuple[float, float]] = ((-0.1, -0.05), (0.1, 0.05))
     thickness: float = 0.006
     edges: tuple[EdgeSpec, ...] = field(default_factory=paper_edges)
+    outline: tuple[tuple[float, float], ...] | None = None
+    holes: tuple[Circle | Polygon, ...] = ()
+    file: str | None = None
 
     def __post_init__(self) -> None:
         if not _number("plate.thickness", self.thickness) > 0.0:
             raise ValueError(f"plate.thickness must be > 0 m, got {self.thickness!r}")
         object.__setattr__(self, "thickness", float(self.thickness))
+        if self.outline is not None:
+            outline = _polygon("plate.outline", self.outline)
+            object.__setattr__(self, "outline", outline)
+            v = np.asarray(outline)
+            lo, hi = v.min(axis=0), v.max(axis=0)
+            object.__setattr__(
+                self, "corners", ((float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1])))
+            )
         try:
             (x0, y0), (x1, y1) = self.corners
         except (TypeError, ValueError):
@@ -235,6 +383,111 @@ class PlateSpec:
         names = [e.name for e in self.edges]
         if len(set(names)) != len(names):
             raise ValueError(f"plate.edges: duplicate edge names {names}")
+        self._check_file()
+        self._check_holes()
+        self._check_edges()
+
+    def _check_file(self) -> None:
+        if self.file is None:
+            return
+        if not isinstance(self.file, str) or Path(self.file).suffix.lower() not in (
+            ".geo",
+            ".msh",
+        ):
+            raise ValueError(f"plate.file must be a gmsh .geo or .msh file, got {self.file!r}")
+        if self.outline is not None or self.holes:
+            raise ValueError("plate.file: give a file, or an outline and holes, not both")
+        if not Path(self.file).is_file():
+            raise ValueError(f"plate.file: no such file {self.file!r}")
+
+    def _check_holes(self) -> None:
+        holes = tuple(self.holes)
+        object.__setattr__(self, "holes", holes)
+        outer = self.boundary
+        for k, hole in enumerate(holes):
+            where = f"plate.holes[{k}]"
+            if isinstance(hole, Circle):
+                center = np.array([hole.center])
+                inside = (
+                    bool(points_in_polygon(center, outer)[0])
+                    and float(distance_to_polygon(center, outer)[0]) > hole.radius
+                )
+            elif isinstance(hole, Polygon):
+                inside = polygon_inside(hole.vertices, outer)
+            else:
+                raise ValueError(f"{where} must be a Circle or a Polygon, got {hole!r}")
+            if not inside:
+                raise ValueError(f"{where} must lie inside the plate, without touching its edge")
+            for j in range(k):
+                if not _disjoint(holes[j], hole):
+                    raise ValueError(f"plate.holes[{j}] and {where} overlap or touch")
+
+    def _check_edges(self) -> None:
+        count = len(self.outline) if self.outline is not None else 0
+        used: dict[int, str] = {}
+        for e in self.edges:
+            where = f"edges.{e.name}"
+            if e.name == HOLES and e.tag is None:
+                if not self.holes:
+                    raise ValueError(f"{where}: the plate has no holes (plate.holes)")
+                if e.segments is not None:
+                    raise ValueError(f"{where}: the holes' boundary takes no segments")
+                if not e.uniform:
+                    raise ValueError(
+                        f"{where}: a linear [start, end] stress needs a straight edge; give "
+                        "the holes a number"
+                    )
+                continue
+            if e.segments is not None:
+                if self.outline is None:
+                    raise ValueError(
+                        f"{where}.segments names segments of plate.outline, which this "
+                        "plate does not have"
+                    )
+                for k in e.segments:
+                    if k >= count:
+                        raise ValueError(
+                            f"{where}.segments: {k} is not a segment of the outline (0 to "
+                            f"{count - 1}: segment k runs from vertex k to vertex k + 1)"
+                        )
+                    if k in used:
+                        raise ValueError(
+                            f"{where}.segments: segment {k} is already in edges.{used[k]}"
+                        )
+                    used[k] = e.name
+            elif self.outline is not None and e.tag is None:
+                raise ValueError(
+                    f"{where}: a plate given by its outline names its boundary parts by "
+                    f"segments = [k, ...] (outline segments 0 to {count - 1}), or "
+                    f"{HOLES!r} for the holes"
+                )
+
+    @property
+    def meshed_by_gmsh(self) -> bool:
+        """Whether gmsh meshes the plate (an outline, holes or a file)."""
+        return self.outline is not None or bool(self.holes) or self.file is not None
+
+    @property
+    def boundary(self) -> tuple[tuple[float, float], ...]:
+        """The outer boundary as a polygon: the outline, or the rectangle's four corners.
+
+        For a file, the bounding box.
+        """
+        if self.outline is not None:
+            return self.outline
+        (x0, y0), (x1, y1) = self.corners
+        return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+
+    @property
+    def area(self) -> float:
+        """The plate's area (m^2): the outer boundary's less the holes' (a file: its box)."""
+        total = abs(polygon_area(self.boundary))
+        for hole in self.holes:
+            if isinstance(hole, Circle):
+                total -= math.pi * hole.radius**2
+            else:
+                total -= abs(polygon_area(hole.vertices))
+        return total
 
     @property
     def length(self) -> float:
@@ -294,22 +547,59 @@ class MeshSpec:
         return 3 * (self.nx + 1) * (self.ny + 1)
 
 
+def _disjoint(a: Circle | Polygon, b: Circle | Polygon) -> bool:
+    """Whether two holes neither overlap nor touch (a circle as a 256-gon, to 1e-4 r)."""
+    if isinstance(a, Circle) and isinstance(b, Circle):
+        return math.dist(a.center, b.center) > a.radius + b.radius
+    pa, pb = (_hole_polygon(h) for h in (a, b))
+    return polygons_disjoint(pa, pb)
+
+
+def _hole_polygon(hole: Circle | Polygon) -> npt.NDArray[np.float64]:
+    if isinstance(hole, Circle):
+        return circle_points(hole.center, hole.radius, 256)
+    return np.asarray(hole.vertices, dtype=float)
+
+
+#: Name of the holes' boundary part in ``[edges.*]``.
+HOLES = "holes"
+
+
+#: Sides of an obstacle: "above" (on the +w side: w <= 0 in its zone), "below" (w >= 0);
+#: "both" only for a foundation (a bilateral Winkler foundation, springs everywhere).
+SIDES = ("above", "below", "both")
+
+Box = tuple[tuple[float, float], tuple[float, float]]
+
+
 @dataclass(frozen=True)
 class ObstacleSpec:
-    """Rigid flat obstacle just above the plate over a contact zone.
+    r"""Rigid flat obstacle, or Winkler foundation, on one side of the plate over a zone.
 
-    The deflection must satisfy w <= 0 at every mesh node of the closed zone.
+    With ``side = "above"`` the deflection must satisfy w <= 0 at every mesh node of the
+    closed zone; with ``"below"``, w >= 0. With a ``foundation_stiffness`` :math:`k_f`
+    the obstacle is a tensionless (compression-only) Winkler foundation instead: the
+    plate may press into it, against a pressure :math:`k_f w` (above; :math:`-k_f w`
+    below), and lift off it freely; :math:`k_f \to \infty` is the rigid obstacle.
+    ``side = "both"`` is then a bilateral foundation (springs in tension too).
 
     Args:
-        zone: ``"all"`` (the whole closed plate), a box
-            ``((xmin, xmax), (ymin, ymax))``, or a predicate
-            ``f(x) -> bool array`` on coordinates of shape (3, n).
-        tolerance: Geometric tolerance (m) for a node to count as inside a box;
-            ``None`` uses 1e-8 times the plate size.
+        zone: ``"all"`` (the whole closed plate), a box ``((xmin, xmax), (ymin, ymax))``,
+            a :class:`Polygon`, a :class:`Circle`, or a predicate ``f(x) -> bool array``
+            on coordinates of shape (3, n).
+        tolerance: Geometric tolerance (m) for a node to count as inside a box, polygon
+            or circle; ``None`` uses 1e-8 times the plate size.
+        side: One of :data:`SIDES`: where the obstacle lies (w, the deflection, is
+            positive towards "above"); "both" only with a foundation.
+        foundation_stiffness: Winkler modulus :math:`k_f` (N/m^3, Pa/m), > 0; ``None``
+            for a rigid obstacle. The springs are lumped at the zone's nodes: node k
+            carries :math:`k_f \int \varphi_k\,dx` (its tributary area).
     """
 
-    zone: Literal["all"] | tuple[tuple[float, float], tuple[float, float]] | Predicate = "all"
+    zone: Literal["all"] | Box | Polygon | Circle | Predicate = "all"
     tolerance: float | None = None
+    side: str = "above"
+    foundation_stiffness: float | None = None
 
     def __post_init__(self) -> None:
         if isinstance(self.zone, str):
@@ -318,6 +608,8 @@ class ObstacleSpec:
                     f'obstacle.zone must be "all", [[xmin, xmax], [ymin, ymax]] or a '
                     f"callable, got {self.zone!r}"
                 )
+        elif isinstance(self.zone, Polygon | Circle):
+            pass
         elif not callable(self.zone):
             try:
                 (x0, x1), (y0, y1) = self.zone
@@ -336,11 +628,43 @@ class ObstacleSpec:
             object.__setattr__(self, "zone", box)
         if self.tolerance is not None and not _number("obstacle.tolerance", self.tolerance) >= 0:
             raise ValueError(f"obstacle.tolerance must be >= 0 m, got {self.tolerance!r}")
+        if self.foundation_stiffness is not None:
+            if not _number("obstacle.foundation_stiffness", self.foundation_stiffness) > 0.0:
+                raise ValueError(
+                    "obstacle.foundation_stiffness (Winkler modulus) must be > 0 N/m^3, got "
+                    f"{self.foundation_stiffness!r}; leave it out for a rigid obstacle"
+                )
+            object.__setattr__(self, "foundation_stiffness", float(self.foundation_stiffness))
+        if self.side == "both" and self.foundation_stiffness is None:
+            raise ValueError(
+                'obstacle.side = "both": a rigid obstacle on both sides of the plate is a '
+                "bilateral support (w = 0 in the zone), not an obstacle; give an edge its "
+                '[edges.NAME] support (e.g. support = "simply_supported"), or one side '
+                '("above" or "below"); "both" is for a foundation (foundation_stiffness)'
+            )
+        _choice("obstacle.side", self.side, SIDES)
+
+    @property
+    def sign(self) -> float:
+        """+1 for an obstacle above (w <= 0 admissible), -1 below (w >= 0), 0 for both."""
+        return {"above": 1.0, "below": -1.0}.get(self.side, 0.0)
+
+    @property
+    def kind(self) -> str:
+        """Kind: "rigid", "tensionless" (one-sided foundation) or "bilateral" (foundation)."""
+        if self.foundation_stiffness is None:
+            return "rigid"
+        return "bilateral" if self.side == "both" else "tensionless"
 
     def describe(self) -> str:
         """Short human-readable description of the zone."""
         if isinstance(self.zone, str):
             return "whole plate"
+        if isinstance(self.zone, Polygon):
+            return f"polygon of {len(self.zone.vertices)} vertices"
+        if isinstance(self.zone, Circle):
+            (cx, cy), r = self.zone.center, self.zone.radius
+            return f"circle about ({cx:g}, {cy:g}) of radius {r:g}"
         if callable(self.zone):
             return f"predicate {getattr(self.zone, '__name__', 'zone')}"
         (x0, x1), (y0, y1) = self.zone
@@ -355,11 +679,19 @@ class ObstacleSpec:
         """
         if isinstance(self.zone, str):
             return np.ones(x.shape[1], dtype=bool)
+        tol = 1e-8 * size if self.tolerance is None else self.tolerance
+        if isinstance(self.zone, Polygon):
+            return points_in_polygon(x[:2].T, self.zone.vertices, tol)
+        if isinstance(self.zone, Circle):
+            return points_in_circle(x[:2].T, self.zone.center, self.zone.radius, tol)
         if callable(self.zone):
             return np.asarray(self.zone(x), dtype=bool)
-        tol = 1e-8 * size if self.tolerance is None else self.tolerance
         (x0, x1), (y0, y1) = self.zone
         return (x[0] >= x0 - tol) & (x[0] <= x1 + tol) & (x[1] >= y0 - tol) & (x[1] <= y1 + tol)
+
+    def same_zone(self, other: ObstacleSpec) -> bool:
+        """Whether ``other`` has the same zone (a predicate only when it is the same one)."""
+        return self.zone is other.zone or (not callable(self.zone) and self.zone == other.zone)
 
 
 @dataclass(frozen=True)
@@ -447,6 +779,8 @@ class ProblemSpec:
         solver: Solver options.
         units: The unit system results are printed in (one of :data:`UNITS`; the
             numbers here are SI whatever it is).
+        obstacles: Several obstacles (the file's ``[[obstacles]]`` tables), instead of
+            ``obstacle``; their constrained nodes are the union of their zones'.
     """
 
     name: str = "plate"
@@ -456,14 +790,95 @@ class ProblemSpec:
     obstacle: ObstacleSpec | None = None
     solver: SolverSpec = field(default_factory=SolverSpec)
     units: str = "SI"
+    obstacles: tuple[ObstacleSpec, ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
             raise ValueError(f"name must be a string, got {self.name!r}")
         _choice("units", self.units, tuple(UNITS))
+        object.__setattr__(self, "obstacles", tuple(self.obstacles))
+        plate = self.plate
+        if plate.meshed_by_gmsh and self.mesh.size is None:
+            if plate.file is None:
+                raise ValueError(
+                    "mesh.size: a plate meshed by gmsh (outline or holes) needs [mesh] size = "
+                    "h, the characteristic cell size (m)"
+                )
+        if plate.file is not None and plate.file.lower().endswith(".msh") and self.mesh.size:
+            raise ValueError("mesh.size: a .msh file is meshed already; leave size out")
+        if self.obstacle is not None and self.obstacles:
+            raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
+        for k, o in enumerate(self.obstacles):
+            if not isinstance(o, ObstacleSpec):
+                raise ValueError(f"obstacles[{k}] must be an ObstacleSpec, got {o!r}")
+        found = self.all_obstacles
+        kinds = {o.kind for o in found}
+        if {"rigid", "tensionless"} <= kinds:
+            raise ValueError(
+                "rigid obstacles and tensionless foundations in one problem are not "
+                "supported: give every one-sided obstacle a foundation_stiffness, or none "
+                '(a bilateral foundation, side = "both", goes with either)'
+            )
+        if "tensionless" in kinds and self.solver.method != "auto":
+            raise ValueError(
+                f'solver.method = "{self.solver.method}": a tensionless foundation is solved '
+                'by its own spring-set iteration; use method = "auto"'
+            )
+        for j, first in enumerate(found):
+            for k in range(j + 1, len(found)):
+                second = found[k]
+                if not (
+                    first.same_zone(second) and {first.side, second.side} == {"above", "below"}
+                ):
+                    continue
+                label = f"{self.obstacle_label(j)} and {self.obstacle_label(k)}"
+                if first.kind == second.kind == "tensionless":
+                    raise ValueError(
+                        f"{label} give the same foundation zone on both sides of the plate: "
+                        'write it once with side = "both" (a bilateral foundation)'
+                    )
+                raise ValueError(
+                    f"{label} give the same zone on both sides of the plate: that is a "
+                    "bilateral support (w = 0 there), not an obstacle; give an edge its "
+                    '[edges.NAME] support (e.g. support = "simply_supported"), or keep one '
+                    "side"
+                )
+
+    @property
+    def unilateral_obstacles(self) -> tuple[ObstacleSpec, ...]:
+        """The one-sided obstacles (rigid or tensionless foundations): the contact nodes'."""
+        return tuple(o for o in self.all_obstacles if o.kind != "bilateral")
+
+    @property
+    def bilateral_foundations(self) -> tuple[ObstacleSpec, ...]:
+        """The bilateral foundations (``side = "both"``): springs added to the stiffness."""
+        return tuple(o for o in self.all_obstacles if o.kind == "bilateral")
+
+    @property
+    def tensionless(self) -> bool:
+        """Whether the one-sided obstacles are tensionless foundations."""
+        return any(o.kind == "tensionless" for o in self.all_obstacles)
+
+    @property
+    def all_obstacles(self) -> tuple[ObstacleSpec, ...]:
+        """Every obstacle: ``(obstacle,)`` or ``obstacles`` (empty for the free plate)."""
+        return (self.obstacle,) if self.obstacle is not None else self.obstacles
+
+    def obstacle_label(self, k: int) -> str:
+        """How the file names obstacle k of :attr:`all_obstacles` (for messages)."""
+        return "obstacle" if self.obstacle is not None else f"obstacles[{k}]"
+
+    def without_obstacles(self) -> ProblemSpec:
+        """Copy of the free plate (no obstacle)."""
+        return replace(self, obstacle=None, obstacles=())
 
     def with_mesh(self, nx: int, ny: int) -> ProblemSpec:
-        """Copy with another mesh resolution."""
+        """Copy with another mesh resolution (the structured rectangle only)."""
+        if self.plate.meshed_by_gmsh:
+            raise ValueError(
+                "nx, ny (--nx, --ny) set the structured rectangle's cells; a plate meshed by "
+                "gmsh takes [mesh] size = h"
+            )
         return replace(self, mesh=MeshSpec(nx, ny))
 
     def with_solver(self, **changes: Any) -> ProblemSpec:
@@ -504,7 +919,6 @@ _DIMENSIONS: dict[tuple[str, str], tuple[int, int]] = {
     ("material", "E"): (0, 1),
     ("material", "membrane_voigt"): (1, 1),  # N/m = Pa m
     ("material", "bending_voigt"): (3, 1),  # N m = Pa m^3
-    ("obstacle", "tolerance"): (1, 0),
     ("mesh", "size"): (1, 0),
 }
 
@@ -523,19 +937,162 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
         if isinstance(out.get(table), dict) and key in out[table]:
             factor = (length**pl * stress**ps) ** sign
             out[table][key] = _scaled(out[table][key], factor, f"{table}.{key}")
-    obstacle = out.get("obstacle")
-    if isinstance(obstacle, dict) and isinstance(obstacle.get("zone"), list):
-        obstacle["zone"] = _scaled(obstacle["zone"], length**sign, "obstacle.zone")
+    plate = out.get("plate")
+    if isinstance(plate, dict):
+        if "outline" in plate:
+            plate["outline"] = _scaled(plate["outline"], length**sign, "plate.outline")
+        if isinstance(plate.get("holes"), list):
+            plate["holes"] = [
+                {
+                    k: _scaled(v, length**sign, f"plate.holes[{j}].{k}")
+                    if k in ("center", "radius", "outline")
+                    else v
+                    for k, v in hole.items()
+                }
+                if isinstance(hole, Mapping)
+                else hole
+                for j, hole in enumerate(plate["holes"])
+            ]
+    if isinstance(out.get("obstacle"), dict):
+        out["obstacle"] = _obstacle_to_si(out["obstacle"], "obstacle", length**sign, stress**sign)
+    if isinstance(out.get("obstacles"), list):
+        out["obstacles"] = [
+            _obstacle_to_si(t, f"obstacles[{k}]", length**sign, stress**sign)
+            if isinstance(t, Mapping)
+            else t
+            for k, t in enumerate(out["obstacles"])
+        ]
+    return out
+
+
+def _obstacle_to_si(
+    table: Mapping[str, Any], where: str, length: float, stress: float
+) -> dict[str, Any]:
+    """An obstacle table with its lengths times ``length`` and stresses times ``stress``."""
+    out = dict(table)
+    for key in ("polygon", "tolerance"):
+        if key in out:
+            out[key] = _scaled(out[key], length, f"{where}.{key}")
+    if "foundation_stiffness" in out:  # N/m^3 = Pa/m
+        out["foundation_stiffness"] = _scaled(
+            out["foundation_stiffness"], stress / length, f"{where}.foundation_stiffness"
+        )
+    if isinstance(out.get("zone"), list):
+        out["zone"] = _scaled(out["zone"], length, f"{where}.zone")
+    if isinstance(out.get("circle"), Mapping):
+        circle = dict(out["circle"])
+        for key in ("center", "radius"):
+            if key in circle:
+                circle[key] = _scaled(circle[key], length, f"{where}.circle.{key}")
+        out["circle"] = circle
+    return out
+
+
+#: Keys of an ``[obstacle]`` or ``[[obstacles]]`` table.
+OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "foundation_stiffness", "tolerance")
+
+
+def _holes(tables: Any) -> tuple[Circle | Polygon, ...]:
+    """``[[plate.holes]]`` tables: center and radius (a circle) or outline (a polygon)."""
+    if not isinstance(tables, list):
+        raise ValueError(f"plate.holes must be a list of tables ([[plate.holes]]), got {tables!r}")
+    holes: list[Circle | Polygon] = []
+    for k, table in enumerate(tables):
+        where = f"plate.holes[{k}]"
+        kw = _take(table, ("center", "radius", "outline"), where)
+        if set(kw) == {"outline"}:
+            holes.append(Polygon(_polygon(f"{where}.outline", kw["outline"])))
+        elif set(kw) == {"center", "radius"}:
+            try:
+                holes.append(Circle(kw["center"], kw["radius"]))
+            except ValueError as err:
+                raise ValueError(f"{where}.{err}") from None
+        else:
+            raise ValueError(
+                f"[{where}] needs center = [x, y] and radius = r (a circle), or outline = "
+                f"[[x, y], ...] (a polygon); got {sorted(kw)}"
+            )
+    return tuple(holes)
+
+
+def _obstacle_from_table(table: Any, where: str) -> ObstacleSpec:
+    """An :class:`ObstacleSpec` from its table; messages name ``where`` (e.g. obstacles[1])."""
+    kw = _take(table, OBSTACLE_KEYS, where)
+    given = [key for key in ("zone", "polygon", "circle") if key in kw]
+    if len(given) != 1:
+        raise ValueError(
+            f'[{where}] needs zone = "all" (the whole plate) or [[xmin, xmax], [ymin, ymax]], '
+            "or polygon = [[x, y], ...], or circle = {center = [x, y], radius = r}: exactly "
+            f"one of them; got {given or 'none'}"
+        )
+    try:
+        if "polygon" in kw:
+            kw["zone"] = Polygon(_polygon(f"{where}.polygon", kw.pop("polygon")))
+        elif "circle" in kw:
+            circle = _take(kw.pop("circle"), ("center", "radius"), f"{where}.circle")
+            if set(circle) != {"center", "radius"}:
+                raise ValueError(f"{where}.circle needs center = [x, y] and radius = r")
+            kw["zone"] = Circle(**circle)
+        return ObstacleSpec(**kw)
+    except ValueError as err:
+        message = str(err)
+        if message.startswith("obstacle."):
+            message = where + message[len("obstacle") :]
+        elif message.startswith("circle."):
+            message = f"{where}.{message}"
+        raise ValueError(message) from None
+
+
+def _plate_table(plate: PlateSpec) -> dict[str, Any]:
+    """The file form of the plate."""
+    out: dict[str, Any] = {"thickness": plate.thickness}
+    if plate.file is not None:
+        out["file"] = plate.file
+    elif plate.outline is not None:
+        out["outline"] = [list(v) for v in plate.outline]
+    else:
+        out["corners"] = [list(c) for c in plate.corners]
+    holes: list[dict[str, Any]] = []
+    for hole in plate.holes:
+        if isinstance(hole, Circle):
+            holes.append({"center": list(hole.center), "radius": hole.radius})
+        else:
+            holes.append({"outline": [list(v) for v in hole.vertices]})
+    if holes:
+        out["holes"] = holes
+    return out
+
+
+def _obstacle_table(obstacle: ObstacleSpec) -> dict[str, Any]:
+    """The file form of an obstacle (every key with the value used)."""
+    zone = obstacle.zone
+    out: dict[str, Any] = {}
+    if isinstance(zone, Polygon):
+        out["polygon"] = [list(v) for v in zone.vertices]
+    elif isinstance(zone, Circle):
+        out["circle"] = {"center": list(zone.center), "radius": zone.radius}
+    elif callable(zone):
+        raise ValueError("problem_to_dict: a predicate obstacle zone cannot be written")
+    else:
+        out["zone"] = zone if isinstance(zone, str) else [list(z) for z in zone]
+    out["side"] = obstacle.side
+    if obstacle.foundation_stiffness is not None:
+        out["foundation_stiffness"] = obstacle.foundation_stiffness
+    if obstacle.tolerance is not None:
+        out["tolerance"] = obstacle.tolerance
     return out
 
 
 def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSpec:
     """Build a :class:`ProblemSpec` from a TOML-shaped mapping (schema: README).
 
-    Tables: ``[plate]`` (corners, thickness), ``[material]`` (E, nu, shear_correction,
+    Tables: ``[plate]`` (corners, or outline, or file; thickness; ``[[plate.holes]]``
+    with center and radius, or outline), ``[material]`` (E, nu, shear_correction,
     membrane_voigt, bending_voigt), ``[edges.<name>]`` (support, inplane,
-    normal_stress, shear_stress), ``[mesh]`` (nx, ny; or size, a cell size), ``[obstacle]`` (zone,
-    tolerance; absent = free plate), ``[solver]`` (the :class:`SolverSpec` fields);
+    normal_stress, shear_stress, segments), ``[mesh]`` (nx, ny; or size, a cell size),
+    ``[obstacle]`` (zone, polygon or circle, side, foundation_stiffness, tolerance;
+    absent = free plate) or several ``[[obstacles]]``
+    with the same keys, ``[solver]`` (the :class:`SolverSpec` fields);
     top-level ``name`` and ``units``. Unknown tables or keys raise ``ValueError``.
 
     Missing values take the paper's, with one exception for the load: if any edge table
@@ -544,13 +1101,30 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     no edge load at all).
     """
     top = _take(
-        data, ("name", "units", "plate", "material", "edges", "mesh", "obstacle", "solver"), "top"
+        data,
+        ("name", "units", "plate", "material", "edges", "mesh", "obstacle", "obstacles", "solver"),
+        "top",
     )
     units = _choice("units", top.get("units", "SI"), tuple(UNITS))
     top = _to_si(top, units)
-    plate_kw = _take(top.get("plate", {}), ("corners", "thickness"), "plate")
-    edge_tables = _take(top.get("edges", {}), EDGE_NAMES, "edges")
-    edges = {e.name: e for e in paper_edges()}
+    plate_kw = _take(
+        top.get("plate", {}), ("corners", "thickness", "outline", "holes", "file"), "plate"
+    )
+    gmsh_plate = any(key in plate_kw for key in ("outline", "file"))
+    if gmsh_plate and "corners" in plate_kw:
+        raise ValueError(
+            "[plate]: give corners (a rectangle), or outline (a polygon) or file (a gmsh "
+            "file), not both"
+        )
+    if "holes" in plate_kw:
+        plate_kw["holes"] = _holes(plate_kw["holes"])
+    given = top.get("edges", {})
+    if gmsh_plate:  # a file's or an outline's part names are checked by PlateSpec
+        names = tuple(given) if isinstance(given, Mapping) else ()
+    else:
+        names = (*EDGE_NAMES, HOLES) if "holes" in plate_kw else EDGE_NAMES
+    edge_tables = _take(given, names, "edges")
+    edges = {} if gmsh_plate else {e.name: e for e in paper_edges()}
     load_keys = ("normal_stress", "shear_stress")
     loads_given = any(
         key in table for table in edge_tables.values() if isinstance(table, Mapping)
@@ -558,9 +1132,11 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     )  # fmt: skip
     if loads_given:
         edges = {n: replace(e, normal_stress=0.0, shear_stress=0.0) for n, e in edges.items()}
+    edge_keys = ("support", "inplane", "normal_stress", "shear_stress", "segments")
     for edge_name, edge_table in edge_tables.items():
-        kw = _take(edge_table, _names(EdgeSpec)[1:-1], f"edges.{edge_name}")
-        edges[edge_name] = replace(edges[edge_name], **kw)
+        kw = _take(edge_table, edge_keys, f"edges.{edge_name}")
+        edge = edges.get(edge_name, EdgeSpec(edge_name))
+        edges[edge_name] = replace(edge, **kw)
     plate = PlateSpec(**plate_kw, edges=tuple(edges.values()))
     material_kw = _take(top.get("material", {"E": 1.0e9, "nu": 0.3}), _names(Material), "material")
     for key in ("E", "nu"):
@@ -568,7 +1144,13 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
             raise ValueError(f"[material] needs {key!r}")
     material = Material(**material_kw)
     mesh_kw = _take(top.get("mesh", {}), _names(MeshSpec), "mesh")
-    if "size" in mesh_kw:
+    if plate.meshed_by_gmsh:
+        if "nx" in mesh_kw or "ny" in mesh_kw:
+            raise ValueError(
+                "[mesh]: a plate meshed by gmsh (outline, holes or file) takes size = h (the "
+                "characteristic cell size), not nx and ny"
+            )
+    elif "size" in mesh_kw:
         if "nx" in mesh_kw or "ny" in mesh_kw:
             raise ValueError("[mesh]: give size (a cell size) or nx and ny, not both")
         mesh_kw["nx"], mesh_kw["ny"] = MeshSpec.cells_for(
@@ -577,12 +1159,18 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     mesh = MeshSpec(**mesh_kw)
     obstacle = None
     if "obstacle" in top:
-        obstacle_kw = _take(top["obstacle"], ("zone", "tolerance"), "obstacle")
-        if "zone" not in obstacle_kw:
+        obstacle = _obstacle_from_table(top["obstacle"], "obstacle")
+    obstacles: list[ObstacleSpec] = []
+    if "obstacles" in top:
+        tables = top["obstacles"]
+        if not isinstance(tables, list) or not tables:
             raise ValueError(
-                '[obstacle] needs zone = "all" (the whole plate) or [[xmin, xmax], [ymin, ymax]]'
+                "obstacles must be a list of tables ([[obstacles]] in TOML), at least one, "
+                f"got {tables!r}"
             )
-        obstacle = ObstacleSpec(**obstacle_kw)
+        if obstacle is not None:
+            raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
+        obstacles = [_obstacle_from_table(t, f"obstacles[{k}]") for k, t in enumerate(tables)]
     solver = SolverSpec(**_take(top.get("solver", {}), _names(SolverSpec), "solver"))
     label = top.get("name", name)
     if not isinstance(label, str):
@@ -595,6 +1183,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         obstacle=obstacle,
         solver=solver,
         units=units,
+        obstacles=tuple(obstacles),
     )
 
 
@@ -615,7 +1204,7 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
     out: dict[str, Any] = {
         "name": spec.name,
         "units": "SI",
-        "plate": {"corners": [list(c) for c in plate.corners], "thickness": plate.thickness},
+        "plate": _plate_table(plate),
         "material": {
             k: v for k, v in vars(spec.material).items() if v is not None
         },  # tuples become lists in JSON/TOML
@@ -623,24 +1212,25 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
             e.name: {
                 "support": e.support,
                 "inplane": e.inplane,
-                "normal_stress": e.normal_stress,
-                "shear_stress": e.shear_stress,
+                "normal_stress": stress_value(e.normal_stress),
+                "shear_stress": stress_value(e.shear_stress),
             }
+            | ({} if e.segments is None else {"segments": list(e.segments)})
             for e in plate.edges
         },
-        "mesh": {"nx": mesh.nx, "ny": mesh.ny} if mesh.size is None else {"size": mesh.size},
+        "mesh": (
+            {"size": mesh.size}
+            if mesh.size is not None
+            else {}
+            if plate.meshed_by_gmsh
+            else {"nx": mesh.nx, "ny": mesh.ny}
+        ),
         "solver": dict(vars(spec.solver)),
     }
     if spec.obstacle is not None:
-        zone = spec.obstacle.zone
-        if callable(zone):
-            raise ValueError("problem_to_dict: a predicate obstacle zone cannot be written")
-        obstacle: dict[str, Any] = {
-            "zone": zone if isinstance(zone, str) else [list(z) for z in zone]
-        }
-        if spec.obstacle.tolerance is not None:
-            obstacle["tolerance"] = spec.obstacle.tolerance
-        out["obstacle"] = obstacle
+        out["obstacle"] = _obstacle_table(spec.obstacle)
+    if spec.obstacles:
+        out["obstacles"] = [_obstacle_table(o) for o in spec.obstacles]
     for key in ("membrane_voigt", "bending_voigt"):
         if key in out["material"]:
             out["material"][key] = [list(row) for row in out["material"][key]]
@@ -648,6 +1238,11 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         out = _to_si(out, units, inverse=True)
         out["units"] = units
     return out
+
+
+def stress_value(value: float | tuple[float, float]) -> float | list[float]:
+    """An edge stress as written in a file: a number or ``[start, end]``."""
+    return list(value) if isinstance(value, tuple) else value
 
 
 def load_toml(path: str | Path) -> ProblemSpec:
@@ -667,6 +1262,10 @@ def load_toml(path: str | Path) -> ProblemSpec:
         ) from None
     except tomllib.TOMLDecodeError as err:
         raise ValueError(f"{path}: invalid TOML: {err}") from None
+    plate = data.get("plate")
+    if isinstance(plate, dict) and isinstance(plate.get("file"), str):
+        # A gmsh file is found next to the problem file.
+        plate["file"] = str((path.parent / plate["file"]).resolve())
     try:
         return problem_from_dict(data, name=path.stem)
     except ValueError as err:

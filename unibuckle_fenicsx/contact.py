@@ -8,6 +8,7 @@ array of these numbers, means the same nodes on every rank and for every partiti
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -15,6 +16,8 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 import dolfinx
+import dolfinx.la
+import ufl
 
 import numpy as np
 import numpy.typing as npt
@@ -22,11 +25,14 @@ import numpy.typing as npt
 from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec
 
 __all__ = [
+    "BilateralZoneError",
     "ContactSetManager",
     "EmptyZoneError",
     "PlateDofs",
     "check_zone_has_nodes",
+    "foundation_springs",
     "orientation",
+    "tributary_areas",
 ]
 
 
@@ -63,20 +69,80 @@ class EmptyZoneError(ValueError):
     """The obstacle zone holds no free mesh node."""
 
 
-def check_zone_has_nodes(msh: dolfinx.mesh.Mesh, obstacle: ObstacleSpec, size: float) -> None:
-    """Raise :class:`EmptyZoneError` if no mesh node lies in the closed zone (cheap pre-check).
+class BilateralZoneError(ValueError):
+    """Obstacles on opposite sides of the plate share a mesh node."""
+
+
+ObstacleLike = ObstacleSpec | Sequence[ObstacleSpec]
+
+
+def _as_tuple(obstacles: ObstacleLike) -> tuple[ObstacleSpec, ...]:
+    return (obstacles,) if isinstance(obstacles, ObstacleSpec) else tuple(obstacles)
+
+
+def _label(obstacles: tuple[ObstacleSpec, ...], k: int, labels: Sequence[str] | None) -> str:
+    if labels is not None:
+        return labels[k]
+    return "obstacle" if len(obstacles) == 1 else f"obstacles[{k}]"
+
+
+def check_zone_has_nodes(
+    msh: dolfinx.mesh.Mesh,
+    obstacles: ObstacleLike,
+    size: float,
+    labels: Sequence[str] | None = None,
+) -> None:
+    """Cheap pre-checks of the obstacle zones on the mesh nodes, before any solve.
+
+    Raises :class:`EmptyZoneError` if a zone holds no mesh node, and
+    :class:`BilateralZoneError` if a node lies in zones on both sides of the plate (a
+    bilateral support there, not an obstacle).
+
+    Args:
+        msh: The mesh.
+        obstacles: One obstacle or several.
+        size: Plate size (scales the zones' default tolerance).
+        labels: How the problem file names each obstacle (default "obstacle" or
+            "obstacles[k]").
 
     Note:
         Collective.
     """
+    found = _as_tuple(obstacles)
     x = msh.geometry.x
     n_owned = msh.geometry.index_map().size_local
-    inside = int(np.count_nonzero(obstacle.contains(x[:n_owned].T, size)))
-    if msh.comm.allreduce(inside, op=MPI.SUM) == 0:
-        raise EmptyZoneError(
-            f"obstacle.zone {obstacle.describe()} holds no free mesh node: none of the "
-            f"{msh.geometry.index_map().size_global} mesh nodes lies in it; enlarge the zone "
-            "or refine the mesh"
+    points = x[:n_owned].T
+    inside = [o.contains(points, size) for o in found]
+    for k, (o, mask) in enumerate(zip(found, inside, strict=True)):
+        if msh.comm.allreduce(int(np.count_nonzero(mask)), op=MPI.SUM) == 0:
+            raise EmptyZoneError(
+                f"{_label(found, k, labels)}.zone {o.describe()} holds no free mesh node: "
+                f"none of the {msh.geometry.index_map().size_global} mesh nodes lies in it; "
+                "enlarge the zone or refine the mesh"
+            )
+    above = np.zeros(n_owned, dtype=bool)
+    below = np.zeros(n_owned, dtype=bool)
+    for o, mask in zip(found, inside, strict=True):
+        if o.side == "above":
+            above |= mask
+        elif o.side == "below":
+            below |= mask
+    both = np.flatnonzero(above & below)
+    local = x[both[0], :2].tolist() if both.size else None
+    shared = [p for p in msh.comm.allgather(local) if p is not None]
+    if shared:
+        names = [_label(found, k, labels) for k in range(len(found))]
+        raise BilateralZoneError(
+            f"obstacle zones on both sides of the plate share mesh nodes, e.g. "
+            f"({shared[0][0]:.6g}, {shared[0][1]:.6g}) ({', '.join(names)}: "
+            f"{', '.join(f'{o.describe()} ({o.side})' for o in found)}): "
+            + (
+                'a foundation on both sides is one zone with side = "both" (a bilateral '
+                "foundation); make the zones disjoint"
+                if any(o.kind == "tensionless" for o in found)
+                else "a node held on both sides is a bilateral support (w = 0), not an "
+                "obstacle; give an edge its [edges.NAME] support, or make the zones disjoint"
+            )
         )
 
 
@@ -126,37 +192,128 @@ class _Owned:
     global_dofs: npt.NDArray[np.int64]  # W global dof of each
 
 
+def tributary_areas(model: PlateDofs) -> dolfinx.la.Vector:
+    r"""Lumped areas :math:`\int \varphi_k\,dx` of the w-space's nodes (owned and ghosts).
+
+    The row sums of the Q1 mass matrix: a lumped Winkler foundation puts the spring
+    :math:`k_f \int \varphi_k\,dx` at node k.
+
+    Note:
+        Collective.
+    """
+    v = ufl.TestFunction(model.Vw)
+    areas = dolfinx.fem.assemble_vector(dolfinx.fem.form(v * ufl.dx))
+    areas.scatter_reverse(dolfinx.la.InsertMode.add)
+    areas.scatter_forward()
+    return areas
+
+
+def _zone_dofs(
+    model: PlateDofs, obstacle: ObstacleSpec, size: float
+) -> tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]:
+    """(W dofs, Vw dofs) of the w-DOFs of the zone's nodes, ghosts included (not collective)."""
+    dofs_W, dofs_Vw = dolfinx.fem.locate_dofs_geometrical(
+        (model.w_subspace, model.Vw), lambda x: obstacle.contains(x, size)
+    )
+    return np.asarray(dofs_W, dtype=np.int32), np.asarray(dofs_Vw, dtype=np.int32)
+
+
+def foundation_springs(
+    model: PlateDofs, foundations: Sequence[ObstacleSpec]
+) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]:
+    r"""Global W rows owned by this rank and lumped spring stiffnesses of ``foundations``.
+
+    Node k of a zone gets :math:`k_f \int \varphi_k\,dx` (N/m), summed over the zones
+    holding it; nodes fixed by edge supports are left out.
+
+    Note:
+        Collective.
+    """
+    size = max(model.plate.length, model.plate.width)
+    areas = tributary_areas(model).array
+    springs: dict[int, float] = {}
+    for o in foundations:
+        assert o.foundation_stiffness is not None
+        dofs_W, dofs_Vw = _zone_dofs(model, o, size)
+        for dw, dv in zip(dofs_W.tolist(), dofs_Vw.tolist(), strict=True):
+            springs[dw] = springs.get(dw, 0.0) + o.foundation_stiffness * float(areas[dv])
+    local = np.array(sorted(springs), dtype=np.int32)
+    keep = (local < model.num_owned_dofs) & ~np.isin(local, model.bc_dofs)
+    local = local[keep]
+    values = np.array([springs[d] for d in local.tolist()], dtype=float)
+    return model.global_dofs(local), values
+
+
 class ContactSetManager:
-    """Constrained w-DOFs of an obstacle zone, and candidate sets as removed DOFs.
+    r"""Constrained w-DOFs of the obstacle zones, and candidate sets as removed DOFs.
+
+    The manager works in *oriented* values :math:`z_k = s_k w_k`, with :math:`s_k = +1`
+    at the nodes of an obstacle above the plate and -1 below, so that every constraint
+    reads :math:`z_k \le 0` and every algorithm sees one kind of obstacle:
+    :meth:`values` returns z, :meth:`scatter` takes z.
 
     Args:
         model: The plate model (the assembled pencil, or any :class:`PlateDofs`).
-        obstacle: The obstacle zone.
+        obstacles: One obstacle or several (their zones' nodes are united; a node in
+            zones on both sides raises :class:`BilateralZoneError`).
 
     Attributes:
         coordinates: (i, 2) coordinates of the constrained nodes, same on all ranks.
-        num_edge_fixed: Nodes of the zone already fixed (w = 0) by edge supports.
+        signs: (i,) :math:`s_k`, same on all ranks.
+        stiffness: (i,) lumped spring stiffness (N/m) of each node, same on all ranks,
+            for tensionless foundations (:func:`foundation_springs`); None for rigid
+            obstacles.
+        num_edge_fixed: Nodes of the zones already fixed (w = 0) by edge supports.
 
     Note:
-        Construction is collective. Raises :class:`EmptyZoneError` if the zone holds no
+        Construction is collective. Raises :class:`EmptyZoneError` if the zones hold no
         free mesh node.
     """
 
-    def __init__(self, model: PlateDofs, obstacle: ObstacleSpec) -> None:
+    def __init__(self, model: PlateDofs, obstacles: ObstacleLike) -> None:
         self.model = model
-        self.obstacle = obstacle
+        self.obstacles = _as_tuple(obstacles)
+        if not self.obstacles:
+            raise ValueError("ContactSetManager needs at least one obstacle")
+        kinds = {o.kind for o in self.obstacles}
+        if "bilateral" in kinds or len(kinds) != 1:
+            raise ValueError(
+                "ContactSetManager takes one-sided obstacles of one kind: all rigid or all "
+                f"tensionless foundations, got {sorted(kinds)}"
+            )
         comm = model.mesh.comm
         Vw = model.Vw
         size = max(model.plate.length, model.plate.width)
-        dofs_W, dofs_Vw = dolfinx.fem.locate_dofs_geometrical(
-            (model.w_subspace, Vw), lambda x: obstacle.contains(x, size)
-        )
+        tensionless = kinds == {"tensionless"}
+        areas = tributary_areas(model).array if tensionless else None
+        found: dict[int, tuple[int, float]] = {}  # W dof -> (Vw dof, sign)
+        spring: dict[int, float] = {}  # W dof -> stiffness (foundations)
+        conflict = False
+        for o in self.obstacles:
+            dofs_W, dofs_Vw = _zone_dofs(model, o, size)
+            for dw, dv in zip(dofs_W.tolist(), dofs_Vw.tolist(), strict=True):
+                conflict |= dw in found and found[dw][1] != o.sign
+                found[dw] = (dv, o.sign)
+                if areas is not None:
+                    assert o.foundation_stiffness is not None
+                    spring[dw] = spring.get(dw, 0.0) + o.foundation_stiffness * float(areas[dv])
+        if comm.allreduce(conflict, op=MPI.LOR):
+            raise BilateralZoneError(
+                "obstacle zones on both sides of the plate share a mesh node: a bilateral "
+                "support (w = 0), not an obstacle; give an edge its [edges.NAME] support, "
+                "or make the zones disjoint"
+            )
+        order_W = np.array(sorted(found), dtype=np.int32)
+        dofs_W = order_W
+        dofs_Vw = np.array([found[d][0] for d in order_W.tolist()], dtype=np.int32)
+        signs = np.array([found[d][1] for d in order_W.tolist()], dtype=float)
+        springs = np.array([spring.get(d, 0.0) for d in order_W.tolist()], dtype=float)
         n_owned = model.num_owned_dofs
-        owned = dofs_W < n_owned
-        dofs_W, dofs_Vw = dofs_W[owned], dofs_Vw[owned]
+        keep = dofs_W < n_owned
         fixed = np.isin(dofs_W, model.bc_dofs)
-        self.num_edge_fixed = int(comm.allreduce(int(fixed.sum()), op=MPI.SUM))
-        dofs_W, dofs_Vw = dofs_W[~fixed], dofs_Vw[~fixed]
+        self.num_edge_fixed = int(comm.allreduce(int((fixed & keep).sum()), op=MPI.SUM))
+        keep &= ~fixed
+        dofs_W, dofs_Vw, signs, springs = dofs_W[keep], dofs_Vw[keep], signs[keep], springs[keep]
         xy = Vw.tabulate_dof_coordinates()[dofs_Vw, :2]
 
         gathered = comm.allgather(xy)
@@ -166,10 +323,15 @@ class ContactSetManager:
         keys = np.round(all_xy / (1e-9 * size)).astype(np.int64)
         order = np.lexsort((keys[:, 0], keys[:, 1]))
         self.coordinates: npt.NDArray[np.float64] = all_xy[order]
+        self.signs: npt.NDArray[np.float64] = np.concatenate(comm.allgather(signs))[order]
+        self.stiffness: npt.NDArray[np.float64] | None = (
+            np.concatenate(comm.allgather(springs))[order] if tensionless else None
+        )
         if self.coordinates.shape[0] == 0:
             nx = model.mesh.topology.index_map(0).size_global
+            zones = "; ".join(o.describe() for o in self.obstacles)
             raise EmptyZoneError(
-                f"obstacle.zone {obstacle.describe()} holds no free mesh node "
+                f"obstacle.zone {zones} holds no free mesh node "
                 f"({self.num_edge_fixed} zone nodes are fixed by edge supports; the mesh "
                 f"has {nx} vertices, spacing about {self._spacing():.3g} m): enlarge the "
                 "zone or refine the mesh"
@@ -179,6 +341,11 @@ class ContactSetManager:
         rank_pos[order] = np.arange(len(order), dtype=np.int64)
         positions = rank_pos[offset : offset + len(dofs_W)]
         self._owned = _Owned(positions, dofs_W.astype(np.int32), model.global_dofs(dofs_W))
+
+    @property
+    def obstacle(self) -> ObstacleSpec:
+        """The first obstacle (the only one for a problem with one ``[obstacle]``)."""
+        return self.obstacles[0]
 
     def _spacing(self) -> float:
         msh = self.model.mesh
@@ -195,8 +362,17 @@ class ContactSetManager:
         mask = np.isin(self._owned.positions, active)
         return self._owned.global_dofs[mask]
 
+    def node_rows(
+        self, active: npt.NDArray[np.int64]
+    ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
+        """(global W rows, node numbers) owned by this rank of the nodes ``active``."""
+        mask = np.isin(self._owned.positions, active)
+        return self._owned.global_dofs[mask], self._owned.positions[mask]
+
     def values(self, u: PETSc.Vec) -> npt.NDArray[np.float64]:
-        """Entries of the W-vector ``u`` at the constrained nodes, (i,), same on all ranks.
+        """Oriented entries :math:`s_k u_k` of the W-vector ``u`` at the constrained nodes.
+
+        (i,), same on all ranks.
 
         Note:
             Collective.
@@ -204,15 +380,16 @@ class ContactSetManager:
         local = np.zeros(self.size)
         local[self._owned.positions] = u.array_r[self._owned.local_dofs]
         self.model.mesh.comm.Allreduce(MPI.IN_PLACE, local, op=MPI.SUM)
-        return local
+        return self.signs * local
 
     def scatter(self, values: npt.NDArray[np.float64], u: PETSc.Vec) -> PETSc.Vec:
-        """Set the W-vector ``u`` to ``values`` (i,) at the constrained nodes, zero elsewhere.
+        r"""Set ``u`` to :math:`s_k` times ``values`` at the constrained nodes, zero elsewhere.
 
         The inverse of :meth:`values` for a vector supported on I. Not collective.
         """
         u.zeroEntries()
-        u.array[self._owned.local_dofs] = values[self._owned.positions]
+        positions = self._owned.positions
+        u.array[self._owned.local_dofs] = self.signs[positions] * values[positions]
         return u
 
     def global_rows(self) -> npt.NDArray[np.int64]:

@@ -115,8 +115,10 @@ def _inertia_minus(
     K.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)  # type: ignore[arg-type]
     rows = problem.contact.global_rows().astype(PETSc.IntType)
     owned = problem.contact._owned
+    signs = problem.contact.signs  # N acts on the oriented values s_k u_k
     for position, row in zip(owned.positions, owned.global_dofs, strict=True):
-        K.setValues([row], rows, -N[position, :], addv=PETSc.InsertMode.ADD_VALUES)  # type: ignore[arg-type]
+        entries = -signs[position] * signs * N[position, :]
+        K.setValues([row], rows, entries, addv=PETSc.InsertMode.ADD_VALUES)  # type: ignore[arg-type]
     K.assemble()
     factor = SymmetricFactorization(K, CERTIFY_PREFIX + "sdp_")
     try:

@@ -18,7 +18,15 @@ if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.config import ProblemSpec
     from unibuckle_fenicsx.problem import BucklingProblem
 
-__all__ = ["mirror_to_match", "nodal_deflection", "problem_zone", "section", "zone_box"]
+__all__ = [
+    "mesh_triangles",
+    "mirror_to_match",
+    "nodal_deflection",
+    "problem_zone",
+    "section",
+    "zone_box",
+    "zone_outlines",
+]
 
 
 def zone_box(
@@ -26,24 +34,49 @@ def zone_box(
 ) -> tuple[tuple[float, float], tuple[float, float]] | None:
     """Obstacle zone of ``spec`` as ``((xmin, xmax), (ymin, ymax))``; ``None`` without one.
 
+    A polygon or circle gives its bounding box; several obstacles the box around all.
+
     Args:
         spec: The problem.
         constrained: Coordinates of the constrained nodes (needed for a predicate
             zone, whose bounding box is returned).
     """
-    obstacle = spec.obstacle
-    if obstacle is None:
+    outlines = zone_outlines(spec)
+    if not outlines:
+        if spec.all_obstacles and constrained is not None and len(constrained):
+            lo, hi = constrained.min(axis=0), constrained.max(axis=0)
+            return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
         return None
-    if isinstance(obstacle.zone, str):
-        (x0, y0), (x1, y1) = spec.plate.corners
-        return (x0, x1), (y0, y1)
-    if callable(obstacle.zone):
-        if constrained is None or len(constrained) == 0:
-            return None
-        lo, hi = constrained.min(axis=0), constrained.max(axis=0)
-        return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
-    (x0, x1), (y0, y1) = obstacle.zone
-    return (x0, x1), (y0, y1)
+    points = np.vstack([xy for xy, _ in outlines])
+    lo, hi = points.min(axis=0), points.max(axis=0)
+    return (float(lo[0]), float(hi[0])), (float(lo[1]), float(hi[1]))
+
+
+def zone_outlines(spec: ProblemSpec) -> list[tuple[npt.NDArray[np.float64], str]]:
+    """Outline (n, 2), closed implicitly, and side of every obstacle zone, for drawing.
+
+    "all" gives the plate's outer boundary (its outline, or its bounding box), a circle
+    96 points; a predicate zone has no outline and is left out.
+    """
+    from unibuckle_fenicsx.config import Circle, Polygon
+    from unibuckle_fenicsx.geometry import circle_points
+
+    out = []
+    for obstacle in spec.all_obstacles:
+        zone = obstacle.zone
+        if isinstance(zone, str):
+            xy = np.asarray(spec.plate.boundary, dtype=float)
+        elif isinstance(zone, Polygon):
+            xy = np.asarray(zone.vertices, dtype=float)
+        elif isinstance(zone, Circle):
+            xy = circle_points(zone.center, zone.radius)
+        elif callable(zone):
+            continue
+        else:
+            (x0, x1), (y0, y1) = zone
+            xy = np.array([[x0, y0], [x1, y0], [x1, y1], [x0, y1]], dtype=float)
+        out.append((xy, obstacle.side))
+    return out
 
 
 def problem_zone(
@@ -142,3 +175,23 @@ def mirror_to_match(
     if mirrored > direct:
         return xm, wm, True
     return x, w, False
+
+
+def mesh_triangles(
+    problem: BucklingProblem, u: dolfinx.fem.Function
+) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.int32]]:
+    """Node coordinates (n, 2), deflection (n,) and triangles (2 per quadrilateral, (m, 3)).
+
+    The plate's own cells, split along a diagonal, for contour plots that leave holes and
+    re-entrant corners empty (a triangulation of the nodes alone would fill them).
+    Serial problems only (``comm.size == 1``).
+    """
+    if problem.comm.size != 1:
+        raise RuntimeError("mesh_triangles draws serial problems only (comm.size == 1)")
+    w, _ = problem.model.split(u)
+    Vw = w.function_space
+    xy = Vw.tabulate_dof_coordinates()[:, :2]
+    cells = Vw.dofmap.list  # Q1 on quadrilaterals: DOLFINx's tensor order 0, 1, 2, 3
+    quads = cells[:, [0, 1, 3, 2]]  # counter-clockwise
+    triangles = np.vstack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]]).astype(np.int32)
+    return xy, w.x.array.real.copy(), triangles

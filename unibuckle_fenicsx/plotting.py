@@ -11,8 +11,9 @@ called on one rank (3-D figures need a serial problem, ``comm.size == 1``). Defl
 within the feasibility tolerance of zero are drawn as zero (``tau``), so that rounding on a
 flat contact region does not read as penetration.
 
-Sign convention: the obstacle lies just above the plate, the admissible deflection in
-the zone is :math:`w \le 0`, so figures draw the obstacle at :math:`w = 0^+`.
+Sign convention: an obstacle above the plate (the default) admits :math:`w \le 0` in its
+zone and is drawn at :math:`w = 0^+`; one below admits :math:`w \ge 0`, drawn at
+:math:`w = 0^-`.
 """
 
 from __future__ import annotations
@@ -34,6 +35,7 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "THEME",
+    "plot_contact_map",
     "plot_contact_set",
     "plot_convergence",
     "plot_load_paths",
@@ -150,7 +152,9 @@ def plot_mode_3d(
     grid = pv.UnstructuredGrid(*dolfinx.plot.vtk_mesh(w.function_space))  # type: ignore[arg-type]
     grid.point_data["w / max|w|"] = _normalised(w.x.array.real, tau)
     grid.set_active_scalars("w / max|w|")
-    warp = THEME["warp"]
+    # The theme's sizes are for the paper's 0.2 m plate; others are scaled alike.
+    scale = max(problem.spec.plate.length, problem.spec.plate.width) / 0.2
+    warp = THEME["warp"] * scale
     warped = grid.warp_by_scalar("w / max|w|", factor=warp)
 
     font = _font_file()
@@ -188,14 +192,21 @@ def plot_mode_3d(
     plate_outline = pv.Rectangle([[px0, py0, 0.0], [px1, py0, 0.0], [px1, py1, 0.0]])
     plotter.add_mesh(plate_outline.extract_feature_edges(), color="gray", line_width=1.5)
     box = problem_zone(problem) if show_zone else None
-    lift = 0.02 * warp
+    # An obstacle above is drawn just above w = 0, one below just below it.
+    sides = {o.side for o in problem.spec.all_obstacles}
+    below = sides == {"below"}
+    lift = (-0.02 if below else 0.02) * warp
     legend: list[tuple[str, str]] = []
     if box is not None:
         (x0, x1), (y0, y1) = box
         plane = pv.Rectangle([[x0, y0, lift], [x1, y0, lift], [x1, y1, lift]])
         plotter.add_mesh(plane, color=THEME["obstacle_color"], opacity=0.2)
         plotter.add_mesh(plane.extract_feature_edges(), color="black", line_width=4)
-        legend.append(("obstacle zone (w <= 0 there)", "#303030"))
+        text = {
+            frozenset({"above"}): "obstacle zone (w <= 0 there)",
+            frozenset({"below"}): "obstacle zone below (w >= 0 there)",
+        }.get(frozenset(sides), "obstacle zones (both sides)")
+        legend.append((text, "#303030"))
     cxy = np.asarray(contact_coordinates if contact_coordinates is not None else [], dtype=float)
     cxy = cxy.reshape(-1, 2)
     if len(cxy):
@@ -226,8 +237,8 @@ def plot_mode_3d(
         xlabel="x", ylabel="y", zlabel="w", color="black", viewport=(0.72, 0.0, 0.86, 0.18)
     )
     plotter.camera_position = [
-        (px0 - 0.12, py0 - 0.28, 0.22),
-        (0.5 * (px0 + px1) + 0.01 * (px1 - px0), 0.5 * (py0 + py1), -0.005),
+        (px0 - 0.12 * scale, py0 - 0.28 * scale, 0.22 * scale),
+        (0.5 * (px0 + px1) + 0.01 * (px1 - px0), 0.5 * (py0 + py1), -0.005 * scale),
         (0.0, 0.0, 1.0),
     ]
     plotter.camera.zoom(1.18)
@@ -396,6 +407,90 @@ def plot_contact_set(
         fontsize=THEME["mpl_font_size"] - 2,
         frameon=False,
     )
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
+# -- contact map on the plate's own mesh -------------------------------------------------
+def plot_contact_map(
+    path: str | Path,
+    xy: npt.ArrayLike,
+    w: npt.ArrayLike,
+    triangles: npt.ArrayLike,
+    *,
+    boundary: npt.ArrayLike,
+    holes: Sequence[npt.ArrayLike] = (),
+    zones: Sequence[tuple[npt.ArrayLike, str]] = (),
+    contact_coordinates: npt.ArrayLike = (),
+    title: str = "",
+    tau: float = 0.0,
+) -> Path:
+    """Top view of a plate of any shape: mode contours, holes, obstacle zones, contact nodes.
+
+    Args:
+        path: PNG to write.
+        xy: (n, 2) node coordinates.
+        w: (n,) deflection at the nodes.
+        triangles: (m, 3) triangles of the plate's cells
+            (:func:`~unibuckle_fenicsx.fields.mesh_triangles`), so holes stay empty.
+        boundary: (k, 2) outer boundary polygon.
+        holes: Hole outlines (polygons; circles as many points).
+        zones: (outline, side) of each obstacle zone
+            (:func:`~unibuckle_fenicsx.fields.zone_outlines`); dashed, labelled by side.
+        contact_coordinates: (|Z|, 2) coordinates of the contact set.
+        title: Axes title.
+        tau: Relative deflections below this are drawn as zero.
+
+    Returns:
+        The written path.
+    """
+    plt = _pyplot()
+    path = _prepare(path)
+    xy = np.asarray(xy, dtype=float)
+    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    levels = np.linspace(-1.05, 1.05, 22)
+    cs = ax.tricontourf(
+        xy[:, 0],
+        xy[:, 1],
+        np.asarray(triangles),
+        _normalised(np.asarray(w), tau),
+        levels=levels,
+        cmap=THEME["cmap"],
+    )
+    cbar = fig.colorbar(cs, ax=ax, shrink=0.8, ticks=np.linspace(-1, 1, 5))
+    cbar.set_label("w / max|w|")
+    for outline in (boundary, *holes):
+        ring = np.asarray(outline, dtype=float)
+        ring = np.vstack([ring, ring[:1]])
+        ax.plot(ring[:, 0], ring[:, 1], "-", color="black", lw=1.2)
+    styles = {"above": ("--", "obstacle above (w <= 0)"), "below": (":", "obstacle below (w >= 0)")}
+    shown: set[str] = set()
+    for outline, side in zones:
+        ring = np.asarray(outline, dtype=float)
+        ring = np.vstack([ring, ring[:1]])
+        ls, label = styles.get(side, ("-.", f"foundation ({side})"))
+        ax.plot(ring[:, 0], ring[:, 1], ls, color="dimgray", lw=2.5,
+                label=None if side in shown else label)  # fmt: skip
+        shown.add(side)
+    z = np.atleast_2d(np.asarray(contact_coordinates, dtype=float))
+    nz = z.shape[0] if z.size else 0
+    if nz:
+        ax.plot(z[:, 0], z[:, 1], "o", ms=4 if nz < 300 else 2.5, mfc="black", mec="white",
+                mew=0.5, label=f"contact set Z ({nz})")  # fmt: skip
+    lo, hi = xy.min(axis=0), xy.max(axis=0)
+    pad = 0.02 * float((hi - lo).max())
+    ax.set_xlim(lo[0] - pad, hi[0] + pad)
+    ax.set_ylim(lo[1] - pad, hi[1] + pad)
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    if title:
+        ax.set_title(title)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=3,
+                  fontsize=THEME["mpl_font_size"] - 2, frameon=False)  # fmt: skip
     fig.tight_layout()
     fig.savefig(path)
     plt.close(fig)

@@ -30,11 +30,12 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.config import EdgeSpec, Material, PlateSpec
 from unibuckle_fenicsx.materials import membrane_voigt
-from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tag
+from unibuckle_fenicsx.mesh import edge_line, edge_normal_axis, edge_tags
 
 __all__ = [
     "DIRECT_LU",
     "Prestress",
+    "edge_traction",
     "membrane_force",
     "pin_rigid_motions",
     "solve_prestress",
@@ -64,6 +65,36 @@ def membrane_force(
 ) -> ufl.core.expr.Expr:
     r"""Membrane stress resultant :math:`N = C_m \varepsilon(u)` (N/m) as a UFL tensor."""
     return voigt_to_ufl(membrane_voigt(material, thickness), ufl.sym(ufl.grad(u)))
+
+
+def edge_traction(
+    msh: dolfinx.mesh.Mesh,
+    facet_tags: dolfinx.mesh.MeshTags,
+    plate: PlateSpec,
+    edge: EdgeSpec,
+    tag: int | None = None,
+) -> ufl.core.expr.Expr:
+    r"""Edge stress vector per unit load, :math:`\sigma_n n + \tau_s s` (Pa/Pa), in UFL.
+
+    n is the outward normal, :math:`s = (-n_y, n_x)` the counter-clockwise tangent. A
+    stress given as a pair (start, end) varies linearly with the position
+    :math:`\xi = (x - P)\cdot(Q - P)/|Q - P|^2` between the edge's start P and end Q
+    (:func:`~unibuckle_fenicsx.mesh.edge_line`; ``tag``: the segment of an edge of
+    several, each with its own line).
+
+    Note:
+        Collective for an edge given by a facet tag.
+    """
+    n = ufl.FacetNormal(msh)
+    s = ufl.as_vector([-n[1], n[0]])
+    if edge.uniform:
+        return edge.normal_ends[0] * n + edge.shear_ends[0] * s
+    start, end = edge_line(msh, facet_tags, plate, edge, tag)
+    d = end - start
+    x = ufl.SpatialCoordinate(msh)
+    xi = ufl.dot(x - ufl.as_vector(start.tolist()), ufl.as_vector(d.tolist())) / float(d @ d)
+    (n0, n1), (s0, s1) = edge.normal_ends, edge.shear_ends
+    return (n0 + (n1 - n0) * xi) * n + (s0 + (s1 - s0) * xi) * s
 
 
 @dataclass
@@ -152,7 +183,7 @@ def solve_prestress(
 
     Args:
         msh: Plate mesh.
-        facet_tags: Edge markers (:func:`unibuckle_fenicsx.mesh.edge_tag`).
+        facet_tags: Edge markers (:func:`unibuckle_fenicsx.mesh.edge_tags`).
         plate: Thickness and edge conditions (in-plane supports and tractions).
         material: Membrane stiffness.
         degree: Lagrange degree of the in-plane displacement.
@@ -177,15 +208,12 @@ def solve_prestress(
     V = dolfinx.fem.functionspace(msh, basix.ufl.element("Lagrange", cell.name, degree, shape=(2,)))
     u, v = ufl.TrialFunction(V), ufl.TestFunction(V)
     ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
-    n = ufl.FacetNormal(msh)
-    s = ufl.as_vector([-n[1], n[0]])
 
     a = ufl.inner(membrane_force(u, material, t), ufl.sym(ufl.grad(v))) * ufl.dx
     terms = [
-        t
-        * (e.normal_stress * ufl.dot(n, v) + e.shear_stress * ufl.dot(s, v))
-        * ds(edge_tag(plate, e))
+        t * ufl.dot(edge_traction(msh, facet_tags, plate, e, tag), v) * ds(tag)
         for e in loaded
+        for tag in edge_tags(plate, e)
     ]
     L = terms[0]
     for term in terms[1:]:
@@ -196,17 +224,18 @@ def solve_prestress(
     for e in plate.edges:
         if e.inplane == "free":
             continue
-        facets = facet_tags.find(edge_tag(plate, e))
-        components: tuple[int, ...] = (0, 1)
-        if e.inplane == "roller":
-            components = (edge_normal_axis(msh, facet_tags, edge_tag(plate, e), e.name),)
-        for c in components:
-            Vc, _ = V.sub(c).collapse()
-            dofs = dolfinx.fem.locate_dofs_topological((V.sub(c), Vc), fdim, facets)
-            bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
+        for tag in edge_tags(plate, e):
+            facets = facet_tags.find(tag)
+            components: tuple[int, ...] = (0, 1)
+            if e.inplane == "roller":
+                components = (edge_normal_axis(msh, facet_tags, tag, e.name),)
+            for c in components:
+                Vc, _ = V.sub(c).collapse()
+                dofs = dolfinx.fem.locate_dofs_topological((V.sub(c), Vc), fdim, facets)
+                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
     pinned = not bcs
     if pinned:
-        _check_self_equilibrated(msh, ds, n, s, plate, loaded)
+        _check_self_equilibrated(msh, facet_tags, ds, plate, loaded)
         bcs = pin_rigid_motions(V, msh)
 
     problem = dolfinx.fem.petsc.LinearProblem(
@@ -240,9 +269,8 @@ def solve_prestress(
 
 def _check_self_equilibrated(
     msh: dolfinx.mesh.Mesh,
+    facet_tags: dolfinx.mesh.MeshTags,
     ds: ufl.Measure,
-    n: ufl.core.expr.Expr,
-    s: ufl.core.expr.Expr,
     plate: PlateSpec,
     loaded: list[EdgeSpec],
 ) -> None:
@@ -253,12 +281,13 @@ def _check_self_equilibrated(
     moment = 0.0
     total = 0.0
     for e in loaded:
-        tr = e.normal_stress * n + e.shear_stress * s
-        m = ds(edge_tag(plate, e))
-        for c in range(2):
-            force[c] += _scalar(tr[c] * m)
-        moment += _scalar((x[0] * tr[1] - x[1] * tr[0]) * m)
-        total += _scalar(ufl.sqrt(ufl.dot(tr, tr)) * m)
+        for tag in edge_tags(plate, e):
+            tr = edge_traction(msh, facet_tags, plate, e, tag)
+            m = ds(tag)
+            for c in range(2):
+                force[c] += _scalar(tr[c] * m)
+            moment += _scalar((x[0] * tr[1] - x[1] * tr[0]) * m)
+            total += _scalar(ufl.sqrt(ufl.dot(tr, tr)) * m)
     force = [msh.comm.allreduce(f, op=MPI.SUM) for f in force]
     moment = msh.comm.allreduce(moment, op=MPI.SUM)
     total = msh.comm.allreduce(total, op=MPI.SUM)

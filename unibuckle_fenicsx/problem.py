@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -29,10 +29,15 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.contact import ContactSetManager, check_zone_has_nodes, orientation
+from unibuckle_fenicsx.contact import (
+    ContactSetManager,
+    check_zone_has_nodes,
+    foundation_springs,
+    orientation,
+)
 from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, EigenPair, GEPSolver, Owner, release
 from unibuckle_fenicsx.materials import bending_stiffness
-from unibuckle_fenicsx.mesh import create_plate_mesh
+from unibuckle_fenicsx.mesh import build_plate_mesh
 from unibuckle_fenicsx.plate.model import PlateModel
 from unibuckle_fenicsx.prestress import solve_prestress
 
@@ -58,14 +63,26 @@ def available_memory() -> int | None:
 
 
 def _check_memory(spec: ProblemSpec, comm: MPI.Comm) -> None:
-    """Refuse a mesh whose estimated memory exceeds what the machine has (collective)."""
-    need = BYTES_PER_DOF * spec.mesh.num_dofs
+    """Refuse a mesh whose estimated memory exceeds what the machine has (collective).
+
+    A plate meshed by gmsh is estimated at 3 DOFs per h^2 of its area (a file: not).
+    """
+    plate = spec.plate
+    if plate.file is not None:
+        return
+    if plate.meshed_by_gmsh:
+        assert spec.mesh.size is not None
+        dofs = int(3 * plate.area / spec.mesh.size**2)
+        what = f"mesh.size = {spec.mesh.size:g} m on {plate.area:.3g} m^2 gives about"
+    else:
+        dofs = spec.mesh.num_dofs
+        what = f"mesh.nx x mesh.ny = {spec.mesh.nx} x {spec.mesh.ny} gives"
+    need = BYTES_PER_DOF * dofs
     free = available_memory()
     have = comm.allreduce(free if free is not None else -1, op=MPI.MIN)
     if have > 0 and need > have:
         raise ValueError(
-            f"mesh.nx x mesh.ny = {spec.mesh.nx} x {spec.mesh.ny} gives "
-            f"{spec.mesh.num_dofs:,} DOFs, which need about {need / 1e9:.3g} GB "
+            f"{what} {dofs:,} DOFs, which need about {need / 1e9:.3g} GB "
             f"({BYTES_PER_DOF / 1000:.0f} kB per DOF), more than the {have / 1e9:.3g} GB "
             "available: use a coarser mesh or more machines"
         )
@@ -140,8 +157,8 @@ class BucklingProblem(Owner):
         eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
             is ``-unibuckle_eps_view``).
         mesh: A quadrilateral DOLFINx mesh to use instead of ``spec.mesh`` (the
-            rectangle); ``spec.plate.corners`` should then be its bounding box (used for
-            tolerances and the buckling coefficient's width).
+            rectangle, or gmsh's plate); ``spec.plate.corners`` should then be its
+            bounding box (used for tolerances and the buckling coefficient's width).
         facet_tags: Edge markers of ``mesh``, matched by :class:`EdgeSpec` ``tag``.
 
     Attributes:
@@ -169,6 +186,8 @@ class BucklingProblem(Owner):
         self.timings: dict[str, float] = {}
         #: The mesh came from the user (not spec.mesh): no coarse copies can be made.
         self.custom_mesh = mesh is not None
+        #: The structured rectangle of spec.mesh (coarser copies exist: multilevel).
+        self.structured = mesh is None and not spec.plate.meshed_by_gmsh
         if mesh is not None:
             if facet_tags is None:
                 raise ValueError(
@@ -181,11 +200,15 @@ class BucklingProblem(Owner):
             comm = mesh.comm
         else:
             _check_memory(spec, comm)
-            self.mesh, self.facet_tags = create_plate_mesh(spec.plate, spec.mesh, comm)
+            self.mesh, self.facet_tags, plate = build_plate_mesh(spec.plate, spec.mesh, comm)
+            # A file's edges get their tags, its corners the mesh's bounding box.
+            self.spec = spec = replace(spec, plate=plate)
         self.comm = comm
-        if spec.obstacle is not None:
+        obstacles = spec.all_obstacles
+        if obstacles:
             size = max(spec.plate.length, spec.plate.width)
-            check_zone_has_nodes(self.mesh, spec.obstacle, size)
+            labels = [spec.obstacle_label(k) for k in range(len(obstacles))]
+            check_zone_has_nodes(self.mesh, obstacles, size, labels)
         self.prestress = solve_prestress(
             self.mesh, self.facet_tags, spec.plate, spec.material, spec.solver.prestress_degree
         )
@@ -194,6 +217,8 @@ class BucklingProblem(Owner):
         self.model = PlateModel(
             self.mesh, self.facet_tags, spec.plate, spec.material, self.prestress, spec.solver.shear
         )
+        if spec.bilateral_foundations:
+            self.model.add_springs(*foundation_springs(self.model, spec.bilateral_foundations))
         t2 = time.perf_counter()
         self.timings["assembly_s"] = t2 - t1
         self._check_geometric_stiffness()
@@ -204,9 +229,8 @@ class BucklingProblem(Owner):
             tol=spec.solver.eps_tol,
             options={**EIGEN_OPTIONS, **(eps_options or {})},
         )
-        self.contact = (
-            ContactSetManager(self.model, spec.obstacle) if spec.obstacle is not None else None
-        )
+        unilateral = spec.unilateral_obstacles
+        self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
         self.free: Mode | None = None
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
@@ -234,6 +258,11 @@ class BucklingProblem(Owner):
             )
 
     # -- primitives ----------------------------------------------------------------
+    @property
+    def tensionless(self) -> bool:
+        """Whether the contact nodes carry a tensionless foundation (springs), not obstacles."""
+        return self.contact is not None and self.contact.stiffness is not None
+
     @property
     def num_constrained(self) -> int:
         """i, the number of constrained nodes (0 without obstacle)."""

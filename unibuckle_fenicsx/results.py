@@ -10,7 +10,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from unibuckle_fenicsx.config import UNITS, ProblemSpec, problem_to_dict
+from unibuckle_fenicsx.config import UNITS, ProblemSpec, problem_to_dict, stress_value
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution
@@ -34,7 +34,7 @@ class BucklingResult:
         critical_force_N_per_m: N = t lambda.
         buckling_coefficient_k: k = N b^2 / (pi^2 D), b = plate width.
         dofs: Global DOF count of (w, theta).
-        mesh: [nx, ny] (a user-supplied mesh: [number of cells]).
+        mesh: [nx, ny] (a user-supplied or gmsh mesh: [number of cells]).
         eigensolves: Linear eigen solves, including the free one.
         wall_time_s: Wall time of the whole solve (set-up included).
         constrained_nodes: i, nodes in the closed obstacle zone with free deflection.
@@ -81,7 +81,7 @@ class BucklingResult:
     timings: dict[str, float] = field(default_factory=dict)
     mpi_size: int = 1
     method_chosen_by: str = ""
-    edge_loads: dict[str, dict[str, float]] = field(default_factory=dict)
+    edge_loads: dict[str, dict[str, Any]] = field(default_factory=dict)
     units: str = "SI"
     input: dict[str, Any] | None = None
     versions: dict[str, str] = field(default_factory=dict)
@@ -116,7 +116,7 @@ class BucklingResult:
             dofs=problem.model.num_dofs,
             mesh=(
                 [problem.mesh.topology.index_map(2).size_global]
-                if problem.custom_mesh
+                if not problem.structured
                 else [spec.mesh.nx, spec.mesh.ny]
             ),
             eigensolves=1 + (0 if solution is None else solution.eigensolves),
@@ -128,7 +128,10 @@ class BucklingResult:
                 "free_eigen_iterations": free.eigen.iterations,
             },
             edge_loads={
-                e.name: {"normal_stress": e.normal_stress, "shear_stress": e.shear_stress}
+                e.name: {
+                    "normal_stress": stress_value(e.normal_stress),
+                    "shear_stress": stress_value(e.shear_stress),
+                }
                 for e in spec.plate.edges
             },
             units=spec.units,
@@ -185,7 +188,7 @@ class BucklingResult:
         loaded = [
             f"{name} {_load_text(load)}"
             for name, load in self.edge_loads.items()
-            if load["normal_stress"] or load["shear_stress"]
+            if _load_text(load)
         ]
         return (
             f"{self.case}: lambda_c = {self.critical_load_Pa / scale:.6e} {unit} "
@@ -197,12 +200,15 @@ class BucklingResult:
         )
 
 
-def _load_text(load: dict[str, float]) -> str:
+def _load_text(load: dict[str, Any]) -> str:
     parts = []
-    if load["normal_stress"]:
-        parts.append(f"normal {load['normal_stress']:g}")
-    if load["shear_stress"]:
-        parts.append(f"shear {load['shear_stress']:g}")
+    for key in ("normal", "shear"):
+        value = load[f"{key}_stress"]
+        if isinstance(value, list | tuple):
+            if any(value):
+                parts.append(f"{key} {value[0]:g} to {value[1]:g} (linear)")
+        elif value:
+            parts.append(f"{key} {value:g}")
     return ", ".join(parts)
 
 

@@ -249,7 +249,7 @@ def solve_active_set(
         Collective on ``problem.comm``.
     """
     if problem.contact is None:
-        raise ValueError("solve_active_set needs a problem with an obstacle (spec.obstacle)")
+        raise ValueError("solve_active_set needs a problem with an obstacle")
     if int(max_iterations) != max_iterations or max_iterations < 1:
         raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
     if int(coarse_min_cells) != coarse_min_cells or coarse_min_cells < 2:
@@ -264,7 +264,7 @@ def solve_active_set(
     free_load = problem.solve_free().load
     spec = problem.spec
     details: dict[str, Any] = {"free_load": free_load}
-    structured = multilevel and not problem.custom_mesh  # coarse copies need spec.mesh
+    structured = multilevel and problem.structured  # coarse copies need spec.mesh
     levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
     coarse_solves = 0
     penalty_solves = 0  # the penalty solver has its own eigen solver
@@ -324,7 +324,7 @@ def solve_active_set(
         details["seeded_on"] = [prev.spec.mesh.nx, prev.spec.mesh.ny]
     else:
         runs = _multi_seed(problem, max_iterations)
-        details["seeded_on"] = [spec.mesh.nx, spec.mesh.ny]
+        details["seeded_on"] = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
     if prev is not None:
         prev.destroy()
 

@@ -58,7 +58,7 @@ from unibuckle_fenicsx.eigen import (
     extreme_eigenvalues,
     release,
 )
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 
 __all__ = [
     "CONDITION_PREFIX",
@@ -66,6 +66,7 @@ __all__ = [
     "TIE_RTOL",
     "PenaltySolver",
     "PenaltyStep",
+    "SpringIteration",
     "solve_penalty",
 ]
 
@@ -102,6 +103,30 @@ class PenaltyStep:
     penetrating: npt.NDArray[np.int64]
 
 
+@dataclass(frozen=True)
+class SpringIteration:
+    r"""How :meth:`PenaltySolver.iterate_springs` ended.
+
+    Attributes:
+        candidate: The returned mode (the iterate with the smallest quotient), its load
+            the quotient and its ``active`` set the nodes pressing the springs.
+        steps: Every eigen solve.
+        step: The returned iterate's step.
+        status: "converged" (a fixed point), "cycle", "max_iterations" or "no-finite-load".
+        cycle_length: Length of the cycle (0 if none).
+        ties: Orientation ties broken by the deterministic rule.
+        lower_bound: :math:`\lambda_{free}`.
+    """
+
+    candidate: Candidate
+    steps: list[PenaltyStep]
+    step: PenaltyStep
+    status: str
+    cycle_length: int
+    ties: int
+    lower_bound: float
+
+
 def _key(nodes: npt.NDArray[np.int64]) -> tuple[int, ...]:
     return tuple(int(k) for k in nodes)
 
@@ -133,7 +158,7 @@ class PenaltySolver(Owner):
         if not isinstance(problem, BucklingProblem):
             raise ValueError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
         if problem.contact is None:
-            raise ValueError("the penalty method needs an obstacle (problem.spec.obstacle is None)")
+            raise ValueError("the penalty method needs an obstacle (the problem has none)")
         self.problem = problem
         A = problem.model.A
         diag = A.getDiagonal()
@@ -144,7 +169,6 @@ class PenaltySolver(Owner):
         self._work = A.createVecLeft()
         self._Av = A.createVecLeft()
         self._Bv = A.createVecLeft()
-        self._rho_abs = 0.0
         self._active = np.empty(0, dtype=np.int64)
         options = {**EIGEN_OPTIONS, **(eps_options or {})}
         self.gep = GEPSolver(
@@ -158,28 +182,40 @@ class PenaltySolver(Owner):
         self.solves = 0
 
     # -- the penalised operator ---------------------------------------------------------
-    def set_springs(self, rho_abs: float, active: npt.NDArray[np.int64]) -> None:
-        r""":math:`A_{pen} = A + \rho_{abs}\sum_{k \in S} e_k e_k^T` (S = ``active``), in place."""
+    def set_springs(
+        self, rho_abs: float | npt.NDArray[np.float64], active: npt.NDArray[np.int64]
+    ) -> None:
+        r""":math:`A_{pen} = A + \sum_{k \in S} \rho_k e_k e_k^T` (S = ``active``), in place.
+
+        Args:
+            rho_abs: The spring stiffness :math:`\rho_k`: one value for every node, or
+                one per constrained node (i,).
+            active: The spring set S (node numbers).
+        """
         assert self.problem.contact is not None
         same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
         self.problem.model.A.copy(self.A_pen, structure=same)
         self._springs.zeroEntries()
-        rows = self.problem.contact.removed_rows(active).astype(PETSc.IntType)
-        self._springs.setValues(rows, np.full(len(rows), rho_abs))
+        rows, nodes = self.problem.contact.node_rows(active)
+        values = np.broadcast_to(np.asarray(rho_abs, dtype=float), (self.problem.contact.size,))
+        self._springs.setValues(rows.astype(PETSc.IntType), values[nodes])
         self._springs.assemble()
         self.A_pen.setDiagonal(self._springs, addv=PETSc.InsertMode.ADD_VALUES)
         self.gep.operators_changed()
-        self._rho_abs = rho_abs
         self._active = np.asarray(active, dtype=np.int64)
 
-    def quotient(self, vec: PETSc.Vec, rho_abs: float) -> float:
-        r""":math:`R_\rho(v) = (v^TAv + \rho_{abs}\sum_I \max(0, v_k)^2) / v^TBv`."""
+    def quotient(self, vec: PETSc.Vec, rho_abs: float | npt.NDArray[np.float64]) -> float:
+        r""":math:`R_\rho(v) = (v^TAv + \sum_I \rho_k \max(0, v_k)^2) / v^TBv`.
+
+        ``rho_abs``: one stiffness for every node, or one per constrained node; v_k are the
+        oriented values at the constrained nodes.
+        """
         assert self.problem.contact is not None
         self.problem.model.A.mult(vec, self._Av)
         self.problem.model.B.mult(vec, self._Bv)
         vals = self.problem.contact.values(vec)
-        num = float(np.real(vec.dot(self._Av))) + rho_abs * float(
-            np.sum(np.maximum(vals, 0.0) ** 2)
+        num = float(np.real(vec.dot(self._Av))) + float(
+            np.sum(np.asarray(rho_abs) * np.maximum(vals, 0.0) ** 2)
         )
         den = float(np.real(vec.dot(self._Bv)))
         return float(num / den) if den > 0.0 else math.inf
@@ -248,11 +284,88 @@ class PenaltySolver(Owner):
             ``upper_bound`` = inf (the mode penetrates), ``global_optimum_proven``
             False, and ``details`` (see the code).
         """
+        if not (isinstance(rho, int | float) and math.isfinite(rho) and rho > 0.0):
+            raise ValueError(f"rho (relative penalty) must be finite and > 0, got {rho!r}")
+        rho_abs = float(rho) * self.max_diag
+        solves0 = self.solves
+        it = self.iterate_springs(
+            rho_abs,
+            initial_active=initial_active,
+            max_iterations=max_iterations,
+            threshold=threshold,
+            lower_bound=lower_bound,
+            tie_rtol=tie_rtol,
+            label=f"penalty rho={rho:.3g}",
+        )
+        step = it.step
+        details: dict[str, object] = {
+            "penalty_rho": float(rho),
+            "penalty_rho_abs": rho_abs,
+            "penalty_max_diag_A": self.max_diag,
+            "penalty_status": it.status,
+            "penalty_cycle_length": it.cycle_length,
+            "penalty_iterations": len(it.steps),
+            "penalty_orientation_ties": it.ties,
+            "penalty_max_penetration": step.penetration,
+            "penalty_penetrating_set": [int(k) for k in step.penetrating],
+            "penalty_springs": [int(k) for k in step.springs],
+            "penalty_eigenvalue": step.load,
+            "penalty_history": [s.quotient for s in it.steps],
+        }
+        if condition:
+            lo, hi = self.condition_number()
+            details["penalty_eig_min_A_pen"] = lo
+            details["penalty_eig_max_A_pen"] = hi
+            details["penalty_condition_number"] = hi / lo
+        return UnilateralSolution(
+            candidate=it.candidate,
+            method="penalty",
+            eigensolves=self.solves - solves0,
+            lower_bound=float(it.lower_bound),
+            global_optimum_proven=False,
+            upper_bound=math.inf,
+            details=details,
+        )
+
+    def iterate_springs(
+        self,
+        rho_abs: float | npt.NDArray[np.float64],
+        *,
+        initial_active: npt.NDArray[np.int64] | None = None,
+        max_iterations: int = 100,
+        threshold: float = 0.0,
+        lower_bound: float | None = None,
+        tie_rtol: float = TIE_RTOL,
+        label: str = "springs",
+    ) -> SpringIteration:
+        r"""The iteration on the spring set S for the springs ``rho_abs`` (N/m).
+
+        Minimises :math:`(a(v,v) + \sum_{k\in I}\rho_k\max(0, v_k)^2)/b(v,v)` (see the
+        module docstring): the penalty method with one stiffness for every node, or a
+        tensionless Winkler foundation with its physical nodal springs.
+
+        Args:
+            rho_abs: Absolute spring stiffness: one value, or one per constrained node.
+            initial_active: Starting spring set S_0 (default empty: the free plate).
+            max_iterations: Eigen solves allowed, >= 1.
+            threshold: A node penetrates when :math:`v_k >` threshold * max|w|, in
+                [0, 1e-2].
+            lower_bound: :math:`\lambda_{free}` if known (see :meth:`solve`).
+            tie_rtol: Tie tolerance of the two orientations' spring energies, in [0, 1).
+            label: Name in log messages.
+
+        Returns:
+            The iteration (the returned candidate, every step, how it ended).
+
+        Note:
+            Collective.
+        """
         problem = self.problem
         contact = problem.contact
         assert contact is not None
-        if not (isinstance(rho, int | float) and math.isfinite(rho) and rho > 0.0):
-            raise ValueError(f"rho (relative penalty) must be finite and > 0, got {rho!r}")
+        weights = np.broadcast_to(np.asarray(rho_abs, dtype=float), (contact.size,))
+        if not (np.all(np.isfinite(weights)) and np.all(weights > 0.0)):
+            raise ValueError("rho_abs (spring stiffness) must be finite and > 0 at every node")
         if int(max_iterations) != max_iterations or max_iterations < 1:
             raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
         if not 0.0 <= tie_rtol < 1.0:
@@ -263,8 +376,6 @@ class PenaltySolver(Owner):
         active = np.unique(np.asarray([] if initial_active is None else initial_active, np.int64))
         if active.size and (active.min() < 0 or active.max() >= i):
             raise ValueError(f"initial_active must hold node numbers in [0, {i}), got {active}")
-        rho_abs = float(rho) * self.max_diag
-        solves0 = self.solves
 
         vec = self._work
         best: PETSc.Vec | None = None
@@ -278,15 +389,15 @@ class PenaltySolver(Owner):
         ties = 0
         for it in range(int(max_iterations)):
             seen[_key(active)] = it
-            self.set_springs(rho_abs, active)
+            self.set_springs(weights, active)
             pair = self.gep.solve(out=vec, initial=previous)
             self.solves += 1
             if lower_bound is None and not active.size:
                 lower_bound = pair.value
             wmax = problem.max_abs_w(vec)
             vals = contact.values(vec) / wmax
-            up = float(np.sum(np.maximum(vals, 0.0) ** 2))
-            down = float(np.sum(np.maximum(-vals, 0.0) ** 2))
+            up = float(np.sum(weights * np.maximum(vals, 0.0) ** 2))
+            down = float(np.sum(weights * np.maximum(-vals, 0.0) ** 2))
             if abs(up - down) > tie_rtol * (up + down):
                 sign = 1.0 if up < down else -1.0
             else:
@@ -301,14 +412,14 @@ class PenaltySolver(Owner):
                 ties += 1
             vec.scale(sign / wmax)
             vals = sign * vals
-            q = self.quotient(vec, rho_abs)
+            q = self.quotient(vec, weights)
             penetrating = np.flatnonzero(vals > threshold).astype(np.int64)
             steps.append(
                 PenaltyStep(active, pair.value, q, max(float(vals.max()), 0.0), penetrating)
             )
             logger.debug(
-                "penalty rho=%.3g it %d: |S|=%d lambda_S=%.10g R=%.10g penetration %.3g",
-                rho, it, active.size, pair.value, q, steps[-1].penetration,
+                "%s it %d: |S|=%d lambda_S=%.10g R=%.10g penetration %.3g",
+                label, it, active.size, pair.value, q, steps[-1].penetration,
             )  # fmt: skip
             if q < best_q:
                 best_q, best_step = q, it
@@ -328,17 +439,16 @@ class PenaltySolver(Owner):
                 status = "cycle"
                 cycle_length = it + 1 - seen[key]
                 logger.warning(
-                    "penalty rho=%.3g: the penetrating set cycles (length %d) after %d solves; "
+                    "%s: the penetrating set cycles (length %d) after %d solves; "
                     "returning the iterate with the smallest penalised quotient",
-                    rho, cycle_length, it + 1,
+                    label, cycle_length, it + 1,
                 )  # fmt: skip
                 break
             active = penetrating
         if status == "max_iterations":
             logger.warning(
-                "penalty rho=%.3g: no fixed point after %d solves (-max_iterations)",
-                rho, max_iterations,
-            )  # fmt: skip
+                "%s: no fixed point after %d solves (-max_iterations)", label, max_iterations
+            )
         if best is None:
             # Every iterate had b(v, v) <= 0 (an infinite penalised quotient): the load
             # grows without bound with rho, no admissible mode buckles. Keep the last.
@@ -351,42 +461,17 @@ class PenaltySolver(Owner):
         u.x.scatter_forward()
         best.destroy()
         step = steps[best_step]
-        # Oriented and scaled above: the penalty's own orientation minimises R_rho.
+        # Oriented and scaled above: the iteration's own orientation minimises R_rho.
         candidate = problem.candidate(u, step.quotient, step.penetrating, sign=1.0)
         if status != "converged":
             # Leave A_pen with the springs of the returned mode, for condition().
-            self.set_springs(rho_abs, step.springs)
+            self.set_springs(weights, step.springs)
         if lower_bound is None:
             fresh = problem.free is None
             lower_bound = problem.solve_free().load
             self.solves += int(fresh)
-        details: dict[str, object] = {
-            "penalty_rho": float(rho),
-            "penalty_rho_abs": rho_abs,
-            "penalty_max_diag_A": self.max_diag,
-            "penalty_status": status,
-            "penalty_cycle_length": cycle_length,
-            "penalty_iterations": len(steps),
-            "penalty_orientation_ties": ties,
-            "penalty_max_penetration": step.penetration,
-            "penalty_penetrating_set": [int(k) for k in step.penetrating],
-            "penalty_springs": [int(k) for k in step.springs],
-            "penalty_eigenvalue": step.load,
-            "penalty_history": [s.quotient for s in steps],
-        }
-        if condition:
-            lo, hi = self.condition_number()
-            details["penalty_eig_min_A_pen"] = lo
-            details["penalty_eig_max_A_pen"] = hi
-            details["penalty_condition_number"] = hi / lo
-        return UnilateralSolution(
-            candidate=candidate,
-            method="penalty",
-            eigensolves=self.solves - solves0,
-            lower_bound=float(lower_bound),
-            global_optimum_proven=False,
-            upper_bound=math.inf,
-            details=details,
+        return SpringIteration(
+            candidate, steps, step, status, cycle_length, ties, float(lower_bound)
         )
 
     def destroy(self) -> None:

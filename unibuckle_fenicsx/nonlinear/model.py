@@ -58,10 +58,16 @@ from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpe
 from unibuckle_fenicsx.contact import ContactSetManager
 from unibuckle_fenicsx.eigen import Owner, release, set_options
 from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, shear_stiffness
-from unibuckle_fenicsx.mesh import create_plate_mesh, edge_normal_axis, edge_tag
+from unibuckle_fenicsx.mesh import (
+    build_plate_mesh,
+    edge_facets,
+    edge_normal_axis,
+    edge_tag,
+    edge_tags,
+)
 from unibuckle_fenicsx.plate.model import edge_support_bcs, mitc_shear_matrix
 from unibuckle_fenicsx.plate.spaces import MixedDofs
-from unibuckle_fenicsx.prestress import pin_rigid_motions, voigt_to_ufl
+from unibuckle_fenicsx.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
 
 __all__ = [
     "CONTROLS",
@@ -119,9 +125,11 @@ def displacement_axis(plate: PlateSpec, control: str) -> int | None:
     problem = None
     if not loaded:
         problem = "no edge is loaded"
-    elif any(e.shear_stress != 0.0 or e.normal_stress >= 0.0 for e in loaded):
+    elif not all(e.uniform for e in loaded):
+        problem = "its loaded edges must carry a uniform stress (not a [start, end] pair)"
+    elif any(e.shear_ends[0] != 0.0 or e.normal_ends[0] >= 0.0 for e in loaded):
         problem = "its loaded edges must carry compression only (no shear, no tension)"
-    elif len({e.normal_stress for e in loaded}) != 1:
+    elif len({e.normal_ends[0] for e in loaded}) != 1:
         problem = "its loaded edges must carry the same normal stress"
     elif any(e.name not in EDGE_NAMES or e.tag is not None for e in loaded):
         problem = "its loaded edges must be edges of the rectangle (left, right, bottom, top)"
@@ -200,7 +208,8 @@ class VonKarmanPlate(MixedDofs, Owner):
         self._displacement_axis = displacement_axis(spec.plate, control)
 
         if mesh is None or facet_tags is None:
-            mesh, facet_tags = create_plate_mesh(spec.plate, spec.mesh, comm)
+            mesh, facet_tags, plate = build_plate_mesh(spec.plate, spec.mesh, comm)
+            self.plate = plate
         self.mesh, self.facet_tags = mesh, facet_tags
         msh = self.mesh
         self.comm = msh.comm
@@ -214,7 +223,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         self.Vw, map_w = self.W.sub(W_SUB).collapse()
         self.w_dofs = np.asarray(map_w[0], dtype=np.int32)  # Vw dof -> W dof
         self.bending_bcs = edge_support_bcs(
-            self.W, self.facet_tags, spec.plate, w_sub=W_SUB, theta_sub=THETA_SUB
+            self.W, self.facet_tags, self.plate, w_sub=W_SUB, theta_sub=THETA_SUB
         )
         self.bc_dofs = np.unique(
             np.concatenate(
@@ -249,20 +258,19 @@ class VonKarmanPlate(MixedDofs, Owner):
         Pi = energy / self.energy_scale * ufl.dx
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
         n = ufl.FacetNormal(msh)
-        s = ufl.as_vector([-n[1], n[0]])
+        tractions = [
+            (edge_traction(msh, self.facet_tags, self.plate, e, tag), tag)
+            for e in loaded
+            for tag in edge_tags(self.plate, e)
+        ]
         if control == "load":
-            for edge in loaded:
-                traction = edge.normal_stress * n + edge.shear_stress * s
-                Pi = Pi - (self.load * t / self.energy_scale) * ufl.inner(traction, u) * ds(
-                    edge_tag(spec.plate, edge)
-                )
+            for traction, tag in tractions:
+                Pi = Pi - (self.load * t / self.energy_scale) * ufl.inner(traction, u) * ds(tag)
         v, dx_ = ufl.TestFunction(self.W), ufl.TrialFunction(self.W)
         # The edge loads' vector per unit lambda: the scale of the residual.
         unit_load = sum(
-            (t / self.energy_scale)
-            * ufl.inner(e.normal_stress * n + e.shear_stress * s, ufl.split(v)[U_SUB])
-            * ds(edge_tag(spec.plate, e))
-            for e in loaded
+            (t / self.energy_scale) * ufl.inner(traction, ufl.split(v)[U_SUB]) * ds(tag)
+            for traction, tag in tractions
         )
         f = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(unit_load))
         _add_ghosts(f)
@@ -279,9 +287,9 @@ class VonKarmanPlate(MixedDofs, Owner):
         self._edge_forms = [
             (
                 dolfinx.fem.form(
-                    t * ufl.inner(ufl.split(self.x)[U_SUB], n) * ds(edge_tag(spec.plate, e))
+                    t * ufl.inner(ufl.split(self.x)[U_SUB], n) * ds(edge_tags(self.plate, e))
                 ),
-                _scalar(dolfinx.fem.form(1.0 * ds(edge_tag(spec.plate, e))), self.comm),
+                _scalar(dolfinx.fem.form(1.0 * ds(edge_tags(self.plate, e))), self.comm),
                 e,
             )
             for e in loaded
@@ -309,9 +317,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         self._Kd: PETSc.Vec | None = self._xs.duplicate()
 
         self.contact = (
-            ContactSetManager(self, spec.obstacle)
-            if obstacle and spec.obstacle is not None
-            else None
+            ContactSetManager(self, spec.all_obstacles) if obstacle and spec.all_obstacles else None
         )
         snes = PETSc.SNES().create(self.comm)
         snes.setFunction(self._residual, self.b)
@@ -325,10 +331,14 @@ class VonKarmanPlate(MixedDofs, Owner):
             self._upper = self._xs.duplicate()
             self._lower.set(PETSc.NINFINITY)
             self._upper.set(PETSc.INFINITY)
+            # Obstacle above: w <= 0 (upper bound); below: w >= 0 (lower bound).
             rows = self.contact.global_rows()
             lo, hi = self._upper.getOwnershipRange()
-            mine = rows[(rows >= lo) & (rows < hi)]
-            self._upper.array[mine - lo] = 0.0
+            mine = (rows >= lo) & (rows < hi)
+            above = mine & (self.contact.signs > 0)
+            below = mine & (self.contact.signs < 0)
+            self._upper.array[rows[above] - lo] = 0.0
+            self._lower.array[rows[below] - lo] = 0.0
             snes.setVariableBounds(self._lower, self._upper)
         else:
             options.setdefault("snes_type", "newtonls")
@@ -344,9 +354,12 @@ class VonKarmanPlate(MixedDofs, Owner):
         bcs: list[dolfinx.fem.DirichletBC] = []
         held = {0: False, 1: False}  # a component held along an edge (no translation)
 
-        def fix(edge: EdgeSpec, c: int, value: float | dolfinx.fem.Constant) -> None:
+        def fix(
+            edge: EdgeSpec, c: int, value: float | dolfinx.fem.Constant, tag: int | None = None
+        ) -> None:
             Vc, _ = U.sub(c).collapse()
-            facets = self.facet_tags.find(edge_tag(plate, edge))
+            tags = edge_tags(plate, edge) if tag is None else (tag,)
+            facets = edge_facets(self.facet_tags, tags)
             dofs = dolfinx.fem.locate_dofs_topological((U.sub(c), Vc), fdim, facets)
             bcs.append(dolfinx.fem.dirichletbc(value, dofs[0], U.sub(c)))
 
@@ -363,12 +376,13 @@ class VonKarmanPlate(MixedDofs, Owner):
                 continue
             if e.inplane == "free":
                 continue
-            components: tuple[int, ...] = (0, 1)
-            if e.inplane == "roller":
-                components = (edge_normal_axis(msh, self.facet_tags, edge_tag(plate, e), e.name),)
-            for c in components:
-                fix(e, c, 0.0)
-                held[c] = True
+            for tag in edge_tags(plate, e):
+                components: tuple[int, ...] = (0, 1)
+                if e.inplane == "roller":
+                    components = (edge_normal_axis(msh, self.facet_tags, tag, e.name),)
+                for c in components:
+                    fix(e, c, 0.0, tag)
+                    held[c] = True
         if axis is None and not bcs:
             bcs += pin_rigid_motions(U, msh)
         elif axis is not None and not held[1 - axis]:
@@ -436,12 +450,13 @@ class VonKarmanPlate(MixedDofs, Owner):
                 constant.value = factor * value / self.thickness  # type: ignore[assignment]
 
     def project(self) -> None:
-        """Clip the state onto the obstacle (w <= 0 at the zone's nodes); not collective."""
+        """Clip the state onto the obstacles (w <= 0 above, >= 0 below); not collective."""
         if self.contact is None:
             return
-        assert self._upper is not None
+        assert self._upper is not None and self._lower is not None
         arr = self.x.x.petsc_vec.array
         np.minimum(arr, self._upper.array, out=arr)
+        np.maximum(arr, self._lower.array, out=arr)
         self.x.x.scatter_forward()
 
     def solve(self) -> StepReport:
@@ -471,7 +486,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         return self.thickness * float(self.comm.allreduce(local, op=MPI.MAX))
 
     def zone_deflection(self) -> npt.NDArray[np.float64]:
-        """Deflection (m) at the zone's nodes, (i,), same on every rank (empty without obstacle)."""
+        """Deflection (m) towards the obstacles at the zone nodes, s_k w_k (empty without one)."""
         if self.contact is None:
             return np.empty(0)
         return self.thickness * self.contact.values(self.x.x.petsc_vec)
@@ -525,13 +540,13 @@ class VonKarmanPlate(MixedDofs, Owner):
             force = float(self.comm.allreduce(float(b.array[dofs].sum()), op=MPI.SUM))
             # Scaled residual -> N: times D11 / t.
             force *= sign * self.energy_scale / self.thickness
-            loads.append(force / (self.thickness * length * edge.normal_stress))
+            loads.append(force / (self.thickness * length * edge.normal_ends[0]))
         return float(np.mean(loads))
 
     def flat_shortening(self, load: float) -> float:
         """End shortening (m) of the flat plate under ``load`` (linear membrane estimate)."""
         axis = self._displacement_axis if self._displacement_axis is not None else 0
-        stress = max(abs(e.normal_stress) for e in self.plate.edges if e.loaded)
+        stress = max(abs(v) for e in self.plate.edges if e.loaded for v in e.normal_ends)
         strain = float(self._compliance[axis, axis]) * load * self.thickness * stress
         length = self.plate.length if axis == 0 else self.plate.width
         return strain * length

@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from mpi4py import MPI
@@ -435,11 +435,14 @@ def _embed(
     x0.x.scatter_forward()
 
 
-def _pressure_shape(problem: BucklingProblem) -> dolfinx.fem.Function:
-    """Deflection under a uniform downward pressure (linear plate), max |w| = 1, w <= 0."""
+def _pressure_shape(problem: BucklingProblem, sign: float = 1.0) -> dolfinx.fem.Function:
+    """Deflection under a uniform pressure away from the obstacles (linear plate), max |w| = 1.
+
+    ``sign`` = +1 (obstacles above): downward, w <= 0; -1 (below): upward.
+    """
     model = problem.model
     z, _ = ufl.split(ufl.TestFunction(model.W))
-    f = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(-1.0 * z * ufl.dx))
+    f = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(-sign * z * ufl.dx))
     f.ghostUpdate(addv=True, mode="reverse")  # ADD_VALUES, SCATTER_REVERSE
     dolfinx.fem.petsc.set_bc(f, model.bcs)
     ksp = PETSc.KSP().create(problem.comm)  # type: ignore[arg-type]
@@ -507,7 +510,14 @@ def imperfection_shape(
         else:
             out.x.array[:] *= _orientation(problem, out)
     if contact is not None:
-        p = _pressure_shape(problem)
+        sides = {float(v) for v in contact.signs}
+        if len(sides) != 1:
+            raise ValueError(
+                "the nonlinear analysis pushes the imperfection off the obstacles by a uniform "
+                "pressure: it needs every obstacle on one side of the plate (all above or all "
+                "below)"
+            )
+        p = _pressure_shape(problem, sides.pop())
         out.x.petsc_vec.axpy(PUSH_OFF, p.x.petsc_vec)
         out.x.scatter_forward()
         out.x.petsc_vec.scale(1.0 / problem.max_abs_w(out.x.petsc_vec))
@@ -633,7 +643,7 @@ def contact_check(plate: VonKarmanPlate, rtol: float = 1e-8) -> dict[str, Any]:
         indicator = F.duplicate()
         try:
             plate.contact.scatter(on.astype(float), indicator)
-            skip |= indicator.array > 0.5
+            skip |= np.abs(indicator.array) > 0.5
         finally:
             indicator.destroy()
         out.update(
@@ -680,7 +690,17 @@ def solve_nonlinear(
     """
     t0 = time.perf_counter()
     options = NonlinearOptions() if options is None else options
-    obstacle = options.obstacle and spec.obstacle is not None
+    if any(o.foundation_stiffness is not None for o in spec.all_obstacles):
+        raise ValueError(
+            "the nonlinear analysis models rigid obstacles only, not Winkler foundations "
+            "(foundation_stiffness)"
+        )
+    obstacle = options.obstacle and bool(spec.all_obstacles)
+    if obstacle and len({o.side for o in spec.all_obstacles}) > 1:
+        raise ValueError(
+            "the nonlinear analysis needs every obstacle on one side of the plate (all "
+            "above or all below): the imperfection is pushed off them by a uniform pressure"
+        )
     if options.shape == "unilateral" and not obstacle:
         raise ValueError(
             'shape = "unilateral" needs a problem with an obstacle (and obstacle = true)'
@@ -702,7 +722,7 @@ def solve_nonlinear(
             raise ValueError("linear: the analysis given is of another plate or mesh")
     owns_linear = linear is None
     if linear is None:
-        linear = solve_linear(spec if obstacle else replace(spec, obstacle=None), comm)
+        linear = solve_linear(spec if obstacle else spec.without_obstacles(), comm)
     timings = {"linear_s": time.perf_counter() - t0}
     result = linear.result
     reference = result.critical_load_Pa if obstacle else result.free_load_Pa

@@ -14,7 +14,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.config import Material, PlateSpec
 from unibuckle_fenicsx.eigen import Owner, release
 from unibuckle_fenicsx.materials import bending_voigt, shear_stiffness
-from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tag
+from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tags
 from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_form
 from unibuckle_fenicsx.plate.spaces import (
     MixedDofs,
@@ -102,6 +102,25 @@ class PlateModel(MixedDofs, Owner):
         """:math:`P^T M_s P` with P's columns of edge-constrained DOFs zeroed."""
         return mitc_shear_matrix(self.W, self.bc_dofs, ks)
 
+    def add_springs(self, rows: npt.NDArray[np.int64], stiffness: npt.NDArray[np.float64]) -> None:
+        r"""Add nodal springs to A: :math:`A_{kk} \mathrel{+}= k_k` at the global ``rows``.
+
+        A bilateral Winkler foundation (lumped springs at the w-DOFs, see
+        :func:`~unibuckle_fenicsx.contact.foundation_springs`); A stays SPD.
+
+        Args:
+            rows: Global W rows owned by this rank (free w-DOFs).
+            stiffness: Spring stiffness (N/m) of each.
+
+        Note:
+            Collective.
+        """
+        diag = self.A.createVecLeft()
+        diag.setValues(rows.astype(PETSc.IntType), stiffness)
+        diag.assemble()
+        self.A.setDiagonal(diag, addv=PETSc.InsertMode.ADD_VALUES)
+        diag.destroy()
+
     @property
     def w_subspace(self) -> dolfinx.fem.FunctionSpace:
         """The sub-space of W holding w."""
@@ -151,22 +170,22 @@ def edge_support_bcs(
     for e in plate.edges:
         if e.support == "free":
             continue
-        tag = edge_tag(plate, e)
-        facets = facet_tags.find(tag)
-        subs: list[tuple[int, ...]] = [(w_sub,)]
-        if e.support == "clamped":
-            subs += [(theta_sub, 0), (theta_sub, 1)]
-        elif e.support == "simply_supported":
-            # theta . s = 0: the rotation component along the edge direction.
-            normal = edge_normal_axis(msh, facet_tags, tag, e.name)
-            subs.append((theta_sub, 1 - normal))
-        for path in subs:
-            sub = W
-            for i in path:
-                sub = sub.sub(i)
-            Vc, _ = sub.collapse()
-            dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
-            bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
+        for tag in edge_tags(plate, e):
+            facets = facet_tags.find(tag)
+            subs: list[tuple[int, ...]] = [(w_sub,)]
+            if e.support == "clamped":
+                subs += [(theta_sub, 0), (theta_sub, 1)]
+            elif e.support == "simply_supported":
+                # theta . s = 0: the rotation component along the edge (each segment's).
+                normal = edge_normal_axis(msh, facet_tags, tag, e.name)
+                subs.append((theta_sub, 1 - normal))
+            for path in subs:
+                sub = W
+                for i in path:
+                    sub = sub.sub(i)
+                Vc, _ = sub.collapse()
+                dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
+                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
     return bcs
 
 

@@ -1,0 +1,273 @@
+r"""Winkler foundations: bilateral (springs everywhere) and tensionless (compression only).
+
+A foundation of modulus :math:`k_f` (N/m^3) is lumped at the zone's nodes
+(:math:`k_f\int\varphi_k`). Expected values:
+
+- bilateral, simply supported strip of width b: with :math:`w = \sin(\pi x/l)\sin(\pi
+  y/b)` the thin-plate coefficient is :math:`k(\varphi) = 1/\varphi^2 + 2 +
+  \varphi^2(1 + K)`, :math:`\varphi = l/b`, :math:`K = k_f b^4/(\pi^4 D)`; its minimum
+  over :math:`\varphi` is :math:`2 + 2\sqrt{1 + K}` (the long strip), reached at
+  :math:`\varphi = (1 + K)^{-1/4}` (the plate analogue of the bar on an elastic
+  foundation, Timoshenko and Gere, *Theory of Elastic Stability*, 1961, chapter 2: the
+  same computation with a sine across the width);
+- tensionless: the quotient grows with :math:`k_f` (pointwise), lies between the free
+  plate (:math:`k_f = 0`) and the rigid obstacle (:math:`k_f \to \infty`, whose spring
+  term vanishes on every admissible mode), and tends to the rigid value: for a long
+  plate with clamped loaded edges and simply supported long edges the thin-plate limit is
+  16/3 (an interior buckle between two touch-down lines, README "Every plate the schema
+  describes"), for simply supported loaded edges 9/2 (a buckle against the loaded edge).
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+from dataclasses import replace
+
+from mpi4py import MPI
+
+import numpy as np
+import pytest
+
+from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.cases import plate_case
+from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.contact import tributary_areas
+from unibuckle_fenicsx.materials import bending_stiffness
+from unibuckle_fenicsx.problem import BucklingProblem
+
+THICKNESS = 1e-3  # b = 1 m: t/b = 1e-3, the thin limit
+D = bending_stiffness(1.0e9, 0.3, THICKNESS)
+
+
+def modulus(K):
+    """k_f (N/m^3) of the non-dimensional foundation stiffness K = k_f b^4/(pi^4 D), b = 1."""
+    return K * math.pi**4 * D
+
+
+def strip_k(aspect, K):
+    """Thin-plate k of the simply supported a x 1 plate on a bilateral foundation."""
+    return min(1 / p**2 + 2 + p**2 * (1 + K) for p in (aspect / m for m in range(1, 60)))
+
+
+def strip(aspect, ny, zone=None, supports="simply_supported"):
+    return plate_case(
+        "strip",
+        length=aspect,
+        width=1.0,
+        thickness=THICKNESS,
+        nx=round(aspect * ny),
+        ny=ny,
+        zone=zone,
+        supports=supports,
+    )
+
+
+# -- schema ------------------------------------------------------------------------------
+def test_foundation_keys_are_read_checked_and_written_back():
+    data = {"obstacle": {"zone": "all", "foundation_stiffness": 2.0e6, "side": "below"}}
+    spec = problem_from_dict(data)
+    assert spec.obstacle.kind == "tensionless" and spec.tensionless
+    assert problem_from_dict(problem_to_dict(spec)) == spec
+    both = problem_from_dict(
+        {"obstacle": {"zone": "all", "foundation_stiffness": 1.0, "side": "both"}}
+    )
+    assert both.obstacle.kind == "bilateral" and not both.tensionless
+    assert both.bilateral_foundations == (both.obstacle,) and both.unilateral_obstacles == ()
+    # N/mm^3 in a mm-N-MPa file: 1 N/mm^3 = 1e9 N/m^3.
+    mm = problem_from_dict(
+        {"units": "mm-N-MPa", "obstacle": {"zone": "all", "foundation_stiffness": 0.002}}
+    )
+    assert mm.obstacle.foundation_stiffness == pytest.approx(2.0e6, rel=1e-15)
+    assert problem_to_dict(mm, units="mm-N-MPa")["obstacle"][
+        "foundation_stiffness"
+    ] == pytest.approx(0.002)
+
+
+@pytest.mark.parametrize(
+    "data, match",
+    [
+        (
+            {"obstacle": {"zone": "all", "foundation_stiffness": 0.0}},
+            r"obstacle\.foundation_stiffness .* must be > 0 N/m\^3",
+        ),
+        (
+            {"obstacle": {"zone": "all", "foundation_stiffness": "stiff"}},
+            r"obstacle\.foundation_stiffness must be a number",
+        ),
+        (
+            {"obstacle": {"zone": "all", "side": "both"}},
+            r"bilateral support.*support.*foundation_stiffness",
+        ),
+        (
+            {
+                "obstacles": [
+                    {"zone": "all", "foundation_stiffness": 1.0},
+                    {"zone": [[0, 0.1], [0, 0.1]]},
+                ]
+            },
+            r"rigid obstacles and tensionless foundations in one problem are not supported",
+        ),
+        (
+            {
+                "obstacle": {"zone": "all", "foundation_stiffness": 1.0},
+                "solver": {"method": "active-set"},
+            },
+            r'solver\.method = "active-set": a tensionless foundation .* use method = "auto"',
+        ),
+        (
+            {
+                "obstacles": [
+                    {"zone": "all", "foundation_stiffness": 1.0},
+                    {"zone": "all", "foundation_stiffness": 1.0, "side": "below"},
+                ]
+            },
+            r'same foundation zone on both sides .* side = "both"',
+        ),
+    ],
+)
+def test_bad_foundations_name_the_parameter(data, match):
+    with pytest.raises(ValueError, match=match):
+        problem_from_dict(data)
+
+
+def test_a_bilateral_foundation_goes_with_a_rigid_obstacle():
+    data = {
+        "obstacles": [
+            {"zone": "all", "foundation_stiffness": 1.0e3, "side": "both"},
+            {"zone": [[-0.04, 0.04], [-0.05, 0.05]]},
+        ]
+    }
+    spec = problem_from_dict(data).with_mesh(12, 6)
+    with solve(spec) as analysis:
+        assert analysis.result.method != "foundation" and analysis.result.certificate["kkt"]
+
+
+# -- the spring term ---------------------------------------------------------------------
+def test_tributary_areas_sum_to_the_plate_area():
+    spec = strip(1.5, 6, ObstacleSpec("all", foundation_stiffness=1.0))
+    with BucklingProblem(spec, MPI.COMM_WORLD) as problem:
+        areas = tributary_areas(problem.model)
+        n = problem.model.Vw.dofmap.index_map.size_local
+        total = MPI.COMM_WORLD.allreduce(float(areas.array[:n].sum()), op=MPI.SUM)
+        # Interior nodes of a uniform grid carry one cell: h^2.
+        assert problem.contact.stiffness.max() == pytest.approx((1.5 / 9) * (1.0 / 6), rel=1e-12)
+    assert total == pytest.approx(1.5, rel=1e-13)
+
+
+@pytest.mark.parametrize("aspect, K", [(2.0, 15.0), (3.0, 3.0)])
+def test_bilateral_foundation_against_the_strip_formula(aspect, K):
+    """Bilateral foundation: k = min over the half-waves of 1/phi^2 + 2 + phi^2 (1 + K).
+
+    (2, 15): four half-waves of b/2, exactly the long strip's 2 + 2 sqrt(1 + K) = 10;
+    (3, 3): four half-waves of 0.75 b, 6.028, 0.5 % above the long strip's 6. Meshes of
+    b/16 and b/32: the finer within 1 % of the formula, Richardson (rate 2) within 1e-3.
+    """
+    zone = ObstacleSpec("all", foundation_stiffness=modulus(K), side="both")
+    ks = []
+    for ny in (16, 32):
+        with solve(strip(aspect, ny, zone)) as analysis:
+            assert analysis.result.method == "free"  # the springs are part of A
+            ks.append(analysis.result.buckling_coefficient_k)
+    exact = strip_k(aspect, K)
+    assert ks[1] == pytest.approx(exact, rel=1e-2)
+    assert ks[1] + (ks[1] - ks[0]) / 3 == pytest.approx(exact, rel=1e-3)
+    assert exact == pytest.approx(2 + 2 * math.sqrt(1 + K), rel=5e-3)
+
+
+# -- tensionless ---------------------------------------------------------------------------
+def test_foundation_the_free_mode_turns_away_from_is_proven_inactive():
+    """A foundation the free mode turns away from is inactive, proven.
+
+    A square plate's first mode is one-signed: turned away from a whole-plate foundation
+    it presses nothing, so the load is the free one and the bracket closes.
+    """
+    spec = strip(1.0, 8, ObstacleSpec("all", foundation_stiffness=modulus(100.0)))
+    with solve(spec) as analysis:
+        result = analysis.result
+    assert result.method == "foundation" and result.contact_nodes == 0
+    assert result.critical_load_Pa == pytest.approx(result.free_load_Pa, rel=1e-10)
+    assert result.certificate["kkt"] and result.certificate["global_optimum_proven"]
+
+
+@pytest.mark.parametrize("supports", ["simply_supported", "loaded_clamped"])
+def test_tensionless_foundation_lies_between_free_and_rigid_and_grows(supports):
+    """a/b = 3, 24x8 cells, t/b = 1e-3, whole-plate foundation, K = 1 ... 1e4.
+
+    k(K) increases strictly, stays between the free plate's and the rigid obstacle's k
+    on the same mesh, and at K = 1e4 is within 2e-4 of the rigid value. Every result is
+    a stationary point of the spring quotient (certificate: residual, and the smallest
+    eigenvalue of its pencil).
+    """
+    edges = (
+        "simply_supported"
+        if supports == "simply_supported"
+        else {"left": "clamped", "right": "clamped"}
+    )
+    base = strip(3.0, 8, supports=edges)
+    with solve(base) as analysis:
+        free = analysis.result.buckling_coefficient_k
+    with solve(replace(base, obstacle=ObstacleSpec("all"))) as analysis:
+        rigid = analysis.result.buckling_coefficient_k
+        assert analysis.result.certificate["kkt"]
+    ks = []
+    for K in (1.0, 10.0, 100.0, 1e3, 1e4):
+        with solve(
+            replace(base, obstacle=ObstacleSpec("all", foundation_stiffness=modulus(K)))
+        ) as analysis:
+            result = analysis.result
+        assert result.method == "foundation"
+        cert = result.certificate
+        assert cert["kkt"] and cert["smallest_of_reduced"], (K, cert)
+        assert cert["relative_residual"] < 1e-6
+        ks.append(result.buckling_coefficient_k)
+    assert free < ks[0], (free, ks)
+    assert all(x < y for x, y in itertools.pairwise(ks)), ks
+    assert ks[-1] <= rigid * (1 + 1e-8), (ks, rigid)
+    assert ks[-1] == pytest.approx(rigid, rel=2e-4)
+
+
+def test_foundation_below_is_the_mirror_of_above():
+    base = strip(3.0, 8, supports={"left": "clamped", "right": "clamped"})
+    loads = []
+    for side in ("above", "below"):
+        zone = ObstacleSpec("all", foundation_stiffness=modulus(10.0), side=side)
+        with solve(replace(base, obstacle=zone)) as analysis:
+            loads.append(analysis.result.critical_load_Pa)
+            coordinates = analysis.result.contact_coordinates
+            if side == "above":
+                first = coordinates
+    assert loads[1] == pytest.approx(loads[0], rel=1e-9)
+    assert sorted(map(tuple, coordinates)) == sorted(map(tuple, first))
+
+
+@pytest.mark.convergence
+def test_tensionless_limit_tends_to_sixteen_thirds():
+    """Loaded edges clamped, a/b = 3: K = 1e4 tends to the rigid obstacle, both to 16/3.
+
+    36x12 and 72x24 cells: the foundation's k lies below the rigid obstacle's by the
+    foundation's own (mesh-independent) compliance, measured 1.5e-5 and 2.4e-4; the rigid
+    value converges to the thin long-plate limit 16/3 at rate 2 (error ratio about 4).
+    """
+    base = {ny: strip(3.0, ny, supports={"left": "clamped", "right": "clamped"}) for ny in (12, 24)}
+    rigid, soft = [], []
+    for ny, spec in base.items():
+        with solve(replace(spec, obstacle=ObstacleSpec("all"))) as analysis:
+            rigid.append(analysis.result.buckling_coefficient_k)
+        zone = ObstacleSpec("all", foundation_stiffness=modulus(1e4))
+        with solve(replace(spec, obstacle=zone)) as analysis:
+            assert analysis.result.certificate["kkt"]
+            soft.append(analysis.result.buckling_coefficient_k)
+    for s, r in zip(soft, rigid, strict=True):
+        assert s <= r * (1 + 1e-8) and s == pytest.approx(r, rel=1e-3)
+    errors = np.array(rigid) - 16 / 3
+    assert errors[0] > errors[1] > 0
+    assert 3.0 < errors[0] / errors[1] < 5.0, errors
+
+
+def test_nonlinear_analysis_refuses_a_foundation():
+    from unibuckle_fenicsx.nonlinear import solve_nonlinear
+
+    spec = strip(3.0, 6, ObstacleSpec("all", foundation_stiffness=modulus(10.0)))
+    with pytest.raises(ValueError, match=r"rigid obstacles only, not Winkler foundations"):
+        solve_nonlinear(spec)

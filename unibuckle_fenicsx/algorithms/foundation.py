@@ -1,0 +1,234 @@
+r"""Tensionless (compression-only) Winkler foundation: the spring-set iteration.
+
+A foundation of modulus :math:`k_f` (N/m^3) on one side of the plate over a zone pushes
+back with the pressure :math:`k_f w` where the plate presses into it and lets go where it
+lifts off. Lumped at the zone's nodes (node k carries the spring
+:math:`\rho_k = k_f \int\varphi_k\,dx`, its tributary area), the critical load is the
+minimum of the piecewise quadratic quotient
+
+.. math::
+
+    \lambda_f = \min_{v \ne 0}
+    \frac{a(v, v) + \sum_{k \in I} \rho_k \max(0, s_k v_k)^2}{b(v, v)},
+
+with :math:`s_k = +1` for a foundation above the plate and -1 below. This is the
+penalised quotient of :mod:`.penalty` with physical, per-node springs instead of a
+numerical penalty, so the same iteration on the spring set S (the nodes pressing the
+foundation) solves it: the smallest eigenpair of :math:`(A + \sum_{k\in S}\rho_k e_k
+e_k^T, B)`, oriented to press the foundation least, until S repeats. Its limits:
+:math:`k_f \to 0` gives the free plate, :math:`k_f \to \infty` the rigid obstacle; springs
+on both sides (a bilateral foundation, ``side = "both"``) are simply added to A.
+
+Bounds: :math:`\lambda_{free} \le \lambda_f` (the spring term is non-negative), and the
+returned load, a value of the quotient, is an upper bound of :math:`\lambda_f`. The
+iteration starts from the free plate (no springs) and from every spring active (the
+bilateral foundation's mode); the smaller quotient is returned.
+
+The iteration on S need not decrease the quotient, and it can cycle. When neither start
+reaches a fixed point, an *arc descent* takes over from the best iterate v: with S the
+nodes v presses, and u the smallest mode of the pencil with S's springs, the quotient is
+minimised over the circle :math:`\cos\theta\, v + \sin\theta\, u` (six inner
+products and the nodal values: no solve), and the minimiser becomes the next v. The
+quotient never increases, so it cannot cycle; it stops when a step gains less than
+:data:`ARC_RTOL`.
+
+Note:
+    Collective on the problem's communicator.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
+from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+
+__all__ = ["FOUNDATION_PREFIX", "solve_foundation"]
+
+logger = logging.getLogger(__name__)
+
+#: Options prefix of the foundation's eigen solver.
+FOUNDATION_PREFIX = "unibuckle_foundation_"
+#: The arc descent stops when a step lowers the quotient by less than this, relatively.
+ARC_RTOL = 1e-12
+#: Angles sampled on the circle before the golden-section refinement.
+ARC_SAMPLES = 720
+
+
+def solve_foundation(
+    problem: BucklingProblem,
+    *,
+    max_iterations: int = 100,
+    eps_options: dict[str, str | float | int] | None = None,
+) -> UnilateralSolution:
+    r"""Critical load of the plate on its tensionless foundation (module docstring).
+
+    Args:
+        problem: A problem whose contact nodes carry a tensionless foundation
+            (``problem.tensionless``).
+        max_iterations: Eigen solves allowed per start, >= 1.
+        eps_options: Extra EPS options under ``unibuckle_foundation_``.
+
+    Returns:
+        The solution: its candidate's load is the quotient of the returned mode, its
+        ``active`` set the nodes pressing the foundation; ``lower_bound`` =
+        :math:`\lambda_{free}`, ``upper_bound`` = the load; proven optimal only when
+        the free mode, turned away from the foundation, presses nothing (then the two
+        bounds meet).
+
+    Note:
+        Collective.
+    """
+    contact = problem.contact
+    if contact is None or contact.stiffness is None:
+        raise ValueError("solve_foundation needs a problem with a tensionless foundation")
+    if int(max_iterations) != max_iterations or max_iterations < 1:
+        raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    lower = problem.solve_free().load
+    springs = contact.stiffness
+    runs: dict[str, SpringIteration] = {}
+    with PenaltySolver(problem, prefix=FOUNDATION_PREFIX, eps_options=eps_options) as solver:
+        starts = {"free": np.empty(0, np.int64), "bilateral": np.arange(contact.size)}
+        for name, start in starts.items():
+            runs[name] = solver.iterate_springs(
+                springs,
+                initial_active=start,
+                max_iterations=max_iterations,
+                lower_bound=lower,
+                label=f"foundation ({name} start)",
+            )
+        # The smaller quotient; on a tie the start from the free plate.
+        name = min(runs, key=lambda n: (runs[n].candidate.load, n != "free"))
+        best = runs[name]
+        candidate, status = best.candidate, best.status
+        arc_steps = 0
+        if status != "converged" and math.isfinite(candidate.load):
+            candidate, status, arc_steps = _arc_descent(
+                problem, solver, springs, candidate, max_iterations
+            )
+            name += "+arc"
+        solves = solver.solves
+    load = candidate.load
+    proven = status == "converged" and not candidate.active.size
+    proven = proven and load <= lower * (1.0 + 1e-8)
+    details = {
+        "foundation_start": name,
+        "foundation_status": status,
+        "foundation_arc_steps": arc_steps,
+        "foundation_iterations": {n: len(r.steps) for n, r in runs.items()},
+        "foundation_loads": {n: r.candidate.load for n, r in runs.items()},
+        "foundation_statuses": {n: r.status for n, r in runs.items()},
+        "foundation_pressing_nodes": int(candidate.active.size),
+        "foundation_max_penetration": max(float(candidate.values.max()), 0.0),
+        "foundation_spring_range_N_per_m": [float(springs.min()), float(springs.max())],
+        "foundation_history": [s.quotient for s in best.steps],
+    }
+    logger.info(
+        "foundation: lambda = %.10g (start %s, %s, %d pressing nodes, %d eigen solves)",
+        load, name, status, candidate.active.size, solves,
+    )  # fmt: skip
+    return UnilateralSolution(
+        candidate=candidate,
+        method="foundation",
+        eigensolves=solves,
+        lower_bound=lower,
+        global_optimum_proven=bool(proven),
+        upper_bound=load if math.isfinite(load) else math.inf,
+        details=details,
+    )
+
+
+def _arc_descent(
+    problem: BucklingProblem,
+    solver: PenaltySolver,
+    springs: npt.NDArray[np.float64],
+    start: Candidate,
+    max_iterations: int,
+) -> tuple[Candidate, str, int]:
+    """Monotone descent of the spring quotient along arcs (module docstring), from ``start``.
+
+    Returns the candidate reached, "converged" (a step gains less than
+    :data:`ARC_RTOL`) or "max_iterations", and the steps taken.
+    """
+    contact = problem.contact
+    assert contact is not None
+    A, B = problem.model.A, problem.model.B
+    v = start.mode.x.petsc_vec.copy()
+    u, Av, Au, Bv, Bu = (v.duplicate() for _ in range(5))
+    q = start.load
+    status = "max_iterations"
+    steps = 0
+    try:
+        for steps in range(1, int(max_iterations) + 1):
+            z_v = contact.values(v)
+            pressing = np.flatnonzero(z_v > 0.0).astype(np.int64)
+            solver.set_springs(springs, pressing)
+            solver.gep.solve(out=u, initial=v)
+            solver.solves += 1
+            # u A-orthogonal to v, of v's A-norm: the circle is then well conditioned; a
+            # u parallel to v means v is the pencil's mode, a fixed point.
+            A.mult(v, Av)
+            A.mult(u, Au)
+            vav, uau = float(v.dot(Av)), float(u.dot(Au))
+            u.axpy(-float(v.dot(Au)) / vav, v)
+            A.mult(u, Au)
+            rest = float(u.dot(Au))
+            if rest <= 1e-16 * uau:
+                status = "converged"
+                break
+            u.scale(float(np.sqrt(vav / rest)))
+            A.mult(u, Au)
+            B.mult(v, Bv)
+            B.mult(u, Bu)
+            a = np.array([v.dot(Av), v.dot(Au), u.dot(Au)], dtype=float)
+            b = np.array([v.dot(Bv), v.dot(Bu), u.dot(Bu)], dtype=float)
+            z_u = contact.values(u)
+
+            def quotient(
+                theta: npt.NDArray[np.float64],
+                a: npt.NDArray[np.float64] = a,
+                b: npt.NDArray[np.float64] = b,
+                z_v: npt.NDArray[np.float64] = z_v,
+                z_u: npt.NDArray[np.float64] = z_u,
+            ) -> npt.NDArray[np.float64]:
+                c, s = np.cos(theta), np.sin(theta)
+                num = c * c * a[0] + 2 * c * s * a[1] + s * s * a[2]
+                den = c * c * b[0] + 2 * c * s * b[1] + s * s * b[2]
+                z = np.outer(c, z_v) + np.outer(s, z_u)
+                num = num + (springs * np.maximum(z, 0.0) ** 2).sum(axis=1)
+                return np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), np.inf)
+
+            grid = np.linspace(0.0, 2.0 * np.pi, ARC_SAMPLES, endpoint=False)
+            k = int(np.argmin(quotient(grid)))
+            lo, hi = grid[k] - 2 * np.pi / ARC_SAMPLES, grid[k] + 2 * np.pi / ARC_SAMPLES
+            golden = 0.5 * (np.sqrt(5.0) - 1.0)
+            for _ in range(60):  # golden section in the bracket around the best sample
+                m1, m2 = hi - golden * (hi - lo), lo + golden * (hi - lo)
+                if quotient(np.array([m1]))[0] <= quotient(np.array([m2]))[0]:
+                    hi = m2
+                else:
+                    lo = m1
+            theta = 0.5 * (lo + hi)
+            q_new = float(quotient(np.array([theta]))[0])
+            if not q_new < q * (1.0 - ARC_RTOL):
+                status = "converged"
+                break
+            v.scale(float(np.cos(theta)))
+            v.axpy(float(np.sin(theta)), u)
+            v.scale(1.0 / problem.max_abs_w(v))
+            q = q_new
+        mode = problem.new_mode()
+        v.copy(mode.x.petsc_vec)
+        mode.x.scatter_forward()
+        z = contact.values(v)
+        candidate = problem.candidate(mode, q, np.flatnonzero(z > 0.0).astype(np.int64), sign=1.0)
+    finally:
+        for vec in (v, u, Av, Au, Bv, Bu):
+            vec.destroy()
+    logger.info("foundation: arc descent %s after %d steps, R = %.12g", status, steps, q)
+    return candidate, status, steps

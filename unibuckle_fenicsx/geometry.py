@@ -1,0 +1,167 @@
+"""Plane geometry of outlines, holes and obstacle zones: polygons and circles (numpy only).
+
+Polygons are sequences of vertices (x, y), closed implicitly (the last vertex joins the
+first); segment k runs from vertex k to vertex k + 1.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+
+import numpy as np
+import numpy.typing as npt
+
+__all__ = [
+    "circle_points",
+    "distance_to_polygon",
+    "is_simple",
+    "points_in_circle",
+    "points_in_polygon",
+    "polygon_area",
+    "polygon_inside",
+    "polygons_disjoint",
+]
+
+Vertices = Sequence[Sequence[float]] | npt.NDArray[np.float64]
+
+
+def polygon_area(vertices: Vertices) -> float:
+    """Signed area (positive for counter-clockwise vertices), by the shoelace formula."""
+    v = np.asarray(vertices, dtype=float)
+    x, y = v[:, 0], v[:, 1]
+    return 0.5 * float(np.dot(x, np.roll(y, -1)) - np.dot(np.roll(x, -1), y))
+
+
+def _segments_cross(
+    p: npt.NDArray[np.float64],
+    q: npt.NDArray[np.float64],
+    r: npt.NDArray[np.float64],
+    s: npt.NDArray[np.float64],
+    tol: float,
+) -> bool:
+    """Whether the closed segments pq and rs share a point (within ``tol``)."""
+
+    def orient(
+        a: npt.NDArray[np.float64], b: npt.NDArray[np.float64], c: npt.NDArray[np.float64]
+    ) -> float:
+        return float((b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]))
+
+    # Orientations are areas: their tolerance is tol times the longer segment.
+    length = float(max(np.linalg.norm(q - p), np.linalg.norm(s - r)))
+    area = tol * length
+    d1, d2 = orient(r, s, p), orient(r, s, q)
+    d3, d4 = orient(p, q, r), orient(p, q, s)
+    if ((d1 > area and d2 < -area) or (d1 < -area and d2 > area)) and (
+        (d3 > area and d4 < -area) or (d3 < -area and d4 > area)
+    ):
+        return True
+    # Touching or collinear overlap: a point of one segment on the other.
+    for a, b, c in ((r, s, p), (r, s, q), (p, q, r), (p, q, s)):
+        if _point_segment_distance(c, a, b) <= tol:
+            return True
+    return False
+
+
+def _point_segment_distance(
+    c: npt.NDArray[np.float64], a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]
+) -> float:
+    d = b - a
+    t = float(np.clip(np.dot(c - a, d) / max(float(np.dot(d, d)), 1e-300), 0.0, 1.0))
+    return float(np.linalg.norm(c - (a + t * d)))
+
+
+def is_simple(vertices: Vertices) -> bool:
+    """Whether the closed polygon has no repeated vertex and no self-intersection."""
+    v = np.asarray(vertices, dtype=float)
+    n = len(v)
+    size = float(np.ptp(v, axis=0).max())
+    tol = 1e-12 * size
+    for k in range(n):
+        for j in range(k + 1, n):
+            if np.linalg.norm(v[k] - v[j]) <= tol:
+                return False
+    for k in range(n):
+        for j in range(k + 1, n):
+            if j == k + 1 or (k == 0 and j == n - 1):
+                continue  # adjacent segments share a vertex
+            if _segments_cross(v[k], v[(k + 1) % n], v[j], v[(j + 1) % n], tol):
+                return False
+    return True
+
+
+def distance_to_polygon(
+    points: npt.NDArray[np.float64], vertices: Vertices
+) -> npt.NDArray[np.float64]:
+    """Distance of each point (n, 2) to the polygon's boundary."""
+    v = np.asarray(vertices, dtype=float)
+    p = np.asarray(points, dtype=float)[:, :2]
+    a, b = v, np.roll(v, -1, axis=0)
+    d = b - a  # (m, 2)
+    rel = p[:, None, :] - a[None, :, :]  # (n, m, 2)
+    t = np.clip(
+        np.einsum("nmk,mk->nm", rel, d) / np.maximum(np.einsum("mk,mk->m", d, d), 1e-300), 0.0, 1.0
+    )
+    nearest = a[None, :, :] + t[..., None] * d[None, :, :]
+    return np.linalg.norm(p[:, None, :] - nearest, axis=2).min(axis=1)
+
+
+def points_in_polygon(
+    points: npt.NDArray[np.float64], vertices: Vertices, tol: float = 0.0
+) -> npt.NDArray[np.bool_]:
+    """Mask of the points (n, 2 or more columns) in the closed polygon, or within ``tol`` of it.
+
+    Even-odd ray casting for the interior; the boundary counts as inside through the
+    distance test, so a node on an edge of the zone is in the zone.
+    """
+    v = np.asarray(vertices, dtype=float)
+    p = np.asarray(points, dtype=float)
+    x, y = p[:, 0], p[:, 1]
+    inside = np.zeros(len(p), dtype=bool)
+    for (x0, y0), (x1, y1) in zip(v, np.roll(v, -1, axis=0), strict=True):
+        crosses = (y0 > y) != (y1 > y)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            xc = x0 + (y - y0) * (x1 - x0) / (y1 - y0)
+        inside ^= crosses & (x < xc)
+    return inside | (distance_to_polygon(p, v) <= tol)
+
+
+def points_in_circle(
+    points: npt.NDArray[np.float64], center: Sequence[float], radius: float, tol: float = 0.0
+) -> npt.NDArray[np.bool_]:
+    """Mask of the points (n, 2 or more columns) in the closed disc, or within ``tol`` of it."""
+    p = np.asarray(points, dtype=float)
+    return np.hypot(p[:, 0] - center[0], p[:, 1] - center[1]) <= radius + tol
+
+
+def polygon_inside(inner: Vertices, outer: Vertices) -> bool:
+    """Whether the polygon ``inner`` lies strictly inside ``outer`` (vertices and no crossing)."""
+    a, b = np.asarray(inner, dtype=float), np.asarray(outer, dtype=float)
+    if not points_in_polygon(a, b).all() or (distance_to_polygon(a, b) == 0.0).any():
+        return False
+    size = float(np.ptp(b, axis=0).max())
+    for k in range(len(a)):
+        for j in range(len(b)):
+            if _segments_cross(a[k], a[(k + 1) % len(a)], b[j], b[(j + 1) % len(b)], 1e-12 * size):
+                return False
+    return True
+
+
+def circle_points(center: Sequence[float], radius: float, n: int = 96) -> npt.NDArray[np.float64]:
+    """``n`` points on the circle (counter-clockwise), for drawing."""
+    phi = np.linspace(0.0, 2.0 * np.pi, n, endpoint=False)
+    return np.column_stack([center[0] + radius * np.cos(phi), center[1] + radius * np.sin(phi)])
+
+
+def polygons_disjoint(a: Vertices, b: Vertices) -> bool:
+    """Whether two polygons neither overlap, nor touch, nor contain one another."""
+    pa, pb = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    size = float(max(np.ptp(pa, axis=0).max(), np.ptp(pb, axis=0).max()))
+    if points_in_polygon(pa, pb).any() or points_in_polygon(pb, pa).any():
+        return False
+    for k in range(len(pa)):
+        for j in range(len(pb)):
+            if _segments_cross(
+                pa[k], pa[(k + 1) % len(pa)], pb[j], pb[(j + 1) % len(pb)], 1e-12 * size
+            ):
+                return False
+    return True
