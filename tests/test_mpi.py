@@ -116,6 +116,15 @@ def test_pipeline_steps_match_serial(nprocs, serial_steps):
             _compare_certificates(s["certificate"], p["certificate"], name)
 
 
+def _config_on_two_ranks(tmp_path, path):
+    """``unibuckle solve --config path`` serially and on 2 ranks: equal results (both)."""
+    args = ["--config", str(path)]
+    ser = _cli_serial(tmp_path, args)
+    par, _ = _cli_parallel(tmp_path, args, 2)
+    _compare_results(ser, par, 2)
+    return ser, par
+
+
 def _cli_serial(tmp_path, args):
     out = tmp_path / "serial.json"
     assert cli_main(["solve", *args, "--json", str(out), "--output", str(tmp_path / "vtx1")]) == 0
@@ -228,10 +237,7 @@ def test_cli_stress_gradient_distributed(tmp_path):
         "[mesh]\nnx = 16\nny = 12\n"
         '[obstacle]\nzone = "all"\n[solver]\nmethod = "active-set"\n'
     )
-    args = ["--config", str(path)]
-    ser = _cli_serial(tmp_path, args)
-    par, _ = _cli_parallel(tmp_path, args, 2)
-    _compare_results(ser, par, 2)
+    ser, par = _config_on_two_ranks(tmp_path, path)
     assert ser["certificate"]["kkt"] and ser["ratio_to_free"] > 1.05
     assert par["edge_loads"]["left"]["normal_stress"] == [1.0, -1.0]
 
@@ -249,10 +255,7 @@ def test_cli_several_obstacles_distributed(tmp_path):
         '[[obstacles]]\ncircle = {center = [0.05, 0.0], radius = 0.03}\nside = "below"\n'
         '[solver]\nmethod = "active-set"\n'
     )
-    args = ["--config", str(path)]
-    ser = _cli_serial(tmp_path, args)
-    par, _ = _cli_parallel(tmp_path, args, 2)
-    _compare_results(ser, par, 2)
+    ser, _ = _config_on_two_ranks(tmp_path, path)
     assert ser["certificate"]["kkt"] and ser["constrained_nodes"] > 20
 
 
@@ -272,10 +275,7 @@ def test_cli_foundation_distributed(tmp_path, side):
         "[mesh]\nnx = 24\nny = 8\n"
         f'[obstacle]\nzone = "all"\nside = "{side}"\nfoundation_stiffness = 2.0e7\n'
     )
-    args = ["--config", str(path)]
-    ser = _cli_serial(tmp_path, args)
-    par, _ = _cli_parallel(tmp_path, args, 2)
-    _compare_results(ser, par, 2)
+    ser, par = _config_on_two_ranks(tmp_path, path)
     assert ser["method"] == ("foundation" if side == "above" else "free")
     if side == "above":
         assert ser["certificate"]["kkt"] and ser["contact_nodes"] > 0
@@ -303,8 +303,5 @@ def test_cli_gmsh_plate_distributed(tmp_path):
         "[mesh]\nsize = 0.025\n"
         '[obstacle]\nzone = "all"\nside = "below"\n[solver]\nmethod = "active-set"\n'
     )
-    args = ["--config", str(path)]
-    ser = _cli_serial(tmp_path, args)
-    par, _ = _cli_parallel(tmp_path, args, 2)
-    _compare_results(ser, par, 2)
+    ser, _ = _config_on_two_ranks(tmp_path, path)
     assert ser["certificate"]["kkt"] and len(ser["mesh"]) == 1

@@ -315,6 +315,39 @@ def plot_section(
 
 
 # -- contact set -----------------------------------------------------------------------
+def _mode_bands(
+    fig: Any,
+    ax: Any,
+    xy: npt.NDArray[np.float64],
+    w: npt.ArrayLike,
+    tau: float,
+    triangles: npt.ArrayLike | None = None,
+) -> None:
+    """Filled bands of w / max|w| (centred on 0, ±0.1, ...: 0 is neutral) and a colour bar.
+
+    ``triangles`` (the cells') keeps holes empty; without it the nodes are triangulated.
+    """
+    levels = np.linspace(-1.05, 1.05, 22)
+    tri = () if triangles is None else (np.asarray(triangles),)
+    cs = ax.tricontourf(
+        xy[:, 0], xy[:, 1], *tri, _normalised(np.asarray(w), tau), levels=levels,
+        cmap=THEME["cmap"],
+    )  # fmt: skip
+    cbar = fig.colorbar(cs, ax=ax, shrink=0.8, ticks=np.linspace(-1, 1, 5))
+    cbar.set_label("w / max|w|")
+
+
+def _contact_markers(
+    ax: Any, coordinates: npt.ArrayLike, sizes: tuple[float, float], many: int
+) -> None:
+    """The contact set Z as black dots (the smaller size from ``many`` nodes on)."""
+    z = np.atleast_2d(np.asarray(coordinates, dtype=float))
+    nz = z.shape[0] if z.size else 0
+    if nz:
+        ax.plot(z[:, 0], z[:, 1], "o", ms=sizes[0] if nz < many else sizes[1], mfc="black",
+                mec="white", mew=0.5, label=f"contact set Z ({nz})")  # fmt: skip
+
+
 def plot_contact_set(
     path: str | Path,
     xy: npt.ArrayLike,
@@ -348,12 +381,7 @@ def plot_contact_set(
     xy = np.asarray(xy, dtype=float)
     (px0, py0), (px1, py1) = corners
     fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
-    levels = np.linspace(-1.05, 1.05, 22)  # bands centred on 0, ±0.1, ...: 0 is neutral
-    cs = ax.tricontourf(
-        xy[:, 0], xy[:, 1], _normalised(np.asarray(w), tau), levels=levels, cmap=THEME["cmap"]
-    )
-    cbar = fig.colorbar(cs, ax=ax, shrink=0.8, ticks=np.linspace(-1, 1, 5))
-    cbar.set_label("w / max|w|")
+    _mode_bands(fig, ax, xy, w, tau)
     if zone is not None:
         (x0, x1), (y0, y1) = zone
         ax.add_patch(
@@ -380,19 +408,7 @@ def plot_contact_set(
             alpha=0.6 if dense else 1.0,
             label=f"constrained nodes I ({len(cxy)})",
         )
-    z = np.atleast_2d(np.asarray(contact_coordinates, dtype=float))
-    nz = z.shape[0] if z.size else 0
-    if nz:
-        ax.plot(
-            z[:, 0],
-            z[:, 1],
-            "o",
-            ms=5 if nz < 500 else 3,
-            mfc="black",
-            mec="white",
-            mew=0.5,
-            label=f"contact set Z ({nz})",
-        )
+    _contact_markers(ax, contact_coordinates, sizes=(5, 3), many=500)
     ax.set_xlim(px0, px1)
     ax.set_ylim(py0, py1)
     ax.set_aspect("equal")
@@ -450,17 +466,7 @@ def plot_contact_map(
     path = _prepare(path)
     xy = np.asarray(xy, dtype=float)
     fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
-    levels = np.linspace(-1.05, 1.05, 22)
-    cs = ax.tricontourf(
-        xy[:, 0],
-        xy[:, 1],
-        np.asarray(triangles),
-        _normalised(np.asarray(w), tau),
-        levels=levels,
-        cmap=THEME["cmap"],
-    )
-    cbar = fig.colorbar(cs, ax=ax, shrink=0.8, ticks=np.linspace(-1, 1, 5))
-    cbar.set_label("w / max|w|")
+    _mode_bands(fig, ax, xy, w, tau, triangles)
     for outline in (boundary, *holes):
         ring = np.asarray(outline, dtype=float)
         ring = np.vstack([ring, ring[:1]])
@@ -474,11 +480,7 @@ def plot_contact_map(
         ax.plot(ring[:, 0], ring[:, 1], ls, color="dimgray", lw=2.5,
                 label=None if side in shown else label)  # fmt: skip
         shown.add(side)
-    z = np.atleast_2d(np.asarray(contact_coordinates, dtype=float))
-    nz = z.shape[0] if z.size else 0
-    if nz:
-        ax.plot(z[:, 0], z[:, 1], "o", ms=4 if nz < 300 else 2.5, mfc="black", mec="white",
-                mew=0.5, label=f"contact set Z ({nz})")  # fmt: skip
+    _contact_markers(ax, contact_coordinates, sizes=(4, 2.5), many=300)
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     pad = 0.02 * float((hi - lo).max())
     ax.set_xlim(lo[0] - pad, hi[0] + pad)

@@ -55,6 +55,8 @@ GRADIENT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solve
 #: d within this angle of u is u (an eigenvector is accurate to about the eigen solver's
 #: tolerance, 1e-10, over the spectral gap; a smaller threshold makes round-off a step).
 SAME_DIRECTION = 1e-8
+#: Kinds of step counted by :func:`descend`.
+STEP_KINDS = ("full", "partial", "zero", "gradient")
 #: A blocking angle below this fraction of the step's full angle is a zero step (the node
 #: is at the obstacle up to round-off).
 ZERO_STEP = 1e-9
@@ -196,14 +198,14 @@ def descend(
     run = Run("descent", best_feasible=start, final=start)
     if start.kkt:
         run.status = "kkt"
-        return run, {"full": 0, "partial": 0, "zero": 0, "gradient": 0}
+        return run, dict.fromkeys(STEP_KINDS, 0)
     u = start.mode.x.petsc_vec.copy()
     work = u.duplicate()
-    gradient = _Gradient(problem)
+    gradient: _Gradient | None = None
     working = start.active
     release = _pulling(start, n, tau)
     by_gradient = False
-    steps = {"full": 0, "partial": 0, "zero": 0, "gradient": 0}
+    steps = dict.fromkeys(STEP_KINDS, 0)
     try:
         for step in range(max_steps):
             run.iterations = step + 1
@@ -211,12 +213,13 @@ def descend(
             cand: Candidate | None = None
             if by_gradient:
                 steps["gradient"] += 1
+                gradient = gradient or _Gradient(problem)  # rarely needed: made on first use
                 d = gradient.direction(u, trial)
+                arc = _Arc(A, B, u, d, work)
+                d.destroy()
             else:
                 cand = problem.evaluate(trial, initial=u)
-                d = cand.mode.x.petsc_vec.copy()
-            arc = _Arc(A, B, u, d, work)
-            d.destroy()
+                arc = _Arc(A, B, u, cand.mode.x.petsc_vec, work)
             free = np.ones(n, dtype=bool)
             free[trial] = False
             e1 = problem.contact.values(arc.e1)
@@ -274,7 +277,8 @@ def descend(
     finally:
         u.destroy()
         work.destroy()
-        gradient.destroy()
+        if gradient is not None:
+            gradient.destroy()
     return run, steps
 
 
