@@ -8,6 +8,10 @@ r"""Active-set method (algorithms/active_set.py) against independent computation
 - The paper's zones: a certified KKT point; the interlacing order of the zones
   (c2 within c1 within c3) orders the loads; multilevel equals single-level.
 - The lattice lower bound is valid, and closes on small problems.
+- The iteration with looser thresholds first ends at KKT points of the exact problem:
+  checked with dense LAPACK on the random family, and with scipy's sparse Lanczos on a
+  thin plate (t/b = 1e-3, whole-plate obstacle) where the thresholds are what lets the
+  polish of the prolonged coarse contact set end within its iterate budget.
 - ``mpiexec -n 2``: the distributed result equals the serial one.
 - ``-m convergence``: the unilateral load of each zone converges at rate h^2 (20x10 ..
   160x80), with a Richardson-extrapolated value.
@@ -23,14 +27,23 @@ from mpi4py import MPI
 
 import numpy as np
 import pytest
+import scipy.sparse as sp
+import scipy.sparse.linalg
 from conftest import run_mpi
 from exhaustive import RTOL, exhaustive_minimum
 
-from unibuckle_fenicsx.algorithms.active_set import solve_active_set
-from unibuckle_fenicsx.algorithms.multilevel import prolong_contact_set
-from unibuckle_fenicsx.cases import paper_case
+from unibuckle_fenicsx.algorithms.active_set import (
+    POLISH_ITERATIONS,
+    THRESHOLDS,
+    _distinct_kkt,
+    _multi_seed,
+    solve_active_set,
+)
+from unibuckle_fenicsx.algorithms.multilevel import prolong, prolong_contact_set
+from unibuckle_fenicsx.algorithms.pdas import iterate
+from unibuckle_fenicsx.cases import paper_case, plate_case
 from unibuckle_fenicsx.certify import certify
-from unibuckle_fenicsx.config import ProblemSpec
+from unibuckle_fenicsx.config import ObstacleSpec, ProblemSpec
 from unibuckle_fenicsx.problem import BucklingProblem
 
 HERE = Path(__file__).resolve().parent
@@ -146,6 +159,92 @@ def test_multilevel_equals_single_level():
         assert np.array_equal(multi.active, single.active)
         assert multi.details["fine_eigensolves"] < single.details["fine_eigensolves"]
         problem.destroy()
+
+
+def _sparse_kkt(problem: BucklingProblem, active) -> tuple[bool, float]:
+    """KKT conditions of the contact set ``active`` and its load, by scipy alone.
+
+    The largest eigenvalue theta of B x = theta A x on the DOFs left after removing the
+    edge DOFs and the w-DOFs of Z (ARPACK Lanczos, ``scipy.sparse.linalg.eigsh``), load
+    1/theta; the mode must lie below the obstacle off Z and the obstacle must only push
+    on Z, to the solver's tolerance tau (README, "The problem").
+    """
+
+    def csr(mat):
+        indptr, indices, data = mat.getValuesCSR()
+        return sp.csr_matrix((data, indices, indptr), shape=mat.getSize())
+
+    A, B = csr(problem.model.A), csr(problem.model.B)
+    rows = problem.contact.global_rows()
+    removed = np.union1d(problem.model.bc_dofs, rows[np.asarray(active, dtype=int)])
+    keep = np.setdiff1d(np.arange(A.shape[0]), removed)
+    Ak, Bk = A[keep][:, keep].tocsc(), B[keep][:, keep]
+    theta, x = scipy.sparse.linalg.eigsh(Bk, k=1, M=Ak, which="LA", tol=1e-12)
+    load = 1.0 / theta[0]
+    u = np.zeros(A.shape[0])
+    u[keep] = x[:, 0]
+    u /= np.abs(u[problem.model.w_dofs]).max()
+    on_z = np.zeros(problem.num_constrained, dtype=bool)
+    on_z[np.asarray(active, dtype=int)] = True
+    for v in (u, -u):
+        r = A @ v - load * (B @ v)
+        if (
+            v[rows[~on_z]].max(initial=-1.0) <= problem.tau
+            and r[rows[on_z]].max(initial=-1.0) <= problem.tau * np.abs(A @ v).max()
+        ):
+            return True, load
+    return False, load
+
+
+@serial
+def test_threshold_iteration_ends_at_kkt_points(active_specs):
+    """From the free mode's violating sets, with thresholds: dense-checked KKT points."""
+    for spec in active_specs[:10]:
+        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        free = problem.solve_free().function.x.petsc_vec
+        values = problem.contact.values(free)
+        best, _, _ = exhaustive_minimum(problem)
+        for start in (np.flatnonzero(values > 0), np.flatnonzero(values < 0)):
+            run = iterate(problem, "t", start, free, 100, thresholds=THRESHOLDS)
+            if run.status != "kkt":  # a cycle, as without thresholds (measured)
+                continue
+            ok, load = _sparse_kkt(problem, run.final.active)
+            assert ok and abs(run.final.load - load) <= RTOL * load, spec.name
+            assert run.final.load >= best * (1 - RTOL), spec.name
+        problem.destroy()
+
+
+@serial
+def test_thresholds_polish_a_thin_plate_within_budget():
+    """Thin SSSS plate 0.3 x 0.1 m, t = 1e-4, whole-plate obstacle, 60 x 20.
+
+    The best KKT contact set of the 30 x 10 level, prolonged: iterating at tau = 1e-8 at
+    once takes 33 iterates (measured), more than the polish budget; with the thresholds it
+    ends at a KKT point (checked by scipy) within the budget.
+    """
+    spec = plate_case(
+        "thin",
+        length=0.3,
+        width=0.1,
+        thickness=1e-4,
+        supports="simply_supported",
+        load="uniaxial",
+        nx=60,
+        ny=20,
+        zone=ObstacleSpec(zone="all"),
+    )
+    with (
+        BucklingProblem(spec, MPI.COMM_SELF) as fine,
+        BucklingProblem(spec.with_mesh(30, 10), MPI.COMM_SELF) as coarse,
+    ):
+        best = _distinct_kkt(_multi_seed(coarse, 100))[0]
+        start = prolong(coarse, fine, best.active)
+        plain = iterate(fine, "plain", start, None, POLISH_ITERATIONS)
+        run = iterate(fine, "thresholds", start, None, POLISH_ITERATIONS, thresholds=THRESHOLDS)
+        assert plain.status == "max-iterations"
+        assert run.status == "kkt"
+        ok, load = _sparse_kkt(fine, run.final.active)
+        assert ok and abs(run.final.load - load) <= RTOL * load
 
 
 def test_prolongation_includes_midway_nodes():

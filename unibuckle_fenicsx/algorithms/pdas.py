@@ -8,7 +8,9 @@ the nodes of Z whose multiplier pulls (:math:`r_k > \tau \|Au\|_\infty`). It sto
 KKT point when neither set is empty. A contact set met twice is a cycle: the iteration then
 switches to a damped rule (add only the most violated node(s), release only from a feasible
 mode) and, if that cycles too, stops and says so. Every feasible reduced mode is an
-admissible mode, so its load is an upper bound whatever the iteration does.
+admissible mode, so its load is an upper bound whatever the iteration does. With
+``thresholds``, the same rule runs first with looser tolerances in place of
+:math:`\tau`, each until the point is KKT at it; the end is KKT at :math:`\tau`.
 
 Note:
     All decisions use values reduced over the ranks, so every rank takes the same path;
@@ -77,6 +79,7 @@ def iterate(
     initial: PETSc.Vec | None,
     max_iterations: int,
     greedy: bool = False,
+    thresholds: tuple[float, ...] = (),
 ) -> Run:
     """Primal-dual active-set iteration from the contact set ``start``.
 
@@ -89,6 +92,10 @@ def iterate(
         max_iterations: Eigen solves allowed, >= 1.
         greedy: Add only the most violated node(s) per iterate (the paper's idea that
             small contact sets come first), instead of every violated node.
+        thresholds: Looser tolerances (decreasing, each above ``problem.tau``) to
+            converge with first: the iteration ignores violations and pulls below the
+            current threshold, and moves to the next one at a point that is KKT at this
+            one, warm-started (README, "Every plate the schema describes").
 
     Note:
         Collective.
@@ -98,6 +105,8 @@ def iterate(
     tau = problem.tau
     run = Run(seed)
     active = np.unique(np.asarray(start, dtype=np.int64))
+    stages = [t for t in thresholds if t > tau] + [tau]
+    stage = 0
     seen: set[bytes] = set()
     damped = False
     vec = initial
@@ -117,10 +126,16 @@ def iterate(
             run.status = "kkt"
             break
         inz = _mask(n, active)
-        add = ~inz & (cand.values > tau)
+        while True:
+            level = stages[stage]
+            add = ~inz & (cand.values > level)
+            release = inz & (cand.forces > level)
+            if add.any() or release.any() or stage == len(stages) - 1:
+                break
+            # KKT at this threshold: tighten it (same contact set and mode).
+            stage, damped, seen = stage + 1, False, set()
         if (greedy or damped) and add.any():
             add &= cand.values >= cand.values[add].max() * (1.0 - 1e-9)
-        release = inz & (cand.forces > tau)
         if damped and add.any():
             release[:] = False
         new = (inz & ~release) | add
