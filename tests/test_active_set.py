@@ -8,10 +8,11 @@ r"""Active-set method (algorithms/active_set.py) against independent computation
 - The paper's zones: a certified KKT point; the interlacing order of the zones
   (c2 within c1 within c3) orders the loads; multilevel equals single-level.
 - The lattice lower bound is valid, and closes on small problems.
-- The iteration with looser thresholds first ends at KKT points of the exact problem:
-  checked with dense LAPACK on the random family, and with scipy's sparse Lanczos on a
-  thin plate (t/b = 1e-3, whole-plate obstacle) where the thresholds are what lets the
-  polish of the prolonged coarse contact set end within its iterate budget.
+- The iteration with looser thresholds first ends at KKT points of the exact problem,
+  checked with scipy's sparse Lanczos (ARPACK): on the random family (and never below
+  the dense exhaustive minimum), and on a thin plate (t/b = 1e-3, whole-plate obstacle)
+  where the thresholds are what lets the polish of the prolonged coarse contact set end
+  within its iterate budget.
 - ``mpiexec -n 2``: the distributed result equals the serial one.
 - ``-m convergence``: the unilateral load of each zone converges at rate h^2 (20x10 ..
   160x80), with a Richardson-extrapolated value.
