@@ -32,7 +32,7 @@ from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver
 from unibuckle_fenicsx.problem import BucklingProblem
 
-__all__ = ["COLD_PENALTIES", "SOFT_STAGE_ITERATIONS", "WARM_PENALTIES", "penalty_continuation"]
+__all__ = ["COLD_PENALTIES", "WARM_PENALTIES", "penalty_continuation"]
 
 logger = logging.getLogger(__name__)
 
@@ -40,12 +40,6 @@ logger = logging.getLogger(__name__)
 COLD_PENALTIES = (1e-2, 1.0, 1e2, 1e4, 1e6)
 #: Penalties from a spring set prolonged from a coarser mesh.
 WARM_PENALTIES = (1.0, 1e2, 1e4, 1e6)
-#: Eigen solves allowed to the first, softest penalty from the free plate. It only
-#: warm-starts the next one, and on thin plates its spring set cycles: on the 90x30 plate
-#: of the README's thin-plate table with the loaded edges clamped it found no fixed point
-#: in 200 solves, and capped at 50 the chain ends at a lower KKT point in 467 eigen solves
-#: in all instead of 709 (under shear: 901 instead of 959, also lower).
-SOFT_STAGE_ITERATIONS = 50
 
 
 def penalty_continuation(
@@ -63,8 +57,7 @@ def penalty_continuation(
         start: Initial spring set; None starts from the free plate.
         penalties: Increasing relative penalties (default :data:`COLD_PENALTIES` from
             the free plate, :data:`WARM_PENALTIES` from a given set).
-        max_iterations: Eigen solves allowed per penalty (the first of a cold start:
-            at most :data:`SOFT_STAGE_ITERATIONS`).
+        max_iterations: Eigen solves allowed per penalty.
         polish_iterations: Active-set iterates allowed for the final, exact polish.
 
     Returns:
@@ -80,11 +73,10 @@ def penalty_continuation(
     springs = None if start is None else np.asarray(start, dtype=np.int64)
     solves = 0
     with PenaltySolver(problem) as pen:
-        for stage, rho in enumerate(penalties):
-            cap = max_iterations
-            if stage == 0 and start is None:
-                cap = min(max_iterations, SOFT_STAGE_ITERATIONS)
-            sol = pen.solve(rho, initial_active=springs, max_iterations=cap, lower_bound=lower)
+        for rho in penalties:
+            sol = pen.solve(
+                rho, initial_active=springs, max_iterations=max_iterations, lower_bound=lower
+            )
             solves += sol.eigensolves
             springs = sol.active
             logger.debug(
