@@ -113,6 +113,28 @@ def dense_reduced_load(problem: BucklingProblem, active: tuple[int, ...]) -> flo
     return 1.0 / theta[-1] if theta[-1] > 1e-10 * np.abs(theta).max() else math.inf
 
 
+def satisfies_kkt(problem: BucklingProblem, A, B, x: np.ndarray, load: float, active) -> bool:
+    """Whether the mode x (all DOFs) of the contact set ``active`` satisfies the KKT conditions.
+
+    Oriented to the obstacle's side, it must lie below the obstacle off Z and the obstacle
+    must only push on Z (README, "The problem"), both to the solver's tolerance tau. A and
+    B are the assembled matrices (dense arrays or scipy sparse).
+    """
+    u = x / np.abs(x[problem.model.w_dofs]).max()
+    rows = problem.contact.global_rows()
+    on_z = np.zeros(problem.num_constrained, dtype=bool)
+    on_z[np.asarray(active, dtype=int)] = True
+    tau = problem.tau
+    for v in (u, -u):
+        r = A @ v - load * (B @ v)
+        if (
+            v[rows[~on_z]].max(initial=-1.0) <= tau  # below the obstacle
+            and r[rows[on_z]].max(initial=-1.0) <= tau * np.abs(A @ v).max()  # only pushes
+        ):
+            return True
+    return False
+
+
 def membrane_force_scale(spec) -> float:
     """T times the largest edge stress of ``spec`` (N/m per unit load): the size of N0."""
     stresses = [e.max_stress() for e in spec.plate.edges]

@@ -27,7 +27,7 @@ import numpy as np
 import pytest
 import scipy.linalg
 from conftest import run_mpi
-from exhaustive import RTOL, dense, dense_reduced_load, exhaustive_minimum
+from exhaustive import RTOL, dense, dense_reduced_load, exhaustive_minimum, satisfies_kkt
 from test_stress_family import FAMILY, _reference
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
@@ -45,31 +45,17 @@ def dense_kkt(problem: BucklingProblem, active) -> bool:
     """The KKT conditions of the contact set ``active``, by LAPACK alone.
 
     The smallest positive eigenpair of the dense pencil with the edge DOFs and the w-DOFs
-    of Z removed (``scipy.linalg.eigh``, no condensation), oriented to the obstacle's
-    side: it must lie below the obstacle off Z and the obstacle must only push on Z
-    (README, "The problem"), both to the solver's tolerance tau.
+    of Z removed (``scipy.linalg.eigh``, no condensation), checked by
+    :func:`exhaustive.satisfies_kkt`.
     """
     A, B = dense(problem.model.A), dense(problem.model.B)
     rows = problem.contact.global_rows()
     removed = np.union1d(problem.model.bc_dofs, rows[np.asarray(active, dtype=int)])
     keep = np.setdiff1d(np.arange(A.shape[0]), removed)
     theta, X = scipy.linalg.eigh(B[np.ix_(keep, keep)], A[np.ix_(keep, keep)])
-    load = 1.0 / theta[-1]
     u = np.zeros(A.shape[0])
     u[keep] = X[:, -1]
-    u /= np.abs(u[problem.model.w_dofs]).max()
-    on_z = np.zeros(problem.num_constrained, dtype=bool)
-    on_z[np.asarray(active, dtype=int)] = True
-    tau = problem.tau
-    for sign in (1.0, -1.0):
-        v = sign * u
-        r = A @ v - load * (B @ v)
-        if (
-            v[rows[~on_z]].max(initial=-1.0) <= tau  # below the obstacle
-            and r[rows[on_z]].max(initial=-1.0) <= tau * np.abs(A @ v).max()  # only pushes
-        ):
-            return True
-    return False
+    return satisfies_kkt(problem, A, B, u, 1.0 / theta[-1], active)
 
 
 def _descend_from_free(problem: BucklingProblem):

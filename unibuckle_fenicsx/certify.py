@@ -280,12 +280,12 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     if not math.isfinite(cand.load):
         raise ValueError("certify_foundation: the candidate has no finite load")
     u = cand.mode.x.petsc_vec
-    z = contact.values(u) / problem.max_abs_w(u)
+    scale = problem.max_abs_w(u)
+    z = contact.values(u) / scale
     pressing = np.flatnonzero(z > 0.0).astype(np.int64)
     r, _, au_2 = problem.residual(cand.load, u)
     spring = u.duplicate()
     try:
-        scale = problem.max_abs_w(u)
         contact.scatter(contact.stiffness * np.maximum(z, 0.0) * scale, spring)
         r.axpy(1.0, spring)
     finally:

@@ -348,6 +348,22 @@ def _contact_markers(
                 mec="white", mew=0.5, label=f"contact set Z ({nz})")  # fmt: skip
 
 
+def _finish_top_view(plt: Any, fig: Any, ax: Any, path: Path, title: str) -> Path:
+    """Equal axes in metres, the title, the legend below the plot; write and close."""
+    ax.set_aspect("equal")
+    ax.set_xlabel("x (m)")
+    ax.set_ylabel("y (m)")
+    if title:
+        ax.set_title(title)
+    if ax.get_legend_handles_labels()[0]:
+        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=3,
+                  fontsize=THEME["mpl_font_size"] - 2, frameon=False)  # fmt: skip
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
 def plot_contact_set(
     path: str | Path,
     xy: npt.ArrayLike,
@@ -411,22 +427,7 @@ def plot_contact_set(
     _contact_markers(ax, contact_coordinates, sizes=(5, 3), many=500)
     ax.set_xlim(px0, px1)
     ax.set_ylim(py0, py1)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    if title:
-        ax.set_title(title)
-    ax.legend(
-        loc="upper center",
-        bbox_to_anchor=(0.5, -0.18),
-        ncol=3,
-        fontsize=THEME["mpl_font_size"] - 2,
-        frameon=False,
-    )
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _finish_top_view(plt, fig, ax, path, title)
 
 
 # -- contact map on the plate's own mesh -------------------------------------------------
@@ -485,18 +486,7 @@ def plot_contact_map(
     pad = 0.02 * float((hi - lo).max())
     ax.set_xlim(lo[0] - pad, hi[0] + pad)
     ax.set_ylim(lo[1] - pad, hi[1] + pad)
-    ax.set_aspect("equal")
-    ax.set_xlabel("x (m)")
-    ax.set_ylabel("y (m)")
-    if title:
-        ax.set_title(title)
-    if ax.get_legend_handles_labels()[0]:
-        ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=3,
-                  fontsize=THEME["mpl_font_size"] - 2, frameon=False)  # fmt: skip
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _finish_top_view(plt, fig, ax, path, title)
 
 
 # -- convergence -----------------------------------------------------------------------
