@@ -16,6 +16,7 @@ from unibuckle_fenicsx.algorithms import (
     UnilateralSolution,
     candidate_count,
 )
+from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
 from unibuckle_fenicsx.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner
@@ -69,15 +70,20 @@ def choose_method(
         return "enumerate", f"--candidate-parallel: 2^{i} = {shown} candidate sets"
     if options.method != "auto":
         return options.method, "given"
+    plate = spec.plate
+    slenderness = plate.thickness / min(plate.length, plate.width)
+    local = "interior-point" if slenderness < THIN_PLATE else "active-set"
+    why = f"t/b = {slenderness:.3g} {'<' if local == 'interior-point' else '>='} {THIN_PLATE:g}"
     if count > options.max_candidates:
-        return "active-set", (
-            f"auto: 2^{i} = {shown} candidate sets exceed max_candidates = {options.max_candidates}"
+        return local, (
+            f"auto: 2^{i} = {shown} candidate sets exceed max_candidates = "
+            f"{options.max_candidates}; {why}"
         )
     if estimate > options.enumeration_budget_s:
-        return "active-set", (
+        return local, (
             f"auto: enumerating 2^{i} = {shown} sets would take about {estimate:.3g} s "
             f"({solve_time_s:.3g} s per eigen solve), above enumeration_budget_s = "
-            f"{options.enumeration_budget_s:g}"
+            f"{options.enumeration_budget_s:g}; {why}"
         )
     return "enumerate", (
         f"auto: 2^{i} = {shown} candidate sets, about {estimate:.3g} s "
@@ -100,6 +106,14 @@ def _run_method(
             candidate_comm=candidate_comm,
             # "auto" must be exact: the paper's stopping rule is not (README).
             until_proven=options.until_proven or options.method == "auto",
+        )
+    if method == "interior-point":
+        from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_unilateral
+
+        options = problem.spec.solver
+        return solve_unilateral(
+            problem,
+            ChainOptions(max_iterations=options.max_iterations, bound_budget=options.bound_budget),
         )
     if method == "active-set":
         from unibuckle_fenicsx.algorithms.active_set import solve_active_set
@@ -229,7 +243,7 @@ def solve(
         free,
         solution,
         certificate,
-        method=method,
+        method=method if solution is None else solution.method,
         wall_time_s=time.perf_counter() - t0,
         mpi_size=comm.size,
     )

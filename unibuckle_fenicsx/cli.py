@@ -20,6 +20,8 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
+from unibuckle_fenicsx.config import METHODS
+
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.config import ProblemSpec
 
@@ -127,10 +129,11 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     s.add_argument("--ny", type=int, help="cells along y, >= 2 (default: paper 20, or the TOML's)")
     s.add_argument(
         "--method",
-        choices=["auto", "enumerate", "active-set", "penalty"],
+        choices=list(METHODS),
         help="unilateral algorithm (default auto: exact enumeration when 2^i <= "
         "--max-candidates and its estimated time fits --enumeration-budget, else "
-        "active-set; enumerate alone = the paper's stopping rule)",
+        "interior-point on thin plates (t/b < 0.02) and active-set on thicker ones; "
+        "enumerate alone = the paper's stopping rule)",
     )
     s.add_argument(
         "--complete",
@@ -160,7 +163,8 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
         type=int,
         metavar="N",
         help="active-set: iterates per seed and mesh level (default 100; the feasible "
-        "descent, the last fallback, may use 10x as many solves)",
+        "descent, the last fallback, may use 10x as many solves); interior-point: the "
+        "same for its active-set fallback",
     )
     s.add_argument(
         "--bound-budget",
@@ -303,8 +307,8 @@ _METHOD_FLAGS = {
     "--until-proven": (("enumerate",), "until_proven"),
     "--max-candidates": (("enumerate", "auto"), "max_candidates"),
     "--enumeration-budget": (("auto",), "enumeration_budget_s"),
-    "--max-iterations": (("active-set", "auto"), "max_iterations"),
-    "--bound-budget": (("active-set", "auto"), "bound_budget"),
+    "--max-iterations": (("active-set", "interior-point", "auto"), "max_iterations"),
+    "--bound-budget": (("active-set", "interior-point", "auto"), "bound_budget"),
     "--penalty": (("penalty",), "penalty"),
 }
 

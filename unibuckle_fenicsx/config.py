@@ -69,7 +69,7 @@ BENDING_SUPPORTS = ("simply_supported", "simply_supported_soft", "clamped", "fre
 #: In-plane conditions for the prestress solve.
 INPLANE_SUPPORTS = ("free", "clamped", "roller")
 #: Unilateral solution methods.
-METHODS = ("auto", "enumerate", "active-set", "penalty")
+METHODS = ("auto", "enumerate", "interior-point", "active-set", "penalty")
 #: Unit systems of a problem file: name -> (metres per length unit, pascals per stress
 #: unit, stress unit's name). Forces follow (N for both).
 UNITS: dict[str, tuple[float, float, str]] = {
@@ -701,8 +701,10 @@ class SolverSpec:
     Args:
         method: One of :data:`METHODS`; "auto" enumerates (with ``until_proven``) when
             the candidate count 2^i is at most ``max_candidates`` and the estimated
-            enumeration time is within ``enumeration_budget_s``, and uses the
-            active-set method otherwise.
+            enumeration time is within ``enumeration_budget_s``; otherwise it runs the
+            nested interior-point method on thin plates (thickness below
+            :data:`~unibuckle_fenicsx.algorithms.chain.THIN_PLATE` of the shorter side)
+            and the multilevel active-set method on the others.
         tau: Relative feasibility/contact tolerance (README, "The problem"), in (0, 1e-2].
         eps_tol: SLEPc convergence tolerance, in (0, 1e-4].
         max_candidates: Largest candidate count the enumeration accepts, >= 1.

@@ -357,6 +357,21 @@ class ContactSetManager:
         """Number i of constrained nodes."""
         return int(self.coordinates.shape[0])
 
+    @property
+    def owned_positions(self) -> npt.NDArray[np.int64]:
+        """Node numbers (0..i-1) of the constrained nodes owned by this rank."""
+        return self._owned.positions
+
+    @property
+    def owned_local_dofs(self) -> npt.NDArray[np.int32]:
+        """Local W DOF of each owned constrained node (order of :attr:`owned_positions`)."""
+        return self._owned.local_dofs
+
+    @property
+    def owned_signs(self) -> npt.NDArray[np.float64]:
+        """:math:`s_k` of each owned constrained node (order of :attr:`owned_positions`)."""
+        return self.signs[self._owned.positions]
+
     def removed_rows(self, active: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
         """Global W rows owned by this rank of the nodes ``active`` (node numbers)."""
         mask = np.isin(self._owned.positions, active)

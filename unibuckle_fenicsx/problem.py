@@ -268,6 +268,11 @@ class BucklingProblem(Owner):
         """i, the number of constrained nodes (0 without obstacle)."""
         return 0 if self.contact is None else self.contact.size
 
+    @property
+    def owned_w_dofs(self) -> npt.NDArray[np.int32]:
+        """Local W DOFs of the deflection w owned by this rank."""
+        return self._w_owned
+
     def new_mode(self, name: str = "mode") -> dolfinx.fem.Function:
         """A zero function on the (w, theta) space."""
         return dolfinx.fem.Function(self.model.W, name=name)

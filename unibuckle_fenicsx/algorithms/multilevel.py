@@ -1,19 +1,68 @@
-"""A hierarchy of coarser structured meshes, and contact sets carried up it.
+"""A hierarchy of coarser structured meshes; modes and contact sets carried up it.
 
-On a fine mesh the active-set iteration moves the contact zone by about one node layer
-per iterate (one sparse LU each), so the seeds run on a coarser copy of the plate and
-their best contact sets are prolonged level by level (:func:`prolong_contact_set`),
-where a couple of iterates polish them.
+The unilateral solvers start on a coarse copy of the plate and carry what they found
+to the next finer mesh: the interior-point method its mode (:class:`Prolongation`), the
+active-set iteration its contact set (:func:`prolong_contact_set`).
 """
 
 from __future__ import annotations
+
+import dolfinx
 
 import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.problem import BucklingProblem
 
-__all__ = ["mesh_levels", "prolong", "prolong_contact_set"]
+__all__ = [
+    "Prolongation",
+    "mesh_levels",
+    "prolong",
+    "prolong_contact_set",
+]
+
+
+class Prolongation:
+    """Interpolation from a coarse problem's spaces to a fine one's (any two meshes).
+
+    Q1 functions are interpolated at the fine nodes (exact on nested meshes); the
+    point-ownership data is computed once and shared by w and theta.
+
+    Args:
+        coarse: The coarse problem.
+        fine: The fine problem (the same plate).
+
+    Note:
+        Construction and every method are collective.
+    """
+
+    def __init__(self, coarse: BucklingProblem, fine: BucklingProblem) -> None:
+        self.coarse, self.fine = coarse, fine
+        Vf = fine.model.Vw
+        topology = Vf.mesh.topology
+        index_map = topology.index_map(topology.dim)
+        self._cells = np.arange(index_map.size_local + index_map.num_ghosts, dtype=np.int32)
+        self._data = dolfinx.fem.create_interpolation_data(Vf, coarse.model.Vw, self._cells)
+
+    def _interpolate(
+        self, source: dolfinx.fem.Function, target: dolfinx.fem.Function
+    ) -> dolfinx.fem.Function:
+        target.interpolate_nonmatching(source, self._cells, self._data)
+        return target
+
+    def mode(self, u: dolfinx.fem.Function) -> dolfinx.fem.Function:
+        """The coarse (w, theta) function ``u`` interpolated on the fine space."""
+        Wc, Wf = self.coarse.model.W, self.fine.model.W
+        out = self.fine.new_mode("prolonged")
+        for sub in (0, 1):
+            Vc, map_c = Wc.sub(sub).collapse()
+            Vf, map_f = Wf.sub(sub).collapse()
+            fc = dolfinx.fem.Function(Vc)
+            fc.x.array[:] = u.x.array[np.asarray(map_c[0])]
+            ff = self._interpolate(fc, dolfinx.fem.Function(Vf))
+            out.x.array[np.asarray(map_f[0])] = ff.x.array
+        out.x.scatter_forward()
+        return out
 
 
 def mesh_levels(nx: int, ny: int, coarse_min_cells: int) -> list[tuple[int, int]]:

@@ -1,0 +1,199 @@
+r"""The nested interior-point Newton method (README, "The fast route on thin plates").
+
+- The Newton direction solves the linearised optimality conditions
+  :math:`F_u = Au - \lambda Bu + E\nu`, :math:`F_c = \nu\circ g - \mu`,
+  :math:`F_n = \frac12(u^TBu - 1)` (g = -E^T u): compared with a dense Newton solve of
+  the full Jacobian, written here with numpy from the assembled matrices.
+- Interpolation between nested meshes is exact for Q1 functions (a linear field).
+- The route on problems of the random stress family agrees with the exhaustive minimum
+  over all 2^i contact sets (dense linear algebra, ``tests/exhaustive.py``) wherever the
+  active-set method does (sample here, the whole family with ``-m stress``).
+- A thin plate (t/b = 1e-3) against a whole-plate obstacle: the route answers with a
+  certified KKT point that is the smallest eigenvalue of its reduced pencil, and the mode
+  vanishes on the contact set; two ranks give the serial answer.
+- An option under the prefix ``unibuckle_ipm_`` reaches the factorisation.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx
+
+import numpy as np
+import pytest
+from conftest import run_mpi
+from exhaustive import dense
+from test_stress_family import FAMILY, _check
+
+from unibuckle_fenicsx.algorithms.interior_point import IPM_PREFIX, InteriorPointNewton
+from unibuckle_fenicsx.algorithms.multilevel import Prolongation
+from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.cases import plate_case
+from unibuckle_fenicsx.config import ObstacleSpec, problem_to_dict
+from unibuckle_fenicsx.problem import BucklingProblem
+
+serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
+PARALLEL = Path(__file__).parent / "mpi" / "interior_point_parallel.py"
+#: Problems of the stress family run through the interior-point route by default.
+SAMPLE = 12
+
+
+def _thin(name: str = "ssss", nx: int = 6, ny: int = 3, **kw) -> object:
+    supports = {"cs": {"left": "clamped", "right": "clamped"}}.get(name, "simply_supported")
+    return plate_case(
+        name,
+        length=0.3,
+        width=0.1,
+        thickness=1e-4,
+        supports=supports,
+        nx=nx,
+        ny=ny,
+        zone=ObstacleSpec(zone="all"),
+        **kw,
+    )
+
+
+@serial
+def test_newton_direction_solves_the_linearised_conditions():
+    problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    with InteriorPointNewton(problem) as newton:
+        u = newton.pressure_mode()  # strictly inside the cone
+        vec = u.x.petsc_vec
+        vec.scale(0.7)  # not normalised: F_n != 0
+        A, B = dense(problem.model.A), dense(problem.model.B)
+        x = vec.array.copy()
+        n = x.size
+        rows = newton._dofs
+        E = np.zeros((n, rows.size))
+        E[rows, np.arange(rows.size)] = newton._signs
+        gap = -E.T @ x
+        assert gap.min() > 0
+        rng = np.random.default_rng(7)
+        nu = rng.uniform(0.5, 2.0, rows.size) * np.abs(A @ x).max() * 1e-3
+        lam = 0.5 * problem.solve_free().load  # K positive definite: no regularisation
+        mu_abs = float(np.mean(nu * gap))
+        problem.model.A.mult(vec, newton._Au)
+        problem.model.B.mult(vec, newton._Bu)
+        newton._Au.copy(newton._Fu)
+        newton._Fu.axpy(-lam, newton._Bu)
+        newton._add_zone(newton._Fu, nu)
+        step = newton.direction(vec, lam, nu, gap, mu_abs)
+        assert step is not None
+        dlam, dz, dnu = step
+        du = newton._du.array.copy()
+    problem.destroy()
+    # Dense Newton on (u, lambda, nu).
+    m = rows.size
+    F = np.concatenate(
+        [A @ x - lam * (B @ x) + E @ nu, nu * gap - mu_abs, [0.5 * (x @ B @ x - 1.0)]]
+    )
+    J = np.zeros((n + m + 1, n + m + 1))
+    J[:n, :n] = A - lam * B
+    J[:n, n : n + m] = E
+    J[:n, -1] = -(B @ x)
+    J[n : n + m, :n] = -nu[:, None] * E.T
+    J[n : n + m, n : n + m] = np.diag(gap)
+    J[-1, :n] = B @ x
+    delta = np.linalg.solve(J, -F)
+    scale = np.abs(delta[:n]).max()
+    assert np.abs(du - delta[:n]).max() <= 1e-8 * scale
+    assert np.allclose(dz, E.T @ delta[:n], rtol=0, atol=1e-8 * scale)
+    assert abs(dlam - delta[-1]) <= 1e-8 * max(abs(delta[-1]), lam)
+    assert np.allclose(dnu, delta[n : n + m], rtol=1e-6, atol=1e-8 * np.abs(delta[n:-1]).max())
+
+
+@serial
+def test_prolongation_is_exact_for_q1():
+    coarse = BucklingProblem(_thin(nx=4, ny=2), MPI.COMM_SELF)
+    fine = BucklingProblem(_thin(nx=8, ny=4), MPI.COMM_SELF)
+    carry = Prolongation(coarse, fine)
+    u = coarse.new_mode()
+    u.sub(0).interpolate(lambda x: 1.0 + 2.0 * x[0] - 3.0 * x[1])
+    u.x.scatter_forward()
+    v = carry.mode(u)
+    w = dolfinx.fem.Function(fine.model.Vw)
+    w.interpolate(lambda x: 1.0 + 2.0 * x[0] - 3.0 * x[1])
+    assert np.allclose(v.x.array[fine.model.w_dofs], w.x.array, atol=1e-12)
+    for p in (coarse, fine):
+        p.destroy()
+
+
+@serial
+@pytest.mark.parametrize(
+    ("spec", "kind", "i"), FAMILY[:SAMPLE], ids=[s.name for s, *_ in FAMILY[:SAMPLE]]
+)
+def test_route_equals_exhaustive_minimum_sample(spec, kind, i):
+    _check(replace(spec, solver=replace(spec.solver, method="interior-point")), kind, i)
+
+
+@serial
+@pytest.mark.stress
+@pytest.mark.parametrize(
+    ("spec", "kind", "i"), FAMILY[SAMPLE:], ids=[s.name for s, *_ in FAMILY[SAMPLE:]]
+)
+def test_route_equals_exhaustive_minimum_family(spec, kind, i):
+    _check(replace(spec, solver=replace(spec.solver, method="interior-point")), kind, i)
+
+
+def _route(spec) -> dict:
+    with solve(spec, MPI.COMM_WORLD) as analysis:
+        sol, cert = analysis.solution, analysis.certificate
+        assert sol is not None and cert is not None
+        problem = analysis.problem
+        assert problem.contact is not None
+        values = problem.contact.values(sol.candidate.mode.x.petsc_vec)
+        return {
+            "method": analysis.result.method,
+            "load": sol.load,
+            "coordinates": problem.contact.coordinates[sol.active].tolist(),
+            "kkt": cert.kkt,
+            "smallest": cert.smallest_of_reduced,
+            "on_contact": float(np.abs(values[sol.active]).max(initial=0.0)),
+            "levels": sol.details.get("levels", []),
+        }
+
+
+@serial
+def test_thin_plate_route_is_certified():
+    """SSSS, loaded edges clamped: 45x15 cells, t/b = 1e-3, whole-plate obstacle."""
+    for name in ("ssss", "cs"):
+        report = _route(_thin(name, nx=45, ny=15))
+        assert report["method"].startswith("interior-point"), report["method"]
+        assert report["kkt"] and report["smallest"], report
+        assert report["on_contact"] == 0.0  # removed DOFs of the reduced pencil
+        meshes = [lv["mesh"] for lv in report["levels"]]
+        assert meshes == [[22, 7], [45, 15]], meshes
+        assert all(lv["newton_steps"] > 0 for lv in report["levels"])
+
+
+@pytest.mark.mpi
+@serial
+def test_two_ranks_give_the_serial_answer(tmp_path):
+    spec = _thin("cs", nx=45, ny=15)
+    serial_report = _route(spec)
+    path = tmp_path / "plate.json"
+    path.write_text(json.dumps({"input": problem_to_dict(spec)}))
+    report = json.loads(run_mpi(PARALLEL, 2, str(path)).strip().splitlines()[-1])
+    assert report["kkt"] and report["smallest"]
+    assert abs(report["load"] - serial_report["load"]) <= 1e-8 * serial_report["load"]
+    assert report["coordinates"] == serial_report["coordinates"]
+
+
+@serial
+def test_option_under_the_prefix_reaches_the_factorisation():
+    problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    opts = PETSc.Options()
+    opts[f"{IPM_PREFIX}mat_mumps_icntl_14"] = 57
+    try:
+        with InteriorPointNewton(problem) as newton:
+            factor = newton.ksp.getPC().getFactorMatrix()
+            assert factor.getMumpsIcntl(14) == 57
+    finally:
+        del opts[f"{IPM_PREFIX}mat_mumps_icntl_14"]
+        problem.destroy()

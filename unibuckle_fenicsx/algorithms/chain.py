@@ -1,0 +1,583 @@
+r"""Which route answers a unilateral problem, and in what order: the solver chain.
+
+For a rigid obstacle (any side, several zones) the chain is
+
+1. **Nested interior-point Newton** (:mod:`.interior_point`). On the coarsest mesh of a
+   structured plate (halved while the shorter side keeps ``coarse_min_cells`` cells; a
+   gmsh or user mesh has one level) the method runs from a few starts (the free mode's
+   parts on either side of the obstacle, the deflection under a pressure on the whole
+   zone and on either end): the buckle may sit almost anywhere at nearly the same load,
+   and each start finds one arrangement. The lowest critical state is carried to the
+   next finer mesh by interpolating its mode, load and obstacle push; there a few
+   Newton steps restore the barrier problem, and so on to the fine mesh.
+2. **Contact set and exact eigenpair.** The fine barrier solution gives the contact set
+   Z (the nodes whose push exceeds their gap); the smallest eigenpair of the pencil with
+   Z removed (:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`) is the
+   returned critical state, checked against the KKT conditions. If it fails, the
+   barrier is driven lower once more, then the active-set iteration (:mod:`.pdas`)
+   polishes Z.
+3. **Fallback**: the multilevel active-set method (:mod:`.active_set`, with its penalty
+   continuation and feasible descent) when no KKT point was reached.
+
+Tensionless foundations run their spring-set iteration (:mod:`.foundation`); small
+zones are enumerated (:mod:`.enumeration`; :func:`~unibuckle_fenicsx.analysis.choose_method`
+decides).
+
+Every link leaves a typed record (:class:`LinkRecord`); the solution's ``method`` names
+the route that answered.
+
+Note:
+    Collective on the problem's communicator.
+"""
+
+from __future__ import annotations
+
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+import numpy as np
+
+from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
+from unibuckle_fenicsx.algorithms.bounds import PROOF_RTOL, lattice_bound
+from unibuckle_fenicsx.algorithms.interior_point import (
+    BarrierPoint,
+    InteriorPointNewton,
+    NewtonRecord,
+    NewtonStatus,
+)
+from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
+from unibuckle_fenicsx.algorithms.pdas import iterate
+from unibuckle_fenicsx.contact import EmptyZoneError
+from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+
+__all__ = ["THIN_PLATE", "ChainOptions", "LevelRecord", "LinkRecord", "solve_unilateral"]
+
+logger = logging.getLogger(__name__)
+
+#: "auto" runs the interior-point route on plates whose thickness is below this fraction
+#: of the shorter side, the multilevel active set on thicker ones. Measured (README,
+#: "Speed"): at t/b = 1e-3 the active set needs hundreds of eigen solves on a whole-face
+#: obstacle; at the paper's t/b = 0.06 it needs two to three per mesh level and beats the
+#: interior point, whose coarse exploration then costs more than the whole active set.
+THIN_PLATE = 0.02
+
+
+@dataclass(frozen=True)
+class ChainOptions:
+    """Settings of the chain.
+
+    Attributes:
+        coarse_min_cells: Fewest cells along the shorter side of the coarsest mesh.
+        seeds: Starts of the interior-point method on the coarsest mesh.
+        compare_mu: Barrier parameter at which the starts are compared.
+        explore_mu_min: Barrier parameter at which the starts' contact sets are read.
+        twin_rtol: Starts whose barrier solutions' loads at ``compare_mu`` agree to this
+            (relative) lead to the same arrangement.
+        level_mu: Barrier parameter of the central-path point carried from one mesh to
+            the next.
+        fine_mu_min: ... and the fine mesh, before its contact set is read.
+        last_mu_min: ... once more when that contact set is not a KKT point.
+        clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes.
+        max_steps: Newton steps per run.
+        escapes: Saddle escapes allowed per run.
+        escape_mu: Barrier parameter the run restarts with after an escape (small: a
+            larger one would lift the flattened buckle again).
+        polish_iterations: Active-set iterates allowed to polish a contact set.
+        max_iterations: Iterates per seed of the fallback active-set method.
+        bound_budget: Eigen solves of the lattice lower bound (small zones).
+    """
+
+    coarse_min_cells: int = 6
+    seeds: tuple[str, ...] = ("free-", "free+", "pressure", "end-low", "middle", "end-high")
+    compare_mu: float = 1e-4
+    explore_mu_min: float = 1e-14
+    twin_rtol: float = 1e-7
+    level_mu: float = 1e-6
+    fine_mu_min: float = 1e-14
+    last_mu_min: float = 1e-14
+    clip_margin: float = 1e-6
+    max_steps: int = 100
+    escapes: int = 3
+    escape_mu: float = 1e-10
+    polish_iterations: int = 25
+    max_iterations: int = 100
+    bound_budget: int = 64
+
+
+@dataclass
+class LinkRecord:
+    """One run of one link of the chain.
+
+    Attributes:
+        link: "interior-point", "evaluate", "active-set polish", "fallback".
+        seed: The start (or level) it ran from.
+        status: How it ended.
+        steps: Newton steps or active-set iterates.
+        factorizations: Numeric factorisations (interior point).
+        eigensolves: Eigen solves.
+        seconds: Wall time.
+        load: The load it ended with (None if none).
+        contact_nodes: |Z| (None if no contact set was read).
+        kkt: It ended at a KKT point.
+    """
+
+    link: str
+    seed: str
+    status: str
+    steps: int = 0
+    factorizations: int = 0
+    eigensolves: int = 0
+    seconds: float = 0.0
+    load: float | None = None
+    contact_nodes: int | None = None
+    kkt: bool = False
+
+
+@dataclass
+class LevelRecord:
+    """What the chain did on one mesh.
+
+    Attributes:
+        mesh: [nx, ny] (structured) or ["fine"].
+        constrained_nodes: i on this mesh.
+        links: The runs on it.
+        seconds: Wall time on it (set-up included).
+    """
+
+    mesh: list[Any]
+    constrained_nodes: int
+    links: list[LinkRecord] = field(default_factory=list)
+    seconds: float = 0.0
+
+    @property
+    def newton_steps(self) -> int:
+        """Interior-point Newton steps on this mesh."""
+        return sum(r.steps for r in self.links if r.link == "interior-point")
+
+    @property
+    def factorizations(self) -> int:
+        """Numeric factorisations on this mesh."""
+        return sum(r.factorizations for r in self.links)
+
+    @property
+    def eigensolves(self) -> int:
+        """Eigen solves on this mesh."""
+        return sum(r.eigensolves for r in self.links)
+
+    def as_dict(self) -> dict[str, Any]:
+        """JSON-ready mapping."""
+        return {
+            "mesh": self.mesh,
+            "constrained_nodes": self.constrained_nodes,
+            "newton_steps": self.newton_steps,
+            "factorizations": self.factorizations,
+            "eigensolves": self.eigensolves,
+            "seconds": self.seconds,
+            "links": [vars(r) for r in self.links],
+        }
+
+
+def _newton_link(seed: str, record: NewtonRecord) -> LinkRecord:
+    return LinkRecord(
+        "interior-point",
+        seed,
+        record.status.value,
+        steps=record.steps,
+        factorizations=record.factorizations,
+        seconds=record.seconds,
+        load=record.load,
+    )
+
+
+def _start(newton: InteriorPointNewton, seed: str, push: Any) -> Any:
+    """The start ``seed`` on ``newton``'s problem, strictly inside the cone."""
+    problem = newton.problem
+    assert problem.contact is not None
+    if seed in ("free-", "free+"):
+        free = problem.solve_free().function.x.petsc_vec
+        u = newton.negative_part(free, 1.0 if seed == "free-" else -1.0)
+        return newton.make_interior(u, push=push)
+    if seed == "pressure":
+        u = problem.new_mode("start")
+        push.x.petsc_vec.copy(u.x.petsc_vec)
+        u.x.scatter_forward()
+        return u
+    xy = problem.contact.coordinates
+    (x0, y0), (x1, y1) = problem.spec.plate.corners
+    axis = 0 if x1 - x0 >= y1 - y0 else 1
+    lo, hi = (x0, x1) if axis == 0 else (y0, y1)
+    c = (xy[:, axis] - lo) / (hi - lo)
+    windows = {"end-low": (0.0, 1 / 3), "middle": (1 / 3, 2 / 3), "end-high": (2 / 3, 1.0)}
+    if seed not in windows:
+        raise ValueError(f"unknown interior-point start {seed!r}")
+    a, b = windows[seed]
+    weights = np.where((c >= a) & (c <= b), 1.0, 0.01)
+    return newton.pressure_mode(weights)
+
+
+def _read_contact(
+    problem: BucklingProblem,
+    newton: InteriorPointNewton,
+    point: BarrierPoint,
+    level: LevelRecord,
+    label: str,
+) -> Candidate:
+    """The exact critical state of the contact set read off ``point``."""
+    t0 = time.perf_counter()
+    solves0 = problem.eigensolver.solves
+    active = newton.contact_set(point)
+    cand = problem.evaluate(active, initial=point.mode.x.petsc_vec)
+    level.links.append(
+        LinkRecord(
+            "evaluate",
+            label,
+            "kkt" if cand.kkt else "not-kkt",
+            eigensolves=problem.eigensolver.solves - solves0,
+            seconds=time.perf_counter() - t0,
+            load=cand.load if math.isfinite(cand.load) else None,
+            contact_nodes=len(active),
+            kkt=cand.kkt,
+        )
+    )
+    return cand
+
+
+def _polish(
+    problem: BucklingProblem, cand: Candidate, level: LevelRecord, label: str, budget: int
+) -> Candidate | None:
+    """Active-set iteration from ``cand``'s contact set; its KKT point or best feasible."""
+    t0 = time.perf_counter()
+    solves0 = problem.eigensolver.solves
+    run = iterate(problem, label, cand.active, cand.mode.x.petsc_vec, budget)
+    final = run.final if run.status == "kkt" else run.best_feasible
+    level.links.append(
+        LinkRecord(
+            "active-set polish",
+            label,
+            run.status,
+            steps=run.iterations,
+            eigensolves=problem.eigensolver.solves - solves0,
+            seconds=time.perf_counter() - t0,
+            load=None if final is None else final.load,
+            contact_nodes=None if final is None else len(final.active),
+            kkt=final is not None and final.kkt,
+        )
+    )
+    return final
+
+
+def _critical_state(
+    problem: BucklingProblem,
+    newton: InteriorPointNewton,
+    point: BarrierPoint,
+    level: LevelRecord,
+    label: str,
+    options: ChainOptions,
+    carry: bool = True,
+) -> tuple[Candidate | None, BarrierPoint]:
+    """Read the contact set off ``point``; escape a saddle, drive the barrier lower, polish.
+
+    Returns the KKT point (or None) and the barrier point it belongs to (recomputed
+    after a polish only when ``carry``: it goes on to a finer mesh).
+    """
+    cand = _read_contact(problem, newton, point, level, label)
+    if cand.kkt:
+        return cand, point
+    for attempt in range(options.escapes):
+        saddle = not cand.feasible and cand.load < point.load * (1.0 - 1e-9)
+        if not (saddle and newton.escape(point, cand.mode.x.petsc_vec)):
+            break
+        tag = f"{label} (escape {attempt + 1})"
+        point, rec = newton.solve(
+            point.mode,
+            load=point.load,
+            mu=max(point.mu, options.escape_mu),
+            mu_min=max(point.mu, options.fine_mu_min),
+            max_steps=options.max_steps,
+        )
+        level.links.append(_newton_link(tag, rec))
+        cand = _read_contact(problem, newton, point, level, tag)
+        if cand.kkt:
+            return cand, point
+    if point.mu > options.last_mu_min:
+        point, rec = newton.solve(
+            point.mode,
+            load=point.load,
+            push=point.push,
+            mu=point.mu,
+            mu_min=options.last_mu_min,
+            max_steps=options.max_steps,
+        )
+        level.links.append(_newton_link(label + " (lower barrier)", rec))
+        cand = _read_contact(problem, newton, point, level, label + " (lower barrier)")
+        if cand.kkt:
+            return cand, point
+    if math.isfinite(cand.load):
+        polished = _polish(problem, cand, level, label, options.polish_iterations)
+        if polished is not None and polished.kkt and not carry:
+            return polished, point
+        if polished is not None and polished.kkt:
+            # The barrier point that goes with it, for the next mesh.
+            fresh = newton.from_candidate(polished, options.level_mu)
+            fresh, rec = newton.solve(
+                fresh.mode,
+                load=fresh.load,
+                push=fresh.push,
+                mu=fresh.mu,
+                mu_min=point.mu,
+                max_steps=options.max_steps,
+            )
+            level.links.append(_newton_link(label + " (after polish)", rec))
+            return polished, fresh
+    return None, point
+
+
+def _explore(
+    problem: BucklingProblem, level: LevelRecord, options: ChainOptions
+) -> tuple[list[Candidate], BarrierPoint | None, Candidate | None]:
+    """Run the starts on ``problem``: its KKT points, and the best one's barrier point.
+
+    A start whose barrier solution at ``compare_mu`` has the load of one met before
+    (relative ``twin_rtol``) leads to the same arrangement and is not taken further.
+    """
+    found: list[tuple[Candidate, BarrierPoint]] = []
+    seen: list[float] = []
+    with InteriorPointNewton(problem) as newton:
+        push = newton.pressure_mode()
+        for seed in options.seeds:
+            try:
+                start = _start(newton, seed, push)
+                point, rec = newton.solve(
+                    start, mu=1e-2, mu_min=options.compare_mu, max_steps=options.max_steps
+                )
+            except (ValueError, FloatingPointError) as err:
+                level.links.append(LinkRecord("interior-point", seed, f"no start: {err}"))
+                continue
+            level.links.append(_newton_link(seed, rec))
+            if rec.status is not NewtonStatus.CONVERGED:
+                continue
+            if any(abs(point.load - load) <= options.twin_rtol * load for load in seen):
+                level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
+                continue
+            seen.append(point.load)
+            point, rec = newton.solve(
+                point.mode,
+                load=point.load,
+                push=point.push,
+                mu=point.mu,
+                mu_min=options.explore_mu_min,
+                max_steps=options.max_steps,
+            )
+            level.links.append(_newton_link(seed, rec))
+            if rec.status is not NewtonStatus.CONVERGED:
+                continue
+            cand, point = _critical_state(problem, newton, point, level, seed, options)
+            if cand is not None:
+                found.append((cand, point))
+        if not found:
+            return [], None, None
+        found.sort(key=lambda cp: cp[0].load)
+        best, point = found[0]
+        point = _central(newton, point, level, options, "best, lifted")
+    return [c for c, _ in found], point, best
+
+
+def _central(
+    newton: InteriorPointNewton,
+    point: BarrierPoint,
+    level: LevelRecord,
+    options: ChainOptions,
+    label: str,
+) -> BarrierPoint:
+    r"""The point of the central path at ``level_mu`` near ``point`` (what is carried up).
+
+    On the central path the push is :math:`\mu/g` node by node, so a finer mesh can
+    start from the interpolated mode alone, at the same barrier parameter.
+    """
+    lifted, rec = newton.solve(
+        point.mode,
+        load=point.load,
+        push=point.push,
+        mu=options.level_mu,
+        mu_min=options.level_mu,
+        max_steps=options.max_steps,
+    )
+    level.links.append(_newton_link(label, rec))
+    return lifted
+
+
+def _refine(
+    coarse: BucklingProblem,
+    fine: BucklingProblem,
+    point: BarrierPoint,
+    level: LevelRecord,
+    options: ChainOptions,
+    last: bool,
+) -> tuple[Candidate | None, BarrierPoint | None]:
+    """Carry ``point`` from ``coarse`` to ``fine`` and solve the barrier problem there."""
+    label = "prolonged"
+    carry = Prolongation(coarse, fine)
+    mode = carry.mode(point.mode)
+    with InteriorPointNewton(fine) as newton:
+        try:
+            newton.relax(mode.x.petsc_vec, "deflection")
+            if newton.clip(mode, options.clip_margin):
+                pass
+            newton.relax(mode.x.petsc_vec, "rotations")
+            new, rec = newton.solve(
+                mode,
+                mu=options.level_mu,
+                mu_min=options.fine_mu_min if last else options.level_mu,
+                max_steps=options.max_steps,
+            )
+        except (ValueError, FloatingPointError) as err:
+            level.links.append(LinkRecord("interior-point", label, f"failed: {err}"))
+            return None, None
+        level.links.append(_newton_link(label, rec))
+        if not last:
+            return None, new
+        cand, new = _critical_state(fine, newton, new, level, label, options, carry=False)
+        return cand, new
+
+
+def _fallback(problem: BucklingProblem, options: ChainOptions) -> UnilateralSolution:
+    from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+
+    return solve_active_set(
+        problem, max_iterations=options.max_iterations, bound_budget=options.bound_budget
+    )
+
+
+def solve_unilateral(
+    problem: BucklingProblem, options: ChainOptions | None = None
+) -> UnilateralSolution:
+    """Critical state of ``problem`` (rigid obstacles) by the chain of the module docstring.
+
+    Args:
+        problem: A set-up problem with a rigid obstacle.
+        options: Settings (default :class:`ChainOptions`).
+
+    Returns:
+        The critical state with its bracket and the per-mesh records in
+        ``details["levels"]``.
+
+    Raises:
+        NoAdmissibleModeError: No route produced an admissible mode.
+
+    Note:
+        Collective on ``problem.comm``.
+    """
+    options = options or ChainOptions()
+    if problem.contact is None or problem.tensionless:
+        raise ValueError("solve_unilateral needs a problem with a rigid obstacle")
+    t0 = time.perf_counter()
+    solves0 = problem.eigensolver.solves
+    free_load = problem.solve_free().load
+    spec = problem.spec
+    meshes = (
+        mesh_levels(spec.mesh.nx, spec.mesh.ny, options.coarse_min_cells)
+        if problem.structured
+        else []
+    )
+    levels: list[LevelRecord] = []
+    other_solves = 0
+    prev: BucklingProblem | None = None
+    point: BarrierPoint | None = None
+    chosen: Candidate | None = None
+    explored: list[Candidate] = []
+    for k, nx_ny in enumerate([*meshes, None]):
+        tl = time.perf_counter()
+        last = nx_ny is None
+        try:
+            current = (
+                problem if nx_ny is None else BucklingProblem(spec.with_mesh(*nx_ny), problem.comm)
+            )
+        except EmptyZoneError:
+            continue
+        if nx_ny is not None:
+            mesh: list[Any] = list(nx_ny)
+        else:
+            mesh = [spec.mesh.nx, spec.mesh.ny] if problem.structured else ["fine"]
+        level = LevelRecord(mesh, current.num_constrained)
+        levels.append(level)
+        if point is None:
+            explored, point, best = _explore(current, level, options)
+            if last:
+                chosen = best
+        else:
+            assert prev is not None
+            cand, new = _refine(prev, current, point, level, options, last)
+            point = new
+            if last:
+                chosen = cand
+        level.seconds = time.perf_counter() - tl
+        if current is not problem:
+            other_solves += current.eigensolver.solves
+        if problem.comm.rank == 0:
+            PROGRESS.info(
+                "interior point, mesh %s (i = %d): %d Newton steps, %d factorisations, "
+                "%d eigen solves, %.2f s",
+                "x".join(map(str, level.mesh)), level.constrained_nodes, level.newton_steps,
+                level.factorizations, level.eigensolves, level.seconds,
+            )  # fmt: skip
+        if prev is not None and prev is not problem:
+            prev.destroy()
+        prev = current
+        if point is None and not last:
+            break  # nothing to carry: the fallback runs on the fine mesh
+    if prev is not None and prev is not problem:
+        prev.destroy()
+
+    if chosen is None or not chosen.kkt:
+        logger.warning("interior point: no KKT point on the fine mesh; the active-set chain runs")
+        solution = _fallback(problem, options)
+        solution.details["interior_point_levels"] = [lv.as_dict() for lv in levels]
+        solution.method = "active-set (after interior point)"
+        solution.eigensolves += other_solves
+        return solution
+
+    lower, bound_evals, better, complete = lattice_bound(
+        problem, free_load, chosen.load, options.bound_budget
+    )
+    warnings: list[str] = []
+    if better is not None:
+        warnings.append(
+            f"the lattice search found a lower feasible load {better.load:.10g} than the "
+            f"interior-point critical state {chosen.load:.10g}"
+        )
+        chosen = better
+    lower = max(lower, free_load)
+    proven = bool(lower >= chosen.load * (1 - PROOF_RTOL))
+    route = "interior-point"
+    if any(r.link == "active-set polish" and r.kkt for r in levels[-1].links):
+        route += " + active-set polish"
+    details: dict[str, Any] = {
+        "free_load": free_load,
+        "route": route,
+        "levels": [lv.as_dict() for lv in levels],
+        "coarse_kkt_loads": sorted(c.load for c in explored),
+        "fine_eigensolves": problem.eigensolver.solves - solves0,
+        "coarse_eigensolves": other_solves,
+        "bound_evaluations": bound_evals,
+        "bound_search_complete": complete,
+        "lower_bound_by": "lattice" if bound_evals else "interlacing",
+        "wall_time_s": time.perf_counter() - t0,
+    }
+    if warnings:
+        details["warning"] = "; ".join(warnings)
+    if not math.isfinite(chosen.load):
+        raise NoAdmissibleModeError("the interior-point route ended without a finite load")
+    return UnilateralSolution(
+        candidate=chosen,
+        method=route,
+        eigensolves=problem.eigensolver.solves - solves0 + other_solves,
+        lower_bound=min(lower, chosen.load),
+        global_optimum_proven=proven,
+        upper_bound=chosen.load if chosen.feasible else math.inf,
+        kkt_points=[chosen],
+        details=details,
+    )

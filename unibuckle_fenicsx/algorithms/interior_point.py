@@ -1,0 +1,698 @@
+r"""Interior-point Newton method for the unilateral eigenproblem on one mesh.
+
+The critical state minimises the Rayleigh quotient on the cone
+:math:`\{u: z_k = s_k u_k \le 0,\ k \in I\}` (oriented values, see
+:class:`~unibuckle_fenicsx.contact.ContactSetManager`). With the gap
+:math:`g = -z > 0` and the obstacle's push :math:`\nu > 0` at the constrained nodes,
+the barrier problem :math:`\min \tfrac12 u^TAu - \mu\sum_k \log g_k` on
+:math:`u^TBu = 1` has the optimality conditions
+
+.. math::
+
+    F_u = Au - \lambda Bu + E\nu = 0, \qquad F_c = \nu \circ g - \mu = 0, \qquad
+    F_n = \tfrac12 (u^TBu - 1) = 0,
+
+(E scatters oriented nodal values into W) which tend to the KKT conditions of the
+critical state as :math:`\mu \to 0`. One Newton step is one numeric :math:`LDL^T`
+(MUMPS; the pattern is A's, so the symbolic analysis is done once) of
+
+.. math::
+
+    K = A - \lambda B + E\,\mathrm{diag}(\nu/g)\,E^T
+
+and two solves, :math:`y_2 = K^{-1}Bu` and :math:`y_1 = K^{-1}(-F_u + E(F_c/g))`:
+:math:`\delta\lambda = (-F_n - (Bu)^Ty_1)/((Bu)^Ty_2)`, :math:`\delta u = y_1 +
+\delta\lambda\, y_2`, :math:`\delta\nu = (-F_c + \nu \circ E^T\delta u)/g`.
+
+Why a barrier. On thin long plates the critical mode lies almost flat on the obstacle:
+thousands of constrained nodes have both a gap and a push close to zero. An active-set
+step must decide for each of them whether it touches; the decisions flip from one step
+to the next and their number grows with the mesh. The barrier treats those nodes
+smoothly, and Newton's method on the barrier problem needs about the same number of
+steps on every mesh (the nested driver, :mod:`.chain`, starts each mesh from the
+previous one's solution).
+
+Safeguards (Nocedal & Wright, *Numerical Optimization*, 2nd ed., ch. 19; Wächter &
+Biegler, Math. Program. 106, 2006, the IPOPT paper):
+
+- inertia control: the bordered matrix :math:`[[K, -Bu], [-Bu^T, 0]]` must have exactly
+  one negative eigenvalue, i.e. :math:`\mathrm{neg}(K) + [(Bu)^Ty_2 > 0] = 1` (K positive
+  definite on the tangent space of the constraint), read off MUMPS's inertia; otherwise
+  :math:`\delta\,\mathrm{diag}(A)` is added and K refactorised;
+- fraction to the boundary (0.995) for the gap; the push is updated componentwise, each
+  entry kept above 0.005 of its old value;
+- a backtracking line search on the barrier objective (the iterate is rescaled to
+  :math:`u^TBu = 1` after each trial) while the residual is large, full steps near the
+  solution (where the objective's changes are below its rounding);
+- the barrier parameter is kept while :math:`\|F_u\|/\|Au\| > 10^{-2}`, then decreased
+  superlinearly (:math:`\mu \leftarrow \min(0.2\mu, \mu^{1.5})`) each time the barrier
+  problem is solved to :math:`10\mu`.
+
+The complementarity is scaled by :math:`\lambda\|Bu\|_\infty\max|w|` (a push times a
+gap), not by :math:`\|Au\|_\infty`, which a prolonged mode's shear pollutes.
+
+Written here because no library solves a nonconvex eigenproblem on a cone: PETSc's
+TAO interior-point solvers need a convex (or unconstrained-Hessian) problem and no
+normalisation constraint, SNES VI solves complementarity problems without the
+eigenvalue.
+
+Note:
+    All decisions use values reduced over the ranks; every method is collective on the
+    problem's communicator.
+"""
+
+from __future__ import annotations
+
+import enum
+import logging
+import math
+import time
+from dataclasses import dataclass, field
+from typing import Any
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import dolfinx
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.eigen import LDL_OPTIONS, Owner, release, set_options
+from unibuckle_fenicsx.problem import BucklingProblem
+
+__all__ = [
+    "IPM_PREFIX",
+    "BarrierPoint",
+    "InteriorPointNewton",
+    "NewtonOptions",
+    "NewtonRecord",
+    "NewtonStatus",
+]
+
+logger = logging.getLogger(__name__)
+
+#: Options prefix of the Newton matrix's factorisation (``-unibuckle_ipm_ksp_view``).
+IPM_PREFIX = "unibuckle_ipm_"
+
+_SAME = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
+_SUBSET = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
+
+
+def _dot(a: PETSc.Vec, b: PETSc.Vec) -> float:
+    """:math:`a^T b` of real vectors (collective)."""
+    return float(a.dot(b))  # type: ignore[arg-type]
+
+
+class NewtonStatus(enum.Enum):
+    """How a run of :meth:`InteriorPointNewton.solve` ended."""
+
+    CONVERGED = "converged"
+    MAX_STEPS = "max-steps"
+    INERTIA = "inertia-correction-failed"
+    BREAKDOWN = "breakdown"
+
+
+@dataclass(frozen=True)
+class NewtonOptions:
+    r"""Settings of the interior-point Newton method (scaled quantities).
+
+    Attributes:
+        keep_mu_until: The barrier parameter is not decreased while
+            :math:`\|F_u\|_2/\|Au\|_2` exceeds this.
+        kappa_eps: The barrier problem counts as solved when its scaled residuals are
+            at most ``kappa_eps`` times :math:`\mu`.
+        kappa_mu: Linear factor of the decrease of :math:`\mu`.
+        theta_mu: Superlinear exponent of the decrease of :math:`\mu`.
+        residual_floor: Scaled residual of :math:`F_u` that counts as zero (its
+            rounding on thin plates: :math:`|A||u| \gg |Au|`).
+        fraction: Fraction to the boundary.
+        local_residual: Below this scaled residual, full steps are taken (no line
+            search).
+        delta_first: First regularisation :math:`\delta` (relative to diag(A)).
+        delta_max: Largest regularisation before giving up.
+    """
+
+    keep_mu_until: float = 1e-2
+    kappa_eps: float = 10.0
+    kappa_mu: float = 0.2
+    theta_mu: float = 1.5
+    residual_floor: float = 1e-8
+    fraction: float = 0.995
+    local_residual: float = 1e-2
+    delta_first: float = 1e-4
+    delta_max: float = 1e6
+
+
+@dataclass
+class BarrierPoint:
+    r"""An iterate of the interior-point method.
+
+    Attributes:
+        mode: u = (w, theta), :math:`u^TBu = 1`, strictly inside the cone.
+        load: :math:`\lambda`.
+        push: :math:`\nu > 0` at the constrained nodes owned by this rank, in the
+            order of :meth:`~unibuckle_fenicsx.contact.ContactSetManager.owned_positions`.
+        mu: Scaled barrier parameter.
+    """
+
+    mode: dolfinx.fem.Function
+    load: float
+    push: npt.NDArray[np.float64]
+    mu: float
+
+
+@dataclass
+class NewtonRecord:
+    r"""What one run of the method did.
+
+    Attributes:
+        status: How it ended.
+        steps: Newton steps taken.
+        factorizations: Numeric factorisations (steps plus inertia corrections).
+        seconds: Wall time.
+        load: Final :math:`\\lambda`.
+        mu: Final scaled barrier parameter.
+        history: (load, mu, scaled residual of F_u, scaled complementarity) per step.
+    """
+
+    status: NewtonStatus = NewtonStatus.MAX_STEPS
+    steps: int = 0
+    factorizations: int = 0
+    seconds: float = 0.0
+    load: float = math.nan
+    mu: float = math.nan
+    history: list[tuple[float, float, float, float]] = field(default_factory=list)
+
+
+class InteriorPointNewton(Owner):
+    """The interior-point Newton method on one problem (owns K, its LDLᵀ and work vectors).
+
+    Args:
+        problem: A problem with a rigid obstacle.
+        options: Settings (default :class:`NewtonOptions`).
+        prefix: Options prefix of the factorisation.
+
+    Note:
+        Construction, every method and :meth:`destroy` are collective.
+    """
+
+    def __init__(
+        self,
+        problem: BucklingProblem,
+        options: NewtonOptions | None = None,
+        prefix: str = IPM_PREFIX,
+    ) -> None:
+        contact = problem.contact
+        if contact is None or problem.tensionless:
+            raise ValueError("InteriorPointNewton needs a problem with a rigid obstacle")
+        self.problem = problem
+        self.options = options or NewtonOptions()
+        self.comm = problem.comm
+        self.contact = contact
+        self._dofs = contact.owned_local_dofs
+        self._signs = contact.owned_signs
+        A, B = problem.model.A, problem.model.B
+        self.A, self.B = A, B
+        self.K = A.duplicate(copy=True)
+        self.ksp = PETSc.KSP().create(A.comm)
+        self.ksp.setOperators(self.K)
+        self.K.setOption(PETSc.Mat.Option.SPD, False)
+        self.K.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        set_options(self.ksp, prefix, LDL_OPTIONS, setup=True)
+        self.prefix = prefix
+        self.factorizations = 1
+        self._diag_A = A.createVecLeft()
+        A.getDiagonal(self._diag_A)
+        self._diag = A.createVecLeft()  # diagonal modification of K
+        self._Au, self._Bu, self._Fu = A.createVecLeft(), A.createVecLeft(), A.createVecLeft()
+        self._y1, self._y2, self._rhs = A.createVecLeft(), A.createVecLeft(), A.createVecLeft()
+        self._du, self._trial = A.createVecLeft(), A.createVecLeft()
+        self._delta_last = 0.0
+
+    # -- oriented values on the zone (owned nodes, no communication) -----------------
+    def oriented(self, vec: PETSc.Vec) -> npt.NDArray[np.float64]:
+        """:math:`z = s_k u_k` at the owned constrained nodes of the W-vector ``vec``."""
+        return self._signs * vec.array_r[self._dofs]  # type: ignore[return-value]
+
+    def _add_zone(self, vec: PETSc.Vec, values: npt.NDArray[np.float64]) -> None:
+        """``vec += E values`` (oriented values at the owned constrained nodes)."""
+        vec.array[self._dofs] += self._signs * values
+
+    def _min(self, values: npt.NDArray[np.float64]) -> float:
+        return float(self.comm.allreduce(values.min() if values.size else math.inf, op=MPI.MIN))
+
+    def _max(self, values: npt.NDArray[np.float64]) -> float:
+        return float(self.comm.allreduce(values.max() if values.size else -math.inf, op=MPI.MAX))
+
+    def _sum(self, value: float) -> float:
+        return float(self.comm.allreduce(float(value), op=MPI.SUM))
+
+    # -- the Newton matrix -------------------------------------------------------------
+    def _factor(
+        self,
+        load: float,
+        sigma: npt.NDArray[np.float64] | None,
+        delta: float = 0.0,
+        stiff: tuple[npt.NDArray[np.bool_], float] | None = None,
+    ) -> tuple[int, int]:
+        r"""Factorise :math:`A - \lambda B + E \Sigma E^T + \delta\,diag(A)`; its inertia.
+
+        ``stiff = (mask, value)`` adds ``value`` to the diagonal of the owned DOFs in
+        ``mask``.
+        """
+        self.A.copy(self.K, structure=_SAME)
+        if load:
+            self.K.axpy(-load, self.B, structure=_SUBSET)
+        self._diag.zeroEntries()
+        if delta:
+            self._diag.axpy(delta, self._diag_A)
+        if sigma is not None:
+            self._add_zone(self._diag, sigma)
+        if stiff is not None:
+            self._diag.array[stiff[0]] += stiff[1]
+        self.K.setDiagonal(self._diag, addv=PETSc.InsertMode.ADD_VALUES)
+        self.ksp.setOperators(self.K)
+        self.ksp.setUp()
+        self.factorizations += 1
+        nneg, nzero, _ = self.ksp.getPC().getFactorMatrix().getInertia()
+        return int(nneg), int(nzero)
+
+    # -- starts ------------------------------------------------------------------------
+    def pressure_mode(self, weights: npt.NDArray[np.float64] | None = None) -> dolfinx.fem.Function:
+        r"""Deflection under nodal forces ``weights`` pushing the plate off the obstacle.
+
+        :math:`A u = -E\,\omega` (one factorisation of A): for positive weights a
+        deflection strictly inside the cone on simply supported and clamped plates, with
+        rotations consistent with it.
+
+        Args:
+            weights: (i,) nonnegative weights of the constrained nodes (default all 1).
+        """
+        n = self.contact.size
+        weights = np.ones(n) if weights is None else np.asarray(weights, dtype=float)
+        self._factor(0.0, None)
+        self._rhs.zeroEntries()
+        self._add_zone(self._rhs, -weights[self.contact.owned_positions])
+        u = self.problem.new_mode("start")
+        self.ksp.solve(self._rhs, u.x.petsc_vec)
+        u.x.scatter_forward()
+        return u
+
+    def relax(self, vec: PETSc.Vec, free: str = "rotations") -> None:
+        r"""Minimise :math:`a(u, u)` over the rotations (or the deflection) of ``vec``.
+
+        A mode interpolated from another mesh, or built from nodal deflections, is not
+        in this mesh's discrete Kirchhoff kernel: its assumed shear strain is not small
+        and, on a thin plate, its quotient is orders of magnitude off. Minimising the
+        energy over w with the rotations held (a Poisson-like problem: w integrates the
+        rotations along the edges), then over the rotations with w held, restores it
+        while keeping the shape. The held DOFs get a stiff diagonal
+        (:math:`10^8 \max \mathrm{diag} A`, so they move by 1e-8 of the correction); one
+        factorisation of a matrix with A's pattern each.
+
+        Args:
+            vec: The W-vector, changed in place.
+            free: "rotations" or "deflection": the DOFs that move.
+        """
+        if free not in ("rotations", "deflection"):
+            raise ValueError(f'free must be "rotations" or "deflection", got {free!r}')
+        held = np.zeros(vec.getLocalSize(), dtype=bool)
+        held[self.problem.owned_w_dofs] = True
+        if free == "deflection":
+            held = ~held
+        big = 1e8 * float(self._diag_A.norm(PETSc.NormType.INFINITY))
+        self._factor(0.0, None, stiff=(held, big))
+        self.A.mult(vec, self._rhs)
+        self._rhs.array[held] = 0.0
+        self._rhs.scale(-1.0)
+        self.ksp.solve(self._rhs, self._y1)
+        self._y1.array[held] = 0.0
+        vec.axpy(1.0, self._y1)
+
+    def relax_rotations(self, vec: PETSc.Vec) -> None:
+        """:meth:`relax` over the rotations."""
+        self.relax(vec, "rotations")
+
+    def clip(self, u: dolfinx.fem.Function, margin: float) -> int:
+        """Move the deflection of the nodes closer to the obstacle than ``margin`` max|w| back.
+
+        Each such node gets the gap ``margin`` max|w| exactly (its rotations are left;
+        call :meth:`relax` after). For a mode interpolated from a coarser mesh the
+        nodes are few and the changes of the order of the interpolation error.
+
+        Returns:
+            The number of nodes moved (over all ranks).
+        """
+        vec = u.x.petsc_vec
+        limit = -margin * self.problem.max_abs_w(vec)
+        z = self.oriented(vec)
+        moved = z > limit
+        vec.array[self._dofs[moved]] = self._signs[moved] * limit
+        u.x.scatter_forward()
+        return int(self.comm.allreduce(int(moved.sum()), op=MPI.SUM))
+
+    def negative_part(self, vec: PETSc.Vec, sign: float = 1.0) -> dolfinx.fem.Function:
+        """The mode ``sign * vec`` with its deflection set to 0 where it crosses the obstacle.
+
+        The rotations are relaxed (:meth:`relax_rotations`); the result is not yet
+        strictly inside the cone (see :meth:`make_interior`).
+        """
+        u = self.problem.new_mode("start")
+        u.x.petsc_vec.array[:] = sign * vec.array_r
+        z = self.oriented(u.x.petsc_vec)
+        u.x.petsc_vec.array[self._dofs[z > 0.0]] = 0.0
+        self.relax_rotations(u.x.petsc_vec)
+        u.x.scatter_forward()
+        return u
+
+    def make_interior(
+        self,
+        u: dolfinx.fem.Function,
+        margin: float = 1e-2,
+        push: dolfinx.fem.Function | None = None,
+    ) -> dolfinx.fem.Function:
+        """Add the pressure deflection to ``u`` so that it lies strictly inside the cone.
+
+        The deflection ``push`` (default :meth:`pressure_mode` with unit weights) is
+        added with the smallest amplitude that gives every constrained node a gap of at
+        least ``margin`` max|w(u)| (node by node: a node next to a clamped edge, where
+        the pressure deflection is small, asks for much only if u crosses there).
+        """
+        push = push if push is not None else self.pressure_mode()
+        gap_push = -self.oriented(push.x.petsc_vec)
+        if not self._min(gap_push) > 0.0:
+            raise ValueError("the pressure deflection does not lie inside the cone")
+        need = self.oriented(u.x.petsc_vec) + margin * self.problem.max_abs_w(u.x.petsc_vec)
+        short = need > 0.0
+        amount = max(self._max(need[short] / gap_push[short]), 0.0)
+        if amount > 0.0:
+            u.x.petsc_vec.axpy(amount, push.x.petsc_vec)
+            u.x.scatter_forward()
+        return u
+
+    # -- the method --------------------------------------------------------------------
+    def _normalize(self, vec: PETSc.Vec) -> None:
+        self.B.mult(vec, self._Bu)
+        b = _dot(vec, self._Bu)
+        if not b > 0.0:
+            raise FloatingPointError("b(u, u) <= 0: the mode carries no geometric stiffness")
+        vec.scale(1.0 / math.sqrt(b))
+
+    def _merit(self, vec: PETSc.Vec, mu_abs: float) -> float:
+        """Barrier objective of the normalised ``vec`` (inf outside the cone)."""
+        gap = -self.oriented(vec)
+        if self._min(gap) <= 0.0:
+            return math.inf
+        self.A.mult(vec, self._Au)
+        return 0.5 * _dot(vec, self._Au) - mu_abs * self._sum(np.log(gap).sum())
+
+    def solve(
+        self,
+        mode: dolfinx.fem.Function,
+        *,
+        load: float | None = None,
+        push: npt.NDArray[np.float64] | None = None,
+        mu: float = 1e-2,
+        mu_min: float = 1e-12,
+        max_steps: int = 100,
+    ) -> tuple[BarrierPoint, NewtonRecord]:
+        r"""Run the method from ``mode`` (strictly inside the cone; updated in place).
+
+        Args:
+            mode: Start, strictly inside the cone; becomes the final iterate.
+            load: Start :math:`\lambda` (default the Rayleigh quotient of ``mode``).
+            push: Start :math:`\nu` (default :math:`\mu/g`); entries below
+                :math:`10^{-3}\mu/g` are raised to it.
+            mu: Start scaled barrier parameter.
+            mu_min: The run converges when the barrier problem at ``mu_min`` is solved.
+            max_steps: Newton steps allowed.
+
+        Returns:
+            The final iterate and the record of the run.
+        """
+        opts = self.options
+        t0 = time.perf_counter()
+        f0 = self.factorizations
+        record = NewtonRecord()
+        u = mode.x.petsc_vec
+        self._normalize(u)
+        gap = -self.oriented(u)
+        if not self._min(gap) > 0.0:
+            raise ValueError("InteriorPointNewton.solve: the start is not inside the cone")
+        self.A.mult(u, self._Au)
+        lam = _dot(u, self._Au) if load is None else float(load)
+        nu = np.asarray(push, dtype=float) if push is not None else None
+        keep = True
+        mu_abs = math.nan
+        for step in range(max_steps + 1):
+            self.A.mult(u, self._Au)
+            self.B.mult(u, self._Bu)
+            gap = -self.oriented(u)
+            w_scale = self.problem.max_abs_w(u)
+            f_scale = lam * float(self._Bu.norm(PETSc.NormType.INFINITY))
+            if not (math.isfinite(f_scale) and f_scale > 0.0):
+                record.status = NewtonStatus.BREAKDOWN
+                break
+            scale = f_scale * w_scale
+            mu_abs = mu * scale
+            if nu is None:
+                nu = mu_abs / gap
+            elif step == 0:
+                nu = np.maximum(nu, 1e-3 * mu_abs / gap)
+            self._Au.copy(self._Fu)
+            self._Fu.axpy(-lam, self._Bu)
+            self._add_zone(self._Fu, nu)
+            e_u = float(self._Fu.norm(PETSc.NormType.INFINITY)) / f_scale
+            rel_u = float(self._Fu.norm()) / float(self._Au.norm())
+            e_c = self._max(np.abs(nu * gap - mu_abs)) / scale if gap.size else 0.0
+            e_c = max(e_c, 0.0)
+            record.history.append((lam, mu, e_u, e_c))
+            logger.debug(
+                "ipm step %d: lambda %.12g mu %.1e e_u %.2e e_c %.2e rel_u %.2e",
+                step, lam, mu, e_u, e_c, rel_u,
+            )  # fmt: skip
+            # -- barrier parameter ---------------------------------------------------
+            if keep and rel_u <= opts.keep_mu_until:
+                keep = False
+            if not keep:
+                floor = opts.residual_floor
+                while (
+                    mu > mu_min
+                    and max(e_u, e_c) <= max(opts.kappa_eps * mu, floor)
+                    and (e_c <= opts.kappa_eps * mu)
+                ):
+                    mu = max(mu_min, min(opts.kappa_mu * mu, mu**opts.theta_mu))
+                    mu_abs = mu * scale
+                    e_c = max(self._max(np.abs(nu * gap - mu_abs)) / scale, 0.0)
+                if (
+                    mu <= mu_min
+                    and e_u <= max(opts.kappa_eps * mu, floor)
+                    and (e_c <= opts.kappa_eps * mu)
+                ):
+                    record.status = NewtonStatus.CONVERGED
+                    break
+            if step == max_steps:
+                record.status = NewtonStatus.MAX_STEPS
+                break
+            # -- Newton direction with inertia control ----------------------------------
+            direction = self.direction(u, lam, nu, gap, mu_abs)
+            if direction is None:
+                record.status = NewtonStatus.INERTIA
+                break
+            dlam, dz, dnu = direction
+            # -- step length ------------------------------------------------------------
+            closing = dz > 0.0  # the gap closes: -dz < 0
+            alpha_max = min(1.0, self._min(opts.fraction * gap[closing] / dz[closing]))
+            if abs(dlam) > 0.5 * lam:
+                alpha_max = min(alpha_max, 0.5 * lam / abs(dlam))
+            alpha = self._line_search(u, mu_abs, alpha_max, dz, gap, e_u)
+            lam += alpha * dlam
+            nu = np.maximum(nu + dnu, (1.0 - opts.fraction) * nu)
+            record.steps += 1
+        record.factorizations = self.factorizations - f0
+        record.seconds = time.perf_counter() - t0
+        record.load = lam
+        record.mu = mu
+        mode.x.scatter_forward()
+        assert nu is not None
+        return BarrierPoint(mode, lam, nu, mu), record
+
+    def direction(
+        self,
+        u: PETSc.Vec,
+        lam: float,
+        nu: npt.NDArray[np.float64],
+        gap: npt.NDArray[np.float64],
+        mu_abs: float,
+    ) -> tuple[float, npt.NDArray[np.float64], npt.NDArray[np.float64]] | None:
+        r"""The Newton direction at (u, lambda, nu) for the absolute barrier ``mu_abs``.
+
+        Solves the linearised optimality conditions (module docstring) with the
+        inertia-controlled factorisation of K; :math:`\delta u` is left in ``self._du``
+        (valid until the next call). ``self._Fu`` must hold :math:`F_u` and
+        ``self._Bu`` :math:`Bu` at u.
+
+        Returns:
+            :math:`(\delta\lambda, z(\delta u), \delta\nu)`, or None when the
+            regularisation reached ``delta_max`` without the right inertia.
+        """
+        opts = self.options
+        f_c = nu * gap - mu_abs
+        sigma = nu / gap
+        # After a corrected step, start from a third of the last correction.
+        delta = max(1e-12, self._delta_last / 3.0) if self._delta_last else 0.0
+        while True:
+            nneg, nzero = self._factor(lam, sigma, delta)
+            self.ksp.solve(self._Bu, self._y2)
+            by2 = _dot(self._Bu, self._y2)
+            if nzero == 0 and nneg + (1 if by2 > 0.0 else 0) == 1:
+                break
+            delta = (
+                opts.delta_first if delta == 0.0 else delta * (8.0 if self._delta_last else 100.0)
+            )
+            if delta > opts.delta_max:
+                return None
+        self._delta_last = delta if delta > 1e-11 else 0.0
+        self._Fu.copy(self._rhs)
+        self._rhs.scale(-1.0)
+        self._add_zone(self._rhs, f_c / gap)
+        self.ksp.solve(self._rhs, self._y1)
+        f_n = 0.5 * (_dot(u, self._Bu) - 1.0)
+        dlam = (-f_n - _dot(self._Bu, self._y1)) / by2
+        self._y1.copy(self._du)
+        self._du.axpy(dlam, self._y2)
+        dz = self.oriented(self._du)
+        dnu = (-f_c + nu * dz) / gap
+        return dlam, dz, dnu
+
+    def _line_search(
+        self,
+        u: PETSc.Vec,
+        mu_abs: float,
+        alpha: float,
+        dz: npt.NDArray[np.float64],
+        gap: npt.NDArray[np.float64],
+        e_u: float,
+    ) -> float:
+        """Backtrack from ``alpha`` on the barrier objective; apply the step to ``u``."""
+        local = e_u <= self.options.local_residual
+        phi0 = self._merit(u, mu_abs)
+        self.A.mult(u, self._Au)
+        slope = _dot(self._Au, self._du) + mu_abs * self._sum((dz / gap).sum())
+        for _ in range(30):
+            u.copy(self._trial)
+            self._trial.axpy(alpha, self._du)
+            self._normalize(self._trial)
+            if local or slope >= 0.0:
+                break
+            phi = self._merit(self._trial, mu_abs)
+            if phi <= phi0 + 1e-4 * alpha * slope + 1e-10 * abs(phi0):
+                break
+            alpha *= 0.5
+        self._trial.copy(u)
+        return alpha
+
+    def escape(self, point: BarrierPoint, lower: PETSc.Vec, fraction: float = 0.99) -> bool:
+        r"""Leave a saddle along a lower mode of the contact-reduced pencil (in place).
+
+        At a stationary point whose contact-reduced pencil has an eigenvector ``lower``
+        with a smaller load, :math:`R` decreases along :math:`u + t v` (v the part of
+        ``lower`` B-orthogonal to u) in both directions; the step goes, in the
+        direction that lowers R more, to ``fraction`` of the way to the first node
+        that would touch the obstacle. (Two weakly coupled buckles with nearly equal
+        loads: the barrier keeps both, the lower antisymmetric combination moves the
+        weight to the one with the smaller load until the other lies on the obstacle.)
+
+        Returns:
+            Whether the quotient decreased (the mode is then rescaled, the push reset).
+        """
+        u = point.mode.x.petsc_vec
+        self.B.mult(u, self._Bu)
+        lower.copy(self._du)
+        self._du.axpy(-_dot(self._du, self._Bu), u)
+        self.B.mult(self._du, self._rhs)
+        norm = _dot(self._du, self._rhs)
+        if not norm > 0.0:
+            return False
+        self._du.scale(1.0 / math.sqrt(norm))
+        gap = -self.oriented(u)
+        dz = self.oriented(self._du)
+        self.A.mult(u, self._Au)
+        r0 = _dot(u, self._Au)
+        best, best_t = r0, 0.0
+        for sign in (1.0, -1.0):
+            moving = sign * dz > 0.0
+            t = fraction * self._min(gap[moving] / (sign * dz[moving]))
+            t = min(t, 1e3) if math.isfinite(t) else 1e3
+            u.copy(self._trial)
+            self._trial.axpy(sign * t, self._du)
+            self._normalize(self._trial)
+            self.A.mult(self._trial, self._Au)
+            r = _dot(self._trial, self._Au)
+            if r < best:
+                best, best_t = r, sign * t
+        if best_t == 0.0:
+            return False
+        u.axpy(best_t, self._du)
+        self._normalize(u)
+        point.mode.x.scatter_forward()
+        point.load = best
+        self.B.mult(u, self._Bu)
+        f_scale = best * float(self._Bu.norm(PETSc.NormType.INFINITY))
+        point.push = point.mu * f_scale * self.problem.max_abs_w(u) / (-self.oriented(u))
+        return True
+
+    def reaction_push(
+        self, mode: dolfinx.fem.Function, load: float, mu: float
+    ) -> npt.NDArray[np.float64]:
+        r"""Push estimate at ``mode``: the reaction :math:`-z(Au - \lambda Bu)`.
+
+        At least :math:`\mu/g` at every node. ``mode`` must lie strictly inside the
+        cone; it is normalised in place.
+        """
+        vec = mode.x.petsc_vec
+        self._normalize(vec)
+        self.A.mult(vec, self._Au)
+        self.B.mult(vec, self._Bu)
+        self._Au.copy(self._Fu)
+        self._Fu.axpy(-load, self._Bu)
+        f_scale = load * float(self._Bu.norm(PETSc.NormType.INFINITY))
+        gap = -self.oriented(vec)
+        mu_abs = mu * f_scale * self.problem.max_abs_w(vec)
+        return np.maximum(-self.oriented(self._Fu), mu_abs / gap)
+
+    def from_candidate(self, cand: Any, mu: float) -> BarrierPoint:
+        r"""A barrier point near an exact critical state ``cand`` (a :class:`Candidate`).
+
+        The mode is pushed strictly inside the cone (by :math:`10^{-6}` of its
+        amplitude); the push is :meth:`reaction_push`.
+        """
+        u = self.problem.new_mode("barrier")
+        cand.mode.x.petsc_vec.copy(u.x.petsc_vec)
+        u.x.scatter_forward()
+        self.make_interior(u, margin=1e-6)
+        push = self.reaction_push(u, float(cand.load), mu)
+        return BarrierPoint(u, float(cand.load), push, mu)
+
+    def contact_set(self, point: BarrierPoint) -> npt.NDArray[np.int64]:
+        r"""The nodes whose gap is at most :math:`\tau \max|w|`: the contact set Z.
+
+        Same on every rank (node numbers, sorted). A node in the degenerate part of the
+        obstacle (gap and push both near zero) counts as touching only when its gap is
+        at the solver's tolerance.
+        """
+        u = point.mode.x.petsc_vec
+        gap = -self.oriented(u) / self.problem.max_abs_w(u)
+        mine = self.contact.owned_positions[gap <= self.problem.tau]
+        return np.sort(np.concatenate(self.comm.allgather(mine))).astype(np.int64)
+
+    def destroy(self) -> None:
+        """Destroy the matrix, its factorisation and the work vectors (collective)."""
+        release(
+            self, "ksp", "K", "_diag_A", "_diag", "_Au", "_Bu", "_Fu", "_y1", "_y2", "_rhs",
+            "_du", "_trial",
+        )  # fmt: skip
+
+    def __del__(self) -> None:
+        self.destroy()
