@@ -62,7 +62,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
-from unibuckle_fenicsx.algorithms.bounds import PROOF_RTOL, lattice_bound
+from unibuckle_fenicsx.algorithms.bounds import PROOF_RTOL, bracket
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
@@ -424,17 +424,11 @@ def solve_active_set(
         chosen = _prune(problem, chosen)
 
     # -- bounds ---------------------------------------------------------------------
-    lower, bound_evals, better, complete = lattice_bound(
-        problem, free_load, chosen.load, bound_budget
-    )
-    if better is not None:
-        warnings.append(
-            f"the lattice search found a lower feasible load {better.load:.10g} "
-            f"than the active-set point {chosen.load:.10g}"
-        )
-        chosen = better
-    lower = max(lower, free_load)
-    proven = bool(lower >= chosen.load * (1 - PROOF_RTOL))
+    closed = bracket(problem, free_load, chosen, bound_budget, "active-set")
+    if closed.warning:
+        warnings.append(closed.warning)
+    chosen, lower, proven = closed.chosen, closed.lower, closed.proven
+    bound_evals, complete = closed.evaluations, closed.complete
 
     groups = _twin_groups(kkt)
     details.update(

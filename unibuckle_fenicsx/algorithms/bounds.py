@@ -13,12 +13,13 @@ from __future__ import annotations
 
 import heapq
 import math
+from dataclasses import dataclass
 
 import numpy as np
 
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 
-__all__ = ["PROOF_RTOL", "lattice_bound"]
+__all__ = ["PROOF_RTOL", "Bracket", "bracket", "lattice_bound"]
 
 #: Relative tolerance for "the bracket is closed".
 PROOF_RTOL = 1e-10
@@ -72,3 +73,45 @@ def lattice_bound(
     lower = min(frontier[0][0], upper) if frontier else upper
     complete = not frontier or frontier[0][0] >= upper * (1 - PROOF_RTOL)
     return lower, evaluations, better, complete
+
+
+@dataclass(frozen=True)
+class Bracket:
+    """The critical state after the lattice search, with its verified bracket.
+
+    Attributes:
+        chosen: The returned critical state (the search's lower feasible one if found).
+        lower: Lower bound, at least the free load.
+        proven: The bracket closes (relative :data:`PROOF_RTOL`).
+        evaluations: Eigen solves of the search.
+        complete: The search completed.
+        warning: What the search changed, in words (None if nothing).
+    """
+
+    chosen: Candidate
+    lower: float
+    proven: bool
+    evaluations: int
+    complete: bool
+    warning: str | None
+
+
+def bracket(
+    problem: BucklingProblem, free_load: float, chosen: Candidate, budget: int, route: str
+) -> Bracket:
+    """Close the bracket of ``chosen`` by :func:`lattice_bound` (small zones) and interlacing.
+
+    Note:
+        Collective.
+    """
+    lower, evaluations, better, complete = lattice_bound(problem, free_load, chosen.load, budget)
+    warning = None
+    if better is not None:
+        warning = (
+            f"the lattice search found a lower feasible load {better.load:.10g} than the "
+            f"{route} critical state {chosen.load:.10g}"
+        )
+        chosen = better
+    lower = max(lower, free_load)
+    proven = bool(lower >= chosen.load * (1 - PROOF_RTOL))
+    return Bracket(chosen, lower, proven, evaluations, complete, warning)

@@ -41,7 +41,7 @@ from typing import Any
 import numpy as np
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
-from unibuckle_fenicsx.algorithms.bounds import PROOF_RTOL, lattice_bound
+from unibuckle_fenicsx.algorithms.bounds import bracket
 from unibuckle_fenicsx.algorithms.interior_point import (
     BarrierPoint,
     InteriorPointNewton,
@@ -193,6 +193,30 @@ def _newton_link(seed: str, record: NewtonRecord) -> LinkRecord:
     )
 
 
+def _run(
+    newton: InteriorPointNewton,
+    point: BarrierPoint,
+    level: LevelRecord,
+    label: str,
+    options: ChainOptions,
+    *,
+    mu: float,
+    mu_min: float,
+    keep_push: bool = True,
+) -> tuple[BarrierPoint, NewtonRecord]:
+    """Continue the method from ``point`` (updated in place) and record the run."""
+    new, rec = newton.solve(
+        point.mode,
+        load=point.load,
+        push=point.push if keep_push else None,
+        mu=mu,
+        mu_min=mu_min,
+        max_steps=options.max_steps,
+    )
+    level.links.append(_newton_link(label, rec))
+    return new, rec
+
+
 def _start(newton: InteriorPointNewton, seed: str, push: Any) -> Any:
     """The start ``seed`` on ``newton``'s problem, strictly inside the cone."""
     problem = newton.problem
@@ -292,28 +316,17 @@ def _critical_state(
         if not (saddle and newton.escape(point, cand.mode.x.petsc_vec)):
             break
         tag = f"{label} (escape {attempt + 1})"
-        point, rec = newton.solve(
-            point.mode,
-            load=point.load,
-            mu=max(point.mu, options.escape_mu),
-            mu_min=max(point.mu, options.fine_mu_min),
-            max_steps=options.max_steps,
-        )
-        level.links.append(_newton_link(tag, rec))
+        point, _ = _run(
+            newton, point, level, tag, options, keep_push=False,
+            mu=max(point.mu, options.escape_mu), mu_min=max(point.mu, options.fine_mu_min),
+        )  # fmt: skip
         cand = _read_contact(problem, newton, point, level, tag)
         if cand.kkt:
             return cand, point
     if point.mu > options.last_mu_min:
-        point, rec = newton.solve(
-            point.mode,
-            load=point.load,
-            push=point.push,
-            mu=point.mu,
-            mu_min=options.last_mu_min,
-            max_steps=options.max_steps,
-        )
-        level.links.append(_newton_link(label + " (lower barrier)", rec))
-        cand = _read_contact(problem, newton, point, level, label + " (lower barrier)")
+        tag = label + " (lower barrier)"
+        point, _ = _run(newton, point, level, tag, options, mu=point.mu, mu_min=options.last_mu_min)
+        cand = _read_contact(problem, newton, point, level, tag)
         if cand.kkt:
             return cand, point
     if math.isfinite(cand.load):
@@ -323,15 +336,10 @@ def _critical_state(
         if polished is not None and polished.kkt:
             # The barrier point that goes with it, for the next mesh.
             fresh = newton.from_candidate(polished, options.level_mu)
-            fresh, rec = newton.solve(
-                fresh.mode,
-                load=fresh.load,
-                push=fresh.push,
-                mu=fresh.mu,
-                mu_min=point.mu,
-                max_steps=options.max_steps,
-            )
-            level.links.append(_newton_link(label + " (after polish)", rec))
+            fresh, _ = _run(
+                newton, fresh, level, label + " (after polish)", options,
+                mu=fresh.mu, mu_min=point.mu,
+            )  # fmt: skip
             return polished, fresh
     return None, point
 
@@ -364,15 +372,9 @@ def _explore(
                 level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
                 continue
             seen.append(point.load)
-            point, rec = newton.solve(
-                point.mode,
-                load=point.load,
-                push=point.push,
-                mu=point.mu,
-                mu_min=options.explore_mu_min,
-                max_steps=options.max_steps,
+            point, rec = _run(
+                newton, point, level, seed, options, mu=point.mu, mu_min=options.explore_mu_min
             )
-            level.links.append(_newton_link(seed, rec))
             if rec.status is not NewtonStatus.CONVERGED:
                 continue
             cand, point = _critical_state(problem, newton, point, level, seed, options)
@@ -398,15 +400,9 @@ def _central(
     On the central path the push is :math:`\mu/g` node by node, so a finer mesh can
     start from the interpolated mode alone, at the same barrier parameter.
     """
-    lifted, rec = newton.solve(
-        point.mode,
-        load=point.load,
-        push=point.push,
-        mu=options.level_mu,
-        mu_min=options.level_mu,
-        max_steps=options.max_steps,
+    lifted, _ = _run(
+        newton, point, level, label, options, mu=options.level_mu, mu_min=options.level_mu
     )
-    level.links.append(_newton_link(label, rec))
     return lifted
 
 
@@ -540,18 +536,8 @@ def solve_unilateral(
         solution.eigensolves += other_solves
         return solution
 
-    lower, bound_evals, better, complete = lattice_bound(
-        problem, free_load, chosen.load, options.bound_budget
-    )
-    warnings: list[str] = []
-    if better is not None:
-        warnings.append(
-            f"the lattice search found a lower feasible load {better.load:.10g} than the "
-            f"interior-point critical state {chosen.load:.10g}"
-        )
-        chosen = better
-    lower = max(lower, free_load)
-    proven = bool(lower >= chosen.load * (1 - PROOF_RTOL))
+    closed = bracket(problem, free_load, chosen, options.bound_budget, "interior-point")
+    chosen, lower, proven = closed.chosen, closed.lower, closed.proven
     route = "interior-point"
     if any(r.link == "active-set polish" and r.kkt for r in levels[-1].links):
         route += " + active-set polish"
@@ -562,13 +548,13 @@ def solve_unilateral(
         "coarse_kkt_loads": sorted(c.load for c in explored),
         "fine_eigensolves": problem.eigensolver.solves - solves0,
         "coarse_eigensolves": other_solves,
-        "bound_evaluations": bound_evals,
-        "bound_search_complete": complete,
-        "lower_bound_by": "lattice" if bound_evals else "interlacing",
+        "bound_evaluations": closed.evaluations,
+        "bound_search_complete": closed.complete,
+        "lower_bound_by": "lattice" if closed.evaluations else "interlacing",
         "wall_time_s": time.perf_counter() - t0,
     }
-    if warnings:
-        details["warning"] = "; ".join(warnings)
+    if closed.warning:
+        details["warning"] = closed.warning
     if not math.isfinite(chosen.load):
         raise NoAdmissibleModeError("the interior-point route ended without a finite load")
     return UnilateralSolution(
