@@ -99,6 +99,15 @@ _SAME = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
 _SUBSET = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
 
 
+def _abs_matrix(mat: PETSc.Mat) -> PETSc.Mat:
+    """A new matrix with the entries' absolute values (the caller destroys it)."""
+    out = mat.duplicate(copy=True)
+    indptr, indices, values = out.getValuesCSR()
+    out.setValuesCSR(indptr, indices, np.abs(values))  # type: ignore[arg-type]
+    out.assemble()
+    return out
+
+
 def _dot(a: PETSc.Vec, b: PETSc.Vec) -> float:
     """:math:`a^T b` of real vectors (collective)."""
     return float(a.dot(b))  # type: ignore[arg-type]
@@ -228,6 +237,8 @@ class InteriorPointNewton(Owner):
         self._Au, self._Bu, self._Fu = A.createVecLeft(), A.createVecLeft(), A.createVecLeft()
         self._y1, self._y2, self._rhs = A.createVecLeft(), A.createVecLeft(), A.createVecLeft()
         self._du, self._trial = A.createVecLeft(), A.createVecLeft()
+        # |A| and |B| for the rounding floor of the residual (thin plates: |A||u| >> |Au|).
+        self._abs_A, self._abs_B = _abs_matrix(A), _abs_matrix(B)
         self._delta_last = 0.0
 
     # -- oriented values on the zone (owned nodes, no communication) -----------------
@@ -464,6 +475,7 @@ class InteriorPointNewton(Owner):
             self._Fu.axpy(-lam, self._Bu)
             self._add_zone(self._Fu, nu)
             e_u = float(self._Fu.norm(PETSc.NormType.INFINITY)) / f_scale
+            floor = max(opts.residual_floor, self._rounding(u, lam) / f_scale)
             rel_u = float(self._Fu.norm()) / float(self._Au.norm())
             e_c = self._max(np.abs(nu * gap - mu_abs)) / scale if gap.size else 0.0
             e_c = max(e_c, 0.0)
@@ -476,7 +488,6 @@ class InteriorPointNewton(Owner):
             if keep and rel_u <= opts.keep_mu_until:
                 keep = False
             if not keep:
-                floor = opts.residual_floor
                 while (
                     mu > mu_min
                     and max(e_u, e_c) <= max(opts.kappa_eps * mu, floor)
@@ -565,6 +576,20 @@ class InteriorPointNewton(Owner):
         dz = self.oriented(self._du)
         dnu = (-f_c + nu * dz) / gap
         return dlam, dz, dnu
+
+    def _rounding(self, u: PETSc.Vec, lam: float) -> float:
+        r"""Rounding level of :math:`F_u`: :math:`100\,\epsilon\,(|A| + \lambda|B|)|u|`.
+
+        The largest entry; on thin plates it lies far above :math:`\epsilon |Au|`.
+        """
+        u.copy(self._trial)
+        self._trial.abs()
+        self._abs_A.mult(self._trial, self._rhs)
+        self._rhs.abs()
+        self._abs_B.mult(self._trial, self._y1)
+        self._rhs.axpy(lam, self._y1)
+        eps = float(np.finfo(float).eps)
+        return 100.0 * eps * float(self._rhs.norm(PETSc.NormType.INFINITY))
 
     def _line_search(
         self,
@@ -689,10 +714,8 @@ class InteriorPointNewton(Owner):
 
     def destroy(self) -> None:
         """Destroy the matrix, its factorisation and the work vectors (collective)."""
-        release(
-            self, "ksp", "K", "_diag_A", "_diag", "_Au", "_Bu", "_Fu", "_y1", "_y2", "_rhs",
-            "_du", "_trial",
-        )  # fmt: skip
+        release(self, "ksp", "K", "_abs_A", "_abs_B", "_diag_A", "_diag")
+        release(self, "_Au", "_Bu", "_Fu", "_y1", "_y2", "_rhs", "_du", "_trial")
 
     def __del__(self) -> None:
         self.destroy()
