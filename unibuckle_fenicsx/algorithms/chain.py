@@ -42,6 +42,7 @@ import numpy as np
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
+from unibuckle_fenicsx.algorithms.descent import descend
 from unibuckle_fenicsx.algorithms.interior_point import (
     BarrierPoint,
     InteriorPointNewton,
@@ -79,6 +80,7 @@ class ChainOptions:
             (relative) lead to the same arrangement.
         level_mu: Barrier parameter of the central-path point carried from one mesh to
             the next.
+        flat_mu: ... and of the second try when the first ends at no KKT point.
         fine_mu_min: ... and the fine mesh, before its contact set is read.
         last_mu_min: ... once more when that contact set is not a KKT point.
         clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes.
@@ -87,6 +89,9 @@ class ChainOptions:
         escape_mu: Barrier parameter the run restarts with after an escape (small: a
             larger one would lift the flattened buckle again).
         polish_iterations: Active-set iterates allowed to polish a contact set.
+        quick_polish_iterations: ... on the first try of the fine mesh.
+        descent_steps: Eigen solves allowed to the feasible descent after a polish that
+            ends at an admissible mode short of a KKT point.
         max_iterations: Iterates per seed of the fallback active-set method.
         bound_budget: Eigen solves of the lattice lower bound (small zones).
     """
@@ -97,6 +102,7 @@ class ChainOptions:
     explore_mu_min: float = 1e-14
     twin_rtol: float = 1e-7
     level_mu: float = 1e-6
+    flat_mu: float = 1e-10
     fine_mu_min: float = 1e-14
     last_mu_min: float = 1e-14
     clip_margin: float = 1e-6
@@ -104,6 +110,8 @@ class ChainOptions:
     escapes: int = 3
     escape_mu: float = 1e-10
     polish_iterations: int = 25
+    quick_polish_iterations: int = 5
+    descent_steps: int = 50
     max_iterations: int = 100
     bound_budget: int = 64
 
@@ -294,6 +302,31 @@ def _polish(
     return final
 
 
+def _descend(
+    problem: BucklingProblem, start: Candidate, level: LevelRecord, label: str, budget: int
+) -> Candidate:
+    """Feasible descent (:mod:`.descent`) from the admissible ``start``: it cannot cycle."""
+    t0 = time.perf_counter()
+    solves0 = problem.eigensolver.solves
+    run, _ = descend(problem, start, budget)
+    final = run.final if run.status == "kkt" else run.best_feasible
+    assert final is not None
+    level.links.append(
+        LinkRecord(
+            "feasible descent",
+            label,
+            run.status,
+            steps=run.iterations,
+            eigensolves=problem.eigensolver.solves - solves0,
+            seconds=time.perf_counter() - t0,
+            load=final.load,
+            contact_nodes=len(final.active),
+            kkt=final.kkt,
+        )
+    )
+    return final
+
+
 def _critical_state(
     problem: BucklingProblem,
     newton: InteriorPointNewton,
@@ -302,16 +335,18 @@ def _critical_state(
     label: str,
     options: ChainOptions,
     carry: bool = True,
+    quick: bool = False,
 ) -> tuple[Candidate | None, BarrierPoint]:
     """Read the contact set off ``point``; escape a saddle, drive the barrier lower, polish.
 
     Returns the KKT point (or None) and the barrier point it belongs to (recomputed
-    after a polish only when ``carry``: it goes on to a finer mesh).
+    after a polish only when ``carry``: it goes on to a finer mesh). ``quick``: no
+    escapes, a short polish and no descent (a second try follows).
     """
     cand = _read_contact(problem, newton, point, level, label)
     if cand.kkt:
         return cand, point
-    for attempt in range(options.escapes):
+    for attempt in range(0 if quick else options.escapes):
         saddle = not cand.feasible and cand.load < point.load * (1.0 - 1e-9)
         if not (saddle and newton.escape(point, cand.mode.x.petsc_vec)):
             break
@@ -330,7 +365,10 @@ def _critical_state(
         if cand.kkt:
             return cand, point
     if math.isfinite(cand.load):
-        polished = _polish(problem, cand, level, label, options.polish_iterations)
+        budget = options.quick_polish_iterations if quick else options.polish_iterations
+        polished = _polish(problem, cand, level, label, budget)
+        if polished is not None and polished.feasible and not polished.kkt and not quick:
+            polished = _descend(problem, polished, level, label, options.descent_steps)
         if polished is not None and polished.kkt and not carry:
             return polished, point
         if polished is not None and polished.kkt:
@@ -346,8 +384,11 @@ def _critical_state(
 
 def _explore(
     problem: BucklingProblem, level: LevelRecord, options: ChainOptions
-) -> tuple[list[Candidate], BarrierPoint | None, Candidate | None]:
-    """Run the starts on ``problem``: its KKT points, and the best one's barrier point.
+) -> tuple[list[Candidate], tuple[BarrierPoint, BarrierPoint] | None, Candidate | None]:
+    """Run the starts on ``problem``: its KKT points, and the best one's barrier points.
+
+    The best one's barrier point is returned on the central path at ``level_mu`` and at
+    ``flat_mu`` (see :func:`_ascend`).
 
     A start whose barrier solution at ``compare_mu`` has the load of one met before
     (relative ``twin_rtol``) leads to the same arrangement and is not taken further.
@@ -384,8 +425,9 @@ def _explore(
             return [], None, None
         found.sort(key=lambda cp: cp[0].load)
         best, point = found[0]
-        point = _central(newton, point, level, options, "best, lifted")
-    return [c for c, _ in found], point, best
+        flat = _central(newton, point, level, options, "best, kept flat", options.flat_mu)
+        point = _central(newton, point, level, options, "best, lifted", options.level_mu)
+    return [c for c, _ in found], (point, flat), best
 
 
 def _central(
@@ -394,15 +436,18 @@ def _central(
     level: LevelRecord,
     options: ChainOptions,
     label: str,
+    mu: float,
 ) -> BarrierPoint:
-    r"""The point of the central path at ``level_mu`` near ``point`` (what is carried up).
+    r"""The point of the central path at ``mu`` near ``point`` (what is carried up).
 
     On the central path the push is :math:`\mu/g` node by node, so a finer mesh can
-    start from the interpolated mode alone, at the same barrier parameter.
+    start from the interpolated mode alone, at the same barrier parameter. The mode is
+    copied: ``point`` is left as it was.
     """
-    lifted, _ = _run(
-        newton, point, level, label, options, mu=options.level_mu, mu_min=options.level_mu
-    )
+    start = BarrierPoint(newton.problem.new_mode("central"), point.load, point.push, point.mu)
+    point.mode.x.petsc_vec.copy(start.mode.x.petsc_vec)
+    start.mode.x.scatter_forward()
+    lifted, _ = _run(newton, start, level, label, options, mu=mu, mu_min=mu)
     return lifted
 
 
@@ -413,21 +458,28 @@ def _refine(
     level: LevelRecord,
     options: ChainOptions,
     last: bool,
+    mu: float,
+    label: str = "prolonged",
+    quick: bool = False,
 ) -> tuple[Candidate | None, BarrierPoint | None]:
-    """Carry ``point`` from ``coarse`` to ``fine`` and solve the barrier problem there."""
-    label = "prolonged"
+    """Carry ``point`` from ``coarse`` to ``fine`` and solve the barrier problem there.
+
+    The interpolated mode is relaxed into the fine mesh's discrete Kirchhoff kernel
+    (:meth:`~.interior_point.InteriorPointNewton.relax`), then the method runs from
+    the barrier parameter ``mu``: to ``mu`` on an intermediate mesh, to ``fine_mu_min``
+    on the fine one, whose critical state is read.
+    """
     carry = Prolongation(coarse, fine)
     mode = carry.mode(point.mode)
     with InteriorPointNewton(fine) as newton:
         try:
             newton.relax(mode.x.petsc_vec, "deflection")
-            if newton.clip(mode, options.clip_margin):
-                pass
+            newton.clip(mode, options.clip_margin)
             newton.relax(mode.x.petsc_vec, "rotations")
             new, rec = newton.solve(
                 mode,
-                mu=options.level_mu,
-                mu_min=options.fine_mu_min if last else options.level_mu,
+                mu=mu,
+                mu_min=options.fine_mu_min if last else mu,
                 max_steps=options.max_steps,
             )
         except (ValueError, FloatingPointError) as err:
@@ -436,8 +488,78 @@ def _refine(
         level.links.append(_newton_link(label, rec))
         if not last:
             return None, new
-        cand, new = _critical_state(fine, newton, new, level, label, options, carry=False)
+        cand, new = _critical_state(
+            fine, newton, new, level, label, options, carry=False, quick=quick
+        )
         return cand, new
+
+
+def _level_record(problem: BucklingProblem) -> LevelRecord:
+    spec = problem.spec
+    mesh: list[Any] = [spec.mesh.nx, spec.mesh.ny] if problem.structured else ["fine"]
+    return LevelRecord(mesh, problem.num_constrained)
+
+
+def _report(problem: BucklingProblem, level: LevelRecord) -> None:
+    if problem.comm.rank == 0:
+        PROGRESS.info(
+            "interior point, mesh %s (i = %d): %d Newton steps, %d factorisations, "
+            "%d eigen solves, %.2f s",
+            "x".join(map(str, level.mesh)), level.constrained_nodes, level.newton_steps,
+            level.factorizations, level.eigensolves, level.seconds,
+        )  # fmt: skip
+
+
+def _ascend(
+    problems: list[BucklingProblem],
+    point: BarrierPoint,
+    levels: list[LevelRecord],
+    options: ChainOptions,
+    mu: float,
+    label: str,
+    quick: bool,
+) -> Candidate | None:
+    """Carry ``point`` from ``problems[0]`` up to the fine mesh at barrier parameter ``mu``."""
+    current: BarrierPoint | None = point
+    for k in range(1, len(problems)):
+        tl = time.perf_counter()
+        level = levels[k]
+        last = k == len(problems) - 1
+        assert current is not None
+        cand, current = _refine(
+            problems[k - 1], problems[k], current, level, options, last, mu, label, quick
+        )
+        level.seconds += time.perf_counter() - tl
+        _report(problems[k], level)
+        if current is None:
+            return None
+        if last:
+            return cand
+    return None
+
+
+def _levels(
+    problems: list[BucklingProblem], options: ChainOptions
+) -> tuple[list[LevelRecord], list[Candidate], Candidate | None]:
+    """Explore the coarsest mesh and carry its best critical state up to the finest.
+
+    The state is carried on the central path at ``level_mu``, where the contact lines
+    still move freely. If the fine mesh then ends at no KKT point (typically at a saddle
+    where buckles that the barrier keeps apart have almost equal loads), it is carried
+    once more at ``flat_mu``, which keeps the parts lying on the obstacle flat.
+    """
+    levels = [_level_record(p) for p in problems]
+    tl = time.perf_counter()
+    explored, points, best = _explore(problems[0], levels[0], options)
+    levels[0].seconds = time.perf_counter() - tl
+    _report(problems[0], levels[0])
+    if len(problems) == 1 or points is None:
+        return levels, explored, best
+    point, flat = points
+    chosen = _ascend(problems, point, levels, options, options.level_mu, "prolonged", True)
+    if chosen is None or not chosen.kkt:
+        chosen = _ascend(problems, flat, levels, options, options.flat_mu, "prolonged flat", False)
+    return levels, explored, chosen
 
 
 def _fallback(problem: BucklingProblem, options: ChainOptions) -> UnilateralSolution:
@@ -479,54 +601,19 @@ def solve_unilateral(
         if problem.structured
         else []
     )
-    levels: list[LevelRecord] = []
-    other_solves = 0
-    prev: BucklingProblem | None = None
-    point: BarrierPoint | None = None
-    chosen: Candidate | None = None
-    explored: list[Candidate] = []
-    for k, nx_ny in enumerate([*meshes, None]):
-        tl = time.perf_counter()
-        last = nx_ny is None
+    problems: list[BucklingProblem] = []
+    for nx, ny in meshes:
         try:
-            current = (
-                problem if nx_ny is None else BucklingProblem(spec.with_mesh(*nx_ny), problem.comm)
-            )
+            problems.append(BucklingProblem(spec.with_mesh(nx, ny), problem.comm))
         except EmptyZoneError:
             continue
-        if nx_ny is not None:
-            mesh: list[Any] = list(nx_ny)
-        else:
-            mesh = [spec.mesh.nx, spec.mesh.ny] if problem.structured else ["fine"]
-        level = LevelRecord(mesh, current.num_constrained)
-        levels.append(level)
-        if point is None:
-            explored, point, best = _explore(current, level, options)
-            if last:
-                chosen = best
-        else:
-            assert prev is not None
-            cand, new = _refine(prev, current, point, level, options, last)
-            point = new
-            if last:
-                chosen = cand
-        level.seconds = time.perf_counter() - tl
-        if current is not problem:
-            other_solves += current.eigensolver.solves
-        if problem.comm.rank == 0:
-            PROGRESS.info(
-                "interior point, mesh %s (i = %d): %d Newton steps, %d factorisations, "
-                "%d eigen solves, %.2f s",
-                "x".join(map(str, level.mesh)), level.constrained_nodes, level.newton_steps,
-                level.factorizations, level.eigensolves, level.seconds,
-            )  # fmt: skip
-        if prev is not None and prev is not problem:
-            prev.destroy()
-        prev = current
-        if point is None and not last:
-            break  # nothing to carry: the fallback runs on the fine mesh
-    if prev is not None and prev is not problem:
-        prev.destroy()
+    problems.append(problem)
+    try:
+        levels, explored, chosen = _levels(problems, options)
+    finally:
+        other_solves = sum(p.eigensolver.solves for p in problems[:-1])
+        for p in problems[:-1]:
+            p.destroy()
 
     if chosen is None or not chosen.kkt:
         logger.warning("interior point: no KKT point on the fine mesh; the active-set chain runs")
@@ -539,8 +626,9 @@ def solve_unilateral(
     closed = bracket(problem, free_load, chosen, options.bound_budget, "interior-point")
     chosen, lower, proven = closed.chosen, closed.lower, closed.proven
     route = "interior-point"
-    if any(r.link == "active-set polish" and r.kkt for r in levels[-1].links):
-        route += " + active-set polish"
+    for link in ("active-set polish", "feasible descent"):
+        if any(r.link == link and r.kkt for r in levels[-1].links):
+            route += f" + {link}"
     details: dict[str, Any] = {
         "free_load": free_load,
         "route": route,
