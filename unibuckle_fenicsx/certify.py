@@ -16,9 +16,8 @@ bound; interlacing, the lattice search and exhaustive enumeration give lower bou
 :mod:`unibuckle_fenicsx.copositivity` proves one just below a KKT point's load when
 :math:`A - \lambda B` is copositive on the cone there (a rank-2 certificate that costs one
 sparse :math:`LDL^T`, or a semidefinite program for small i). The result is *proven*
-globally optimal when the verified bracket closes to :data:`PROOF_GAP`. When it is proven,
-the smallest-eigenvalue check is not run (the proof says more: no admissible mode at all
-has a lower load).
+globally optimal when the verified bracket closes to :data:`PROOF_GAP`. The
+smallest-eigenvalue check runs on every route, proven or not.
 
 Every check here is collective on the problem's communicator.
 """
@@ -66,12 +65,14 @@ class Certificate:
         feasibility_margin: :math:`\max_{I \setminus Z} u_k / \max|w|` (negative: strictly
             below the obstacle; ``-inf`` when Z = I).
         max_contact_force: :math:`\max_Z r_k / \|Au\|_\infty` (``-inf`` when Z is empty).
+        max_contact_value: :math:`\max_Z |u_k| / \max|w|` (0 for an eigenvector of the
+            reduced pencil; checked, not assumed).
         relative_residual: :math:`\|r\ \text{off}\ Z\|_2 / \|Au\|_2`.
         tolerance: :math:`\tau`.
         kkt: Feasible, forces at most :math:`\tau`, residual at most :math:`\sqrt\tau`.
         smallest_of_reduced: :math:`\lambda` is the smallest eigenvalue of the reduced
-            pencil (inertia check); ``None`` when not checked (the global proof makes
-            it moot, or certification is off).
+            pencil (inertia check, on every route); ``None`` when not checked
+            (certification off, or a mode not computed by an eigen solve).
         lower_bound: Verified lower bound on the critical load.
         upper_bound: Load of an admissible mode (``inf`` if the mode is not admissible).
         relative_gap: (upper - lower) / upper.
@@ -98,6 +99,7 @@ class Certificate:
     proven_by: str
     copositivity: dict[str, Any] | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
+    max_contact_value: float = 0.0
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready mapping."""
@@ -105,6 +107,7 @@ class Certificate:
             "feasible": self.feasible,
             "feasibility_margin": self.feasibility_margin,
             "max_contact_force": self.max_contact_force,
+            "max_contact_value": self.max_contact_value,
             "relative_residual": self.relative_residual,
             "tolerance": self.tolerance,
             "kkt": self.kkt,
@@ -192,7 +195,14 @@ def certify(
     if not math.isfinite(cand.load):
         raise ValueError("certify: the candidate has no finite load")
     residual = _residual_off_contact(problem, cand)
-    kkt = cand.feasible and cand.max_force <= tau and residual <= math.sqrt(tau)
+    # The mode must vanish on Z (checked, not assumed: a mode from elsewhere than an
+    # eigen solve of the reduced pencil need not).
+    on_contact = float(np.abs(cand.values[cand.active]).max(initial=0.0))
+    kkt = (
+        cand.feasible and cand.max_force <= tau and residual <= math.sqrt(tau) and on_contact <= tau
+    )
+    if on_contact > tau:
+        notes.append(f"the mode does not vanish on the contact set (max |u_Z| = {on_contact:.3g})")
     # Only the eigenvalue of a reduced pencil whose mode is admissible bounds the critical
     # load from above (a penalised quotient lies below it).
     upper = solution.upper_bound
@@ -221,9 +231,7 @@ def certify(
     gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
     proven = bool(kkt and gap <= PROOF_GAP and (algorithm_proof or proven_by != "interlacing"))
     smallest: bool | None = None
-    if proven:
-        pass  # the global bound says more than the reduced pencil's inertia would
-    elif check_smallest and global_bound and cand.eigen is not None:
+    if check_smallest and global_bound and cand.eigen is not None:
         sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
         neg, _, _ = reduced_inertia(problem, cand.active, sigma)
         smallest = neg == 0
@@ -238,6 +246,7 @@ def certify(
         feasible=cand.feasible,
         feasibility_margin=cand.margin,
         max_contact_force=cand.max_force,
+        max_contact_value=on_contact,
         relative_residual=residual,
         tolerance=tau,
         kkt=bool(kkt),
