@@ -17,6 +17,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from unibuckle_fenicsx.algorithms.descent import descend
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 
 __all__ = ["PROOF_RTOL", "Bracket", "bracket", "lattice_bound"]
@@ -111,6 +112,13 @@ def bracket(
             f"the lattice search found a lower feasible load {better.load:.10g} than the "
             f"{route} critical state {chosen.load:.10g}"
         )
+        if not better.kkt:
+            # An admissible mode, not yet a critical state: the feasible descent (it
+            # cannot cycle, and R does not increase) takes it to one.
+            run, _ = descend(problem, better, max(10 * problem.num_constrained, 50))
+            if run.final is not None and run.status == "kkt":
+                better = run.final
+            evaluations += run.iterations
         chosen = better
     lower = max(lower, free_load)
     proven = bool(lower >= chosen.load * (1 - PROOF_RTOL))

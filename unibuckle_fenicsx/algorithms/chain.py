@@ -88,6 +88,9 @@ class ChainOptions:
         escapes: Saddle escapes allowed per run.
         escape_mu: Barrier parameter the run restarts with after an escape (small: a
             larger one would lift the flattened buckle again).
+        refine_margin: Critical states within this (relative) of the lowest on a mesh
+            are carried to the next.
+        arrangements: ... at most this many.
         polish_iterations: Active-set iterates allowed to polish a contact set.
         quick_polish_iterations: ... on the first try of the fine mesh.
         descent_steps: Eigen solves allowed to the feasible descent after a polish that
@@ -109,6 +112,8 @@ class ChainOptions:
     max_steps: int = 100
     escapes: int = 3
     escape_mu: float = 1e-10
+    refine_margin: float = 2e-3
+    arrangements: int = 3
     polish_iterations: int = 25
     quick_polish_iterations: int = 5
     descent_steps: int = 50
@@ -382,13 +387,23 @@ def _critical_state(
     return None, point
 
 
+@dataclass
+class _Arrangement:
+    """A critical state being carried up the meshes: its barrier points and load."""
+
+    load: float
+    point: BarrierPoint  # on the central path at level_mu
+    flat: BarrierPoint  # on the coarsest mesh, at flat_mu
+
+
 def _explore(
     problem: BucklingProblem, level: LevelRecord, options: ChainOptions
-) -> tuple[list[Candidate], tuple[BarrierPoint, BarrierPoint] | None, Candidate | None]:
-    """Run the starts on ``problem``: its KKT points, and the best one's barrier points.
+) -> tuple[list[Candidate], list[_Arrangement]]:
+    """Run the starts on ``problem``: its KKT points, and the arrangements to carry up.
 
-    The best one's barrier point is returned on the central path at ``level_mu`` and at
-    ``flat_mu`` (see :func:`_ascend`).
+    The distinct KKT points within ``refine_margin`` of the lowest (at most
+    ``arrangements``) are carried, each as its barrier point on the central path at
+    ``level_mu`` and at ``flat_mu`` (see :func:`_levels`).
 
     A start whose barrier solution at ``compare_mu`` has the load of one met before
     (relative ``twin_rtol``) leads to the same arrangement and is not taken further.
@@ -421,13 +436,18 @@ def _explore(
             cand, point = _critical_state(problem, newton, point, level, seed, options)
             if cand is not None:
                 found.append((cand, point))
-        if not found:
-            return [], None, None
         found.sort(key=lambda cp: cp[0].load)
-        best, point = found[0]
-        flat = _central(newton, point, level, options, "best, kept flat", options.flat_mu)
-        point = _central(newton, point, level, options, "best, lifted", options.level_mu)
-    return [c for c, _ in found], (point, flat), best
+        carried: list[_Arrangement] = []
+        for cand, point in found:
+            far = cand.load > found[0][0].load * (1.0 + options.refine_margin)
+            twin = any(abs(cand.load - a.load) <= options.twin_rtol * a.load for a in carried)
+            if far or twin or len(carried) == options.arrangements:
+                continue
+            tag = f"{cand.load:.10g}"
+            flat = _central(newton, point, level, options, f"{tag}, kept flat", options.flat_mu)
+            lifted = _central(newton, point, level, options, f"{tag}, lifted", options.level_mu)
+            carried.append(_Arrangement(cand.load, lifted, flat))
+    return [c for c, _ in found], carried
 
 
 def _central(
@@ -510,54 +530,83 @@ def _report(problem: BucklingProblem, level: LevelRecord) -> None:
         )  # fmt: skip
 
 
+def _carry(
+    problems: list[BucklingProblem],
+    k: int,
+    points: list[BarrierPoint],
+    level: LevelRecord,
+    options: ChainOptions,
+    mu: float,
+    label: str,
+    quick: bool,
+) -> tuple[list[Candidate], list[BarrierPoint]]:
+    """Carry every point from ``problems[k - 1]`` to ``problems[k]``.
+
+    On an intermediate mesh the points whose loads lie more than ``refine_margin`` above
+    the lowest are dropped (the meshes rank the arrangements better as they get finer);
+    on the finest, the KKT points met are returned.
+    """
+    tl = time.perf_counter()
+    last = k == len(problems) - 1
+    found: list[Candidate] = []
+    carried: list[BarrierPoint] = []
+    for j, point in enumerate(points):
+        tag = label if len(points) == 1 else f"{label} {j + 1}"
+        cand, new = _refine(
+            problems[k - 1], problems[k], point, level, options, last, mu, tag, quick
+        )
+        if cand is not None and cand.kkt:
+            found.append(cand)
+        if new is not None and not last:
+            carried.append(new)
+    if carried:
+        lowest = min(p.load for p in carried)
+        carried = [p for p in carried if p.load <= lowest * (1.0 + options.refine_margin)]
+    level.seconds += time.perf_counter() - tl
+    _report(problems[k], level)
+    return found, carried
+
+
 def _ascend(
     problems: list[BucklingProblem],
-    point: BarrierPoint,
+    points: list[BarrierPoint],
     levels: list[LevelRecord],
     options: ChainOptions,
     mu: float,
     label: str,
     quick: bool,
 ) -> Candidate | None:
-    """Carry ``point`` from ``problems[0]`` up to the fine mesh at barrier parameter ``mu``."""
-    current: BarrierPoint | None = point
+    """Carry ``points`` from ``problems[0]`` to the fine mesh; the lowest KKT point there."""
     for k in range(1, len(problems)):
-        tl = time.perf_counter()
-        level = levels[k]
-        last = k == len(problems) - 1
-        assert current is not None
-        cand, current = _refine(
-            problems[k - 1], problems[k], current, level, options, last, mu, label, quick
-        )
-        level.seconds += time.perf_counter() - tl
-        _report(problems[k], level)
-        if current is None:
+        found, points = _carry(problems, k, points, levels[k], options, mu, label, quick)
+        if k == len(problems) - 1:
+            return min(found, key=lambda c: c.load) if found else None
+        if not points:
             return None
-        if last:
-            return cand
     return None
 
 
 def _levels(
     problems: list[BucklingProblem], options: ChainOptions
 ) -> tuple[list[LevelRecord], list[Candidate], Candidate | None]:
-    """Explore the coarsest mesh and carry its best critical state up to the finest.
+    """Explore the coarsest mesh and carry its best critical states up to the finest.
 
-    The state is carried on the central path at ``level_mu``, where the contact lines
+    The states are carried on the central path at ``level_mu``, where the contact lines
     still move freely. If the fine mesh then ends at no KKT point (typically at a saddle
-    where buckles that the barrier keeps apart have almost equal loads), it is carried
-    once more at ``flat_mu``, which keeps the parts lying on the obstacle flat.
+    where buckles that the barrier keeps apart have almost equal loads), the lowest is
+    carried once more at ``flat_mu``, which keeps the parts lying on the obstacle flat.
     """
     levels = [_level_record(p) for p in problems]
     tl = time.perf_counter()
-    explored, points, best = _explore(problems[0], levels[0], options)
+    explored, carried = _explore(problems[0], levels[0], options)
     levels[0].seconds = time.perf_counter() - tl
     _report(problems[0], levels[0])
-    if len(problems) == 1 or points is None:
-        return levels, explored, best
-    point, flat = points
-    chosen = _ascend(problems, point, levels, options, options.level_mu, "prolonged", True)
-    if chosen is None or not chosen.kkt:
+    if len(problems) == 1 or not carried:
+        return levels, explored, (explored[0] if explored else None)
+    points = [a.point for a in carried]
+    chosen = _ascend(problems, points, levels, options, options.level_mu, "prolonged", True)
+    if chosen is None:
+        flat = [carried[0].flat]
         chosen = _ascend(problems, flat, levels, options, options.flat_mu, "prolonged flat", False)
     return levels, explored, chosen
 
