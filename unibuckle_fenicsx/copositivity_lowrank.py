@@ -57,7 +57,6 @@ from __future__ import annotations
 
 import math
 import time
-import warnings
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -153,8 +152,8 @@ class AccurateResidual:
         self.terms = int(comm.allreduce(length, op=MPI.MAX)) + 1
         x = K.createVecRight()
         self._local = PETSc.Vec().createSeq(len(needed), comm=PETSc.COMM_SELF)
-        index = PETSc.IS().createGeneral(needed.astype(PETSc.IntType), comm=PETSc.COMM_SELF)
-        self._scatter = PETSc.Scatter().create(x, index, self._local, None)
+        index = PETSc.IS().createGeneral(needed.astype(PETSc.IntType), comm=PETSc.COMM_SELF)  # type: ignore[arg-type]
+        self._scatter = PETSc.Scatter().create(x, index, self._local, None)  # type: ignore[arg-type]
         index.destroy()
         x.destroy()
 
@@ -162,7 +161,10 @@ class AccurateResidual:
         out = np.empty((self._local.getSize(), len(xs)))
         for j, x in enumerate(xs):
             self._scatter.scatter(
-                x, self._local, PETSc.InsertMode.INSERT, PETSc.ScatterMode.FORWARD
+                x,
+                self._local,
+                PETSc.InsertMode.INSERT,  # type: ignore[arg-type]
+                PETSc.ScatterMode.FORWARD,  # type: ignore[arg-type]
             )
             out[:, j] = self._local.array_r
         return out
@@ -212,7 +214,7 @@ class AccurateResidual:
         # computed sum of |terms| is itself rounded (a factor 1 + gamma_n covers it).
         m = self.terms
         err = (U * np.abs(rho) + _gamma(m) ** 2 * total * (1 + _gamma(m + 1))) / (1.0 - U)
-        return rho, err
+        return np.asarray(rho, dtype=np.float64), np.asarray(err, dtype=np.float64)
 
     def destroy(self) -> None:
         """Destroy the scatter and its work vector."""
@@ -237,6 +239,19 @@ class LowRankOptions:
         max_columns: Columns of U at most.
         max_cuts: Cuts (new columns from a negative direction of S) per delta.
         max_pieces: Simplicial pieces of the orthant per delta.
+        time_budget: Wall time allowed, in free eigen solves
+            (``problem.timings["free_solve_s"]``; None: no limit). Checked between
+            pieces and cuts, by all ranks together; the search then stops with what is
+            verified.
+        min_time_s: ... but at least this many seconds (on coarse meshes the dense
+            programs, not the solves, set the time).
+        mode_iterations: Block inverse iterations for the pencil-mode columns (used when
+            the first columns see fewer than m negative directions).
+        unit_cuts: When a cut's positive part cannot be added, the unit vectors of up to
+            this many of its most violated nodes are tried instead.
+        unit_columns: With at most this many constrained nodes, U = I (their unit vectors).
+        prune_condition: Older columns that leave the scaled G's condition number above
+            this are dropped (0: never); an ill-conditioned S defeats the SDP.
         near: A piece whose minimum (scaled to a unit diagonal) lies below this is first
             tightened by a cut at its minimiser, if that mode is not admissible.
         refinements: Refinement steps of each solve (double-double residuals).
@@ -247,8 +262,8 @@ class LowRankOptions:
             number stays below ``max_condition`` (the SDP solver's accuracy).
     """
 
-    deltas: tuple[float, ...] = (1e-3, 1e-4, 1e-5, 1e-6)
-    fallback: tuple[float, ...] = (1e-2,)
+    deltas: tuple[float, ...] = (1e-4, 1e-5, 1e-6)
+    fallback: tuple[float, ...] = (1e-3, 1e-2)
     max_columns: int = 48
     max_cuts: int = 24
     max_pieces: int = 64
@@ -257,6 +272,12 @@ class LowRankOptions:
     select_margin: float = 8.0
     max_condition: float = 1e12
     near: float = 1e-4
+    prune_condition: float = 1e6
+    mode_iterations: int = 3
+    unit_cuts: int = 4
+    unit_columns: int = 24
+    time_budget: float | None = 5.0
+    min_time_s: float = 2.0
 
 
 @dataclass
@@ -288,6 +309,14 @@ class LowRankOutcome:
     why: str = ""
     refuting: dict[str, Any] | None = None
     solves: int = 0
+    _deadline: tuple[float, MPI.Comm] | None = None
+
+    def out_of_time(self) -> bool:
+        """Past the time budget, by the slowest rank's clock (collective)."""
+        if self._deadline is None:
+            return False
+        end, comm = self._deadline
+        return bool(comm.allreduce(time.perf_counter() > end, op=MPI.LOR))
 
     def record(self) -> dict[str, Any]:
         """JSON-ready summary (without the refuting mode's vector)."""
@@ -319,6 +348,7 @@ class _Columns:
         self.xI: list[npt.NDArray[np.float64]] = []
         self.d_norm: list[float] = []
         self._G: dict[tuple[int, int], tuple[float, float]] = {}
+        self.dropped: set[int] = set()
         self.comm = problem.comm
 
     @property
@@ -338,7 +368,9 @@ class _Columns:
             if not top > 0.0 or len(self.values) + len(new) >= self.max_columns:
                 continue
             v = v / top
-            if any(float(np.abs(o - v).max()) <= 1e-6 for o in [*self.values, *(q for _, q in new)]):
+            if any(
+                float(np.abs(o - v).max()) <= 1e-6 for o in [*self.values, *(q for _, q in new)]
+            ):
                 continue
             new.append((name, v))
         if not new:
@@ -382,8 +414,12 @@ class _Columns:
         xa = self.x[a].array_r
         rb, eb = self.rho[b], self.err[b]
         local = np.array(
-            [float(xa @ rb), float(np.abs(xa) @ np.abs(rb)), float(np.abs(xa) @ eb),
-             float((np.abs(rb) + eb) @ (np.abs(rb) + eb))]  # fmt: skip
+            [
+                float(xa @ rb),
+                float(np.abs(xa) @ np.abs(rb)),
+                float(np.abs(xa) @ eb),
+                float((np.abs(rb) + eb) @ (np.abs(rb) + eb)),
+            ]
         )
         t2, abs2, ea, rb2 = self.comm.allreduce(local, op=MPI.SUM)
         n = self.x[a].getSize()
@@ -410,6 +446,13 @@ class _Columns:
                 G[i, j], E[i, j] = self._entry(a, use[j])
                 G[j, i], E[j, i] = G[i, j], E[i, j]
         return G, E
+
+    def gram_negative(self, opts: LowRankOptions) -> int:
+        """Negative eigenvalues of the scaled G of the well-conditioned columns."""
+        use = _select(self, [], opts)
+        G, E = self.gram(use)
+        dg = 1.0 / _pow2(np.sqrt(np.maximum(np.abs(np.diag(G)), np.diag(E))))
+        return int((np.linalg.eigvalsh(G * dg[:, None] * dg[None, :]) < 0).sum())
 
     def combination(self, coef: npt.NDArray[np.float64]) -> PETSc.Vec:
         """sum_a coef_a x_a (a new vector; the caller destroys it)."""
@@ -477,13 +520,9 @@ def _spn(P: npt.NDArray[np.float64]) -> tuple[float, npt.NDArray[np.float64], An
     diag = ii == jj
     scale = np.where(diag, 1.0, math.sqrt(2.0))
     pair = {(int(a), int(b)): q for q, (a, b) in enumerate(zip(iu, ju, strict=True))}
-    rows, cols, vals = [], [], []
-    for row in range(k):
-        if diag[row]:
-            rows.append(row), cols.append(0), vals.append(1.0)  # t on the diagonal
-        else:
-            rows.append(row), cols.append(1 + pair[(int(ii[row]), int(jj[row]))])
-            vals.append(scale[row])
+    # t on the diagonal, N_ab (scaled) off it
+    cols = [0 if diag[row] else 1 + pair[(int(ii[row]), int(jj[row]))] for row in range(k)]
+    rows, vals = list(range(k)), scale.tolist()
     A_psd = sp.csc_matrix((vals, (rows, cols)), shape=(k, 1 + p))
     A_nn = sp.hstack([sp.csc_matrix((p, 1)), -sp.identity(p, format="csc")])
     A_t = sp.csc_matrix(([1.0], ([0], [0])), shape=(1, 1 + p))
@@ -552,6 +591,41 @@ def _starts(P: npt.NDArray[np.float64], dual: Any) -> list[npt.NDArray[np.float6
     return out
 
 
+def _conditioning(cols: _Columns, use: list[int]) -> tuple[float, npt.NDArray[np.float64]]:
+    """(min|eig| / max|eig| of the scaled G of ``use``, the eigenvector of min|eig|)."""
+    G, E = cols.gram(use)
+    dg = 1.0 / _pow2(np.sqrt(np.maximum(np.abs(np.diag(G)), np.diag(E))))
+    w, V = np.linalg.eigh(G * dg[:, None] * dg[None, :])
+    k = int(np.argmin(np.abs(w)))
+    return float(abs(w[k]) / np.abs(w).max()), V[:, k]
+
+
+def _prune(cols: _Columns, use: list[int], opts: LowRankOptions) -> list[int]:
+    """Drop older columns that nearly repeat newer ones (in the K^-1 metric).
+
+    While the scaled G's condition number exceeds ``prune_condition``, the column of the
+    smallest eigenvector's support (not the first) whose removal helps most is dropped,
+    if that improves the conditioning tenfold. Ill-conditioned S defeats the SDP.
+    """
+    out = list(use)
+    while len(out) > 2:
+        ratio, v = _conditioning(cols, out)
+        if ratio * opts.prune_condition >= 1.0:
+            break
+        best: tuple[float, int] | None = None
+        for pos in np.flatnonzero(np.abs(v) > 0.1):
+            if pos == 0:
+                continue
+            trial = out[:pos] + out[pos + 1 :]
+            r_trial, _ = _conditioning(cols, trial)
+            if best is None or r_trial > best[0]:
+                best = (r_trial, int(pos))
+        if best is None or best[0] < 10 * ratio:
+            break
+        cols.dropped.add(out.pop(best[1]))
+    return out
+
+
 def _select(cols: _Columns, use: list[int], opts: LowRankOptions) -> list[int]:
     """``use`` and then each further column in turn, kept if G stays well conditioned.
 
@@ -560,7 +634,7 @@ def _select(cols: _Columns, use: list[int], opts: LowRankOptions) -> list[int]:
     """
     out = list(use)
     for a in range(cols.r):
-        if a in out:
+        if a in out or a in cols.dropped:
             continue
         trial = [*out, a]
         G, E = cols.gram(trial)
@@ -570,7 +644,7 @@ def _select(cols: _Columns, use: list[int], opts: LowRankOptions) -> list[int]:
         eig = np.abs(np.linalg.eigvalsh(Gs))
         if margin > opts.select_margin and eig.min() * opts.max_condition > eig.max():
             out.append(a)
-    return out
+    return _prune(cols, out, opts) if opts.prune_condition else out
 
 
 def _pow2(d: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
@@ -649,6 +723,7 @@ def _orthant(
     opts: LowRankOptions,
     stats: dict[str, Any],
     near: float,
+    out_of_time: Any,
 ) -> tuple[bool, npt.NDArray[np.float64] | None]:
     """Copositivity of S = Gs^-1 on the orthant, piece by piece.
 
@@ -686,13 +761,62 @@ def _orthant(
         stats["f"] = f
         if f < near:
             return False, Vn @ z
-        if done + len(queue) + 2 > opts.max_pieces:
+        if done + len(queue) + 2 > opts.max_pieces or out_of_time():
             stats["pieces"] = done + len(queue) + 1
-            stats["stopped"] = "pieces"
+            stats["stopped"] = "time" if out_of_time() else "pieces"
             return False, None
         queue += _split_piece(V, Vn, Ps, z)
     stats["pieces"] = done
     return True, None
+
+
+def _pencil_modes(
+    problem: BucklingProblem,
+    matrix: ShiftedMatrix,
+    cols: _Columns,
+    lam: float,
+    m: int,
+    iterations: int,
+) -> list[tuple[str, npt.NDArray[np.float64]]]:
+    r"""Positive and negative parts on I of approximate pencil modes below ``lam``.
+
+    Block inverse iteration :math:`V \leftarrow K^{-1}BV` with the factorised K (block
+    m + 2, started from the columns' solutions), then Rayleigh-Ritz on (A, B); the Ritz
+    vectors with a value below ``lam`` (heuristics only: the certificate checks whatever
+    columns it gets).
+    """
+    assert problem.contact is not None
+    k = min(m + 2, cols.r)
+    V = [x.copy() for x in cols.x[-k:]]
+    work = V[0].duplicate()
+    for _ in range(iterations):
+        for v in V:
+            problem.model.B.mult(v, work)
+            matrix.solve(work, v)
+            v.scale(1.0 / float(v.norm()))  # type: ignore[arg-type]
+    AV = [problem.model.A.createVecLeft() for _ in V]
+    BV = [problem.model.B.createVecLeft() for _ in V]
+    for v, a, b in zip(V, AV, BV, strict=True):
+        problem.model.A.mult(v, a)
+        problem.model.B.mult(v, b)
+    Am = np.array([[v.dot(a).real for a in AV] for v in V])
+    Bm = np.array([[v.dot(b).real for b in BV] for v in V])
+    out: list[tuple[str, npt.NDArray[np.float64]]] = []
+    try:
+        import scipy.linalg
+
+        theta, Y = scipy.linalg.eigh(0.5 * (Bm + Bm.T), 0.5 * (Am + Am.T))
+    except (np.linalg.LinAlgError, ValueError):
+        theta, Y = np.zeros(0), np.zeros((k, 0))
+    for j in range(len(theta)):
+        if theta[j] > 0 and 1.0 / theta[j] < lam:
+            work.zeroEntries()
+            work.maxpy(Y[:, j].tolist(), V)
+            values = problem.contact.values(work)
+            out += [(f"mode{j}+", np.maximum(values, 0.0)), (f"mode{j}-", np.maximum(-values, 0.0))]
+    for v in (*V, *AV, *BV, work):
+        v.destroy()
+    return out
 
 
 def _reaction(candidate: Candidate) -> npt.NDArray[np.float64]:
@@ -700,10 +824,17 @@ def _reaction(candidate: Candidate) -> npt.NDArray[np.float64]:
 
 
 def _sources(
-    problem: BucklingProblem, candidate: Candidate, others: list[Candidate]
+    problem: BucklingProblem, candidate: Candidate, others: list[Candidate], units: int
 ) -> list[tuple[str, npt.NDArray[np.float64]]]:
-    """The first columns (oriented values on I), in order of use."""
+    """The first columns (oriented values on I), in order of use.
+
+    With at most ``units`` constrained nodes, their unit vectors (U = I: the relaxation is
+    exact, the route is the full copositivity test of the Schur complement).
+    """
     assert problem.contact is not None
+    i = problem.num_constrained
+    if i <= units:
+        return [(f"node{k}", np.eye(1, i, k)[0]) for k in range(i)]
     w_plus = _reaction(candidate)
     sources = [("reaction", w_plus)]
     mirrors = mirror_maps(problem)
@@ -742,10 +873,14 @@ def lowrank_certificate(
     """
     opts = opts or LowRankOptions()
     out = LowRankOutcome()
-    sources = _sources(problem, candidate, others)
+    free_s = problem.timings.get("free_solve_s")
+    if opts.time_budget is not None and free_s:
+        budget = max(opts.time_budget * free_s, opts.min_time_s)
+        out._deadline = (time.perf_counter() + budget, problem.comm)
+    sources = _sources(problem, candidate, others, opts.unit_columns)
     queue = list(opts.deltas)
     fallback = list(opts.fallback)
-    while queue:
+    while queue and not out.out_of_time():
         delta = queue.pop(0)
         attempt, sources = _attempt(problem, matrix, candidate, delta, sources, opts, out)
         out.attempts.append(attempt)
@@ -759,14 +894,14 @@ def lowrank_certificate(
             fallback = []
         elif out.value is not None:
             break  # the previous (larger) delta stands
-        elif not queue:
-            queue, fallback = fallback, []
+        else:
+            queue, fallback = fallback, []  # nothing verified: larger deltas
     if out.value is None and out.refuting is None:
         last = out.attempts[-1] if out.attempts else {}
         out.why = str(last.get("why", "no delta tried"))
         out.r = int(last.get("r", 0))
         out.pieces = int(last.get("pieces", 0))
-        out.margin = float(last.get("best_t", -math.inf))
+        out.margin = float(last.get("best_t") or -math.inf)
     out.solves = matrix.solves
     return out
 
@@ -797,6 +932,8 @@ def _attempt(
     cols = _Columns(problem, matrix, opts.refinements, opts.max_columns)
     try:
         cols.add(sources)
+        if _select(cols, [], opts) and cols.gram_negative(opts) < neg:
+            cols.add(_pencil_modes(problem, matrix, cols, lam, neg, opts.mode_iterations))
         cuts = 0
         use: list[int] = []
         near = opts.near
@@ -815,15 +952,20 @@ def _attempt(
                 )
                 break
             stats: dict[str, Any] = {}
-            proven, ys = _orthant(Gs, Es, neg, opts, stats, near)
+            proven, ys = _orthant(Gs, Es, neg, opts, stats, near, out.out_of_time)
             attempt.update(pieces=int(stats.get("pieces", 0)), best_t=stats.get("best_t"))
             if proven:
                 attempt.update(proven=True, margin=stats.get("margin", math.inf), why="")
                 break
             if ys is None:
+                budget = (
+                    "the time budget"
+                    if stats.get("stopped") == "time"
+                    else f"{opts.max_pieces} pieces"
+                )
                 attempt["why"] = (
-                    f"S is not proven copositive within {opts.max_pieces} pieces (best SDP "
-                    f"margin {stats.get('best_t', -math.inf):.3g}, {cuts} cuts)"
+                    f"S is not proven copositive within {budget} (best SDP margin "
+                    f"{stats.get('best_t', -math.inf):.3g}, {cuts} cuts)"
                 )
                 break
             y = ys / dg  # G_s = D G D, S_s = D^-1 S D^-1: y = D^-1 y_s
@@ -844,15 +986,27 @@ def _attempt(
                     f"< {lam:.10g}"
                 )
                 break
-            added = 0
+            if out.out_of_time():
+                attempt["why"] = f"the time budget ({cuts} cuts)"
+                break
+            grown = False
             if not admissible and cuts < opts.max_cuts:
-                added = cols.add([(f"cut{cuts}", values)])
-            if not added or _select(cols, use, opts) == use:
+                # The positive part of u; if it repeats a column or leaves G singular, the
+                # unit vectors of its most violated nodes (all of them: the full SDP).
+                order = np.argsort(-values)[: opts.unit_cuts]
+                units = [(f"cut{cuts}-node{k}", np.eye(1, len(values), k)[0])
+                         for k in order if values[k] > 0]  # fmt: skip
+                for item in [(f"cut{cuts}", values), *units]:
+                    if cols.add([item]) and _select(cols, use, opts) != use:
+                        grown = True
+                        break
+            if not grown:
                 if near > 0.0:
                     near = 0.0  # no tightening cut there: partition instead
                     continue
                 attempt["why"] = (
-                    f"budget: {cuts} cuts" if cuts >= opts.max_cuts
+                    f"budget: {cuts} cuts"
+                    if cuts >= opts.max_cuts
                     else "a cut repeats a column or leaves G nearly singular"
                 )
                 break
@@ -870,7 +1024,7 @@ def _refuting(
     Au, Bu = u.duplicate(), u.duplicate()
     problem.model.A.mult(u, Au)
     problem.model.B.mult(u, Bu)
-    a, b = float(u.dot(Au)), float(u.dot(Bu))
+    a, b = u.dot(Au).real, u.dot(Bu).real
     Au.destroy()
     Bu.destroy()
     if not b > 0:
