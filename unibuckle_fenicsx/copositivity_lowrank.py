@@ -552,29 +552,32 @@ def _spn(P: npt.NDArray[np.float64]) -> tuple[float, npt.NDArray[np.float64], An
 def _simplex_min(
     P: npt.NDArray[np.float64], starts: list[npt.NDArray[np.float64]], iterations: int = 100
 ) -> tuple[float, npt.NDArray[np.float64]]:
-    """Local minima of z'Pz on the simplex {z >= 0, sum z = 1} from ``starts``; the best."""
+    """Local minima of z'Pz on the simplex {z >= 0, sum z = 1} from ``starts``; the best.
+
+    Frank-Wolfe with exact line search (a quadratic), all starts at once.
+    """
     n = P.shape[0]
-    best = (math.inf, np.full(n, 1.0 / n))
-    for z0 in starts:
-        z = np.maximum(z0, 0.0)
-        if not z.sum() > 0:
-            continue
-        z = z / z.sum()
-        for _ in range(iterations):  # Frank-Wolfe with exact line search on a quadratic
-            g = P @ z
-            k = int(np.argmin(g))
-            d = -z.copy()
-            d[k] += 1.0
-            slope = float(g @ d)
-            if slope >= -1e-15 * max(1.0, abs(float(z @ g))):
-                break
-            curv = float(d @ P @ d)
-            step = 1.0 if curv <= 0 else min(1.0, -slope / curv)
-            z = z + step * d
-        f = float(z @ P @ z)
-        if f < best[0]:
-            best = (f, z)
-    return best
+    Z = np.array([np.maximum(z, 0.0) for z in starts if np.maximum(z, 0.0).sum() > 0])
+    if not len(Z):
+        Z = np.full((1, n), 1.0 / n)
+    Z = Z / Z.sum(axis=1, keepdims=True)
+    rows = np.arange(len(Z))
+    for _ in range(iterations):
+        G = Z @ P
+        k = np.argmin(G, axis=1)
+        D = -Z
+        D[rows, k] += 1.0
+        slope = np.einsum("ij,ij->i", G, D)
+        curv = np.einsum("ij,ij->i", D @ P, D)
+        active = slope < -1e-15 * np.maximum(1.0, np.abs(np.einsum("ij,ij->i", Z, G)))
+        if not active.any():
+            break
+        with np.errstate(divide="ignore", invalid="ignore"):
+            step = np.where(curv > 0, np.minimum(1.0, -slope / curv), 1.0)
+        Z = Z + np.where(active, step, 0.0)[:, None] * D
+    f = np.einsum("ij,ij->i", Z @ P, Z)
+    best = int(np.argmin(f))
+    return float(f[best]), Z[best]
 
 
 def _starts(P: npt.NDArray[np.float64], dual: Any) -> list[npt.NDArray[np.float64]]:
