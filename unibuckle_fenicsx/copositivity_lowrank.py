@@ -262,8 +262,8 @@ class LowRankOptions:
             number stays below ``max_condition`` (the SDP solver's accuracy).
     """
 
-    deltas: tuple[float, ...] = (1e-4, 1e-5, 1e-6)
-    fallback: tuple[float, ...] = (1e-3, 1e-2)
+    deltas: tuple[float, ...] = (1e-3, 1e-4, 1e-5, 1e-6)
+    fallback: tuple[float, ...] = (1e-2,)
     max_columns: int = 48
     max_cuts: int = 24
     max_pieces: int = 64
@@ -273,7 +273,7 @@ class LowRankOptions:
     max_condition: float = 1e12
     near: float = 1e-4
     prune_condition: float = 1e6
-    mode_iterations: int = 3
+    mode_iterations: int = 6
     unit_cuts: int = 4
     unit_columns: int = 24
     time_budget: float | None = 5.0
@@ -784,18 +784,22 @@ def _pencil_modes(
     r"""Positive and negative parts on I of approximate pencil modes below ``lam``.
 
     Block inverse iteration :math:`V \leftarrow K^{-1}BV` with the factorised K (block
-    m + 2, started from the columns' solutions), then Rayleigh-Ritz on (A, B); the Ritz
+    m + 3, started from the free mode and the last columns' solutions, orthogonalised),
+    then Rayleigh-Ritz on (A, B); the Ritz
     vectors with a value below ``lam`` (heuristics only: the certificate checks whatever
     columns it gets).
     """
     assert problem.contact is not None
-    k = min(m + 2, cols.r)
-    V = [x.copy() for x in cols.x[-k:]]
+    k = min(m + 3, cols.r + 1)
+    V = [problem.solve_free().function.x.petsc_vec.copy()]
+    V += [x.copy() for x in cols.x[-(k - 1) :]]
     work = V[0].duplicate()
     for _ in range(iterations):
-        for v in V:
+        for j, v in enumerate(V):
             problem.model.B.mult(v, work)
             matrix.solve(work, v)
+            for q in V[:j]:  # modified Gram-Schmidt: keep the block independent
+                v.axpy(-v.dot(q).real, q)
             v.scale(1.0 / float(v.norm()))  # type: ignore[arg-type]
     AV = [problem.model.A.createVecLeft() for _ in V]
     BV = [problem.model.B.createVecLeft() for _ in V]
