@@ -800,7 +800,7 @@ def _pencil_modes(
             matrix.solve(work, v)
             for q in V[:j]:  # modified Gram-Schmidt: keep the block independent
                 v.axpy(-v.dot(q).real, q)
-            v.scale(1.0 / float(v.norm()))  # type: ignore[arg-type]
+            v.scale(1.0 / float(v.norm()))
     AV = [problem.model.A.createVecLeft() for _ in V]
     BV = [problem.model.B.createVecLeft() for _ in V]
     for v, a, b in zip(V, AV, BV, strict=True):
