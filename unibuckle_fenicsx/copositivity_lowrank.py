@@ -13,9 +13,10 @@ are nonnegative there (in oriented values). With :math:`G = U^TK^{-1}U` (r solve
    :math:`\lambda`, a verified lower bound.
 
 Copositivity of S is proven piecewise: the orthant is split into simplicial cones
-cone(V) (edge bisection, midpoints exact in binary) and on each one
+cone(V) (a star split at the piece's local minimiser, exact as checked in rational
+arithmetic, else edge bisection, whose midpoints are exact in binary) and on each one
 :math:`V^TSV - N \succ 0` with :math:`N \ge 0` (entrywise; an r x r semidefinite program,
-cvxpy + Clarabel, the ``sdp`` extra) proves :math:`y^TSy \ge 0` there (SPN). Nothing the
+Clarabel called directly, the ``sdp`` extra) proves :math:`y^TSy \ge 0` there (SPN). Nothing the
 SDP returns is trusted: N is clipped to :math:`N \ge 0` and checked through the bordered
 matrix :math:`M = [[-G, V], [V^T, -N]]`, :math:`\mathrm{In}(M) = \mathrm{In}(-G) +
 \mathrm{In}(V^TSV - N)` (Haynsworth), so no inverse of G is needed: M must have exactly
@@ -25,18 +26,24 @@ backward error of LAPACK's symmetric eigensolver (taken as :math:`4 n u \|M\|_F`
 
 **Columns**: the contact reaction of the KKT point (the route is tight when the reaction
 of the true minimiser is a column), its mirror images, the reactions of the other KKT
-points met, and the positive and negative parts on I of the free mode. Then **cuts**:
+points met, the positive and negative parts on I of the free mode and, if G then has
+fewer than m negative eigenvalues, of approximate pencil modes below :math:`\lambda`
+(block inverse iteration with the factorised K); on zones of at most
+``unit_columns`` nodes, U = I instead (the exact relaxation). Columns that leave G
+nearly singular are not used (an ill-conditioned S defeats the SDP). Then **cuts**:
 a :math:`y \ge 0` with :math:`y^TSy < 0` gives :math:`u = -K^{-1}USy` (the minimiser of
 :math:`u^TKu` on :math:`U^Tu = -y`, with :math:`u^TKu = y^TSy < 0`); the positive part of
 u on I becomes a new column (it cuts u off), and if it is empty, u is an admissible mode
 with a load below :math:`\lambda`: the KKT point is *refuted*, and u is handed back.
-Budgets bound the columns, cuts and pieces; the relative distances :math:`\delta` below
-the load are tried from small to large, one factorisation each.
+Budgets bound the columns, cuts, pieces and time; the relative distances
+:math:`\delta` below the load are tried from 1e-3 down while they are verified (else
+1e-2), one factorisation each: the result is the smallest verified gap.
 
 **Rounding.** Each entry is :math:`G_{ab} = u_a^Tx_b + x_a^T\rho_b + \rho_a^TK^{-1}\rho_b`
 with :math:`x_b` the computed (refined) solution and :math:`\rho_b = u_b - Kx_b` its exact
 residual. On thin plates :math:`|K||x| \gg |Kx|` (shear stiffness against bending: at
-t/b = 1e-3 a double-precision residual leaves G wrong in the third digit), so
+t/b = 1e-3 the rounding bound of a double-precision residual is a million times that
+of the one below; README, "Verification"), so
 :math:`\rho` is computed in twice the working precision: Dot2 of T. Ogita, S. M. Rump and
 S. Oishi, "Accurate sum and dot product", SIAM J. Sci. Comput. 26 (2005) 1955-1988
 (TwoSum of D. E. Knuth, TwoProduct of T. J. Dekker with Veltkamp's splitting), with
