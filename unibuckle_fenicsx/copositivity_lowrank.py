@@ -35,7 +35,7 @@ a :math:`y \ge 0` with :math:`y^TSy < 0` gives :math:`u = -K^{-1}USy` (the minim
 :math:`u^TKu` on :math:`U^Tu = -y`, with :math:`u^TKu = y^TSy < 0`); the positive part of
 u on I becomes a new column (it cuts u off), and if it is empty, u is an admissible mode
 with a load below :math:`\lambda`: the KKT point is *refuted*, and u is handed back.
-Budgets bound the columns, cuts, pieces and time; the relative distances
+Budgets bound the columns, cuts, pieces (and, optionally, time); the relative distances
 :math:`\delta` below the load are tried from 1e-3 down while they are verified (else
 1e-2), one factorisation each: the result is the smallest verified gap.
 
@@ -247,9 +247,10 @@ class LowRankOptions:
         max_cuts: Cuts (new columns from a negative direction of S) per delta.
         max_pieces: Simplicial pieces of the orthant per delta.
         time_budget: Wall time allowed, in free eigen solves
-            (``problem.timings["free_solve_s"]``; None: no limit). Checked between
-            pieces and cuts, by all ranks together; the search then stops with what is
-            verified.
+            (``problem.timings["free_solve_s"]``; None, the default: no limit, so that
+            the answer depends on the counts above only, the same on every machine and
+            partition). Checked between pieces and cuts, by all ranks together; the
+            search then stops with what is verified.
         min_time_s: ... but at least this many seconds (on coarse meshes the dense
             programs, not the solves, set the time).
         mode_iterations: Block inverse iterations for the pencil-mode columns (used when
@@ -283,7 +284,7 @@ class LowRankOptions:
     mode_iterations: int = 6
     unit_cuts: int = 4
     unit_columns: int = 24
-    time_budget: float | None = 5.0
+    time_budget: float | None = None
     min_time_s: float = 2.0
 
 
