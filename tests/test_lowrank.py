@@ -11,7 +11,9 @@ r"""The low-rank copositivity certificate (several pencil eigenvalues below the 
   1e-4 and 1e-3; a refuting mode is admissible with a load between the minimum and the
   claimed load. A sample runs by default, the whole family under ``-m stress``.
 - On the thin SSSS plate 0.3 x 0.1 x 1e-4 m (README, "Thin plates"), whose pencil has two
-  eigenvalues below lambda_c, the returned load is bracketed to at least 1e-3.
+  eigenvalues below lambda_c, the returned load is bracketed to at least 1e-3, and the
+  wrong KKT point of the interior buckle (k near 16/3 against the end buckle's 9/2) is
+  not bracketed above the end buckle's load.
 """
 
 from __future__ import annotations
@@ -28,9 +30,10 @@ from exhaustive import RTOL, exhaustive_minimum
 from families import long_plate_family
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.certify import BRACKET_GAP
+from unibuckle_fenicsx.certify import BRACKET_GAP, certify
 from unibuckle_fenicsx.config import ObstacleSpec
 from unibuckle_fenicsx.copositivity import ShiftedMatrix
 from unibuckle_fenicsx.copositivity_lowrank import (
@@ -198,3 +201,36 @@ def test_thin_ssss_plate_is_bracketed():
     assert data["status"] == cert.status and data["negative_eigenvalues"] >= 2
     assert data["copositivity"]["lowrank"]["r"] >= 2
     assert "bracketed to" in text or "proven=yes" in text
+
+
+@serial
+def test_interior_bump_on_the_thin_ssss_plate_is_not_bracketed():
+    """A wrong KKT point of the thin SSSS plate (0.3 x 0.1 x 1e-4 m, 45 x 15) stays unproven.
+
+    The interior buckle between two touch-downs (thin-plate k = 16/3; README, "Every
+    plate the schema describes") is a KKT point of the SSSS plate too, found here by the
+    active-set iteration from the contact set of the plate with clamped loaded edges; the
+    end buckle (k = 9/2) has a lower load. The lower bound certified at the interior
+    buckle must stay below the end buckle's load (that of an admissible mode, so an upper
+    bound on the critical load), and a refuting mode, if one is found, must be admissible
+    and below the interior buckle's load.
+    """
+    ssss = plate_case("ssss", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
+                      zone=ObstacleSpec(zone="all"))  # fmt: skip
+    clamped = plate_case("cs", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
+                         supports={"left": "clamped", "right": "clamped"},
+                         zone=ObstacleSpec(zone="all")).with_solver(certify=False)  # fmt: skip
+    with solve(clamped, MPI.COMM_SELF) as analysis:
+        start = analysis.solution.active.copy()
+    with BucklingProblem(ssss, MPI.COMM_SELF) as problem:
+        end_bump = solve_active_set(problem).load
+        run = iterate(problem, "interior", start, None, 200, thresholds=(1e-4, 1e-6))
+        assert run.status == "kkt" and run.final is not None
+        bump = run.final
+        k = problem.buckling_coefficient(bump.load)
+        assert abs(k - 16 / 3) < 0.1 and bump.load > end_bump * 1.1, (k, bump.load, end_bump)
+        cert = certify(problem, bump)
+    assert cert.kkt and cert.status == "kkt-only", cert
+    assert cert.lower_bound <= end_bump
+    if cert.refuting_mode is not None:
+        assert cert.refuting_mode.feasible and cert.refuting_mode.load < bump.load
