@@ -203,3 +203,57 @@ def stress_family(
         if min_constrained <= i <= max_constrained:
             found.append((spec, kind, i))
     return found
+
+
+# -- long plates with several pencil eigenvalues below the critical load -------------------
+#: Edge supports of :func:`long_plate_family` (loaded edges x = const).
+LONG_SUPPORTS = (
+    {},  # SSSS
+    {"left": "clamped", "right": "clamped"},
+    {"bottom": "clamped", "top": "clamped"},
+    dict.fromkeys(EDGE_NAMES, "clamped"),
+)
+
+
+def long_plate_family(count: int, seed: int = 20261207, max_constrained: int = 14):
+    """The first ``count`` long plates (a/b 2.5-4.5) on coarse meshes, i <= ``max_constrained``.
+
+    Uniaxial compression or shear, the four support cases of :data:`LONG_SUPPORTS`, t/b
+    log-uniform in [1e-3, 3e-2], the obstacle over the whole plate or over a strip of it
+    (above or below). Each item is (spec, i). Whether two or more pencil eigenvalues lie
+    below the critical load is for the caller to check (it depends on the solution).
+    """
+    from unibuckle_fenicsx.cases import plate_case
+
+    rng = np.random.default_rng(seed)
+    found = []
+    while len(found) < count:
+        aspect = float(rng.uniform(2.5, 4.5))
+        width, ny = 0.1, int(rng.integers(2, 4))
+        nx = int(np.clip(round(aspect * ny * rng.uniform(0.8, 1.2)), 5, 10))
+        supports = LONG_SUPPORTS[int(rng.integers(0, len(LONG_SUPPORTS)))]
+        load = "shear" if rng.random() < 0.2 and ny == 3 else "uniaxial"
+        length = aspect * width
+        if rng.random() < 0.5:
+            zone: str | tuple = "all"
+        else:
+            x0, x1 = np.sort(rng.uniform(0, length, 2))
+            zone = ((float(x0), float(x1)), (0.0, width))
+        side = "above" if rng.random() < 0.7 else "below"
+        spec = plate_case(
+            f"long{len(found)}",
+            length=length,
+            width=width,
+            thickness=width * float(10 ** rng.uniform(-3.0, np.log10(3e-2))),
+            supports=supports,
+            load=load,
+            nx=nx,
+            ny=ny,
+            zone=ObstacleSpec(zone=zone, side=side),
+            solver=SolverSpec(method="active-set"),
+        )
+        edges = spec.plate.edges
+        i = _constrained_nodes(edges, length, width, nx, ny, zone)
+        if 4 <= i <= max_constrained:
+            found.append((spec, i))
+    return found

@@ -77,6 +77,10 @@ def test_lower_bound_never_exceeds_the_exhaustive_minimum(active_specs):
 def test_a_wrong_kkt_point_is_never_proven(active_specs):
     """random29: every seed stops at the KKT point 23.646 MPa, the minimum is 23.142 MPa.
 
+    Its certificate is not proven, its lower bound stays below the minimum, and a
+    refuting mode, if the low-rank route finds one, is admissible and lies between the
+    minimum and the returned load.
+
     Also a claimed load slightly above the true minimum (the true KKT point with its load
     raised by 1e-6 and 1e-4 relative) is never proven.
     """
@@ -88,6 +92,11 @@ def test_a_wrong_kkt_point_is_never_proven(active_specs):
         assert sol.load > best * (1 + 1e-3)  # the iteration misses the global minimum
         cert = certify(problem, sol)
         assert not cert.global_optimum_proven and cert.lower_bound <= best
+        assert cert.status != "proven"
+        if cert.refuting_mode is not None:  # the low-rank route met a lower admissible mode
+            assert cert.refuting_mode.feasible
+            assert best * (1 - 1e-8) <= cert.refuting_mode.load < sol.load
+            assert cert.upper_bound == cert.refuting_mode.load
         exact = solve_active_set(problem, bound_budget=2**problem.num_constrained)
         assert exact.load == pytest.approx(best, rel=1e-8)
         for excess in (1e-6, 1e-4):

@@ -305,3 +305,39 @@ def test_cli_gmsh_plate_distributed(tmp_path):
     )
     ser, _ = _config_on_two_ranks(tmp_path, path)
     assert ser["certificate"]["kkt"] and len(ser["mesh"]) == 1
+
+
+def test_lowrank_certificate_distributed_equals_serial():
+    """The low-rank route on 2 ranks: same bound (to the loads' 1e-8), columns and pieces.
+
+    A thin SSSS plate (t/b = 1e-3, 30 x 10 cells, two pencil eigenvalues below its
+    load), the contact set of the serial active-set answer; the double-double residuals
+    gather their ghost values through a PETSc scatter.
+    """
+    spec = importlib.util.spec_from_file_location(
+        "lowrank_parallel", HERE / "mpi" / "lowrank_parallel.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+    from unibuckle_fenicsx.cases import plate_case
+    from unibuckle_fenicsx.config import ObstacleSpec
+    from unibuckle_fenicsx.problem import BucklingProblem
+
+    plate = plate_case("thin", length=0.3, width=0.1, thickness=1e-4, nx=30, ny=10,
+                       zone=ObstacleSpec(zone="all"))  # fmt: skip
+    with BucklingProblem(plate, MPI.COMM_SELF) as problem:
+        active = solve_active_set(problem).active
+    serial = module.certificate(MPI.COMM_SELF, 30, 10, active)
+    assert serial["method"] == "lowrank-spn" and serial["m"] >= 2, serial
+    nodes = ",".join(str(k) for k in active)
+    out = run_mpi(HERE / "mpi" / "lowrank_parallel.py", 2, "30", "10", nodes)
+    par = json.loads(out.strip().splitlines()[-1])
+    assert _same_load(par["load"], serial["load"])
+    assert (par["method"], par["m"], par["r"], par["pieces"]) == (
+        serial["method"],
+        serial["m"],
+        serial["r"],
+        serial["pieces"],
+    )
+    assert abs(par["value"] - serial["value"]) <= LOAD_RTOL * serial["value"]

@@ -15,9 +15,16 @@ Global. The algorithms bracket the critical load: any admissible mode's load is 
 bound; interlacing, the lattice search and exhaustive enumeration give lower bounds, and
 :mod:`unibuckle_fenicsx.copositivity` proves one just below a KKT point's load when
 :math:`A - \lambda B` is copositive on the cone there (a rank-2 certificate that costs one
-sparse :math:`LDL^T`, or a semidefinite program for small i). The result is *proven*
-globally optimal when the verified bracket closes to :data:`PROOF_GAP`. The
-smallest-eigenvalue check runs on every route, proven or not.
+sparse :math:`LDL^T`, or a semidefinite program for small i), or, when several pencil
+eigenvalues lie below the load, a slightly lower one by the low-rank route
+(:mod:`unibuckle_fenicsx.copositivity_lowrank`). The result is a *verified bracket*:
+*proven* globally optimal when it closes to :data:`PROOF_GAP`, *bracketed* when its
+verified relative gap is at most :data:`BRACKET_GAP` (the load is then known to that
+accuracy: no admissible mode has a load below the lower bound), otherwise "KKT only".
+The smallest-eigenvalue check runs on every route, proven or not. When the low-rank
+route meets an admissible mode with a lower load than the KKT point's, the point is
+refuted: the certificate hands that mode back (:attr:`Certificate.refuting_mode`) and its
+load becomes the upper bound.
 
 Every check here is collective on the problem's communicator.
 """
@@ -40,6 +47,7 @@ from unibuckle_fenicsx.eigen import SymmetricFactorization
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 
 __all__ = [
+    "BRACKET_GAP",
     "CERTIFY_PREFIX",
     "PROOF_GAP",
     "Certificate",
@@ -52,6 +60,9 @@ logger = logging.getLogger(__name__)
 
 #: Relative gap (upper - lower)/upper below which the global optimum counts as proven.
 PROOF_GAP = 1e-6
+#: A verified relative gap at most this is reported as "bracketed" (the load is known to
+#: that accuracy), above it the result is a KKT point only.
+BRACKET_GAP = 1e-3
 #: The smallest-eigenvalue check looks below lambda (1 - SMALLEST_RTOL_FACTOR eps_tol).
 SMALLEST_RTOL_FACTOR = 1e3
 
@@ -79,10 +90,16 @@ class Certificate:
         global_optimum_proven: The gap is at most :data:`PROOF_GAP`.
         proven_by: What gave the lower bound: "interlacing" (the free load),
             "lattice", "enumeration", or a copositivity route ("rank2-spn", "sdp-spn",
-            "sdp-sectors", "psd").
+            "sdp-sectors", "lowrank-spn", "psd").
         copositivity: The copositivity certificate's record (route, delta, verified
-            margins, factorisations, solves, seconds), or None if it did not run.
+            margins, m, factorisations, solves, seconds, the low-rank route's record),
+            or None if it did not run.
         notes: Anything that failed or was skipped, in words.
+        refuting_mode: An admissible mode with a lower load than the returned one, found
+            by the low-rank route (the returned KKT point is then not the global
+            minimum): a :class:`~unibuckle_fenicsx.problem.Candidate` (its ``eigen`` is
+            None: a Rayleigh quotient, not an eigenpair) from which a solver can
+            continue. Not in :meth:`as_dict` (its load is: ``refuting_load_Pa``).
     """
 
     feasible: bool
@@ -100,6 +117,26 @@ class Certificate:
     copositivity: dict[str, Any] | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
     max_contact_value: float = 0.0
+    refuting_mode: Candidate | None = None
+
+    @property
+    def status(self) -> str:
+        """One of proven, bracketed (verified gap <= :data:`BRACKET_GAP`), kkt-only, not-kkt."""
+        if not self.kkt:
+            return "not-kkt"
+        if self.global_optimum_proven:
+            return "proven"
+        if self.proven_by != "interlacing" and self.relative_gap <= BRACKET_GAP:
+            return "bracketed"
+        return "kkt-only"
+
+    @property
+    def negative_eigenvalues(self) -> int | None:
+        """m: pencil eigenvalues below the shifts tried (None if no factorisation ran)."""
+        if self.copositivity is None:
+            return None
+        m = self.copositivity.get("negative_eigenvalues")
+        return None if m is None else int(m)
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready mapping."""
@@ -117,6 +154,9 @@ class Certificate:
             "relative_gap": self.relative_gap,
             "global_optimum_proven": self.global_optimum_proven,
             "proven_by": self.proven_by,
+            "status": self.status,
+            "negative_eigenvalues": self.negative_eigenvalues,
+            "refuting_load_Pa": None if self.refuting_mode is None else self.refuting_mode.load,
             "copositivity": self.copositivity,
             "notes": list(self.notes),
         }
@@ -214,18 +254,30 @@ def certify(
     proven_by = str(solution.details.get("lower_bound_by", "interlacing"))
     algorithm_proof = solution.global_optimum_proven
     record: dict[str, Any] | None = None
+    refuting: Candidate | None = None
     if not algorithm_proof and global_bound and kkt and cand.eigen is not None:
         bound = copositivity_bound(problem, cand, solution.kkt_points, options)
         record = {
             "method": bound.method,
             "delta": bound.delta,
             "margins": bound.margins,
+            "negative_eigenvalues": bound.negative_eigenvalues,
             **{k: bound.timings[k] for k in ("factorisations", "solves")},
             "time_s": bound.timings["total_s"],
+            "lowrank": bound.lowrank,
         }
         notes += list(bound.notes)
+        if bound.refuting is not None:
+            refuting = _refuting_candidate(problem, bound.refuting)
+            if refuting.feasible:
+                upper = min(upper, refuting.load)
+                notes.append(
+                    f"refuted: an admissible mode has the load {refuting.load!r} < "
+                    f"{cand.load!r} (Certificate.refuting_mode)"
+                )
         if bound.value is not None and bound.value > lower:
             lower, proven_by = min(bound.value, upper), bound.method
+        lower = min(lower, upper)
     elif not algorithm_proof and not global_bound:
         notes.append("global certification skipped (solver.certify = false)")
     gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
@@ -258,7 +310,18 @@ def certify(
         proven_by=proven_by,
         copositivity=record,
         notes=tuple(notes),
+        refuting_mode=refuting,
     )
+
+
+def _refuting_candidate(problem: BucklingProblem, refuting: dict[str, Any]) -> Candidate:
+    """The low-rank route's refuting mode as a :class:`Candidate` (contact set: its zeros)."""
+    u = problem.new_mode("refuting_mode")
+    u.x.petsc_vec.array[:] = refuting["vector"]
+    u.x.scatter_forward()
+    values = np.asarray(refuting["values"])
+    active = np.flatnonzero(values >= -problem.tau).astype(np.int64)
+    return problem.candidate(u, float(refuting["load"]), active, sign=1.0)
 
 
 def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -> Certificate:
@@ -308,16 +371,15 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     upper = cand.load
     gap = (upper - lower) / upper
     proven = bool(kkt and solution.global_optimum_proven and gap <= PROOF_GAP)
-    smallest: bool | None = None
+    sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
+    neg, _, _ = _spring_inertia(problem, pressing, sigma)
+    smallest = neg == 0
+    if not smallest:
+        notes.append(
+            f"the pencil with the springs of the pressing nodes has {neg} eigenvalue(s) "
+            "below the returned load"
+        )
     if not proven:
-        sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
-        neg, _, _ = _spring_inertia(problem, pressing, sigma)
-        smallest = neg == 0
-        if not smallest:
-            notes.append(
-                f"the pencil with the springs of the pressing nodes has {neg} eigenvalue(s) "
-                "below the returned load"
-            )
         notes.append(
             f"tensionless foundation: {pressing.size} of {contact.size} nodes press it; a "
             "stationary point of the spring quotient, global optimality not proven"

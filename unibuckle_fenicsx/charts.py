@@ -3,8 +3,9 @@ r"""Design charts of a sweep (matplotlib): k against the swept number.
 One figure, :func:`plot_sweep`: the buckling coefficient :math:`k = N b^2/(\pi^2 D)`
 of the plate without obstacle (bilateral, the free load) and with it (unilateral), one
 curve per combination of the other swept numbers. Unilateral points are marked by their
-certificate: filled = proven globally optimal, open = KKT point only, cross = not
-certified. When the sweep varies ``plate.length`` or ``plate.width`` the abscissa is the
+certificate: filled circle = proven globally optimal, filled diamond = bracketed (a
+verified relative gap of at most 1e-3, written beside it), open circle = KKT point only,
+cross = not certified. When the sweep varies ``plate.length`` or ``plate.width`` the abscissa is the
 aspect ratio a/b.
 
 Exact thin-plate curves are drawn where they exist (:func:`reference_k`):
@@ -141,6 +142,11 @@ def plot_sweep(
                     ax.plot(x[i], k[i], "x", color=colour, ms=7)
                 elif cert.get("global_optimum_proven"):
                     ax.plot(x[i], k[i], "o", color=colour, ms=6)
+                elif cert.get("status") == "bracketed":
+                    ax.plot(x[i], k[i], "D", color=colour, ms=5)
+                    ax.annotate(f"{float(cert['relative_gap']):.0e}", (x[i], k[i]),
+                                textcoords="offset points", xytext=(4, 4), fontsize=6,
+                                color=colour)  # fmt: skip
                 else:
                     ax.plot(x[i], k[i], "o", mfc="white", color=colour, ms=6)
         # Exact curves on a fine grid of the swept number.
@@ -165,8 +171,13 @@ def plot_sweep(
                 label = f"{name}, thin plate ({what}){suffix}"
                 ax.plot(xs[o], ys[o], style, color="0.35", lw=1.2, label=label)
     # Legend entries for the certificate markers.
-    for style, mfc, text in (("o", "0.2", "proven optimal"), ("o", "white", "KKT only"),
-                             ("x", "0.2", "not certified")):  # fmt: skip
+    markers = (
+        ("o", "0.2", "proven optimal"),
+        ("D", "0.2", "bracketed (verified gap)"),
+        ("o", "white", "KKT only"),
+        ("x", "0.2", "not certified"),
+    )
+    for style, mfc, text in markers:
         ax.plot([], [], style, color="0.2", mfc=mfc, label=text)
     # Keep the interesting range readable: very short plates have large k.
     solved_lines = [m for m in lines if "buckling_coefficient_k" in m]

@@ -48,7 +48,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -58,6 +58,9 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.eigen import Owner, SymmetricFactorization, release
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+
+if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.copositivity_lowrank import LowRankOptions
 
 __all__ = [
     "CERTIFY_PREFIX",
@@ -87,6 +90,8 @@ class BoundOptions:
         sdp_max_constrained: The SDP routes run when i is at most this (dense i x i
             semidefinite programs: seconds at i = 50, inaccurate beyond about 80).
         sectors: Sector counts tried by the sector SDP route (two negative eigenvalues).
+        lowrank: Budgets of the low-rank route (two or more negative eigenvalues, any
+            i; :mod:`unibuckle_fenicsx.copositivity_lowrank`); None skips it.
     """
 
     deltas: tuple[float, ...] = (1e-9, 2e-9, 5e-9, 1e-8, 2e-8, 5e-8, 1e-7, 2e-7, 5e-7, 1e-6)
@@ -96,6 +101,13 @@ class BoundOptions:
     search_iterations: int = 100
     sdp_max_constrained: int = 60
     sectors: tuple[int, ...] = (3, 4, 8)
+    lowrank: LowRankOptions | None = field(default_factory=lambda: _lowrank_options())
+
+
+def _lowrank_options() -> LowRankOptions:
+    from unibuckle_fenicsx.copositivity_lowrank import LowRankOptions
+
+    return LowRankOptions()
 
 
 @dataclass(frozen=True)
@@ -104,13 +116,19 @@ class LowerBound:
 
     Attributes:
         value: The verified lower bound (None if no route succeeded).
-        method: "psd", "rank2-spn", "sdp-spn", "sdp-sectors", or "none".
+        method: "psd", "rank2-spn", "sdp-spn", "sdp-sectors", "lowrank-spn", or "none".
         delta: Relative distance of ``value`` below the load.
         margins: The verified quantities (alpha, beta, gamma and their error bounds, or
             the SDP's smallest eigenvalue).
         attempts: Per delta tried: the inertia of K and what each route found.
         notes: What failed, in words.
         timings: Seconds and counts (factorisations, solves).
+        negative_eigenvalues: m, the pencil eigenvalues below the first shift tried (the
+            negative eigenvalues of K there).
+        lowrank: The low-rank route's record (None if it did not run).
+        refuting: An admissible mode with a lower load than the KKT point's, met by the
+            low-rank route (load, oriented values at I, owned entries of the W-vector),
+            or None.
     """
 
     value: float | None
@@ -120,6 +138,9 @@ class LowerBound:
     attempts: tuple[dict[str, Any], ...] = ()
     notes: tuple[str, ...] = ()
     timings: dict[str, float] = field(default_factory=dict)
+    negative_eigenvalues: int | None = None
+    lowrank: dict[str, Any] | None = None
+    refuting: dict[str, Any] | None = None
 
 
 @dataclass
@@ -307,15 +328,15 @@ def mirror_maps(problem: BucklingProblem, tol: float = 1e-9) -> dict[str, npt.ND
     cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
     size = max(x1 - x0, y1 - y0)
 
-    def key(p: npt.NDArray[np.float64]) -> tuple[int, int]:
-        kx, ky = np.round((p - (cx, cy)) / (tol * size)).astype(np.int64)
-        return int(kx), int(ky)
+    def keys(p: npt.NDArray[np.float64]) -> list[tuple[int, int]]:
+        k = np.round((p - (cx, cy)) / (tol * size)).astype(np.int64)
+        return [(int(a), int(b)) for a, b in k.tolist()]
 
-    index = {key(p): k for k, p in enumerate(xy)}
+    index = {key: k for k, key in enumerate(keys(xy))}
     out = {}
     for name, (sx, sy) in {"x": (-1, 1), "y": (1, -1), "xy": (-1, -1)}.items():
         image = np.column_stack([cx + sx * (xy[:, 0] - cx), cy + sy * (xy[:, 1] - cy)])
-        perm = [index.get(key(p)) for p in image]
+        perm = [index.get(key) for key in keys(image)]
         if all(k is not None for k in perm):
             out[name] = np.asarray(perm, dtype=np.int64)
     return out
@@ -501,6 +522,10 @@ def copositivity_bound(
     a = -np.sign(sigma) * phi  # normalisation a'w = 1 of the other nappe
     matrix = ShiftedMatrix(problem.model.A, problem.model.B)
     result: LowerBound | None = None
+    m: int | None = None
+    several = False  # two or more pencil eigenvalues below some shift tried
+    lowrank: dict[str, Any] | None = None
+    refuting: dict[str, Any] | None = None
     try:
         if not w_plus.max() > 0:
             notes.append("the KKT point has no contact force (w+ = 0)")
@@ -511,6 +536,8 @@ def copositivity_bound(
             neg, zero, pos = matrix.factor(lam)
             attempt: dict[str, Any] = {"delta": delta, "inertia": [neg, zero, pos]}
             attempts.append(attempt)
+            m = neg if m is None else m
+            several |= neg >= 2
             if zero:
                 attempt["why"] = "K(lambda_lb) is singular"
                 continue
@@ -540,6 +567,14 @@ def copositivity_bound(
                     break
                 if route.get("unavailable") or route.get("too_large"):
                     break
+        if result is None and several and opts.lowrank is not None:
+            outcome = _lowrank(problem, matrix, candidate, others or [], opts.lowrank, notes)
+            if outcome is not None:
+                lowrank, refuting = outcome.record(), outcome.refuting
+                if outcome.value is not None:
+                    margins = {"r": outcome.r, "pieces": outcome.pieces,
+                               "margin": outcome.margin, "m": outcome.m}  # fmt: skip
+                    result = LowerBound(outcome.value, "lowrank-spn", outcome.delta, margins)
     finally:
         timings = {  # the slowest rank's, so that the record is the same on every rank
             "total_s": problem.comm.allreduce(time.perf_counter() - t0, op=MPI.MAX),
@@ -564,7 +599,39 @@ def copositivity_bound(
         tuple(attempts),
         tuple(notes),
         timings,
+        m,
+        lowrank,
+        refuting,
     )
+
+
+def _lowrank(
+    problem: BucklingProblem,
+    matrix: ShiftedMatrix,
+    candidate: Candidate,
+    others: list[Candidate],
+    options: LowRankOptions,
+    notes: list[str],
+) -> Any:
+    """The low-rank route (needs Clarabel and SciPy, the ``sdp`` extra); None without them."""
+    try:
+        from unibuckle_fenicsx.copositivity_lowrank import lowrank_certificate
+    except ImportError as err:
+        notes.append(
+            "several pencil eigenvalues lie below the load: the low-rank certificate needs "
+            f"the 'sdp' extra (pip install 'unibuckle_fenicsx[sdp]'): {err}"
+        )
+        return None
+    outcome = lowrank_certificate(problem, matrix, candidate, others, options)
+    if outcome.value is None:
+        notes.append(
+            f"low-rank certificate: no verified bound (m = {outcome.m} pencil eigenvalues "
+            f"below, r = {outcome.r} columns, {outcome.pieces} pieces, best SDP margin "
+            f"{outcome.margin:.3g}): {outcome.why}"
+        )
+    elif outcome.why:
+        notes.append(f"low-rank certificate: {outcome.why}")
+    return outcome
 
 
 def _sdp(
@@ -580,8 +647,8 @@ def _sdp(
     if i > opts.sdp_max_constrained:
         notes.append(
             f"{neg} pencil eigenvalues lie below the load: the rank-2 certificate does not "
-            f"apply, and the SDP route is limited to i <= {opts.sdp_max_constrained} "
-            f"constrained nodes (here {i})"
+            f"apply, and the full SDP route is limited to i <= {opts.sdp_max_constrained} "
+            f"constrained nodes (here {i}): the low-rank route runs"
         )
         return {"too_large": True}
     try:

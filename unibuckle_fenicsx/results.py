@@ -178,12 +178,9 @@ class BucklingResult:
         z = ""
         if self.constrained_nodes:
             cert = self.certificate or {}
-            proven = "no"
-            if cert.get("global_optimum_proven"):
-                proven = f"yes ({cert.get('proven_by')}, gap {cert.get('relative_gap', 0):.1e})"
             z = (
                 f"  i={self.constrained_nodes} |Z|={self.contact_nodes}"
-                f"  KKT={'yes' if cert.get('kkt') else 'NO'}  proven={proven}"
+                f"  KKT={'yes' if cert.get('kkt') else 'NO'}  {_verified(cert)}"
             )
         loaded = [
             f"{name} {_load_text(load)}"
@@ -198,6 +195,33 @@ class BucklingResult:
             f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s\n"
             f"  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}"
         )
+
+
+def _gap_text(gap: float) -> str:
+    """The relative gap rounded up to one significant digit: 8.1e-05 -> "9e-05"."""
+    if gap <= 0:
+        return "0"
+    exponent = math.floor(math.log10(gap))
+    digit = math.ceil(round(gap / 10.0**exponent, 9))
+    if digit >= 10:
+        digit, exponent = 1, exponent + 1
+    return f"{digit}e{exponent:+03d}"
+
+
+def _verified(cert: dict[str, Any]) -> str:
+    """What the certificate verified, for the summary line."""
+    m = cert.get("negative_eigenvalues")
+    below = f", m={m}" if m is not None else ""
+    status = cert.get("status")
+    gap = cert.get("relative_gap")
+    if cert.get("global_optimum_proven"):
+        return f"proven=yes ({cert.get('proven_by')}, gap {float(gap or 0):.1e}{below})"
+    if status == "bracketed" and isinstance(gap, float):
+        return f"proven=no, bracketed to {_gap_text(gap)} ({cert.get('proven_by')}{below})"
+    refuted = cert.get("refuting_load_Pa")
+    if isinstance(refuted, float):
+        return f"proven=no, refuted: an admissible mode has {refuted:.6e} Pa"
+    return f"proven=no (KKT only{below})"
 
 
 def _load_text(load: dict[str, Any]) -> str:
