@@ -52,7 +52,7 @@ CASES = {
 LENGTH, WIDTH, THICKNESS = 0.3, 0.1, 1e-4
 
 
-def _spec(name: str, nx: int, ny: int):  # noqa: ANN202
+def _spec(name: str, nx: int, ny: int):
     supports, load, _ = CASES[name]
     return plate_case(
         name,
@@ -85,7 +85,7 @@ def _lowrank(cert: Certificate) -> tuple[object, object]:
     return lowrank.get("r", "-"), lowrank.get("pieces", "-")
 
 
-def _cli_seconds(spec) -> float:  # noqa: ANN001
+def _cli_seconds(spec) -> float:
     """Wall time of ``unibuckle solve`` on ``spec`` (a whole process)."""
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "plate.json"
