@@ -254,6 +254,14 @@ class EdgeSpec:
             rectangle (tags 1..4 in :data:`EDGE_NAMES` order).
         segments: The outline segments forming this boundary part (segment k runs from
             vertex k to vertex k + 1), for a plate given by its ``outline``.
+        rotational_stiffness: Elastic restraint of the rotation about the edge,
+            :math:`k_r` (N m per m per rad, i.e. N), >= 0: the energy
+            :math:`\tfrac12\int k_r (\theta\cdot n)^2\,ds`, on an edge whose support leaves
+            that rotation free (not "clamped"). 0: none; :math:`k_r \to \infty`: clamped.
+        translational_stiffness: Elastic support of the deflection along the edge,
+            :math:`k_t` (N/m per m, i.e. N/m^2), >= 0: :math:`\tfrac12\int k_t w^2\,ds`,
+            on an edge whose support leaves w free ("free"). :math:`k_t \to \infty`:
+            the soft simple support.
     """
 
     name: str
@@ -263,6 +271,8 @@ class EdgeSpec:
     shear_stress: float | tuple[float, float] = 0.0
     tag: int | None = None
     segments: tuple[int, ...] | None = None
+    rotational_stiffness: float = 0.0
+    translational_stiffness: float = 0.0
 
     def __post_init__(self) -> None:
         where = f"edges.{self.name}"
@@ -284,6 +294,32 @@ class EdgeSpec:
             if len(set(segments)) != len(segments):
                 raise ValueError(f"{where}.segments repeats a segment: {list(segments)}")
             object.__setattr__(self, "segments", segments)
+        self._check_springs(where)
+
+    def _check_springs(self, where: str) -> None:
+        """The edge springs: finite, >= 0, on DOFs the support leaves free."""
+        for name in ("rotational_stiffness", "translational_stiffness"):
+            if not _number(f"{where}.{name}", getattr(self, name)) >= 0.0:
+                raise ValueError(
+                    f"{where}.{name} must be >= 0 (0: no spring), got {getattr(self, name)!r}"
+                )
+            object.__setattr__(self, name, float(getattr(self, name)))
+        if self.rotational_stiffness > 0.0 and self.support == "clamped":
+            raise ValueError(
+                f'{where}.rotational_stiffness: support = "clamped" fixes the rotation '
+                "already; a rotational spring needs a support that leaves it free "
+                '("simply_supported", "simply_supported_soft" or "free")'
+            )
+        if self.translational_stiffness > 0.0 and self.support != "free":
+            raise ValueError(
+                f'{where}.translational_stiffness: support = "{self.support}" fixes the '
+                'deflection already; an elastically supported edge has support = "free"'
+            )
+
+    @property
+    def springs(self) -> bool:
+        """Whether the edge carries a rotational or a translational spring."""
+        return self.rotational_stiffness > 0.0 or self.translational_stiffness > 0.0
 
     @property
     def loaded(self) -> bool:
@@ -937,6 +973,14 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
         if isinstance(out.get(table), dict) and key in out[table]:
             factor = (length**pl * stress**ps) ** sign
             out[table][key] = _scaled(out[table][key], factor, f"{table}.{key}")
+    edges = out.get("edges")
+    if isinstance(edges, dict):
+        out["edges"] = {
+            name: _edge_to_si(table, f"edges.{name}", length, stress, sign)
+            if isinstance(table, Mapping)
+            else table
+            for name, table in edges.items()
+        }
     plate = out.get("plate")
     if isinstance(plate, dict):
         if "outline" in plate:
@@ -962,6 +1006,24 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
             else t
             for k, t in enumerate(out["obstacles"])
         ]
+    return out
+
+
+#: Keys of an ``[edges.NAME]`` table converted by a file's ``units``: key -> powers of
+#: (length, stress).
+_EDGE_DIMENSIONS: dict[str, tuple[int, int]] = {
+    "translational_stiffness": (0, 1),  # N/m^2 = Pa; rotational_stiffness is N in both
+}
+
+
+def _edge_to_si(
+    table: Mapping[str, Any], where: str, length: float, stress: float, sign: int
+) -> dict[str, Any]:
+    """An edge table with its dimensional values converted (see :func:`_to_si`)."""
+    out = dict(table)
+    for key, (pl, ps) in _EDGE_DIMENSIONS.items():
+        if key in out:
+            out[key] = _scaled(out[key], (length**pl * stress**ps) ** sign, f"{where}.{key}")
     return out
 
 
@@ -1132,7 +1194,15 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     )  # fmt: skip
     if loads_given:
         edges = {n: replace(e, normal_stress=0.0, shear_stress=0.0) for n, e in edges.items()}
-    edge_keys = ("support", "inplane", "normal_stress", "shear_stress", "segments")
+    edge_keys = (
+        "support",
+        "inplane",
+        "normal_stress",
+        "shear_stress",
+        "segments",
+        "rotational_stiffness",
+        "translational_stiffness",
+    )
     for edge_name, edge_table in edge_tables.items():
         kw = _take(edge_table, edge_keys, f"edges.{edge_name}")
         edge = edges.get(edge_name, EdgeSpec(edge_name))
@@ -1214,6 +1284,8 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
                 "inplane": e.inplane,
                 "normal_stress": stress_value(e.normal_stress),
                 "shear_stress": stress_value(e.shear_stress),
+                "rotational_stiffness": e.rotational_stiffness,
+                "translational_stiffness": e.translational_stiffness,
             }
             | ({} if e.segments is None else {"segments": list(e.segments)})
             for e in plate.edges

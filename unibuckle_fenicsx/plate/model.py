@@ -24,7 +24,7 @@ from unibuckle_fenicsx.plate.spaces import (
 )
 from unibuckle_fenicsx.prestress import Prestress
 
-__all__ = ["PlateModel", "edge_support_bcs", "mitc_shear_matrix"]
+__all__ = ["PlateModel", "edge_spring_form", "edge_support_bcs", "mitc_shear_matrix"]
 
 
 class PlateModel(MixedDofs, Owner):
@@ -75,6 +75,9 @@ class PlateModel(MixedDofs, Owner):
         D = bending_voigt(material, plate.thickness)
         ks = shear_stiffness(material, plate.thickness)
         a = bending_form(u, v, D)
+        springs = edge_spring_form(u, v, facet_tags, plate)
+        if springs is not None:
+            a = a + springs
         if shear == "full":
             a = a + shear_form(u, v, ks)
         elif shear != "mitc":
@@ -187,6 +190,57 @@ def edge_support_bcs(
                 dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
                 bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
     return bcs
+
+
+def edge_spring_form(
+    u: ufl.Argument | ufl.core.expr.Expr,
+    v: ufl.Argument | ufl.core.expr.Expr,
+    facet_tags: dolfinx.mesh.MeshTags,
+    plate: PlateSpec,
+    *,
+    w_sub: int = 0,
+    theta_sub: int = 1,
+    scale: float = 1.0,
+) -> ufl.Form | None:
+    r"""Elastic edge restraints :math:`\sum_e \int_e k_r (\theta\cdot n)(\eta\cdot n) + k_t wz\,ds`.
+
+    The second variation of :math:`\tfrac12\int k_r (\theta\cdot n)^2 + k_t w^2\,ds` over the
+    edges with a ``rotational_stiffness`` :math:`k_r` or a ``translational_stiffness``
+    :math:`k_t` (:class:`~unibuckle_fenicsx.config.EdgeSpec`); n is the outward normal,
+    so :math:`\theta\cdot n` is the rotation about the edge. The springs act on the
+    DOFs the support leaves free (the loader refuses the others); assembled with the
+    supports' Dirichlet rows, they do not touch the fixed ones.
+
+    Args:
+        u: Trial function (or state) of a mixed space holding w and theta.
+        v: Test function.
+        facet_tags: Edge markers.
+        plate: The edges.
+        w_sub: Sub-space index of w.
+        theta_sub: Sub-space index of theta.
+        scale: Factor on w in the space (the von Karman plate's unknown is w/t).
+
+    Returns:
+        The form, or None when no edge has a spring.
+    """
+    sprung = [e for e in plate.edges if e.springs]
+    if not sprung:
+        return None
+    parts_u, parts_v = ufl.split(u), ufl.split(v)
+    w, theta = scale * parts_u[w_sub], parts_u[theta_sub]
+    z, eta = scale * parts_v[w_sub], parts_v[theta_sub]
+    domain = ufl.domain.extract_unique_domain(u)
+    ds = ufl.Measure("ds", domain=domain, subdomain_data=facet_tags)
+    n = ufl.FacetNormal(domain)
+    form = None
+    for e in sprung:
+        for tag in edge_tags(plate, e):
+            term = (
+                e.rotational_stiffness * ufl.dot(theta, n) * ufl.dot(eta, n)
+                + e.translational_stiffness * w * z
+            ) * ds(tag)
+            form = term if form is None else form + term
+    return form
 
 
 def mitc_shear_matrix(
