@@ -224,3 +224,43 @@ def test_long_plate_against_a_whole_plate_obstacle():
     richardson = (16 * k[1] - 9 * k[0]) / 7
     assert 5.2 < reference < 5.3
     assert richardson == pytest.approx(reference, rel=2e-4), (k, richardson, reference)
+
+
+# -- the nonlinear path --------------------------------------------------------------------
+def test_nonlinear_path_with_springs_and_points_reaches_the_linear_load():
+    """The von Karman plate (its own energy) with edge springs, a tie and a spring point.
+
+    Its Southwell load equals the linear critical load of the same model to 1e-3 (the
+    imperfection is 1e-3 t), which without the springs and points is 30 % lower: the
+    nonlinear model holds every restraint the linear one does.
+    """
+    from unibuckle_fenicsx.nonlinear import NonlinearOptions, solve_nonlinear
+
+    data = {
+        "plate": {"corners": [[0, 0], [2.0, 1.0]], "thickness": 0.01},
+        "material": {"E": 2.0e11, "nu": 0.3},
+        "edges": {
+            "left": {"normal_stress": -1.0},
+            "right": {"normal_stress": -1.0},
+            "bottom": {"rotational_stiffness": 3.0e5},
+            "top": {"support": "free", "translational_stiffness": 5e6, "rotational_stiffness": 1e4},
+        },
+        "mesh": {"nx": 10, "ny": 5},
+        "points": [{"at": [1.2, 0.4], "kind": "spring", "stiffness": 1e6}, {"at": [0.6, 0.6]}],
+    }
+    spec = problem_from_dict(data)
+    bare = problem_from_dict(
+        {k: v for k, v in data.items() if k != "points"}
+        | {
+            "edges": {
+                "left": {"normal_stress": -1.0},
+                "right": {"normal_stress": -1.0},
+                "top": {"support": "free"},
+            }
+        }
+    )
+    options = NonlinearOptions(max_load=1.1, max_step=0.1)
+    with solve_nonlinear(spec, options, MPI.COMM_WORLD) as analysis:
+        nl = analysis.result
+    assert nl.completed and nl.southwell_ratio == pytest.approx(1.0, abs=1e-3)
+    assert load(bare).critical_load_Pa < 0.75 * nl.linear_critical_load_Pa

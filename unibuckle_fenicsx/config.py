@@ -42,6 +42,7 @@ __all__ = [
     "HOLES",
     "INPLANE_SUPPORTS",
     "METHODS",
+    "POINT_KINDS",
     "SIDES",
     "UNITS",
     "Circle",
@@ -50,6 +51,7 @@ __all__ = [
     "MeshSpec",
     "ObstacleSpec",
     "PlateSpec",
+    "PointSpec",
     "Polygon",
     "ProblemSpec",
     "SolverSpec",
@@ -535,6 +537,21 @@ class PlateSpec:
         """Extent in y (m)."""
         return self.corners[1][1] - self.corners[0][1]
 
+    def contains(self, points: npt.NDArray[np.float64], tol: float) -> npt.NDArray[np.bool_]:
+        """Mask of the points (n, 2) in the closed plate (within ``tol``), not in a hole.
+
+        For a file, its bounding box (the mesh is not known yet).
+        """
+        inside = points_in_polygon(points, self.boundary, tol)
+        for hole in self.holes:
+            if isinstance(hole, Circle):
+                inside &= ~points_in_circle(points, hole.center, hole.radius, -tol)
+            else:
+                inside &= ~points_in_polygon(points, hole.vertices) | (
+                    distance_to_polygon(points, hole.vertices) <= tol
+                )
+        return inside
+
     def edge(self, name: str) -> EdgeSpec:
         """The edge called ``name``."""
         for e in self.edges:
@@ -608,6 +625,18 @@ SIDES = ("above", "below", "both")
 Box = tuple[tuple[float, float], tuple[float, float]]
 
 
+def _box(name: str, value: Any) -> Box:
+    """A box [[xmin, xmax], [ymin, ymax]] of finite numbers, min <= max."""
+    try:
+        (x0, x1), (y0, y1) = value
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be [[xmin, xmax], [ymin, ymax]], got {value!r}") from None
+    box = ((_number(name, x0), _number(name, x1)), (_number(name, y0), _number(name, y1)))
+    if box[0][0] > box[0][1] or box[1][0] > box[1][1]:
+        raise ValueError(f"{name} needs xmin <= xmax and ymin <= ymax, got {value!r}")
+    return box
+
+
 @dataclass(frozen=True)
 class ObstacleSpec:
     r"""Rigid flat obstacle, or Winkler foundation, on one side of the plate over a zone.
@@ -647,21 +676,7 @@ class ObstacleSpec:
         elif isinstance(self.zone, Polygon | Circle):
             pass
         elif not callable(self.zone):
-            try:
-                (x0, x1), (y0, y1) = self.zone
-            except (TypeError, ValueError):
-                raise ValueError(
-                    f"obstacle.zone must be [[xmin, xmax], [ymin, ymax]], got {self.zone!r}"
-                ) from None
-            box = (
-                (_number("obstacle.zone", x0), _number("obstacle.zone", x1)),
-                (_number("obstacle.zone", y0), _number("obstacle.zone", y1)),
-            )
-            if box[0][0] > box[0][1] or box[1][0] > box[1][1]:
-                raise ValueError(
-                    f"obstacle.zone needs xmin <= xmax and ymin <= ymax, got {self.zone!r}"
-                )
-            object.__setattr__(self, "zone", box)
+            object.__setattr__(self, "zone", _box("obstacle.zone", self.zone))
         if self.tolerance is not None and not _number("obstacle.tolerance", self.tolerance) >= 0:
             raise ValueError(f"obstacle.tolerance must be >= 0 m, got {self.tolerance!r}")
         if self.foundation_stiffness is not None:
@@ -728,6 +743,135 @@ class ObstacleSpec:
     def same_zone(self, other: ObstacleSpec) -> bool:
         """Whether ``other`` has the same zone (a predicate only when it is the same one)."""
         return self.zone is other.zone or (not callable(self.zone) and self.zone == other.zone)
+
+
+#: Kinds of point restraint: w = 0, the obstacle's cone at the point, or a spring.
+POINT_KINDS = ("bilateral", "one-sided", "spring")
+
+
+def _pair(name: str, value: Any) -> tuple[float, float]:
+    """A pair [a, b] of finite numbers."""
+    if not isinstance(value, list | tuple) or len(value) != 2:
+        raise ValueError(f"{name} must be a pair [x, y] of numbers, got {value!r}")
+    return (_number(name, value[0]), _number(name, value[1]))
+
+
+@dataclass(frozen=True)
+class PointSpec:
+    r"""Point restraints: one point, or a grid of them (bolts, tie bars, studs).
+
+    Each point acts on the mesh node nearest to it (the snap distance is reported).
+
+    Args:
+        at: One point (x, y) (m); or None for a grid.
+        spacing: The grid's spacing (sx, sy) (m), > 0 (a number: the same in x and y).
+        offset: A point of the grid (m); default the region's lower-left corner.
+        region: The box ((xmin, xmax), (ymin, ymax)) (m) holding the grid's points (a
+            degenerate side gives a line); default the plate's bounding box. Points
+            outside the plate (or in a hole) are left out.
+        kind: One of :data:`POINT_KINDS`: "bilateral" (w = 0), "one-sided" (the
+            obstacle's cone at the point: w <= 0 with ``side`` "above", w >= 0
+            "below"), "spring" (a spring of ``stiffness`` N/m to w = 0).
+        stiffness: The spring's stiffness (N/m), > 0, for ``kind = "spring"`` only.
+        side: "above" or "below", for ``kind = "one-sided"`` only.
+    """
+
+    at: tuple[float, float] | None = None
+    spacing: tuple[float, float] | None = None
+    offset: tuple[float, float] | None = None
+    region: Box | None = None
+    kind: str = "bilateral"
+    stiffness: float | None = None
+    side: str = "above"
+
+    def __post_init__(self) -> None:
+        where = "points"
+        _choice(f"{where}.kind", self.kind, POINT_KINDS)
+        if (self.at is None) == (self.spacing is None):
+            raise ValueError(
+                "[[points]] needs at = [x, y] (one point) or spacing = s or [sx, sy] (a "
+                "grid, with optional offset and region): exactly one of them"
+            )
+        if self.at is not None:
+            object.__setattr__(self, "at", _pair(f"{where}.at", self.at))
+            for name in ("offset", "region"):
+                if getattr(self, name) is not None:
+                    raise ValueError(f"{where}.{name} belongs to a grid (spacing), not to at")
+        else:
+            spacing: Any = self.spacing
+            if not isinstance(spacing, list | tuple):
+                spacing = (spacing, spacing)
+            pair = _pair(f"{where}.spacing", spacing)
+            if min(pair) <= 0.0:
+                raise ValueError(f"{where}.spacing must be > 0 m, got {self.spacing!r}")
+            object.__setattr__(self, "spacing", pair)
+            if self.offset is not None:
+                object.__setattr__(self, "offset", _pair(f"{where}.offset", self.offset))
+            if self.region is not None:
+                object.__setattr__(self, "region", _box(f"{where}.region", self.region))
+        if self.kind == "spring":
+            if self.stiffness is None or not _number(f"{where}.stiffness", self.stiffness) > 0:
+                raise ValueError(
+                    f'{where}.stiffness: kind = "spring" needs a stiffness > 0 N/m, got '
+                    f"{self.stiffness!r}"
+                )
+            object.__setattr__(self, "stiffness", float(self.stiffness))
+        elif self.stiffness is not None:
+            raise ValueError(f'{where}.stiffness belongs to kind = "spring", not "{self.kind}"')
+        _choice(f"{where}.side", self.side, ("above", "below"))
+        if self.side != "above" and self.kind != "one-sided":
+            raise ValueError(f'{where}.side belongs to kind = "one-sided", not "{self.kind}"')
+
+    @property
+    def sign(self) -> float:
+        """+1 for a one-sided point above (w <= 0 admissible), -1 below."""
+        return 1.0 if self.side == "above" else -1.0
+
+    def locations(self, plate: PlateSpec) -> npt.NDArray[np.float64]:
+        """The points (n, 2) (m): ``at``, or the grid's points inside the plate.
+
+        Raises:
+            ValueError: ``at`` outside the plate, or a grid with no point in it.
+        """
+        size = max(plate.length, plate.width)
+        tol = 1e-9 * size
+        if self.at is not None:
+            points = np.array([self.at])
+        else:
+            assert self.spacing is not None
+            region = self.region if self.region is not None else tuple(zip(*plate.corners))
+            offset = self.offset if self.offset is not None else (region[0][0], region[1][0])
+            axes = []
+            for (lo, hi), step, start in zip(region, self.spacing, offset, strict=True):
+                first = math.ceil((lo - start - tol) / step)
+                last = math.floor((hi - start + tol) / step)
+                if last - first > 100_000:
+                    raise ValueError(
+                        f"points.spacing {self.spacing} gives more than 100000 points per row"
+                    )
+                axes.append(start + step * np.arange(first, last + 1))
+            gx, gy = np.meshgrid(*axes, indexing="ij")
+            points = np.column_stack([gx.ravel(), gy.ravel()])
+        inside = plate.contains(points, tol) if plate.file is None else np.ones(len(points), bool)
+        if self.at is not None and not inside.all():
+            raise ValueError(f"points.at {list(self.at)} lies outside the plate (or in a hole)")
+        points = points[inside]
+        if not len(points):
+            raise ValueError(
+                f"points: the grid of spacing {list(self.spacing or ())} holds no point of "
+                "the plate; check spacing, offset and region"
+            )
+        return points
+
+    def describe(self) -> str:
+        """Short description (for messages and the summary)."""
+        what = self.kind if self.kind != "spring" else f"spring {self.stiffness:g} N/m"
+        if self.kind == "one-sided":
+            what += f" ({self.side})"
+        if self.at is not None:
+            return f"{what} at ({self.at[0]:g}, {self.at[1]:g})"
+        assert self.spacing is not None
+        return f"{what} grid of spacing {self.spacing[0]:g} x {self.spacing[1]:g}"
 
 
 @dataclass(frozen=True)
@@ -817,6 +961,7 @@ class ProblemSpec:
             numbers here are SI whatever it is).
         obstacles: Several obstacles (the file's ``[[obstacles]]`` tables), instead of
             ``obstacle``; their constrained nodes are the union of their zones'.
+        points: Point restraints (the file's ``[[points]]`` tables).
     """
 
     name: str = "plate"
@@ -827,6 +972,7 @@ class ProblemSpec:
     solver: SolverSpec = field(default_factory=SolverSpec)
     units: str = "SI"
     obstacles: tuple[ObstacleSpec, ...] = ()
+    points: tuple[PointSpec, ...] = ()
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -847,8 +993,22 @@ class ProblemSpec:
         for k, o in enumerate(self.obstacles):
             if not isinstance(o, ObstacleSpec):
                 raise ValueError(f"obstacles[{k}] must be an ObstacleSpec, got {o!r}")
+        object.__setattr__(self, "points", tuple(self.points))
+        for k, point in enumerate(self.points):
+            if not isinstance(point, PointSpec):
+                raise ValueError(f"points[{k}] must be a PointSpec, got {point!r}")
+            try:
+                point.locations(plate)
+            except ValueError as err:
+                raise ValueError(f"points[{k}]{str(err)[len('points') :]}") from None
         found = self.all_obstacles
         kinds = {o.kind for o in found}
+        if self.one_sided_points and "tensionless" in kinds:
+            raise ValueError(
+                'points: one-sided points (kind = "one-sided") join a rigid obstacle\'s cone; '
+                'with a tensionless foundation give them a stiffness (kind = "spring") or '
+                "make the foundation rigid"
+            )
         if {"rigid", "tensionless"} <= kinds:
             raise ValueError(
                 "rigid obstacles and tensionless foundations in one problem are not "
@@ -879,6 +1039,11 @@ class ProblemSpec:
                     '[edges.NAME] support (e.g. support = "simply_supported"), or keep one '
                     "side"
                 )
+
+    @property
+    def one_sided_points(self) -> tuple[PointSpec, ...]:
+        """The point restraints that join the obstacle's cone."""
+        return tuple(p for p in self.points if p.kind == "one-sided")
 
     @property
     def unilateral_obstacles(self) -> tuple[ObstacleSpec, ...]:
@@ -999,13 +1164,14 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
             ]
     if isinstance(out.get("obstacle"), dict):
         out["obstacle"] = _obstacle_to_si(out["obstacle"], "obstacle", length**sign, stress**sign)
-    if isinstance(out.get("obstacles"), list):
-        out["obstacles"] = [
-            _obstacle_to_si(t, f"obstacles[{k}]", length**sign, stress**sign)
-            if isinstance(t, Mapping)
-            else t
-            for k, t in enumerate(out["obstacles"])
-        ]
+    for key, convert in (("points", _point_to_si), ("obstacles", _obstacle_to_si)):
+        if isinstance(out.get(key), list):
+            out[key] = [
+                convert(t, f"{key}[{k}]", length**sign, stress**sign)
+                if isinstance(t, Mapping)
+                else t
+                for k, t in enumerate(out[key])
+            ]
     return out
 
 
@@ -1024,6 +1190,19 @@ def _edge_to_si(
     for key, (pl, ps) in _EDGE_DIMENSIONS.items():
         if key in out:
             out[key] = _scaled(out[key], (length**pl * stress**ps) ** sign, f"{where}.{key}")
+    return out
+
+
+def _point_to_si(
+    table: Mapping[str, Any], where: str, length: float, stress: float
+) -> dict[str, Any]:
+    """A points table with its lengths times ``length``, its stiffness (N/m) converted."""
+    out = dict(table)
+    for key in ("at", "spacing", "offset", "region"):
+        if key in out:
+            out[key] = _scaled(out[key], length, f"{where}.{key}")
+    if "stiffness" in out:  # N/m = Pa m
+        out["stiffness"] = _scaled(out["stiffness"], stress * length, f"{where}.stiffness")
     return out
 
 
@@ -1164,7 +1343,18 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     """
     top = _take(
         data,
-        ("name", "units", "plate", "material", "edges", "mesh", "obstacle", "obstacles", "solver"),
+        (
+            "name",
+            "units",
+            "plate",
+            "material",
+            "edges",
+            "mesh",
+            "obstacle",
+            "obstacles",
+            "points",
+            "solver",
+        ),
         "top",
     )
     units = _choice("units", top.get("units", "SI"), tuple(UNITS))
@@ -1241,6 +1431,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         if obstacle is not None:
             raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
         obstacles = [_obstacle_from_table(t, f"obstacles[{k}]") for k, t in enumerate(tables)]
+    points = _points(top["points"]) if "points" in top else ()
     solver = SolverSpec(**_take(top.get("solver", {}), _names(SolverSpec), "solver"))
     label = top.get("name", name)
     if not isinstance(label, str):
@@ -1254,7 +1445,47 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         solver=solver,
         units=units,
         obstacles=tuple(obstacles),
+        points=points,
     )
+
+
+def _points(tables: Any) -> tuple[PointSpec, ...]:
+    """``[[points]]`` tables; messages name ``points[k]``."""
+    if not isinstance(tables, list) or not tables:
+        raise ValueError(
+            f"points must be a list of tables ([[points]] in TOML), at least one, got {tables!r}"
+        )
+    out = []
+    for k, table in enumerate(tables):
+        kw = _take(table, _names(PointSpec), f"points[{k}]")
+        try:
+            out.append(PointSpec(**kw))
+        except ValueError as err:
+            message = str(err)
+            if message.startswith("points"):
+                message = f"points[{k}]" + message[len("points") :]
+            raise ValueError(message) from None
+    return tuple(out)
+
+
+def _point_table(point: PointSpec) -> dict[str, Any]:
+    """The file form of a point restraint (every key with the value used)."""
+    out: dict[str, Any] = {"kind": point.kind}
+    if point.at is not None:
+        out["at"] = list(point.at)
+    else:
+        assert point.spacing is not None
+        sx, sy = point.spacing
+        out["spacing"] = sx if sx == sy else [sx, sy]
+        if point.offset is not None:
+            out["offset"] = list(point.offset)
+        if point.region is not None:
+            out["region"] = [list(r) for r in point.region]
+    if point.stiffness is not None:
+        out["stiffness"] = point.stiffness
+    if point.kind == "one-sided":
+        out["side"] = point.side
+    return out
 
 
 def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
@@ -1303,6 +1534,8 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         out["obstacle"] = _obstacle_table(spec.obstacle)
     if spec.obstacles:
         out["obstacles"] = [_obstacle_table(o) for o in spec.obstacles]
+    if spec.points:
+        out["points"] = [_point_table(p) for p in spec.points]
     for key in ("membrane_voigt", "bending_voigt"):
         if key in out["material"]:
             out["material"][key] = [list(row) for row in out["material"][key]]

@@ -30,6 +30,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.contact import (
+    BilateralZoneError,
     ContactSetManager,
     check_zone_has_nodes,
     foundation_springs,
@@ -39,6 +40,7 @@ from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, EigenPair, GEPSolver, Owner, 
 from unibuckle_fenicsx.materials import bending_stiffness
 from unibuckle_fenicsx.mesh import build_plate_mesh
 from unibuckle_fenicsx.plate.model import PlateModel
+from unibuckle_fenicsx.points import point_obstacles
 from unibuckle_fenicsx.prestress import solve_prestress
 
 __all__ = ["BYTES_PER_DOF", "BucklingProblem", "Candidate", "Mode", "available_memory"]
@@ -215,7 +217,13 @@ class BucklingProblem(Owner):
         t1 = time.perf_counter()
         self.timings["prestress_s"] = t1 - t0
         self.model = PlateModel(
-            self.mesh, self.facet_tags, spec.plate, spec.material, self.prestress, spec.solver.shear
+            self.mesh,
+            self.facet_tags,
+            spec.plate,
+            spec.material,
+            self.prestress,
+            spec.solver.shear,
+            points=spec.points,
         )
         if spec.bilateral_foundations:
             self.model.add_springs(*foundation_springs(self.model, spec.bilateral_foundations))
@@ -229,8 +237,18 @@ class BucklingProblem(Owner):
             tol=spec.solver.eps_tol,
             options={**EIGEN_OPTIONS, **(eps_options or {})},
         )
-        unilateral = spec.unilateral_obstacles
-        self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
+        unilateral = spec.unilateral_obstacles + tuple(
+            point_obstacles(self.model.points, spec.plate)
+        )
+        try:
+            self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
+        except BilateralZoneError as err:
+            if not spec.one_sided_points:
+                raise
+            raise BilateralZoneError(
+                "points: a one-sided point acts on a node held from the other side too (an "
+                'obstacle zone or another point): that holds w = 0, give it kind = "bilateral"'
+            ) from err
         self.free: Mode | None = None
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None

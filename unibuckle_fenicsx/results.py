@@ -138,6 +138,8 @@ class BucklingResult:
             input=_input(spec),
             versions=versions(),
         )
+        if problem.model.points:
+            result.details["point_restraints"] = [g.report() for g in problem.model.points]
         if solution is None or certificate is None:
             result.lower_bound_Pa = result.upper_bound_Pa = free.load
             return result
@@ -190,14 +192,27 @@ class BucklingResult:
             for name, load in self.edge_loads.items()
             if _load_text(load)
         ]
+        extra = "".join(f"\n  {line}" for line in self._model_lines())
         return (
             f"{self.case}: lambda_c = {self.critical_load_Pa / scale:.6e} {unit} "
             f"({self.critical_load_Pa / self.free_load_Pa:.4f} x free "
             f"{self.free_load_Pa / scale:.6e} {unit}), "
             f"k = {self.buckling_coefficient_k:.4f}, method {self.method}{z}, "
             f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s\n"
-            f"  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}"
+            f"  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}{extra}"
         )
+
+    def _model_lines(self) -> list[str]:
+        """Summary lines of what the model holds beyond plate, edges and obstacle."""
+        length = UNITS[self.units][0]
+        lines = []
+        for p in self.details.get("point_restraints", []):
+            lines.append(
+                f"points: {p['restraint']}: {p['points']} points on {p['nodes']} nodes, "
+                f"largest snap distance {p['max_snap_distance_m'] / length:.3g}"
+                f" {'m' if self.units == 'SI' else 'mm'}"
+            )
+        return lines
 
 
 def _load_text(load: dict[str, Any]) -> str:

@@ -65,8 +65,9 @@ from unibuckle_fenicsx.mesh import (
     edge_tag,
     edge_tags,
 )
-from unibuckle_fenicsx.plate.model import edge_support_bcs, mitc_shear_matrix
+from unibuckle_fenicsx.plate.model import edge_spring_form, edge_support_bcs, mitc_shear_matrix
 from unibuckle_fenicsx.plate.spaces import MixedDofs
+from unibuckle_fenicsx.points import point_bcs, point_springs, snap_points
 from unibuckle_fenicsx.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
 
 __all__ = [
@@ -225,6 +226,13 @@ class VonKarmanPlate(MixedDofs, Owner):
         self.bending_bcs = edge_support_bcs(
             self.W, self.facet_tags, self.plate, w_sub=W_SUB, theta_sub=THETA_SUB
         )
+        self.points = snap_points(self.Vw, self.plate, spec.points)
+        if spec.one_sided_points:
+            raise ValueError(
+                "points: the nonlinear analysis does not model one-sided points (kind = "
+                '"one-sided"); give them kind = "bilateral" or "spring", or leave them out'
+            )
+        self.bending_bcs += point_bcs(self.W, self.Vw, self.points, self.plate, w_sub=W_SUB)
         self.bc_dofs = np.unique(
             np.concatenate(
                 [bc.dof_indices()[0] for bc in self.bending_bcs] or [np.empty(0, np.int32)]
@@ -256,6 +264,10 @@ class VonKarmanPlate(MixedDofs, Owner):
             gamma = ufl.grad(w - w0) - (theta_h - theta0_h)
             energy = energy + 0.5 * ks * ufl.inner(gamma, gamma)
         Pi = energy / self.energy_scale * ufl.dx
+        d = (t * (w_h - w0_h), theta_h - theta0_h)  # from the stress-free imperfect shape
+        springs = edge_spring_form(d, d, self.facet_tags, self.plate)
+        if springs is not None:
+            Pi = Pi + (0.5 / self.energy_scale) * springs
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
         n = ufl.FacetNormal(msh)
         tractions = [
@@ -309,6 +321,7 @@ class VonKarmanPlate(MixedDofs, Owner):
                 column_scale=scale.x.petsc_vec,
             )
             self.Ks = Ks
+        self._add_point_springs(t)
         self.J: PETSc.Mat | None = dolfinx.fem.petsc.create_matrix(self.J_form)
         self._merged = False
         self.b: PETSc.Vec | None = dolfinx.fem.petsc.create_vector(self.W)
@@ -388,6 +401,29 @@ class VonKarmanPlate(MixedDofs, Owner):
         elif axis is not None and not held[1 - axis]:
             bcs += pin_rigid_motions(U, msh, only=1 - axis)
         return bcs
+
+    def _add_point_springs(self, t: float) -> None:
+        """Spring points: k_p t^2 / D11 on the diagonal of K_s (the quadratic part, about x0)."""
+        if not any(g.spec.kind == "spring" for g in self.points):
+            return
+        local, stiffness = point_springs(self.Vw, self.w_dofs, self.points, self.plate)
+        keep = ~np.isin(local, self.bc_dofs)
+        rows = self.global_dofs(local[keep])
+        stiffness = stiffness[keep] * t**2 / self.energy_scale
+        if self.Ks is None:
+            n = self.num_owned_dofs
+            self.Ks = PETSc.Mat().createAIJ(
+                ((n, None), (n, None)),  # type: ignore[arg-type]
+                nnz=1,
+                comm=self.comm,
+            )
+            lo, hi = self.Ks.getOwnershipRange()
+            for r in range(lo, hi):
+                self.Ks.setValue(r, r, 0.0)
+        self.Ks.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)  # type: ignore[arg-type]
+        for r, k in zip(rows.tolist(), stiffness.tolist(), strict=True):
+            self.Ks.setValue(r, r, k, addv=True)
+        self.Ks.assemble()
 
     # -- PlateDofs (for ContactSetManager) -------------------------------------------
     @property

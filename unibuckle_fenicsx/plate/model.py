@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from petsc4py import PETSc
 
 import dolfinx
@@ -11,7 +13,7 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import Material, PlateSpec
+from unibuckle_fenicsx.config import Material, PlateSpec, PointSpec
 from unibuckle_fenicsx.eigen import Owner, release
 from unibuckle_fenicsx.materials import bending_voigt, shear_stiffness
 from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tags
@@ -22,6 +24,7 @@ from unibuckle_fenicsx.plate.spaces import (
     create_shear_space,
     mitc_shear_operator,
 )
+from unibuckle_fenicsx.points import point_bcs, point_springs, snap_points
 from unibuckle_fenicsx.prestress import Prestress
 
 __all__ = ["PlateModel", "edge_spring_form", "edge_support_bcs", "mitc_shear_matrix"]
@@ -43,6 +46,8 @@ class PlateModel(MixedDofs, Owner):
         material: Elastic constants.
         prestress: Membrane force per unit load.
         shear: "mitc" (locking-free) or "full" (plain full integration, locks).
+        points: Point restraints (:mod:`~unibuckle_fenicsx.points`): bilateral ones
+            become zero Dirichlet conditions, springs diagonal entries of A.
 
     Note:
         Construction and :meth:`destroy` are collective.
@@ -56,6 +61,7 @@ class PlateModel(MixedDofs, Owner):
         material: Material,
         prestress: Prestress,
         shear: str = "mitc",
+        points: Sequence[PointSpec] = (),
     ) -> None:
         if msh.topology.cell_type != dolfinx.mesh.CellType.quadrilateral:
             raise ValueError("the MITC plate element needs a quadrilateral mesh")
@@ -66,7 +72,9 @@ class PlateModel(MixedDofs, Owner):
         self.W = create_plate_space(msh)
         self.Vw, map_w = self.W.sub(0).collapse()
         self.w_dofs = np.asarray(map_w[0], dtype=np.int32)  # Vw local dof -> W local dof
-        self.bcs = self._edge_bcs(facet_tags)
+        #: The point restraints on the mesh (snapped to nodes).
+        self.points = snap_points(self.Vw, plate, points)
+        self.bcs = self._edge_bcs(facet_tags) + point_bcs(self.W, self.Vw, self.points, plate)
         self.bc_dofs = np.unique(
             np.concatenate([bc.dof_indices()[0] for bc in self.bcs] or [np.empty(0, np.int32)])
         ).astype(np.int32)
@@ -75,7 +83,7 @@ class PlateModel(MixedDofs, Owner):
         D = bending_voigt(material, plate.thickness)
         ks = shear_stiffness(material, plate.thickness)
         a = bending_form(u, v, D)
-        springs = edge_spring_form(u, v, facet_tags, plate)
+        springs = edge_spring_form(ufl.split(u), ufl.split(v), facet_tags, plate)
         if springs is not None:
             a = a + springs
         if shear == "full":
@@ -93,6 +101,10 @@ class PlateModel(MixedDofs, Owner):
             S.destroy()
         self.B = dolfinx.fem.petsc.assemble_matrix(self.b_form, bcs=self.bcs, diag=0.0)
         self.B.assemble()
+        rows, stiffness = point_springs(self.Vw, self.w_dofs, self.points, plate)
+        if any(g.spec.kind == "spring" for g in self.points):
+            keep = ~np.isin(rows, self.bc_dofs)
+            self.add_springs(self.global_dofs(rows[keep]), stiffness[keep])
         self.A.setOption(PETSc.Mat.Option.SPD, True)
         self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         self.B.setOption(PETSc.Mat.Option.SYMMETRIC, True)
@@ -193,14 +205,10 @@ def edge_support_bcs(
 
 
 def edge_spring_form(
-    u: ufl.Argument | ufl.core.expr.Expr,
-    v: ufl.Argument | ufl.core.expr.Expr,
+    u: tuple[ufl.core.expr.Expr, ufl.core.expr.Expr],
+    v: tuple[ufl.core.expr.Expr, ufl.core.expr.Expr],
     facet_tags: dolfinx.mesh.MeshTags,
     plate: PlateSpec,
-    *,
-    w_sub: int = 0,
-    theta_sub: int = 1,
-    scale: float = 1.0,
 ) -> ufl.Form | None:
     r"""Elastic edge restraints :math:`\sum_e \int_e k_r (\theta\cdot n)(\eta\cdot n) + k_t wz\,ds`.
 
@@ -212,13 +220,10 @@ def edge_spring_form(
     supports' Dirichlet rows, they do not touch the fixed ones.
 
     Args:
-        u: Trial function (or state) of a mixed space holding w and theta.
-        v: Test function.
+        u: (w, theta) of the trial function (or of a state).
+        v: (z, eta) of the test function (or of a state: ``u`` again for the energy).
         facet_tags: Edge markers.
         plate: The edges.
-        w_sub: Sub-space index of w.
-        theta_sub: Sub-space index of theta.
-        scale: Factor on w in the space (the von Karman plate's unknown is w/t).
 
     Returns:
         The form, or None when no edge has a spring.
@@ -226,10 +231,8 @@ def edge_spring_form(
     sprung = [e for e in plate.edges if e.springs]
     if not sprung:
         return None
-    parts_u, parts_v = ufl.split(u), ufl.split(v)
-    w, theta = scale * parts_u[w_sub], parts_u[theta_sub]
-    z, eta = scale * parts_v[w_sub], parts_v[theta_sub]
-    domain = ufl.domain.extract_unique_domain(u)
+    (w, theta), (z, eta) = u, v
+    domain = ufl.domain.extract_unique_domain(theta)
     ds = ufl.Measure("ds", domain=domain, subdomain_data=facet_tags)
     n = ufl.FacetNormal(domain)
     form = None
