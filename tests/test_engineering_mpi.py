@@ -1,9 +1,10 @@
 """The engineering features under ``mpiexec -n 2``: the serial answers, partition-independent.
 
-Restrained edges, point restraints (snapped off-grid, bilateral, one-sided, springs) on
-small meshes, each solved in this process and by ``tests/mpi/engineering.py`` on two
-ranks: loads to 1e-8 relative (the eigen solves converge to 1e-10), contact nodes and
-snapped nodes exactly (their choice is partition-independent by construction).
+Restrained edges, point restraints (snapped off-grid, bilateral, one-sided, springs), an
+angle-ply laminate, on small meshes, each solved in this process and by
+``tests/mpi/engineering.py`` on two ranks: loads to 1e-8 relative (the eigen solves
+converge to 1e-10), contact nodes and snapped nodes exactly (their choice is
+partition-independent by construction).
 """
 
 from __future__ import annotations
@@ -30,6 +31,8 @@ PLATE = {"corners": [[0.0, 0.0], [2.0, 1.0]], "thickness": 0.01}
 MATERIAL = {"E": 2.0e11, "nu": 0.3}
 EDGES = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
 
+PLY = {"E1": 1.4e11, "E2": 1.0e10, "G12": 5.0e9, "nu12": 0.3, "G13": 5.0e9, "G23": 3.0e9}
+
 PROBLEMS = {
     "restrained edges, obstacle": {
         "plate": PLATE,
@@ -45,6 +48,15 @@ PROBLEMS = {
         },
         "mesh": {"nx": 12, "ny": 6},
         "obstacle": {"zone": "all"},
+    },
+    "laminate (45/-45/-45/45), obstacle": {
+        "plate": {"corners": [[0.0, 0.0], [2.0, 1.0]]},
+        "material": {
+            "plies": [{"thickness": 0.0025, "angle": a, **PLY} for a in (45, -45, -45, 45)]
+        },
+        "edges": EDGES,
+        "mesh": {"nx": 12, "ny": 6},
+        "obstacle": {"zone": [[0.0, 1.0], [0.0, 1.0]], "side": "below"},
     },
     "points: off-grid ties, springs, one-sided studs": {
         "plate": PLATE,

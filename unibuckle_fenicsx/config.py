@@ -35,6 +35,7 @@ from unibuckle_fenicsx.geometry import (
     polygon_inside,
     polygons_disjoint,
 )
+from unibuckle_fenicsx.laminate import laminate
 
 __all__ = [
     "BENDING_SUPPORTS",
@@ -51,6 +52,7 @@ __all__ = [
     "MeshSpec",
     "ObstacleSpec",
     "PlateSpec",
+    "Ply",
     "PointSpec",
     "Polygon",
     "ProblemSpec",
@@ -130,6 +132,47 @@ def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
 
 
 @dataclass(frozen=True)
+class Ply:
+    r"""One orthotropic ply of a laminate (:mod:`~unibuckle_fenicsx.laminate`).
+
+    Args:
+        thickness: Ply thickness (m), > 0.
+        angle: Fibre angle from the x axis, counter-clockwise (degrees).
+        E1: Young's modulus along the fibres (Pa), > 0.
+        E2: Young's modulus across the fibres (Pa), > 0.
+        G12: In-plane shear modulus (Pa), > 0.
+        nu12: Major Poisson's ratio, :math:`|\nu_{12}| < \sqrt{E_1/E_2}` (a positive
+            definite ply).
+        G13: Transverse shear modulus in the 1-3 plane (Pa), > 0.
+        G23: Transverse shear modulus in the 2-3 plane (Pa), > 0.
+    """
+
+    thickness: float
+    angle: float
+    E1: float
+    E2: float
+    G12: float
+    nu12: float
+    G13: float
+    G23: float
+
+    def __post_init__(self) -> None:
+        for name in ("thickness", "E1", "E2", "G12", "G13", "G23"):
+            value = _number(f"material.plies.{name}", getattr(self, name))
+            if not value > 0.0:
+                unit = "m" if name == "thickness" else "Pa"
+                raise ValueError(f"material.plies.{name} must be > 0 {unit}, got {value!r}")
+            object.__setattr__(self, name, value)
+        for name in ("angle", "nu12"):
+            object.__setattr__(self, name, _number(f"material.plies.{name}", getattr(self, name)))
+        if not abs(self.nu12) < math.sqrt(self.E1 / self.E2):
+            raise ValueError(
+                f"material.plies.nu12 must satisfy |nu12| < sqrt(E1/E2) = "
+                f"{math.sqrt(self.E1 / self.E2):.4g} (a positive definite ply), got {self.nu12!r}"
+            )
+
+
+@dataclass(frozen=True)
 class Material:
     r"""Linear elastic material.
 
@@ -146,6 +189,12 @@ class Material:
             :math:`D_{\alpha\beta\nu\mu}`, 3x3 Voigt (N m) acting on
             :math:`(\kappa_{11}, \kappa_{22}, 2\kappa_{12})`. ``None``: isotropic
             :math:`D = E t^3/(12(1-\nu^2))`.
+        plies: A laminate, bottom ply first (:class:`Ply`): its membrane, bending and
+            transverse shear stiffness by classical lamination theory with first-order
+            shear (:mod:`~unibuckle_fenicsx.laminate`, ``shear_correction`` the factor
+            on the shear); symmetric stacks only (no bending-membrane coupling). E and
+            nu are then the laminate's in-plane constants :math:`E_x, \nu_{xy}`: build
+            it with :meth:`from_plies`.
     """
 
     E: float
@@ -153,8 +202,27 @@ class Material:
     shear_correction: float = 5.0 / 6.0
     membrane_voigt: tuple[tuple[float, ...], ...] | None = None
     bending_voigt: tuple[tuple[float, ...], ...] | None = None
+    plies: tuple[Ply, ...] = ()
+
+    @classmethod
+    def from_plies(cls, plies: Any, shear_correction: float = 5.0 / 6.0) -> Material:
+        """The laminate of ``plies`` (bottom first), E and nu its in-plane constants."""
+        if not isinstance(plies, list | tuple) or not plies:
+            raise ValueError(
+                "material.plies must be a list of tables ([[material.plies]] in TOML), at "
+                f"least one, got {plies!r}"
+            )
+        for k, ply in enumerate(plies):
+            if not isinstance(ply, Ply):
+                raise ValueError(f"material.plies[{k}] must be a Ply, got {ply!r}")
+        E, nu = laminate(plies).engineering_constants()
+        return cls(E=E, nu=nu, shear_correction=shear_correction, plies=tuple(plies))
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "plies", tuple(self.plies))
+        if self.plies:
+            self._check_laminate()
+            return
         if not _number("material.E", self.E) > 0.0:
             raise ValueError(f"material.E (Young's modulus) must be > 0 Pa, got {self.E!r}")
         if not -1.0 < _number("material.nu", self.nu) < 0.5:
@@ -184,6 +252,35 @@ class Material:
             object.__setattr__(self, name, tuple(tuple(float(c) for c in row) for row in mat))
         for name in ("E", "nu", "shear_correction"):
             object.__setattr__(self, name, float(getattr(self, name)))
+
+    def _check_laminate(self) -> None:
+        """A symmetric stack of plies; E and nu its in-plane constants."""
+        if self.membrane_voigt is not None or self.bending_voigt is not None:
+            raise ValueError(
+                "material.plies: a laminate's stiffness comes from its plies; give plies, or "
+                "membrane_voigt and bending_voigt, not both"
+            )
+        if not _number("material.shear_correction", self.shear_correction) > 0.0:
+            raise ValueError(
+                f"material.shear_correction must be > 0, got {self.shear_correction!r}"
+            )
+        stack = laminate(self.plies, self.shear_correction)
+        if stack.coupling > 1e-10:
+            raise ValueError(
+                "material.plies: the stack is not symmetric about its mid-plane (bending-"
+                f"membrane coupling: largest |B_ij| = {np.abs(stack.B).max():.4g} N, "
+                f"{stack.coupling:.2g} of max|A_ij| t); unsymmetric laminates bend under "
+                "in-plane load and are not modelled: give a stack symmetric about its "
+                "mid-plane (same thickness, angle and material at equal distances)"
+            )
+        E, nu = stack.engineering_constants()
+        if not (math.isclose(self.E, E, rel_tol=1e-9) and math.isclose(self.nu, nu, rel_tol=1e-9)):
+            raise ValueError(
+                f"material.E and material.nu of a laminate are its in-plane constants E_x = "
+                f"{E:.6g} Pa and nu_xy = {nu:.6g} from the plies (got {self.E!r}, {self.nu!r}): "
+                "leave them out (Material.from_plies)"
+            )
+        object.__setattr__(self, "shear_correction", float(self.shear_correction))
 
 
 @dataclass(frozen=True)
@@ -993,6 +1090,13 @@ class ProblemSpec:
         for k, o in enumerate(self.obstacles):
             if not isinstance(o, ObstacleSpec):
                 raise ValueError(f"obstacles[{k}] must be an ObstacleSpec, got {o!r}")
+        if self.material.plies:
+            total = sum(ply.thickness for ply in self.material.plies)
+            if not math.isclose(plate.thickness, total, rel_tol=1e-9):
+                raise ValueError(
+                    f"plate.thickness = {plate.thickness!r} m differs from the plies' total "
+                    f"{total!r} m"
+                )
         object.__setattr__(self, "points", tuple(self.points))
         for k, point in enumerate(self.points):
             if not isinstance(point, PointSpec):
@@ -1138,6 +1242,21 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
         if isinstance(out.get(table), dict) and key in out[table]:
             factor = (length**pl * stress**ps) ** sign
             out[table][key] = _scaled(out[table][key], factor, f"{table}.{key}")
+    material = out.get("material")
+    if isinstance(material, dict) and isinstance(material.get("plies"), list):
+        material["plies"] = [
+            {
+                k: _scaled(
+                    v, length**sign if k == "thickness" else stress**sign, f"material.plies.{k}"
+                )
+                if k in ("thickness", "E1", "E2", "G12", "G13", "G23")
+                else v
+                for k, v in ply.items()
+            }
+            if isinstance(ply, Mapping)
+            else ply
+            for ply in material["plies"]
+        ]
     edges = out.get("edges")
     if isinstance(edges, dict):
         out["edges"] = {
@@ -1398,11 +1517,16 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         edge = edges.get(edge_name, EdgeSpec(edge_name))
         edges[edge_name] = replace(edge, **kw)
     plate = PlateSpec(**plate_kw, edges=tuple(edges.values()))
-    material_kw = _take(top.get("material", {"E": 1.0e9, "nu": 0.3}), _names(Material), "material")
-    for key in ("E", "nu"):
-        if key not in material_kw:
-            raise ValueError(f"[material] needs {key!r}")
-    material = Material(**material_kw)
+    material = _material(top.get("material", {"E": 1.0e9, "nu": 0.3}))
+    if material.plies:
+        total = sum(ply.thickness for ply in material.plies)
+        if "thickness" not in plate_kw:
+            plate = replace(plate, thickness=total)
+        elif not math.isclose(plate.thickness, total, rel_tol=1e-9):
+            raise ValueError(
+                f"plate.thickness = {plate.thickness!r} m differs from the plies' total "
+                f"{total!r} m: leave plate.thickness out for a laminate (it is the plies')"
+            )
     mesh_kw = _take(top.get("mesh", {}), _names(MeshSpec), "mesh")
     if plate.meshed_by_gmsh:
         if "nx" in mesh_kw or "ny" in mesh_kw:
@@ -1449,6 +1573,44 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     )
 
 
+#: Keys of a ``[[material.plies]]`` table.
+PLY_KEYS = ("thickness", "angle", "E1", "E2", "G12", "nu12", "G13", "G23")
+
+
+def _material(table: Any) -> Material:
+    """``[material]``: E and nu, or ``[[material.plies]]`` (a laminate)."""
+    kw = _take(table, _names(Material), "material")
+    if "plies" not in kw:
+        for key in ("E", "nu"):
+            if key not in kw:
+                raise ValueError(f"[material] needs {key!r} (or [[material.plies]])")
+        return Material(**kw)
+    other = sorted(set(kw) - {"plies", "shear_correction"})
+    if other:
+        raise ValueError(
+            f"[material] with plies takes shear_correction only besides them, not {other}: "
+            "a laminate's stiffness (and its E_x, nu_xy) comes from its plies"
+        )
+    tables = kw.pop("plies")
+    if not isinstance(tables, list) or not tables:
+        raise ValueError(
+            "material.plies must be a list of tables ([[material.plies]] in TOML), at least "
+            f"one, got {tables!r}"
+        )
+    plies = []
+    for k, ply in enumerate(tables):
+        where = f"material.plies[{k}]"
+        ply_kw = _take(ply, PLY_KEYS, where)
+        missing = [key for key in PLY_KEYS if key not in ply_kw]
+        if missing:
+            raise ValueError(f"[{where}] needs {missing} (keys: {list(PLY_KEYS)})")
+        try:
+            plies.append(Ply(**ply_kw))
+        except ValueError as err:
+            raise ValueError(str(err).replace("material.plies.", f"{where}.")) from None
+    return Material.from_plies(plies, **kw)
+
+
 def _points(tables: Any) -> tuple[PointSpec, ...]:
     """``[[points]]`` tables; messages name ``points[k]``."""
     if not isinstance(tables, list) or not tables:
@@ -1466,6 +1628,22 @@ def _points(tables: Any) -> tuple[PointSpec, ...]:
                 message = f"points[{k}]" + message[len("points") :]
             raise ValueError(message) from None
     return tuple(out)
+
+
+def _material_table(material: Material) -> dict[str, Any]:
+    """The file form of the material (a laminate: its plies, not E and nu)."""
+    if material.plies:
+        return {
+            "shear_correction": material.shear_correction,
+            "plies": [dict(vars(ply)) for ply in material.plies],
+        }
+    out: dict[str, Any] = {
+        k: v for k, v in vars(material).items() if v is not None and k != "plies"
+    }
+    for key in ("membrane_voigt", "bending_voigt"):
+        if key in out:
+            out[key] = [list(row) for row in out[key]]
+    return out
 
 
 def _point_table(point: PointSpec) -> dict[str, Any]:
@@ -1506,9 +1684,7 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         "name": spec.name,
         "units": "SI",
         "plate": _plate_table(plate),
-        "material": {
-            k: v for k, v in vars(spec.material).items() if v is not None
-        },  # tuples become lists in JSON/TOML
+        "material": _material_table(spec.material),
         "edges": {
             e.name: {
                 "support": e.support,
@@ -1536,9 +1712,6 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         out["obstacles"] = [_obstacle_table(o) for o in spec.obstacles]
     if spec.points:
         out["points"] = [_point_table(p) for p in spec.points]
-    for key in ("membrane_voigt", "bending_voigt"):
-        if key in out["material"]:
-            out["material"][key] = [list(row) for row in out["material"][key]]
     if units != "SI":
         out = _to_si(out, units, inverse=True)
         out["units"] = units

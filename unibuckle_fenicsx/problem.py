@@ -37,7 +37,7 @@ from unibuckle_fenicsx.contact import (
     orientation,
 )
 from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, EigenPair, GEPSolver, Owner, release
-from unibuckle_fenicsx.materials import bending_stiffness
+from unibuckle_fenicsx.materials import reference_bending_stiffness
 from unibuckle_fenicsx.mesh import build_plate_mesh
 from unibuckle_fenicsx.plate.model import PlateModel
 from unibuckle_fenicsx.points import point_obstacles
@@ -415,9 +415,12 @@ class BucklingProblem(Owner):
 
     # -- reporting ------------------------------------------------------------------
     def buckling_coefficient(self, load: float) -> float:
-        r""":math:`k = N b^2/(\pi^2 D)` with N = t lambda and b the plate width (y extent)."""
+        r""":math:`k = N b^2/(\pi^2 D)` with N = t lambda and b the plate width (y extent).
+
+        D is :math:`\sqrt{D_{11}D_{22}}` of the bending stiffness (an isotropic plate's D).
+        """
         plate, mat = self.spec.plate, self.spec.material
-        D = bending_stiffness(mat.E, mat.nu, plate.thickness)
+        D = reference_bending_stiffness(mat, plate.thickness)
         return plate.thickness * load * plate.width**2 / (np.pi**2 * D)
 
     def destroy(self) -> None:

@@ -57,7 +57,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
 from unibuckle_fenicsx.contact import ContactSetManager
 from unibuckle_fenicsx.eigen import Owner, release, set_options
-from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, shear_stiffness
+from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, transverse_shear
 from unibuckle_fenicsx.mesh import (
     build_plate_mesh,
     edge_facets,
@@ -65,6 +65,7 @@ from unibuckle_fenicsx.mesh import (
     edge_tag,
     edge_tags,
 )
+from unibuckle_fenicsx.plate.forms import shear_force
 from unibuckle_fenicsx.plate.model import edge_spring_form, edge_support_bcs, mitc_shear_matrix
 from unibuckle_fenicsx.plate.spaces import MixedDofs
 from unibuckle_fenicsx.points import point_bcs, point_springs, snap_points
@@ -259,10 +260,10 @@ class VonKarmanPlate(MixedDofs, Owner):
         energy = 0.5 * ufl.inner(voigt_to_ufl(Cm, e), e) + 0.5 * ufl.inner(
             voigt_to_ufl(D, kappa), kappa
         )
-        ks = shear_stiffness(spec.material, t)
+        ks = transverse_shear(spec.material, t)
         if spec.solver.shear == "full":
             gamma = ufl.grad(w - w0) - (theta_h - theta0_h)
-            energy = energy + 0.5 * ks * ufl.inner(gamma, gamma)
+            energy = energy + 0.5 * ufl.inner(shear_force(gamma, ks), gamma)
         Pi = energy / self.energy_scale * ufl.dx
         d = (t * (w_h - w0_h), theta_h - theta0_h)  # from the stress-free imperfect shape
         springs = edge_spring_form(d, d, self.facet_tags, self.plate)

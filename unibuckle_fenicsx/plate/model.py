@@ -15,9 +15,9 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.config import Material, PlateSpec, PointSpec
 from unibuckle_fenicsx.eigen import Owner, release
-from unibuckle_fenicsx.materials import bending_voigt, shear_stiffness
+from unibuckle_fenicsx.materials import bending_voigt, transverse_shear
 from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tags
-from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_form
+from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_force, shear_form
 from unibuckle_fenicsx.plate.spaces import (
     MixedDofs,
     create_plate_space,
@@ -81,7 +81,7 @@ class PlateModel(MixedDofs, Owner):
 
         u, v = ufl.TrialFunction(self.W), ufl.TestFunction(self.W)
         D = bending_voigt(material, plate.thickness)
-        ks = shear_stiffness(material, plate.thickness)
+        ks = transverse_shear(material, plate.thickness)
         a = bending_form(u, v, D)
         springs = edge_spring_form(ufl.split(u), ufl.split(v), facet_tags, plate)
         if springs is not None:
@@ -113,7 +113,7 @@ class PlateModel(MixedDofs, Owner):
         """Zero Dirichlet conditions of the edge supports (hard SS: w and tangential theta)."""
         return edge_support_bcs(self.W, facet_tags, self.plate)
 
-    def _mitc_shear_matrix(self, ks: float) -> PETSc.Mat:
+    def _mitc_shear_matrix(self, ks: float | npt.NDArray[np.float64]) -> PETSc.Mat:
         """:math:`P^T M_s P` with P's columns of edge-constrained DOFs zeroed."""
         return mitc_shear_matrix(self.W, self.bc_dofs, ks)
 
@@ -249,7 +249,7 @@ def edge_spring_form(
 def mitc_shear_matrix(
     W: dolfinx.fem.FunctionSpace,
     bc_dofs: npt.NDArray[np.int32],
-    ks: float,
+    ks: float | npt.NDArray[np.float64],
     *,
     w_sub: int = 0,
     theta_sub: int = 1,
@@ -264,7 +264,7 @@ def mitc_shear_matrix(
     Args:
         W: Mixed space holding w and theta.
         bc_dofs: Local W DOFs fixed by the edge supports.
-        ks: Shear stiffness :math:`\kappa_s G t` (N/m).
+        ks: Shear stiffness :math:`\kappa_s G t`, or a 2x2 matrix H (a laminate) (N/m).
         w_sub: Sub-space of W holding w.
         theta_sub: Sub-space of W holding theta.
         column_scale: Optional W-vector D: the matrix becomes :math:`D P^T M_s P D`
@@ -278,7 +278,11 @@ def mitc_shear_matrix(
     """
     Vs = create_shear_space(W.mesh)
     g, d = ufl.TrialFunction(Vs), ufl.TestFunction(Vs)
-    Ms = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(ks * ufl.inner(g, d) * ufl.dx))
+    # A laminate's 2x2 H, or the scalar kappa_s G t.
+    energy = (
+        ufl.inner(shear_force(g, ks), d) if isinstance(ks, np.ndarray) else ks * ufl.inner(g, d)
+    )
+    Ms = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(energy * ufl.dx))
     Ms.assemble()
     P = mitc_shear_operator(W, Vs, w_sub=w_sub, theta_sub=theta_sub)
     keep = P.createVecRight()
