@@ -180,3 +180,31 @@ def test_one_sided_points_against_the_hermite_plate():
         k.append(out.buckling_coefficient_k)
     richardson = (4 * k[1] - k[0]) / 3
     assert richardson == pytest.approx(reference, rel=1e-4), (k, richardson, reference)
+
+
+def test_the_new_keys_are_sweep_paths():
+    """Every key added for restraints, points, plies and loads is a --vary path."""
+    from unibuckle_fenicsx.sweep import point_problem
+
+    ply = {"thickness": 0.001, "angle": 0.0, "E1": 1e11, "E2": 1e10, "G12": 5e9, "nu12": 0.3}
+    ply |= {"G13": 5e9, "G23": 3e9}
+    data = {
+        "plate": {"corners": [[0, 0], [3, 1]]},
+        "material": {"plies": [ply]},
+        "edges": {"left": {"normal_stress": -1.0}, "top": {"fixed_shear_stress": 0.0}},
+        "points": [{"spacing": 0.5, "region": [[0, 3], [0.5, 0.5]]}],
+    }
+    base = problem_to_dict(problem_from_dict(data))
+    point = {
+        "edges.top.rotational_stiffness": 7.0,
+        "points.0.spacing": 0.75,
+        "material.plies.0.angle": 30.0,
+        "load.fixed_factor": 0.5,
+        "edges.bottom.fixed_normal_stress": -2.0,
+    }
+    spec = point_problem(base, point)
+    assert spec.plate.edge("top").rotational_stiffness == 7.0
+    assert spec.points[0].spacing == (0.75, 0.75)
+    assert spec.material.plies[0].angle == 30.0
+    assert spec.load.fixed_factor == 0.5
+    assert spec.plate.edge("bottom").fixed_normal_stress == -2.0

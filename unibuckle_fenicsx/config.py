@@ -48,6 +48,7 @@ __all__ = [
     "UNITS",
     "Circle",
     "EdgeSpec",
+    "LoadSpec",
     "Material",
     "MeshSpec",
     "ObstacleSpec",
@@ -63,6 +64,7 @@ __all__ = [
     "problem_to_dict",
     "stress_ends",
     "stress_value",
+    "temperature_field",
 ]
 
 #: Edge names of a rectangular plate, in facet-tag order 1..4.
@@ -195,6 +197,9 @@ class Material:
             on the shear); symmetric stacks only (no bending-membrane coupling). E and
             nu are then the laminate's in-plane constants :math:`E_x, \nu_{xy}`: build
             it with :meth:`from_plies`.
+        thermal_expansion: Coefficient of thermal expansion :math:`\alpha` (1/K), >= 0,
+            the same in every direction (the free thermal strain :math:`\alpha\Delta T I`);
+            not for a laminate, whose plies expand differently.
     """
 
     E: float
@@ -203,6 +208,7 @@ class Material:
     membrane_voigt: tuple[tuple[float, ...], ...] | None = None
     bending_voigt: tuple[tuple[float, ...], ...] | None = None
     plies: tuple[Ply, ...] = ()
+    thermal_expansion: float = 0.0
 
     @classmethod
     def from_plies(cls, plies: Any, shear_correction: float = 5.0 / 6.0) -> Material:
@@ -220,6 +226,16 @@ class Material:
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "plies", tuple(self.plies))
+        alpha = _number("material.thermal_expansion", self.thermal_expansion)
+        if not alpha >= 0.0:
+            raise ValueError(f"material.thermal_expansion must be >= 0 1/K, got {alpha!r}")
+        object.__setattr__(self, "thermal_expansion", alpha)
+        if alpha and self.plies:
+            raise ValueError(
+                "material.thermal_expansion: a laminate's plies expand differently (their "
+                "own coefficients along and across the fibres), which is not modelled; a "
+                "thermal load needs an isotropic material or Voigt matrices"
+            )
         if self.plies:
             self._check_laminate()
             return
@@ -361,6 +377,10 @@ class EdgeSpec:
             :math:`k_t` (N/m per m, i.e. N/m^2), >= 0: :math:`\tfrac12\int k_t w^2\,ds`,
             on an edge whose support leaves w free ("free"). :math:`k_t \to \infty`:
             the soft simple support.
+        fixed_normal_stress: Normal edge stress (Pa) applied as is, not scaled by the
+            load factor (the fixed part of the load, :class:`LoadSpec`); a number or a
+            pair, as ``normal_stress``.
+        fixed_shear_stress: Tangential edge stress (Pa) applied as is.
     """
 
     name: str
@@ -372,6 +392,8 @@ class EdgeSpec:
     segments: tuple[int, ...] | None = None
     rotational_stiffness: float = 0.0
     translational_stiffness: float = 0.0
+    fixed_normal_stress: float | tuple[float, float] = 0.0
+    fixed_shear_stress: float | tuple[float, float] = 0.0
 
     def __post_init__(self) -> None:
         where = f"edges.{self.name}"
@@ -379,7 +401,7 @@ class EdgeSpec:
             raise ValueError(f"edge names must be non-empty strings, got {self.name!r}")
         _choice(f"{where}.support", self.support, BENDING_SUPPORTS)
         _choice(f"{where}.inplane", self.inplane, INPLANE_SUPPORTS)
-        for name in ("normal_stress", "shear_stress"):
+        for name in ("normal_stress", "shear_stress", "fixed_normal_stress", "fixed_shear_stress"):
             object.__setattr__(self, name, _stress(f"{where}.{name}", getattr(self, name)))
         if self.tag is not None:
             _integer(f"{where}.tag", self.tag, 0)
@@ -424,6 +446,22 @@ class EdgeSpec:
     def loaded(self) -> bool:
         r"""Whether this edge carries a traction (belongs to :math:`\gamma_1`)."""
         return any(v != 0.0 for v in (*self.normal_ends, *self.shear_ends))
+
+    @property
+    def fixed_loaded(self) -> bool:
+        """Whether the edge carries a fixed traction."""
+        ends = (*stress_ends(self.fixed_normal_stress), *stress_ends(self.fixed_shear_stress))
+        return any(v != 0.0 for v in ends)
+
+    def fixed_part(self) -> EdgeSpec:
+        """This edge with its fixed stresses as the stresses (and no fixed part)."""
+        return replace(
+            self,
+            normal_stress=self.fixed_normal_stress,
+            shear_stress=self.fixed_shear_stress,
+            fixed_normal_stress=0.0,
+            fixed_shear_stress=0.0,
+        )
 
     @property
     def normal_ends(self) -> tuple[float, float]:
@@ -634,6 +672,15 @@ class PlateSpec:
         """Extent in y (m)."""
         return self.corners[1][1] - self.corners[0][1]
 
+    def fixed_part(self) -> PlateSpec:
+        """The plate with its edges' fixed stresses as the stresses (for the fixed prestress)."""
+        return replace(self, edges=tuple(e.fixed_part() for e in self.edges))
+
+    @property
+    def fixed_loaded(self) -> bool:
+        """Whether an edge carries a fixed stress."""
+        return any(e.fixed_loaded for e in self.edges)
+
     def contains(self, points: npt.NDArray[np.float64], tol: float) -> npt.NDArray[np.bool_]:
         """Mask of the points (n, 2) in the closed plate (within ``tol``), not in a hole.
 
@@ -840,6 +887,68 @@ class ObstacleSpec:
     def same_zone(self, other: ObstacleSpec) -> bool:
         """Whether ``other`` has the same zone (a predicate only when it is the same one)."""
         return self.zone is other.zone or (not callable(self.zone) and self.zone == other.zone)
+
+
+Temperature = float | tuple[float, float, float]
+
+
+def _temperature(name: str, value: Any) -> Temperature:
+    """A temperature rise: a number (K), or [T0, dT/dx, dT/dy] (K, K/m) for a linear field."""
+    if isinstance(value, list | tuple):
+        if len(value) != 3:
+            raise ValueError(
+                f"{name} must be a number (a uniform rise, K) or [T0, dT/dx, dT/dy] (the "
+                f"linear field T0 + dT/dx x + dT/dy y, K and K/m), got {value!r}"
+            )
+        return (_number(name, value[0]), _number(name, value[1]), _number(name, value[2]))
+    return _number(name, value)
+
+
+def temperature_field(value: Temperature) -> tuple[float, float, float]:
+    """(T0, dT/dx, dT/dy) of a temperature rise."""
+    return value if isinstance(value, tuple) else (value, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class LoadSpec:
+    r"""The load besides the edge stresses: temperature rises, scaled and fixed.
+
+    The prestress is :math:`N = N_{fixed} + \lambda N_{scaled}`: the scaled part is the
+    edges' ``normal_stress`` and ``shear_stress`` (per unit load) with ``temperature``;
+    the fixed part, applied as is, the edges' ``fixed_normal_stress`` and
+    ``fixed_shear_stress`` (Pa) with ``fixed_temperature``, times ``fixed_factor``. A
+    temperature rise :math:`\Delta T` gives the free thermal strain
+    :math:`\alpha\Delta T I` (``[material] thermal_expansion``), which the edges'
+    in-plane conditions turn into a prestress. The buckling pencil is
+    :math:`(A - B_{fixed}, B_{scaled})`.
+
+    Args:
+        temperature: The rise per unit load factor: a number (K, uniform) or
+            ``(T0, dTdx, dTdy)``, the linear field :math:`T_0 + T_{,x} x + T_{,y} y` (K, K/m).
+        fixed_temperature: A rise applied as is, the same forms.
+        fixed_factor: A factor on the whole fixed part (the fixed edge stresses and
+            ``fixed_temperature``), 1 by default: a sweep over it draws an interaction
+            curve with one ``--vary``; 0 switches the fixed part off.
+    """
+
+    temperature: Temperature = 0.0
+    fixed_temperature: Temperature = 0.0
+    fixed_factor: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("temperature", "fixed_temperature"):
+            object.__setattr__(self, name, _temperature(f"load.{name}", getattr(self, name)))
+        object.__setattr__(self, "fixed_factor", _number("load.fixed_factor", self.fixed_factor))
+
+    @property
+    def thermal(self) -> bool:
+        """Whether the scaled part has a temperature rise."""
+        return any(temperature_field(self.temperature))
+
+    @property
+    def fixed_thermal(self) -> bool:
+        """Whether the fixed part has a temperature rise."""
+        return any(temperature_field(self.fixed_temperature))
 
 
 #: Kinds of point restraint: w = 0, the obstacle's cone at the point, or a spring.
@@ -1059,6 +1168,7 @@ class ProblemSpec:
         obstacles: Several obstacles (the file's ``[[obstacles]]`` tables), instead of
             ``obstacle``; their constrained nodes are the union of their zones'.
         points: Point restraints (the file's ``[[points]]`` tables).
+        load: Temperature rises, scaled and fixed (the ``[load]`` table).
     """
 
     name: str = "plate"
@@ -1070,6 +1180,7 @@ class ProblemSpec:
     units: str = "SI"
     obstacles: tuple[ObstacleSpec, ...] = ()
     points: tuple[PointSpec, ...] = ()
+    load: LoadSpec = field(default_factory=LoadSpec)
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -1097,6 +1208,7 @@ class ProblemSpec:
                     f"plate.thickness = {plate.thickness!r} m differs from the plies' total "
                     f"{total!r} m"
                 )
+        self._check_load()
         object.__setattr__(self, "points", tuple(self.points))
         for k, point in enumerate(self.points):
             if not isinstance(point, PointSpec):
@@ -1143,6 +1255,42 @@ class ProblemSpec:
                     '[edges.NAME] support (e.g. support = "simply_supported"), or keep one '
                     "side"
                 )
+
+    def _check_load(self) -> None:
+        """Temperatures need a thermal expansion and an edge held in its plane."""
+        load = self.load
+        if (load.thermal or load.fixed_thermal) and not self.material.thermal_expansion:
+            which = "load.temperature" if load.thermal else "load.fixed_temperature"
+            raise ValueError(
+                f"{which}: a temperature rise needs [material] thermal_expansion > 0 (1/K)"
+            )
+        held = any(e.inplane != "free" for e in self.plate.edges)
+        for name, on in (("temperature", load.thermal), ("fixed_temperature", load.fixed_thermal)):
+            if on and not held:
+                raise ValueError(
+                    f"load.{name}: the temperature rise leaves the plate stress-free (a "
+                    "uniform or linear rise expands a plate free in its plane without "
+                    'stress): hold an edge in its plane (inplane = "clamped" or "roller")'
+                )
+
+    def check_scaled_load(self) -> None:
+        """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""
+        if not self.load.thermal and not any(e.loaded for e in self.plate.edges):
+            raise ValueError(
+                "no load to scale: give an edge a non-zero normal_stress or shear_stress (per "
+                "unit load), or [load] temperature (a rise per unit load factor)"
+                + (
+                    "; the fixed part (fixed_normal_stress, fixed_shear_stress, "
+                    "fixed_temperature) is applied as is, not scaled"
+                    if self.has_fixed_load
+                    else ""
+                )
+            )
+
+    @property
+    def has_fixed_load(self) -> bool:
+        """Whether the load has a fixed part (edge stresses or a temperature rise)."""
+        return bool(self.load.fixed_factor) and (self.plate.fixed_loaded or self.load.fixed_thermal)
 
     @property
     def one_sided_points(self) -> tuple[PointSpec, ...]:
@@ -1242,6 +1390,12 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
         if isinstance(out.get(table), dict) and key in out[table]:
             factor = (length**pl * stress**ps) ** sign
             out[table][key] = _scaled(out[table][key], factor, f"{table}.{key}")
+    load = out.get("load")
+    if isinstance(load, dict):
+        for key in ("temperature", "fixed_temperature"):
+            value = load.get(key)
+            if isinstance(value, list) and len(value) == 3:  # K, K/m, K/m
+                load[key] = [value[0], *_scaled(value[1:], length**-sign, f"load.{key}")]
     material = out.get("material")
     if isinstance(material, dict) and isinstance(material.get("plies"), list):
         material["plies"] = [
@@ -1298,6 +1452,8 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
 #: (length, stress).
 _EDGE_DIMENSIONS: dict[str, tuple[int, int]] = {
     "translational_stiffness": (0, 1),  # N/m^2 = Pa; rotational_stiffness is N in both
+    "fixed_normal_stress": (0, 1),  # Pa (normal_stress is per unit load: no unit)
+    "fixed_shear_stress": (0, 1),
 }
 
 
@@ -1456,9 +1612,9 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     top-level ``name`` and ``units``. Unknown tables or keys raise ``ValueError``.
 
     Missing values take the paper's, with one exception for the load: if any edge table
-    gives ``normal_stress`` or ``shear_stress``, the edges that give neither carry no load
-    (the paper's unit compression of the short edges applies only to a file that sets
-    no edge load at all).
+    gives ``normal_stress``, ``shear_stress`` or a fixed stress, or the file has a
+    ``[load]`` table, the edges that give no stress carry no load (the paper's unit
+    compression of the short edges applies only to a file that sets no load at all).
     """
     top = _take(
         data,
@@ -1472,6 +1628,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
             "obstacle",
             "obstacles",
             "points",
+            "load",
             "solver",
         ),
         "top",
@@ -1496,11 +1653,11 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         names = (*EDGE_NAMES, HOLES) if "holes" in plate_kw else EDGE_NAMES
     edge_tables = _take(given, names, "edges")
     edges = {} if gmsh_plate else {e.name: e for e in paper_edges()}
-    load_keys = ("normal_stress", "shear_stress")
+    load_keys = ("normal_stress", "shear_stress", "fixed_normal_stress", "fixed_shear_stress")
     loads_given = any(
         key in table for table in edge_tables.values() if isinstance(table, Mapping)
         for key in load_keys
-    )  # fmt: skip
+    ) or (isinstance(top.get("load"), Mapping) and bool(top["load"]))  # fmt: skip
     if loads_given:
         edges = {n: replace(e, normal_stress=0.0, shear_stress=0.0) for n, e in edges.items()}
     edge_keys = (
@@ -1511,6 +1668,8 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         "segments",
         "rotational_stiffness",
         "translational_stiffness",
+        "fixed_normal_stress",
+        "fixed_shear_stress",
     )
     for edge_name, edge_table in edge_tables.items():
         kw = _take(edge_table, edge_keys, f"edges.{edge_name}")
@@ -1556,6 +1715,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
             raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
         obstacles = [_obstacle_from_table(t, f"obstacles[{k}]") for k, t in enumerate(tables)]
     points = _points(top["points"]) if "points" in top else ()
+    load = LoadSpec(**_take(top.get("load", {}), _names(LoadSpec), "load"))
     solver = SolverSpec(**_take(top.get("solver", {}), _names(SolverSpec), "solver"))
     label = top.get("name", name)
     if not isinstance(label, str):
@@ -1570,6 +1730,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         units=units,
         obstacles=tuple(obstacles),
         points=points,
+        load=load,
     )
 
 
@@ -1585,7 +1746,7 @@ def _material(table: Any) -> Material:
             if key not in kw:
                 raise ValueError(f"[material] needs {key!r} (or [[material.plies]])")
         return Material(**kw)
-    other = sorted(set(kw) - {"plies", "shear_correction"})
+    other = sorted(set(kw) - {"plies", "shear_correction", "thermal_expansion"})
     if other:
         raise ValueError(
             f"[material] with plies takes shear_correction only besides them, not {other}: "
@@ -1608,6 +1769,8 @@ def _material(table: Any) -> Material:
             plies.append(Ply(**ply_kw))
         except ValueError as err:
             raise ValueError(str(err).replace("material.plies.", f"{where}.")) from None
+    if kw.pop("thermal_expansion", 0.0):
+        Material(E=1.0, nu=0.0, thermal_expansion=1.0, plies=tuple(plies))  # raises
     return Material.from_plies(plies, **kw)
 
 
@@ -1636,6 +1799,7 @@ def _material_table(material: Material) -> dict[str, Any]:
         return {
             "shear_correction": material.shear_correction,
             "plies": [dict(vars(ply)) for ply in material.plies],
+            "thermal_expansion": material.thermal_expansion,
         }
     out: dict[str, Any] = {
         k: v for k, v in vars(material).items() if v is not None and k != "plies"
@@ -1693,6 +1857,8 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
                 "shear_stress": stress_value(e.shear_stress),
                 "rotational_stiffness": e.rotational_stiffness,
                 "translational_stiffness": e.translational_stiffness,
+                "fixed_normal_stress": stress_value(e.fixed_normal_stress),
+                "fixed_shear_stress": stress_value(e.fixed_shear_stress),
             }
             | ({} if e.segments is None else {"segments": list(e.segments)})
             for e in plate.edges
@@ -1712,6 +1878,10 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         out["obstacles"] = [_obstacle_table(o) for o in spec.obstacles]
     if spec.points:
         out["points"] = [_point_table(p) for p in spec.points]
+    out["load"] = {
+        key: list(value) if isinstance(value, tuple) else value
+        for key, value in vars(spec.load).items()
+    }
     if units != "SI":
         out = _to_si(out, units, inverse=True)
         out["units"] = units

@@ -690,6 +690,12 @@ def solve_nonlinear(
     """
     t0 = time.perf_counter()
     options = NonlinearOptions() if options is None else options
+    if spec.load.thermal or spec.has_fixed_load:
+        raise ValueError(
+            "the nonlinear analysis models edge loads scaled by lambda only: temperature "
+            "rises ([load]) and fixed loads (fixed_normal_stress, fixed_shear_stress) are "
+            "not in its energy"
+        )
     if any(o.foundation_stiffness is not None for o in spec.all_obstacles):
         raise ValueError(
             "the nonlinear analysis models rigid obstacles only, not Winkler foundations "

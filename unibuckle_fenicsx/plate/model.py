@@ -48,6 +48,10 @@ class PlateModel(MixedDofs, Owner):
         shear: "mitc" (locking-free) or "full" (plain full integration, locks).
         points: Point restraints (:mod:`~unibuckle_fenicsx.points`): bilateral ones
             become zero Dirichlet conditions, springs diagonal entries of A.
+        fixed_prestress: The fixed part of the load: A holds :math:`a - b_{fixed}`, so the
+            pencil is :math:`(A - B_{fixed}, B)` (A need not be positive definite then:
+            :class:`~unibuckle_fenicsx.problem.BucklingProblem` checks it).
+        fixed_factor: Factor on the fixed prestress.
 
     Note:
         Construction and :meth:`destroy` are collective.
@@ -62,6 +66,8 @@ class PlateModel(MixedDofs, Owner):
         prestress: Prestress,
         shear: str = "mitc",
         points: Sequence[PointSpec] = (),
+        fixed_prestress: Prestress | None = None,
+        fixed_factor: float = 1.0,
     ) -> None:
         if msh.topology.cell_type != dolfinx.mesh.CellType.quadrilateral:
             raise ValueError("the MITC plate element needs a quadrilateral mesh")
@@ -86,6 +92,8 @@ class PlateModel(MixedDofs, Owner):
         springs = edge_spring_form(ufl.split(u), ufl.split(v), facet_tags, plate)
         if springs is not None:
             a = a + springs
+        if fixed_prestress is not None:  # A - B_fixed: the fixed load's geometric stiffness
+            a = a - fixed_factor * geometric_form(u, v, fixed_prestress.N0)
         if shear == "full":
             a = a + shear_form(u, v, ks)
         elif shear != "mitc":
