@@ -1,10 +1,10 @@
 """The engineering features under ``mpiexec -n 2``: the serial answers, partition-independent.
 
 Restrained edges, point restraints (snapped off-grid, bilateral, one-sided, springs), an
-angle-ply laminate, a thermal load with a fixed shear and rise, on small meshes, each
-solved in this process and by ``tests/mpi/engineering.py`` on two ranks: loads to 1e-8
-relative (the eigen solves converge to 1e-10), contact nodes and snapped nodes exactly
-(their choice is partition-independent by construction).
+angle-ply laminate, a thermal load with a fixed shear and rise, the design output, on
+small meshes, each solved in this process and by ``tests/mpi/engineering.py`` on two
+ranks: loads to 1e-8 relative (the eigen solves converge to 1e-10), contact nodes and
+snapped nodes exactly (their choice is partition-independent by construction).
 """
 
 from __future__ import annotations
@@ -48,6 +48,7 @@ PROBLEMS = {
         },
         "mesh": {"nx": 12, "ny": 6},
         "obstacle": {"zone": "all"},
+        "design": {"yield_stress": 3.55e8, "partial_factor": 1.1},
     },
     "laminate (45/-45/-45/45), obstacle": {
         "plate": {"corners": [[0.0, 0.0], [2.0, 1.0]]},
@@ -105,6 +106,9 @@ def test_engineering_features_on_two_ranks_give_the_serial_answer(tmp_path):
             if ser.get(key) is not None:
                 assert par[key] == pytest.approx(ser[key], rel=LOAD_RTOL), (name, key)
         assert par["contact_coordinates"] == ser["contact_coordinates"], name
+        if ser.get("design"):
+            for key in ("sigma_cr_Pa", "relative_slenderness", "reduction_factor", "psi"):
+                assert par["design"][key] == pytest.approx(ser["design"][key], rel=LOAD_RTOL)
         assert par["point_restraints"] == ser["point_restraints"], name
         assert par["kkt"] == ser["kkt"] is True, name
         assert ser["contact_coordinates"], name  # the obstacle or the points are active

@@ -47,6 +47,7 @@ __all__ = [
     "SIDES",
     "UNITS",
     "Circle",
+    "DesignSpec",
     "EdgeSpec",
     "LoadSpec",
     "Material",
@@ -951,6 +952,27 @@ class LoadSpec:
         return any(temperature_field(self.fixed_temperature))
 
 
+@dataclass(frozen=True)
+class DesignSpec:
+    r"""Design output by EN 1993-1-5 (:mod:`~unibuckle_fenicsx.design`).
+
+    Args:
+        yield_stress: :math:`f_y` (Pa), > 0.
+        partial_factor: :math:`\gamma_{M1}`, > 0 (1.0, the recommended value of
+            EN 1993-1-1, 6.1).
+    """
+
+    yield_stress: float
+    partial_factor: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name, unit in (("yield_stress", " Pa"), ("partial_factor", "")):
+            value = _number(f"design.{name}", getattr(self, name))
+            if not value > 0.0:
+                raise ValueError(f"design.{name} must be > 0{unit}, got {value!r}")
+            object.__setattr__(self, name, value)
+
+
 #: Kinds of point restraint: w = 0, the obstacle's cone at the point, or a spring.
 POINT_KINDS = ("bilateral", "one-sided", "spring")
 
@@ -1169,6 +1191,7 @@ class ProblemSpec:
             ``obstacle``; their constrained nodes are the union of their zones'.
         points: Point restraints (the file's ``[[points]]`` tables).
         load: Temperature rises, scaled and fixed (the ``[load]`` table).
+        design: The EN 1993-1-5 design output's data (``[design]``), or None.
     """
 
     name: str = "plate"
@@ -1181,6 +1204,7 @@ class ProblemSpec:
     obstacles: tuple[ObstacleSpec, ...] = ()
     points: tuple[PointSpec, ...] = ()
     load: LoadSpec = field(default_factory=LoadSpec)
+    design: DesignSpec | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -1209,6 +1233,7 @@ class ProblemSpec:
                     f"{total!r} m"
                 )
         self._check_load()
+        self._check_design()
         object.__setattr__(self, "points", tuple(self.points))
         for k, point in enumerate(self.points):
             if not isinstance(point, PointSpec):
@@ -1272,6 +1297,22 @@ class ProblemSpec:
                     "uniform or linear rise expands a plate free in its plane without "
                     'stress): hold an edge in its plane (inplane = "clamped" or "roller")'
                 )
+
+    def _check_design(self) -> None:
+        """The design output needs a compressive normal edge stress (its sigma_cr)."""
+        if self.design is None:
+            return
+        if not isinstance(self.design, DesignSpec):
+            raise ValueError(f"design must be a DesignSpec, got {self.design!r}")
+        compressed = any(
+            min(*stress_ends(e.normal_stress), *stress_ends(e.fixed_normal_stress)) < 0.0
+            for e in self.plate.edges
+        )
+        if not compressed:
+            raise ValueError(
+                "design: the EN 1993-1-5 output takes sigma_cr as a compressive normal edge "
+                "stress, and this load has none (give a loaded edge normal_stress < 0)"
+            )
 
     def check_scaled_load(self) -> None:
         """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""
@@ -1373,6 +1414,7 @@ _DIMENSIONS: dict[tuple[str, str], tuple[int, int]] = {
     ("material", "membrane_voigt"): (1, 1),  # N/m = Pa m
     ("material", "bending_voigt"): (3, 1),  # N m = Pa m^3
     ("mesh", "size"): (1, 0),
+    ("design", "yield_stress"): (0, 1),
 }
 
 
@@ -1629,6 +1671,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
             "obstacles",
             "points",
             "load",
+            "design",
             "solver",
         ),
         "top",
@@ -1716,6 +1759,12 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         obstacles = [_obstacle_from_table(t, f"obstacles[{k}]") for k, t in enumerate(tables)]
     points = _points(top["points"]) if "points" in top else ()
     load = LoadSpec(**_take(top.get("load", {}), _names(LoadSpec), "load"))
+    design = None
+    if "design" in top:
+        design_kw = _take(top["design"], _names(DesignSpec), "design")
+        if "yield_stress" not in design_kw:
+            raise ValueError("[design] needs yield_stress (f_y)")
+        design = DesignSpec(**design_kw)
     solver = SolverSpec(**_take(top.get("solver", {}), _names(SolverSpec), "solver"))
     label = top.get("name", name)
     if not isinstance(label, str):
@@ -1731,6 +1780,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         obstacles=tuple(obstacles),
         points=points,
         load=load,
+        design=design,
     )
 
 
@@ -1882,6 +1932,8 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         key: list(value) if isinstance(value, tuple) else value
         for key, value in vars(spec.load).items()
     }
+    if spec.design is not None:
+        out["design"] = dict(vars(spec.design))
     if units != "SI":
         out = _to_si(out, units, inverse=True)
         out["units"] = units

@@ -62,6 +62,8 @@ class BucklingResult:
             N_scaled).
         critical_temperature_K: With a temperature rise in the scaled load: lambda times
             its largest rise over the plate (the uniform rise's critical value).
+        design: With ``[design]``: the relative slenderness and the reduction factor of
+            EN 1993-1-5 from this sigma_cr (:func:`~unibuckle_fenicsx.design.design_output`).
         units: The unit system the summary prints in (the numbers here are SI).
         input: The problem solved, every key with the value used, in SI
             (:func:`~unibuckle_fenicsx.config.problem_to_dict`; None for a predicate zone).
@@ -95,6 +97,7 @@ class BucklingResult:
     edge_loads: dict[str, dict[str, Any]] = field(default_factory=dict)
     critical_load_factor: float | None = None
     critical_temperature_K: float | None = None
+    design: dict[str, Any] | None = None
     units: str = "SI"
     input: dict[str, Any] | None = None
     versions: dict[str, str] = field(default_factory=dict)
@@ -163,6 +166,10 @@ class BucklingResult:
         )
         if problem.model.points:
             result.details["point_restraints"] = [g.report() for g in problem.model.points]
+        if spec.design is not None:
+            from unibuckle_fenicsx.design import design_output
+
+            result.design = design_output(spec, spec.design, load)
         if solution is None or certificate is None:
             result.lower_bound_Pa = result.upper_bound_Pa = free.load
             return result
@@ -253,6 +260,20 @@ class BucklingResult:
         ]
         if load.get("fixed_temperature"):
             fixed.append(f"temperature rise {load['fixed_temperature']} K")
+        if self.design is not None:
+            d = self.design
+            rho = d["reduction_factor"]
+            lines.append(
+                f"EN 1993-1-5: sigma_cr = {d['sigma_cr_Pa'] / scale:.4g} {unit} ({d['edge']}), "
+                f"psi = {d['psi']:.3g}, slenderness {d['relative_slenderness']:.4g}, rho = "
+                + (
+                    f"{rho:.4g}, rho f_y/gamma_M1 = {d['reduced_design_stress_Pa'] / scale:.4g} "
+                    f"{unit}"
+                    if rho is not None
+                    else "none (psi < -3)"
+                )
+                + " (4.2) calibrated on bilateral plates"
+            )
         factor = load.get("fixed_factor", 1.0)
         if fixed and factor:
             times = "" if factor == 1.0 else f"{factor:g} x "
