@@ -804,12 +804,17 @@ class ObstacleSpec:
         foundation_stiffness: Winkler modulus :math:`k_f` (N/m^3, Pa/m), > 0; ``None``
             for a rigid obstacle. The springs are lumped at the zone's nodes: node k
             carries :math:`k_f \int \varphi_k\,dx` (its tributary area).
+        gap: Clearance g (m) >= 0 between the flat plate and a rigid obstacle: w <= g
+            (above), w >= -g (below). The nonlinear analysis follows the plate onto it;
+            the linear critical state ignores an obstacle with a gap (an infinitesimal
+            buckle does not reach it).
     """
 
     zone: Literal["all"] | Box | Polygon | Circle | Predicate = "all"
     tolerance: float | None = None
     side: str = "above"
     foundation_stiffness: float | None = None
+    gap: float = 0.0
 
     def __post_init__(self) -> None:
         if isinstance(self.zone, str):
@@ -839,6 +844,15 @@ class ObstacleSpec:
                 '("above" or "below"); "both" is for a foundation (foundation_stiffness)'
             )
         _choice("obstacle.side", self.side, SIDES)
+        gap = _number("obstacle.gap", self.gap)
+        if not gap >= 0.0:
+            raise ValueError(f"obstacle.gap must be >= 0 m, got {gap!r}")
+        if gap and self.foundation_stiffness is not None:
+            raise ValueError(
+                "obstacle.gap: a gap is modelled for rigid obstacles only, not for a "
+                "foundation (foundation_stiffness)"
+            )
+        object.__setattr__(self, "gap", gap)
 
     @property
     def sign(self) -> float:
@@ -1340,8 +1354,16 @@ class ProblemSpec:
 
     @property
     def unilateral_obstacles(self) -> tuple[ObstacleSpec, ...]:
-        """The one-sided obstacles (rigid or tensionless foundations): the contact nodes'."""
-        return tuple(o for o in self.all_obstacles if o.kind != "bilateral")
+        """The one-sided obstacles (rigid or tensionless foundations): the contact nodes'.
+
+        Without those with a gap: an infinitesimal buckle does not reach them.
+        """
+        return tuple(o for o in self.all_obstacles if o.kind != "bilateral" and not o.gap)
+
+    @property
+    def gapped_obstacles(self) -> tuple[ObstacleSpec, ...]:
+        """The obstacles with a gap (the nonlinear analysis' only)."""
+        return tuple(o for o in self.all_obstacles if o.gap)
 
     @property
     def bilateral_foundations(self) -> tuple[ObstacleSpec, ...]:
@@ -1528,7 +1550,7 @@ def _obstacle_to_si(
 ) -> dict[str, Any]:
     """An obstacle table with its lengths times ``length`` and stresses times ``stress``."""
     out = dict(table)
-    for key in ("polygon", "tolerance"):
+    for key in ("polygon", "tolerance", "gap"):
         if key in out:
             out[key] = _scaled(out[key], length, f"{where}.{key}")
     if "foundation_stiffness" in out:  # N/m^3 = Pa/m
@@ -1547,7 +1569,7 @@ def _obstacle_to_si(
 
 
 #: Keys of an ``[obstacle]`` or ``[[obstacles]]`` table.
-OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "foundation_stiffness", "tolerance")
+OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "foundation_stiffness", "tolerance", "gap")
 
 
 def _holes(tables: Any) -> tuple[Circle | Polygon, ...]:
@@ -1638,6 +1660,7 @@ def _obstacle_table(obstacle: ObstacleSpec) -> dict[str, Any]:
         out["foundation_stiffness"] = obstacle.foundation_stiffness
     if obstacle.tolerance is not None:
         out["tolerance"] = obstacle.tolerance
+    out["gap"] = obstacle.gap
     return out
 
 

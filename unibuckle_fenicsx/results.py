@@ -166,6 +166,12 @@ class BucklingResult:
         )
         if problem.model.points:
             result.details["point_restraints"] = [g.report() for g in problem.model.points]
+        if spec.gapped_obstacles:
+            result.details["gapped_obstacles"] = (
+                f"{len(spec.gapped_obstacles)} obstacle(s) with a gap left out of the linear "
+                "critical state (an infinitesimal buckle does not reach them); unibuckle "
+                "nonlinear follows the plate onto them"
+            )
         if spec.design is not None:
             from unibuckle_fenicsx.design import design_output
 
@@ -247,6 +253,8 @@ class BucklingResult:
         """Summary lines of what the model holds beyond plate, edges and obstacle."""
         length, scale, unit = UNITS[self.units]
         lines = []
+        if "gapped_obstacles" in self.details:
+            lines.append(self.details["gapped_obstacles"])
         load = (self.input or {}).get("load", {})
         if self.critical_temperature_K is not None:
             lines.append(

@@ -23,8 +23,9 @@ the shear energy is quadratic, so :math:`K_s` is assembled once and adds
 :math:`K_s(x - x_0)` to the residual and :math:`K_s` to the Jacobian. The edge supports
 and the edge loads are those of the same :class:`~unibuckle_fenicsx.config.ProblemSpec`.
 
-The obstacle (:math:`w \le 0` at the zone's nodes, the nodes of
-:class:`~unibuckle_fenicsx.contact.ContactSetManager`) enters as variable bounds of PETSc's
+The obstacle (:math:`w \le g` at the zone's nodes, the nodes of
+:class:`~unibuckle_fenicsx.contact.ContactSetManager`, g the obstacle's gap, 0 by
+default) enters as variable bounds of PETSc's
 reduced-space VI Newton method (``vinewtonrsls``); the other bounds are
 ``PETSc.INFINITY``. DOLFINx's ``NonlinearProblem`` takes no bounds and assembles forms
 only (the MITC shear is a matrix), so the SNES is wired here, with the same assembly
@@ -345,14 +346,14 @@ class VonKarmanPlate(MixedDofs, Owner):
             self._upper = self._xs.duplicate()
             self._lower.set(PETSc.NINFINITY)
             self._upper.set(PETSc.INFINITY)
-            # Obstacle above: w <= 0 (upper bound); below: w >= 0 (lower bound).
+            # Obstacle above: w <= g (upper bound); below: w >= -g (lower bound); w/t here.
             rows = self.contact.global_rows()
             lo, hi = self._upper.getOwnershipRange()
             mine = (rows >= lo) & (rows < hi)
             above = mine & (self.contact.signs > 0)
             below = mine & (self.contact.signs < 0)
-            self._upper.array[rows[above] - lo] = 0.0
-            self._lower.array[rows[below] - lo] = 0.0
+            self._upper.array[rows[above] - lo] = self.contact.gaps[above] / t
+            self._lower.array[rows[below] - lo] = -self.contact.gaps[below] / t
             snes.setVariableBounds(self._lower, self._upper)
         else:
             options.setdefault("snes_type", "newtonls")
@@ -528,10 +529,16 @@ class VonKarmanPlate(MixedDofs, Owner):
             return np.empty(0)
         return self.thickness * self.contact.values(self.x.x.petsc_vec)
 
+    def zone_clearance(self, x: dolfinx.fem.Function | None = None) -> npt.NDArray[np.float64]:
+        """s_k w_k - g_k (m) at the zone nodes: <= 0 admissible, 0 on the obstacle."""
+        if self.contact is None:
+            return np.empty(0)
+        x = self.x if x is None else x
+        return self.thickness * self.contact.values(x.x.petsc_vec) - self.contact.gaps
+
     def contact_nodes(self, rtol: float = 1e-9) -> npt.NDArray[np.int64]:
-        """Zone nodes on the obstacle: w >= -rtol t (the VI keeps them at w = 0)."""
-        w = self.zone_deflection()
-        return np.flatnonzero(w >= -rtol * self.thickness).astype(np.int64)
+        """Zone nodes on the obstacle: s w >= g - rtol t (the VI keeps them at s w = g)."""
+        return np.flatnonzero(self.zone_clearance() >= -rtol * self.thickness).astype(np.int64)
 
     def end_shortening(self) -> float:
         """Mean inward normal displacement of the loaded edges, summed over them (m)."""
