@@ -1111,9 +1111,9 @@ class PointSpec:
         if self.kind == "one-sided":
             what += f" ({self.side})"
         if self.at is not None:
-            return f"{what} at ({self.at[0]:g}, {self.at[1]:g})"
+            return f"{what} at ({self.at[0]:g}, {self.at[1]:g}) m"
         assert self.spacing is not None
-        return f"{what} grid of spacing {self.spacing[0]:g} x {self.spacing[1]:g}"
+        return f"{what} grid of spacing {self.spacing[0]:g} x {self.spacing[1]:g} m"
 
 
 @dataclass(frozen=True)
@@ -1252,6 +1252,8 @@ class ProblemSpec:
         for k, point in enumerate(self.points):
             if not isinstance(point, PointSpec):
                 raise ValueError(f"points[{k}] must be a PointSpec, got {point!r}")
+            if plate.file is not None:
+                continue  # the plate's extent is known once the file is meshed
             try:
                 point.locations(plate)
             except ValueError as err:

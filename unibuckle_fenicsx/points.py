@@ -102,6 +102,7 @@ def snap_points(
         chosen = [min(candidates) for candidates in zip(*gathered, strict=True)]
         nodes = np.array([[c[2], c[1]] for c in chosen], dtype=float).reshape(-1, 2)
         distances = np.array([c[3] for c in chosen], dtype=float)
+        distances[distances <= 1e-9 * size] = 0.0  # rounding of coordinates, not a snap
         out.append(SnappedPoints(spec, wanted, nodes, distances))
     return out
 
