@@ -208,3 +208,32 @@ def test_the_new_keys_are_sweep_paths():
     assert spec.material.plies[0].angle == 30.0
     assert spec.load.fixed_factor == 0.5
     assert spec.plate.edge("bottom").fixed_normal_stress == -2.0
+
+
+@pytest.mark.parametrize(
+    "toml, key",
+    [
+        ("[edges.top]\nrotational_stiffness = -1.0\n", "edges.top.rotational_stiffness"),
+        ("[edges.top]\ntranslational_stiffness = 5.0\n", "edges.top.translational_stiffness"),
+        ("[[points]]\nat = [0.5, 0.0]\n", "points[0].at"),
+        ('[[points]]\nspacing = 0.1\nkind = "spring"\n', "points[0].stiffness"),
+        (
+            "[[material.plies]]\nthickness = 0.003\nangle = 0.0\nE1 = 1e11\nE2 = 1e10\n"
+            "G12 = 5e9\nnu12 = 0.3\nG13 = 5e9\nG23 = 3e9\n[[material.plies]]\n"
+            "thickness = 0.003\nangle = 90.0\nE1 = 1e11\nE2 = 1e10\nG12 = 5e9\nnu12 = 0.3\n"
+            "G13 = 5e9\nG23 = 3e9\n",
+            "material.plies",
+        ),
+        ("[load]\nfixed_factor = 'x'\n", "load.fixed_factor"),
+        ("[design]\nyield_stress = -355.0\n", "design.yield_stress"),
+        ('[obstacle]\nzone = "all"\ngap = -0.001\n', "obstacle.gap"),
+    ],
+)
+def test_cli_refuses_each_new_key_with_exit_2(tmp_path, capsys, toml, key):
+    """Bad values are refused before any solve, the key named (exit status 2)."""
+    from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
+
+    path = tmp_path / "p.toml"
+    path.write_text(toml)
+    assert main(["solve", "--config", str(path), "-q"]) == EXIT_BAD_INPUT
+    assert key in capsys.readouterr().err
