@@ -123,7 +123,7 @@ def test_plies_are_read_converted_and_written_back():
     )
     assert problem_from_dict(problem_to_dict(spec, units="mm-N-MPa")) == spec
     written = problem_to_dict(spec, units="mm-N-MPa")["material"]
-    assert set(written) == {"shear_correction", "plies"}
+    assert set(written) == {"shear_correction", "plies", "thermal_expansion"}
     assert written["plies"][1] == pytest.approx(data["material"]["plies"][1])
 
 
