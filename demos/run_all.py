@@ -39,6 +39,7 @@ DEMOS = (
     "study_penalty.py",  # figures/penalty_*.png; no row in the table
     "demo_nonlinear.py",  # figures/nonlinear/; no row in the table
     "demo_realistic.py",  # figures/realistic/; no row in the table
+    "demo_column.py",  # figures/column/; no row in the table
 )
 CASES = ("free", "c1", "c2", "c3")
 COLUMNS = (

@@ -346,7 +346,11 @@ def test_json_says_what_it_solved_and_reruns(tmp_path, capsys):
     assert main(["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--json", str(out)]) == 0
     data = json.loads(out.read_text())
     assert data["input"]["mesh"] == {"nx": 8, "ny": 4}
-    assert data["input"]["obstacle"] == {"zone": [[-0.04, 0.04], [-0.02, 0.02]], "side": "above"}
+    assert data["input"]["obstacle"] == {
+        "zone": [[-0.04, 0.04], [-0.02, 0.02]],
+        "side": "above",
+        "gap": 0.0,
+    }
     assert data["input"]["solver"]["tau"] == 1e-8  # defaults included
     for key in ("unibuckle_fenicsx", "dolfinx", "PETSc", "SLEPc", "python"):
         assert key in data["versions"], key

@@ -47,6 +47,9 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
     pngs["nonlinear/deformed_c1.png"] = (h3, w3)
     pngs["realistic/mode.png"] = (h3, w3)  # demo_realistic
     pngs["realistic/contact_map.png"] = line
+    pngs["column/mode.png"] = (h3, w3)  # demo_column
+    pngs["column/contact_map.png"] = line
+    pngs["column/tie_spacing.png"] = (750, 1125)  # charts.plot_sweep
     return pngs
 
 
@@ -70,7 +73,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for demo in (
         "demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3",
-        "demo_garland", "demo_nonlinear", "demo_realistic",
+        "demo_garland", "demo_nonlinear", "demo_realistic", "demo_column",
     ):  # fmt: skip
         assert f"{demo}.py: ok" in proc.stdout
     assert "lambda/lambda_free" in proc.stdout and "eigen solves" in proc.stdout
@@ -87,6 +90,11 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
         assert pixels.std() > 0.03 and away_from_white > 0.02, (
             f"{rel} looks blank (std {pixels.std():.3g}, non-white {away_from_white:.3g})"
         )
+
+    column = json.loads((figures / "column" / "results.json").read_text())
+    assert column["certificate"]["kkt"] and 0.0 < column["design"]["reduction_factor"] <= 1.0
+    assert column["critical_stress_MPa"] >= column["free_stress_MPa"] * (1 - 1e-8)
+    assert all(row["status"] == "ok" for row in column["tie_spacing_study"])
 
     for case in CASES:
         data = json.loads((figures / case / "results.json").read_text())

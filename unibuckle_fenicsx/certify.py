@@ -126,7 +126,9 @@ class Certificate:
             return "not-kkt"
         if self.global_optimum_proven:
             return "proven"
-        if self.proven_by != "interlacing" and self.relative_gap <= BRACKET_GAP:
+        # A bound verified at lambda (1 - BRACKET_GAP) gives the gap BRACKET_GAP up to the
+        # rounding of (upper - lower) / upper.
+        if self.proven_by != "interlacing" and self.relative_gap <= BRACKET_GAP * (1 + 1e-9):
             return "bracketed"
         return "kkt-only"
 

@@ -59,7 +59,14 @@ def reference_k(spec: ProblemSpec) -> tuple[float | None, float | None, str]:
     Returns:
         (bilateral k or None, unilateral k or None, what the unilateral value is).
     """
-    if not _uniaxial_x(spec):
+    plain = not (
+        spec.points
+        or spec.has_fixed_load
+        or spec.load.thermal
+        or spec.material.plies
+        or any(e.springs for e in spec.plate.edges)
+    )
+    if not plain or not _uniaxial_x(spec):  # the curves below know none of these
         return None, None, ""
     supports = {edge.name: edge.support for edge in spec.plate.edges}
     phi = spec.plate.length / spec.plate.width
@@ -80,7 +87,9 @@ def _unit(path: str, units: str) -> str:
     stress = UNITS[units][2]
     if path in ("plate.length", "plate.width", "mesh.size", "plate.thickness"):
         return length
-    if path.startswith(("plate.corners", "obstacle.zone", "obstacle.tolerance")):
+    if path.startswith(("plate.corners", "obstacle.zone", "obstacle.tolerance", "obstacle.gap")):
+        return length
+    if path.startswith("points.") and path.split(".")[2] in ("at", "spacing", "offset", "region"):
         return length
     if path == "material.E":
         return stress
@@ -179,7 +188,7 @@ def plot_sweep(
     )
     for style, mfc, text in markers:
         ax.plot([], [], style, color="0.2", mfc=mfc, label=text)
-    # Keep the interesting range readable: very short plates have large k.
+    # Keep the interesting range readable: very short plates have large k (aspect sweeps).
     solved_lines = [m for m in lines if "buckling_coefficient_k" in m]
     shown = [float(m["buckling_coefficient_k"]) for m in solved_lines] + [
         float(m["buckling_coefficient_k"]) * m["free_load_Pa"] / m["critical_load_Pa"]
@@ -187,7 +196,7 @@ def plot_sweep(
     ]
     if shown:
         low, high = min(shown), max(shown)
-        ax.set_ylim(0.9 * low, min(1.05 * high, 2.5 * low))
+        ax.set_ylim(0.9 * low, min(1.05 * high, 2.5 * low) if aspect else 1.05 * high)
     ax.set_xlabel("aspect ratio a/b" if aspect else f"{first.path} ({_unit(first.path, units)})")
     ax.set_ylabel(r"buckling coefficient $k = N b^2 / (\pi^2 D)$")
     ax.set_title(title or f"{base.get('name', 'plate')}: k against {first.path}")

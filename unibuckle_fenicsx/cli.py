@@ -53,7 +53,9 @@ SWEEP_EPILOG = f"""\
 --vary PATH=START:STOP:N gives N values from START to STOP (ends included);
 --vary PATH=V1,V2,... gives a list. PATH is the dotted path of a number of the
 problem file, list entries by index: plate.thickness, material.nu,
-edges.left.normal_stress, plate.corners.1.0 (x1), obstacle.zone.0.1, mesh.size;
+edges.left.normal_stress, plate.corners.1.0 (x1), obstacle.zone.0.1, mesh.size,
+edges.top.rotational_stiffness, points.0.spacing, material.plies.0.angle,
+load.fixed_factor (the fixed part's factor: an interaction curve);
 plate.length and plate.width set x1 = x0 + value and y1 = y0 + value. Several
 --vary make a grid (the first varies slowest). Values are in the file's units. Give
 [mesh] size = h in the file for a cell count that follows the plate's size.

@@ -35,6 +35,7 @@ from unibuckle_fenicsx.geometry import (
     polygon_inside,
     polygons_disjoint,
 )
+from unibuckle_fenicsx.laminate import laminate
 
 __all__ = [
     "BENDING_SUPPORTS",
@@ -42,14 +43,19 @@ __all__ = [
     "HOLES",
     "INPLANE_SUPPORTS",
     "METHODS",
+    "POINT_KINDS",
     "SIDES",
     "UNITS",
     "Circle",
+    "DesignSpec",
     "EdgeSpec",
+    "LoadSpec",
     "Material",
     "MeshSpec",
     "ObstacleSpec",
     "PlateSpec",
+    "Ply",
+    "PointSpec",
     "Polygon",
     "ProblemSpec",
     "SolverSpec",
@@ -59,6 +65,7 @@ __all__ = [
     "problem_to_dict",
     "stress_ends",
     "stress_value",
+    "temperature_field",
 ]
 
 #: Edge names of a rectangular plate, in facet-tag order 1..4.
@@ -128,6 +135,47 @@ def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
 
 
 @dataclass(frozen=True)
+class Ply:
+    r"""One orthotropic ply of a laminate (:mod:`~unibuckle_fenicsx.laminate`).
+
+    Args:
+        thickness: Ply thickness (m), > 0.
+        angle: Fibre angle from the x axis, counter-clockwise (degrees).
+        E1: Young's modulus along the fibres (Pa), > 0.
+        E2: Young's modulus across the fibres (Pa), > 0.
+        G12: In-plane shear modulus (Pa), > 0.
+        nu12: Major Poisson's ratio, :math:`|\nu_{12}| < \sqrt{E_1/E_2}` (a positive
+            definite ply).
+        G13: Transverse shear modulus in the 1-3 plane (Pa), > 0.
+        G23: Transverse shear modulus in the 2-3 plane (Pa), > 0.
+    """
+
+    thickness: float
+    angle: float
+    E1: float
+    E2: float
+    G12: float
+    nu12: float
+    G13: float
+    G23: float
+
+    def __post_init__(self) -> None:
+        for name in ("thickness", "E1", "E2", "G12", "G13", "G23"):
+            value = _number(f"material.plies.{name}", getattr(self, name))
+            if not value > 0.0:
+                unit = "m" if name == "thickness" else "Pa"
+                raise ValueError(f"material.plies.{name} must be > 0 {unit}, got {value!r}")
+            object.__setattr__(self, name, value)
+        for name in ("angle", "nu12"):
+            object.__setattr__(self, name, _number(f"material.plies.{name}", getattr(self, name)))
+        if not abs(self.nu12) < math.sqrt(self.E1 / self.E2):
+            raise ValueError(
+                f"material.plies.nu12 must satisfy |nu12| < sqrt(E1/E2) = "
+                f"{math.sqrt(self.E1 / self.E2):.4g} (a positive definite ply), got {self.nu12!r}"
+            )
+
+
+@dataclass(frozen=True)
 class Material:
     r"""Linear elastic material.
 
@@ -144,6 +192,15 @@ class Material:
             :math:`D_{\alpha\beta\nu\mu}`, 3x3 Voigt (N m) acting on
             :math:`(\kappa_{11}, \kappa_{22}, 2\kappa_{12})`. ``None``: isotropic
             :math:`D = E t^3/(12(1-\nu^2))`.
+        plies: A laminate, bottom ply first (:class:`Ply`): its membrane, bending and
+            transverse shear stiffness by classical lamination theory with first-order
+            shear (:mod:`~unibuckle_fenicsx.laminate`, ``shear_correction`` the factor
+            on the shear); symmetric stacks only (no bending-membrane coupling). E and
+            nu are then the laminate's in-plane constants :math:`E_x, \nu_{xy}`: build
+            it with :meth:`from_plies`.
+        thermal_expansion: Coefficient of thermal expansion :math:`\alpha` (1/K), >= 0,
+            the same in every direction (the free thermal strain :math:`\alpha\Delta T I`);
+            not for a laminate, whose plies expand differently.
     """
 
     E: float
@@ -151,8 +208,38 @@ class Material:
     shear_correction: float = 5.0 / 6.0
     membrane_voigt: tuple[tuple[float, ...], ...] | None = None
     bending_voigt: tuple[tuple[float, ...], ...] | None = None
+    plies: tuple[Ply, ...] = ()
+    thermal_expansion: float = 0.0
+
+    @classmethod
+    def from_plies(cls, plies: Any, shear_correction: float = 5.0 / 6.0) -> Material:
+        """The laminate of ``plies`` (bottom first), E and nu its in-plane constants."""
+        if not isinstance(plies, list | tuple) or not plies:
+            raise ValueError(
+                "material.plies must be a list of tables ([[material.plies]] in TOML), at "
+                f"least one, got {plies!r}"
+            )
+        for k, ply in enumerate(plies):
+            if not isinstance(ply, Ply):
+                raise ValueError(f"material.plies[{k}] must be a Ply, got {ply!r}")
+        E, nu = laminate(plies).engineering_constants()
+        return cls(E=E, nu=nu, shear_correction=shear_correction, plies=tuple(plies))
 
     def __post_init__(self) -> None:
+        object.__setattr__(self, "plies", tuple(self.plies))
+        alpha = _number("material.thermal_expansion", self.thermal_expansion)
+        if not alpha >= 0.0:
+            raise ValueError(f"material.thermal_expansion must be >= 0 1/K, got {alpha!r}")
+        object.__setattr__(self, "thermal_expansion", alpha)
+        if alpha and self.plies:
+            raise ValueError(
+                "material.thermal_expansion: a laminate's plies expand differently (their "
+                "own coefficients along and across the fibres), which is not modelled; a "
+                "thermal load needs an isotropic material or Voigt matrices"
+            )
+        if self.plies:
+            self._check_laminate()
+            return
         if not _number("material.E", self.E) > 0.0:
             raise ValueError(f"material.E (Young's modulus) must be > 0 Pa, got {self.E!r}")
         if not -1.0 < _number("material.nu", self.nu) < 0.5:
@@ -182,6 +269,35 @@ class Material:
             object.__setattr__(self, name, tuple(tuple(float(c) for c in row) for row in mat))
         for name in ("E", "nu", "shear_correction"):
             object.__setattr__(self, name, float(getattr(self, name)))
+
+    def _check_laminate(self) -> None:
+        """A symmetric stack of plies; E and nu its in-plane constants."""
+        if self.membrane_voigt is not None or self.bending_voigt is not None:
+            raise ValueError(
+                "material.plies: a laminate's stiffness comes from its plies; give plies, or "
+                "membrane_voigt and bending_voigt, not both"
+            )
+        if not _number("material.shear_correction", self.shear_correction) > 0.0:
+            raise ValueError(
+                f"material.shear_correction must be > 0, got {self.shear_correction!r}"
+            )
+        stack = laminate(self.plies, self.shear_correction)
+        if stack.coupling > 1e-10:
+            raise ValueError(
+                "material.plies: the stack is not symmetric about its mid-plane (bending-"
+                f"membrane coupling: largest |B_ij| = {np.abs(stack.B).max():.4g} N, "
+                f"{stack.coupling:.2g} of max|A_ij| t); unsymmetric laminates bend under "
+                "in-plane load and are not modelled: give a stack symmetric about its "
+                "mid-plane (same thickness, angle and material at equal distances)"
+            )
+        E, nu = stack.engineering_constants()
+        if not (math.isclose(self.E, E, rel_tol=1e-9) and math.isclose(self.nu, nu, rel_tol=1e-9)):
+            raise ValueError(
+                f"material.E and material.nu of a laminate are its in-plane constants E_x = "
+                f"{E:.6g} Pa and nu_xy = {nu:.6g} from the plies (got {self.E!r}, {self.nu!r}): "
+                "leave them out (Material.from_plies)"
+            )
+        object.__setattr__(self, "shear_correction", float(self.shear_correction))
 
 
 @dataclass(frozen=True)
@@ -254,6 +370,18 @@ class EdgeSpec:
             rectangle (tags 1..4 in :data:`EDGE_NAMES` order).
         segments: The outline segments forming this boundary part (segment k runs from
             vertex k to vertex k + 1), for a plate given by its ``outline``.
+        rotational_stiffness: Elastic restraint of the rotation about the edge,
+            :math:`k_r` (N m per m per rad, i.e. N), >= 0: the energy
+            :math:`\tfrac12\int k_r (\theta\cdot n)^2\,ds`, on an edge whose support leaves
+            that rotation free (not "clamped"). 0: none; :math:`k_r \to \infty`: clamped.
+        translational_stiffness: Elastic support of the deflection along the edge,
+            :math:`k_t` (N/m per m, i.e. N/m^2), >= 0: :math:`\tfrac12\int k_t w^2\,ds`,
+            on an edge whose support leaves w free ("free"). :math:`k_t \to \infty`:
+            the soft simple support.
+        fixed_normal_stress: Normal edge stress (Pa) applied as is, not scaled by the
+            load factor (the fixed part of the load, :class:`LoadSpec`); a number or a
+            pair, as ``normal_stress``.
+        fixed_shear_stress: Tangential edge stress (Pa) applied as is.
     """
 
     name: str
@@ -263,6 +391,10 @@ class EdgeSpec:
     shear_stress: float | tuple[float, float] = 0.0
     tag: int | None = None
     segments: tuple[int, ...] | None = None
+    rotational_stiffness: float = 0.0
+    translational_stiffness: float = 0.0
+    fixed_normal_stress: float | tuple[float, float] = 0.0
+    fixed_shear_stress: float | tuple[float, float] = 0.0
 
     def __post_init__(self) -> None:
         where = f"edges.{self.name}"
@@ -270,7 +402,7 @@ class EdgeSpec:
             raise ValueError(f"edge names must be non-empty strings, got {self.name!r}")
         _choice(f"{where}.support", self.support, BENDING_SUPPORTS)
         _choice(f"{where}.inplane", self.inplane, INPLANE_SUPPORTS)
-        for name in ("normal_stress", "shear_stress"):
+        for name in ("normal_stress", "shear_stress", "fixed_normal_stress", "fixed_shear_stress"):
             object.__setattr__(self, name, _stress(f"{where}.{name}", getattr(self, name)))
         if self.tag is not None:
             _integer(f"{where}.tag", self.tag, 0)
@@ -284,11 +416,53 @@ class EdgeSpec:
             if len(set(segments)) != len(segments):
                 raise ValueError(f"{where}.segments repeats a segment: {list(segments)}")
             object.__setattr__(self, "segments", segments)
+        self._check_springs(where)
+
+    def _check_springs(self, where: str) -> None:
+        """The edge springs: finite, >= 0, on DOFs the support leaves free."""
+        for name in ("rotational_stiffness", "translational_stiffness"):
+            if not _number(f"{where}.{name}", getattr(self, name)) >= 0.0:
+                raise ValueError(
+                    f"{where}.{name} must be >= 0 (0: no spring), got {getattr(self, name)!r}"
+                )
+            object.__setattr__(self, name, float(getattr(self, name)))
+        if self.rotational_stiffness > 0.0 and self.support == "clamped":
+            raise ValueError(
+                f'{where}.rotational_stiffness: support = "clamped" fixes the rotation '
+                "already; a rotational spring needs a support that leaves it free "
+                '("simply_supported", "simply_supported_soft" or "free")'
+            )
+        if self.translational_stiffness > 0.0 and self.support != "free":
+            raise ValueError(
+                f'{where}.translational_stiffness: support = "{self.support}" fixes the '
+                'deflection already; an elastically supported edge has support = "free"'
+            )
+
+    @property
+    def springs(self) -> bool:
+        """Whether the edge carries a rotational or a translational spring."""
+        return self.rotational_stiffness > 0.0 or self.translational_stiffness > 0.0
 
     @property
     def loaded(self) -> bool:
         r"""Whether this edge carries a traction (belongs to :math:`\gamma_1`)."""
         return any(v != 0.0 for v in (*self.normal_ends, *self.shear_ends))
+
+    @property
+    def fixed_loaded(self) -> bool:
+        """Whether the edge carries a fixed traction."""
+        ends = (*stress_ends(self.fixed_normal_stress), *stress_ends(self.fixed_shear_stress))
+        return any(v != 0.0 for v in ends)
+
+    def fixed_part(self) -> EdgeSpec:
+        """This edge with its fixed stresses as the stresses (and no fixed part)."""
+        return replace(
+            self,
+            normal_stress=self.fixed_normal_stress,
+            shear_stress=self.fixed_shear_stress,
+            fixed_normal_stress=0.0,
+            fixed_shear_stress=0.0,
+        )
 
     @property
     def normal_ends(self) -> tuple[float, float]:
@@ -499,6 +673,30 @@ class PlateSpec:
         """Extent in y (m)."""
         return self.corners[1][1] - self.corners[0][1]
 
+    def fixed_part(self) -> PlateSpec:
+        """The plate with its edges' fixed stresses as the stresses (for the fixed prestress)."""
+        return replace(self, edges=tuple(e.fixed_part() for e in self.edges))
+
+    @property
+    def fixed_loaded(self) -> bool:
+        """Whether an edge carries a fixed stress."""
+        return any(e.fixed_loaded for e in self.edges)
+
+    def contains(self, points: npt.NDArray[np.float64], tol: float) -> npt.NDArray[np.bool_]:
+        """Mask of the points (n, 2) in the closed plate (within ``tol``), not in a hole.
+
+        For a file, its bounding box (the mesh is not known yet).
+        """
+        inside = points_in_polygon(points, self.boundary, tol)
+        for hole in self.holes:
+            if isinstance(hole, Circle):
+                inside &= ~points_in_circle(points, hole.center, hole.radius, -tol)
+            else:
+                inside &= ~points_in_polygon(points, hole.vertices) | (
+                    distance_to_polygon(points, hole.vertices) <= tol
+                )
+        return inside
+
     def edge(self, name: str) -> EdgeSpec:
         """The edge called ``name``."""
         for e in self.edges:
@@ -572,6 +770,18 @@ SIDES = ("above", "below", "both")
 Box = tuple[tuple[float, float], tuple[float, float]]
 
 
+def _box(name: str, value: Any) -> Box:
+    """A box [[xmin, xmax], [ymin, ymax]] of finite numbers, min <= max."""
+    try:
+        (x0, x1), (y0, y1) = value
+    except (TypeError, ValueError):
+        raise ValueError(f"{name} must be [[xmin, xmax], [ymin, ymax]], got {value!r}") from None
+    box = ((_number(name, x0), _number(name, x1)), (_number(name, y0), _number(name, y1)))
+    if box[0][0] > box[0][1] or box[1][0] > box[1][1]:
+        raise ValueError(f"{name} needs xmin <= xmax and ymin <= ymax, got {value!r}")
+    return box
+
+
 @dataclass(frozen=True)
 class ObstacleSpec:
     r"""Rigid flat obstacle, or Winkler foundation, on one side of the plate over a zone.
@@ -594,12 +804,17 @@ class ObstacleSpec:
         foundation_stiffness: Winkler modulus :math:`k_f` (N/m^3, Pa/m), > 0; ``None``
             for a rigid obstacle. The springs are lumped at the zone's nodes: node k
             carries :math:`k_f \int \varphi_k\,dx` (its tributary area).
+        gap: Clearance g (m) >= 0 between the flat plate and a rigid obstacle: w <= g
+            (above), w >= -g (below). The nonlinear analysis follows the plate onto it;
+            the linear critical state ignores an obstacle with a gap (an infinitesimal
+            buckle does not reach it).
     """
 
     zone: Literal["all"] | Box | Polygon | Circle | Predicate = "all"
     tolerance: float | None = None
     side: str = "above"
     foundation_stiffness: float | None = None
+    gap: float = 0.0
 
     def __post_init__(self) -> None:
         if isinstance(self.zone, str):
@@ -611,21 +826,7 @@ class ObstacleSpec:
         elif isinstance(self.zone, Polygon | Circle):
             pass
         elif not callable(self.zone):
-            try:
-                (x0, x1), (y0, y1) = self.zone
-            except (TypeError, ValueError):
-                raise ValueError(
-                    f"obstacle.zone must be [[xmin, xmax], [ymin, ymax]], got {self.zone!r}"
-                ) from None
-            box = (
-                (_number("obstacle.zone", x0), _number("obstacle.zone", x1)),
-                (_number("obstacle.zone", y0), _number("obstacle.zone", y1)),
-            )
-            if box[0][0] > box[0][1] or box[1][0] > box[1][1]:
-                raise ValueError(
-                    f"obstacle.zone needs xmin <= xmax and ymin <= ymax, got {self.zone!r}"
-                )
-            object.__setattr__(self, "zone", box)
+            object.__setattr__(self, "zone", _box("obstacle.zone", self.zone))
         if self.tolerance is not None and not _number("obstacle.tolerance", self.tolerance) >= 0:
             raise ValueError(f"obstacle.tolerance must be >= 0 m, got {self.tolerance!r}")
         if self.foundation_stiffness is not None:
@@ -643,6 +844,15 @@ class ObstacleSpec:
                 '("above" or "below"); "both" is for a foundation (foundation_stiffness)'
             )
         _choice("obstacle.side", self.side, SIDES)
+        gap = _number("obstacle.gap", self.gap)
+        if not gap >= 0.0:
+            raise ValueError(f"obstacle.gap must be >= 0 m, got {gap!r}")
+        if gap and self.foundation_stiffness is not None:
+            raise ValueError(
+                "obstacle.gap: a gap is modelled for rigid obstacles only, not for a "
+                "foundation (foundation_stiffness)"
+            )
+        object.__setattr__(self, "gap", gap)
 
     @property
     def sign(self) -> float:
@@ -692,6 +902,218 @@ class ObstacleSpec:
     def same_zone(self, other: ObstacleSpec) -> bool:
         """Whether ``other`` has the same zone (a predicate only when it is the same one)."""
         return self.zone is other.zone or (not callable(self.zone) and self.zone == other.zone)
+
+
+Temperature = float | tuple[float, float, float]
+
+
+def _temperature(name: str, value: Any) -> Temperature:
+    """A temperature rise: a number (K), or [T0, dT/dx, dT/dy] (K, K/m) for a linear field."""
+    if isinstance(value, list | tuple):
+        if len(value) != 3:
+            raise ValueError(
+                f"{name} must be a number (a uniform rise, K) or [T0, dT/dx, dT/dy] (the "
+                f"linear field T0 + dT/dx x + dT/dy y, K and K/m), got {value!r}"
+            )
+        return (_number(name, value[0]), _number(name, value[1]), _number(name, value[2]))
+    return _number(name, value)
+
+
+def temperature_field(value: Temperature) -> tuple[float, float, float]:
+    """(T0, dT/dx, dT/dy) of a temperature rise."""
+    return value if isinstance(value, tuple) else (value, 0.0, 0.0)
+
+
+@dataclass(frozen=True)
+class LoadSpec:
+    r"""The load besides the edge stresses: temperature rises, scaled and fixed.
+
+    The prestress is :math:`N = N_{fixed} + \lambda N_{scaled}`: the scaled part is the
+    edges' ``normal_stress`` and ``shear_stress`` (per unit load) with ``temperature``;
+    the fixed part, applied as is, the edges' ``fixed_normal_stress`` and
+    ``fixed_shear_stress`` (Pa) with ``fixed_temperature``, times ``fixed_factor``. A
+    temperature rise :math:`\Delta T` gives the free thermal strain
+    :math:`\alpha\Delta T I` (``[material] thermal_expansion``), which the edges'
+    in-plane conditions turn into a prestress. The buckling pencil is
+    :math:`(A - B_{fixed}, B_{scaled})`.
+
+    Args:
+        temperature: The rise per unit load factor: a number (K, uniform) or
+            ``(T0, dTdx, dTdy)``, the linear field :math:`T_0 + T_{,x} x + T_{,y} y` (K, K/m).
+        fixed_temperature: A rise applied as is, the same forms.
+        fixed_factor: A factor on the whole fixed part (the fixed edge stresses and
+            ``fixed_temperature``), 1 by default: a sweep over it draws an interaction
+            curve with one ``--vary``; 0 switches the fixed part off.
+    """
+
+    temperature: Temperature = 0.0
+    fixed_temperature: Temperature = 0.0
+    fixed_factor: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name in ("temperature", "fixed_temperature"):
+            object.__setattr__(self, name, _temperature(f"load.{name}", getattr(self, name)))
+        object.__setattr__(self, "fixed_factor", _number("load.fixed_factor", self.fixed_factor))
+
+    @property
+    def thermal(self) -> bool:
+        """Whether the scaled part has a temperature rise."""
+        return any(temperature_field(self.temperature))
+
+    @property
+    def fixed_thermal(self) -> bool:
+        """Whether the fixed part has a temperature rise."""
+        return any(temperature_field(self.fixed_temperature))
+
+
+@dataclass(frozen=True)
+class DesignSpec:
+    r"""Design output by EN 1993-1-5 (:mod:`~unibuckle_fenicsx.design`).
+
+    Args:
+        yield_stress: :math:`f_y` (Pa), > 0.
+        partial_factor: :math:`\gamma_{M1}`, > 0 (1.0, the recommended value of
+            EN 1993-1-1, 6.1).
+    """
+
+    yield_stress: float
+    partial_factor: float = 1.0
+
+    def __post_init__(self) -> None:
+        for name, unit in (("yield_stress", " Pa"), ("partial_factor", "")):
+            value = _number(f"design.{name}", getattr(self, name))
+            if not value > 0.0:
+                raise ValueError(f"design.{name} must be > 0{unit}, got {value!r}")
+            object.__setattr__(self, name, value)
+
+
+#: Kinds of point restraint: w = 0, the obstacle's cone at the point, or a spring.
+POINT_KINDS = ("bilateral", "one-sided", "spring")
+
+
+def _pair(name: str, value: Any) -> tuple[float, float]:
+    """A pair [a, b] of finite numbers."""
+    if not isinstance(value, list | tuple) or len(value) != 2:
+        raise ValueError(f"{name} must be a pair [x, y] of numbers, got {value!r}")
+    return (_number(name, value[0]), _number(name, value[1]))
+
+
+@dataclass(frozen=True)
+class PointSpec:
+    r"""Point restraints: one point, or a grid of them (bolts, tie bars, studs).
+
+    Each point acts on the mesh node nearest to it (the snap distance is reported).
+
+    Args:
+        at: One point (x, y) (m); or None for a grid.
+        spacing: The grid's spacing (sx, sy) (m), > 0 (a number: the same in x and y).
+        offset: A point of the grid (m); default the region's lower-left corner.
+        region: The box ((xmin, xmax), (ymin, ymax)) (m) holding the grid's points (a
+            degenerate side gives a line); default the plate's bounding box. Points
+            outside the plate (or in a hole) are left out.
+        kind: One of :data:`POINT_KINDS`: "bilateral" (w = 0), "one-sided" (the
+            obstacle's cone at the point: w <= 0 with ``side`` "above", w >= 0
+            "below"), "spring" (a spring of ``stiffness`` N/m to w = 0).
+        stiffness: The spring's stiffness (N/m), > 0, for ``kind = "spring"`` only.
+        side: "above" or "below", for ``kind = "one-sided"`` only.
+    """
+
+    at: tuple[float, float] | None = None
+    spacing: tuple[float, float] | None = None
+    offset: tuple[float, float] | None = None
+    region: Box | None = None
+    kind: str = "bilateral"
+    stiffness: float | None = None
+    side: str = "above"
+
+    def __post_init__(self) -> None:
+        where = "points"
+        _choice(f"{where}.kind", self.kind, POINT_KINDS)
+        if (self.at is None) == (self.spacing is None):
+            raise ValueError(
+                "[[points]] needs at = [x, y] (one point) or spacing = s or [sx, sy] (a "
+                "grid, with optional offset and region): exactly one of them"
+            )
+        if self.at is not None:
+            object.__setattr__(self, "at", _pair(f"{where}.at", self.at))
+            for name in ("offset", "region"):
+                if getattr(self, name) is not None:
+                    raise ValueError(f"{where}.{name} belongs to a grid (spacing), not to at")
+        else:
+            spacing: Any = self.spacing
+            if not isinstance(spacing, list | tuple):
+                spacing = (spacing, spacing)
+            pair = _pair(f"{where}.spacing", spacing)
+            if min(pair) <= 0.0:
+                raise ValueError(f"{where}.spacing must be > 0 m, got {self.spacing!r}")
+            object.__setattr__(self, "spacing", pair)
+            if self.offset is not None:
+                object.__setattr__(self, "offset", _pair(f"{where}.offset", self.offset))
+            if self.region is not None:
+                object.__setattr__(self, "region", _box(f"{where}.region", self.region))
+        if self.kind == "spring":
+            if self.stiffness is None or not _number(f"{where}.stiffness", self.stiffness) > 0:
+                raise ValueError(
+                    f'{where}.stiffness: kind = "spring" needs a stiffness > 0 N/m, got '
+                    f"{self.stiffness!r}"
+                )
+            object.__setattr__(self, "stiffness", float(self.stiffness))
+        elif self.stiffness is not None:
+            raise ValueError(f'{where}.stiffness belongs to kind = "spring", not "{self.kind}"')
+        _choice(f"{where}.side", self.side, ("above", "below"))
+        if self.side != "above" and self.kind != "one-sided":
+            raise ValueError(f'{where}.side belongs to kind = "one-sided", not "{self.kind}"')
+
+    @property
+    def sign(self) -> float:
+        """+1 for a one-sided point above (w <= 0 admissible), -1 below."""
+        return 1.0 if self.side == "above" else -1.0
+
+    def locations(self, plate: PlateSpec) -> npt.NDArray[np.float64]:
+        """The points (n, 2) (m): ``at``, or the grid's points inside the plate.
+
+        Raises:
+            ValueError: ``at`` outside the plate, or a grid with no point in it.
+        """
+        size = max(plate.length, plate.width)
+        tol = 1e-9 * size
+        if self.at is not None:
+            points = np.array([self.at])
+        else:
+            assert self.spacing is not None
+            region = self.region if self.region is not None else tuple(zip(*plate.corners))
+            offset = self.offset if self.offset is not None else (region[0][0], region[1][0])
+            axes = []
+            for (lo, hi), step, start in zip(region, self.spacing, offset, strict=True):
+                first = math.ceil((lo - start - tol) / step)
+                last = math.floor((hi - start + tol) / step)
+                if last - first > 100_000:
+                    raise ValueError(
+                        f"points.spacing {self.spacing} gives more than 100000 points per row"
+                    )
+                axes.append(start + step * np.arange(first, last + 1))
+            gx, gy = np.meshgrid(*axes, indexing="ij")
+            points = np.column_stack([gx.ravel(), gy.ravel()])
+        inside = plate.contains(points, tol) if plate.file is None else np.ones(len(points), bool)
+        if self.at is not None and not inside.all():
+            raise ValueError(f"points.at {list(self.at)} lies outside the plate (or in a hole)")
+        points = points[inside]
+        if not len(points):
+            raise ValueError(
+                f"points: the grid of spacing {list(self.spacing or ())} holds no point of "
+                "the plate; check spacing, offset and region"
+            )
+        return points
+
+    def describe(self) -> str:
+        """Short description (for messages and the summary)."""
+        what = self.kind if self.kind != "spring" else f"spring {self.stiffness:g} N/m"
+        if self.kind == "one-sided":
+            what += f" ({self.side})"
+        if self.at is not None:
+            return f"{what} at ({self.at[0]:g}, {self.at[1]:g}) m"
+        assert self.spacing is not None
+        return f"{what} grid of spacing {self.spacing[0]:g} x {self.spacing[1]:g} m"
 
 
 @dataclass(frozen=True)
@@ -783,6 +1205,9 @@ class ProblemSpec:
             numbers here are SI whatever it is).
         obstacles: Several obstacles (the file's ``[[obstacles]]`` tables), instead of
             ``obstacle``; their constrained nodes are the union of their zones'.
+        points: Point restraints (the file's ``[[points]]`` tables).
+        load: Temperature rises, scaled and fixed (the ``[load]`` table).
+        design: The EN 1993-1-5 design output's data (``[design]``), or None.
     """
 
     name: str = "plate"
@@ -793,6 +1218,9 @@ class ProblemSpec:
     solver: SolverSpec = field(default_factory=SolverSpec)
     units: str = "SI"
     obstacles: tuple[ObstacleSpec, ...] = ()
+    points: tuple[PointSpec, ...] = ()
+    load: LoadSpec = field(default_factory=LoadSpec)
+    design: DesignSpec | None = None
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
@@ -813,8 +1241,33 @@ class ProblemSpec:
         for k, o in enumerate(self.obstacles):
             if not isinstance(o, ObstacleSpec):
                 raise ValueError(f"obstacles[{k}] must be an ObstacleSpec, got {o!r}")
+        if self.material.plies:
+            total = sum(ply.thickness for ply in self.material.plies)
+            if not math.isclose(plate.thickness, total, rel_tol=1e-9):
+                raise ValueError(
+                    f"plate.thickness = {plate.thickness!r} m differs from the plies' total "
+                    f"{total!r} m"
+                )
+        self._check_load()
+        self._check_design()
+        object.__setattr__(self, "points", tuple(self.points))
+        for k, point in enumerate(self.points):
+            if not isinstance(point, PointSpec):
+                raise ValueError(f"points[{k}] must be a PointSpec, got {point!r}")
+            if plate.file is not None:
+                continue  # the plate's extent is known once the file is meshed
+            try:
+                point.locations(plate)
+            except ValueError as err:
+                raise ValueError(f"points[{k}]{str(err)[len('points') :]}") from None
         found = self.all_obstacles
         kinds = {o.kind for o in found}
+        if self.one_sided_points and "tensionless" in kinds:
+            raise ValueError(
+                'points: one-sided points (kind = "one-sided") join a rigid obstacle\'s cone; '
+                'with a tensionless foundation give them a stiffness (kind = "spring") or '
+                "make the foundation rigid"
+            )
         if {"rigid", "tensionless"} <= kinds:
             raise ValueError(
                 "rigid obstacles and tensionless foundations in one problem are not "
@@ -846,10 +1299,75 @@ class ProblemSpec:
                     "side"
                 )
 
+    def _check_load(self) -> None:
+        """Temperatures need a thermal expansion and an edge held in its plane."""
+        load = self.load
+        if (load.thermal or load.fixed_thermal) and not self.material.thermal_expansion:
+            which = "load.temperature" if load.thermal else "load.fixed_temperature"
+            raise ValueError(
+                f"{which}: a temperature rise needs [material] thermal_expansion > 0 (1/K)"
+            )
+        held = any(e.inplane != "free" for e in self.plate.edges)
+        for name, on in (("temperature", load.thermal), ("fixed_temperature", load.fixed_thermal)):
+            if on and not held:
+                raise ValueError(
+                    f"load.{name}: the temperature rise leaves the plate stress-free (a "
+                    "uniform or linear rise expands a plate free in its plane without "
+                    'stress): hold an edge in its plane (inplane = "clamped" or "roller")'
+                )
+
+    def _check_design(self) -> None:
+        """The design output needs a compressive normal edge stress (its sigma_cr)."""
+        if self.design is None:
+            return
+        if not isinstance(self.design, DesignSpec):
+            raise ValueError(f"design must be a DesignSpec, got {self.design!r}")
+        compressed = any(
+            min(*stress_ends(e.normal_stress), *stress_ends(e.fixed_normal_stress)) < 0.0
+            for e in self.plate.edges
+        )
+        if not compressed:
+            raise ValueError(
+                "design: the EN 1993-1-5 output takes sigma_cr as a compressive normal edge "
+                "stress, and this load has none (give a loaded edge normal_stress < 0)"
+            )
+
+    def check_scaled_load(self) -> None:
+        """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""
+        if not self.load.thermal and not any(e.loaded for e in self.plate.edges):
+            raise ValueError(
+                "no load to scale: give an edge a non-zero normal_stress or shear_stress (per "
+                "unit load), or [load] temperature (a rise per unit load factor)"
+                + (
+                    "; the fixed part (fixed_normal_stress, fixed_shear_stress, "
+                    "fixed_temperature) is applied as is, not scaled"
+                    if self.has_fixed_load
+                    else ""
+                )
+            )
+
+    @property
+    def has_fixed_load(self) -> bool:
+        """Whether the load has a fixed part (edge stresses or a temperature rise)."""
+        return bool(self.load.fixed_factor) and (self.plate.fixed_loaded or self.load.fixed_thermal)
+
+    @property
+    def one_sided_points(self) -> tuple[PointSpec, ...]:
+        """The point restraints that join the obstacle's cone."""
+        return tuple(p for p in self.points if p.kind == "one-sided")
+
     @property
     def unilateral_obstacles(self) -> tuple[ObstacleSpec, ...]:
-        """The one-sided obstacles (rigid or tensionless foundations): the contact nodes'."""
-        return tuple(o for o in self.all_obstacles if o.kind != "bilateral")
+        """The one-sided obstacles (rigid or tensionless foundations): the contact nodes'.
+
+        Without those with a gap: an infinitesimal buckle does not reach them.
+        """
+        return tuple(o for o in self.all_obstacles if o.kind != "bilateral" and not o.gap)
+
+    @property
+    def gapped_obstacles(self) -> tuple[ObstacleSpec, ...]:
+        """The obstacles with a gap (the nonlinear analysis' only)."""
+        return tuple(o for o in self.all_obstacles if o.gap)
 
     @property
     def bilateral_foundations(self) -> tuple[ObstacleSpec, ...]:
@@ -922,6 +1440,7 @@ _DIMENSIONS: dict[tuple[str, str], tuple[int, int]] = {
     ("material", "membrane_voigt"): (1, 1),  # N/m = Pa m
     ("material", "bending_voigt"): (3, 1),  # N m = Pa m^3
     ("mesh", "size"): (1, 0),
+    ("design", "yield_stress"): (0, 1),
 }
 
 
@@ -939,6 +1458,35 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
         if isinstance(out.get(table), dict) and key in out[table]:
             factor = (length**pl * stress**ps) ** sign
             out[table][key] = _scaled(out[table][key], factor, f"{table}.{key}")
+    load = out.get("load")
+    if isinstance(load, dict):
+        for key in ("temperature", "fixed_temperature"):
+            value = load.get(key)
+            if isinstance(value, list) and len(value) == 3:  # K, K/m, K/m
+                load[key] = [value[0], *_scaled(value[1:], length**-sign, f"load.{key}")]
+    material = out.get("material")
+    if isinstance(material, dict) and isinstance(material.get("plies"), list):
+        material["plies"] = [
+            {
+                k: _scaled(
+                    v, length**sign if k == "thickness" else stress**sign, f"material.plies.{k}"
+                )
+                if k in ("thickness", "E1", "E2", "G12", "G13", "G23")
+                else v
+                for k, v in ply.items()
+            }
+            if isinstance(ply, Mapping)
+            else ply
+            for ply in material["plies"]
+        ]
+    edges = out.get("edges")
+    if isinstance(edges, dict):
+        out["edges"] = {
+            name: _edge_to_si(table, f"edges.{name}", length, stress, sign)
+            if isinstance(table, Mapping)
+            else table
+            for name, table in edges.items()
+        }
     plate = out.get("plate")
     if isinstance(plate, dict):
         if "outline" in plate:
@@ -957,13 +1505,47 @@ def _to_si(top: dict[str, Any], units: str, inverse: bool = False) -> dict[str, 
             ]
     if isinstance(out.get("obstacle"), dict):
         out["obstacle"] = _obstacle_to_si(out["obstacle"], "obstacle", length**sign, stress**sign)
-    if isinstance(out.get("obstacles"), list):
-        out["obstacles"] = [
-            _obstacle_to_si(t, f"obstacles[{k}]", length**sign, stress**sign)
-            if isinstance(t, Mapping)
-            else t
-            for k, t in enumerate(out["obstacles"])
-        ]
+    for key, convert in (("points", _point_to_si), ("obstacles", _obstacle_to_si)):
+        if isinstance(out.get(key), list):
+            out[key] = [
+                convert(t, f"{key}[{k}]", length**sign, stress**sign)
+                if isinstance(t, Mapping)
+                else t
+                for k, t in enumerate(out[key])
+            ]
+    return out
+
+
+#: Keys of an ``[edges.NAME]`` table converted by a file's ``units``: key -> powers of
+#: (length, stress).
+_EDGE_DIMENSIONS: dict[str, tuple[int, int]] = {
+    "translational_stiffness": (0, 1),  # N/m^2 = Pa; rotational_stiffness is N in both
+    "fixed_normal_stress": (0, 1),  # Pa (normal_stress is per unit load: no unit)
+    "fixed_shear_stress": (0, 1),
+}
+
+
+def _edge_to_si(
+    table: Mapping[str, Any], where: str, length: float, stress: float, sign: int
+) -> dict[str, Any]:
+    """An edge table with its dimensional values converted (see :func:`_to_si`)."""
+    out = dict(table)
+    for key, (pl, ps) in _EDGE_DIMENSIONS.items():
+        if key in out:
+            out[key] = _scaled(out[key], (length**pl * stress**ps) ** sign, f"{where}.{key}")
+    return out
+
+
+def _point_to_si(
+    table: Mapping[str, Any], where: str, length: float, stress: float
+) -> dict[str, Any]:
+    """A points table with its lengths times ``length``, its stiffness (N/m) converted."""
+    out = dict(table)
+    for key in ("at", "spacing", "offset", "region"):
+        if key in out:
+            out[key] = _scaled(out[key], length, f"{where}.{key}")
+    if "stiffness" in out:  # N/m = Pa m
+        out["stiffness"] = _scaled(out["stiffness"], stress * length, f"{where}.stiffness")
     return out
 
 
@@ -972,7 +1554,7 @@ def _obstacle_to_si(
 ) -> dict[str, Any]:
     """An obstacle table with its lengths times ``length`` and stresses times ``stress``."""
     out = dict(table)
-    for key in ("polygon", "tolerance"):
+    for key in ("polygon", "tolerance", "gap"):
         if key in out:
             out[key] = _scaled(out[key], length, f"{where}.{key}")
     if "foundation_stiffness" in out:  # N/m^3 = Pa/m
@@ -991,7 +1573,7 @@ def _obstacle_to_si(
 
 
 #: Keys of an ``[obstacle]`` or ``[[obstacles]]`` table.
-OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "foundation_stiffness", "tolerance")
+OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "foundation_stiffness", "tolerance", "gap")
 
 
 def _holes(tables: Any) -> tuple[Circle | Polygon, ...]:
@@ -1082,6 +1664,7 @@ def _obstacle_table(obstacle: ObstacleSpec) -> dict[str, Any]:
         out["foundation_stiffness"] = obstacle.foundation_stiffness
     if obstacle.tolerance is not None:
         out["tolerance"] = obstacle.tolerance
+    out["gap"] = obstacle.gap
     return out
 
 
@@ -1098,13 +1681,26 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     top-level ``name`` and ``units``. Unknown tables or keys raise ``ValueError``.
 
     Missing values take the paper's, with one exception for the load: if any edge table
-    gives ``normal_stress`` or ``shear_stress``, the edges that give neither carry no load
-    (the paper's unit compression of the short edges applies only to a file that sets
-    no edge load at all).
+    gives ``normal_stress``, ``shear_stress`` or a fixed stress, or the file has a
+    ``[load]`` table, the edges that give no stress carry no load (the paper's unit
+    compression of the short edges applies only to a file that sets no load at all).
     """
     top = _take(
         data,
-        ("name", "units", "plate", "material", "edges", "mesh", "obstacle", "obstacles", "solver"),
+        (
+            "name",
+            "units",
+            "plate",
+            "material",
+            "edges",
+            "mesh",
+            "obstacle",
+            "obstacles",
+            "points",
+            "load",
+            "design",
+            "solver",
+        ),
         "top",
     )
     units = _choice("units", top.get("units", "SI"), tuple(UNITS))
@@ -1127,24 +1723,39 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         names = (*EDGE_NAMES, HOLES) if "holes" in plate_kw else EDGE_NAMES
     edge_tables = _take(given, names, "edges")
     edges = {} if gmsh_plate else {e.name: e for e in paper_edges()}
-    load_keys = ("normal_stress", "shear_stress")
+    load_keys = ("normal_stress", "shear_stress", "fixed_normal_stress", "fixed_shear_stress")
     loads_given = any(
         key in table for table in edge_tables.values() if isinstance(table, Mapping)
         for key in load_keys
-    )  # fmt: skip
+    ) or (isinstance(top.get("load"), Mapping) and bool(top["load"]))  # fmt: skip
     if loads_given:
         edges = {n: replace(e, normal_stress=0.0, shear_stress=0.0) for n, e in edges.items()}
-    edge_keys = ("support", "inplane", "normal_stress", "shear_stress", "segments")
+    edge_keys = (
+        "support",
+        "inplane",
+        "normal_stress",
+        "shear_stress",
+        "segments",
+        "rotational_stiffness",
+        "translational_stiffness",
+        "fixed_normal_stress",
+        "fixed_shear_stress",
+    )
     for edge_name, edge_table in edge_tables.items():
         kw = _take(edge_table, edge_keys, f"edges.{edge_name}")
         edge = edges.get(edge_name, EdgeSpec(edge_name))
         edges[edge_name] = replace(edge, **kw)
     plate = PlateSpec(**plate_kw, edges=tuple(edges.values()))
-    material_kw = _take(top.get("material", {"E": 1.0e9, "nu": 0.3}), _names(Material), "material")
-    for key in ("E", "nu"):
-        if key not in material_kw:
-            raise ValueError(f"[material] needs {key!r}")
-    material = Material(**material_kw)
+    material = _material(top.get("material", {"E": 1.0e9, "nu": 0.3}))
+    if material.plies:
+        total = sum(ply.thickness for ply in material.plies)
+        if "thickness" not in plate_kw:
+            plate = replace(plate, thickness=total)
+        elif not math.isclose(plate.thickness, total, rel_tol=1e-9):
+            raise ValueError(
+                f"plate.thickness = {plate.thickness!r} m differs from the plies' total "
+                f"{total!r} m: leave plate.thickness out for a laminate (it is the plies')"
+            )
     mesh_kw = _take(top.get("mesh", {}), _names(MeshSpec), "mesh")
     if plate.meshed_by_gmsh:
         if "nx" in mesh_kw or "ny" in mesh_kw:
@@ -1173,6 +1784,14 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         if obstacle is not None:
             raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
         obstacles = [_obstacle_from_table(t, f"obstacles[{k}]") for k, t in enumerate(tables)]
+    points = _points(top["points"]) if "points" in top else ()
+    load = LoadSpec(**_take(top.get("load", {}), _names(LoadSpec), "load"))
+    design = None
+    if "design" in top:
+        design_kw = _take(top["design"], _names(DesignSpec), "design")
+        if "yield_stress" not in design_kw:
+            raise ValueError("[design] needs yield_stress (f_y)")
+        design = DesignSpec(**design_kw)
     solver = SolverSpec(**_take(top.get("solver", {}), _names(SolverSpec), "solver"))
     label = top.get("name", name)
     if not isinstance(label, str):
@@ -1186,7 +1805,106 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         solver=solver,
         units=units,
         obstacles=tuple(obstacles),
+        points=points,
+        load=load,
+        design=design,
     )
+
+
+#: Keys of a ``[[material.plies]]`` table.
+PLY_KEYS = ("thickness", "angle", "E1", "E2", "G12", "nu12", "G13", "G23")
+
+
+def _material(table: Any) -> Material:
+    """``[material]``: E and nu, or ``[[material.plies]]`` (a laminate)."""
+    kw = _take(table, _names(Material), "material")
+    if "plies" not in kw:
+        for key in ("E", "nu"):
+            if key not in kw:
+                raise ValueError(f"[material] needs {key!r} (or [[material.plies]])")
+        return Material(**kw)
+    other = sorted(set(kw) - {"plies", "shear_correction", "thermal_expansion"})
+    if other:
+        raise ValueError(
+            f"[material] with plies takes shear_correction only besides them, not {other}: "
+            "a laminate's stiffness (and its E_x, nu_xy) comes from its plies"
+        )
+    tables = kw.pop("plies")
+    if not isinstance(tables, list) or not tables:
+        raise ValueError(
+            "material.plies must be a list of tables ([[material.plies]] in TOML), at least "
+            f"one, got {tables!r}"
+        )
+    plies = []
+    for k, ply in enumerate(tables):
+        where = f"material.plies[{k}]"
+        ply_kw = _take(ply, PLY_KEYS, where)
+        missing = [key for key in PLY_KEYS if key not in ply_kw]
+        if missing:
+            raise ValueError(f"[{where}] needs {missing} (keys: {list(PLY_KEYS)})")
+        try:
+            plies.append(Ply(**ply_kw))
+        except ValueError as err:
+            raise ValueError(str(err).replace("material.plies.", f"{where}.")) from None
+    if kw.pop("thermal_expansion", 0.0):
+        Material(E=1.0, nu=0.0, thermal_expansion=1.0, plies=tuple(plies))  # raises
+    return Material.from_plies(plies, **kw)
+
+
+def _points(tables: Any) -> tuple[PointSpec, ...]:
+    """``[[points]]`` tables; messages name ``points[k]``."""
+    if not isinstance(tables, list) or not tables:
+        raise ValueError(
+            f"points must be a list of tables ([[points]] in TOML), at least one, got {tables!r}"
+        )
+    out = []
+    for k, table in enumerate(tables):
+        kw = _take(table, _names(PointSpec), f"points[{k}]")
+        try:
+            out.append(PointSpec(**kw))
+        except ValueError as err:
+            message = str(err)
+            if message.startswith("points"):
+                message = f"points[{k}]" + message[len("points") :]
+            raise ValueError(message) from None
+    return tuple(out)
+
+
+def _material_table(material: Material) -> dict[str, Any]:
+    """The file form of the material (a laminate: its plies, not E and nu)."""
+    if material.plies:
+        return {
+            "shear_correction": material.shear_correction,
+            "plies": [dict(vars(ply)) for ply in material.plies],
+            "thermal_expansion": material.thermal_expansion,
+        }
+    out: dict[str, Any] = {
+        k: v for k, v in vars(material).items() if v is not None and k != "plies"
+    }
+    for key in ("membrane_voigt", "bending_voigt"):
+        if key in out:
+            out[key] = [list(row) for row in out[key]]
+    return out
+
+
+def _point_table(point: PointSpec) -> dict[str, Any]:
+    """The file form of a point restraint (every key with the value used)."""
+    out: dict[str, Any] = {"kind": point.kind}
+    if point.at is not None:
+        out["at"] = list(point.at)
+    else:
+        assert point.spacing is not None
+        sx, sy = point.spacing
+        out["spacing"] = sx if sx == sy else [sx, sy]
+        if point.offset is not None:
+            out["offset"] = list(point.offset)
+        if point.region is not None:
+            out["region"] = [list(r) for r in point.region]
+    if point.stiffness is not None:
+        out["stiffness"] = point.stiffness
+    if point.kind == "one-sided":
+        out["side"] = point.side
+    return out
 
 
 def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
@@ -1207,15 +1925,17 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         "name": spec.name,
         "units": "SI",
         "plate": _plate_table(plate),
-        "material": {
-            k: v for k, v in vars(spec.material).items() if v is not None
-        },  # tuples become lists in JSON/TOML
+        "material": _material_table(spec.material),
         "edges": {
             e.name: {
                 "support": e.support,
                 "inplane": e.inplane,
                 "normal_stress": stress_value(e.normal_stress),
                 "shear_stress": stress_value(e.shear_stress),
+                "rotational_stiffness": e.rotational_stiffness,
+                "translational_stiffness": e.translational_stiffness,
+                "fixed_normal_stress": stress_value(e.fixed_normal_stress),
+                "fixed_shear_stress": stress_value(e.fixed_shear_stress),
             }
             | ({} if e.segments is None else {"segments": list(e.segments)})
             for e in plate.edges
@@ -1233,9 +1953,14 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         out["obstacle"] = _obstacle_table(spec.obstacle)
     if spec.obstacles:
         out["obstacles"] = [_obstacle_table(o) for o in spec.obstacles]
-    for key in ("membrane_voigt", "bending_voigt"):
-        if key in out["material"]:
-            out["material"][key] = [list(row) for row in out["material"][key]]
+    if spec.points:
+        out["points"] = [_point_table(p) for p in spec.points]
+    out["load"] = {
+        key: list(value) if isinstance(value, tuple) else value
+        for key, value in vars(spec.load).items()
+    }
+    if spec.design is not None:
+        out["design"] = dict(vars(spec.design))
     if units != "SI":
         out = _to_si(out, units, inverse=True)
         out["units"] = units

@@ -264,6 +264,9 @@ class ContactSetManager:
             for tensionless foundations (:func:`foundation_springs`); None for rigid
             obstacles.
         num_edge_fixed: Nodes of the zones already fixed (w = 0) by edge supports.
+        gaps: (i,) the obstacle's gap g (m) at each node (the constraint is
+            :math:`s_k w_k \le g_k`), same on all ranks; zero but in the nonlinear
+            analysis (the linear problem leaves obstacles with a gap out).
 
     Note:
         Construction is collective. Raises :class:`EmptyZoneError` if the zones hold no
@@ -288,12 +291,14 @@ class ContactSetManager:
         areas = tributary_areas(model).array if tensionless else None
         found: dict[int, tuple[int, float]] = {}  # W dof -> (Vw dof, sign)
         spring: dict[int, float] = {}  # W dof -> stiffness (foundations)
+        gap: dict[int, float] = {}  # W dof -> the smallest gap of its obstacles
         conflict = False
         for o in self.obstacles:
             dofs_W, dofs_Vw = _zone_dofs(model, o, size)
             for dw, dv in zip(dofs_W.tolist(), dofs_Vw.tolist(), strict=True):
                 conflict |= dw in found and found[dw][1] != o.sign
                 found[dw] = (dv, o.sign)
+                gap[dw] = min(gap.get(dw, o.gap), o.gap)
                 if areas is not None:
                     assert o.foundation_stiffness is not None
                     spring[dw] = spring.get(dw, 0.0) + o.foundation_stiffness * float(areas[dv])
@@ -308,12 +313,14 @@ class ContactSetManager:
         dofs_Vw = np.array([found[d][0] for d in order_W.tolist()], dtype=np.int32)
         signs = np.array([found[d][1] for d in order_W.tolist()], dtype=float)
         springs = np.array([spring.get(d, 0.0) for d in order_W.tolist()], dtype=float)
+        gaps = np.array([gap[d] for d in order_W.tolist()], dtype=float)
         n_owned = model.num_owned_dofs
         keep = dofs_W < n_owned
         fixed = np.isin(dofs_W, model.bc_dofs)
         self.num_edge_fixed = int(comm.allreduce(int((fixed & keep).sum()), op=MPI.SUM))
         keep &= ~fixed
         dofs_W, dofs_Vw, signs, springs = dofs_W[keep], dofs_Vw[keep], signs[keep], springs[keep]
+        gaps = gaps[keep]
         xy = Vw.tabulate_dof_coordinates()[dofs_Vw, :2]
 
         gathered = comm.allgather(xy)
@@ -324,6 +331,7 @@ class ContactSetManager:
         order = np.lexsort((keys[:, 0], keys[:, 1]))
         self.coordinates: npt.NDArray[np.float64] = all_xy[order]
         self.signs: npt.NDArray[np.float64] = np.concatenate(comm.allgather(signs))[order]
+        self.gaps: npt.NDArray[np.float64] = np.concatenate(comm.allgather(gaps))[order]
         self.stiffness: npt.NDArray[np.float64] | None = (
             np.concatenate(comm.allgather(springs))[order] if tensionless else None
         )

@@ -8,6 +8,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import Material
+from unibuckle_fenicsx.laminate import laminate
 
 __all__ = [
     "bending_stiffness",
@@ -15,8 +16,10 @@ __all__ = [
     "membrane_voigt",
     "navier_load_kirchhoff",
     "navier_load_mindlin",
+    "reference_bending_stiffness",
     "shear_modulus",
     "shear_stiffness",
+    "transverse_shear",
 ]
 
 
@@ -39,8 +42,26 @@ def _isotropic_voigt(nu: float) -> npt.NDArray[np.float64]:
     return np.array([[1.0, nu, 0.0], [nu, 1.0, 0.0], [0.0, 0.0, (1.0 - nu) / 2.0]])
 
 
+def transverse_shear(material: Material, thickness: float) -> float | npt.NDArray[np.float64]:
+    r"""Transverse shear stiffness (N/m): :math:`\kappa_s G t`, or a laminate's 2x2 H."""
+    if material.plies:
+        return laminate(material.plies, material.shear_correction).H
+    return shear_stiffness(material, thickness)
+
+
+def reference_bending_stiffness(material: Material, thickness: float) -> float:
+    r""":math:`\sqrt{D_{11} D_{22}}` (N m), the scale of the buckling coefficient k.
+
+    An isotropic plate's D; for an orthotropic plate the usual normalisation of k.
+    """
+    D = bending_voigt(material, thickness)
+    return float(np.sqrt(D[0, 0] * D[1, 1]))
+
+
 def membrane_voigt(material: Material, thickness: float) -> npt.NDArray[np.float64]:
     r"""Membrane stiffness (N/m), 3x3 Voigt on :math:`(\varepsilon_{11}, \varepsilon_{22}, 2\varepsilon_{12})`."""  # noqa: E501
+    if material.plies:
+        return laminate(material.plies).A
     if material.membrane_voigt is not None:
         return np.asarray(material.membrane_voigt, dtype=float)
     return material.E * thickness / (1.0 - material.nu**2) * _isotropic_voigt(material.nu)
@@ -48,6 +69,8 @@ def membrane_voigt(material: Material, thickness: float) -> npt.NDArray[np.float
 
 def bending_voigt(material: Material, thickness: float) -> npt.NDArray[np.float64]:
     r"""Bending stiffness, 3x3 Voigt on :math:`(\kappa_{11}, \kappa_{22}, 2\kappa_{12})` (N m)."""
+    if material.plies:
+        return laminate(material.plies).D
     if material.bending_voigt is not None:
         return np.asarray(material.bending_voigt, dtype=float)
     D = bending_stiffness(material.E, material.nu, thickness)

@@ -443,6 +443,7 @@ def plot_contact_map(
     contact_coordinates: npt.ArrayLike = (),
     title: str = "",
     tau: float = 0.0,
+    ties: npt.ArrayLike = (),
 ) -> Path:
     """Top view of a plate of any shape: mode contours, holes, obstacle zones, contact nodes.
 
@@ -459,6 +460,7 @@ def plot_contact_map(
         contact_coordinates: (|Z|, 2) coordinates of the contact set.
         title: Axes title.
         tau: Relative deflections below this are drawn as zero.
+        ties: (k, 2) nodes of point restraints (bolts, tie bars), drawn as crosses.
 
     Returns:
         The written path.
@@ -467,6 +469,10 @@ def plot_contact_map(
     path = _prepare(path)
     xy = np.asarray(xy, dtype=float)
     fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    points = np.asarray(ties, dtype=float).reshape(-1, 2)
+    if len(points):
+        ax.plot(points[:, 0], points[:, 1], "x", color="red", ms=9, mew=2.2, zorder=5,
+                label="point restraints")  # fmt: skip
     _mode_bands(fig, ax, xy, w, tau, triangles)
     for outline in (boundary, *holes):
         ring = np.asarray(outline, dtype=float)

@@ -28,7 +28,13 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import EdgeSpec, Material, PlateSpec
+from unibuckle_fenicsx.config import (
+    EdgeSpec,
+    Material,
+    PlateSpec,
+    Temperature,
+    temperature_field,
+)
 from unibuckle_fenicsx.materials import membrane_voigt
 from unibuckle_fenicsx.mesh import edge_line, edge_normal_axis, edge_tags
 
@@ -39,6 +45,7 @@ __all__ = [
     "membrane_force",
     "pin_rigid_motions",
     "solve_prestress",
+    "thermal_force",
     "voigt_to_ufl",
 ]
 
@@ -171,6 +178,22 @@ def pin_rigid_motions(
     return bcs
 
 
+def thermal_force(
+    msh: dolfinx.mesh.Mesh, material: Material, thickness: float, temperature: Temperature
+) -> ufl.core.expr.Expr | None:
+    r"""The membrane force of the free thermal strain, :math:`C_m \alpha\Delta T(x) I` (N/m).
+
+    None for a zero rise. :math:`\Delta T = T_0 + T_{,x} x + T_{,y} y`.
+    """
+    T0, gx, gy = temperature_field(temperature)
+    if not (T0 or gx or gy):
+        return None
+    x = ufl.SpatialCoordinate(msh)
+    rise = T0 + gx * x[0] + gy * x[1]
+    strain = material.thermal_expansion * rise * ufl.Identity(2)
+    return voigt_to_ufl(membrane_voigt(material, thickness), strain)
+
+
 def solve_prestress(
     msh: dolfinx.mesh.Mesh,
     facet_tags: dolfinx.mesh.MeshTags,
@@ -178,29 +201,40 @@ def solve_prestress(
     material: Material,
     degree: int = 1,
     petsc_options: dict[str, str | bool] | None = None,
+    *,
+    temperature: Temperature = 0.0,
+    fixed: bool = False,
 ) -> Prestress:
-    """Solve the membrane problem under the unit load and return :math:`N^0`.
+    r"""Solve the membrane problem under the unit load and return :math:`N^0`.
+
+    With a temperature rise :math:`\Delta T` the membrane force is
+    :math:`N = C_m(\varepsilon(u) - \alpha\Delta T I)`, and the thermal strain enters
+    the right-hand side as :math:`\int C_m \alpha\Delta T I : \varepsilon(v)`.
 
     Args:
         msh: Plate mesh.
         facet_tags: Edge markers (:func:`unibuckle_fenicsx.mesh.edge_tags`).
         plate: Thickness and edge conditions (in-plane supports and tractions).
-        material: Membrane stiffness.
+        material: Membrane stiffness (and thermal expansion).
         degree: Lagrange degree of the in-plane displacement.
         petsc_options: KSP options (default :data:`DIRECT_LU`), prefix
             ``unibuckle_prestress_``.
+        temperature: A temperature rise (K; or the linear field, see
+            :class:`~unibuckle_fenicsx.config.LoadSpec`).
+        fixed: The fixed part of the load (applied as is): no check that it compresses.
 
     Returns:
-        The prestress; raises ``ValueError`` if no edge is loaded, if the load is not
-        self-equilibrated on a plate held by no in-plane support, or if the plate is
-        in tension everywhere (no buckling under a positive load).
+        The prestress; raises ``ValueError`` if nothing is loaded, if the load is not
+        self-equilibrated on a plate held by no in-plane support, or (unless ``fixed``)
+        if the plate is in tension everywhere (no buckling under a positive load).
 
     Note:
         Collective.
     """
     t = plate.thickness
     loaded = [e for e in plate.edges if e.loaded]
-    if not loaded:
+    thermal = thermal_force(msh, material, t, temperature)
+    if not loaded and thermal is None:
         raise ValueError(
             "no edge is loaded: give at least one edge a non-zero normal_stress or shear_stress"
         )
@@ -215,6 +249,8 @@ def solve_prestress(
         for e in loaded
         for tag in edge_tags(plate, e)
     ]
+    if thermal is not None:
+        terms.append(ufl.inner(thermal, ufl.sym(ufl.grad(v))) * ufl.dx)
     L = terms[0]
     for term in terms[1:]:
         L = L + term
@@ -235,7 +271,8 @@ def solve_prestress(
                 bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
     pinned = not bcs
     if pinned:
-        _check_self_equilibrated(msh, facet_tags, ds, plate, loaded)
+        if loaded:  # a thermal strain is self-equilibrated
+            _check_self_equilibrated(msh, facet_tags, ds, plate, loaded)
         bcs = pin_rigid_motions(V, msh)
 
     problem = dolfinx.fem.petsc.LinearProblem(
@@ -251,18 +288,25 @@ def solve_prestress(
     del problem
 
     N0 = membrane_force(uh, material, t)
+    if thermal is not None:
+        N0 = N0 - thermal
     max_compression, max_tension = _principal_extremes(msh, N0, degree)
     logger.info(
-        "prestress: max compression %.6g N/m, max tension %.6g N/m per unit load",
+        "prestress%s: max compression %.6g N/m, max tension %.6g N/m%s",
+        " (fixed part)" if fixed else "",
         max_compression,
         max_tension,
+        "" if fixed else " per unit load",
     )
     scale = max(max_compression, max_tension)
+    if fixed:
+        return Prestress(uh, N0, max_compression, max_tension, pinned)
     if max_compression <= 1e-10 * scale:
         raise ValueError(
             "the load puts the plate in tension everywhere (largest compressive membrane "
             f"force {max_compression:.3g} N/m against tension {max_tension:.3g} N/m): no "
             "buckling under a positive load; reverse the sign of normal_stress"
+            + (" or of the temperature rise" if thermal is not None else "")
         )
     return Prestress(uh, N0, max_compression, max_tension, pinned)
 

@@ -30,20 +30,32 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.contact import (
+    BilateralZoneError,
     ContactSetManager,
     check_zone_has_nodes,
     foundation_springs,
     orientation,
 )
-from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, EigenPair, GEPSolver, Owner, release
-from unibuckle_fenicsx.materials import bending_stiffness
+from unibuckle_fenicsx.eigen import (
+    EIGEN_OPTIONS,
+    EigenPair,
+    GEPSolver,
+    Owner,
+    SymmetricFactorization,
+    release,
+)
+from unibuckle_fenicsx.materials import reference_bending_stiffness
 from unibuckle_fenicsx.mesh import build_plate_mesh
 from unibuckle_fenicsx.plate.model import PlateModel
+from unibuckle_fenicsx.points import point_obstacles
 from unibuckle_fenicsx.prestress import solve_prestress
 
 __all__ = ["BYTES_PER_DOF", "BucklingProblem", "Candidate", "Mode", "available_memory"]
 
 logger = logging.getLogger(__name__)
+
+#: Options prefix of the LDL^T that checks A - B_fixed (``-unibuckle_fixed_ksp_view``).
+FIXED_LOAD_PREFIX = "unibuckle_fixed_"
 
 #: Peak memory per (w, theta) DOF of a solve, measured with MUMPS on one rank: 7.8 kB at
 #: 155k DOFs, 5.8 kB at 617k (README, "Parallel runs"); the estimate uses 8 kB.
@@ -182,6 +194,8 @@ class BucklingProblem(Owner):
         facet_tags: dolfinx.mesh.MeshTags | None = None,
     ) -> None:
         t0 = time.perf_counter()
+        if spec.has_fixed_load:
+            spec.check_scaled_load()
         self.spec = spec
         self.timings: dict[str, float] = {}
         #: The mesh came from the user (not spec.mesh): no coarse copies can be made.
@@ -209,19 +223,49 @@ class BucklingProblem(Owner):
             size = max(spec.plate.length, spec.plate.width)
             labels = [spec.obstacle_label(k) for k in range(len(obstacles))]
             check_zone_has_nodes(self.mesh, obstacles, size, labels)
+        degree = spec.solver.prestress_degree
         self.prestress = solve_prestress(
-            self.mesh, self.facet_tags, spec.plate, spec.material, spec.solver.prestress_degree
+            self.mesh,
+            self.facet_tags,
+            spec.plate,
+            spec.material,
+            degree,
+            temperature=spec.load.temperature,
+        )
+        #: The fixed part of the prestress (applied as is), or None.
+        self.fixed_prestress = (
+            solve_prestress(
+                self.mesh,
+                self.facet_tags,
+                spec.plate.fixed_part(),
+                spec.material,
+                degree,
+                temperature=spec.load.fixed_temperature,
+                fixed=True,
+            )
+            if spec.has_fixed_load
+            else None
         )
         t1 = time.perf_counter()
         self.timings["prestress_s"] = t1 - t0
         self.model = PlateModel(
-            self.mesh, self.facet_tags, spec.plate, spec.material, self.prestress, spec.solver.shear
+            self.mesh,
+            self.facet_tags,
+            spec.plate,
+            spec.material,
+            self.prestress,
+            spec.solver.shear,
+            points=spec.points,
+            fixed_prestress=self.fixed_prestress,
+            fixed_factor=spec.load.fixed_factor,
         )
         if spec.bilateral_foundations:
             self.model.add_springs(*foundation_springs(self.model, spec.bilateral_foundations))
         t2 = time.perf_counter()
         self.timings["assembly_s"] = t2 - t1
         self._check_geometric_stiffness()
+        if self.fixed_prestress is not None:
+            self._check_fixed_load()
         self.eigensolver = GEPSolver(
             self.model.A,
             self.model.B,
@@ -229,8 +273,18 @@ class BucklingProblem(Owner):
             tol=spec.solver.eps_tol,
             options={**EIGEN_OPTIONS, **(eps_options or {})},
         )
-        unilateral = spec.unilateral_obstacles
-        self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
+        unilateral = spec.unilateral_obstacles + tuple(
+            point_obstacles(self.model.points, spec.plate)
+        )
+        try:
+            self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
+        except BilateralZoneError as err:
+            if not spec.one_sided_points:
+                raise
+            raise BilateralZoneError(
+                "points: a one-sided point acts on a node held from the other side too (an "
+                'obstacle zone or another point): that holds w = 0, give it kind = "bilateral"'
+            ) from err
         self.free: Mode | None = None
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
@@ -255,6 +309,28 @@ class BucklingProblem(Owner):
                 "the plate has no positive buckling load on this mesh: the geometric "
                 f"stiffness b(w, w) vanishes on the free deflections (|B| = {b_norm:.3g} "
                 f"against |N0| = {scale:.3g} N/m); refine the mesh or check the edge loads"
+            )
+
+    def _check_fixed_load(self) -> None:
+        r"""Refuse a fixed load that buckles the plate by itself (collective).
+
+        The pencil is :math:`(A - B_{fixed}, B)`; every algorithm and the certificate need
+        its first matrix positive definite, which the inertia of its :math:`LDL^T`
+        (MUMPS) tells: no negative and no zero pivot.
+        """
+        K = self.model.A.duplicate(copy=True)
+        try:
+            with SymmetricFactorization(K, FIXED_LOAD_PREFIX) as factor:
+                negative, zero, _ = factor.inertia()
+        finally:
+            K.destroy()
+        if negative or zero:
+            self.model.destroy()
+            raise ValueError(
+                "the fixed load alone buckles the plate (fixed_normal_stress, "
+                "fixed_shear_stress, fixed_temperature): the stiffness less its geometric "
+                f"stiffness, A - B_fixed, has {negative} negative and {zero} zero "
+                "eigenvalue(s); lower the fixed part below its own critical value"
             )
 
     # -- primitives ----------------------------------------------------------------
@@ -402,9 +478,12 @@ class BucklingProblem(Owner):
 
     # -- reporting ------------------------------------------------------------------
     def buckling_coefficient(self, load: float) -> float:
-        r""":math:`k = N b^2/(\pi^2 D)` with N = t lambda and b the plate width (y extent)."""
+        r""":math:`k = N b^2/(\pi^2 D)` with N = t lambda and b the plate width (y extent).
+
+        D is :math:`\sqrt{D_{11}D_{22}}` of the bending stiffness (an isotropic plate's D).
+        """
         plate, mat = self.spec.plate, self.spec.material
-        D = bending_stiffness(mat.E, mat.nu, plate.thickness)
+        D = reference_bending_stiffness(mat, plate.thickness)
         return plate.thickness * load * plate.width**2 / (np.pi**2 * D)
 
     def destroy(self) -> None:

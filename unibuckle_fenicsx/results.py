@@ -10,7 +10,13 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from unibuckle_fenicsx.config import UNITS, ProblemSpec, problem_to_dict, stress_value
+from unibuckle_fenicsx.config import (
+    UNITS,
+    ProblemSpec,
+    problem_to_dict,
+    stress_value,
+    temperature_field,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution
@@ -51,6 +57,13 @@ class BucklingResult:
         mpi_size: Ranks used.
         method_chosen_by: Why this method ran ("given", or the "auto" rule's reason).
         edge_loads: Per edge, its normal and shear stress per unit load (tension > 0).
+        critical_load_factor: lambda, the factor on the scaled part of the load (the
+            same number as critical_load_Pa; with a fixed part, N = N_fixed + lambda
+            N_scaled).
+        critical_temperature_K: With a temperature rise in the scaled load: lambda times
+            its largest rise over the plate (the uniform rise's critical value).
+        design: With ``[design]``: the relative slenderness and the reduction factor of
+            EN 1993-1-5 from this sigma_cr (:func:`~unibuckle_fenicsx.design.design_output`).
         units: The unit system the summary prints in (the numbers here are SI).
         input: The problem solved, every key with the value used, in SI
             (:func:`~unibuckle_fenicsx.config.problem_to_dict`; None for a predicate zone).
@@ -82,6 +95,9 @@ class BucklingResult:
     mpi_size: int = 1
     method_chosen_by: str = ""
     edge_loads: dict[str, dict[str, Any]] = field(default_factory=dict)
+    critical_load_factor: float | None = None
+    critical_temperature_K: float | None = None
+    design: dict[str, Any] | None = None
     units: str = "SI"
     input: dict[str, Any] | None = None
     versions: dict[str, str] = field(default_factory=dict)
@@ -132,12 +148,34 @@ class BucklingResult:
                     "normal_stress": stress_value(e.normal_stress),
                     "shear_stress": stress_value(e.shear_stress),
                 }
+                | (
+                    {
+                        "fixed_normal_stress": stress_value(e.fixed_normal_stress),
+                        "fixed_shear_stress": stress_value(e.fixed_shear_stress),
+                    }
+                    if e.fixed_loaded
+                    else {}
+                )
                 for e in spec.plate.edges
             },
+            critical_load_factor=load,
+            critical_temperature_K=_critical_temperature(spec, load),
             units=spec.units,
             input=_input(spec),
             versions=versions(),
         )
+        if problem.model.points:
+            result.details["point_restraints"] = [g.report() for g in problem.model.points]
+        if spec.gapped_obstacles:
+            result.details["gapped_obstacles"] = (
+                f"{len(spec.gapped_obstacles)} obstacle(s) with a gap left out of the linear "
+                "critical state (an infinitesimal buckle does not reach them); unibuckle "
+                "nonlinear follows the plate onto them"
+            )
+        if spec.design is not None:
+            from unibuckle_fenicsx.design import design_output
+
+            result.design = design_output(spec, spec.design, load)
         if solution is None or certificate is None:
             result.lower_bound_Pa = result.upper_bound_Pa = free.load
             return result
@@ -173,7 +211,7 @@ class BucklingResult:
         return data if timings else _without_timings(data)
 
     def summary(self) -> str:
-        """Two lines for the terminal: the result, and the load it is a multiple of."""
+        """Lines for the terminal: the result, the load it is a multiple of, the model."""
         scale, unit = UNITS[self.units][1:]
         z = ""
         if self.constrained_nodes:
@@ -187,14 +225,71 @@ class BucklingResult:
             for name, load in self.edge_loads.items()
             if _load_text(load)
         ]
+        extra = "".join(f"\n  {line}" for line in self._model_lines())
+        if loaded:
+            head = (
+                f"lambda_c = {self.critical_load_Pa / scale:.6e} {unit} "
+                f"({self.critical_load_Pa / self.free_load_Pa:.4f} x free "
+                f"{self.free_load_Pa / scale:.6e} {unit}), "
+                f"k = {self.buckling_coefficient_k:.4f}"
+            )
+            second = f"\n  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}"
+        else:  # a temperature rise alone is scaled: lambda is a factor on it
+            head = (
+                f"lambda_c = {self.critical_load_Pa:.6e} (factor on the temperature rise; "
+                f"{self.critical_load_Pa / self.free_load_Pa:.4f} x free "
+                f"{self.free_load_Pa:.6e})"
+            )
+            second = ""
         return (
-            f"{self.case}: lambda_c = {self.critical_load_Pa / scale:.6e} {unit} "
-            f"({self.critical_load_Pa / self.free_load_Pa:.4f} x free "
-            f"{self.free_load_Pa / scale:.6e} {unit}), "
-            f"k = {self.buckling_coefficient_k:.4f}, method {self.method}{z}, "
-            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s\n"
-            f"  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}"
+            f"{self.case}: {head}, method {self.method}{z}, "
+            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{second}{extra}"
         )
+
+    def _model_lines(self) -> list[str]:
+        """Summary lines of what the model holds beyond plate, edges and obstacle."""
+        length, scale, unit = UNITS[self.units]
+        lines = []
+        if "gapped_obstacles" in self.details:
+            lines.append(self.details["gapped_obstacles"])
+        load = (self.input or {}).get("load", {})
+        if self.critical_temperature_K is not None:
+            lines.append(
+                f"temperature rise per unit lambda {load.get('temperature')}: critical rise "
+                f"{self.critical_temperature_K:.6g} K"
+            )
+        fixed = [
+            f"{name} {_load_text(edge, 'fixed_', scale, ' ' + unit)}"
+            for name, edge in self.edge_loads.items()
+            if "fixed_normal_stress" in edge
+        ]
+        if load.get("fixed_temperature"):
+            fixed.append(f"temperature rise {load['fixed_temperature']} K")
+        if self.design is not None:
+            d = self.design
+            rho = d["reduction_factor"]
+            lines.append(
+                f"EN 1993-1-5: sigma_cr = {d['sigma_cr_Pa'] / scale:.4g} {unit} ({d['edge']}), "
+                f"psi = {d['psi']:.3g}, slenderness {d['relative_slenderness']:.4g}, rho = "
+                + (
+                    f"{rho:.4g}, rho f_y/gamma_M1 = {d['reduced_design_stress_Pa'] / scale:.4g} "
+                    f"{unit}"
+                    if rho is not None
+                    else "none (psi < -3)"
+                )
+                + " (4.2) calibrated on bilateral plates"
+            )
+        factor = load.get("fixed_factor", 1.0)
+        if fixed and factor:
+            times = "" if factor == 1.0 else f"{factor:g} x "
+            lines.append(f"fixed load (applied as is): {times}{'; '.join(fixed)}")
+        for p in self.details.get("point_restraints", []):
+            lines.append(
+                f"points: {p['restraint']}: {p['points']} points on {p['nodes']} nodes, "
+                f"largest snap distance {p['max_snap_distance_m'] / length:.3g}"
+                f" {'m' if self.units == 'SI' else 'mm'}"
+            )
+        return lines
 
 
 def _gap_text(gap: float) -> str:
@@ -224,16 +319,26 @@ def _verified(cert: dict[str, Any]) -> str:
     return f"proven=no (KKT only{below})"
 
 
-def _load_text(load: dict[str, Any]) -> str:
+def _load_text(load: dict[str, Any], prefix: str = "", scale: float = 1.0, unit: str = "") -> str:
+    """The edge stresses of ``load`` (``prefix`` "fixed_": the fixed ones, in ``unit``)."""
     parts = []
     for key in ("normal", "shear"):
-        value = load[f"{key}_stress"]
+        value = load[f"{prefix}{key}_stress"]
         if isinstance(value, list | tuple):
             if any(value):
-                parts.append(f"{key} {value[0]:g} to {value[1]:g} (linear)")
+                parts.append(f"{key} {value[0] / scale:g} to {value[1] / scale:g}{unit} (linear)")
         elif value:
-            parts.append(f"{key} {value:g}")
+            parts.append(f"{key} {value / scale:g}{unit}")
     return ", ".join(parts)
+
+
+def _critical_temperature(spec: ProblemSpec, load: float) -> float | None:
+    """The critical rise: lambda times the scaled field's largest rise over the plate."""
+    if not spec.load.thermal:
+        return None
+    T0, gx, gy = temperature_field(spec.load.temperature)
+    rises = [T0 + gx * x + gy * y for x, y in spec.plate.boundary]
+    return load * max(rises, key=abs)
 
 
 def _input(spec: ProblemSpec) -> dict[str, Any] | None:

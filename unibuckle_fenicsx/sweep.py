@@ -21,9 +21,12 @@ not converge); the last three lines hold ``error`` instead of the results.
 **Paths** name any number of the TOML schema (README, "Problem files") by its dotted
 path, list entries by index: ``plate.thickness``, ``material.nu``,
 ``edges.left.normal_stress``, ``plate.corners.1.0`` (x1), ``obstacle.zone.0.1``,
-``mesh.size``. Two shortcuts move a corner: ``plate.length`` sets x1 = x0 + value and
-``plate.width`` sets y1 = y0 + value. Values are in the base file's ``units``. Write
-``[mesh] size = h`` in the base file so that the cell count follows the plate's size.
+``mesh.size``, ``edges.top.rotational_stiffness``, ``points.0.spacing`` (a tie
+spacing), ``material.plies.0.angle``, ``load.fixed_factor`` (the fixed part's factor:
+an interaction curve), ``design.yield_stress``. Two shortcuts move a corner:
+``plate.length`` sets x1 = x0 + value and ``plate.width`` sets y1 = y0 + value. Values
+are in the base file's ``units``. Write ``[mesh] size = h`` in the base file so that the
+cell count follows the plate's size.
 
 **Resume.** Each line is appended with one ``write`` of the whole line and flushed to
 disk, so a killed sweep leaves complete lines (and at most one truncated last line,

@@ -23,8 +23,9 @@ the shear energy is quadratic, so :math:`K_s` is assembled once and adds
 :math:`K_s(x - x_0)` to the residual and :math:`K_s` to the Jacobian. The edge supports
 and the edge loads are those of the same :class:`~unibuckle_fenicsx.config.ProblemSpec`.
 
-The obstacle (:math:`w \le 0` at the zone's nodes, the nodes of
-:class:`~unibuckle_fenicsx.contact.ContactSetManager`) enters as variable bounds of PETSc's
+The obstacle (:math:`w \le g` at the zone's nodes, the nodes of
+:class:`~unibuckle_fenicsx.contact.ContactSetManager`, g the obstacle's gap, 0 by
+default) enters as variable bounds of PETSc's
 reduced-space VI Newton method (``vinewtonrsls``); the other bounds are
 ``PETSc.INFINITY``. DOLFINx's ``NonlinearProblem`` takes no bounds and assembles forms
 only (the MITC shear is a matrix), so the SNES is wired here, with the same assembly
@@ -57,7 +58,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
 from unibuckle_fenicsx.contact import ContactSetManager
 from unibuckle_fenicsx.eigen import Owner, release, set_options
-from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, shear_stiffness
+from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, transverse_shear
 from unibuckle_fenicsx.mesh import (
     build_plate_mesh,
     edge_facets,
@@ -65,8 +66,10 @@ from unibuckle_fenicsx.mesh import (
     edge_tag,
     edge_tags,
 )
-from unibuckle_fenicsx.plate.model import edge_support_bcs, mitc_shear_matrix
+from unibuckle_fenicsx.plate.forms import shear_force
+from unibuckle_fenicsx.plate.model import edge_spring_form, edge_support_bcs, mitc_shear_matrix
 from unibuckle_fenicsx.plate.spaces import MixedDofs
+from unibuckle_fenicsx.points import point_bcs, point_springs, snap_points
 from unibuckle_fenicsx.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
 
 __all__ = [
@@ -225,6 +228,13 @@ class VonKarmanPlate(MixedDofs, Owner):
         self.bending_bcs = edge_support_bcs(
             self.W, self.facet_tags, self.plate, w_sub=W_SUB, theta_sub=THETA_SUB
         )
+        self.points = snap_points(self.Vw, self.plate, spec.points)
+        if spec.one_sided_points:
+            raise ValueError(
+                "points: the nonlinear analysis does not model one-sided points (kind = "
+                '"one-sided"); give them kind = "bilateral" or "spring", or leave them out'
+            )
+        self.bending_bcs += point_bcs(self.W, self.Vw, self.points, self.plate, w_sub=W_SUB)
         self.bc_dofs = np.unique(
             np.concatenate(
                 [bc.dof_indices()[0] for bc in self.bending_bcs] or [np.empty(0, np.int32)]
@@ -251,11 +261,15 @@ class VonKarmanPlate(MixedDofs, Owner):
         energy = 0.5 * ufl.inner(voigt_to_ufl(Cm, e), e) + 0.5 * ufl.inner(
             voigt_to_ufl(D, kappa), kappa
         )
-        ks = shear_stiffness(spec.material, t)
+        ks = transverse_shear(spec.material, t)
         if spec.solver.shear == "full":
             gamma = ufl.grad(w - w0) - (theta_h - theta0_h)
-            energy = energy + 0.5 * ks * ufl.inner(gamma, gamma)
+            energy = energy + 0.5 * ufl.inner(shear_force(gamma, ks), gamma)
         Pi = energy / self.energy_scale * ufl.dx
+        d = (t * (w_h - w0_h), theta_h - theta0_h)  # from the stress-free imperfect shape
+        springs = edge_spring_form(d, d, self.facet_tags, self.plate)
+        if springs is not None:
+            Pi = Pi + (0.5 / self.energy_scale) * springs
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
         n = ufl.FacetNormal(msh)
         tractions = [
@@ -309,6 +323,7 @@ class VonKarmanPlate(MixedDofs, Owner):
                 column_scale=scale.x.petsc_vec,
             )
             self.Ks = Ks
+        self._add_point_springs(t)
         self.J: PETSc.Mat | None = dolfinx.fem.petsc.create_matrix(self.J_form)
         self._merged = False
         self.b: PETSc.Vec | None = dolfinx.fem.petsc.create_vector(self.W)
@@ -331,14 +346,14 @@ class VonKarmanPlate(MixedDofs, Owner):
             self._upper = self._xs.duplicate()
             self._lower.set(PETSc.NINFINITY)
             self._upper.set(PETSc.INFINITY)
-            # Obstacle above: w <= 0 (upper bound); below: w >= 0 (lower bound).
+            # Obstacle above: w <= g (upper bound); below: w >= -g (lower bound); w/t here.
             rows = self.contact.global_rows()
             lo, hi = self._upper.getOwnershipRange()
             mine = (rows >= lo) & (rows < hi)
             above = mine & (self.contact.signs > 0)
             below = mine & (self.contact.signs < 0)
-            self._upper.array[rows[above] - lo] = 0.0
-            self._lower.array[rows[below] - lo] = 0.0
+            self._upper.array[rows[above] - lo] = self.contact.gaps[above] / t
+            self._lower.array[rows[below] - lo] = -self.contact.gaps[below] / t
             snes.setVariableBounds(self._lower, self._upper)
         else:
             options.setdefault("snes_type", "newtonls")
@@ -388,6 +403,29 @@ class VonKarmanPlate(MixedDofs, Owner):
         elif axis is not None and not held[1 - axis]:
             bcs += pin_rigid_motions(U, msh, only=1 - axis)
         return bcs
+
+    def _add_point_springs(self, t: float) -> None:
+        """Spring points: k_p t^2 / D11 on the diagonal of K_s (the quadratic part, about x0)."""
+        if not any(g.spec.kind == "spring" for g in self.points):
+            return
+        local, stiffness = point_springs(self.Vw, self.w_dofs, self.points, self.plate)
+        keep = ~np.isin(local, self.bc_dofs)
+        rows = self.global_dofs(local[keep])
+        stiffness = stiffness[keep] * t**2 / self.energy_scale
+        if self.Ks is None:
+            n = self.num_owned_dofs
+            self.Ks = PETSc.Mat().createAIJ(
+                ((n, None), (n, None)),  # type: ignore[arg-type]
+                nnz=1,
+                comm=self.comm,
+            )
+            lo, hi = self.Ks.getOwnershipRange()
+            for r in range(lo, hi):
+                self.Ks.setValue(r, r, 0.0)
+        self.Ks.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)  # type: ignore[arg-type]
+        for r, k in zip(rows.tolist(), stiffness.tolist(), strict=True):
+            self.Ks.setValue(r, r, k, addv=True)
+        self.Ks.assemble()
 
     # -- PlateDofs (for ContactSetManager) -------------------------------------------
     @property
@@ -491,10 +529,16 @@ class VonKarmanPlate(MixedDofs, Owner):
             return np.empty(0)
         return self.thickness * self.contact.values(self.x.x.petsc_vec)
 
+    def zone_clearance(self, x: dolfinx.fem.Function | None = None) -> npt.NDArray[np.float64]:
+        """s_k w_k - g_k (m) at the zone nodes: <= 0 admissible, 0 on the obstacle."""
+        if self.contact is None:
+            return np.empty(0)
+        x = self.x if x is None else x
+        return self.thickness * self.contact.values(x.x.petsc_vec) - self.contact.gaps
+
     def contact_nodes(self, rtol: float = 1e-9) -> npt.NDArray[np.int64]:
-        """Zone nodes on the obstacle: w >= -rtol t (the VI keeps them at w = 0)."""
-        w = self.zone_deflection()
-        return np.flatnonzero(w >= -rtol * self.thickness).astype(np.int64)
+        """Zone nodes on the obstacle: s w >= g - rtol t (the VI keeps them at s w = g)."""
+        return np.flatnonzero(self.zone_clearance() >= -rtol * self.thickness).astype(np.int64)
 
     def end_shortening(self) -> float:
         """Mean inward normal displacement of the loaded edges, summed over them (m)."""

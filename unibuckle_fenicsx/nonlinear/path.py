@@ -297,7 +297,9 @@ class NonlinearResult:
         completed: The path reached ``max_load``.
         stop_reason: Why the path stopped.
         rejected_steps: Steps halved after a failed solve or a too large jump.
-        constrained_nodes: Zone nodes with w <= 0 imposed.
+        constrained_nodes: Zone nodes with w <= g imposed (g the obstacle's gap).
+        contact_load_Pa: The load of the first state on the path with a node on the
+            obstacle (None if none): with a gap, where the plate reaches the obstacle.
         contact_check: The contact conditions at the last state (see
             :meth:`NonlinearAnalysis.contact_check`).
         options: The options used.
@@ -332,6 +334,7 @@ class NonlinearResult:
     contact_check: dict[str, Any]
     options: dict[str, Any]
     wall_time_s: float
+    contact_load_Pa: float | None = None
     timings: dict[str, float] = field(default_factory=dict)
     mpi_size: int = 1
     units: str = "SI"
@@ -371,6 +374,13 @@ class NonlinearResult:
             f"lambda = {last['load_Pa'] / scale:.6e} {unit}, max|w|/t = "
             f"{last['max_w_m'] / self.thickness_m:.4g}, {last['contact_nodes']} contact "
             f"nodes; {self.stop_reason}; {self.wall_time_s:.2f} s"
+            + (
+                f"\n  the plate reaches the obstacle at lambda = "
+                f"{self.contact_load_Pa / scale:.6e} {unit} "
+                f"({self.contact_load_Pa / self.linear_critical_load_Pa:.4f} x linear)"
+                if self.contact_load_Pa is not None and self.obstacle
+                else ""
+            )
         )
 
 
@@ -531,6 +541,21 @@ def imperfection_shape(
     return out, name
 
 
+def _check_gaps(plate: VonKarmanPlate, imperfection: float) -> None:
+    """Refuse an imperfection that reaches an obstacle across its gap (collective)."""
+    if plate.contact is None or not plate.contact.gaps.any():
+        return
+    clearance = plate.zone_clearance(plate.x0)
+    gapped = plate.contact.gaps > 0
+    if clearance[gapped].max() >= 0.0:
+        raise ValueError(
+            f"obstacle.gap: the imperfection (delta = {imperfection:g}, max |w0| = "
+            f"{imperfection * plate.thickness:.3g} m) reaches an obstacle across its gap "
+            f"(smallest gap {plate.contact.gaps[gapped].min():.3g} m): lower the "
+            "imperfection or widen the gap"
+        )
+
+
 def _trace(
     plate: VonKarmanPlate,
     options: NonlinearOptions,
@@ -636,7 +661,7 @@ def contact_check(plate: VonKarmanPlate, rtol: float = 1e-8) -> dict[str, Any]:
     out: dict[str, Any] = {"force_scale": scale, "rtol": rtol}
     ok = True
     if plate.contact is not None:
-        w = plate.zone_deflection()
+        w = plate.zone_clearance()  # s w - g: <= 0 admissible
         on = np.zeros(plate.contact.size, dtype=bool)
         on[plate.contact_nodes()] = True
         forces = plate.contact.values(F) / scale
@@ -690,6 +715,12 @@ def solve_nonlinear(
     """
     t0 = time.perf_counter()
     options = NonlinearOptions() if options is None else options
+    if spec.load.thermal or spec.has_fixed_load:
+        raise ValueError(
+            "the nonlinear analysis models edge loads scaled by lambda only: temperature "
+            "rises ([load]) and fixed loads (fixed_normal_stress, fixed_shear_stress) are "
+            "not in its energy"
+        )
     if any(o.foundation_stiffness is not None for o in spec.all_obstacles):
         raise ValueError(
             "the nonlinear analysis models rigid obstacles only, not Winkler foundations "
@@ -749,6 +780,7 @@ def solve_nonlinear(
             plate.snes.setTolerances(atol=ATOL * plate.unit_load_norm * reference)
         shape, shape_name = imperfection_shape(linear, options.shape, obstacle)
         _embed(plate, shape, linear.problem, options.imperfection * spec.plate.thickness)
+        _check_gaps(plate, options.imperfection)
         timings["setup_s"] = time.perf_counter() - t1
         t1 = time.perf_counter()
         path, completed, why, rejected = _trace(plate, options, reference, label)
@@ -795,6 +827,7 @@ def solve_nonlinear(
         stop_reason=why,
         rejected_steps=rejected,
         constrained_nodes=0 if plate.contact is None else plate.contact.size,
+        contact_load_Pa=next((q.load_Pa for q in path if q.contact_nodes), None),
         contact_check=check,
         options={**asdict(options), "degree": degree},
         wall_time_s=time.perf_counter() - t0,

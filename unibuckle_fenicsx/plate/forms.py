@@ -50,8 +50,12 @@ def bending_moment(
     return voigt_to_ufl(D_voigt, curvature(theta))
 
 
-def shear_force(gamma: ufl.core.expr.Expr, shear_stiffness: float) -> ufl.core.expr.Expr:
-    r""":math:`Q = \kappa_s G t\, \gamma` (N/m)."""
+def shear_force(
+    gamma: ufl.core.expr.Expr, shear_stiffness: float | npt.NDArray[np.float64]
+) -> ufl.core.expr.Expr:
+    r""":math:`Q = \kappa_s G t\, \gamma`, or :math:`H\gamma` with a 2x2 H (N/m)."""
+    if isinstance(shear_stiffness, np.ndarray):
+        return ufl.dot(ufl.as_matrix(shear_stiffness.tolist()), gamma)
     return shear_stiffness * gamma
 
 
@@ -62,7 +66,9 @@ def bending_form(u: ufl.Argument, v: ufl.Argument, D_voigt: npt.NDArray[np.float
     return ufl.inner(bending_moment(theta, D_voigt), curvature(eta)) * ufl.dx
 
 
-def shear_form(u: ufl.Argument, v: ufl.Argument, shear_stiffness: float) -> ufl.Form:
+def shear_form(
+    u: ufl.Argument, v: ufl.Argument, shear_stiffness: float | npt.NDArray[np.float64]
+) -> ufl.Form:
     r"""Fully integrated shear energy :math:`\int \kappa_s G t\,\gamma(u)\cdot\gamma(v)`.
 
     Locks as t -> 0 on bilinear elements; kept for comparison with the MITC shear.

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 from petsc4py import PETSc
 
 import dolfinx
@@ -11,20 +13,21 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import Material, PlateSpec
+from unibuckle_fenicsx.config import Material, PlateSpec, PointSpec
 from unibuckle_fenicsx.eigen import Owner, release
-from unibuckle_fenicsx.materials import bending_voigt, shear_stiffness
+from unibuckle_fenicsx.materials import bending_voigt, transverse_shear
 from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tags
-from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_form
+from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_force, shear_form
 from unibuckle_fenicsx.plate.spaces import (
     MixedDofs,
     create_plate_space,
     create_shear_space,
     mitc_shear_operator,
 )
+from unibuckle_fenicsx.points import point_bcs, point_springs, snap_points
 from unibuckle_fenicsx.prestress import Prestress
 
-__all__ = ["PlateModel", "edge_support_bcs", "mitc_shear_matrix"]
+__all__ = ["PlateModel", "edge_spring_form", "edge_support_bcs", "mitc_shear_matrix"]
 
 
 class PlateModel(MixedDofs, Owner):
@@ -43,6 +46,12 @@ class PlateModel(MixedDofs, Owner):
         material: Elastic constants.
         prestress: Membrane force per unit load.
         shear: "mitc" (locking-free) or "full" (plain full integration, locks).
+        points: Point restraints (:mod:`~unibuckle_fenicsx.points`): bilateral ones
+            become zero Dirichlet conditions, springs diagonal entries of A.
+        fixed_prestress: The fixed part of the load: A holds :math:`a - b_{fixed}`, so the
+            pencil is :math:`(A - B_{fixed}, B)` (A need not be positive definite then:
+            :class:`~unibuckle_fenicsx.problem.BucklingProblem` checks it).
+        fixed_factor: Factor on the fixed prestress.
 
     Note:
         Construction and :meth:`destroy` are collective.
@@ -56,6 +65,9 @@ class PlateModel(MixedDofs, Owner):
         material: Material,
         prestress: Prestress,
         shear: str = "mitc",
+        points: Sequence[PointSpec] = (),
+        fixed_prestress: Prestress | None = None,
+        fixed_factor: float = 1.0,
     ) -> None:
         if msh.topology.cell_type != dolfinx.mesh.CellType.quadrilateral:
             raise ValueError("the MITC plate element needs a quadrilateral mesh")
@@ -66,15 +78,22 @@ class PlateModel(MixedDofs, Owner):
         self.W = create_plate_space(msh)
         self.Vw, map_w = self.W.sub(0).collapse()
         self.w_dofs = np.asarray(map_w[0], dtype=np.int32)  # Vw local dof -> W local dof
-        self.bcs = self._edge_bcs(facet_tags)
+        #: The point restraints on the mesh (snapped to nodes).
+        self.points = snap_points(self.Vw, plate, points)
+        self.bcs = self._edge_bcs(facet_tags) + point_bcs(self.W, self.Vw, self.points, plate)
         self.bc_dofs = np.unique(
             np.concatenate([bc.dof_indices()[0] for bc in self.bcs] or [np.empty(0, np.int32)])
         ).astype(np.int32)
 
         u, v = ufl.TrialFunction(self.W), ufl.TestFunction(self.W)
         D = bending_voigt(material, plate.thickness)
-        ks = shear_stiffness(material, plate.thickness)
+        ks = transverse_shear(material, plate.thickness)
         a = bending_form(u, v, D)
+        springs = edge_spring_form(ufl.split(u), ufl.split(v), facet_tags, plate)
+        if springs is not None:
+            a = a + springs
+        if fixed_prestress is not None:  # A - B_fixed: the fixed load's geometric stiffness
+            a = a - fixed_factor * geometric_form(u, v, fixed_prestress.N0)
         if shear == "full":
             a = a + shear_form(u, v, ks)
         elif shear != "mitc":
@@ -90,6 +109,10 @@ class PlateModel(MixedDofs, Owner):
             S.destroy()
         self.B = dolfinx.fem.petsc.assemble_matrix(self.b_form, bcs=self.bcs, diag=0.0)
         self.B.assemble()
+        rows, stiffness = point_springs(self.Vw, self.w_dofs, self.points, plate)
+        if any(g.spec.kind == "spring" for g in self.points):
+            keep = ~np.isin(rows, self.bc_dofs)
+            self.add_springs(self.global_dofs(rows[keep]), stiffness[keep])
         self.A.setOption(PETSc.Mat.Option.SPD, True)
         self.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)
         self.B.setOption(PETSc.Mat.Option.SYMMETRIC, True)
@@ -98,7 +121,7 @@ class PlateModel(MixedDofs, Owner):
         """Zero Dirichlet conditions of the edge supports (hard SS: w and tangential theta)."""
         return edge_support_bcs(self.W, facet_tags, self.plate)
 
-    def _mitc_shear_matrix(self, ks: float) -> PETSc.Mat:
+    def _mitc_shear_matrix(self, ks: float | npt.NDArray[np.float64]) -> PETSc.Mat:
         """:math:`P^T M_s P` with P's columns of edge-constrained DOFs zeroed."""
         return mitc_shear_matrix(self.W, self.bc_dofs, ks)
 
@@ -189,10 +212,52 @@ def edge_support_bcs(
     return bcs
 
 
+def edge_spring_form(
+    u: tuple[ufl.core.expr.Expr, ufl.core.expr.Expr],
+    v: tuple[ufl.core.expr.Expr, ufl.core.expr.Expr],
+    facet_tags: dolfinx.mesh.MeshTags,
+    plate: PlateSpec,
+) -> ufl.Form | None:
+    r"""Elastic edge restraints :math:`\sum_e \int_e k_r (\theta\cdot n)(\eta\cdot n) + k_t wz\,ds`.
+
+    The second variation of :math:`\tfrac12\int k_r (\theta\cdot n)^2 + k_t w^2\,ds` over the
+    edges with a ``rotational_stiffness`` :math:`k_r` or a ``translational_stiffness``
+    :math:`k_t` (:class:`~unibuckle_fenicsx.config.EdgeSpec`); n is the outward normal,
+    so :math:`\theta\cdot n` is the rotation about the edge. The springs act on the
+    DOFs the support leaves free (the loader refuses the others); assembled with the
+    supports' Dirichlet rows, they do not touch the fixed ones.
+
+    Args:
+        u: (w, theta) of the trial function (or of a state).
+        v: (z, eta) of the test function (or of a state: ``u`` again for the energy).
+        facet_tags: Edge markers.
+        plate: The edges.
+
+    Returns:
+        The form, or None when no edge has a spring.
+    """
+    sprung = [e for e in plate.edges if e.springs]
+    if not sprung:
+        return None
+    (w, theta), (z, eta) = u, v
+    domain = ufl.domain.extract_unique_domain(theta)
+    ds = ufl.Measure("ds", domain=domain, subdomain_data=facet_tags)
+    n = ufl.FacetNormal(domain)
+    form = None
+    for e in sprung:
+        for tag in edge_tags(plate, e):
+            term = (
+                e.rotational_stiffness * ufl.dot(theta, n) * ufl.dot(eta, n)
+                + e.translational_stiffness * w * z
+            ) * ds(tag)
+            form = term if form is None else form + term
+    return form
+
+
 def mitc_shear_matrix(
     W: dolfinx.fem.FunctionSpace,
     bc_dofs: npt.NDArray[np.int32],
-    ks: float,
+    ks: float | npt.NDArray[np.float64],
     *,
     w_sub: int = 0,
     theta_sub: int = 1,
@@ -207,7 +272,7 @@ def mitc_shear_matrix(
     Args:
         W: Mixed space holding w and theta.
         bc_dofs: Local W DOFs fixed by the edge supports.
-        ks: Shear stiffness :math:`\kappa_s G t` (N/m).
+        ks: Shear stiffness :math:`\kappa_s G t`, or a 2x2 matrix H (a laminate) (N/m).
         w_sub: Sub-space of W holding w.
         theta_sub: Sub-space of W holding theta.
         column_scale: Optional W-vector D: the matrix becomes :math:`D P^T M_s P D`
@@ -221,7 +286,11 @@ def mitc_shear_matrix(
     """
     Vs = create_shear_space(W.mesh)
     g, d = ufl.TrialFunction(Vs), ufl.TestFunction(Vs)
-    Ms = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(ks * ufl.inner(g, d) * ufl.dx))
+    # A laminate's 2x2 H, or the scalar kappa_s G t.
+    energy = (
+        ufl.inner(shear_force(g, ks), d) if isinstance(ks, np.ndarray) else ks * ufl.inner(g, d)
+    )
+    Ms = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(energy * ufl.dx))
     Ms.assemble()
     P = mitc_shear_operator(W, Vs, w_sub=w_sub, theta_sub=theta_sub)
     keep = P.createVecRight()
