@@ -186,7 +186,7 @@ def test_thin_ssss_plate_is_bracketed():
     and the low-rank record; the summary says "bracketed to".
     """
     spec = plate_case("ssss", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
-                      zone=ObstacleSpec(zone="all"))  # fmt: skip
+                      zone=ObstacleSpec(zone="all")).with_solver(bracket=True)  # fmt: skip
     with solve(spec, MPI.COMM_SELF) as analysis:
         cert = analysis.certificate
         load = analysis.result.critical_load_Pa
@@ -216,7 +216,7 @@ def test_interior_bump_on_the_thin_ssss_plate_is_not_bracketed():
     and below the interior buckle's load.
     """
     ssss = plate_case("ssss", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
-                      zone=ObstacleSpec(zone="all"))  # fmt: skip
+                      zone=ObstacleSpec(zone="all")).with_solver(bracket=True)  # fmt: skip
     clamped = plate_case("cs", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
                          supports={"left": "clamped", "right": "clamped"},
                          zone=ObstacleSpec(zone="all")).with_solver(certify=False)  # fmt: skip

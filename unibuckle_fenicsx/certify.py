@@ -258,6 +258,8 @@ def certify(
     record: dict[str, Any] | None = None
     refuting: Candidate | None = None
     if not algorithm_proof and global_bound and kkt and cand.eigen is not None:
+        if options is None and not problem.spec.solver.bracket:
+            options = BoundOptions(lowrank=None)  # the low-rank route on request only
         bound = copositivity_bound(problem, cand, solution.kkt_points, options)
         record = {
             "method": bound.method,

@@ -180,6 +180,12 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
         help="skip the global-optimality certificate (for speed studies; KKT is still checked)",
     )
     s.add_argument(
+        "--bracket",
+        action="store_true",
+        help="also try the low-rank verified bracket when several pencil eigenvalues lie "
+        "below the load (thin long plates; tens of free solves' time)",
+    )
+    s.add_argument(
         "--penalty",
         type=float,
         metavar="RHO",
@@ -331,6 +337,8 @@ def _solver_changes(args: argparse.Namespace) -> tuple[dict[str, Any], list[str]
     }
     if args.no_certify:
         changes["certify"] = False
+    if args.bracket:
+        changes["bracket"] = True
     ignored = []
     method = args.method or "auto"
     for flag, value in values.items():

@@ -1143,6 +1143,9 @@ class SolverSpec:
             >= 0 (it runs when the budget covers the i singletons).
         certify: Verify the result's global optimality (README, "Proving the global
             minimum"); off for speed studies.
+        bracket: Also try the low-rank verified bracket when two or more pencil
+            eigenvalues lie below the load (README, "Proving the global minimum"): tens of
+            free solves' time on a thin plate of 90x30 cells, so off by default.
         penalty: Penalty stiffness rho for ``method="penalty"`` (relative to the
             largest diagonal entry of A), > 0.
         prestress_degree: Lagrange degree of the in-plane displacement, >= 1.
@@ -1160,6 +1163,7 @@ class SolverSpec:
     max_iterations: int = 100
     bound_budget: int = 64
     certify: bool = True
+    bracket: bool = False
     penalty: float = 1e3
     prestress_degree: int = 1
     shear: str = "mitc"
@@ -1184,7 +1188,7 @@ class SolverSpec:
             ("prestress_degree", 1),
         ):
             object.__setattr__(self, name, _integer(f"solver.{name}", getattr(self, name), minimum))
-        for name in ("complete", "until_proven", "certify"):
+        for name in ("complete", "until_proven", "certify", "bracket"):
             object.__setattr__(self, name, _boolean(f"solver.{name}", getattr(self, name)))
         for name in ("tau", "eps_tol", "enumeration_budget_s", "penalty"):
             object.__setattr__(self, name, float(getattr(self, name)))
