@@ -11,13 +11,16 @@ For a rigid obstacle (any side, several zones) the chain is
    next finer mesh by interpolating its mode, load and obstacle push; there a few
    Newton steps restore the barrier problem, and so on to the fine mesh.
 2. **Contact set and exact eigenpair.** The fine barrier solution gives the contact set
-   Z (the nodes whose push exceeds their gap); the smallest eigenpair of the pencil with
-   Z removed (:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`) is the
-   returned critical state, checked against the KKT conditions. If it fails, the
-   barrier is driven lower once more, then the active-set iteration (:mod:`.pdas`)
-   polishes Z.
-3. **Fallback**: the multilevel active-set method (:mod:`.active_set`, with its penalty
-   continuation and feasible descent) when no KKT point was reached.
+   Z (the nodes whose gap is at the tolerance ``tau``); the smallest eigenpair of the
+   pencil with Z removed (:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`)
+   is the returned critical state, checked against the KKT conditions. If it fails, the
+   barrier is driven lower and the active-set iteration (:mod:`.pdas`) polishes Z; if
+   that fails too, the coarse state is carried once more at a small barrier parameter
+   (flat parts stay flat), with saddle escapes, a longer polish and the feasible descent
+   (:mod:`.descent`).
+3. **Fallbacks.** The feasible descent from the lowest admissible mode met (it cannot
+   cycle); then the multilevel active-set method (:mod:`.active_set`, with its penalty
+   continuation) from scratch.
 
 Tensionless foundations run their spring-set iteration (:mod:`.foundation`); small
 zones are enumerated (:mod:`.enumeration`; :func:`~unibuckle_fenicsx.analysis.choose_method`
@@ -95,6 +98,8 @@ class ChainOptions:
         quick_polish_iterations: ... on the first try of the fine mesh.
         descent_steps: Eigen solves allowed to the feasible descent after a polish that
             ends at an admissible mode short of a KKT point.
+        descent_budget: Eigen solves (per ``max_iterations``) of the last descent, from
+            the lowest admissible mode met, when the fine mesh ended at no KKT point.
         max_iterations: Iterates per seed of the fallback active-set method.
         bound_budget: Eigen solves of the lattice lower bound (small zones).
     """
@@ -117,6 +122,7 @@ class ChainOptions:
     polish_iterations: int = 25
     quick_polish_iterations: int = 5
     descent_steps: int = 50
+    descent_budget: int = 10
     max_iterations: int = 100
     bound_budget: int = 64
 
@@ -165,6 +171,15 @@ class LevelRecord:
     constrained_nodes: int
     links: list[LinkRecord] = field(default_factory=list)
     seconds: float = 0.0
+    #: The admissible mode with the lowest load met on this mesh (not in the record).
+    best_admissible: Candidate | None = field(default=None, repr=False)
+
+    def offer(self, cand: Candidate | None) -> None:
+        """Keep ``cand`` if it is admissible with a lower load than the best so far."""
+        if cand is None or not cand.feasible or not math.isfinite(cand.load):
+            return
+        if self.best_admissible is None or cand.load < self.best_admissible.load:
+            self.best_admissible = cand
 
     @property
     def newton_steps(self) -> int:
@@ -268,6 +283,7 @@ def _read_contact(
     solves0 = problem.eigensolver.solves
     active = newton.contact_set(point)
     cand = problem.evaluate(active, initial=point.mode.x.petsc_vec)
+    level.offer(cand)
     level.links.append(
         LinkRecord(
             "evaluate",
@@ -291,6 +307,7 @@ def _polish(
     solves0 = problem.eigensolver.solves
     run = iterate(problem, label, cand.active, cand.mode.x.petsc_vec, budget)
     final = run.final if run.status == "kkt" else run.best_feasible
+    level.offer(final)
     level.links.append(
         LinkRecord(
             "active-set polish",
@@ -316,6 +333,7 @@ def _descend(
     run, _ = descend(problem, start, budget)
     final = run.final if run.status == "kkt" else run.best_feasible
     assert final is not None
+    level.offer(final)
     level.links.append(
         LinkRecord(
             "feasible descent",
@@ -664,6 +682,13 @@ def solve_unilateral(
         for p in problems[:-1]:
             p.destroy()
 
+    if (chosen is None or not chosen.kkt) and levels and levels[-1].best_admissible is not None:
+        # The lowest admissible mode met, taken to a critical state by the feasible
+        # descent (monotone: it cannot cycle), before anything starts afresh.
+        budget = options.descent_budget * options.max_iterations
+        final = _descend(problem, levels[-1].best_admissible, levels[-1], "fallback", budget)
+        if final.kkt:
+            chosen = final
     if chosen is None or not chosen.kkt:
         logger.warning("interior point: no KKT point on the fine mesh; the active-set chain runs")
         solution = _fallback(problem, options)
