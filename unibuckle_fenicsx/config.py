@@ -25,6 +25,7 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.checks import check_features, check_supports, check_thickness
 from unibuckle_fenicsx.geometry import (
     circle_points,
     distance_to_polygon,
@@ -386,6 +387,7 @@ class PlateSpec:
         self._check_file()
         self._check_holes()
         self._check_edges()
+        check_thickness(self)
 
     def _check_file(self) -> None:
         if self.file is None:
@@ -421,6 +423,7 @@ class PlateSpec:
             for j in range(k):
                 if not _disjoint(holes[j], hole):
                     raise ValueError(f"plate.holes[{j}] and {where} overlap or touch")
+        check_features(self, None)  # touching within rounding (a tangent hole)
 
     def _check_edges(self) -> None:
         count = len(self.outline) if self.outline is not None else 0
@@ -808,12 +811,15 @@ class ProblemSpec:
                 )
         if plate.file is not None and plate.file.lower().endswith(".msh") and self.mesh.size:
             raise ValueError("mesh.size: a .msh file is meshed already; leave size out")
+        if plate.meshed_by_gmsh:
+            check_features(plate, self.mesh.size)
         if self.obstacle is not None and self.obstacles:
             raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
         for k, o in enumerate(self.obstacles):
             if not isinstance(o, ObstacleSpec):
                 raise ValueError(f"obstacles[{k}] must be an ObstacleSpec, got {o!r}")
         found = self.all_obstacles
+        check_supports(self)
         kinds = {o.kind for o in found}
         if {"rigid", "tensionless"} <= kinds:
             raise ValueError(
