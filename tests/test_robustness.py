@@ -55,21 +55,6 @@ def run_script(*args: str, cwd: Path, **kwargs) -> subprocess.CompletedProcess[s
     )  # fmt: skip
 
 
-@pytest.fixture
-def nothing_built(monkeypatch):
-    """Fail the test if a mesh is built or a solve starts: refusals come first."""
-    import unibuckle_fenicsx.analysis
-    import unibuckle_fenicsx.nonlinear
-    import unibuckle_fenicsx.problem
-
-    def refuse(*args, **kwargs):
-        raise AssertionError("work started before the input was refused")
-
-    monkeypatch.setattr(unibuckle_fenicsx.analysis, "solve", refuse)
-    monkeypatch.setattr(unibuckle_fenicsx.problem, "build_plate_mesh", refuse)
-    monkeypatch.setattr(unibuckle_fenicsx.nonlinear, "solve_nonlinear", refuse)
-
-
 # -- outputs -------------------------------------------------------------------------------
 def _output_cases(tmp: Path) -> list[tuple[list[str], str]]:
     blocker = tmp / "a_file"

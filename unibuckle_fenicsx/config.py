@@ -1014,7 +1014,8 @@ def _holes(tables: Any) -> tuple[Circle | Polygon, ...]:
             try:
                 holes.append(Circle(kw["center"], kw["radius"]))
             except ValueError as err:
-                raise ValueError(f"{where}.{err}") from None
+                # Circle's messages name circle.center/radius; the file's keys are these.
+                raise ValueError(f"{where}.{str(err).removeprefix('circle.')}") from None
         else:
             raise ValueError(
                 f"[{where}] needs center = [x, y] and radius = r (a circle), or outline = "

@@ -195,24 +195,22 @@ def clip_polygon(subject: Vertices, convex: Vertices) -> npt.NDArray[np.float64]
     ``subject`` may be any simple polygon: the result may then hold zero-width bridges,
     which add nothing to its area (use it for :func:`polygon_area`).
     """
-    out = np.asarray(subject, dtype=float)
+    out = np.asarray(subject, dtype=float).reshape(-1, 2)
     c = _counter_clockwise(np.asarray(convex, dtype=float))
     for a, b in zip(c, np.roll(c, -1, axis=0), strict=True):
         if len(out) == 0:
             break
         edge = b - a
         side = edge[0] * (out[:, 1] - a[1]) - edge[1] * (out[:, 0] - a[0])  # >= 0: inside
-        kept = []
-        for k in range(len(out)):
-            p, q = out[k - 1], out[k]
-            sp, sq = side[k - 1], side[k]
-            if sq >= 0.0:
-                if sp < 0.0:
-                    kept.append(p + (q - p) * (sp / (sp - sq)))
-                kept.append(q)
-            elif sp >= 0.0:
-                kept.append(p + (q - p) * (sp / (sp - sq)))
-        out = np.array(kept).reshape(-1, 2)
+        inside = side >= 0.0
+        prev, side_prev = np.roll(out, 1, axis=0), np.roll(side, 1)
+        crossing = inside != np.roll(inside, 1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.where(crossing, side_prev / (side_prev - side), 0.0)
+        cut = prev + (out - prev) * t[:, None]
+        # Vertex k of the result: the crossing into (or out of) edge k, then vertex k.
+        points = np.stack([cut, out], axis=1).reshape(-1, 2)
+        out = points[np.stack([crossing, inside], axis=1).reshape(-1)]
     return out
 
 
@@ -240,14 +238,17 @@ def triangulate(vertices: Vertices) -> list[npt.NDArray[np.float64]]:
 def intersection_area(a: Vertices, b: Vertices) -> float:
     """Area of the intersection of two simple polygons.
 
-    Clipped by the convex one (:func:`clip_polygon`); if neither is convex, ``b`` is
-    clipped by each triangle of ``a``.
+    One is clipped by the other when that one is convex (:func:`clip_polygon`), the
+    cheaper way round; otherwise by each triangle of the polygon with fewer vertices.
     """
-    if is_convex(b):
-        return abs(polygon_area(clip_polygon(a, b))) if len(a) else 0.0
-    if is_convex(a):
-        return abs(polygon_area(clip_polygon(b, a)))
-    return sum(abs(polygon_area(clip_polygon(b, t))) for t in triangulate(a))
+    pa, pb = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if len(pa) < len(pb):
+        pa, pb = pb, pa  # pb: the one with fewer vertices, the clipper if it can be
+    if is_convex(pb):
+        return abs(polygon_area(clip_polygon(pa, pb)))
+    if is_convex(pa) and len(pa) <= 3 * (len(pb) - 2):
+        return abs(polygon_area(clip_polygon(pb, pa)))
+    return sum(abs(polygon_area(clip_polygon(pa, t))) for t in triangulate(pb))
 
 
 def disc_polygon(center: Sequence[float], radius: float, n: int = 4096) -> npt.NDArray[np.float64]:
