@@ -256,6 +256,7 @@ def long_plate_family(count: int, seed: int = 20261207, max_constrained: int = 1
         i = _constrained_nodes(edges, length, width, nx, ny, zone)
         if 4 <= i <= max_constrained:
             found.append((spec, i))
+    return found
 
 
 # -- the schema family: every feature of the problem file ---------------------------------
@@ -324,7 +325,7 @@ def _segment_traction(sigma, p, q) -> tuple[float, float]:
     return float(n @ t), float(s @ t)
 
 
-def _zone(rng: np.random.Generator, length: float, width: float, h: float):
+def _zone_table(rng: np.random.Generator, length: float, width: float, h: float):
     """A random zone table: box (inside or reaching out), polygon, circle or all."""
     kind = str(rng.choice(("box", "polygon", "circle", "all"), p=(0.45, 0.2, 0.2, 0.15)))
     if kind == "all":
@@ -433,7 +434,7 @@ def _schema_problem(rng: np.random.Generator, name: str) -> tuple[dict, list[str
     tables, boxes = [], []
     side = str(rng.choice(("above", "below")))
     for _ in range(count):
-        table, zone = _zone(rng, length, width, h)
+        table, zone = _zone_table(rng, length, width, h)
         if zone == "all" and count > 1:
             continue
         box = _bounding_box(table, length, width)
@@ -452,7 +453,7 @@ def _schema_problem(rng: np.random.Generator, name: str) -> tuple[dict, list[str
     if tensionless:
         features.append("tensionless")
     elif rng.random() < 0.15:
-        table, zone = _zone(rng, length, width, h)
+        table, zone = _zone_table(rng, length, width, h)
         tables.append({**table, "side": "both", "foundation_stiffness": D / width**4 * 100})
         features.append(f"bilateral {zone}")
     if not tables:
