@@ -1,4 +1,4 @@
-"""Shared fixtures: MPI-safe teardown, the random family of active problems; mpiexec."""
+"""Shared fixtures: teardown, the random active problems, nothing built before a refusal."""
 
 from __future__ import annotations
 
@@ -30,6 +30,21 @@ def active_specs():
     from families import active_family
 
     return active_family()[0]
+
+
+@pytest.fixture
+def nothing_built(monkeypatch):
+    """Fail the test if a mesh is built or a solve starts: refusals come first."""
+    import unibuckle_fenicsx.analysis
+    import unibuckle_fenicsx.nonlinear
+    import unibuckle_fenicsx.problem
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("work started before the input was refused")
+
+    monkeypatch.setattr(unibuckle_fenicsx.analysis, "solve", refuse)
+    monkeypatch.setattr(unibuckle_fenicsx.problem, "build_plate_mesh", refuse)
+    monkeypatch.setattr(unibuckle_fenicsx.nonlinear, "solve_nonlinear", refuse)
 
 
 def run_mpi(script: str | Path, nprocs: int, *args: str, timeout: float = 600) -> str:

@@ -25,6 +25,25 @@ def dense(mat) -> np.ndarray:
     return np.asarray(mat.getValues(idx, idx))
 
 
+def condensed(problem: BucklingProblem):
+    r"""(S, B_ww, free w-DOFs, position of each constrained node among them), densely.
+
+    :math:`S = A_{ww} - A_{w\theta} A_{\theta\theta}^{-1} A_{\theta w}` on the free
+    w-DOFs: the rotations condensed out (b acts on w only).
+    """
+    A, B = dense(problem.model.A), dense(problem.model.B)
+    n = A.shape[0]
+    bc = problem.model.bc_dofs
+    w_all = problem.model.w_dofs
+    w = np.setdiff1d(w_all, bc)  # free w-DOFs (serial: local == global)
+    th = np.setdiff1d(np.setdiff1d(np.arange(n), w_all), bc)
+    Ath = A[np.ix_(th, th)]
+    S = A[np.ix_(w, w)] - A[np.ix_(w, th)] @ np.linalg.solve(Ath, A[np.ix_(th, w)])
+    contact = problem.contact
+    rows = [int(contact.removed_rows(np.array([k]))[0]) for k in range(contact.size)]
+    return S, B[np.ix_(w, w)], w, np.searchsorted(w, rows)
+
+
 def exhaustive_minimum(
     problem: BucklingProblem, rtol: float = RTOL
 ) -> tuple[float, list[tuple[int, ...]], int]:
@@ -41,18 +60,9 @@ def exhaustive_minimum(
         (lambda_min, or inf if no subset has a positive load; every Z with a feasible
         mode and lambda within ``rtol`` of the minimum; number of feasible sets).
     """
-    A, B = dense(problem.model.A), dense(problem.model.B)
-    n = A.shape[0]
-    bc = problem.model.bc_dofs
-    w_all = problem.model.w_dofs
-    w = np.setdiff1d(w_all, bc)  # free w-DOFs (serial: local == global)
-    th = np.setdiff1d(np.setdiff1d(np.arange(n), w_all), bc)
-    Ath = A[np.ix_(th, th)]
-    S = A[np.ix_(w, w)] - A[np.ix_(w, th)] @ np.linalg.solve(Ath, A[np.ix_(th, w)])
-    Bw = B[np.ix_(w, w)]
+    S, Bw, w, node_pos = condensed(problem)
     contact = problem.contact
     i = contact.size
-    node_pos = np.searchsorted(w, [int(contact.removed_rows(np.array([k]))[0]) for k in range(i)])
     tau = problem.tau
     loads: list[tuple[float, tuple[int, ...]]] = []
     for p in range(i + 1):
@@ -116,20 +126,23 @@ def dense_reduced_load(problem: BucklingProblem, active: tuple[int, ...]) -> flo
 def satisfies_kkt(problem: BucklingProblem, A, B, x: np.ndarray, load: float, active) -> bool:
     """Whether the mode x (all DOFs) of the contact set ``active`` satisfies the KKT conditions.
 
-    Oriented to the obstacle's side, it must lie below the obstacle off Z and the obstacle
-    must only push on Z (README, "The problem"), both to the solver's tolerance tau. A and
-    B are the assembled matrices (dense arrays or scipy sparse).
+    Oriented to each node's obstacle (:math:`s_k w_k`, s = +1 under an obstacle above, -1
+    over one below), it must stay off the obstacle off Z and the obstacle must only push
+    on Z (README, "The problem"), both to the solver's tolerance tau. A and B are the
+    assembled matrices (dense arrays or scipy sparse).
     """
     u = x / np.abs(x[problem.model.w_dofs]).max()
     rows = problem.contact.global_rows()
+    signs = problem.contact.signs
     on_z = np.zeros(problem.num_constrained, dtype=bool)
     on_z[np.asarray(active, dtype=int)] = True
     tau = problem.tau
     for v in (u, -u):
         r = A @ v - load * (B @ v)
+        z, force = signs * v[rows], signs * r[rows]
         if (
-            v[rows[~on_z]].max(initial=-1.0) <= tau  # below the obstacle
-            and r[rows[on_z]].max(initial=-1.0) <= tau * np.abs(A @ v).max()  # only pushes
+            z[~on_z].max(initial=-1.0) <= tau  # off the obstacle
+            and force[on_z].max(initial=-1.0) <= tau * np.abs(A @ v).max()  # only pushes
         ):
             return True
     return False
@@ -139,3 +152,55 @@ def membrane_force_scale(spec) -> float:
     """T times the largest edge stress of ``spec`` (N/m per unit load): the size of N0."""
     stresses = [e.max_stress() for e in spec.plate.edges]
     return spec.plate.thickness * max(stresses)
+
+
+def exhaustive_tensionless(problem: BucklingProblem) -> float:
+    r"""The critical load on tensionless foundations, by trying every spring set.
+
+    The load minimises :math:`R(v) = (a(v, v) + \sum_k \rho_k \max(0, s_k v_k)^2)/b(v, v)`
+    (the spring term counts where the plate presses). For a set S of nodes let
+    :math:`\lambda_S, u_S` be the smallest eigenpair of :math:`(A + \sum_{k \in S}
+    \rho_k e_k e_k^T, B)`. Then :math:`R(\pm u_S) \le \lambda_S` when the nodes
+    :math:`\pm u_S` presses lie in S, and at the minimiser u*, with S* the nodes it
+    presses, :math:`\lambda_{S^*} \le R(u^*)`: so :math:`\min_S \min_\pm R(\pm u_S)`,
+    over every S, is the critical load (R(v) is never below it). Dense, on the condensed
+    pencil (rotations out, the springs act on w); inf if no mode has b > 0.
+    """
+    S, Bw, _, node_pos = condensed(problem)
+    contact = problem.contact
+    rho, signs, i = contact.stiffness, contact.signs, contact.size
+    best = math.inf
+    subsets = np.array(list(itertools.product((False, True), repeat=i)), dtype=bool)
+    for chunk in np.array_split(subsets, max(1, len(subsets) // 1024)):
+        K = np.repeat(S[None], len(chunk), axis=0)
+        diag = np.zeros((len(chunk), S.shape[0]))
+        diag[:, node_pos] = chunk * rho
+        K[:, np.arange(S.shape[0]), np.arange(S.shape[0])] += diag
+        Li = np.linalg.inv(np.linalg.cholesky(K))
+        C = Li @ Bw @ np.swapaxes(Li, 1, 2)
+        _, Y = np.linalg.eigh(0.5 * (C + np.swapaxes(C, 1, 2)))
+        X = (np.swapaxes(Li, 1, 2) @ Y[:, :, -1:])[:, :, 0]
+        for x in (X, -X):
+            b = np.einsum("cm,mn,cn->c", x, Bw, x)
+            z = signs * x[:, node_pos]
+            a = np.einsum("cm,mn,cn->c", x, S, x) + (rho * np.maximum(z, 0.0) ** 2).sum(axis=1)
+            ok = b > 1e-12 * np.abs(b).max()
+            if ok.any():
+                best = min(best, float((a[ok] / b[ok]).min()))
+    return best
+
+
+def satisfies_spring_kkt(problem: BucklingProblem, A, B, x: np.ndarray, load: float) -> bool:
+    r"""Whether x (all DOFs) is stationary for the tensionless quotient at ``load``.
+
+    The residual :math:`Au + \sum_k \rho_k \max(0, z_k) s_k e_k - \lambda Bu`, z the
+    oriented mode at the foundation's nodes, against :math:`\|Au\|_2`: at most
+    :math:`\sqrt\tau` (the solver's tolerance for a stationary point).
+    """
+    u = x / np.abs(x[problem.model.w_dofs]).max()
+    contact = problem.contact
+    rows = contact.global_rows()
+    z = contact.signs * u[rows]
+    r = A @ u - load * (B @ u)
+    r[rows] += contact.stiffness * np.maximum(z, 0.0) * contact.signs
+    return bool(np.linalg.norm(r) <= math.sqrt(problem.tau) * np.linalg.norm(A @ u))

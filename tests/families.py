@@ -257,3 +257,244 @@ def long_plate_family(count: int, seed: int = 20261207, max_constrained: int = 1
         if 4 <= i <= max_constrained:
             found.append((spec, i))
     return found
+
+
+# -- the schema family: every feature of the problem file ---------------------------------
+#: The family's numbers that reach the compiled forms (stiffness, thickness, plate size)
+#: come from short lists: the forms hold them as literals, and each new value costs a JIT
+#: compilation (about 10 s) on a cold cache.
+MODULI = (1.0e9, 2.1e11)
+POISSON = (0.0, 0.3, 0.45)
+SLENDERNESS = (1e-3, 1e-2, 6e-2)
+ASPECTS = (0.75, 1.0, 1.5, 2.0, 3.0)
+
+#: Outlines of the schema family on the unit box (scaled to length x width): a rectangle,
+#: a trapezoid (one inclined edge), an L and a house (two inclined edges).
+OUTLINES = {
+    "rectangle": ((0, 0), (1, 0), (1, 1), (0, 1)),
+    "trapezoid": ((0, 0), (1, 0), (0.75, 1), (0, 1)),
+    "L": ((0, 0), (1, 0), (1, 0.5), (0.5, 0.5), (0.5, 1), (0, 1)),
+    "house": ((0, 0), (1, 0), (1, 0.6), (0.5, 1), (0, 0.6)),
+}
+
+
+def _rotated_voigt(q: np.ndarray, angle: float) -> np.ndarray:
+    """The Voigt matrix (e11, e22, 2 e12) of the stiffness ``q`` turned by ``angle``."""
+    index = ((0, 0), (1, 1), (0, 1))
+    C = np.zeros((2, 2, 2, 2))
+    for a, (i, j) in enumerate(index):
+        for b, (k, m) in enumerate(index):
+            for p, q_ in ((i, j), (j, i)):
+                for r, s in ((k, m), (m, k)):
+                    C[p, q_, r, s] = q[a, b]
+    c, s_ = np.cos(angle), np.sin(angle)
+    R = np.array([[c, -s_], [s_, c]])
+    Cr = np.einsum("ia,jb,kc,ld,abcd->ijkl", R, R, R, R, C)
+    return np.array([[Cr[i, j, k, m] for (k, m) in index] for (i, j) in index])
+
+
+def _material(rng: np.random.Generator, thickness: float) -> tuple[dict, str]:
+    E, nu = float(rng.choice(MODULI)), float(rng.choice(POISSON))
+    table = {"E": E, "nu": nu}
+    if rng.random() < 0.3:  # orthotropic, turned: a fully populated SPD stiffness
+        e2 = E * float(rng.choice((0.3, 0.7)))
+        nu21 = nu * e2 / E
+        g = E / (2 * (1 + nu)) * 0.5
+        d = 1 - nu * nu21
+        q = np.array([[E / d, nu * e2 / d, 0], [nu * e2 / d, e2 / d, 0], [0, 0, g]])
+        q = _rotated_voigt(q, float(rng.choice((0.0, np.pi / 6, np.pi / 3))))
+        table["membrane_voigt"] = (thickness * q).tolist()
+        table["bending_voigt"] = (thickness**3 / 12 * q).tolist()
+        return table, "anisotropic"
+    return table, "isotropic"
+
+
+def _stress_state(rng: np.random.Generator) -> tuple[float, float, float] | None:
+    sxx, syy, sxy = (float(rng.choice(v)) for v in (SIGMA_XX, SIGMA_YY, SIGMA_XY))
+    if 0.5 * (sxx + syy) - np.hypot(0.5 * (sxx - syy), sxy) >= 0.0:
+        return None  # no compressive principal stress: nothing buckles
+    return sxx, syy, sxy
+
+
+def _segment_traction(sigma, p, q) -> tuple[float, float]:
+    """(normal, counter-clockwise shear) stress of the uniform state on segment p -> q."""
+    sxx, syy, sxy = sigma
+    s = (np.asarray(q, float) - p) / np.linalg.norm(np.asarray(q, float) - p)
+    n = np.array([s[1], -s[0]])  # outward for a counter-clockwise outline
+    t = np.array([[sxx, sxy], [sxy, syy]]) @ n
+    return float(n @ t), float(s @ t)
+
+
+def _zone_table(rng: np.random.Generator, length: float, width: float, h: float):
+    """A random zone table: box (inside or reaching out), polygon, circle or all."""
+    kind = str(rng.choice(("box", "polygon", "circle", "all"), p=(0.45, 0.2, 0.2, 0.15)))
+    if kind == "all":
+        return {"zone": "all"}, kind
+    cx, cy = rng.uniform(0.15, 0.85) * length, rng.uniform(0.15, 0.85) * width
+    if kind == "circle":
+        return {"circle": {"center": [cx, cy], "radius": float(rng.uniform(1.2, 2.5) * h)}}, kind
+    hx, hy = (float(rng.uniform(1.2, 3.0) * h) for _ in range(2))
+    if kind == "box":
+        return {"zone": [[cx - hx, cx + hx], [cy - hy, cy + hy]]}, kind
+    angles = np.sort(rng.uniform(0, 2 * np.pi, int(rng.integers(3, 6))))
+    if np.diff(np.concatenate([angles, [angles[0] + 2 * np.pi]])).max() > 0.9 * np.pi:
+        angles = np.linspace(0, 2 * np.pi, len(angles), endpoint=False) + angles[0]
+    vertices = [[cx + hx * np.cos(a), cy + hy * np.sin(a)] for a in angles]
+    return {"polygon": vertices}, kind
+
+
+def _bounding_box(table: dict, length: float, width: float) -> np.ndarray:
+    """[[xmin, ymin], [xmax, ymax]] of a zone table."""
+    if "circle" in table:
+        c, r = np.asarray(table["circle"]["center"]), table["circle"]["radius"]
+        return np.array([c - r, c + r])
+    if "polygon" in table:
+        v = np.asarray(table["polygon"])
+        return np.array([v.min(axis=0), v.max(axis=0)])
+    if table["zone"] == "all":
+        return np.array([[0.0, 0.0], [length, width]])
+    (x0, x1), (y0, y1) = table["zone"]
+    return np.array([[x0, y0], [x1, y1]])
+
+
+def _apart(a: np.ndarray, b: np.ndarray) -> bool:
+    """Whether two boxes are separated (by 1e-6 of their size) along x or y."""
+    gap = 1e-6 * float(np.ptp(np.concatenate([a, b]), axis=0).max())
+    return bool((a[0] > b[1] + gap).any() or (b[0] > a[1] + gap).any())
+
+
+def _schema_problem(rng: np.random.Generator, name: str) -> tuple[dict, list[str]]:
+    """One random problem file (a mapping) and the features it uses."""
+    features: list[str] = []
+    width = 0.1
+    length = width * float(rng.choice(ASPECTS))
+    thickness = width * float(rng.choice(SLENDERNESS))
+    sigma = _stress_state(rng)
+    if sigma is None:
+        raise ValueError("no compression")
+    geometry = str(rng.choice(("rectangle", "outline", "holes"), p=(0.6, 0.25, 0.15)))
+    data: dict = {"name": name, "plate": {"thickness": thickness}}
+    edges: dict = {}
+    cells = int(rng.integers(2, 5)) if geometry != "holes" else 4
+    h = width / cells
+    if geometry == "rectangle":
+        data["plate"]["corners"] = [[0.0, 0.0], [length, width]]
+        loads = {
+            "left": (sigma[0], sigma[2]), "right": (sigma[0], sigma[2]),
+            "bottom": (sigma[1], -sigma[2]), "top": (sigma[1], -sigma[2]),
+        }  # fmt: skip
+        gradient = rng.random() < 0.3
+        for edge in EDGE_NAMES:
+            normal, shear = loads[edge]
+            table = {"support": str(rng.choice(SUPPORTS, p=SUPPORT_WEIGHTS))}
+            table["normal_stress"], table["shear_stress"] = normal, shear
+            if gradient and edge in ("left", "right"):  # + sigma_xx linear in y
+                table["normal_stress"] = [normal - 0.5, normal + 0.5]
+            edges[edge] = table
+        features.append("gradient" if gradient else "uniform")
+        if rng.random() < 0.3:
+            data["mesh"] = {"size": h}
+        else:
+            data["mesh"] = {"nx": max(2, round(length / h)), "ny": cells}
+    else:
+        shape = str(rng.choice(list(OUTLINES))) if geometry == "outline" else "rectangle"
+        vertices = [[x * length, y * width] for x, y in OUTLINES[shape]]
+        features.append(f"outline {shape}")
+        n = len(vertices)
+        for k in range(n):
+            p, q = np.asarray(vertices[k]), np.asarray(vertices[(k + 1) % n])
+            normal, shear = _segment_traction(sigma, p, q)
+            inclined = min(abs(q - p)) > 1e-12
+            choices = ("simply_supported_soft", "clamped", "free") if inclined else SUPPORTS
+            support = str(rng.choice(choices))
+            edges[f"s{k}"] = {
+                "segments": [k], "support": support, "normal_stress": normal, "shear_stress": shear,
+            }  # fmt: skip
+        data["plate"]["outline"] = vertices
+        if geometry == "holes":
+            holes = [{"center": [0.5 * length, 0.5 * width], "radius": 0.2 * width}]
+            if length > 1.6 * width:
+                holes[0]["center"][0] = 0.3 * length
+                holes.append(
+                    {"outline": [[0.65 * length, 0.35 * width], [0.8 * length, 0.35 * width],
+                                 [0.72 * length, 0.65 * width]]}
+                )  # fmt: skip
+            data["plate"]["holes"] = holes
+            edges["holes"] = {"support": str(rng.choice(("free", "clamped")))}
+            features.append(f"{len(holes)} hole(s)")
+        data["mesh"] = {"size": h}
+    data["edges"] = edges
+    material, kind = _material(rng, thickness)
+    data["material"] = material
+    features.append(kind)
+    # Obstacles: rigid, or tensionless foundations, plus maybe a bilateral foundation.
+    count = int(rng.choice((1, 2, 3), p=(0.55, 0.35, 0.1)))
+    tensionless = rng.random() < 0.15
+    D = material["E"] * thickness**3 / (12 * (1 - material["nu"] ** 2))
+    tables, boxes = [], []
+    side = str(rng.choice(("above", "below")))
+    for _ in range(count):
+        table, zone = _zone_table(rng, length, width, h)
+        if zone == "all" and count > 1:
+            continue
+        box = _bounding_box(table, length, width)
+        # The other side only for a zone apart from the others (no node in both).
+        near = {t["side"] for t, other in zip(tables, boxes, strict=True) if not _apart(box, other)}
+        if len(near) > 1:
+            continue
+        table["side"] = (
+            near.pop() if near else str(rng.choice(("above", "below"))) if tables else side
+        )
+        if tensionless:
+            table["foundation_stiffness"] = D / width**4 * float(rng.choice((1.0, 1e2, 1e4)))
+        tables.append(table)
+        boxes.append(box)
+        features.append(f"{zone} {table['side']}")
+    if tensionless:
+        features.append("tensionless")
+    elif rng.random() < 0.15:
+        table, zone = _zone_table(rng, length, width, h)
+        tables.append({**table, "side": "both", "foundation_stiffness": D / width**4 * 100})
+        features.append(f"bilateral {zone}")
+    if not tables:
+        raise ValueError("no obstacle")
+    if len(tables) == 1:
+        data["obstacle"] = tables[0]
+    else:
+        data["obstacles"] = tables
+    method = (
+        "auto"
+        if tensionless
+        else str(rng.choice(("auto", "active-set", "enumerate"), p=(0.5, 0.3, 0.2)))
+    )
+    data["solver"] = {"method": method, "enumeration_budget_s": 2.0}
+    if method == "enumerate":  # exact, and refused beyond 2^12 candidate sets
+        data["solver"] |= {"until_proven": True, "max_candidates": 4096}
+    features.append(method)
+    return data, features
+
+
+def schema_family(count: int, seed: int = 20260301) -> list[tuple[dict, list[str]]]:
+    """The first ``count`` random problem files the schema accepts, with their features.
+
+    Every feature of the problem file: the rectangle (cells or a size), outlines with
+    inclined edges, holes (a circle, a polygon), the four supports, uniform normal and
+    shear stress states and stress gradients, isotropic and anisotropic (turned
+    orthotropic) stiffness, one to three obstacles with box, polygon, circle or
+    whole-plate zones on either side, tensionless and bilateral foundations, and the
+    methods auto, active-set and enumerate. Draws the schema refuses (a mechanism, two
+    zones on both sides of the plate) are drawn again: refusing them is the bad-input
+    family's concern.
+    """
+    from unibuckle_fenicsx.config import problem_from_dict
+
+    rng = np.random.default_rng(seed)
+    found: list[tuple[dict, list[str]]] = []
+    while len(found) < count:
+        try:
+            data, features = _schema_problem(rng, f"schema{len(found)}")
+            problem_from_dict(data)
+        except ValueError:
+            continue
+        found.append((data, features))
+    return found

@@ -93,7 +93,7 @@ def test_help(tmp_path):
 
 
 def test_solve_free_case_writes_json(tmp_path, capsys):
-    out = tmp_path / "sub" / "free.json"
+    out = tmp_path / "free.json"
     assert main(["solve", "--case", "free", "--nx", "20", "--ny", "10", "--json", str(out)]) == 0
     stdout = capsys.readouterr().out.strip().splitlines()
     assert len(stdout) == 2 and stdout[0].startswith("free: lambda_c = ")

@@ -8,6 +8,7 @@ cubic triangles, plain shear, scipy's Lanczos).
 
 from __future__ import annotations
 
+import json
 import sys
 from dataclasses import replace
 
@@ -33,6 +34,7 @@ from unibuckle_fenicsx.config import (  # noqa: E402
 from unibuckle_fenicsx.gmsh_mesh import GMSH_OPTIONS  # noqa: E402
 from unibuckle_fenicsx.materials import navier_load_mindlin  # noqa: E402
 from unibuckle_fenicsx.problem import BucklingProblem  # noqa: E402
+from unibuckle_fenicsx.zones import zone_report  # noqa: E402
 
 #: The paper's plate as an outline: segment 0 bottom, 1 right, 2 top, 3 left.
 PAPER_OUTLINE = [[-0.1, -0.05], [0.1, -0.05], [0.1, 0.05], [-0.1, 0.05]]
@@ -76,6 +78,7 @@ def test_outline_holes_and_segments_round_trip():
             },
             "edges": {
                 "left": {"segments": [4], "normal_stress": [-1, -0.5]},
+                "right": {"segments": [1]},  # one straight edge alone is a mechanism
                 "holes": {"support": "free"},
             },
             "mesh": {"size": 0.1},
@@ -229,6 +232,125 @@ def test_gmsh_rectangle_reproduces_the_structured_mesh():
     assert ours.contact_coordinates == structured.contact_coordinates
     assert ours.certificate["kkt"] and ours.mesh == [200]
     assert ours.details["seeded_on"] == "fine"
+
+
+def _outline_and_structured(corners, zone, size=0.01):
+    """The same plate as an outline (gmsh) and as the structured rectangle, with ``zone``."""
+    (x0, y0), (x1, y1) = corners
+    obstacle = {"obstacle": {"zone": zone}}
+    outline = problem_from_dict(
+        {
+            "plate": {"outline": [[x0, y0], [x1, y0], [x1, y1], [x0, y1]], "thickness": 0.006},
+            "edges": {
+                "loaded": {"segments": [1, 3], "normal_stress": -1.0},
+                "long": {"segments": [0, 2]},
+            },
+            "mesh": {"size": size},
+            **obstacle,
+        }
+    )
+    structured = problem_from_dict(
+        {"plate": {"corners": [[x0, y0], [x1, y1]]}, "mesh": {"size": size}, **obstacle}
+    )
+    return outline, structured
+
+
+@pytest.mark.parametrize(
+    ("corners", "zone"),
+    [
+        # The paper's plate moved to the origin, its c1-like zone moved with it.
+        (((0.0, 0.0), (0.2, 0.1)), [[0.06, 0.14], [0.0, 0.1]]),
+        # Far from the origin, a zone inside the plate.
+        (((1.3, -0.7), (1.5, -0.6)), [[1.33, 1.41], [-0.68, -0.62]]),
+        # A zone reaching beyond the plate, and a line zone.
+        (((0.0, 0.0), (0.3, 0.1)), [[0.17, 0.5], [0.03, 0.2]]),
+        (((0.0, 0.0), (0.3, 0.1)), [[0.12, 0.12], [0.02, 0.08]]),
+    ],
+)
+def test_gmsh_rectangle_anywhere_equals_the_structured_mesh(corners, zone):
+    """An outline rectangle anywhere, with any box zone on the grid's lines.
+
+    The structured mesh has nodes on the zone's edges; gmsh's mesh has the zone's edges
+    as mesh lines and structured patches, so both solve the same discrete problem: the
+    loads agree to 1e-10 and the contact nodes are the same. (Without the zone's lines,
+    the plate at [0, 0.2] x [0, 0.1] with the zone [0.06, 0.14] gave 1.41307e7 Pa with
+    i = 72 against the structured mesh's 1.45685e7 Pa with i = 81.)
+    """
+    outline, structured = _outline_and_structured(corners, zone)
+    results = []
+    for spec in (outline, structured):
+        with solve(spec, MPI.COMM_WORLD) as analysis:
+            results.append(analysis.result)
+    ours, grid = results
+    assert ours.mesh == [grid.mesh[0] * grid.mesh[1]]
+    assert ours.free_load_Pa == pytest.approx(grid.free_load_Pa, rel=1e-10)
+    assert ours.critical_load_Pa == pytest.approx(grid.critical_load_Pa, rel=1e-10)
+    assert ours.constrained_nodes == grid.constrained_nodes
+    assert np.allclose(
+        sorted(map(tuple, ours.contact_coordinates)),
+        sorted(map(tuple, grid.contact_coordinates)),
+        rtol=0.0,
+        atol=1e-12,
+    )
+    for report in (ours.obstacle_zones[0], grid.obstacle_zones[0]):
+        assert report["discrete_area_m2"] == pytest.approx(report["area_m2"], rel=1e-12)
+
+
+@pytest.mark.parametrize("size", [0.05, 0.01])
+def test_circular_zone_is_the_circle(size):
+    """The zone's circle is a mesh line: the discrete zone is the inscribed polygon.
+
+    At least 32 cell edges on the circle: its area is within 1 % of pi r^2 (the regular
+    32-gon has 32 sin(2 pi / 32) / (2 pi) = 99.36 % of it), at a cell size of 2.5 r as
+    at r; every node on the circle is in the zone.
+    """
+    r = 0.02
+    spec = problem_from_dict(
+        {
+            "plate": {
+                "outline": [[0.0, 0.0], [0.2, 0.0], [0.2, 0.1], [0.0, 0.1]],
+                "thickness": 0.006,
+            },
+            "edges": {
+                "loaded": {"segments": [1, 3], "normal_stress": -1.0},
+                "long": {"segments": [0, 2]},
+            },
+            "mesh": {"size": size},
+            "obstacle": {"circle": {"center": [0.1, 0.05], "radius": r}},
+        }
+    )
+    with BucklingProblem(spec, MPI.COMM_WORLD) as problem:
+        (report,) = zone_report(problem.mesh, spec.all_obstacles, spec.plate, ["obstacle"])
+        x = problem.mesh.geometry.x
+        n_owned = problem.mesh.geometry.index_map().size_local
+        on_circle = np.abs(np.hypot(x[:n_owned, 0] - 0.1, x[:n_owned, 1] - 0.05) - r) < 1e-12
+        count = MPI.COMM_WORLD.allreduce(int(on_circle.sum()), op=MPI.SUM)
+    assert report["area_m2"] == pytest.approx(np.pi * r**2, rel=1e-6)
+    assert 0.99 * np.pi * r**2 < report["discrete_area_m2"] <= np.pi * r**2
+    assert count >= 32
+
+
+def test_structured_zone_off_the_grid_is_reported(tmp_path, capsys):
+    """The structured mesh and a zone whose edges miss its lines: the summary says so.
+
+    20 x 10 cells of 0.01 m, zone [0.065, 0.135] x [0, 0.1]: the cells with every node in
+    it are [0.07, 0.13] x [0, 0.1], 0.006 m^2 of 0.007 m^2 (85.71 %), on 7 x 11 = 77 nodes.
+    """
+    path = tmp_path / "off.toml"
+    path.write_text(
+        "[plate]\ncorners = [[0.0, 0.0], [0.2, 0.1]]\n[mesh]\nnx = 20\nny = 10\n"
+        "[obstacle]\nzone = [[0.065, 0.135], [0.0, 0.1]]\n"
+    )
+    out = tmp_path / "off.json"
+    assert cli_main(["solve", "--config", str(path), "--json", str(out), "-q"]) == 0
+    summary = capsys.readouterr().out
+    assert "obstacle zone on the mesh: the cells with every node in it cover 85.71% of its " in (
+        summary
+    )
+    (report,) = json.loads(out.read_text())["obstacle_zones"]
+    assert report["area_m2"] == pytest.approx(0.007, rel=1e-12)
+    assert report["discrete_area_m2"] == pytest.approx(0.006, rel=1e-12)
+    assert report["nodes"] == 77
 
 
 def test_unnamed_boundary_parts_are_free():

@@ -138,7 +138,8 @@ def _cli_parallel(tmp_path, args, nprocs):
     assert report["status"] == [0] * nprocs, report
     assert report["json_writes"] == [1] + [0] * (nprocs - 1), report  # once, on rank 0
     assert report["vtx_calls"] == [1] * nprocs, report  # collective
-    assert len(stdout) == 3 and ": lambda_c = " in stdout[0]  # one summary (two lines)
+    # One summary (two lines, and one per obstacle zone the mesh does not follow exactly).
+    assert ": lambda_c = " in stdout[0] and sum(": lambda_c = " in line for line in stdout) == 1
     for name in ("w", "theta"):
         bp = (
             outdir / "vtx" / f"{json.loads((outdir / 'result.json').read_text())['case']}_{name}.bp"
@@ -220,7 +221,7 @@ def test_cli_bad_input_distributed(tmp_path):
     outdir = tmp_path / "np2"
     report = json.loads(run_mpi(CLI, 2, str(outdir), "--", "--config", str(path)).splitlines()[-1])
     assert report == {"status": [2, 2], "json_writes": [0, 0], "vtx_calls": [0, 0]}
-    assert not outdir.exists()
+    assert list(outdir.iterdir()) == []  # the folder of --json, made by the harness, empty
 
 
 def test_cli_stress_gradient_distributed(tmp_path):

@@ -222,3 +222,49 @@ def test_whole_plate_obstacle_bending_load_two_discretisations_agree():
     fd_limit = fd[1] + (fd[1] - fd[0]) / 3.0
     assert fe_limit == pytest.approx(fd_limit, rel=2e-4), (fe, fd)
     assert fe_limit / RITZ_BENDING - 1 > 0.09
+
+
+# -- on an outline: each segment's own direction ------------------------------------------
+def _outline_ends(parts):
+    """The 0.2 x 0.1 plate as an outline; ``parts``: the [[edges.NAME]] tables of the ends."""
+    pytest.importorskip("gmsh")
+    outline = [[0.0, 0.0], [0.2, 0.0], [0.2, 0.1], [0.0, 0.1]]
+    return problem_from_dict(
+        {
+            "plate": {"outline": outline, "thickness": 0.006},
+            "edges": {**parts, "long": {"segments": [0, 2]}},
+            "mesh": {"size": 0.01},
+        }
+    )
+
+
+def test_gradient_on_an_outline_runs_along_each_segment():
+    """The README's example: the rectangle's left/right [-1, 0] as outline segments 1 and 3.
+
+    Segment 1 (right) runs up from vertex 1, segment 3 (left) down from vertex 3, so the
+    rectangle's [-1, 0] on both ends (-1 at y = 0) is [-1, 0] on segment 1 and [0, -1] on
+    segment 3: the same load as the structured rectangle's, to 1e-10 (gmsh meshes the
+    outline rectangle as the structured grid). One part of both segments with [-1, 0]
+    is an antisymmetric load, not self-equilibrated: refused, the message saying why.
+    """
+    ours = _outline_ends(
+        {
+            "right_end": {"segments": [1], "normal_stress": [-1.0, 0.0]},
+            "left_end": {"segments": [3], "normal_stress": [0.0, -1.0]},
+        }
+    )
+    rectangle = problem_from_dict(
+        {
+            "plate": {"corners": [[0.0, 0.0], [0.2, 0.1]]},
+            "edges": {"left": {"normal_stress": [-1.0, 0.0]}, "right": {"normal_stress": [-1, 0]}},
+            "mesh": {"nx": 20, "ny": 10},
+        }
+    )
+    loads = []
+    for spec in (ours, rectangle):
+        with solve(spec, MPI.COMM_WORLD) as analysis:
+            loads.append(analysis.result.critical_load_Pa)
+    assert loads[0] == pytest.approx(loads[1], rel=1e-10)
+    trap = _outline_ends({"ends": {"segments": [1, 3], "normal_stress": [-1.0, 0.0]}})
+    with pytest.raises(ValueError, match=r"not self-equilibrated .* edges\.ends: its \[start, "):
+        solve(trap, MPI.COMM_WORLD)

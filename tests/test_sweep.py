@@ -207,6 +207,48 @@ def test_killed_sweep_resumes_to_the_same_file(tmp_path):
     assert "holds a point of another sweep" in other.stderr
 
 
+def test_a_line_is_reused_only_for_the_same_input(tmp_path, capsys):
+    """Edit the base file (E halved) and re-run: every point is solved again.
+
+    With the edge stress given, N0 does not depend on E and a, the bending and shear
+    energy, is proportional to it: the loads halve exactly (to the eigen solver's
+    tolerance). A line of the same input is kept; the file ends as a fresh sweep's.
+    """
+    from unibuckle_fenicsx.cli import main
+
+    base = tmp_path / "small.toml"
+    base.write_text(SMALL)
+    out = tmp_path / "k.jsonl"
+    args = ["sweep", "--config", str(base), "--vary", "plate.thickness=0.005,0.006"]
+    assert main([*args, "--json", str(out)]) == EXIT_OK
+    before = read_lines(out)
+    capsys.readouterr()
+
+    base.write_text(SMALL.replace("E = 1.0e9", "E = 0.5e9"))
+    assert main([*args, "--json", str(out)]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert f"2 line(s) of {out} hold another input" in err, err
+    after = read_lines(out)
+    for old, new in zip(before, after, strict=True):
+        assert new["input"]["material"]["E"] == 0.5e9
+        assert new["critical_load_Pa"] == pytest.approx(old["critical_load_Pa"] / 2, rel=1e-8)
+    fresh = tmp_path / "fresh.jsonl"
+    assert main([*args, "--json", str(fresh)]) == EXIT_OK
+    assert out.read_text() == fresh.read_text()
+
+    # One point of the same input is kept, the other (a line of another input) solved.
+    lines = out.read_text().splitlines()
+    stale = json.loads(lines[1])
+    stale["input"]["material"]["E"] = 1.0e9
+    stale["critical_load_Pa"] = 1.0
+    out.write_text(lines[0] + "\n" + json.dumps(stale) + "\n")
+    capsys.readouterr()
+    assert main([*args, "--json", str(out)]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert "1 of 2 points already in" in err and "1 line(s)" in err, err
+    assert out.read_text() == fresh.read_text()
+
+
 def test_bad_sweep_input(tmp_path):
     base = tmp_path / "small.toml"
     base.write_text(SMALL)

@@ -25,7 +25,7 @@ from unibuckle_fenicsx.config import METHODS
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.config import ProblemSpec
 
-__all__ = ["EXIT_BAD_INPUT", "EXIT_NOT_CERTIFIED", "EXIT_OK", "main"]
+__all__ = ["EXIT_BAD_INPUT", "EXIT_INTERRUPTED", "EXIT_NOT_CERTIFIED", "EXIT_OK", "main"]
 
 #: A certified critical state was found.
 EXIT_OK = 0
@@ -33,8 +33,18 @@ EXIT_OK = 0
 EXIT_BAD_INPUT = 2
 #: A numerical difficulty: no certified critical state (the JSON holds what was found).
 EXIT_NOT_CERTIFIED = 3
+#: Interrupted (Ctrl-C): 128 + SIGINT, the shell's convention.
+EXIT_INTERRUPTED = 130
+
+#: What --json and --output may create (README, "Command line").
+OUTPUT_HELP = """\
+--json PATH writes one file; its folder must exist. --output DIR writes its files
+in DIR, creating DIR (not its parents) if it is missing. Both are checked before
+anything is solved: a path that cannot be written is refused (exit status 2)."""
 
 EPILOG = f"""\
+{OUTPUT_HELP}
+
 exit status:
   {EXIT_OK}  a critical state satisfying its certificate (KKT) was found
   {EXIT_BAD_INPUT}  bad input (the message names the parameter and the allowed range);
@@ -43,6 +53,7 @@ exit status:
      still holds the best admissible load found (an upper bound), the lower bound and a
      certificate saying what failed; when no admissible mode with a finite load
      exists (or none was found), the message gives the lower bound and no JSON is written
+  {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
 
 Single-dash options that argparse does not know go to PETSc/SLEPc under the package's
 prefixes, e.g. -unibuckle_eps_view, -unibuckle_eps_tol 1e-12, -unibuckle_certify_ksp_view.
@@ -62,14 +73,19 @@ plate.length and plate.width set x1 = x0 + value and y1 = y0 + value. Several
 
 Each finished point appends one JSON line to --json: index, point, status and the keys
 of 'unibuckle solve --json' (without wall times). Re-running the same command resumes:
-points already in the file are skipped. Under mpiexec -n P the points are shared among
-P/R groups of --ranks-per-point R ranks.
+a point already in the file is skipped if its line's input equals the point's problem
+(after an edit of the base file, the points it changes are solved again). The folder
+of --json must exist; a file that is not a sweep's JSON lines is refused, not
+overwritten. Under mpiexec -n P the points are shared among P/R groups of
+--ranks-per-point R ranks.
 
 exit status:
   {EXIT_OK}  every point has a certified critical state
   {EXIT_BAD_INPUT}  bad input (a --vary, the base file, a point the schema refuses);
      nothing was solved
   {EXIT_NOT_CERTIFIED}  some points have no certified critical state (their lines say why)
+  {EXIT_INTERRUPTED}  interrupted (Ctrl-C): the finished points are in --json; the same
+     command resumes
 """
 
 
@@ -88,8 +104,13 @@ exit status:
      nothing was solved
   {EXIT_NOT_CERTIFIED}  a numerical difficulty: the path stopped early (SNES did not converge
      at the smallest step; the JSON holds the path up to there and stop_reason), the
-     knee was not passed, or the contact conditions fail; when no load step converged
-     or the linear solve failed, the message says why and no JSON is written
+     knee was not passed, or the contact conditions fail; the message lists what the
+     path validated (the loads read off it, the contact conditions) and what it did
+     not; when no load step converged or the linear solve failed, the message says
+     why and no JSON is written
+  {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
+
+{OUTPUT_HELP}
 
 Single-dash options go to PETSc under the prefixes unibuckle_nl_ (the SNES, its KSP:
 -unibuckle_nl_snes_monitor, -unibuckle_nl_snes_view), unibuckle_ (the linear eigen
@@ -198,12 +219,16 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
         help="under mpiexec: each rank holds a serial copy and enumerates a share "
         "of the candidate sets (default: distribute the mesh)",
     )
-    s.add_argument("--json", metavar="PATH", help="write the result as JSON")
+    s.add_argument(
+        "--json", metavar="PATH", help="write the result as JSON (the folder must exist)"
+    )
     s.add_argument(
         "--output",
         metavar="DIR",
         help="write the mode, obstacle zone and contact set for ParaView (VTX .bp) and "
-        "as VTK (.pvd/.vtu, readable by pyvista.read)",
+        "as VTK (.pvd/.vtu, readable by pyvista.read) into DIR (created if missing; its "
+        "parent must exist): NAME_w.bp, NAME_theta.bp, NAME.pvd, with NAME the problem's "
+        "name, characters other than letters, digits, '.', '-' and '_' replaced by '_'",
     )
     s.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
     s.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
@@ -228,7 +253,8 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
         "--json",
         metavar="PATH",
         required=True,
-        help="JSON-lines output; an existing file of the same sweep is resumed",
+        help="JSON-lines output (the folder must exist); an existing file of the same "
+        "sweep is resumed",
     )
     w.add_argument(
         "--plot",
@@ -304,7 +330,9 @@ def _nonlinear_parser(sub: Any) -> None:
         metavar="FRACTION",
         help="largest load step, relative to the linear critical load (default 0.05)",
     )
-    n.add_argument("--json", metavar="PATH", help="write the result as JSON")
+    n.add_argument(
+        "--json", metavar="PATH", help="write the result as JSON (the folder must exist)"
+    )
     n.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
     n.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
 
@@ -351,23 +379,66 @@ def _solver_changes(args: argparse.Namespace) -> tuple[dict[str, Any], list[str]
     return changes, ignored
 
 
-def _check_writable(args: argparse.Namespace) -> str | None:
-    """Why --json or --output cannot be written, or None (before any solve)."""
-    targets = []
-    if args.json:
-        targets.append(("--json", Path(args.json).parent))
+def _probe_folder(flag: str, folder: Path, target: Path) -> str | None:
+    """Why ``target`` cannot be created in the existing ``folder``, or None (a probe file)."""
+    import tempfile
+
+    try:
+        fd, name = tempfile.mkstemp(prefix=".unibuckle-probe-", dir=folder)
+    except OSError as err:
+        return f"{flag}: cannot create {target}: {folder} takes no new file ({err.strerror or err})"
+    os.close(fd)
+    os.unlink(name)
+    return None
+
+
+def _missing_folder(flag: str, folder: Path) -> str:
+    """The message for a folder that does not exist (naming a file in its way, if any)."""
+    existing = folder
+    while not existing.exists() and existing != existing.parent:
+        existing = existing.parent
+    if existing.exists() and not existing.is_dir():
+        return f"{flag}: {existing} is not a directory"
+    return f"{flag}: the folder {folder} does not exist; create it first"
+
+
+def _check_outputs(args: argparse.Namespace) -> str | None:
+    """Why --json, --plot or --output cannot be written, or None; run before any solve.
+
+    --json PATH (and --plot PNG) needs an existing folder in which a file can be created (tried, not
+    inferred from permission bits, which root and /proc ignore); --output DIR is
+    created later if missing, so its parent must exist and take a new entry. Nothing is
+    left behind.
+    """
+    files = [("--json", args.json), ("--plot", getattr(args, "plot", None))]  # plot: sweep
+    for flag, value in files:
+        if not value:
+            continue
+        path = Path(value)
+        folder = path.parent
+        if path.is_dir():
+            return f"{flag}: {path} is a directory; give a file name"
+        if not folder.is_dir():
+            return _missing_folder(flag, folder)
+        if path.exists():
+            try:  # appending nothing leaves the file as it is
+                with path.open("ab"):
+                    pass
+            except OSError as err:
+                return f"{flag}: cannot write {path} ({err.strerror or err})"
+        elif problem := _probe_folder(flag, folder, path):
+            return problem
     if getattr(args, "output", None):  # solve only
-        targets.append(("--output", Path(args.output)))
-    for flag, directory in targets:
-        existing = directory
-        while not existing.exists() and existing != existing.parent:
-            existing = existing.parent
-        if not existing.is_dir():
-            return f"{flag}: {existing} is not a directory"
-        if not os.access(existing, os.W_OK | os.X_OK):
-            return f"{flag}: cannot write in {existing} (permission denied)"
-    if args.json and Path(args.json).is_dir():
-        return f"--json: {args.json} is a directory"
+        directory = Path(args.output)
+        if directory.exists() and not directory.is_dir():
+            return f"--output: {directory} is not a directory"
+        folder = directory
+        if not directory.exists():
+            folder = directory.parent
+            if not folder.is_dir():
+                return _missing_folder("--output", folder) + " (--output creates one folder)"
+        if problem := _probe_folder("--output", folder, directory):
+            return problem
     return None
 
 
@@ -392,48 +463,107 @@ def main(argv: Sequence[str] | None = None) -> int:
         sub = solve_parser if args.command == "solve" else parser
         sub.error(f"unrecognized arguments: {' '.join(unknown)}")
 
-    import petsc4py
     from mpi4py import MPI  # before petsc4py: loads libmpi
+
+    comm = MPI.COMM_WORLD
+    # The outputs first: a path that cannot be written is refused before PETSc, DOLFINx
+    # and the problem are even loaded.
+    problem = comm.bcast(_check_outputs(args) if comm.rank == 0 else None, root=0)
+    if problem is not None:
+        return _fail(comm, problem)
+    _logging(args.verbose, args.quiet, comm.rank)
+    try:
+        return _run(args, rest, comm)
+    except KeyboardInterrupt:
+        if comm.rank == 0:
+            where = "nothing written"
+            if args.command == "sweep":
+                where = f"the finished points are in {args.json}; the same command resumes"
+            print(f"\nunibuckle: interrupted; {where}", file=sys.stderr, flush=True)
+        return EXIT_INTERRUPTED
+    except Exception as err:
+        refused = _petsc_error(err, rest)
+        if refused is None:
+            raise
+        return _fail(comm, *refused)
+
+
+def _petsc_error(err: BaseException, options: Sequence[str]) -> tuple[str, int] | None:
+    """The message and exit status of a PETSc/SLEPc error in ``err`` (or its causes).
+
+    An error raised while an object reads its options (``*SetFromOptions``) is a bad
+    command-line option (exit 2); any other PETSc error is a numerical difficulty.
+    petsc4py reports an error inside a Cython call as a SystemError whose cause is the
+    PETSc.Error: the chain is searched.
+    """
+    from petsc4py import PETSc
+
+    found: BaseException | None = err
+    seen = 0
+    while found is not None and not isinstance(found, PETSc.Error) and seen < 8:
+        found = found.__cause__ or found.__context__
+        seen += 1
+    if not isinstance(found, PETSc.Error):
+        return None
+    lines = [line.removeprefix("[0] ").strip() for line in str(found).splitlines()]
+    reason = "; ".join(line for line in lines[1:] if line and "() at " not in line)
+    reason = reason or lines[0]
+    if any("SetFromOptions()" in line for line in lines):
+        given = " ".join(options) or "none"
+        return (
+            f"PETSc/SLEPc refused an option ({reason}); the options given: {given}",
+            EXIT_BAD_INPUT,
+        )
+    return f"PETSc/SLEPc failed: {reason} ({lines[0]}); no result written", EXIT_NOT_CERTIFIED
+
+
+def _run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> int:
+    """The subcommand of ``args``, with PETSc given the single-dash options ``rest``."""
+    import petsc4py
 
     petsc4py.init([sys.argv[0], *rest])
 
+    if args.command == "sweep":
+        return _sweep(args, comm)
+    if args.command == "nonlinear":
+        return _nonlinear(args, comm)
+    return _solve(args, comm)
+
+
+def _solve(args: argparse.Namespace, comm: Any) -> int:
+    """``unibuckle solve``: one problem, its summary, JSON and fields."""
     from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
     from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.eigen import EigenSolveError
     from unibuckle_fenicsx.results import write_fields, write_json
 
-    comm = MPI.COMM_WORLD
-    _logging(args.verbose, args.quiet, comm.rank)
-    if args.command == "sweep":
-        return _sweep(args, comm)
-    if args.command == "nonlinear":
-        return _nonlinear(args, comm)
-
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
         return _fail(comm, message, status)
 
-    problem = comm.bcast(_check_writable(args) if comm.rank == 0 else None, root=0)
-    if problem is not None:
-        return fail(problem)
     try:
         spec = _spec_from_args(args)
         changes, ignored = _solver_changes(args)
         spec = spec.with_solver(**changes)
     except (ValueError, OSError) as err:
         return fail(str(err))
-    if ignored and comm.rank == 0:
+    if comm.rank == 0:
         method = spec.solver.method
         for flag in ignored:
             print(f"unibuckle: warning: {flag} is ignored with --method {method}", file=sys.stderr)
+    _warn_plate_model(spec, comm)
     try:
         analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
     except (ValueError, ImportError) as err:  # ImportError: an extra is missing (gmsh)
         return fail(str(err))
     except (EigenSolveError, NoAdmissibleModeError) as err:
         return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
+    unwritten = None
     with analysis:
         if args.output:
-            write_fields(analysis, args.output)
+            try:
+                write_fields(analysis, args.output)
+            except OSError as err:  # the folder went away during the solve
+                unwritten = f"--output {args.output}: {err}"
     result = analysis.result
     status = EXIT_OK
     certificate = result.certificate
@@ -441,17 +571,32 @@ def main(argv: Sequence[str] | None = None) -> int:
         status = EXIT_NOT_CERTIFIED
     if comm.rank == 0:
         if args.json:
-            write_json(result, args.json)
+            try:
+                write_json(result, args.json)
+            except OSError as err:
+                unwritten = f"--json {args.json}: {err}"
         print(result.summary(), flush=True)
         if status != EXIT_OK:
             notes = "; ".join((certificate or {}).get("notes", [])) or "see the certificate"
             print(
                 f"unibuckle: error: no certified critical state ({notes}); the bracket "
                 f"[{result.lower_bound_Pa}, {result.upper_bound_Pa}] Pa is "
-                + (f"in {args.json}" if args.json else "above"),
+                + (f"in {args.json}" if args.json and unwritten is None else "above"),
                 file=sys.stderr,
             )
+    unwritten = comm.bcast(unwritten, root=0)
+    if unwritten is not None:
+        return fail(f"could not write {unwritten}; the result is the summary above")
     return status
+
+
+def _warn_plate_model(spec: ProblemSpec, comm: Any) -> None:
+    """A warning on stderr when the plate lies outside the plate model's usual range."""
+    from unibuckle_fenicsx.checks import plate_model_note
+
+    note = plate_model_note(spec.plate)
+    if note is not None and comm.rank == 0:
+        print(f"unibuckle: warning: {note}", file=sys.stderr)
 
 
 def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
@@ -465,9 +610,6 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
         return _fail(comm, message, status)
 
-    problem = comm.bcast(_check_writable(args) if comm.rank == 0 else None, root=0)
-    if problem is not None:
-        return fail(problem)
     try:
         options = NonlinearOptions(
             imperfection=args.imperfection,
@@ -485,6 +627,13 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
             if message.startswith(name):
                 message = "--" + name.replace("_", "-") + message[len(name) :]
         return fail(message)
+    if args.shape == "unilateral" and (args.no_obstacle or not spec.all_obstacles):
+        why = "--no-obstacle removes it" if args.no_obstacle else "the problem has none"
+        return fail(
+            f"--shape unilateral takes the imperfection from the unilateral mode, which needs "
+            f"an obstacle, and {why}: give --shape free (or auto)"
+        )
+    _warn_plate_model(spec, comm)
     try:
         analysis = solve_nonlinear(spec, options, comm)
     except (ValueError, ImportError) as err:
@@ -493,22 +642,59 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
         return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
     with analysis:
         result = analysis.result
+    unwritten = None
     if comm.rank == 0:
         if args.json:
-            path = Path(args.json)
-            path.parent.mkdir(parents=True, exist_ok=True)
-            path.write_text(json.dumps(result.as_dict(), indent=2) + "\n")
+            try:
+                Path(args.json).write_text(json.dumps(result.as_dict(), indent=2) + "\n")
+            except OSError as err:
+                unwritten = f"could not write --json {args.json}: {err}"
         print(result.summary(), flush=True)
         if not result.ok:
             print(
-                f"unibuckle: error: the path does not validate the critical state "
-                f"({result.stop_reason}; Southwell {result.southwell_load_Pa}, inflection "
-                f"{result.inflection_load_Pa}, contact conditions "
-                f"{'hold' if result.contact_check.get('satisfied') else 'FAIL'})"
-                + (f"; what was obtained is in {args.json}" if args.json else ""),
+                f"unibuckle: error: {nonlinear_verdict(result, args.max_load)}"
+                + (f"; the path obtained is in {args.json}" if args.json and not unwritten else ""),
                 file=sys.stderr,
             )
+    unwritten = comm.bcast(unwritten, root=0)
+    if unwritten is not None:
+        return fail(f"{unwritten}; the result is the summary above")
     return EXIT_OK if result.ok else EXIT_NOT_CERTIFIED
+
+
+def nonlinear_verdict(result: Any, max_load: float) -> str:
+    """What an incomplete load path validated, and what it did not (one paragraph).
+
+    Args:
+        result: A :class:`~unibuckle_fenicsx.nonlinear.NonlinearResult` that is not ``ok``.
+        max_load: The --max-load asked for (a multiple of the linear critical load).
+    """
+    linear = result.linear_critical_load_Pa
+    validated, missing = [], []
+    for name, load in (
+        ("Southwell", result.southwell_load_Pa),
+        ("inflection", result.inflection_load_Pa),
+    ):
+        if load is None:
+            missing.append(f"the {name} load (the path stopped before it could be read)")
+        else:
+            validated.append(f"the {name} load {load:.6e} Pa ({load / linear - 1:+.1e} relative)")
+    check = result.contact_check
+    if check.get("satisfied", True):
+        validated.append("the contact conditions at the last converged state")
+    else:
+        missing.append(f"the contact conditions at the last converged state ({check})")
+    reached = result.path[-1]["load_Pa"] / linear if result.path else 0.0
+    if not result.completed:
+        missing.append(
+            f"the path from {reached:.4g} to --max-load {max_load:g} x the linear load "
+            f"({result.stop_reason})"
+        )
+    return (
+        f"the load path does not validate everything against the linear critical load "
+        f"{linear:.6e} Pa. Validated: {', '.join(validated) or 'nothing'}. Not validated: "
+        f"{', '.join(missing)}"
+    )
 
 
 def _fail(comm: Any, message: str, status: int = EXIT_BAD_INPUT) -> int:
@@ -523,13 +709,21 @@ def _spec_from_args(args: argparse.Namespace) -> ProblemSpec:
     from unibuckle_fenicsx.cases import paper_case
     from unibuckle_fenicsx.config import load_problem
 
-    spec = paper_case(args.case) if args.case else load_problem(args.config)
+    spec = paper_case(args.case) if args.case else _load_config(args.config, load_problem)
     if args.nx is not None or args.ny is not None:
         spec = spec.with_mesh(
             spec.mesh.nx if args.nx is None else args.nx,
             spec.mesh.ny if args.ny is None else args.ny,
         )
     return spec
+
+
+def _load_config(path: str, load: Any) -> Any:
+    """``load(path)``, an unreadable file named with its option (ValueError)."""
+    try:
+        return load(path)
+    except OSError as err:
+        raise ValueError(f"--config {path}: cannot read it ({err.strerror or err})") from None
 
 
 #: Option names of the nonlinear analysis that are also command-line flags.
@@ -541,13 +735,8 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
     from unibuckle_fenicsx.sweep import base_mapping, parse_variation, run_sweep
 
     def fail(message: str) -> int:
-        if comm.rank == 0:
-            print(f"unibuckle: error: {message}", file=sys.stderr)
-        return EXIT_BAD_INPUT
+        return _fail(comm, message)
 
-    problem = comm.bcast(_check_writable(args) if comm.rank == 0 else None, root=0)
-    if problem is not None:
-        return fail(problem)
     if args.plot and comm.rank == 0:
         try:
             import matplotlib as mpl  # noqa: F401
@@ -562,7 +751,7 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
         sweep_lines.setLevel(logging.ERROR if args.quiet or comm.rank else logging.INFO)
     try:
         variations = [parse_variation(v) for v in args.vary]
-        base = base_mapping(args.config)
+        base = _load_config(args.config, base_mapping)
         lines = run_sweep(
             base,
             variations,

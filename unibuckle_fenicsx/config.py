@@ -25,6 +25,7 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.checks import check_features, check_supports, check_thickness
 from unibuckle_fenicsx.geometry import (
     circle_points,
     distance_to_polygon,
@@ -560,6 +561,7 @@ class PlateSpec:
         self._check_file()
         self._check_holes()
         self._check_edges()
+        check_thickness(self)
 
     def _check_file(self) -> None:
         if self.file is None:
@@ -595,6 +597,7 @@ class PlateSpec:
             for j in range(k):
                 if not _disjoint(holes[j], hole):
                     raise ValueError(f"plate.holes[{j}] and {where} overlap or touch")
+        check_features(self, None)  # touching within rounding (a tangent hole)
 
     def _check_edges(self) -> None:
         count = len(self.outline) if self.outline is not None else 0
@@ -1240,6 +1243,8 @@ class ProblemSpec:
                 )
         if plate.file is not None and plate.file.lower().endswith(".msh") and self.mesh.size:
             raise ValueError("mesh.size: a .msh file is meshed already; leave size out")
+        if plate.meshed_by_gmsh:
+            check_features(plate, self.mesh.size)
         if self.obstacle is not None and self.obstacles:
             raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
         for k, o in enumerate(self.obstacles):
@@ -1265,6 +1270,7 @@ class ProblemSpec:
             except ValueError as err:
                 raise ValueError(f"points[{k}]{str(err)[len('points') :]}") from None
         found = self.all_obstacles
+        check_supports(self)
         kinds = {o.kind for o in found}
         if self.one_sided_points and "tensionless" in kinds:
             raise ValueError(
@@ -1594,7 +1600,8 @@ def _holes(tables: Any) -> tuple[Circle | Polygon, ...]:
             try:
                 holes.append(Circle(kw["center"], kw["radius"]))
             except ValueError as err:
-                raise ValueError(f"{where}.{err}") from None
+                # Circle's messages name circle.center/radius; the file's keys are these.
+                raise ValueError(f"{where}.{str(err).removeprefix('circle.')}") from None
         else:
             raise ValueError(
                 f"[{where}] needs center = [x, y] and radius = r (a circle), or outline = "

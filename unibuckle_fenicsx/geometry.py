@@ -1,5 +1,9 @@
 """Plane geometry of outlines, holes and obstacle zones: polygons and circles (numpy only).
 
+Hand-written (a few dozen lines each: point in polygon, distances, convex clipping, ear
+clipping) so that the package needs no geometry library for its checks and its zone
+areas; gmsh, which would do the clipping, is an optional extra.
+
 Polygons are sequences of vertices (x, y), closed implicitly (the last vertex joins the
 first); segment k runs from vertex k to vertex k + 1.
 """
@@ -13,13 +17,18 @@ import numpy.typing as npt
 
 __all__ = [
     "circle_points",
+    "clip_polygon",
+    "disc_polygon",
     "distance_to_polygon",
+    "intersection_area",
+    "is_convex",
     "is_simple",
     "points_in_circle",
     "points_in_polygon",
     "polygon_area",
     "polygon_inside",
     "polygons_disjoint",
+    "triangulate",
 ]
 
 Vertices = Sequence[Sequence[float]] | npt.NDArray[np.float64]
@@ -165,3 +174,87 @@ def polygons_disjoint(a: Vertices, b: Vertices) -> bool:
             ):
                 return False
     return True
+
+
+def _counter_clockwise(v: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    return v if polygon_area(v) >= 0.0 else v[::-1]
+
+
+def is_convex(vertices: Vertices) -> bool:
+    """Whether the simple polygon is convex (no reflex vertex; collinear ones allowed)."""
+    v = np.asarray(vertices, dtype=float)
+    d = np.roll(v, -1, axis=0) - v
+    cross = d[:, 0] * np.roll(d[:, 1], -1) - d[:, 1] * np.roll(d[:, 0], -1)
+    scale = float(np.abs(d).max()) ** 2
+    return bool((cross >= -1e-12 * scale).all() or (cross <= 1e-12 * scale).all())
+
+
+def clip_polygon(subject: Vertices, convex: Vertices) -> npt.NDArray[np.float64]:
+    """The part of ``subject`` inside the convex polygon ``convex`` (Sutherland-Hodgman).
+
+    ``subject`` may be any simple polygon: the result may then hold zero-width bridges,
+    which add nothing to its area (use it for :func:`polygon_area`).
+    """
+    out = np.asarray(subject, dtype=float).reshape(-1, 2)
+    c = _counter_clockwise(np.asarray(convex, dtype=float))
+    for a, b in zip(c, np.roll(c, -1, axis=0), strict=True):
+        if len(out) == 0:
+            break
+        edge = b - a
+        side = edge[0] * (out[:, 1] - a[1]) - edge[1] * (out[:, 0] - a[0])  # >= 0: inside
+        inside = side >= 0.0
+        prev, side_prev = np.roll(out, 1, axis=0), np.roll(side, 1)
+        crossing = inside != np.roll(inside, 1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            t = np.where(crossing, side_prev / (side_prev - side), 0.0)
+        cut = prev + (out - prev) * t[:, None]
+        # Vertex k of the result: the crossing into (or out of) edge k, then vertex k.
+        points = np.stack([cut, out], axis=1).reshape(-1, 2)
+        out = points[np.stack([crossing, inside], axis=1).reshape(-1)]
+    return out
+
+
+def triangulate(vertices: Vertices) -> list[npt.NDArray[np.float64]]:
+    """Triangles covering the simple polygon (ear clipping, O(n^3): small polygons)."""
+    v = list(_counter_clockwise(np.asarray(vertices, dtype=float)))
+    triangles = []
+    while len(v) > 3:
+        for k in range(len(v)):
+            a, b, c = v[k - 1], v[k], v[(k + 1) % len(v)]
+            if polygon_area([a, b, c]) <= 0.0:
+                continue  # reflex (or flat) corner
+            others = [p for p in v if not any(p is q for q in (a, b, c))]
+            if others and points_in_polygon(np.array(others), [a, b, c]).any():
+                continue
+            triangles.append(np.array([a, b, c]))
+            del v[k]
+            break
+        else:  # only flat corners left
+            break
+    triangles.append(np.array(v[:3]))
+    return triangles
+
+
+def intersection_area(a: Vertices, b: Vertices) -> float:
+    """Area of the intersection of two simple polygons.
+
+    One is clipped by the other when that one is convex (:func:`clip_polygon`), the
+    cheaper way round; otherwise by each triangle of the polygon with fewer vertices.
+    """
+    pa, pb = np.asarray(a, dtype=float), np.asarray(b, dtype=float)
+    if len(pa) < len(pb):
+        pa, pb = pb, pa  # pb: the one with fewer vertices, the clipper if it can be
+    if is_convex(pb):
+        return abs(polygon_area(clip_polygon(pa, pb)))
+    if is_convex(pa) and len(pa) <= 3 * (len(pb) - 2):
+        return abs(polygon_area(clip_polygon(pb, pa)))
+    return sum(abs(polygon_area(clip_polygon(pa, t))) for t in triangulate(pb))
+
+
+def disc_polygon(center: Sequence[float], radius: float, n: int = 4096) -> npt.NDArray[np.float64]:
+    """A regular n-gon with the disc's area (its radius enlarged by the n-gon's deficit).
+
+    Clipped by a polygon, it gives the area of the disc's part to O(n^-2).
+    """
+    scale = np.sqrt(2.0 * np.pi / (n * np.sin(2.0 * np.pi / n)))
+    return circle_points(center, radius * scale, n)

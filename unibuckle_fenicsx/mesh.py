@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 
 from mpi4py import MPI
@@ -11,7 +12,14 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import EDGE_NAMES, HOLES, EdgeSpec, MeshSpec, PlateSpec
+from unibuckle_fenicsx.config import (
+    EDGE_NAMES,
+    HOLES,
+    EdgeSpec,
+    MeshSpec,
+    ObstacleSpec,
+    PlateSpec,
+)
 from unibuckle_fenicsx.gmsh_mesh import HOLES_TAG, gmsh_plate_mesh, segment_tag
 
 __all__ = [
@@ -214,14 +222,18 @@ def edge_line(
 
 
 def build_plate_mesh(
-    plate: PlateSpec, spec: MeshSpec, comm: MPI.Comm = MPI.COMM_WORLD
+    plate: PlateSpec,
+    spec: MeshSpec,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    obstacles: Sequence[ObstacleSpec] = (),
 ) -> tuple[dolfinx.mesh.Mesh, dolfinx.mesh.MeshTags, PlateSpec]:
     """The plate's mesh, its facet tags, and the plate with every edge's tag resolved.
 
     The rectangle: :func:`create_plate_mesh` (the plate unchanged). Meshed by gmsh
     (:func:`~unibuckle_fenicsx.gmsh_mesh.gmsh_plate_mesh`): a file's ``[edges.NAME]`` get
     the tag of the physical curve called NAME (an error listing the file's names if there
-    is none), and its ``corners`` become the mesh's bounding box.
+    is none), and its ``corners`` become the mesh's bounding box; the edges of the
+    ``obstacles``' zones are mesh lines of a plate gmsh builds.
 
     Note:
         Collective on ``comm``.
@@ -229,7 +241,7 @@ def build_plate_mesh(
     if not plate.meshed_by_gmsh:
         msh, tags = create_plate_mesh(plate, spec, comm)
         return msh, tags, plate
-    msh, tags, groups = gmsh_plate_mesh(plate, spec, comm)
+    msh, tags, groups = gmsh_plate_mesh(plate, spec, comm, obstacles)
     if plate.file is None:
         return msh, tags, plate
     missing = [e.name for e in plate.edges if e.tag is None and e.name not in groups]

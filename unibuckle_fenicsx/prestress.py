@@ -337,10 +337,17 @@ def _check_self_equilibrated(
     total = msh.comm.allreduce(total, op=MPI.SUM)
     size = max(plate.length, plate.width)
     if max(abs(force[0]), abs(force[1]), abs(moment) / size) > 1e-10 * total:
+        # A [start, end] pair on a part of several segments runs along each one.
+        trap = [e for e in loaded if not e.uniform and e.segments and len(e.segments) > 1]
+        hint = "".join(
+            f"; edges.{e.name}: its [start, end] stress runs along each of its segments "
+            f"{list(e.segments or ())} from vertex k to vertex k + 1 (README, stress gradients)"
+            for e in trap
+        )
         raise ValueError(
             'every edge is free in its plane (inplane = "free") but the load is not '
             f"self-equilibrated (resultant force {force}, moment {moment:.3g} per unit "
-            'thickness): set inplane = "clamped" or "roller" on some edge'
+            f'thickness): set inplane = "clamped" or "roller" on some edge{hint}'
         )
 
 

@@ -214,7 +214,9 @@ class BucklingProblem(Owner):
             comm = mesh.comm
         else:
             _check_memory(spec, comm)
-            self.mesh, self.facet_tags, plate = build_plate_mesh(spec.plate, spec.mesh, comm)
+            self.mesh, self.facet_tags, plate = build_plate_mesh(
+                spec.plate, spec.mesh, comm, spec.all_obstacles
+            )
             # A file's edges get their tags, its corners the mesh's bounding box.
             self.spec = spec = replace(spec, plate=plate)
         self.comm = comm

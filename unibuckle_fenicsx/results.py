@@ -4,12 +4,14 @@ from __future__ import annotations
 
 import json
 import math
+import re
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from unibuckle_fenicsx.checks import plate_model_note
 from unibuckle_fenicsx.config import (
     UNITS,
     ProblemSpec,
@@ -17,6 +19,7 @@ from unibuckle_fenicsx.config import (
     stress_value,
     temperature_field,
 )
+from unibuckle_fenicsx.zones import zone_report
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution
@@ -24,7 +27,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.certify import Certificate
     from unibuckle_fenicsx.problem import BucklingProblem, Mode
 
-__all__ = ["BucklingResult", "versions", "write_fields", "write_json"]
+__all__ = ["BucklingResult", "file_stem", "versions", "write_fields", "write_json"]
 
 
 @dataclass
@@ -67,7 +70,10 @@ class BucklingResult:
         units: The unit system the summary prints in (the numbers here are SI).
         input: The problem solved, every key with the value used, in SI
             (:func:`~unibuckle_fenicsx.config.problem_to_dict`; None for a predicate zone).
-        versions: Versions of the package, DOLFINx, PETSc, SLEPc, Python and NumPy.
+        versions: Versions of the package and of the libraries that computed the result
+            (:func:`versions`).
+        obstacle_zones: Per obstacle, the zone's area on the plate against the discrete
+            zone's and its node count (:func:`~unibuckle_fenicsx.zones.zone_report`).
     """
 
     case: str
@@ -101,6 +107,7 @@ class BucklingResult:
     units: str = "SI"
     input: dict[str, Any] | None = None
     versions: dict[str, str] = field(default_factory=dict)
+    obstacle_zones: list[dict[str, Any]] = field(default_factory=list)
 
     @classmethod
     def from_solution(
@@ -176,6 +183,14 @@ class BucklingResult:
             from unibuckle_fenicsx.design import design_output
 
             result.design = design_output(spec, spec.design, load)
+        note = plate_model_note(spec.plate)
+        if note is not None:
+            result.details["plate_model"] = note
+        if spec.all_obstacles:
+            labels = [spec.obstacle_label(k) for k in range(len(spec.all_obstacles))]
+            result.obstacle_zones = zone_report(
+                problem.mesh, spec.all_obstacles, spec.plate, labels
+            )
         if solution is None or certificate is None:
             result.lower_bound_Pa = result.upper_bound_Pa = free.load
             return result
@@ -226,6 +241,7 @@ class BucklingResult:
             if _load_text(load)
         ]
         extra = "".join(f"\n  {line}" for line in self._model_lines())
+        extra += "".join(f"\n  {text}" for text in map(_zone_text, self.obstacle_zones) if text)
         if loaded:
             head = (
                 f"lambda_c = {self.critical_load_Pa / scale:.6e} {unit} "
@@ -319,6 +335,18 @@ def _verified(cert: dict[str, Any]) -> str:
     return f"proven=no (KKT only{below})"
 
 
+def _zone_text(zone: dict[str, Any]) -> str:
+    """A line on a discrete zone that differs from its zone by more than 1e-6, or ''."""
+    area, discrete = zone.get("area_m2"), zone["discrete_area_m2"]
+    if area is None or area <= 0.0 or abs(discrete - area) <= 1e-6 * area:
+        return ""
+    return (
+        f"{zone['obstacle']} zone on the mesh: the cells with every node in it cover "
+        f"{discrete / area:.2%} of its area ({zone['nodes']} nodes); the obstacle acts on "
+        "the mesh nodes in the zone"
+    )
+
+
 def _load_text(load: dict[str, Any], prefix: str = "", scale: float = 1.0, unit: str = "") -> str:
     """The edge stresses of ``load`` (``prefix`` "fixed_": the fixed ones, in ``unit``)."""
     parts = []
@@ -354,7 +382,21 @@ def versions() -> dict[str, str]:
     from importlib.metadata import PackageNotFoundError, version
 
     out = {"python": platform.python_version(), "numpy": np.__version__}
-    for dist in ("unibuckle_fenicsx", "fenics-dolfinx", "petsc4py", "slepc4py", "fenics-basix"):
+    # Distributions that can take part in a result (installed ones only): meshing (gmsh),
+    # MPI, the SDP certificate (cvxpy, clarabel), the dense references (scipy).
+    dists = (
+        "unibuckle_fenicsx",
+        "fenics-dolfinx",
+        "petsc4py",
+        "slepc4py",
+        "fenics-basix",
+        "mpi4py",
+        "gmsh",
+        "cvxpy",
+        "clarabel",
+        "scipy",
+    )
+    for dist in dists:
         try:
             out[dist] = version(dist)
         except PackageNotFoundError:
@@ -408,10 +450,22 @@ def write_json(result: BucklingResult, path: str | Path) -> Path:
     return path
 
 
+def file_stem(name: str) -> str:
+    """``name`` as one file name, which leads out of no folder.
+
+    Characters other than letters, digits, '.', '-' and '_' become '_', and so do
+    leading dots.
+    """
+    stem = re.sub(r"[^A-Za-z0-9._-]", "_", name)
+    stem = re.sub(r"^\.+", lambda m: "_" * len(m.group()), stem)
+    return stem or "plate"
+
+
 def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
     """Write the mode, the free mode, the obstacle zone and the contact set for viewing.
 
-    Files, for ParaView (ADIOS2 VTX reader): ``<case>_w.bp`` (w, w_free, obstacle_zone,
+    ``<case>`` is the problem's name made a safe file name (:func:`file_stem`). Files,
+    for ParaView (ADIOS2 VTX reader): ``<case>_w.bp`` (w, w_free, obstacle_zone,
     contact on the Q1 space) and ``<case>_theta.bp`` (the rotation); and the same fields
     as VTK, ``<case>.pvd`` (with ``.pvtu``/``.vtu`` pieces), which ParaView and
     ``pyvista.read`` open without ADIOS2.
@@ -436,12 +490,13 @@ def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
     if problem.contact is not None and analysis.solution is not None:
         fields.append(problem.contact.indicator())
         fields.append(problem.contact.node_function(analysis.solution.active))
-    case = analysis.result.case
+    case = file_stem(analysis.result.case)
     paths = [directory / f"{case}_w.bp", directory / f"{case}_theta.bp"]
     for path, funcs in ((paths[0], fields), (paths[1], [theta])):
         with dolfinx.io.VTXWriter(problem.comm, path, funcs, engine="BP4") as writer:
             writer.write(0.0)
     paths.append(directory / f"{case}.pvd")
+    assert all(path.parent == directory for path in paths)
     with dolfinx.io.VTKFile(problem.comm, paths[-1], "w") as vtk:
         vtk.write_function([*fields, theta], 0.0)
     return paths

@@ -30,9 +30,12 @@ cell count follows the plate's size.
 
 **Resume.** Each line is appended with one ``write`` of the whole line and flushed to
 disk, so a killed sweep leaves complete lines (and at most one truncated last line,
-which is dropped). Run the same command again: the points already in the file are
-skipped, the rest solved; at the end the file is rewritten (atomically) in point order,
-so an interrupted and resumed sweep leaves the same file as an uninterrupted one.
+which is dropped). Run the same command again: a point already in the file is skipped
+if its line's ``input`` (the problem solved, every key) equals the point's problem now,
+and solved again otherwise (the base file was edited); the rest are solved; at the end
+the file is rewritten (atomically) in point order, so an interrupted and resumed sweep
+leaves the same file as an uninterrupted one. A file with a line that is not a sweep's
+(another file given by mistake, bytes that are not UTF-8) is refused, not rewritten.
 
 **Distribution.** Under ``mpiexec -n P`` with ``ranks_per_point = R`` (P divisible by
 R), the ranks form P/R sub-communicators of R ranks; each solves every (P/R)-th of the
@@ -69,6 +72,7 @@ __all__ = [
     "Variation",
     "base_mapping",
     "parse_variation",
+    "point_input",
     "point_problem",
     "read_lines",
     "run_sweep",
@@ -234,17 +238,50 @@ def point_problem(base: Mapping[str, Any], point: Mapping[str, float]) -> Proble
         raise ValueError(f"sweep point {dict(point)}: {err}") from None
 
 
-def read_lines(path: str | Path) -> list[dict[str, Any]]:
-    """The complete JSON lines of a sweep file (a truncated or foreign line is dropped)."""
+def read_lines(path: str | Path, *, strict: bool = False) -> list[dict[str, Any]]:
+    """The JSON lines of a sweep file.
+
+    Args:
+        path: The file.
+        strict: Refuse a line that is not a sweep's line (``ValueError`` naming the file
+            and the line), except a last line without its newline, cut by a kill, which
+            is dropped; otherwise every such line is dropped.
+    """
+    data = Path(path).read_bytes()
+    texts = data.split(b"\n")
+    cut = texts.pop()  # after the last newline: empty, or a line cut by a kill
     out = []
-    for text in Path(path).read_text().splitlines():
-        try:
-            line = json.loads(text)
-        except json.JSONDecodeError:
-            continue
-        if isinstance(line, dict) and isinstance(line.get("index"), int) and "point" in line:
+    for number, raw in enumerate(texts, start=1):
+        line, why = _parse_line(raw)
+        if line is not None:
             out.append(line)
+        elif strict:
+            raise ValueError(
+                f"--json {path}: line {number} is not a line of a sweep ({why}); give "
+                "another file or delete this one"
+            )
+    line, _ = _parse_line(cut)
+    if line is not None and not strict:
+        out.append(line)
     return out
+
+
+def _parse_line(raw: bytes) -> tuple[dict[str, Any] | None, str]:
+    """A sweep line from its bytes, or None and why not."""
+    try:
+        line = json.loads(raw.decode("utf-8"))
+    except UnicodeDecodeError as err:
+        return None, f"not UTF-8 text: {err.reason} at byte {err.start}"
+    except json.JSONDecodeError as err:
+        return None, f"not JSON: {err.msg}"
+    if isinstance(line, dict) and isinstance(line.get("index"), int) and "point" in line:
+        return line, ""
+    return None, "no index and point"
+
+
+def point_input(spec: ProblemSpec) -> dict[str, Any]:
+    """The ``input`` a point's line stores: its problem, every key, as read back from JSON."""
+    return json.loads(json.dumps(problem_to_dict(spec)))
 
 
 def _write_atomically(path: Path, lines: list[dict[str, Any]]) -> None:
@@ -266,26 +303,44 @@ def _append(path: Path, line: dict[str, Any]) -> None:
         os.close(fd)
 
 
-def _done_points(path: Path, points: list[dict[str, float]]) -> dict[int, dict[str, Any]]:
-    """The lines already in ``path`` (checked against ``points``), the file cleaned up."""
+def _done_points(
+    path: Path, points: list[dict[str, float]], inputs: list[dict[str, Any]]
+) -> tuple[dict[int, dict[str, Any]], int]:
+    """The lines of ``path`` that can be kept, and how many are stale; the file cleaned up.
+
+    A line is kept if its point is this sweep's and its stored ``input`` equals the
+    point's problem now (the base file may have changed since); a stale line is dropped,
+    so that its point is solved again.
+
+    Raises:
+        ValueError: A line of another sweep, or one that is not a sweep's line.
+    """
     if not path.exists():
-        return {}
-    lines = read_lines(path)
+        return {}, 0
     done: dict[int, dict[str, Any]] = {}
-    for line in lines:
+    stale = 0
+    for line in read_lines(path, strict=True):
         k = line["index"]
         if not 0 <= k < len(points) or line["point"] != points[k]:
             raise ValueError(
                 f"--json {path}: holds a point of another sweep (line index {k}, point "
                 f"{line['point']}); give another file or delete it"
             )
+        if line.get("input") != inputs[k]:
+            stale += 1
+            continue
         done.setdefault(k, line)
     _write_atomically(path, [done[k] for k in sorted(done)])  # drop a truncated last line
-    return done
+    return done, stale
 
 
 def _solve_point(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
-    """Solve one point; the JSON-ready line body (results, or the error)."""
+    """Solve one point; the JSON-ready line body (results, or the error; and the input)."""
+    body = _solve(spec, comm)
+    return {**body, "input": point_input(spec)}
+
+
+def _solve(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
     from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
     from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.eigen import EigenSolveError
@@ -360,13 +415,14 @@ def run_sweep(
     path = Path(out)
     error = None
     done: dict[int, dict[str, Any]] = {}
+    stale = 0
     if comm.rank == 0:
         try:
             path.parent.mkdir(parents=True, exist_ok=True)
-            done = _done_points(path, points)
+            done, stale = _done_points(path, points, [point_input(spec) for spec in specs])
         except (ValueError, OSError) as err:
             error = str(err)
-    error, done = comm.bcast((error, done), root=0)
+    error, done, stale = comm.bcast((error, done, stale), root=0)
     if error is not None:
         raise ValueError(error)
     todo = [k for k in range(len(points)) if k not in done]
@@ -378,6 +434,13 @@ def run_sweep(
         show = progress and comm.rank == 0
         if show and done:
             PROGRESS.info("sweep: %d of %d points already in %s", len(done), len(points), path)
+        if show and stale:
+            PROGRESS.info(
+                "sweep: %d line(s) of %s hold another input (the base file changed): "
+                "solving their points again",
+                stale,
+                path,
+            )
         bar = _tqdm(len(points), len(done), show)
         lines = Progress(
             "sweep", len(todo), interval=0.0, enabled=show and bar is None, logger=PROGRESS

@@ -36,6 +36,9 @@ def main() -> None:
 
     results.write_json = counting_json
     results.write_fields = counting_vtx
+    if comm.rank == 0:  # the folder of --json must exist
+        outdir.mkdir(parents=True, exist_ok=True)
+    comm.Barrier()
     status = cli_main(
         ["solve", *args, "--json", str(outdir / "result.json"), "--output", str(outdir / "vtx")]
     )

@@ -211,7 +211,9 @@ class VonKarmanPlate(MixedDofs, Owner):
         self._displacement_axis = displacement_axis(spec.plate, control)
 
         if mesh is None or facet_tags is None:
-            mesh, facet_tags, plate = build_plate_mesh(spec.plate, spec.mesh, comm)
+            mesh, facet_tags, plate = build_plate_mesh(
+                spec.plate, spec.mesh, comm, spec.all_obstacles
+            )
             self.plate = plate
         self.mesh, self.facet_tags = mesh, facet_tags
         msh = self.mesh

@@ -1,0 +1,408 @@
+"""A demanding user's command lines: nothing lost, nothing wrong, nothing outside its folder.
+
+Outputs that cannot be written are refused before anything is solved (and nothing is
+created that was not asked for); a bad PETSc option, Ctrl-C and an unreadable file give a
+message, not a traceback; a problem's name writes nowhere but the output folder; a
+mechanism, a tangent or tiny hole and a plate too thick for the plate model are refused
+naming their keys; an incomplete nonlinear path says what it validated.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import re
+import signal
+import subprocess
+import sys
+import time
+from importlib.metadata import PackageNotFoundError, version
+from pathlib import Path
+
+from mpi4py import MPI
+
+import pytest
+
+from unibuckle_fenicsx.checks import MAX_THICKNESS_RATIO, THICK_PLATE_RATIO
+from unibuckle_fenicsx.cli import (
+    EXIT_BAD_INPUT,
+    EXIT_INTERRUPTED,
+    EXIT_NOT_CERTIFIED,
+    EXIT_OK,
+    main,
+)
+from unibuckle_fenicsx.config import problem_from_dict
+from unibuckle_fenicsx.results import file_stem, versions
+
+SCRIPT = Path(sys.executable).parent / "unibuckle"
+serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs its own processes")
+
+SMALL = """\
+[plate]
+corners = [[0.0, 0.0], [0.2, 0.1]]
+thickness = 0.006
+[mesh]
+nx = 8
+ny = 4
+"""
+
+
+def run_script(*args: str, cwd: Path, **kwargs) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    return subprocess.run(
+        [str(SCRIPT), *args], capture_output=True, text=True, timeout=300, env=env, cwd=cwd,
+        **kwargs,
+    )  # fmt: skip
+
+
+# -- outputs -------------------------------------------------------------------------------
+def _output_cases(tmp: Path) -> list[tuple[list[str], str]]:
+    blocker = tmp / "a_file"
+    blocker.write_text("")
+    (tmp / "results.json").mkdir()
+    return [
+        (["--json", "/proc/nonexistent/o.json"], "--json: the folder /proc/nonexistent does not"),
+        (["--json", "/proc/o.json"], "--json: cannot create /proc/o.json"),
+        (["--output", "/proc/nope"], "--output: cannot create /proc/nope"),
+        (["--json", str(tmp / "missing" / "o.json")], f"the folder {tmp / 'missing'} does not"),
+        (["--output", str(tmp / "missing" / "vtx")], f"the folder {tmp / 'missing'} does not"),
+        (["--json", str(blocker / "o.json")], f"--json: {blocker} is not a directory"),
+        (["--output", str(blocker)], f"--output: {blocker} is not a directory"),
+        (["--json", str(tmp / "results.json")], "is a directory; give a file name"),
+    ]
+
+
+@pytest.mark.parametrize("command", ["solve", "nonlinear", "sweep"])
+def test_unwritable_outputs_are_refused_at_once(tmp_path, capsys, nothing_built, command):
+    """Exit 2 within a second, before anything is built, and no folder is created."""
+    config = tmp_path / "plate.toml"
+    config.write_text(SMALL)
+    before = sorted(tmp_path.rglob("*"))
+    for args, message in _output_cases(tmp_path):
+        if command != "solve" and args[0] == "--output":
+            continue
+        head = {
+            "solve": ["solve", "--case", "c1", "--nx", "320", "--ny", "160"],
+            "nonlinear": ["nonlinear", "--case", "c1"],
+            "sweep": ["sweep", "--config", str(config), "--vary", "plate.thickness=0.005,0.006"],
+        }[command]
+        t0 = time.perf_counter()
+        assert main([*head, *args]) == EXIT_BAD_INPUT, args
+        elapsed = time.perf_counter() - t0
+        err = capsys.readouterr().err
+        assert message in err and "Traceback" not in err, (args, err)
+        assert elapsed < 1.0, f"{args}: refused after {elapsed:.2f} s"
+    after = sorted(tmp_path.rglob("*"))
+    assert after == sorted({*before, tmp_path / "a_file", tmp_path / "results.json"})
+    assert not Path("/proc/nonexistent").exists()
+
+
+@serial
+def test_the_console_script_refuses_an_unwritable_json_in_under_a_second(tmp_path):
+    """The command of the report: 30 s of solving, then a traceback; now exit 2 at once."""
+    args = ["solve", "--case", "c1", "--nx", "320", "--ny", "160"]
+    for extra in (["--json", "/proc/nonexistent/o.json"], ["--output", "/proc/nope"]):
+        t0 = time.perf_counter()
+        proc = run_script(*args, *extra, cwd=tmp_path)
+        elapsed = time.perf_counter() - t0
+        assert proc.returncode == EXIT_BAD_INPUT, proc.stderr
+        assert proc.stderr.startswith(f"unibuckle: error: {extra[0]}: "), proc.stderr
+        assert "Traceback" not in proc.stderr
+        # The check runs before PETSc and DOLFINx are loaded: 0.4-0.8 s measured, most of
+        # it the interpreter's start (2-core machine shared with other jobs: a margin).
+        assert elapsed < 3.0, f"{extra}: {elapsed:.2f} s"
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_json_into_an_existing_folder_and_output_creating_one(tmp_path, capsys):
+    """What is allowed: --json in an existing folder, --output creating its own folder."""
+    out = tmp_path / "o.json"
+    vtx = tmp_path / "vtx"
+    args = ["solve", "--case", "free", "--nx", "8", "--ny", "4"]
+    assert main([*args, "--json", str(out), "--output", str(vtx)]) == EXIT_OK
+    assert json.loads(out.read_text())["method"] == "free"
+    names = {p.name for p in vtx.iterdir()}
+    assert {"free_w.bp", "free_theta.bp", "free.pvd"} <= names
+    assert all(name.startswith("free") for name in names), names
+    assert {p.name for p in tmp_path.iterdir()} == {"o.json", "vtx"}  # no probe left
+    capsys.readouterr()
+
+
+# -- PETSc options, Ctrl-C -------------------------------------------------------------------
+@serial
+@pytest.mark.parametrize(
+    ("option", "reason"),
+    [
+        (["-unibuckle_st_type", "nonsense"], "Unable to find requested ST type nonsense"),
+        (["-unibuckle_eps_tol", "abc"], "Input string abc has no numeric value"),
+    ],
+)
+def test_bad_petsc_option_exit_2(tmp_path, option, reason):
+    proc = run_script("solve", "--case", "c1", "--nx", "8", "--ny", "4", *option, cwd=tmp_path)
+    assert proc.returncode == EXIT_BAD_INPUT, proc.stderr
+    assert "Traceback" not in proc.stderr and proc.stdout == ""
+    assert "PETSc/SLEPc refused an option" in proc.stderr and reason in proc.stderr
+    assert " ".join(option) in proc.stderr
+
+
+@serial
+def test_ctrl_c_during_a_sweep(tmp_path):
+    """SIGINT: a one-line message, exit 130, the finished lines intact and resumable."""
+    base = tmp_path / "base.toml"
+    base.write_text(SMALL)
+    out = tmp_path / "k.jsonl"
+    vary = ["--vary", "plate.thickness=0.002:0.006:12"]
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    proc = subprocess.Popen(
+        [str(SCRIPT), "sweep", "--config", str(base), *vary, "--json", str(out), "-q"],
+        env=env, cwd=tmp_path, stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
+    )  # fmt: skip
+    deadline = time.monotonic() + 300
+    while not (out.exists() and out.read_text().count("\n") >= 1):
+        assert proc.poll() is None, "the sweep ended before it could be interrupted"
+        assert time.monotonic() < deadline
+        time.sleep(0.02)
+    proc.send_signal(signal.SIGINT)
+    _, stderr = proc.communicate(timeout=120)
+    assert proc.returncode == EXIT_INTERRUPTED, stderr
+    assert "Traceback" not in stderr and "KeyboardInterrupt" not in stderr, stderr
+    assert f"unibuckle: interrupted; the finished points are in {out}" in stderr
+    lines = out.read_text().splitlines()
+    assert 1 <= len(lines) < 12 and all(json.loads(line)["status"] == "ok" for line in lines)
+    again = run_script("sweep", "--config", str(base), *vary, "--json", str(out), cwd=tmp_path)
+    assert again.returncode == EXIT_OK, again.stderr
+    assert f"{len(lines)} of 12 points already in" in again.stderr
+
+
+# -- names ---------------------------------------------------------------------------------
+def test_file_stem():
+    assert file_stem("c1") == "c1"
+    assert file_stem("../../evil/x") == "___.._evil_x"
+    assert file_stem(".hidden") == "_hidden"
+    assert file_stem("plate 1/2 (steel)") == "plate_1_2__steel_"
+    assert file_stem("") == "plate"
+    for name in ("../../evil/x", "/etc/passwd", "..", "a/../../b", "C:\\x"):
+        assert "/" not in file_stem(name) and not file_stem(name).startswith(".")
+
+
+def test_a_name_writes_nowhere_but_the_output_folder(tmp_path, capsys):
+    config = tmp_path / "evil.toml"
+    config.write_text('name = "../../evil/x"\n' + SMALL)
+    work = tmp_path / "a" / "b"
+    work.mkdir(parents=True)
+    out = work / "out"
+    assert main(["solve", "--config", str(config), "--output", str(out)]) == EXIT_OK
+    assert "../../evil/x: lambda_c" in capsys.readouterr().out  # the label is kept
+    written = sorted(p.relative_to(tmp_path) for p in tmp_path.rglob("*") if p.is_file())
+    outside = [p for p in written if p.parts[:3] != ("a", "b", "out") and p.name != "evil.toml"]
+    assert outside == [], outside
+    assert (out / "___.._evil_x.pvd").is_file() and (out / "___.._evil_x_w.bp").is_dir()
+
+
+# -- refused problems: a mechanism, holes, thickness ----------------------------------------
+@pytest.mark.parametrize(
+    ("edges", "what"),
+    [
+        (
+            '[edges.left]\nsupport = "free"\nnormal_stress = -1.0\n'
+            '[edges.right]\nsupport = "free"\nnormal_stress = -1.0\n'
+            '[edges.bottom]\nsupport = "free"\n[edges.top]\nsupport = "free"\n',
+            "every boundary part is free",
+        ),
+        (
+            "[edges.left]\nnormal_stress = -1.0\n"
+            '[edges.right]\nsupport = "free"\nnormal_stress = -1.0\n'
+            '[edges.bottom]\nsupport = "free"\n[edges.top]\nsupport = "free"\n',
+            "the only support (edges.left.support = 'simply_supported') lies on one straight",
+        ),
+    ],
+)
+def test_a_mechanism_is_refused_naming_the_supports(tmp_path, capsys, nothing_built, edges, what):
+    """Every edge free (or a single simply supported one): exit 2, not exit 3 after a solve."""
+    config = tmp_path / "free.toml"
+    config.write_text(SMALL + edges)
+    assert main(["solve", "--config", str(config)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "edges.*.support" in err and what in err and "rigid body" in err, err
+
+
+def test_supports_that_hold_the_plate_are_accepted():
+    """Two supported edges, one clamped edge, or a bilateral foundation hold the plate."""
+    free = {"support": "free"}
+    loads = {"normal_stress": -1.0}
+    for edges, extra in (
+        ({"left": loads, "right": loads, "bottom": free, "top": free}, {}),
+        ({"left": {**loads, "support": "clamped"}, "right": {**free, **loads}}, {}),
+        (
+            {"left": {**free, **loads}, "right": {**free, **loads}, "bottom": free, "top": free},
+            {"obstacle": {"zone": "all", "side": "both", "foundation_stiffness": 1e9}},
+        ),
+    ):
+        problem_from_dict({"edges": edges, **extra})
+    with pytest.raises(ValueError, match=r"edges\.\*\.support: every boundary part is free"):
+        problem_from_dict(
+            {
+                "edges": {
+                    "left": {**free, **loads},
+                    "right": {**free, **loads},
+                    "bottom": free,
+                    "top": free,
+                },
+                "obstacle": {"zone": "all", "foundation_stiffness": 1e9},  # tensionless
+            }
+        )
+
+
+def _holed(center, radius, size=0.01):
+    return {
+        "plate": {
+            "corners": [[0.0, 0.0], [0.3, 0.1]],
+            "holes": [{"center": center, "radius": radius}],
+        },
+        "mesh": {"size": size},
+    }
+
+
+@pytest.mark.parametrize(
+    ("center", "radius", "match"),
+    [
+        # Tangent to the top edge y = 0.1; in floating point its distance exceeds r by 3e-18.
+        (
+            [0.1, 0.1 - 0.02],
+            0.02,
+            r"the gap between plate\.holes\[0\] and the plate's edge is .*touches",
+        ),
+        ([0.1, 0.05], 1e-7, r"plate\.holes\[0\]\.radius = 1e-07 m .* below mesh\.size / 100"),
+        ([0.1, 0.05], 0.04999, r"gap between plate\.holes\[0\] and the plate's edge .* mesh\.size"),
+    ],
+)
+def test_tangent_and_tiny_holes_are_refused_before_gmsh(nothing_built, center, radius, match):
+    with pytest.raises(ValueError, match=match):
+        problem_from_dict(_holed(center, radius))
+
+
+@serial
+def test_a_plate_gmsh_cannot_mesh_names_its_features():
+    """A ligament of mesh.size/50: allowed, but gmsh leaves triangles; the keys are named."""
+    pytest.importorskip("gmsh")
+    spec = problem_from_dict(_holed([0.1, 0.1 - 0.03 - 2e-4], 0.03))
+    from unibuckle_fenicsx.gmsh_mesh import gmsh_plate_mesh
+
+    with pytest.raises(ValueError) as err:
+        gmsh_plate_mesh(spec.plate, spec.mesh, MPI.COMM_SELF)
+    message = str(err.value)
+    assert "mesh.size = 0.01 m" in message
+    assert "the gap between plate.holes[0] and the plate's edge: 0.0002 m" in message
+    assert "Recombine" not in message, message
+
+
+def test_thickness_outside_the_plate_model(tmp_path, capsys, nothing_built):
+    """t/b = 100 is refused naming plate.thickness; t/b = 0.3 gets a warning."""
+    config = tmp_path / "thick.toml"
+    config.write_text(SMALL.replace("thickness = 0.006", "thickness = 10.0"))
+    assert main(["solve", "--config", str(config)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert "plate.thickness = 10 m is 100 times the plate's smaller side 0.1 m" in err, err
+    assert f"at most {MAX_THICKNESS_RATIO:g} times it" in err
+
+
+def test_moderately_thick_plate_gets_a_warning(tmp_path, capsys):
+    config = tmp_path / "thick.toml"
+    config.write_text(SMALL.replace("thickness = 0.006", "thickness = 0.03"))
+    out = tmp_path / "thick.json"
+    assert main(["solve", "--config", str(config), "--json", str(out)]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert "unibuckle: warning: plate.thickness = 0.03 m is 0.3 times" in err, err
+    assert f"up to t/b of about {THICK_PLATE_RATIO:g}" in err
+    assert "0.3 times" in json.loads(out.read_text())["details"]["plate_model"]
+
+
+# -- files and flags named ------------------------------------------------------------------
+def test_missing_config_names_the_option(tmp_path, capsys, nothing_built):
+    missing = tmp_path / "nowhere.toml"
+    sweep = ["sweep", "--vary", "plate.thickness=1,2", "--json", str(tmp_path / "k.jsonl")]
+    for head in (["solve"], ["nonlinear"], sweep):
+        assert main([*head, "--config", str(missing)]) == EXIT_BAD_INPUT
+        err = capsys.readouterr().err
+        assert f"--config {missing}: cannot read it (No such file or directory)" in err, err
+        assert "[Errno" not in err
+
+
+def test_sweep_file_that_is_not_a_sweep_is_refused_and_kept(tmp_path, capsys, nothing_built):
+    """Bytes that are not UTF-8, or another file: named, refused, left as they were."""
+    config = tmp_path / "base.toml"
+    config.write_text(SMALL)
+    vary = ["--vary", "plate.thickness=0.005,0.006"]
+    for name, data, why in (
+        ("binary.jsonl", b"\xff\xfe\x00garbage\n", "not UTF-8 text"),
+        ("notes.txt", b"my notes, not a sweep\n", "not JSON"),
+    ):
+        path = tmp_path / name
+        path.write_bytes(data)
+        assert main(["sweep", "--config", str(config), *vary, "--json", str(path)]) == 2
+        err = capsys.readouterr().err
+        assert f"--json {path}: line " in err and why in err, err
+        assert path.read_bytes() == data
+
+
+def test_nonlinear_unilateral_shape_without_obstacle_names_the_flags(capsys, nothing_built):
+    for args, why in (
+        (["--case", "free"], "the problem has none"),
+        (["--case", "c1", "--no-obstacle"], "--no-obstacle removes it"),
+    ):
+        assert main(["nonlinear", *args, "--shape", "unilateral"]) == EXIT_BAD_INPUT
+        err = capsys.readouterr().err
+        assert "--shape unilateral" in err and why in err and "obstacle = true" not in err, err
+
+
+def test_versions_name_every_library_that_took_part():
+    found = versions()
+    for dist in ("mpi4py", "gmsh", "cvxpy", "clarabel", "petsc4py", "fenics-dolfinx"):
+        try:
+            expected = version(dist)
+        except PackageNotFoundError:
+            assert dist not in found
+        else:
+            assert found[dist] == expected
+
+
+# -- an incomplete nonlinear path -----------------------------------------------------------
+def test_incomplete_path_says_what_it_validated(tmp_path, capsys, monkeypatch):
+    """SNES fails past the knee; both loads are read and the contact holds: say so."""
+    import unibuckle_fenicsx.nonlinear
+    from unibuckle_fenicsx.nonlinear import NonlinearResult
+
+    linear = 1.4316e7
+    result = NonlinearResult(
+        case="c1", mesh=[20, 20], dofs=1, obstacle=True, control="load", imperfection=1e-3,
+        imperfection_shape="unilateral", thickness_m=0.006, linear_critical_load_Pa=linear,
+        free_load_Pa=1.276e7, linear_method="active-set", southwell_load_Pa=linear * (1 + 1.5e-4),
+        southwell_points=5, inflection_load_Pa=linear * (1 - 2e-4), southwell_ratio=1 + 1.5e-4,
+        inflection_ratio=1 - 2e-4, completed=False,
+        path=[{"load_Pa": 1.05 * linear, "max_w_m": 1e-3, "contact_nodes": 9}],
+        stop_reason="SNES diverged at the smallest step (DIVERGED_LINE_SEARCH)",
+        rejected_steps=3, constrained_nodes=171, contact_check={"satisfied": True},
+        options={}, wall_time_s=1.0,
+    )  # fmt: skip
+
+    class Analysis:
+        def __init__(self):
+            self.result = result
+
+        def __enter__(self):
+            return self
+
+        def __exit__(self, *exc):
+            return None
+
+    monkeypatch.setattr(unibuckle_fenicsx.nonlinear, "solve_nonlinear", lambda *a: Analysis())
+    out = tmp_path / "nl.json"
+    assert main(["nonlinear", "--case", "c1", "--json", str(out)]) == EXIT_NOT_CERTIFIED
+    err = capsys.readouterr().err
+    validated, _, missing = err.partition("Not validated:")
+    assert re.search(r"Validated: the Southwell load 1\.431\d+e\+07 Pa \(\+1\.5e-04", validated)
+    assert "the inflection load" in validated and "(-2.0e-04 relative)" in validated
+    assert "the contact conditions at the last converged state" in validated
+    assert "the path from 1.05 to --max-load 1.2 x the linear load" in missing
+    assert "DIVERGED_LINE_SEARCH" in missing
+    assert json.loads(out.read_text())["completed"] is False

@@ -1,0 +1,249 @@
+"""Checks of a whole problem that no single key can make: supports, plate model, geometry.
+
+Run by :class:`~unibuckle_fenicsx.config.ProblemSpec` and
+:class:`~unibuckle_fenicsx.config.PlateSpec` when they are built, before any mesh: each
+raises ``ValueError`` naming the keys (or, for :func:`plate_model_note`, returns a
+warning). numpy only; the config types are imported where they are used (config imports
+this module).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.geometry import distance_to_polygon
+
+if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.config import PlateSpec, ProblemSpec
+
+__all__ = [
+    "FEATURE_RATIO",
+    "MAX_THICKNESS_RATIO",
+    "THICK_PLATE_RATIO",
+    "TOUCH_TOLERANCE",
+    "check_features",
+    "check_supports",
+    "check_thickness",
+    "plate_features",
+    "plate_model_note",
+]
+
+#: Above this thickness over the plate's smaller side, a warning: Reissner-Mindlin
+#: theory (transverse shear, plane sections, no thickness stretch) is the usual model of
+#: moderately thick plates up to t/b of about 0.2.
+THICK_PLATE_RATIO = 0.2
+#: Above this thickness over the plate's smaller side the body is not a plate: refused.
+MAX_THICKNESS_RATIO = 0.5
+#: Gmsh plates: a hole, a ligament or an outline segment shorter than mesh.size over
+#: this is refused (gmsh's quadrilaterals cannot be graded down to it reliably: a hole of
+#: radius 1e-4 m or a ligament of 2e-4 m at mesh.size = 0.01 m leave triangles).
+FEATURE_RATIO = 100.0
+#: Gaps below this times the plate's size are a contact (tangent holes, say): refused.
+TOUCH_TOLERANCE = 1e-9
+
+
+def _smaller_side(plate: PlateSpec) -> float:
+    return min(plate.length, plate.width)
+
+
+def check_thickness(plate: PlateSpec) -> None:
+    """Refuse a plate thicker than :data:`MAX_THICKNESS_RATIO` times its smaller side.
+
+    The sides are those of the rectangle or of the outline's bounding box (a gmsh file's
+    are known only once meshed: not checked).
+    """
+    if plate.file is not None:
+        return
+    b = _smaller_side(plate)
+    if plate.thickness > MAX_THICKNESS_RATIO * b:
+        raise ValueError(
+            f"plate.thickness = {plate.thickness:g} m is {plate.thickness / b:.3g} times the "
+            f"plate's smaller side {b:g} m: not a plate; plate.thickness must be at most "
+            f"{MAX_THICKNESS_RATIO:g} times it (Reissner-Mindlin theory is a model of plates "
+            f"up to t/b of about {THICK_PLATE_RATIO:g})"
+        )
+
+
+def plate_model_note(plate: PlateSpec) -> str | None:
+    """A warning when t/b exceeds :data:`THICK_PLATE_RATIO`, else None."""
+    if plate.file is not None:
+        return None
+    b = _smaller_side(plate)
+    ratio = plate.thickness / b
+    if ratio <= THICK_PLATE_RATIO:
+        return None
+    return (
+        f"plate.thickness = {plate.thickness:g} m is {ratio:.3g} times the plate's smaller "
+        f"side {b:g} m: Reissner-Mindlin theory (transverse shear, no thickness stretch) is "
+        f"a model of plates up to t/b of about {THICK_PLATE_RATIO:g}; beyond, compare with a "
+        "3-D solid model"
+    )
+
+
+def _collinear(points: npt.NDArray[np.float64], size: float) -> bool:
+    """Whether the points (n, 2) lie on one straight line (within 1e-9 of ``size``)."""
+    if len(points) < 3:
+        return True
+    d = points - points[0]
+    s = np.linalg.svd(d, compute_uv=False)
+    return bool(s.size < 2 or s[1] <= 1e-9 * size * math.sqrt(len(points)))
+
+
+def check_supports(spec: ProblemSpec) -> None:
+    """Refuse supports that leave a rigid-body motion of the deflection (a mechanism).
+
+    With no clamped edge, the supported boundary must not lie on one straight line
+    (a plate held on one line turns about it): every edge free, or a single simply
+    supported edge, is refused. A bilateral foundation (springs everywhere) holds the
+    plate, an obstacle or a tensionless foundation does not (the plate lifts off it).
+    An edge given by a facet tag of a user mesh is taken to hold the plate; for a gmsh
+    file only "every part free" is checked (its geometry is known once meshed).
+
+    Raises:
+        ValueError: Naming ``edges.*.support``.
+    """
+    from unibuckle_fenicsx.config import EDGE_NAMES, HOLES, Circle
+
+    plate = spec.plate
+    if spec.bilateral_foundations:
+        return
+    held = [e for e in plate.edges if e.support != "free"]
+    if any(e.support == "clamped" for e in held):
+        return
+    if held and (plate.file is not None or any(e.tag is not None for e in held)):
+        return  # a file's or a user mesh's parts: their geometry is known once meshed
+    size = max(plate.length, plate.width)
+    points: list[tuple[float, float]] = []
+    for e in held:
+        if e.name == HOLES and plate.holes:
+            if any(isinstance(h, Circle) for h in plate.holes):
+                return
+            points += [v for h in plate.holes for v in h.vertices]  # type: ignore[union-attr]
+        elif e.segments is not None and plate.outline is not None:
+            v = plate.outline
+            points += [v[k] for k in e.segments] + [v[(k + 1) % len(v)] for k in e.segments]
+        elif e.name in EDGE_NAMES:
+            (x0, y0), (x1, y1) = plate.corners
+            points += {
+                "left": [(x0, y0), (x0, y1)],
+                "right": [(x1, y0), (x1, y1)],
+                "bottom": [(x0, y0), (x1, y0)],
+                "top": [(x0, y1), (x1, y1)],
+            }[e.name]
+    if held and not _collinear(np.asarray(points, dtype=float), size):
+        return
+    if not held:
+        what = "every boundary part is free"
+    else:
+        names = ", ".join(f"edges.{e.name}.support = {e.support!r}" for e in held)
+        what = f"the only support ({names}) lies on one straight line"
+    raise ValueError(
+        f"edges.*.support: {what}: the plate can move as a rigid body (a mechanism, no "
+        "buckling load); support edges that are not all in line (e.g. simply_supported "
+        'on two opposite edges), clamp one, or add a bilateral foundation (side = "both")'
+    )
+
+
+def _polygon_gap(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> float:
+    """Distance between the boundaries of two disjoint polygons (vertex to segment)."""
+    return float(min(distance_to_polygon(a, b).min(), distance_to_polygon(b, a).min()))
+
+
+def _segment_lengths(v: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    return np.linalg.norm(np.roll(v, -1, axis=0) - v, axis=1)
+
+
+def _neck(v: npt.NDArray[np.float64]) -> float:
+    """Smallest distance of a vertex to a segment not adjacent to it (a narrow neck)."""
+    n = len(v)
+    best = math.inf
+    for k in range(n):
+        others = [j for j in range(n) if j not in (k, (k - 1) % n)]
+        for j in others:
+            seg = np.array([v[j], v[(j + 1) % n]])
+            d = float(distance_to_polygon(v[k : k + 1], seg)[0])
+            best = min(best, d)
+    return best
+
+
+def plate_features(plate: PlateSpec) -> list[tuple[float, str]]:
+    """The smallest lengths gmsh must resolve, each with the keys it comes from.
+
+    Hole diameters and shortest hole segments, the gaps between a hole and the plate's
+    edge and between two holes, the outline's shortest segment and narrowest neck.
+    Sorted, smallest first.
+    """
+    from unibuckle_fenicsx.config import Circle
+
+    outer = np.asarray(plate.boundary, dtype=float)
+    out: list[tuple[float, str]] = []
+    if plate.outline is not None:
+        k = int(np.argmin(_segment_lengths(outer)))
+        out.append((float(_segment_lengths(outer)[k]), f"plate.outline segment {k}"))
+        if len(outer) > 3:
+            out.append((_neck(outer), "plate.outline (its narrowest neck)"))
+    shapes: list[tuple[str, Circle | None, npt.NDArray[np.float64]]] = []
+    for k, hole in enumerate(plate.holes):
+        where = f"plate.holes[{k}]"
+        if isinstance(hole, Circle):
+            out.append((2.0 * hole.radius, f"{where}.radius = {hole.radius:g} m (its diameter)"))
+            gap = float(distance_to_polygon(np.array([hole.center]), outer)[0]) - hole.radius
+            shapes.append((where, hole, np.empty((0, 2))))
+        else:
+            v = np.asarray(hole.vertices, dtype=float)
+            j = int(np.argmin(_segment_lengths(v)))
+            out.append((float(_segment_lengths(v)[j]), f"{where}.outline segment {j}"))
+            gap = _polygon_gap(v, outer)
+            shapes.append((where, None, v))
+        out.append((gap, f"the gap between {where} and the plate's edge"))
+    for j in range(len(shapes)):
+        for k in range(j):
+            (wa, ca, va), (wb, cb, vb) = shapes[k], shapes[j]
+            if ca is not None and cb is not None:
+                gap = math.dist(ca.center, cb.center) - ca.radius - cb.radius
+            elif ca is not None or cb is not None:
+                circle = ca if ca is not None else cb
+                poly = vb if ca is not None else va
+                assert circle is not None
+                gap = float(distance_to_polygon(np.array([circle.center]), poly)[0])
+                gap -= circle.radius
+            else:
+                gap = _polygon_gap(va, vb)
+            out.append((gap, f"the gap between {wa} and {wb}"))
+    return sorted(out, key=lambda item: item[0])
+
+
+def check_features(plate: PlateSpec, mesh_size: float | None) -> None:
+    """Refuse holes that touch, and features gmsh cannot resolve at ``mesh_size``.
+
+    A gap below :data:`TOUCH_TOLERANCE` times the plate's size is a contact; with a mesh
+    size (a plate meshed here by gmsh), every length of :func:`plate_features` must be
+    at least ``mesh_size /`` :data:`FEATURE_RATIO`.
+
+    Raises:
+        ValueError: Naming the hole or outline, and ``mesh.size``.
+    """
+    if not plate.holes and plate.outline is None:
+        return
+    size = max(plate.length, plate.width)
+    features = plate_features(plate)
+    for length, what in features:
+        if what.startswith("the gap") and length <= TOUCH_TOLERANCE * size:
+            raise ValueError(
+                f"{what} is {length:.3g} m: the hole touches it; holes must lie inside the "
+                "plate without touching its edge or each other"
+            )
+    if mesh_size is None or plate.file is not None:
+        return
+    limit = mesh_size / FEATURE_RATIO
+    for length, what in features:
+        if length < limit:
+            raise ValueError(
+                f"{what} is {length:.3g} m, below mesh.size / {FEATURE_RATIO:g} = {limit:.3g} "
+                "m: gmsh cannot grade its quadrilaterals from mesh.size down to it; give a "
+                "smaller mesh.size or a larger feature"
+            )
