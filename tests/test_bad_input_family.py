@@ -1,16 +1,18 @@
 r"""The bad-input family: every key of the problem file given a bad value, and bad files.
 
-Three base problem files hold every key of the schema (README, "Problem files"): a
+Five base problem files hold every key of the schema (README, "Problem files"): a
 rectangle with an anisotropic material, every edge key, three obstacles (box, polygon,
 circle) and every solver key; a bilateral foundation; an outline with holes, segments
-and a cell size. Each of their values, and each number inside a list value, is replaced
-in turn by a value of the wrong type (a string, a boolean, a list, a table), by nan,
-inf or -inf, and by values out of its range (:data:`OUT_OF_RANGE`); the file is written
-as TOML and given to ``unibuckle solve --config``. Each must exit with status 2, before
-any mesh is built, with a message that names the file and the key (``material.E``,
-``obstacles[1].polygon``, ``plate.holes[0].radius``, ...) and no traceback. Then the
-files themselves: missing, a folder, not UTF-8, not TOML, a JSON result without a
-problem; and outputs that cannot be written.
+and a cell size; restrained edges, fixed and thermal loads, design output, point
+restraints and a gapped obstacle; a laminate. Each of their values, and each number
+inside a list value, is replaced in turn by a value of the wrong type (a string, a
+boolean, a list, a table), by nan, inf or -inf, and by values out of its range
+(:data:`OUT_OF_RANGE`); the file is written as TOML and given to ``unibuckle solve
+--config``. Each must exit with status 2, before any mesh is built, with a message that
+names the file and the key (``material.E``, ``obstacles[1].polygon``,
+``plate.holes[0].radius``, ...) and no traceback. Then the files themselves: missing, a
+folder, not UTF-8, not TOML, a JSON result without a problem; and outputs that cannot be
+written.
 
 The default run takes every :data:`SAMPLE_STEP`-th case; ``-m stress`` runs them all.
 """
@@ -30,7 +32,7 @@ from unibuckle_fenicsx.config import problem_from_dict
 
 SAMPLE_STEP = 8
 #: The family's size: keys (and numbers inside list values) and bad values in all.
-KEYS, VALUES = 128, 796
+KEYS, VALUES = 211, 1407
 
 _D = 1e9 * 0.006**3 / 12 / (1 - 0.09)
 _Q = [[1.0, 0.3, 0.0], [0.3, 1.0, 0.0], [0.0, 0.0, 0.35]]
@@ -101,8 +103,57 @@ OUTLINE = {
     "mesh": {"size": 0.02},
     "obstacle": {"zone": [[0.1, 0.15], [0.0, 0.1]], "side": "below"},
 }
-BASES = {"rectangle": RECTANGLE, "foundation": FOUNDATION, "outline": OUTLINE}
+_PLY = {"E1": 1.4e11, "E2": 1.0e10, "nu12": 0.3, "G12": 5.0e9, "G13": 5.0e9, "G23": 3.0e9}
+LAMINATE = {
+    "plate": {"corners": [[0.0, 0.0], [0.3, 0.1]]},
+    "material": {
+        "plies": [
+            {"thickness": 0.002, "angle": 0.0, **_PLY},
+            {"thickness": 0.002, "angle": 90.0, **_PLY},
+            {"thickness": 0.002, "angle": 0.0, **_PLY},
+        ],
+    },
+    "mesh": {"nx": 12, "ny": 4},
+}
+FEATURES = {
+    "plate": {"corners": [[0.0, 0.0], [0.3, 0.1]], "thickness": 0.006},
+    "material": {"E": 2.1e11, "nu": 0.3, "thermal_expansion": 1.2e-5},
+    "edges": {
+        "left": {
+            "support": "simply_supported",
+            "inplane": "clamped",
+            "normal_stress": -1.0,
+            "rotational_stiffness": 100.0,
+            "fixed_normal_stress": -0.5,
+        },
+        "right": {"support": "simply_supported", "inplane": "clamped", "normal_stress": -1.0},
+        "bottom": {
+            "support": "free",
+            "translational_stiffness": 1.0e6,
+            "fixed_shear_stress": 0.1,
+        },
+    },
+    "load": {"temperature": 1.0, "fixed_temperature": 0.5, "fixed_factor": 0.5},
+    "design": {"yield_stress": 3.55e8, "partial_factor": 1.1},
+    "points": [
+        {"at": [0.15, 0.05], "kind": "spring", "stiffness": 1.0e5},
+        {"spacing": [0.1, 0.05], "offset": [0.05, 0.0], "region": [[0.0, 0.3], [0.0, 0.1]]},
+        {"at": [0.2, 0.05], "kind": "one-sided", "side": "below"},
+    ],
+    "mesh": {"nx": 12, "ny": 4},
+    "obstacle": {"zone": "all", "side": "above", "gap": 1e-4},
+    "solver": {"bracket": True},
+}
+BASES = {
+    "rectangle": RECTANGLE,
+    "foundation": FOUNDATION,
+    "outline": OUTLINE,
+    "features": FEATURES,
+    "laminate": LAMINATE,
+}
 
+#: The arrays of tables ([[key]]): their entries are named key[k].
+TABLE_ARRAYS = ("obstacles", "holes", "points", "plies")
 #: Values out of range, by key (numbers of the right type); a pair (value, name) when the
 #: message rightly names another key (a hole too large for the plate: the hole).
 OUT_OF_RANGE: dict[str, list[Any]] = {
@@ -125,11 +176,25 @@ OUT_OF_RANGE: dict[str, list[Any]] = {
     "foundation_stiffness": [0.0, -1.0],
     "radius": [0.0, -0.02],
     "segments": [[7], [1, 1]],
+    "thermal_expansion": [-1.2e-5],
+    "E1": [0.0, -1.0],
+    "E2": [0.0],
+    "G12": [0.0],
+    "G13": [-1.0],
+    "G23": [0.0],
+    "nu12": [4.0],  # |nu12| < sqrt(E1/E2) = 3.74 for a positive definite ply
+    "rotational_stiffness": [-1.0],
+    "translational_stiffness": [-1.0],
+    "yield_stress": [0.0, -1.0],
+    "partial_factor": [0.0],
+    "stiffness": [0.0, -1.0],
+    "spacing": [[0.0, 0.05], [-0.1, 0.05]],
+    "gap": [-1e-4],
 }
 #: Keys whose value is a choice, and values not among the choices.
-CHOICES = {"support", "inplane", "side", "method", "shear", "units"}
+CHOICES = {"support", "inplane", "side", "method", "shear", "units", "kind"}
 #: Keys that are booleans.
-BOOLEANS = {"complete", "until_proven", "certify"}
+BOOLEANS = {"complete", "until_proven", "certify", "bracket"}
 
 
 def _name(path: tuple) -> str:
@@ -137,7 +202,7 @@ def _name(path: tuple) -> str:
     out = ""
     for k, part in enumerate(path):
         if isinstance(part, int):
-            if path[k - 1] in ("obstacles", "holes"):
+            if path[k - 1] in TABLE_ARRAYS:
                 out += f"[{part}]"
                 continue
             break  # an entry of a list value: the key is named
@@ -150,7 +215,7 @@ def _leaves(node: Any, path: tuple = ()):
     if isinstance(node, dict):
         for key, value in node.items():
             yield from _leaves(value, (*path, key))
-    elif isinstance(node, list) and path[-1] in ("obstacles", "holes"):
+    elif isinstance(node, list) and path[-1] in TABLE_ARRAYS:
         for k, value in enumerate(node):
             yield from _leaves(value, (*path, k))
     else:
@@ -189,9 +254,11 @@ def _bad_values(path: tuple, value: Any) -> list[tuple[Any, str]]:
             # either).
             if not isinstance(value, list):
                 bad.append([1.0])
-            elif not key.endswith("_stress"):
+            elif not key.endswith("_stress") and key != "spacing":  # a number is one too
                 bad.append(1.0)
-            bad += OUT_OF_RANGE.get(key, [])
+            # A ply 10 m thick: the stack's thickness is refused (plate.thickness), or its
+            # symmetry; the ply's own range is > 0.
+            bad += [v for v in OUT_OF_RANGE.get(key, []) if "plies" not in path or v != 10.0]
     cases = [(v, name) for v in bad]
     if key == "radius" and "holes" in path:
         cases.append((1.0, name.removesuffix(".radius")))  # the hole leaves the plate
@@ -254,7 +321,7 @@ def _is_table(key: str, value: Any) -> bool:
     """A table ([key]), or an array of tables ([[key]]); else an inline value."""
     if isinstance(value, dict):
         return True
-    return key in ("obstacles", "holes") and isinstance(value, list) and bool(value)
+    return key in TABLE_ARRAYS and isinstance(value, list) and bool(value)
 
 
 CASES = _cases()
@@ -299,7 +366,17 @@ def test_every_key_is_in_the_family():
     """The bases hold every key of the schema (a new key must join them); the counts."""
     from dataclasses import fields
 
-    from unibuckle_fenicsx.config import OBSTACLE_KEYS, Material, MeshSpec, SolverSpec
+    from unibuckle_fenicsx.config import (
+        OBSTACLE_KEYS,
+        PLY_KEYS,
+        DesignSpec,
+        EdgeSpec,
+        LoadSpec,
+        Material,
+        MeshSpec,
+        PointSpec,
+        SolverSpec,
+    )
 
     covered = {
         tuple(p for p in path if isinstance(p, str))[-2:]
@@ -310,15 +387,24 @@ def test_every_key_is_in_the_family():
     wanted = {("name",), ("units",)}
     wanted |= {("plate", k) for k in ("corners", "thickness", "outline")}
     wanted |= {("holes", k) for k in ("center", "radius", "outline")}
-    wanted |= {("material", f.name) for f in fields(Material)}
+    wanted |= {("material", f.name) for f in fields(Material) if f.name != "plies"}
     wanted |= {(e, k) for e in ("left", "right", "ends") for k in ("support",)}
     wanted |= {("left", k) for k in ("inplane", "normal_stress", "shear_stress")}
     wanted |= {("ends", "segments")}
     wanted |= {("mesh", f.name) for f in fields(MeshSpec)}
     wanted |= {("solver", f.name) for f in fields(SolverSpec)}
+    wanted |= {("load", f.name) for f in fields(LoadSpec)}
+    wanted |= {("design", f.name) for f in fields(DesignSpec)}
+    wanted |= {("points", f.name) for f in fields(PointSpec)}
+    wanted |= {("plies", k) for k in PLY_KEYS}
+    edge_keys = {f.name for f in fields(EdgeSpec)} - {"name", "tag", "segments"}
+    edge_names = {"left", "right", "bottom", "top", "ends", "sides"}
+    missing_edge_keys = edge_keys - {k for e, *k in covered if e in edge_names for k in k}
+    assert not missing_edge_keys, missing_edge_keys
     keys = set(OBSTACLE_KEYS) - {"circle"} | {"center", "radius"}
     obstacle_keys = {k for path, _ in _leaves(RECTANGLE) if "obstacles" in path for k in path}
-    obstacle_keys |= set(FOUNDATION["obstacle"]) | set(OUTLINE["obstacle"])
+    for base in (FOUNDATION, OUTLINE, FEATURES):
+        obstacle_keys |= set(base["obstacle"])
     assert keys <= obstacle_keys, keys - obstacle_keys
     missing = wanted - covered
     assert not missing, missing
