@@ -18,8 +18,11 @@ With ``--cli`` it also times what a user waits: ``unibuckle solve`` on the plate
 ``unibuckle solve`` on the same plate without obstacle (whole processes, start-up and
 JIT cache included).
 
+With ``--bracket`` the certificate also runs the low-rank verified bracket
+(``solver.bracket``; off by default: it costs tens of free solves on these plates).
+
 Usage: python bench/bench_plates.py [--meshes 90x30,180x60] [--cases ssss,cs,sc,cccc,shear]
-[--cli] [--json FILE]
+[--cli] [--bracket] [--json FILE]
 """
 
 from __future__ import annotations
@@ -102,6 +105,9 @@ def main() -> None:
     parser.add_argument("--cases", default=",".join(CASES))
     parser.add_argument("--cli", action="store_true", help="also time whole CLI processes")
     parser.add_argument("--json", help="append one JSON line per row to this file")
+    parser.add_argument(
+        "--bracket", action="store_true", help="also run the low-rank bracket (solver.bracket)"
+    )
     args, _ = parser.parse_known_args()
     comm = MPI.COMM_WORLD
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
@@ -116,6 +122,8 @@ def main() -> None:
     for nx, ny in meshes:
         for name in args.cases.split(","):
             spec = _spec(name, nx, ny)
+            if args.bracket:
+                spec = spec.with_solver(bracket=True)
             with solve(spec, comm) as analysis:
                 r, sol, cert = analysis.result, analysis.solution, analysis.certificate
                 assert sol is not None and cert is not None
@@ -130,6 +138,7 @@ def main() -> None:
                 )
                 row = {
                     "case": name,
+                    "bracket": args.bracket,
                     "edges": CASES[name][2],
                     "mesh": f"{nx}x{ny}",
                     "i": r.constrained_nodes,

@@ -17,6 +17,7 @@ from __future__ import annotations
 
 import logging
 from dataclasses import dataclass
+from typing import Any
 
 from mpi4py import MPI
 
@@ -60,10 +61,22 @@ DIRECT_LU: dict[str, str | bool] = {
 }
 
 
+def material_constant(value: Any, expr: ufl.core.expr.Expr) -> dolfinx.fem.Constant:
+    """``value`` as a :class:`dolfinx.fem.Constant` on the mesh of ``expr``.
+
+    Material and load numbers enter the forms as constants, not as literals: the
+    generated code is then the same for every thickness, material and edge stress, and
+    a sweep compiles its forms once (a literal would make each new plate a JIT compile
+    of several seconds).
+    """
+    domain = ufl.domain.extract_unique_domain(expr)
+    return dolfinx.fem.Constant(domain, np.asarray(value, dtype=dolfinx.default_scalar_type))
+
+
 def voigt_to_ufl(C: npt.NDArray[np.float64], eps: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
     """Apply a 3x3 Voigt stiffness to a symmetric 2x2 UFL tensor, returning a tensor."""
     e = ufl.as_vector([eps[0, 0], eps[1, 1], 2.0 * eps[0, 1]])
-    s = ufl.as_matrix(C.tolist()) * e
+    s = material_constant(C, eps) * e
     return ufl.as_matrix([[s[0], s[2]], [s[2], s[1]]])
 
 
@@ -95,12 +108,16 @@ def edge_traction(
     n = ufl.FacetNormal(msh)
     s = ufl.as_vector([-n[1], n[0]])
     if edge.uniform:
-        return edge.normal_ends[0] * n + edge.shear_ends[0] * s
+        sigma, tau = (material_constant(ends[0], n) for ends in (edge.normal_ends, edge.shear_ends))
+        return sigma * n + tau * s
     start, end = edge_line(msh, facet_tags, plate, edge, tag)
     d = end - start
     x = ufl.SpatialCoordinate(msh)
-    xi = ufl.dot(x - ufl.as_vector(start.tolist()), ufl.as_vector(d.tolist())) / float(d @ d)
-    (n0, n1), (s0, s1) = edge.normal_ends, edge.shear_ends
+    P, Q = material_constant(start, x), material_constant(d / float(d @ d), x)
+    xi = ufl.dot(x - P, Q)
+    (n0, n1), (s0, s1) = (
+        material_constant(ends, n) for ends in (edge.normal_ends, edge.shear_ends)
+    )
     return (n0 + (n1 - n0) * xi) * n + (s0 + (s1 - s0) * xi) * s
 
 
@@ -189,8 +206,9 @@ def thermal_force(
     if not (T0 or gx or gy):
         return None
     x = ufl.SpatialCoordinate(msh)
-    rise = T0 + gx * x[0] + gy * x[1]
-    strain = material.thermal_expansion * rise * ufl.Identity(2)
+    field = material_constant([T0, gx, gy], x)
+    rise = field[0] + field[1] * x[0] + field[2] * x[1]
+    strain = material_constant(material.thermal_expansion, x) * rise * ufl.Identity(2)
     return voigt_to_ufl(membrane_voigt(material, thickness), strain)
 
 
@@ -244,8 +262,9 @@ def solve_prestress(
     ds = ufl.Measure("ds", domain=msh, subdomain_data=facet_tags)
 
     a = ufl.inner(membrane_force(u, material, t), ufl.sym(ufl.grad(v))) * ufl.dx
+    thickness = material_constant(t, v)
     terms = [
-        t * ufl.dot(edge_traction(msh, facet_tags, plate, e, tag), v) * ds(tag)
+        thickness * ufl.dot(edge_traction(msh, facet_tags, plate, e, tag), v) * ds(tag)
         for e in loaded
         for tag in edge_tags(plate, e)
     ]

@@ -20,7 +20,7 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.prestress import voigt_to_ufl
+from unibuckle_fenicsx.prestress import material_constant, voigt_to_ufl
 
 __all__ = [
     "bending_form",
@@ -54,9 +54,8 @@ def shear_force(
     gamma: ufl.core.expr.Expr, shear_stiffness: float | npt.NDArray[np.float64]
 ) -> ufl.core.expr.Expr:
     r""":math:`Q = \kappa_s G t\, \gamma`, or :math:`H\gamma` with a 2x2 H (N/m)."""
-    if isinstance(shear_stiffness, np.ndarray):
-        return ufl.dot(ufl.as_matrix(shear_stiffness.tolist()), gamma)
-    return shear_stiffness * gamma
+    H = material_constant(shear_stiffness, gamma)
+    return ufl.dot(H, gamma) if isinstance(shear_stiffness, np.ndarray) else H * gamma
 
 
 def bending_form(u: ufl.Argument, v: ufl.Argument, D_voigt: npt.NDArray[np.float64]) -> ufl.Form:

@@ -25,7 +25,7 @@ from unibuckle_fenicsx.plate.spaces import (
     mitc_shear_operator,
 )
 from unibuckle_fenicsx.points import point_bcs, point_springs, snap_points
-from unibuckle_fenicsx.prestress import Prestress
+from unibuckle_fenicsx.prestress import Prestress, material_constant
 
 __all__ = ["PlateModel", "edge_spring_form", "edge_support_bcs", "mitc_shear_matrix"]
 
@@ -93,7 +93,8 @@ class PlateModel(MixedDofs, Owner):
         if springs is not None:
             a = a + springs
         if fixed_prestress is not None:  # A - B_fixed: the fixed load's geometric stiffness
-            a = a - fixed_factor * geometric_form(u, v, fixed_prestress.N0)
+            factor = material_constant(fixed_factor, u)
+            a = a - factor * geometric_form(u, v, fixed_prestress.N0)
         if shear == "full":
             a = a + shear_form(u, v, ks)
         elif shear != "mitc":
@@ -247,8 +248,8 @@ def edge_spring_form(
     for e in sprung:
         for tag in edge_tags(plate, e):
             term = (
-                e.rotational_stiffness * ufl.dot(theta, n) * ufl.dot(eta, n)
-                + e.translational_stiffness * w * z
+                material_constant(e.rotational_stiffness, n) * ufl.dot(theta, n) * ufl.dot(eta, n)
+                + material_constant(e.translational_stiffness, n) * w * z
             ) * ds(tag)
             form = term if form is None else form + term
     return form
@@ -287,9 +288,7 @@ def mitc_shear_matrix(
     Vs = create_shear_space(W.mesh)
     g, d = ufl.TrialFunction(Vs), ufl.TestFunction(Vs)
     # A laminate's 2x2 H, or the scalar kappa_s G t.
-    energy = (
-        ufl.inner(shear_force(g, ks), d) if isinstance(ks, np.ndarray) else ks * ufl.inner(g, d)
-    )
+    energy = ufl.inner(shear_force(g, ks), d)
     Ms = dolfinx.fem.petsc.assemble_matrix(dolfinx.fem.form(energy * ufl.dx))
     Ms.assemble()
     P = mitc_shear_operator(W, Vs, w_sub=w_sub, theta_sub=theta_sub)
