@@ -122,7 +122,7 @@ class ChainOptions:
     polish_iterations: int = 25
     quick_polish_iterations: int = 5
     descent_steps: int = 50
-    descent_budget: int = 10
+    descent_budget: int = 1
     max_iterations: int = 100
     bound_budget: int = 64
 
