@@ -648,7 +648,12 @@ def _sdp(
         notes.append(
             f"{neg} pencil eigenvalues lie below the load: the rank-2 certificate does not "
             f"apply, and the full SDP route is limited to i <= {opts.sdp_max_constrained} "
-            f"constrained nodes (here {i}): the low-rank route runs"
+            f"constrained nodes (here {i})"
+            + (
+                ": the low-rank route runs"
+                if opts.lowrank is not None
+                else ": the low-rank bracket runs on request (solver.bracket = true, --bracket)"
+            )
         )
         return {"too_large": True}
     try:
