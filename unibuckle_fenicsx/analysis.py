@@ -20,6 +20,7 @@ from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
 from unibuckle_fenicsx.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.problem import BucklingProblem
 from unibuckle_fenicsx.results import BucklingResult
 
@@ -45,7 +46,7 @@ def choose_method(
     options = spec.solver
     if spec.tensionless:
         if candidate_parallel:
-            raise ValueError(
+            raise InputError(
                 "--candidate-parallel splits the enumeration's candidate sets; a tensionless "
                 "foundation is solved by its spring-set iteration: drop --candidate-parallel"
             )
@@ -56,12 +57,12 @@ def choose_method(
     estimate = math.inf if i > 1000 else count * solve_time_s
     if candidate_parallel:
         if options.method not in ("auto", "enumerate"):
-            raise ValueError(
+            raise InputError(
                 f"--candidate-parallel splits the enumeration's candidate sets: it needs "
                 f'method "enumerate" or "auto", not {options.method!r}'
             )
         if count > options.max_candidates:
-            raise ValueError(
+            raise InputError(
                 f"--candidate-parallel runs the enumeration, but i = {i} constrained nodes "
                 f"give 2^{i} = {shown} candidate sets, above max_candidates = "
                 f"{options.max_candidates}: drop --candidate-parallel (the active-set "
@@ -130,7 +131,7 @@ def _run_method(
         from unibuckle_fenicsx.algorithms.foundation import solve_foundation
 
         return solve_foundation(problem, max_iterations=problem.spec.solver.max_iterations)
-    raise ValueError(f"unknown method {method!r}")
+    raise InputError(f"unknown method {method!r}")
 
 
 @dataclass
@@ -200,7 +201,7 @@ def solve(
     """
     t0 = time.perf_counter()
     if mesh is not None and candidate_parallel:
-        raise ValueError("candidate_parallel builds its own serial meshes: pass no mesh")
+        raise InputError("candidate_parallel builds its own serial meshes: pass no mesh")
     problem = BucklingProblem(
         spec,
         MPI.COMM_SELF if candidate_parallel else comm,

@@ -21,6 +21,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from unibuckle_fenicsx.config import METHODS
+from unibuckle_fenicsx.errors import InputError
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.config import ProblemSpec
@@ -723,7 +724,7 @@ def _load_config(path: str, load: Any) -> Any:
     try:
         return load(path)
     except OSError as err:
-        raise ValueError(f"--config {path}: cannot read it ({err.strerror or err})") from None
+        raise InputError(f"--config {path}: cannot read it ({err.strerror or err})") from None
 
 
 #: Option names of the nonlinear analysis that are also command-line flags.

@@ -26,6 +26,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.checks import check_features, check_supports, check_thickness
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import (
     circle_points,
     distance_to_polygon,
@@ -91,22 +92,22 @@ Predicate = Callable[[npt.NDArray[np.float64]], npt.NDArray[np.bool_]]
 def _number(name: str, value: Any) -> float:
     """``value`` as a finite float; a string, a boolean or NaN/inf is refused."""
     if isinstance(value, bool) or not isinstance(value, int | float | np.integer | np.floating):
-        raise ValueError(f"{name} must be a number, got {value!r} ({type(value).__name__})")
+        raise InputError(f"{name} must be a number, got {value!r} ({type(value).__name__})")
     value = float(value)
     if not math.isfinite(value):
-        raise ValueError(f"{name} must be a finite number, got {value!r}")
+        raise InputError(f"{name} must be a finite number, got {value!r}")
     return value
 
 
 def _integer(name: str, value: Any, minimum: int) -> int:
     if isinstance(value, bool) or not isinstance(value, int | np.integer) or value < minimum:
-        raise ValueError(f"{name} must be an integer >= {minimum}, got {value!r}")
+        raise InputError(f"{name} must be an integer >= {minimum}, got {value!r}")
     return int(value)
 
 
 def _boolean(name: str, value: Any) -> bool:
     if not isinstance(value, bool | np.bool_):
-        raise ValueError(f"{name} must be true or false, got {value!r} ({type(value).__name__})")
+        raise InputError(f"{name} must be true or false, got {value!r} ({type(value).__name__})")
     return bool(value)
 
 
@@ -114,7 +115,7 @@ def _stress(name: str, value: Any) -> float | tuple[float, float]:
     """An edge stress: a number, or a pair ``[start, end]`` of numbers (linear along the edge)."""
     if isinstance(value, list | tuple):
         if len(value) != 2:
-            raise ValueError(
+            raise InputError(
                 f"{name} must be a number or a pair [start, end] (linear along the edge), "
                 f"got {value!r}"
             )
@@ -131,7 +132,7 @@ def stress_ends(value: float | tuple[float, float]) -> tuple[float, float]:
 
 def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
     if not isinstance(value, str) or value not in choices:
-        raise ValueError(f"{name} must be one of {choices}, got {value!r}")
+        raise InputError(f"{name} must be one of {choices}, got {value!r}")
     return value
 
 
@@ -165,12 +166,12 @@ class Ply:
             value = _number(f"material.plies.{name}", getattr(self, name))
             if not value > 0.0:
                 unit = "m" if name == "thickness" else "Pa"
-                raise ValueError(f"material.plies.{name} must be > 0 {unit}, got {value!r}")
+                raise InputError(f"material.plies.{name} must be > 0 {unit}, got {value!r}")
             object.__setattr__(self, name, value)
         for name in ("angle", "nu12"):
             object.__setattr__(self, name, _number(f"material.plies.{name}", getattr(self, name)))
         if not abs(self.nu12) < math.sqrt(self.E1 / self.E2):
-            raise ValueError(
+            raise InputError(
                 f"material.plies.nu12 must satisfy |nu12| < sqrt(E1/E2) = "
                 f"{math.sqrt(self.E1 / self.E2):.4g} (a positive definite ply), got {self.nu12!r}"
             )
@@ -216,13 +217,13 @@ class Material:
     def from_plies(cls, plies: Any, shear_correction: float = 5.0 / 6.0) -> Material:
         """The laminate of ``plies`` (bottom first), E and nu its in-plane constants."""
         if not isinstance(plies, list | tuple) or not plies:
-            raise ValueError(
+            raise InputError(
                 "material.plies must be a list of tables ([[material.plies]] in TOML), at "
                 f"least one, got {plies!r}"
             )
         for k, ply in enumerate(plies):
             if not isinstance(ply, Ply):
-                raise ValueError(f"material.plies[{k}] must be a Ply, got {ply!r}")
+                raise InputError(f"material.plies[{k}] must be a Ply, got {ply!r}")
         E, nu = laminate(plies).engineering_constants()
         return cls(E=E, nu=nu, shear_correction=shear_correction, plies=tuple(plies))
 
@@ -230,10 +231,10 @@ class Material:
         object.__setattr__(self, "plies", tuple(self.plies))
         alpha = _number("material.thermal_expansion", self.thermal_expansion)
         if not alpha >= 0.0:
-            raise ValueError(f"material.thermal_expansion must be >= 0 1/K, got {alpha!r}")
+            raise InputError(f"material.thermal_expansion must be >= 0 1/K, got {alpha!r}")
         object.__setattr__(self, "thermal_expansion", alpha)
         if alpha and self.plies:
-            raise ValueError(
+            raise InputError(
                 "material.thermal_expansion: a laminate's plies expand differently (their "
                 "own coefficients along and across the fibres), which is not modelled; a "
                 "thermal load needs an isotropic material or Voigt matrices"
@@ -242,13 +243,13 @@ class Material:
             self._check_laminate()
             return
         if not _number("material.E", self.E) > 0.0:
-            raise ValueError(f"material.E (Young's modulus) must be > 0 Pa, got {self.E!r}")
+            raise InputError(f"material.E (Young's modulus) must be > 0 Pa, got {self.E!r}")
         if not -1.0 < _number("material.nu", self.nu) < 0.5:
-            raise ValueError(
+            raise InputError(
                 f"material.nu (Poisson's ratio) must lie in (-1, 0.5), got {self.nu!r}"
             )
         if not _number("material.shear_correction", self.shear_correction) > 0.0:
-            raise ValueError(
+            raise InputError(
                 f"material.shear_correction must be > 0, got {self.shear_correction!r}"
             )
         for name in ("membrane_voigt", "bending_voigt"):
@@ -260,13 +261,13 @@ class Material:
                     [[_number(f"material.{name}", c) for c in row] for row in value], dtype=float
                 )
             except TypeError:
-                raise ValueError(f"material.{name} must be a 3x3 matrix, got {value!r}") from None
+                raise InputError(f"material.{name} must be a 3x3 matrix, got {value!r}") from None
             if mat.shape != (3, 3):
-                raise ValueError(f"material.{name} must be a finite 3x3 matrix, got {value!r}")
+                raise InputError(f"material.{name} must be a finite 3x3 matrix, got {value!r}")
             if not np.allclose(mat, mat.T, rtol=1e-12, atol=0.0):
-                raise ValueError(f"material.{name} must be symmetric")
+                raise InputError(f"material.{name} must be symmetric")
             if np.linalg.eigvalsh(mat).min() <= 0.0:
-                raise ValueError(f"material.{name} must be positive definite")
+                raise InputError(f"material.{name} must be positive definite")
             object.__setattr__(self, name, tuple(tuple(float(c) for c in row) for row in mat))
         for name in ("E", "nu", "shear_correction"):
             object.__setattr__(self, name, float(getattr(self, name)))
@@ -274,17 +275,17 @@ class Material:
     def _check_laminate(self) -> None:
         """A symmetric stack of plies; E and nu its in-plane constants."""
         if self.membrane_voigt is not None or self.bending_voigt is not None:
-            raise ValueError(
+            raise InputError(
                 "material.plies: a laminate's stiffness comes from its plies; give plies, or "
                 "membrane_voigt and bending_voigt, not both"
             )
         if not _number("material.shear_correction", self.shear_correction) > 0.0:
-            raise ValueError(
+            raise InputError(
                 f"material.shear_correction must be > 0, got {self.shear_correction!r}"
             )
         stack = laminate(self.plies, self.shear_correction)
         if stack.coupling > 1e-10:
-            raise ValueError(
+            raise InputError(
                 "material.plies: the stack is not symmetric about its mid-plane (bending-"
                 f"membrane coupling: largest |B_ij| = {np.abs(stack.B).max():.4g} N, "
                 f"{stack.coupling:.2g} of max|A_ij| t); unsymmetric laminates bend under "
@@ -293,7 +294,7 @@ class Material:
             )
         E, nu = stack.engineering_constants()
         if not (math.isclose(self.E, E, rel_tol=1e-9) and math.isclose(self.nu, nu, rel_tol=1e-9)):
-            raise ValueError(
+            raise InputError(
                 f"material.E and material.nu of a laminate are its in-plane constants E_x = "
                 f"{E:.6g} Pa and nu_xy = {nu:.6g} from the plies (got {self.E!r}, {self.nu!r}): "
                 "leave them out (Material.from_plies)"
@@ -312,12 +313,12 @@ class Circle:
         try:
             cx, cy = self.center
         except (TypeError, ValueError):
-            raise ValueError(f"circle.center must be [x, y], got {self.center!r}") from None
+            raise InputError(f"circle.center must be [x, y], got {self.center!r}") from None
         object.__setattr__(
             self, "center", (_number("circle.center", cx), _number("circle.center", cy))
         )
         if not _number("circle.radius", self.radius) > 0.0:
-            raise ValueError(f"circle.radius must be > 0 m, got {self.radius!r}")
+            raise InputError(f"circle.radius must be > 0 m, got {self.radius!r}")
         object.__setattr__(self, "radius", float(self.radius))
 
 
@@ -334,20 +335,20 @@ class Polygon:
 def _polygon(name: str, value: Any) -> tuple[tuple[float, float], ...]:
     """A simple polygon of at least three vertices [[x, y], ...] with a non-zero area."""
     if not isinstance(value, list | tuple) or len(value) < 3:
-        raise ValueError(f"{name} must be a list of at least 3 points [[x, y], ...], got {value!r}")
+        raise InputError(f"{name} must be a list of at least 3 points [[x, y], ...], got {value!r}")
     vertices = []
     for point in value:
         if not isinstance(point, list | tuple) or len(point) != 2:
-            raise ValueError(f"{name}: each vertex must be a point [x, y], got {point!r}")
+            raise InputError(f"{name}: each vertex must be a point [x, y], got {point!r}")
         vertices.append((_number(name, point[0]), _number(name, point[1])))
     if not is_simple(vertices):
-        raise ValueError(
+        raise InputError(
             f"{name} must be a simple polygon (no repeated vertex, no self-intersection), "
             f"got {value!r}"
         )
     size = float(np.ptp(np.asarray(vertices), axis=0).max())
     if abs(polygon_area(vertices)) <= 1e-12 * size * size:
-        raise ValueError(f"{name} has no area (collinear vertices), got {value!r}")
+        raise InputError(f"{name} has no area (collinear vertices), got {value!r}")
     return tuple(vertices)
 
 
@@ -400,7 +401,7 @@ class EdgeSpec:
     def __post_init__(self) -> None:
         where = f"edges.{self.name}"
         if not isinstance(self.name, str) or not self.name:
-            raise ValueError(f"edge names must be non-empty strings, got {self.name!r}")
+            raise InputError(f"edge names must be non-empty strings, got {self.name!r}")
         _choice(f"{where}.support", self.support, BENDING_SUPPORTS)
         _choice(f"{where}.inplane", self.inplane, INPLANE_SUPPORTS)
         for name in ("normal_stress", "shear_stress", "fixed_normal_stress", "fixed_shear_stress"):
@@ -409,13 +410,13 @@ class EdgeSpec:
             _integer(f"{where}.tag", self.tag, 0)
         if self.segments is not None:
             if not isinstance(self.segments, list | tuple) or not self.segments:
-                raise ValueError(
+                raise InputError(
                     f"{where}.segments must be a non-empty list of outline segment numbers "
                     f"[k, ...], got {self.segments!r}"
                 )
             segments = tuple(_integer(f"{where}.segments", k, 0) for k in self.segments)
             if len(set(segments)) != len(segments):
-                raise ValueError(f"{where}.segments repeats a segment: {list(segments)}")
+                raise InputError(f"{where}.segments repeats a segment: {list(segments)}")
             object.__setattr__(self, "segments", segments)
         self._check_springs(where)
 
@@ -423,18 +424,18 @@ class EdgeSpec:
         """The edge springs: finite, >= 0, on DOFs the support leaves free."""
         for name in ("rotational_stiffness", "translational_stiffness"):
             if not _number(f"{where}.{name}", getattr(self, name)) >= 0.0:
-                raise ValueError(
+                raise InputError(
                     f"{where}.{name} must be >= 0 (0: no spring), got {getattr(self, name)!r}"
                 )
             object.__setattr__(self, name, float(getattr(self, name)))
         if self.rotational_stiffness > 0.0 and self.support == "clamped":
-            raise ValueError(
+            raise InputError(
                 f'{where}.rotational_stiffness: support = "clamped" fixes the rotation '
                 "already; a rotational spring needs a support that leaves it free "
                 '("simply_supported", "simply_supported_soft" or "free")'
             )
         if self.translational_stiffness > 0.0 and self.support != "free":
-            raise ValueError(
+            raise InputError(
                 f'{where}.translational_stiffness: support = "{self.support}" fixes the '
                 'deflection already; an elastically supported edge has support = "free"'
             )
@@ -528,7 +529,7 @@ class PlateSpec:
 
     def __post_init__(self) -> None:
         if not _number("plate.thickness", self.thickness) > 0.0:
-            raise ValueError(f"plate.thickness must be > 0 m, got {self.thickness!r}")
+            raise InputError(f"plate.thickness must be > 0 m, got {self.thickness!r}")
         object.__setattr__(self, "thickness", float(self.thickness))
         if self.outline is not None:
             outline = _polygon("plate.outline", self.outline)
@@ -541,7 +542,7 @@ class PlateSpec:
         try:
             (x0, y0), (x1, y1) = self.corners
         except (TypeError, ValueError):
-            raise ValueError(
+            raise InputError(
                 f"plate.corners must be [[x0, y0], [x1, y1]], got {self.corners!r}"
             ) from None
         corners = (
@@ -550,14 +551,14 @@ class PlateSpec:
         )
         object.__setattr__(self, "corners", corners)
         if not (corners[1][0] > corners[0][0] and corners[1][1] > corners[0][1]):
-            raise ValueError(
+            raise InputError(
                 "plate.corners must satisfy x1 > x0 and y1 > y0 (a non-degenerate "
                 f"rectangle), got {self.corners!r}"
             )
         object.__setattr__(self, "edges", tuple(self.edges))
         names = [e.name for e in self.edges]
         if len(set(names)) != len(names):
-            raise ValueError(f"plate.edges: duplicate edge names {names}")
+            raise InputError(f"plate.edges: duplicate edge names {names}")
         self._check_file()
         self._check_holes()
         self._check_edges()
@@ -570,11 +571,11 @@ class PlateSpec:
             ".geo",
             ".msh",
         ):
-            raise ValueError(f"plate.file must be a gmsh .geo or .msh file, got {self.file!r}")
+            raise InputError(f"plate.file must be a gmsh .geo or .msh file, got {self.file!r}")
         if self.outline is not None or self.holes:
-            raise ValueError("plate.file: give a file, or an outline and holes, not both")
+            raise InputError("plate.file: give a file, or an outline and holes, not both")
         if not Path(self.file).is_file():
-            raise ValueError(f"plate.file: no such file {self.file!r}")
+            raise InputError(f"plate.file: no such file {self.file!r}")
 
     def _check_holes(self) -> None:
         holes = tuple(self.holes)
@@ -591,12 +592,12 @@ class PlateSpec:
             elif isinstance(hole, Polygon):
                 inside = polygon_inside(hole.vertices, outer)
             else:
-                raise ValueError(f"{where} must be a Circle or a Polygon, got {hole!r}")
+                raise InputError(f"{where} must be a Circle or a Polygon, got {hole!r}")
             if not inside:
-                raise ValueError(f"{where} must lie inside the plate, without touching its edge")
+                raise InputError(f"{where} must lie inside the plate, without touching its edge")
             for j in range(k):
                 if not _disjoint(holes[j], hole):
-                    raise ValueError(f"plate.holes[{j}] and {where} overlap or touch")
+                    raise InputError(f"plate.holes[{j}] and {where} overlap or touch")
         check_features(self, None)  # touching within rounding (a tangent hole)
 
     def _check_edges(self) -> None:
@@ -606,34 +607,34 @@ class PlateSpec:
             where = f"edges.{e.name}"
             if e.name == HOLES and e.tag is None:
                 if not self.holes:
-                    raise ValueError(f"{where}: the plate has no holes (plate.holes)")
+                    raise InputError(f"{where}: the plate has no holes (plate.holes)")
                 if e.segments is not None:
-                    raise ValueError(f"{where}: the holes' boundary takes no segments")
+                    raise InputError(f"{where}: the holes' boundary takes no segments")
                 if not e.uniform:
-                    raise ValueError(
+                    raise InputError(
                         f"{where}: a linear [start, end] stress needs a straight edge; give "
                         "the holes a number"
                     )
                 continue
             if e.segments is not None:
                 if self.outline is None:
-                    raise ValueError(
+                    raise InputError(
                         f"{where}.segments names segments of plate.outline, which this "
                         "plate does not have"
                     )
                 for k in e.segments:
                     if k >= count:
-                        raise ValueError(
+                        raise InputError(
                             f"{where}.segments: {k} is not a segment of the outline (0 to "
                             f"{count - 1}: segment k runs from vertex k to vertex k + 1)"
                         )
                     if k in used:
-                        raise ValueError(
+                        raise InputError(
                             f"{where}.segments: segment {k} is already in edges.{used[k]}"
                         )
                     used[k] = e.name
             elif self.outline is not None and e.tag is None:
-                raise ValueError(
+                raise InputError(
                     f"{where}: a plate given by its outline names its boundary parts by "
                     f"segments = [k, ...] (outline segments 0 to {count - 1}), or "
                     f"{HOLES!r} for the holes"
@@ -729,14 +730,14 @@ class MeshSpec:
             object.__setattr__(self, name, _integer(f"mesh.{name}", getattr(self, name), 2))
         if self.size is not None:
             if not _number("mesh.size", self.size) > 0.0:
-                raise ValueError(f"mesh.size must be > 0 m, got {self.size!r}")
+                raise InputError(f"mesh.size must be > 0 m, got {self.size!r}")
             object.__setattr__(self, "size", float(self.size))
 
     @staticmethod
     def cells_for(length: float, width: float, size: float) -> tuple[int, int]:
         """Cells (nx, ny) of side at most ``size`` on a ``length`` x ``width`` plate (>= 2)."""
         if not _number("mesh.size", size) > 0.0:
-            raise ValueError(f"mesh.size must be > 0 m, got {size!r}")
+            raise InputError(f"mesh.size must be > 0 m, got {size!r}")
         # 1e-9: a size that divides the side exactly gives that many cells, not one more.
         return tuple(  # type: ignore[return-value]
             max(2, math.ceil(side / size * (1.0 - 1e-9))) for side in (length, width)
@@ -778,10 +779,10 @@ def _box(name: str, value: Any) -> Box:
     try:
         (x0, x1), (y0, y1) = value
     except (TypeError, ValueError):
-        raise ValueError(f"{name} must be [[xmin, xmax], [ymin, ymax]], got {value!r}") from None
+        raise InputError(f"{name} must be [[xmin, xmax], [ymin, ymax]], got {value!r}") from None
     box = ((_number(name, x0), _number(name, x1)), (_number(name, y0), _number(name, y1)))
     if box[0][0] > box[0][1] or box[1][0] > box[1][1]:
-        raise ValueError(f"{name} needs xmin <= xmax and ymin <= ymax, got {value!r}")
+        raise InputError(f"{name} needs xmin <= xmax and ymin <= ymax, got {value!r}")
     return box
 
 
@@ -822,7 +823,7 @@ class ObstacleSpec:
     def __post_init__(self) -> None:
         if isinstance(self.zone, str):
             if self.zone != "all":
-                raise ValueError(
+                raise InputError(
                     f'obstacle.zone must be "all", [[xmin, xmax], [ymin, ymax]] or a '
                     f"callable, got {self.zone!r}"
                 )
@@ -831,16 +832,16 @@ class ObstacleSpec:
         elif not callable(self.zone):
             object.__setattr__(self, "zone", _box("obstacle.zone", self.zone))
         if self.tolerance is not None and not _number("obstacle.tolerance", self.tolerance) >= 0:
-            raise ValueError(f"obstacle.tolerance must be >= 0 m, got {self.tolerance!r}")
+            raise InputError(f"obstacle.tolerance must be >= 0 m, got {self.tolerance!r}")
         if self.foundation_stiffness is not None:
             if not _number("obstacle.foundation_stiffness", self.foundation_stiffness) > 0.0:
-                raise ValueError(
+                raise InputError(
                     "obstacle.foundation_stiffness (Winkler modulus) must be > 0 N/m^3, got "
                     f"{self.foundation_stiffness!r}; leave it out for a rigid obstacle"
                 )
             object.__setattr__(self, "foundation_stiffness", float(self.foundation_stiffness))
         if self.side == "both" and self.foundation_stiffness is None:
-            raise ValueError(
+            raise InputError(
                 'obstacle.side = "both": a rigid obstacle on both sides of the plate is a '
                 "bilateral support (w = 0 in the zone), not an obstacle; give an edge its "
                 '[edges.NAME] support (e.g. support = "simply_supported"), or one side '
@@ -849,9 +850,9 @@ class ObstacleSpec:
         _choice("obstacle.side", self.side, SIDES)
         gap = _number("obstacle.gap", self.gap)
         if not gap >= 0.0:
-            raise ValueError(f"obstacle.gap must be >= 0 m, got {gap!r}")
+            raise InputError(f"obstacle.gap must be >= 0 m, got {gap!r}")
         if gap and self.foundation_stiffness is not None:
-            raise ValueError(
+            raise InputError(
                 "obstacle.gap: a gap is modelled for rigid obstacles only, not for a "
                 "foundation (foundation_stiffness)"
             )
@@ -914,7 +915,7 @@ def _temperature(name: str, value: Any) -> Temperature:
     """A temperature rise: a number (K), or [T0, dT/dx, dT/dy] (K, K/m) for a linear field."""
     if isinstance(value, list | tuple):
         if len(value) != 3:
-            raise ValueError(
+            raise InputError(
                 f"{name} must be a number (a uniform rise, K) or [T0, dT/dx, dT/dy] (the "
                 f"linear field T0 + dT/dx x + dT/dy y, K and K/m), got {value!r}"
             )
@@ -986,7 +987,7 @@ class DesignSpec:
         for name, unit in (("yield_stress", " Pa"), ("partial_factor", "")):
             value = _number(f"design.{name}", getattr(self, name))
             if not value > 0.0:
-                raise ValueError(f"design.{name} must be > 0{unit}, got {value!r}")
+                raise InputError(f"design.{name} must be > 0{unit}, got {value!r}")
             object.__setattr__(self, name, value)
 
 
@@ -997,7 +998,7 @@ POINT_KINDS = ("bilateral", "one-sided", "spring")
 def _pair(name: str, value: Any) -> tuple[float, float]:
     """A pair [a, b] of finite numbers."""
     if not isinstance(value, list | tuple) or len(value) != 2:
-        raise ValueError(f"{name} must be a pair [x, y] of numbers, got {value!r}")
+        raise InputError(f"{name} must be a pair [x, y] of numbers, got {value!r}")
     return (_number(name, value[0]), _number(name, value[1]))
 
 
@@ -1033,7 +1034,7 @@ class PointSpec:
         where = "points"
         _choice(f"{where}.kind", self.kind, POINT_KINDS)
         if (self.at is None) == (self.spacing is None):
-            raise ValueError(
+            raise InputError(
                 "[[points]] needs at = [x, y] (one point) or spacing = s or [sx, sy] (a "
                 "grid, with optional offset and region): exactly one of them"
             )
@@ -1041,14 +1042,14 @@ class PointSpec:
             object.__setattr__(self, "at", _pair(f"{where}.at", self.at))
             for name in ("offset", "region"):
                 if getattr(self, name) is not None:
-                    raise ValueError(f"{where}.{name} belongs to a grid (spacing), not to at")
+                    raise InputError(f"{where}.{name} belongs to a grid (spacing), not to at")
         else:
             spacing: Any = self.spacing
             if not isinstance(spacing, list | tuple):
                 spacing = (spacing, spacing)
             pair = _pair(f"{where}.spacing", spacing)
             if min(pair) <= 0.0:
-                raise ValueError(f"{where}.spacing must be > 0 m, got {self.spacing!r}")
+                raise InputError(f"{where}.spacing must be > 0 m, got {self.spacing!r}")
             object.__setattr__(self, "spacing", pair)
             if self.offset is not None:
                 object.__setattr__(self, "offset", _pair(f"{where}.offset", self.offset))
@@ -1056,16 +1057,16 @@ class PointSpec:
                 object.__setattr__(self, "region", _box(f"{where}.region", self.region))
         if self.kind == "spring":
             if self.stiffness is None or not _number(f"{where}.stiffness", self.stiffness) > 0:
-                raise ValueError(
+                raise InputError(
                     f'{where}.stiffness: kind = "spring" needs a stiffness > 0 N/m, got '
                     f"{self.stiffness!r}"
                 )
             object.__setattr__(self, "stiffness", float(self.stiffness))
         elif self.stiffness is not None:
-            raise ValueError(f'{where}.stiffness belongs to kind = "spring", not "{self.kind}"')
+            raise InputError(f'{where}.stiffness belongs to kind = "spring", not "{self.kind}"')
         _choice(f"{where}.side", self.side, ("above", "below"))
         if self.side != "above" and self.kind != "one-sided":
-            raise ValueError(f'{where}.side belongs to kind = "one-sided", not "{self.kind}"')
+            raise InputError(f'{where}.side belongs to kind = "one-sided", not "{self.kind}"')
 
     @property
     def sign(self) -> float:
@@ -1091,7 +1092,7 @@ class PointSpec:
                 first = math.ceil((lo - start - tol) / step)
                 last = math.floor((hi - start + tol) / step)
                 if last - first > 100_000:
-                    raise ValueError(
+                    raise InputError(
                         f"points.spacing {self.spacing} gives more than 100000 points per row"
                     )
                 axes.append(start + step * np.arange(first, last + 1))
@@ -1099,10 +1100,10 @@ class PointSpec:
             points = np.column_stack([gx.ravel(), gy.ravel()])
         inside = plate.contains(points, tol) if plate.file is None else np.ones(len(points), bool)
         if self.at is not None and not inside.all():
-            raise ValueError(f"points.at {list(self.at)} lies outside the plate (or in a hole)")
+            raise InputError(f"points.at {list(self.at)} lies outside the plate (or in a hole)")
         points = points[inside]
         if not len(points):
-            raise ValueError(
+            raise InputError(
                 f"points: the grid of spacing {list(self.spacing or ())} holds no point of "
                 "the plate; check spacing, offset and region"
             )
@@ -1175,15 +1176,15 @@ class SolverSpec:
         _choice("solver.method", self.method, METHODS)
         _choice("solver.shear", self.shear, ("mitc", "full"))
         if not 0.0 < _number("solver.tau", self.tau) <= 1e-2:
-            raise ValueError(f"solver.tau must lie in (0, 1e-2], got {self.tau!r}")
+            raise InputError(f"solver.tau must lie in (0, 1e-2], got {self.tau!r}")
         if not 0.0 < _number("solver.eps_tol", self.eps_tol) <= 1e-4:
-            raise ValueError(f"solver.eps_tol must lie in (0, 1e-4], got {self.eps_tol!r}")
+            raise InputError(f"solver.eps_tol must lie in (0, 1e-4], got {self.eps_tol!r}")
         if not _number("solver.enumeration_budget_s", self.enumeration_budget_s) > 0.0:
-            raise ValueError(
+            raise InputError(
                 f"solver.enumeration_budget_s must be > 0 s, got {self.enumeration_budget_s!r}"
             )
         if not _number("solver.penalty", self.penalty) > 0.0:
-            raise ValueError(f"solver.penalty must be > 0, got {self.penalty!r}")
+            raise InputError(f"solver.penalty must be > 0, got {self.penalty!r}")
         for name, minimum in (
             ("max_candidates", 1),
             ("max_iterations", 1),
@@ -1231,29 +1232,29 @@ class ProblemSpec:
 
     def __post_init__(self) -> None:
         if not isinstance(self.name, str):
-            raise ValueError(f"name must be a string, got {self.name!r}")
+            raise InputError(f"name must be a string, got {self.name!r}")
         _choice("units", self.units, tuple(UNITS))
         object.__setattr__(self, "obstacles", tuple(self.obstacles))
         plate = self.plate
         if plate.meshed_by_gmsh and self.mesh.size is None:
             if plate.file is None:
-                raise ValueError(
+                raise InputError(
                     "mesh.size: a plate meshed by gmsh (outline or holes) needs [mesh] size = "
                     "h, the characteristic cell size (m)"
                 )
         if plate.file is not None and plate.file.lower().endswith(".msh") and self.mesh.size:
-            raise ValueError("mesh.size: a .msh file is meshed already; leave size out")
+            raise InputError("mesh.size: a .msh file is meshed already; leave size out")
         if plate.meshed_by_gmsh:
             check_features(plate, self.mesh.size)
         if self.obstacle is not None and self.obstacles:
-            raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
+            raise InputError("give one [obstacle] table or several [[obstacles]] tables, not both")
         for k, o in enumerate(self.obstacles):
             if not isinstance(o, ObstacleSpec):
-                raise ValueError(f"obstacles[{k}] must be an ObstacleSpec, got {o!r}")
+                raise InputError(f"obstacles[{k}] must be an ObstacleSpec, got {o!r}")
         if self.material.plies:
             total = sum(ply.thickness for ply in self.material.plies)
             if not math.isclose(plate.thickness, total, rel_tol=1e-9):
-                raise ValueError(
+                raise InputError(
                     f"plate.thickness = {plate.thickness!r} m differs from the plies' total "
                     f"{total!r} m"
                 )
@@ -1262,30 +1263,30 @@ class ProblemSpec:
         object.__setattr__(self, "points", tuple(self.points))
         for k, point in enumerate(self.points):
             if not isinstance(point, PointSpec):
-                raise ValueError(f"points[{k}] must be a PointSpec, got {point!r}")
+                raise InputError(f"points[{k}] must be a PointSpec, got {point!r}")
             if plate.file is not None:
                 continue  # the plate's extent is known once the file is meshed
             try:
                 point.locations(plate)
             except ValueError as err:
-                raise ValueError(f"points[{k}]{str(err)[len('points') :]}") from None
+                raise InputError(f"points[{k}]{str(err)[len('points') :]}") from None
         found = self.all_obstacles
         check_supports(self)
         kinds = {o.kind for o in found}
         if self.one_sided_points and "tensionless" in kinds:
-            raise ValueError(
+            raise InputError(
                 'points: one-sided points (kind = "one-sided") join a rigid obstacle\'s cone; '
                 'with a tensionless foundation give them a stiffness (kind = "spring") or '
                 "make the foundation rigid"
             )
         if {"rigid", "tensionless"} <= kinds:
-            raise ValueError(
+            raise InputError(
                 "rigid obstacles and tensionless foundations in one problem are not "
                 "supported: give every one-sided obstacle a foundation_stiffness, or none "
                 '(a bilateral foundation, side = "both", goes with either)'
             )
         if "tensionless" in kinds and self.solver.method != "auto":
-            raise ValueError(
+            raise InputError(
                 f'solver.method = "{self.solver.method}": a tensionless foundation is solved '
                 'by its own spring-set iteration; use method = "auto"'
             )
@@ -1298,11 +1299,11 @@ class ProblemSpec:
                     continue
                 label = f"{self.obstacle_label(j)} and {self.obstacle_label(k)}"
                 if first.kind == second.kind == "tensionless":
-                    raise ValueError(
+                    raise InputError(
                         f"{label} give the same foundation zone on both sides of the plate: "
                         'write it once with side = "both" (a bilateral foundation)'
                     )
-                raise ValueError(
+                raise InputError(
                     f"{label} give the same zone on both sides of the plate: that is a "
                     "bilateral support (w = 0 there), not an obstacle; give an edge its "
                     '[edges.NAME] support (e.g. support = "simply_supported"), or keep one '
@@ -1314,13 +1315,13 @@ class ProblemSpec:
         load = self.load
         if (load.thermal or load.fixed_thermal) and not self.material.thermal_expansion:
             which = "load.temperature" if load.thermal else "load.fixed_temperature"
-            raise ValueError(
+            raise InputError(
                 f"{which}: a temperature rise needs [material] thermal_expansion > 0 (1/K)"
             )
         held = any(e.inplane != "free" for e in self.plate.edges)
         for name, on in (("temperature", load.thermal), ("fixed_temperature", load.fixed_thermal)):
             if on and not held:
-                raise ValueError(
+                raise InputError(
                     f"load.{name}: the temperature rise leaves the plate stress-free (a "
                     "uniform or linear rise expands a plate free in its plane without "
                     'stress): hold an edge in its plane (inplane = "clamped" or "roller")'
@@ -1331,13 +1332,13 @@ class ProblemSpec:
         if self.design is None:
             return
         if not isinstance(self.design, DesignSpec):
-            raise ValueError(f"design must be a DesignSpec, got {self.design!r}")
+            raise InputError(f"design must be a DesignSpec, got {self.design!r}")
         compressed = any(
             min(*stress_ends(e.normal_stress), *stress_ends(e.fixed_normal_stress)) < 0.0
             for e in self.plate.edges
         )
         if not compressed:
-            raise ValueError(
+            raise InputError(
                 "design: the EN 1993-1-5 output takes sigma_cr as a compressive normal edge "
                 "stress, and this load has none (give a loaded edge normal_stress < 0)"
             )
@@ -1345,7 +1346,7 @@ class ProblemSpec:
     def check_scaled_load(self) -> None:
         """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""
         if not self.load.thermal and not any(e.loaded for e in self.plate.edges):
-            raise ValueError(
+            raise InputError(
                 "no load to scale: give an edge a non-zero normal_stress or shear_stress (per "
                 "unit load), or [load] temperature (a rise per unit load factor)"
                 + (
@@ -1405,7 +1406,7 @@ class ProblemSpec:
     def with_mesh(self, nx: int, ny: int) -> ProblemSpec:
         """Copy with another mesh resolution (the structured rectangle only)."""
         if self.plate.meshed_by_gmsh:
-            raise ValueError(
+            raise InputError(
                 "nx, ny (--nx, --ny) set the structured rectangle's cells; a plate meshed by "
                 "gmsh takes [mesh] size = h"
             )
@@ -1424,10 +1425,10 @@ class ProblemSpec:
 
 def _take(table: Mapping[str, Any], allowed: tuple[str, ...], where: str) -> dict[str, Any]:
     if not isinstance(table, Mapping):
-        raise ValueError(f"[{where}] must be a table, got {table!r}")
+        raise InputError(f"[{where}] must be a table, got {table!r}")
     unknown = sorted(set(table) - set(allowed))
     if unknown:
-        raise ValueError(f"unknown key(s) {unknown} in [{where}]; allowed: {list(allowed)}")
+        raise InputError(f"unknown key(s) {unknown} in [{where}]; allowed: {list(allowed)}")
     return dict(table)
 
 
@@ -1589,7 +1590,7 @@ OBSTACLE_KEYS = ("zone", "polygon", "circle", "side", "foundation_stiffness", "t
 def _holes(tables: Any) -> tuple[Circle | Polygon, ...]:
     """``[[plate.holes]]`` tables: center and radius (a circle) or outline (a polygon)."""
     if not isinstance(tables, list):
-        raise ValueError(f"plate.holes must be a list of tables ([[plate.holes]]), got {tables!r}")
+        raise InputError(f"plate.holes must be a list of tables ([[plate.holes]]), got {tables!r}")
     holes: list[Circle | Polygon] = []
     for k, table in enumerate(tables):
         where = f"plate.holes[{k}]"
@@ -1601,9 +1602,9 @@ def _holes(tables: Any) -> tuple[Circle | Polygon, ...]:
                 holes.append(Circle(kw["center"], kw["radius"]))
             except ValueError as err:
                 # Circle's messages name circle.center/radius; the file's keys are these.
-                raise ValueError(f"{where}.{str(err).removeprefix('circle.')}") from None
+                raise InputError(f"{where}.{str(err).removeprefix('circle.')}") from None
         else:
-            raise ValueError(
+            raise InputError(
                 f"[{where}] needs center = [x, y] and radius = r (a circle), or outline = "
                 f"[[x, y], ...] (a polygon); got {sorted(kw)}"
             )
@@ -1615,7 +1616,7 @@ def _obstacle_from_table(table: Any, where: str) -> ObstacleSpec:
     kw = _take(table, OBSTACLE_KEYS, where)
     given = [key for key in ("zone", "polygon", "circle") if key in kw]
     if len(given) != 1:
-        raise ValueError(
+        raise InputError(
             f'[{where}] needs zone = "all" (the whole plate) or [[xmin, xmax], [ymin, ymax]], '
             "or polygon = [[x, y], ...], or circle = {center = [x, y], radius = r}: exactly "
             f"one of them; got {given or 'none'}"
@@ -1626,7 +1627,7 @@ def _obstacle_from_table(table: Any, where: str) -> ObstacleSpec:
         elif "circle" in kw:
             circle = _take(kw.pop("circle"), ("center", "radius"), f"{where}.circle")
             if set(circle) != {"center", "radius"}:
-                raise ValueError(f"{where}.circle needs center = [x, y] and radius = r")
+                raise InputError(f"{where}.circle needs center = [x, y] and radius = r")
             kw["zone"] = Circle(**circle)
         return ObstacleSpec(**kw)
     except ValueError as err:
@@ -1635,7 +1636,7 @@ def _obstacle_from_table(table: Any, where: str) -> ObstacleSpec:
             message = where + message[len("obstacle") :]
         elif message.startswith("circle."):
             message = f"{where}.{message}"
-        raise ValueError(message) from None
+        raise InputError(message) from None
 
 
 def _plate_table(plate: PlateSpec) -> dict[str, Any]:
@@ -1667,7 +1668,7 @@ def _obstacle_table(obstacle: ObstacleSpec) -> dict[str, Any]:
     elif isinstance(zone, Circle):
         out["circle"] = {"center": list(zone.center), "radius": zone.radius}
     elif callable(zone):
-        raise ValueError("problem_to_dict: a predicate obstacle zone cannot be written")
+        raise InputError("problem_to_dict: a predicate obstacle zone cannot be written")
     else:
         out["zone"] = zone if isinstance(zone, str) else [list(z) for z in zone]
     out["side"] = obstacle.side
@@ -1721,7 +1722,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     )
     gmsh_plate = any(key in plate_kw for key in ("outline", "file"))
     if gmsh_plate and "corners" in plate_kw:
-        raise ValueError(
+        raise InputError(
             "[plate]: give corners (a rectangle), or outline (a polygon) or file (a gmsh "
             "file), not both"
         )
@@ -1763,20 +1764,20 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         if "thickness" not in plate_kw:
             plate = replace(plate, thickness=total)
         elif not math.isclose(plate.thickness, total, rel_tol=1e-9):
-            raise ValueError(
+            raise InputError(
                 f"plate.thickness = {plate.thickness!r} m differs from the plies' total "
                 f"{total!r} m: leave plate.thickness out for a laminate (it is the plies')"
             )
     mesh_kw = _take(top.get("mesh", {}), _names(MeshSpec), "mesh")
     if plate.meshed_by_gmsh:
         if "nx" in mesh_kw or "ny" in mesh_kw:
-            raise ValueError(
+            raise InputError(
                 "[mesh]: a plate meshed by gmsh (outline, holes or file) takes size = h (the "
                 "characteristic cell size), not nx and ny"
             )
     elif "size" in mesh_kw:
         if "nx" in mesh_kw or "ny" in mesh_kw:
-            raise ValueError("[mesh]: give size (a cell size) or nx and ny, not both")
+            raise InputError("[mesh]: give size (a cell size) or nx and ny, not both")
         mesh_kw["nx"], mesh_kw["ny"] = MeshSpec.cells_for(
             plate.length, plate.width, mesh_kw["size"]
         )
@@ -1788,12 +1789,12 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     if "obstacles" in top:
         tables = top["obstacles"]
         if not isinstance(tables, list) or not tables:
-            raise ValueError(
+            raise InputError(
                 "obstacles must be a list of tables ([[obstacles]] in TOML), at least one, "
                 f"got {tables!r}"
             )
         if obstacle is not None:
-            raise ValueError("give one [obstacle] table or several [[obstacles]] tables, not both")
+            raise InputError("give one [obstacle] table or several [[obstacles]] tables, not both")
         obstacles = [_obstacle_from_table(t, f"obstacles[{k}]") for k, t in enumerate(tables)]
     points = _points(top["points"]) if "points" in top else ()
     load = LoadSpec(**_take(top.get("load", {}), _names(LoadSpec), "load"))
@@ -1801,12 +1802,12 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     if "design" in top:
         design_kw = _take(top["design"], _names(DesignSpec), "design")
         if "yield_stress" not in design_kw:
-            raise ValueError("[design] needs yield_stress (f_y)")
+            raise InputError("[design] needs yield_stress (f_y)")
         design = DesignSpec(**design_kw)
     solver = SolverSpec(**_take(top.get("solver", {}), _names(SolverSpec), "solver"))
     label = top.get("name", name)
     if not isinstance(label, str):
-        raise ValueError(f"name must be a string, got {label!r}")
+        raise InputError(f"name must be a string, got {label!r}")
     return ProblemSpec(
         name=label,
         plate=plate,
@@ -1832,17 +1833,17 @@ def _material(table: Any) -> Material:
     if "plies" not in kw:
         for key in ("E", "nu"):
             if key not in kw:
-                raise ValueError(f"[material] needs {key!r} (or [[material.plies]])")
+                raise InputError(f"[material] needs {key!r} (or [[material.plies]])")
         return Material(**kw)
     other = sorted(set(kw) - {"plies", "shear_correction", "thermal_expansion"})
     if other:
-        raise ValueError(
+        raise InputError(
             f"[material] with plies takes shear_correction only besides them, not {other}: "
             "a laminate's stiffness (and its E_x, nu_xy) comes from its plies"
         )
     tables = kw.pop("plies")
     if not isinstance(tables, list) or not tables:
-        raise ValueError(
+        raise InputError(
             "material.plies must be a list of tables ([[material.plies]] in TOML), at least "
             f"one, got {tables!r}"
         )
@@ -1852,11 +1853,11 @@ def _material(table: Any) -> Material:
         ply_kw = _take(ply, PLY_KEYS, where)
         missing = [key for key in PLY_KEYS if key not in ply_kw]
         if missing:
-            raise ValueError(f"[{where}] needs {missing} (keys: {list(PLY_KEYS)})")
+            raise InputError(f"[{where}] needs {missing} (keys: {list(PLY_KEYS)})")
         try:
             plies.append(Ply(**ply_kw))
         except ValueError as err:
-            raise ValueError(str(err).replace("material.plies.", f"{where}.")) from None
+            raise InputError(str(err).replace("material.plies.", f"{where}.")) from None
     if kw.pop("thermal_expansion", 0.0):
         Material(E=1.0, nu=0.0, thermal_expansion=1.0, plies=tuple(plies))  # raises
     return Material.from_plies(plies, **kw)
@@ -1865,7 +1866,7 @@ def _material(table: Any) -> Material:
 def _points(tables: Any) -> tuple[PointSpec, ...]:
     """``[[points]]`` tables; messages name ``points[k]``."""
     if not isinstance(tables, list) or not tables:
-        raise ValueError(
+        raise InputError(
             f"points must be a list of tables ([[points]] in TOML), at least one, got {tables!r}"
         )
     out = []
@@ -1877,7 +1878,7 @@ def _points(tables: Any) -> tuple[PointSpec, ...]:
             message = str(err)
             if message.startswith("points"):
                 message = f"points[{k}]" + message[len("points") :]
-            raise ValueError(message) from None
+            raise InputError(message) from None
     return tuple(out)
 
 
@@ -1995,11 +1996,11 @@ def load_toml(path: str | Path) -> ProblemSpec:
     try:
         data = tomllib.loads(path.read_bytes().decode("utf-8"))
     except UnicodeDecodeError as err:
-        raise ValueError(
+        raise InputError(
             f"{path}: not a UTF-8 text file ({err.reason} at byte {err.start})"
         ) from None
     except tomllib.TOMLDecodeError as err:
-        raise ValueError(f"{path}: invalid TOML: {err}") from None
+        raise InputError(f"{path}: invalid TOML: {err}") from None
     plate = data.get("plate")
     if isinstance(plate, dict) and isinstance(plate.get("file"), str):
         # A gmsh file is found next to the problem file.
@@ -2007,7 +2008,7 @@ def load_toml(path: str | Path) -> ProblemSpec:
     try:
         return problem_from_dict(data, name=path.stem)
     except ValueError as err:
-        raise ValueError(f"{path}: {err}") from None
+        raise InputError(f"{path}: {err}") from None
 
 
 def load_problem(path: str | Path) -> ProblemSpec:
@@ -2023,12 +2024,12 @@ def load_problem(path: str | Path) -> ProblemSpec:
     try:
         data = json.loads(path.read_bytes().decode("utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise ValueError(f"{path}: not a JSON result or problem file: {err}") from None
+        raise InputError(f"{path}: not a JSON result or problem file: {err}") from None
     if isinstance(data, dict) and "input" in data:
         data = data["input"]
         if data is None:
-            raise ValueError(f"{path}: this result's problem has no file form (a predicate zone)")
+            raise InputError(f"{path}: this result's problem has no file form (a predicate zone)")
     try:
         return problem_from_dict(data, name=path.stem)
     except ValueError as err:
-        raise ValueError(f"{path}: {err}") from None
+        raise InputError(f"{path}: {err}") from None
