@@ -196,8 +196,13 @@ def solve(
     Returns:
         The analysis (result, mode, problem); the caller destroys it (or uses ``with``).
 
+    Raises:
+        InputError: The problem is refused (before any solve, or once its mesh exists).
+        NumericalError: A solve did not converge, or no admissible mode was found.
+
     Note:
-        Collective on ``comm``.
+        Collective on ``comm``. On an error, every PETSc/SLEPc object built here is
+        destroyed before the error propagates (collectively: every rank raises).
     """
     t0 = time.perf_counter()
     if mesh is not None and candidate_parallel:
@@ -209,6 +214,24 @@ def solve(
         mesh=mesh,
         facet_tags=facet_tags,
     )
+    try:
+        return _analyse(spec, problem, comm, candidate_parallel, t0)
+    except BaseException:
+        # A failed solve (or Ctrl-C) must not leave the problem's PETSc objects to the
+        # garbage collector, whose order differs between ranks: the caller may go on
+        # collectively (the sweep's next point).
+        problem.destroy()
+        raise
+
+
+def _analyse(
+    spec: ProblemSpec,
+    problem: BucklingProblem,
+    comm: MPI.Comm,
+    candidate_parallel: bool,
+    t0: float,
+) -> Analysis:
+    """The solves of :func:`solve` on ``problem``, set up from ``spec`` (collective)."""
     t_free = time.perf_counter()
     free = problem.solve_free()
     t_free = comm.allreduce(time.perf_counter() - t_free, op=MPI.MAX)

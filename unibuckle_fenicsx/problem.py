@@ -262,6 +262,17 @@ class BucklingProblem(Owner):
             fixed_prestress=self.fixed_prestress,
             fixed_factor=spec.load.fixed_factor,
         )
+        try:
+            self._set_up(spec, eps_options, t1)
+        except BaseException:
+            self.destroy()  # collective: every rank raises (the checks agree)
+            raise
+        self.timings["setup_s"] = time.perf_counter() - t0
+
+    def _set_up(
+        self, spec: ProblemSpec, eps_options: dict[str, str | float | int] | None, t1: float
+    ) -> None:
+        """The springs, the checks, the eigen solver and the contact sets (collective)."""
         if spec.bilateral_foundations:
             self.model.add_springs(*foundation_springs(self.model, spec.bilateral_foundations))
         t2 = time.perf_counter()
@@ -294,7 +305,6 @@ class BucklingProblem(Owner):
         self.tau = spec.solver.tau
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         self._w_owned = self.model.w_dofs[:n_owned_w]
-        self.timings["setup_s"] = time.perf_counter() - t0
 
     def _check_geometric_stiffness(self) -> None:
         """Refuse a B that is round-off (collective).
@@ -492,5 +502,7 @@ class BucklingProblem(Owner):
     def destroy(self) -> None:
         """Destroy the PETSc/SLEPc objects (collective)."""
         release(self, "_r", "_Bu")
-        self.eigensolver.destroy()
-        self.model.destroy()
+        for name in ("eigensolver", "model"):  # absent when the constructor failed early
+            owner = getattr(self, name, None)
+            if owner is not None:
+                owner.destroy()

@@ -15,8 +15,12 @@ does not depend on the run). ``status`` is "ok" (a certified critical state),
 "not-certified" (the result fails its KKT certificate; the line still holds the
 bracket), "refused" (the problem was refused once its mesh existed, e.g. an obstacle
 zone that holds no node or a load that buckles nothing), "no-admissible-mode" (no
-admissible mode with a finite load was found) or "eigen-failure" (an eigen solve did
-not converge); the last three lines hold ``error`` instead of the results.
+admissible mode with a finite load was found), "eigen-failure" (an eigen solve did
+not converge) or "failed" (another numerical failure,
+:class:`~unibuckle_fenicsx.errors.NumericalError`); the last four lines hold ``error``
+instead of the results. A failed point's PETSc objects are destroyed before the next
+point (collectively: every rank of the point takes the same branch). Any other error is
+a bug: it stops the sweep.
 
 **Paths** name any number of the TOML schema (README, "Problem files") by its dotted
 path, list entries by index: ``plate.thickness``, ``material.nu``,
@@ -65,7 +69,7 @@ from typing import Any
 from mpi4py import MPI
 
 from unibuckle_fenicsx.config import ProblemSpec, load_problem, problem_from_dict, problem_to_dict
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.progress import Progress
 
 __all__ = [
@@ -86,7 +90,7 @@ __all__ = [
 PROGRESS = logging.getLogger("unibuckle_fenicsx.progress.sweep")
 
 #: Status of a sweep line, see the module docstring.
-STATUSES = ("ok", "not-certified", "refused", "no-admissible-mode", "eigen-failure")
+STATUSES = ("ok", "not-certified", "refused", "no-admissible-mode", "eigen-failure", "failed")
 #: Shortcut paths: name -> the coordinate (0: x, 1: y) of the second corner they set.
 SHORTCUTS = {"plate.length": 0, "plate.width": 1}
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+)\s*$")
@@ -349,12 +353,14 @@ def _solve(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
     try:
         with solve(spec, comm) as analysis:
             result = analysis.result
-    except ValueError as err:
+    except InputError as err:
         return {"status": "refused", "error": str(err)}
     except NoAdmissibleModeError as err:
         return {"status": "no-admissible-mode", "error": str(err)}
     except EigenSolveError as err:
         return {"status": "eigen-failure", "error": str(err)}
+    except NumericalError as err:
+        return {"status": "failed", "error": str(err)}
     cert = result.certificate
     status = "not-certified" if cert is not None and not cert["kkt"] else "ok"
     return {"status": status, **result.as_dict(timings=False)}
