@@ -284,6 +284,15 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     w.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
     w.add_argument("-q", "--quiet", action="store_true", help="no progress bar or lines")
     _nonlinear_parser(sub)
+    k = sub.add_parser(
+        "schema",
+        help="print the JSON Schema of a problem file (or its dotted keys)",
+        description="Print the JSON Schema of a problem file: for editor completion of "
+        "TOML files (e.g. a '#:schema' line for taplo) and the reference of the keys. "
+        "The repository keeps it in schema/unibuckle-problem.schema.json.",
+    )
+    k.add_argument("--keys", action="store_true", help="print the dotted keys instead")
+    k.add_argument("--output", metavar="PATH", help="write to PATH instead of stdout")
     return parser, s
 
 
@@ -475,6 +484,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         sub = solve_parser if args.command == "solve" else parser
         sub.error(f"unrecognized arguments: {' '.join(unknown)}")
 
+    if args.command == "schema":
+        return _schema(args)
+
     from mpi4py import MPI  # before petsc4py: loads libmpi
 
     comm = MPI.COMM_WORLD
@@ -504,6 +516,24 @@ def main(argv: Sequence[str] | None = None) -> int:
         traceback.print_exc()  # on every rank that fails: the bug may be on one
         print(BUG_REPORT, file=sys.stderr, flush=True)
         return EXIT_BUG
+
+
+def _schema(args: argparse.Namespace) -> int:
+    """``unibuckle schema``: the JSON Schema of a problem file, or its dotted keys."""
+    import json
+
+    from unibuckle_fenicsx.config import accepted_keys, json_schema
+
+    text = "\n".join(accepted_keys()) if args.keys else json.dumps(json_schema(), indent=2)
+    if not args.output:
+        print(text)
+        return EXIT_OK
+    try:
+        Path(args.output).write_text(text + "\n")
+    except OSError as err:
+        print(f"unibuckle: error: --output {args.output}: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return EXIT_OK
 
 
 def _petsc_error(err: BaseException, options: Sequence[str]) -> tuple[str, int] | None:
