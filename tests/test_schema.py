@@ -150,7 +150,7 @@ def test_the_input_echo_passes_the_schema_and_round_trips(tmp_path):
         ),
         (
             {"plate": {"holes": [{"center": [0, 0], "radius": 0.01}, {"outline": [[0, 0]]}]}},
-            r"^plate\.holes\[1\]\.outline must be a list of length >= 3, got \[\[0, 0\]\]$",
+            r"^plate\.holes\[1\]\.outline must be a list of at least 3 entries, got \[\[0, 0\]\]$",
         ),
     ],
 )
