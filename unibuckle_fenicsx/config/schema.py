@@ -45,6 +45,7 @@ from collections.abc import Mapping
 from typing import Annotated, Any, Literal, Union
 
 import msgspec
+import numpy as np
 from msgspec import UNSET, Meta, Struct, UnsetType
 
 from unibuckle_fenicsx.errors import InputError
@@ -275,6 +276,10 @@ def _message(err: msgspec.ValidationError, data: Any) -> tuple[str, bool]:
         got = f"{value!r} ({_TYPES.get(wrong[2], wrong[2])})"
         return f"{key or 'the file'} must be {wanted}, got {got}", False
     if shape := re.match(r"Expected `array` of (length .*?)(?:, got .*)?$", what):
+        if typing.get_origin(_unwrap(_field_types().get(_pattern(key)))) is Union:
+            # A number or a list (an edge stress, a temperature field, a spacing): the
+            # dataclass's check says what the list means ("a pair [start, end]").
+            return f"{key} must be a number or a list of {shape[1]}, got {value!r}", True
         if _pattern(key) + "[]" in _tables(lists=True):
             what = f"tables ([[{key}]] in TOML), at least one"
             return f"{key} must be a list of {what}, got {value!r}", False
@@ -318,6 +323,15 @@ def _choices(key: str) -> tuple[str, ...]:
     return tuple(a for lit in literals for a in typing.get_args(lit))
 
 
+def _plain(value: Any) -> Any:
+    """``value`` with numpy scalars as Python numbers (msgspec takes exact types only)."""
+    if isinstance(value, Mapping):
+        return {k: _plain(v) for k, v in value.items()}
+    if isinstance(value, list | tuple):
+        return [_plain(v) for v in value]
+    return value.item() if isinstance(value, np.generic) else value
+
+
 def validate_document(data: Mapping[str, Any]) -> str | None:
     """Check the TOML-shaped ``data`` against :class:`ProblemFile`.
 
@@ -330,7 +344,7 @@ def validate_document(data: Mapping[str, Any]) -> str | None:
             a choice not among the allowed ones; the message names the key.
     """
     try:
-        msgspec.convert(data, ProblemFile)
+        msgspec.convert(_plain(data), ProblemFile)
     except msgspec.ValidationError as err:
         message, bound = _message(err, data)
         if not bound:
