@@ -341,7 +341,8 @@ def _check_key(tmp_path, capsys, cases):
         path.write_text(to_toml(data))
         err = _refused(path, capsys)
         assert str(path) in err, (value, err)
-        pattern = rf"(?<![\w.\[]){re.escape(name)}(?![\w\[])"
+        # The key, or an entry of its value (key[i][j]), not a key below it (key[i].sub).
+        pattern = rf"(?<![\w.\[]){re.escape(name)}(?!\w)(?!(\[\d+\])+\.)"
         assert re.search(pattern, err), f"{value!r}: {name!r} not in {err}"
 
 

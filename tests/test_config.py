@@ -267,7 +267,7 @@ def test_obstacle_box_contains_closed_zone():
         ('[solver]\nmax_candidates = "many"\n', r"solver\.max_candidates must be an integer"),
         ("[mesh]\nnx = 8.0\n", r"mesh\.nx must be an integer"),
         ('[edges.left]\nnormal_stress = "-1"\n', r"edges\.left\.normal_stress must be a number"),
-        ('[obstacle]\nzone = [["a", 1], [0, 1]]\n', r"obstacle\.zone must be a number"),
+        ('[obstacle]\nzone = [["a", 1], [0, 1]]\n', r"obstacle\.zone\[0\]\[0\] must be a number"),
         ("[obstacle]\ntolerance = 1e-9\n", r"\[obstacle\] needs zone"),
         ("name = 3\n", r"name must be a string"),
         ('units = "inch"\n', r"units must be one of \('SI', 'mm-N-MPa'\)"),

@@ -89,7 +89,10 @@ def test_polygon_and_circle_tables():
             r"obstacles\[1\]\.polygon must be a simple",
         ),
         ({"polygon": [[0, 0], [1, 1], [2, 2]]}, r"obstacles\[1\]\.polygon has no area"),
-        ({"polygon": [[0, 0], [1, "a"], [1, 0]]}, r"obstacles\[1\]\.polygon must be a number"),
+        (
+            {"polygon": [[0, 0], [1, "a"], [1, 0]]},
+            r"obstacles\[1\]\.polygon\[1\]\[1\] must be a number",
+        ),
         ({"circle": {"center": [0, 0]}}, r"obstacles\[1\]\.circle needs center"),
         (
             {"circle": {"center": [0, 0], "radius": -1}},

@@ -98,7 +98,7 @@ def test_point_tables_are_read_converted_and_written_back():
         ({}, r"\[\[points\]\] needs at = \[x, y\].*or spacing"),
         ({"at": [1, 0.5], "spacing": 1}, r"exactly one of them"),
         ({"spacing": 0}, r"points\[0\]\.spacing must be > 0 m"),
-        ({"spacing": [1, "a"]}, r"points\[0\]\.spacing must be a number"),
+        ({"spacing": [1, "a"]}, r"points\[0\]\.spacing\[1\] must be a number"),
         ({"at": [1, 0.5], "kind": "spring"}, r'points\[0\]\.stiffness: kind = "spring" needs'),
         ({"at": [1, 0.5], "stiffness": 5.0}, r'points\[0\]\.stiffness belongs to kind = "spring"'),
         ({"at": [1, 0.5], "side": "below"}, r'points\[0\]\.side belongs to kind = "one-sided"'),

@@ -89,7 +89,7 @@ def test_pair_is_read_checked_and_written_back():
     [
         ([1.0, 2.0, 3.0], r"edges\.left\.normal_stress must be a number or a pair \[start, end\]"),
         ([1.0], r"edges\.left\.normal_stress must be a number or a pair"),
-        (["1", -1.0], r"edges\.left\.normal_stress must be a number"),
+        (["1", -1.0], r"edges\.left\.normal_stress\[0\] must be a number"),
         ([1.0, float("nan")], r"edges\.left\.normal_stress must be a finite number"),
     ],
 )

@@ -20,6 +20,7 @@ from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
 from unibuckle_fenicsx.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.problem import BucklingProblem
 from unibuckle_fenicsx.results import BucklingResult
 
@@ -45,7 +46,7 @@ def choose_method(
     options = spec.solver
     if spec.tensionless:
         if candidate_parallel:
-            raise ValueError(
+            raise InputError(
                 "--candidate-parallel splits the enumeration's candidate sets; a tensionless "
                 "foundation is solved by its spring-set iteration: drop --candidate-parallel"
             )
@@ -56,12 +57,12 @@ def choose_method(
     estimate = math.inf if i > 1000 else count * solve_time_s
     if candidate_parallel:
         if options.method not in ("auto", "enumerate"):
-            raise ValueError(
+            raise InputError(
                 f"--candidate-parallel splits the enumeration's candidate sets: it needs "
                 f'method "enumerate" or "auto", not {options.method!r}'
             )
         if count > options.max_candidates:
-            raise ValueError(
+            raise InputError(
                 f"--candidate-parallel runs the enumeration, but i = {i} constrained nodes "
                 f"give 2^{i} = {shown} candidate sets, above max_candidates = "
                 f"{options.max_candidates}: drop --candidate-parallel (the active-set "
@@ -130,7 +131,7 @@ def _run_method(
         from unibuckle_fenicsx.algorithms.foundation import solve_foundation
 
         return solve_foundation(problem, max_iterations=problem.spec.solver.max_iterations)
-    raise ValueError(f"unknown method {method!r}")
+    raise InputError(f"unknown method {method!r}")
 
 
 @dataclass
@@ -195,12 +196,17 @@ def solve(
     Returns:
         The analysis (result, mode, problem); the caller destroys it (or uses ``with``).
 
+    Raises:
+        InputError: The problem is refused (before any solve, or once its mesh exists).
+        NumericalError: A solve did not converge, or no admissible mode was found.
+
     Note:
-        Collective on ``comm``.
+        Collective on ``comm``. On an error, every PETSc/SLEPc object built here is
+        destroyed before the error propagates (collectively: every rank raises).
     """
     t0 = time.perf_counter()
     if mesh is not None and candidate_parallel:
-        raise ValueError("candidate_parallel builds its own serial meshes: pass no mesh")
+        raise InputError("candidate_parallel builds its own serial meshes: pass no mesh")
     problem = BucklingProblem(
         spec,
         MPI.COMM_SELF if candidate_parallel else comm,
@@ -208,6 +214,24 @@ def solve(
         mesh=mesh,
         facet_tags=facet_tags,
     )
+    try:
+        return _analyse(spec, problem, comm, candidate_parallel, t0)
+    except BaseException:
+        # A failed solve (or Ctrl-C) must not leave the problem's PETSc objects to the
+        # garbage collector, whose order differs between ranks: the caller may go on
+        # collectively (the sweep's next point).
+        problem.destroy()
+        raise
+
+
+def _analyse(
+    spec: ProblemSpec,
+    problem: BucklingProblem,
+    comm: MPI.Comm,
+    candidate_parallel: bool,
+    t0: float,
+) -> Analysis:
+    """The solves of :func:`solve` on ``problem``, set up from ``spec`` (collective)."""
     t_free = time.perf_counter()
     free = problem.solve_free()
     t_free = comm.allreduce(time.perf_counter() - t_free, op=MPI.MAX)

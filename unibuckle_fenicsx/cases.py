@@ -14,6 +14,7 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
+from unibuckle_fenicsx.errors import InputError
 
 __all__ = ["CASES", "LOADS", "paper_case", "plate_case"]
 
@@ -46,7 +47,7 @@ def paper_case(
     free lateral expansion. Default mesh: the paper's 20 x 20 quadrilaterals.
     """
     if name not in CASES:
-        raise ValueError(f"case must be one of {list(CASES)}, got {name!r}")
+        raise InputError(f"case must be one of {list(CASES)}, got {name!r}")
     return ProblemSpec(
         name=name,
         plate=PlateSpec(),
@@ -88,11 +89,11 @@ def plate_case(
         solver: Default options.
     """
     if load not in LOADS:
-        raise ValueError(f"load must be one of {list(LOADS)}, got {load!r}")
+        raise InputError(f"load must be one of {list(LOADS)}, got {load!r}")
     per_edge = dict.fromkeys(EDGE_NAMES, supports) if isinstance(supports, str) else dict(supports)
     unknown = set(per_edge) - set(EDGE_NAMES)
     if unknown:
-        raise ValueError(f"supports: unknown edge(s) {sorted(unknown)}; edges: {EDGE_NAMES}")
+        raise InputError(f"supports: unknown edge(s) {sorted(unknown)}; edges: {EDGE_NAMES}")
     edges = tuple(
         EdgeSpec(
             edge,

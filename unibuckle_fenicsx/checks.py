@@ -15,6 +15,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import distance_to_polygon
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -60,7 +61,7 @@ def check_thickness(plate: PlateSpec) -> None:
         return
     b = _smaller_side(plate)
     if plate.thickness > MAX_THICKNESS_RATIO * b:
-        raise ValueError(
+        raise InputError(
             f"plate.thickness = {plate.thickness:g} m is {plate.thickness / b:.3g} times the "
             f"plate's smaller side {b:g} m: not a plate; plate.thickness must be at most "
             f"{MAX_THICKNESS_RATIO:g} times it (Reissner-Mindlin theory is a model of plates "
@@ -141,7 +142,7 @@ def check_supports(spec: ProblemSpec) -> None:
     else:
         names = ", ".join(f"edges.{e.name}.support = {e.support!r}" for e in held)
         what = f"the only support ({names}) lies on one straight line"
-    raise ValueError(
+    raise InputError(
         f"edges.*.support: {what}: the plate can move as a rigid body (a mechanism, no "
         "buckling load); support edges that are not all in line (e.g. simply_supported "
         'on two opposite edges), clamp one, or add a bilateral foundation (side = "both")'
@@ -233,7 +234,7 @@ def check_features(plate: PlateSpec, mesh_size: float | None) -> None:
     features = plate_features(plate)
     for length, what in features:
         if what.startswith("the gap") and length <= TOUCH_TOLERANCE * size:
-            raise ValueError(
+            raise InputError(
                 f"{what} is {length:.3g} m: the hole touches it; holes must lie inside the "
                 "plate without touching its edge or each other"
             )
@@ -242,7 +243,7 @@ def check_features(plate: PlateSpec, mesh_size: float | None) -> None:
     limit = mesh_size / FEATURE_RATIO
     for length, what in features:
         if length < limit:
-            raise ValueError(
+            raise InputError(
                 f"{what} is {length:.3g} m, below mesh.size / {FEATURE_RATIO:g} = {limit:.3g} "
                 "m: gmsh cannot grade its quadrilaterals from mesh.size down to it; give a "
                 "smaller mesh.size or a larger feature"

@@ -16,11 +16,13 @@ import argparse
 import logging
 import os
 import sys
+import traceback
 from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 from unibuckle_fenicsx.config import METHODS
+from unibuckle_fenicsx.errors import InputError, NumericalError
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.config import ProblemSpec
@@ -33,8 +35,15 @@ EXIT_OK = 0
 EXIT_BAD_INPUT = 2
 #: A numerical difficulty: no certified critical state (the JSON holds what was found).
 EXIT_NOT_CERTIFIED = 3
+#: An internal error (a bug): the traceback and a request for a report.
+EXIT_BUG = 1
 #: Interrupted (Ctrl-C): 128 + SIGINT, the shell's convention.
 EXIT_INTERRUPTED = 130
+#: The line after the traceback of an internal error.
+BUG_REPORT = (
+    "unibuckle: internal error: this is a bug in unibuckle_fenicsx, not a problem with "
+    "your input; please report it (the command, the problem file and the traceback above)"
+)
 
 #: What --json and --output may create (README, "Command line").
 OUTPUT_HELP = """\
@@ -53,6 +62,7 @@ exit status:
      still holds the best admissible load found (an upper bound), the lower bound and a
      certificate saying what failed; when no admissible mode with a finite load
      exists (or none was found), the message gives the lower bound and no JSON is written
+  {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
 
 Single-dash options that argparse does not know go to PETSc/SLEPc under the package's
@@ -84,6 +94,7 @@ exit status:
   {EXIT_BAD_INPUT}  bad input (a --vary, the base file, a point the schema refuses);
      nothing was solved
   {EXIT_NOT_CERTIFIED}  some points have no certified critical state (their lines say why)
+  {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C): the finished points are in --json; the same
      command resumes
 """
@@ -108,6 +119,7 @@ exit status:
      path validated (the loads read off it, the contact conditions) and what it did
      not; when no load step converged or the linear solve failed, the message says
      why and no JSON is written
+  {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
 
 {OUTPUT_HELP}
@@ -272,6 +284,15 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     w.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
     w.add_argument("-q", "--quiet", action="store_true", help="no progress bar or lines")
     _nonlinear_parser(sub)
+    k = sub.add_parser(
+        "schema",
+        help="print the JSON Schema of a problem file (or its dotted keys)",
+        description="Print the JSON Schema of a problem file: for editor completion of "
+        "TOML files (e.g. a '#:schema' line for taplo) and the reference of the keys. "
+        "The repository keeps it in schema/unibuckle-problem.schema.json.",
+    )
+    k.add_argument("--keys", action="store_true", help="print the dotted keys instead")
+    k.add_argument("--output", metavar="PATH", help="write to PATH instead of stdout")
     return parser, s
 
 
@@ -463,6 +484,9 @@ def main(argv: Sequence[str] | None = None) -> int:
         sub = solve_parser if args.command == "solve" else parser
         sub.error(f"unrecognized arguments: {' '.join(unknown)}")
 
+    if args.command == "schema":
+        return _schema(args)
+
     from mpi4py import MPI  # before petsc4py: loads libmpi
 
     comm = MPI.COMM_WORLD
@@ -481,11 +505,35 @@ def main(argv: Sequence[str] | None = None) -> int:
                 where = f"the finished points are in {args.json}; the same command resumes"
             print(f"\nunibuckle: interrupted; {where}", file=sys.stderr, flush=True)
         return EXIT_INTERRUPTED
+    except InputError as err:
+        return _fail(comm, str(err))
+    except NumericalError as err:
+        return _fail(comm, f"{err} (no result written)", EXIT_NOT_CERTIFIED)
     except Exception as err:
         refused = _petsc_error(err, rest)
-        if refused is None:
-            raise
-        return _fail(comm, *refused)
+        if refused is not None:
+            return _fail(comm, *refused)
+        traceback.print_exc()  # on every rank that fails: the bug may be on one
+        print(BUG_REPORT, file=sys.stderr, flush=True)
+        return EXIT_BUG
+
+
+def _schema(args: argparse.Namespace) -> int:
+    """``unibuckle schema``: the JSON Schema of a problem file, or its dotted keys."""
+    import json
+
+    from unibuckle_fenicsx.config import accepted_keys, json_schema
+
+    text = "\n".join(accepted_keys()) if args.keys else json.dumps(json_schema(), indent=2)
+    if not args.output:
+        print(text)
+        return EXIT_OK
+    try:
+        Path(args.output).write_text(text + "\n")
+    except OSError as err:
+        print(f"unibuckle: error: --output {args.output}: {err}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    return EXIT_OK
 
 
 def _petsc_error(err: BaseException, options: Sequence[str]) -> tuple[str, int] | None:
@@ -532,9 +580,7 @@ def _run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> int:
 
 def _solve(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle solve``: one problem, its summary, JSON and fields."""
-    from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
     from unibuckle_fenicsx.analysis import solve
-    from unibuckle_fenicsx.eigen import EigenSolveError
     from unibuckle_fenicsx.results import write_fields, write_json
 
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
@@ -553,9 +599,9 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
     _warn_plate_model(spec, comm)
     try:
         analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
-    except (ValueError, ImportError) as err:  # ImportError: an extra is missing (gmsh)
+    except (InputError, ImportError) as err:  # ImportError: an extra is missing (gmsh)
         return fail(str(err))
-    except (EigenSolveError, NoAdmissibleModeError) as err:
+    except NumericalError as err:
         return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
     unwritten = None
     with analysis:
@@ -603,9 +649,7 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle nonlinear``: the load path, the Southwell and inflection loads."""
     import json
 
-    from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
-    from unibuckle_fenicsx.eigen import EigenSolveError
-    from unibuckle_fenicsx.nonlinear import NonlinearError, NonlinearOptions, solve_nonlinear
+    from unibuckle_fenicsx.nonlinear import NonlinearOptions, solve_nonlinear
 
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
         return _fail(comm, message, status)
@@ -636,9 +680,9 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
     _warn_plate_model(spec, comm)
     try:
         analysis = solve_nonlinear(spec, options, comm)
-    except (ValueError, ImportError) as err:
+    except (InputError, ImportError) as err:
         return fail(str(err))
-    except (EigenSolveError, NoAdmissibleModeError, NonlinearError) as err:
+    except NumericalError as err:
         return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
     with analysis:
         result = analysis.result
@@ -723,7 +767,7 @@ def _load_config(path: str, load: Any) -> Any:
     try:
         return load(path)
     except OSError as err:
-        raise ValueError(f"--config {path}: cannot read it ({err.strerror or err})") from None
+        raise InputError(f"--config {path}: cannot read it ({err.strerror or err})") from None
 
 
 #: Option names of the nonlinear analysis that are also command-line flags.
@@ -760,7 +804,7 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
             ranks_per_point=args.ranks_per_point,
             progress=not args.quiet,
         )
-    except (ValueError, OSError, ImportError) as err:
+    except (InputError, OSError, ImportError) as err:
         return fail(str(err))
     if comm.rank == 0:
         from collections import Counter

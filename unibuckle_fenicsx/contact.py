@@ -23,6 +23,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec
+from unibuckle_fenicsx.errors import InputError
 
 __all__ = [
     "BilateralZoneError",
@@ -65,11 +66,11 @@ class PlateDofs(Protocol):
         ...
 
 
-class EmptyZoneError(ValueError):
+class EmptyZoneError(InputError):
     """The obstacle zone holds no free mesh node."""
 
 
-class BilateralZoneError(ValueError):
+class BilateralZoneError(InputError):
     """Obstacles on opposite sides of the plate share a mesh node."""
 
 
@@ -277,10 +278,10 @@ class ContactSetManager:
         self.model = model
         self.obstacles = _as_tuple(obstacles)
         if not self.obstacles:
-            raise ValueError("ContactSetManager needs at least one obstacle")
+            raise InputError("ContactSetManager needs at least one obstacle")
         kinds = {o.kind for o in self.obstacles}
         if "bilateral" in kinds or len(kinds) != 1:
-            raise ValueError(
+            raise InputError(
                 "ContactSetManager takes one-sided obstacles of one kind: all rigid or all "
                 f"tensionless foundations, got {sorted(kinds)}"
             )

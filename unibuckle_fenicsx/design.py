@@ -28,6 +28,7 @@ import math
 from typing import Any
 
 from unibuckle_fenicsx.config import DesignSpec, ProblemSpec, stress_ends
+from unibuckle_fenicsx.errors import InputError
 
 __all__ = ["CLAUSES", "design_output", "reduction_factor"]
 
@@ -47,7 +48,7 @@ CALIBRATION = (
 def reduction_factor(slenderness: float, psi: float) -> float:
     r""":math:`\rho` of EN 1993-1-5 (4.2), internal compression elements, :math:`\psi \ge -3`."""
     if not -3.0 <= psi <= 1.0:
-        raise ValueError(f"psi must lie in [-3, 1] (EN 1993-1-5, Table 4.1), got {psi!r}")
+        raise InputError(f"psi must lie in [-3, 1] (EN 1993-1-5, Table 4.1), got {psi!r}")
     if slenderness <= 0.5 + math.sqrt(0.085 - 0.055 * psi):
         return 1.0
     return min(1.0, (slenderness - 0.055 * (3.0 + psi)) / slenderness**2)

@@ -31,6 +31,8 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.errors import NumericalError
+
 try:
     from petsc4py import PETSc
     from slepc4py import SLEPc
@@ -154,7 +156,7 @@ def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False)
             opts.delValue(key)
 
 
-class EigenSolveError(RuntimeError):
+class EigenSolveError(NumericalError):
     """The eigen solve did not converge."""
 
 

@@ -12,6 +12,8 @@ from typing import TYPE_CHECKING
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.errors import InputError
+
 if TYPE_CHECKING:  # pragma: no cover
     import dolfinx
 
@@ -132,7 +134,7 @@ def section(
     xy, w = xy[first], w[first]  # drop duplicates (none in serial)
     rows = np.unique(np.round(xy[:, 1] / (1e-9 * scale))) * 1e-9 * scale
     if y < rows[0] - 1e-9 * scale or y > rows[-1] + 1e-9 * scale:
-        raise ValueError(f"section: y = {y} lies outside the plate [{rows[0]}, {rows[-1]}]")
+        raise InputError(f"section: y = {y} lies outside the plate [{rows[0]}, {rows[-1]}]")
     below = rows[rows <= y + 1e-9 * scale].max()
     above = rows[rows >= y - 1e-9 * scale].min()
 

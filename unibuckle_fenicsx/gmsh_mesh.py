@@ -42,6 +42,7 @@ import numpy as np
 
 from unibuckle_fenicsx.checks import FEATURE_RATIO, plate_features
 from unibuckle_fenicsx.config import EDGE_NAMES, Circle, MeshSpec, ObstacleSpec, PlateSpec, Polygon
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import distance_to_polygon
 
 __all__ = [
@@ -350,7 +351,7 @@ def _quadrilaterals_only(gmsh: Any, hint: str = "") -> None:
     }
     others = {k: n for k, n in kinds.items() if not k.startswith("Quadrilateral 4")}
     if others or not kinds:
-        raise ValueError(
+        raise InputError(
             f"the gmsh mesh must consist of bilinear quadrilaterals (the MITC element), got "
             f"{kinds or 'no 2-D cells'}{hint}"
         )
@@ -413,7 +414,7 @@ def gmsh_plate_mesh(
             gmsh.finalize()
     error = comm.bcast(error, root=0)
     if error is not None:
-        raise ValueError(error)
+        raise InputError(error)
     try:
         model = gmsh.model if gmsh is not None else None
         data = dolfinx.io.gmsh.model_to_mesh(model, comm, 0, gdim=2)
@@ -440,7 +441,7 @@ def _mesh_file(gmsh: Any, plate: PlateSpec, spec: MeshSpec) -> None:
             gmsh.option.setNumber("Mesh.MeshSizeMax", spec.size)
         gmsh.model.mesh.generate(2)
     if not gmsh.model.getPhysicalGroups(2):
-        raise ValueError(
+        raise InputError(
             "no physical surface (Physical Surface(...) = {...}): gmsh's cells "
             "reach DOLFINx through physical groups"
         )
@@ -484,7 +485,7 @@ def _mesh_built(gmsh: Any, plate: PlateSpec, size: float, curves: list[Curve]) -
                 failures[0],
             )
         return
-    raise ValueError(
+    raise InputError(
         f"gmsh could not mesh the plate with quadrilaterals only at mesh.size = {size:g} m "
         f"({failures[-1]}); the plate's smallest features: {_features_text(plate)}: give a "
         "smaller mesh.size, or enlarge them"

@@ -20,6 +20,7 @@ from unibuckle_fenicsx.config import (
     ObstacleSpec,
     PlateSpec,
 )
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.gmsh_mesh import HOLES_TAG, gmsh_plate_mesh, segment_tag
 
 __all__ = [
@@ -96,7 +97,7 @@ def edge_tag(plate: PlateSpec, edge: EdgeSpec) -> int:
     """The one facet tag of ``edge`` (see :func:`edge_tags`); an error if it has several."""
     tags = edge_tags(plate, edge)
     if len(tags) != 1:
-        raise ValueError(f"edge {edge.name!r} has several facet tags {tags}")
+        raise InputError(f"edge {edge.name!r} has several facet tags {tags}")
     return tags[0]
 
 
@@ -115,7 +116,7 @@ def edge_tags(plate: PlateSpec, edge: EdgeSpec) -> tuple[int, ...]:
     if edge.name == HOLES and plate.holes:
         return (HOLES_TAG,)
     if edge.name not in EDGE_NAMES or plate.outline is not None or plate.file is not None:
-        raise ValueError(
+        raise InputError(
             f"edge {edge.name!r} has no facet tag; rectangle edges are named {EDGE_NAMES}"
         )
     return (EDGE_NAMES.index(edge.name) + 1,)
@@ -153,12 +154,12 @@ def edge_normal_axis(
     along_y = msh.comm.allreduce(along_y, op=MPI.LAND)
     along_x = msh.comm.allreduce(along_x, op=MPI.LAND)
     if count == 0:
-        raise ValueError(f"edge {name!r} (facet tag {tag}) holds no facet of the mesh")
+        raise InputError(f"edge {name!r} (facet tag {tag}) holds no facet of the mesh")
     if along_y:
         return 0
     if along_x:
         return 1
-    raise ValueError(
+    raise InputError(
         f"edge {name!r} is not parallel to a coordinate axis: hard simple support and "
         "in-plane rollers need axis-aligned edges (use simply_supported_soft or clamped)"
     )
@@ -205,7 +206,7 @@ def edge_line(
     lo = np.min(msh.comm.allgather(x.min(axis=0) if nodes.size else np.full(2, np.inf)), axis=0)
     hi = np.max(msh.comm.allgather(x.max(axis=0) if nodes.size else np.full(2, -np.inf)), axis=0)
     if not np.all(np.isfinite(lo)):
-        raise ValueError(f"edge {edge.name!r} (facet tag {tag}) holds no facet of the mesh")
+        raise InputError(f"edge {edge.name!r} (facet tag {tag}) holds no facet of the mesh")
     axis = int(np.argmax(hi - lo))
     # The extreme nodes along that axis (same on every rank).
     candidates = []
@@ -246,7 +247,7 @@ def build_plate_mesh(
         return msh, tags, plate
     missing = [e.name for e in plate.edges if e.tag is None and e.name not in groups]
     if missing:
-        raise ValueError(
+        raise InputError(
             f"edges.{missing[0]}: {plate.file} has no boundary part (physical curve) named "
             f"{missing[0]!r}; its boundary parts: {sorted(groups)}"
         )

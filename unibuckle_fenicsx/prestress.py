@@ -36,6 +36,7 @@ from unibuckle_fenicsx.config import (
     Temperature,
     temperature_field,
 )
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.materials import membrane_voigt
 from unibuckle_fenicsx.mesh import edge_line, edge_normal_axis, edge_tags
 
@@ -253,7 +254,7 @@ def solve_prestress(
     loaded = [e for e in plate.edges if e.loaded]
     thermal = thermal_force(msh, material, t, temperature)
     if not loaded and thermal is None:
-        raise ValueError(
+        raise InputError(
             "no edge is loaded: give at least one edge a non-zero normal_stress or shear_stress"
         )
     cell = msh.basix_cell()
@@ -321,7 +322,7 @@ def solve_prestress(
     if fixed:
         return Prestress(uh, N0, max_compression, max_tension, pinned)
     if max_compression <= 1e-10 * scale:
-        raise ValueError(
+        raise InputError(
             "the load puts the plate in tension everywhere (largest compressive membrane "
             f"force {max_compression:.3g} N/m against tension {max_tension:.3g} N/m): no "
             "buckling under a positive load; reverse the sign of normal_stress"
@@ -363,7 +364,7 @@ def _check_self_equilibrated(
             f"{list(e.segments or ())} from vertex k to vertex k + 1 (README, stress gradients)"
             for e in trap
         )
-        raise ValueError(
+        raise InputError(
             'every edge is free in its plane (inplane = "free") but the load is not '
             f"self-equilibrated (resultant force {force}, moment {moment:.3g} per unit "
             f'thickness): set inplane = "clamped" or "roller" on some edge{hint}'

@@ -44,6 +44,7 @@ from unibuckle_fenicsx.eigen import (
     SymmetricFactorization,
     release,
 )
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.materials import reference_bending_stiffness
 from unibuckle_fenicsx.mesh import build_plate_mesh
 from unibuckle_fenicsx.plate.model import PlateModel
@@ -93,7 +94,7 @@ def _check_memory(spec: ProblemSpec, comm: MPI.Comm) -> None:
     free = available_memory()
     have = comm.allreduce(free if free is not None else -1, op=MPI.MIN)
     if have > 0 and need > have:
-        raise ValueError(
+        raise InputError(
             f"{what} {dofs:,} DOFs, which need about {need / 1e9:.3g} GB "
             f"({BYTES_PER_DOF / 1000:.0f} kB per DOF), more than the {have / 1e9:.3g} GB "
             "available: use a coarser mesh or more machines"
@@ -204,12 +205,12 @@ class BucklingProblem(Owner):
         self.structured = mesh is None and not spec.plate.meshed_by_gmsh
         if mesh is not None:
             if facet_tags is None:
-                raise ValueError(
+                raise InputError(
                     "facet_tags: a user mesh needs its edge facet tags (EdgeSpec.tag, or "
                     "tags 1..4 for edges named left, right, bottom, top)"
                 )
             if mesh.topology.cell_type != dolfinx.mesh.CellType.quadrilateral:
-                raise ValueError("mesh: the MITC plate element needs a quadrilateral mesh")
+                raise InputError("mesh: the MITC plate element needs a quadrilateral mesh")
             self.mesh, self.facet_tags = mesh, facet_tags
             comm = mesh.comm
         else:
@@ -261,6 +262,17 @@ class BucklingProblem(Owner):
             fixed_prestress=self.fixed_prestress,
             fixed_factor=spec.load.fixed_factor,
         )
+        try:
+            self._set_up(spec, eps_options, t1)
+        except BaseException:
+            self.destroy()  # collective: every rank raises (the checks agree)
+            raise
+        self.timings["setup_s"] = time.perf_counter() - t0
+
+    def _set_up(
+        self, spec: ProblemSpec, eps_options: dict[str, str | float | int] | None, t1: float
+    ) -> None:
+        """The springs, the checks, the eigen solver and the contact sets (collective)."""
         if spec.bilateral_foundations:
             self.model.add_springs(*foundation_springs(self.model, spec.bilateral_foundations))
         t2 = time.perf_counter()
@@ -293,7 +305,6 @@ class BucklingProblem(Owner):
         self.tau = spec.solver.tau
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         self._w_owned = self.model.w_dofs[:n_owned_w]
-        self.timings["setup_s"] = time.perf_counter() - t0
 
     def _check_geometric_stiffness(self) -> None:
         """Refuse a B that is round-off (collective).
@@ -307,7 +318,7 @@ class BucklingProblem(Owner):
         b_norm = float(self.model.B.norm(PETSc.NormType.INFINITY))
         if b_norm <= 1e-10 * scale:
             self.model.destroy()
-            raise ValueError(
+            raise InputError(
                 "the plate has no positive buckling load on this mesh: the geometric "
                 f"stiffness b(w, w) vanishes on the free deflections (|B| = {b_norm:.3g} "
                 f"against |N0| = {scale:.3g} N/m); refine the mesh or check the edge loads"
@@ -328,7 +339,7 @@ class BucklingProblem(Owner):
             K.destroy()
         if negative or zero:
             self.model.destroy()
-            raise ValueError(
+            raise InputError(
                 "the fixed load alone buckles the plate (fixed_normal_stress, "
                 "fixed_shear_stress, fixed_temperature): the stiffness less its geometric "
                 f"stiffness, A - B_fixed, has {negative} negative and {zero} zero "
@@ -371,7 +382,7 @@ class BucklingProblem(Owner):
             u = self.new_mode("free_mode")
             pair = self.eigensolver.solve(out=u.x.petsc_vec)
             if not np.isfinite(pair.value):
-                raise ValueError(
+                raise InputError(
                     "the plate has no positive buckling load on this mesh: the geometric "
                     "stiffness b(w, w) is nowhere positive on the free deflections (edge "
                     "loads in tension, or the supports fix every deflection DOF); check the "
@@ -491,5 +502,7 @@ class BucklingProblem(Owner):
     def destroy(self) -> None:
         """Destroy the PETSc/SLEPc objects (collective)."""
         release(self, "_r", "_Bu")
-        self.eigensolver.destroy()
-        self.model.destroy()
+        for name in ("eigensolver", "model"):  # absent when the constructor failed early
+            owner = getattr(self, name, None)
+            if owner is not None:
+                owner.destroy()

@@ -15,8 +15,12 @@ does not depend on the run). ``status`` is "ok" (a certified critical state),
 "not-certified" (the result fails its KKT certificate; the line still holds the
 bracket), "refused" (the problem was refused once its mesh existed, e.g. an obstacle
 zone that holds no node or a load that buckles nothing), "no-admissible-mode" (no
-admissible mode with a finite load was found) or "eigen-failure" (an eigen solve did
-not converge); the last three lines hold ``error`` instead of the results.
+admissible mode with a finite load was found), "eigen-failure" (an eigen solve did
+not converge) or "failed" (another numerical failure,
+:class:`~unibuckle_fenicsx.errors.NumericalError`); the last four lines hold ``error``
+instead of the results. A failed point's PETSc objects are destroyed before the next
+point (collectively: every rank of the point takes the same branch). Any other error is
+a bug: it stops the sweep.
 
 **Paths** name any number of the TOML schema (README, "Problem files") by its dotted
 path, list entries by index: ``plate.thickness``, ``material.nu``,
@@ -65,6 +69,7 @@ from typing import Any
 from mpi4py import MPI
 
 from unibuckle_fenicsx.config import ProblemSpec, load_problem, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.progress import Progress
 
 __all__ = [
@@ -85,7 +90,7 @@ __all__ = [
 PROGRESS = logging.getLogger("unibuckle_fenicsx.progress.sweep")
 
 #: Status of a sweep line, see the module docstring.
-STATUSES = ("ok", "not-certified", "refused", "no-admissible-mode", "eigen-failure")
+STATUSES = ("ok", "not-certified", "refused", "no-admissible-mode", "eigen-failure", "failed")
 #: Shortcut paths: name -> the coordinate (0: x, 1: y) of the second corner they set.
 SHORTCUTS = {"plate.length": 0, "plate.width": 1}
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+)\s*$")
@@ -108,9 +113,9 @@ def _float(text: str, what: str) -> float:
     try:
         value = float(text)
     except ValueError:
-        raise ValueError(f"--vary {what}: {text.strip()!r} is not a number") from None
+        raise InputError(f"--vary {what}: {text.strip()!r} is not a number") from None
     if not math.isfinite(value):
-        raise ValueError(f"--vary {what}: {text.strip()!r} is not a finite number")
+        raise InputError(f"--vary {what}: {text.strip()!r} is not a finite number")
     return value
 
 
@@ -123,7 +128,7 @@ def parse_variation(text: str) -> Variation:
     path, sep, spec = text.partition("=")
     path = path.strip()
     if not sep or not path or not spec.strip():
-        raise ValueError(f"--vary {text!r}: expected PATH=START:STOP:N or PATH=V1,V2,...")
+        raise InputError(f"--vary {text!r}: expected PATH=START:STOP:N or PATH=V1,V2,...")
     match = _RANGE.match(spec)
     if match:
         start, stop = _float(match[1], text), _float(match[2], text)
@@ -132,13 +137,13 @@ def parse_variation(text: str) -> Variation:
         except ValueError:
             count = 0
         if count < 1 or str(count) != match[3].strip():
-            raise ValueError(f"--vary {text!r}: N must be an integer >= 1, got {match[3]!r}")
+            raise InputError(f"--vary {text!r}: N must be an integer >= 1, got {match[3]!r}")
         if count == 1:
             values: tuple[float, ...] = (start,)
         else:
             values = tuple(start + (stop - start) * k / (count - 1) for k in range(count))
     elif ":" in spec:
-        raise ValueError(f"--vary {text!r}: a range is START:STOP:N (three numbers)")
+        raise InputError(f"--vary {text!r}: a range is START:STOP:N (three numbers)")
     else:
         values = tuple(_float(v, text) for v in spec.split(","))
     return Variation(path, values)
@@ -151,10 +156,10 @@ def sweep_points(variations: Sequence[Variation]) -> list[dict[str, float]]:
         ValueError: No variation, or a path given twice.
     """
     if not variations:
-        raise ValueError("a sweep needs at least one --vary")
+        raise InputError("a sweep needs at least one --vary")
     paths = [v.path for v in variations]
     if len(set(paths)) != len(paths):
-        raise ValueError(f"--vary: a path is given twice: {paths}")
+        raise InputError(f"--vary: a path is given twice: {paths}")
     return [dict(zip(paths, combo, strict=True)) for combo in itertools.product(
         *(v.values for v in variations)
     )]  # fmt: skip
@@ -188,7 +193,7 @@ def set_value(data: dict[str, Any], path: str, value: float) -> None:
         axis = SHORTCUTS[path]
         corners = data.get("plate", {}).get("corners")
         if not isinstance(corners, list):
-            raise ValueError(f"--vary {path}: the problem has no plate.corners")
+            raise InputError(f"--vary {path}: the problem has no plate.corners")
         corners[1][axis] = corners[0][axis] + value
         return
     keys = path.split(".")
@@ -197,28 +202,28 @@ def set_value(data: dict[str, Any], path: str, value: float) -> None:
         where = ".".join(keys[:depth]) or "the problem file"
         if isinstance(node, Mapping):
             if key not in node:
-                raise ValueError(
+                raise InputError(
                     f"--vary {path}: {where} has no key {key!r} (keys: {sorted(node)}; "
                     f"shortcuts: {sorted(SHORTCUTS)})"
                 )
         elif isinstance(node, list):
             if not (key.isdigit() and int(key) < len(node)):
-                raise ValueError(
+                raise InputError(
                     f"--vary {path}: {where} is a list of {len(node)}; {key!r} is not an "
                     f"index in [0, {len(node) - 1}]"
                 )
         else:
-            raise ValueError(f"--vary {path}: {where} = {node!r} is not a table or a list")
+            raise InputError(f"--vary {path}: {where} = {node!r} is not a table or a list")
         if depth < len(keys) - 1:
             node = node[key] if isinstance(node, Mapping) else node[int(key)]
     leaf = keys[-1]
     index: Any = leaf if isinstance(node, Mapping) else int(leaf)
     current = node[index]
     if not _is_number(current):
-        raise ValueError(f"--vary {path}: the value there, {current!r}, is not a number")
+        raise InputError(f"--vary {path}: the value there, {current!r}, is not a number")
     if isinstance(current, int):
         if value != int(value):
-            raise ValueError(f"--vary {path}: must be an integer, got {value!r}")
+            raise InputError(f"--vary {path}: must be an integer, got {value!r}")
         value = int(value)
     node[index] = value
 
@@ -235,7 +240,7 @@ def point_problem(base: Mapping[str, Any], point: Mapping[str, float]) -> Proble
     try:
         return problem_from_dict(data, name=str(base.get("name", "plate")))
     except ValueError as err:
-        raise ValueError(f"sweep point {dict(point)}: {err}") from None
+        raise InputError(f"sweep point {dict(point)}: {err}") from None
 
 
 def read_lines(path: str | Path, *, strict: bool = False) -> list[dict[str, Any]]:
@@ -256,7 +261,7 @@ def read_lines(path: str | Path, *, strict: bool = False) -> list[dict[str, Any]
         if line is not None:
             out.append(line)
         elif strict:
-            raise ValueError(
+            raise InputError(
                 f"--json {path}: line {number} is not a line of a sweep ({why}); give "
                 "another file or delete this one"
             )
@@ -322,7 +327,7 @@ def _done_points(
     for line in read_lines(path, strict=True):
         k = line["index"]
         if not 0 <= k < len(points) or line["point"] != points[k]:
-            raise ValueError(
+            raise InputError(
                 f"--json {path}: holds a point of another sweep (line index {k}, point "
                 f"{line['point']}); give another file or delete it"
             )
@@ -348,12 +353,14 @@ def _solve(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
     try:
         with solve(spec, comm) as analysis:
             result = analysis.result
-    except ValueError as err:
+    except InputError as err:
         return {"status": "refused", "error": str(err)}
     except NoAdmissibleModeError as err:
         return {"status": "no-admissible-mode", "error": str(err)}
     except EigenSolveError as err:
         return {"status": "eigen-failure", "error": str(err)}
+    except NumericalError as err:
+        return {"status": "failed", "error": str(err)}
     cert = result.certificate
     status = "not-certified" if cert is not None and not cert["kkt"] else "ok"
     return {"status": status, **result.as_dict(timings=False)}
@@ -405,9 +412,9 @@ def run_sweep(
         Collective on ``comm``.
     """
     if int(ranks_per_point) != ranks_per_point or ranks_per_point < 1:
-        raise ValueError(f"ranks_per_point must be an integer >= 1, got {ranks_per_point!r}")
+        raise InputError(f"ranks_per_point must be an integer >= 1, got {ranks_per_point!r}")
     if comm.size % ranks_per_point:
-        raise ValueError(
+        raise InputError(
             f"ranks_per_point = {ranks_per_point} must divide the number of ranks ({comm.size})"
         )
     points = sweep_points(variations)
@@ -424,7 +431,7 @@ def run_sweep(
             error = str(err)
     error, done, stale = comm.bcast((error, done, stale), root=0)
     if error is not None:
-        raise ValueError(error)
+        raise InputError(error)
     todo = [k for k in range(len(points)) if k not in done]
     groups = comm.size // ranks_per_point
     color = comm.rank // ranks_per_point

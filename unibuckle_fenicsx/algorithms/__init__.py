@@ -18,13 +18,15 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.errors import NumericalError
+
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.problem import Candidate
 
 __all__ = ["NoAdmissibleModeError", "UnilateralSolution", "candidate_count"]
 
 
-class NoAdmissibleModeError(RuntimeError):
+class NoAdmissibleModeError(NumericalError):
     """No admissible mode with a finite load was found (the message gives the bracket)."""
 
 

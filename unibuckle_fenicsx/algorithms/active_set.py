@@ -68,6 +68,7 @@ from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.contact import EmptyZoneError
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 
@@ -280,15 +281,15 @@ def solve_active_set(
         Collective on ``problem.comm``.
     """
     if problem.contact is None:
-        raise ValueError("solve_active_set needs a problem with an obstacle")
+        raise InputError("solve_active_set needs a problem with an obstacle")
     if int(max_iterations) != max_iterations or max_iterations < 1:
-        raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+        raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
     if int(coarse_min_cells) != coarse_min_cells or coarse_min_cells < 2:
-        raise ValueError(f"coarse_min_cells must be an integer >= 2, got {coarse_min_cells!r}")
+        raise InputError(f"coarse_min_cells must be an integer >= 2, got {coarse_min_cells!r}")
     if not (math.isfinite(refine_margin) and refine_margin >= 0):
-        raise ValueError(f"refine_margin must be a finite number >= 0, got {refine_margin!r}")
+        raise InputError(f"refine_margin must be a finite number >= 0, got {refine_margin!r}")
     if int(bound_budget) != bound_budget or bound_budget < 0:
-        raise ValueError(f"bound_budget must be an integer >= 0, got {bound_budget!r}")
+        raise InputError(f"bound_budget must be an integer >= 0, got {bound_budget!r}")
 
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves

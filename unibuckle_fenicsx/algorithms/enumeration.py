@@ -59,6 +59,7 @@ from unibuckle_fenicsx.algorithms import (
     UnilateralSolution,
     candidate_count,
 )
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.progress import Progress
@@ -237,16 +238,16 @@ def enumerate_contact_sets(
         Collective on ``problem.comm`` and on ``candidate_comm``.
     """
     if problem.contact is None:
-        raise ValueError("enumerate_contact_sets needs a problem with an obstacle")
+        raise InputError("enumerate_contact_sets needs a problem with an obstacle")
     if (
         isinstance(max_candidates, bool)
         or int(max_candidates) != max_candidates
         or max_candidates < 1
     ):
-        raise ValueError(f"max_candidates must be an integer >= 1, got {max_candidates!r}")
+        raise InputError(f"max_candidates must be an integer >= 1, got {max_candidates!r}")
     ccomm = MPI.COMM_SELF if candidate_comm is None else candidate_comm
     if ccomm.size > 1 and problem.comm.size > 1:
-        raise ValueError(
+        raise InputError(
             "candidate_comm needs a serial copy of the problem on every rank "
             f"(problem.comm has {problem.comm.size} ranks): build it on MPI.COMM_SELF, "
             "e.g. analysis.solve(..., candidate_parallel=True)"
@@ -254,7 +255,7 @@ def enumerate_contact_sets(
     i = problem.contact.size
     count = candidate_count(i)
     if count > max_candidates:
-        raise ValueError(
+        raise InputError(
             f"enumeration may need {count} candidate sets (2^{i}, i = {i} constrained "
             f"nodes), above max_candidates = {max_candidates}: use --method active-set "
             "(or a coarser mesh, a smaller zone, or a larger --max-candidates)"

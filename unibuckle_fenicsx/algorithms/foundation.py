@@ -46,6 +46,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 
 __all__ = ["FOUNDATION_PREFIX", "solve_foundation"]
@@ -86,9 +87,9 @@ def solve_foundation(
     """
     contact = problem.contact
     if contact is None or contact.stiffness is None:
-        raise ValueError("solve_foundation needs a problem with a tensionless foundation")
+        raise InputError("solve_foundation needs a problem with a tensionless foundation")
     if int(max_iterations) != max_iterations or max_iterations < 1:
-        raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+        raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
     lower = problem.solve_free().load
     springs = contact.stiffness
     runs: dict[str, SpringIteration] = {}

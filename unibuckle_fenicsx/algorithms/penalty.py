@@ -58,6 +58,7 @@ from unibuckle_fenicsx.eigen import (
     extreme_eigenvalues,
     release,
 )
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.problem import BucklingProblem, Candidate
 
 __all__ = [
@@ -156,9 +157,9 @@ class PenaltySolver(Owner):
         eps_options: dict[str, str | float | int] | None = None,
     ) -> None:
         if not isinstance(problem, BucklingProblem):
-            raise ValueError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
+            raise InputError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
         if problem.contact is None:
-            raise ValueError("the penalty method needs an obstacle (the problem has none)")
+            raise InputError("the penalty method needs an obstacle (the problem has none)")
         self.problem = problem
         A = problem.model.A
         diag = A.getDiagonal()
@@ -285,7 +286,7 @@ class PenaltySolver(Owner):
             False, and ``details`` (see the code).
         """
         if not (isinstance(rho, int | float) and math.isfinite(rho) and rho > 0.0):
-            raise ValueError(f"rho (relative penalty) must be finite and > 0, got {rho!r}")
+            raise InputError(f"rho (relative penalty) must be finite and > 0, got {rho!r}")
         rho_abs = float(rho) * self.max_diag
         solves0 = self.solves
         it = self.iterate_springs(
@@ -365,17 +366,17 @@ class PenaltySolver(Owner):
         assert contact is not None
         weights = np.broadcast_to(np.asarray(rho_abs, dtype=float), (contact.size,))
         if not (np.all(np.isfinite(weights)) and np.all(weights > 0.0)):
-            raise ValueError("rho_abs (spring stiffness) must be finite and > 0 at every node")
+            raise InputError("rho_abs (spring stiffness) must be finite and > 0 at every node")
         if int(max_iterations) != max_iterations or max_iterations < 1:
-            raise ValueError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+            raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
         if not 0.0 <= tie_rtol < 1.0:
-            raise ValueError(f"tie_rtol must lie in [0, 1), got {tie_rtol!r}")
+            raise InputError(f"tie_rtol must lie in [0, 1), got {tie_rtol!r}")
         if not 0.0 <= threshold <= 1e-2:
-            raise ValueError(f"threshold must lie in [0, 1e-2], got {threshold!r}")
+            raise InputError(f"threshold must lie in [0, 1e-2], got {threshold!r}")
         i = contact.size
         active = np.unique(np.asarray([] if initial_active is None else initial_active, np.int64))
         if active.size and (active.min() < 0 or active.max() >= i):
-            raise ValueError(f"initial_active must hold node numbers in [0, {i}), got {active}")
+            raise InputError(f"initial_active must hold node numbers in [0, {i}), got {active}")
 
         vec = self._work
         best: PETSc.Vec | None = None
@@ -512,7 +513,7 @@ def solve_penalty(
         Collective.
     """
     if not (isinstance(rho, int | float) and math.isfinite(rho) and rho > 0.0):
-        raise ValueError(f"rho (relative penalty) must be finite and > 0, got {rho!r}")
+        raise InputError(f"rho (relative penalty) must be finite and > 0, got {rho!r}")
     solver = PenaltySolver(problem, eps_options=eps_options)
     try:
         return solver.solve(

@@ -58,6 +58,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
 from unibuckle_fenicsx.contact import ContactSetManager
 from unibuckle_fenicsx.eigen import Owner, release, set_options
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, transverse_shear
 from unibuckle_fenicsx.mesh import (
     build_plate_mesh,
@@ -121,7 +122,7 @@ def displacement_axis(plate: PlateSpec, control: str) -> int | None:
             uniaxial compression of opposite rectangle edges (checked before any work).
     """
     if control not in CONTROLS:
-        raise ValueError(f"control must be one of {CONTROLS}, got {control!r}")
+        raise InputError(f"control must be one of {CONTROLS}, got {control!r}")
     if control != "displacement":
         return None
     loaded = [e for e in plate.edges if e.loaded]
@@ -139,7 +140,7 @@ def displacement_axis(plate: PlateSpec, control: str) -> int | None:
     elif len({0 if e.name in ("left", "right") else 1 for e in loaded}) != 1:
         problem = "its loaded edges must be opposite edges"
     if problem is not None:
-        raise ValueError(
+        raise InputError(
             'control = "displacement" (end shortening) needs a uniaxial compression: '
             f'{problem}; use control = "load"'
         )
@@ -198,14 +199,14 @@ class VonKarmanPlate(MixedDofs, Owner):
         facet_tags: dolfinx.mesh.MeshTags | None = None,
     ) -> None:
         if degree not in (1, 2):
-            raise ValueError(f"degree (in-plane displacement) must be 1 or 2, got {degree!r}")
+            raise InputError(f"degree (in-plane displacement) must be 1 or 2, got {degree!r}")
         self.spec = spec
         self.plate = spec.plate
         self.control = control
         self.thickness = t = spec.plate.thickness
         loaded = [e for e in spec.plate.edges if e.loaded]
         if not loaded:
-            raise ValueError(
+            raise InputError(
                 "no edge is loaded: give at least one edge a non-zero normal_stress or shear_stress"
             )
         self._displacement_axis = displacement_axis(spec.plate, control)
@@ -232,7 +233,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         )
         self.points = snap_points(self.Vw, self.plate, spec.points)
         if spec.one_sided_points:
-            raise ValueError(
+            raise InputError(
                 "points: the nonlinear analysis does not model one-sided points (kind = "
                 '"one-sided"); give them kind = "bilateral" or "spring", or leave them out'
             )

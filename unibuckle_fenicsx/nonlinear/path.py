@@ -51,6 +51,7 @@ from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
 from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.eigen import Owner, set_options
+from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.nonlinear.model import (
     CONTROLS,
     THETA_SUB,
@@ -99,7 +100,7 @@ SHAPE_LU: dict[str, str | float | int | bool] = {
 }
 
 
-class NonlinearError(RuntimeError):
+class NonlinearError(NumericalError):
     """The nonlinear solve failed before any load step converged."""
 
 
@@ -139,7 +140,7 @@ class NonlinearOptions:
 
     def __post_init__(self) -> None:
         if not 0.0 < _number("imperfection", self.imperfection) <= 1.0:
-            raise ValueError(
+            raise InputError(
                 "imperfection (delta: max |w0| / thickness) must lie in (0, 1], got "
                 f"{self.imperfection!r}"
             )
@@ -147,21 +148,21 @@ class NonlinearOptions:
         _choice("control", self.control, CONTROLS)
         _boolean("obstacle", self.obstacle)
         if not 0.0 < _number("max_load", self.max_load) <= 5.0:
-            raise ValueError(
+            raise InputError(
                 "max_load (a multiple of the linear critical load) must lie in (0, 5], got "
                 f"{self.max_load!r}"
             )
         if not 0.0 < _number("max_step", self.max_step) <= 1.0:
-            raise ValueError(f"max_step must lie in (0, 1], got {self.max_step!r}")
+            raise InputError(f"max_step must lie in (0, 1], got {self.max_step!r}")
         if not 0.0 < _number("min_step", self.min_step) <= self.max_step:
-            raise ValueError(
+            raise InputError(
                 f"min_step must lie in (0, max_step = {self.max_step}], got {self.min_step!r}"
             )
         if not 0.0 < _number("deflection_step", self.deflection_step) <= 1.0:
-            raise ValueError(f"deflection_step must lie in (0, 1], got {self.deflection_step!r}")
+            raise InputError(f"deflection_step must lie in (0, 1], got {self.deflection_step!r}")
         _integer("max_steps", self.max_steps, 1)
         if self.degree is not None and (isinstance(self.degree, bool) or self.degree not in (1, 2)):
-            raise ValueError(f"degree (in-plane displacement) must be 1 or 2, got {self.degree!r}")
+            raise InputError(f"degree (in-plane displacement) must be 1 or 2, got {self.degree!r}")
 
 
 @dataclass(frozen=True)
@@ -500,7 +501,7 @@ def imperfection_shape(
     contact = problem.contact if obstacle else None
     name = shape if shape != "auto" else ("unilateral" if contact is not None else "free")
     if name == "unilateral" and (contact is None or linear.solution is None):
-        raise ValueError('shape = "unilateral" needs a problem with its obstacle')
+        raise InputError('shape = "unilateral" needs a problem with its obstacle')
     out = dolfinx.fem.Function(problem.model.W, name="imperfection_shape")
     if name == "unilateral":
         out.x.array[:] = linear.mode.x.array  # oriented: w <= 0 in the zone
@@ -512,7 +513,7 @@ def imperfection_shape(
                 out.x.array[:] *= -1.0
                 values = -values
             if values.max() > 0.0:
-                raise ValueError(
+                raise InputError(
                     'shape = "free": the free mode crosses the obstacle whichever its sign '
                     f"(w > 0 at {int((values > 0).sum())} of the {contact.size} zone nodes); "
                     'use shape = "unilateral"'
@@ -522,7 +523,7 @@ def imperfection_shape(
     if contact is not None:
         sides = {float(v) for v in contact.signs}
         if len(sides) != 1:
-            raise ValueError(
+            raise InputError(
                 "the nonlinear analysis pushes the imperfection off the obstacles by a uniform "
                 "pressure: it needs every obstacle on one side of the plate (all above or all "
                 "below)"
@@ -534,7 +535,7 @@ def imperfection_shape(
         out.x.scatter_forward()
         worst = float(contact.values(out.x.petsc_vec).max())
         if worst >= 0.0:
-            raise ValueError(
+            raise InputError(
                 f'the imperfection shape "{name}" touches the obstacle (w = {worst:.3g} '
                 "max|w| at a zone node after the push-off)"
             )
@@ -548,7 +549,7 @@ def _check_gaps(plate: VonKarmanPlate, imperfection: float) -> None:
     clearance = plate.zone_clearance(plate.x0)
     gapped = plate.contact.gaps > 0
     if clearance[gapped].max() >= 0.0:
-        raise ValueError(
+        raise InputError(
             f"obstacle.gap: the imperfection (delta = {imperfection:g}, max |w0| = "
             f"{imperfection * plate.thickness:.3g} m) reaches an obstacle across its gap "
             f"(smallest gap {plate.contact.gaps[gapped].min():.3g} m): lower the "
@@ -716,41 +717,41 @@ def solve_nonlinear(
     t0 = time.perf_counter()
     options = NonlinearOptions() if options is None else options
     if spec.load.thermal or spec.has_fixed_load:
-        raise ValueError(
+        raise InputError(
             "the nonlinear analysis models edge loads scaled by lambda only: temperature "
             "rises ([load]) and fixed loads (fixed_normal_stress, fixed_shear_stress) are "
             "not in its energy"
         )
     if any(o.foundation_stiffness is not None for o in spec.all_obstacles):
-        raise ValueError(
+        raise InputError(
             "the nonlinear analysis models rigid obstacles only, not Winkler foundations "
             "(foundation_stiffness)"
         )
     obstacle = options.obstacle and bool(spec.all_obstacles)
     if obstacle and len({o.side for o in spec.all_obstacles}) > 1:
-        raise ValueError(
+        raise InputError(
             "the nonlinear analysis needs every obstacle on one side of the plate (all "
             "above or all below): the imperfection is pushed off them by a uniform pressure"
         )
     if options.shape == "unilateral" and not obstacle:
-        raise ValueError(
+        raise InputError(
             'shape = "unilateral" needs a problem with an obstacle (and obstacle = true)'
         )
     displacement_axis(spec.plate, options.control)
     degree = options.degree if options.degree is not None else spec.solver.prestress_degree
     if degree not in (1, 2):
-        raise ValueError(
+        raise InputError(
             f"solver.prestress_degree = {degree} sets the in-plane displacement degree of "
             "the nonlinear model, which must be 1 or 2: give degree"
         )
     if linear is not None:
         if obstacle and linear.problem.contact is None:
-            raise ValueError(
+            raise InputError(
                 "linear: the analysis given was solved without the obstacle; pass one of "
                 "the problem with its obstacle (or obstacle = false)"
             )
         if linear.problem.spec.mesh != spec.mesh or linear.problem.spec.plate != spec.plate:
-            raise ValueError("linear: the analysis given is of another plate or mesh")
+            raise InputError("linear: the analysis given is of another plate or mesh")
     owns_linear = linear is None
     if linear is None:
         linear = solve_linear(spec if obstacle else spec.without_obstacles(), comm)

@@ -15,6 +15,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.config import Material, PlateSpec, PointSpec
 from unibuckle_fenicsx.eigen import Owner, release
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.materials import bending_voigt, transverse_shear
 from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tags
 from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_force, shear_form
@@ -70,7 +71,7 @@ class PlateModel(MixedDofs, Owner):
         fixed_factor: float = 1.0,
     ) -> None:
         if msh.topology.cell_type != dolfinx.mesh.CellType.quadrilateral:
-            raise ValueError("the MITC plate element needs a quadrilateral mesh")
+            raise InputError("the MITC plate element needs a quadrilateral mesh")
         self.mesh = msh
         self.plate = plate
         self.material = material
@@ -98,7 +99,7 @@ class PlateModel(MixedDofs, Owner):
         if shear == "full":
             a = a + shear_form(u, v, ks)
         elif shear != "mitc":
-            raise ValueError(f'shear must be "mitc" or "full", got {shear!r}')
+            raise InputError(f'shear must be "mitc" or "full", got {shear!r}')
         self.a_form = dolfinx.fem.form(a)
         self.b_form = dolfinx.fem.form(geometric_form(u, v, prestress.N0))
 

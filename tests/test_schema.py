@@ -1,0 +1,160 @@
+"""The published schema of a problem file: the file in the repository, the CLI, the keys.
+
+The JSON Schema in ``schema/unibuckle-problem.schema.json`` must be the package's
+(:func:`~unibuckle_fenicsx.config.json_schema`), every key of
+:func:`~unibuckle_fenicsx.config.accepted_keys` must load, and the JSON ``input`` echo
+(:func:`~unibuckle_fenicsx.config.problem_to_dict`) must pass the schema. The documents
+below are problems written for this test (README, "Problem files"); the bad-input
+family's three bases come from its module.
+"""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Any
+
+import pytest
+from conftest import ROOT
+from test_bad_input_family import BASES
+
+from unibuckle_fenicsx.cli import EXIT_OK, main
+from unibuckle_fenicsx.config import (
+    accepted_keys,
+    json_schema,
+    problem_from_dict,
+    problem_to_dict,
+)
+from unibuckle_fenicsx.config.schema import validate_document
+
+SCHEMA_FILE = ROOT / "schema" / "unibuckle-problem.schema.json"
+
+_PLY = {"E1": 140e9, "E2": 10e9, "G12": 5e9, "nu12": 0.3, "G13": 5e9, "G23": 3e9}
+#: A symmetric laminate [0/90/0] with edge springs, fixed stresses, points and design data.
+LAMINATE = {
+    "plate": {"corners": [[0.0, 0.0], [0.2, 0.1]]},
+    "material": {
+        "shear_correction": 5.0 / 6.0,
+        "plies": [{"thickness": 0.002, "angle": a, **_PLY} for a in (0.0, 90.0, 0.0)],
+    },
+    "edges": {
+        "left": {"normal_stress": -1.0, "fixed_normal_stress": -1e6, "fixed_shear_stress": 0.0},
+        "right": {"normal_stress": -1.0, "rotational_stiffness": 10.0},
+        "top": {"support": "free", "translational_stiffness": 1e6},
+    },
+    "load": {"temperature": 0.0, "fixed_temperature": 0.0, "fixed_factor": 1.0},
+    "design": {"yield_stress": 355e6, "partial_factor": 1.0},
+    "points": [
+        {"at": [0.1, 0.05], "kind": "spring", "stiffness": 1e5},
+        {
+            "spacing": 0.05,
+            "offset": [0.0, 0.0],
+            "region": [[0.0, 0.2], [0.0, 0.1]],
+            "kind": "one-sided",
+            "side": "below",
+        },
+    ],
+    "solver": {"bracket": True},
+    "obstacle": {"circle": {"center": [0.1, 0.05], "radius": 0.02}, "tolerance": 1e-9},
+}
+#: A heated isotropic plate against a polygon with a gap.
+THERMAL = {
+    "material": {"E": 2.1e11, "nu": 0.3, "thermal_expansion": 1.2e-5},
+    "edges": {"left": {"inplane": "clamped"}, "right": {"inplane": "clamped"}},
+    "load": {"temperature": [10.0, 0.0, 0.0]},
+    "obstacle": {"polygon": [[-0.05, -0.02], [0.05, -0.02], [0.0, 0.03]], "gap": 0.001},
+}
+#: A bilateral foundation under the plate and a rigid obstacle with a gap above it.
+TWO_OBSTACLES = {
+    "obstacles": [
+        {"zone": "all", "side": "both", "foundation_stiffness": 1e6},
+        {"zone": [[-0.02, 0.02], [-0.02, 0.02]], "side": "above", "gap": 0.001},
+    ],
+}
+
+
+def _keys(data: dict[str, Any], prefix: str = "") -> set[str]:
+    """The dotted keys of ``data`` in the form of :func:`accepted_keys`."""
+    out = set()
+    for key, value in data.items():
+        name = "edges.<name>" if prefix == "edges." else prefix + key
+        if isinstance(value, dict):
+            out |= _keys(value, name + ".")
+        elif isinstance(value, list) and value and all(isinstance(v, dict) for v in value):
+            for table in value:
+                out |= _keys(table, name + "[].")
+        else:
+            out.add(name)
+    return out
+
+
+def _gmsh_file(tmp_path: Path) -> dict[str, Any]:
+    geo = tmp_path / "plate.geo"
+    geo.write_text("// read by gmsh when meshed; loading only needs the file\n")
+    plate = {"file": str(geo), "thickness": 0.006}
+    return {"plate": plate, "edges": {"rim": {"support": "clamped"}}, "mesh": {"size": 0.01}}
+
+
+def test_the_schema_file_is_the_packages():
+    assert json.loads(SCHEMA_FILE.read_text()) == json_schema()
+
+
+def test_unibuckle_schema_writes_it(tmp_path, capsys):
+    out = tmp_path / "schema.json"
+    assert main(["schema", "--output", str(out)]) == EXIT_OK
+    assert json.loads(out.read_text()) == json_schema()
+    assert main(["schema", "--keys"]) == EXIT_OK
+    assert capsys.readouterr().out.split() == accepted_keys()
+
+
+def test_every_accepted_key_loads(tmp_path):
+    """The documents hold every accepted key, and nothing else; each loads."""
+    documents = [*BASES.values(), LAMINATE, THERMAL, TWO_OBSTACLES, _gmsh_file(tmp_path)]
+    for data in documents:
+        problem_from_dict(data)
+    covered = set().union(*(_keys(data) for data in documents))
+    assert covered == set(accepted_keys())
+
+
+def test_the_input_echo_passes_the_schema_and_round_trips(tmp_path):
+    for data in [*BASES.values(), LAMINATE, THERMAL, TWO_OBSTACLES]:
+        spec = problem_from_dict(data)
+        for units in ("SI", "mm-N-MPa"):
+            echo = json.loads(json.dumps(problem_to_dict(spec, units=units)))
+            assert validate_document(echo) is None
+            assert _keys(echo) <= set(accepted_keys())
+        # Written in SI, the echo is the problem (in other units, up to rounding).
+        assert problem_from_dict(problem_to_dict(spec), name=spec.name) == spec
+
+
+@pytest.mark.parametrize(
+    ("data", "match"),
+    [
+        (
+            {"obstacles": [{"zone": "all"}, {"circle": {"center": [0, 0], "radius": "5"}}]},
+            r"^obstacles\[1\]\.circle\.radius must be a number, got '5' \(a string\)$",
+        ),
+        (
+            {"obstacles": [{"zone": "all"}, {"circle": {"center": [0, 0], "r": 1.0}}]},
+            r"^unknown key\(s\) \['r'\] in \[obstacles\[1\]\.circle\]; allowed: "
+            r"\['center', 'radius'\]$",
+        ),
+        (
+            {"obstacles": [{"zone": "all"}, {"circle": {"center": [0, 0], "radius": -1.0}}]},
+            r"^obstacles\[1\]\.circle\.radius must be > 0 m, got -1\.0$",
+        ),
+        (
+            {"edges": {"left": {}, "top": {"support": "pinned"}}},
+            r"^edges\.top\.support must be one of \('simply_supported', "
+            r"'simply_supported_soft', 'clamped', 'free'\), got 'pinned'$",
+        ),
+        (
+            {"plate": {"holes": [{"center": [0, 0], "radius": 0.01}, {"outline": [[0, 0]]}]}},
+            r"^plate\.holes\[1\]\.outline must be a list of at least 3 entries, got \[\[0, 0\]\]$",
+        ),
+    ],
+)
+def test_error_locations(data, match):
+    """Where the schema finds the error, in the file's own terms."""
+    with pytest.raises(ValueError, match=match):
+        problem_from_dict(data)
