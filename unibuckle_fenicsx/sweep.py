@@ -5,7 +5,7 @@ solves the base problem at every point of the grid of the ``--vary`` values (the
 ``--vary`` varies slowest), each with the normal method and certificate, and writes one
 JSON line per point as soon as it is done:
 
-.. code-block:: json
+.. code-block:: text
 
     {"index": 0, "point": {"plate.length": 0.05}, "status": "ok",
      "critical_load_Pa": ..., "buckling_coefficient_k": ..., ...}
