@@ -18,7 +18,7 @@ zone that holds no node or a load that buckles nothing), "no-admissible-mode" (n
 admissible mode with a finite load was found) or "eigen-failure" (an eigen solve did
 not converge); the last three lines hold ``error`` instead of the results.
 
-**Paths** name any number of the TOML schema (README, "Problem files") by its dotted
+**Paths** name any number of the TOML schema (:doc:`/guide/plate`) by its dotted
 path, list entries by index: ``plate.thickness``, ``material.nu``,
 ``edges.left.normal_stress``, ``plate.corners.1.0`` (x1), ``obstacle.zone.0.1``,
 ``mesh.size``, ``edges.top.rotational_stiffness``, ``points.0.spacing`` (a tie
