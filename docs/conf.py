@@ -9,6 +9,10 @@ HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE / "_ext"))
 sys.path.insert(0, str(HERE.parent))
 
+# mpi4py first: the PyPI wheels of petsc4py and DOLFINx find the MPI library that
+# mpi4py loads, and autodoc may import any module of the package first.
+from mpi4py import MPI  # noqa: E402, F401
+
 import unibuckle_fenicsx  # noqa: E402
 
 project = "unibuckle_fenicsx"
