@@ -313,25 +313,98 @@ def schema_page() -> str:
         ]
     else:
         defaults = _defaults()
+        described = _described()
         lines += [
-            f"Generated from {source} when these pages were built; the default of each "
-            "key is the value the loader fills in for a file that omits it (the "
-            "paper's plate; empty where it has none). The meaning, unit and range of "
-            "each key are in {doc}`../guide/plate`.",
+            f"Generated from {source} when these pages were built: the keys from the "
+            "loader's unknown-key check, each one's meaning from the docstring of the "
+            "class it fills (parent key's where it has none), its default the value the "
+            "loader fills in for a file that omits it (the paper's plate; empty where it "
+            "has none). Examples of every table: {doc}`../guide/plate`.",
             "",
-            "| key | table | default |",
+            "| key | default | meaning |",
             "|---|---|---|",
         ]
         for key in keys:
-            table = key.rsplit(".", 1)[0] if "." in key else "(top level)"
             default = defaults.get(key)
             lines.append(
-                "| `{}` | `[{}]` | {} |".format(
-                    key, table, "" if default is None else f"`{json.dumps(default)}`"
+                "| `{}` | {} | {} |".format(
+                    key,
+                    "" if default is None else f"`{json.dumps(default)}`",
+                    _cell(described.get(key, "")),
                 )
             )
     lines += ["", f"{len(keys)} keys."]
     return "\n".join(lines) + "\n"
+
+
+#: The class each table of the problem file fills, by its dotted prefix.
+TABLE_CLASSES = {
+    "": "ProblemSpec",
+    "plate": "PlateSpec",
+    "material": "Material",
+    "material.plies[]": "Ply",
+    "edges.<name>": "EdgeSpec",
+    "mesh": "MeshSpec",
+    "obstacle": "ObstacleSpec",
+    "obstacles[]": "ObstacleSpec",
+    "points[]": "PointSpec",
+    "load": "LoadSpec",
+    "design": "DesignSpec",
+    "solver": "SolverSpec",
+}
+
+
+def _myst(text: str) -> str:
+    """Inline markup of a reST docstring as MyST: math as $...$, roles and literals as code."""
+    text = re.sub(r":math:`([^`]*)`", r"$\1$", text)
+    text = re.sub(r":[\w:]+:`~?([^`]*)`", r"`\1`", text)
+    return re.sub(r"``([^`]+)``", r"`\1`", text)
+
+
+def arg_docs(cls: type) -> dict[str, str]:
+    """``{argument: its description}`` from the ``Args:`` section of a Google docstring."""
+    import inspect
+
+    doc = inspect.getdoc(cls) or ""
+    found: dict[str, str] = {}
+    inside, name = False, None
+    for line in doc.splitlines():
+        if line.strip() in ("Args:", "Attributes:"):
+            inside = True
+            continue
+        if inside:
+            if line and not line.startswith(" "):
+                inside = False
+                continue
+            match = re.match(r"^    (\w+)(?: \([^)]*\))?: (.*)$", line)
+            if match:
+                name = match.group(1)
+                found[name] = match.group(2)
+            elif name and line.startswith("        "):
+                found[name] += " " + line.strip()
+    return {key: _myst(text) for key, text in found.items()}
+
+
+def _described() -> dict[str, str]:
+    """Dotted key -> its meaning, from the docstrings of the classes the tables fill."""
+    from unibuckle_fenicsx import config
+
+    keys, _ = accepted_keys()
+    docs = {
+        prefix: arg_docs(getattr(config, name))
+        for prefix, name in TABLE_CLASSES.items()
+        if hasattr(config, name)
+    }
+    described = {}
+    for key in keys:
+        parts = key.split(".")
+        for cut in range(len(parts) - 1, -1, -1):  # the table's own class, then a parent's
+            prefix, name = ".".join(parts[:cut]), parts[cut]
+            text = docs.get(prefix, {}).get(name.removesuffix("[]"))
+            if text:
+                described[key] = text
+                break
+    return described
 
 
 def _defaults() -> dict[str, Any]:
