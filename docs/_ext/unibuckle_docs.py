@@ -436,9 +436,18 @@ def _defaults() -> dict[str, Any]:
 # Benchmarks
 # --------------------------------------------------------------------------------------
 
+
 #: How each results file is reproduced: a function of its rows, so that the command
 #: names the meshes and cases the file actually holds.
+def _listed(rows: list[dict[str, Any]], key: str) -> str:
+    return ",".join(dict.fromkeys(str(r[key]) for r in rows))
+
+
 COMMANDS = {
+    "certify": lambda rows: (
+        f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
+        f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"
+    ),
     "plates": lambda rows: (
         "python bench/bench_plates.py --meshes {} --cases {} --json bench/results/plates.jsonl"
     ).format(
@@ -454,8 +463,10 @@ def _format(value: Any) -> str:
     if isinstance(value, float):
         if math.isnan(value):
             return "nan"
-        if value != 0 and (abs(value) >= 1e6 or abs(value) < 1e-3):
-            return f"{value:.6g}"
+        if value != 0 and abs(value) < 1e-3:
+            return f"{value:.2g}"
+        if abs(value) >= 1e6:
+            return f"{value:.2f}"
         return f"{value:.4g}" if abs(value) < 100 else f"{value:.2f}"
     if value is None:
         return "-"
