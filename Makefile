@@ -32,6 +32,7 @@ bench: setup
 # and the bench tables are generated from the package and the stored results).
 docs: setup
 	@$(PY) -c 'import sphinx, myst_parser, furo' 2>/dev/null || $(PY) -m pip install --quiet -e '.[docs]'
+	@rm -rf docs/reference/_autosummary  # regenerated: a moved module leaves no stale page
 	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
 
 clean:
