@@ -443,17 +443,26 @@ def _listed(rows: list[dict[str, Any]], key: str) -> str:
     return ",".join(dict.fromkeys(str(r[key]) for r in rows))
 
 
+def _plates_commands(rows: list[dict[str, Any]]) -> str:
+    """The ``bench_plates.py`` runs that wrote the rows: one per mesh, with its flags."""
+    commands = []
+    for mesh in dict.fromkeys(str(r["mesh"]) for r in rows):
+        group = [r for r in rows if str(r["mesh"]) == mesh]
+        flags = " --cli" if any(r.get("cli_ratio") is not None for r in group) else ""
+        flags += " --bracket" if any(r.get("bracket") for r in group) else ""
+        commands.append(
+            f"python bench/bench_plates.py --meshes {mesh} --cases {_listed(group, 'case')}"
+            f"{flags} --json bench/results/plates.jsonl"
+        )
+    return "`, then `".join(commands)
+
+
 COMMANDS = {
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"
     ),
-    "plates": lambda rows: (
-        "python bench/bench_plates.py --meshes {} --cases {} --json bench/results/plates.jsonl"
-    ).format(
-        ",".join(dict.fromkeys(str(r["mesh"]) for r in rows)),
-        ",".join(dict.fromkeys(str(r["case"]) for r in rows)),
-    ),
+    "plates": lambda rows: _plates_commands(rows),
 }
 
 
