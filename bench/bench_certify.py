@@ -5,23 +5,46 @@ one process), then the certificate's time over the free solve's (cold: LU includ
 its route, the verified gap, and its factorisations and solves. Target: at most one free
 solve.
 
-Usage: python bench/bench_certify.py [--meshes 160x80,320x160] [--cases c1,c3]
+With ``--json FILE`` each row is also appended to FILE as one JSON line (the
+documentation renders ``bench/results/certify.jsonl`` as a table).
+
+Usage: python bench/bench_certify.py [--meshes 160x80,320x160] [--cases c1,c3] [--json FILE]
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 
 from mpi4py import MPI
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
 
+#: The JSON keys of a row, in the table's order.
+JSON_KEYS = (
+    "case",
+    "mesh",
+    "dofs",
+    "i",
+    "contact_nodes",
+    "free_solve_s",
+    "certificate_s",
+    "ratio",
+    "proven_by",
+    "relative_gap",
+    "factorisations",
+    "solves",
+    "load_Pa",
+    "lower_bound_Pa",
+)
+
 
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--meshes", default="160x80,320x160")
     parser.add_argument("--cases", default="c1,c3")
+    parser.add_argument("--json", help="append one JSON line per row to this file")
     args, _ = parser.parse_known_args()
     comm = MPI.COMM_WORLD
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
@@ -63,6 +86,10 @@ def main() -> None:
                 "| {} | {} | {} | {} | {} | {:.2f} | {:.2f} | **{:.2f}** | {} | {:.0e} | {} "
                 "| {} | {:.2f} | {:.2f} |".format(*row)
             )
+        if args.json:
+            with open(args.json, "a") as f:
+                for row in rows:
+                    f.write(json.dumps(dict(zip(JSON_KEYS, row, strict=True))) + "\n")
 
 
 if __name__ == "__main__":

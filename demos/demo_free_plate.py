@@ -117,7 +117,7 @@ if comm.rank == 0:
 #   lies in (1.8, 2.2).
 # - On the paper's 20 × 20 mesh the error is below 1 % (measured 0.54 %); on the
 #   refined 80 × 80 mesh below 0.05 % (measured 0.034 %; about 2e-4 at 160 × 80, see
-#   the README's verification section).
+#   the documentation's verification page, the test suite).
 
 # %%
 assert np.all(loads > lambda_rm), loads

@@ -15,7 +15,7 @@
 # plate the mode must keep to one side, so the m ≥ 2 garlands are out of reach: the
 # single buckle (φ + 1/φ)² holds up to φ = √2, where it reaches 4.5, and beyond it a
 # buckle against a loaded edge that touches down on the obstacle gives 4.5 whatever the
-# length (README, "Every plate the schema describes"). With the loaded edges clamped the
+# length (the documentation's thin-plate values). With the loaded edges clamped the
 # unilateral curve falls to 16/3, the buckle between two touch-downs.
 #
 # This demo illustrates how to:

@@ -19,9 +19,10 @@
 # `solve` with method "auto" runs the paper's enumeration of contact sets when the
 # 2^i candidate sets are few, and the active-set method otherwise (i = 171 constrained
 # nodes on the 20 × 20 mesh). Every answer comes with a certificate: the optimality
-# conditions of the README ("The problem": residual off the contact set Z, mode strictly
-# negative on I \ Z, obstacle only pushing on Z, λ the smallest eigenvalue of the pencil
-# with Z removed) and a verified bracket of the critical load.
+# conditions ("The problem and its KKT conditions" in the documentation: residual off the
+# contact set Z, mode strictly negative on I \ Z, obstacle only pushing on Z, λ the
+# smallest eigenvalue of the pencil with Z removed) and a verified bracket of the
+# critical load.
 #
 # This demo illustrates how to:
 #

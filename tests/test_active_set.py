@@ -277,10 +277,11 @@ def test_distributed_equals_serial():
 
 
 # -- convergence ------------------------------------------------------------------------
-#: The README's mesh-convergence table ("Results: the paper's plate"): unilateral loads in
-#: MPa on 20x10, 40x20, 80x40, 160x80, and the Richardson-extrapolated limits. The tests
-#: below recompute them, check the physics they claim (monotone decrease, rate h^2) and
-#: that the README prints what the code computes, to its printed digits.
+#: The mesh-convergence table of the docs (demos/paper.md; its limits in the README's
+#: results): unilateral loads in MPa on 20x10, 40x20, 80x40, 160x80, and the
+#: Richardson-extrapolated limits. The tests below recompute them, check the physics they
+#: claim (monotone decrease, rate h^2) and that the documentation prints what the code
+#: computes, to its printed digits.
 README_LOADS_MPA = {
     "c1": (14.568475, 14.376150, 14.328634, 14.316799),
     "c2": (14.566406, 14.373741, 14.326155, 14.314276),

@@ -105,7 +105,7 @@ def _run_method(
             complete=options.complete,
             max_candidates=options.max_candidates,
             candidate_comm=candidate_comm,
-            # "auto" must be exact: the paper's stopping rule is not (README).
+            # "auto" must be exact: the paper's stopping rule is not (docs: methods/enumeration).
             until_proven=options.until_proven or options.method == "auto",
         )
     if method == "interior-point":

@@ -1,7 +1,7 @@
 r"""Certificates of a unilateral critical state: local (KKT) and global (lower bound).
 
 Local. A candidate (:math:`\lambda`, u, Z) is a critical state of the discrete problem
-when (README, "The problem"; paper, Lemma 5.1)
+when (:doc:`/methods/problem`; paper, Lemma 5.1)
 
 - :math:`r = Au - \lambda Bu` vanishes off Z (relative residual below :math:`\sqrt\tau`),
 - :math:`u_k \le \tau \max|w|` on I (the mode does not cross the obstacle),

@@ -15,7 +15,7 @@ Exact thin-plate curves are drawn where they exist (:func:`reference_k`):
   *Theory of Elastic Stability*, 1961, section 9.2);
 - the same plate with the obstacle over the whole plate: the single buckle
   :math:`(\phi + 1/\phi)^2` up to :math:`\phi = \sqrt 2`, where it reaches 4.5, and 4.5
-  beyond (README, "Every plate the schema describes": a buckle against the loaded edge
+  beyond (:doc:`/verification/thin_plates`: a buckle against the loaded edge
   that touches down, f = 2 sin t (1 + cos t), has k = 9/2);
 - loaded edges clamped, unloaded simply supported, whole-plate obstacle: the long-plate
   value 16/3 (an interior buckle between two touch-downs, f = cos³(px)).

@@ -7,7 +7,7 @@ towards the admissible side of the obstacle, with its values and contact forces 
 constrained nodes. Nothing here keeps a "current" mode: whoever holds a candidate holds
 its mode.
 
-The discrete critical state (README, "The problem"): the smallest :math:`\lambda` and
+The discrete critical state (:doc:`/methods/problem`): the smallest :math:`\lambda` and
 :math:`u \ne 0` with :math:`u_k \le 0` on the constrained nodes I, :math:`r = Au -
 \lambda Bu = 0` off the contact set Z, :math:`u_k < 0` on :math:`I \setminus Z`,
 :math:`r_k \le 0` on Z, and :math:`\lambda` the smallest eigenvalue of the pencil with Z
@@ -59,7 +59,7 @@ logger = logging.getLogger(__name__)
 FIXED_LOAD_PREFIX = "unibuckle_fixed_"
 
 #: Peak memory per (w, theta) DOF of a solve, measured with MUMPS on one rank: 7.8 kB at
-#: 155k DOFs, 5.8 kB at 617k (README, "Parallel runs"); the estimate uses 8 kB.
+#: 155k DOFs, 5.8 kB at 617k (:doc:`/guide/mpi`); the estimate uses 8 kB.
 BYTES_PER_DOF = 8000
 
 

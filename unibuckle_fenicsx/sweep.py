@@ -5,7 +5,7 @@ solves the base problem at every point of the grid of the ``--vary`` values (the
 ``--vary`` varies slowest), each with the normal method and certificate, and writes one
 JSON line per point as soon as it is done:
 
-.. code-block:: json
+.. code-block:: text
 
     {"index": 0, "point": {"plate.length": 0.05}, "status": "ok",
      "critical_load_Pa": ..., "buckling_coefficient_k": ..., ...}
@@ -22,7 +22,7 @@ instead of the results. A failed point's PETSc objects are destroyed before the 
 point (collectively: every rank of the point takes the same branch). Any other error is
 a bug: it stops the sweep.
 
-**Paths** name any number of the TOML schema (README, "Problem files") by its dotted
+**Paths** name any number of the TOML schema (:doc:`/guide/plate`) by its dotted
 path, list entries by index: ``plate.thickness``, ``material.nu``,
 ``edges.left.normal_stress``, ``plate.corners.1.0`` (x1), ``obstacle.zone.0.1``,
 ``mesh.size``, ``edges.top.rotational_stiffness``, ``points.0.spacing`` (a tie

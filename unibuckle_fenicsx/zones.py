@@ -1,6 +1,6 @@
 r"""How the mesh sees each obstacle zone: the discrete zone against the zone given.
 
-The obstacle acts at the mesh nodes of the closed zone (README, "The problem"): the
+The obstacle acts at the mesh nodes of the closed zone (:doc:`/methods/problem`): the
 bilinear deflection is then :math:`\le 0` on every cell whose four nodes are in the zone,
 and only there. So the *discrete zone* is the union of those cells; its area, next to the
 area of the zone given (its part on the plate), says how far the mesh follows the zone.

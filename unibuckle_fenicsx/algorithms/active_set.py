@@ -1,6 +1,6 @@
 r"""Primal-dual active-set method for the unilateral critical state, with bounds.
 
-The discrete problem (README, "The problem"): the smallest :math:`\lambda` and
+The discrete problem (:doc:`/methods/problem`): the smallest :math:`\lambda` and
 :math:`u \neq 0` with :math:`u_k \le 0` on the constrained nodes I and
 
 - :math:`r = A u - \lambda B u` zero off the contact set :math:`Z = \{k: u_k = 0\}`,
@@ -83,17 +83,18 @@ TWIN_RTOL = 1e-8
 POLISH_ITERATIONS = 25
 #: Eigen solves allowed to the feasible descent, per ``max_iterations``.
 DESCENT_BUDGET = 10
-#: Looser tolerances the iteration converges with first (README, "Every plate the schema
-#: describes"): on thin plates the mode's tails, 1e-3 to 1e-8 of the buckle, flip sign
-#: from one contact set to the next, and chasing them at the final tolerance at once
-#: moves the contact lines a node per iterate.
+#: Looser tolerances the iteration converges with first (:doc:`/methods/active_set`):
+#: on thin plates the mode's tails, 1e-3 to 1e-8 of the buckle, flip sign from one
+#: contact set to the next, and chasing them at the final tolerance at once moves the
+#: contact lines a node per iterate.
 THRESHOLDS = (1e-2, 1e-3, 1e-4, 1e-6)
 #: Iterates allowed to a greedy seed when another seed has reached a KKT point (it adds
 #: one node per iterate and is there for small contact sets: on the paper's plate it ends
-#: in 5-13, on the thin plates of the README's table it was still adding nodes after 100
-#: on the 45x15 level). When no other seed has, it gets ``max_iterations``: its best
-#: admissible mode may then be the feasible descent's start (on the long clamped plate of
-#: the README's descent table, at b/6, it gives k = 5.6673 where a capped run gives 5.7015).
+#: in 5-13, on the thin plates of the changelog's active-set table it was still adding
+#: nodes after 100 on the 45x15 level). When no other seed has, it gets
+#: ``max_iterations``: its best admissible mode may then be the feasible descent's start
+#: (on the long clamped plate of the descent table of :doc:`/verification/thin_plates`,
+#: at b/6, it gives k = 5.6673 where a capped run gives 5.7015).
 GREEDY_ITERATIONS = 25
 #: Seeds run on the coarsest level, in this order.
 SEED_NAMES = ("free+", "free-", "all", "end-low", "middle", "end-high", "greedy+", "greedy-")
@@ -378,8 +379,7 @@ def solve_active_set(
             f"eigen solves) ended {'at a KKT point' if run.status == 'kkt' else run.status}"
         )
     if not kkt:
-        # Both stalled: the feasible descent cannot cycle (README, "Every plate the
-        # schema describes").
+        # Both stalled: the feasible descent cannot cycle (docs: methods/active_set).
         last, steps = _descent(problem, runs, DESCENT_BUDGET * max_iterations)
         if last is not None:
             runs.append(last)

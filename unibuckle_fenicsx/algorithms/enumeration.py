@@ -17,7 +17,7 @@ critical one. Every result therefore carries a proven lower bound:
 
 Optimality. The critical state's contact set Z has a feasible reduced first mode
 (Lemma 5.1), so it is one of the feasible sets. Removing more DOFs never lowers the
-smallest eigenvalue (interlacing, README "The problem"), so a set Z with :math:`|Z| > q`
+smallest eigenvalue (interlacing, :doc:`/methods/problem`), so a set Z with :math:`|Z| > q`
 has :math:`\lambda(Z) \ge \max_{S \subset Z, |S| = q} \lambda(S)`, a maximum over at
 least q + 1 distinct sets of size q; it is therefore at least :math:`\mu_q`, the
 (q+1)-th smallest :math:`\lambda(S)` over *all* sets of size q (feasible or not). After

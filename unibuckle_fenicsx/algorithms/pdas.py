@@ -95,7 +95,7 @@ def iterate(
         thresholds: Looser tolerances (decreasing, each above ``problem.tau``) to
             converge with first: the iteration ignores violations and pulls below the
             current threshold, and moves to the next one at a point that is KKT at this
-            one, warm-started (README, "Every plate the schema describes").
+            one, warm-started (:doc:`/methods/active_set`).
 
     Note:
         Collective.

@@ -94,7 +94,7 @@ class PenaltyStep:
         load: Smallest eigenvalue :math:`\lambda_S` of :math:`(A_S, B)`.
         quotient: :math:`R_\rho` of the oriented mode (equals ``load`` at a fixed point).
         penetration: Largest oriented :math:`w_k/\max|w|` over I (0 if none penetrates).
-        penetrating: Sorted node numbers with :math:`w_k > ` threshold: the next S.
+        penetrating: Sorted node numbers with :math:`w_k` above the threshold: the next S.
     """
 
     springs: npt.NDArray[np.int64]
@@ -266,7 +266,7 @@ class PenaltySolver(Owner):
                 first solve is the free plate). For a sequence of penalties, pass the
                 previous penalty's set (continuation).
             max_iterations: Eigen solves allowed, >= 1.
-            threshold: A node penetrates when :math:`w_k > ` threshold * max|w|; in
+            threshold: A node penetrates when :math:`w_k` above the threshold * max|w|; in
                 [0, 1e-2].
             condition: Also estimate the condition number of the final :math:`A_{pen}`
                 (:meth:`condition_number`, two extra SLEPc solves).
