@@ -23,7 +23,7 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 def _interior_nodes_in_box(nx, ny, length, width, box) -> int:

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED, EXIT_OK, _parser, main
-from unibuckle_fenicsx.materials import navier_load_mindlin
+from unibuckle_fenicsx.model.materials import navier_load_mindlin
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
 
@@ -272,7 +272,7 @@ def test_unwritable_output_is_refused_before_solving(tmp_path, capsys, no_solve,
 
 def test_one_cell_and_huge_meshes_are_refused(capsys, monkeypatch):
     """--nx 1 names mesh.nx; a 100000 x 100000 mesh is refused with its memory estimate."""
-    import unibuckle_fenicsx.problem as problem_module
+    import unibuckle_fenicsx.model.problem as problem_module
 
     assert main(["solve", "--case", "free", "--nx", "1"]) == EXIT_BAD_INPUT
     assert "mesh.nx must be an integer >= 2" in capsys.readouterr().err

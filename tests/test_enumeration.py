@@ -28,10 +28,10 @@ from conftest import ROOT, run_mpi
 from unibuckle_fenicsx.algorithms.enumeration import TIE_RTOL, enumerate_contact_sets
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.certify import certify
+from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.config import ObstacleSpec, ProblemSpec
-from unibuckle_fenicsx.contact import EmptyZoneError
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 RTOL = 1e-9
 BIG = 10**12  # max_candidates that never refuses

@@ -32,9 +32,9 @@ import pytest
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
-from unibuckle_fenicsx.contact import tributary_areas
-from unibuckle_fenicsx.materials import bending_stiffness
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.contact import tributary_areas
+from unibuckle_fenicsx.model.materials import bending_stiffness
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 THICKNESS = 1e-3  # b = 1 m: t/b = 1e-3, the thin limit
 D = bending_stiffness(1.0e9, 0.3, THICKNESS)

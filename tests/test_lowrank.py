@@ -33,17 +33,12 @@ from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.certify import BRACKET_GAP, certify
+from unibuckle_fenicsx.certificate.accurate import AccurateResidual, two_product, two_sum
+from unibuckle_fenicsx.certificate.certify import BRACKET_GAP, certify
+from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions, lowrank_certificate
+from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.config import ObstacleSpec
-from unibuckle_fenicsx.copositivity import ShiftedMatrix
-from unibuckle_fenicsx.copositivity_lowrank import (
-    AccurateResidual,
-    LowRankOptions,
-    lowrank_certificate,
-    two_product,
-    two_sum,
-)
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 pytest.importorskip("clarabel")
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")

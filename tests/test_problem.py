@@ -14,8 +14,8 @@ import pytest
 from unibuckle_fenicsx import EdgeSpec, MeshSpec, PlateSpec, paper_case
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.eigen import GEPSolver
-from unibuckle_fenicsx.mesh import create_plate_mesh
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.mesh import create_plate_mesh
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 def test_user_mesh_with_own_tags_matches_rectangle():

@@ -17,10 +17,10 @@ from unibuckle_fenicsx.algorithms import (
     candidate_count,
 )
 from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
-from unibuckle_fenicsx.certify import Certificate, certify, certify_foundation
+from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.results import BucklingResult
 
 __all__ = ["Analysis", "choose_method", "solve"]
@@ -189,7 +189,7 @@ def solve(
         eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
             is ``-unibuckle_eps_view``).
         mesh: Optional quadrilateral mesh replacing ``spec.mesh`` (with ``facet_tags``;
-            see :class:`~unibuckle_fenicsx.problem.BucklingProblem`).
+            see :class:`~unibuckle_fenicsx.model.problem.BucklingProblem`).
         facet_tags: Edge markers of ``mesh``.
 
     Returns:

@@ -535,7 +535,7 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
     from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
     from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.eigen import EigenSolveError
-    from unibuckle_fenicsx.results import write_fields, write_json
+    from unibuckle_fenicsx.io import write_fields, write_json
 
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
         return _fail(comm, message, status)
@@ -772,7 +772,7 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
             flush=True,
         )
         if args.plot:
-            from unibuckle_fenicsx.charts import plot_sweep
+            from unibuckle_fenicsx.viz.charts import plot_sweep
 
             print(f"sweep: chart {plot_sweep(lines, variations, base, args.plot)}")
     ok = all(line["status"] == "ok" for line in lines)

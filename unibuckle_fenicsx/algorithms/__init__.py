@@ -1,8 +1,8 @@
 """Unilateral critical-state algorithms.
 
-Each takes a :class:`~unibuckle_fenicsx.problem.BucklingProblem` with an obstacle and
+Each takes a :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle and
 returns a :class:`UnilateralSolution` holding the chosen
-:class:`~unibuckle_fenicsx.problem.Candidate` (load, contact set and its own mode):
+:class:`~unibuckle_fenicsx.model.problem.Candidate` (load, contact set and its own mode):
 
 - :mod:`.enumeration`: the paper's direct method (section 5.3), 2^i candidate sets;
 - :mod:`.active_set`: primal-dual active-set iteration from several seeds
@@ -19,7 +19,7 @@ import numpy as np
 import numpy.typing as npt
 
 if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.problem import Candidate
+    from unibuckle_fenicsx.model.problem import Candidate
 
 __all__ = ["NoAdmissibleModeError", "UnilateralSolution", "candidate_count"]
 

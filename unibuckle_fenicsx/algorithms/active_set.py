@@ -47,7 +47,7 @@ answer is replaced and the replacement is reported.
 
 Note:
     All decisions use values reduced over the ranks
-    (:meth:`~unibuckle_fenicsx.contact.ContactSetManager.values`), so every rank takes
+    (:meth:`~unibuckle_fenicsx.model.contact.ContactSetManager.values`), so every rank takes
     the same path; the function is collective on ``problem.comm``.
 """
 
@@ -67,8 +67,8 @@ from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
-from unibuckle_fenicsx.contact import EmptyZoneError
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 
 __all__ = ["SEED_NAMES", "TWIN_RTOL", "solve_active_set"]

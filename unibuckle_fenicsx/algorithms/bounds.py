@@ -18,7 +18,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from unibuckle_fenicsx.algorithms.descent import descend
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 
 __all__ = ["PROOF_RTOL", "Bracket", "bracket", "lattice_bound"]
 

@@ -12,7 +12,7 @@ For a rigid obstacle (any side, several zones) the chain is
    Newton steps restore the barrier problem, and so on to the fine mesh.
 2. **Contact set and exact eigenpair.** The fine barrier solution gives the contact set
    Z (the nodes whose gap is at the tolerance ``tau``); the smallest eigenpair of the
-   pencil with Z removed (:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`)
+   pencil with Z removed (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`)
    is the returned critical state, checked against the KKT conditions. If it fails, the
    barrier is driven lower and the active-set iteration (:mod:`.pdas`) polishes Z; if
    that fails too, the coarse state is carried once more at a small barrier parameter
@@ -54,8 +54,8 @@ from unibuckle_fenicsx.algorithms.interior_point import (
 )
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
 from unibuckle_fenicsx.algorithms.pdas import iterate
-from unibuckle_fenicsx.contact import EmptyZoneError
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 
 __all__ = ["THIN_PLATE", "ChainOptions", "LevelRecord", "LinkRecord", "solve_unilateral"]

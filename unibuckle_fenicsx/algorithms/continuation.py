@@ -30,7 +30,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = ["COLD_PENALTIES", "WARM_PENALTIES", "penalty_continuation"]
 

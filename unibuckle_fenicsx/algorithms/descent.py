@@ -46,7 +46,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms.pdas import Run
 from unibuckle_fenicsx.eigen import set_options
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 
 __all__ = ["admissible_start", "descend"]
 

@@ -3,7 +3,7 @@ r"""The paper's direct method (Ayadi, section 5.3): enumerate the contact sets b
 For p = 0, 1, ..., i (i = number of constrained nodes) and every subset Z of I with
 |Z| = p, in the lexicographic order of :func:`itertools.combinations`, compute the
 smallest eigenpair of the pencil with the w-DOFs of Z removed
-(:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`). The mode is *feasible*
+(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`). The mode is *feasible*
 when, suitably oriented, it is negative on :math:`I \setminus Z` (tolerance tau). Keep
 the smallest feasible load and stop after the first p that produced a feasible mode
 (:math:`p^*`), or visit every p (``complete=True``) to check the paper's observation
@@ -59,7 +59,7 @@ from unibuckle_fenicsx.algorithms import (
     UnilateralSolution,
     candidate_count,
 )
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.progress import Progress
 

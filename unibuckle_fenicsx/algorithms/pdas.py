@@ -1,7 +1,7 @@
 r"""The primal-dual active-set iteration on the contact set.
 
 From a seed :math:`Z_0`, repeat: solve the reduced pencil
-(:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`, warm-started from the
+(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`, warm-started from the
 previous mode; the candidate comes back oriented away from the obstacle), add the nodes of
 :math:`I \setminus Z` where the mode violates the obstacle (:math:`u_k > \tau`) and release
 the nodes of Z whose multiplier pulls (:math:`r_k > \tau \|Au\|_\infty`). It stops at a
@@ -28,7 +28,7 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 
 __all__ = ["Run", "iterate"]
 

@@ -29,7 +29,7 @@ admissible mode is one). The lower bound reported is :math:`\lambda_{free}`
 (interlacing). ``rho`` is given relative to the largest diagonal entry of A:
 :math:`\rho_{abs} = \rho \max_j A_{jj}`.
 
-A is assembled once (by :class:`~unibuckle_fenicsx.plate.model.PlateModel`); the
+A is assembled once (by :class:`~unibuckle_fenicsx.model.plate.model.PlateModel`); the
 springs are added on the diagonal of a private copy :math:`A_{pen}`, which has its
 own :class:`~unibuckle_fenicsx.eigen.GEPSolver` with the options prefix
 ``unibuckle_penalty_``.
@@ -58,7 +58,7 @@ from unibuckle_fenicsx.eigen import (
     extreme_eigenvalues,
     release,
 )
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 
 __all__ = [
     "CONDITION_PREFIX",
@@ -135,7 +135,7 @@ class PenaltySolver(Owner):
     r"""Penalised pencil :math:`(A + \rho_{abs} \sum_{k\in S} e_k e_k^T, B)` of a problem.
 
     Args:
-        problem: A :class:`~unibuckle_fenicsx.problem.BucklingProblem` with an obstacle.
+        problem: A :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle.
         prefix: Options prefix of the eigen solver (``-<prefix>eps_view`` etc. apply).
         eps_options: Extra EPS options under ``prefix`` (merged into
             :data:`~unibuckle_fenicsx.eigen.EIGEN_OPTIONS`).
@@ -496,7 +496,7 @@ def solve_penalty(
     r"""Penalty method for one relative penalty ``rho`` (see the module docstring).
 
     Args:
-        problem: A :class:`~unibuckle_fenicsx.problem.BucklingProblem` with an obstacle.
+        problem: A :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle.
         rho: Penalty relative to the largest diagonal entry of A, finite and > 0.
         initial_active: Starting spring set (default empty).
         max_iterations: Eigen solves allowed, >= 1.

@@ -18,13 +18,13 @@ with Reissner–Mindlin bending and shear) is
     \kappa = \mathrm{sym}\nabla(\theta - \theta_0),
 
 with the membrane and bending stiffnesses of the linear model and :math:`K_s = P^T M_s P`
-its MITC shear stiffness (:func:`~unibuckle_fenicsx.plate.model.mitc_shear_matrix`):
+its MITC shear stiffness (:func:`~unibuckle_fenicsx.model.plate.model.mitc_shear_matrix`):
 the shear energy is quadratic, so :math:`K_s` is assembled once and adds
 :math:`K_s(x - x_0)` to the residual and :math:`K_s` to the Jacobian. The edge supports
 and the edge loads are those of the same :class:`~unibuckle_fenicsx.config.ProblemSpec`.
 
 The obstacle (:math:`w \le g` at the zone's nodes, the nodes of
-:class:`~unibuckle_fenicsx.contact.ContactSetManager`, g the obstacle's gap, 0 by
+:class:`~unibuckle_fenicsx.model.contact.ContactSetManager`, g the obstacle's gap, 0 by
 default) enters as variable bounds of PETSc's
 reduced-space VI Newton method (``vinewtonrsls``); the other bounds are
 ``PETSc.INFINITY``. DOLFINx's ``NonlinearProblem`` takes no bounds and assembles forms
@@ -56,21 +56,25 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
-from unibuckle_fenicsx.contact import ContactSetManager
 from unibuckle_fenicsx.eigen import Owner, release, set_options
-from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, transverse_shear
-from unibuckle_fenicsx.mesh import (
+from unibuckle_fenicsx.model.contact import ContactSetManager
+from unibuckle_fenicsx.model.materials import bending_voigt, membrane_voigt, transverse_shear
+from unibuckle_fenicsx.model.mesh import (
     build_plate_mesh,
     edge_facets,
     edge_normal_axis,
     edge_tag,
     edge_tags,
 )
-from unibuckle_fenicsx.plate.forms import shear_force
-from unibuckle_fenicsx.plate.model import edge_spring_form, edge_support_bcs, mitc_shear_matrix
-from unibuckle_fenicsx.plate.spaces import MixedDofs
-from unibuckle_fenicsx.points import point_bcs, point_springs, snap_points
-from unibuckle_fenicsx.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
+from unibuckle_fenicsx.model.plate.forms import shear_force
+from unibuckle_fenicsx.model.plate.model import (
+    edge_spring_form,
+    edge_support_bcs,
+    mitc_shear_matrix,
+)
+from unibuckle_fenicsx.model.plate.spaces import MixedDofs
+from unibuckle_fenicsx.model.points import point_bcs, point_springs, snap_points
+from unibuckle_fenicsx.model.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
 
 __all__ = [
     "CONTROLS",

@@ -1,7 +1,7 @@
 r"""Copositivity certificates by semidefinite programming (two or more negative eigenvalues).
 
 Needs the ``sdp`` extra (cvxpy with the Clarabel interior-point solver). Used by
-:mod:`unibuckle_fenicsx.copositivity` when :math:`K(\lambda) = A - \lambda B` has two or
+:mod:`unibuckle_fenicsx.certificate.copositivity` when :math:`K(\lambda) = A - \lambda B` has two or
 more negative eigenvalues, where the rank-2 route does not apply, and only for small i
 (dense i x i programs).
 
@@ -45,9 +45,9 @@ except ImportError as err:  # pragma: no cover
         "the SDP certificate needs cvxpy and Clarabel: pip install 'unibuckle_fenicsx[sdp]'"
     ) from err
 
-from unibuckle_fenicsx.copositivity import CERTIFY_PREFIX, EPS, ShiftedMatrix
+from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX, EPS, ShiftedMatrix
 from unibuckle_fenicsx.eigen import SymmetricFactorization
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = ["SDP_SOLVER", "sector_certificate", "spn_certificate"]
 

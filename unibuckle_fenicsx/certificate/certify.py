@@ -13,11 +13,11 @@ when (README, "The problem"; paper, Lemma 5.1)
 
 Global. The algorithms bracket the critical load: any admissible mode's load is an upper
 bound; interlacing, the lattice search and exhaustive enumeration give lower bounds, and
-:mod:`unibuckle_fenicsx.copositivity` proves one just below a KKT point's load when
+:mod:`unibuckle_fenicsx.certificate.copositivity` proves one just below a KKT point's load when
 :math:`A - \lambda B` is copositive on the cone there (a rank-2 certificate that costs one
 sparse :math:`LDL^T`, or a semidefinite program for small i), or, when several pencil
 eigenvalues lie below the load, a slightly lower one by the low-rank route
-(:mod:`unibuckle_fenicsx.copositivity_lowrank`). The result is a *verified bracket*:
+(:mod:`unibuckle_fenicsx.certificate.copositivity_lowrank`). The result is a *verified bracket*:
 *proven* globally optimal when it closes to :data:`PROOF_GAP`, *bracketed* when its
 verified relative gap is at most :data:`BRACKET_GAP` (the load is then known to that
 accuracy: no admissible mode has a load below the lower bound), otherwise "KKT only".
@@ -42,9 +42,10 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
-from unibuckle_fenicsx.copositivity import CERTIFY_PREFIX, BoundOptions, copositivity_bound
+from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
+from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX
 from unibuckle_fenicsx.eigen import SymmetricFactorization
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 
 __all__ = [
     "BRACKET_GAP",
@@ -97,7 +98,7 @@ class Certificate:
         notes: Anything that failed or was skipped, in words.
         refuting_mode: An admissible mode with a lower load than the returned one, found
             by the low-rank route (the returned KKT point is then not the global
-            minimum): a :class:`~unibuckle_fenicsx.problem.Candidate` (its ``eigen`` is
+            minimum): a :class:`~unibuckle_fenicsx.model.problem.Candidate` (its ``eigen`` is
             None: a Rayleigh quotient, not an eigenpair) from which a solver can
             continue. Not in :meth:`as_dict` (its load is: ``refuting_load_Pa``).
     """

@@ -29,13 +29,6 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.contact import (
-    BilateralZoneError,
-    ContactSetManager,
-    check_zone_has_nodes,
-    foundation_springs,
-    orientation,
-)
 from unibuckle_fenicsx.eigen import (
     EIGEN_OPTIONS,
     EigenPair,
@@ -44,11 +37,18 @@ from unibuckle_fenicsx.eigen import (
     SymmetricFactorization,
     release,
 )
-from unibuckle_fenicsx.materials import reference_bending_stiffness
-from unibuckle_fenicsx.mesh import build_plate_mesh
-from unibuckle_fenicsx.plate.model import PlateModel
-from unibuckle_fenicsx.points import point_obstacles
-from unibuckle_fenicsx.prestress import solve_prestress
+from unibuckle_fenicsx.model.contact import (
+    BilateralZoneError,
+    ContactSetManager,
+    check_zone_has_nodes,
+    foundation_springs,
+    orientation,
+)
+from unibuckle_fenicsx.model.materials import reference_bending_stiffness
+from unibuckle_fenicsx.model.mesh import build_plate_mesh
+from unibuckle_fenicsx.model.plate.model import PlateModel
+from unibuckle_fenicsx.model.points import point_obstacles
+from unibuckle_fenicsx.model.prestress import solve_prestress
 
 __all__ = ["BYTES_PER_DOF", "BucklingProblem", "Candidate", "Mode", "available_memory"]
 
@@ -126,7 +126,7 @@ class Candidate:
         active: Sorted node numbers of the contact set Z.
         load: :math:`\lambda(Z)` (``inf`` when no geometric stiffness is left).
         mode: The mode (w, theta), oriented (see
-            :func:`~unibuckle_fenicsx.contact.orientation`) and scaled to max |w| = 1.
+            :func:`~unibuckle_fenicsx.model.contact.orientation`) and scaled to max |w| = 1.
         values: The mode at the constrained nodes (max |w| = 1 over the plate).
         forces: :math:`r = Au - \lambda Bu` at the constrained nodes, relative to
             :math:`\|Au\|_\infty` (positive: the node pulls the obstacle).
@@ -175,7 +175,7 @@ class BucklingProblem(Owner):
 
     Attributes:
         eigensolver: The :class:`~unibuckle_fenicsx.eigen.GEPSolver` of the pencil.
-        contact: The :class:`~unibuckle_fenicsx.contact.ContactSetManager` (None
+        contact: The :class:`~unibuckle_fenicsx.model.contact.ContactSetManager` (None
             without obstacle).
         free: The free mode, once :meth:`solve_free` has run.
 
@@ -425,7 +425,7 @@ class BucklingProblem(Owner):
             active: Sorted contact set Z claimed for it.
             eigen: SLEPc's report, if ``u`` is an eigenvector.
             sign: Orientation to apply instead of
-                :func:`~unibuckle_fenicsx.contact.orientation`'s.
+                :func:`~unibuckle_fenicsx.model.contact.orientation`'s.
 
         Note:
             Collective.

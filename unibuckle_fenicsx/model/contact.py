@@ -39,7 +39,7 @@ __all__ = [
 class PlateDofs(Protocol):
     """What :class:`ContactSetManager` needs of a plate model: its w-DOFs and supports.
 
-    :class:`~unibuckle_fenicsx.plate.model.PlateModel` (the (w, theta) space) and the
+    :class:`~unibuckle_fenicsx.model.plate.model.PlateModel` (the (w, theta) space) and the
     von Karman model (u, w, theta) both provide it.
     """
 

@@ -26,10 +26,11 @@ from mpi4py import MPI
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx import fields, plotting
 from unibuckle_fenicsx.analysis import Analysis, solve
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.results import BucklingResult, write_fields
+from unibuckle_fenicsx.io import write_fields
+from unibuckle_fenicsx.results import BucklingResult
+from unibuckle_fenicsx.viz import fields, plotting
 
 __all__ = [
     "COARSE_MESHES",

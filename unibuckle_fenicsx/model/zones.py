@@ -5,7 +5,7 @@ bilinear deflection is then :math:`\le 0` on every cell whose four nodes are in 
 and only there. So the *discrete zone* is the union of those cells; its area, next to the
 area of the zone given (its part on the plate), says how far the mesh follows the zone.
 On a gmsh plate the zone's edges are mesh lines
-(:func:`~unibuckle_fenicsx.gmsh_mesh.gmsh_plate_mesh`) and the two agree, up to the
+(:func:`~unibuckle_fenicsx.model.gmsh_mesh.gmsh_plate_mesh`) and the two agree, up to the
 polygon a circle's cells inscribe; on the structured rectangle they agree when the grid
 has lines on the zone's edges.
 """

@@ -1,6 +1,6 @@
 """Data of a solved problem for figures: nodal deflections, sections, the zone's box.
 
-Kept apart from :mod:`unibuckle_fenicsx.plotting` (which only draws): the functions that
+Kept apart from :mod:`unibuckle_fenicsx.viz.plotting` (which only draws): the functions that
 read a mode are collective on the mesh communicator and return the same arrays on every
 rank, so that drawing can happen on rank 0 alone.
 """
@@ -16,7 +16,7 @@ if TYPE_CHECKING:  # pragma: no cover
     import dolfinx
 
     from unibuckle_fenicsx.config import ProblemSpec
-    from unibuckle_fenicsx.problem import BucklingProblem
+    from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
     "mesh_triangles",
