@@ -162,7 +162,10 @@ class Analysis(Owner):
     @property
     def free_mode(self) -> dolfinx.fem.Function:
         """The mode without obstacle, max |w| = 1."""
-        assert self.problem.free is not None
+        if self.problem.free is None:
+            raise RuntimeError(
+                "free_mode: expected self.problem.free is not None (an internal invariant)"
+            )
         return self.problem.free.function
 
     def destroy(self) -> None:

@@ -251,7 +251,8 @@ class GEPSolver(Owner):
         else:
             self.A.copy(self._Aw, structure=same)  # type: ignore[arg-type]
             self.B.copy(self._Bw, structure=same)  # type: ignore[arg-type]
-        assert self._Bw is not None
+        if self._Bw is None:
+            raise RuntimeError("reduced: expected self._Bw is not None (an internal invariant)")
         rows = np.ascontiguousarray(removed, dtype=PETSc.IntType)
         self._Aw.zeroRowsColumns(rows, diag=1.0)  # type: ignore[arg-type]
         self._Bw.zeroRowsColumns(rows, diag=0.0)  # type: ignore[arg-type]
@@ -282,7 +283,8 @@ class GEPSolver(Owner):
         """
         n_removed = self.A.comm.tompi4py().allreduce(0 if removed is None else len(removed))
         if n_removed:
-            assert removed is not None
+            if removed is None:
+                raise RuntimeError("solve: expected removed is not None (an internal invariant)")
             A, B = self.reduced(removed)
         else:
             A, B = self.A, self.B

@@ -68,7 +68,11 @@ def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
         with dolfinx.io.VTXWriter(problem.comm, path, funcs, engine="BP4") as writer:
             writer.write(0.0)
     paths.append(directory / f"{case}.pvd")
-    assert all(path.parent == directory for path in paths)
+    if not all(path.parent == directory for path in paths):
+        raise RuntimeError(
+            "write_fields: expected all(path.parent == directory for path in paths) (an internal "
+            "invariant)"
+        )
     with dolfinx.io.VTKFile(problem.comm, paths[-1], "w") as vtk:
         vtk.write_function([*fields, theta], 0.0)
     return paths

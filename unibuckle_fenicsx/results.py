@@ -191,7 +191,10 @@ class BucklingResult:
             result.lower_bound_Pa = result.upper_bound_Pa = free.load
             return result
         contact = problem.contact
-        assert contact is not None
+        if contact is None:
+            raise ValueError(
+                "from_solution: the problem has no obstacle (this needs an obstacle zone)"
+            )
         active = solution.active
         rows = contact.removed_rows(active)
         result.constrained_nodes = problem.num_constrained

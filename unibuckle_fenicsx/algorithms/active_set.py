@@ -62,7 +62,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
-from unibuckle_fenicsx.algorithms.bounds import PROOF_RTOL, bracket
+from unibuckle_fenicsx.algorithms.bounds import bracket
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
@@ -70,13 +70,12 @@ from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+from unibuckle_fenicsx.tolerances import PROOF_RTOL, ROUNDING_RTOL, TWIN_RTOL
 
-__all__ = ["SEED_NAMES", "TWIN_RTOL", "solve_active_set"]
+__all__ = ["SEED_NAMES", "solve_active_set"]
 
 logger = logging.getLogger(__name__)
 
-#: Loads within this relative distance are equal-load twins.
-TWIN_RTOL = 1e-8
 #: Iterates allowed when polishing a prolonged contact set (it needs one to three when
 #: the coarser level predicts the fine one; more means it stalls: the fallback takes over).
 POLISH_ITERATIONS = 25
@@ -102,7 +101,8 @@ def _seeds(
     problem: BucklingProblem, free_values: npt.NDArray[np.float64], tau: float
 ) -> list[tuple[str, npt.NDArray[np.int64]]]:
     """Seed contact sets (deduplicated, in :data:`SEED_NAMES` order)."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("_seeds: the problem has no obstacle (this needs an obstacle zone)")
     xy = problem.contact.coordinates
     plate = problem.spec.plate
     (x0, y0), (x1, y1) = plate.corners
@@ -128,7 +128,7 @@ def _seeds(
         elif name in ("greedy+", "greedy-"):
             v = free_values if name == "greedy+" else -free_values
             z = (
-                np.flatnonzero(v >= v.max() * (1.0 - 1e-9))
+                np.flatnonzero(v >= v.max() * (1.0 - ROUNDING_RTOL))
                 if v.max() > tau * scale
                 else np.empty(0, np.intp)
             )
@@ -145,7 +145,8 @@ def _seeds(
 
 def _multi_seed(problem: BucklingProblem, max_iterations: int) -> list[Run]:
     """Run the iteration from every seed, starting from the free mode."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("_multi_seed: the problem has no obstacle (this needs an obstacle zone)")
     free = problem.solve_free().function.x.petsc_vec
     values = problem.contact.values(free)
     runs: list[Run] = []
@@ -183,7 +184,9 @@ def _polish(
 
 
 def _twin_groups(points: list[Candidate]) -> list[list[Candidate]]:
-    """Group KKT points (sorted by load) whose loads agree within :data:`TWIN_RTOL`.
+    """Group KKT points (sorted by load) whose loads agree within TWIN_RTOL (relative).
+
+    (:data:`~unibuckle_fenicsx.tolerances.TWIN_RTOL`.)
 
     Each group is ordered by contact-set size, then lexicographically, so that its
     first member does not depend on rounding (e.g. on the number of ranks).
@@ -316,7 +319,10 @@ def solve_active_set(
             coarse_runs = _multi_seed(cp, max_iterations)
             runs = coarse_runs
         else:
-            assert prev is not None
+            if prev is None:
+                raise RuntimeError(
+                    "solve_active_set: expected prev is not None (an internal invariant)"
+                )
             runs = _polish(cp, prev, candidates, min(max_iterations, POLISH_ITERATIONS))
         kkt = _distinct_kkt(runs)
         groups = _twin_groups(kkt)
@@ -363,7 +369,7 @@ def solve_active_set(
     warnings: list[str] = []
     if not kkt:
         # The iteration stalled on this mesh: penalty continuation, started from the free
-        # plate (a stalled contact set is a poorer start, measured on thin plates).
+        # plate (on thin plates a stalled contact set is a poorer start).
         run, penalty_solves = penalty_continuation(problem, None, max_iterations=200)
         runs.append(run)
         kkt = _distinct_kkt(runs)

@@ -57,6 +57,7 @@ from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 __all__ = ["THIN_PLATE", "ChainOptions", "LevelRecord", "LinkRecord", "solve_unilateral"]
 
@@ -370,7 +371,7 @@ def _critical_state(
     if cand.kkt:
         return cand, point
     for attempt in range(0 if quick else options.escapes):
-        saddle = not cand.feasible and cand.load < point.load * (1.0 - 1e-9)
+        saddle = not cand.feasible and cand.load < point.load * (1.0 - ROUNDING_RTOL)
         if not (saddle and newton.escape(point, cand.mode.x.petsc_vec)):
             break
         tag = f"{label} (escape {attempt + 1})"

@@ -83,7 +83,8 @@ def penalty_continuation(
                 "penalty continuation rho=%g: %s, %d solves, R = %.10g, |S| = %d",
                 rho, sol.details["penalty_status"], sol.eigensolves, sol.load, len(springs),
             )  # fmt: skip
-        assert springs is not None, "penalties must not be empty"
+        if springs is None:
+            raise ValueError("penalties must not be empty")
         mode = sol.candidate.mode.x.petsc_vec
         run = iterate(problem, "penalty", springs, mode, polish_iterations)
     if run.final is not None and not math.isfinite(run.final.load):

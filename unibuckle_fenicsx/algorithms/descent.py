@@ -47,19 +47,14 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms.pdas import Run
 from unibuckle_fenicsx.eigen import set_options
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL, SAME_DIRECTION, ZERO_STEP
 
 __all__ = ["admissible_start", "descend"]
 
 #: Options of the gradient release's solve (prefix ``unibuckle_descent_``).
 GRADIENT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-#: d within this angle of u is u (an eigenvector is accurate to about the eigen solver's
-#: tolerance, 1e-10, over the spectral gap; a smaller threshold makes round-off a step).
-SAME_DIRECTION = 1e-8
 #: Kinds of step counted by :func:`descend`.
 STEP_KINDS = ("full", "partial", "zero", "gradient")
-#: A blocking angle below this fraction of the step's full angle is a zero step (the node
-#: is at the obstacle up to round-off).
-ZERO_STEP = 1e-9
 
 
 def admissible_start(
@@ -150,7 +145,8 @@ class _Gradient:
     def direction(self, u: PETSc.Vec, working: npt.NDArray[np.int64]) -> PETSc.Vec:
         """The direction g for the working set ``working`` (a new vector)."""
         problem = self.problem
-        assert problem.contact is not None
+        if problem.contact is None:
+            raise ValueError("direction: the problem has no obstacle (this needs an obstacle zone)")
         A, B = problem.model.A, problem.model.B
         rows = np.asarray(problem.contact.removed_rows(working), dtype=PETSc.IntType)
         Aw, _ = problem.eigensolver.reduced(rows)
@@ -192,7 +188,10 @@ def descend(
     Note:
         Collective.
     """
-    assert problem.contact is not None and start.feasible
+    if problem.contact is None:
+        raise ValueError("descend: the problem has no obstacle (this needs an obstacle zone)")
+    if not start.feasible:
+        raise ValueError("descend: start must be feasible (an admissible mode)")
     n, tau = problem.contact.size, problem.tau
     A, B = problem.model.A, problem.model.B
     run = Run("descent", best_feasible=start, final=start)
@@ -291,5 +290,5 @@ def _pulling(
     forces = cand.forces[cand.active]
     pull = forces > tau
     if largest and pull.any():
-        pull &= forces >= forces[pull].max() * (1.0 - 1e-9)
+        pull &= forces >= forces[pull].max() * (1.0 - ROUNDING_RTOL)
     return cand.active[pull].astype(np.int64)

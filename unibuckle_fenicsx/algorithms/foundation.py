@@ -30,7 +30,7 @@ nodes v presses, and u the smallest mode of the pencil with S's springs, the quo
 minimised over the circle :math:`\cos\theta\, v + \sin\theta\, u` (six inner
 products and the nodal values: no solve), and the minimiser becomes the next v. The
 quotient never increases, so it cannot cycle; it stops when a step gains less than
-:data:`ARC_RTOL`.
+:data:`~unibuckle_fenicsx.tolerances.ARC_RTOL`.
 
 Note:
     Collective on the problem's communicator.
@@ -47,6 +47,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import ARC_RTOL
 
 __all__ = ["FOUNDATION_PREFIX", "solve_foundation"]
 
@@ -54,8 +55,6 @@ logger = logging.getLogger(__name__)
 
 #: Options prefix of the foundation's eigen solver.
 FOUNDATION_PREFIX = "unibuckle_foundation_"
-#: The arc descent stops when a step lowers the quotient by less than this, relatively.
-ARC_RTOL = 1e-12
 #: Angles sampled on the circle before the golden-section refinement.
 ARC_SAMPLES = 720
 
@@ -152,11 +151,12 @@ def _arc_descent(
 ) -> tuple[Candidate, str, int]:
     """Monotone descent of the spring quotient along arcs (module docstring), from ``start``.
 
-    Returns the candidate reached, "converged" (a step gains less than
-    :data:`ARC_RTOL`) or "max_iterations", and the steps taken.
+    Returns the candidate reached, CONVERGED (a step gains less than
+    :data:`~unibuckle_fenicsx.tolerances.ARC_RTOL`) or MAX_ITERATIONS, and the steps taken.
     """
     contact = problem.contact
-    assert contact is not None
+    if contact is None:
+        raise ValueError("_arc_descent: the problem has no obstacle (this needs an obstacle zone)")
     A, B = problem.model.A, problem.model.B
     v = start.mode.x.petsc_vec.copy()
     u, Av, Au, Bv, Bu = (v.duplicate() for _ in range(5))

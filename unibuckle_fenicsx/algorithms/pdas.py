@@ -29,6 +29,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 __all__ = ["Run", "iterate"]
 
@@ -100,7 +101,8 @@ def iterate(
     Note:
         Collective.
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("iterate: the problem has no obstacle (this needs an obstacle zone)")
     n = problem.contact.size
     tau = problem.tau
     run = Run(seed)
@@ -135,7 +137,7 @@ def iterate(
             # KKT at this threshold: tighten it (same contact set and mode).
             stage, damped, seen = stage + 1, False, set()
         if (greedy or damped) and add.any():
-            add &= cand.values >= cand.values[add].max() * (1.0 - 1e-9)
+            add &= cand.values >= cand.values[add].max() * (1.0 - ROUNDING_RTOL)
         if damped and add.any():
             release[:] = False
         new = (inz & ~release) | add

@@ -18,9 +18,10 @@ iterates on S (a semismooth Newton step): solve the smallest eigenpair of
 :math:`(A_S, B)`, orient the mode (its sign is free) to minimise the penetration, and
 take as the next S the nodes with :math:`v_k > 0` (when both orientations penetrate
 alike, as the antisymmetric free mode of the paper's symmetric plate does, the tie is
-broken deterministically, see :data:`TIE_RTOL`). A fixed point (S repeats) is a
-stationary point of :math:`R_\rho`; a set that reappears after more than one step is a
-cycle, which is reported (the iterate with the smallest :math:`R_\rho` is returned).
+broken deterministically, see :data:`~unibuckle_fenicsx.tolerances.ENERGY_TIE_RTOL`). A
+fixed point (S repeats) is a stationary point of :math:`R_\rho`; a set that reappears after
+more than one step is a cycle, which is reported (the iterate with the smallest
+:math:`R_\rho` is returned).
 
 The stationary point found is not proven to be the global minimum of :math:`R_\rho`,
 and its mode penetrates the obstacle by :math:`O(1/\rho)`: the result is neither a
@@ -59,11 +60,11 @@ from unibuckle_fenicsx.eigen import (
     release,
 )
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import ENERGY_TIE_RTOL
 
 __all__ = [
     "CONDITION_PREFIX",
     "PENALTY_PREFIX",
-    "TIE_RTOL",
     "PenaltySolver",
     "PenaltyStep",
     "SpringIteration",
@@ -74,11 +75,6 @@ logger = logging.getLogger(__name__)
 
 #: Options prefix of the penalty eigen solver.
 PENALTY_PREFIX = "unibuckle_penalty_"
-
-#: Relative tie tolerance of the two orientations' penetration energies. The free mode
-#: of a symmetric problem ties exactly; computed with an EPS tolerance of 1e-10 its two
-#: energies differ by about that, so 1e-6 leaves four orders of margin either way.
-TIE_RTOL = 1e-6
 
 #: Options prefix of the extreme-eigenvalue solvers of :meth:`PenaltySolver.condition_number`.
 CONDITION_PREFIX = "unibuckle_penalty_cond_"
@@ -112,7 +108,7 @@ class SpringIteration:
             the quotient and its ``active`` set the nodes pressing the springs.
         steps: Every eigen solve.
         step: The returned iterate's step.
-        status: "converged" (a fixed point), "cycle", "max_iterations" or "no-finite-load".
+        status: CONVERGED (a fixed point), CYCLE, MAX_ITERATIONS or NO_FINITE_LOAD.
         cycle_length: Length of the cycle (0 if none).
         ties: Orientation ties broken by the deterministic rule.
         lower_bound: :math:`\lambda_{free}`.
@@ -192,7 +188,10 @@ class PenaltySolver(Owner):
                 one per constrained node (i,).
             active: The spring set S (node numbers).
         """
-        assert self.problem.contact is not None
+        if self.problem.contact is None:
+            raise ValueError(
+                "set_springs: the problem has no obstacle (this needs an obstacle zone)"
+            )
         same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
         self.problem.model.A.copy(self.A_pen, structure=same)
         self._springs.zeroEntries()
@@ -210,7 +209,8 @@ class PenaltySolver(Owner):
         ``rho_abs``: one stiffness for every node, or one per constrained node; v_k are the
         oriented values at the constrained nodes.
         """
-        assert self.problem.contact is not None
+        if self.problem.contact is None:
+            raise ValueError("quotient: the problem has no obstacle (this needs an obstacle zone)")
         self.problem.model.A.mult(vec, self._Av)
         self.problem.model.B.mult(vec, self._Bv)
         vals = self.problem.contact.values(vec)
@@ -255,7 +255,7 @@ class PenaltySolver(Owner):
         threshold: float = 0.0,
         condition: bool = False,
         lower_bound: float | None = None,
-        tie_rtol: float = TIE_RTOL,
+        tie_rtol: float = ENERGY_TIE_RTOL,
     ) -> UnilateralSolution:
         r"""Iterate on the penetrating set for one penalty.
 
@@ -335,7 +335,7 @@ class PenaltySolver(Owner):
         max_iterations: int = 100,
         threshold: float = 0.0,
         lower_bound: float | None = None,
-        tie_rtol: float = TIE_RTOL,
+        tie_rtol: float = ENERGY_TIE_RTOL,
         label: str = "springs",
     ) -> SpringIteration:
         r"""The iteration on the spring set S for the springs ``rho_abs`` (N/m).
@@ -362,7 +362,10 @@ class PenaltySolver(Owner):
         """
         problem = self.problem
         contact = problem.contact
-        assert contact is not None
+        if contact is None:
+            raise ValueError(
+                "iterate_springs: the problem has no obstacle (this needs an obstacle zone)"
+            )
         weights = np.broadcast_to(np.asarray(rho_abs, dtype=float), (contact.size,))
         if not (np.all(np.isfinite(weights)) and np.all(weights > 0.0)):
             raise ValueError("rho_abs (spring stiffness) must be finite and > 0 at every node")
@@ -490,7 +493,7 @@ def solve_penalty(
     max_iterations: int = 100,
     threshold: float = 0.0,
     condition: bool = False,
-    tie_rtol: float = TIE_RTOL,
+    tie_rtol: float = ENERGY_TIE_RTOL,
     eps_options: dict[str, str | float | int] | None = None,
 ) -> UnilateralSolution:
     r"""Penalty method for one relative penalty ``rho`` (see the module docstring).

@@ -17,9 +17,10 @@ bound; interlacing, the lattice search and exhaustive enumeration give lower bou
 :math:`A - \lambda B` is copositive on the cone there (a rank-2 certificate that costs one
 sparse :math:`LDL^T`, or a semidefinite program for small i), or, when several pencil
 eigenvalues lie below the load, a slightly lower one by the low-rank route
-(:mod:`unibuckle_fenicsx.certificate.copositivity_lowrank`). The result is a *verified bracket*:
-*proven* globally optimal when it closes to :data:`PROOF_GAP`, *bracketed* when its
-verified relative gap is at most :data:`BRACKET_GAP` (the load is then known to that
+(:mod:`unibuckle_fenicsx.certificate.copositivity_lowrank`). The result is a *verified
+bracket*: *proven* globally optimal when it closes to
+:data:`~unibuckle_fenicsx.tolerances.PROOF_GAP`, *bracketed* when its verified relative gap is
+at most :data:`~unibuckle_fenicsx.tolerances.BRACKET_GAP` (the load is then known to that
 accuracy: no admissible mode has a load below the lower bound), otherwise "KKT only".
 The smallest-eigenvalue check runs on every route, proven or not. When the low-rank
 route meets an admissible mode with a lower load than the KKT point's, the point is
@@ -46,6 +47,7 @@ from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivit
 from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX
 from unibuckle_fenicsx.eigen import SymmetricFactorization
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import BRACKET_GAP, PROOF_GAP, ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
 
 __all__ = [
     "BRACKET_GAP",
@@ -58,14 +60,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-#: Relative gap (upper - lower)/upper below which the global optimum counts as proven.
-PROOF_GAP = 1e-6
-#: A verified relative gap at most this is reported as "bracketed" (the load is known to
-#: that accuracy), above it the result is a KKT point only.
-BRACKET_GAP = 1e-3
-#: The smallest-eigenvalue check looks below lambda (1 - SMALLEST_RTOL_FACTOR eps_tol).
-SMALLEST_RTOL_FACTOR = 1e3
 
 
 @dataclass(frozen=True)
@@ -88,7 +82,7 @@ class Certificate:
         lower_bound: Verified lower bound on the critical load.
         upper_bound: Load of an admissible mode (``inf`` if the mode is not admissible).
         relative_gap: (upper - lower) / upper.
-        global_optimum_proven: The gap is at most :data:`PROOF_GAP`.
+        global_optimum_proven: The gap is at most :data:`~unibuckle_fenicsx.tolerances.PROOF_GAP`.
         proven_by: What gave the lower bound: "interlacing" (the free load),
             "lattice", "enumeration", or a copositivity route ("rank2-spn", "sdp-spn",
             "sdp-sectors", "lowrank-spn", "psd").
@@ -122,14 +116,16 @@ class Certificate:
 
     @property
     def status(self) -> str:
-        """One of proven, bracketed (verified gap <= :data:`BRACKET_GAP`), kkt-only, not-kkt."""
+        """One of proven, bracketed (verified gap <= BRACKET_GAP), kkt-only, not-kkt."""
         if not self.kkt:
             return "not-kkt"
         if self.global_optimum_proven:
             return "proven"
         # A bound verified at lambda (1 - BRACKET_GAP) gives the gap BRACKET_GAP up to the
         # rounding of (upper - lower) / upper.
-        if self.proven_by != "interlacing" and self.relative_gap <= BRACKET_GAP * (1 + 1e-9):
+        if self.proven_by != "interlacing" and self.relative_gap <= BRACKET_GAP * (
+            1 + ROUNDING_RTOL
+        ):
             return "bracketed"
         return "kkt-only"
 
@@ -176,7 +172,10 @@ def reduced_inertia(
     Note:
         Collective.
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError(
+            "reduced_inertia: the problem has no obstacle (this needs an obstacle zone)"
+        )
     A_Z, B_Z = problem.eigensolver.reduced(problem.contact.removed_rows(active))
     K = A_Z.duplicate(copy=True)
     K.axpy(-sigma, B_Z, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
@@ -190,7 +189,10 @@ def reduced_inertia(
 
 def _residual_off_contact(problem: BucklingProblem, candidate: Candidate) -> float:
     r""":math:`\|r\|_2 / \|Au\|_2` with the rows of Z left out."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError(
+            "_residual_off_contact: the problem has no obstacle (this needs an obstacle zone)"
+        )
     r, _, au_2 = problem.residual(candidate.load, candidate.mode.x.petsc_vec)
     rows = problem.contact.removed_rows(candidate.active)
     r.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))  # type: ignore[arg-type]
@@ -411,7 +413,11 @@ def _spring_inertia(
 ) -> tuple[int, int, int]:
     r"""Inertia of :math:`A + \sum_{k \in S} \rho_k e_k e_k^T - \sigma B` (collective)."""
     contact = problem.contact
-    assert contact is not None and contact.stiffness is not None
+    if contact is None or contact.stiffness is None:
+        raise RuntimeError(
+            "_spring_inertia: expected contact is not None and contact.stiffness is not None (an "
+            "internal invariant)"
+        )
     K = problem.model.A.duplicate(copy=True)
     diag = K.createVecLeft()
     rows, nodes = contact.node_rows(pressing)

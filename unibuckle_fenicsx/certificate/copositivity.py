@@ -171,7 +171,10 @@ def _search_other_nappe(
     Projected gradient with Barzilai-Borwein steps and exact line search, one solve per
     iterate; stops at the first :math:`f > 0`. Returns (best w, its f, iterations).
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError(
+            "_search_other_nappe: the problem has no obstacle (this needs an obstacle zone)"
+        )
     contact = problem.contact
     vec = problem.model.A.createVecRight()
     x = vec.duplicate()
@@ -223,7 +226,10 @@ def _predict_delta(problem: BucklingProblem, matrix: ShiftedMatrix, candidate: C
     """
     u = candidate.mode.x.petsc_vec
     matrix.build(candidate.load)
-    assert matrix.Kabs is not None
+    if matrix.Kabs is None:
+        raise RuntimeError(
+            "_predict_delta: expected matrix.Kabs is not None (an internal invariant)"
+        )
     r, _, _ = problem.residual(candidate.load, u)
     ua, Ku, Bu = u.duplicate(), u.duplicate(), u.duplicate()
     ua.array[:] = np.abs(u.array_r)
@@ -245,7 +251,8 @@ def _rank2(
     options: BoundOptions,
 ) -> tuple[dict[str, Any], dict[str, Any] | None]:
     """Alpha for w+, then beta and gamma for each w- candidate; the first that certifies."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("_rank2: the problem has no obstacle (this needs an obstacle zone)")
     contact = problem.contact
     vec = problem.model.A.createVecRight()
     sp = matrix.refined(contact.scatter(w_plus, vec.duplicate()))
@@ -303,7 +310,10 @@ def copositivity_bound(
     Note:
         Collective.
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError(
+            "copositivity_bound: the problem has no obstacle (this needs an obstacle zone)"
+        )
     opts = options or BoundOptions()
     t0 = time.perf_counter()
     notes: list[str] = []

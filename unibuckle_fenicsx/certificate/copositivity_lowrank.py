@@ -184,7 +184,11 @@ class _Columns:
     def __init__(
         self, problem: BucklingProblem, matrix: ShiftedMatrix, refinements: int, max_columns: int
     ):
-        assert problem.contact is not None and matrix.K is not None
+        if problem.contact is None or matrix.K is None:
+            raise RuntimeError(
+                "__init__: expected problem.contact is not None and matrix.K is not None (an "
+                "internal invariant)"
+            )
         self.problem, self.matrix, self.refinements = problem, matrix, refinements
         self.max_columns = max_columns
         self.contact = problem.contact
@@ -639,7 +643,8 @@ def _pencil_modes(
     vectors with a value below ``lam`` (heuristics only: the certificate checks whatever
     columns it gets).
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("_pencil_modes: the problem has no obstacle (this needs an obstacle zone)")
     k = min(m + 3, cols.r + 1)
     V = [problem.solve_free().function.x.petsc_vec.copy()]
     V += [x.copy() for x in cols.x[-(k - 1) :]]
@@ -688,7 +693,8 @@ def _sources(
     With at most ``units`` constrained nodes, their unit vectors (U = I: the relaxation is
     exact, the route is the full copositivity test of the Schur complement).
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("_sources: the problem has no obstacle (this needs an obstacle zone)")
     i = problem.num_constrained
     if i <= units:
         return [(f"node{k}", np.eye(1, i, k)[0]) for k in range(i)]
@@ -773,7 +779,8 @@ def _attempt(
     out: LowRankOutcome,
 ) -> tuple[dict[str, Any], list[tuple[str, npt.NDArray[np.float64]]]]:
     """One delta: factorise, columns, cuts, pieces. Returns (record, columns to reuse)."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("_attempt: the problem has no obstacle (this needs an obstacle zone)")
     contact = problem.contact
     lam = candidate.load * (1.0 - delta)
     neg, zero, _ = matrix.factor(lam)

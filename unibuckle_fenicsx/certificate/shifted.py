@@ -23,6 +23,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.eigen import Owner, SymmetricFactorization, release
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = ["CERTIFY_PREFIX", "EPS", "ShiftedMatrix", "Solve", "absdot", "mirror_maps", "norm2"]
 
@@ -107,7 +108,8 @@ class ShiftedMatrix(Owner):
             self.Kabs = K.duplicate(copy=True)
         else:
             K = self.K
-            assert self.Kt is not None
+            if self.Kt is None:
+                raise RuntimeError("build: expected self.Kt is not None (an internal invariant)")
             K.zeroEntries()
             K.axpy(1.0, self.A, structure=subset)  # type: ignore[arg-type]
             K.axpy(-lam, self.B, structure=subset)  # type: ignore[arg-type]
@@ -118,7 +120,8 @@ class ShiftedMatrix(Owner):
             K.scale(0.5)
         K.setOption(PETSc.Mat.Option.SPD, False)  # type: ignore[arg-type]
         K.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
-        assert self.Kabs is not None
+        if self.Kabs is None:
+            raise RuntimeError("build: expected self.Kabs is not None (an internal invariant)")
         K.copy(self.Kabs, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)  # type: ignore[arg-type]
         ai, aj, av = self.Kabs.getValuesCSR()
         self.Kabs.zeroEntries()
@@ -142,7 +145,8 @@ class ShiftedMatrix(Owner):
 
     def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
         """X = K^-1 b with the current factorisation."""
-        assert self.factorization is not None
+        if self.factorization is None:
+            raise RuntimeError("ShiftedMatrix.solve: call factor() first")
         t0 = time.perf_counter()
         self.factorization.solve(b, x)
         self.solves += 1
@@ -155,7 +159,11 @@ class ShiftedMatrix(Owner):
         :math:`\gamma_m(|w| + |K||x|)`, :math:`\gamma_m = m\epsilon/(1 - m\epsilon)`,
         m the longest row plus one. ``w`` is owned by the returned :class:`Solve`.
         """
-        assert self.K is not None and self.Kabs is not None
+        if self.K is None or self.Kabs is None:
+            raise RuntimeError(
+                "refined: expected self.K is not None and self.Kabs is not None (an internal "
+                "invariant)"
+            )
         x, rho, dx = w.duplicate(), w.duplicate(), w.duplicate()
         self.solve(w, x)
         self.K.mult(x, rho)
@@ -198,14 +206,17 @@ class ShiftedMatrix(Owner):
         self.destroy()
 
 
-def mirror_maps(problem: BucklingProblem, tol: float = 1e-9) -> dict[str, npt.NDArray[np.int64]]:
+def mirror_maps(
+    problem: BucklingProblem, tol: float = GEOMETRY_RTOL
+) -> dict[str, npt.NDArray[np.int64]]:
     """Permutations of the constrained nodes under the plate's mirror symmetries.
 
     A reflection (about x = centre, y = centre, or both) appears only when it maps the
     node set onto itself. The images of a reaction are candidates, nothing more: the
     certificate checks whatever it is given.
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("mirror_maps: the problem has no obstacle (this needs an obstacle zone)")
     xy = problem.contact.coordinates
     (x0, y0), (x1, y1) = problem.spec.plate.corners
     cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)

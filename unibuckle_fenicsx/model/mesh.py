@@ -88,7 +88,10 @@ def create_plate_mesh(
         order_facets[order].astype(np.int32),
         np.concatenate(values)[order].astype(np.int32),
     )
-    assert len(EDGE_NAMES) == 4
+    if len(EDGE_NAMES) != 4:
+        raise RuntimeError(
+            "create_plate_mesh: expected len(EDGE_NAMES) == 4 (an internal invariant)"
+        )
     return msh, tags
 
 

@@ -283,7 +283,10 @@ def solve_prestress(
         petsc_options_prefix="unibuckle_prestress_",
     )
     uh = problem.solve()
-    assert isinstance(uh, dolfinx.fem.Function)
+    if not isinstance(uh, dolfinx.fem.Function):
+        raise RuntimeError(
+            "solve_prestress: expected isinstance(uh, dolfinx.fem.Function) (an internal invariant)"
+        )
     uh.name = "prestress_displacement"
     del problem
 

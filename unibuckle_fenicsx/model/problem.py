@@ -57,8 +57,8 @@ logger = logging.getLogger(__name__)
 #: Options prefix of the LDL^T that checks A - B_fixed (``-unibuckle_fixed_ksp_view``).
 FIXED_LOAD_PREFIX = "unibuckle_fixed_"
 
-#: Peak memory per (w, theta) DOF of a solve, measured with MUMPS on one rank: 7.8 kB at
-#: 155k DOFs, 5.8 kB at 617k (README, "Parallel runs"); the estimate uses 8 kB.
+#: Peak memory per (w, theta) DOF of a solve with MUMPS on one rank, rounded up from the
+#: figures of README, "Parallel runs" (it falls as the mesh grows, so 8 kB is an upper bound).
 BYTES_PER_DOF = 8000
 
 
@@ -83,7 +83,10 @@ def _check_memory(spec: ProblemSpec, comm: MPI.Comm) -> None:
     if plate.file is not None:
         return
     if plate.meshed_by_gmsh:
-        assert spec.mesh.size is not None
+        if spec.mesh.size is None:
+            raise RuntimeError(
+                "_check_memory: expected spec.mesh.size is not None (an internal invariant)"
+            )
         dofs = int(3 * plate.area / spec.mesh.size**2)
         what = f"mesh.size = {spec.mesh.size:g} m on {plate.area:.3g} m^2 gives about"
     else:
@@ -396,7 +399,8 @@ class BucklingProblem(Owner):
         Note:
             Collective; ``active`` must be the same on every rank.
         """
-        assert self.contact is not None, "evaluate() needs an obstacle"
+        if self.contact is None:
+            raise ValueError("evaluate: the problem has no obstacle (this needs an obstacle zone)")
         active = np.unique(np.asarray(active, dtype=np.int64))
         u = self.new_mode()
         pair = self.eigensolver.solve(
@@ -430,7 +434,8 @@ class BucklingProblem(Owner):
         Note:
             Collective.
         """
-        assert self.contact is not None
+        if self.contact is None:
+            raise ValueError("candidate: the problem has no obstacle (this needs an obstacle zone)")
         n = self.contact.size
         vec = u.x.petsc_vec
         if not np.isfinite(load):
@@ -470,7 +475,8 @@ class BucklingProblem(Owner):
         """
         if self._r is None:
             self._r, self._Bu = u.duplicate(), u.duplicate()
-        assert self._Bu is not None
+        if self._Bu is None:
+            raise RuntimeError("residual: expected self._Bu is not None (an internal invariant)")
         self.model.A.mult(u, self._r)
         au_inf = self._r.norm(PETSc.NormType.INFINITY)  # type: ignore[arg-type]
         au_2 = self._r.norm()

@@ -55,7 +55,8 @@ def zone_area(obstacle: ObstacleSpec, plate: PlateSpec) -> float | None:
     area = intersection_area(shape, plate.boundary)
     for hole in plate.holes:
         hole_shape = _shape(hole)
-        assert hole_shape is not None
+        if hole_shape is None:
+            raise RuntimeError("zone_area: expected hole_shape is not None (an internal invariant)")
         area -= intersection_area(shape, hole_shape)
     return max(area, 0.0)
 

@@ -460,7 +460,11 @@ class VonKarmanPlate(MixedDofs, Owner):
         dolfinx.fem.petsc.apply_lifting(b, [self.J_form], bcs=[self.bcs], x0=[x], alpha=-1.0)
         _add_ghosts(b)
         if self.Ks is not None:
-            assert self._d is not None and self._Kd is not None
+            if self._d is None or self._Kd is None:
+                raise RuntimeError(
+                    "_residual: expected self._d is not None and self._Kd is not None (an "
+                    "internal invariant)"
+                )
             x.copy(self._d)
             self._d.axpy(-1.0, self.x0.x.petsc_vec)
             self.Ks.mult(self._d, self._Kd)
@@ -497,7 +501,11 @@ class VonKarmanPlate(MixedDofs, Owner):
         """Clip the state onto the obstacles (w <= 0 above, >= 0 below); not collective."""
         if self.contact is None:
             return
-        assert self._upper is not None and self._lower is not None
+        if self._upper is None or self._lower is None:
+            raise RuntimeError(
+                "project: expected self._upper is not None and self._lower is not None (an "
+                "internal invariant)"
+            )
         arr = self.x.x.petsc_vec.array
         np.minimum(arr, self._upper.array, out=arr)
         np.maximum(arr, self._lower.array, out=arr)
@@ -511,7 +519,11 @@ class VonKarmanPlate(MixedDofs, Owner):
         Note:
             Collective.
         """
-        assert self.snes is not None and self._xs is not None
+        if self.snes is None or self._xs is None:
+            raise RuntimeError(
+                "solve: expected self.snes is not None and self._xs is not None (an internal "
+                "invariant)"
+            )
         self._to_vector(self._xs)
         self.snes.solve(None, self._xs)
         reason = int(self.snes.getConvergedReason())  # type: ignore[call-overload]
@@ -558,7 +570,11 @@ class VonKarmanPlate(MixedDofs, Owner):
 
         Returns a work vector owned by the plate (valid until the next call).
         """
-        assert self.b is not None and self._xs is not None
+        if self.b is None or self._xs is None:
+            raise RuntimeError(
+                "residual_vector: expected self.b is not None and self._xs is not None (an "
+                "internal invariant)"
+            )
         self._to_vector(self._xs)
         self._residual(None, self._xs, self.b)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs, alpha=0.0)
@@ -570,7 +586,11 @@ class VonKarmanPlate(MixedDofs, Owner):
         The support's normal force on each loaded edge, divided by t, its length and its
         normal stress per unit load; the mean over the loaded edges.
         """
-        assert self._displacement_axis is not None and self.b is not None
+        if self._displacement_axis is None or self.b is None:
+            raise RuntimeError(
+                "edge_reaction_load: expected self._displacement_axis is not None and self.b is "
+                "not None (an internal invariant)"
+            )
         axis = self._displacement_axis
         b = self.b
         with b.localForm() as local:

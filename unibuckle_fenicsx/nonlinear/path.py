@@ -48,6 +48,7 @@ from unibuckle_fenicsx.nonlinear.model import (
 )
 from unibuckle_fenicsx.progress import LOGGER
 from unibuckle_fenicsx.results import versions
+from unibuckle_fenicsx.tolerances import NONLINEAR_ATOL
 
 __all__ = [
     "SHAPES",
@@ -64,8 +65,6 @@ logger = logging.getLogger(__name__)
 #: Imperfection shapes: the linear free mode, the unilateral mode, or "auto" (the
 #: unilateral mode with the obstacle, the free mode without).
 SHAPES = ("auto", "free", "unilateral")
-#: SNES absolute tolerance, relative to the load vector at the reference load.
-ATOL = 1e-11
 
 
 class NonlinearError(RuntimeError):
@@ -514,8 +513,11 @@ def solve_nonlinear(
         )
         opts = PETSc.Options()
         if not opts.hasName("unibuckle_nl_snes_atol"):
-            assert plate.snes is not None
-            plate.snes.setTolerances(atol=ATOL * plate.unit_load_norm * reference)
+            if plate.snes is None:
+                raise RuntimeError(
+                    "solve_nonlinear: expected plate.snes is not None (an internal invariant)"
+                )
+            plate.snes.setTolerances(atol=NONLINEAR_ATOL * plate.unit_load_norm * reference)
         shape, shape_name = imperfection_shape(linear, options.shape, obstacle)
         embed(plate, shape, linear.problem, options.imperfection * spec.plate.thickness)
         check_gaps(plate, options.imperfection)
