@@ -75,6 +75,7 @@ from unibuckle_fenicsx.model.plate.model import (
 from unibuckle_fenicsx.model.plate.spaces import MixedDofs
 from unibuckle_fenicsx.model.points import point_bcs, point_springs, snap_points
 from unibuckle_fenicsx.model.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
+from unibuckle_fenicsx.nonlinear.choices import CONTROLS
 
 __all__ = [
     "CONTROLS",
@@ -83,9 +84,6 @@ __all__ = [
     "VonKarmanPlate",
     "displacement_axis",
 ]
-
-#: Path controls: the edge load, or the end shortening of the loaded edges.
-CONTROLS = ("load", "displacement")
 
 #: Default SNES options (prefix ``unibuckle_nl_``): Newton with MUMPS LU; the VI type is
 #: set when the plate has an obstacle. Tolerances act on the scaled residual.

@@ -31,6 +31,7 @@ from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
 from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.eigen import Owner
+from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
 from unibuckle_fenicsx.nonlinear.estimators import (
     inflection_load,
     southwell_load,
@@ -42,7 +43,6 @@ from unibuckle_fenicsx.nonlinear.imperfection import (
     to_linear_space,
 )
 from unibuckle_fenicsx.nonlinear.model import (
-    CONTROLS,
     VonKarmanPlate,
     displacement_axis,
 )
@@ -62,10 +62,6 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: Imperfection shapes: the linear free mode, the unilateral mode, or "auto" (the
-#: unilateral mode with the obstacle, the free mode without).
-SHAPES = ("auto", "free", "unilateral")
-
 
 class NonlinearError(RuntimeError):
     """The nonlinear solve failed before any load step converged."""
@@ -78,7 +74,7 @@ class NonlinearOptions:
     Args:
         imperfection: :math:`\delta`, the imperfection's amplitude max :math:`|w_0|`
             relative to the thickness, in (0, 1].
-        shape: Imperfection shape, one of :data:`SHAPES`.
+        shape: Imperfection shape, one of :data:`~unibuckle_fenicsx.nonlinear.choices.SHAPES`.
         control: "load" (edge traction :math:`\lambda`, adaptive steps) or
             "displacement" (end shortening of the loaded edges; :math:`\lambda` from the
             edge reactions; a uniaxial compression only).
