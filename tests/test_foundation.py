@@ -29,8 +29,10 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 
+from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
+from unibuckle_fenicsx.certificate.certify import certify_foundation
 from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.model.contact import tributary_areas
 from unibuckle_fenicsx.model.materials import bending_stiffness
@@ -188,6 +190,26 @@ def test_foundation_the_free_mode_turns_away_from_is_proven_inactive():
     assert result.method == "foundation" and result.contact_nodes == 0
     assert result.critical_load_Pa == pytest.approx(result.free_load_Pa, rel=1e-10)
     assert result.certificate["kkt"] and result.certificate["global_optimum_proven"]
+
+
+def test_the_foundation_certificate_reads_the_typed_status_never_a_default():
+    """The certificate takes the spring-set status from ``solution.status``.
+
+    A solution without one is refused (before, a missing "foundation_status" key read as
+    "converged" and certified); an unconverged status is not KKT. The status reaches the
+    JSON under its old key and spelling.
+    """
+    spec = strip(1.0, 8, ObstacleSpec("all", foundation_stiffness=modulus(100.0)))
+    with solve(spec) as analysis:
+        solution = analysis.solution
+        assert solution is not None and solution.status is RunStatus.CONVERGED
+        assert analysis.result.details["foundation_status"] == "converged"
+        with pytest.raises(ValueError, match=r"solution\.status"):
+            certify_foundation(analysis.problem, replace(solution, status=None))
+        stalled = certify_foundation(
+            analysis.problem, replace(solution, status=RunStatus.MAX_ITERATIONS)
+        )
+        assert not stalled.kkt
 
 
 @pytest.mark.parametrize("supports", ["simply_supported", "loaded_clamped"])

@@ -210,7 +210,7 @@ class BucklingResult:
             certificate.upper_bound if math.isfinite(certificate.upper_bound) else None
         )
         result.certificate = certificate.as_dict()
-        result.details.update(solution.details)
+        result.details.update(solution.report())
         return result
 
     def as_dict(self, timings: bool = True) -> dict[str, Any]:

@@ -61,7 +61,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
+from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
@@ -152,7 +152,7 @@ def _multi_seed(problem: BucklingProblem, max_iterations: int) -> list[Run]:
     runs: list[Run] = []
     for name, z in _seeds(problem, values, problem.tau):  # the greedy seeds come last
         greedy = name.startswith("greedy")
-        capped = greedy and any(r.status == "kkt" for r in runs)
+        capped = greedy and any(r.status is RunStatus.KKT for r in runs)
         budget = min(max_iterations, GREEDY_ITERATIONS) if capped else max_iterations
         runs.append(iterate(problem, name, z, free, budget, greedy=greedy))
     return runs
@@ -173,7 +173,7 @@ def _polish(
         iterate(problem, f"candidate{k}", prolong(coarse, problem, z), None, max_iterations)
         for k, z in enumerate(candidates)
     ]
-    if candidates and not any(r.status == "kkt" for r in runs):
+    if candidates and not any(r.status is RunStatus.KKT for r in runs):
         z = prolong(coarse, problem, candidates[0])
         runs.append(
             iterate(
@@ -204,7 +204,7 @@ def _distinct_kkt(runs: list[Run]) -> list[Candidate]:
     """Distinct KKT end points of ``runs``, sorted by load then lexicographically."""
     found: dict[bytes, Candidate] = {}
     for run in runs:
-        if run.status == "kkt" and run.final is not None:
+        if run.status is RunStatus.KKT and run.final is not None:
             found.setdefault(run.final.key(), run.final)
     return sorted(found.values(), key=lambda s: (s.load, len(s.active), tuple(s.active)))
 
@@ -399,7 +399,7 @@ def solve_active_set(
                 f"{'at a KKT point' if last.status == 'kkt' else last.status}"
             )
     feasible = [r.best_feasible for r in runs if r.best_feasible is not None]
-    cycles = [r.seed for r in runs + coarse_runs if r.status == "cycle"]
+    cycles = [r.seed for r in runs + coarse_runs if r.status is RunStatus.CYCLE]
     if cycles:
         warnings.append(f"active-set iteration cycled from seed(s) {cycles}")
     if kkt:
@@ -449,7 +449,6 @@ def solve_active_set(
             "penalty_eigensolves": penalty_solves,
             "bound_evaluations": bound_evals,
             "bound_search_complete": complete,
-            "lower_bound_by": "lattice" if bound_evals else "interlacing",
             "wall_time_s": time.perf_counter() - t0,
         }
     )
@@ -465,5 +464,6 @@ def solve_active_set(
         global_optimum_proven=proven,
         upper_bound=chosen.load if chosen.feasible else math.inf,
         kkt_points=kkt,
+        lower_bound_by="lattice" if bound_evals else "interlacing",
         details=details,
     )

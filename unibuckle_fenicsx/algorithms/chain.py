@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
+from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
 from unibuckle_fenicsx.algorithms.descent import descend
 from unibuckle_fenicsx.algorithms.interior_point import (
@@ -307,7 +307,7 @@ def _polish(
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     run = iterate(problem, label, cand.active, cand.mode.x.petsc_vec, budget)
-    final = run.final if run.status == "kkt" else run.best_feasible
+    final = run.final if run.status is RunStatus.KKT else run.best_feasible
     level.offer(final)
     level.links.append(
         LinkRecord(
@@ -332,7 +332,7 @@ def _descend(
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     run, _ = descend(problem, start, budget)
-    final = run.final if run.status == "kkt" else run.best_feasible
+    final = run.final if run.status is RunStatus.KKT else run.best_feasible
     assert final is not None
     level.offer(final)
     level.links.append(

@@ -28,6 +28,7 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver
 from unibuckle_fenicsx.model.problem import BucklingProblem
@@ -88,5 +89,5 @@ def penalty_continuation(
         mode = sol.candidate.mode.x.petsc_vec
         run = iterate(problem, "penalty", springs, mode, polish_iterations)
     if run.final is not None and not math.isfinite(run.final.load):
-        run.status = "no-finite-load"
+        run.status = RunStatus.NO_FINITE_LOAD
     return run, solves

@@ -355,7 +355,6 @@ def enumerate_contact_sets(
         "monotone": monotone,
         "monotone_violations": violations,
         "lower_bound_interlacing": with_feasible[0].load_min,
-        "lower_bound_by": "enumeration",
         "enumeration_wall_s": time.perf_counter() - t_start,
     }
     if problem.comm.rank == 0 and rank == 0:
@@ -376,5 +375,6 @@ def enumerate_contact_sets(
         global_optimum_proven=bool(proven),
         upper_bound=float(load),
         p_star=p_star,
+        lower_bound_by="enumeration",
         details=details,
     )

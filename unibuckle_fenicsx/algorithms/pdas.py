@@ -28,6 +28,8 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.algorithms import RunStatus
+from unibuckle_fenicsx.algorithms.sets import SetLog
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
@@ -40,7 +42,7 @@ class Run:
 
     Attributes:
         seed: Name of the seed.
-        status: "kkt", "cycle", "max-iterations" or "no-finite-load".
+        status: KKT, CYCLE, MAX_ITERATIONS or NO_FINITE_LOAD.
         iterations: Eigen solves used.
         final: The last candidate.
         best_feasible: The feasible candidate with the smallest load met (an upper bound).
@@ -48,7 +50,7 @@ class Run:
     """
 
     seed: str
-    status: str = "max-iterations"
+    status: RunStatus = RunStatus.MAX_ITERATIONS
     iterations: int = 0
     final: Candidate | None = None
     best_feasible: Candidate | None = None
@@ -109,23 +111,23 @@ def iterate(
     active = np.unique(np.asarray(start, dtype=np.int64))
     stages = [t for t in thresholds if t > tau] + [tau]
     stage = 0
-    seen: set[bytes] = set()
+    seen = SetLog()
     damped = False
     vec = initial
     for it in range(max_iterations):
-        seen.add(active.tobytes())
+        seen.visit(active, it)
         cand = problem.evaluate(active, initial=vec)
         vec = cand.mode.x.petsc_vec
         run.iterations = it + 1
         run.final = cand
         run.history.append((len(active), cand.load, cand.feasible))
         if not math.isfinite(cand.load):
-            run.status = "no-finite-load"
+            run.status = RunStatus.NO_FINITE_LOAD
             break
         if cand.feasible and (run.best_feasible is None or cand.load < run.best_feasible.load):
             run.best_feasible = cand
         if cand.kkt:
-            run.status = "kkt"
+            run.status = RunStatus.KKT
             break
         inz = _mask(n, active)
         while True:
@@ -135,20 +137,21 @@ def iterate(
             if add.any() or release.any() or stage == len(stages) - 1:
                 break
             # KKT at this threshold: tighten it (same contact set and mode).
-            stage, damped, seen = stage + 1, False, set()
+            stage, damped = stage + 1, False
+            seen.clear()
         if (greedy or damped) and add.any():
             add &= cand.values >= cand.values[add].max() * (1.0 - ROUNDING_RTOL)
         if damped and add.any():
             release[:] = False
         new = (inz & ~release) | add
         nxt = np.flatnonzero(new).astype(np.int64)
-        if nxt.tobytes() in seen:
+        if nxt in seen:
             if damped:
-                run.status = "cycle"
+                run.status = RunStatus.CYCLE
                 break
             # Switch to the damped rule and forget the cycle.
             damped = True
-            seen = set()
+            seen.clear()
             new = inz | add if add.any() else inz & ~release
             nxt = np.flatnonzero(new).astype(np.int64)
         active = nxt

@@ -50,7 +50,8 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms.sets import SetLog
 from unibuckle_fenicsx.eigen import (
     EIGEN_OPTIONS,
     EXTREME_OPTIONS,
@@ -117,7 +118,7 @@ class SpringIteration:
     candidate: Candidate
     steps: list[PenaltyStep]
     step: PenaltyStep
-    status: str
+    status: RunStatus
     cycle_length: int
     ties: int
     lower_bound: float
@@ -385,13 +386,13 @@ class PenaltySolver(Owner):
         best_q = math.inf
         best_step = -1
         previous: PETSc.Vec | None = None
-        seen: dict[tuple[int, ...], int] = {}
+        seen = SetLog()
         steps: list[PenaltyStep] = []
-        status = "max_iterations"
+        status = RunStatus.MAX_ITERATIONS
         cycle_length = 0
         ties = 0
         for it in range(int(max_iterations)):
-            seen[_key(active)] = it
+            seen.visit(active, it)
             self.set_springs(weights, active)
             pair = self.gep.solve(out=vec, initial=previous)
             self.solves += 1
@@ -434,13 +435,12 @@ class PenaltySolver(Owner):
                 previous = vec.copy()
             else:
                 vec.copy(previous)
-            key = _key(penetrating)
-            if key == _key(active):
-                status = "converged"
+            if np.array_equal(penetrating, active):
+                status = RunStatus.CONVERGED
                 break
-            if key in seen:
-                status = "cycle"
-                cycle_length = it + 1 - seen[key]
+            if penetrating in seen:
+                status = RunStatus.CYCLE
+                cycle_length = seen.cycle_length(penetrating, it)
                 logger.warning(
                     "%s: the penetrating set cycles (length %d) after %d solves; "
                     "returning the iterate with the smallest penalised quotient",
@@ -448,7 +448,7 @@ class PenaltySolver(Owner):
                 )  # fmt: skip
                 break
             active = penetrating
-        if status == "max_iterations":
+        if status is RunStatus.MAX_ITERATIONS:
             logger.warning(
                 "%s: no fixed point after %d solves (-max_iterations)", label, max_iterations
             )
@@ -456,7 +456,7 @@ class PenaltySolver(Owner):
             # Every iterate had b(v, v) <= 0 (an infinite penalised quotient): the load
             # grows without bound with rho, no admissible mode buckles. Keep the last.
             best, best_step = vec.copy(), len(steps) - 1
-            status = "no-finite-load"
+            status = RunStatus.NO_FINITE_LOAD
         if previous is not None:
             previous.destroy()
         u = problem.new_mode()
@@ -466,7 +466,7 @@ class PenaltySolver(Owner):
         step = steps[best_step]
         # Oriented and scaled above: the iteration's own orientation minimises R_rho.
         candidate = problem.candidate(u, step.quotient, step.penetrating, sign=1.0)
-        if status != "converged":
+        if status is not RunStatus.CONVERGED:
             # Leave A_pen with the springs of the returned mode, for condition().
             self.set_springs(weights, step.springs)
         if lower_bound is None:

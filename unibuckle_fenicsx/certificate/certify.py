@@ -42,7 +42,7 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX
 from unibuckle_fenicsx.eigen import SymmetricFactorization
@@ -56,6 +56,7 @@ __all__ = [
     "Certificate",
     "certify",
     "certify_foundation",
+    "pencil_inertia",
     "reduced_inertia",
 ]
 
@@ -177,13 +178,31 @@ def reduced_inertia(
             "reduced_inertia: the problem has no obstacle (this needs an obstacle zone)"
         )
     A_Z, B_Z = problem.eigensolver.reduced(problem.contact.removed_rows(active))
-    K = A_Z.duplicate(copy=True)
-    K.axpy(-sigma, B_Z, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
-    factor = SymmetricFactorization(K, CERTIFY_PREFIX)
+    return pencil_inertia(A_Z, B_Z, sigma)
+
+
+def pencil_inertia(
+    A: PETSc.Mat, B: PETSc.Mat, sigma: float, diagonal: PETSc.Vec | None = None
+) -> tuple[int, int, int]:
+    r"""Inertia (negative, zero, positive) of :math:`A + \mathrm{diag}(d) - \sigma B`.
+
+    One MUMPS :math:`LDL^T` under the prefix ``unibuckle_certify_``; A and B are not
+    modified, ``diagonal`` (d) is optional.
+
+    Note:
+        Collective.
+    """
+    K = A.duplicate(copy=True)
     try:
-        return factor.inertia()
+        if diagonal is not None:
+            K.setDiagonal(diagonal, addv=PETSc.InsertMode.ADD_VALUES)  # type: ignore[arg-type]
+        K.axpy(-sigma, B, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
+        factor = SymmetricFactorization(K, CERTIFY_PREFIX)
+        try:
+            return factor.inertia()
+        finally:
+            factor.destroy()
     finally:
-        factor.destroy()
         K.destroy()
 
 
@@ -256,7 +275,8 @@ def certify(
     elif not cand.feasible:
         notes.append("the mode crosses the obstacle: its load is not an upper bound")
     lower = min(solution.lower_bound, upper)
-    proven_by = str(solution.details.get("lower_bound_by", "interlacing"))
+    # No stated proof: the lower bound is the free load, by interlacing.
+    proven_by = solution.lower_bound_by or "interlacing"
     algorithm_proof = solution.global_optimum_proven
     record: dict[str, Any] | None = None
     refuting: Candidate | None = None
@@ -352,7 +372,11 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
         Collective.
     """
     contact = problem.contact
-    assert contact is not None and contact.stiffness is not None
+    if contact is None or contact.stiffness is None:
+        raise RuntimeError(
+            "certify_foundation: expected contact is not None and contact.stiffness is not None "
+            "(an internal invariant)"
+        )
     cand = solution.candidate
     tau = problem.tau
     notes: list[str] = []
@@ -370,9 +394,14 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     finally:
         spring.destroy()
     residual = float(r.norm()) / au_2  # type: ignore[arg-type]
-    status = solution.details.get("foundation_status", "converged")
-    kkt = residual <= math.sqrt(tau) and status == "converged"
-    if status != "converged":
+    status = solution.status
+    if status is None:
+        raise ValueError(
+            "certify_foundation: the solution carries no spring-set status (solution.status); "
+            "it needs one from solve_foundation"
+        )
+    kkt = residual <= math.sqrt(tau) and status is RunStatus.CONVERGED
+    if status is not RunStatus.CONVERGED:
         notes.append(f"the spring-set iteration did not converge ({status})")
     lower = min(solution.lower_bound, cand.load)
     upper = cand.load
@@ -418,17 +447,11 @@ def _spring_inertia(
             "_spring_inertia: expected contact is not None and contact.stiffness is not None (an "
             "internal invariant)"
         )
-    K = problem.model.A.duplicate(copy=True)
-    diag = K.createVecLeft()
-    rows, nodes = contact.node_rows(pressing)
-    diag.setValues(rows.astype(PETSc.IntType), contact.stiffness[nodes])
-    diag.assemble()
-    K.setDiagonal(diag, addv=PETSc.InsertMode.ADD_VALUES)
-    diag.destroy()
-    K.axpy(-sigma, problem.model.B, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-    factor = SymmetricFactorization(K, CERTIFY_PREFIX)
+    diag = problem.model.A.createVecLeft()
     try:
-        return factor.inertia()
+        rows, nodes = contact.node_rows(pressing)
+        diag.setValues(rows.astype(PETSc.IntType), contact.stiffness[nodes])
+        diag.assemble()
+        return pencil_inertia(problem.model.A, problem.model.B, sigma, diag)
     finally:
-        factor.destroy()
-        K.destroy()
+        diag.destroy()
