@@ -44,12 +44,15 @@ __all__ = [
     "EIGEN_OPTIONS",
     "EXTREME_OPTIONS",
     "LDL_OPTIONS",
+    "RUN_EPS_PREFIXES",
     "EigenPair",
     "EigenSolveError",
     "GEPSolver",
     "Owner",
     "SymmetricFactorization",
     "extreme_eigenvalues",
+    "pop_run_options",
+    "push_run_options",
     "release",
     "set_options",
     "swapped_eigenpairs",
@@ -152,6 +155,37 @@ def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False)
     finally:
         for key in pushed:
             opts.delValue(key)
+
+
+#: Options prefixes of the eigen solvers of one run that take the EPS options given in
+#: Python (:class:`~unibuckle_fenicsx.model.problem.BucklingProblem` ``eps_options``): the
+#: pencil on every mesh level, the penalty stages and the foundation's spring iteration.
+RUN_EPS_PREFIXES = ("unibuckle_", "unibuckle_penalty_", "unibuckle_foundation_")
+
+
+def push_run_options(options: Options | None) -> list[tuple[str, str]]:
+    """Put ``options`` in PETSc's options database under each of :data:`RUN_EPS_PREFIXES`.
+
+    Every eigen solver the run creates afterwards reads them there (its
+    ``setFromOptions``), whichever module builds it. An option the database already
+    holds (the command line's) is left alone: it wins. Returns what was put, for
+    :func:`pop_run_options`.
+    """
+    pushed: list[tuple[str, str]] = []
+    for prefix in RUN_EPS_PREFIXES:
+        opts = PETSc.Options(prefix)
+        for key, value in (options or {}).items():
+            if not opts.hasName(key):
+                opts.setValue(key, value)
+                pushed.append((prefix, key))
+    return pushed
+
+
+def pop_run_options(pushed: list[tuple[str, str]]) -> None:
+    """Remove from the options database what :func:`push_run_options` put there."""
+    for prefix, key in pushed:
+        PETSc.Options(prefix).delValue(key)
+    pushed.clear()
 
 
 class EigenSolveError(RuntimeError):

@@ -81,6 +81,9 @@ logger = logging.getLogger(__name__)
 POLISH_ITERATIONS = 25
 #: Eigen solves allowed to the feasible descent, per ``max_iterations``.
 DESCENT_BUDGET = 10
+#: Eigen solves allowed to each penalty of the penalty continuation, per
+#: ``max_iterations`` (a spring-set iteration per penalty, from a soft start).
+PENALTY_BUDGET = 2
 #: Looser tolerances the iteration converges with first (README, "Every plate the schema
 #: describes"): on thin plates the mode's tails, 1e-3 to 1e-8 of the buckle, flip sign
 #: from one contact set to the next, and chasing them at the final tolerance at once
@@ -370,7 +373,9 @@ def solve_active_set(
     if not kkt:
         # The iteration stalled on this mesh: penalty continuation, started from the free
         # plate (on thin plates a stalled contact set is a poorer start).
-        run, penalty_solves = penalty_continuation(problem, None, max_iterations=200)
+        run, penalty_solves = penalty_continuation(
+            problem, None, max_iterations=PENALTY_BUDGET * max_iterations
+        )
         runs.append(run)
         kkt = _distinct_kkt(runs)
         details["fallback"] = {

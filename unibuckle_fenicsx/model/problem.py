@@ -35,6 +35,8 @@ from unibuckle_fenicsx.eigen import (
     GEPSolver,
     Owner,
     SymmetricFactorization,
+    pop_run_options,
+    push_run_options,
     release,
 )
 from unibuckle_fenicsx.model.contact import (
@@ -169,8 +171,12 @@ class BucklingProblem(Owner):
         spec: The problem.
         comm: Communicator of the mesh (``MPI.COMM_SELF`` gives each rank its own
             serial copy, for candidate-parallel enumeration).
-        eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
-            is ``-unibuckle_eps_view``).
+        eps_options: Extra EPS options of the run: under the prefix ``unibuckle_`` (so
+            ``eps_view`` is ``-unibuckle_eps_view``) for this pencil and the coarser
+            levels' copies, and under ``unibuckle_penalty_`` and ``unibuckle_foundation_``
+            for the penalty stages and the foundation
+            (:data:`~unibuckle_fenicsx.eigen.RUN_EPS_PREFIXES`). The problem holds them in
+            PETSc's options database until :meth:`destroy`; the command line's win.
         mesh: A quadrilateral DOLFINx mesh to use instead of ``spec.mesh`` (the
             rectangle, or gmsh's plate); ``spec.plate.corners`` should then be its
             bounding box (used for tolerances and the buckling coefficient's width).
@@ -296,6 +302,8 @@ class BucklingProblem(Owner):
         self.tau = spec.solver.tau
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         self._w_owned = self.model.w_dofs[:n_owned_w]
+        # Last: a refused problem leaves nothing in the options database.
+        self._run_options = push_run_options(eps_options)
         self.timings["setup_s"] = time.perf_counter() - t0
 
     def _check_geometric_stiffness(self) -> None:
@@ -495,7 +503,8 @@ class BucklingProblem(Owner):
         return plate.thickness * load * plate.width**2 / (np.pi**2 * D)
 
     def destroy(self) -> None:
-        """Destroy the PETSc/SLEPc objects (collective)."""
+        """Destroy the PETSc/SLEPc objects (collective) and take back the run's options."""
         release(self, "_r", "_Bu")
+        pop_run_options(getattr(self, "_run_options", []))
         self.eigensolver.destroy()
         self.model.destroy()
