@@ -273,7 +273,7 @@ def test_tensionless_limit_tends_to_sixteen_thirds():
     """
     base = {ny: strip(3.0, ny, supports={"left": "clamped", "right": "clamped"}) for ny in (12, 24)}
     rigid, soft = [], []
-    for ny, spec in base.items():
+    for spec in base.values():
         with solve(replace(spec, obstacle=ObstacleSpec("all"))) as analysis:
             rigid.append(analysis.result.buckling_coefficient_k)
         zone = ObstacleSpec("all", foundation_stiffness=modulus(1e4))

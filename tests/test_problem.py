@@ -29,7 +29,9 @@ def test_user_mesh_with_own_tags_matches_rectangle():
 
     msh, tags = create_plate_mesh(spec.plate, MeshSpec(8, 4), MPI.COMM_WORLD)
     user_tags = dolfinx.mesh.meshtags(msh, 1, tags.indices, tags.values + 10)
-    edges = tuple(replace(e, tag=t) for e, t in zip(spec.plate.edges, (11, 12, 13, 14)))
+    edges = tuple(
+        replace(e, tag=t) for e, t in zip(spec.plate.edges, (11, 12, 13, 14), strict=True)
+    )
     user_spec = replace(spec, plate=replace(spec.plate, edges=edges))
     with solve(user_spec, mesh=msh, facet_tags=user_tags) as analysis:
         result = analysis.result

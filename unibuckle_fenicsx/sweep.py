@@ -202,7 +202,8 @@ def _locate(data: dict[str, Any], path: str, flag: str) -> tuple[Any, Any]:
                     f"index in [0, {len(node) - 1}]"
                 )
         else:
-            raise ValueError(f"{flag} {path}: {where} = {node!r} is not a table or a list")
+            # A user's path through a value: bad input (exit 2), not a type error of the code.
+            raise ValueError(f"{flag} {path}: {where} = {node!r} is not a table or a list")  # noqa: TRY004
         if depth < len(keys) - 1:
             node = node[key] if isinstance(node, Mapping) else node[int(key)]
     leaf = keys[-1]

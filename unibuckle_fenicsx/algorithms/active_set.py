@@ -252,7 +252,7 @@ def _prune(problem: BucklingProblem, cand: Candidate) -> Candidate:
     return cand
 
 
-def solve_active_set(
+def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fallbacks and bound in one documented sequence
     problem: BucklingProblem,
     *,
     max_iterations: int = 100,

@@ -198,7 +198,7 @@ def _finite_or_none(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def enumerate_contact_sets(
+def enumerate_contact_sets(  # noqa: C901 - the paper's level loop with its stopping rules (section 5.3)
     problem: BucklingProblem,
     *,
     complete: bool = False,

@@ -153,7 +153,7 @@ class PenaltySolver(Owner):
         eps_options: dict[str, str | float | int] | None = None,
     ) -> None:
         if not isinstance(problem, BucklingProblem):
-            raise ValueError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
+            raise TypeError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
         if problem.contact is None:
             raise ValueError("the penalty method needs an obstacle (the problem has none)")
         self.problem = problem
@@ -328,7 +328,7 @@ class PenaltySolver(Owner):
             details=details,
         )
 
-    def iterate_springs(
+    def iterate_springs(  # noqa: C901 - one spring-set iteration: orientation, tie rule, cycle and best iterate
         self,
         rho_abs: float | npt.NDArray[np.float64],
         *,

@@ -219,7 +219,7 @@ def _residual_off_contact(problem: BucklingProblem, candidate: Candidate) -> flo
     return float(r.norm()) / au_2  # type: ignore[arg-type]
 
 
-def certify(
+def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the order the docstring gives
     problem: BucklingProblem,
     solution: UnilateralSolution | Candidate,
     *,

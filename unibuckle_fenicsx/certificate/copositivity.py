@@ -190,7 +190,8 @@ def _search_other_nappe(
     step = 1.0 / max(float(np.abs(y).max()), 1e-300)
     w_prev = g_prev = None
     it = 0
-    for it in range(1, iterations + 1):
+    for _ in range(iterations):
+        it += 1
         g = 2 * y
         if w_prev is not None and g_prev is not None:
             s, dg = w - w_prev, g - g_prev
@@ -290,7 +291,7 @@ def _rank2(
     return record, found
 
 
-def copositivity_bound(
+def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (rank 2, SDP, low rank)
     problem: BucklingProblem,
     candidate: Candidate,
     others: list[Candidate] | None = None,

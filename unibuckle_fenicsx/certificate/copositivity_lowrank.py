@@ -769,7 +769,7 @@ def lowrank_certificate(
     return out
 
 
-def _attempt(
+def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (module docstring)
     problem: BucklingProblem,
     matrix: ShiftedMatrix,
     candidate: Candidate,

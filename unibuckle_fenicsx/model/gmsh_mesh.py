@@ -357,7 +357,7 @@ def _quadrilaterals_only(gmsh: Any, hint: str = "") -> None:
         )
 
 
-def gmsh_plate_mesh(
+def gmsh_plate_mesh(  # noqa: C901 - gmsh's session on rank 0, its errors, and the broadcast, in one place
     plate: PlateSpec,
     spec: MeshSpec,
     comm: MPI.Comm = MPI.COMM_WORLD,
@@ -398,6 +398,10 @@ def gmsh_plate_mesh(
     if comm.rank == 0:
         if gmsh is None:
             raise RuntimeError("gmsh_plate_mesh: expected gmsh is not None (an internal invariant)")
+        if plate.file is None and spec.size is None:
+            raise RuntimeError(
+                "gmsh_plate_mesh: expected spec.size is not None (an internal invariant)"
+            )
         gmsh.initialize(interruptible=False)
         try:
             for key, value in GMSH_OPTIONS.items():
@@ -405,11 +409,8 @@ def gmsh_plate_mesh(
             if plate.file is not None:
                 _mesh_file(gmsh, plate, spec)
             else:
-                if spec.size is None:
-                    raise RuntimeError(
-                        "gmsh_plate_mesh: expected spec.size is not None (an internal invariant)"
-                    )
-                _mesh_built(gmsh, plate, spec.size, zone_curves(obstacles, spec.size))
+                size = float(spec.size or 0.0)  # checked above
+                _mesh_built(gmsh, plate, size, zone_curves(obstacles, size))
         except ValueError as err:
             error = str(err) if plate.file is None else f"plate.file {plate.file}: {err}"
         except Exception as err:  # gmsh raises plain Exceptions

@@ -284,7 +284,7 @@ def solve_prestress(
     )
     uh = problem.solve()
     if not isinstance(uh, dolfinx.fem.Function):
-        raise RuntimeError(
+        raise TypeError(
             "solve_prestress: expected isinstance(uh, dolfinx.fem.Function) (an internal invariant)"
         )
     uh.name = "prestress_displacement"

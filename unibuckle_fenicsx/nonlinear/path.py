@@ -420,7 +420,20 @@ def contact_check(plate: VonKarmanPlate, rtol: float = 1e-8) -> dict[str, Any]:
     return out
 
 
-def solve_nonlinear(
+def _default_atol(plate: VonKarmanPlate, reference: float) -> None:
+    """Set SNES's absolute tolerance, unless the command line gives one.
+
+    :data:`~unibuckle_fenicsx.tolerances.NONLINEAR_ATOL` relative to the load vector at
+    ``reference``.
+    """
+    if PETSc.Options().hasName("unibuckle_nl_snes_atol"):
+        return
+    if plate.snes is None:
+        raise RuntimeError("_default_atol: expected plate.snes is not None (an internal invariant)")
+    plate.snes.setTolerances(atol=NONLINEAR_ATOL * plate.unit_load_norm * reference)
+
+
+def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path with cleanup on every exit
     spec: ProblemSpec,
     options: NonlinearOptions | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,
@@ -507,13 +520,7 @@ def solve_nonlinear(
             mesh=linear.problem.mesh,
             facet_tags=linear.problem.facet_tags,
         )
-        opts = PETSc.Options()
-        if not opts.hasName("unibuckle_nl_snes_atol"):
-            if plate.snes is None:
-                raise RuntimeError(
-                    "solve_nonlinear: expected plate.snes is not None (an internal invariant)"
-                )
-            plate.snes.setTolerances(atol=NONLINEAR_ATOL * plate.unit_load_norm * reference)
+        _default_atol(plate, reference)
         shape, shape_name = imperfection_shape(linear, options.shape, obstacle)
         embed(plate, shape, linear.problem, options.imperfection * spec.plate.thickness)
         check_gaps(plate, options.imperfection)
