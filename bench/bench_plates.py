@@ -41,7 +41,7 @@ from mpi4py import MPI
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.certify import Certificate
+from unibuckle_fenicsx.certificate.certify import Certificate
 from unibuckle_fenicsx.config import ObstacleSpec, problem_to_dict
 
 #: name -> (edge supports, load, description of the edges)

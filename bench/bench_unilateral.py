@@ -19,7 +19,7 @@ from mpi4py import MPI
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 def main() -> None:

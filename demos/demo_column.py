@@ -42,12 +42,12 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx import fields, study
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.config import problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.design import reduction_factor
-from unibuckle_fenicsx.materials import bending_stiffness
+from unibuckle_fenicsx.model.materials import bending_stiffness
 from unibuckle_fenicsx.sweep import Variation, run_sweep
+from unibuckle_fenicsx.viz import fields, study
 
 warnings.filterwarnings("error")  # demos run warning-free
 
@@ -107,7 +107,7 @@ with solve(spec, comm) as analysis:
     at_ties = np.abs(node_xy[:, None, :] - ties[None, :, :]).max(axis=2).min(axis=1) < 1e-9
     w_ties = node_w[at_ties]
     if comm.size == 1:
-        from unibuckle_fenicsx import plotting
+        from unibuckle_fenicsx.viz import plotting
 
         xy, w, triangles = fields.mesh_triangles(problem, analysis.mode)
         title = (
@@ -152,7 +152,7 @@ if comm.rank == 0 and lines_path.exists():
 comm.Barrier()
 lines = run_sweep(base, [variation], lines_path, comm, progress=False)
 if comm.rank == 0:
-    from unibuckle_fenicsx.charts import plot_sweep
+    from unibuckle_fenicsx.viz.charts import plot_sweep
 
     chart = plot_sweep(
         lines,

@@ -38,8 +38,9 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx import paper_case, study
-from unibuckle_fenicsx.materials import navier_load_mindlin
+from unibuckle_fenicsx import paper_case
+from unibuckle_fenicsx.model.materials import navier_load_mindlin
+from unibuckle_fenicsx.viz import study
 
 warnings.filterwarnings("error")  # demos run warning-free
 

@@ -23,7 +23,7 @@
 # - describe the plate once (a TOML-shaped mapping with `[mesh] size`, so that the
 #   cell count follows the plate's length) and sweep its length with
 #   :func:`unibuckle_fenicsx.sweep.run_sweep`, the engine of `unibuckle sweep`;
-# - draw the chart with :func:`unibuckle_fenicsx.charts.plot_sweep` (bilateral and
+# - draw the chart with :func:`unibuckle_fenicsx.viz.charts.plot_sweep` (bilateral and
 #   unilateral, the exact thin-plate curves, each point's certificate);
 # - check the curves against the exact values.
 #
@@ -40,9 +40,9 @@ import warnings
 
 from mpi4py import MPI
 
-from unibuckle_fenicsx import study
-from unibuckle_fenicsx.charts import plot_sweep, reference_k
 from unibuckle_fenicsx.sweep import parse_variation, point_problem, run_sweep
+from unibuckle_fenicsx.viz import study
+from unibuckle_fenicsx.viz.charts import plot_sweep, reference_k
 
 warnings.filterwarnings("error")  # demos run warning-free
 

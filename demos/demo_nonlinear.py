@@ -46,10 +46,11 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx import fields, paper_case, plotting, study
+from unibuckle_fenicsx import paper_case
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.fields import zone_box
 from unibuckle_fenicsx.nonlinear import NonlinearOptions, solve_nonlinear, southwell_window
+from unibuckle_fenicsx.viz import fields, plotting, study
+from unibuckle_fenicsx.viz.fields import zone_box
 
 warnings.filterwarnings("error")  # demos run warning-free
 

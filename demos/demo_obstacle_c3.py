@@ -29,8 +29,9 @@ import warnings
 
 from mpi4py import MPI
 
-from unibuckle_fenicsx import SolverSpec, fields, paper_case, study
+from unibuckle_fenicsx import SolverSpec, paper_case
 from unibuckle_fenicsx.analysis import Analysis
+from unibuckle_fenicsx.viz import fields, study
 
 warnings.filterwarnings("error")  # demos run warning-free
 

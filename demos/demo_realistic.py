@@ -36,9 +36,9 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx import fields, study
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.config import problem_from_dict
+from unibuckle_fenicsx.viz import fields, study
 
 warnings.filterwarnings("error")  # demos run warning-free
 
@@ -93,7 +93,7 @@ with solve(spec, comm) as analysis:
     xy_zone = problem.contact.coordinates
     if comm.size == 1:
         xy, w, triangles = fields.mesh_triangles(problem, analysis.mode)
-        from unibuckle_fenicsx import plotting
+        from unibuckle_fenicsx.viz import plotting
 
         figures.mkdir(parents=True, exist_ok=True)
         title = (

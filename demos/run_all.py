@@ -92,9 +92,9 @@ def _table(rows: list[list[str]]) -> tuple[str, str]:
 
 def _compare_cases(paper: dict[str, dict[str, Any]], figures: Path) -> list[str]:
     """Section A of every case on the paper's mesh, and the paper's comparisons."""
-    from unibuckle_fenicsx import plotting
     from unibuckle_fenicsx.cases import paper_case
-    from unibuckle_fenicsx.fields import mirror_to_match, zone_box
+    from unibuckle_fenicsx.viz import plotting
+    from unibuckle_fenicsx.viz.fields import mirror_to_match, zone_box
 
     load = {}
     for case, data in paper.items():
@@ -187,8 +187,8 @@ def main(argv: list[str] | None = None) -> int:
         print(text)
         (figures / "results.md").write_text(md + "\n")
     if studies:
-        from unibuckle_fenicsx import plotting
-        from unibuckle_fenicsx.materials import navier_load_mindlin
+        from unibuckle_fenicsx.model.materials import navier_load_mindlin
+        from unibuckle_fenicsx.viz import plotting
 
         free = json.loads((figures / "free" / "results.json").read_text())
         reference = free.get("reference_Pa") if "free" in studies else None

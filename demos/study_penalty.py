@@ -43,12 +43,13 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx import fields, paper_case
+from unibuckle_fenicsx import paper_case
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver
-from unibuckle_fenicsx.certify import certify
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.certificate.certify import certify
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.viz import fields
 
 # %% [markdown]
 # ## Parameters

@@ -36,14 +36,14 @@ def active_specs():
 def nothing_built(monkeypatch):
     """Fail the test if a mesh is built or a solve starts: refusals come first."""
     import unibuckle_fenicsx.analysis
+    import unibuckle_fenicsx.model.problem
     import unibuckle_fenicsx.nonlinear
-    import unibuckle_fenicsx.problem
 
     def refuse(*args, **kwargs):
         raise AssertionError("work started before the input was refused")
 
     monkeypatch.setattr(unibuckle_fenicsx.analysis, "solve", refuse)
-    monkeypatch.setattr(unibuckle_fenicsx.problem, "build_plate_mesh", refuse)
+    monkeypatch.setattr(unibuckle_fenicsx.model.problem, "build_plate_mesh", refuse)
     monkeypatch.setattr(unibuckle_fenicsx.nonlinear, "solve_nonlinear", refuse)
 
 

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import scipy.linalg
 
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 #: Relative agreement of loads: SLEPc converges to a relative residual of eps_tol = 1e-10
 #: and LAPACK to about 1e-13 here, so 1e-8 leaves a margin of 100.

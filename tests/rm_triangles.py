@@ -135,7 +135,7 @@ def holed_plate_load(
 
 def navier_check(b: float, t: float, h: float) -> tuple[float, float]:
     """(this discretisation's load, the Navier load) of the square without hole (m = 1)."""
-    from unibuckle_fenicsx.materials import navier_load_mindlin
+    from unibuckle_fenicsx.model.materials import navier_load_mindlin
 
     load = holed_plate_load(b, 1e-9 * b, t, h)  # a hole far below the mesh size
     return load, navier_load_mindlin(1.0e9, 0.3, t, b, b)[0]

@@ -21,7 +21,8 @@ from exhaustive import exhaustive_minimum
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.certify import PROOF_GAP, certify
+from unibuckle_fenicsx.certificate.certify import certify
+from unibuckle_fenicsx.certificate.copositivity import copositivity_bound
 from unibuckle_fenicsx.config import (
     EdgeSpec,
     Material,
@@ -31,8 +32,8 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.copositivity import copositivity_bound
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.tolerances import PROOF_GAP
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 

@@ -18,7 +18,7 @@ import numpy as np
 import pytest
 
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED, EXIT_OK, _parser, main
-from unibuckle_fenicsx.materials import navier_load_mindlin
+from unibuckle_fenicsx.model.materials import navier_load_mindlin
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
 
@@ -186,6 +186,60 @@ def test_bad_flag_value_exits_2(args, match, capsys):
     assert re.search(match, err), err
 
 
+def test_set_changes_the_value_at_its_dotted_path():
+    """--set PATH=VALUE changes that value of the problem, read as the kind found there."""
+    from unibuckle_fenicsx.cases import paper_case
+    from unibuckle_fenicsx.cli import _spec_from_args
+
+    parser, _ = _parser()
+    args = parser.parse_args(
+        ["solve", "--case", "c1", "--set", "solver.tau=1e-9", "--set", "solver.method=penalty"]
+    )
+    spec = _spec_from_args(args)
+    assert spec.solver.tau == 1e-9 and spec.solver.method == "penalty"
+    assert paper_case("c1").solver.tau != 1e-9  # the value was changed, not already there
+    assert spec.plate == paper_case("c1").plate  # and nothing else
+
+
+@pytest.mark.parametrize(
+    ("setting", "match"),
+    [
+        ("solver.nope=1", r"--set solver\.nope: solver has no key 'nope'"),
+        ("solver.tau=abc", r"--set solver\.tau: 'abc' is not a number"),
+        ("solver.tau", r"--set 'solver\.tau': give PATH=VALUE"),
+        ("solver.tau=0.5", r"solver\.tau"),  # the schema's range
+    ],
+)
+def test_bad_set_exits_2_naming_it(setting, match, capsys, no_solve):
+    assert main(["solve", "--case", "free", "--set", setting]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert re.search(match, err), err
+
+
+def test_nonlinear_flag_defaults_are_the_options_defaults():
+    """The nonlinear flags' defaults are NonlinearOptions' and its choices the package's.
+
+    The CLI keeps the defaults to build its parser without importing DOLFINx.
+    """
+    import dataclasses
+
+    from unibuckle_fenicsx.cli import _NONLINEAR_DEFAULTS
+    from unibuckle_fenicsx.nonlinear import CONTROLS, SHAPES, NonlinearOptions
+
+    fields = {f.name: f.default for f in dataclasses.fields(NonlinearOptions)}
+    assert _NONLINEAR_DEFAULTS == {k: fields[k] for k in _NONLINEAR_DEFAULTS}
+    parser, _ = _parser()
+    args = parser.parse_args(["nonlinear", "--case", "c1"])
+    assert {k: getattr(args, k) for k in _NONLINEAR_DEFAULTS} == _NONLINEAR_DEFAULTS
+    choices = {
+        a.dest: tuple(a.choices)
+        for sub in parser._subparsers._group_actions[0].choices.values()
+        for a in sub._actions
+        if a.choices
+    }
+    assert choices["shape"] == SHAPES and choices["control"] == CONTROLS
+
+
 def test_missing_config_file_exits_2(tmp_path, capsys):
     assert main(["solve", "--config", str(tmp_path / "nowhere.toml")]) == 2
     assert "nowhere.toml" in capsys.readouterr().err
@@ -272,7 +326,7 @@ def test_unwritable_output_is_refused_before_solving(tmp_path, capsys, no_solve,
 
 def test_one_cell_and_huge_meshes_are_refused(capsys, monkeypatch):
     """--nx 1 names mesh.nx; a 100000 x 100000 mesh is refused with its memory estimate."""
-    import unibuckle_fenicsx.problem as problem_module
+    import unibuckle_fenicsx.model.problem as problem_module
 
     assert main(["solve", "--case", "free", "--nx", "1"]) == EXIT_BAD_INPUT
     assert "mesh.nx must be an integer >= 2" in capsys.readouterr().err

@@ -22,7 +22,7 @@ serial_only = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs its own p
 
 def _expected_pngs() -> dict[str, tuple[int, int]]:
     """PNG path (relative to the figures directory) -> (height, width) in pixels."""
-    from unibuckle_fenicsx.plotting import THEME
+    from unibuckle_fenicsx.viz.plotting import THEME
 
     w3, h3 = THEME["window_size"]
     fw, fh = THEME["figsize"]
@@ -115,8 +115,9 @@ def test_section_of_free_mode_is_the_navier_shape():
     and scaled to max |w| = 1 it is +-sin(2 pi x'/a). The MITC4 mode's nodal values on the
     paper's mesh match it within 2 % of max |w|.
     """
-    from unibuckle_fenicsx import fields, paper_case
-    from unibuckle_fenicsx.problem import BucklingProblem
+    from unibuckle_fenicsx import paper_case
+    from unibuckle_fenicsx.model.problem import BucklingProblem
+    from unibuckle_fenicsx.viz import fields
 
     spec = paper_case("free", 20, 20)
     with BucklingProblem(spec, MPI.COMM_WORLD) as problem:
@@ -131,7 +132,7 @@ def test_section_of_free_mode_is_the_navier_shape():
 def test_zone_box_of_the_paper_cases():
     """zone_box returns the paper's zones (section 6), and the plate for "all" (c3)."""
     from unibuckle_fenicsx import paper_case
-    from unibuckle_fenicsx.fields import zone_box
+    from unibuckle_fenicsx.viz.fields import zone_box
 
     assert zone_box(paper_case("free")) is None
     assert zone_box(paper_case("c1")) == ((-0.04, 0.04), (-0.05, 0.05))

@@ -25,13 +25,14 @@ import numpy as np
 import pytest
 from conftest import ROOT, run_mpi
 
-from unibuckle_fenicsx.algorithms.enumeration import TIE_RTOL, enumerate_contact_sets
+from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.certify import certify
+from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.config import ObstacleSpec, ProblemSpec
-from unibuckle_fenicsx.contact import EmptyZoneError
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.tolerances import LOAD_TIE_RTOL
 
 RTOL = 1e-9
 BIG = 10**12  # max_candidates that never refuses
@@ -51,9 +52,9 @@ CASES = {
 
 
 def _pick(entries: list[tuple[float, tuple[int, ...]]]) -> tuple[float, tuple[int, ...]]:
-    """Smallest load; among loads within TIE_RTOL of it, the lexicographically first set."""
+    """Smallest load; among loads within LOAD_TIE_RTOL of it, the lexicographically first set."""
     best = min(load for load, _ in entries)
-    return min(((s, load) for load, s in entries if load <= best * (1 + TIE_RTOL)))[::-1]
+    return min(((s, load) for load, s in entries if load <= best * (1 + LOAD_TIE_RTOL)))[::-1]
 
 
 def dense_brute_force(problem: BucklingProblem) -> dict:
@@ -103,7 +104,7 @@ def dense_brute_force(problem: BucklingProblem) -> dict:
         "optimum": _pick(feasible),
         "p_star": p_star,
         "paper": _pick(per_p[p_star]),
-        "monotone": all(a <= b * (1 + TIE_RTOL) for a, b in itertools.combinations(known, 2)),
+        "monotone": all(a <= b * (1 + LOAD_TIE_RTOL) for a, b in itertools.combinations(known, 2)),
         "all_removed": by_p[i][0][0],
     }
 

@@ -21,7 +21,7 @@ import pytest
 import unibuckle_fenicsx.analysis
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_BUG, EXIT_NOT_CERTIFIED, EXIT_OK, main
 from unibuckle_fenicsx.errors import InputError, NumericalError, UnibuckleError
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.sweep import parse_variation, run_sweep
 
 #: A small plate with a box obstacle (each point an enumeration of a few sets, ~1 s).

@@ -29,12 +29,14 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 
+from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
+from unibuckle_fenicsx.certificate.certify import certify_foundation
 from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
-from unibuckle_fenicsx.contact import tributary_areas
-from unibuckle_fenicsx.materials import bending_stiffness
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.contact import tributary_areas
+from unibuckle_fenicsx.model.materials import bending_stiffness
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 THICKNESS = 1e-3  # b = 1 m: t/b = 1e-3, the thin limit
 D = bending_stiffness(1.0e9, 0.3, THICKNESS)
@@ -190,6 +192,26 @@ def test_foundation_the_free_mode_turns_away_from_is_proven_inactive():
     assert result.certificate["kkt"] and result.certificate["global_optimum_proven"]
 
 
+def test_the_foundation_certificate_reads_the_typed_status_never_a_default():
+    """The certificate takes the spring-set status from ``solution.status``.
+
+    A solution without one is refused (before, a missing "foundation_status" key read as
+    "converged" and certified); an unconverged status is not KKT. The status reaches the
+    JSON under its old key and spelling.
+    """
+    spec = strip(1.0, 8, ObstacleSpec("all", foundation_stiffness=modulus(100.0)))
+    with solve(spec) as analysis:
+        solution = analysis.solution
+        assert solution is not None and solution.status is RunStatus.CONVERGED
+        assert analysis.result.details["foundation_status"] == "converged"
+        with pytest.raises(ValueError, match=r"solution\.status"):
+            certify_foundation(analysis.problem, replace(solution, status=None))
+        stalled = certify_foundation(
+            analysis.problem, replace(solution, status=RunStatus.MAX_ITERATIONS)
+        )
+        assert not stalled.kkt
+
+
 @pytest.mark.parametrize("supports", ["simply_supported", "loaded_clamped"])
 def test_tensionless_foundation_lies_between_free_and_rigid_and_grows(supports):
     """a/b = 3, 24x8 cells, t/b = 1e-3, whole-plate foundation, K = 1 ... 1e4.
@@ -251,7 +273,7 @@ def test_tensionless_limit_tends_to_sixteen_thirds():
     """
     base = {ny: strip(3.0, ny, supports={"left": "clamped", "right": "clamped"}) for ny in (12, 24)}
     rigid, soft = [], []
-    for ny, spec in base.items():
+    for spec in base.values():
         with solve(replace(spec, obstacle=ObstacleSpec("all"))) as analysis:
             rigid.append(analysis.result.buckling_coefficient_k)
         zone = ObstacleSpec("all", foundation_stiffness=modulus(1e4))

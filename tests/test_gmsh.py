@@ -31,10 +31,10 @@ from unibuckle_fenicsx.config import (  # noqa: E402
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.gmsh_mesh import GMSH_OPTIONS  # noqa: E402
-from unibuckle_fenicsx.materials import navier_load_mindlin  # noqa: E402
-from unibuckle_fenicsx.problem import BucklingProblem  # noqa: E402
-from unibuckle_fenicsx.zones import zone_report  # noqa: E402
+from unibuckle_fenicsx.model.gmsh_mesh import GMSH_OPTIONS  # noqa: E402
+from unibuckle_fenicsx.model.materials import navier_load_mindlin  # noqa: E402
+from unibuckle_fenicsx.model.problem import BucklingProblem  # noqa: E402
+from unibuckle_fenicsx.model.zones import zone_report  # noqa: E402
 
 #: The paper's plate as an outline: segment 0 bottom, 1 right, 2 top, 3 left.
 PAPER_OUTLINE = [[-0.1, -0.05], [0.1, -0.05], [0.1, 0.05], [-0.1, 0.05]]

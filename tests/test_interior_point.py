@@ -36,7 +36,7 @@ from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.config import ObstacleSpec, problem_to_dict
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 PARALLEL = Path(__file__).parent / "mpi" / "interior_point_parallel.py"

@@ -33,17 +33,13 @@ from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.certify import BRACKET_GAP, certify
+from unibuckle_fenicsx.certificate.accurate import AccurateResidual, two_product, two_sum
+from unibuckle_fenicsx.certificate.certify import certify
+from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions, lowrank_certificate
+from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.config import ObstacleSpec
-from unibuckle_fenicsx.copositivity import ShiftedMatrix
-from unibuckle_fenicsx.copositivity_lowrank import (
-    AccurateResidual,
-    LowRankOptions,
-    lowrank_certificate,
-    two_product,
-    two_sum,
-)
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.tolerances import BRACKET_GAP, ROUNDING_RTOL
 
 pytest.importorskip("clarabel")
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
@@ -196,7 +192,7 @@ def test_thin_ssss_plate_is_bracketed():
     assert cert.negative_eigenvalues is not None and cert.negative_eigenvalues >= 2
     assert cert.status in ("bracketed", "proven"), cert
     assert cert.proven_by == "lowrank-spn"
-    assert cert.relative_gap <= BRACKET_GAP * (1 + 1e-9)  # a bound at lambda (1 - 1e-3), rounded
+    assert cert.relative_gap <= BRACKET_GAP * (1 + ROUNDING_RTOL)  # a bound at lambda (1 - 1e-3)
     assert cert.lower_bound <= load <= cert.upper_bound
     assert data["status"] == cert.status and data["negative_eigenvalues"] >= 2
     assert data["copositivity"]["lowrank"]["r"] >= 2

@@ -20,7 +20,7 @@ import pytest
 from conftest import run_mpi
 
 from unibuckle_fenicsx.cli import main as cli_main
-from unibuckle_fenicsx.materials import navier_load_mindlin
+from unibuckle_fenicsx.model.materials import navier_load_mindlin
 
 HERE = Path(__file__).resolve().parent
 STEPS = HERE / "mpi" / "pipeline_steps.py"
@@ -323,7 +323,7 @@ def test_lowrank_certificate_distributed_equals_serial():
     from unibuckle_fenicsx.algorithms.active_set import solve_active_set
     from unibuckle_fenicsx.cases import plate_case
     from unibuckle_fenicsx.config import ObstacleSpec
-    from unibuckle_fenicsx.problem import BucklingProblem
+    from unibuckle_fenicsx.model.problem import BucklingProblem
 
     plate = plate_case("thin", length=0.3, width=0.1, thickness=1e-4, nx=30, ny=10,
                        zone=ObstacleSpec(zone="all"))  # fmt: skip

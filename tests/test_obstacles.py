@@ -28,8 +28,8 @@ from unibuckle_fenicsx.config import (
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.contact import BilateralZoneError
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.contact import BilateralZoneError
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 # -- schema ------------------------------------------------------------------------------

@@ -11,8 +11,8 @@ import pytest
 
 from unibuckle_fenicsx import paper_case
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, solve_penalty
-from unibuckle_fenicsx.certify import certify
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.certificate.certify import certify
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 #: Eigenvalues are solved to a relative residual of 1e-10 (SolverSpec.eps_tol), so loads
 #: compare to 1e-9 relative: an order of magnitude of margin over the solver's error.

@@ -25,14 +25,14 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.contact import EmptyZoneError
-from unibuckle_fenicsx.materials import (
+from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.model.materials import (
     bending_stiffness,
     navier_load_kirchhoff,
     navier_load_mindlin,
     shear_modulus,
 )
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 E, NU = 1.0e9, 0.3
 #: The paper's plate (paper, section 6).

@@ -33,7 +33,7 @@ from unibuckle_fenicsx.config import (
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.materials import bending_stiffness
+from unibuckle_fenicsx.model.materials import bending_stiffness
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate, isotropic

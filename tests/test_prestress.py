@@ -17,8 +17,8 @@ import pytest
 
 from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.config import EdgeSpec, Material, MeshSpec, PlateSpec
-from unibuckle_fenicsx.mesh import create_plate_mesh
-from unibuckle_fenicsx.prestress import solve_prestress
+from unibuckle_fenicsx.model.mesh import create_plate_mesh
+from unibuckle_fenicsx.model.prestress import solve_prestress
 
 T = 0.006
 MATERIAL = Material(E=1.0e9, nu=0.3)

@@ -14,8 +14,8 @@ import pytest
 from unibuckle_fenicsx import EdgeSpec, MeshSpec, PlateSpec, paper_case
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.eigen import GEPSolver
-from unibuckle_fenicsx.mesh import create_plate_mesh
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.mesh import create_plate_mesh
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 def test_user_mesh_with_own_tags_matches_rectangle():
@@ -29,7 +29,9 @@ def test_user_mesh_with_own_tags_matches_rectangle():
 
     msh, tags = create_plate_mesh(spec.plate, MeshSpec(8, 4), MPI.COMM_WORLD)
     user_tags = dolfinx.mesh.meshtags(msh, 1, tags.indices, tags.values + 10)
-    edges = tuple(replace(e, tag=t) for e, t in zip(spec.plate.edges, (11, 12, 13, 14)))
+    edges = tuple(
+        replace(e, tag=t) for e, t in zip(spec.plate.edges, (11, 12, 13, 14), strict=True)
+    )
     user_spec = replace(spec, plate=replace(spec.plate, edges=edges))
     with solve(user_spec, mesh=msh, facet_tags=user_tags) as analysis:
         result = analysis.result

@@ -32,7 +32,8 @@ from unibuckle_fenicsx.cli import (
     main,
 )
 from unibuckle_fenicsx.config import problem_from_dict
-from unibuckle_fenicsx.results import file_stem, versions
+from unibuckle_fenicsx.io import file_stem
+from unibuckle_fenicsx.results import versions
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs its own processes")
@@ -286,7 +287,7 @@ def test_a_plate_gmsh_cannot_mesh_names_its_features():
     """A ligament of mesh.size/50: allowed, but gmsh leaves triangles; the keys are named."""
     pytest.importorskip("gmsh")
     spec = problem_from_dict(_holed([0.1, 0.1 - 0.03 - 2e-4], 0.03))
-    from unibuckle_fenicsx.gmsh_mesh import gmsh_plate_mesh
+    from unibuckle_fenicsx.model.gmsh_mesh import gmsh_plate_mesh
 
     with pytest.raises(ValueError) as err:
         gmsh_plate_mesh(spec.plate, spec.mesh, MPI.COMM_SELF)

@@ -41,10 +41,10 @@ from families import stress_family
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.mesh import create_plate_mesh
-from unibuckle_fenicsx.plate.model import PlateModel
-from unibuckle_fenicsx.prestress import solve_prestress
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.mesh import create_plate_mesh
+from unibuckle_fenicsx.model.plate.model import PlateModel
+from unibuckle_fenicsx.model.prestress import solve_prestress
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 FAMILY_SIZE = 200
 SAMPLE = 20

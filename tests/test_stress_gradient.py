@@ -37,9 +37,9 @@ from unibuckle_fenicsx.config import (
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.mesh import create_plate_mesh
-from unibuckle_fenicsx.prestress import solve_prestress
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.mesh import create_plate_mesh
+from unibuckle_fenicsx.model.prestress import solve_prestress
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 #: Thin plate: the Reissner-Mindlin shear correction is O((t/b)^2) = 1e-6.
 THICKNESS = 1e-3

@@ -23,7 +23,6 @@ import pytest
 from conftest import ROOT, run_mpi
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.charts import reference_k
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK
 from unibuckle_fenicsx.config import MeshSpec, load_toml, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.sweep import (
@@ -34,6 +33,7 @@ from unibuckle_fenicsx.sweep import (
     set_value,
     sweep_points,
 )
+from unibuckle_fenicsx.viz.charts import reference_k
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
 

@@ -36,7 +36,7 @@ import pytest
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.config import LoadSpec, Material, problem_from_dict, problem_to_dict
-from unibuckle_fenicsx.materials import bending_stiffness, navier_load_mindlin
+from unibuckle_fenicsx.model.materials import bending_stiffness, navier_load_mindlin
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate, isotropic
@@ -179,7 +179,7 @@ def test_a_fixed_load_that_buckles_the_plate_alone_is_refused():
     import scipy.linalg
     from exhaustive import dense
 
-    from unibuckle_fenicsx.problem import BucklingProblem
+    from unibuckle_fenicsx.model.problem import BucklingProblem
 
     spec = paper_case("c1", 8, 8)
     with BucklingProblem(spec.without_obstacles(), MPI.COMM_SELF) as problem:

@@ -17,11 +17,11 @@ from unibuckle_fenicsx.algorithms import (
     candidate_count,
 )
 from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
-from unibuckle_fenicsx.certify import Certificate, certify, certify_foundation
+from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.results import BucklingResult
 
 __all__ = ["Analysis", "choose_method", "solve"]
@@ -163,7 +163,10 @@ class Analysis(Owner):
     @property
     def free_mode(self) -> dolfinx.fem.Function:
         """The mode without obstacle, max |w| = 1."""
-        assert self.problem.free is not None
+        if self.problem.free is None:
+            raise RuntimeError(
+                "free_mode: expected self.problem.free is not None (an internal invariant)"
+            )
         return self.problem.free.function
 
     def destroy(self) -> None:
@@ -190,7 +193,7 @@ def solve(
         eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
             is ``-unibuckle_eps_view``).
         mesh: Optional quadrilateral mesh replacing ``spec.mesh`` (with ``facet_tags``;
-            see :class:`~unibuckle_fenicsx.problem.BucklingProblem`).
+            see :class:`~unibuckle_fenicsx.model.problem.BucklingProblem`).
         facet_tags: Edge markers of ``mesh``.
 
     Returns:

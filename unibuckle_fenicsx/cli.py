@@ -8,6 +8,10 @@ One problem, a grid of them, and the load path of the imperfect plate:
 
 Unrecognised ``-prefix_option value`` pairs are passed to PETSc, e.g.
 ``-unibuckle_eps_view`` or ``-unibuckle_prestress_ksp_view``.
+
+The module is about 860 lines: the three subcommands' parsers, their epilogs (the exit
+statuses) and drivers. It is to be split by subcommand once the rework of its exit
+statuses and error handling (on another branch) has landed, to keep that merge small.
 """
 
 from __future__ import annotations
@@ -130,6 +134,70 @@ solves) and unibuckle_prestress_.
 """
 
 
+class _Formatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
+    """Epilogs as written; each option's default appended to its help (when it has one)."""
+
+    def _get_help_string(self, action: argparse.Action) -> str | None:
+        default = action.default
+        if default in (None, []) or isinstance(default, bool) or action.nargs == 0:
+            return action.help  # no default, a switch, a counter or a list: nothing to add
+        return super()._get_help_string(action)
+
+
+def _solver_default(name: str) -> str:
+    """``(default D, or the file's)`` for the solver field ``name`` (schema default D)."""
+    from unibuckle_fenicsx.config import SolverSpec
+
+    value = getattr(SolverSpec(), name)
+    return (
+        f"(default: {value:g}, or the file's)"
+        if isinstance(value, float)
+        else (f"(default: {value}, or the file's)")
+    )
+
+
+def _common_flags() -> argparse.ArgumentParser:
+    """Flags of every subcommand: logging and progress."""
+    common = argparse.ArgumentParser(add_help=False)
+    common.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
+    common.add_argument("-q", "--quiet", action="store_true", help="no progress output on stderr")
+    return common
+
+
+def _problem_flags() -> argparse.ArgumentParser:
+    """Flags naming one problem (solve, nonlinear): its source, mesh, --set and --json."""
+    from unibuckle_fenicsx.cases import CASES
+
+    problem = argparse.ArgumentParser(add_help=False)
+    src = problem.add_mutually_exclusive_group(required=True)
+    src.add_argument(
+        "--case",
+        choices=list(CASES),
+        help="the paper's plate: free (no obstacle), c1 = [-0.04,0.04]x[-0.05,0.05], "
+        "c2 = [-0.04,0.04]x[-0.02,0.02], c3 = whole plate",
+    )
+    src.add_argument(
+        "--config",
+        metavar="FILE",
+        help="problem file: TOML (schema in the README), or a result JSON to re-run its input",
+    )
+    problem.add_argument("--nx", type=int, help="cells along x, >= 2 (default: the problem's)")
+    problem.add_argument("--ny", type=int, help="cells along y, >= 2 (default: the problem's)")
+    problem.add_argument(
+        "--set",
+        metavar="PATH=VALUE",
+        action="append",
+        default=[],
+        dest="settings",
+        help="set a value of the problem file by its dotted path (as --vary of the sweep): "
+        "--set solver.tau=1e-9 --set plate.thickness=0.004 (repeatable; the file's units)",
+    )
+    problem.add_argument(
+        "--json", metavar="PATH", help="write the result as JSON (the folder must exist)"
+    )
+    return problem
+
+
 def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     parser = argparse.ArgumentParser(
         prog="unibuckle",
@@ -141,117 +209,24 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
         ),
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
+    common, problem = _common_flags(), _problem_flags()
     s = sub.add_parser(
         "solve",
+        parents=[problem, common],
         help="solve one problem (a paper case or a TOML file)",
         description="Compute the critical load of one problem and print a one-line summary.",
         epilog=EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=_Formatter,
     )
-    src = s.add_mutually_exclusive_group(required=True)
-    src.add_argument(
-        "--case",
-        choices=["free", "c1", "c2", "c3"],
-        help="the paper's plate: free (no obstacle), c1 = [-0.04,0.04]x[-0.05,0.05], "
-        "c2 = [-0.04,0.04]x[-0.02,0.02], c3 = whole plate",
-    )
-    src.add_argument(
-        "--config",
-        metavar="FILE",
-        help="problem file: TOML (schema in the README), or a result JSON to re-run its input",
-    )
-    s.add_argument("--nx", type=int, help="cells along x, >= 2 (default: paper 20, or the TOML's)")
-    s.add_argument("--ny", type=int, help="cells along y, >= 2 (default: paper 20, or the TOML's)")
-    s.add_argument(
-        "--method",
-        choices=list(METHODS),
-        help="unilateral algorithm (default auto: exact enumeration when 2^i <= "
-        "--max-candidates and its estimated time fits --enumeration-budget, else "
-        "interior-point on thin plates (t/b < 0.02) and active-set on thicker ones; "
-        "enumerate alone = the paper's stopping rule)",
-    )
-    s.add_argument(
-        "--complete",
-        action="store_true",
-        help="enumerate: visit every subset (checks the paper's monotonicity)",
-    )
-    s.add_argument(
-        "--until-proven",
-        action="store_true",
-        help="enumerate: go past the paper's stopping size p* until the interlacing bound "
-        "proves the best set optimal (exact; implied by --method auto)",
-    )
-    s.add_argument(
-        "--max-candidates",
-        type=int,
-        metavar="N",
-        help="enumerate: refuse above N candidate sets (default 100000)",
-    )
-    s.add_argument(
-        "--enumeration-budget",
-        type=float,
-        metavar="SECONDS",
-        help="auto: enumerate only if the estimated time is below this (default 60)",
-    )
-    s.add_argument(
-        "--max-iterations",
-        type=int,
-        metavar="N",
-        help="active-set: iterates per seed and mesh level (default 100; the feasible "
-        "descent, the last fallback, may use 10x as many solves); interior-point: the "
-        "same for its active-set fallback",
-    )
-    s.add_argument(
-        "--bound-budget",
-        type=int,
-        metavar="N",
-        help="active-set: eigen solves for the lattice lower bound (default 64)",
-    )
-    s.add_argument(
-        "--no-certify",
-        action="store_true",
-        help="skip the global-optimality certificate (for speed studies; KKT is still checked)",
-    )
-    s.add_argument(
-        "--bracket",
-        action="store_true",
-        help="also try the low-rank verified bracket when several pencil eigenvalues lie "
-        "below the load (thin long plates; tens of free solves' time)",
-    )
-    s.add_argument(
-        "--penalty",
-        type=float,
-        metavar="RHO",
-        help="penalty stiffness rho for --method penalty (relative to max diag A)",
-    )
-    s.add_argument("--tau", type=float, help="relative feasibility tolerance (default 1e-8)")
-    s.add_argument(
-        "--candidate-parallel",
-        action="store_true",
-        help="under mpiexec: each rank holds a serial copy and enumerates a share "
-        "of the candidate sets (default: distribute the mesh)",
-    )
-    s.add_argument(
-        "--json", metavar="PATH", help="write the result as JSON (the folder must exist)"
-    )
-    s.add_argument(
-        "--output",
-        metavar="DIR",
-        help="write the mode, obstacle zone and contact set for ParaView (VTX .bp) and "
-        "as VTK (.pvd/.vtu, readable by pyvista.read) into DIR (created if missing; its "
-        "parent must exist): NAME_w.bp, NAME_theta.bp, NAME.pvd, with NAME the problem's "
-        "name, characters other than letters, digits, '.', '-' and '_' replaced by '_'",
-    )
-    s.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
-    s.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
-
+    _solve_flags(s)
     w = sub.add_parser(
         "sweep",
+        parents=[common],
         help="solve a problem file over a grid of values of some of its numbers",
         description="Solve the problem of --config at every point of the --vary grid, "
         "writing one JSON line per point (resumable), and optionally a chart of k.",
         epilog=SWEEP_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=_Formatter,
     )
     w.add_argument("--config", metavar="FILE", required=True, help="the base problem (TOML)")
     w.add_argument(
@@ -279,11 +254,9 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
         type=int,
         default=1,
         metavar="R",
-        help="under mpiexec: ranks of each point's mesh (default 1: one point per rank)",
+        help="under mpiexec: ranks of each point's mesh (1: one point per rank)",
     )
-    w.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
-    w.add_argument("-q", "--quiet", action="store_true", help="no progress bar or lines")
-    _nonlinear_parser(sub)
+    _nonlinear_parser(sub, [problem, common])
     k = sub.add_parser(
         "schema",
         help="print the JSON Schema of a problem file (or its dotted keys)",
@@ -296,43 +269,125 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     return parser, s
 
 
-def _nonlinear_parser(sub: Any) -> None:
-    """The ``nonlinear`` subcommand's arguments."""
+def _solve_flags(s: argparse.ArgumentParser) -> None:
+    """The ``solve`` subcommand's own flags (the solver's, and --output)."""
+    s.add_argument(
+        "--method",
+        choices=list(METHODS),
+        help="unilateral algorithm (auto: exact enumeration when 2^i <= --max-candidates "
+        "and its estimated time fits --enumeration-budget, else interior-point on thin "
+        "plates (t/b < 0.02) and active-set on thicker ones; enumerate alone = the "
+        "paper's stopping rule) " + _solver_default("method"),
+    )
+    s.add_argument(
+        "--complete",
+        action="store_true",
+        help="enumerate: visit every subset (checks the paper's monotonicity)",
+    )
+    s.add_argument(
+        "--until-proven",
+        action="store_true",
+        help="enumerate: go past the paper's stopping size p* until the interlacing bound "
+        "proves the best set optimal (exact; implied by --method auto)",
+    )
+    s.add_argument(
+        "--max-candidates",
+        type=int,
+        metavar="N",
+        help="enumerate: refuse above N candidate sets " + _solver_default("max_candidates"),
+    )
+    s.add_argument(
+        "--enumeration-budget",
+        type=float,
+        metavar="SECONDS",
+        help="auto: enumerate only if the estimated time is below this "
+        + _solver_default("enumeration_budget_s"),
+    )
+    s.add_argument(
+        "--max-iterations",
+        type=int,
+        metavar="N",
+        help="active-set: iterates per seed and mesh level (the feasible descent, the last "
+        "fallback, may use 10x as many solves); interior-point: the same for its "
+        "active-set fallback " + _solver_default("max_iterations"),
+    )
+    s.add_argument(
+        "--bound-budget",
+        type=int,
+        metavar="N",
+        help="active-set: eigen solves for the lattice lower bound "
+        + _solver_default("bound_budget"),
+    )
+    s.add_argument(
+        "--no-certify",
+        action="store_true",
+        help="skip the global-optimality certificate (for speed studies; KKT is still checked)",
+    )
+    s.add_argument(
+        "--bracket",
+        action="store_true",
+        help="also try the low-rank verified bracket when several pencil eigenvalues lie "
+        "below the load (thin long plates; tens of free solves' time)",
+    )
+    s.add_argument(
+        "--penalty",
+        type=float,
+        metavar="RHO",
+        help="penalty stiffness rho for --method penalty (relative to max diag A) "
+        + _solver_default("penalty"),
+    )
+    s.add_argument(
+        "--tau", type=float, help="relative feasibility tolerance " + _solver_default("tau")
+    )
+    s.add_argument(
+        "--candidate-parallel",
+        action="store_true",
+        help="under mpiexec: each rank holds a serial copy and enumerates a share "
+        "of the candidate sets (without it: distribute the mesh)",
+    )
+    s.add_argument(
+        "--output",
+        metavar="DIR",
+        help="write the mode, obstacle zone and contact set for ParaView (VTX .bp) and "
+        "as VTK (.pvd/.vtu, readable by pyvista.read) into DIR (created if missing; its "
+        "parent must exist): NAME_w.bp, NAME_theta.bp, NAME.pvd, with NAME the problem's "
+        "name, characters other than letters, digits, '.', '-' and '_' replaced by '_'",
+    )
+
+
+def _nonlinear_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
+    """The ``nonlinear`` subcommand's arguments (defaults: :class:`NonlinearOptions`)."""
+    from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
+
     n = sub.add_parser(
         "nonlinear",
+        parents=parents,
         help="validate the critical load by the load path of the imperfect plate "
         "(von Karman, against the obstacle)",
         description="Follow the load path of the imperfect von Karman plate against the "
         "obstacle and read the buckling load off it (Southwell, steepest rise), next to "
         "the linear critical load.",
         epilog=NONLINEAR_EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
+        formatter_class=_Formatter,
     )
-    src = n.add_mutually_exclusive_group(required=True)
-    src.add_argument(
-        "--case", choices=["free", "c1", "c2", "c3"], help="the paper's plate (as for solve)"
-    )
-    src.add_argument("--config", metavar="FILE", help="problem file (TOML or a result JSON)")
-    n.add_argument("--nx", type=int, help="cells along x, >= 2")
-    n.add_argument("--ny", type=int, help="cells along y, >= 2")
     n.add_argument(
         "--imperfection",
         type=float,
-        default=1e-3,
+        default=_NONLINEAR_DEFAULTS["imperfection"],
         metavar="DELTA",
-        help="imperfection amplitude max|w0| / thickness, in (0, 1] (default 1e-3)",
+        help="imperfection amplitude max|w0| / thickness, in (0, 1]",
     )
     n.add_argument(
         "--shape",
-        choices=["auto", "free", "unilateral"],
-        default="auto",
-        help="imperfection shape: the linear free or unilateral mode (default auto: "
-        "unilateral with the obstacle, free without)",
+        choices=list(SHAPES),
+        default=_NONLINEAR_DEFAULTS["shape"],
+        help="imperfection shape: the linear free or unilateral mode (auto: unilateral "
+        "with the obstacle, free without)",
     )
     n.add_argument(
         "--control",
-        choices=["load", "displacement"],
-        default="load",
+        choices=list(CONTROLS),
+        default=_NONLINEAR_DEFAULTS["control"],
         help="load control (edge traction, adaptive steps) or displacement control (end "
         "shortening of the loaded edges; uniaxial compression only)",
     )
@@ -340,22 +395,28 @@ def _nonlinear_parser(sub: Any) -> None:
     n.add_argument(
         "--max-load",
         type=float,
-        default=1.2,
+        default=_NONLINEAR_DEFAULTS["max_load"],
         metavar="RATIO",
-        help="stop at RATIO times the linear critical load, in (0, 5] (default 1.2)",
+        help="stop at RATIO times the linear critical load, in (0, 5]",
     )
     n.add_argument(
         "--max-step",
         type=float,
-        default=0.05,
+        default=_NONLINEAR_DEFAULTS["max_step"],
         metavar="FRACTION",
-        help="largest load step, relative to the linear critical load (default 0.05)",
+        help="largest load step, relative to the linear critical load",
     )
-    n.add_argument(
-        "--json", metavar="PATH", help="write the result as JSON (the folder must exist)"
-    )
-    n.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
-    n.add_argument("-q", "--quiet", action="store_true", help="no progress lines on stderr")
+
+
+#: The nonlinear flags' defaults: those of NonlinearOptions (its dataclass fields),
+#: repeated here so that building the parser imports no DOLFINx; a test holds them equal.
+_NONLINEAR_DEFAULTS: dict[str, Any] = {
+    "imperfection": 1e-3,
+    "shape": "auto",
+    "control": "load",
+    "max_load": 1.2,
+    "max_step": 0.05,
+}
 
 
 #: Flags that matter only for some methods: flag -> (methods, SolverSpec field).
@@ -581,7 +642,7 @@ def _run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> int:
 def _solve(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle solve``: one problem, its summary, JSON and fields."""
     from unibuckle_fenicsx.analysis import solve
-    from unibuckle_fenicsx.results import write_fields, write_json
+    from unibuckle_fenicsx.io import write_fields, write_json
 
     def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
         return _fail(comm, message, status)
@@ -754,12 +815,36 @@ def _spec_from_args(args: argparse.Namespace) -> ProblemSpec:
     from unibuckle_fenicsx.config import load_problem
 
     spec = paper_case(args.case) if args.case else _load_config(args.config, load_problem)
+    if args.settings:
+        spec = _with_settings(spec, args.settings)
     if args.nx is not None or args.ny is not None:
         spec = spec.with_mesh(
             spec.mesh.nx if args.nx is None else args.nx,
             spec.mesh.ny if args.ny is None else args.ny,
         )
     return spec
+
+
+def _with_settings(spec: ProblemSpec, settings: Sequence[str]) -> ProblemSpec:
+    """``spec`` with the ``--set PATH=VALUE`` changes (dotted paths of the problem file).
+
+    Raises:
+        ValueError: A setting without '=', a path the problem file does not have, or a
+            value the schema refuses (the message names the path).
+    """
+    from unibuckle_fenicsx.config import problem_from_dict, problem_to_dict
+    from unibuckle_fenicsx.sweep import set_text
+
+    data = problem_to_dict(spec, units=spec.units)
+    for setting in settings:
+        path, sep, text = setting.partition("=")
+        if not sep or not path.strip():
+            raise InputError(f"--set {setting!r}: give PATH=VALUE, e.g. solver.tau=1e-9")
+        set_text(data, path.strip(), text.strip())
+    try:
+        return problem_from_dict(data, name=spec.name)
+    except ValueError as err:
+        raise InputError(f"--set {' '.join(settings)}: {err}") from None
 
 
 def _load_config(path: str, load: Any) -> Any:
@@ -816,7 +901,7 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
             flush=True,
         )
         if args.plot:
-            from unibuckle_fenicsx.charts import plot_sweep
+            from unibuckle_fenicsx.viz.charts import plot_sweep
 
             print(f"sweep: chart {plot_sweep(lines, variations, base, args.plot)}")
     ok = all(line["status"] == "ok" for line in lines)

@@ -46,12 +46,15 @@ __all__ = [
     "EIGEN_OPTIONS",
     "EXTREME_OPTIONS",
     "LDL_OPTIONS",
+    "RUN_EPS_PREFIXES",
     "EigenPair",
     "EigenSolveError",
     "GEPSolver",
     "Owner",
     "SymmetricFactorization",
     "extreme_eigenvalues",
+    "pop_run_options",
+    "push_run_options",
     "release",
     "set_options",
     "swapped_eigenpairs",
@@ -156,6 +159,37 @@ def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False)
             opts.delValue(key)
 
 
+#: Options prefixes of the eigen solvers of one run that take the EPS options given in
+#: Python (:class:`~unibuckle_fenicsx.model.problem.BucklingProblem` ``eps_options``): the
+#: pencil on every mesh level, the penalty stages and the foundation's spring iteration.
+RUN_EPS_PREFIXES = ("unibuckle_", "unibuckle_penalty_", "unibuckle_foundation_")
+
+
+def push_run_options(options: Options | None) -> list[tuple[str, str]]:
+    """Put ``options`` in PETSc's options database under each of :data:`RUN_EPS_PREFIXES`.
+
+    Every eigen solver the run creates afterwards reads them there (its
+    ``setFromOptions``), whichever module builds it. An option the database already
+    holds (the command line's) is left alone: it wins. Returns what was put, for
+    :func:`pop_run_options`.
+    """
+    pushed: list[tuple[str, str]] = []
+    for prefix in RUN_EPS_PREFIXES:
+        opts = PETSc.Options(prefix)
+        for key, value in (options or {}).items():
+            if not opts.hasName(key):
+                opts.setValue(key, value)
+                pushed.append((prefix, key))
+    return pushed
+
+
+def pop_run_options(pushed: list[tuple[str, str]]) -> None:
+    """Remove from the options database what :func:`push_run_options` put there."""
+    for prefix, key in pushed:
+        PETSc.Options(prefix).delValue(key)
+    pushed.clear()
+
+
 class EigenSolveError(NumericalError):
     """The eigen solve did not converge."""
 
@@ -253,7 +287,8 @@ class GEPSolver(Owner):
         else:
             self.A.copy(self._Aw, structure=same)  # type: ignore[arg-type]
             self.B.copy(self._Bw, structure=same)  # type: ignore[arg-type]
-        assert self._Bw is not None
+        if self._Bw is None:
+            raise RuntimeError("reduced: expected self._Bw is not None (an internal invariant)")
         rows = np.ascontiguousarray(removed, dtype=PETSc.IntType)
         self._Aw.zeroRowsColumns(rows, diag=1.0)  # type: ignore[arg-type]
         self._Bw.zeroRowsColumns(rows, diag=0.0)  # type: ignore[arg-type]
@@ -284,7 +319,8 @@ class GEPSolver(Owner):
         """
         n_removed = self.A.comm.tompi4py().allreduce(0 if removed is None else len(removed))
         if n_removed:
-            assert removed is not None
+            if removed is None:
+                raise RuntimeError("solve: expected removed is not None (an internal invariant)")
             A, B = self.reduced(removed)
         else:
             A, B = self.A, self.B

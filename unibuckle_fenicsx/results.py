@@ -1,12 +1,9 @@
-"""BucklingResult: what a solve returns, its JSON form, and ParaView output."""
+"""BucklingResult: what a solve returns and its JSON form (files: :mod:`unibuckle_fenicsx.io`)."""
 
 from __future__ import annotations
 
-import json
 import math
-import re
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -19,15 +16,14 @@ from unibuckle_fenicsx.config import (
     stress_value,
     temperature_field,
 )
-from unibuckle_fenicsx.zones import zone_report
+from unibuckle_fenicsx.model.zones import zone_report
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution
-    from unibuckle_fenicsx.analysis import Analysis
-    from unibuckle_fenicsx.certify import Certificate
-    from unibuckle_fenicsx.problem import BucklingProblem, Mode
+    from unibuckle_fenicsx.certificate.certify import Certificate
+    from unibuckle_fenicsx.model.problem import BucklingProblem, Mode
 
-__all__ = ["BucklingResult", "file_stem", "versions", "write_fields", "write_json"]
+__all__ = ["BucklingResult", "versions"]
 
 
 @dataclass
@@ -54,7 +50,7 @@ class BucklingResult:
         contact_dofs: Global W DOF indices of Z (partition-dependent numbering).
         lower_bound_Pa / upper_bound_Pa: Verified bracket of the critical load (the upper
             bound is the load of an admissible mode; None if the method found none).
-        certificate: :class:`~unibuckle_fenicsx.certify.Certificate` as a dict.
+        certificate: :class:`~unibuckle_fenicsx.certificate.certify.Certificate` as a dict.
         details: Method-specific information.
         timings: Seconds per phase.
         mpi_size: Ranks used.
@@ -73,7 +69,7 @@ class BucklingResult:
         versions: Versions of the package and of the libraries that computed the result
             (:func:`versions`).
         obstacle_zones: Per obstacle, the zone's area on the plate against the discrete
-            zone's and its node count (:func:`~unibuckle_fenicsx.zones.zone_report`).
+            zone's and its node count (:func:`~unibuckle_fenicsx.model.zones.zone_report`).
     """
 
     case: str
@@ -195,7 +191,10 @@ class BucklingResult:
             result.lower_bound_Pa = result.upper_bound_Pa = free.load
             return result
         contact = problem.contact
-        assert contact is not None
+        if contact is None:
+            raise ValueError(
+                "from_solution: the problem has no obstacle (this needs an obstacle zone)"
+            )
         active = solution.active
         rows = contact.removed_rows(active)
         result.constrained_nodes = problem.num_constrained
@@ -211,7 +210,7 @@ class BucklingResult:
             certificate.upper_bound if math.isfinite(certificate.upper_bound) else None
         )
         result.certificate = certificate.as_dict()
-        result.details.update(solution.details)
+        result.details.update(solution.report())
         return result
 
     def as_dict(self, timings: bool = True) -> dict[str, Any]:
@@ -440,63 +439,3 @@ def _jsonable(obj: Any) -> Any:
         value = float(obj)
         return value if np.isfinite(value) else str(value)
     return obj
-
-
-def write_json(result: BucklingResult, path: str | Path) -> Path:
-    """Write ``result`` as JSON (call on one rank only)."""
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    path.write_text(json.dumps(result.as_dict(), indent=2) + "\n")
-    return path
-
-
-def file_stem(name: str) -> str:
-    """``name`` as one file name, which leads out of no folder.
-
-    Characters other than letters, digits, '.', '-' and '_' become '_', and so do
-    leading dots.
-    """
-    stem = re.sub(r"[^A-Za-z0-9._-]", "_", name)
-    stem = re.sub(r"^\.+", lambda m: "_" * len(m.group()), stem)
-    return stem or "plate"
-
-
-def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
-    """Write the mode, the free mode, the obstacle zone and the contact set for viewing.
-
-    ``<case>`` is the problem's name made a safe file name (:func:`file_stem`). Files,
-    for ParaView (ADIOS2 VTX reader): ``<case>_w.bp`` (w, w_free, obstacle_zone,
-    contact on the Q1 space) and ``<case>_theta.bp`` (the rotation); and the same fields
-    as VTK, ``<case>.pvd`` (with ``.pvtu``/``.vtu`` pieces), which ParaView and
-    ``pyvista.read`` open without ADIOS2.
-
-    Returns:
-        The paths of the two ``.bp`` directories and of the ``.pvd`` file.
-
-    Note:
-        Collective on the mesh communicator.
-    """
-    import dolfinx.io
-
-    problem = analysis.problem
-    directory = Path(directory)
-    if problem.comm.rank == 0:
-        directory.mkdir(parents=True, exist_ok=True)
-    problem.comm.barrier()
-    w, theta = problem.model.split(analysis.mode)
-    w_free, _ = problem.model.split(analysis.free_mode)
-    w_free.name = "w_free"
-    fields = [w, w_free]
-    if problem.contact is not None and analysis.solution is not None:
-        fields.append(problem.contact.indicator())
-        fields.append(problem.contact.node_function(analysis.solution.active))
-    case = file_stem(analysis.result.case)
-    paths = [directory / f"{case}_w.bp", directory / f"{case}_theta.bp"]
-    for path, funcs in ((paths[0], fields), (paths[1], [theta])):
-        with dolfinx.io.VTXWriter(problem.comm, path, funcs, engine="BP4") as writer:
-            writer.write(0.0)
-    paths.append(directory / f"{case}.pvd")
-    assert all(path.parent == directory for path in paths)
-    with dolfinx.io.VTKFile(problem.comm, paths[-1], "w") as vtk:
-        vtk.write_function([*fields, theta], 0.0)
-    return paths

@@ -81,6 +81,7 @@ __all__ = [
     "point_problem",
     "read_lines",
     "run_sweep",
+    "set_text",
     "set_value",
     "sweep_points",
 ]
@@ -109,13 +110,13 @@ class Variation:
     values: tuple[float, ...]
 
 
-def _float(text: str, what: str) -> float:
+def _float(text: str, what: str, flag: str = "--vary") -> float:
     try:
         value = float(text)
     except ValueError:
-        raise InputError(f"--vary {what}: {text.strip()!r} is not a number") from None
+        raise InputError(f"{flag} {what}: {text.strip()!r} is not a number") from None
     if not math.isfinite(value):
-        raise InputError(f"--vary {what}: {text.strip()!r} is not a finite number")
+        raise InputError(f"{flag} {what}: {text.strip()!r} is not a finite number")
     return value
 
 
@@ -182,7 +183,39 @@ def _is_number(value: Any) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-def set_value(data: dict[str, Any], path: str, value: float) -> None:
+def _locate(data: dict[str, Any], path: str, flag: str) -> tuple[Any, Any]:
+    """The container and key of the value at the dotted ``path`` of ``data``.
+
+    Raises:
+        ValueError: ``path`` names nothing in ``data`` (the message, led by ``flag``,
+            lists what is there).
+    """
+    keys = path.split(".")
+    node: Any = data
+    for depth, key in enumerate(keys):
+        where = ".".join(keys[:depth]) or "the problem file"
+        if isinstance(node, Mapping):
+            if key not in node:
+                raise InputError(
+                    f"{flag} {path}: {where} has no key {key!r} (keys: {sorted(node)}; "
+                    f"shortcuts: {sorted(SHORTCUTS)})"
+                )
+        elif isinstance(node, list):
+            if not (key.isdigit() and int(key) < len(node)):
+                raise InputError(
+                    f"{flag} {path}: {where} is a list of {len(node)}; {key!r} is not an "
+                    f"index in [0, {len(node) - 1}]"
+                )
+        else:
+            # A user's path through a value: bad input (exit 2), not a type error of the code.
+            raise InputError(f"{flag} {path}: {where} = {node!r} is not a table or a list")
+        if depth < len(keys) - 1:
+            node = node[key] if isinstance(node, Mapping) else node[int(key)]
+    leaf = keys[-1]
+    return node, (leaf if isinstance(node, Mapping) else int(leaf))
+
+
+def set_value(data: dict[str, Any], path: str, value: float, flag: str = "--vary") -> None:
     """Set the number at the dotted ``path`` of the problem mapping ``data``, in place.
 
     Raises:
@@ -193,39 +226,48 @@ def set_value(data: dict[str, Any], path: str, value: float) -> None:
         axis = SHORTCUTS[path]
         corners = data.get("plate", {}).get("corners")
         if not isinstance(corners, list):
-            raise InputError(f"--vary {path}: the problem has no plate.corners")
+            raise InputError(f"{flag} {path}: the problem has no plate.corners")
         corners[1][axis] = corners[0][axis] + value
         return
-    keys = path.split(".")
-    node: Any = data
-    for depth, key in enumerate(keys):
-        where = ".".join(keys[:depth]) or "the problem file"
-        if isinstance(node, Mapping):
-            if key not in node:
-                raise InputError(
-                    f"--vary {path}: {where} has no key {key!r} (keys: {sorted(node)}; "
-                    f"shortcuts: {sorted(SHORTCUTS)})"
-                )
-        elif isinstance(node, list):
-            if not (key.isdigit() and int(key) < len(node)):
-                raise InputError(
-                    f"--vary {path}: {where} is a list of {len(node)}; {key!r} is not an "
-                    f"index in [0, {len(node) - 1}]"
-                )
-        else:
-            raise InputError(f"--vary {path}: {where} = {node!r} is not a table or a list")
-        if depth < len(keys) - 1:
-            node = node[key] if isinstance(node, Mapping) else node[int(key)]
-    leaf = keys[-1]
-    index: Any = leaf if isinstance(node, Mapping) else int(leaf)
+    node, index = _locate(data, path, flag)
     current = node[index]
     if not _is_number(current):
-        raise InputError(f"--vary {path}: the value there, {current!r}, is not a number")
+        raise InputError(f"{flag} {path}: the value there, {current!r}, is not a number")
     if isinstance(current, int):
         if value != int(value):
-            raise InputError(f"--vary {path}: must be an integer, got {value!r}")
+            raise InputError(f"{flag} {path}: must be an integer, got {value!r}")
         value = int(value)
     node[index] = value
+
+
+def set_text(data: dict[str, Any], path: str, text: str, flag: str = "--set") -> None:
+    """Set the value at the dotted ``path`` of ``data`` from ``text``, read as the value there.
+
+    A number, a boolean (true/false) or a string replaces one of its kind; the shortcuts
+    of :data:`SHORTCUTS` take a number.
+
+    Raises:
+        ValueError: ``path`` names nothing in ``data``, or ``text`` is not of the kind of
+            the value there (the message, led by ``flag``, names the path).
+    """
+    if path in SHORTCUTS:
+        set_value(data, path, _float(text, path, flag), flag)
+        return
+    node, index = _locate(data, path, flag)
+    current = node[index]
+    if isinstance(current, bool):
+        if text.lower() not in ("true", "false"):
+            raise InputError(f"{flag} {path}: must be true or false, got {text!r}")
+        node[index] = text.lower() == "true"
+    elif _is_number(current):
+        set_value(data, path, _float(text, path, flag), flag)
+    elif isinstance(current, str):
+        node[index] = text
+    else:
+        raise InputError(
+            f"{flag} {path}: the value there, {current!r}, is a table or a list: name one "
+            "of its entries"
+        )
 
 
 def point_problem(base: Mapping[str, Any], point: Mapping[str, float]) -> ProblemSpec:
@@ -366,21 +408,6 @@ def _solve(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
     return {"status": status, **result.as_dict(timings=False)}
 
 
-def _tqdm(total: int, initial: int, enabled: bool) -> Any:
-    """A tqdm bar, or None (with a note naming the extra) if tqdm is not installed."""
-    if not enabled:
-        return None
-    try:
-        from tqdm import tqdm
-    except ImportError:
-        PROGRESS.info(
-            "sweep: install the 'progress' extra (pip install 'unibuckle_fenicsx[progress]') "
-            "for a progress bar; progress lines follow instead"
-        )
-        return None
-    return tqdm(total=total, initial=initial, unit="point", desc="sweep", dynamic_ncols=True)
-
-
 def run_sweep(
     base: Mapping[str, Any],
     variations: Sequence[Variation],
@@ -448,9 +475,15 @@ def run_sweep(
                 stale,
                 path,
             )
-        bar = _tqdm(len(points), len(done), show)
         lines = Progress(
-            "sweep", len(todo), interval=0.0, enabled=show and bar is None, logger=PROGRESS
+            "sweep",
+            len(todo),
+            interval=0.0,
+            enabled=show,
+            logger=PROGRESS,
+            bar=True,
+            initial=len(done),
+            unit="point",
         )
         t0 = time.perf_counter()
         for count, k in enumerate(mine, start=1):
@@ -460,17 +493,13 @@ def run_sweep(
             if comm.rank == 0:
                 # Lines on disk, every group's (a newline ends each complete line).
                 finished = path.read_bytes().count(b"\n") - len(done)
-                if bar is not None:
-                    bar.update(len(done) + finished - bar.n)
                 lines.update(
                     finished,
                     f"point {k} {points[k]}: {body['status']} "
                     f"({time.perf_counter() - t0:.1f} s for {count} point(s) on this rank)",
                 )
         comm.Barrier()
-        if bar is not None:
-            bar.update(len(points) - bar.n)
-            bar.close()
+        lines.close()
     finally:
         sub.Free()
     final = None

@@ -192,7 +192,7 @@ def _alternatives(node: Mapping[str, Any], root: Mapping[str, Any]) -> list[Mapp
     return []
 
 
-def schema_rows(
+def schema_rows(  # noqa: C901 (one branch per JSON Schema construct)
     schema: Mapping[str, Any], root: Mapping[str, Any] | None = None, prefix: str = ""
 ) -> Iterator[tuple[str, Mapping[str, Any]]]:
     """(dotted key, its schema) for every leaf key of a JSON Schema.

@@ -18,7 +18,7 @@ import numpy as np
 
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.config import load_problem
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 problem = BucklingProblem(load_problem(sys.argv[1]), MPI.COMM_WORLD)
 assert problem.contact is not None

@@ -30,11 +30,11 @@ from test_prestress import (
 )
 
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.certify import certify
+from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.config import MeshSpec
-from unibuckle_fenicsx.mesh import create_plate_mesh
-from unibuckle_fenicsx.prestress import solve_prestress
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.mesh import create_plate_mesh
+from unibuckle_fenicsx.model.prestress import solve_prestress
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 def same_on_all_ranks(comm: MPI.Comm, value: object) -> bool:

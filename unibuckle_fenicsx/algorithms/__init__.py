@@ -1,8 +1,8 @@
 """Unilateral critical-state algorithms.
 
-Each takes a :class:`~unibuckle_fenicsx.problem.BucklingProblem` with an obstacle and
+Each takes a :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle and
 returns a :class:`UnilateralSolution` holding the chosen
-:class:`~unibuckle_fenicsx.problem.Candidate` (load, contact set and its own mode):
+:class:`~unibuckle_fenicsx.model.problem.Candidate` (load, contact set and its own mode):
 
 - :mod:`.enumeration`: the paper's direct method (section 5.3), 2^i candidate sets;
 - :mod:`.active_set`: primal-dual active-set iteration from several seeds
@@ -13,6 +13,7 @@ returns a :class:`UnilateralSolution` holding the chosen
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from enum import StrEnum
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
@@ -21,9 +22,26 @@ import numpy.typing as npt
 from unibuckle_fenicsx.errors import NumericalError
 
 if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.problem import Candidate
+    from unibuckle_fenicsx.model.problem import Candidate
 
-__all__ = ["NoAdmissibleModeError", "UnilateralSolution", "candidate_count"]
+__all__ = ["NoAdmissibleModeError", "RunStatus", "UnilateralSolution", "candidate_count"]
+
+
+class RunStatus(StrEnum):
+    """How an iteration ended (its value is what the JSON output shows).
+
+    The active-set and descent runs end at a KKT point (``KKT``); the spring-set
+    iterations of the penalty method and the foundation at a fixed point
+    (``CONVERGED``); any of them may cycle, run out of iterations, stall (no admissible
+    step) or meet a set without a finite load.
+    """
+
+    KKT = "kkt"
+    CONVERGED = "converged"
+    CYCLE = "cycle"
+    MAX_ITERATIONS = "max_iterations"
+    STALLED = "stalled"
+    NO_FINITE_LOAD = "no-finite-load"
 
 
 class NoAdmissibleModeError(NumericalError):
@@ -55,6 +73,10 @@ class UnilateralSolution:
             e.g. the penalty method, whose modes penetrate).
         kkt_points: Other KKT points met (distinct contact sets), for the certificate.
         p_star: Size of the contact set at which enumeration stopped (None otherwise).
+        lower_bound_by: What proves ``lower_bound``: "enumeration", "lattice", or None when
+            it is the free load (interlacing: the obstacle never lowers the load).
+        status: How the method's iteration ended, for methods whose certificate depends on
+            it (the foundation's spring-set iteration); None for the others.
         details: Method-specific, JSON-ready information.
     """
 
@@ -66,7 +88,23 @@ class UnilateralSolution:
     upper_bound: float
     kkt_points: list[Candidate] = field(default_factory=list)
     p_star: int | None = None
+    lower_bound_by: str | None = None
+    status: RunStatus | None = None
     details: dict[str, Any] = field(default_factory=dict)
+
+    def __post_init__(self) -> None:
+        # The chain still hands ``lower_bound_by`` over in ``details``: lift it to the field.
+        if self.lower_bound_by is None and "lower_bound_by" in self.details:
+            self.lower_bound_by = str(self.details.pop("lower_bound_by"))
+
+    def report(self) -> dict[str, Any]:
+        """``details`` with the typed fields under their JSON keys (the output's "details")."""
+        out: dict[str, Any] = dict(self.details)
+        if self.lower_bound_by is not None:
+            out["lower_bound_by"] = self.lower_bound_by
+        if self.status is not None and self.method == "foundation":
+            out["foundation_status"] = str(self.status)
+        return out
 
     @property
     def load(self) -> float:

@@ -47,7 +47,7 @@ answer is replaced and the replacement is reported.
 
 Note:
     All decisions use values reduced over the ranks
-    (:meth:`~unibuckle_fenicsx.contact.ContactSetManager.values`), so every rank takes
+    (:meth:`~unibuckle_fenicsx.model.contact.ContactSetManager.values`), so every rank takes
     the same path; the function is collective on ``problem.comm``.
 """
 
@@ -61,28 +61,30 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
-from unibuckle_fenicsx.algorithms.bounds import PROOF_RTOL, bracket
+from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms.bounds import bracket
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
-from unibuckle_fenicsx.contact import EmptyZoneError
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+from unibuckle_fenicsx.tolerances import PROOF_RTOL, ROUNDING_RTOL, TWIN_RTOL
 
-__all__ = ["SEED_NAMES", "TWIN_RTOL", "solve_active_set"]
+__all__ = ["SEED_NAMES", "solve_active_set"]
 
 logger = logging.getLogger(__name__)
 
-#: Loads within this relative distance are equal-load twins.
-TWIN_RTOL = 1e-8
 #: Iterates allowed when polishing a prolonged contact set (it needs one to three when
 #: the coarser level predicts the fine one; more means it stalls: the fallback takes over).
 POLISH_ITERATIONS = 25
 #: Eigen solves allowed to the feasible descent, per ``max_iterations``.
 DESCENT_BUDGET = 10
+#: Eigen solves allowed to each penalty of the penalty continuation, per
+#: ``max_iterations`` (a spring-set iteration per penalty, from a soft start).
+PENALTY_BUDGET = 2
 #: Looser tolerances the iteration converges with first (:doc:`/methods/active_set`):
 #: on thin plates the mode's tails, 1e-3 to 1e-8 of the buckle, flip sign from one
 #: contact set to the next, and chasing them at the final tolerance at once moves the
@@ -104,7 +106,8 @@ def _seeds(
     problem: BucklingProblem, free_values: npt.NDArray[np.float64], tau: float
 ) -> list[tuple[str, npt.NDArray[np.int64]]]:
     """Seed contact sets (deduplicated, in :data:`SEED_NAMES` order)."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("_seeds: the problem has no obstacle (this needs an obstacle zone)")
     xy = problem.contact.coordinates
     plate = problem.spec.plate
     (x0, y0), (x1, y1) = plate.corners
@@ -130,7 +133,7 @@ def _seeds(
         elif name in ("greedy+", "greedy-"):
             v = free_values if name == "greedy+" else -free_values
             z = (
-                np.flatnonzero(v >= v.max() * (1.0 - 1e-9))
+                np.flatnonzero(v >= v.max() * (1.0 - ROUNDING_RTOL))
                 if v.max() > tau * scale
                 else np.empty(0, np.intp)
             )
@@ -147,13 +150,14 @@ def _seeds(
 
 def _multi_seed(problem: BucklingProblem, max_iterations: int) -> list[Run]:
     """Run the iteration from every seed, starting from the free mode."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("_multi_seed: the problem has no obstacle (this needs an obstacle zone)")
     free = problem.solve_free().function.x.petsc_vec
     values = problem.contact.values(free)
     runs: list[Run] = []
     for name, z in _seeds(problem, values, problem.tau):  # the greedy seeds come last
         greedy = name.startswith("greedy")
-        capped = greedy and any(r.status == "kkt" for r in runs)
+        capped = greedy and any(r.status is RunStatus.KKT for r in runs)
         budget = min(max_iterations, GREEDY_ITERATIONS) if capped else max_iterations
         runs.append(iterate(problem, name, z, free, budget, greedy=greedy))
     return runs
@@ -174,7 +178,7 @@ def _polish(
         iterate(problem, f"candidate{k}", prolong(coarse, problem, z), None, max_iterations)
         for k, z in enumerate(candidates)
     ]
-    if candidates and not any(r.status == "kkt" for r in runs):
+    if candidates and not any(r.status is RunStatus.KKT for r in runs):
         z = prolong(coarse, problem, candidates[0])
         runs.append(
             iterate(
@@ -185,7 +189,9 @@ def _polish(
 
 
 def _twin_groups(points: list[Candidate]) -> list[list[Candidate]]:
-    """Group KKT points (sorted by load) whose loads agree within :data:`TWIN_RTOL`.
+    """Group KKT points (sorted by load) whose loads agree within TWIN_RTOL (relative).
+
+    (:data:`~unibuckle_fenicsx.tolerances.TWIN_RTOL`.)
 
     Each group is ordered by contact-set size, then lexicographically, so that its
     first member does not depend on rounding (e.g. on the number of ranks).
@@ -203,7 +209,7 @@ def _distinct_kkt(runs: list[Run]) -> list[Candidate]:
     """Distinct KKT end points of ``runs``, sorted by load then lexicographically."""
     found: dict[bytes, Candidate] = {}
     for run in runs:
-        if run.status == "kkt" and run.final is not None:
+        if run.status is RunStatus.KKT and run.final is not None:
             found.setdefault(run.final.key(), run.final)
     return sorted(found.values(), key=lambda s: (s.load, len(s.active), tuple(s.active)))
 
@@ -248,7 +254,7 @@ def _prune(problem: BucklingProblem, cand: Candidate) -> Candidate:
     return cand
 
 
-def solve_active_set(
+def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fallbacks and bound in one documented sequence
     problem: BucklingProblem,
     *,
     max_iterations: int = 100,
@@ -318,7 +324,10 @@ def solve_active_set(
             coarse_runs = _multi_seed(cp, max_iterations)
             runs = coarse_runs
         else:
-            assert prev is not None
+            if prev is None:
+                raise RuntimeError(
+                    "solve_active_set: expected prev is not None (an internal invariant)"
+                )
             runs = _polish(cp, prev, candidates, min(max_iterations, POLISH_ITERATIONS))
         kkt = _distinct_kkt(runs)
         groups = _twin_groups(kkt)
@@ -365,8 +374,10 @@ def solve_active_set(
     warnings: list[str] = []
     if not kkt:
         # The iteration stalled on this mesh: penalty continuation, started from the free
-        # plate (a stalled contact set is a poorer start, measured on thin plates).
-        run, penalty_solves = penalty_continuation(problem, None, max_iterations=200)
+        # plate (on thin plates a stalled contact set is a poorer start).
+        run, penalty_solves = penalty_continuation(
+            problem, None, max_iterations=PENALTY_BUDGET * max_iterations
+        )
         runs.append(run)
         kkt = _distinct_kkt(runs)
         details["fallback"] = {
@@ -394,7 +405,7 @@ def solve_active_set(
                 f"{'at a KKT point' if last.status == 'kkt' else last.status}"
             )
     feasible = [r.best_feasible for r in runs if r.best_feasible is not None]
-    cycles = [r.seed for r in runs + coarse_runs if r.status == "cycle"]
+    cycles = [r.seed for r in runs + coarse_runs if r.status is RunStatus.CYCLE]
     if cycles:
         warnings.append(f"active-set iteration cycled from seed(s) {cycles}")
     if kkt:
@@ -444,7 +455,6 @@ def solve_active_set(
             "penalty_eigensolves": penalty_solves,
             "bound_evaluations": bound_evals,
             "bound_search_complete": complete,
-            "lower_bound_by": "lattice" if bound_evals else "interlacing",
             "wall_time_s": time.perf_counter() - t0,
         }
     )
@@ -460,5 +470,6 @@ def solve_active_set(
         global_optimum_proven=proven,
         upper_bound=chosen.load if chosen.feasible else math.inf,
         kkt_points=kkt,
+        lower_bound_by="lattice" if bound_evals else "interlacing",
         details=details,
     )

@@ -18,12 +18,10 @@ from dataclasses import dataclass
 import numpy as np
 
 from unibuckle_fenicsx.algorithms.descent import descend
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import PROOF_RTOL
 
-__all__ = ["PROOF_RTOL", "Bracket", "bracket", "lattice_bound"]
-
-#: Relative tolerance for "the bracket is closed".
-PROOF_RTOL = 1e-10
+__all__ = ["Bracket", "bracket", "lattice_bound"]
 
 
 def lattice_bound(
@@ -44,7 +42,8 @@ def lattice_bound(
     Note:
         Collective.
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("lattice_bound: the problem has no obstacle (this needs an obstacle zone)")
     n = problem.contact.size
     if budget < n:
         return free_load, 0, None, False
@@ -83,7 +82,7 @@ class Bracket:
     Attributes:
         chosen: The returned critical state (the search's lower feasible one if found).
         lower: Lower bound, at least the free load.
-        proven: The bracket closes (relative :data:`PROOF_RTOL`).
+        proven: The bracket closes (relative :data:`~unibuckle_fenicsx.tolerances.PROOF_RTOL`).
         evaluations: Eigen solves of the search.
         complete: The search completed.
         warning: What the search changed, in words (None if nothing).

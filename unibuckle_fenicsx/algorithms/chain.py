@@ -12,7 +12,7 @@ For a rigid obstacle (any side, several zones) the chain is
    Newton steps restore the barrier problem, and so on to the fine mesh.
 2. **Contact set and exact eigenpair.** The fine barrier solution gives the contact set
    Z (the nodes whose gap is at the tolerance ``tau``); the smallest eigenpair of the
-   pencil with Z removed (:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`)
+   pencil with Z removed (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`)
    is the returned critical state, checked against the KKT conditions. If it fails, the
    barrier is driven lower and the active-set iteration (:mod:`.pdas`) polishes Z; if
    that fails too, the coarse state is carried once more at a small barrier parameter
@@ -43,7 +43,7 @@ from typing import Any
 
 import numpy as np
 
-from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, UnilateralSolution
+from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
 from unibuckle_fenicsx.algorithms.descent import descend
 from unibuckle_fenicsx.algorithms.interior_point import (
@@ -54,9 +54,10 @@ from unibuckle_fenicsx.algorithms.interior_point import (
 )
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
 from unibuckle_fenicsx.algorithms.pdas import iterate
-from unibuckle_fenicsx.contact import EmptyZoneError
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 __all__ = ["THIN_PLATE", "ChainOptions", "LevelRecord", "LinkRecord", "solve_unilateral"]
 
@@ -306,7 +307,7 @@ def _polish(
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     run = iterate(problem, label, cand.active, cand.mode.x.petsc_vec, budget)
-    final = run.final if run.status == "kkt" else run.best_feasible
+    final = run.final if run.status is RunStatus.KKT else run.best_feasible
     level.offer(final)
     level.links.append(
         LinkRecord(
@@ -331,7 +332,7 @@ def _descend(
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     run, _ = descend(problem, start, budget)
-    final = run.final if run.status == "kkt" else run.best_feasible
+    final = run.final if run.status is RunStatus.KKT else run.best_feasible
     assert final is not None
     level.offer(final)
     level.links.append(
@@ -370,7 +371,7 @@ def _critical_state(
     if cand.kkt:
         return cand, point
     for attempt in range(0 if quick else options.escapes):
-        saddle = not cand.feasible and cand.load < point.load * (1.0 - 1e-9)
+        saddle = not cand.feasible and cand.load < point.load * (1.0 - ROUNDING_RTOL)
         if not (saddle and newton.escape(point, cand.mode.x.petsc_vec)):
             break
         tag = f"{label} (escape {attempt + 1})"

@@ -28,9 +28,10 @@ import math
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = ["COLD_PENALTIES", "WARM_PENALTIES", "penalty_continuation"]
 
@@ -83,9 +84,10 @@ def penalty_continuation(
                 "penalty continuation rho=%g: %s, %d solves, R = %.10g, |S| = %d",
                 rho, sol.details["penalty_status"], sol.eigensolves, sol.load, len(springs),
             )  # fmt: skip
-        assert springs is not None, "penalties must not be empty"
+        if springs is None:
+            raise ValueError("penalties must not be empty")
         mode = sol.candidate.mode.x.petsc_vec
         run = iterate(problem, "penalty", springs, mode, polish_iterations)
     if run.final is not None and not math.isfinite(run.final.load):
-        run.status = "no-finite-load"
+        run.status = RunStatus.NO_FINITE_LOAD
     return run, solves

@@ -44,22 +44,19 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.algorithms import RunStatus
+from unibuckle_fenicsx.algorithms.arc import ArcPlane
 from unibuckle_fenicsx.algorithms.pdas import Run
 from unibuckle_fenicsx.eigen import set_options
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL, ZERO_STEP
 
 __all__ = ["admissible_start", "descend"]
 
 #: Options of the gradient release's solve (prefix ``unibuckle_descent_``).
 GRADIENT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
-#: d within this angle of u is u (an eigenvector is accurate to about the eigen solver's
-#: tolerance, 1e-10, over the spectral gap; a smaller threshold makes round-off a step).
-SAME_DIRECTION = 1e-8
 #: Kinds of step counted by :func:`descend`.
 STEP_KINDS = ("full", "partial", "zero", "gradient")
-#: A blocking angle below this fraction of the step's full angle is a zero step (the node
-#: is at the obstacle up to round-off).
-ZERO_STEP = 1e-9
 
 
 def admissible_start(
@@ -86,7 +83,7 @@ def admissible_start(
     return (cand if cand.feasible else None), solves
 
 
-class _Arc:
+class _Arc(ArcPlane):
     r"""The arc from u towards d on which R decreases.
 
     :math:`e_1 = u/\|u\|_A`, :math:`e_2` the A-orthogonal part of d (unit, with the sign on
@@ -96,38 +93,13 @@ class _Arc:
     holding u, :math:`x(\varphi_m)` is d.
     """
 
-    def __init__(
-        self, A: PETSc.Mat, B: PETSc.Mat, u: PETSc.Vec, d: PETSc.Vec, work: PETSc.Vec
-    ) -> None:
-        def form(M: PETSc.Mat, x: PETSc.Vec, y: PETSc.Vec) -> float:
-            M.mult(y, work)
-            return float(x.dot(work).real)
-
-        self.e1 = u.copy()
-        self.e1.scale(1.0 / math.sqrt(form(A, u, u)))
-        self.e2 = d.copy()
-        self.e2.axpy(-form(A, d, self.e1), self.e1)
-        s = math.sqrt(max(form(A, self.e2, self.e2), 0.0))
+    def __init__(self, A: PETSc.Mat, B: PETSc.Mat, u: PETSc.Vec, d: PETSc.Vec) -> None:
+        super().__init__(A, B, u, d)
         self.phi_max = 0.0
-        if s > SAME_DIRECTION * math.sqrt(form(A, d, d)):
-            self.e2.scale(1.0 / s)
-            b11, b12 = form(B, self.e1, self.e1), form(B, self.e1, self.e2)
-            b22 = form(B, self.e2, self.e2)
-            if b12 < 0.0:
-                self.e2.scale(-1.0)
-                b12 = -b12
-            self.phi_max = 0.5 * math.atan2(2.0 * b12, b11 - b22)
-
-    def point(self, phi: float) -> PETSc.Vec:
-        """x(phi), a new vector."""
-        x = self.e1.copy()
-        x.scale(math.cos(phi))
-        x.axpy(math.sin(phi), self.e2)
-        return x
-
-    def destroy(self) -> None:
-        self.e1.destroy()
-        self.e2.destroy()
+        if self.e2 is not None:
+            if self.b12 < 0.0:
+                self.flip()
+            self.phi_max = 0.5 * math.atan2(2.0 * self.b12, self.b11 - self.b22)
 
 
 class _Gradient:
@@ -150,7 +122,8 @@ class _Gradient:
     def direction(self, u: PETSc.Vec, working: npt.NDArray[np.int64]) -> PETSc.Vec:
         """The direction g for the working set ``working`` (a new vector)."""
         problem = self.problem
-        assert problem.contact is not None
+        if problem.contact is None:
+            raise ValueError("direction: the problem has no obstacle (this needs an obstacle zone)")
         A, B = problem.model.A, problem.model.B
         rows = np.asarray(problem.contact.removed_rows(working), dtype=PETSc.IntType)
         Aw, _ = problem.eigensolver.reduced(rows)
@@ -185,22 +158,24 @@ def descend(
         max_steps: Solves allowed (eigen and gradient), >= 1.
 
     Returns:
-        A run named "descent" (status "kkt" at a KKT point, else "max-iterations" or
-        "stalled"; ``best_feasible`` is the last admissible eigen mode met: R never
+        A run named "descent" (status KKT at a KKT point, else MAX_ITERATIONS or
+        STALLED; ``best_feasible`` is the last admissible eigen mode met: R never
         increases, so it is also the lowest) and the number of steps of each kind.
 
     Note:
         Collective.
     """
-    assert problem.contact is not None and start.feasible
+    if problem.contact is None:
+        raise ValueError("descend: the problem has no obstacle (this needs an obstacle zone)")
+    if not start.feasible:
+        raise ValueError("descend: start must be feasible (an admissible mode)")
     n, tau = problem.contact.size, problem.tau
     A, B = problem.model.A, problem.model.B
     run = Run("descent", best_feasible=start, final=start)
     if start.kkt:
-        run.status = "kkt"
+        run.status = RunStatus.KKT
         return run, dict.fromkeys(STEP_KINDS, 0)
     u = start.mode.x.petsc_vec.copy()
-    work = u.duplicate()
     gradient: _Gradient | None = None
     working = start.active
     release = _pulling(start, n, tau)
@@ -215,15 +190,17 @@ def descend(
                 steps["gradient"] += 1
                 gradient = gradient or _Gradient(problem)  # rarely needed: made on first use
                 d = gradient.direction(u, trial)
-                arc = _Arc(A, B, u, d, work)
+                arc = _Arc(A, B, u, d)
                 d.destroy()
             else:
                 cand = problem.evaluate(trial, initial=u)
-                arc = _Arc(A, B, u, cand.mode.x.petsc_vec, work)
+                arc = _Arc(A, B, u, cand.mode.x.petsc_vec)
             free = np.ones(n, dtype=bool)
             free[trial] = False
             e1 = problem.contact.values(arc.e1)
-            e2 = problem.contact.values(arc.e2) if arc.phi_max > 0.0 else np.zeros(n)
+            e2 = np.zeros(n)
+            if arc.phi_max > 0.0 and arc.e2 is not None:
+                e2 = problem.contact.values(arc.e2)
             # Nodes that the end of the arc puts above the obstacle beyond the tolerance.
             end = math.cos(arc.phi_max) * e1 + math.sin(arc.phi_max) * e2
             target = arc.point(arc.phi_max)
@@ -247,7 +224,7 @@ def descend(
                 release = np.setdiff1d(release, blocked)
                 if had and release.size == 0:
                     if by_gradient:
-                        run.status = "stalled"
+                        run.status = RunStatus.STALLED
                         break
                     release, by_gradient = _pulling(run.final, n, tau, largest=True), True
                 continue
@@ -264,7 +241,7 @@ def descend(
                 if cand.feasible:
                     run.best_feasible = cand
                 if cand.kkt:
-                    run.status = "kkt"
+                    run.status = RunStatus.KKT
                     break
                 release = _pulling(cand, n, tau)
                 continue
@@ -276,7 +253,6 @@ def descend(
             by_gradient = False
     finally:
         u.destroy()
-        work.destroy()
         if gradient is not None:
             gradient.destroy()
     return run, steps
@@ -291,5 +267,5 @@ def _pulling(
     forces = cand.forces[cand.active]
     pull = forces > tau
     if largest and pull.any():
-        pull &= forces >= forces[pull].max() * (1.0 - 1e-9)
+        pull &= forces >= forces[pull].max() * (1.0 - ROUNDING_RTOL)
     return cand.active[pull].astype(np.int64)

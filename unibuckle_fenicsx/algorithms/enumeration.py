@@ -3,7 +3,7 @@ r"""The paper's direct method (Ayadi, section 5.3): enumerate the contact sets b
 For p = 0, 1, ..., i (i = number of constrained nodes) and every subset Z of I with
 |Z| = p, in the lexicographic order of :func:`itertools.combinations`, compute the
 smallest eigenpair of the pencil with the w-DOFs of Z removed
-(:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`). The mode is *feasible*
+(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`). The mode is *feasible*
 when, suitably oriented, it is negative on :math:`I \setminus Z` (tolerance tau). Keep
 the smallest feasible load and stop after the first p that produced a feasible mode
 (:math:`p^*`), or visit every p (``complete=True``) to check the paper's observation
@@ -30,8 +30,9 @@ complete mode is exhaustive. These arguments assume, as the paper does, that the
 reduced first eigenvalue is simple.
 
 Ties (mirror-symmetric sets have equal loads up to rounding) are broken
-deterministically: the smallest load, and among loads within :data:`TIE_RTOL` of it
-the lexicographically smallest set. Every candidate solve starts from the same
+deterministically: the smallest load, and among loads within
+:data:`~unibuckle_fenicsx.tolerances.LOAD_TIE_RTOL` of it the lexicographically smallest
+set. Every candidate solve starts from the same
 pseudo-random vector (seeded, indexed by global DOF), so that a set's load does not
 depend on which sets were solved before on the same rank.
 
@@ -60,18 +61,15 @@ from unibuckle_fenicsx.algorithms import (
     candidate_count,
 )
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.progress import Progress
+from unibuckle_fenicsx.tolerances import LOAD_TIE_RTOL, PROOF_RTOL
 
-__all__ = ["PROOF_RTOL", "TIE_RTOL", "LevelSummary", "enumerate_contact_sets"]
+__all__ = ["LevelSummary", "enumerate_contact_sets"]
 
 logger = logging.getLogger(__name__)
 
-#: Loads within this relative distance of the smallest are ties (lexicographic pick).
-TIE_RTOL = 1e-10
-#: Relative tolerance for "lower bound equals load" (global optimum proven).
-PROOF_RTOL = 1e-10
 #: Seed of the start vector shared by all candidate solves.
 START_SEED = 20240503
 
@@ -112,11 +110,11 @@ def _start_vector(problem: BucklingProblem) -> PETSc.Vec:
 
 
 def _pick(entries: list[tuple[float, tuple[int, ...]]]) -> tuple[float, tuple[int, ...] | None]:
-    """Smallest load, then lexicographically smallest set among loads within TIE_RTOL."""
+    """Smallest load, then lexicographically smallest set among loads within LOAD_TIE_RTOL."""
     if not entries:
         return math.inf, None
     best = min(load for load, _ in entries)
-    ties = [(s, load) for load, s in entries if load <= best * (1.0 + TIE_RTOL)]
+    ties = [(s, load) for load, s in entries if load <= best * (1.0 + LOAD_TIE_RTOL)]
     s, load = min(ties)
     return load, s
 
@@ -139,7 +137,7 @@ def _reduce_level(
     # Global minimum first, then each rank offers its lexicographic pick within the ties.
     local_min = min((load for load, _ in feasible), default=math.inf)
     global_min = comm.allreduce(local_min, op=MPI.MIN)
-    offers = [(load, s) for load, s in feasible if load <= global_min * (1.0 + TIE_RTOL)]
+    offers = [(load, s) for load, s in feasible if load <= global_min * (1.0 + LOAD_TIE_RTOL)]
     local_offer = min(offers, key=lambda e: e[1]) if offers else None
     picks = [e for e in comm.allgather(local_offer) if e is not None]
     best_load, best_set = _pick(picks)
@@ -161,15 +159,15 @@ def _monotonicity(levels: list[LevelSummary]) -> tuple[bool, list[list[int]]]:
     violations = [
         [a.p, b.p]
         for a, b in itertools.combinations(feasible, 2)
-        if a.best_load > b.best_load * (1.0 + TIE_RTOL)
+        if a.best_load > b.best_load * (1.0 + LOAD_TIE_RTOL)
     ]
     return not violations, violations
 
 
 def _keep_ties(ties: list[Candidate], cand: Candidate) -> list[Candidate]:
-    """Add ``cand`` to the feasible candidates within TIE_RTOL of the smallest load."""
+    """Add ``cand`` to the feasible candidates within LOAD_TIE_RTOL of the smallest load."""
     best = min([c.load for c in ties] + [cand.load])
-    return [c for c in [*ties, cand] if c.load <= best * (1.0 + TIE_RTOL)]
+    return [c for c in [*ties, cand] if c.load <= best * (1.0 + LOAD_TIE_RTOL)]
 
 
 def _share(problem: BucklingProblem, mine: Candidate | None, ccomm: MPI.Comm) -> Candidate:
@@ -179,15 +177,18 @@ def _share(problem: BucklingProblem, mine: Candidate | None, ccomm: MPI.Comm) ->
     """
     owner = ccomm.allreduce(ccomm.rank if mine is not None else ccomm.size, op=MPI.MIN)
     if ccomm.size == 1:
-        assert mine is not None
+        if mine is None:
+            raise RuntimeError("_share: expected mine is not None (an internal invariant)")
         return mine
     payload = None
     if ccomm.rank == owner:
-        assert mine is not None
+        if mine is None:
+            raise RuntimeError("_share: expected mine is not None (an internal invariant)")
         payload = (mine.mode.x.array.copy(), mine.load, mine.active, mine.eigen)
     array, load, active, eigen = ccomm.bcast(payload, root=owner)
     if ccomm.rank == owner:
-        assert mine is not None
+        if mine is None:
+            raise RuntimeError("_share: expected mine is not None (an internal invariant)")
         return mine
     u = problem.new_mode()
     u.x.array[:] = array
@@ -198,7 +199,7 @@ def _finite_or_none(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def enumerate_contact_sets(
+def enumerate_contact_sets(  # noqa: C901 - the paper's level loop with its stopping rules (section 5.3)
     problem: BucklingProblem,
     *,
     complete: bool = False,
@@ -273,7 +274,7 @@ def enumerate_contact_sets(
             t0 = time.perf_counter()
             loads: list[float] = []
             feasible: list[tuple[float, tuple[int, ...]]] = []
-            ties: list[Candidate] = []  # feasible candidates within TIE_RTOL of the best
+            ties: list[Candidate] = []  # feasible candidates within LOAD_TIE_RTOL of the best
             n = 0
             progress = Progress(f"enumeration p = {p}", math.comb(i, p), enabled=talk)
             for j, combo in enumerate(itertools.combinations(range(i), p)):
@@ -326,7 +327,10 @@ def enumerate_contact_sets(
         )
     p_star = with_feasible[0].p
     load, chosen = _pick([(lv.best_load, lv.best_set) for lv in with_feasible])  # type: ignore[misc]
-    assert chosen is not None
+    if chosen is None:
+        raise RuntimeError(
+            "enumerate_contact_sets: expected chosen is not None (an internal invariant)"
+        )
     last = levels[-1]
     # Sets larger than the last size visited: >= its (p+1)-th smallest load.
     lower = load if last.p == i else min(load, last.load_kth)
@@ -352,7 +356,6 @@ def enumerate_contact_sets(
         "monotone": monotone,
         "monotone_violations": violations,
         "lower_bound_interlacing": with_feasible[0].load_min,
-        "lower_bound_by": "enumeration",
         "enumeration_wall_s": time.perf_counter() - t_start,
     }
     if problem.comm.rank == 0 and rank == 0:
@@ -373,5 +376,6 @@ def enumerate_contact_sets(
         global_optimum_proven=bool(proven),
         upper_bound=float(load),
         p_star=p_star,
+        lower_bound_by="enumeration",
         details=details,
     )

@@ -30,7 +30,7 @@ nodes v presses, and u the smallest mode of the pencil with S's springs, the quo
 minimised over the circle :math:`\cos\theta\, v + \sin\theta\, u` (six inner
 products and the nodal values: no solve), and the minimiser becomes the next v. The
 quotient never increases, so it cannot cycle; it stops when a step gains less than
-:data:`ARC_RTOL`.
+:data:`~unibuckle_fenicsx.tolerances.ARC_RTOL`.
 
 Note:
     Collective on the problem's communicator.
@@ -44,10 +44,11 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import ARC_RTOL, TWIN_RTOL
 
 __all__ = ["FOUNDATION_PREFIX", "solve_foundation"]
 
@@ -55,8 +56,6 @@ logger = logging.getLogger(__name__)
 
 #: Options prefix of the foundation's eigen solver.
 FOUNDATION_PREFIX = "unibuckle_foundation_"
-#: The arc descent stops when a step lowers the quotient by less than this, relatively.
-ARC_RTOL = 1e-12
 #: Angles sampled on the circle before the golden-section refinement.
 ARC_SAMPLES = 720
 
@@ -108,18 +107,17 @@ def solve_foundation(
         best = runs[name]
         candidate, status = best.candidate, best.status
         arc_steps = 0
-        if status != "converged" and math.isfinite(candidate.load):
+        if status is not RunStatus.CONVERGED and math.isfinite(candidate.load):
             candidate, status, arc_steps = _arc_descent(
                 problem, solver, springs, candidate, max_iterations
             )
             name += "+arc"
         solves = solver.solves
     load = candidate.load
-    proven = status == "converged" and not candidate.active.size
-    proven = proven and load <= lower * (1.0 + 1e-8)
+    proven = status is RunStatus.CONVERGED and not candidate.active.size
+    proven = proven and load <= lower * (1.0 + TWIN_RTOL)
     details = {
         "foundation_start": name,
-        "foundation_status": status,
         "foundation_arc_steps": arc_steps,
         "foundation_iterations": {n: len(r.steps) for n, r in runs.items()},
         "foundation_loads": {n: r.candidate.load for n, r in runs.items()},
@@ -140,6 +138,7 @@ def solve_foundation(
         lower_bound=lower,
         global_optimum_proven=bool(proven),
         upper_bound=load if math.isfinite(load) else math.inf,
+        status=status,
         details=details,
     )
 
@@ -150,22 +149,24 @@ def _arc_descent(
     springs: npt.NDArray[np.float64],
     start: Candidate,
     max_iterations: int,
-) -> tuple[Candidate, str, int]:
+) -> tuple[Candidate, RunStatus, int]:
     """Monotone descent of the spring quotient along arcs (module docstring), from ``start``.
 
-    Returns the candidate reached, "converged" (a step gains less than
-    :data:`ARC_RTOL`) or "max_iterations", and the steps taken.
+    Returns the candidate reached, CONVERGED (a step gains less than
+    :data:`~unibuckle_fenicsx.tolerances.ARC_RTOL`) or MAX_ITERATIONS, and the steps taken.
     """
     contact = problem.contact
-    assert contact is not None
+    if contact is None:
+        raise ValueError("_arc_descent: the problem has no obstacle (this needs an obstacle zone)")
     A, B = problem.model.A, problem.model.B
     v = start.mode.x.petsc_vec.copy()
     u, Av, Au, Bv, Bu = (v.duplicate() for _ in range(5))
     q = start.load
-    status = "max_iterations"
+    status = RunStatus.MAX_ITERATIONS
     steps = 0
     try:
-        for steps in range(1, int(max_iterations) + 1):
+        for _ in range(int(max_iterations)):
+            steps += 1
             z_v = contact.values(v)
             pressing = np.flatnonzero(z_v > 0.0).astype(np.int64)
             solver.set_springs(springs, pressing)
@@ -180,7 +181,7 @@ def _arc_descent(
             A.mult(u, Au)
             rest = float(u.dot(Au))
             if rest <= 1e-16 * uau:
-                status = "converged"
+                status = RunStatus.CONVERGED
                 break
             u.scale(float(np.sqrt(vav / rest)))
             A.mult(u, Au)
@@ -217,7 +218,7 @@ def _arc_descent(
             theta = 0.5 * (lo + hi)
             q_new = float(quotient(np.array([theta]))[0])
             if not q_new < q * (1.0 - ARC_RTOL):
-                status = "converged"
+                status = RunStatus.CONVERGED
                 break
             v.scale(float(np.cos(theta)))
             v.axpy(float(np.sin(theta)), u)

@@ -2,7 +2,7 @@ r"""Interior-point Newton method for the unilateral eigenproblem on one mesh.
 
 The critical state minimises the Rayleigh quotient on the cone
 :math:`\{u: z_k = s_k u_k \le 0,\ k \in I\}` (oriented values, see
-:class:`~unibuckle_fenicsx.contact.ContactSetManager`). With the gap
+:class:`~unibuckle_fenicsx.model.contact.ContactSetManager`). With the gap
 :math:`g = -z > 0` and the obstacle's push :math:`\nu > 0` at the constrained nodes,
 the barrier problem :math:`\min \tfrac12 u^TAu - \mu\sum_k \log g_k` on
 :math:`u^TBu = 1` has the optimality conditions
@@ -79,7 +79,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.eigen import LDL_OPTIONS, Owner, release, set_options
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
     "IPM_PREFIX",
@@ -161,7 +161,7 @@ class BarrierPoint:
         mode: u = (w, theta), :math:`u^TBu = 1`, strictly inside the cone.
         load: :math:`\lambda`.
         push: :math:`\nu > 0` at the constrained nodes owned by this rank, in the
-            order of :meth:`~unibuckle_fenicsx.contact.ContactSetManager.owned_positions`.
+            order of :meth:`~unibuckle_fenicsx.model.contact.ContactSetManager.owned_positions`.
         mu: Scaled barrier parameter.
     """
 

@@ -12,7 +12,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
     "Prolongation",
@@ -129,7 +129,8 @@ def prolong(
     active: npt.NDArray[np.int64],
 ) -> npt.NDArray[np.int64]:
     """Contact set ``active`` of the structured ``coarse`` problem, on ``fine``'s nodes."""
-    assert coarse.contact is not None and fine.contact is not None
+    if coarse.contact is None or fine.contact is None:
+        raise ValueError("prolong: the problem has no obstacle (this needs an obstacle zone)")
     plate = fine.spec.plate
     nx, ny = coarse.spec.mesh.nx, coarse.spec.mesh.ny
     return prolong_contact_set(

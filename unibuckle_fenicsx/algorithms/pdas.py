@@ -1,7 +1,7 @@
 r"""The primal-dual active-set iteration on the contact set.
 
 From a seed :math:`Z_0`, repeat: solve the reduced pencil
-(:meth:`~unibuckle_fenicsx.problem.BucklingProblem.evaluate`, warm-started from the
+(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`, warm-started from the
 previous mode; the candidate comes back oriented away from the obstacle), add the nodes of
 :math:`I \setminus Z` where the mode violates the obstacle (:math:`u_k > \tau`) and release
 the nodes of Z whose multiplier pulls (:math:`r_k > \tau \|Au\|_\infty`). It stops at a
@@ -28,7 +28,10 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.algorithms import RunStatus
+from unibuckle_fenicsx.algorithms.sets import SetLog
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 __all__ = ["Run", "iterate"]
 
@@ -39,7 +42,7 @@ class Run:
 
     Attributes:
         seed: Name of the seed.
-        status: "kkt", "cycle", "max-iterations" or "no-finite-load".
+        status: KKT, CYCLE, MAX_ITERATIONS or NO_FINITE_LOAD.
         iterations: Eigen solves used.
         final: The last candidate.
         best_feasible: The feasible candidate with the smallest load met (an upper bound).
@@ -47,7 +50,7 @@ class Run:
     """
 
     seed: str
-    status: str = "max-iterations"
+    status: RunStatus = RunStatus.MAX_ITERATIONS
     iterations: int = 0
     final: Candidate | None = None
     best_feasible: Candidate | None = None
@@ -100,30 +103,31 @@ def iterate(
     Note:
         Collective.
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("iterate: the problem has no obstacle (this needs an obstacle zone)")
     n = problem.contact.size
     tau = problem.tau
     run = Run(seed)
     active = np.unique(np.asarray(start, dtype=np.int64))
     stages = [t for t in thresholds if t > tau] + [tau]
     stage = 0
-    seen: set[bytes] = set()
+    seen = SetLog()
     damped = False
     vec = initial
     for it in range(max_iterations):
-        seen.add(active.tobytes())
+        seen.visit(active, it)
         cand = problem.evaluate(active, initial=vec)
         vec = cand.mode.x.petsc_vec
         run.iterations = it + 1
         run.final = cand
         run.history.append((len(active), cand.load, cand.feasible))
         if not math.isfinite(cand.load):
-            run.status = "no-finite-load"
+            run.status = RunStatus.NO_FINITE_LOAD
             break
         if cand.feasible and (run.best_feasible is None or cand.load < run.best_feasible.load):
             run.best_feasible = cand
         if cand.kkt:
-            run.status = "kkt"
+            run.status = RunStatus.KKT
             break
         inz = _mask(n, active)
         while True:
@@ -133,20 +137,21 @@ def iterate(
             if add.any() or release.any() or stage == len(stages) - 1:
                 break
             # KKT at this threshold: tighten it (same contact set and mode).
-            stage, damped, seen = stage + 1, False, set()
+            stage, damped = stage + 1, False
+            seen.clear()
         if (greedy or damped) and add.any():
-            add &= cand.values >= cand.values[add].max() * (1.0 - 1e-9)
+            add &= cand.values >= cand.values[add].max() * (1.0 - ROUNDING_RTOL)
         if damped and add.any():
             release[:] = False
         new = (inz & ~release) | add
         nxt = np.flatnonzero(new).astype(np.int64)
-        if nxt.tobytes() in seen:
+        if nxt in seen:
             if damped:
-                run.status = "cycle"
+                run.status = RunStatus.CYCLE
                 break
             # Switch to the damped rule and forget the cycle.
             damped = True
-            seen = set()
+            seen.clear()
             new = inz | add if add.any() else inz & ~release
             nxt = np.flatnonzero(new).astype(np.int64)
         active = nxt

@@ -18,9 +18,10 @@ iterates on S (a semismooth Newton step): solve the smallest eigenpair of
 :math:`(A_S, B)`, orient the mode (its sign is free) to minimise the penetration, and
 take as the next S the nodes with :math:`v_k > 0` (when both orientations penetrate
 alike, as the antisymmetric free mode of the paper's symmetric plate does, the tie is
-broken deterministically, see :data:`TIE_RTOL`). A fixed point (S repeats) is a
-stationary point of :math:`R_\rho`; a set that reappears after more than one step is a
-cycle, which is reported (the iterate with the smallest :math:`R_\rho` is returned).
+broken deterministically, see :data:`~unibuckle_fenicsx.tolerances.ENERGY_TIE_RTOL`). A
+fixed point (S repeats) is a stationary point of :math:`R_\rho`; a set that reappears after
+more than one step is a cycle, which is reported (the iterate with the smallest
+:math:`R_\rho` is returned).
 
 The stationary point found is not proven to be the global minimum of :math:`R_\rho`,
 and its mode penetrates the obstacle by :math:`O(1/\rho)`: the result is neither a
@@ -29,7 +30,7 @@ admissible mode is one). The lower bound reported is :math:`\lambda_{free}`
 (interlacing). ``rho`` is given relative to the largest diagonal entry of A:
 :math:`\rho_{abs} = \rho \max_j A_{jj}`.
 
-A is assembled once (by :class:`~unibuckle_fenicsx.plate.model.PlateModel`); the
+A is assembled once (by :class:`~unibuckle_fenicsx.model.plate.model.PlateModel`); the
 springs are added on the diagonal of a private copy :math:`A_{pen}`, which has its
 own :class:`~unibuckle_fenicsx.eigen.GEPSolver` with the options prefix
 ``unibuckle_penalty_``.
@@ -49,7 +50,8 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms.sets import SetLog
 from unibuckle_fenicsx.eigen import (
     EIGEN_OPTIONS,
     EXTREME_OPTIONS,
@@ -59,12 +61,12 @@ from unibuckle_fenicsx.eigen import (
     release,
 )
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import ENERGY_TIE_RTOL
 
 __all__ = [
     "CONDITION_PREFIX",
     "PENALTY_PREFIX",
-    "TIE_RTOL",
     "PenaltySolver",
     "PenaltyStep",
     "SpringIteration",
@@ -75,11 +77,6 @@ logger = logging.getLogger(__name__)
 
 #: Options prefix of the penalty eigen solver.
 PENALTY_PREFIX = "unibuckle_penalty_"
-
-#: Relative tie tolerance of the two orientations' penetration energies. The free mode
-#: of a symmetric problem ties exactly; computed with an EPS tolerance of 1e-10 its two
-#: energies differ by about that, so 1e-6 leaves four orders of margin either way.
-TIE_RTOL = 1e-6
 
 #: Options prefix of the extreme-eigenvalue solvers of :meth:`PenaltySolver.condition_number`.
 CONDITION_PREFIX = "unibuckle_penalty_cond_"
@@ -113,7 +110,7 @@ class SpringIteration:
             the quotient and its ``active`` set the nodes pressing the springs.
         steps: Every eigen solve.
         step: The returned iterate's step.
-        status: "converged" (a fixed point), "cycle", "max_iterations" or "no-finite-load".
+        status: CONVERGED (a fixed point), CYCLE, MAX_ITERATIONS or NO_FINITE_LOAD.
         cycle_length: Length of the cycle (0 if none).
         ties: Orientation ties broken by the deterministic rule.
         lower_bound: :math:`\lambda_{free}`.
@@ -122,7 +119,7 @@ class SpringIteration:
     candidate: Candidate
     steps: list[PenaltyStep]
     step: PenaltyStep
-    status: str
+    status: RunStatus
     cycle_length: int
     ties: int
     lower_bound: float
@@ -136,7 +133,7 @@ class PenaltySolver(Owner):
     r"""Penalised pencil :math:`(A + \rho_{abs} \sum_{k\in S} e_k e_k^T, B)` of a problem.
 
     Args:
-        problem: A :class:`~unibuckle_fenicsx.problem.BucklingProblem` with an obstacle.
+        problem: A :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle.
         prefix: Options prefix of the eigen solver (``-<prefix>eps_view`` etc. apply).
         eps_options: Extra EPS options under ``prefix`` (merged into
             :data:`~unibuckle_fenicsx.eigen.EIGEN_OPTIONS`).
@@ -157,7 +154,7 @@ class PenaltySolver(Owner):
         eps_options: dict[str, str | float | int] | None = None,
     ) -> None:
         if not isinstance(problem, BucklingProblem):
-            raise InputError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
+            raise TypeError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
         if problem.contact is None:
             raise InputError("the penalty method needs an obstacle (the problem has none)")
         self.problem = problem
@@ -193,7 +190,10 @@ class PenaltySolver(Owner):
                 one per constrained node (i,).
             active: The spring set S (node numbers).
         """
-        assert self.problem.contact is not None
+        if self.problem.contact is None:
+            raise ValueError(
+                "set_springs: the problem has no obstacle (this needs an obstacle zone)"
+            )
         same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
         self.problem.model.A.copy(self.A_pen, structure=same)
         self._springs.zeroEntries()
@@ -211,7 +211,8 @@ class PenaltySolver(Owner):
         ``rho_abs``: one stiffness for every node, or one per constrained node; v_k are the
         oriented values at the constrained nodes.
         """
-        assert self.problem.contact is not None
+        if self.problem.contact is None:
+            raise ValueError("quotient: the problem has no obstacle (this needs an obstacle zone)")
         self.problem.model.A.mult(vec, self._Av)
         self.problem.model.B.mult(vec, self._Bv)
         vals = self.problem.contact.values(vec)
@@ -256,7 +257,7 @@ class PenaltySolver(Owner):
         threshold: float = 0.0,
         condition: bool = False,
         lower_bound: float | None = None,
-        tie_rtol: float = TIE_RTOL,
+        tie_rtol: float = ENERGY_TIE_RTOL,
     ) -> UnilateralSolution:
         r"""Iterate on the penetrating set for one penalty.
 
@@ -328,7 +329,7 @@ class PenaltySolver(Owner):
             details=details,
         )
 
-    def iterate_springs(
+    def iterate_springs(  # noqa: C901 - one spring-set iteration: orientation, tie rule, cycle and best iterate
         self,
         rho_abs: float | npt.NDArray[np.float64],
         *,
@@ -336,7 +337,7 @@ class PenaltySolver(Owner):
         max_iterations: int = 100,
         threshold: float = 0.0,
         lower_bound: float | None = None,
-        tie_rtol: float = TIE_RTOL,
+        tie_rtol: float = ENERGY_TIE_RTOL,
         label: str = "springs",
     ) -> SpringIteration:
         r"""The iteration on the spring set S for the springs ``rho_abs`` (N/m).
@@ -363,7 +364,10 @@ class PenaltySolver(Owner):
         """
         problem = self.problem
         contact = problem.contact
-        assert contact is not None
+        if contact is None:
+            raise ValueError(
+                "iterate_springs: the problem has no obstacle (this needs an obstacle zone)"
+            )
         weights = np.broadcast_to(np.asarray(rho_abs, dtype=float), (contact.size,))
         if not (np.all(np.isfinite(weights)) and np.all(weights > 0.0)):
             raise InputError("rho_abs (spring stiffness) must be finite and > 0 at every node")
@@ -383,13 +387,13 @@ class PenaltySolver(Owner):
         best_q = math.inf
         best_step = -1
         previous: PETSc.Vec | None = None
-        seen: dict[tuple[int, ...], int] = {}
+        seen = SetLog()
         steps: list[PenaltyStep] = []
-        status = "max_iterations"
+        status = RunStatus.MAX_ITERATIONS
         cycle_length = 0
         ties = 0
         for it in range(int(max_iterations)):
-            seen[_key(active)] = it
+            seen.visit(active, it)
             self.set_springs(weights, active)
             pair = self.gep.solve(out=vec, initial=previous)
             self.solves += 1
@@ -432,13 +436,12 @@ class PenaltySolver(Owner):
                 previous = vec.copy()
             else:
                 vec.copy(previous)
-            key = _key(penetrating)
-            if key == _key(active):
-                status = "converged"
+            if np.array_equal(penetrating, active):
+                status = RunStatus.CONVERGED
                 break
-            if key in seen:
-                status = "cycle"
-                cycle_length = it + 1 - seen[key]
+            if penetrating in seen:
+                status = RunStatus.CYCLE
+                cycle_length = seen.cycle_length(penetrating, it)
                 logger.warning(
                     "%s: the penetrating set cycles (length %d) after %d solves; "
                     "returning the iterate with the smallest penalised quotient",
@@ -446,7 +449,7 @@ class PenaltySolver(Owner):
                 )  # fmt: skip
                 break
             active = penetrating
-        if status == "max_iterations":
+        if status is RunStatus.MAX_ITERATIONS:
             logger.warning(
                 "%s: no fixed point after %d solves (-max_iterations)", label, max_iterations
             )
@@ -454,7 +457,7 @@ class PenaltySolver(Owner):
             # Every iterate had b(v, v) <= 0 (an infinite penalised quotient): the load
             # grows without bound with rho, no admissible mode buckles. Keep the last.
             best, best_step = vec.copy(), len(steps) - 1
-            status = "no-finite-load"
+            status = RunStatus.NO_FINITE_LOAD
         if previous is not None:
             previous.destroy()
         u = problem.new_mode()
@@ -464,7 +467,7 @@ class PenaltySolver(Owner):
         step = steps[best_step]
         # Oriented and scaled above: the iteration's own orientation minimises R_rho.
         candidate = problem.candidate(u, step.quotient, step.penetrating, sign=1.0)
-        if status != "converged":
+        if status is not RunStatus.CONVERGED:
             # Leave A_pen with the springs of the returned mode, for condition().
             self.set_springs(weights, step.springs)
         if lower_bound is None:
@@ -491,13 +494,13 @@ def solve_penalty(
     max_iterations: int = 100,
     threshold: float = 0.0,
     condition: bool = False,
-    tie_rtol: float = TIE_RTOL,
+    tie_rtol: float = ENERGY_TIE_RTOL,
     eps_options: dict[str, str | float | int] | None = None,
 ) -> UnilateralSolution:
     r"""Penalty method for one relative penalty ``rho`` (see the module docstring).
 
     Args:
-        problem: A :class:`~unibuckle_fenicsx.problem.BucklingProblem` with an obstacle.
+        problem: A :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle.
         rho: Penalty relative to the largest diagonal entry of A, finite and > 0.
         initial_active: Starting spring set (default empty).
         max_iterations: Eigen solves allowed, >= 1.

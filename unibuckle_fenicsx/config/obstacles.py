@@ -302,7 +302,9 @@ class PointSpec:
             points = np.array([self.at])
         else:
             assert self.spacing is not None
-            region = self.region if self.region is not None else tuple(zip(*plate.corners))
+            region = (
+                self.region if self.region is not None else tuple(zip(*plate.corners, strict=True))
+            )
             offset = self.offset if self.offset is not None else (region[0][0], region[1][0])
             axes = []
             for (lo, hi), step, start in zip(region, self.spacing, offset, strict=True):

@@ -18,13 +18,13 @@ with Reissner–Mindlin bending and shear) is
     \kappa = \mathrm{sym}\nabla(\theta - \theta_0),
 
 with the membrane and bending stiffnesses of the linear model and :math:`K_s = P^T M_s P`
-its MITC shear stiffness (:func:`~unibuckle_fenicsx.plate.model.mitc_shear_matrix`):
+its MITC shear stiffness (:func:`~unibuckle_fenicsx.model.plate.model.mitc_shear_matrix`):
 the shear energy is quadratic, so :math:`K_s` is assembled once and adds
 :math:`K_s(x - x_0)` to the residual and :math:`K_s` to the Jacobian. The edge supports
 and the edge loads are those of the same :class:`~unibuckle_fenicsx.config.ProblemSpec`.
 
 The obstacle (:math:`w \le g` at the zone's nodes, the nodes of
-:class:`~unibuckle_fenicsx.contact.ContactSetManager`, g the obstacle's gap, 0 by
+:class:`~unibuckle_fenicsx.model.contact.ContactSetManager`, g the obstacle's gap, 0 by
 default) enters as variable bounds of PETSc's
 reduced-space VI Newton method (``vinewtonrsls``); the other bounds are
 ``PETSc.INFINITY``. DOLFINx's ``NonlinearProblem`` takes no bounds and assembles forms
@@ -56,22 +56,27 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
-from unibuckle_fenicsx.contact import ContactSetManager
 from unibuckle_fenicsx.eigen import Owner, release, set_options
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.materials import bending_voigt, membrane_voigt, transverse_shear
-from unibuckle_fenicsx.mesh import (
+from unibuckle_fenicsx.model.contact import ContactSetManager
+from unibuckle_fenicsx.model.materials import bending_voigt, membrane_voigt, transverse_shear
+from unibuckle_fenicsx.model.mesh import (
     build_plate_mesh,
     edge_facets,
     edge_normal_axis,
     edge_tag,
     edge_tags,
 )
-from unibuckle_fenicsx.plate.forms import shear_force
-from unibuckle_fenicsx.plate.model import edge_spring_form, edge_support_bcs, mitc_shear_matrix
-from unibuckle_fenicsx.plate.spaces import MixedDofs
-from unibuckle_fenicsx.points import point_bcs, point_springs, snap_points
-from unibuckle_fenicsx.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
+from unibuckle_fenicsx.model.plate.forms import shear_force
+from unibuckle_fenicsx.model.plate.model import (
+    edge_spring_form,
+    edge_support_bcs,
+    mitc_shear_matrix,
+)
+from unibuckle_fenicsx.model.plate.spaces import MixedDofs
+from unibuckle_fenicsx.model.points import point_bcs, point_springs, snap_points
+from unibuckle_fenicsx.model.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
+from unibuckle_fenicsx.nonlinear.choices import CONTROLS
 
 __all__ = [
     "CONTROLS",
@@ -80,9 +85,6 @@ __all__ = [
     "VonKarmanPlate",
     "displacement_axis",
 ]
-
-#: Path controls: the edge load, or the end shortening of the loaded edges.
-CONTROLS = ("load", "displacement")
 
 #: Default SNES options (prefix ``unibuckle_nl_``): Newton with MUMPS LU; the VI type is
 #: set when the plate has an obstacle. Tolerances act on the scaled residual.
@@ -457,7 +459,11 @@ class VonKarmanPlate(MixedDofs, Owner):
         dolfinx.fem.petsc.apply_lifting(b, [self.J_form], bcs=[self.bcs], x0=[x], alpha=-1.0)
         _add_ghosts(b)
         if self.Ks is not None:
-            assert self._d is not None and self._Kd is not None
+            if self._d is None or self._Kd is None:
+                raise RuntimeError(
+                    "_residual: expected self._d is not None and self._Kd is not None (an "
+                    "internal invariant)"
+                )
             x.copy(self._d)
             self._d.axpy(-1.0, self.x0.x.petsc_vec)
             self.Ks.mult(self._d, self._Kd)
@@ -494,7 +500,11 @@ class VonKarmanPlate(MixedDofs, Owner):
         """Clip the state onto the obstacles (w <= 0 above, >= 0 below); not collective."""
         if self.contact is None:
             return
-        assert self._upper is not None and self._lower is not None
+        if self._upper is None or self._lower is None:
+            raise RuntimeError(
+                "project: expected self._upper is not None and self._lower is not None (an "
+                "internal invariant)"
+            )
         arr = self.x.x.petsc_vec.array
         np.minimum(arr, self._upper.array, out=arr)
         np.maximum(arr, self._lower.array, out=arr)
@@ -508,7 +518,11 @@ class VonKarmanPlate(MixedDofs, Owner):
         Note:
             Collective.
         """
-        assert self.snes is not None and self._xs is not None
+        if self.snes is None or self._xs is None:
+            raise RuntimeError(
+                "solve: expected self.snes is not None and self._xs is not None (an internal "
+                "invariant)"
+            )
         self._to_vector(self._xs)
         self.snes.solve(None, self._xs)
         reason = int(self.snes.getConvergedReason())  # type: ignore[call-overload]
@@ -555,7 +569,11 @@ class VonKarmanPlate(MixedDofs, Owner):
 
         Returns a work vector owned by the plate (valid until the next call).
         """
-        assert self.b is not None and self._xs is not None
+        if self.b is None or self._xs is None:
+            raise RuntimeError(
+                "residual_vector: expected self.b is not None and self._xs is not None (an "
+                "internal invariant)"
+            )
         self._to_vector(self._xs)
         self._residual(None, self._xs, self.b)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs, alpha=0.0)
@@ -567,7 +585,11 @@ class VonKarmanPlate(MixedDofs, Owner):
         The support's normal force on each loaded edge, divided by t, its length and its
         normal stress per unit load; the mean over the loaded edges.
         """
-        assert self._displacement_axis is not None and self.b is not None
+        if self._displacement_axis is None or self.b is None:
+            raise RuntimeError(
+                "edge_reaction_load: expected self._displacement_axis is not None and self.b is "
+                "not None (an internal invariant)"
+            )
         axis = self._displacement_axis
         b = self.b
         with b.localForm() as local:

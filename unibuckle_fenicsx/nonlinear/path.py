@@ -7,27 +7,8 @@ the von Kármán plate (:class:`~unibuckle_fenicsx.nonlinear.model.VonKarmanPlat
 given the stress-free imperfection :math:`w_0 = \delta t\,\hat\phi` (max :math:`|w_0| =
 \delta t`) and loaded step by step, against the obstacle; the knee of the path
 max :math:`|w|` against :math:`\lambda` is read off twice, independently of the linear
-eigen solve:
-
-- **Southwell's method** (R. V. Southwell, *On the analysis of experimental observations
-  in problems of elastic stability*, Proc. R. Soc. Lond. A 135, 1932, 601–616): below the
-  critical load the additional deflection :math:`\delta_w = \max|w| - \delta t` of an
-  imperfect structure grows as :math:`\delta_w = a\lambda/(\lambda_c - \lambda)`, i.e.
-  :math:`\delta_w/\lambda = a/\lambda_c + \delta_w/\lambda_c`: a straight line in
-  :math:`\delta_w` of slope :math:`1/\lambda_S`. Fitted on the path's points with
-  :data:`SOUTHWELL_WINDOW` (:math:`0.5\,\lambda_i \le \lambda \le 0.95\,\lambda_i`, with
-  :math:`\lambda_i` the inflection load) and :math:`\delta_w \le t/10` (small deflection:
-  the relation is linear theory);
-- the **inflection load** :math:`\lambda_i`: where max :math:`|w|` rises most steeply,
-  the maximum of :math:`d\max|w|/d\lambda` by central differences on the path (uneven
-  steps), refined by the vertex of the parabola through the largest slope and its two
-  neighbours. For a stable symmetric bifurcation (plates) it tends to :math:`\lambda_c`
-  as :math:`\delta \to 0`.
-
-The imperfection is the linear free mode or the unilateral mode; with the obstacle it is
-pushed strictly off it (:data:`PUSH_OFF` times the deflection under a uniform pressure,
-which is negative inside the plate): a shape touching the obstacle with zero reaction
-stalls the active set.
+eigen solve (:mod:`~unibuckle_fenicsx.nonlinear.estimators`: Southwell's method and the
+inflection load). The imperfection shape: :mod:`~unibuckle_fenicsx.nonlinear.imperfection`.
 """
 
 from __future__ import annotations
@@ -42,7 +23,6 @@ from petsc4py import PETSc
 
 import dolfinx
 import dolfinx.fem.petsc
-import ufl
 
 import numpy as np
 import numpy.typing as npt
@@ -50,54 +30,38 @@ import numpy.typing as npt
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
 from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
-from unibuckle_fenicsx.eigen import Owner, set_options
+from unibuckle_fenicsx.eigen import Owner
 from unibuckle_fenicsx.errors import InputError, NumericalError
+from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
+from unibuckle_fenicsx.nonlinear.estimators import (
+    inflection_load,
+    southwell_load,
+)
+from unibuckle_fenicsx.nonlinear.imperfection import (
+    check_gaps,
+    embed,
+    imperfection_shape,
+    to_linear_space,
+)
 from unibuckle_fenicsx.nonlinear.model import (
-    CONTROLS,
-    THETA_SUB,
     VonKarmanPlate,
     displacement_axis,
 )
-from unibuckle_fenicsx.problem import BucklingProblem
 from unibuckle_fenicsx.progress import LOGGER
 from unibuckle_fenicsx.results import versions
+from unibuckle_fenicsx.tolerances import NONLINEAR_ATOL
 
 __all__ = [
-    "PUSH_OFF",
     "SHAPES",
-    "SOUTHWELL_WINDOW",
     "NonlinearAnalysis",
     "NonlinearError",
     "NonlinearOptions",
     "NonlinearResult",
     "PathPoint",
-    "inflection_load",
     "solve_nonlinear",
-    "southwell_load",
-    "southwell_window",
 ]
 
 logger = logging.getLogger(__name__)
-
-#: Imperfection shapes: the linear free mode, the unilateral mode, or "auto" (the
-#: unilateral mode with the obstacle, the free mode without).
-SHAPES = ("auto", "free", "unilateral")
-#: Southwell fit window: loads between these fractions of the inflection load.
-SOUTHWELL_WINDOW = (0.5, 0.95)
-#: ... and additional deflections up to this fraction of the thickness.
-SOUTHWELL_MAX_DEFLECTION = 0.1
-#: Weight of the uniform-pressure deflection added to a mode to keep the imperfection
-#: strictly off the obstacle (relative, both shapes scaled to max |w| = 1).
-PUSH_OFF = 1e-2
-#: SNES absolute tolerance, relative to the load vector at the reference load.
-ATOL = 1e-11
-#: Linear solve of the push-off shape (prefix ``unibuckle_nl_shape_``).
-SHAPE_LU: dict[str, str | float | int | bool] = {
-    "ksp_type": "preonly",
-    "pc_type": "lu",
-    "pc_factor_mat_solver_type": "mumps",
-    "ksp_error_if_not_converged": True,
-}
 
 
 class NonlinearError(NumericalError):
@@ -111,7 +75,7 @@ class NonlinearOptions:
     Args:
         imperfection: :math:`\delta`, the imperfection's amplitude max :math:`|w_0|`
             relative to the thickness, in (0, 1].
-        shape: Imperfection shape, one of :data:`SHAPES`.
+        shape: Imperfection shape, one of :data:`~unibuckle_fenicsx.nonlinear.choices.SHAPES`.
         control: "load" (edge traction :math:`\lambda`, adaptive steps) or
             "displacement" (end shortening of the loaded edges; :math:`\lambda` from the
             edge reactions; a uniaxial compression only).
@@ -182,94 +146,6 @@ class PathPoint:
     contact_nodes: int
     end_shortening_m: float
     newton_iterations: int
-
-
-def southwell_window(
-    loads: npt.ArrayLike,
-    max_w: npt.ArrayLike,
-    initial: float,
-    knee: float,
-    thickness: float,
-) -> npt.NDArray[np.bool_]:
-    r"""The path points Southwell's fit uses.
-
-    Those with :math:`\lambda` within :data:`SOUTHWELL_WINDOW` times ``knee`` and an
-    additional deflection :math:`0 < \delta_w = \max|w| - w_0 \le`
-    :data:`SOUTHWELL_MAX_DEFLECTION` t.
-    """
-    lam = np.asarray(loads, dtype=float)
-    dw = np.asarray(max_w, dtype=float) - initial
-    lo, hi = SOUTHWELL_WINDOW
-    mask = (lam >= lo * knee) & (lam <= hi * knee) & (dw > 0.0)
-    return np.asarray(mask & (dw <= SOUTHWELL_MAX_DEFLECTION * thickness), dtype=bool)
-
-
-def southwell_load(
-    loads: npt.ArrayLike,
-    max_w: npt.ArrayLike,
-    initial: float,
-    knee: float,
-    thickness: float,
-) -> tuple[float | None, int]:
-    r"""Southwell's estimate of the critical load from a path below its knee.
-
-    Fits :math:`\delta_w/\lambda = a + \delta_w/\lambda_S` (least squares) on the
-    points of :func:`southwell_window`, where :math:`\delta_w = \max|w| - w_0`.
-
-    Args:
-        loads: :math:`\lambda` along the path.
-        max_w: max :math:`|w|` along the path.
-        initial: max :math:`|w_0|`, the imperfection.
-        knee: The load the window is relative to (the inflection load).
-        thickness: t.
-
-    Returns:
-        :math:`\lambda_S` (None with fewer than three points in the window or a
-        non-positive slope) and the number of points fitted.
-    """
-    lam = np.asarray(loads, dtype=float)
-    dw = np.asarray(max_w, dtype=float) - initial
-    mask = southwell_window(lam, max_w, initial, knee, thickness)
-    count = int(mask.sum())
-    if count < 3:
-        return None, count
-    slope, _ = np.polyfit(dw[mask], dw[mask] / lam[mask], 1)
-    return (float(1.0 / slope) if slope > 0.0 else None), count
-
-
-def inflection_load(loads: npt.ArrayLike, max_w: npt.ArrayLike) -> float | None:
-    r"""The load where max :math:`|w|` rises most steeply along the path.
-
-    Central differences on uneven steps (second order) at the interior points; the
-    largest slope and its two neighbours define a parabola whose vertex is returned
-    (kept within the neighbours' loads).
-
-    Returns:
-        The inflection load, or None if the steepest slope is at the path's first or
-        last interior point (the path does not pass the knee).
-    """
-    lam = np.asarray(loads, dtype=float)
-    w = np.asarray(max_w, dtype=float)
-    if lam.size < 5 or np.any(np.diff(lam) <= 0.0):
-        keep = np.concatenate([[True], np.diff(lam) > 0.0]) if lam.size else lam.astype(bool)
-        lam, w = lam[keep], w[keep]
-        if lam.size < 5:
-            return None
-    h0 = lam[1:-1] - lam[:-2]
-    h1 = lam[2:] - lam[1:-1]
-    slope = (
-        -h1 / (h0 * (h0 + h1)) * w[:-2]
-        + (h1 - h0) / (h0 * h1) * w[1:-1]
-        + h0 / (h1 * (h0 + h1)) * w[2:]
-    )
-    k = int(np.argmax(slope))
-    if k == 0 or k == slope.size - 1:
-        return None
-    x = lam[k : k + 3]  # interior points k-1, k, k+1 of slope <-> lam[k], lam[k+1], lam[k+2]
-    y = slope[k - 1 : k + 2]
-    a, b, _ = np.polyfit(x - x[1], y, 2)
-    vertex = x[1] - b / (2 * a) if a < 0.0 else x[1]
-    return float(np.clip(vertex, x[0], x[2]))
 
 
 @dataclass
@@ -414,149 +290,6 @@ class NonlinearAnalysis(Owner):
             self.linear.destroy()
 
 
-def to_linear_space(
-    plate: VonKarmanPlate, x: dolfinx.fem.Function, problem: BucklingProblem
-) -> dolfinx.fem.Function:
-    """(w, theta) of the scaled state ``x`` in physical units on the linear (w, theta) space."""
-    W = problem.model.W
-    out = dolfinx.fem.Function(W, name="deflection")
-    t = plate.thickness
-    for sub_x, sub_w, factor in ((1, 0, t), (THETA_SUB, 1, 1.0)):
-        source = x.sub(sub_x).collapse()
-        Vt, dofs = W.sub(sub_w).collapse()
-        target = dolfinx.fem.Function(Vt)
-        target.interpolate(source)
-        out.x.array[dofs[0]] = factor * target.x.array
-    out.x.scatter_forward()
-    return out
-
-
-def _embed(
-    plate: VonKarmanPlate, shape: dolfinx.fem.Function, problem: BucklingProblem, amplitude: float
-) -> None:
-    """x0 = (0, amplitude * w / t, amplitude * theta) from a linear (w, theta) shape."""
-    x0 = plate.x0
-    x0.x.array[:] = 0.0
-    for sub_w, sub_x, factor in ((0, 1, amplitude / plate.thickness), (1, THETA_SUB, amplitude)):
-        source = shape.sub(sub_w).collapse()
-        Vt, dofs = plate.W.sub(sub_x).collapse()
-        target = dolfinx.fem.Function(Vt)
-        target.interpolate(source)
-        x0.x.array[dofs[0]] = factor * target.x.array
-    x0.x.scatter_forward()
-
-
-def _pressure_shape(problem: BucklingProblem, sign: float = 1.0) -> dolfinx.fem.Function:
-    """Deflection under a uniform pressure away from the obstacles (linear plate), max |w| = 1.
-
-    ``sign`` = +1 (obstacles above): downward, w <= 0; -1 (below): upward.
-    """
-    model = problem.model
-    z, _ = ufl.split(ufl.TestFunction(model.W))
-    f = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(-sign * z * ufl.dx))
-    f.ghostUpdate(addv=True, mode="reverse")  # ADD_VALUES, SCATTER_REVERSE
-    dolfinx.fem.petsc.set_bc(f, model.bcs)
-    ksp = PETSc.KSP().create(problem.comm)  # type: ignore[arg-type]
-    ksp.setOperators(model.A)
-    set_options(ksp, "unibuckle_nl_shape_", SHAPE_LU)
-    p = dolfinx.fem.Function(model.W, name="pressure_shape")
-    try:
-        ksp.solve(f, p.x.petsc_vec)
-    finally:
-        ksp.destroy()
-        f.destroy()
-    p.x.scatter_forward()
-    p.x.petsc_vec.scale(1.0 / problem.max_abs_w(p.x.petsc_vec))
-    p.x.scatter_forward()
-    return p
-
-
-def _orientation(problem: BucklingProblem, mode: dolfinx.fem.Function) -> float:
-    """A partition-independent sign: that of the integral of w times an asymmetric weight."""
-    (x0, y0), (x1, y1) = problem.spec.plate.corners
-    xs = ufl.SpatialCoordinate(problem.mesh)
-    weight = 1.0 + (xs[0] - x0) / (x1 - x0) + 0.37 * (xs[1] - y0) / (y1 - y0)
-    w, _ = ufl.split(mode)
-    value = dolfinx.fem.assemble_scalar(dolfinx.fem.form(weight * w * ufl.dx))
-    value = problem.comm.allreduce(value, op=MPI.SUM)
-    return -1.0 if value > 0.0 else 1.0  # mostly downward
-
-
-def imperfection_shape(
-    linear: Analysis, shape: str, obstacle: bool
-) -> tuple[dolfinx.fem.Function, str]:
-    """The imperfection's (w, theta) on the linear space, max |w| = 1, and its name.
-
-    With the obstacle: w < 0 at every zone node (pushed off by :data:`PUSH_OFF` times the
-    uniform-pressure deflection).
-
-    Raises:
-        ValueError: "unilateral" without an obstacle; "free" with an obstacle when the
-            free mode crosses it whichever its sign.
-
-    Note:
-        Collective.
-    """
-    problem = linear.problem
-    contact = problem.contact if obstacle else None
-    name = shape if shape != "auto" else ("unilateral" if contact is not None else "free")
-    if name == "unilateral" and (contact is None or linear.solution is None):
-        raise InputError('shape = "unilateral" needs a problem with its obstacle')
-    out = dolfinx.fem.Function(problem.model.W, name="imperfection_shape")
-    if name == "unilateral":
-        out.x.array[:] = linear.mode.x.array  # oriented: w <= 0 in the zone
-    else:
-        out.x.array[:] = linear.free_mode.x.array
-        if contact is not None:
-            values = contact.values(out.x.petsc_vec)
-            if -values.min() < values.max():  # the sign with the lower max over the zone
-                out.x.array[:] *= -1.0
-                values = -values
-            if values.max() > 0.0:
-                raise InputError(
-                    'shape = "free": the free mode crosses the obstacle whichever its sign '
-                    f"(w > 0 at {int((values > 0).sum())} of the {contact.size} zone nodes); "
-                    'use shape = "unilateral"'
-                )
-        else:
-            out.x.array[:] *= _orientation(problem, out)
-    if contact is not None:
-        sides = {float(v) for v in contact.signs}
-        if len(sides) != 1:
-            raise InputError(
-                "the nonlinear analysis pushes the imperfection off the obstacles by a uniform "
-                "pressure: it needs every obstacle on one side of the plate (all above or all "
-                "below)"
-            )
-        p = _pressure_shape(problem, sides.pop())
-        out.x.petsc_vec.axpy(PUSH_OFF, p.x.petsc_vec)
-        out.x.scatter_forward()
-        out.x.petsc_vec.scale(1.0 / problem.max_abs_w(out.x.petsc_vec))
-        out.x.scatter_forward()
-        worst = float(contact.values(out.x.petsc_vec).max())
-        if worst >= 0.0:
-            raise InputError(
-                f'the imperfection shape "{name}" touches the obstacle (w = {worst:.3g} '
-                "max|w| at a zone node after the push-off)"
-            )
-    return out, name
-
-
-def _check_gaps(plate: VonKarmanPlate, imperfection: float) -> None:
-    """Refuse an imperfection that reaches an obstacle across its gap (collective)."""
-    if plate.contact is None or not plate.contact.gaps.any():
-        return
-    clearance = plate.zone_clearance(plate.x0)
-    gapped = plate.contact.gaps > 0
-    if clearance[gapped].max() >= 0.0:
-        raise InputError(
-            f"obstacle.gap: the imperfection (delta = {imperfection:g}, max |w0| = "
-            f"{imperfection * plate.thickness:.3g} m) reaches an obstacle across its gap "
-            f"(smallest gap {plate.contact.gaps[gapped].min():.3g} m): lower the "
-            "imperfection or widen the gap"
-        )
-
-
 def _trace(
     plate: VonKarmanPlate,
     options: NonlinearOptions,
@@ -688,7 +421,20 @@ def contact_check(plate: VonKarmanPlate, rtol: float = 1e-8) -> dict[str, Any]:
     return out
 
 
-def solve_nonlinear(
+def _default_atol(plate: VonKarmanPlate, reference: float) -> None:
+    """Set SNES's absolute tolerance, unless the command line gives one.
+
+    :data:`~unibuckle_fenicsx.tolerances.NONLINEAR_ATOL` relative to the load vector at
+    ``reference``.
+    """
+    if PETSc.Options().hasName("unibuckle_nl_snes_atol"):
+        return
+    if plate.snes is None:
+        raise RuntimeError("_default_atol: expected plate.snes is not None (an internal invariant)")
+    plate.snes.setTolerances(atol=NONLINEAR_ATOL * plate.unit_load_norm * reference)
+
+
+def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path with cleanup on every exit
     spec: ProblemSpec,
     options: NonlinearOptions | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,
@@ -775,13 +521,10 @@ def solve_nonlinear(
             mesh=linear.problem.mesh,
             facet_tags=linear.problem.facet_tags,
         )
-        opts = PETSc.Options()
-        if not opts.hasName("unibuckle_nl_snes_atol"):
-            assert plate.snes is not None
-            plate.snes.setTolerances(atol=ATOL * plate.unit_load_norm * reference)
+        _default_atol(plate, reference)
         shape, shape_name = imperfection_shape(linear, options.shape, obstacle)
-        _embed(plate, shape, linear.problem, options.imperfection * spec.plate.thickness)
-        _check_gaps(plate, options.imperfection)
+        embed(plate, shape, linear.problem, options.imperfection * spec.plate.thickness)
+        check_gaps(plate, options.imperfection)
         timings["setup_s"] = time.perf_counter() - t1
         t1 = time.perf_counter()
         path, completed, why, rejected = _trace(plate, options, reference, label)

@@ -20,7 +20,7 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.prestress import material_constant, voigt_to_ufl
+from unibuckle_fenicsx.model.prestress import material_constant, voigt_to_ufl
 
 __all__ = [
     "bending_form",

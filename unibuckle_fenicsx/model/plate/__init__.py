@@ -1,5 +1,5 @@
 """Reissner-Mindlin plate: spaces, MITC shear interpolation, UFL forms, assembled pencil."""
 
-from unibuckle_fenicsx.plate.model import PlateModel
+from unibuckle_fenicsx.model.plate.model import PlateModel
 
 __all__ = ["PlateModel"]

@@ -24,6 +24,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
     "BilateralZoneError",
@@ -40,7 +41,7 @@ __all__ = [
 class PlateDofs(Protocol):
     """What :class:`ContactSetManager` needs of a plate model: its w-DOFs and supports.
 
-    :class:`~unibuckle_fenicsx.plate.model.PlateModel` (the (w, theta) space) and the
+    :class:`~unibuckle_fenicsx.model.plate.model.PlateModel` (the (w, theta) space) and the
     von Karman model (u, w, theta) both provide it.
     """
 
@@ -234,7 +235,11 @@ def foundation_springs(
     areas = tributary_areas(model).array
     springs: dict[int, float] = {}
     for o in foundations:
-        assert o.foundation_stiffness is not None
+        if o.foundation_stiffness is None:
+            raise RuntimeError(
+                "foundation_springs: expected o.foundation_stiffness is not None (an internal "
+                "invariant)"
+            )
         dofs_W, dofs_Vw = _zone_dofs(model, o, size)
         for dw, dv in zip(dofs_W.tolist(), dofs_Vw.tolist(), strict=True):
             springs[dw] = springs.get(dw, 0.0) + o.foundation_stiffness * float(areas[dv])
@@ -301,7 +306,11 @@ class ContactSetManager:
                 found[dw] = (dv, o.sign)
                 gap[dw] = min(gap.get(dw, o.gap), o.gap)
                 if areas is not None:
-                    assert o.foundation_stiffness is not None
+                    if o.foundation_stiffness is None:
+                        raise RuntimeError(
+                            "__init__: expected o.foundation_stiffness is not None (an internal "
+                            "invariant)"
+                        )
                     spring[dw] = spring.get(dw, 0.0) + o.foundation_stiffness * float(areas[dv])
         if comm.allreduce(conflict, op=MPI.LOR):
             raise BilateralZoneError(
@@ -328,7 +337,7 @@ class ContactSetManager:
         # Round away partition-dependent last bits (0.0 vs 9e-19), and -0.0.
         all_xy = np.round(np.vstack(gathered), 12) + 0.0
         # Quantise before sorting: equal nodes must sort alike on every partition.
-        keys = np.round(all_xy / (1e-9 * size)).astype(np.int64)
+        keys = np.round(all_xy / (GEOMETRY_RTOL * size)).astype(np.int64)
         order = np.lexsort((keys[:, 0], keys[:, 1]))
         self.coordinates: npt.NDArray[np.float64] = all_xy[order]
         self.signs: npt.NDArray[np.float64] = np.concatenate(comm.allgather(signs))[order]

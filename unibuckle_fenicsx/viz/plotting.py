@@ -6,7 +6,7 @@ wrote. 3-D figures render off screen; without a display, VTK's EGL window is sel
 so that no X server is needed (set ``VTK_DEFAULT_OPENGL_WINDOW`` to override).
 
 This module only draws. The data (nodal deflections, sections, the zone's box) come from
-:mod:`unibuckle_fenicsx.fields`, whose functions are collective; the writers here are
+:mod:`unibuckle_fenicsx.viz.fields`, whose functions are collective; the writers here are
 called on one rank (3-D figures need a serial problem, ``comm.size == 1``). Deflections
 within the feasibility tolerance of zero are drawn as zero (``tau``), so that rounding on a
 flat contact region does not read as penetration.
@@ -14,6 +14,10 @@ flat contact region does not read as penetration.
 Sign convention: an obstacle above the plate (the default) admits :math:`w \le 0` in its
 zone and is drawn at :math:`w = 0^+`; one below admits :math:`w \ge 0`, drawn at
 :math:`w = 0^-`.
+
+The module is about 700 lines because it holds one self-contained writer per figure kind
+(3-D mode, section, contact set and map, convergence, load paths, Southwell); they share
+only the drawing helpers at the top.
 """
 
 from __future__ import annotations
@@ -26,12 +30,12 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.fields import problem_zone
+from unibuckle_fenicsx.viz.fields import problem_zone
 
 if TYPE_CHECKING:  # pragma: no cover
     import dolfinx
 
-    from unibuckle_fenicsx.problem import BucklingProblem
+    from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
     "THEME",
@@ -380,10 +384,10 @@ def plot_contact_set(
 
     Args:
         path: PNG to write.
-        xy: (n, 2) node coordinates (:func:`~unibuckle_fenicsx.fields.nodal_deflection`).
+        xy: (n, 2) node coordinates (:func:`~unibuckle_fenicsx.viz.fields.nodal_deflection`).
         w: (n,) deflection of the mode at those nodes.
         corners: The plate's corners.
-        zone: The obstacle zone's box (:func:`~unibuckle_fenicsx.fields.zone_box`).
+        zone: The obstacle zone's box (:func:`~unibuckle_fenicsx.viz.fields.zone_box`).
         constrained: (i, 2) coordinates of the constrained nodes I.
         contact_coordinates: (|Z|, 2) coordinates of the contact set.
         title: Axes title.
@@ -452,11 +456,11 @@ def plot_contact_map(
         xy: (n, 2) node coordinates.
         w: (n,) deflection at the nodes.
         triangles: (m, 3) triangles of the plate's cells
-            (:func:`~unibuckle_fenicsx.fields.mesh_triangles`), so holes stay empty.
+            (:func:`~unibuckle_fenicsx.viz.fields.mesh_triangles`), so holes stay empty.
         boundary: (k, 2) outer boundary polygon.
         holes: Hole outlines (polygons; circles as many points).
         zones: (outline, side) of each obstacle zone
-            (:func:`~unibuckle_fenicsx.fields.zone_outlines`); dashed, labelled by side.
+            (:func:`~unibuckle_fenicsx.viz.fields.zone_outlines`); dashed, labelled by side.
         contact_coordinates: (|Z|, 2) coordinates of the contact set.
         title: Axes title.
         tau: Relative deflections below this are drawn as zero.

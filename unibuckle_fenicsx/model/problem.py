@@ -29,27 +29,29 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.contact import (
-    BilateralZoneError,
-    ContactSetManager,
-    check_zone_has_nodes,
-    foundation_springs,
-    orientation,
-)
 from unibuckle_fenicsx.eigen import (
     EIGEN_OPTIONS,
     EigenPair,
     GEPSolver,
     Owner,
     SymmetricFactorization,
+    pop_run_options,
+    push_run_options,
     release,
 )
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.materials import reference_bending_stiffness
-from unibuckle_fenicsx.mesh import build_plate_mesh
-from unibuckle_fenicsx.plate.model import PlateModel
-from unibuckle_fenicsx.points import point_obstacles
-from unibuckle_fenicsx.prestress import solve_prestress
+from unibuckle_fenicsx.model.contact import (
+    BilateralZoneError,
+    ContactSetManager,
+    check_zone_has_nodes,
+    foundation_springs,
+    orientation,
+)
+from unibuckle_fenicsx.model.materials import reference_bending_stiffness
+from unibuckle_fenicsx.model.mesh import build_plate_mesh
+from unibuckle_fenicsx.model.plate.model import PlateModel
+from unibuckle_fenicsx.model.points import point_obstacles
+from unibuckle_fenicsx.model.prestress import solve_prestress
 
 __all__ = ["BYTES_PER_DOF", "BucklingProblem", "Candidate", "Mode", "available_memory"]
 
@@ -84,7 +86,10 @@ def _check_memory(spec: ProblemSpec, comm: MPI.Comm) -> None:
     if plate.file is not None:
         return
     if plate.meshed_by_gmsh:
-        assert spec.mesh.size is not None
+        if spec.mesh.size is None:
+            raise RuntimeError(
+                "_check_memory: expected spec.mesh.size is not None (an internal invariant)"
+            )
         dofs = int(3 * plate.area / spec.mesh.size**2)
         what = f"mesh.size = {spec.mesh.size:g} m on {plate.area:.3g} m^2 gives about"
     else:
@@ -127,7 +132,7 @@ class Candidate:
         active: Sorted node numbers of the contact set Z.
         load: :math:`\lambda(Z)` (``inf`` when no geometric stiffness is left).
         mode: The mode (w, theta), oriented (see
-            :func:`~unibuckle_fenicsx.contact.orientation`) and scaled to max |w| = 1.
+            :func:`~unibuckle_fenicsx.model.contact.orientation`) and scaled to max |w| = 1.
         values: The mode at the constrained nodes (max |w| = 1 over the plate).
         forces: :math:`r = Au - \lambda Bu` at the constrained nodes, relative to
             :math:`\|Au\|_\infty` (positive: the node pulls the obstacle).
@@ -167,8 +172,12 @@ class BucklingProblem(Owner):
         spec: The problem.
         comm: Communicator of the mesh (``MPI.COMM_SELF`` gives each rank its own
             serial copy, for candidate-parallel enumeration).
-        eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
-            is ``-unibuckle_eps_view``).
+        eps_options: Extra EPS options of the run: under the prefix ``unibuckle_`` (so
+            ``eps_view`` is ``-unibuckle_eps_view``) for this pencil and the coarser
+            levels' copies, and under ``unibuckle_penalty_`` and ``unibuckle_foundation_``
+            for the penalty stages and the foundation
+            (:data:`~unibuckle_fenicsx.eigen.RUN_EPS_PREFIXES`). The problem holds them in
+            PETSc's options database until :meth:`destroy`; the command line's win.
         mesh: A quadrilateral DOLFINx mesh to use instead of ``spec.mesh`` (the
             rectangle, or gmsh's plate); ``spec.plate.corners`` should then be its
             bounding box (used for tolerances and the buckling coefficient's width).
@@ -176,7 +185,7 @@ class BucklingProblem(Owner):
 
     Attributes:
         eigensolver: The :class:`~unibuckle_fenicsx.eigen.GEPSolver` of the pencil.
-        contact: The :class:`~unibuckle_fenicsx.contact.ContactSetManager` (None
+        contact: The :class:`~unibuckle_fenicsx.model.contact.ContactSetManager` (None
             without obstacle).
         free: The free mode, once :meth:`solve_free` has run.
 
@@ -305,6 +314,8 @@ class BucklingProblem(Owner):
         self.tau = spec.solver.tau
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         self._w_owned = self.model.w_dofs[:n_owned_w]
+        # Last: a refused problem leaves nothing in the options database.
+        self._run_options = push_run_options(eps_options)
 
     def _check_geometric_stiffness(self) -> None:
         """Refuse a B that is round-off (collective).
@@ -407,7 +418,8 @@ class BucklingProblem(Owner):
         Note:
             Collective; ``active`` must be the same on every rank.
         """
-        assert self.contact is not None, "evaluate() needs an obstacle"
+        if self.contact is None:
+            raise ValueError("evaluate: the problem has no obstacle (this needs an obstacle zone)")
         active = np.unique(np.asarray(active, dtype=np.int64))
         u = self.new_mode()
         pair = self.eigensolver.solve(
@@ -436,12 +448,13 @@ class BucklingProblem(Owner):
             active: Sorted contact set Z claimed for it.
             eigen: SLEPc's report, if ``u`` is an eigenvector.
             sign: Orientation to apply instead of
-                :func:`~unibuckle_fenicsx.contact.orientation`'s.
+                :func:`~unibuckle_fenicsx.model.contact.orientation`'s.
 
         Note:
             Collective.
         """
-        assert self.contact is not None
+        if self.contact is None:
+            raise ValueError("candidate: the problem has no obstacle (this needs an obstacle zone)")
         n = self.contact.size
         vec = u.x.petsc_vec
         if not np.isfinite(load):
@@ -481,7 +494,8 @@ class BucklingProblem(Owner):
         """
         if self._r is None:
             self._r, self._Bu = u.duplicate(), u.duplicate()
-        assert self._Bu is not None
+        if self._Bu is None:
+            raise RuntimeError("residual: expected self._Bu is not None (an internal invariant)")
         self.model.A.mult(u, self._r)
         au_inf = self._r.norm(PETSc.NormType.INFINITY)  # type: ignore[arg-type]
         au_2 = self._r.norm()
@@ -500,8 +514,9 @@ class BucklingProblem(Owner):
         return plate.thickness * load * plate.width**2 / (np.pi**2 * D)
 
     def destroy(self) -> None:
-        """Destroy the PETSc/SLEPc objects (collective)."""
+        """Destroy the PETSc/SLEPc objects (collective) and take back the run's options."""
         release(self, "_r", "_Bu")
+        pop_run_options(getattr(self, "_run_options", []))
         for name in ("eigensolver", "model"):  # absent when the constructor failed early
             owner = getattr(self, name, None)
             if owner is not None:

@@ -26,10 +26,11 @@ from mpi4py import MPI
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx import fields, plotting
 from unibuckle_fenicsx.analysis import Analysis, solve
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.results import BucklingResult, write_fields
+from unibuckle_fenicsx.io import write_fields
+from unibuckle_fenicsx.results import BucklingResult
+from unibuckle_fenicsx.viz import fields, plotting
 
 __all__ = [
     "COARSE_MESHES",
@@ -114,13 +115,15 @@ class MeshStudy:
         (and labelled so).
         """
         point = self.at(mesh)
-        assert point.section is not None and point.free_section is not None
+        if point.section is None or point.free_section is None:
+            raise ValueError(f"plot_section: mesh {mesh} was run without a section")
         (xf, wf), (xu, wu) = point.free_section, point.section
         sign = 1.0 if np.dot(wf, wu) >= 0 else -1.0
         extra = []
         for other, label in others:
             section = self.at(other).section
-            assert section is not None
+            if section is None:
+                raise ValueError(f"plot_section: mesh {other} was run without a section")
             x, w, flipped = fields.mirror_to_match(xu, wu, *section)
             extra.append((x, w, label + (" (mirrored)" if flipped else "")))
         return plotting.plot_section(
@@ -247,7 +250,8 @@ def mesh_study(
                     )
             if zone is not None and mesh == contact_mesh:
                 xy, w = fields.nodal_deflection(problem, analysis.mode)
-                assert problem.contact is not None
+                if problem.contact is None:
+                    raise RuntimeError("a zone without a contact manager (an internal invariant)")
                 if comm.rank == 0:
                     plotting.plot_contact_set(
                         figures / "contact_set.png",
@@ -317,9 +321,12 @@ def check_certified(results: Sequence[BucklingResult], rtol: float) -> None:
     """
     for r in results:
         cert = r.certificate
-        assert cert is not None and cert["kkt"], f"{r.mesh}: certificate fails: {cert}"
-        assert cert["global_optimum_proven"] or cert["smallest_of_reduced"], (
-            f"{r.mesh}: neither proven nor the smallest eigenvalue: {cert}"
-        )
-        assert r.critical_load_Pa >= r.free_load_Pa * (1 - rtol), (r.mesh, r.ratio_to_free)
-        assert r.lower_bound_Pa is not None and r.lower_bound_Pa >= r.free_load_Pa * (1 - rtol)
+        # Explicit raises, not assert statements: the check must hold under python -O too.
+        if cert is None or not cert["kkt"]:
+            raise AssertionError(f"{r.mesh}: certificate fails: {cert}")
+        if not (cert["global_optimum_proven"] or cert["smallest_of_reduced"]):
+            raise AssertionError(f"{r.mesh}: neither proven nor the smallest eigenvalue: {cert}")
+        if r.critical_load_Pa < r.free_load_Pa * (1 - rtol):
+            raise AssertionError(f"{r.mesh}: load below the free load ({r.ratio_to_free})")
+        if r.lower_bound_Pa is None or r.lower_bound_Pa < r.free_load_Pa * (1 - rtol):
+            raise AssertionError(f"{r.mesh}: lower bound {r.lower_bound_Pa} below the free load")

@@ -21,7 +21,7 @@ from unibuckle_fenicsx.config import (
     PlateSpec,
 )
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.gmsh_mesh import HOLES_TAG, gmsh_plate_mesh, segment_tag
+from unibuckle_fenicsx.model.gmsh_mesh import HOLES_TAG, gmsh_plate_mesh, segment_tag
 
 __all__ = [
     "build_plate_mesh",
@@ -89,7 +89,10 @@ def create_plate_mesh(
         order_facets[order].astype(np.int32),
         np.concatenate(values)[order].astype(np.int32),
     )
-    assert len(EDGE_NAMES) == 4
+    if len(EDGE_NAMES) != 4:
+        raise RuntimeError(
+            "create_plate_mesh: expected len(EDGE_NAMES) == 4 (an internal invariant)"
+        )
     return msh, tags
 
 
@@ -105,8 +108,8 @@ def edge_tags(plate: PlateSpec, edge: EdgeSpec) -> tuple[int, ...]:
     """Facet tags of ``edge``.
 
     Its ``tag`` if set (a user mesh, or a file's physical curve); an outline's segments'
-    tags (:func:`~unibuckle_fenicsx.gmsh_mesh.segment_tag`); the holes'
-    (:data:`~unibuckle_fenicsx.gmsh_mesh.HOLES_TAG`); else its position in
+    tags (:func:`~unibuckle_fenicsx.model.gmsh_mesh.segment_tag`); the holes'
+    (:data:`~unibuckle_fenicsx.model.gmsh_mesh.HOLES_TAG`); else its position in
     :data:`EDGE_NAMES` + 1 (the rectangle, meshed by either route).
     """
     if edge.tag is not None:
@@ -231,7 +234,7 @@ def build_plate_mesh(
     """The plate's mesh, its facet tags, and the plate with every edge's tag resolved.
 
     The rectangle: :func:`create_plate_mesh` (the plate unchanged). Meshed by gmsh
-    (:func:`~unibuckle_fenicsx.gmsh_mesh.gmsh_plate_mesh`): a file's ``[edges.NAME]`` get
+    (:func:`~unibuckle_fenicsx.model.gmsh_mesh.gmsh_plate_mesh`): a file's ``[edges.NAME]`` get
     the tag of the physical curve called NAME (an error listing the file's names if there
     is none), and its ``corners`` become the mesh's bounding box; the edges of the
     ``obstacles``' zones are mesh lines of a plate gmsh builds.

@@ -1,7 +1,7 @@
 r"""Copositivity certificates by semidefinite programming (two or more negative eigenvalues).
 
 Needs the ``sdp`` extra (cvxpy with the Clarabel interior-point solver). Used by
-:mod:`unibuckle_fenicsx.copositivity` when :math:`K(\lambda) = A - \lambda B` has two or
+:mod:`unibuckle_fenicsx.certificate.copositivity` when :math:`K(\lambda) = A - \lambda B` has two or
 more negative eigenvalues, where the rank-2 route does not apply, and only for small i
 (dense i x i programs).
 
@@ -45,9 +45,9 @@ except ImportError as err:  # pragma: no cover
         "the SDP certificate needs cvxpy and Clarabel: pip install 'unibuckle_fenicsx[sdp]'"
     ) from err
 
-from unibuckle_fenicsx.copositivity import CERTIFY_PREFIX, EPS, ShiftedMatrix
+from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX, EPS, ShiftedMatrix
 from unibuckle_fenicsx.eigen import SymmetricFactorization
-from unibuckle_fenicsx.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = ["SDP_SOLVER", "sector_certificate", "spn_certificate"]
 
@@ -66,7 +66,10 @@ def _inverse_on_constrained(
     problem: BucklingProblem, matrix: ShiftedMatrix
 ) -> npt.NDArray[np.float64]:
     """M = [K^-1]_II by i refined solves, symmetrised."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError(
+            "_inverse_on_constrained: the problem has no obstacle (this needs an obstacle zone)"
+        )
     n = problem.num_constrained
     M = np.empty((n, n))
     vec = problem.model.A.createVecRight()
@@ -110,7 +113,11 @@ def _inertia_minus(
     problem: BucklingProblem, matrix: ShiftedMatrix, N: npt.NDArray[np.float64]
 ) -> tuple[int, int]:
     """(negative, zero) pivots of K - N_pad, a separate MUMPS LDL^T."""
-    assert problem.contact is not None and matrix.K is not None
+    if problem.contact is None or matrix.K is None:
+        raise RuntimeError(
+            "_inertia_minus: expected problem.contact is not None and matrix.K is not None (an "
+            "internal invariant)"
+        )
     K = matrix.K.duplicate(copy=True)
     K.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)  # type: ignore[arg-type]
     rows = problem.contact.global_rows().astype(PETSc.IntType)
@@ -134,7 +141,8 @@ def spn_certificate(problem: BucklingProblem, matrix: ShiftedMatrix, lam: float)
 
     ``matrix`` holds the factorisation of :math:`K(\lambda)`, ``lam`` its shift.
     """
-    assert matrix.factorization is not None
+    if matrix.factorization is None:
+        raise ValueError("spn_certificate: matrix must be factorised (ShiftedMatrix.factor)")
     neg_K = matrix.factorization.inertia()[0]
     S = np.linalg.inv(_inverse_on_constrained(problem, matrix))
     S = 0.5 * (S + S.T)
@@ -174,7 +182,8 @@ def _lowest_modes(problem: BucklingProblem, nev: int) -> list[PETSc.Vec]:
     )
     modes = []
     for theta, v in sorted(pairs, key=lambda p: -p[0]):
-        assert v is not None
+        if v is None:
+            raise RuntimeError("_lowest_modes: expected v is not None (an internal invariant)")
         if theta > 0.0:
             modes.append(v)
         else:
@@ -186,7 +195,11 @@ def sector_certificate(
     problem: BucklingProblem, matrix: ShiftedMatrix, lam: float, sectors: tuple[int, ...]
 ) -> dict[str, Any]:
     """Copositivity on every sector piece of the cone (two negative eigenvalues)."""
-    assert problem.contact is not None and matrix.factorization is not None
+    if problem.contact is None or matrix.factorization is None:
+        raise RuntimeError(
+            "sector_certificate: expected problem.contact is not None and matrix.factorization is "
+            "not None (an internal invariant)"
+        )
     neg_K = matrix.factorization.inertia()[0]
     out: dict[str, Any] = {"ok": False, "neg_K": neg_K, "lambda": lam}
     if neg_K != 2:

@@ -5,7 +5,7 @@ bilinear deflection is then :math:`\le 0` on every cell whose four nodes are in 
 and only there. So the *discrete zone* is the union of those cells; its area, next to the
 area of the zone given (its part on the plate), says how far the mesh follows the zone.
 On a gmsh plate the zone's edges are mesh lines
-(:func:`~unibuckle_fenicsx.gmsh_mesh.gmsh_plate_mesh`) and the two agree, up to the
+(:func:`~unibuckle_fenicsx.model.gmsh_mesh.gmsh_plate_mesh`) and the two agree, up to the
 polygon a circle's cells inscribe; on the structured rectangle they agree when the grid
 has lines on the zone's edges.
 """
@@ -55,7 +55,8 @@ def zone_area(obstacle: ObstacleSpec, plate: PlateSpec) -> float | None:
     area = intersection_area(shape, plate.boundary)
     for hole in plate.holes:
         hole_shape = _shape(hole)
-        assert hole_shape is not None
+        if hole_shape is None:
+            raise RuntimeError("zone_area: expected hole_shape is not None (an internal invariant)")
         area -= intersection_area(shape, hole_shape)
     return max(area, 0.0)
 

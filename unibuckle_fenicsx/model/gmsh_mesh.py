@@ -44,6 +44,7 @@ from unibuckle_fenicsx.checks import FEATURE_RATIO, plate_features
 from unibuckle_fenicsx.config import EDGE_NAMES, Circle, MeshSpec, ObstacleSpec, PlateSpec, Polygon
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import distance_to_polygon
+from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
     "HOLES_TAG",
@@ -261,7 +262,7 @@ def _point_sizes(
         x, y, _ = gmsh.model.getValue(0, p, [])
         h = size
         for (cx, cy), r, n in circles:
-            if abs(math.hypot(x - cx, y - cy) - r) <= 1e-9 * max(r, size):
+            if abs(math.hypot(x - cx, y - cy) - r) <= GEOMETRY_RTOL * max(r, size):
                 h = min(h, 2.0 * math.pi * r / n)
         gmsh.model.mesh.setSize([(0, p)], h)
 
@@ -323,14 +324,14 @@ def _structure_parallelograms(gmsh: Any, size: float) -> int:
         for j in range(4):
             for k in range(j + 1, 4):
                 cross = vectors[j][0] * vectors[k][1] - vectors[j][1] * vectors[k][0]
-                if abs(cross) <= 1e-9 * lengths[j] * lengths[k] and abs(
+                if abs(cross) <= GEOMETRY_RTOL * lengths[j] * lengths[k] and abs(
                     lengths[j] - lengths[k]
-                ) <= 1e-9 * max(lengths[j], lengths[k]):
+                ) <= GEOMETRY_RTOL * max(lengths[j], lengths[k]):
                     paired.update((j, k))
         if len(paired) != 4:
             continue
         for (_, c), length in zip(boundary, lengths, strict=True):
-            cells = max(1, math.ceil(length / size * (1.0 - 1e-9)))
+            cells = max(1, math.ceil(length / size * (1.0 - GEOMETRY_RTOL)))
             gmsh.model.mesh.setTransfiniteCurve(c, cells + 1)
         gmsh.model.mesh.setTransfiniteSurface(s)
         gmsh.model.mesh.setRecombine(2, s)
@@ -357,7 +358,7 @@ def _quadrilaterals_only(gmsh: Any, hint: str = "") -> None:
         )
 
 
-def gmsh_plate_mesh(
+def gmsh_plate_mesh(  # noqa: C901 - gmsh's session on rank 0, its errors, and the broadcast, in one place
     plate: PlateSpec,
     spec: MeshSpec,
     comm: MPI.Comm = MPI.COMM_WORLD,
@@ -396,7 +397,12 @@ def gmsh_plate_mesh(
     if error is not None:
         raise ImportError(error.removeprefix("ImportError: "))
     if comm.rank == 0:
-        assert gmsh is not None
+        if gmsh is None:
+            raise RuntimeError("gmsh_plate_mesh: expected gmsh is not None (an internal invariant)")
+        if plate.file is None and spec.size is None:
+            raise RuntimeError(
+                "gmsh_plate_mesh: expected spec.size is not None (an internal invariant)"
+            )
         gmsh.initialize(interruptible=False)
         try:
             for key, value in GMSH_OPTIONS.items():
@@ -404,8 +410,8 @@ def gmsh_plate_mesh(
             if plate.file is not None:
                 _mesh_file(gmsh, plate, spec)
             else:
-                assert spec.size is not None
-                _mesh_built(gmsh, plate, spec.size, zone_curves(obstacles, spec.size))
+                size = float(spec.size or 0.0)  # checked above
+                _mesh_built(gmsh, plate, size, zone_curves(obstacles, size))
         except ValueError as err:
             error = str(err) if plate.file is None else f"plate.file {plate.file}: {err}"
         except Exception as err:  # gmsh raises plain Exceptions
@@ -420,7 +426,10 @@ def gmsh_plate_mesh(
         data = dolfinx.io.gmsh.model_to_mesh(model, comm, 0, gdim=2)
     finally:
         if comm.rank == 0:
-            assert gmsh is not None
+            if gmsh is None:
+                raise RuntimeError(
+                    "gmsh_plate_mesh: expected gmsh is not None (an internal invariant)"
+                )
             gmsh.finalize()
     msh = data.mesh
     tags = data.facet_tags
@@ -434,7 +443,8 @@ def gmsh_plate_mesh(
 
 def _mesh_file(gmsh: Any, plate: PlateSpec, spec: MeshSpec) -> None:
     """Open (and mesh, for a .geo) the plate's file in the current gmsh session."""
-    assert plate.file is not None
+    if plate.file is None:
+        raise RuntimeError("_mesh_file: expected plate.file is not None (an internal invariant)")
     gmsh.open(plate.file)
     if not plate.file.lower().endswith(".msh"):
         if spec.size is not None:

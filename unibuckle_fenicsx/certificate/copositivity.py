@@ -35,7 +35,7 @@ its nappe), so the route is complete there; only finding :math:`w_-` can fail.
 inactive obstacle).
 
 **SDP routes** (two or more pencil eigenvalues below, small i; the ``sdp`` extra):
-:mod:`unibuckle_fenicsx.copositivity_sdp`.
+:mod:`unibuckle_fenicsx.certificate.copositivity_sdp`.
 
 What is certified is the stored, symmetrised matrix fl(A - lambda B); the rounding of the
 products lambda B_ij (1e-16 relative) is far below the gaps used (>= 1e-9).
@@ -51,29 +51,23 @@ from dataclasses import dataclass, field
 from typing import TYPE_CHECKING, Any
 
 from mpi4py import MPI
-from petsc4py import PETSc
 
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.eigen import Owner, SymmetricFactorization, release
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.certificate.shifted import (
+    EPS,
+    ShiftedMatrix,
+    absdot,
+    mirror_maps,
+    norm2,
+)
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 
 if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.copositivity_lowrank import LowRankOptions
+    from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions
 
-__all__ = [
-    "CERTIFY_PREFIX",
-    "BoundOptions",
-    "LowerBound",
-    "ShiftedMatrix",
-    "copositivity_bound",
-    "mirror_maps",
-]
-
-#: Options prefix of the certificate's factorisations (``-unibuckle_certify_ksp_view``).
-CERTIFY_PREFIX = "unibuckle_certify_"
-EPS = float(np.finfo(float).eps)
+__all__ = ["BoundOptions", "LowerBound", "copositivity_bound"]
 
 
 @dataclass(frozen=True)
@@ -91,7 +85,7 @@ class BoundOptions:
             semidefinite programs: seconds at i = 50, inaccurate beyond about 80).
         sectors: Sector counts tried by the sector SDP route (two negative eigenvalues).
         lowrank: Budgets of the low-rank route (two or more negative eigenvalues, any
-            i; :mod:`unibuckle_fenicsx.copositivity_lowrank`); None skips it.
+            i; :mod:`unibuckle_fenicsx.certificate.copositivity_lowrank`); None skips it.
     """
 
     deltas: tuple[float, ...] = (1e-9, 2e-9, 5e-9, 1e-8, 2e-8, 5e-8, 1e-7, 2e-7, 5e-7, 1e-6)
@@ -105,7 +99,7 @@ class BoundOptions:
 
 
 def _lowrank_options() -> LowRankOptions:
-    from unibuckle_fenicsx.copositivity_lowrank import LowRankOptions
+    from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions
 
     return LowRankOptions()
 
@@ -143,203 +137,10 @@ class LowerBound:
     refuting: dict[str, Any] | None = None
 
 
-@dataclass
-class Solve:
-    """A refined solve x = K^-1 w: x, the computed residual and its error data."""
-
-    w: PETSc.Vec
-    x: PETSc.Vec
-    rho: PETSc.Vec  # computed w - K x
-    err: PETSc.Vec  # componentwise bound on the rounding of rho
-    d: PETSc.Vec  # K^-1 rho: estimate of the remaining error of x
-
-    def destroy(self) -> None:
-        """Destroy the vectors."""
-        for v in (self.w, self.x, self.rho, self.err, self.d):
-            v.destroy()
-
-
-def _norm(v: PETSc.Vec) -> float:
-    """The 2-norm of ``v`` (collective)."""
-    return float(v.norm())  # type: ignore[arg-type]
-
-
-def _absdot(a: PETSc.Vec, b: PETSc.Vec) -> float:
-    comm = a.getComm().tompi4py()
-    return float(comm.allreduce(float(np.abs(a.array_r) @ np.abs(b.array_r)), op=MPI.SUM))
-
-
-class ShiftedMatrix(Owner):
-    r""":math:`K(\lambda) = \mathrm{sym}(A - \lambda B)`, its :math:`|K|`, and its :math:`LDL^T`.
-
-    The pattern is built once; :meth:`factor` rebuilds the values for a new
-    :math:`\lambda` and factorises (MUMPS Cholesky, symmetric indefinite; the SPD flag of
-    A, which ``MatDuplicate`` propagates, is cleared, else MUMPS assumes a positive
-    definite matrix and may report a wrong inertia without error).
-
-    Args:
-        A: Stiffness (AIJ).
-        B: Geometric stiffness (AIJ).
-        prefix: Options prefix of the factorisation.
-
-    Note:
-        Collective. The owner must :meth:`destroy` it.
-    """
-
-    def __init__(self, A: PETSc.Mat, B: PETSc.Mat, prefix: str = CERTIFY_PREFIX) -> None:
-        for mat, name in ((A, "A"), (B, "B")):
-            if mat.getType() not in ("seqaij", "mpiaij"):
-                raise TypeError(f"{name} must be AIJ for the LDL^T inertia, got {mat.getType()}")
-        self.A, self.B, self.prefix = A, B, prefix
-        self.K: PETSc.Mat | None = None
-        self.Kt: PETSc.Mat | None = None
-        self.Kabs: PETSc.Mat | None = None
-        self.factorization: SymmetricFactorization | None = None
-        self.row_length = 0
-        self.solves = 0
-        self.factorisations = 0
-        self.factor_s = 0.0
-        self.solve_s = 0.0
-
-    def build(self, lam: float) -> PETSc.Mat:
-        """Assemble K(lam) and |K| (collective)."""
-        subset = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
-        if self.K is None:
-            K = self.A.duplicate(copy=True)
-            K.axpy(-lam, self.B, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
-            K.setOption(PETSc.Mat.Option.SYMMETRIC, False)  # type: ignore[arg-type]
-            self.Kt = K.transpose(PETSc.Mat())  # not in place: an output matrix
-            K.axpy(1.0, self.Kt, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
-            K.scale(0.5)
-            self.K = K
-            ai, _, _ = K.getValuesCSR()
-            local = int(np.diff(ai).max()) if len(ai) > 1 else 0
-            self.row_length = int(K.getComm().tompi4py().allreduce(local, op=MPI.MAX))
-            self.Kabs = K.duplicate(copy=True)
-        else:
-            K = self.K
-            assert self.Kt is not None
-            K.zeroEntries()
-            K.axpy(1.0, self.A, structure=subset)  # type: ignore[arg-type]
-            K.axpy(-lam, self.B, structure=subset)  # type: ignore[arg-type]
-            K.setOption(PETSc.Mat.Option.SYMMETRIC, False)  # type: ignore[arg-type]
-            self.Kt.destroy()
-            self.Kt = K.transpose(PETSc.Mat())
-            K.axpy(1.0, self.Kt, structure=subset)  # type: ignore[arg-type]
-            K.scale(0.5)
-        K.setOption(PETSc.Mat.Option.SPD, False)  # type: ignore[arg-type]
-        K.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
-        assert self.Kabs is not None
-        K.copy(self.Kabs, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)  # type: ignore[arg-type]
-        ai, aj, av = self.Kabs.getValuesCSR()
-        self.Kabs.zeroEntries()
-        self.Kabs.setValuesCSR(ai, aj, np.abs(av))  # type: ignore[arg-type]
-        self.Kabs.assemble()
-        return K
-
-    def factor(self, lam: float) -> tuple[int, int, int]:
-        """Build and factorise K(lam); its inertia (negative, zero, positive)."""
-        t0 = time.perf_counter()
-        K = self.build(lam)
-        if self.factorization is None:
-            self.factorization = SymmetricFactorization(K, self.prefix)
-        else:
-            self.factorization.ksp.setOperators(K)
-            self.factorization.ksp.setUp()
-        self.factorisations += 1
-        inertia = self.factorization.inertia()
-        self.factor_s += time.perf_counter() - t0
-        return inertia
-
-    def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
-        """X = K^-1 b with the current factorisation."""
-        assert self.factorization is not None
-        t0 = time.perf_counter()
-        self.factorization.solve(b, x)
-        self.solves += 1
-        self.solve_s += time.perf_counter() - t0
-
-    def refined(self, w: PETSc.Vec) -> Solve:
-        r"""Solve K x = w, refined once, with the residual and the rounding bound of it.
-
-        The residual's rounding is bounded componentwise by
-        :math:`\gamma_m(|w| + |K||x|)`, :math:`\gamma_m = m\epsilon/(1 - m\epsilon)`,
-        m the longest row plus one. ``w`` is owned by the returned :class:`Solve`.
-        """
-        assert self.K is not None and self.Kabs is not None
-        x, rho, dx = w.duplicate(), w.duplicate(), w.duplicate()
-        self.solve(w, x)
-        self.K.mult(x, rho)
-        rho.aypx(-1.0, w)
-        self.solve(rho, dx)
-        x.axpy(1.0, dx)
-        self.K.mult(x, rho)
-        rho.aypx(-1.0, w)
-        err = w.duplicate()
-        dx.array[:] = np.abs(x.array_r)
-        self.Kabs.mult(dx, err)
-        err.array[:] += np.abs(w.array_r)
-        m = self.row_length + 1
-        err.scale(m * EPS / (1 - m * EPS))
-        self.solve(rho, dx)
-        return Solve(w, x, rho, err, dx)
-
-    @staticmethod
-    def bilinear(a: Solve, b: Solve) -> tuple[float, float]:
-        r""":math:`w_a^T K^{-1} w_b` and a bound on the error of that value.
-
-        :math:`|w_a^TK^{-1}w_b - w_a^Tx_b| = |x_a^T\rho_b|` (exact x, exact residual) is at
-        most :math:`|\hat x_a|^T(|\hat\rho_b| + e_b) + \|d_a\|\,\||\hat\rho_b| + e_b\|`,
-        plus the rounding of the dot product.
-        """
-        value = a.w.dot(b.x).real
-        rb = b.rho.duplicate()
-        rb.array[:] = np.abs(b.rho.array_r) + b.err.array_r
-        bound = _absdot(a.x, rb) + _norm(a.d) * _norm(rb)
-        rb.destroy()
-        n = a.w.getSize()
-        bound += n * EPS / (1 - n * EPS) * _absdot(a.w, b.x)
-        return value, bound
-
-    def destroy(self) -> None:
-        """Destroy the matrices and the factorisation (collective)."""
-        release(self, "factorization", "K", "Kt", "Kabs")
-
-    def __del__(self) -> None:
-        self.destroy()
-
-
 def _reaction(candidate: Candidate) -> npt.NDArray[np.float64]:
     """The contact reaction max(0, -r) at I of a KKT point, scaled to max 1."""
     w = np.maximum(0.0, -candidate.forces)
     return w / w.max() if w.max() > 0 else w
-
-
-def mirror_maps(problem: BucklingProblem, tol: float = 1e-9) -> dict[str, npt.NDArray[np.int64]]:
-    """Permutations of the constrained nodes under the plate's mirror symmetries.
-
-    A reflection (about x = centre, y = centre, or both) appears only when it maps the
-    node set onto itself. The images of a reaction are candidates, nothing more: the
-    certificate checks whatever it is given.
-    """
-    assert problem.contact is not None
-    xy = problem.contact.coordinates
-    (x0, y0), (x1, y1) = problem.spec.plate.corners
-    cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
-    size = max(x1 - x0, y1 - y0)
-
-    def keys(p: npt.NDArray[np.float64]) -> list[tuple[int, int]]:
-        k = np.round((p - (cx, cy)) / (tol * size)).astype(np.int64)
-        return [(int(a), int(b)) for a, b in k.tolist()]
-
-    index = {key: k for k, key in enumerate(keys(xy))}
-    out = {}
-    for name, (sx, sy) in {"x": (-1, 1), "y": (1, -1), "xy": (-1, -1)}.items():
-        image = np.column_stack([cx + sx * (xy[:, 0] - cx), cy + sy * (xy[:, 1] - cy)])
-        perm = [index.get(key) for key in keys(image)]
-        if all(k is not None for k in perm):
-            out[name] = np.asarray(perm, dtype=np.int64)
-    return out
 
 
 def _project(z: npt.NDArray[np.float64], a: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
@@ -370,7 +171,10 @@ def _search_other_nappe(
     Projected gradient with Barzilai-Borwein steps and exact line search, one solve per
     iterate; stops at the first :math:`f > 0`. Returns (best w, its f, iterations).
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError(
+            "_search_other_nappe: the problem has no obstacle (this needs an obstacle zone)"
+        )
     contact = problem.contact
     vec = problem.model.A.createVecRight()
     x = vec.duplicate()
@@ -386,7 +190,8 @@ def _search_other_nappe(
     step = 1.0 / max(float(np.abs(y).max()), 1e-300)
     w_prev = g_prev = None
     it = 0
-    for it in range(1, iterations + 1):
+    for _ in range(iterations):
+        it += 1
         g = 2 * y
         if w_prev is not None and g_prev is not None:
             s, dg = w - w_prev, g - g_prev
@@ -422,14 +227,17 @@ def _predict_delta(problem: BucklingProblem, matrix: ShiftedMatrix, candidate: C
     """
     u = candidate.mode.x.petsc_vec
     matrix.build(candidate.load)
-    assert matrix.Kabs is not None
+    if matrix.Kabs is None:
+        raise RuntimeError(
+            "_predict_delta: expected matrix.Kabs is not None (an internal invariant)"
+        )
     r, _, _ = problem.residual(candidate.load, u)
     ua, Ku, Bu = u.duplicate(), u.duplicate(), u.duplicate()
     ua.array[:] = np.abs(u.array_r)
     matrix.Kabs.mult(ua, Ku)
     problem.model.B.mult(u, Bu)
     m = matrix.row_length + 1
-    num = m * EPS * (_absdot(u, r) + float(ua.dot(Ku)))
+    num = m * EPS * (absdot(u, r) + float(ua.dot(Ku)))
     den = candidate.load * float(u.dot(Bu))
     for v in (ua, Ku, Bu):
         v.destroy()
@@ -444,13 +252,14 @@ def _rank2(
     options: BoundOptions,
 ) -> tuple[dict[str, Any], dict[str, Any] | None]:
     """Alpha for w+, then beta and gamma for each w- candidate; the first that certifies."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError("_rank2: the problem has no obstacle (this needs an obstacle zone)")
     contact = problem.contact
     vec = problem.model.A.createVecRight()
     sp = matrix.refined(contact.scatter(w_plus, vec.duplicate()))
     a_val, alpha_err = ShiftedMatrix.bilinear(sp, sp)
     alpha = -a_val
-    scale_p = _norm(sp.x) * _norm(sp.w)
+    scale_p = norm2(sp.x) * norm2(sp.w)
     record: dict[str, Any] = {"alpha": alpha, "alpha_err": alpha_err}
     record["alpha_ok"] = bool(
         alpha > options.safety * alpha_err and alpha > options.rel_margin * scale_p
@@ -463,7 +272,7 @@ def _rank2(
             b_val, beta_err = ShiftedMatrix.bilinear(sm, sm)
             gamma, gamma_err = ShiftedMatrix.bilinear(sp, sm)
             beta = -b_val
-            scale_m = _norm(sm.x) * _norm(sm.w)
+            scale_m = norm2(sm.x) * norm2(sm.w)
             sm.destroy()
             ok = (
                 beta > options.safety * beta_err
@@ -482,7 +291,7 @@ def _rank2(
     return record, found
 
 
-def copositivity_bound(
+def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (rank 2, SDP, low rank)
     problem: BucklingProblem,
     candidate: Candidate,
     others: list[Candidate] | None = None,
@@ -502,7 +311,10 @@ def copositivity_bound(
     Note:
         Collective.
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError(
+            "copositivity_bound: the problem has no obstacle (this needs an obstacle zone)"
+        )
     opts = options or BoundOptions()
     t0 = time.perf_counter()
     notes: list[str] = []
@@ -615,7 +427,7 @@ def _lowrank(
 ) -> Any:
     """The low-rank route (needs Clarabel and SciPy, the ``sdp`` extra); None without them."""
     try:
-        from unibuckle_fenicsx.copositivity_lowrank import lowrank_certificate
+        from unibuckle_fenicsx.certificate.copositivity_lowrank import lowrank_certificate
     except ImportError as err:
         notes.append(
             "several pencil eigenvalues lie below the load: the low-rank certificate needs "
@@ -657,7 +469,7 @@ def _sdp(
         )
         return {"too_large": True}
     try:
-        from unibuckle_fenicsx import copositivity_sdp
+        from unibuckle_fenicsx.certificate import copositivity_sdp
     except ImportError as err:
         notes.append(
             f"{neg} pencil eigenvalues lie below the load: the SDP route needs the 'sdp' "

@@ -13,13 +13,14 @@ when (:doc:`/methods/problem`; paper, Lemma 5.1)
 
 Global. The algorithms bracket the critical load: any admissible mode's load is an upper
 bound; interlacing, the lattice search and exhaustive enumeration give lower bounds, and
-:mod:`unibuckle_fenicsx.copositivity` proves one just below a KKT point's load when
+:mod:`unibuckle_fenicsx.certificate.copositivity` proves one just below a KKT point's load when
 :math:`A - \lambda B` is copositive on the cone there (a rank-2 certificate that costs one
 sparse :math:`LDL^T`, or a semidefinite program for small i), or, when several pencil
 eigenvalues lie below the load, a slightly lower one by the low-rank route
-(:mod:`unibuckle_fenicsx.copositivity_lowrank`). The result is a *verified bracket*:
-*proven* globally optimal when it closes to :data:`PROOF_GAP`, *bracketed* when its
-verified relative gap is at most :data:`BRACKET_GAP` (the load is then known to that
+(:mod:`unibuckle_fenicsx.certificate.copositivity_lowrank`). The result is a *verified
+bracket*: *proven* globally optimal when it closes to
+:data:`~unibuckle_fenicsx.tolerances.PROOF_GAP`, *bracketed* when its verified relative gap is
+at most :data:`~unibuckle_fenicsx.tolerances.BRACKET_GAP` (the load is then known to that
 accuracy: no admissible mode has a load below the lower bound), otherwise "KKT only".
 The smallest-eigenvalue check runs on every route, proven or not. When the low-rank
 route meets an admissible mode with a lower load than the KKT point's, the point is
@@ -41,10 +42,12 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution
-from unibuckle_fenicsx.copositivity import CERTIFY_PREFIX, BoundOptions, copositivity_bound
+from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
+from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
+from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX
 from unibuckle_fenicsx.eigen import SymmetricFactorization
-from unibuckle_fenicsx.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.tolerances import BRACKET_GAP, PROOF_GAP, ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
 
 __all__ = [
     "BRACKET_GAP",
@@ -53,18 +56,11 @@ __all__ = [
     "Certificate",
     "certify",
     "certify_foundation",
+    "pencil_inertia",
     "reduced_inertia",
 ]
 
 logger = logging.getLogger(__name__)
-
-#: Relative gap (upper - lower)/upper below which the global optimum counts as proven.
-PROOF_GAP = 1e-6
-#: A verified relative gap at most this is reported as "bracketed" (the load is known to
-#: that accuracy), above it the result is a KKT point only.
-BRACKET_GAP = 1e-3
-#: The smallest-eigenvalue check looks below lambda (1 - SMALLEST_RTOL_FACTOR eps_tol).
-SMALLEST_RTOL_FACTOR = 1e3
 
 
 @dataclass(frozen=True)
@@ -87,7 +83,7 @@ class Certificate:
         lower_bound: Verified lower bound on the critical load.
         upper_bound: Load of an admissible mode (``inf`` if the mode is not admissible).
         relative_gap: (upper - lower) / upper.
-        global_optimum_proven: The gap is at most :data:`PROOF_GAP`.
+        global_optimum_proven: The gap is at most :data:`~unibuckle_fenicsx.tolerances.PROOF_GAP`.
         proven_by: What gave the lower bound: "interlacing" (the free load),
             "lattice", "enumeration", or a copositivity route ("rank2-spn", "sdp-spn",
             "sdp-sectors", "lowrank-spn", "psd").
@@ -97,7 +93,7 @@ class Certificate:
         notes: Anything that failed or was skipped, in words.
         refuting_mode: An admissible mode with a lower load than the returned one, found
             by the low-rank route (the returned KKT point is then not the global
-            minimum): a :class:`~unibuckle_fenicsx.problem.Candidate` (its ``eigen`` is
+            minimum): a :class:`~unibuckle_fenicsx.model.problem.Candidate` (its ``eigen`` is
             None: a Rayleigh quotient, not an eigenpair) from which a solver can
             continue. Not in :meth:`as_dict` (its load is: ``refuting_load_Pa``).
     """
@@ -121,14 +117,16 @@ class Certificate:
 
     @property
     def status(self) -> str:
-        """One of proven, bracketed (verified gap <= :data:`BRACKET_GAP`), kkt-only, not-kkt."""
+        """One of proven, bracketed (verified gap <= BRACKET_GAP), kkt-only, not-kkt."""
         if not self.kkt:
             return "not-kkt"
         if self.global_optimum_proven:
             return "proven"
         # A bound verified at lambda (1 - BRACKET_GAP) gives the gap BRACKET_GAP up to the
         # rounding of (upper - lower) / upper.
-        if self.proven_by != "interlacing" and self.relative_gap <= BRACKET_GAP * (1 + 1e-9):
+        if self.proven_by != "interlacing" and self.relative_gap <= BRACKET_GAP * (
+            1 + ROUNDING_RTOL
+        ):
             return "bracketed"
         return "kkt-only"
 
@@ -175,21 +173,45 @@ def reduced_inertia(
     Note:
         Collective.
     """
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError(
+            "reduced_inertia: the problem has no obstacle (this needs an obstacle zone)"
+        )
     A_Z, B_Z = problem.eigensolver.reduced(problem.contact.removed_rows(active))
-    K = A_Z.duplicate(copy=True)
-    K.axpy(-sigma, B_Z, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
-    factor = SymmetricFactorization(K, CERTIFY_PREFIX)
+    return pencil_inertia(A_Z, B_Z, sigma)
+
+
+def pencil_inertia(
+    A: PETSc.Mat, B: PETSc.Mat, sigma: float, diagonal: PETSc.Vec | None = None
+) -> tuple[int, int, int]:
+    r"""Inertia (negative, zero, positive) of :math:`A + \mathrm{diag}(d) - \sigma B`.
+
+    One MUMPS :math:`LDL^T` under the prefix ``unibuckle_certify_``; A and B are not
+    modified, ``diagonal`` (d) is optional.
+
+    Note:
+        Collective.
+    """
+    K = A.duplicate(copy=True)
     try:
-        return factor.inertia()
+        if diagonal is not None:
+            K.setDiagonal(diagonal, addv=PETSc.InsertMode.ADD_VALUES)  # type: ignore[arg-type]
+        K.axpy(-sigma, B, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
+        factor = SymmetricFactorization(K, CERTIFY_PREFIX)
+        try:
+            return factor.inertia()
+        finally:
+            factor.destroy()
     finally:
-        factor.destroy()
         K.destroy()
 
 
 def _residual_off_contact(problem: BucklingProblem, candidate: Candidate) -> float:
     r""":math:`\|r\|_2 / \|Au\|_2` with the rows of Z left out."""
-    assert problem.contact is not None
+    if problem.contact is None:
+        raise ValueError(
+            "_residual_off_contact: the problem has no obstacle (this needs an obstacle zone)"
+        )
     r, _, au_2 = problem.residual(candidate.load, candidate.mode.x.petsc_vec)
     rows = problem.contact.removed_rows(candidate.active)
     r.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))  # type: ignore[arg-type]
@@ -197,7 +219,7 @@ def _residual_off_contact(problem: BucklingProblem, candidate: Candidate) -> flo
     return float(r.norm()) / au_2  # type: ignore[arg-type]
 
 
-def certify(
+def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the order the docstring gives
     problem: BucklingProblem,
     solution: UnilateralSolution | Candidate,
     *,
@@ -253,7 +275,8 @@ def certify(
     elif not cand.feasible:
         notes.append("the mode crosses the obstacle: its load is not an upper bound")
     lower = min(solution.lower_bound, upper)
-    proven_by = str(solution.details.get("lower_bound_by", "interlacing"))
+    # No stated proof: the lower bound is the free load, by interlacing.
+    proven_by = solution.lower_bound_by or "interlacing"
     algorithm_proof = solution.global_optimum_proven
     record: dict[str, Any] | None = None
     refuting: Candidate | None = None
@@ -349,7 +372,11 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
         Collective.
     """
     contact = problem.contact
-    assert contact is not None and contact.stiffness is not None
+    if contact is None or contact.stiffness is None:
+        raise RuntimeError(
+            "certify_foundation: expected contact is not None and contact.stiffness is not None "
+            "(an internal invariant)"
+        )
     cand = solution.candidate
     tau = problem.tau
     notes: list[str] = []
@@ -367,9 +394,14 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     finally:
         spring.destroy()
     residual = float(r.norm()) / au_2  # type: ignore[arg-type]
-    status = solution.details.get("foundation_status", "converged")
-    kkt = residual <= math.sqrt(tau) and status == "converged"
-    if status != "converged":
+    status = solution.status
+    if status is None:
+        raise ValueError(
+            "certify_foundation: the solution carries no spring-set status (solution.status); "
+            "it needs one from solve_foundation"
+        )
+    kkt = residual <= math.sqrt(tau) and status is RunStatus.CONVERGED
+    if status is not RunStatus.CONVERGED:
         notes.append(f"the spring-set iteration did not converge ({status})")
     lower = min(solution.lower_bound, cand.load)
     upper = cand.load
@@ -410,18 +442,16 @@ def _spring_inertia(
 ) -> tuple[int, int, int]:
     r"""Inertia of :math:`A + \sum_{k \in S} \rho_k e_k e_k^T - \sigma B` (collective)."""
     contact = problem.contact
-    assert contact is not None and contact.stiffness is not None
-    K = problem.model.A.duplicate(copy=True)
-    diag = K.createVecLeft()
-    rows, nodes = contact.node_rows(pressing)
-    diag.setValues(rows.astype(PETSc.IntType), contact.stiffness[nodes])
-    diag.assemble()
-    K.setDiagonal(diag, addv=PETSc.InsertMode.ADD_VALUES)
-    diag.destroy()
-    K.axpy(-sigma, problem.model.B, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)
-    factor = SymmetricFactorization(K, CERTIFY_PREFIX)
+    if contact is None or contact.stiffness is None:
+        raise RuntimeError(
+            "_spring_inertia: expected contact is not None and contact.stiffness is not None (an "
+            "internal invariant)"
+        )
+    diag = problem.model.A.createVecLeft()
     try:
-        return factor.inertia()
+        rows, nodes = contact.node_rows(pressing)
+        diag.setValues(rows.astype(PETSc.IntType), contact.stiffness[nodes])
+        diag.assemble()
+        return pencil_inertia(problem.model.A, problem.model.B, sigma, diag)
     finally:
-        factor.destroy()
-        K.destroy()
+        diag.destroy()

@@ -37,8 +37,8 @@ from unibuckle_fenicsx.config import (
     temperature_field,
 )
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.materials import membrane_voigt
-from unibuckle_fenicsx.mesh import edge_line, edge_normal_axis, edge_tags
+from unibuckle_fenicsx.model.materials import membrane_voigt
+from unibuckle_fenicsx.model.mesh import edge_line, edge_normal_axis, edge_tags
 
 __all__ = [
     "DIRECT_LU",
@@ -100,7 +100,7 @@ def edge_traction(
     n is the outward normal, :math:`s = (-n_y, n_x)` the counter-clockwise tangent. A
     stress given as a pair (start, end) varies linearly with the position
     :math:`\xi = (x - P)\cdot(Q - P)/|Q - P|^2` between the edge's start P and end Q
-    (:func:`~unibuckle_fenicsx.mesh.edge_line`; ``tag``: the segment of an edge of
+    (:func:`~unibuckle_fenicsx.model.mesh.edge_line`; ``tag``: the segment of an edge of
     several, each with its own line).
 
     Note:
@@ -232,7 +232,7 @@ def solve_prestress(
 
     Args:
         msh: Plate mesh.
-        facet_tags: Edge markers (:func:`unibuckle_fenicsx.mesh.edge_tags`).
+        facet_tags: Edge markers (:func:`unibuckle_fenicsx.model.mesh.edge_tags`).
         plate: Thickness and edge conditions (in-plane supports and tractions).
         material: Membrane stiffness (and thermal expansion).
         degree: Lagrange degree of the in-plane displacement.
@@ -303,7 +303,10 @@ def solve_prestress(
         petsc_options_prefix="unibuckle_prestress_",
     )
     uh = problem.solve()
-    assert isinstance(uh, dolfinx.fem.Function)
+    if not isinstance(uh, dolfinx.fem.Function):
+        raise TypeError(
+            "solve_prestress: expected isinstance(uh, dolfinx.fem.Function) (an internal invariant)"
+        )
     uh.name = "prestress_displacement"
     del problem
 

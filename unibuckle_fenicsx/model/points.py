@@ -29,6 +29,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec, PointSpec
+from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
     "SnappedPoints",
@@ -93,7 +94,7 @@ def snap_points(
             if len(xy):
                 d = np.hypot(xy[:, 0] - p[0], xy[:, 1] - p[1])
                 # Distance quantised far below any cell size; ties by (y, x).
-                quantised = np.round(d / (1e-9 * size))
+                quantised = np.round(d / (GEOMETRY_RTOL * size))
                 k = int(np.lexsort((xy[:, 0], xy[:, 1], quantised))[0])
                 best.append((float(quantised[k]), float(xy[k, 1]), float(xy[k, 0]), float(d[k])))
             else:
@@ -102,7 +103,7 @@ def snap_points(
         chosen = [min(candidates) for candidates in zip(*gathered, strict=True)]
         nodes = np.array([[c[2], c[1]] for c in chosen], dtype=float).reshape(-1, 2)
         distances = np.array([c[3] for c in chosen], dtype=float)
-        distances[distances <= 1e-9 * size] = 0.0  # rounding of coordinates, not a snap
+        distances[distances <= GEOMETRY_RTOL * size] = 0.0  # rounding of coordinates, not a snap
         out.append(SnappedPoints(spec, wanted, nodes, distances))
     return out
 
@@ -177,7 +178,10 @@ def point_springs(
     for g in snapped:
         if g.spec.kind != "spring":
             continue
-        assert g.spec.stiffness is not None
+        if g.spec.stiffness is None:
+            raise RuntimeError(
+                "point_springs: expected g.spec.stiffness is not None (an internal invariant)"
+            )
         for node in g.nodes:
             d = np.abs(xy[:2].T - node).max(axis=1) if n_owned else np.empty(0)
             stiffness[d <= tol] += g.spec.stiffness

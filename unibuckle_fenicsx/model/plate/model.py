@@ -16,17 +16,22 @@ import numpy.typing as npt
 from unibuckle_fenicsx.config import Material, PlateSpec, PointSpec
 from unibuckle_fenicsx.eigen import Owner, release
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.materials import bending_voigt, transverse_shear
-from unibuckle_fenicsx.mesh import edge_normal_axis, edge_tags
-from unibuckle_fenicsx.plate.forms import bending_form, geometric_form, shear_force, shear_form
-from unibuckle_fenicsx.plate.spaces import (
+from unibuckle_fenicsx.model.materials import bending_voigt, transverse_shear
+from unibuckle_fenicsx.model.mesh import edge_normal_axis, edge_tags
+from unibuckle_fenicsx.model.plate.forms import (
+    bending_form,
+    geometric_form,
+    shear_force,
+    shear_form,
+)
+from unibuckle_fenicsx.model.plate.spaces import (
     MixedDofs,
     create_plate_space,
     create_shear_space,
     mitc_shear_operator,
 )
-from unibuckle_fenicsx.points import point_bcs, point_springs, snap_points
-from unibuckle_fenicsx.prestress import Prestress, material_constant
+from unibuckle_fenicsx.model.points import point_bcs, point_springs, snap_points
+from unibuckle_fenicsx.model.prestress import Prestress, material_constant
 
 __all__ = ["PlateModel", "edge_spring_form", "edge_support_bcs", "mitc_shear_matrix"]
 
@@ -35,7 +40,7 @@ class PlateModel(MixedDofs, Owner):
     r"""Reissner-Mindlin plate with the assembled matrices A (stiffness) and B (geometric).
 
     A is the bending stiffness plus the MITC shear stiffness :math:`P^T M_s P`
-    (:func:`~unibuckle_fenicsx.plate.spaces.mitc_shear_operator`); B is
+    (:func:`~unibuckle_fenicsx.model.plate.spaces.mitc_shear_operator`); B is
     :math:`-\int N^0\nabla w\cdot\nabla z`. Edge-constrained DOFs have zero rows and
     columns with diagonal 1 in A and 0 in B, so they map to :math:`\lambda = \infty`.
     Both matrices are assembled once, here.
@@ -47,11 +52,11 @@ class PlateModel(MixedDofs, Owner):
         material: Elastic constants.
         prestress: Membrane force per unit load.
         shear: "mitc" (locking-free) or "full" (plain full integration, locks).
-        points: Point restraints (:mod:`~unibuckle_fenicsx.points`): bilateral ones
+        points: Point restraints (:mod:`~unibuckle_fenicsx.model.points`): bilateral ones
             become zero Dirichlet conditions, springs diagonal entries of A.
         fixed_prestress: The fixed part of the load: A holds :math:`a - b_{fixed}`, so the
             pencil is :math:`(A - B_{fixed}, B)` (A need not be positive definite then:
-            :class:`~unibuckle_fenicsx.problem.BucklingProblem` checks it).
+            :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` checks it).
         fixed_factor: Factor on the fixed prestress.
 
     Note:
@@ -131,7 +136,7 @@ class PlateModel(MixedDofs, Owner):
         r"""Add nodal springs to A: :math:`A_{kk} \mathrel{+}= k_k` at the global ``rows``.
 
         A bilateral Winkler foundation (lumped springs at the w-DOFs, see
-        :func:`~unibuckle_fenicsx.contact.foundation_springs`); A stays SPD.
+        :func:`~unibuckle_fenicsx.model.contact.foundation_springs`); A stays SPD.
 
         Args:
             rows: Global W rows owned by this rank (free w-DOFs).

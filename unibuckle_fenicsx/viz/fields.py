@@ -1,6 +1,6 @@
 """Data of a solved problem for figures: nodal deflections, sections, the zone's box.
 
-Kept apart from :mod:`unibuckle_fenicsx.plotting` (which only draws): the functions that
+Kept apart from :mod:`unibuckle_fenicsx.viz.plotting` (which only draws): the functions that
 read a mode are collective on the mesh communicator and return the same arrays on every
 rank, so that drawing can happen on rank 0 alone.
 """
@@ -13,12 +13,13 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 if TYPE_CHECKING:  # pragma: no cover
     import dolfinx
 
     from unibuckle_fenicsx.config import ProblemSpec
-    from unibuckle_fenicsx.problem import BucklingProblem
+    from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
     "mesh_triangles",
@@ -129,22 +130,22 @@ def section(
     """
     xy, w = nodal_deflection(problem, u)
     scale = max(problem.spec.plate.length, problem.spec.plate.width)
-    keys = np.round(xy / (1e-9 * scale)).astype(np.int64)
+    keys = np.round(xy / (GEOMETRY_RTOL * scale)).astype(np.int64)
     _, first = np.unique(keys, axis=0, return_index=True)
     xy, w = xy[first], w[first]  # drop duplicates (none in serial)
-    rows = np.unique(np.round(xy[:, 1] / (1e-9 * scale))) * 1e-9 * scale
-    if y < rows[0] - 1e-9 * scale or y > rows[-1] + 1e-9 * scale:
+    rows = np.unique(np.round(xy[:, 1] / (GEOMETRY_RTOL * scale))) * GEOMETRY_RTOL * scale
+    if y < rows[0] - GEOMETRY_RTOL * scale or y > rows[-1] + GEOMETRY_RTOL * scale:
         raise InputError(f"section: y = {y} lies outside the plate [{rows[0]}, {rows[-1]}]")
-    below = rows[rows <= y + 1e-9 * scale].max()
-    above = rows[rows >= y - 1e-9 * scale].min()
+    below = rows[rows <= y + GEOMETRY_RTOL * scale].max()
+    above = rows[rows >= y - GEOMETRY_RTOL * scale].min()
 
     def row(yr: float) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
-        mask = np.abs(xy[:, 1] - yr) <= 1e-9 * scale
+        mask = np.abs(xy[:, 1] - yr) <= GEOMETRY_RTOL * scale
         order = np.argsort(xy[mask, 0])
         return xy[mask, 0][order], w[mask][order]
 
     x0, w0 = row(below)
-    if above - below <= 1e-9 * scale:
+    if above - below <= GEOMETRY_RTOL * scale:
         return x0, w0
     x1, w1 = row(above)
     s = (y - below) / (above - below)

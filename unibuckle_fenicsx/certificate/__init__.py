@@ -1,0 +1,1 @@
+"""Certificates of global optimality: reduced inertia and copositivity bounds."""

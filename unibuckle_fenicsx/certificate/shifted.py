@@ -1,0 +1,236 @@
+"""The shifted matrix K(lambda) = sym(A - lambda B) with rigorous error bounds, and mirror maps.
+
+The common ground of the copositivity routes (:mod:`~unibuckle_fenicsx.certificate.copositivity`,
+:mod:`~unibuckle_fenicsx.certificate.copositivity_sdp`,
+:mod:`~unibuckle_fenicsx.certificate.copositivity_lowrank`): the matrix each certifies, its
+refined solves with floating-point bounds, and the plate's mirror symmetries of the
+constrained nodes.
+
+Note:
+    Collective on the problem's communicator. Options prefix ``unibuckle_certify_``.
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.eigen import Owner, SymmetricFactorization, release
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
+
+__all__ = ["CERTIFY_PREFIX", "EPS", "ShiftedMatrix", "Solve", "absdot", "mirror_maps", "norm2"]
+
+#: Options prefix of the certificate's factorisations (``-unibuckle_certify_ksp_view``).
+CERTIFY_PREFIX = "unibuckle_certify_"
+EPS = float(np.finfo(float).eps)
+
+
+@dataclass
+class Solve:
+    """A refined solve x = K^-1 w: x, the computed residual and its error data."""
+
+    w: PETSc.Vec
+    x: PETSc.Vec
+    rho: PETSc.Vec  # computed w - K x
+    err: PETSc.Vec  # componentwise bound on the rounding of rho
+    d: PETSc.Vec  # K^-1 rho: estimate of the remaining error of x
+
+    def destroy(self) -> None:
+        """Destroy the vectors."""
+        for v in (self.w, self.x, self.rho, self.err, self.d):
+            v.destroy()
+
+
+def norm2(v: PETSc.Vec) -> float:
+    """The 2-norm of ``v`` (collective)."""
+    return float(v.norm())  # type: ignore[arg-type]
+
+
+def absdot(a: PETSc.Vec, b: PETSc.Vec) -> float:
+    """The sum of |a_i| |b_i| (collective)."""
+    comm = a.getComm().tompi4py()
+    return float(comm.allreduce(float(np.abs(a.array_r) @ np.abs(b.array_r)), op=MPI.SUM))
+
+
+class ShiftedMatrix(Owner):
+    r""":math:`K(\lambda) = \mathrm{sym}(A - \lambda B)`, its :math:`|K|`, and its :math:`LDL^T`.
+
+    The pattern is built once; :meth:`factor` rebuilds the values for a new
+    :math:`\lambda` and factorises (MUMPS Cholesky, symmetric indefinite; the SPD flag of
+    A, which ``MatDuplicate`` propagates, is cleared, else MUMPS assumes a positive
+    definite matrix and may report a wrong inertia without error).
+
+    Args:
+        A: Stiffness (AIJ).
+        B: Geometric stiffness (AIJ).
+        prefix: Options prefix of the factorisation.
+
+    Note:
+        Collective. The owner must :meth:`destroy` it.
+    """
+
+    def __init__(self, A: PETSc.Mat, B: PETSc.Mat, prefix: str = CERTIFY_PREFIX) -> None:
+        for mat, name in ((A, "A"), (B, "B")):
+            if mat.getType() not in ("seqaij", "mpiaij"):
+                raise TypeError(f"{name} must be AIJ for the LDL^T inertia, got {mat.getType()}")
+        self.A, self.B, self.prefix = A, B, prefix
+        self.K: PETSc.Mat | None = None
+        self.Kt: PETSc.Mat | None = None
+        self.Kabs: PETSc.Mat | None = None
+        self.factorization: SymmetricFactorization | None = None
+        self.row_length = 0
+        self.solves = 0
+        self.factorisations = 0
+        self.factor_s = 0.0
+        self.solve_s = 0.0
+
+    def build(self, lam: float) -> PETSc.Mat:
+        """Assemble K(lam) and |K| (collective)."""
+        subset = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
+        if self.K is None:
+            K = self.A.duplicate(copy=True)
+            K.axpy(-lam, self.B, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
+            K.setOption(PETSc.Mat.Option.SYMMETRIC, False)  # type: ignore[arg-type]
+            self.Kt = K.transpose(PETSc.Mat())  # not in place: an output matrix
+            K.axpy(1.0, self.Kt, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
+            K.scale(0.5)
+            self.K = K
+            ai, _, _ = K.getValuesCSR()
+            local = int(np.diff(ai).max()) if len(ai) > 1 else 0
+            self.row_length = int(K.getComm().tompi4py().allreduce(local, op=MPI.MAX))
+            self.Kabs = K.duplicate(copy=True)
+        else:
+            K = self.K
+            if self.Kt is None:
+                raise RuntimeError("build: expected self.Kt is not None (an internal invariant)")
+            K.zeroEntries()
+            K.axpy(1.0, self.A, structure=subset)  # type: ignore[arg-type]
+            K.axpy(-lam, self.B, structure=subset)  # type: ignore[arg-type]
+            K.setOption(PETSc.Mat.Option.SYMMETRIC, False)  # type: ignore[arg-type]
+            self.Kt.destroy()
+            self.Kt = K.transpose(PETSc.Mat())
+            K.axpy(1.0, self.Kt, structure=subset)  # type: ignore[arg-type]
+            K.scale(0.5)
+        K.setOption(PETSc.Mat.Option.SPD, False)  # type: ignore[arg-type]
+        K.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
+        if self.Kabs is None:
+            raise RuntimeError("build: expected self.Kabs is not None (an internal invariant)")
+        K.copy(self.Kabs, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)  # type: ignore[arg-type]
+        ai, aj, av = self.Kabs.getValuesCSR()
+        self.Kabs.zeroEntries()
+        self.Kabs.setValuesCSR(ai, aj, np.abs(av))  # type: ignore[arg-type]
+        self.Kabs.assemble()
+        return K
+
+    def factor(self, lam: float) -> tuple[int, int, int]:
+        """Build and factorise K(lam); its inertia (negative, zero, positive)."""
+        t0 = time.perf_counter()
+        K = self.build(lam)
+        if self.factorization is None:
+            self.factorization = SymmetricFactorization(K, self.prefix)
+        else:
+            self.factorization.ksp.setOperators(K)
+            self.factorization.ksp.setUp()
+        self.factorisations += 1
+        inertia = self.factorization.inertia()
+        self.factor_s += time.perf_counter() - t0
+        return inertia
+
+    def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
+        """X = K^-1 b with the current factorisation."""
+        if self.factorization is None:
+            raise RuntimeError("ShiftedMatrix.solve: call factor() first")
+        t0 = time.perf_counter()
+        self.factorization.solve(b, x)
+        self.solves += 1
+        self.solve_s += time.perf_counter() - t0
+
+    def refined(self, w: PETSc.Vec) -> Solve:
+        r"""Solve K x = w, refined once, with the residual and the rounding bound of it.
+
+        The residual's rounding is bounded componentwise by
+        :math:`\gamma_m(|w| + |K||x|)`, :math:`\gamma_m = m\epsilon/(1 - m\epsilon)`,
+        m the longest row plus one. ``w`` is owned by the returned :class:`Solve`.
+        """
+        if self.K is None or self.Kabs is None:
+            raise RuntimeError(
+                "refined: expected self.K is not None and self.Kabs is not None (an internal "
+                "invariant)"
+            )
+        x, rho, dx = w.duplicate(), w.duplicate(), w.duplicate()
+        self.solve(w, x)
+        self.K.mult(x, rho)
+        rho.aypx(-1.0, w)
+        self.solve(rho, dx)
+        x.axpy(1.0, dx)
+        self.K.mult(x, rho)
+        rho.aypx(-1.0, w)
+        err = w.duplicate()
+        dx.array[:] = np.abs(x.array_r)
+        self.Kabs.mult(dx, err)
+        err.array[:] += np.abs(w.array_r)
+        m = self.row_length + 1
+        err.scale(m * EPS / (1 - m * EPS))
+        self.solve(rho, dx)
+        return Solve(w, x, rho, err, dx)
+
+    @staticmethod
+    def bilinear(a: Solve, b: Solve) -> tuple[float, float]:
+        r""":math:`w_a^T K^{-1} w_b` and a bound on the error of that value.
+
+        :math:`|w_a^TK^{-1}w_b - w_a^Tx_b| = |x_a^T\rho_b|` (exact x, exact residual) is at
+        most :math:`|\hat x_a|^T(|\hat\rho_b| + e_b) + \|d_a\|\,\||\hat\rho_b| + e_b\|`,
+        plus the rounding of the dot product.
+        """
+        value = a.w.dot(b.x).real
+        rb = b.rho.duplicate()
+        rb.array[:] = np.abs(b.rho.array_r) + b.err.array_r
+        bound = absdot(a.x, rb) + norm2(a.d) * norm2(rb)
+        rb.destroy()
+        n = a.w.getSize()
+        bound += n * EPS / (1 - n * EPS) * absdot(a.w, b.x)
+        return value, bound
+
+    def destroy(self) -> None:
+        """Destroy the matrices and the factorisation (collective)."""
+        release(self, "factorization", "K", "Kt", "Kabs")
+
+    def __del__(self) -> None:
+        self.destroy()
+
+
+def mirror_maps(
+    problem: BucklingProblem, tol: float = GEOMETRY_RTOL
+) -> dict[str, npt.NDArray[np.int64]]:
+    """Permutations of the constrained nodes under the plate's mirror symmetries.
+
+    A reflection (about x = centre, y = centre, or both) appears only when it maps the
+    node set onto itself. The images of a reaction are candidates, nothing more: the
+    certificate checks whatever it is given.
+    """
+    if problem.contact is None:
+        raise ValueError("mirror_maps: the problem has no obstacle (this needs an obstacle zone)")
+    xy = problem.contact.coordinates
+    (x0, y0), (x1, y1) = problem.spec.plate.corners
+    cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
+    size = max(x1 - x0, y1 - y0)
+
+    def keys(p: npt.NDArray[np.float64]) -> list[tuple[int, int]]:
+        k = np.round((p - (cx, cy)) / (tol * size)).astype(np.int64)
+        return [(int(a), int(b)) for a, b in k.tolist()]
+
+    index = {key: k for k, key in enumerate(keys(xy))}
+    out = {}
+    for name, (sx, sy) in {"x": (-1, 1), "y": (1, -1), "xy": (-1, -1)}.items():
+        image = np.column_stack([cx + sx * (xy[:, 0] - cx), cy + sy * (xy[:, 1] - cy)])
+        perm = [index.get(key) for key in keys(image)]
+        if all(k is not None for k in perm):
+            out[name] = np.asarray(perm, dtype=np.int64)
+    return out

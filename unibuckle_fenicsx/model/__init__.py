@@ -1,0 +1,1 @@
+"""The plate problem: mesh, prestress, Reissner-Mindlin plate, obstacle contact, pencil."""

@@ -1,0 +1,1 @@
+"""Figures and studies: field data, plots, charts over a swept parameter, mesh studies."""
