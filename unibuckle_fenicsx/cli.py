@@ -179,7 +179,8 @@ def _problem_flags() -> argparse.ArgumentParser:
     src.add_argument(
         "--config",
         metavar="FILE",
-        help="problem file: TOML (schema in the README), or a result JSON to re-run its input",
+        help="problem file: TOML (its keys: unibuckle schema --keys), or a result JSON to "
+        "re-run its input",
     )
     problem.add_argument("--nx", type=int, help="cells along x, >= 2 (default: the problem's)")
     problem.add_argument("--ny", type=int, help="cells along y, >= 2 (default: the problem's)")

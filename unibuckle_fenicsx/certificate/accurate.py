@@ -4,7 +4,7 @@ Each entry is :math:`G_{ab} = u_a^Tx_b + x_a^T\rho_b + \rho_a^TK^{-1}\rho_b`
 with :math:`x_b` the computed (refined) solution and :math:`\rho_b = u_b - Kx_b` its exact
 residual. On thin plates :math:`|K||x| \gg |Kx|` (shear stiffness against bending: at
 t/b = 1e-3 the rounding bound of a double-precision residual is a million times that
-of the one below; README, "Verification"), so
+of the one below; :doc:`/verification/index`), so
 :math:`\rho` is computed in twice the working precision: Dot2 of T. Ogita, S. M. Rump and
 S. Oishi, "Accurate sum and dot product", SIAM J. Sci. Comput. 26 (2005) 1955-1988
 (TwoSum of D. E. Knuth, TwoProduct of T. J. Dekker with Veltkamp's splitting), with

@@ -98,7 +98,7 @@ def _obstacle_from_table(table: Any, where: str) -> ObstacleSpec:
 
 
 def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSpec:
-    """Build a :class:`ProblemSpec` from a TOML-shaped mapping (schema: README).
+    """Build a :class:`ProblemSpec` from a TOML-shaped mapping (:doc:`/guide/plate`).
 
     Tables: ``[plate]`` (corners, or outline, or file; thickness; ``[[plate.holes]]``
     with center and radius, or outline), ``[material]`` (E, nu, shear_correction,

@@ -36,7 +36,7 @@ class SolverSpec:
             nested interior-point method on thin plates (thickness below
             :data:`~unibuckle_fenicsx.algorithms.chain.THIN_PLATE` of the shorter side)
             and the multilevel active-set method on the others.
-        tau: Relative feasibility/contact tolerance (README, "The problem"), in (0, 1e-2].
+        tau: Relative feasibility/contact tolerance :doc:`/methods/problem`, in (0, 1e-2].
         eps_tol: SLEPc convergence tolerance, in (0, 1e-4].
         max_candidates: Largest candidate count the enumeration accepts, >= 1.
         enumeration_budget_s: "auto" enumerates only if the estimate (2^i times the
@@ -45,15 +45,15 @@ class SolverSpec:
             feasible size p (to check the paper's monotonicity).
         until_proven: Enumerate past the paper's stopping size p* until the
             interlacing bound proves the best feasible set optimal (exact; the
-            paper's rule is not, see the README).
+            paper's rule is not, see :doc:`/methods/enumeration`).
         max_iterations: Active-set iterates per seed and mesh level, >= 1 (the feasible
-            descent, the chain's last link, may use ten times as many solves).
+            descent, the chain's last link, may use as many solves again).
         bound_budget: Eigen solves allowed for the active set's lattice lower bound,
             >= 0 (it runs when the budget covers the i singletons).
-        certify: Verify the result's global optimality (README, "Proving the global
-            minimum"); off for speed studies.
+        certify: Verify the result's global optimality (:doc:`/methods/certificates`);
+            off for speed studies.
         bracket: Also try the low-rank verified bracket when two or more pencil
-            eigenvalues lie below the load (README, "Proving the global minimum"): tens of
+            eigenvalues lie below the load (:doc:`/methods/certificates`): tens of
             free solves' time on a thin plate of 90x30 cells, so off by default.
         penalty: Penalty stiffness rho for ``method="penalty"`` (relative to the
             largest diagonal entry of A), > 0.

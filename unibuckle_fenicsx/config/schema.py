@@ -1,6 +1,6 @@
 r"""The schema of a problem file, on msgspec: types, ranges, choices, no unknown key.
 
-Each table of a problem file (README, "Problem files") is a frozen :class:`msgspec.Struct`
+Each table of a problem file (:doc:`/guide/plate`) is a frozen :class:`msgspec.Struct`
 that forbids unknown fields; :func:`validate_document` converts a TOML-shaped mapping
 with :func:`msgspec.convert` and turns msgspec's error into an
 :class:`~unibuckle_fenicsx.errors.InputError` that names the key where it happened
@@ -203,7 +203,7 @@ class SolverTable(_Table, frozen=True):
 
 
 class ProblemFile(_Table, frozen=True):
-    """A problem file (README, "Problem files"); every table optional."""
+    """A problem file (:doc:`/guide/plate`); every table optional."""
 
     name: str | UnsetType = UNSET
     units: Literal["SI", "mm-N-MPa"] | UnsetType = UNSET

@@ -364,7 +364,8 @@ def _check_self_equilibrated(
         trap = [e for e in loaded if not e.uniform and e.segments and len(e.segments) > 1]
         hint = "".join(
             f"; edges.{e.name}: its [start, end] stress runs along each of its segments "
-            f"{list(e.segments or ())} from vertex k to vertex k + 1 (README, stress gradients)"
+            f"{list(e.segments or ())} from vertex k to vertex k + 1 (documentation: "
+            "'Describing a plate', stress gradients)"
             for e in trap
         )
         raise InputError(
