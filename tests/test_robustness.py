@@ -23,7 +23,6 @@ from mpi4py import MPI
 
 import pytest
 
-from unibuckle_fenicsx.checks import MAX_THICKNESS_RATIO, THICK_PLATE_RATIO
 from unibuckle_fenicsx.cli import (
     EXIT_BAD_INPUT,
     EXIT_INTERRUPTED,
@@ -32,6 +31,7 @@ from unibuckle_fenicsx.cli import (
     main,
 )
 from unibuckle_fenicsx.config import problem_from_dict
+from unibuckle_fenicsx.config.checks import MAX_THICKNESS_RATIO, THICK_PLATE_RATIO
 from unibuckle_fenicsx.io import file_stem
 from unibuckle_fenicsx.results import versions
 

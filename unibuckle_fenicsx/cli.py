@@ -700,7 +700,7 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
 
 def _warn_plate_model(spec: ProblemSpec, comm: Any) -> None:
     """A warning on stderr when the plate lies outside the plate model's usual range."""
-    from unibuckle_fenicsx.checks import plate_model_note
+    from unibuckle_fenicsx.config.checks import plate_model_note
 
     note = plate_model_note(spec.plate)
     if note is not None and comm.rank == 0:

@@ -8,7 +8,6 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from unibuckle_fenicsx.checks import plate_model_note
 from unibuckle_fenicsx.config import (
     UNITS,
     ProblemSpec,
@@ -16,6 +15,7 @@ from unibuckle_fenicsx.config import (
     stress_value,
     temperature_field,
 )
+from unibuckle_fenicsx.config.checks import plate_model_note
 from unibuckle_fenicsx.model.zones import zone_report
 
 if TYPE_CHECKING:  # pragma: no cover

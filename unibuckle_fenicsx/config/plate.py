@@ -14,7 +14,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.checks import check_features, check_thickness
+from unibuckle_fenicsx.config.checks import check_features, check_thickness
 from unibuckle_fenicsx.config.values import (
     BENDING_SUPPORTS,
     HOLES,

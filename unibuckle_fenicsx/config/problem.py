@@ -6,7 +6,7 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from unibuckle_fenicsx.checks import check_features, check_supports
+from unibuckle_fenicsx.config.checks import check_features, check_supports
 from unibuckle_fenicsx.config.material import Material
 from unibuckle_fenicsx.config.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
 from unibuckle_fenicsx.config.plate import (

@@ -29,7 +29,7 @@ plate and disjoint, outline segments named once, an edge name the plate has), th
 edge-load rule (edges that give no stress carry none once any edge or ``[load]`` gives
 one), the unit systems (a file's numbers converted to SI), the positive definite
 material matrices and symmetric laminates, and the mechanism checks
-(:mod:`unibuckle_fenicsx.checks`). Those live in the frozen dataclasses of the Python
+(:mod:`unibuckle_fenicsx.config.checks`). Those live in the frozen dataclasses of the Python
 API (:mod:`~unibuckle_fenicsx.config.plate` and its siblings), which are also built
 directly in code, without a file, and so check their own values too. A bound violated
 in a file is reported by the dataclass's check, which gives the unit (``plate.thickness

@@ -2,24 +2,26 @@
 
 Run by :class:`~unibuckle_fenicsx.config.ProblemSpec` and
 :class:`~unibuckle_fenicsx.config.PlateSpec` when they are built, before any mesh: each
-raises ``ValueError`` naming the keys (or, for :func:`plate_model_note`, returns a
-warning). numpy only; the config types are imported where they are used (config imports
-this module).
+raises :class:`~unibuckle_fenicsx.errors.InputError` naming the keys (or, for
+:func:`plate_model_note`, returns a warning). numpy only; the config classes import this
+module, so it reads their fields and imports them for type checking only.
 """
 
 from __future__ import annotations
 
 import math
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, TypeGuard, cast
 
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.config.values import EDGE_NAMES, HOLES
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import distance_to_polygon
 
 if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.config import PlateSpec, ProblemSpec
+    from unibuckle_fenicsx.config.plate import Circle, PlateSpec, Polygon
+    from unibuckle_fenicsx.config.problem import ProblemSpec
 
 __all__ = [
     "FEATURE_RATIO",
@@ -107,8 +109,6 @@ def check_supports(spec: ProblemSpec) -> None:
     Raises:
         ValueError: Naming ``edges.*.support``.
     """
-    from unibuckle_fenicsx.config import EDGE_NAMES, HOLES, Circle
-
     plate = spec.plate
     if spec.bilateral_foundations:
         return
@@ -121,7 +121,7 @@ def check_supports(spec: ProblemSpec) -> None:
     points: list[tuple[float, float]] = []
     for e in held:
         if e.name == HOLES and plate.holes:
-            if any(isinstance(h, Circle) for h in plate.holes):
+            if any(_is_circle(h) for h in plate.holes):
                 return
             points += [v for h in plate.holes for v in h.vertices]  # type: ignore[union-attr]
         elif e.segments is not None and plate.outline is not None:
@@ -178,8 +178,6 @@ def plate_features(plate: PlateSpec) -> list[tuple[float, str]]:
     edge and between two holes, the outline's shortest segment and narrowest neck.
     Sorted, smallest first.
     """
-    from unibuckle_fenicsx.config import Circle
-
     outer = np.asarray(plate.boundary, dtype=float)
     out: list[tuple[float, str]] = []
     if plate.outline is not None:
@@ -190,12 +188,12 @@ def plate_features(plate: PlateSpec) -> list[tuple[float, str]]:
     shapes: list[tuple[str, Circle | None, npt.NDArray[np.float64]]] = []
     for k, hole in enumerate(plate.holes):
         where = f"plate.holes[{k}]"
-        if isinstance(hole, Circle):
+        if _is_circle(hole):
             out.append((2.0 * hole.radius, f"{where}.radius = {hole.radius:g} m (its diameter)"))
             gap = float(distance_to_polygon(np.array([hole.center]), outer)[0]) - hole.radius
             shapes.append((where, hole, np.empty((0, 2))))
         else:
-            v = np.asarray(hole.vertices, dtype=float)
+            v = np.asarray(cast("Polygon", hole).vertices, dtype=float)
             j = int(np.argmin(_segment_lengths(v)))
             out.append((float(_segment_lengths(v)[j]), f"{where}.outline segment {j}"))
             gap = _polygon_gap(v, outer)
@@ -248,3 +246,11 @@ def check_features(plate: PlateSpec, mesh_size: float | None) -> None:
                 "m: gmsh cannot grade its quadrilaterals from mesh.size down to it; give a "
                 "smaller mesh.size or a larger feature"
             )
+
+
+def _is_circle(hole: Circle | Polygon) -> TypeGuard[Circle]:
+    """A circular hole (:class:`~unibuckle_fenicsx.config.plate.Circle`: it has a radius).
+
+    Read from its fields, not its class: the config classes import these checks.
+    """
+    return hasattr(hole, "radius")
