@@ -130,6 +130,51 @@ def test_prolongation_is_exact_for_q1():
 
 
 @serial
+def test_lift_is_the_least_energy_correction():
+    """``lift`` moves every node off the obstacle by the correction of least energy.
+
+    A coarse clamped plate's free mode, carried to a finer mesh and relaxed, crosses
+    the obstacle on half the plate. The correction c = lifted - start gives every such
+    node its prescribed gap, and among all corrections with those nodal deflections
+    (the nodal clip's is one) it has the least energy a(c, c) (the minimum-energy
+    extension of prescribed values): checked against the clip's correction.
+    """
+    coarse = BucklingProblem(_thin("cs", nx=12, ny=4), MPI.COMM_SELF)
+    fine = BucklingProblem(_thin("cs", nx=24, ny=8), MPI.COMM_SELF)
+    margin = 1e-3
+    with InteriorPointNewton(fine) as newton:
+        start = Prolongation(coarse, fine).mode(coarse.solve_free().function)
+        newton.relax(start.x.petsc_vec, "deflection")
+        newton.relax(start.x.petsc_vec, "rotations")
+        amplitude = fine.max_abs_w(start.x.petsc_vec)
+        lifted, clipped = fine.new_mode(), fine.new_mode()
+        for target in (lifted, clipped):
+            target.x.array[:] = start.x.array
+        moved = newton.lift(lifted, margin)
+        assert moved > 0
+        # The clip at the same (fixed) limit as the lift's first correction.
+        z0 = newton.oriented(start.x.petsc_vec)
+        near = z0 > -margin * amplitude
+        vec = clipped.x.petsc_vec
+        vec.array[newton._dofs[near]] = newton._signs[near] * (-margin * amplitude)
+        gap = -newton.oriented(lifted.x.petsc_vec)
+        assert gap.min() >= margin * fine.max_abs_w(lifted.x.petsc_vec) * (1 - 1e-9)
+
+        def energy(c):
+            out = c.duplicate()
+            fine.model.A.mult(c, out)
+            return c.dot(out)
+
+        c_lift = lifted.x.petsc_vec.copy()
+        c_lift.axpy(-1.0, start.x.petsc_vec)
+        c_clip = clipped.x.petsc_vec.copy()
+        c_clip.axpy(-1.0, start.x.petsc_vec)
+        assert energy(c_lift) <= energy(c_clip)
+    for p in (coarse, fine):
+        p.destroy()
+
+
+@serial
 @pytest.mark.parametrize(
     ("spec", "kind", "i"), FAMILY[:SAMPLE], ids=[s.name for s, *_ in FAMILY[:SAMPLE]]
 )

@@ -49,6 +49,7 @@ from unibuckle_fenicsx.algorithms.descent import descend
 from unibuckle_fenicsx.algorithms.interior_point import (
     BarrierPoint,
     InteriorPointNewton,
+    NewtonOptions,
     NewtonRecord,
     NewtonStatus,
 )
@@ -429,7 +430,9 @@ def _explore(
     """
     found: list[tuple[Candidate, BarrierPoint]] = []
     seen: list[float] = []
-    with InteriorPointNewton(problem) as newton:
+    # Damped steps (a correction that decays from step to step) keep each start near
+    # its own arrangement: measured, plain first steps let starts jump past the lowest.
+    with InteriorPointNewton(problem, NewtonOptions(plain_first=False)) as newton:
         push = newton.pressure_mode()
         for seed in options.seeds:
             try:
@@ -504,7 +507,9 @@ def _refine(
     """Carry ``point`` from ``coarse`` to ``fine`` and solve the barrier problem there.
 
     The interpolated mode is relaxed into the fine mesh's discrete Kirchhoff kernel
-    (:meth:`~.interior_point.InteriorPointNewton.relax`), then the method runs from
+    (:meth:`~.interior_point.InteriorPointNewton.relax`), the nodes it brings too close
+    to the obstacle are moved back by the least-energy correction
+    (:meth:`~.interior_point.InteriorPointNewton.lift`), then the method runs from
     the barrier parameter ``mu``: to ``mu`` on an intermediate mesh, to ``fine_mu_min``
     on the fine one, whose critical state is read.
     """
@@ -513,8 +518,8 @@ def _refine(
     with InteriorPointNewton(fine) as newton:
         try:
             newton.relax(mode.x.petsc_vec, "deflection")
-            newton.clip(mode, options.clip_margin)
             newton.relax(mode.x.petsc_vec, "rotations")
+            newton.lift(mode, options.clip_margin)
             new, rec = newton.solve(
                 mode,
                 mu=mu,

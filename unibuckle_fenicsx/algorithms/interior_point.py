@@ -38,7 +38,11 @@ Biegler, Math. Program. 106, 2006, the IPOPT paper):
 - inertia control: the bordered matrix :math:`[[K, -Bu], [-Bu^T, 0]]` must have exactly
   one negative eigenvalue, i.e. :math:`\mathrm{neg}(K) + [(Bu)^Ty_2 > 0] = 1` (K positive
   definite on the tangent space of the constraint), read off MUMPS's inertia; otherwise
-  :math:`\delta\,\mathrm{diag}(A)` is added and K refactorised;
+  :math:`\delta\,\mathrm{diag}(A)` is added and K refactorised. After a full step (or
+  one that needed no correction) the unmodified matrix is tried first (IPOPT's rule):
+  a correction carried from step to step damps the steps and the convergence turns
+  linear (measured on a thin simply supported plate at 180×60: 25 steps, 16 with the
+  rule);
 - fraction to the boundary (0.995) for the gap; the push is updated componentwise, each
   entry kept above 0.005 of its old value;
 - a backtracking line search on the barrier objective (the iterate is rescaled to
@@ -140,6 +144,10 @@ class NewtonOptions:
             search).
         delta_first: First regularisation :math:`\delta` (relative to diag(A)).
         delta_max: Largest regularisation before giving up.
+        plain_first: After a full step or one that needed no correction, try the
+            unmodified matrix first (IPOPT's rule; fast local convergence). Off, the
+            correction decays by a third per step (damped steps that stay near the
+            start: the exploration of the coarsest mesh uses this).
     """
 
     keep_mu_until: float = 1e-2
@@ -151,6 +159,7 @@ class NewtonOptions:
     local_residual: float = 1e-2
     delta_first: float = 1e-4
     delta_max: float = 1e6
+    plain_first: bool = True
 
 
 @dataclass
@@ -239,7 +248,8 @@ class InteriorPointNewton(Owner):
         self._du, self._trial = A.createVecLeft(), A.createVecLeft()
         # |A| and |B| for the rounding floor of the residual (thin plates: |A||u| >> |Au|).
         self._abs_A, self._abs_B = _abs_matrix(A), _abs_matrix(B)
-        self._delta_last = 0.0
+        self._delta_last = 0.0  # the last nonzero inertia correction
+        self._last_correction = 0.0  # the correction of the last step
 
     # -- oriented values on the zone (owned nodes, no communication) -----------------
     def oriented(self, vec: PETSc.Vec) -> npt.NDArray[np.float64]:
@@ -363,6 +373,38 @@ class InteriorPointNewton(Owner):
         u.x.scatter_forward()
         return int(self.comm.allreduce(int(moved.sum()), op=MPI.SUM))
 
+    def lift(self, u: dolfinx.fem.Function, margin: float) -> int:
+        r"""Move the nodes closer to the obstacle than ``margin`` max|w| back, smoothly.
+
+        The correction :math:`c` is the deformation of least energy :math:`a(c, c)` that
+        gives each such node the gap ``margin`` max|w| exactly (its deflection held by a
+        stiff diagonal, as in :meth:`relax`; one factorisation). Unlike moving the nodes
+        alone (:meth:`clip`), it keeps the mode in the discrete Kirchhoff kernel: on a
+        thin clamped plate a mode carried from a coarser mesh keeps its quotient within
+        a few per cent instead of gaining a third. Nodes that the correction still
+        leaves too close are then clipped.
+
+        Returns:
+            The number of nodes moved by the correction (over all ranks).
+        """
+        vec = u.x.petsc_vec
+        limit = -margin * self.problem.max_abs_w(vec)
+        z = self.oriented(vec)
+        moved = z > limit
+        count = int(self.comm.allreduce(int(moved.sum()), op=MPI.SUM))
+        if count:
+            held = np.zeros(vec.getLocalSize(), dtype=bool)
+            held[self._dofs[moved]] = True
+            big = 1e8 * float(self._diag_A.norm(PETSc.NormType.INFINITY))
+            self._factor(0.0, None, stiff=(held, big))
+            self._rhs.zeroEntries()
+            self._rhs.array[self._dofs[moved]] = big * self._signs[moved] * (limit - z[moved])
+            self.ksp.solve(self._rhs, self._y1)
+            vec.axpy(1.0, self._y1)
+            u.x.scatter_forward()
+        self.clip(u, margin)
+        return count
+
     def negative_part(self, vec: PETSc.Vec, sign: float = 1.0) -> dolfinx.fem.Function:
         """The mode ``sign * vec`` with its deflection set to 0 where it crosses the obstacle.
 
@@ -456,6 +498,7 @@ class InteriorPointNewton(Owner):
         nu = np.asarray(push, dtype=float) if push is not None else None
         keep = True
         mu_abs = math.nan
+        plain_first = opts.plain_first
         for step in range(max_steps + 1):
             self.A.mult(u, self._Au)
             self.B.mult(u, self._Bu)
@@ -507,7 +550,7 @@ class InteriorPointNewton(Owner):
                 record.status = NewtonStatus.MAX_STEPS
                 break
             # -- Newton direction with inertia control ----------------------------------
-            direction = self.direction(u, lam, nu, gap, mu_abs)
+            direction = self.direction(u, lam, nu, gap, mu_abs, plain_first)
             if direction is None:
                 record.status = NewtonStatus.INERTIA
                 break
@@ -518,6 +561,11 @@ class InteriorPointNewton(Owner):
             if abs(dlam) > 0.5 * lam:
                 alpha_max = min(alpha_max, 0.5 * lam / abs(dlam))
             alpha = self._line_search(u, mu_abs, alpha_max, dz, gap, e_u)
+            plain_first = opts.plain_first and (alpha == 1.0 or self._last_correction == 0.0)
+            logger.debug(
+                "ipm step %d: alpha %.3g (boundary %.3g) dlambda %.3g correction %.3g",
+                step, alpha, alpha_max, dlam, self._last_correction,
+            )  # fmt: skip
             lam += alpha * dlam
             nu = np.maximum(nu + dnu, (1.0 - opts.fraction) * nu)
             record.steps += 1
@@ -536,6 +584,7 @@ class InteriorPointNewton(Owner):
         nu: npt.NDArray[np.float64],
         gap: npt.NDArray[np.float64],
         mu_abs: float,
+        plain_first: bool = True,
     ) -> tuple[float, npt.NDArray[np.float64], npt.NDArray[np.float64]] | None:
         r"""The Newton direction at (u, lambda, nu) for the absolute barrier ``mu_abs``.
 
@@ -551,20 +600,28 @@ class InteriorPointNewton(Owner):
         opts = self.options
         f_c = nu * gap - mu_abs
         sigma = nu / gap
-        # After a corrected step, start from a third of the last correction.
-        delta = max(1e-12, self._delta_last / 3.0) if self._delta_last else 0.0
+        # The unmodified matrix is tried first (IPOPT's rule IC-1) after a full step
+        # or an uncorrected one: a regularisation kept from step to step damps the
+        # steps and makes the convergence linear. Otherwise (short corrected steps, far
+        # from a minimiser) the correction starts from a third of the last one.
+        if opts.plain_first:
+            memory = self._delta_last
+        else:
+            memory = self._last_correction if self._last_correction > 1e-11 else 0.0
+        retry = memory / 3.0 if memory else opts.delta_first
+        delta = retry if memory and not plain_first else 0.0
         while True:
             nneg, nzero = self._factor(lam, sigma, delta)
             self.ksp.solve(self._Bu, self._y2)
             by2 = _dot(self._Bu, self._y2)
             if nzero == 0 and nneg + (1 if by2 > 0.0 else 0) == 1:
                 break
-            delta = (
-                opts.delta_first if delta == 0.0 else delta * (8.0 if self._delta_last else 100.0)
-            )
+            delta = retry if delta == 0.0 else delta * (8.0 if memory else 100.0)
             if delta > opts.delta_max:
                 return None
-        self._delta_last = delta if delta > 1e-11 else 0.0
+        self._last_correction = delta
+        if delta:
+            self._delta_last = delta
         self._Fu.copy(self._rhs)
         self._rhs.scale(-1.0)
         self._add_zone(self._rhs, f_c / gap)
