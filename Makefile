@@ -15,10 +15,10 @@ demo: setup
 	$(PY) demos/run_all.py
 
 test: setup lint
-	$(PY) -m pytest tests
+	$(PY) -m pytest -n auto --dist loadfile tests
 
 test-all: setup
-	$(PY) -m pytest tests -m "convergence or stress or not (convergence or stress)"
+	$(PY) -m pytest -n auto --dist loadfile tests -m "convergence or stress or slow or demo or not (convergence or stress or slow or demo)"
 
 lint: setup
 	$(VENV)/bin/ruff check unibuckle_fenicsx tests demos bench docs

@@ -65,6 +65,7 @@ def family(active_specs) -> list[ProblemSpec]:
 KNOWN_LOCAL_MINIMA = {"random29"}
 
 
+@pytest.mark.slow
 @serial
 def test_random_family_matches_exhaustive_enumeration(family):
     """Same load (1e-8) and contact set as the dense exhaustive minimum, 50 problems.
@@ -103,6 +104,7 @@ def test_random_family_matches_exhaustive_enumeration(family):
     assert sum(m == 1 for *_, m in report) >= 40, report
 
 
+@pytest.mark.slow
 @serial
 def test_lattice_bound_is_valid_and_closes(family):
     """Lower bound <= exhaustive minimum; proven optimum equals it (first 8 problems)."""

@@ -52,6 +52,7 @@ def test_paper_cases_are_proven(case):
         assert cert.smallest_of_reduced is True  # checked on every route, proven or not
 
 
+@pytest.mark.slow
 @serial
 def test_lower_bound_never_exceeds_the_exhaustive_minimum(active_specs):
     """50 random small problems: the verified bound <= the dense exhaustive minimum.

@@ -24,6 +24,7 @@ LOAD_RTOL = 1e-8
 
 pytestmark = [
     pytest.mark.mpi,
+    pytest.mark.slow,
     pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="launches mpiexec itself"),
 ]
 

@@ -305,6 +305,7 @@ def test_reference_values():
 # -- MPI ----------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.mpi
 @pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="launches mpiexec itself")
 def test_two_ranks_give_the_serial_lines(tmp_path):
