@@ -38,11 +38,15 @@ Biegler, Math. Program. 106, 2006, the IPOPT paper):
 - inertia control: the bordered matrix :math:`[[K, -Bu], [-Bu^T, 0]]` must have exactly
   one negative eigenvalue, i.e. :math:`\mathrm{neg}(K) + [(Bu)^Ty_2 > 0] = 1` (K positive
   definite on the tangent space of the constraint), read off MUMPS's inertia; otherwise
-  :math:`\delta\,\mathrm{diag}(A)` is added and K refactorised. After a full step (or
-  one that needed no correction) the unmodified matrix is tried first (IPOPT's rule):
-  a correction carried from step to step damps the steps and the convergence turns
-  linear (measured on a thin simply supported plate at 180×60: 25 steps, 16 with the
-  rule);
+  :math:`\delta\lambda D` is added (D: row sums of :math:`|B|`, a fraction
+  :math:`\delta` of the geometric stiffness given back; at :math:`\delta = 1` K is
+  positive definite) and K refactorised. After a full step (or one that needed no
+  correction) the unmodified matrix is tried first (IPOPT's rule): a correction carried
+  from step to step damps the steps and the convergence turns linear. Measured on a
+  thin plate's fine mesh (90×30; SSSS at 180×60 in brackets), fine-level Newton steps
+  with the former correction :math:`\delta\,\mathrm{diag}(A)` decaying from step to
+  step, then with both changes: SSSS 20 → 11 (25 → 16 with the rule alone), loaded
+  edges clamped 67 → 45, shear 99 → 51, CCCC 32 → 34, unloaded edges clamped 58 → 48;
 - fraction to the boundary (0.995) for the gap; the push is updated componentwise, each
   entry kept above 0.005 of its old value;
 - a backtracking line search on the barrier objective (the iterate is rescaled to
@@ -142,12 +146,20 @@ class NewtonOptions:
         fraction: Fraction to the boundary.
         local_residual: Below this scaled residual, full steps are taken (no line
             search).
-        delta_first: First regularisation :math:`\delta` (relative to diag(A)).
-        delta_max: Largest regularisation before giving up.
+        delta_first: First regularisation :math:`\delta` (in the units of ``metric``).
+        delta_max: Largest regularisation before giving up (with the geometric
+            metric the matrix is positive definite at 1, which is the cap).
         plain_first: After a full step or one that needed no correction, try the
             unmodified matrix first (IPOPT's rule; fast local convergence). Off, the
             correction decays by a third per step (damped steps that stay near the
             start: the exploration of the coarsest mesh uses this).
+        metric: The matrix of the regularisation. "geometric": :math:`\lambda D`
+            with D the row sums of :math:`|B|`, so that :math:`\delta` is the fraction
+            of the geometric stiffness given back (:math:`D - B` is diagonally
+            dominant, hence :math:`K + \lambda D \succeq A + E\Sigma E^T \succ 0`).
+            "stiffness": diag(A), whose shear part on a thin plate is about
+            :math:`(b/t)^2` times the bending stiffness, so that even a small
+            :math:`\delta` damps the bending steps heavily.
     """
 
     keep_mu_until: float = 1e-2
@@ -160,6 +172,7 @@ class NewtonOptions:
     delta_first: float = 1e-4
     delta_max: float = 1e6
     plain_first: bool = True
+    metric: str = "geometric"
 
 
 @dataclass
@@ -226,6 +239,11 @@ class InteriorPointNewton(Owner):
             raise ValueError("InteriorPointNewton needs a problem with a rigid obstacle")
         self.problem = problem
         self.options = options or NewtonOptions()
+        if self.options.metric not in ("geometric", "stiffness"):
+            raise ValueError(
+                f'NewtonOptions.metric must be "geometric" or "stiffness", '
+                f"got {self.options.metric!r}"
+            )
         self.comm = problem.comm
         self.contact = contact
         self._dofs = contact.owned_local_dofs
@@ -248,6 +266,13 @@ class InteriorPointNewton(Owner):
         self._du, self._trial = A.createVecLeft(), A.createVecLeft()
         # |A| and |B| for the rounding floor of the residual (thin plates: |A||u| >> |Au|).
         self._abs_A, self._abs_B = _abs_matrix(A), _abs_matrix(B)
+        self._reg = A.createVecLeft()
+        if self.options.metric == "geometric":
+            # Row sums of |B|: diag(D) - B is diagonally dominant, D bounds B above.
+            self._trial.set(1.0)
+            self._abs_B.mult(self._trial, self._reg)
+        else:
+            A.getDiagonal(self._reg)
         self._delta_last = 0.0  # the last nonzero inertia correction
         self._last_correction = 0.0  # the correction of the last step
 
@@ -287,7 +312,8 @@ class InteriorPointNewton(Owner):
             self.K.axpy(-load, self.B, structure=_SUBSET)
         self._diag.zeroEntries()
         if delta:
-            self._diag.axpy(delta, self._diag_A)
+            geometric = self.options.metric == "geometric"
+            self._diag.axpy(delta * load if geometric else delta, self._reg)
         if sigma is not None:
             self._add_zone(self._diag, sigma)
         if stiff is not None:
@@ -609,6 +635,7 @@ class InteriorPointNewton(Owner):
         else:
             memory = self._last_correction if self._last_correction > 1e-11 else 0.0
         retry = memory / 3.0 if memory else opts.delta_first
+        limit = min(opts.delta_max, 1.0) if opts.metric == "geometric" else opts.delta_max
         delta = retry if memory and not plain_first else 0.0
         while True:
             nneg, nzero = self._factor(lam, sigma, delta)
@@ -616,9 +643,9 @@ class InteriorPointNewton(Owner):
             by2 = _dot(self._Bu, self._y2)
             if nzero == 0 and nneg + (1 if by2 > 0.0 else 0) == 1:
                 break
-            delta = retry if delta == 0.0 else delta * (8.0 if memory else 100.0)
-            if delta > opts.delta_max:
+            if delta >= limit:
                 return None
+            delta = min(limit, retry if delta == 0.0 else delta * (8.0 if memory else 100.0))
         self._last_correction = delta
         if delta:
             self._delta_last = delta
@@ -771,7 +798,7 @@ class InteriorPointNewton(Owner):
 
     def destroy(self) -> None:
         """Destroy the matrix, its factorisation and the work vectors (collective)."""
-        release(self, "ksp", "K", "_abs_A", "_abs_B", "_diag_A", "_diag")
+        release(self, "ksp", "K", "_abs_A", "_abs_B", "_diag_A", "_diag", "_reg")
         release(self, "_Au", "_Bu", "_Fu", "_y1", "_y2", "_rhs", "_du", "_trial")
 
     def __del__(self) -> None:
