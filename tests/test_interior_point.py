@@ -249,3 +249,16 @@ def test_option_under_the_prefix_reaches_the_factorisation():
     finally:
         del opts[f"{IPM_PREFIX}mat_mumps_icntl_14"]
         problem.destroy()
+
+
+def test_stall_watch_counts_steps_without_halving():
+    """The run stops after ``stall_steps`` steps in which the residual did not halve."""
+    from unibuckle_fenicsx.algorithms.interior_point import _StallWatch
+
+    watch = _StallWatch(3)
+    # 1.0 sets the best; 0.6, 0.9, 0.51 do not halve it: the third of them stalls.
+    assert [watch.stalled(r) for r in (1.0, 0.6, 0.9, 0.51)] == [False, False, False, True]
+    watch = _StallWatch(3)
+    # Halving (0.5, then 0.2) resets the count.
+    assert not any(watch.stalled(r) for r in (1.0, 0.8, 0.5, 0.45, 0.2, 0.15, 0.19))
+    assert not any(_StallWatch(0).stalled(1.0) for _ in range(50))

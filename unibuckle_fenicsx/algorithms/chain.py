@@ -212,7 +212,7 @@ class LevelRecord:
 
 
 #: Newton settings of the coarsest mesh's starts (see :func:`_explore`).
-EXPLORE = NewtonOptions(plain_first=False, metric="stiffness")
+EXPLORE = NewtonOptions(plain_first=False, metric="stiffness", stall_steps=0)
 
 
 def _newton_link(seed: str, record: NewtonRecord) -> LinkRecord:

@@ -127,6 +127,7 @@ class NewtonStatus(enum.Enum):
     CONVERGED = "converged"
     MAX_STEPS = "max-steps"
     INERTIA = "inertia-correction-failed"
+    STALLED = "stalled"
     BREAKDOWN = "breakdown"
 
 
@@ -160,6 +161,12 @@ class NewtonOptions:
             "stiffness": diag(A), whose shear part on a thin plate is about
             :math:`(b/t)^2` times the bending stiffness, so that even a small
             :math:`\delta` damps the bending steps heavily.
+        stall_steps: At the last barrier parameter, the run stops (status
+            "stalled") when the residual of :math:`F_u` has not halved in this many
+            steps (0: never). Measured on a thin plate with clamped unloaded edges
+            (180×60): at :math:`\mu = 10^{-14}` the steps crawled for 80 steps with the
+            residual at 0.05–0.6 and the load settled to 3e-9; the caller reads the
+            contact set there as at convergence.
     """
 
     keep_mu_until: float = 1e-2
@@ -173,6 +180,7 @@ class NewtonOptions:
     delta_max: float = 1e6
     plain_first: bool = True
     metric: str = "geometric"
+    stall_steps: int = 10
 
 
 @dataclass
@@ -214,6 +222,24 @@ class NewtonRecord:
     load: float = math.nan
     mu: float = math.nan
     history: list[tuple[float, float, float, float]] = field(default_factory=list)
+
+
+@dataclass
+class _StallWatch:
+    """Whether the residual has not halved in ``steps`` steps (``steps = 0``: never)."""
+
+    steps: int
+    best: float = math.inf
+    since: int = 0
+
+    def stalled(self, residual: float) -> bool:
+        if not self.steps:
+            return False
+        if residual <= 0.5 * self.best:
+            self.best, self.since = residual, 0
+        else:
+            self.since += 1
+        return self.since >= self.steps
 
 
 class InteriorPointNewton(Owner):
@@ -525,6 +551,7 @@ class InteriorPointNewton(Owner):
         keep = True
         mu_abs = math.nan
         plain_first = opts.plain_first
+        watch = _StallWatch(opts.stall_steps)
         for step in range(max_steps + 1):
             self.A.mult(u, self._Au)
             self.B.mult(u, self._Bu)
@@ -571,6 +598,9 @@ class InteriorPointNewton(Owner):
                     and (e_c <= opts.kappa_eps * mu)
                 ):
                     record.status = NewtonStatus.CONVERGED
+                    break
+                if mu <= mu_min and watch.stalled(e_u):
+                    record.status = NewtonStatus.STALLED
                     break
             if step == max_steps:
                 record.status = NewtonStatus.MAX_STEPS
