@@ -161,12 +161,13 @@ class NewtonOptions:
             "stiffness": diag(A), whose shear part on a thin plate is about
             :math:`(b/t)^2` times the bending stiffness, so that even a small
             :math:`\delta` damps the bending steps heavily.
-        stall_steps: At the last barrier parameter, the run stops (status
-            "stalled") when the residual of :math:`F_u` has not halved in this many
-            steps (0: never). Measured on a thin plate with clamped unloaded edges
-            (180×60): at :math:`\mu = 10^{-14}` the steps crawled for 80 steps with the
-            residual at 0.05–0.6 and the load settled to 3e-9; the caller reads the
-            contact set there as at convergence.
+        stall_steps: Once the barrier parameter has come down to ``mu_min`` (not in a
+            run held at one parameter), the run stops (status "stalled") when the
+            residual of :math:`F_u` has not halved in this many steps (0: never).
+            Measured on a thin plate with clamped unloaded edges (180×60): at
+            :math:`\mu = 10^{-14}` the steps crawled for 80 steps with the residual
+            at 0.05–0.6 and the load settled to 3e-9; the caller reads the contact
+            set there as at convergence.
     """
 
     keep_mu_until: float = 1e-2
@@ -551,7 +552,8 @@ class InteriorPointNewton(Owner):
         keep = True
         mu_abs = math.nan
         plain_first = opts.plain_first
-        watch = _StallWatch(opts.stall_steps)
+        watch = _StallWatch(opts.stall_steps)  # once mu has come down to mu_min
+        mu_start = mu
         for step in range(max_steps + 1):
             self.A.mult(u, self._Au)
             self.B.mult(u, self._Bu)
@@ -599,7 +601,7 @@ class InteriorPointNewton(Owner):
                 ):
                     record.status = NewtonStatus.CONVERGED
                     break
-                if mu <= mu_min and watch.stalled(e_u):
+                if mu <= mu_min < mu_start and watch.stalled(e_u):
                     record.status = NewtonStatus.STALLED
                     break
             if step == max_steps:
