@@ -31,7 +31,11 @@ from conftest import run_mpi
 from exhaustive import dense
 from test_stress_family import FAMILY, _check
 
-from unibuckle_fenicsx.algorithms.interior_point import IPM_PREFIX, InteriorPointNewton
+from unibuckle_fenicsx.algorithms.interior_point import (
+    IPM_PREFIX,
+    InteriorPointNewton,
+    _StallWatch,
+)
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
@@ -253,8 +257,6 @@ def test_option_under_the_prefix_reaches_the_factorisation():
 
 def test_stall_watch_counts_steps_without_halving():
     """The run stops after ``stall_steps`` steps in which the residual did not halve."""
-    from unibuckle_fenicsx.algorithms.interior_point import _StallWatch
-
     watch = _StallWatch(3)
     # 1.0 sets the best; 0.6, 0.9, 0.51 do not halve it: the third of them stalls.
     assert [watch.stalled(r) for r in (1.0, 0.6, 0.9, 0.51)] == [False, False, False, True]

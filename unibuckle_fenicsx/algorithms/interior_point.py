@@ -293,13 +293,13 @@ class InteriorPointNewton(Owner):
         self._du, self._trial = A.createVecLeft(), A.createVecLeft()
         # |A| and |B| for the rounding floor of the residual (thin plates: |A||u| >> |Au|).
         self._abs_A, self._abs_B = _abs_matrix(A), _abs_matrix(B)
-        self._reg = A.createVecLeft()
+        # The regularisation's diagonal: diag(A), or the row sums of |B| (D - B is then
+        # diagonally dominant: D bounds B above).
+        self._reg = self._diag_A
         if self.options.metric == "geometric":
-            # Row sums of |B|: diag(D) - B is diagonally dominant, D bounds B above.
+            self._reg = A.createVecLeft()
             self._trial.set(1.0)
             self._abs_B.mult(self._trial, self._reg)
-        else:
-            A.getDiagonal(self._reg)
         self._delta_last = 0.0  # the last nonzero inertia correction
         self._last_correction = 0.0  # the correction of the last step
 
@@ -352,6 +352,10 @@ class InteriorPointNewton(Owner):
         nneg, nzero, _ = self.ksp.getPC().getFactorMatrix().getInertia()
         return int(nneg), int(nzero)
 
+    def _held_diagonal(self) -> float:
+        """Diagonal entry that holds a DOF (:meth:`relax`, :meth:`lift`): 1e8 max diag(A)."""
+        return 1e8 * float(self._diag_A.norm(PETSc.NormType.INFINITY))
+
     # -- starts ------------------------------------------------------------------------
     def pressure_mode(self, weights: npt.NDArray[np.float64] | None = None) -> dolfinx.fem.Function:
         r"""Deflection under nodal forces ``weights`` pushing the plate off the obstacle.
@@ -395,7 +399,7 @@ class InteriorPointNewton(Owner):
         held[self.problem.owned_w_dofs] = True
         if free == "deflection":
             held = ~held
-        big = 1e8 * float(self._diag_A.norm(PETSc.NormType.INFINITY))
+        big = self._held_diagonal()
         self._factor(0.0, None, stiff=(held, big))
         self.A.mult(vec, self._rhs)
         self._rhs.array[held] = 0.0
@@ -448,7 +452,7 @@ class InteriorPointNewton(Owner):
         if count:
             held = np.zeros(vec.getLocalSize(), dtype=bool)
             held[self._dofs[moved]] = True
-            big = 1e8 * float(self._diag_A.norm(PETSc.NormType.INFINITY))
+            big = self._held_diagonal()
             self._factor(0.0, None, stiff=(held, big))
             self._rhs.zeroEntries()
             self._rhs.array[self._dofs[moved]] = big * self._signs[moved] * (limit - z[moved])
@@ -830,6 +834,8 @@ class InteriorPointNewton(Owner):
 
     def destroy(self) -> None:
         """Destroy the matrix, its factorisation and the work vectors (collective)."""
+        if self._reg is self._diag_A:
+            self._reg = None
         release(self, "ksp", "K", "_abs_A", "_abs_B", "_diag_A", "_diag", "_reg")
         release(self, "_Au", "_Bu", "_Fu", "_y1", "_y2", "_rhs", "_du", "_trial")
 

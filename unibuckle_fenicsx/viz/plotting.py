@@ -110,6 +110,14 @@ def _prepare(path: str | Path) -> Path:
     return path
 
 
+def _save(plt: Any, fig: Any, path: Path) -> Path:
+    """Lay out ``fig``, write it to ``path``, close it; ``path``."""
+    fig.tight_layout()
+    fig.savefig(path)
+    plt.close(fig)
+    return path
+
+
 def _normalised(w: npt.NDArray[np.float64], tau: float) -> npt.NDArray[np.float64]:
     """Deflection divided by max |w|, values within ``tau`` of zero set to zero."""
     wmax = float(np.abs(w).max()) or 1.0
@@ -312,10 +320,7 @@ def plot_section(
     if title:
         ax.set_title(title)
     ax.legend(loc="best", fontsize=THEME["mpl_font_size"] - 2, framealpha=0.9)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 # -- contact set -----------------------------------------------------------------------
@@ -362,10 +367,7 @@ def _finish_top_view(plt: Any, fig: Any, ax: Any, path: Path, title: str) -> Pat
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=3,
                   fontsize=THEME["mpl_font_size"] - 2, frameon=False)  # fmt: skip
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 def plot_contact_set(
@@ -593,10 +595,7 @@ def plot_convergence(
     ax1.legend(fontsize=THEME["mpl_font_size"] - 3)
     if title:
         fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 # -- nonlinear load paths ----------------------------------------------------------------
@@ -646,10 +645,7 @@ def plot_load_paths(
     axes[0].legend(fontsize=THEME["mpl_font_size"] - 3, loc="upper left", framealpha=0.9)
     if title:
         fig.suptitle(title)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
 
 
 #: One series of :func:`plot_southwell`: additional deflection (m), loads (Pa), mask of
@@ -697,7 +693,4 @@ def plot_southwell(
     ax.legend(fontsize=THEME["mpl_font_size"] - 2, loc="upper left")
     if title:
         ax.set_title(title)
-    fig.tight_layout()
-    fig.savefig(path)
-    plt.close(fig)
-    return path
+    return _save(plt, fig, path)
