@@ -13,11 +13,11 @@ For a rigid obstacle (any side, several zones) the chain is
 2. **Contact set and exact eigenpair.** The fine barrier solution gives the contact set
    Z (the nodes whose gap is at the tolerance ``tau``); the smallest eigenpair of the
    pencil with Z removed (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`)
-   is the returned critical state, checked against the KKT conditions. If it fails, the
-   barrier is driven lower and the active-set iteration (:mod:`.pdas`) polishes Z; if
-   that fails too, the coarse state is carried once more at a small barrier parameter
-   (flat parts stay flat), with saddle escapes, a longer polish and the feasible descent
-   (:mod:`.descent`).
+   is the returned critical state, checked against the KKT conditions. If it fails, a
+   saddle is escaped (the lower reduced mode shows the way), the barrier is driven
+   lower and the active-set iteration (:mod:`.pdas`) polishes Z; if that fails too, the
+   coarse state is carried once more at a small barrier parameter (flat parts stay
+   flat), with a longer polish and the feasible descent (:mod:`.descent`).
 3. **Fallbacks.** The feasible descent from the lowest admissible mode met (it cannot
    cycle); then the multilevel active-set method (:mod:`.active_set`, with its penalty
    continuation) from scratch.
@@ -369,13 +369,17 @@ def _critical_state(
     """Read the contact set off ``point``; escape a saddle, drive the barrier lower, polish.
 
     Returns the KKT point (or None) and the barrier point it belongs to (recomputed
-    after a polish only when ``carry``: it goes on to a finer mesh). ``quick``: no
-    escapes, a short polish and no descent (a second try follows).
+    after a polish only when ``carry``: it goes on to a finer mesh). ``quick``: a
+    short polish and no descent (a second try follows). Saddles are escaped on every
+    try: measured, the escape answers the fine mesh's first try where a second try
+    from the coarsest mesh cost more (clamped unloaded edges at 90×30: 47 fine steps
+    and 11 eigen solves, plus 55 steps at 45×15, against 42 and 6; the same load to
+    6e-11, lower).
     """
     cand = _read_contact(problem, newton, point, level, label)
     if cand.kkt:
         return cand, point
-    for attempt in range(0 if quick else options.escapes):
+    for attempt in range(options.escapes):
         saddle = not cand.feasible and cand.load < point.load * (1.0 - ROUNDING_RTOL)
         if not (saddle and newton.escape(point, cand.mode.x.petsc_vec)):
             break
