@@ -44,7 +44,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
-from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX
+from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX, ShiftedMatrix
 from unibuckle_fenicsx.eigen import SymmetricFactorization
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import BRACKET_GAP, PROOF_GAP, ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
@@ -163,12 +163,17 @@ class Certificate:
 
 
 def reduced_inertia(
-    problem: BucklingProblem, active: npt.NDArray[np.int64], sigma: float
+    problem: BucklingProblem,
+    active: npt.NDArray[np.int64],
+    sigma: float,
+    matrix: ShiftedMatrix | None = None,
 ) -> tuple[int, int, int]:
     r"""Inertia of :math:`A_Z - \sigma B_Z`, the pencil with the contact set Z removed.
 
     Its negative count is the number of eigenvalues of the reduced pencil in
-    :math:`(0, \sigma)` (Sylvester's law of inertia, A SPD).
+    :math:`(0, \sigma)` (Sylvester's law of inertia, A SPD). With ``matrix`` (a
+    :class:`~.shifted.ShiftedMatrix` of the same pencil, already factorised) its
+    symbolic analysis is reused: one numeric factorisation.
 
     Note:
         Collective.
@@ -177,7 +182,10 @@ def reduced_inertia(
         raise ValueError(
             "reduced_inertia: the problem has no obstacle (this needs an obstacle zone)"
         )
-    A_Z, B_Z = problem.eigensolver.reduced(problem.contact.removed_rows(active))
+    rows = problem.contact.removed_rows(active)
+    if matrix is not None:
+        return matrix.factor_reduced(rows, sigma)
+    A_Z, B_Z = problem.eigensolver.reduced(rows)
     return pencil_inertia(A_Z, B_Z, sigma)
 
 
@@ -280,47 +288,53 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     algorithm_proof = solution.global_optimum_proven
     record: dict[str, Any] | None = None
     refuting: Candidate | None = None
-    if not algorithm_proof and global_bound and kkt and cand.eigen is not None:
-        if options is None and not problem.spec.solver.bracket:
-            options = BoundOptions(lowrank=None)  # the low-rank route on request only
-        bound = copositivity_bound(problem, cand, solution.kkt_points, options)
-        record = {
-            "method": bound.method,
-            "delta": bound.delta,
-            "margins": bound.margins,
-            "negative_eigenvalues": bound.negative_eigenvalues,
-            **{k: bound.timings[k] for k in ("factorisations", "solves")},
-            "time_s": bound.timings["total_s"],
-            "lowrank": bound.lowrank,
-        }
-        notes += list(bound.notes)
-        if bound.refuting is not None:
-            refuting = _refuting_candidate(problem, bound.refuting)
-            if refuting.feasible:
-                upper = min(upper, refuting.load)
+    # One factorisation object for the copositivity attempt and the smallest-eigenvalue
+    # check (same pattern): the check reuses the attempt's symbolic analysis.
+    matrix = ShiftedMatrix(problem.model.A, problem.model.B)
+    try:
+        if not algorithm_proof and global_bound and kkt and cand.eigen is not None:
+            if options is None and not problem.spec.solver.bracket:
+                options = BoundOptions(lowrank=None)  # the low-rank route on request only
+            bound = copositivity_bound(problem, cand, solution.kkt_points, options, matrix)
+            record = {
+                "method": bound.method,
+                "delta": bound.delta,
+                "margins": bound.margins,
+                "negative_eigenvalues": bound.negative_eigenvalues,
+                **{k: bound.timings[k] for k in ("factorisations", "solves")},
+                "time_s": bound.timings["total_s"],
+                "lowrank": bound.lowrank,
+            }
+            notes += list(bound.notes)
+            if bound.refuting is not None:
+                refuting = _refuting_candidate(problem, bound.refuting)
+                if refuting.feasible:
+                    upper = min(upper, refuting.load)
+                    notes.append(
+                        f"refuted: an admissible mode has the load {refuting.load!r} < "
+                        f"{cand.load!r} (Certificate.refuting_mode)"
+                    )
+            if bound.value is not None and bound.value > lower:
+                lower, proven_by = min(bound.value, upper), bound.method
+            lower = min(lower, upper)
+        elif not algorithm_proof and not global_bound:
+            notes.append("global certification skipped (solver.certify = false)")
+        gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
+        proven = bool(kkt and gap <= PROOF_GAP and (algorithm_proof or proven_by != "interlacing"))
+        smallest: bool | None = None
+        if check_smallest and global_bound and cand.eigen is not None:
+            sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
+            neg, _, _ = reduced_inertia(problem, cand.active, sigma, matrix)
+            smallest = neg == 0
+            if not smallest:
                 notes.append(
-                    f"refuted: an admissible mode has the load {refuting.load!r} < "
-                    f"{cand.load!r} (Certificate.refuting_mode)"
+                    f"the reduced pencil has {neg} eigenvalue(s) below the returned load: "
+                    "not its smallest eigenpair"
                 )
-        if bound.value is not None and bound.value > lower:
-            lower, proven_by = min(bound.value, upper), bound.method
-        lower = min(lower, upper)
-    elif not algorithm_proof and not global_bound:
-        notes.append("global certification skipped (solver.certify = false)")
-    gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
-    proven = bool(kkt and gap <= PROOF_GAP and (algorithm_proof or proven_by != "interlacing"))
-    smallest: bool | None = None
-    if check_smallest and global_bound and cand.eigen is not None:
-        sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
-        neg, _, _ = reduced_inertia(problem, cand.active, sigma)
-        smallest = neg == 0
-        if not smallest:
-            notes.append(
-                f"the reduced pencil has {neg} eigenvalue(s) below the returned load: "
-                "not its smallest eigenpair"
-            )
-    elif cand.eigen is None:
-        notes.append("the mode is not an eigenvector of a reduced pencil (not checked)")
+        elif cand.eigen is None:
+            notes.append("the mode is not an eigenvector of a reduced pencil (not checked)")
+    finally:
+        matrix.destroy()
     return Certificate(
         feasible=cand.feasible,
         feasibility_margin=cand.margin,

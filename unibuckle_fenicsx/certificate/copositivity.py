@@ -296,6 +296,7 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
     candidate: Candidate,
     others: list[Candidate] | None = None,
     options: BoundOptions | None = None,
+    matrix: ShiftedMatrix | None = None,
 ) -> LowerBound:
     r"""Verified lower bound on the critical load near the KKT point ``candidate``.
 
@@ -304,6 +305,9 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
         candidate: The returned KKT point (feasible, forces pushing).
         others: Further KKT points, candidates for the other nappe's :math:`w_-`.
         options: :class:`BoundOptions`.
+        matrix: The :class:`~.shifted.ShiftedMatrix` of the problem's pencil to factorise
+            (the caller's, left alive: its symbolic analysis serves the caller's further
+            factorisations); default a new one, destroyed here.
 
     Returns:
         The bound, with the route and margins that verified it, or ``value=None``.
@@ -332,7 +336,11 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
         if float(phi @ image) * sigma < 0:
             w_minus.append((f"mirror-{name}", image))
     a = -np.sign(sigma) * phi  # normalisation a'w = 1 of the other nappe
-    matrix = ShiftedMatrix(problem.model.A, problem.model.B)
+    own = matrix is None
+    if matrix is None:
+        matrix = ShiftedMatrix(problem.model.A, problem.model.B)
+    factorisations0, solves0 = matrix.factorisations, matrix.solves
+    factor_s0, solve_s0 = matrix.factor_s, matrix.solve_s
     result: LowerBound | None = None
     m: int | None = None
     several = False  # two or more pencil eigenvalues below some shift tried
@@ -390,12 +398,13 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
     finally:
         timings = {  # the slowest rank's, so that the record is the same on every rank
             "total_s": problem.comm.allreduce(time.perf_counter() - t0, op=MPI.MAX),
-            "factor_s": problem.comm.allreduce(matrix.factor_s, op=MPI.MAX),
-            "solve_s": problem.comm.allreduce(matrix.solve_s, op=MPI.MAX),
-            "factorisations": matrix.factorisations,
-            "solves": matrix.solves,
+            "factor_s": problem.comm.allreduce(matrix.factor_s - factor_s0, op=MPI.MAX),
+            "solve_s": problem.comm.allreduce(matrix.solve_s - solve_s0, op=MPI.MAX),
+            "factorisations": matrix.factorisations - factorisations0,
+            "solves": matrix.solves - solves0,
         }
-        matrix.destroy()
+        if own:
+            matrix.destroy()
     if result is None:
         notes.append(
             "no certificate at any delta tried "

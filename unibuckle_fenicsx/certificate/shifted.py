@@ -143,6 +143,34 @@ class ShiftedMatrix(Owner):
         self.factor_s += time.perf_counter() - t0
         return inertia
 
+    def factor_reduced(self, rows: npt.NDArray[np.int64], sigma: float) -> tuple[int, int, int]:
+        r"""Factorise :math:`A_Z - \sigma B_Z` (``rows`` removed: zero, diagonal 1); its inertia.
+
+        The same matrix and pattern as :meth:`factor`, so the symbolic analysis is not
+        repeated (one numeric :math:`LDL^T`); ``rows`` are the global rows owned by this
+        rank. K then holds the reduced pencil (and :math:`|K|` a stale one): call
+        :meth:`factor` before :meth:`solve` or :meth:`refined` again.
+        """
+        t0 = time.perf_counter()
+        if self.K is None:
+            K = self.build(sigma)
+        else:  # A - sigma B is symmetric: no symmetrisation, and |K| is not needed
+            K = self.K
+            subset = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
+            K.zeroEntries()
+            K.axpy(1.0, self.A, structure=subset)  # type: ignore[arg-type]
+            K.axpy(-sigma, self.B, structure=subset)  # type: ignore[arg-type]
+        K.zeroRowsColumns(np.ascontiguousarray(rows, dtype=PETSc.IntType), diag=1.0)  # type: ignore[arg-type]
+        if self.factorization is None:
+            self.factorization = SymmetricFactorization(K, self.prefix)
+        else:
+            self.factorization.ksp.setOperators(K)
+            self.factorization.ksp.setUp()
+        self.factorisations += 1
+        inertia = self.factorization.inertia()
+        self.factor_s += time.perf_counter() - t0
+        return inertia
+
     def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
         """X = K^-1 b with the current factorisation."""
         if self.factorization is None:
