@@ -243,13 +243,21 @@ def test_two_ranks_give_the_serial_answer(tmp_path):
 
 @serial
 def test_option_under_the_prefix_reaches_the_factorisation():
+    """A command-line MUMPS control under the prefix, and the inertia controls, are in effect.
+
+    Construction does not factorise; the controls are read at the first factorisation.
+    """
     problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
     opts = PETSc.Options()
     opts[f"{IPM_PREFIX}mat_mumps_icntl_14"] = 57
     try:
         with InteriorPointNewton(problem) as newton:
+            assert newton.factorizations == 0
+            newton.pressure_mode()  # one factorisation of A
             factor = newton.ksp.getPC().getFactorMatrix()
             assert factor.getMumpsIcntl(14) == 57
+            assert (factor.getMumpsIcntl(13), factor.getMumpsIcntl(24)) == (1, 1)
+            assert factor.getInertia()[0] == 0  # A is positive definite
     finally:
         del opts[f"{IPM_PREFIX}mat_mumps_icntl_14"]
         problem.destroy()

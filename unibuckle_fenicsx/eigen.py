@@ -56,6 +56,7 @@ __all__ = [
     "pop_run_options",
     "push_run_options",
     "release",
+    "set_ldl_options",
     "set_options",
     "swapped_eigenpairs",
 ]
@@ -157,6 +158,27 @@ def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False)
     finally:
         for key in pushed:
             opts.delValue(key)
+
+
+def set_ldl_options(ksp: PETSc.KSP, prefix: str) -> None:
+    """Make ``ksp`` a MUMPS :math:`LDL^T` with inertia (:data:`LDL_OPTIONS`), unfactorised.
+
+    :func:`set_options` with ``setup=True`` would factorise the current operator (the
+    MUMPS controls are read at the first factorisation, while the defaults are in the
+    options database); a matrix whose values are set before every factorisation (the
+    interior point's Newton matrix) does not need that one. The controls go onto the
+    factor matrix instead, which PETSc hands to MUMPS when it starts; the rest of
+    :data:`LDL_OPTIONS` goes through the database (a command-line option under
+    ``prefix`` still wins). The operator must be set. Collective.
+    """
+    mumps = {k: v for k, v in LDL_OPTIONS.items() if k.startswith("mat_mumps_icntl_")}
+    others = {k: v for k, v in LDL_OPTIONS.items() if k not in mumps}
+    set_options(ksp, prefix, others)
+    pc = ksp.getPC()
+    pc.setFactorSetUpSolverType()
+    factor = pc.getFactorMatrix()
+    for key, value in mumps.items():
+        factor.setMumpsIcntl(int(key.rsplit("_", 1)[1]), int(value))
 
 
 #: Options prefixes of the eigen solvers of one run that take the EPS options given in

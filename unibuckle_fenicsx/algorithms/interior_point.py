@@ -86,7 +86,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.eigen import LDL_OPTIONS, Owner, release, set_options
+from unibuckle_fenicsx.eigen import Owner, release, set_ldl_options
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
@@ -285,9 +285,9 @@ class InteriorPointNewton(Owner):
         self.ksp.setOperators(self.K)
         self.K.setOption(PETSc.Mat.Option.SPD, False)
         self.K.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        set_options(self.ksp, prefix, LDL_OPTIONS, setup=True)
+        set_ldl_options(self.ksp, prefix)  # the first _factor analyses K's pattern
         self.prefix = prefix
-        self.factorizations = 1
+        self.factorizations = 0
         self._diag_A = A.createVecLeft()
         A.getDiagonal(self._diag_A)
         self._diag = A.createVecLeft()  # diagonal modification of K
