@@ -339,13 +339,10 @@ class GEPSolver(Owner):
         Note:
             Collective.
         """
-        n_removed = self.A.comm.tompi4py().allreduce(0 if removed is None else len(removed))
-        if n_removed:
-            if removed is None:
-                raise RuntimeError("solve: expected removed is not None (an internal invariant)")
-            A, B = self.reduced(removed)
-        else:
-            A, B = self.A, self.B
+        # Always the work copies, even with nothing removed: the factorisation of the
+        # shift-and-invert then keeps one matrix, whose symbolic analysis serves every
+        # solve (the free plate's and each contact set's).
+        A, B = self.reduced(np.empty(0, np.int64) if removed is None else removed)
         if _is_zero(B):
             # Every DOF carrying geometric stiffness is removed: no finite load.
             if out is not None:
