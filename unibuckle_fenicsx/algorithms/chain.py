@@ -512,6 +512,7 @@ def _refine(
     mu: float,
     label: str = "prolonged",
     quick: bool = False,
+    newton: InteriorPointNewton | None = None,
 ) -> tuple[Candidate | None, BarrierPoint | None]:
     """Carry ``point`` from ``coarse`` to ``fine`` and solve the barrier problem there.
 
@@ -520,11 +521,17 @@ def _refine(
     to the obstacle are moved back by the least-energy correction
     (:meth:`~.interior_point.InteriorPointNewton.lift`), then the method runs from
     the barrier parameter ``mu``: to ``mu`` on an intermediate mesh, to ``fine_mu_min``
-    on the fine one, whose critical state is read.
+    on the fine one, whose critical state is read. ``newton``: the method on ``fine``
+    (the caller's, kept for the level's other arrangements: its factorisation's symbolic
+    analysis is done once per mesh); default a new one.
     """
     carry = Prolongation(coarse, fine)
     mode = carry.mode(point.mode)
-    with InteriorPointNewton(fine) as newton:
+    own = newton is None
+    if newton is None:
+        newton = InteriorPointNewton(fine)
+    newton.forget_corrections()
+    try:
         try:
             newton.relax(mode.x.petsc_vec, "deflection")
             newton.relax(mode.x.petsc_vec, "rotations")
@@ -545,6 +552,9 @@ def _refine(
             fine, newton, new, level, label, options, carry=False, quick=quick
         )
         return cand, new
+    finally:
+        if own:
+            newton.destroy()
 
 
 def _level_record(problem: BucklingProblem) -> LevelRecord:
@@ -572,21 +582,25 @@ def _carry(
     mu: float,
     label: str,
     quick: bool,
+    newtons: dict[int, InteriorPointNewton],
 ) -> tuple[list[Candidate], list[BarrierPoint]]:
     """Carry every point from ``problems[k - 1]`` to ``problems[k]``.
 
     On an intermediate mesh the points whose loads lie more than ``refine_margin`` above
     the lowest are dropped (the meshes rank the arrangements better as they get finer);
-    on the finest, the KKT points met are returned.
+    on the finest, the KKT points met are returned. ``newtons``: the method on each mesh
+    (created here when missing), shared by the arrangements and tries.
     """
     tl = time.perf_counter()
     last = k == len(problems) - 1
     found: list[Candidate] = []
     carried: list[BarrierPoint] = []
+    if k not in newtons:
+        newtons[k] = InteriorPointNewton(problems[k])
     for j, point in enumerate(points):
         tag = label if len(points) == 1 else f"{label} {j + 1}"
         cand, new = _refine(
-            problems[k - 1], problems[k], point, level, options, last, mu, tag, quick
+            problems[k - 1], problems[k], point, level, options, last, mu, tag, quick, newtons[k]
         )
         if cand is not None and cand.kkt:
             found.append(cand)
@@ -608,10 +622,11 @@ def _ascend(
     mu: float,
     label: str,
     quick: bool,
+    newtons: dict[int, InteriorPointNewton],
 ) -> Candidate | None:
     """Carry ``points`` from ``problems[0]`` to the fine mesh; the lowest KKT point there."""
     for k in range(1, len(problems)):
-        found, points = _carry(problems, k, points, levels[k], options, mu, label, quick)
+        found, points = _carry(problems, k, points, levels[k], options, mu, label, quick, newtons)
         if k == len(problems) - 1:
             return min(found, key=lambda c: c.load) if found else None
         if not points:
@@ -637,10 +652,19 @@ def _levels(
     if len(problems) == 1 or not carried:
         return levels, explored, (explored[0] if explored else None)
     points = [a.point for a in carried]
-    chosen = _ascend(problems, points, levels, options, options.level_mu, "prolonged", True)
-    if chosen is None:
-        flat = [carried[0].flat]
-        chosen = _ascend(problems, flat, levels, options, options.flat_mu, "prolonged flat", False)
+    newtons: dict[int, InteriorPointNewton] = {}  # one per mesh: one symbolic analysis
+    try:
+        chosen = _ascend(
+            problems, points, levels, options, options.level_mu, "prolonged", True, newtons
+        )
+        if chosen is None:
+            flat = [carried[0].flat]
+            chosen = _ascend(
+                problems, flat, levels, options, options.flat_mu, "prolonged flat", False, newtons
+            )
+    finally:
+        for newton in newtons.values():
+            newton.destroy()
     return levels, explored, chosen
 
 

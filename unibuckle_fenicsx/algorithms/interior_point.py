@@ -359,6 +359,11 @@ class InteriorPointNewton(Owner):
         """Diagonal entry that holds a DOF (:meth:`relax`, :meth:`lift`): 1e8 max diag(A)."""
         return 1e8 * float(self._diag_A.norm(PETSc.NormType.INFINITY))
 
+    def forget_corrections(self) -> None:
+        """Start the next run as a new method would: no inertia correction remembered."""
+        self._delta_last = 0.0
+        self._last_correction = 0.0
+
     # -- starts ------------------------------------------------------------------------
     def pressure_mode(self, weights: npt.NDArray[np.float64] | None = None) -> dolfinx.fem.Function:
         r"""Deflection under nodal forces ``weights`` pushing the plate off the obstacle.
