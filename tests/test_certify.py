@@ -21,8 +21,9 @@ from exhaustive import exhaustive_minimum
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.certificate.certify import certify
+from unibuckle_fenicsx.certificate.certify import certify, reduced_inertia
 from unibuckle_fenicsx.certificate.copositivity import copositivity_bound
+from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.config import (
     EdgeSpec,
     Material,
@@ -178,3 +179,32 @@ def test_off_centre_zone_is_proven_by_the_search(zone):
     assert cert.proven_by == "rank2-spn"
     assert "mirror" not in cert.copositivity["margins"]["w_minus"]
     assert np.isfinite(cert.copositivity["margins"]["beta"])
+
+
+def test_reduced_inertia_reuses_the_copositivity_factorisation():
+    """The reduced pencil factorised in the copositivity attempt's matrix: a fresh one's inertia.
+
+    The certificate's smallest-eigenvalue check reuses the attempt's symbolic analysis.
+    Reference: the same inertia from an independent LDLᵀ of A_Z - sigma B_Z
+    (``reduced_inertia`` without a matrix), at shifts below and above eigenvalues of the
+    reduced pencil.
+    """
+    problem = BucklingProblem(paper_case("c1", 10, 10), MPI.COMM_WORLD)
+    try:
+        load = problem.solve_free().load
+        assert problem.contact is not None
+        active = np.arange(0, problem.contact.size, 2)
+        matrix = ShiftedMatrix(problem.model.A, problem.model.B)
+        try:
+            matrix.factor(1.1 * load)  # as the copositivity attempt does first
+            shared, fresh = [], []
+            for sigma in (0.9 * load, 1.5 * load, 4.0 * load):
+                shared.append(reduced_inertia(problem, active, sigma, matrix))
+                fresh.append(reduced_inertia(problem, active, sigma))
+        finally:
+            matrix.destroy()
+    finally:
+        problem.destroy()
+    assert shared == fresh
+    negatives = [neg for neg, _, _ in fresh]
+    assert negatives[0] == 0 and negatives[-1] > 0, negatives  # the test says something
