@@ -23,8 +23,15 @@ import pytest
 from conftest import ROOT, run_mpi
 
 from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK
-from unibuckle_fenicsx.config import MeshSpec, load_toml, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.config import (
+    MeshSpec,
+    ObstacleSpec,
+    load_toml,
+    problem_from_dict,
+    problem_to_dict,
+)
 from unibuckle_fenicsx.sweep import (
     Variation,
     parse_variation,
@@ -344,3 +351,23 @@ def test_plot(tmp_path):
     assert json.loads((tmp_path / "l.jsonl").read_text().splitlines()[1])["point"] == {
         "plate.length": 0.3
     }
+
+
+def test_a_thin_plate_line_is_the_same_on_every_run():
+    """A sweep line leaves out every wall time, the interior point's level records' too.
+
+    The route on thin plates records seconds per mesh level and link; a line
+    (``as_dict(timings=False)``, README "Sweeps and charts") must not carry them, or two
+    runs (and a run on two ranks) would write different lines.
+    """
+    spec = plate_case(
+        "thin", length=0.3, width=0.1, thickness=1e-4, nx=12, ny=4, zone=ObstacleSpec("all")
+    )
+    lines = []
+    for _ in range(2):
+        with solve(spec) as analysis:
+            assert analysis.result.method.startswith("interior-point")
+            assert analysis.result.details["levels"][0]["seconds"] > 0.0
+            lines.append(json.dumps(analysis.result.as_dict(timings=False), sort_keys=True))
+    assert lines[0] == lines[1]
+    assert '"seconds"' not in lines[0]

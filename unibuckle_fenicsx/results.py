@@ -217,7 +217,8 @@ class BucklingResult:
         """JSON-ready mapping (non-finite floats become strings).
 
         Args:
-            timings: Keep the wall times (``*_s`` keys, ``timings``) and the "auto" rule's
+            timings: Keep the wall times (``*_s`` and ``seconds`` keys, the latter in
+                the interior point's level records; ``timings``) and the "auto" rule's
                 reason, which quotes a measured time; without them the mapping is the same
                 on every run (for files kept under version control).
         """
@@ -419,7 +420,7 @@ def _without_timings(obj: Any) -> Any:
         return {
             k: _without_timings(v)
             for k, v in obj.items()
-            if not (k.endswith("_s") or k in ("timings", "method_chosen_by"))
+            if not (k.endswith("_s") or k in ("timings", "method_chosen_by", "seconds"))
         }
     if isinstance(obj, list):
         return [_without_timings(v) for v in obj]
