@@ -14,9 +14,10 @@ Usage: python bench/bench_certify.py [--meshes 160x80,320x160] [--cases c1,c3] [
 from __future__ import annotations
 
 import argparse
-import json
 
 from mpi4py import MPI
+
+from _results import append_rows
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
@@ -86,10 +87,7 @@ def main() -> None:
                 "| {} | {} | {} | {} | {} | {:.2f} | {:.2f} | **{:.2f}** | {} | {:.0e} | {} "
                 "| {} | {:.2f} | {:.2f} |".format(*row)
             )
-        if args.json:
-            with open(args.json, "a") as f:
-                for row in rows:
-                    f.write(json.dumps(dict(zip(JSON_KEYS, row, strict=True))) + "\n")
+        append_rows(args.json, (dict(zip(JSON_KEYS, row, strict=True)) for row in rows))
 
 
 if __name__ == "__main__":

@@ -11,10 +11,12 @@ Two studies, each printing a Markdown table:
 
 Usage::
 
-    python bench/bench_enumeration.py scan [--budget 60] [--zones c1 c2 c3]
+    python bench/bench_enumeration.py scan [--budget 60] [--zones c1 c2 c3] [--json FILE]
     python bench/bench_enumeration.py parallel [--case c1 --nx 8 --ny 5] [--repeat 3]
+        [--json FILE]
 
-Timings depend on the machine's load; the table header prints the load average.
+Timings depend on the machine's load; the table header prints the load average. With
+``--json FILE`` each row is also appended to FILE as one JSON line.
 """
 
 from __future__ import annotations
@@ -27,6 +29,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from _results import append_rows
 
 BIN = Path(sys.executable).parent
 MESHES = {
@@ -59,7 +63,7 @@ def run_cli(
         return json.loads(out.read_text()), wall
 
 
-def scan(zones: list[str], budget: float) -> None:
+def scan(zones: list[str], budget: float, json_path: str | None) -> None:
     print(f"load average before: {os.getloadavg()[0]:.2f} (2 cores, shared)\n")
     print("| zone | mesh | i | p* | sets evaluated | lambda_c (MPa) | proven | solve wall (s) |")
     print("|---|---|---|---|---|---|---|---|")
@@ -77,9 +81,23 @@ def scan(zones: list[str], budget: float) -> None:
                 f"| {data['wall_time_s']:.1f} |",
                 flush=True,
             )
+            row = {
+                "study": "scan",
+                "zone": zone,
+                "mesh": f"{nx}x{ny}",
+                "constrained_nodes": data["constrained_nodes"],
+                "p_star": data["p_star"],
+                "candidates_evaluated": d["candidates_evaluated"],
+                "critical_load_Pa": data["critical_load_Pa"],
+                "proven": data["certificate"]["global_optimum_proven"],
+                "wall_time_s": data["wall_time_s"],
+            }
+            append_rows(json_path, [row])
 
 
-def parallel(case: str, nx: int, ny: int, complete: bool, repeat: int) -> None:
+def parallel(
+    case: str, nx: int, ny: int, complete: bool, repeat: int, json_path: str | None
+) -> None:
     extra = ["--complete"] if complete else []
     print(f"load average before: {os.getloadavg()[0]:.2f} (2 cores, shared)\n")
     print("| ranks | sets | enumeration wall (s), best of runs | total wall (s) | speed-up |")
@@ -99,6 +117,18 @@ def parallel(case: str, nx: int, ny: int, complete: bool, repeat: int) -> None:
         base = base or best
         assert all(r == results[0] for r in results)
         print(f"| {nprocs} | {sets} | {best:.2f} | {total:.2f} | {base / best:.2f} |", flush=True)
+        row = {
+            "study": "parallel",
+            "case": case,
+            "mesh": f"{nx}x{ny}",
+            "complete": complete,
+            "ranks": nprocs,
+            "sets": sets,
+            "enumeration_wall_s": best,
+            "total_wall_s": total,
+            "speed_up": base / best,
+        }
+        append_rows(json_path, [row])
 
 
 def main() -> None:
@@ -113,11 +143,13 @@ def main() -> None:
     p.add_argument("--ny", type=int, default=5)
     p.add_argument("--no-complete", action="store_true", help="paper's stopping rule")
     p.add_argument("--repeat", type=int, default=3)
+    for study in (s, p):
+        study.add_argument("--json", help="append one JSON line per row to this file")
     args = parser.parse_args()
     if args.study == "scan":
-        scan(args.zones, args.budget)
+        scan(args.zones, args.budget, args.json)
     else:
-        parallel(args.case, args.nx, args.ny, not args.no_complete, args.repeat)
+        parallel(args.case, args.nx, args.ny, not args.no_complete, args.repeat, args.json)
 
 
 if __name__ == "__main__":

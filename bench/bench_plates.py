@@ -39,6 +39,8 @@ from pathlib import Path
 
 from mpi4py import MPI
 
+from _results import append_rows
+
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.certify import Certificate
@@ -172,9 +174,7 @@ def main() -> None:
                     ),
                     flush=True,
                 )
-                if args.json:
-                    with open(args.json, "a") as f:
-                        f.write(json.dumps(row) + "\n")
+                append_rows(args.json, [row])
 
 
 if __name__ == "__main__":

@@ -9,7 +9,8 @@ keeps the fastest of ``--repeat`` runs, and prints a Markdown table: set-up (mes
 prestress, assembly), solve (free eigen solve plus, for c1, the active-set algorithm), total
 wall time, speed-up, parallel efficiency and peak resident memory per rank
 (``getrusage`` max RSS, which includes the ~150 MB of the Python/DOLFINx runtime). The
-loads of every run are printed too: they must not depend on P.
+loads of every run are printed too: they must not depend on P. With ``--json FILE`` each
+row is also appended to FILE as one JSON line.
 
 Note:
     Timings are only meaningful on an otherwise idle machine with at least max(P) cores.
@@ -26,6 +27,8 @@ import subprocess
 import sys
 import time
 from pathlib import Path
+
+from _results import append_rows
 
 
 def worker(case: str, nx: int, ny: int, method: str) -> None:
@@ -110,7 +113,7 @@ def main() -> None:
     )
     parser.add_argument("--repeat", type=int, default=1, help="keep the fastest of N runs")
     parser.add_argument("--timeout", type=float, default=1800.0, help="seconds per run")
-    parser.add_argument("--json", help="also write the reports to this file")
+    parser.add_argument("--json", help="append one JSON line per row to this file")
     parser.add_argument("--worker", action="store_true", help=argparse.SUPPRESS)
     args = parser.parse_args()
     if args.worker:
@@ -139,8 +142,7 @@ def main() -> None:
     for case, values in loads.items():
         spread = (max(values) - min(values)) / min(values)
         print(f"{case}: load spread over rank counts {spread:.1e} (relative)")
-    if args.json:
-        Path(args.json).write_text(json.dumps(rows, indent=2) + "\n")
+    append_rows(args.json, rows)
 
 
 if __name__ == "__main__":

@@ -3,9 +3,10 @@
 The SSSS plate of the garland demo (b = 1 m, t/b = 1e-3, cells of b/12, whole-plate
 obstacle) swept over a/b; ``unibuckle sweep`` runs once serially and once under
 ``mpiexec -n P`` (one point per rank), each from an empty file, and the table gives the
-wall times, the speed-up and whether the two files are identical.
+wall times, the speed-up and whether the two files are identical. With ``--json FILE``
+each row is also appended to FILE as one JSON line.
 
-Usage: python bench/bench_sweep.py [--ranks 2] [--vary plate.length=0.5:2.25:8]
+Usage: python bench/bench_sweep.py [--ranks 2] [--vary plate.length=0.5:2.25:8] [--json FILE]
 """
 
 from __future__ import annotations
@@ -18,6 +19,8 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+
+from _results import append_rows
 
 BASE = """\
 name = "ssss"
@@ -42,6 +45,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--ranks", type=int, default=2)
     parser.add_argument("--vary", default="plate.length=0.5:2.25:8")
+    parser.add_argument("--json", help="append one JSON line per row to this file")
     args = parser.parse_args()
     bindir = Path(sys.executable).parent
     mpiexec = shutil.which("mpiexec", path=str(bindir)) or "mpiexec"
@@ -71,6 +75,19 @@ def main() -> None:
             f"| {ranks} | {points} | {times[ranks]:.1f} | {times[ranks] / points:.2f} | "
             f"{times[1] / times[ranks]:.2f} | {'-' if ranks == 1 else same} |"
         )
+    rows = [
+        {
+            "vary": args.vary,
+            "ranks": ranks,
+            "points": points,
+            "wall_s": times[ranks],
+            "s_per_point": times[ranks] / points,
+            "speed_up": times[1] / times[ranks],
+            "same_lines_as_serial": None if ranks == 1 else same == "yes",
+        }
+        for ranks in (1, args.ranks)
+    ]
+    append_rows(args.json, rows)
 
 
 if __name__ == "__main__":

@@ -4,9 +4,11 @@ For the paper's plate with the zones c1 and c3, on each mesh: set the problem up
 one free buckling solve (cold: first solve on the problem, LU included), then time
 :func:`~unibuckle_fenicsx.algorithms.active_set.solve_active_set` on the same problem
 (coarse levels and their set-up included). Prints a table; peak memory is the process
-maximum resident set size so far (``resource.getrusage``), i.e. cumulative.
+maximum resident set size so far (``resource.getrusage``), i.e. cumulative. With
+``--json FILE`` each row is also appended to FILE as one JSON line.
 
 Usage: python bench/bench_unilateral.py [--meshes 160x80,320x160] [--cases c1,c3]
+[--json FILE]
 """
 
 from __future__ import annotations
@@ -17,6 +19,8 @@ import time
 
 from mpi4py import MPI
 
+from _results import append_rows
+
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.problem import BucklingProblem
@@ -26,6 +30,7 @@ def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--meshes", default="160x80,320x160")
     parser.add_argument("--cases", default="c1,c3")
+    parser.add_argument("--json", help="append one JSON line per row to this file")
     args, _ = parser.parse_known_args()
     comm = MPI.COMM_WORLD
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
@@ -57,6 +62,22 @@ def main() -> None:
                     f"{sol.load:14.6f} {len(sol.active):5d} {sol.candidate.kkt}",
                     flush=True,
                 )
+                row = {
+                    "case": case,
+                    "mesh": f"{nx}x{ny}",
+                    "ranks": comm.size,
+                    "dofs": problem.model.num_dofs,
+                    "free_solve_s": t_free,
+                    "unilateral_s": t_uni,
+                    "ratio": t_uni / t_free,
+                    "fine_eigensolves": d["fine_eigensolves"],
+                    "coarse_eigensolves": d["coarse_eigensolves"],
+                    "peak_MB": peak / 1024,
+                    "load_Pa": sol.load,
+                    "contact_nodes": len(sol.active),
+                    "kkt": bool(sol.candidate.kkt),
+                }
+                append_rows(args.json, [row])
             problem.destroy()
 
 

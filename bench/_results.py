@@ -1,0 +1,20 @@
+"""Results files of the benchmarks: one JSON object per table row, appended.
+
+The documentation renders some of them as tables (``bench/results/*.jsonl``); every
+bench script takes ``--json FILE`` and appends its rows there.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Iterable, Mapping
+from typing import Any
+
+
+def append_rows(path: str | None, rows: Iterable[Mapping[str, Any]]) -> None:
+    """Append ``rows`` to the file ``path``, one JSON line each (nothing if ``path`` is None)."""
+    if not path:
+        return
+    with open(path, "a", encoding="utf-8") as f:
+        for row in rows:
+            f.write(json.dumps(dict(row)) + "\n")
