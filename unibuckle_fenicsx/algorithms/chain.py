@@ -510,9 +510,9 @@ def _refine(
     options: ChainOptions,
     last: bool,
     mu: float,
-    label: str = "prolonged",
-    quick: bool = False,
-    newton: InteriorPointNewton | None = None,
+    label: str,
+    quick: bool,
+    newton: InteriorPointNewton,
 ) -> tuple[Candidate | None, BarrierPoint | None]:
     """Carry ``point`` from ``coarse`` to ``fine`` and solve the barrier problem there.
 
@@ -523,38 +523,29 @@ def _refine(
     the barrier parameter ``mu``: to ``mu`` on an intermediate mesh, to ``fine_mu_min``
     on the fine one, whose critical state is read. ``newton``: the method on ``fine``
     (the caller's, kept for the level's other arrangements: its factorisation's symbolic
-    analysis is done once per mesh); default a new one.
+    analysis is done once per mesh).
     """
     carry = Prolongation(coarse, fine)
     mode = carry.mode(point.mode)
-    own = newton is None
-    if newton is None:
-        newton = InteriorPointNewton(fine)
     newton.forget_corrections()
     try:
-        try:
-            newton.relax(mode.x.petsc_vec, "deflection")
-            newton.relax(mode.x.petsc_vec, "rotations")
-            newton.lift(mode, options.clip_margin)
-            new, rec = newton.solve(
-                mode,
-                mu=mu,
-                mu_min=options.fine_mu_min if last else mu,
-                max_steps=options.max_steps,
-            )
-        except (ValueError, FloatingPointError) as err:
-            level.links.append(LinkRecord("interior-point", label, f"failed: {err}"))
-            return None, None
-        level.links.append(_newton_link(label, rec))
-        if not last:
-            return None, new
-        cand, new = _critical_state(
-            fine, newton, new, level, label, options, carry=False, quick=quick
+        newton.relax(mode.x.petsc_vec, "deflection")
+        newton.relax(mode.x.petsc_vec, "rotations")
+        newton.lift(mode, options.clip_margin)
+        new, rec = newton.solve(
+            mode,
+            mu=mu,
+            mu_min=options.fine_mu_min if last else mu,
+            max_steps=options.max_steps,
         )
-        return cand, new
-    finally:
-        if own:
-            newton.destroy()
+    except (ValueError, FloatingPointError) as err:
+        level.links.append(LinkRecord("interior-point", label, f"failed: {err}"))
+        return None, None
+    level.links.append(_newton_link(label, rec))
+    if not last:
+        return None, new
+    cand, new = _critical_state(fine, newton, new, level, label, options, carry=False, quick=quick)
+    return cand, new
 
 
 def _level_record(problem: BucklingProblem) -> LevelRecord:

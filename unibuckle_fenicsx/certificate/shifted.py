@@ -132,16 +132,7 @@ class ShiftedMatrix(Owner):
     def factor(self, lam: float) -> tuple[int, int, int]:
         """Build and factorise K(lam); its inertia (negative, zero, positive)."""
         t0 = time.perf_counter()
-        K = self.build(lam)
-        if self.factorization is None:
-            self.factorization = SymmetricFactorization(K, self.prefix)
-        else:
-            self.factorization.ksp.setOperators(K)
-            self.factorization.ksp.setUp()
-        self.factorisations += 1
-        inertia = self.factorization.inertia()
-        self.factor_s += time.perf_counter() - t0
-        return inertia
+        return self._factorise(self.build(lam), t0)
 
     def factor_reduced(self, rows: npt.NDArray[np.int64], sigma: float) -> tuple[int, int, int]:
         r"""Factorise :math:`A_Z - \sigma B_Z` (``rows`` removed: zero, diagonal 1); its inertia.
@@ -161,6 +152,10 @@ class ShiftedMatrix(Owner):
             K.axpy(1.0, self.A, structure=subset)  # type: ignore[arg-type]
             K.axpy(-sigma, self.B, structure=subset)  # type: ignore[arg-type]
         K.zeroRowsColumns(np.ascontiguousarray(rows, dtype=PETSc.IntType), diag=1.0)  # type: ignore[arg-type]
+        return self._factorise(K, t0)
+
+    def _factorise(self, K: PETSc.Mat, t0: float) -> tuple[int, int, int]:
+        """Factorise K (its symbolic analysis done once, on the first call); its inertia."""
         if self.factorization is None:
             self.factorization = SymmetricFactorization(K, self.prefix)
         else:
