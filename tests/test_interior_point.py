@@ -3,14 +3,16 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
 - The Newton direction solves the linearised optimality conditions
   :math:`F_u = Au - \lambda Bu + E\nu`, :math:`F_c = \nu\circ g - \mu`,
   :math:`F_n = \frac12(u^TBu - 1)` (g = -E^T u): compared with a dense Newton solve of
-  the full Jacobian, written here with numpy from the assembled matrices.
+  the full Jacobian, written here with numpy from the assembled matrices, with the
+  obstacle on either side.
 - Interpolation between nested meshes is exact for Q1 functions (a linear field).
 - The route on problems of the random stress family agrees with the exhaustive minimum
   over all 2^i contact sets (dense linear algebra, ``tests/exhaustive.py``) wherever the
   active-set method does (sample here, the whole family with ``-m stress``).
 - A thin plate (t/b = 1e-3) against a whole-plate obstacle: the route answers with a
   certified KKT point that is the smallest eigenvalue of its reduced pencil, and the mode
-  vanishes on the contact set; two ranks give the serial answer.
+  vanishes on the contact set; two ranks give the serial answer; the obstacle below gives
+  the load of the obstacle above (the mirror image w -> -w).
 - An option under the prefix ``unibuckle_ipm_`` reaches the factorisation.
 """
 
@@ -69,8 +71,16 @@ def _thin(name: str = "ssss", nx: int = 6, ny: int = 3, **kw) -> object:
 
 
 @serial
-def test_newton_direction_solves_the_linearised_conditions():
-    problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+@pytest.mark.parametrize("side", ["above", "below"])
+def test_newton_direction_solves_the_linearised_conditions(side):
+    r"""The obstacle on either side.
+
+    The barrier's Hessian :math:`E\,diag(\nu/g)E^T` has the entries
+    :math:`s_k^2\nu_k/g_k = \nu_k/g_k` whatever the sign :math:`s_k` of the side.
+    """
+    spec = _thin(nx=6, ny=3)
+    spec = replace(spec, obstacle=replace(spec.obstacle, side=side))
+    problem = BucklingProblem(spec, MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
         u = newton.pressure_mode()  # strictly inside the cone
         vec = u.x.petsc_vec
@@ -226,6 +236,23 @@ def test_thin_plate_route_is_certified():
         meshes = [lv["mesh"] for lv in report["levels"]]
         assert meshes == [[22, 7], [45, 15]], meshes
         assert all(lv["newton_steps"] > 0 for lv in report["levels"])
+
+
+@serial
+def test_obstacle_below_is_the_mirror_image():
+    """The plate against an obstacle below is the mirror image (w -> -w) of the one above.
+
+    The same load and contact set, by the same route (before the sign fix the route
+    failed on every start below and the slow active-set chain answered).
+    """
+    spec = _thin("ssss", nx=24, ny=8)
+    below = replace(spec, obstacle=replace(spec.obstacle, side="below"))
+    above, under = _route(spec), _route(below)
+    for report in (above, under):
+        assert report["method"] == "interior-point", report["method"]
+        assert report["kkt"] and report["smallest"], report
+    assert under["load"] == pytest.approx(above["load"], rel=1e-9)
+    assert under["coordinates"] == above["coordinates"]
 
 
 @pytest.mark.mpi

@@ -345,7 +345,8 @@ class InteriorPointNewton(Owner):
             geometric = self.options.metric == "geometric"
             self._diag.axpy(delta * load if geometric else delta, self._reg)
         if sigma is not None:
-            self._add_zone(self._diag, sigma)
+            # E diag(sigma) E^T: the entries are s_k^2 sigma_k = sigma_k, whatever the side.
+            self._diag.array[self._dofs] += sigma
         if stiff is not None:
             self._diag.array[stiff[0]] += stiff[1]
         self.K.setDiagonal(self._diag, addv=PETSc.InsertMode.ADD_VALUES)
