@@ -35,13 +35,14 @@ from test_stress_family import FAMILY, _check
 
 from unibuckle_fenicsx.algorithms.interior_point import (
     IPM_PREFIX,
+    PUSH_MARGIN,
     InteriorPointNewton,
     _StallWatch,
 )
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.config import ObstacleSpec, problem_to_dict
+from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
@@ -253,6 +254,68 @@ def test_obstacle_below_is_the_mirror_image():
         assert report["kkt"] and report["smallest"], report
     assert under["load"] == pytest.approx(above["load"], rel=1e-9)
     assert under["coordinates"] == above["coordinates"]
+
+
+def _twisted(nx: int, ny: int, method: str = "interior-point"):
+    """Two zones on opposite sides of a plate with a free edge (t/b = 1e-2).
+
+    Left edge simply supported, right clamped (both loaded), bottom free, top simply
+    supported; w <= 0 on the left 45 %, w >= 0 on the right 45 %.
+    """
+    data = {
+        "plate": {"corners": [[0.0, 0.0], [0.15, 0.1]], "thickness": 1e-3},
+        "material": {"E": 2.1e11, "nu": 0.3},
+        "edges": {
+            "left": {"support": "simply_supported", "normal_stress": -1.0},
+            "right": {"support": "clamped", "normal_stress": -1.0},
+            "bottom": {"support": "free"},
+            "top": {"support": "simply_supported"},
+        },
+        "mesh": {"nx": nx, "ny": ny},
+        "obstacles": [
+            {"zone": [[0.0, 0.0675], [0.0, 0.1]], "side": "above"},
+            {"zone": [[0.0825, 0.15], [0.0, 0.1]], "side": "below"},
+        ],
+        "solver": {"method": method},
+    }
+    return problem_from_dict(data)
+
+
+@serial
+def test_pressure_deflection_is_lifted_into_the_cone():
+    """A pressure deflection that crosses an obstacle is lifted back into the cone.
+
+    The two pushes twist the plate about its free edge across an obstacle; the start is
+    moved back to a gap of at least PUSH_MARGIN max|w| at every constrained node.
+    """
+    problem = BucklingProblem(_twisted(9, 6), MPI.COMM_SELF)
+    with InteriorPointNewton(problem) as newton:
+        plain = problem.new_mode("plain")
+        newton._factor(0.0, None)
+        newton._rhs.zeroEntries()
+        newton._add_zone(newton._rhs, -np.ones(newton.contact.size))
+        newton.ksp.solve(newton._rhs, plain.x.petsc_vec)
+        assert newton.oriented(plain.x.petsc_vec).max() > 0.0  # crosses an obstacle
+        push = newton.pressure_mode()
+        vec = push.x.petsc_vec
+        gap = -newton.oriented(vec)
+        assert gap.min() >= PUSH_MARGIN * problem.max_abs_w(vec) * (1 - 1e-12)
+    problem.destroy()
+
+
+@serial
+def test_obstacles_on_opposite_sides_with_a_free_edge():
+    """The interior-point route answers, with the active-set route's load.
+
+    Before the lift no start existed on the coarsest mesh and the active-set chain
+    answered after the interior point.
+    """
+    route = _route(_twisted(36, 24))
+    assert route["method"] == "interior-point", route["method"]
+    assert route["kkt"] and route["smallest"], route
+    other = _route(_twisted(36, 24, "active-set"))
+    assert other["method"] == "active-set" and other["kkt"]
+    assert route["load"] == pytest.approx(other["load"], rel=1e-9)
 
 
 @pytest.mark.mpi

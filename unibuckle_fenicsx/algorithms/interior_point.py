@@ -103,6 +103,11 @@ logger = logging.getLogger(__name__)
 #: Options prefix of the Newton matrix's factorisation (``-unibuckle_ipm_ksp_view``).
 IPM_PREFIX = "unibuckle_ipm_"
 
+#: Smallest gap (relative to max|w|) of a pressure deflection that had to be lifted off
+#: the obstacle (:meth:`InteriorPointNewton.pressure_mode`); the margin of
+#: :meth:`InteriorPointNewton.make_interior`.
+PUSH_MARGIN = 1e-2
+
 _SAME = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
 _SUBSET = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
 
@@ -371,7 +376,9 @@ class InteriorPointNewton(Owner):
 
         :math:`A u = -E\,\omega` (one factorisation of A): for positive weights a
         deflection strictly inside the cone on simply supported and clamped plates, with
-        rotations consistent with it.
+        rotations consistent with it. Where it is not (obstacles on both sides of a
+        plate with a free edge: the two pushes twist it across an obstacle), the nodes
+        closer to the obstacle than ``margin`` max|w| are moved back by :meth:`lift`.
 
         Args:
             weights: (i,) nonnegative weights of the constrained nodes (default all 1).
@@ -384,6 +391,8 @@ class InteriorPointNewton(Owner):
         u = self.problem.new_mode("start")
         self.ksp.solve(self._rhs, u.x.petsc_vec)
         u.x.scatter_forward()
+        if not self._min(-self.oriented(u.x.petsc_vec)) > 0.0:
+            self.lift(u, PUSH_MARGIN)
         return u
 
     def relax(self, vec: PETSc.Vec, free: str = "rotations") -> None:
@@ -488,7 +497,7 @@ class InteriorPointNewton(Owner):
     def make_interior(
         self,
         u: dolfinx.fem.Function,
-        margin: float = 1e-2,
+        margin: float = PUSH_MARGIN,
         push: dolfinx.fem.Function | None = None,
     ) -> dolfinx.fem.Function:
         """Add the pressure deflection to ``u`` so that it lies strictly inside the cone.
