@@ -3,7 +3,8 @@ r"""Plates meshed by gmsh: outlines, holes, named boundary parts, files; MPI dis
 Expected values: the structured rectangle's (the same plate meshed by gmsh's quad
 algorithm), the Navier load, and for the square plate with a central circular hole an
 independent computation with another mesh family and element (``tests/rm_triangles.py``:
-cubic triangles, plain shear, scipy's Lanczos).
+cubic triangles, plain shear, scipy's Lanczos); for the interior point nested over gmsh
+meshes of sizes 2h and h, the same route on h alone.
 """
 
 from __future__ import annotations
@@ -21,6 +22,7 @@ gmsh = pytest.importorskip("gmsh")
 
 from rm_triangles import holed_plate_load, navier_check  # noqa: E402
 
+from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_unilateral  # noqa: E402
 from unibuckle_fenicsx.analysis import solve  # noqa: E402
 from unibuckle_fenicsx.cases import paper_case  # noqa: E402
 from unibuckle_fenicsx.cli import main as cli_main  # noqa: E402
@@ -540,3 +542,35 @@ def test_holed_plate_with_an_obstacle_is_certified():
         xy = analysis.problem.contact.coordinates
     assert result.certificate["kkt"] and result.ratio_to_free >= 1 - 1e-8
     assert np.hypot(xy[:, 0], xy[:, 1]).min() >= 0.15 * np.cos(np.pi / 16) - 1e-9
+
+
+def test_thin_holed_plate_is_nested_over_gmsh_meshes():
+    """A thin holed plate: the interior point nested over gmsh meshes at 2h and h.
+
+    Against a whole face (the shorter side keeps 6 cells at 2h), with the load of the
+    route on h alone. The meshes are not nested (the carry interpolates between any
+    two); the reference is the same route from starts on the fine mesh itself (no
+    coarser mesh allowed).
+    """
+    data = {
+        "plate": {
+            "corners": [[0.0, 0.0], [0.3, 0.1]],
+            "thickness": 1e-4,
+            "holes": [{"center": [0.15, 0.05], "radius": 0.02}],
+        },
+        "edges": {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}},
+        "mesh": {"size": 0.1 / 16},
+        "obstacle": {"zone": "all", "side": "below"},
+    }
+    loads, meshes = [], []
+    for options in (ChainOptions(), ChainOptions(coarse_min_cells=10**6)):
+        with BucklingProblem(problem_from_dict(data)) as problem:
+            sol = solve_unilateral(problem, options)
+            assert sol.method == "interior-point" and sol.candidate.kkt
+            loads.append(sol.load)
+            meshes.append([level["mesh"] for level in sol.details["levels"]])
+            seeds = [link["seed"] for level in sol.details["levels"] for link in level["links"]]
+    # On one mesh nothing is made for a finer one (central-path points to carry).
+    assert not any("kept flat" in s or "lifted" in s or "after polish" in s for s in seeds)
+    assert meshes == [[["h=0.0125"], ["h=0.00625"]], [["h=0.00625"]]]
+    assert loads[0] == pytest.approx(loads[1], rel=1e-9)
