@@ -21,8 +21,11 @@ JIT cache included).
 With ``--bracket`` the certificate also runs the low-rank verified bracket
 (``solver.bracket``; off by default: it costs tens of free solves on these plates).
 
+With ``--side below`` the face lies below the plate (w >= 0): the mirror image, the same
+loads (w -> -w), by the same route.
+
 Usage: python bench/bench_plates.py [--meshes 90x30,180x60] [--cases ssss,cs,sc,cccc,shear]
-[--cli] [--bracket] [--json FILE]
+[--side above|below] [--cli] [--bracket] [--json FILE]
 """
 
 from __future__ import annotations
@@ -57,7 +60,7 @@ CASES = {
 LENGTH, WIDTH, THICKNESS = 0.3, 0.1, 1e-4
 
 
-def _spec(name: str, nx: int, ny: int):
+def _spec(name: str, nx: int, ny: int, side: str = "above"):
     supports, load, _ = CASES[name]
     return plate_case(
         name,
@@ -68,7 +71,7 @@ def _spec(name: str, nx: int, ny: int):
         load=load,
         nx=nx,
         ny=ny,
-        zone=ObstacleSpec(zone="all"),
+        zone=ObstacleSpec(zone="all", side=side),
     )
 
 
@@ -110,11 +113,17 @@ def main() -> None:
     parser.add_argument(
         "--bracket", action="store_true", help="also run the low-rank bracket (solver.bracket)"
     )
+    parser.add_argument(
+        "--side", choices=("above", "below"), default="above", help="where the face lies"
+    )
     args, _ = parser.parse_known_args()
     comm = MPI.COMM_WORLD
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
     if comm.rank == 0:
-        print(f"MPI ranks: {comm.size}; plate {LENGTH} x {WIDTH} m, t = {THICKNESS} m, zone all")
+        print(
+            f"MPI ranks: {comm.size}; plate {LENGTH} x {WIDTH} m, t = {THICKNESS} m, "
+            f"zone all, face {args.side}"
+        )
         print(
             "| case | mesh | i | \\|Z\\| | levels: steps / factorisations / eigen solves "
             "| route | free solve (s) | ratio | CLI ratio | KKT | smallest | certificate | m "
@@ -123,7 +132,7 @@ def main() -> None:
         print("|" + "---|" * 18, flush=True)
     for nx, ny in meshes:
         for name in args.cases.split(","):
-            spec = _spec(name, nx, ny)
+            spec = _spec(name, nx, ny, args.side)
             if args.bracket:
                 spec = spec.with_solver(bracket=True)
             with solve(spec, comm) as analysis:
@@ -140,6 +149,7 @@ def main() -> None:
                 )
                 row = {
                     "case": name,
+                    "side": args.side,
                     "bracket": args.bracket,
                     "edges": CASES[name][2],
                     "mesh": f"{nx}x{ny}",
