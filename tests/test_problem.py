@@ -1,8 +1,4 @@
-"""BucklingProblem: user meshes, the swapped pencil, the empty contact set.
-
-A user-supplied mesh, the swapped pencil for an indefinite B, and the empty contact set
-(the free pencil, solved once).
-"""
+"""BucklingProblem on a user-supplied mesh, and the swapped pencil for an indefinite B."""
 
 from __future__ import annotations
 
@@ -134,24 +130,3 @@ def test_command_line_option_wins_and_defaults_do_not_leak():
     assert not opts.hasName("unibuckle_test_ldl_mat_mumps_icntl_13")
     ldl.destroy()
     mat.destroy()
-
-
-def test_empty_contact_set_reuses_the_free_solve():
-    """Z = {} removes no node: its pencil is the free one, solved once.
-
-    Before the free solve evaluate({}) runs an eigen solve; after it, none, with the free
-    load, and the same mode (max |w| = 1, the candidate's orientation).
-    """
-    with BucklingProblem(paper_case("c1", 12, 6)) as problem:
-        solved = problem.evaluate(np.array([], dtype=np.int64))
-        free = problem.solve_free()
-        count = problem.eigensolver.solves
-        reused = problem.evaluate(np.array([], dtype=np.int64))
-        assert problem.eigensolver.solves == count
-        assert reused.load == free.load
-        assert solved.load == pytest.approx(free.load, rel=1e-8)  # the eigen tolerance
-        a, b = solved.mode.x.petsc_vec, reused.mode.x.petsc_vec
-        diff = a.copy()
-        diff.axpy(-1.0, b)
-        assert diff.norm() <= 1e-6 * a.norm()
-        diff.destroy()

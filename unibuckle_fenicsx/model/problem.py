@@ -422,11 +422,6 @@ class BucklingProblem(Owner):
             raise ValueError("evaluate: the problem has no obstacle (this needs an obstacle zone)")
         active = np.unique(np.asarray(active, dtype=np.int64))
         u = self.new_mode()
-        if active.size == 0 and self.free is not None:
-            # No node removed: the free pencil, solved already (same matrices, tolerance).
-            self.free.function.x.petsc_vec.copy(u.x.petsc_vec)
-            u.x.scatter_forward()
-            return self.candidate(u, self.free.load, active, eigen=self.free.eigen)
         pair = self.eigensolver.solve(
             self.contact.removed_rows(active), out=u.x.petsc_vec, initial=initial
         )
