@@ -42,8 +42,6 @@ import time
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from mpi4py import MPI
-
 import numpy as np
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, RunStatus, UnilateralSolution
@@ -256,25 +254,23 @@ def _run(
     return new, rec
 
 
-def _canonical_sign(newton: InteriorPointNewton, vec: Any) -> float:
+def _canonical_sign(problem: BucklingProblem, vec: Any) -> float:
     """+1 or -1: the sign that gives ``vec`` a negative oriented value at its largest node.
 
     The largest |oriented value| (to 1e-6 of it; ties to the lowest node number) decides,
     so that the eigen solver's arbitrary sign of the free mode does not, and a plate with
     the obstacle below starts as the mirror image of the one above (measured: under
     shear at 90x30 the face below took 92 fine Newton steps instead of 48, the free-mode
-    starts being taken in the other order; now the same steps on every mesh).
+    starts being taken in the other order; now the same steps on every mesh). Unlike
+    :func:`~unibuckle_fenicsx.model.contact.orientation`, which compares the largest
+    violations on either side, a near tie (an antisymmetric mode) is not decided by
+    rounding, which differs with the number of ranks. Collective.
     """
-    z = newton.oriented(vec)
-    positions = newton.contact.owned_positions
-    top = newton._max(np.abs(z))
-    near = np.abs(z) >= top * (1.0 - 1e-6)
-    first = int(positions[near].min()) if near.any() else np.iinfo(np.int64).max
-    first = int(newton.comm.allreduce(first, op=MPI.MIN))
-    mine = np.flatnonzero(positions == first)
-    value = float(z[mine[0]]) if mine.size else 0.0
-    value = float(newton.comm.allreduce(value, op=MPI.SUM))
-    return 1.0 if value < 0.0 else -1.0
+    assert problem.contact is not None
+    z = problem.contact.values(vec)  # the same on every rank
+    size = np.abs(z)
+    first = int(np.flatnonzero(size >= size.max() * (1.0 - 1e-6))[0])
+    return 1.0 if z[first] < 0.0 else -1.0
 
 
 def _start(newton: InteriorPointNewton, seed: str, push: Any) -> Any:
@@ -283,7 +279,7 @@ def _start(newton: InteriorPointNewton, seed: str, push: Any) -> Any:
     assert problem.contact is not None
     if seed in ("free-", "free+"):
         free = problem.solve_free().function.x.petsc_vec
-        sign = _canonical_sign(newton, free)
+        sign = _canonical_sign(problem, free)
         u = newton.negative_part(free, sign if seed == "free-" else -sign)
         return newton.make_interior(u, push=push)
     if seed == "pressure":
