@@ -166,7 +166,8 @@ class LevelRecord:
     """What the chain did on one mesh.
 
     Attributes:
-        mesh: [nx, ny] (structured) or ["fine"].
+        mesh: [nx, ny] (structured), ["h=<cell size>"] (meshed by gmsh) or ["fine"] (a
+            user's mesh or a mesh file).
         constrained_nodes: i on this mesh.
         links: The runs on it.
         seconds: Wall time on it (set-up included).
