@@ -13,6 +13,8 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
   certified KKT point that is the smallest eigenvalue of its reduced pencil, and the mode
   vanishes on the contact set; two ranks give the serial answer; the obstacle below gives
   the load of the obstacle above (the mirror image w -> -w).
+- Starts that meet on one central path on the coarsest mesh stop there, with the answer
+  of every start taken to the end.
 - An option under the prefix ``unibuckle_ipm_`` reaches the factorisation.
 """
 
@@ -33,6 +35,7 @@ from conftest import run_mpi
 from exhaustive import dense
 from test_stress_family import FAMILY, _check
 
+from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_unilateral
 from unibuckle_fenicsx.algorithms.interior_point import (
     IPM_PREFIX,
     PUSH_MARGIN,
@@ -369,3 +372,25 @@ def test_stall_watch_counts_steps_without_halving():
     # Halving (0.5, then 0.2) resets the count.
     assert not any(watch.stalled(r) for r in (1.0, 0.8, 0.5, 0.45, 0.2, 0.15, 0.19))
     assert not any(_StallWatch(0).stalled(1.0) for _ in range(50))
+
+
+@serial
+def test_starts_on_one_central_path_are_not_taken_further():
+    """A start on the central path of an arrangement met before stops there.
+
+    Thin SSSS plate, 45x15 (coarsest mesh 22x7): several starts reach one arrangement;
+    the lowest critical state is the one found when every start is taken to the end
+    (``twin_rtol = 0``: only bit-identical loads compare equal), in fewer Newton steps
+    on the coarsest mesh.
+    """
+    problem = BucklingProblem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
+    short = solve_unilateral(problem, ChainOptions())
+    full = solve_unilateral(problem, ChainOptions(twin_rtol=0.0))
+    coarse = [sol.details["levels"][0] for sol in (short, full)]
+    assert "met before" in [link["status"] for link in coarse[0]["links"]]
+    assert "met before" not in [link["status"] for link in coarse[1]["links"]]
+    assert coarse[0]["newton_steps"] < coarse[1]["newton_steps"]
+    assert short.method == full.method == "interior-point"
+    assert short.load == pytest.approx(full.load, rel=1e-12)
+    assert short.candidate.kkt
+    problem.destroy()

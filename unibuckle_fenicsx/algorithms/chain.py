@@ -39,6 +39,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
@@ -84,7 +85,8 @@ class ChainOptions:
         seeds: Starts of the interior-point method on the coarsest mesh.
         compare_mu: Barrier parameter at which the starts are compared.
         explore_mu_min: Barrier parameter at which the starts' contact sets are read.
-        twin_rtol: Starts whose barrier solutions' loads at ``compare_mu`` agree to this
+        twin_rtol: Starts whose barrier solutions' loads at ``compare_mu``, or at a
+            barrier parameter passed on the way to ``explore_mu_min``, agree to this
             (relative) lead to the same arrangement.
         level_mu: Barrier parameter of the central-path point carried from one mesh to
             the next.
@@ -241,6 +243,7 @@ def _run(
     mu: float,
     mu_min: float,
     keep_push: bool = True,
+    met_before: Callable[[float, float], bool] | None = None,
 ) -> tuple[BarrierPoint, NewtonRecord]:
     """Continue the method from ``point`` (updated in place) and record the run."""
     new, rec = newton.solve(
@@ -250,6 +253,7 @@ def _run(
         mu=mu,
         mu_min=mu_min,
         max_steps=options.max_steps,
+        met_before=met_before,
     )
     level.links.append(_newton_link(label, rec))
     return new, rec
@@ -459,11 +463,24 @@ def _explore(
     is the only mesh) no barrier point is made for a finer mesh: measured on a plate
     meshed by gmsh (i = 3430), those runs took 230 of the 560 Newton steps.
 
-    A start whose barrier solution at ``compare_mu`` has the load of one met before
-    (relative ``twin_rtol``) leads to the same arrangement and is not taken further.
+    A start whose barrier solution at ``compare_mu``, or at a barrier parameter passed
+    on the way down to ``explore_mu_min`` (every start passes the same ones), has the
+    load of one met before (relative ``twin_rtol``) is on the central path of the same
+    arrangement and is not taken further. Measured on the five plates of
+    ``bench/bench_plates.py`` at 90×30: 2–30 % fewer Newton steps on the coarsest mesh
+    (SSSS 223 → 156, unloaded edges clamped 376 → 324), the same loads and fine steps.
     """
     found: list[tuple[Candidate, BarrierPoint]] = []
-    seen: list[float] = []
+    met: dict[float, list[float]] = {}  # barrier loads met, by barrier parameter
+
+    def met_before(mu: float, load: float) -> bool:
+        """Whether a start met ``load`` at ``mu`` before (else it is remembered)."""
+        loads = met.setdefault(mu, [])
+        if any(abs(load - other) <= options.twin_rtol * other for other in loads):
+            return True
+        loads.append(load)
+        return False
+
     # Damped steps (a stiffness-scaled correction that decays from step to step) keep
     # each start near its own arrangement: measured, with the finer meshes' settings a
     # start jumped past the lowest (CCCC at 90x30 ended 1.8e-4 higher).
@@ -481,16 +498,19 @@ def _explore(
             level.links.append(_newton_link(seed, rec))
             if rec.status is not NewtonStatus.CONVERGED:
                 continue
-            if any(abs(point.load - load) <= options.twin_rtol * load for load in seen):
+            if met_before(options.compare_mu, point.load):
                 level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
                 continue
-            seen.append(point.load)
             point, rec = _run(
-                newton, point, level, seed, options, mu=point.mu, mu_min=options.explore_mu_min
-            )
-            if rec.status is not NewtonStatus.CONVERGED:
+                newton, point, level, seed, options,
+                mu=point.mu, mu_min=options.explore_mu_min,
+                met_before=lambda mu, load, start=point.mu: mu < start and met_before(mu, load),
+            )  # fmt: skip
+            if rec.status is not NewtonStatus.CONVERGED or met_before(point.mu, point.load):
                 continue
             cand, point = _critical_state(problem, newton, point, level, seed, options, carry)
+            if point.mu == options.explore_mu_min:
+                met_before(point.mu, point.load)  # where an escape ended
             if cand is not None:
                 found.append((cand, point))
         found.sort(key=lambda cp: cp[0].load)

@@ -75,6 +75,7 @@ import enum
 import logging
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -134,6 +135,7 @@ class NewtonStatus(enum.Enum):
     INERTIA = "inertia-correction-failed"
     STALLED = "stalled"
     BREAKDOWN = "breakdown"
+    MET_BEFORE = "met before"
 
 
 @dataclass(frozen=True)
@@ -544,6 +546,7 @@ class InteriorPointNewton(Owner):
         mu: float = 1e-2,
         mu_min: float = 1e-12,
         max_steps: int = 100,
+        met_before: Callable[[float, float], bool] | None = None,
     ) -> tuple[BarrierPoint, NewtonRecord]:
         r"""Run the method from ``mode`` (strictly inside the cone; updated in place).
 
@@ -555,6 +558,9 @@ class InteriorPointNewton(Owner):
             mu: Start scaled barrier parameter.
             mu_min: The run converges when the barrier problem at ``mu_min`` is solved.
             max_steps: Newton steps allowed.
+            met_before: Called as ``met_before(mu, load)`` each time the barrier problem
+                at ``mu`` is solved, before ``mu`` is lowered; True ends the run (status
+                ``MET_BEFORE``: the caller has been on this central path before).
 
         Returns:
             The final iterate and the record of the run.
@@ -608,14 +614,11 @@ class InteriorPointNewton(Owner):
             if keep and rel_u <= opts.keep_mu_until:
                 keep = False
             if not keep:
-                while (
-                    mu > mu_min
-                    and max(e_u, e_c) <= max(opts.kappa_eps * mu, floor)
-                    and (e_c <= opts.kappa_eps * mu)
-                ):
-                    mu = max(mu_min, min(opts.kappa_mu * mu, mu**opts.theta_mu))
-                    mu_abs = mu * scale
-                    e_c = max(self._max(np.abs(nu * gap - mu_abs)) / scale, 0.0)
+                mu, e_c, met = self._lower(mu, mu_min, e_u, e_c, floor, nu * gap, scale)
+                mu_abs = mu * scale
+                if met is not None and met_before is not None and met_before(met, lam):
+                    record.status = NewtonStatus.MET_BEFORE
+                    break
                 if (
                     mu <= mu_min
                     and e_u <= max(opts.kappa_eps * mu, floor)
@@ -656,6 +659,34 @@ class InteriorPointNewton(Owner):
         mode.x.scatter_forward()
         assert nu is not None
         return BarrierPoint(mode, lam, nu, mu), record
+
+    def _lower(
+        self,
+        mu: float,
+        mu_min: float,
+        e_u: float,
+        e_c: float,
+        floor: float,
+        products: npt.NDArray[np.float64],
+        scale: float,
+    ) -> tuple[float, float, float | None]:
+        r"""The barrier parameter lowered while its barrier problem counts as solved.
+
+        ``products``: :math:`\nu_k g_k`; ``scale``: that of the complementarity. Returns
+        the new parameter, the scaled complementarity residual there, and the parameter
+        whose barrier problem was found solved (None if ``mu`` stays).
+        """
+        opts = self.options
+        solved = None
+        while (
+            mu > mu_min
+            and max(e_u, e_c) <= max(opts.kappa_eps * mu, floor)
+            and (e_c <= opts.kappa_eps * mu)
+        ):
+            solved = mu if solved is None else solved
+            mu = max(mu_min, min(opts.kappa_mu * mu, mu**opts.theta_mu))
+            e_c = max(self._max(np.abs(products - mu * scale)) / scale, 0.0)
+        return mu, e_c, solved
 
     def direction(
         self,
