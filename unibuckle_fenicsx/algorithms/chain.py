@@ -504,7 +504,7 @@ def _explore(
             point, rec = _run(
                 newton, point, level, seed, options,
                 mu=point.mu, mu_min=options.explore_mu_min,
-                met_before=lambda mu, load, start=point.mu: mu < start and met_before(mu, load),
+                met_before=met_before,
             )  # fmt: skip
             if rec.status is not NewtonStatus.CONVERGED or met_before(point.mu, point.load):
                 continue

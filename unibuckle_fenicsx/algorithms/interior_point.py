@@ -559,8 +559,9 @@ class InteriorPointNewton(Owner):
             mu_min: The run converges when the barrier problem at ``mu_min`` is solved.
             max_steps: Newton steps allowed.
             met_before: Called as ``met_before(mu, load)`` each time the barrier problem
-                at ``mu`` is solved, before ``mu`` is lowered; True ends the run (status
-                ``MET_BEFORE``: the caller has been on this central path before).
+                at a parameter ``mu`` below the start one is solved, before ``mu`` is
+                lowered; True ends the run (status ``MET_BEFORE``: the caller has been on
+                this central path before).
 
         Returns:
             The final iterate and the record of the run.
@@ -614,9 +615,9 @@ class InteriorPointNewton(Owner):
             if keep and rel_u <= opts.keep_mu_until:
                 keep = False
             if not keep:
-                mu, e_c, met = self._lower(mu, mu_min, e_u, e_c, floor, nu * gap, scale)
+                mu, e_c, solved = self._lower(mu, mu_min, e_u, e_c, floor, nu * gap, scale)
                 mu_abs = mu * scale
-                if met is not None and met_before is not None and met_before(met, lam):
+                if solved < mu_start and met_before is not None and met_before(solved, lam):
                     record.status = NewtonStatus.MET_BEFORE
                     break
                 if (
@@ -669,24 +670,23 @@ class InteriorPointNewton(Owner):
         floor: float,
         products: npt.NDArray[np.float64],
         scale: float,
-    ) -> tuple[float, float, float | None]:
+    ) -> tuple[float, float, float]:
         r"""The barrier parameter lowered while its barrier problem counts as solved.
 
         ``products``: :math:`\nu_k g_k`; ``scale``: that of the complementarity. Returns
         the new parameter, the scaled complementarity residual there, and the parameter
-        whose barrier problem was found solved (None if ``mu`` stays).
+        whose barrier problem was found solved (inf if ``mu`` stays).
         """
         opts = self.options
-        solved = None
+        start = mu
         while (
             mu > mu_min
             and max(e_u, e_c) <= max(opts.kappa_eps * mu, floor)
             and (e_c <= opts.kappa_eps * mu)
         ):
-            solved = mu if solved is None else solved
             mu = max(mu_min, min(opts.kappa_mu * mu, mu**opts.theta_mu))
             e_c = max(self._max(np.abs(products - mu * scale)) / scale, 0.0)
-        return mu, e_c, solved
+        return mu, e_c, (start if mu < start else math.inf)
 
     def direction(
         self,
