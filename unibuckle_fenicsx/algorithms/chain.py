@@ -506,7 +506,10 @@ def _explore(
                 mu=point.mu, mu_min=options.explore_mu_min,
                 met_before=met_before,
             )  # fmt: skip
-            if rec.status is not NewtonStatus.CONVERGED or met_before(point.mu, point.load):
+            if rec.status is not NewtonStatus.CONVERGED:
+                continue
+            if met_before(point.mu, point.load):
+                level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
                 continue
             cand, point = _critical_state(problem, newton, point, level, seed, options, carry)
             if point.mu == options.explore_mu_min:
