@@ -7,7 +7,8 @@ For a rigid obstacle (any side, several zones) the chain is
    side keeps ``coarse_min_cells`` cells; a user's mesh has one level) the method runs
    from a few starts (the free mode's parts on either side of the obstacle, the
    deflection under a pressure on the whole zone and on either end): the buckle may sit
-   almost anywhere at nearly the same load, and each start finds one arrangement. The
+   almost anywhere at nearly the same load, and each start finds one arrangement (a
+   start that joins the central path of one met before stops there). The
    lowest critical state is carried to the next finer mesh by interpolating its mode,
    load and obstacle push; there a few Newton steps restore the barrier problem, and so
    on to the fine mesh.
