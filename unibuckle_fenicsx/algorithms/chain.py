@@ -9,9 +9,10 @@ For a rigid obstacle (any side, several zones) the chain is
    deflection under a pressure on the whole zone and on either end): the buckle may sit
    almost anywhere at nearly the same load, and each start finds one arrangement (a
    start that joins the central path of one met before stops there). The
-   lowest critical state is carried to the next finer mesh by interpolating its mode,
-   load and obstacle push; there a few Newton steps restore the barrier problem, and so
-   on to the fine mesh.
+   lowest critical state is carried to the next finer mesh by interpolating its mode (a
+   point of the central path: the push there is μ/g node by node and the load the mode's
+   quotient, so neither needs carrying); there a few Newton steps restore the barrier
+   problem, and so on to the fine mesh.
 2. **Contact set and exact eigenpair.** The fine barrier solution gives the contact set
    Z (the nodes whose gap is at the tolerance ``tau``); the smallest eigenpair of the
    pencil with Z removed (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`)
