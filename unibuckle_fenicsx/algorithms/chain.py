@@ -485,7 +485,7 @@ def _explore(
     def met_before(mu: float, load: float) -> bool:
         """Whether a start met ``load`` at ``mu`` before (else it is remembered)."""
         loads = met.setdefault(mu, [])
-        if any(abs(load - other) <= options.twin_rtol * other for other in loads):
+        if any(math.isclose(load, other, rel_tol=options.twin_rtol) for other in loads):
             return True
         loads.append(load)
         return False
@@ -529,7 +529,7 @@ def _explore(
         carried: list[_Arrangement] = []
         for cand, point in found if carry else []:
             far = cand.load > found[0][0].load * (1.0 + options.refine_margin)
-            twin = any(abs(cand.load - a.load) <= options.twin_rtol * a.load for a in carried)
+            twin = any(math.isclose(cand.load, a.load, rel_tol=options.twin_rtol) for a in carried)
             if far or twin or len(carried) == options.arrangements:
                 continue
             tag = f"{cand.load:.10g}"
