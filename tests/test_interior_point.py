@@ -15,6 +15,10 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
   the load of the obstacle above (the mirror image w -> -w).
 - Starts that meet on one central path on the coarsest mesh stop there, with the answer
   of every start taken to the end.
+- The predicted contact set is the set of nodes that the dense affine-scaling Newton
+  step (the direction for a zero barrier parameter) closes by more than half their gap;
+  read inside a run it leaves the run unchanged; the fine mesh read early gives the
+  load of the mesh read at the end, in fewer Newton steps.
 - An option under the prefix ``unibuckle_ipm_`` reaches the factorisation.
 """
 
@@ -39,7 +43,9 @@ from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_unilateral
 from unibuckle_fenicsx.algorithms.interior_point import (
     IPM_PREFIX,
     PUSH_MARGIN,
+    BarrierPoint,
     InteriorPointNewton,
+    NewtonStatus,
     _StallWatch,
 )
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
@@ -72,6 +78,23 @@ def _thin(name: str = "ssss", nx: int = 6, ny: int = 3, **kw) -> object:
         zone=ObstacleSpec(zone="all"),
         **kw,
     )
+
+
+def _dense_newton_step(A, B, E, x, lam, nu, mu_abs):
+    """Newton's step on (u, nu, lambda) from the full dense Jacobian (reference)."""
+    n, m = x.size, nu.size
+    gap = -E.T @ x
+    F = np.concatenate(
+        [A @ x - lam * (B @ x) + E @ nu, nu * gap - mu_abs, [0.5 * (x @ B @ x - 1.0)]]
+    )
+    J = np.zeros((n + m + 1, n + m + 1))
+    J[:n, :n] = A - lam * B
+    J[:n, n : n + m] = E
+    J[:n, -1] = -(B @ x)
+    J[n : n + m, :n] = -nu[:, None] * E.T
+    J[n : n + m, n : n + m] = np.diag(gap)
+    J[-1, :n] = B @ x
+    return np.linalg.solve(J, -F)
 
 
 @serial
@@ -111,24 +134,12 @@ def test_newton_direction_solves_the_linearised_conditions(side):
         dlam, dz, dnu = step
         du = newton._du.array.copy()
     problem.destroy()
-    # Dense Newton on (u, lambda, nu).
-    m = rows.size
-    F = np.concatenate(
-        [A @ x - lam * (B @ x) + E @ nu, nu * gap - mu_abs, [0.5 * (x @ B @ x - 1.0)]]
-    )
-    J = np.zeros((n + m + 1, n + m + 1))
-    J[:n, :n] = A - lam * B
-    J[:n, n : n + m] = E
-    J[:n, -1] = -(B @ x)
-    J[n : n + m, :n] = -nu[:, None] * E.T
-    J[n : n + m, n : n + m] = np.diag(gap)
-    J[-1, :n] = B @ x
-    delta = np.linalg.solve(J, -F)
+    delta = _dense_newton_step(A, B, E, x, lam, nu, mu_abs)
     scale = np.abs(delta[:n]).max()
     assert np.abs(du - delta[:n]).max() <= 1e-8 * scale
     assert np.allclose(dz, E.T @ delta[:n], rtol=0, atol=1e-8 * scale)
     assert abs(dlam - delta[-1]) <= 1e-8 * max(abs(delta[-1]), lam)
-    assert np.allclose(dnu, delta[n : n + m], rtol=1e-6, atol=1e-8 * np.abs(delta[n:-1]).max())
+    assert np.allclose(dnu, delta[n:-1], rtol=1e-6, atol=1e-8 * np.abs(delta[n:-1]).max())
 
 
 @serial
@@ -393,4 +404,95 @@ def test_starts_on_one_central_path_are_not_taken_further():
     assert short.method == full.method == "interior-point"
     assert short.load == pytest.approx(full.load, rel=1e-12)
     assert short.candidate.kkt
+    problem.destroy()
+
+
+@serial
+def test_predicted_contact_set_is_the_affine_step_indicator():
+    r"""Z = {k : \delta z_k > g_k/2} for the dense Newton step at :math:`\mu = 0`.
+
+    The affine-scaling step moves a gap g to :math:`g - \delta z` and a push
+    :math:`\nu` to :math:`\nu\,\delta z/g`; the gap falls by a larger fraction than
+    the push exactly when :math:`\delta z > g/2` (the Tapia indicator: El-Bakry, Tapia &
+    Zhang, SIAM Rev. 36, 1994). Reference: a dense solve of the full Jacobian, as in
+    :func:`test_newton_direction_solves_the_linearised_conditions`, with pushes that
+    make some gaps close and others open.
+    """
+    problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    with InteriorPointNewton(problem) as newton:
+        u = newton.pressure_mode()
+        newton._normalize(u.x.petsc_vec)
+        x = u.x.petsc_vec.array.copy()
+        A, B = dense(problem.model.A), dense(problem.model.B)
+        n, rows = x.size, newton._dofs
+        E = np.zeros((n, rows.size))
+        E[rows, np.arange(rows.size)] = newton._signs
+        gap = -E.T @ x
+        rng = np.random.default_rng(3)
+        nu = rng.uniform(0.01, 3.0, rows.size) * np.abs(A @ x).max() * 1e-2
+        lam = 0.5 * problem.solve_free().load  # K positive definite: no regularisation
+        active = newton.predicted_contact_set(BarrierPoint(u, lam, nu, 1e-9))
+        positions = newton.contact.owned_positions
+    problem.destroy()
+    dz = E.T @ _dense_newton_step(A, B, E, x, lam, nu, 0.0)[:n]
+    ratio = dz / gap
+    assert (np.abs(ratio - 0.5) > 1e-6).all()  # no node on the fence
+    expected = np.sort(positions[(ratio > 0.5) | (gap - dz <= problem.tau * np.abs(x).max())])
+    assert 0 < expected.size < rows.size  # both kinds present
+    assert np.array_equal(active, expected)
+
+
+@serial
+def test_predicted_contact_set_read_inside_a_run_leaves_it_unchanged():
+    """Read from the ``on_solved`` hook, the set costs no factorisation and no change.
+
+    Thin SSSS plate, 22x7, from the pressure deflection: the run with the hook takes the
+    same steps, factorisations and loads (bit for bit) as the run without it, and the
+    set read inside equals the one computed afresh from a copy of the same point.
+    """
+    problem = BucklingProblem(_thin(nx=22, ny=7), MPI.COMM_SELF)
+    runs, inside, copies = [], [], []
+
+    def hook(point):
+        inside.append(newton.predicted_contact_set(point))
+        mode = problem.new_mode("copy")
+        point.mode.x.petsc_vec.copy(mode.x.petsc_vec)
+        copies.append(BarrierPoint(mode, point.load, point.push.copy(), point.mu))
+        return None
+
+    with InteriorPointNewton(problem) as newton:
+        for on_solved in (None, hook):
+            newton.forget_corrections()
+            _, record = newton.solve(newton.pressure_mode(), mu=1e-2, mu_min=1e-12,
+                                     on_solved=on_solved)  # fmt: skip
+            runs.append(record)
+        fresh = [newton.predicted_contact_set(point) for point in copies]
+    problem.destroy()
+    plain, hooked = runs
+    assert plain.status is hooked.status is NewtonStatus.CONVERGED
+    assert (plain.steps, plain.factorizations) == (hooked.steps, hooked.factorizations)
+    assert plain.history == hooked.history
+    assert len(inside) >= 2
+    assert all(np.array_equal(a, b) for a, b in zip(inside, fresh, strict=True))
+
+
+@serial
+def test_fine_mesh_read_early_gives_the_load_read_at_the_end():
+    """The fine mesh's contact set read at 1e-9: the same critical state, fewer steps.
+
+    Thin SSSS plate, 45x15, whole-plate obstacle: with ``read_mu = 0`` the contact set is
+    read off the gaps at the end (``fine_mu_min``); by default the predicted set read
+    where the barrier problem at 1e-9 is solved is a KKT point, and the run stops there.
+    """
+    problem = BucklingProblem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
+    early = solve_unilateral(problem, ChainOptions())
+    late = solve_unilateral(problem, ChainOptions(read_mu=0.0))
+    fine = [sol.details["levels"][-1] for sol in (early, late)]
+    assert "read" in [link["status"] for link in fine[0]["links"]]
+    assert "read" not in [link["status"] for link in fine[1]["links"]]
+    assert fine[0]["newton_steps"] < fine[1]["newton_steps"]
+    assert early.method == late.method == "interior-point"
+    assert early.candidate.kkt and late.candidate.kkt
+    assert np.array_equal(early.candidate.active, late.candidate.active)
+    assert early.load == pytest.approx(late.load, rel=1e-12)
     problem.destroy()

@@ -450,6 +450,8 @@ def _plates_commands(rows: list[dict[str, Any]]) -> str:
         group = [r for r in rows if str(r["mesh"]) == mesh]
         flags = " --cli" if any(r.get("cli_ratio") is not None for r in group) else ""
         flags += " --bracket" if any(r.get("bracket") for r in group) else ""
+        repeat = max(len(r.get("ratios", [0])) for r in group)
+        flags += f" --repeat {repeat}" if repeat > 1 else ""
         commands.append(
             f"python bench/bench_plates.py --meshes {mesh} --cases {_listed(group, 'case')}"
             f"{flags} --json bench/results/plates.jsonl"

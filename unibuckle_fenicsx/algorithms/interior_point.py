@@ -136,6 +136,7 @@ class NewtonStatus(enum.Enum):
     STALLED = "stalled"
     BREAKDOWN = "breakdown"
     MET_BEFORE = "met before"
+    READ = "read"
 
 
 @dataclass(frozen=True)
@@ -192,6 +193,10 @@ class NewtonOptions:
     plain_first: bool = True
     metric: str = "geometric"
     stall_steps: int = 10
+
+
+#: A Newton direction: :math:`(\delta\lambda, z(\delta u), \delta\nu)`.
+_Direction = tuple[float, npt.NDArray[np.float64], npt.NDArray[np.float64]]
 
 
 @dataclass
@@ -312,6 +317,10 @@ class InteriorPointNewton(Owner):
             self._abs_B.mult(self._trial, self._reg)
         self._delta_last = 0.0  # the last nonzero inertia correction
         self._last_correction = 0.0  # the correction of the last step
+        # Inside a run's on_solved hook: the next step's (mu_abs, plain_first), and its
+        # direction once predicted_contact_set has computed it.
+        self._next: tuple[float, bool] | None = None
+        self._pending: tuple[_Direction | None] | None = None
 
     # -- oriented values on the zone (owned nodes, no communication) -----------------
     def oriented(self, vec: PETSc.Vec) -> npt.NDArray[np.float64]:
@@ -546,7 +555,7 @@ class InteriorPointNewton(Owner):
         mu: float = 1e-2,
         mu_min: float = 1e-12,
         max_steps: int = 100,
-        met_before: Callable[[float, float], bool] | None = None,
+        on_solved: Callable[[BarrierPoint], NewtonStatus | None] | None = None,
     ) -> tuple[BarrierPoint, NewtonRecord]:
         r"""Run the method from ``mode`` (strictly inside the cone; updated in place).
 
@@ -558,10 +567,12 @@ class InteriorPointNewton(Owner):
             mu: Start scaled barrier parameter.
             mu_min: The run converges when the barrier problem at ``mu_min`` is solved.
             max_steps: Newton steps allowed.
-            met_before: Called as ``met_before(mu, load)`` each time the barrier problem
-                at a parameter ``mu`` below the start one is solved, before ``mu`` is
-                lowered; True ends the run (status ``MET_BEFORE``: the caller has been on
-                this central path before).
+            on_solved: Called with the iterate (its ``mu`` the parameter solved for)
+                each time the barrier problem at a parameter below the start one is
+                solved, before the parameter is lowered; a status it returns ends the
+                run with that status (``MET_BEFORE``: the caller has been on this
+                central path before; ``READ``: the caller has read the critical state
+                off the iterate).
 
         Returns:
             The final iterate and the record of the run.
@@ -617,9 +628,15 @@ class InteriorPointNewton(Owner):
             if not keep:
                 mu, e_c, solved = self._lower(mu, mu_min, e_u, e_c, floor, nu * gap, scale)
                 mu_abs = mu * scale
-                if solved < mu_start and met_before is not None and met_before(solved, lam):
-                    record.status = NewtonStatus.MET_BEFORE
-                    break
+                # (Watched first: a run that stops here does not compute a next step.)
+                stalled = mu_min < mu_start and watch.stalled(e_u)
+                if solved < mu_start and on_solved is not None and not stalled:
+                    assert nu is not None
+                    point = BarrierPoint(mode, lam, nu, solved)
+                    stop = self._call_hook(on_solved, point, mu_abs, plain_first)
+                    if stop is not None:
+                        record.status = stop
+                        break
                 if (
                     mu <= mu_min
                     and e_u <= max(opts.kappa_eps * mu, floor)
@@ -627,14 +644,17 @@ class InteriorPointNewton(Owner):
                 ):
                     record.status = NewtonStatus.CONVERGED
                     break
-                if mu_min < mu_start and watch.stalled(e_u):
+                if stalled:
                     record.status = NewtonStatus.STALLED
                     break
             if step == max_steps:
                 record.status = NewtonStatus.MAX_STEPS
                 break
             # -- Newton direction with inertia control ----------------------------------
-            direction = self.direction(u, lam, nu, gap, mu_abs, plain_first)
+            pending = self._take_pending()
+            direction = (
+                pending[0] if pending else self.direction(u, lam, nu, gap, mu_abs, plain_first)
+            )
             if direction is None:
                 record.status = NewtonStatus.INERTIA
                 break
@@ -653,6 +673,7 @@ class InteriorPointNewton(Owner):
             lam += alpha * dlam
             nu = np.maximum(nu + dnu, (1.0 - opts.fraction) * nu)
             record.steps += 1
+        self._pending = None
         record.factorizations = self.factorizations - f0
         record.seconds = time.perf_counter() - t0
         record.load = lam
@@ -660,6 +681,25 @@ class InteriorPointNewton(Owner):
         mode.x.scatter_forward()
         assert nu is not None
         return BarrierPoint(mode, lam, nu, mu), record
+
+    def _call_hook(
+        self,
+        hook: Callable[[BarrierPoint], NewtonStatus | None],
+        point: BarrierPoint,
+        mu_abs: float,
+        plain_first: bool,
+    ) -> NewtonStatus | None:
+        """Call a run's ``on_solved`` hook; the next step is (``mu_abs``, ``plain_first``)."""
+        self._next = (mu_abs, plain_first)
+        try:
+            return hook(point)
+        finally:
+            self._next = None
+
+    def _take_pending(self) -> tuple[_Direction | None] | None:
+        """The next direction if the hook computed it (:meth:`predicted_contact_set`)."""
+        pending, self._pending = self._pending, None
+        return pending
 
     def _lower(
         self,
@@ -696,7 +736,7 @@ class InteriorPointNewton(Owner):
         gap: npt.NDArray[np.float64],
         mu_abs: float,
         plain_first: bool = True,
-    ) -> tuple[float, npt.NDArray[np.float64], npt.NDArray[np.float64]] | None:
+    ) -> _Direction | None:
         r"""The Newton direction at (u, lambda, nu) for the absolute barrier ``mu_abs``.
 
         Solves the linearised optimality conditions (module docstring) with the
@@ -745,6 +785,60 @@ class InteriorPointNewton(Owner):
         dz = self.oriented(self._du)
         dnu = (-f_c + nu * dz) / gap
         return dlam, dz, dnu
+
+    def predicted_contact_set(self, point: BarrierPoint) -> npt.NDArray[np.int64]:
+        r"""The contact set Z that the central path through ``point`` tends to.
+
+        The Newton direction for :math:`\mu = 0` (the affine-scaling predictor) at
+        ``point`` moves each constrained node's gap :math:`g` by :math:`-\delta z`
+        and its push to :math:`\nu\,\delta z/g`. Of a node that ends touching, the
+        gap tends to zero and the push stays; of one that ends free, the reverse. Z
+        holds the nodes whose gap falls by a larger fraction than their push, i.e.
+        :math:`\delta z > g/2` (the Tapia indicator: El-Bakry, Tapia & Zhang, *A study
+        of indicators for identifying zero variables in interior-point methods*, SIAM
+        Rev. 36, 1994), and those whose predicted gap is at the tolerance ``tau``.
+        Read where the barrier problem at a small parameter (:math:`10^{-9}`) is
+        solved, it is on most plates the set read off the gaps at :math:`10^{-14}`,
+        some Newton steps later.
+
+        Inside a run's ``on_solved`` hook it costs one solve: the factorisation is that
+        of the run's next step, which is computed here and kept for it (the run goes on
+        exactly as without the call). Elsewhere it factorises K at ``point`` once.
+        Same on every rank (node numbers, sorted).
+        """
+        u = point.mode.x.petsc_vec
+        lam, nu = point.load, point.push
+        gap = -self.oriented(u)
+        if self._next is not None:  # inside the hook: the run's next direction
+            mu_abs, plain_first = self._next
+            step = self.direction(u, lam, nu, gap, mu_abs, plain_first)
+            self._pending = (step,)
+            if step is not None:
+                # The same system for mu = 0: the right-hand side gains E(mu_abs / g).
+                self._rhs.zeroEntries()
+                self._add_zone(self._rhs, mu_abs / gap)
+                self.ksp.solve(self._rhs, self._trial)
+                self._trial.axpy(1.0, self._y1)
+                dlam = (-0.5 * (_dot(u, self._Bu) - 1.0) - _dot(self._Bu, self._trial)) / (
+                    _dot(self._Bu, self._y2)
+                )
+                self._trial.axpy(dlam, self._y2)
+                dz = self.oriented(self._trial)
+        else:
+            self.A.mult(u, self._Au)
+            self.B.mult(u, self._Bu)
+            self._Au.copy(self._Fu)
+            self._Fu.axpy(-lam, self._Bu)
+            self._add_zone(self._Fu, nu)
+            memory = (self._last_correction, self._delta_last)
+            step = self.direction(u, lam, nu, gap, 0.0)
+            self._last_correction, self._delta_last = memory
+            if step is not None:
+                dz = step[1]
+        tol = self.problem.tau * self.problem.max_abs_w(u)
+        touching = gap <= tol if step is None else (2.0 * dz > gap) | (gap - dz <= tol)
+        mine = self.contact.owned_positions[touching]
+        return np.sort(np.concatenate(self.comm.allgather(mine))).astype(np.int64)
 
     def _rounding(self, u: PETSc.Vec, lam: float) -> float:
         r"""Rounding level of :math:`F_u`: :math:`100\,\epsilon\,(|A| + \lambda|B|)|u|`.
