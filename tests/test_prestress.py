@@ -137,3 +137,33 @@ def test_unbalanced_load_on_free_plate_is_refused():
     msh, tags = create_plate_mesh(plate, MeshSpec(4, 2), MPI.COMM_WORLD)
     with pytest.raises(ValueError, match=r"not self-equilibrated.*inplane"):
         solve_prestress(msh, tags, plate, MATERIAL)
+
+
+def test_equilibrium_of_a_plate_is_checked_once(monkeypatch):
+    """The loads of a plate free in its plane are checked on its first mesh only.
+
+    The resultants are exact edge integrals of the applied stresses, the same on every
+    mesh of the plate; a refused load is refused on every mesh (a failed check is not
+    remembered).
+    """
+    from unibuckle_fenicsx.model import prestress
+
+    calls = []
+    check = prestress._check_self_equilibrated
+    monkeypatch.setattr(prestress, "_EQUILIBRATED", set())
+    monkeypatch.setattr(
+        prestress, "_check_self_equilibrated", lambda *a: calls.append(1) or check(*a)
+    )
+    edges = (EdgeSpec("left", normal_stress=-1.0), EdgeSpec("right", normal_stress=-1.0))
+    plate = PlateSpec(edges=(*edges, EdgeSpec("bottom"), EdgeSpec("top")))
+    for nx, ny in ((8, 4), (4, 2), (8, 4)):
+        msh, tags = create_plate_mesh(plate, MeshSpec(nx, ny), MPI.COMM_WORLD)
+        assert solve_prestress(msh, tags, plate, MATERIAL).pinned_rigid_motions
+    assert len(calls) == 1
+    edges = (EdgeSpec("left", normal_stress=-1.0), EdgeSpec("right"), EdgeSpec("bottom"))
+    unbalanced = PlateSpec(edges=(*edges, EdgeSpec("top")))
+    for nx, ny in ((4, 2), (8, 4)):
+        msh, tags = create_plate_mesh(unbalanced, MeshSpec(nx, ny), MPI.COMM_WORLD)
+        with pytest.raises(ValueError, match=r"not self-equilibrated"):
+            solve_prestress(msh, tags, unbalanced, MATERIAL)
+    assert len(calls) == 3
