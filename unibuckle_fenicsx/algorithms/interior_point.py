@@ -778,13 +778,21 @@ class InteriorPointNewton(Owner):
         self._rhs.scale(-1.0)
         self._add_zone(self._rhs, f_c / gap)
         self.ksp.solve(self._rhs, self._y1)
-        f_n = 0.5 * (_dot(u, self._Bu) - 1.0)
-        dlam = (-f_n - _dot(self._Bu, self._y1)) / by2
         self._y1.copy(self._du)
-        self._du.axpy(dlam, self._y2)
+        dlam = self._add_load_step(u, self._du, by2)
         dz = self.oriented(self._du)
         dnu = (-f_c + nu * dz) / gap
         return dlam, dz, dnu
+
+    def _add_load_step(self, u: PETSc.Vec, y: PETSc.Vec, by2: float) -> float:
+        r""":math:`\delta\lambda` from the linearised normalisation; ``y`` becomes :math:`\delta u`.
+
+        ``y`` solves K y = (right-hand side without the load term), ``self._y2`` is
+        :math:`K^{-1}Bu` and ``by2`` :math:`(Bu)^Ty_2`; :math:`\delta u = y + \delta\lambda\,y_2`.
+        """
+        dlam = (-0.5 * (_dot(u, self._Bu) - 1.0) - _dot(self._Bu, y)) / by2
+        y.axpy(dlam, self._y2)
+        return dlam
 
     def predicted_contact_set(self, point: BarrierPoint) -> npt.NDArray[np.int64]:
         r"""The contact set Z that the central path through ``point`` tends to.
@@ -819,17 +827,10 @@ class InteriorPointNewton(Owner):
                 self._add_zone(self._rhs, mu_abs / gap)
                 self.ksp.solve(self._rhs, self._trial)
                 self._trial.axpy(1.0, self._y1)
-                dlam = (-0.5 * (_dot(u, self._Bu) - 1.0) - _dot(self._Bu, self._trial)) / (
-                    _dot(self._Bu, self._y2)
-                )
-                self._trial.axpy(dlam, self._y2)
+                self._add_load_step(u, self._trial, _dot(self._Bu, self._y2))
                 dz = self.oriented(self._trial)
         else:
-            self.A.mult(u, self._Au)
-            self.B.mult(u, self._Bu)
-            self._Au.copy(self._Fu)
-            self._Fu.axpy(-lam, self._Bu)
-            self._add_zone(self._Fu, nu)
+            self._residual(u, lam, nu)
             memory = (self._last_correction, self._delta_last)
             step = self.direction(u, lam, nu, gap, 0.0)
             self._last_correction, self._delta_last = memory
@@ -931,6 +932,17 @@ class InteriorPointNewton(Owner):
         point.push = point.mu * f_scale * self.problem.max_abs_w(u) / (-self.oriented(u))
         return True
 
+    def _residual(
+        self, u: PETSc.Vec, lam: float, nu: npt.NDArray[np.float64] | None = None
+    ) -> None:
+        r""":math:`Au`, :math:`Bu`, :math:`F_u = Au - \lambda Bu\ (+ E\nu)` into work vectors."""
+        self.A.mult(u, self._Au)
+        self.B.mult(u, self._Bu)
+        self._Au.copy(self._Fu)
+        self._Fu.axpy(-lam, self._Bu)
+        if nu is not None:
+            self._add_zone(self._Fu, nu)
+
     def reaction_push(
         self, mode: dolfinx.fem.Function, load: float, mu: float
     ) -> npt.NDArray[np.float64]:
@@ -941,10 +953,7 @@ class InteriorPointNewton(Owner):
         """
         vec = mode.x.petsc_vec
         self._normalize(vec)
-        self.A.mult(vec, self._Au)
-        self.B.mult(vec, self._Bu)
-        self._Au.copy(self._Fu)
-        self._Fu.axpy(-load, self._Bu)
+        self._residual(vec, load)
         f_scale = load * float(self._Bu.norm(PETSc.NormType.INFINITY))
         gap = -self.oriented(vec)
         mu_abs = mu * f_scale * self.problem.max_abs_w(vec)
