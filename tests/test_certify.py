@@ -208,3 +208,40 @@ def test_reduced_inertia_reuses_the_copositivity_factorisation():
     assert shared == fresh
     negatives = [neg for neg, _, _ in fresh]
     assert negatives[0] == 0 and negatives[-1] > 0, negatives  # the test says something
+
+
+def test_a_bound_verified_at_the_proof_gap_proves_the_optimum():
+    """A lower bound verified at lambda (1 - PROOF_GAP) proves the optimum, whatever its last bit.
+
+    README, "Proving the global minimum": the rank-2 copositivity bound is verified at
+    lambda (1 - delta); at delta = PROOF_GAP the gap (upper - lower) / upper is PROOF_GAP
+    up to rounding, on either side of it (on this plate 1e-6 (1 - 9e-12) in one run,
+    1e-6 (1 + 7e-11) in another). A thin two-sided plate (obstacles above the left part
+    and below the right part) whose bound closes there: "proven" either way, not
+    "bracketed" by the last bit of the gap.
+    """
+    from unibuckle_fenicsx.config import problem_from_dict
+
+    spec = problem_from_dict(
+        {
+            "name": "two-sided",
+            "plate": {"corners": [[0, 0], [0.15, 0.1]], "thickness": 1e-4},
+            "material": {"E": 2.1e11, "nu": 0.3},
+            "edges": {
+                "left": {"support": "simply_supported", "normal_stress": -1.0},
+                "right": {"support": "clamped", "normal_stress": -1.0},
+                "bottom": {"support": "simply_supported"},
+                "top": {"support": "simply_supported"},
+            },
+            "mesh": {"nx": 30, "ny": 20},
+            "obstacles": [
+                {"zone": [[0.0, 0.0675], [0.0, 0.1]], "side": "above"},
+                {"zone": [[0.0825, 0.15], [0.0, 0.1]], "side": "below"},
+            ],
+        }
+    )
+    with solve(spec, MPI.COMM_SELF) as analysis:
+        cert = analysis.result.certificate
+    assert cert["proven_by"] == "rank2-spn"
+    assert cert["relative_gap"] == pytest.approx(PROOF_GAP, rel=1e-6)
+    assert cert["status"] == "proven" and cert["global_optimum_proven"]

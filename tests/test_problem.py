@@ -130,3 +130,45 @@ def test_command_line_option_wins_and_defaults_do_not_leak():
     assert not opts.hasName("unibuckle_test_ldl_mat_mumps_icntl_13")
     ldl.destroy()
     mat.destroy()
+
+
+def test_eigen_solve_near_an_estimate_is_the_smallest():
+    """A solve shifted just below an estimate returns the smallest eigenpair, or solves again.
+
+    Reference: the same reduced pencil solved at target 0 (the free plate's path), and a
+    dense generalized eigensolver (scipy's ``eigh`` of the swapped pencil B x = mu A x,
+    A SPD). A good estimate (1e-5 above) is used as the shift; an estimate three times
+    the load puts eigenvalues below the shift, which the factorisation's inertia shows,
+    and the solve at target 0 runs instead.
+    """
+    from scipy.linalg import eigh
+    from scipy.sparse import csr_matrix
+
+    problem = BucklingProblem(paper_case("c1", 12, 6), MPI.COMM_SELF)
+    assert problem.contact is not None
+    zone = np.arange(problem.contact.size)
+    active = zone[: zone.size // 2]  # any contact set will do
+    cold = problem.evaluate(active)
+    solver = problem.eigensolver
+    keep = np.setdiff1d(
+        np.arange(problem.model.A.getSize()[0]), problem.contact.removed_rows(active)
+    )
+    A, B = (
+        csr_matrix(m.getValuesCSR()[::-1]).toarray()[np.ix_(keep, keep)]
+        for m in (problem.model.A, problem.model.B)
+    )
+    mu = eigh(B, A, eigvals_only=True)
+    dense = 1.0 / mu.max()
+    shifted, again = solver.shifted_solves, solver.unshifted_again
+    start = cold.mode.x.petsc_vec
+    warm = problem.evaluate(active, initial=start, near=cold.load * (1.0 + 1e-5))
+    assert (solver.shifted_solves, solver.unshifted_again) == (shifted + 1, again)
+    far = problem.evaluate(active, initial=start, near=3.0 * cold.load)
+    assert (solver.shifted_solves, solver.unshifted_again) == (shifted + 1, again + 1)
+    problem.destroy()
+    assert cold.load == pytest.approx(dense, rel=1e-8)
+    assert warm.load == pytest.approx(dense, rel=1e-8)
+    assert far.load == pytest.approx(dense, rel=1e-8)
+    # Three times the load lies above the second eigenvalue: the pair nearest that
+    # shift would not have been the smallest.
+    assert np.sort(1.0 / mu[mu > 0])[1] < 3.0 * cold.load * (1.0 - 1e-3)

@@ -24,7 +24,7 @@ most violated node per iterate: small contact sets first, as in the paper; at mo
 The damped rule used after a cycle is also greedy. The smallest
 KKT load is kept; the distinct KKT points and equal-load twins are reported.
 
-**Multilevel** (:mod:`.multilevel`, speed). The cost is one sparse LU per iterate, and
+**Multilevel** (:mod:`.multilevel`, speed). The cost is one sparse factorisation per iterate, and
 on a fine mesh the contact zone moves by one node layer per iterate. So on a fine
 structured mesh the seeds run on a hierarchy of coarser meshes (halved until the shorter
 side has fewer than ``coarse_min_cells`` cells); the best KKT sets (within

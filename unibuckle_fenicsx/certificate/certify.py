@@ -83,7 +83,8 @@ class Certificate:
         lower_bound: Verified lower bound on the critical load.
         upper_bound: Load of an admissible mode (``inf`` if the mode is not admissible).
         relative_gap: (upper - lower) / upper.
-        global_optimum_proven: The gap is at most :data:`~unibuckle_fenicsx.tolerances.PROOF_GAP`.
+        global_optimum_proven: The gap is at most :data:`~unibuckle_fenicsx.tolerances.PROOF_GAP`
+            (up to the rounding of the gap, :data:`~unibuckle_fenicsx.tolerances.ROUNDING_RTOL`).
         proven_by: What gave the lower bound: "interlacing" (the free load),
             "lattice", "enumeration", or a copositivity route ("rank2-spn", "sdp-spn",
             "sdp-sectors", "lowrank-spn", "psd").
@@ -320,7 +321,10 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
         elif not algorithm_proof and not global_bound:
             notes.append("global certification skipped (solver.certify = false)")
         gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
-        proven = bool(kkt and gap <= PROOF_GAP and (algorithm_proof or proven_by != "interlacing"))
+        # A bound verified at lambda (1 - PROOF_GAP) gives the gap PROOF_GAP up to the
+        # rounding of (upper - lower) / upper (as for "bracketed", Certificate.status).
+        closed = gap <= PROOF_GAP * (1 + ROUNDING_RTOL)
+        proven = bool(kkt and closed and (algorithm_proof or proven_by != "interlacing"))
         smallest: bool | None = None
         if check_smallest and global_bound and cand.eigen is not None:
             sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
@@ -420,7 +424,7 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     lower = min(solution.lower_bound, cand.load)
     upper = cand.load
     gap = (upper - lower) / upper
-    proven = bool(kkt and solution.global_optimum_proven and gap <= PROOF_GAP)
+    proven = bool(kkt and solution.global_optimum_proven and gap <= PROOF_GAP * (1 + ROUNDING_RTOL))
     sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
     neg, _, _ = _spring_inertia(problem, pressing, sigma)
     smallest = neg == 0

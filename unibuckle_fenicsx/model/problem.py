@@ -408,12 +408,16 @@ class BucklingProblem(Owner):
         self,
         active: npt.NDArray[np.int64],
         initial: PETSc.Vec | None = None,
+        near: float | None = None,
     ) -> Candidate:
         """Smallest eigenpair with the nodes ``active`` removed, as a :class:`Candidate`.
 
         Args:
             active: Contact set Z (node numbers, any order).
             initial: Optional start vector of the eigen solve (e.g. a previous mode).
+            near: Optional estimate of the load (e.g. that of the state Z is read
+                from): the eigen solve shifts just below it
+                (:meth:`~unibuckle_fenicsx.eigen.GEPSolver.solve`).
 
         Note:
             Collective; ``active`` must be the same on every rank.
@@ -423,7 +427,7 @@ class BucklingProblem(Owner):
         active = np.unique(np.asarray(active, dtype=np.int64))
         u = self.new_mode()
         pair = self.eigensolver.solve(
-            self.contact.removed_rows(active), out=u.x.petsc_vec, initial=initial
+            self.contact.removed_rows(active), out=u.x.petsc_vec, initial=initial, near=near
         )
         return self.candidate(u, pair.value, active, eigen=pair)
 
