@@ -327,7 +327,6 @@ class GEPSolver(Owner):
         self._options = dict(EIGEN_OPTIONS if options is None else options)
         set_options(eps, prefix, self._options)
         self.eps = eps
-        self._tol = tol
         self._near: SLEPc.EPS | None = None  # the shifted solves' EPS, made when needed
         self.shifted_solves = 0  # solves at a shift below an estimate (near=...)
         self.unshifted_again = 0  # ... of which an eigenvalue lay below the shift
@@ -449,7 +448,7 @@ class GEPSolver(Owner):
             eps = SLEPc.EPS().create(self.A.comm)
             eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
             eps.setDimensions(1, NEAR_NCV)
-            eps.setTolerances(self._tol)
+            eps.setTolerances(self.eps.getTolerances()[0])
             eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
             eps.getST().setType(SLEPc.ST.Type.SINVERT)
             set_options(eps, self.prefix + "near_", {**self._options, **NEAR_OPTIONS})
@@ -471,16 +470,8 @@ class GEPSolver(Owner):
         if initial is not None:
             eps.setInitialSpace([initial])
         eps.setTarget(near * (1.0 - NEAR_MARGIN))
-        prefix = self.prefix + "near_"
-        opts = PETSc.Options(prefix)
-        pushed = [key for key in _ST_INERTIA_OPTIONS if not opts.hasName(key)]
-        for key in pushed:
-            opts.setValue(key, _ST_INERTIA_OPTIONS[key])
-        try:
-            eps.setUp()  # the factorisation, with the controls above in the database
-        finally:
-            for key in pushed:
-                opts.delValue(key)
+        # The factorisation, with the inertia controls in the database while it is set up.
+        set_options(eps, self.prefix + "near_", _ST_INERTIA_OPTIONS, setup=True)
         pc = eps.getST().getKSP().getPC()
         if pc.getType() != "cholesky" or pc.getFactorSolverType() != "mumps":
             return False

@@ -341,11 +341,7 @@ def _read_contact(
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     active = newton.predicted_contact_set(point) if predicted else newton.contact_set(point)
-    # Shifted just below the barrier load (a few solves); the empty set is the free
-    # plate's pencil, solved as the free plate was (the same load to the last bit: a
-    # bracket whose bound is the free load then closes at once).
-    near = point.load if len(active) else None
-    cand = problem.evaluate(active, initial=point.mode.x.petsc_vec, near=near)
+    cand = problem.evaluate(active, initial=point.mode.x.petsc_vec, near=point.load)
     level.offer(cand)
     level.links.append(
         LinkRecord(

@@ -63,6 +63,15 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 
+def _within(gap: float, limit: float) -> bool:
+    """Whether the relative gap is at most ``limit``, up to the rounding of the gap.
+
+    A bound verified at lambda (1 - limit) gives the gap ``limit`` to its last bits, on
+    either side of it (:data:`~unibuckle_fenicsx.tolerances.ROUNDING_RTOL`).
+    """
+    return gap <= limit * (1 + ROUNDING_RTOL)
+
+
 @dataclass(frozen=True)
 class Certificate:
     r"""What was verified about a returned critical state.
@@ -123,11 +132,7 @@ class Certificate:
             return "not-kkt"
         if self.global_optimum_proven:
             return "proven"
-        # A bound verified at lambda (1 - BRACKET_GAP) gives the gap BRACKET_GAP up to the
-        # rounding of (upper - lower) / upper.
-        if self.proven_by != "interlacing" and self.relative_gap <= BRACKET_GAP * (
-            1 + ROUNDING_RTOL
-        ):
+        if self.proven_by != "interlacing" and _within(self.relative_gap, BRACKET_GAP):
             return "bracketed"
         return "kkt-only"
 
@@ -321,9 +326,7 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
         elif not algorithm_proof and not global_bound:
             notes.append("global certification skipped (solver.certify = false)")
         gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
-        # A bound verified at lambda (1 - PROOF_GAP) gives the gap PROOF_GAP up to the
-        # rounding of (upper - lower) / upper (as for "bracketed", Certificate.status).
-        closed = gap <= PROOF_GAP * (1 + ROUNDING_RTOL)
+        closed = _within(gap, PROOF_GAP)
         proven = bool(kkt and closed and (algorithm_proof or proven_by != "interlacing"))
         smallest: bool | None = None
         if check_smallest and global_bound and cand.eigen is not None:
@@ -424,7 +427,7 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     lower = min(solution.lower_bound, cand.load)
     upper = cand.load
     gap = (upper - lower) / upper
-    proven = bool(kkt and solution.global_optimum_proven and gap <= PROOF_GAP * (1 + ROUNDING_RTOL))
+    proven = bool(kkt and solution.global_optimum_proven and _within(gap, PROOF_GAP))
     sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
     neg, _, _ = _spring_inertia(problem, pressing, sigma)
     smallest = neg == 0

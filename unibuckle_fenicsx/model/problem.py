@@ -417,7 +417,9 @@ class BucklingProblem(Owner):
             initial: Optional start vector of the eigen solve (e.g. a previous mode).
             near: Optional estimate of the load (e.g. that of the state Z is read
                 from): the eigen solve shifts just below it
-                (:meth:`~unibuckle_fenicsx.eigen.GEPSolver.solve`).
+                (:meth:`~unibuckle_fenicsx.eigen.GEPSolver.solve`). Not for the empty
+                set: that is the free plate's pencil, solved as the free plate is (the
+                same load to the last bit, so a bracket on the free load closes).
 
         Note:
             Collective; ``active`` must be the same on every rank.
@@ -427,7 +429,10 @@ class BucklingProblem(Owner):
         active = np.unique(np.asarray(active, dtype=np.int64))
         u = self.new_mode()
         pair = self.eigensolver.solve(
-            self.contact.removed_rows(active), out=u.x.petsc_vec, initial=initial, near=near
+            self.contact.removed_rows(active),
+            out=u.x.petsc_vec,
+            initial=initial,
+            near=near if active.size else None,
         )
         return self.candidate(u, pair.value, active, eigen=pair)
 
