@@ -11,8 +11,9 @@ import dolfinx
 import numpy as np
 import pytest
 
-from unibuckle_fenicsx import EdgeSpec, MeshSpec, PlateSpec, paper_case
+from unibuckle_fenicsx import EdgeSpec, MeshSpec, ObstacleSpec, PlateSpec, paper_case
 from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.eigen import GEPSolver
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.problem import BucklingProblem
@@ -132,20 +133,31 @@ def test_command_line_option_wins_and_defaults_do_not_leak():
     mat.destroy()
 
 
-def test_eigen_solve_near_an_estimate_is_the_smallest():
+@pytest.mark.parametrize("load", ["uniaxial", "shear"])
+def test_eigen_solve_near_an_estimate_is_the_smallest(load):
     """A solve shifted just below an estimate returns the smallest eigenpair, or solves again.
 
     Reference: the same reduced pencil solved at target 0 (the free plate's path), and a
     dense generalized eigensolver (scipy's ``eigh`` of the swapped pencil B x = mu A x,
     A SPD). A good estimate (1e-5 above) is used as the shift; an estimate three times
     the load puts eigenvalues below the shift, which the factorisation's inertia shows,
-    and the solve at target 0 runs instead.
+    and the solve at target 0 runs instead. Under shear B is indefinite (the pencil's
+    loads come in pairs of opposite sign): the shifted solve is then of the swapped
+    pencil, and the inertia counts its positive eigenvalues.
     """
     from scipy.linalg import eigh
     from scipy.sparse import csr_matrix
 
-    problem = BucklingProblem(paper_case("c1", 12, 6), MPI.COMM_SELF)
+    if load == "uniaxial":
+        spec = paper_case("c1", 12, 6)
+    else:
+        spec = plate_case(
+            "shear", length=0.3, width=0.1, thickness=1e-3, load="shear", nx=12, ny=6,
+            zone=ObstacleSpec(zone="all"),
+        )  # fmt: skip
+    problem = BucklingProblem(spec, MPI.COMM_SELF)
     assert problem.contact is not None
+    assert problem.eigensolver.indefinite == (load == "shear")
     zone = np.arange(problem.contact.size)
     active = zone[: zone.size // 2]  # any contact set will do
     cold = problem.evaluate(active)

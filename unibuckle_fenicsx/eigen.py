@@ -12,7 +12,10 @@ they map to :math:`\lambda = \infty`.
   eigenvalue lies below the shift (else the solve at target 0 runs).
 - B indefinite (tension somewhere): the swapped pencil :math:`B x = \mu A x` (A SPD)
   for the largest real :math:`\mu`, :math:`\lambda = 1/\mu`; the smallest positive
-  :math:`\lambda` whatever the negative ones.
+  :math:`\lambda` whatever the negative ones. A solve given an estimate shifts the
+  swapped pencil to :math:`1/\sigma`: :math:`B - A/\sigma` has a positive eigenvalue
+  for each eigenvalue of the pencil in :math:`(0, \sigma)`, so its inertia proves
+  the same.
 
 Every solver object here has a non-empty options prefix: options are pushed under it
 by :func:`set_options` (the one place that touches the global options database), so
@@ -372,8 +375,7 @@ class GEPSolver(Owner):
                 shifts to :data:`NEAR_MARGIN` below it, and its factorisation's
                 inertia proves that no eigenvalue lies below the shift; if one does
                 (or the factorisation gives no inertia, or nothing converges), the
-                solve at target 0 runs instead. Ignored for the swapped pencil (B
-                indefinite).
+                solve at target 0 runs instead.
 
         Returns:
             The eigenpair, with value ``inf`` when no finite load exists (the removed DOFs
@@ -395,7 +397,7 @@ class GEPSolver(Owner):
             return EigenPair(float("inf"), 0.0, 0, 0)
         start = initial is not None and self._useful_start(initial, B)
         eps = self.eps
-        if near is not None and near > 0.0 and not self.indefinite:
+        if near is not None and near > 0.0:
             if self._solve_below(A, B, near, initial if start else None):
                 eps = self._near
                 self.shifted_solves += 1
@@ -466,16 +468,22 @@ class GEPSolver(Owner):
         the smallest), or when nothing converged. Collective.
         """
         eps = self._near_eps()
-        eps.setOperators(A, B)
+        shift = near * (1.0 - NEAR_MARGIN)
+        if self.indefinite:
+            eps.setOperators(B, A)
+            eps.setTarget(1.0 / shift)
+        else:
+            eps.setOperators(A, B)
+            eps.setTarget(shift)
         if initial is not None:
             eps.setInitialSpace([initial])
-        eps.setTarget(near * (1.0 - NEAR_MARGIN))
         # The factorisation, with the inertia controls in the database while it is set up.
         set_options(eps, self.prefix + "near_", _ST_INERTIA_OPTIONS, setup=True)
         pc = eps.getST().getKSP().getPC()
         if pc.getType() != "cholesky" or pc.getFactorSolverType() != "mumps":
             return False
-        below, _, _ = pc.getFactorMatrix().getInertia()
+        negative, _, positive = pc.getFactorMatrix().getInertia()
+        below = positive if self.indefinite else negative
         if int(below) != 0:
             return False
         eps.solve()

@@ -50,6 +50,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 import numpy as np
+import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
@@ -101,6 +102,13 @@ class ChainOptions:
         twin_rtol: Starts whose barrier solutions' loads at ``compare_mu``, or at a
             barrier parameter passed on the way to ``explore_mu_min``, agree to this
             (relative) lead to the same arrangement.
+        path_rtol: ... or agree to this and their deflections on the zone (scaled
+            to a largest value of 1) to ``path_shape_tol``: a barrier problem solved to
+            a residual of about ten times its parameter fixes the load to only about
+            that (measured on the coarsest mesh of a thin plate with clamped unloaded
+            edges at 1e-6: starts on one central path 1e-8 to 2.5e-6 apart in load and
+            1e-5 to 2e-4 in deflection, two arrangements 3e-4 and 0.9).
+        path_shape_tol: See ``path_rtol``.
         level_mu: Barrier parameter of the central-path point carried from one mesh to
             the next.
         flat_mu: ... and of the second try when the first ends at no KKT point.
@@ -134,6 +142,8 @@ class ChainOptions:
     compare_mu: float = 1e-4
     explore_mu_min: float = 1e-14
     twin_rtol: float = 1e-7
+    path_rtol: float = 1e-4
+    path_shape_tol: float = 1e-2
     level_mu: float = 1e-6
     flat_mu: float = 1e-10
     fine_mu_min: float = 1e-14
@@ -404,7 +414,7 @@ def _polish(
     """Active-set iteration from ``cand``'s contact set; its KKT point or best feasible."""
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
-    run = iterate(problem, label, cand.active, cand.mode.x.petsc_vec, budget)
+    run = iterate(problem, label, cand.active, cand.mode.x.petsc_vec, budget, near=cand.load)
     final = run.final if run.status is RunStatus.KKT else run.best_feasible
     level.offer(final)
     level.links.append(
@@ -523,6 +533,34 @@ class _Arrangement:
     flat: BarrierPoint  # on the coarsest mesh, at flat_mu
 
 
+@dataclass
+class _Paths:
+    """The barrier solutions the starts met, by barrier parameter (see :func:`_explore`)."""
+
+    problem: BucklingProblem
+    options: ChainOptions
+    #: By barrier parameter: (load, oriented values on the zone scaled to max 1) of each.
+    met: dict[float, list[tuple[float, npt.NDArray[np.float64]]]] = field(default_factory=dict)
+
+    def met_before(self, mu: float, point: BarrierPoint) -> bool:
+        """Whether a start met ``point`` (solved at ``mu``) before (else it is remembered).
+
+        Collective (the values are gathered on every rank).
+        """
+        assert self.problem.contact is not None
+        z = self.problem.contact.values(point.mode.x.petsc_vec)  # the same on every rank
+        z = z / np.abs(z).max()
+        seen = self.met.setdefault(mu, [])
+        for load, other in seen:
+            if math.isclose(point.load, load, rel_tol=self.options.twin_rtol):
+                return True
+            if math.isclose(point.load, load, rel_tol=self.options.path_rtol):
+                if np.abs(z - other).max() <= self.options.path_shape_tol:
+                    return True
+        seen.append((point.load, z))
+        return False
+
+
 def _explore(
     problem: BucklingProblem, level: LevelRecord, options: ChainOptions, carry: bool = True
 ) -> tuple[list[Candidate], list[_Arrangement]]:
@@ -536,24 +574,22 @@ def _explore(
 
     A start whose barrier solution at ``compare_mu``, or at a barrier parameter passed
     on the way down to ``explore_mu_min`` (every start passes the same ones), has the
-    load of one met before (relative ``twin_rtol``) is on the central path of the same
-    arrangement and is not taken further. Measured on the five plates of
-    ``bench/bench_plates.py`` at 90×30: 2–30 % fewer Newton steps on the coarsest mesh
-    (SSSS 223 → 156, unloaded edges clamped 376 → 324), the same loads and fine steps.
+    load of one met before (relative ``twin_rtol``), or its load to ``path_rtol`` and
+    its deflection on the zone to ``path_shape_tol``, is on the central path of the
+    same arrangement and is not taken further. Measured on the five plates of
+    ``bench/bench_plates.py`` at 90×30: the loads alone, 2–30 % fewer Newton steps on
+    the coarsest mesh (SSSS 223 → 156, unloaded edges clamped 376 → 324); with the
+    deflections, starts stop at the first parameter below ``compare_mu`` instead of
+    up to 56 steps later (SSSS 157 → 139, loaded edges clamped 161 → 127, unloaded
+    edges clamped 324 → 184, CCCC 123 → 105); the same fine steps, loads within the
+    thin plates' rounding (1e-9).
     """
     found: list[tuple[Candidate, BarrierPoint]] = []
-    met: dict[float, list[float]] = {}  # barrier loads met, by barrier parameter
-
-    def met_before(mu: float, load: float) -> bool:
-        """Whether a start met ``load`` at ``mu`` before (else it is remembered)."""
-        loads = met.setdefault(mu, [])
-        if any(math.isclose(load, other, rel_tol=options.twin_rtol) for other in loads):
-            return True
-        loads.append(load)
-        return False
+    paths = _Paths(problem, options)
+    met_before = paths.met_before
 
     def on_solved(point: BarrierPoint) -> NewtonStatus | None:
-        return NewtonStatus.MET_BEFORE if met_before(point.mu, point.load) else None
+        return NewtonStatus.MET_BEFORE if met_before(point.mu, point) else None
 
     # Damped steps (a stiffness-scaled correction that decays from step to step) keep
     # each start near its own arrangement: measured, with the finer meshes' settings a
@@ -572,7 +608,7 @@ def _explore(
             level.links.append(_newton_link(seed, rec))
             if rec.status is not NewtonStatus.CONVERGED:
                 continue
-            if met_before(options.compare_mu, point.load):
+            if met_before(options.compare_mu, point):
                 level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
                 continue
             point, rec = _run(
@@ -582,12 +618,12 @@ def _explore(
             )  # fmt: skip
             if rec.status is not NewtonStatus.CONVERGED:
                 continue
-            if met_before(point.mu, point.load):
+            if met_before(point.mu, point):
                 level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
                 continue
             cand, point = _critical_state(problem, newton, point, level, seed, options, carry)
             if point.mu == options.explore_mu_min:
-                met_before(point.mu, point.load)  # where an escape ended
+                met_before(point.mu, point)  # where an escape ended
             if cand is not None:
                 found.append((cand, point))
         found.sort(key=lambda cp: cp[0].load)
@@ -626,8 +662,7 @@ def _central(
 
 
 def _refine(
-    coarse: BucklingProblem,
-    fine: BucklingProblem,
+    carry: Prolongation,
     point: BarrierPoint,
     level: LevelRecord,
     options: ChainOptions,
@@ -637,7 +672,7 @@ def _refine(
     quick: bool,
     newton: InteriorPointNewton,
 ) -> tuple[Candidate | None, BarrierPoint | None]:
-    """Carry ``point`` from ``coarse`` to ``fine`` and solve the barrier problem there.
+    """Carry ``point`` to the finer mesh (``carry``) and solve the barrier problem there.
 
     The interpolated mode is relaxed into the fine mesh's discrete Kirchhoff kernel
     (:meth:`~.interior_point.InteriorPointNewton.relax`), the nodes it brings too close
@@ -648,7 +683,7 @@ def _refine(
     (the caller's, kept for the level's other arrangements: its factorisation's symbolic
     analysis is done once per mesh).
     """
-    carry = Prolongation(coarse, fine)
+    fine = carry.fine
     mode = carry.mode(point.mode)
     newton.forget_corrections()
     try:
@@ -759,11 +794,10 @@ def _carry(
     carried: list[BarrierPoint] = []
     if k not in newtons:
         newtons[k] = InteriorPointNewton(problems[k])
+    carry = Prolongation(problems[k - 1], problems[k])
     for j, point in enumerate(points):
         tag = label if len(points) == 1 else f"{label} {j + 1}"
-        cand, new = _refine(
-            problems[k - 1], problems[k], point, level, options, last, mu, tag, quick, newtons[k]
-        )
+        cand, new = _refine(carry, point, level, options, last, mu, tag, quick, newtons[k])
         if cand is not None and cand.kkt:
             found.append(cand)
         if new is not None and not last:

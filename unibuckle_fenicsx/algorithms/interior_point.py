@@ -87,7 +87,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.eigen import Owner, release, set_ldl_options
+from unibuckle_fenicsx.eigen import Owner, release, set_ldl_options, set_options
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
@@ -108,6 +108,22 @@ IPM_PREFIX = "unibuckle_ipm_"
 #: the obstacle (:meth:`InteriorPointNewton.pressure_mode`); the margin of
 #: :meth:`InteriorPointNewton.make_interior`.
 PUSH_MARGIN = 1e-2
+
+#: Solver of :meth:`InteriorPointNewton.relax`'s block of A (the deflection's, or the
+#: rotations': symmetric positive definite), options prefix ``<prefix>relax_w_`` or
+#: ``<prefix>relax_theta_``: conjugate gradients with an incomplete Cholesky
+#: preconditioner (block Jacobi across ranks), made once per mesh. Measured on a thin
+#: plate at 180×60 (i = 10561): 15–25 ms per block (9 and about 50 iterations), against
+#: 0.2–0.3 s for the factorisation of the whole matrix with the other block held by a
+#: stiff diagonal, which it replaces.
+RELAX_OPTIONS: dict[str, str | float | int | bool] = {
+    "ksp_type": "cg",
+    "pc_type": "bjacobi",
+    "sub_pc_type": "icc",
+    "ksp_rtol": 1e-12,
+    "ksp_atol": 0.0,
+    "ksp_max_it": 5000,
+}
 
 _SAME = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
 _SUBSET = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
@@ -315,6 +331,8 @@ class InteriorPointNewton(Owner):
             self._reg = A.createVecLeft()
             self._trial.set(1.0)
             self._abs_B.mult(self._trial, self._reg)
+        # relax(): the solvers of A's deflection and rotation blocks, made on first use.
+        self._blocks: dict[str, tuple[npt.NDArray[np.int64], PETSc.KSP, PETSc.Vec, PETSc.Vec]] = {}
         self._delta_last = 0.0  # the last nonzero inertia correction
         self._last_correction = 0.0  # the correction of the last step
         # Inside a run's on_solved hook: the next step's (mu_abs, plain_first), and its
@@ -414,9 +432,10 @@ class InteriorPointNewton(Owner):
         and, on a thin plate, its quotient is orders of magnitude off. Minimising the
         energy over w with the rotations held (a Poisson-like problem: w integrates the
         rotations along the edges), then over the rotations with w held, restores it
-        while keeping the shape. The held DOFs get a stiff diagonal
-        (:math:`10^8 \max \mathrm{diag} A`, so they move by 1e-8 of the correction); one
-        factorisation of a matrix with A's pattern each.
+        while keeping the shape. Each is a solve with a block of A (the free DOFs'
+        rows and columns; :data:`RELAX_OPTIONS`). Should that solver not converge, the
+        whole matrix is factorised with the held DOFs given a stiff diagonal
+        (:math:`10^8 \max \mathrm{diag} A`, so they move by 1e-8 of the correction).
 
         Args:
             vec: The W-vector, changed in place.
@@ -424,18 +443,46 @@ class InteriorPointNewton(Owner):
         """
         if free not in ("rotations", "deflection"):
             raise ValueError(f'free must be "rotations" or "deflection", got {free!r}')
+        self.A.mult(vec, self._rhs)
+        self._rhs.scale(-1.0)
+        local, ksp, rhs, step = self._block(free)
+        rhs.array[:] = self._rhs.array_r[local]
+        ksp.solve(rhs, step)
+        if int(ksp.getConvergedReason()) > 0:  # type: ignore[call-overload]
+            vec.array[local] += np.asarray(step.array_r, dtype=np.float64)
+            return
+        logger.debug("relax: the %s block's solver did not converge; factorising", free)
         held = np.zeros(vec.getLocalSize(), dtype=bool)
         held[self.problem.owned_w_dofs] = True
         if free == "deflection":
             held = ~held
-        big = self._held_diagonal()
-        self._factor(0.0, None, stiff=(held, big))
-        self.A.mult(vec, self._rhs)
+        self._factor(0.0, None, stiff=(held, self._held_diagonal()))
         self._rhs.array[held] = 0.0
-        self._rhs.scale(-1.0)
         self.ksp.solve(self._rhs, self._y1)
         self._y1.array[held] = 0.0
         vec.axpy(1.0, self._y1)
+
+    def _block(self, free: str) -> tuple[npt.NDArray[np.int64], PETSc.KSP, PETSc.Vec, PETSc.Vec]:
+        """``free``'s owned DOFs (local numbers), the solver of A's block there, work vectors."""
+        if free not in self._blocks:
+            mine = np.zeros(self.A.getLocalSize()[0], dtype=bool)
+            mine[self.problem.owned_w_dofs] = True
+            if free == "rotations":
+                mine = ~mine
+            local = np.flatnonzero(mine)
+            start = self.A.getOwnershipRange()[0]
+            rows = PETSc.IS().createGeneral((start + local).astype(PETSc.IntType), comm=self.A.comm)
+            block = self.A.createSubMatrix(rows, rows)
+            rows.destroy()
+            block.setOption(PETSc.Mat.Option.SPD, True)
+            ksp = PETSc.KSP().create(self.A.comm)
+            ksp.setOperators(block)
+            tag = "w" if free == "deflection" else "theta"
+            set_options(ksp, f"{self.prefix}relax_{tag}_", RELAX_OPTIONS)
+            step, rhs = block.createVecs()
+            block.destroy()  # the KSP holds a reference
+            self._blocks[free] = (local, ksp, rhs, step)
+        return self._blocks[free]
 
     def relax_rotations(self, vec: PETSc.Vec) -> None:
         """:meth:`relax` over the rotations."""
@@ -988,6 +1035,10 @@ class InteriorPointNewton(Owner):
         """Destroy the matrix, its factorisation and the work vectors (collective)."""
         if self._reg is self._diag_A:
             self._reg = None
+        for _, ksp, rhs, step in getattr(self, "_blocks", {}).values():
+            for obj in (ksp, rhs, step):
+                obj.destroy()
+        self._blocks = {}
         release(self, "ksp", "K", "_abs_A", "_abs_B", "_diag_A", "_diag", "_reg")
         release(self, "_Au", "_Bu", "_Fu", "_y1", "_y2", "_rhs", "_du", "_trial")
 

@@ -25,8 +25,14 @@ __all__ = [
 class Prolongation:
     """Interpolation from a coarse problem's spaces to a fine one's (any two meshes).
 
-    Q1 functions are interpolated at the fine nodes (exact on nested meshes); the
-    point-ownership data is computed once and shared by w and theta.
+    Q1 functions are interpolated at the fine nodes (exact on nested meshes). From a
+    structured rectangle (the chain's coarser copies of a structured plate) the
+    bilinear weights of every fine node are computed once from the grid spacing and
+    the coarse values are gathered on every rank; from any other mesh dolfinx's
+    non-matching interpolation does it (its point-ownership data computed once and
+    shared by w and theta). Hand-written because that general route locates every
+    fine node in the coarse mesh's cells: measured at 90×30 → 180×60, 0.2 s to set up
+    and 0.24 s per mode (a sixth of a free solve each), against milliseconds here.
 
     Args:
         coarse: The coarse problem.
@@ -38,31 +44,83 @@ class Prolongation:
 
     def __init__(self, coarse: BucklingProblem, fine: BucklingProblem) -> None:
         self.coarse, self.fine = coarse, fine
+        self._subs = [
+            (coarse.model.W.sub(sub).collapse(), fine.model.W.sub(sub).collapse()) for sub in (0, 1)
+        ]
+        self._grid: list[_BilinearWeights] | None = None
+        if coarse.structured:
+            self._grid = [_BilinearWeights(coarse, Vc, Vf) for (Vc, _), (Vf, _) in self._subs]
+            return
         Vf = fine.model.Vw
         topology = Vf.mesh.topology
         index_map = topology.index_map(topology.dim)
         self._cells = np.arange(index_map.size_local + index_map.num_ghosts, dtype=np.int32)
         self._data = dolfinx.fem.create_interpolation_data(Vf, coarse.model.Vw, self._cells)
 
-    def _interpolate(
-        self, source: dolfinx.fem.Function, target: dolfinx.fem.Function
-    ) -> dolfinx.fem.Function:
-        target.interpolate_nonmatching(source, self._cells, self._data)
-        return target
-
     def mode(self, u: dolfinx.fem.Function) -> dolfinx.fem.Function:
         """The coarse (w, theta) function ``u`` interpolated on the fine space."""
-        Wc, Wf = self.coarse.model.W, self.fine.model.W
         out = self.fine.new_mode("prolonged")
-        for sub in (0, 1):
-            Vc, map_c = Wc.sub(sub).collapse()
-            Vf, map_f = Wf.sub(sub).collapse()
-            fc = dolfinx.fem.Function(Vc)
-            fc.x.array[:] = u.x.array[np.asarray(map_c[0])]
-            ff = self._interpolate(fc, dolfinx.fem.Function(Vf))
-            out.x.array[np.asarray(map_f[0])] = ff.x.array
+        for sub, ((Vc, map_c), (Vf, map_f)) in enumerate(self._subs):
+            coarse_values = u.x.array[np.asarray(map_c[0])]
+            if self._grid is not None:
+                fine_values = self._grid[sub].apply(coarse_values)
+            else:
+                fc = dolfinx.fem.Function(Vc)
+                fc.x.array[:] = coarse_values
+                ff = dolfinx.fem.Function(Vf)
+                ff.interpolate_nonmatching(fc, self._cells, self._data)
+                fine_values = np.asarray(ff.x.array, dtype=np.float64)
+            out.x.array[np.asarray(map_f[0])] = fine_values
         out.x.scatter_forward()
         return out
+
+
+class _BilinearWeights:
+    """Bilinear interpolation from a structured rectangle's Q1 space ``Vc`` at ``Vf``'s nodes.
+
+    Every rank gathers the coarse nodal values (by grid position) and evaluates its fine
+    nodes, ghosts included: no further communication.
+    """
+
+    def __init__(
+        self,
+        coarse: BucklingProblem,
+        Vc: dolfinx.fem.FunctionSpace,
+        Vf: dolfinx.fem.FunctionSpace,
+    ) -> None:
+        (x0, y0), (x1, y1) = coarse.spec.plate.corners
+        nx, ny = coarse.spec.mesh.nx, coarse.spec.mesh.ny
+        hx, hy = (x1 - x0) / nx, (y1 - y0) / ny
+        self.bs = Vc.dofmap.index_map_bs
+        self.comm = Vc.mesh.comm
+        owned = Vc.dofmap.index_map.size_local
+        xy = Vc.tabulate_dof_coordinates()[:owned, :2]
+        ix = np.rint((xy[:, 0] - x0) / hx).astype(np.int64)
+        iy = np.rint((xy[:, 1] - y0) / hy).astype(np.int64)
+        self._owned = owned
+        self._slots = np.concatenate(self.comm.allgather(ix * (ny + 1) + iy))
+        if self._slots.size != (nx + 1) * (ny + 1):
+            raise RuntimeError("Prolongation: the coarse mesh is not the expected rectangle")
+        fx = (Vf.tabulate_dof_coordinates()[:, 0] - x0) / hx
+        fy = (Vf.tabulate_dof_coordinates()[:, 1] - y0) / hy
+        cx = np.clip(np.floor(fx), 0, nx - 1).astype(np.int64)
+        cy = np.clip(np.floor(fy), 0, ny - 1).astype(np.int64)
+        sx, sy = fx - cx, fy - cy
+        self._index = np.stack(
+            [cx * (ny + 1) + cy, (cx + 1) * (ny + 1) + cy, cx * (ny + 1) + cy + 1,
+             (cx + 1) * (ny + 1) + cy + 1], axis=1,
+        )  # fmt: skip
+        self._weight = np.stack(
+            [(1 - sx) * (1 - sy), sx * (1 - sy), (1 - sx) * sy, sx * sy], axis=1
+        )
+
+    def apply(self, coarse_values: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        """Fine nodal values (unrolled blocks) from the coarse ones (unrolled, ghosts too)."""
+        mine = coarse_values.reshape(-1, self.bs)[: self._owned]
+        grid = np.empty((self._slots.size, self.bs))
+        grid[self._slots] = np.concatenate(self.comm.allgather(mine))
+        fine = np.einsum("nk,nkb->nb", self._weight, grid[self._index])
+        return fine.reshape(-1)
 
 
 def mesh_levels(nx: int, ny: int, coarse_min_cells: int) -> list[tuple[int, int]]:

@@ -83,6 +83,7 @@ def iterate(
     max_iterations: int,
     greedy: bool = False,
     thresholds: tuple[float, ...] = (),
+    near: float | None = None,
 ) -> Run:
     """Primal-dual active-set iteration from the contact set ``start``.
 
@@ -99,6 +100,11 @@ def iterate(
             converge with first: the iteration ignores violations and pulls below the
             current threshold, and moves to the next one at a point that is KKT at this
             one, warm-started (:doc:`/methods/active_set`).
+        near: An estimate of the first set's load: each eigen solve then shifts just
+            below the previous iterate's load (or this estimate), the inertia proving
+            that the pair is the smallest
+            (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`).
+            Without it every solve is at 0.
 
     Note:
         Collective.
@@ -116,8 +122,10 @@ def iterate(
     vec = initial
     for it in range(max_iterations):
         seen.visit(active, it)
-        cand = problem.evaluate(active, initial=vec)
+        cand = problem.evaluate(active, initial=vec, near=near)
         vec = cand.mode.x.petsc_vec
+        if near is not None and math.isfinite(cand.load):
+            near = cand.load
         run.iterations = it + 1
         run.final = cand
         run.history.append((len(active), cand.load, cand.feasible))

@@ -417,9 +417,11 @@ class BucklingProblem(Owner):
             initial: Optional start vector of the eigen solve (e.g. a previous mode).
             near: Optional estimate of the load (e.g. that of the state Z is read
                 from): the eigen solve shifts just below it
-                (:meth:`~unibuckle_fenicsx.eigen.GEPSolver.solve`). Not for the empty
-                set: that is the free plate's pencil, solved as the free plate is (the
-                same load to the last bit, so a bracket on the free load closes).
+                (:meth:`~unibuckle_fenicsx.eigen.GEPSolver.solve`).
+
+        The empty set is the free plate's pencil: its candidate is made from
+        :meth:`solve_free`'s pair (solved once; the same load to the last bit, so a
+        bracket on the free load closes), whatever ``initial`` and ``near`` say.
 
         Note:
             Collective; ``active`` must be the same on every rank.
@@ -428,11 +430,13 @@ class BucklingProblem(Owner):
             raise ValueError("evaluate: the problem has no obstacle (this needs an obstacle zone)")
         active = np.unique(np.asarray(active, dtype=np.int64))
         u = self.new_mode()
+        if not active.size:
+            free = self.solve_free()
+            free.function.x.petsc_vec.copy(u.x.petsc_vec)
+            u.x.scatter_forward()
+            return self.candidate(u, free.load, active, eigen=free.eigen)
         pair = self.eigensolver.solve(
-            self.contact.removed_rows(active),
-            out=u.x.petsc_vec,
-            initial=initial,
-            near=near if active.size else None,
+            self.contact.removed_rows(active), out=u.x.petsc_vec, initial=initial, near=near
         )
         return self.candidate(u, pair.value, active, eigen=pair)
 
