@@ -59,6 +59,7 @@ __all__ = [
     "GEPSolver",
     "Owner",
     "SymmetricFactorization",
+    "abs_matrix",
     "extreme_eigenvalues",
     "pop_run_options",
     "push_run_options",
@@ -163,6 +164,15 @@ class Owner:
         tb: TracebackType | None,
     ) -> None:
         self.destroy()
+
+
+def abs_matrix(mat: PETSc.Mat) -> PETSc.Mat:
+    """A new matrix with the entries' absolute values (the caller destroys it; collective)."""
+    out = mat.duplicate(copy=True)
+    indptr, indices, values = out.getValuesCSR()
+    out.setValuesCSR(indptr, indices, np.abs(values))  # type: ignore[arg-type]
+    out.assemble()
+    return out
 
 
 def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False) -> None:

@@ -48,6 +48,11 @@ class BucklingResult:
         contact_coordinates: Coordinates of Z, (|Z|, 2).
         contact_indices: Node numbers of Z (lexicographic (y, x) order of the zone).
         contact_dofs: Global W DOF indices of Z (partition-dependent numbering).
+        load_resolution: How closely double precision fixes the critical load, relative
+            to it (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.load_resolution`:
+            1e-9 to 1e-8 on thin plates, where the shear stiffness dominates; digits beyond
+            it are rounding). None for a tensionless foundation (the springs' stiffness is
+            not counted).
         lower_bound_Pa / upper_bound_Pa: Verified bracket of the critical load (the upper
             bound is the load of an admissible mode; None if the method found none).
         certificate: :class:`~unibuckle_fenicsx.certificate.certify.Certificate` as a dict.
@@ -89,6 +94,7 @@ class BucklingResult:
     contact_coordinates: list[list[float]] = field(default_factory=list)
     contact_indices: list[int] = field(default_factory=list)
     contact_dofs: list[int] = field(default_factory=list)
+    load_resolution: float | None = None
     lower_bound_Pa: float | None = None
     upper_bound_Pa: float | None = None
     certificate: dict[str, Any] | None = None
@@ -167,6 +173,9 @@ class BucklingResult:
             input=_input(spec),
             versions=versions(),
         )
+        if not problem.tensionless:
+            mode = free.function if solution is None else solution.candidate.mode
+            result.load_resolution = problem.load_resolution(mode.x.petsc_vec, load)
         if problem.model.points:
             result.details["point_restraints"] = [g.report() for g in problem.model.points]
         if spec.gapped_obstacles:

@@ -87,7 +87,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.eigen import Owner, release, set_ldl_options, set_options
+from unibuckle_fenicsx.eigen import Owner, abs_matrix, release, set_ldl_options, set_options
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
@@ -127,15 +127,6 @@ RELAX_OPTIONS: dict[str, str | float | int | bool] = {
 
 _SAME = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
 _SUBSET = PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN
-
-
-def _abs_matrix(mat: PETSc.Mat) -> PETSc.Mat:
-    """A new matrix with the entries' absolute values (the caller destroys it)."""
-    out = mat.duplicate(copy=True)
-    indptr, indices, values = out.getValuesCSR()
-    out.setValuesCSR(indptr, indices, np.abs(values))  # type: ignore[arg-type]
-    out.assemble()
-    return out
 
 
 def _dot(a: PETSc.Vec, b: PETSc.Vec) -> float:
@@ -323,7 +314,7 @@ class InteriorPointNewton(Owner):
         self._y1, self._y2, self._rhs = A.createVecLeft(), A.createVecLeft(), A.createVecLeft()
         self._du, self._trial = A.createVecLeft(), A.createVecLeft()
         # |A| and |B| for the rounding floor of the residual (thin plates: |A||u| >> |Au|).
-        self._abs_A, self._abs_B = _abs_matrix(A), _abs_matrix(B)
+        self._abs_A, self._abs_B = abs_matrix(A), abs_matrix(B)
         # The regularisation's diagonal: diag(A), or the row sums of |B| (D - B is then
         # diagonally dominant: D bounds B above).
         self._reg = self._diag_A
