@@ -2,9 +2,16 @@
 
 Relative tolerances compare computed loads (Pa) or nodal values with each other; the
 eigen solver's default relative tolerance (``solver.eps_tol``, 1e-10) is the accuracy of a
-computed load, so no two loads are told apart below it. The problem file's own
-tolerances (``solver.tau``, ``solver.eps_tol``) are inputs, documented with the solver
-options, not here.
+computed load, so no two loads are told apart below it. On thin plates that is not so:
+double precision fixes a load only to its ``load_resolution``
+(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.load_resolution`, 1e-9 to 1e-8
+at t/b = 1e-3), and two solves of one contact set at different shifts differ by that.
+The tolerances below were not raised to it: where a comparison of loads from different
+solves decides (the empty set against the free load), the same pair is reused instead
+(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`); elsewhere such a
+comparison can at worst deny "proven" or a tie that lies within rounding. The problem
+file's own tolerances (``solver.tau``, ``solver.eps_tol``) are inputs, documented with
+the solver options, not here.
 """
 
 from __future__ import annotations
