@@ -586,10 +586,9 @@ def _explore(
     """
     found: list[tuple[Candidate, BarrierPoint]] = []
     paths = _Paths(problem, options)
-    met_before = paths.met_before
 
     def on_solved(point: BarrierPoint) -> NewtonStatus | None:
-        return NewtonStatus.MET_BEFORE if met_before(point.mu, point) else None
+        return NewtonStatus.MET_BEFORE if paths.met_before(point.mu, point) else None
 
     # Damped steps (a stiffness-scaled correction that decays from step to step) keep
     # each start near its own arrangement: measured, with the finer meshes' settings a
@@ -608,7 +607,7 @@ def _explore(
             level.links.append(_newton_link(seed, rec))
             if rec.status is not NewtonStatus.CONVERGED:
                 continue
-            if met_before(options.compare_mu, point):
+            if paths.met_before(options.compare_mu, point):
                 level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
                 continue
             point, rec = _run(
@@ -618,12 +617,12 @@ def _explore(
             )  # fmt: skip
             if rec.status is not NewtonStatus.CONVERGED:
                 continue
-            if met_before(point.mu, point):
+            if paths.met_before(point.mu, point):
                 level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
                 continue
             cand, point = _critical_state(problem, newton, point, level, seed, options, carry)
             if point.mu == options.explore_mu_min:
-                met_before(point.mu, point)  # where an escape ended
+                paths.met_before(point.mu, point)  # where an escape ended
             if cand is not None:
                 found.append((cand, point))
         found.sort(key=lambda cp: cp[0].load)

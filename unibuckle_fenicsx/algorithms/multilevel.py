@@ -101,8 +101,9 @@ class _BilinearWeights:
         self._slots = np.concatenate(self.comm.allgather(ix * (ny + 1) + iy))
         if self._slots.size != (nx + 1) * (ny + 1):
             raise RuntimeError("Prolongation: the coarse mesh is not the expected rectangle")
-        fx = (Vf.tabulate_dof_coordinates()[:, 0] - x0) / hx
-        fy = (Vf.tabulate_dof_coordinates()[:, 1] - y0) / hy
+        fine_xy = Vf.tabulate_dof_coordinates()
+        fx = (fine_xy[:, 0] - x0) / hx
+        fy = (fine_xy[:, 1] - y0) / hy
         cx = np.clip(np.floor(fx), 0, nx - 1).astype(np.int64)
         cy = np.clip(np.floor(fy), 0, ny - 1).astype(np.int64)
         sx, sy = fx - cx, fy - cy
