@@ -41,7 +41,6 @@ from test_stress_family import FAMILY, _check
 
 from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_unilateral
 from unibuckle_fenicsx.algorithms.interior_point import (
-    IPM_PREFIX,
     PUSH_MARGIN,
     BarrierPoint,
     InteriorPointNewton,
@@ -379,11 +378,14 @@ def test_two_ranks_give_the_serial_answer(tmp_path):
 def test_option_under_the_prefix_reaches_the_factorisation():
     """A command-line MUMPS control under the prefix, and the inertia controls, are in effect.
 
+    The Newton matrix is factorised by the mesh's shared LDL^T (prefix ``unibuckle_ldl_``).
     Construction does not factorise; the controls are read at the first factorisation.
     """
     problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    prefix = f"{problem.eigensolver.prefix}ldl_"
+    assert prefix == "unibuckle_ldl_"
     opts = PETSc.Options()
-    opts[f"{IPM_PREFIX}mat_mumps_icntl_14"] = 57
+    opts[f"{prefix}mat_mumps_icntl_14"] = 57
     try:
         with InteriorPointNewton(problem) as newton:
             assert newton.factorizations == 0
@@ -393,7 +395,7 @@ def test_option_under_the_prefix_reaches_the_factorisation():
             assert (factor.getMumpsIcntl(13), factor.getMumpsIcntl(24)) == (1, 1)
             assert factor.getInertia()[0] == 0  # A is positive definite
     finally:
-        del opts[f"{IPM_PREFIX}mat_mumps_icntl_14"]
+        del opts[f"{prefix}mat_mumps_icntl_14"]
         problem.destroy()
 
 

@@ -264,9 +264,13 @@ def test_cli_several_obstacles_distributed(tmp_path):
 def test_cli_foundation_distributed(tmp_path, side):
     """A tensionless (side above) and a bilateral (side both) Winkler foundation on 2 ranks.
 
-    0.3 x 0.1 m plate, loaded edges clamped, 24x8: the spring-set iteration takes the
-    serial path (same load, pressing nodes and certificate); the bilateral springs are
-    part of the stiffness (a free-plate solve).
+    0.3 x 0.1 m plate, loaded edges clamped, 24x8, k_f = 1e7 N/m^3: the spring-set
+    iteration takes the serial path (same load, pressing nodes and certificate); the
+    bilateral springs are part of the stiffness (a free-plate solve). At k_f = 2e7 the
+    iteration from the bilateral start is not monotone (its quotient jumps by 10x and back)
+    and the fixed point it reaches depends on rounding: measured on one machine, 499102.30
+    Pa on 1 rank and 498221.86 on 2, so the returned minimum differed by 8e-6 (the MPI
+    guide, docs/guide/mpi.md, says so).
     """
     path = tmp_path / f"foundation_{side}.toml"
     path.write_text(
@@ -274,7 +278,7 @@ def test_cli_foundation_distributed(tmp_path, side):
         '[edges.left]\nsupport = "clamped"\nnormal_stress = -1.0\n'
         '[edges.right]\nsupport = "clamped"\nnormal_stress = -1.0\n'
         "[mesh]\nnx = 24\nny = 8\n"
-        f'[obstacle]\nzone = "all"\nside = "{side}"\nfoundation_stiffness = 2.0e7\n'
+        f'[obstacle]\nzone = "all"\nside = "{side}"\nfoundation_stiffness = 1.0e7\n'
     )
     ser, par = _config_on_two_ranks(tmp_path, path)
     assert ser["method"] == ("foundation" if side == "above" else "free")

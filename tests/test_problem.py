@@ -133,6 +133,63 @@ def test_command_line_option_wins_and_defaults_do_not_leak():
     mat.destroy()
 
 
+def test_the_factorisations_of_a_mesh_share_one_symbolic_analysis():
+    """One MUMPS analysis per mesh for the Newton matrix, shifted solves and certificate.
+
+    All three have A's pattern: PETSc counts one symbolic LDL^T factorisation, and each
+    factorisation is of its user's values.
+
+    References: the shifted solve's load against the solve of the same reduced pencil at
+    target 0 (its own LU); the inertia of K(1.5 lambda_free) against the count of the
+    pencil's eigenvalues below 1.5 lambda_free from a dense solve (scipy's ``eigh`` of B x =
+    mu A x); a solve with K after another user has factorised the shared matrix against
+    the same solve before (the certificate factorises again).
+    """
+    from petsc4py import PETSc
+
+    from scipy.linalg import eigh
+    from scipy.sparse import csr_matrix
+
+    from unibuckle_fenicsx.algorithms.interior_point import InteriorPointNewton
+    from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
+
+    PETSc.Log.begin()
+    symbolic = PETSc.Log.Event("MatCholFctrSym")
+    spec = plate_case(
+        "thin", length=0.3, width=0.1, thickness=1e-3, nx=12, ny=4, zone=ObstacleSpec(zone="all")
+    )
+    problem = BucklingProblem(spec, MPI.COMM_SELF)
+    assert problem.contact is not None
+    before = symbolic.getPerfInfo()["count"]
+    with InteriorPointNewton(problem) as newton:
+        newton.pressure_mode()  # a factorisation of A: the analysis
+    active = np.arange(problem.contact.size)[::3]
+    cold = problem.evaluate(active)
+    warm = problem.evaluate(active, initial=cold.mode.x.petsc_vec, near=cold.load * (1 + 1e-5))
+    assert problem.eigensolver.shifted_solves == 1
+    lam = 1.5 * problem.solve_free().load
+    pencil = (problem.model.A, problem.model.B)
+    A, B = (csr_matrix(m.getValuesCSR()[::-1]).toarray() for m in pencil)
+    below = int((eigh(B, A, eigvals_only=True) > 1.0 / lam).sum())
+    shared = problem.eigensolver.factorization
+    with ShiftedMatrix(problem.model.A, problem.model.B, shared=shared) as matrix:
+        assert matrix.factor(lam)[0] == below >= 1
+        b = problem.model.A.createVecLeft()
+        b.setArray(np.linspace(1.0, 2.0, b.getLocalSize()))
+        x1, x2 = b.duplicate(), b.duplicate()
+        matrix.solve(b, x1)
+        problem.evaluate(active, initial=cold.mode.x.petsc_vec, near=warm.load)  # takes it
+        assert not shared.holds(matrix)
+        matrix.solve(b, x2)
+        assert matrix.factorisations == 2  # factorised again, numerically only
+        assert np.allclose(x2.array_r, x1.array_r, rtol=1e-12, atol=0.0)
+        for v in (b, x1, x2):
+            v.destroy()
+    assert symbolic.getPerfInfo()["count"] - before == 1
+    assert warm.load == pytest.approx(cold.load, rel=1e-9)
+    problem.destroy()
+
+
 @pytest.mark.parametrize("load", ["uniaxial", "shear"])
 def test_eigen_solve_near_an_estimate_is_the_smallest(load):
     """A solve shifted just below an estimate returns the smallest eigenpair, or solves again.

@@ -14,7 +14,8 @@ the barrier problem :math:`\min \tfrac12 u^TAu - \mu\sum_k \log g_k` on
 
 (E scatters oriented nodal values into W) which tend to the KKT conditions of the
 critical state as :math:`\mu \to 0`. One Newton step is one numeric :math:`LDL^T`
-(MUMPS; the pattern is A's, so the symbolic analysis is done once) of
+(MUMPS; the pattern is A's, so the symbolic analysis is done once per mesh, and shared
+with the shifted eigen solves and the certificate) of
 
 .. math::
 
@@ -87,7 +88,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.eigen import Owner, abs_matrix, release, set_ldl_options, set_options
+from unibuckle_fenicsx.eigen import Owner, abs_matrix, release, set_options
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
@@ -101,7 +102,10 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: Options prefix of the Newton matrix's factorisation (``-unibuckle_ipm_ksp_view``).
+#: Options prefix of the method's own solvers (:data:`RELAX_OPTIONS`:
+#: ``-unibuckle_ipm_relax_w_ksp_view``). The Newton matrix is factorised by the mesh's
+#: shared :math:`LDL^T` (:class:`~unibuckle_fenicsx.eigen.SharedFactorization`, options
+#: prefix ``unibuckle_ldl_``).
 IPM_PREFIX = "unibuckle_ipm_"
 
 #: Smallest gap (relative to max|w|) of a pressure deflection that had to be lifted off
@@ -266,12 +270,16 @@ class _StallWatch:
 
 
 class InteriorPointNewton(Owner):
-    """The interior-point Newton method on one problem (owns K, its LDLᵀ and work vectors).
+    """The interior-point Newton method on one problem (owns its work vectors and solvers).
+
+    The Newton matrix K and its :math:`LDL^T` are the mesh's
+    :class:`~unibuckle_fenicsx.eigen.SharedFactorization` (``problem.eigensolver``'s),
+    whose symbolic analysis the shifted eigen solves and the certificate reuse.
 
     Args:
         problem: A problem with a rigid obstacle.
         options: Settings (default :class:`NewtonOptions`).
-        prefix: Options prefix of the factorisation.
+        prefix: Options prefix of the method's own solvers (:data:`RELAX_OPTIONS`).
 
     Note:
         Construction, every method and :meth:`destroy` are collective.
@@ -299,12 +307,13 @@ class InteriorPointNewton(Owner):
         self._signs = contact.owned_signs
         A, B = problem.model.A, problem.model.B
         self.A, self.B = A, B
-        self.K = A.duplicate(copy=True)
-        self.ksp = PETSc.KSP().create(A.comm)
-        self.ksp.setOperators(self.K)
-        self.K.setOption(PETSc.Mat.Option.SPD, False)
-        self.K.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-        set_ldl_options(self.ksp, prefix)  # the first _factor analyses K's pattern
+        self._ldl = problem.eigensolver.factorization
+        self.K, self.ksp = self._ldl.matrix, self._ldl.ksp  # shared: not destroyed here
+        # B with A's pattern (explicit zeros where B has none): K = A - lambda B is then
+        # an axpy of two value arrays, not a pattern merge (at 90x30 1.4 -> 0.1 ms a
+        # factorisation; the same values: x - lambda * 0 = x).
+        self._B_on_A = A.duplicate(copy=False)
+        self._B_on_A.axpy(1.0, B, structure=_SUBSET)
         self.prefix = prefix
         self.factorizations = 0
         self._diag_A = A.createVecLeft()
@@ -340,14 +349,19 @@ class InteriorPointNewton(Owner):
         """``vec += E values`` (oriented values at the owned constrained nodes)."""
         vec.array[self._dofs] += self._signs * values
 
+    # (On one rank the reductions skip MPI: mpi4py's allreduce of a Python float pickles
+    # it, about 30 us a call, a tenth of a Newton step on the coarsest mesh.)
     def _min(self, values: npt.NDArray[np.float64]) -> float:
-        return float(self.comm.allreduce(values.min() if values.size else math.inf, op=MPI.MIN))
+        local = float(values.min()) if values.size else math.inf
+        return local if self.comm.size == 1 else float(self.comm.allreduce(local, op=MPI.MIN))
 
     def _max(self, values: npt.NDArray[np.float64]) -> float:
-        return float(self.comm.allreduce(values.max() if values.size else -math.inf, op=MPI.MAX))
+        local = float(values.max()) if values.size else -math.inf
+        return local if self.comm.size == 1 else float(self.comm.allreduce(local, op=MPI.MAX))
 
     def _sum(self, value: float) -> float:
-        return float(self.comm.allreduce(float(value), op=MPI.SUM))
+        local = float(value)
+        return local if self.comm.size == 1 else float(self.comm.allreduce(local, op=MPI.SUM))
 
     # -- the Newton matrix -------------------------------------------------------------
     def _factor(
@@ -364,7 +378,7 @@ class InteriorPointNewton(Owner):
         """
         self.A.copy(self.K, structure=_SAME)
         if load:
-            self.K.axpy(-load, self.B, structure=_SUBSET)
+            self.K.axpy(-load, self._B_on_A, structure=_SAME)  # type: ignore[arg-type]
         self._diag.zeroEntries()
         if delta:
             geometric = self.options.metric == "geometric"
@@ -374,12 +388,10 @@ class InteriorPointNewton(Owner):
             self._diag.array[self._dofs] += sigma
         if stiff is not None:
             self._diag.array[stiff[0]] += stiff[1]
-        self.K.setDiagonal(self._diag, addv=PETSc.InsertMode.ADD_VALUES)
-        self.ksp.setOperators(self.K)
-        self.ksp.setUp()
+        self.K.setDiagonal(self._diag, addv=PETSc.InsertMode.ADD_VALUES)  # type: ignore[arg-type]
+        nneg, nzero, _ = self._ldl.factor(self)
         self.factorizations += 1
-        nneg, nzero, _ = self.ksp.getPC().getFactorMatrix().getInertia()
-        return int(nneg), int(nzero)
+        return nneg, nzero
 
     def _held_diagonal(self) -> float:
         """Diagonal entry that holds a DOF (:meth:`relax`, :meth:`lift`): 1e8 max diag(A)."""
@@ -1030,7 +1042,8 @@ class InteriorPointNewton(Owner):
             for obj in (ksp, rhs, step):
                 obj.destroy()
         self._blocks = {}
-        release(self, "ksp", "K", "_abs_A", "_abs_B", "_diag_A", "_diag", "_reg")
+        # (K and its KSP are the problem's shared factorisation: not destroyed here.)
+        release(self, "_B_on_A", "_abs_A", "_abs_B", "_diag_A", "_diag", "_reg")
         release(self, "_Au", "_Bu", "_Fu", "_y1", "_y2", "_rhs", "_du", "_trial")
 
     def __del__(self) -> None:

@@ -296,7 +296,9 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     refuting: Candidate | None = None
     # One factorisation object for the copositivity attempt and the smallest-eigenvalue
     # check (same pattern): the check reuses the attempt's symbolic analysis.
-    matrix = ShiftedMatrix(problem.model.A, problem.model.B)
+    matrix = ShiftedMatrix(
+        problem.model.A, problem.model.B, shared=problem.eigensolver.factorization
+    )
     try:
         if not algorithm_proof and global_bound and kkt and cand.eigen is not None:
             if options is None and not problem.spec.solver.bracket:

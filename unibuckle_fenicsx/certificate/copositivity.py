@@ -338,7 +338,9 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
     a = -np.sign(sigma) * phi  # normalisation a'w = 1 of the other nappe
     own = matrix is None
     if matrix is None:
-        matrix = ShiftedMatrix(problem.model.A, problem.model.B)
+        matrix = ShiftedMatrix(
+            problem.model.A, problem.model.B, shared=problem.eigensolver.factorization
+        )
     factorisations0, solves0 = matrix.factorisations, matrix.solves
     factor_s0, solve_s0 = matrix.factor_s, matrix.solve_s
     result: LowerBound | None = None

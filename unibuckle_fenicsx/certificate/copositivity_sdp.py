@@ -141,9 +141,9 @@ def spn_certificate(problem: BucklingProblem, matrix: ShiftedMatrix, lam: float)
 
     ``matrix`` holds the factorisation of :math:`K(\lambda)`, ``lam`` its shift.
     """
-    if matrix.factorization is None:
+    if not matrix.factored:
         raise ValueError("spn_certificate: matrix must be factorised (ShiftedMatrix.factor)")
-    neg_K = matrix.factorization.inertia()[0]
+    neg_K = matrix.inertia()[0]
     S = np.linalg.inv(_inverse_on_constrained(problem, matrix))
     S = 0.5 * (S + S.T)
     neg_S = int((np.linalg.eigvalsh(S) < 0).sum())
@@ -195,12 +195,12 @@ def sector_certificate(
     problem: BucklingProblem, matrix: ShiftedMatrix, lam: float, sectors: tuple[int, ...]
 ) -> dict[str, Any]:
     """Copositivity on every sector piece of the cone (two negative eigenvalues)."""
-    if problem.contact is None or matrix.factorization is None:
+    if problem.contact is None or not matrix.factored:
         raise RuntimeError(
-            "sector_certificate: expected problem.contact is not None and matrix.factorization is "
-            "not None (an internal invariant)"
+            "sector_certificate: expected problem.contact is not None and matrix.factored (an "
+            "internal invariant)"
         )
-    neg_K = matrix.factorization.inertia()[0]
+    neg_K = matrix.inertia()[0]
     out: dict[str, Any] = {"ok": False, "neg_K": neg_K, "lambda": lam}
     if neg_K != 2:
         out["why"] = "the sector split is implemented for two negative eigenvalues"

@@ -7,7 +7,9 @@ refined solves with floating-point bounds, and the plate's mirror symmetries of 
 constrained nodes.
 
 Note:
-    Collective on the problem's communicator. Options prefix ``unibuckle_certify_``.
+    Collective on the problem's communicator. The factorisations go through the mesh's
+    shared :math:`LDL^T` (:class:`~unibuckle_fenicsx.eigen.SharedFactorization`, options
+    prefix ``unibuckle_ldl_``) when one is given, else under ``unibuckle_certify_``.
 """
 
 from __future__ import annotations
@@ -21,13 +23,14 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.eigen import Owner, SymmetricFactorization, release
+from unibuckle_fenicsx.eigen import Owner, SharedFactorization, SymmetricFactorization, release
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = ["CERTIFY_PREFIX", "EPS", "ShiftedMatrix", "Solve", "absdot", "mirror_maps", "norm2"]
 
-#: Options prefix of the certificate's factorisations (``-unibuckle_certify_ksp_view``).
+#: Options prefix of the certificate's own factorisations (``-unibuckle_certify_ksp_view``):
+#: those not done by the mesh's shared :math:`LDL^T`.
 CERTIFY_PREFIX = "unibuckle_certify_"
 EPS = float(np.finfo(float).eps)
 
@@ -70,13 +73,23 @@ class ShiftedMatrix(Owner):
     Args:
         A: Stiffness (AIJ).
         B: Geometric stiffness (AIJ).
-        prefix: Options prefix of the factorisation.
+        prefix: Options prefix of the factorisation (when not ``shared``).
+        shared: The mesh's shared :math:`LDL^T` (``problem.eigensolver.factorization``):
+            K's values are copied into its matrix and factorised there, reusing the
+            symbolic analysis of the interior-point method and the shifted eigen solves
+            (when K has its pattern; otherwise K gets its own factorisation).
 
     Note:
         Collective. The owner must :meth:`destroy` it.
     """
 
-    def __init__(self, A: PETSc.Mat, B: PETSc.Mat, prefix: str = CERTIFY_PREFIX) -> None:
+    def __init__(
+        self,
+        A: PETSc.Mat,
+        B: PETSc.Mat,
+        prefix: str = CERTIFY_PREFIX,
+        shared: SharedFactorization | None = None,
+    ) -> None:
         for mat, name in ((A, "A"), (B, "B")):
             if mat.getType() not in ("seqaij", "mpiaij"):
                 raise TypeError(f"{name} must be AIJ for the LDL^T inertia, got {mat.getType()}")
@@ -85,6 +98,9 @@ class ShiftedMatrix(Owner):
         self.Kt: PETSc.Mat | None = None
         self.Kabs: PETSc.Mat | None = None
         self.factorization: SymmetricFactorization | None = None
+        self.shared = shared
+        self._on_shared = False  # the last factorisation went through ``shared``
+        self._fits: bool | None = None  # whether K has the shared matrix's pattern
         self.row_length = 0
         self.solves = 0
         self.factorisations = 0
@@ -156,22 +172,53 @@ class ShiftedMatrix(Owner):
 
     def _factorise(self, K: PETSc.Mat, t0: float) -> tuple[int, int, int]:
         """Factorise K (its symbolic analysis done once, on the first call); its inertia."""
-        if self.factorization is None:
-            self.factorization = SymmetricFactorization(K, self.prefix)
+        if self._fits is None:  # K is built once (build): its pattern never changes
+            self._fits = self.shared is not None and self.shared.fits(K)
+        self._on_shared = self._fits
+        if self._on_shared:
+            inertia = self._factor_shared(K)
         else:
-            self.factorization.ksp.setOperators(K)
-            self.factorization.ksp.setUp()
+            if self.factorization is None:
+                self.factorization = SymmetricFactorization(K, self.prefix)
+            else:
+                self.factorization.ksp.setOperators(K)
+                self.factorization.ksp.setUp()
+            inertia = self.factorization.inertia()
         self.factorisations += 1
-        inertia = self.factorization.inertia()
         self.factor_s += time.perf_counter() - t0
         return inertia
 
+    def _factor_shared(self, K: PETSc.Mat) -> tuple[int, int, int]:
+        assert self.shared is not None
+        K.copy(self.shared.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)  # type: ignore[arg-type]
+        return self.shared.factor(self)
+
+    @property
+    def factored(self) -> bool:
+        """Whether K has been factorised (:meth:`factor` or :meth:`factor_reduced`)."""
+        return self._on_shared or self.factorization is not None
+
+    def _current(self) -> SymmetricFactorization | SharedFactorization:
+        """The factorisation of K as it is now (the shared one: again if another took it)."""
+        if self._on_shared:
+            assert self.shared is not None and self.K is not None
+            if not self.shared.holds(self):
+                self._factor_shared(self.K)
+                self.factorisations += 1
+            return self.shared
+        if self.factorization is None:
+            raise RuntimeError("ShiftedMatrix: call factor() first")
+        return self.factorization
+
+    def inertia(self) -> tuple[int, int, int]:
+        """(negative, zero, positive) eigenvalue counts of the factorised K."""
+        return self._current().inertia()
+
     def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
         """X = K^-1 b with the current factorisation."""
-        if self.factorization is None:
-            raise RuntimeError("ShiftedMatrix.solve: call factor() first")
+        factorization = self._current()
         t0 = time.perf_counter()
-        self.factorization.solve(b, x)
+        factorization.ksp.solve(b, x)
         self.solves += 1
         self.solve_s += time.perf_counter() - t0
 
