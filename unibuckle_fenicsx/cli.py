@@ -70,7 +70,7 @@ exit status:
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
 
 Single-dash options that argparse does not know go to PETSc/SLEPc under the package's
-prefixes, e.g. -unibuckle_eps_view, -unibuckle_eps_tol 1e-12, -unibuckle_certify_ksp_view.
+prefixes, e.g. -unibuckle_eps_view, -unibuckle_eps_tol 1e-12, -unibuckle_ldl_ksp_view.
 """
 
 
