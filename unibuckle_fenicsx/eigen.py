@@ -751,10 +751,10 @@ class SharedFactorization(Owner):
     of the eigen solves near an estimate (:math:`A_Z - \sigma B_Z`) and the
     certificate's :math:`A - \lambda B` all have the stiffness matrix's nonzero pattern.
     Each user writes its values into :attr:`matrix` and calls :meth:`factor`; MUMPS's
-    symbolic analysis (the fill-reducing ordering) is done on the first call only. Each
-    user its own matrix and factorisation cost one analysis apiece: measured on a thin
-    plate at 180×60 (33 123 DOFs), 0.19 s each, as long as a numeric factorisation, three
-    of them per mesh.
+    symbolic analysis (the fill-reducing ordering) is done on the first call only. With a
+    matrix and a factorisation each, the three users cost three analyses per mesh:
+    measured on a thin plate at 180×60 (33 123 DOFs), 0.19 s each, as long as a numeric
+    factorisation.
 
     The factorisation belongs to whoever called :meth:`factor` last (:meth:`holds`): a
     user that solves with it later checks that first and factorises again if not.
