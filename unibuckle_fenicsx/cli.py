@@ -561,6 +561,11 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return _run(args, rest, comm)
     except KeyboardInterrupt:
+        # What the interrupt left half-built is destroyed with its traceback, when this
+        # handler ends; a destructor that assumes a finished constructor (dolfinx's
+        # LinearProblem.__del__ reads self._solver) would print "Exception ignored ...
+        # Traceback" after the one-line message.
+        sys.unraisablehook = _after_interrupt
         if comm.rank == 0:
             where = "nothing written"
             if args.command == "sweep":
@@ -800,6 +805,13 @@ def nonlinear_verdict(result: Any, max_load: float) -> str:
         f"the load path does not validate everything against the linear critical load "
         f"{linear:.6e} Pa. Validated: {', '.join(validated) or 'nothing'}. Not validated: "
         f"{', '.join(missing)}"
+    )
+
+
+def _after_interrupt(unraisable: Any) -> None:
+    """``sys.unraisablehook`` once interrupted: a destructor's error is logged, not printed."""
+    logging.getLogger(__name__).debug(
+        "after the interrupt, in %r: %s", unraisable.object, unraisable.exc_value
     )
 
 
