@@ -311,7 +311,7 @@ class InteriorPointNewton(Owner):
         self.K, self.ksp = self._ldl.matrix, self._ldl.ksp  # shared: not destroyed here
         # B with A's pattern (explicit zeros where B has none): K = A - lambda B is then
         # an axpy of two value arrays, not a pattern merge (at 90x30 1.4 -> 0.1 ms a
-        # factorisation; the same values: x - lambda * 0 = x).
+        # factorisation; the same values up to the rounding of a fused multiply-add).
         self._B_on_A = A.duplicate(copy=False)
         self._B_on_A.axpy(1.0, B, structure=_SUBSET)
         self.prefix = prefix
