@@ -54,7 +54,6 @@ __all__ = [
     "EIGEN_OPTIONS",
     "EXTREME_OPTIONS",
     "LDL_OPTIONS",
-    "NEAR_OPTIONS",
     "RUN_EPS_PREFIXES",
     "EigenPair",
     "EigenSolveError",
@@ -77,28 +76,20 @@ logger = logging.getLogger(__name__)
 Options = Mapping[str, str | float | int | bool]
 
 #: Default EPS options of :class:`GEPSolver` (overridable per solver or on the command
-#: line under the prefix).
+#: line under the prefix). The solves at target 0 factorise with an LU; the shifted
+#: solves (``near=...``) with the mesh's :class:`SharedFactorization`, a symmetric
+#: :math:`LDL^T` whose inertia they need. Measured, an :math:`LDL^T` at target 0 too
+#: makes a free solve faster (a thin 90×30 plate: 0.22–0.33 → 0.11–0.22 s) but changes
+#: the rounding that decides between mirror-image contact sets of equal load, and with
+#: it the active set's path (a random 6×3 plate of the test families then ended at a
+#: higher KKT point; a symmetric plate on two ranks at the mirror image of the serial
+#: one).
 EIGEN_OPTIONS: dict[str, str | float | int | bool] = {
     "eps_type": "krylovschur",
     "st_ksp_type": "preonly",
     "st_pc_type": "lu",
     "st_pc_factor_mat_solver_type": "mumps",
     "eps_max_it": 500,
-}
-
-#: What the shifted solves (``near=...``, options prefix ``<prefix>near_``) change in
-#: :data:`EIGEN_OPTIONS` (or the solver's options): MUMPS's symmetric :math:`LDL^T`
-#: ("cholesky" with pivoting, the shifted matrix being indefinite), which reports the
-#: inertia; the factorisation itself is the mesh's :class:`SharedFactorization`
-#: (options prefix ``<prefix>ldl_``). The solves at target 0 keep the LU: measured, an
-#: :math:`LDL^T` there makes a free solve faster (a thin 90×30 plate: 0.22–0.33 →
-#: 0.11–0.22 s) but changes the rounding that decides between mirror-image contact
-#: sets of equal load, and with it the active set's path (a random 6×3 plate of the
-#: test families then ended at a higher KKT point; a symmetric plate on two ranks at
-#: the mirror image of the serial one).
-NEAR_OPTIONS: dict[str, str | float | int | bool] = {
-    "st_pc_type": "cholesky",
-    "st_pc_factor_mat_solver_type": "mumps",
 }
 
 #: A solve given an estimate ``near`` of the eigenvalue shifts to ``near * (1 -
@@ -380,11 +371,11 @@ class GEPSolver(Owner):
             out: Vector receiving the eigenvector (B-normalised by SLEPc).
             initial: Optional start vector (e.g. the previous mode).
             near: Optional estimate of the eigenvalue (the same on every rank): a
-                second EPS (options prefix ``<prefix>near_``, :data:`NEAR_OPTIONS`)
-                shifts to :data:`NEAR_MARGIN` below it, and its factorisation's
-                inertia (:attr:`factorization`, prefix ``<prefix>ldl_``) proves that
-                no eigenvalue lies below the shift; if one does (or nothing
-                converges), the solve at target 0 runs instead.
+                second EPS (options prefix ``<prefix>near_``) shifts to
+                :data:`NEAR_MARGIN` below it, and its factorisation's inertia
+                (:attr:`factorization`, prefix ``<prefix>ldl_``) proves that no
+                eigenvalue lies below the shift; if one does (or nothing converges),
+                the solve at target 0 runs instead.
 
         Returns:
             The eigenpair, with value ``inf`` when no finite load exists (the removed DOFs
@@ -479,7 +470,9 @@ class GEPSolver(Owner):
             eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
             st = eps.getST()
             st.setType(SLEPc.ST.Type.SINVERT)
-            set_options(eps, self.prefix + "near_", {**self._options, **NEAR_OPTIONS})
+            # The EPS options only: its spectral transformation's own solver is replaced.
+            eps_only = {k: v for k, v in self._options.items() if not k.startswith("st_")}
+            set_options(eps, self.prefix + "near_", eps_only)
             st.setMatMode(SLEPc.ST.MatMode.INPLACE)
             st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
             st.setKSP(self.factorization.ksp)

@@ -294,8 +294,8 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     algorithm_proof = solution.global_optimum_proven
     record: dict[str, Any] | None = None
     refuting: Candidate | None = None
-    # One factorisation object for the copositivity attempt and the smallest-eigenvalue
-    # check (same pattern): the check reuses the attempt's symbolic analysis.
+    # One matrix for the copositivity attempt and the smallest-eigenvalue check, both
+    # factorised through the mesh's shared LDL^T (its symbolic analysis done once).
     matrix = ShiftedMatrix(
         problem.model.A, problem.model.B, shared=problem.eigensolver.factorization
     )

@@ -312,6 +312,7 @@ class BucklingProblem(Owner):
         self.free: Mode | None = None
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
+        self._abs: tuple[PETSc.Mat, PETSc.Mat] | None = None  # abs_pencil(), made when needed
         self.tau = spec.solver.tau
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         self._w_owned = self.model.w_dofs[:n_owned_w]
@@ -530,16 +531,26 @@ class BucklingProblem(Owner):
         Note:
             Collective.
         """
-        abs_A = abs_matrix(self.model.A)
+        abs_A, _ = self.abs_pencil()
         size, product = u.duplicate(), u.duplicate()
         size.array[:] = np.abs(u.array_r)
         abs_A.mult(size, product)
         stiffness = float(size.dot(product).real)
         self.model.B.mult(u, product)
         geometric = float(u.dot(product).real)
-        for obj in (abs_A, size, product):
-            obj.destroy()
+        for vec in (size, product):
+            vec.destroy()
         return float(np.finfo(float).eps * stiffness / (geometric * load))
+
+    def abs_pencil(self) -> tuple[PETSc.Mat, PETSc.Mat]:
+        """:math:`|A|` and :math:`|B|` entrywise (rounding bounds), made once and kept.
+
+        Shared by :meth:`load_resolution` and the interior-point method's residual floor;
+        A and B are not changed after set-up. Owned by the problem. Collective.
+        """
+        if self._abs is None:
+            self._abs = (abs_matrix(self.model.A), abs_matrix(self.model.B))
+        return self._abs
 
     # -- reporting ------------------------------------------------------------------
     def buckling_coefficient(self, load: float) -> float:
@@ -554,6 +565,9 @@ class BucklingProblem(Owner):
     def destroy(self) -> None:
         """Destroy the PETSc/SLEPc objects (collective) and take back the run's options."""
         release(self, "_r", "_Bu")
+        for mat in getattr(self, "_abs", None) or ():
+            mat.destroy()
+        self._abs = None
         pop_run_options(getattr(self, "_run_options", []))
         for name in ("eigensolver", "model"):  # absent when the constructor failed early
             owner = getattr(self, name, None)
