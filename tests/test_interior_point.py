@@ -19,6 +19,10 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
   step (the direction for a zero barrier parameter) closes by more than half their gap;
   read inside a run it leaves the run unchanged; the fine mesh read early gives the
   load of the mesh read at the end, in fewer Newton steps.
+- Near a saddle of the barrier problem, the direction of most negative curvature read
+  off the regularised factorisation is that of a dense reference (the Schur complement
+  onto the DOFs with geometric stiffness, on the tangent space), and the step along it
+  lowers the barrier objective.
 - An option under the prefix ``unibuckle_ipm_`` reaches the factorisation.
 """
 
@@ -44,6 +48,7 @@ from unibuckle_fenicsx.algorithms.interior_point import (
     PUSH_MARGIN,
     BarrierPoint,
     InteriorPointNewton,
+    NewtonOptions,
     NewtonStatus,
     _StallWatch,
 )
@@ -162,6 +167,63 @@ def test_newton_direction_solves_the_linearised_conditions(side):
     assert np.allclose(dz, E.T @ delta[:n], rtol=0, atol=1e-8 * scale)
     assert abs(dlam - delta[-1]) <= 1e-8 * max(abs(delta[-1]), lam)
     assert np.allclose(dnu, delta[n:-1], rtol=1e-6, atol=1e-8 * np.abs(delta[n:-1]).max())
+
+
+@serial
+def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
+    r"""At a load above the second free one, K has a negative direction on the tangent space.
+
+    Reference: the smallest eigenvalue of the dense pencil
+    :math:`(Q^TSQ, Q^TM_{PP}Q)`, where P are the DOFs on which the regularisation's
+    diagonal M (the row sums of :math:`\lambda|B|`) is nonzero, S the Schur complement
+    of K onto them (the other DOFs, the rotations, carry no geometric stiffness and
+    are eliminated at their minimum) and Q a basis of the tangent space
+    :math:`(Bu)^Tv = 0`. With as many Krylov vectors as that space has dimensions the
+    Rayleigh–Ritz value is that eigenvalue (to the rounding of the thin plate's solves,
+    measured 1e-11 of it); the step along the direction lowers the barrier objective.
+    """
+    problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    A, B = dense(problem.model.A), dense(problem.model.B)
+    D = np.abs(B).sum(axis=1)
+    P, R = np.flatnonzero(D > 0.0), np.flatnonzero(D == 0.0)
+    # As many Krylov vectors as the tangent space on P has dimensions (one more would
+    # be rounding only, with rotations that are not at their least energy).
+    options = replace(NewtonOptions(), curvature_vectors=P.size - 1)
+    with InteriorPointNewton(problem, options) as newton:
+        u = newton.pressure_mode()  # strictly inside the cone
+        vec = u.x.petsc_vec
+        newton._normalize(vec)
+        x = vec.array.copy()
+        gap = -newton.oriented(vec)
+        second = np.sort(np.linalg.eigvals(np.linalg.solve(A, B)).real)[-2]
+        lam = 1.3 / second  # between the second and third free loads
+        mu_abs = 1e-6 * lam * np.abs(B @ x).max() * np.abs(x).max()
+        nu = mu_abs / gap
+        newton._residual(vec, lam, nu)
+        assert newton.direction(vec, lam, nu, gap, mu_abs) is not None
+        assert newton._last_correction > 0.0  # the unmodified K had the wrong inertia
+        du = newton._du.array.copy()
+        found = newton.negative_curvature(vec, lam)
+        assert found is not None
+        theta, d = found[0], found[1].array.copy()
+        assert np.array_equal(newton._du.array, du)  # the Newton direction is kept
+        phi0 = newton._merit(vec, mu_abs)
+        assert newton._curvature_step(vec, lam, gap, mu_abs) is not None
+        phi1 = newton._merit(vec, mu_abs)
+        sigma = np.zeros(x.size)
+        sigma[newton._dofs] = nu / gap
+    problem.destroy()
+    K = A - lam * B + np.diag(sigma)
+    S = K[np.ix_(P, P)] - K[np.ix_(P, R)] @ np.linalg.solve(K[np.ix_(R, R)], K[np.ix_(R, P)])
+    Q = np.linalg.svd((B @ x)[P][None, :])[2][1:].T  # orthonormal basis of the tangent space
+    M = lam * np.diag(D[P])
+    L = np.linalg.cholesky(Q.T @ M @ Q)
+    reference = np.linalg.eigvalsh(np.linalg.solve(L, np.linalg.solve(L, Q.T @ S @ Q).T))[0]
+    assert reference < -1e-4  # a saddle, as the test intends
+    assert theta == pytest.approx(reference, rel=1e-8)
+    assert abs((B @ x) @ d) <= 1e-10 * np.abs(B @ x).max() * np.abs(d).max()
+    assert (d @ K @ d) / (d @ (lam * D * d)) == pytest.approx(reference, rel=1e-8)
+    assert phi1 < phi0
 
 
 @serial
