@@ -22,7 +22,7 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
 - Near a saddle of the barrier problem, the direction of most negative curvature read
   off the regularised factorisation is that of a dense reference (the Schur complement
   onto the DOFs with geometric stiffness, on the tangent space), and the step along it
-  lowers the barrier objective.
+  lowers the barrier objective; with a few Krylov vectors two ranks find the serial value.
 - An option under the prefix ``unibuckle_ipm_`` reaches the factorisation.
 """
 
@@ -224,6 +224,39 @@ def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
     assert abs((B @ x) @ d) <= 1e-10 * np.abs(B @ x).max() * np.abs(d).max()
     assert (d @ K @ d) / (d @ (lam * D * d)) == pytest.approx(reference, rel=1e-8)
     assert phi1 < phi0
+
+
+@serial
+def test_negative_curvature_is_the_same_on_two_ranks(tmp_path):
+    """Three Krylov vectors: a Ritz value that depends on the start.
+
+    The start is a function of the DOFs' coordinates, not of their numbers, so two ranks
+    find the serial value (to the rounding of the solves, 1e-9 relative on this thin plate).
+    """
+    spec = _thin(nx=12, ny=4)
+    problem = BucklingProblem(spec, MPI.COMM_SELF)
+    A, B = dense(problem.model.A), dense(problem.model.B)
+    lam = 1.3 / np.sort(np.linalg.eigvals(np.linalg.solve(A, B)).real)[-2]
+    with InteriorPointNewton(problem, replace(NewtonOptions(), curvature_vectors=3)) as newton:
+        u = newton.pressure_mode()
+        vec = u.x.petsc_vec
+        newton._normalize(vec)
+        x = vec.array.copy()
+        gap = -newton.oriented(vec)
+        mu_abs = 1e-6 * lam * np.abs(B @ x).max() * np.abs(x).max()
+        nu = mu_abs / gap
+        newton._residual(vec, lam, nu)
+        assert newton.direction(vec, lam, nu, gap, mu_abs) is not None
+        found = newton.negative_curvature(vec, lam)
+        assert found is not None
+    problem.destroy()
+    path = tmp_path / "plate.json"
+    path.write_text(json.dumps({"input": problem_to_dict(spec)}))
+    script = PARALLEL.parent / "negative_curvature_parallel.py"
+    out = run_mpi(script, 2, str(path), repr(float(lam)), "3")
+    report = json.loads(out.strip().splitlines()[-1])
+    assert found[0] < -1e-4
+    assert report["theta"] == pytest.approx(found[0], rel=1e-9)
 
 
 @serial

@@ -1,0 +1,41 @@
+"""The direction of most negative curvature on a mesh distributed over the ranks.
+
+Usage: mpiexec -n 2 python negative_curvature_parallel.py PROBLEM.json LOAD VECTORS
+
+Prints, on rank 0, the JSON of the Rayleigh–Ritz value over ``VECTORS`` Krylov vectors
+at the pressure deflection and the load ``LOAD`` (the serial test's set-up).
+"""
+
+from __future__ import annotations
+
+import json
+import sys
+from dataclasses import replace
+
+from mpi4py import MPI
+
+from unibuckle_fenicsx.algorithms.interior_point import InteriorPointNewton, NewtonOptions
+from unibuckle_fenicsx.config import load_problem
+from unibuckle_fenicsx.model.problem import BucklingProblem
+
+from petsc4py import PETSc  # isort: skip
+
+spec = load_problem(sys.argv[1])
+lam, vectors = float(sys.argv[2]), int(sys.argv[3])
+problem = BucklingProblem(spec, MPI.COMM_WORLD)
+with InteriorPointNewton(problem, replace(NewtonOptions(), curvature_vectors=vectors)) as newton:
+    u = newton.pressure_mode()
+    vec = u.x.petsc_vec
+    newton._normalize(vec)
+    gap = -newton.oriented(vec)
+    newton.B.mult(vec, newton._Bu)
+    w_max = float(vec.norm(PETSc.NormType.INFINITY))
+    mu_abs = 1e-6 * lam * float(newton._Bu.norm(PETSc.NormType.INFINITY)) * w_max
+    nu = mu_abs / gap
+    newton._residual(vec, lam, nu)
+    assert newton.direction(vec, lam, nu, gap, mu_abs) is not None
+    found = newton.negative_curvature(vec, lam)
+    assert found is not None
+problem.destroy()
+if MPI.COMM_WORLD.rank == 0:
+    print(json.dumps({"theta": found[0]}))
