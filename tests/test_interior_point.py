@@ -18,7 +18,8 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
 - The predicted contact set is the set of nodes that the dense affine-scaling Newton
   step (the direction for a zero barrier parameter) closes by more than half their gap;
   read inside a run it leaves the run unchanged; the fine mesh read early gives the
-  load of the mesh read at the end, in fewer Newton steps.
+  load of the mesh read at the end, in fewer Newton steps, and a set predicted at two
+  steps in a row the load of the set read where the barrier problem is solved.
 - Near a saddle of the barrier problem, the direction of most negative curvature read
   off the regularised factorisation is that of a dense reference (the Schur complement
   onto the DOFs with geometric stiffness, on the tangent space), and the step along it
@@ -617,6 +618,29 @@ def test_result_reports_the_load_resolution():
     with solve(paper_case("c1", 8, 4), MPI.COMM_SELF) as analysis:
         thick = analysis.result.load_resolution
     assert thick is not None and thick < 1e-3 * reported
+
+
+@serial
+def test_a_set_predicted_twice_in_a_row_is_read_before_the_barrier_problem_is_solved():
+    """The same critical state as the read where the barrier problem at 1e-9 is solved.
+
+    Thin SSSS plate, 60x20, whole-plate obstacle: by default (``read_stable``) the
+    predicted set is evaluated as soon as two Newton steps predict the same one; without,
+    where the barrier problem at 1e-9 is solved. The same contact set, its load to the
+    rounding of two solves at different shifts, in fewer fine-mesh steps.
+    """
+    problem = BucklingProblem(_thin("ssss", nx=60, ny=20), MPI.COMM_SELF)
+    stable = solve_unilateral(problem, ChainOptions())
+    solved = solve_unilateral(problem, ChainOptions(read_stable=False))
+    fine = [sol.details["levels"][-1] for sol in (stable, solved)]
+    labels = [[link["seed"] for link in level["links"]] for level in fine]
+    assert any("(stable at 1e-09)" in label for label in labels[0])
+    assert not any("stable" in label for label in labels[1])
+    assert fine[0]["newton_steps"] < fine[1]["newton_steps"]
+    assert stable.candidate.kkt and solved.candidate.kkt
+    assert np.array_equal(stable.candidate.active, solved.candidate.active)
+    assert stable.load == pytest.approx(solved.load, rel=_load_rounding(problem, solved.candidate))
+    problem.destroy()
 
 
 @serial

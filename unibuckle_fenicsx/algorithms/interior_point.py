@@ -635,6 +635,7 @@ class InteriorPointNewton(Owner):
         mu_min: float = 1e-12,
         max_steps: int = 100,
         on_solved: Callable[[BarrierPoint], NewtonStatus | None] | None = None,
+        on_step: Callable[[BarrierPoint], NewtonStatus | None] | None = None,
     ) -> tuple[BarrierPoint, NewtonRecord]:
         r"""Run the method from ``mode`` (strictly inside the cone; updated in place).
 
@@ -652,6 +653,9 @@ class InteriorPointNewton(Owner):
                 run with that status (``MET_BEFORE``: the caller has been on this
                 central path before; ``READ``: the caller has read the critical state
                 off the iterate).
+            on_step: Called likewise with the iterate (its ``mu`` the current
+                parameter) at each step below the start parameter where no barrier
+                problem was found solved (so that ``on_solved`` was not called).
 
         Returns:
             The final iterate and the record of the run.
@@ -709,18 +713,25 @@ class InteriorPointNewton(Owner):
                 mu_abs = mu * scale
                 # (Watched first: a run that stops here does not compute a next step.)
                 stalled = mu_min < mu_start and watch.stalled(e_u)
-                if solved < mu_start and on_solved is not None and not stalled:
-                    assert nu is not None
-                    point = BarrierPoint(mode, lam, nu, solved)
-                    stop = self._call_hook(on_solved, point, mu_abs, plain_first)
-                    if stop is not None:
-                        record.status = stop
-                        break
-                if (
+                converged = (
                     mu <= mu_min
                     and e_u <= max(opts.kappa_eps * mu, floor)
                     and (e_c <= opts.kappa_eps * mu)
-                ):
+                )
+                # The hooks: on_solved where a barrier problem below the start one was
+                # found solved, else on_step (below the start parameter; not at the
+                # last step: its next direction would be computed for nothing).
+                hook, at = (on_solved, solved) if solved < mu_start else (on_step, mu)
+                hook = None if hook is on_step and converged else hook
+                if hook is not None and at < mu_start and not stalled:
+                    assert nu is not None
+                    stop = self._call_hook(
+                        hook, BarrierPoint(mode, lam, nu, at), mu_abs, plain_first
+                    )
+                    if stop is not None:
+                        record.status = stop
+                        break
+                if converged:
                     record.status = NewtonStatus.CONVERGED
                     break
                 if stalled:
