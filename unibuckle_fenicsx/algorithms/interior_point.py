@@ -203,6 +203,13 @@ class NewtonOptions:
             steps. Taken at any residual (the unmodified matrix's inertia is often
             wrong far from a stationary point) it cost more steps on every plate and
             CCCC ended 2.7e-7 higher.
+        saddle_curvature: The step is taken when the curvature found,
+            :math:`\theta = v^TKv / v^TMv` (in units of the regularisation: a fraction
+            of the geometric stiffness), is below minus this. Measured: curvatures of
+            -1e-8 to -1e-5 (nearly degenerate plates) gave steps of 1e-14 to 1e-3 of
+            the way to the obstacle that only moved the path (unloaded edges clamped
+            at 45×15 then fell back to the active-set chain); the saddles these steps
+            leave on the benchmark plates have -3e-4 to -3e-3.
         stall_steps: In a run that lowers the barrier parameter (not one held at a
             single parameter), the run stops (status "stalled") when the residual of
             :math:`F_u` has not halved in this many steps (0: never), whatever
@@ -921,8 +928,10 @@ class InteriorPointNewton(Owner):
         Returns:
             :math:`\theta = \min v^TKv / v^TMv` over the Krylov space and its direction
             v (scaled to :math:`v^TBv = 1`; a work vector, valid until the next call);
-            None when the last step needed no correction (``delta = 0``) or no vector
-            was wanted. The Newton direction in ``self._du`` is left as it was.
+            None when the last step needed no correction (``delta = 0``), no vector
+            was wanted, or v carries no geometric stiffness (:math:`v^TBv \le 0`,
+            possible under shear). The Newton direction in ``self._du`` is left as it
+            was.
         """
         opts = self.options
         delta = self._last_correction
@@ -937,6 +946,8 @@ class InteriorPointNewton(Owner):
         # vector in the range of K_delta^{-1} on the DOFs that M weighs (the rotations,
         # which carry no geometric stiffness, stay at their least energy).
         by2 = _dot(self._Bu, self._y2)
+        if by2 == 0.0:
+            return None
         source, size = probe, 0
         for v in basis:
             work.pointwiseMult(metric, source)
@@ -964,7 +975,10 @@ class InteriorPointNewton(Owner):
             for i, vi in enumerate(basis[:size]):
                 H[i, j] = _dot(vi, self._trial)
                 G[i, j] = _dot(vi, work)
-        L = np.linalg.cholesky(0.5 * (G + G.T))
+        try:
+            L = np.linalg.cholesky(0.5 * (G + G.T))
+        except np.linalg.LinAlgError:
+            return None  # (the basis is M-orthonormal: G is the identity up to rounding)
         theta, Y = np.linalg.eigh(np.linalg.solve(L, np.linalg.solve(L, 0.5 * (H + H.T)).T))
         coef = np.linalg.solve(L.T, Y[:, 0])
         d.zeroEntries()
@@ -972,7 +986,10 @@ class InteriorPointNewton(Owner):
             d.axpy(float(c), v)
         d.axpy(-_dot(self._Bu, d) / by2, self._y2)  # tangent again (rounding)
         self.B.mult(d, work)
-        d.scale(1.0 / math.sqrt(_dot(d, work)))
+        norm2 = _dot(d, work)
+        if not norm2 > 0.0:  # (B is indefinite under shear)
+            return None
+        d.scale(1.0 / math.sqrt(norm2))
         return float(theta[0]), d
 
     def _curvature_step(
@@ -1008,8 +1025,12 @@ class InteriorPointNewton(Owner):
         for _ in range(30):
             u.copy(self._trial)
             self._trial.axpy(sign * t, d)
-            self._normalize(self._trial)
             model = t * sign * slope + 0.5 * t * t * curvature
+            try:
+                self._normalize(self._trial)
+            except FloatingPointError:  # b(u, u) <= 0 there (shear): shorter
+                t *= 0.5
+                continue
             if self._merit(self._trial, mu_abs) <= phi0 + 1e-4 * model:
                 break
             t *= 0.5
