@@ -131,15 +131,13 @@ class ChainOptions:
         last_mu_min: ... once more when that contact set is not a KKT point.
         clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
             (the least-energy correction lifts those closer to the obstacle to it).
-            Measured on the five thin plates of ``bench/bench_plates.py`` (fine-mesh
-            steps / factorisations / eigen solves), 1e-6 → 1e-5: CCCC 28/36/2 →
-            26/34/2 and shear 78/117/5 → 56/83/5 at 90×30; unloaded edges clamped
-            38/42/9 → 33/38/8, CCCC 33/37/5 → 30/33/5, shear 79/122/6 → 61/93/6 at
-            180×60; the other plates the same steps. 1e-4 was better still at 90×30
-            (unloaded edges clamped 42 → 32, shear 78 → 51) but worse at 180×60
-            (shear 79 → 135, loaded edges clamped 20 → 25 fine steps). The robustness
-            sweep (350 plates): the same routes and contact sets, factorisations
-            22533 → 22612.
+            Measured, 1e-6 → 1e-5 (fine-mesh steps on the five thin plates of
+            ``bench/bench_plates.py``): CCCC 28 → 26 and 33 → 30, shear 78 → 56 and
+            79 → 61, unloaded edges clamped at 180×60 38 → 33, none longer; but the
+            robustness sweep took 0.35 % more factorisations (43 plates more, 20 fewer)
+            and the sheared column face of ``demos/demo_column.py`` fell back to the
+            active-set chain (3.9 → 4.9 s, the same load): not adopted. 1e-4: better at
+            90×30, worse at 180×60 (shear 79 → 135 fine steps).
         max_steps: Newton steps per run.
         escapes: Saddle escapes allowed per run.
         escape_mu: Barrier parameter the run restarts with after an escape (small: a
@@ -170,7 +168,7 @@ class ChainOptions:
     read_mu: float = 1e-9
     read_stable: bool = True
     last_mu_min: float = 1e-14
-    clip_margin: float = 1e-5
+    clip_margin: float = 1e-6
     max_steps: int = 100
     escapes: int = 3
     escape_mu: float = 1e-10
