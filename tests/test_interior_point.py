@@ -170,6 +170,27 @@ def test_newton_direction_solves_the_linearised_conditions(side):
     assert np.allclose(dnu, delta[n:-1], rtol=1e-6, atol=1e-8 * np.abs(delta[n:-1]).max())
 
 
+def at_saddle(newton: InteriorPointNewton, lam: float) -> tuple:
+    """The pressure deflection at ``lam``, with the Newton step's factorisation made there.
+
+    ``lam`` above the second free load: the unmodified K has a negative direction on the
+    tangent space, so the factorisation is regularised (:meth:`direction`). Returns the
+    normalised iterate (a function: its vector lives as long as it), its gaps, pushes
+    (mu/g) and absolute barrier parameter. Collective (also used by
+    ``tests/mpi/negative_curvature_parallel.py``).
+    """
+    u = newton.pressure_mode()  # strictly inside the cone
+    vec = u.x.petsc_vec
+    newton._normalize(vec)  # leaves Bu in newton._Bu
+    gap = -newton.oriented(vec)
+    w_max = float(vec.norm(PETSc.NormType.INFINITY))
+    mu_abs = 1e-6 * lam * float(newton._Bu.norm(PETSc.NormType.INFINITY)) * w_max
+    nu = mu_abs / gap
+    newton._residual(vec, lam, nu)
+    assert newton.direction(vec, lam, nu, gap, mu_abs) is not None
+    return u, gap, nu, mu_abs
+
+
 @serial
 def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
     r"""At a load above the second free one, K has a negative direction on the tangent space.
@@ -190,23 +211,17 @@ def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
     # As many Krylov vectors as the tangent space on P has dimensions (one more would
     # be rounding only, with rotations that are not at their least energy).
     options = replace(NewtonOptions(), curvature_vectors=P.size - 1)
+    second = np.sort(np.linalg.eigvals(np.linalg.solve(A, B)).real)[-2]
+    lam = 1.3 / second  # between the second and third free loads
     with InteriorPointNewton(problem, options) as newton:
-        u = newton.pressure_mode()  # strictly inside the cone
+        u, gap, nu, mu_abs = at_saddle(newton, lam)
         vec = u.x.petsc_vec
-        newton._normalize(vec)
         x = vec.array.copy()
-        gap = -newton.oriented(vec)
-        second = np.sort(np.linalg.eigvals(np.linalg.solve(A, B)).real)[-2]
-        lam = 1.3 / second  # between the second and third free loads
-        mu_abs = 1e-6 * lam * np.abs(B @ x).max() * np.abs(x).max()
-        nu = mu_abs / gap
-        newton._residual(vec, lam, nu)
-        assert newton.direction(vec, lam, nu, gap, mu_abs) is not None
         assert newton._last_correction > 0.0  # the unmodified K had the wrong inertia
         du = newton._du.array.copy()
         found = newton.negative_curvature(vec, lam)
         assert found is not None
-        theta, d = found[0], found[1].array.copy()
+        theta, d, curvature = found[0], found[1].array.copy(), found[2]
         assert np.array_equal(newton._du.array, du)  # the Newton direction is kept
         phi0 = newton._merit(vec, mu_abs)
         assert newton._curvature_step(vec, lam, gap, mu_abs) is not None
@@ -224,6 +239,7 @@ def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
     assert theta == pytest.approx(reference, rel=1e-8)
     assert abs((B @ x) @ d) <= 1e-10 * np.abs(B @ x).max() * np.abs(d).max()
     assert (d @ K @ d) / (d @ (lam * D * d)) == pytest.approx(reference, rel=1e-8)
+    assert curvature == pytest.approx(d @ K @ d, rel=1e-8)
     assert phi1 < phi0
 
 
@@ -239,16 +255,8 @@ def test_negative_curvature_is_the_same_on_two_ranks(tmp_path):
     A, B = dense(problem.model.A), dense(problem.model.B)
     lam = 1.3 / np.sort(np.linalg.eigvals(np.linalg.solve(A, B)).real)[-2]
     with InteriorPointNewton(problem, replace(NewtonOptions(), curvature_vectors=3)) as newton:
-        u = newton.pressure_mode()
-        vec = u.x.petsc_vec
-        newton._normalize(vec)
-        x = vec.array.copy()
-        gap = -newton.oriented(vec)
-        mu_abs = 1e-6 * lam * np.abs(B @ x).max() * np.abs(x).max()
-        nu = mu_abs / gap
-        newton._residual(vec, lam, nu)
-        assert newton.direction(vec, lam, nu, gap, mu_abs) is not None
-        found = newton.negative_curvature(vec, lam)
+        u, *_ = at_saddle(newton, lam)
+        found = newton.negative_curvature(u.x.petsc_vec, lam)
         assert found is not None
     problem.destroy()
     path = tmp_path / "plate.json"

@@ -11,6 +11,7 @@ from __future__ import annotations
 import json
 import sys
 from dataclasses import replace
+from pathlib import Path
 
 from mpi4py import MPI
 
@@ -18,23 +19,15 @@ from unibuckle_fenicsx.algorithms.interior_point import InteriorPointNewton, New
 from unibuckle_fenicsx.config import load_problem
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
-from petsc4py import PETSc  # isort: skip
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+from test_interior_point import at_saddle
 
 spec = load_problem(sys.argv[1])
 lam, vectors = float(sys.argv[2]), int(sys.argv[3])
 problem = BucklingProblem(spec, MPI.COMM_WORLD)
 with InteriorPointNewton(problem, replace(NewtonOptions(), curvature_vectors=vectors)) as newton:
-    u = newton.pressure_mode()
-    vec = u.x.petsc_vec
-    newton._normalize(vec)
-    gap = -newton.oriented(vec)
-    newton.B.mult(vec, newton._Bu)
-    w_max = float(vec.norm(PETSc.NormType.INFINITY))
-    mu_abs = 1e-6 * lam * float(newton._Bu.norm(PETSc.NormType.INFINITY)) * w_max
-    nu = mu_abs / gap
-    newton._residual(vec, lam, nu)
-    assert newton.direction(vec, lam, nu, gap, mu_abs) is not None
-    found = newton.negative_curvature(vec, lam)
+    u, *_ = at_saddle(newton, lam)
+    found = newton.negative_curvature(u.x.petsc_vec, lam)
     assert found is not None
 problem.destroy()
 if MPI.COMM_WORLD.rank == 0:

@@ -889,12 +889,6 @@ class InteriorPointNewton(Owner):
         dnu = (-f_c + nu * dz) / gap
         return dlam, dz, dnu
 
-    def _metric(self, lam: float, out: PETSc.Vec) -> None:
-        r"""``out`` = the diagonal M whose multiple :math:`\delta M` regularises K at ``lam``."""
-        self._reg.copy(out)
-        if self.options.metric == "geometric":
-            out.scale(lam)
-
     def _probe(self) -> PETSc.Vec:
         """Start of the negative-curvature Krylov space: a fixed pseudo-random field.
 
@@ -913,7 +907,7 @@ class InteriorPointNewton(Owner):
         f.x.scatter_forward()
         return f.x.petsc_vec.copy()
 
-    def negative_curvature(self, u: PETSc.Vec, lam: float) -> tuple[float, PETSc.Vec] | None:
+    def negative_curvature(self, u: PETSc.Vec, lam: float) -> tuple[float, PETSc.Vec, float] | None:
         r"""The direction of most negative curvature of K on the tangent space.
 
         Uses the last factorisation, :math:`K_\delta = K + \delta M` with
@@ -926,8 +920,9 @@ class InteriorPointNewton(Owner):
         (K, M) on the tangent space, the most negative :math:`\theta` dominates.
 
         Returns:
-            :math:`\theta = \min v^TKv / v^TMv` over the Krylov space and its direction
-            v (scaled to :math:`v^TBv = 1`; a work vector, valid until the next call);
+            :math:`\theta = \min v^TKv / v^TMv` over the Krylov space, its direction
+            v (scaled to :math:`v^TBv = 1`; a work vector, valid until the next call)
+            and :math:`v^TKv`;
             None when the last step needed no correction (``delta = 0``), no vector
             was wanted, or v carries no geometric stiffness (:math:`v^TBv \le 0`,
             possible under shear). The Newton direction in ``self._du`` is left as it
@@ -941,7 +936,9 @@ class InteriorPointNewton(Owner):
             extra = opts.curvature_vectors + 3  # the metric, work, direction, basis
             self._krylov = [self._probe()] + [u.duplicate() for _ in range(extra)]
         probe, metric, work, d, *basis = self._krylov
-        self._metric(lam, metric)
+        self._reg.copy(metric)  # M: the diagonal whose multiple delta M regularises K
+        if opts.metric == "geometric":
+            metric.scale(lam)
         # Projected on the tangent space along y2 = K_delta^{-1} Bu, which keeps every
         # vector in the range of K_delta^{-1} on the DOFs that M weighs (the rotations,
         # which carry no geometric stiffness, stay at their least energy).
@@ -990,7 +987,10 @@ class InteriorPointNewton(Owner):
         if not norm2 > 0.0:  # (B is indefinite under shear)
             return None
         d.scale(1.0 / math.sqrt(norm2))
-        return float(theta[0]), d
+        self.K.mult(d, self._trial)  # K v = K_delta v - delta M v
+        work.pointwiseMult(metric, d)
+        curvature = _dot(d, self._trial) - delta * _dot(d, work)
+        return float(theta[0]), d, curvature
 
     def _curvature_step(
         self, u: PETSc.Vec, lam: float, gap: npt.NDArray[np.float64], mu_abs: float
@@ -1010,11 +1010,7 @@ class InteriorPointNewton(Owner):
         found = self.negative_curvature(u, lam)
         if found is None or not found[0] < -opts.saddle_curvature:
             return None
-        (theta, d), work = found, self._rhs
-        self.K.mult(d, self._trial)
-        self._metric(lam, work)
-        work.pointwiseMult(work, d)
-        curvature = _dot(d, self._trial) - self._last_correction * _dot(d, work)
+        theta, d, curvature = found
         dz = self.oriented(d)
         self.A.mult(u, self._Au)
         slope = _dot(self._Au, d) + mu_abs * self._sum((dz / gap).sum())
