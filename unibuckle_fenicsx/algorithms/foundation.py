@@ -15,7 +15,11 @@ with :math:`s_k = +1` for a foundation above the plate and -1 below. This is the
 penalised quotient of :mod:`.penalty` with physical, per-node springs instead of a
 numerical penalty, so the same iteration on the spring set S (the nodes pressing the
 foundation) solves it: the smallest eigenpair of :math:`(A + \sum_{k\in S}\rho_k e_k
-e_k^T, B)`, oriented to press the foundation least, until S repeats. Its limits:
+e_k^T, B)`, oriented to press the foundation least, until S repeats. A node presses
+when it moves into the foundation by more than
+:data:`~unibuckle_fenicsx.tolerances.PRESSING_RTOL` of max|w|: a node within rounding of
+the foundation (on a nodal line of the mode) would otherwise press or not with the number
+of ranks, and the iteration would take another path. Its limits:
 :math:`k_f \to 0` gives the free plate, :math:`k_f \to \infty` the rigid obstacle; springs
 on both sides (a bilateral foundation, ``side = "both"``) are simply added to A.
 
@@ -48,7 +52,7 @@ from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
-from unibuckle_fenicsx.tolerances import ARC_RTOL, TWIN_RTOL
+from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
 __all__ = ["FOUNDATION_PREFIX", "solve_foundation"]
 
@@ -101,6 +105,7 @@ def solve_foundation(
                 max_iterations=max_iterations,
                 lower_bound=lower,
                 label=f"foundation ({name} start)",
+                threshold=PRESSING_RTOL,
             )
         # The smaller quotient; on a tie the start from the free plate.
         name = min(runs, key=lambda n: (runs[n].candidate.load, n != "free"))
@@ -168,7 +173,7 @@ def _arc_descent(
         for _ in range(int(max_iterations)):
             steps += 1
             z_v = contact.values(v)
-            pressing = np.flatnonzero(z_v > 0.0).astype(np.int64)
+            pressing = _pressing(z_v, problem.max_abs_w(v))
             solver.set_springs(springs, pressing)
             solver.gep.solve(out=u, initial=v)
             solver.solves += 1
@@ -228,9 +233,14 @@ def _arc_descent(
         v.copy(mode.x.petsc_vec)
         mode.x.scatter_forward()
         z = contact.values(v)
-        candidate = problem.candidate(mode, q, np.flatnonzero(z > 0.0).astype(np.int64), sign=1.0)
+        candidate = problem.candidate(mode, q, _pressing(z, problem.max_abs_w(v)), sign=1.0)
     finally:
         for vec in (v, u, Av, Au, Bv, Bu):
             vec.destroy()
     logger.info("foundation: arc descent %s after %d steps, R = %.12g", status, steps, q)
     return candidate, status, steps
+
+
+def _pressing(values: npt.NDArray[np.float64], max_w: float) -> npt.NDArray[np.int64]:
+    """The nodes whose values move them into the foundation by more than rounding."""
+    return np.flatnonzero(values > PRESSING_RTOL * max_w).astype(np.int64)
