@@ -47,7 +47,13 @@ from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivit
 from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX, ShiftedMatrix
 from unibuckle_fenicsx.eigen import SymmetricFactorization
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
-from unibuckle_fenicsx.tolerances import BRACKET_GAP, PROOF_GAP, ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
+from unibuckle_fenicsx.tolerances import (
+    BRACKET_GAP,
+    PRESSING_RTOL,
+    PROOF_GAP,
+    ROUNDING_RTOL,
+    SMALLEST_RTOL_FACTOR,
+)
 
 __all__ = [
     "BRACKET_GAP",
@@ -378,7 +384,9 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     r"""Certify a critical state on a tensionless foundation (:mod:`.algorithms.foundation`).
 
     With :math:`z_k = s_k u_k` the oriented mode at the foundation's nodes and
-    :math:`S = \{k: z_k > 0\}` the nodes pressing it, the quotient
+    :math:`S = \{k: z_k > \epsilon \max|w|\}` the nodes pressing it (ε =
+    :data:`~unibuckle_fenicsx.tolerances.PRESSING_RTOL`, as the solver counts them), the
+    quotient
     :math:`R_f = (a + \sum \rho_k \max(0, z_k)^2)/b` is stationary at u when
 
     - :math:`r_f = Au + \sum_k \rho_k \max(0, z_k) s_k e_k - \lambda Bu` vanishes
@@ -408,7 +416,7 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     u = cand.mode.x.petsc_vec
     scale = problem.max_abs_w(u)
     z = contact.values(u) / scale
-    pressing = np.flatnonzero(z > 0.0).astype(np.int64)
+    pressing = np.flatnonzero(z > PRESSING_RTOL).astype(np.int64)  # as the solver counts them
     r, _, au_2 = problem.residual(cand.load, u)
     spring = u.duplicate()
     try:
