@@ -89,6 +89,12 @@ class ChainOptions:
 
     Attributes:
         coarse_min_cells: Fewest cells along the shorter side of the coarsest mesh.
+            Measured on the five thin plates of ``bench/bench_plates.py`` at 90×30
+            (coarsest 22×7 at 4–7): at 3 (an 11×3 exploration mesh) SSSS took 3.9 free
+            solves instead of 5.5, but loaded edges clamped and CCCC ended at higher
+            critical states (9.2e-6 and 1.8e-4 above): 11×3 cells rank the
+            arrangements wrongly; at 8 (exploring on 45×15) every plate was slower
+            (SSSS 7.5, shear 44.9 free solves) and CCCC ended higher.
         seeds: Starts of the interior-point method on the coarsest mesh: "free-" and
             "free+" (the free mode's parts on either side of the obstacle), "pressure"
             (the deflection under a pressure on the whole zone), "end-low", "middle",
