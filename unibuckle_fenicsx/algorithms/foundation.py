@@ -55,12 +55,16 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
-from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
+from unibuckle_fenicsx.algorithms.penalty import (
+    PenaltySolver,
+    SpringIteration,
+    least_pressing_sign,
+)
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
-__all__ = ["FOUNDATION_PREFIX", "solve_foundation"]
+__all__ = ["FOUNDATION_PREFIX", "pressing_nodes", "solve_foundation"]
 
 logger = logging.getLogger(__name__)
 
@@ -166,12 +170,10 @@ def _starts(
     contact = problem.contact
     assert contact is not None
     starts = {"free": np.empty(0, np.int64), "bilateral": np.arange(contact.size)}
-    free = problem.solve_free().function.x.petsc_vec
-    values = contact.values(free) / problem.max_abs_w(free)
-    up = float(np.sum(springs * np.maximum(values, 0.0) ** 2))
-    down = float(np.sum(springs * np.maximum(-values, 0.0) ** 2))
+    values = contact.values(problem.solve_free().function.x.petsc_vec)  # max|w| = 1
     # The first step keeps the orientation that presses less; this start takes the other.
-    turned = _pressing(-values if up < down else values, 1.0)
+    sign, _ = least_pressing_sign(values, springs, PRESSING_RTOL)
+    turned = pressing_nodes(-sign * values, 1.0)
     if 0 < turned.size < contact.size:
         starts["turned"] = turned
     return starts
@@ -202,7 +204,7 @@ def _arc_descent(
         for _ in range(int(max_iterations)):
             steps += 1
             z_v = contact.values(v)
-            pressing = _pressing(z_v, problem.max_abs_w(v))
+            pressing = pressing_nodes(z_v, problem.max_abs_w(v))
             solver.set_springs(springs, pressing)
             solver.gep.solve(out=u, initial=v)
             solver.solves += 1
@@ -262,7 +264,7 @@ def _arc_descent(
         v.copy(mode.x.petsc_vec)
         mode.x.scatter_forward()
         z = contact.values(v)
-        candidate = problem.candidate(mode, q, _pressing(z, problem.max_abs_w(v)), sign=1.0)
+        candidate = problem.candidate(mode, q, pressing_nodes(z, problem.max_abs_w(v)), sign=1.0)
     finally:
         for vec in (v, u, Av, Au, Bv, Bu):
             vec.destroy()
@@ -270,6 +272,6 @@ def _arc_descent(
     return candidate, status, steps
 
 
-def _pressing(values: npt.NDArray[np.float64], max_w: float) -> npt.NDArray[np.int64]:
+def pressing_nodes(values: npt.NDArray[np.float64], max_w: float) -> npt.NDArray[np.int64]:
     """The nodes whose values move them into the foundation by more than rounding."""
     return np.flatnonzero(values > PRESSING_RTOL * max_w).astype(np.int64)

@@ -43,17 +43,12 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms.foundation import pressing_nodes
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX, ShiftedMatrix
 from unibuckle_fenicsx.eigen import SymmetricFactorization
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
-from unibuckle_fenicsx.tolerances import (
-    BRACKET_GAP,
-    PRESSING_RTOL,
-    PROOF_GAP,
-    ROUNDING_RTOL,
-    SMALLEST_RTOL_FACTOR,
-)
+from unibuckle_fenicsx.tolerances import BRACKET_GAP, PROOF_GAP, ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
 
 __all__ = [
     "BRACKET_GAP",
@@ -416,7 +411,7 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     u = cand.mode.x.petsc_vec
     scale = problem.max_abs_w(u)
     z = contact.values(u) / scale
-    pressing = np.flatnonzero(z > PRESSING_RTOL).astype(np.int64)  # as the solver counts them
+    pressing = pressing_nodes(z, 1.0)  # as the solver counts them
     r, _, au_2 = problem.residual(cand.load, u)
     spring = u.duplicate()
     try:
