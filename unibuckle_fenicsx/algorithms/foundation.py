@@ -25,14 +25,17 @@ on both sides (a bilateral foundation, ``side = "both"``) are simply added to A.
 
 Bounds: :math:`\lambda_{free} \le \lambda_f` (the spring term is non-negative), and the
 returned load, a value of the quotient, is an upper bound of :math:`\lambda_f`. The
-iteration starts from the free plate (no springs), from every spring active (the
-bilateral foundation's mode) and from the nodes the free mode presses when turned
-towards the foundation (the orientation the first start rejects); the smallest quotient
-is returned. The quotient has several local minima on long plates, and each start finds
-one: measured on 24 plates (0.3 × 0.1 m, t = 1 mm, loaded edges clamped or simply
-supported, 24×8 and 36×12, k_f = 3e6 to 1e9 N/m³), the third start and the arc descent
-from every start that cycles (below) lowered 4 answers (by 5.4e-7 to 1.4e-4) and raised
-none, for 57 % more eigen solves.
+iteration starts from the free plate (no springs) and from every spring active (the
+bilateral foundation's mode); the smallest quotient is returned. The quotient has
+several local minima on long plates, and each start finds one. Measured on 24 plates
+(0.3 × 0.1 m, t = 1 mm, loaded edges clamped or simply supported, 24×8 and 36×12,
+k_f = 3e6 to 1e9 N/m³): the arc descent (below) from every start that cycles, not only
+from the best one, lowered 2 answers (by 5.4e-7 and 5.9e-6) and raised none, for 8 %
+more eigen solves. A third start (the nodes the free mode presses when turned towards
+the foundation) lowered 2 more (by 7.8e-5 and 1.4e-4) but cost 57 % more eigen solves
+there, and on the thin plate of ``bench/bench_plates.py`` (t = 0.1 mm, SSSS, 90×30)
+30–90 % more free solves (k_f = 1e2, 1e4, 1e6 N/m³: 4.7, 36.9, 49.0 → 6.3, 49.6, 79.8)
+for the same loads: not adopted.
 
 The iteration on S need not decrease the quotient, and it can cycle. When a start
 reaches no fixed point, an *arc descent* takes over from its best iterate v: with S the
@@ -55,11 +58,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
-from unibuckle_fenicsx.algorithms.penalty import (
-    PenaltySolver,
-    SpringIteration,
-    least_pressing_sign,
-)
+from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
@@ -108,7 +107,8 @@ def solve_foundation(
     runs: dict[str, SpringIteration] = {}
     finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
     with PenaltySolver(problem, prefix=FOUNDATION_PREFIX, eps_options=eps_options) as solver:
-        for name, start in _starts(problem, springs).items():
+        starts = {"free": np.empty(0, np.int64), "bilateral": np.arange(contact.size)}
+        for name, start in starts.items():
             run = solver.iterate_springs(
                 springs,
                 initial_active=start,
@@ -161,22 +161,6 @@ def solve_foundation(
         status=status,
         details=details,
     )
-
-
-def _starts(
-    problem: BucklingProblem, springs: npt.NDArray[np.float64]
-) -> dict[str, npt.NDArray[np.int64]]:
-    """The spring sets the iteration starts from (module docstring); no set twice."""
-    contact = problem.contact
-    assert contact is not None
-    starts = {"free": np.empty(0, np.int64), "bilateral": np.arange(contact.size)}
-    values = contact.values(problem.solve_free().function.x.petsc_vec)  # max|w| = 1
-    # The first step keeps the orientation that presses less; this start takes the other.
-    sign, _ = least_pressing_sign(values, springs, PRESSING_RTOL)
-    turned = pressing_nodes(-sign * values, 1.0)
-    if 0 < turned.size < contact.size:
-        starts["turned"] = turned
-    return starts
 
 
 def _arc_descent(

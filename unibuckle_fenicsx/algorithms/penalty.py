@@ -125,30 +125,6 @@ class SpringIteration:
     lower_bound: float
 
 
-def least_pressing_sign(
-    values: npt.NDArray[np.float64],
-    weights: npt.NDArray[np.float64],
-    threshold: float,
-    tie_rtol: float = ENERGY_TIE_RTOL,
-) -> tuple[float, bool]:
-    """The sign (+1 or -1) of a mode whose springs' energy is the smaller, and whether tied.
-
-    ``values``: the mode's oriented values at the constrained nodes over max|w|; the
-    energy of an orientation is the sum of ``weights`` times its penetration squared. A
-    tie (within ``tie_rtol``: e.g. the antisymmetric free mode under a zone symmetric
-    about x = 0, whose two unilateral modes are mirror images with equal loads) would be
-    decided by rounding and flip with tiny changes of rho; the lexicographically smaller
-    set of nodes beyond ``threshold`` decides it instead (the enumeration's tie rule).
-    """
-    up = float(np.sum(weights * np.maximum(values, 0.0) ** 2))
-    down = float(np.sum(weights * np.maximum(-values, 0.0) ** 2))
-    if abs(up - down) > tie_rtol * (up + down):
-        return (1.0 if up < down else -1.0), False
-    plus = _key(np.flatnonzero(values > threshold))
-    minus = _key(np.flatnonzero(-values > threshold))
-    return (1.0 if plus <= minus else -1.0), True
-
-
 def _key(nodes: npt.NDArray[np.int64]) -> tuple[int, ...]:
     return tuple(int(k) for k in nodes)
 
@@ -425,8 +401,20 @@ class PenaltySolver(Owner):
                 lower_bound = pair.value
             wmax = problem.max_abs_w(vec)
             vals = contact.values(vec) / wmax
-            sign, tied = least_pressing_sign(vals, weights, threshold, tie_rtol)
-            ties += tied
+            up = float(np.sum(weights * np.maximum(vals, 0.0) ** 2))
+            down = float(np.sum(weights * np.maximum(-vals, 0.0) ** 2))
+            if abs(up - down) > tie_rtol * (up + down):
+                sign = 1.0 if up < down else -1.0
+            else:
+                # Tie (e.g. the antisymmetric free mode under a zone symmetric about x = 0:
+                # both orientations penetrate alike, and the two unilateral modes are
+                # mirror images with equal loads). Decided by rounding, the choice would
+                # flip with tiny changes of rho; take the lexicographically smaller
+                # penetrating set instead (the enumeration's tie rule).
+                plus = _key(np.flatnonzero(vals > threshold))
+                minus = _key(np.flatnonzero(-vals > threshold))
+                sign = 1.0 if plus <= minus else -1.0
+                ties += 1
             vec.scale(sign / wmax)
             vals = sign * vals
             q = self.quotient(vec, weights)
