@@ -11,6 +11,14 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 
+def print_header(title: str, columns: Iterable[str]) -> None:
+    """Print ``title`` and the head of a Markdown table with ``columns``."""
+    names = list(columns)
+    print(title)
+    print("| " + " | ".join(names) + " |")
+    print("|" + "---|" * len(names), flush=True)
+
+
 def append_rows(path: str | None, rows: Iterable[Mapping[str, Any]]) -> None:
     """Append ``rows`` to the file ``path``, one JSON line each (nothing if ``path`` is None)."""
     if not path:

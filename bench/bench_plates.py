@@ -49,7 +49,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-from _results import append_rows
+from _results import append_rows, print_header
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
@@ -67,13 +67,20 @@ CASES = {
 LENGTH, WIDTH, THICKNESS = 0.3, 0.1, 1e-4
 
 
-def _spec(name: str, nx: int, ny: int, side: str = "above"):
+def _spec(
+    name: str,
+    nx: int,
+    ny: int,
+    side: str = "above",
+    thickness: float = THICKNESS,
+    length: float = LENGTH,
+):
     supports, load, _ = CASES[name]
     return plate_case(
         name,
-        length=LENGTH,
+        length=length,
         width=WIDTH,
-        thickness=THICKNESS,
+        thickness=thickness,
         supports=supports,
         load=load,
         nx=nx,
@@ -138,16 +145,15 @@ def main() -> None:
     comm = MPI.COMM_WORLD
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
     if comm.rank == 0:
-        print(
+        print_header(
             f"MPI ranks: {comm.size}; plate {LENGTH} x {WIDTH} m, t = {THICKNESS} m, "
-            f"zone all, face {args.side}"
-        )
-        print(
-            "| case | mesh | i | \\|Z\\| | levels: steps / factorisations / eigen solves "
-            "| route | free solve (s) | ratio | CLI ratio | KKT | smallest | certificate | m "
-            "| r | pieces | certificate / free | k | lambda_c (Pa) |"
-        )
-        print("|" + "---|" * 18, flush=True)
+            f"zone all, face {args.side}",
+            (
+                "case", "mesh", "i", "\\|Z\\|", "levels: steps / factorisations / eigen solves",
+                "route", "free solve (s)", "ratio", "CLI ratio", "KKT", "smallest",
+                "certificate", "m", "r", "pieces", "certificate / free", "k", "lambda_c (Pa)",
+            ),
+        )  # fmt: skip
     for nx, ny in meshes:
         for name in args.cases.split(","):
             spec = _spec(name, nx, ny, args.side)

@@ -465,6 +465,11 @@ COMMANDS = {
         f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"
     ),
     "plates": lambda rows: _plates_commands(rows),
+    "routes": lambda rows: (
+        f"python bench/bench_routes.py --meshes {_listed(rows, 'mesh')} "
+        f"--cases {_listed(rows, 'case')} --thicknesses {_listed(rows, 'thickness_m')} "
+        f"--json bench/results/routes.jsonl"
+    ),
 }
 
 

@@ -49,6 +49,8 @@ from collections.abc import Callable
 from dataclasses import dataclass, field, replace
 from typing import Any
 
+from slepc4py import SLEPc
+
 import numpy as np
 import numpy.typing as npt
 
@@ -65,6 +67,7 @@ from unibuckle_fenicsx.algorithms.interior_point import (
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.config import ProblemSpec
+from unibuckle_fenicsx.eigen import Owner, release, swapped_eigenpairs
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
@@ -76,10 +79,15 @@ __all__ = ["THIN_PLATE", "ChainOptions", "LevelRecord", "LinkRecord", "solve_uni
 logger = logging.getLogger(__name__)
 
 #: "auto" runs the interior-point route on plates whose thickness is below this fraction
-#: of the shorter side, the multilevel active set on thicker ones. Measured (README,
-#: "Speed"): at t/b = 1e-3 the active set needs hundreds of eigen solves on a whole-face
-#: obstacle; at the paper's t/b = 0.06 it needs two to three per mesh level and beats the
-#: interior point, whose coarse exploration then costs more than the whole active set.
+#: of the shorter side, the multilevel active set on thicker ones. Measured: at t/b = 1e-3
+#: the active set needs hundreds of eigen solves on a whole-face obstacle; on the paper's
+#: plate (t/b = 0.06, a/b = 2) the active set costs 2–3.4 free solves at 160×80 and the
+#: interior point 3.9–4.6. On long plates against a whole face the interior point is
+#: usually the faster above 0.02 too (``bench/bench_routes.py``: 0.3 × 0.1 m, t/b =
+#: 0.02–0.06, five edge and load cases: the faster on 18 of 20, median 4.1×; the active
+#: set needs 212–1133 eigen solves), but the two routes end at different critical
+#: states on some of them, either one lower; the threshold stays where the answers of
+#: ``auto`` have been (the documentation's benchmarks page, "Which route").
 THIN_PLATE = 0.02
 
 
@@ -98,11 +106,19 @@ class ChainOptions:
         seeds: Starts of the interior-point method on the coarsest mesh: "free-" and
             "free+" (the free mode's parts on either side of the obstacle), "pressure"
             (the deflection under a pressure on the whole zone), "end-low", "middle",
-            "end-high" (a pressure on a third of the plate's longer side). The last
-            three cost up to 57 % of the coarsest mesh's Newton steps (unloaded edges
-            clamped at 90×30: 324 against 140 without them) and found no lower critical
-            state on 191 random plates, but without them the design chart's thin plate
-            with clamped loaded edges at a/b = 2.75 (cells of b/12) ends 6.8e-5 higher.
+            "end-high" (a pressure on a third of the plate's longer side), "free2-" and
+            "free2+" (the parts of the free plate's second mode). The three pressures
+            on a third cost up to 57 % of the coarsest mesh's Newton steps (unloaded
+            edges clamped at 90×30: 324 against 140 without them) and found no lower
+            critical state on 191 random plates, but without them the design chart's
+            thin plate with clamped loaded edges at a/b = 2.75 (cells of b/12) ends
+            6.8e-5 higher. The second mode's parts reach an arrangement no other start
+            does (on a clamped 0.3 × 0.1 m plate against a whole face: two buckles in
+            the middle, the ends flat or with a small buckle, where the other starts end
+            at three buckles): at 90×30 its critical state lies 2.1e-5 (t = 0.1 mm),
+            1.8e-4 (1 mm) and 9.2e-5 (2 mm) below theirs, and 2.3e-6 at 180×60 (0.1
+            mm); both arrangements are then carried to the fine mesh, which doubles
+            the time on those plates (``bench/bench_plates.py``).
         compare_mu: Barrier parameter at which the starts are compared.
         explore_mu_min: Barrier parameter at which the starts' contact sets are read.
         twin_rtol: Starts whose barrier solutions' loads at ``compare_mu``, or at a
@@ -162,7 +178,16 @@ class ChainOptions:
     """
 
     coarse_min_cells: int = 6
-    seeds: tuple[str, ...] = ("free-", "free+", "pressure", "end-low", "middle", "end-high")
+    seeds: tuple[str, ...] = (
+        "free-",
+        "free+",
+        "pressure",
+        "end-low",
+        "middle",
+        "end-high",
+        "free2-",
+        "free2+",
+    )
     compare_mu: float = 1e-4
     explore_mu_min: float = 1e-14
     twin_rtol: float = 1e-7
@@ -334,14 +359,59 @@ def _canonical_sign(problem: BucklingProblem, vec: Any) -> float:
     return 1.0 if z[first] < 0.0 else -1.0
 
 
-def _start(newton: InteriorPointNewton, seed: str, push: Any) -> Any:
-    """The start ``seed`` on ``newton``'s problem, strictly inside the cone."""
+def _second_free_mode(problem: BucklingProblem) -> Any:
+    """The free plate's second buckling mode (PETSc vector; the caller destroys it).
+
+    The two lowest pairs of the swapped pencil B x = theta A x (theta = 1/lambda, so that
+    an indefinite B is handled as everywhere else); None when SLEPc converges fewer.
+    Collective.
+    """
+    pairs = swapped_eigenpairs(
+        problem.model.A,
+        problem.model.B,
+        "unibuckle_ipm_free2_",
+        which=SLEPc.EPS.Which.LARGEST_REAL,
+        nev=2,
+        tol=1e-8,
+        vectors=True,
+    )
+    second = None
+    for k, (theta, vec) in enumerate(pairs):
+        if k == 1 and theta > 0.0:
+            second = vec
+        elif vec is not None:
+            vec.destroy()
+    return second
+
+
+class _SecondMode(Owner):
+    """The free plate's second mode (:func:`_second_free_mode`) if ``wanted``; owns it."""
+
+    def __init__(self, problem: BucklingProblem, wanted: bool) -> None:
+        self.second = _second_free_mode(problem) if wanted else None
+
+    def destroy(self) -> None:
+        """Destroy the mode (collective)."""
+        release(self, "second")
+
+
+def _start(newton: InteriorPointNewton, seed: str, push: Any, second: Any = None) -> Any:
+    """The start ``seed`` on ``newton``'s problem, strictly inside the cone.
+
+    ``second``: the free plate's second mode (:func:`_second_free_mode`), for the seeds
+    "free2-" and "free2+".
+    """
     problem = newton.problem
     assert problem.contact is not None
-    if seed in ("free-", "free+"):
-        free = problem.solve_free().function.x.petsc_vec
-        sign = _canonical_sign(problem, free)
-        u = newton.negative_part(free, sign if seed == "free-" else -sign)
+    if seed in ("free-", "free+", "free2-", "free2+"):
+        if seed.startswith("free2"):
+            if second is None:
+                raise ValueError("the free plate's second mode did not converge")
+            mode = second
+        else:
+            mode = problem.solve_free().function.x.petsc_vec
+        sign = _canonical_sign(problem, mode)
+        u = newton.negative_part(mode, sign if seed.endswith("-") else -sign)
         return newton.make_interior(u, push=push)
     if seed == "pressure":
         u = problem.new_mode("start")
@@ -644,11 +714,12 @@ def _explore(
     # Damped steps (a stiffness-scaled correction that decays from step to step) keep
     # each start near its own arrangement: measured, with the finer meshes' settings a
     # start jumped past the lowest (CCCC at 90x30 ended 1.8e-4 higher).
-    with InteriorPointNewton(problem, EXPLORE) as newton:
+    wanted = any(seed.startswith("free2") for seed in options.seeds)
+    with InteriorPointNewton(problem, EXPLORE) as newton, _SecondMode(problem, wanted) as modes:
         push = newton.pressure_mode()
         for seed in options.seeds:
             try:
-                start = _start(newton, seed, push)
+                start = _start(newton, seed, push, modes.second)
                 point, rec = newton.solve(
                     start, mu=1e-2, mu_min=options.compare_mu, max_steps=options.max_steps
                 )
