@@ -14,7 +14,9 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
   vanishes on the contact set; two ranks give the serial answer; the obstacle below gives
   the load of the obstacle above (the mirror image w -> -w).
 - Starts that meet on one central path on the coarsest mesh stop there, with the answer
-  of every start taken to the end.
+  of every start taken to the end. The second free mode's starts are the second
+  eigenpair of a dense solve; with them a clamped plate's route ends no higher than the
+  active set's (at its two-buckle state).
 - The predicted contact set is the set of nodes that the dense affine-scaling Newton
   step (the direction for a zero barrier parameter) closes by more than half their gap;
   read inside a run it leaves the run unchanged; the fine mesh read early gives the
@@ -40,11 +42,12 @@ import dolfinx
 
 import numpy as np
 import pytest
+import scipy.linalg
 from conftest import run_mpi
 from exhaustive import dense
 from test_stress_family import FAMILY, _check
 
-from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_unilateral
+from unibuckle_fenicsx.algorithms.chain import ChainOptions, _second_free_mode, solve_unilateral
 from unibuckle_fenicsx.algorithms.interior_point import (
     PUSH_MARGIN,
     BarrierPoint,
@@ -540,6 +543,59 @@ def test_starts_on_one_central_path_are_not_taken_further():
     assert short.load == pytest.approx(full.load, rel=resolution)
     assert short.candidate.kkt
     problem.destroy()
+
+
+@serial
+def test_second_free_mode_is_the_pencils_second_eigenpair():
+    """The starts "free2-" and "free2+" are the parts of the free plate's second mode.
+
+    Reference: a dense solve of B x = theta A x (scipy.linalg.eigh) on the assembled
+    matrices of a thin SSSS plate (6x3); the mode's Rayleigh quotient a(u, u)/b(u, u) is
+    the second smallest positive load 1/theta. Tolerance: dense and SLEPc solves of these
+    plates agree to a few 1e-8 (cond(A) ~ 1e11, ``tests/test_stress_family.py``).
+    """
+    problem = BucklingProblem(_thin("ssss", nx=6, ny=3), MPI.COMM_SELF)
+    A, B = dense(problem.model.A), dense(problem.model.B)
+    theta = scipy.linalg.eigh(B, A, eigvals_only=True)
+    loads = np.sort(1.0 / theta[theta > 0.0])
+    assert loads[1] > loads[0] * (1.0 + 1e-3)  # a simple second eigenvalue
+    vec = _second_free_mode(problem)
+    assert vec is not None
+    x = vec.array.copy()
+    vec.destroy()
+    assert x @ A @ x / (x @ B @ x) == pytest.approx(loads[1], rel=1e-6)
+    problem.destroy()
+
+
+@serial
+@pytest.mark.parametrize("thickness", [1e-3, 2e-3])
+def test_clamped_plate_reaches_its_two_buckle_state(thickness):
+    """A clamped 0.3 x 0.1 m plate against a whole face (t = 1, 2 mm; 45x15).
+
+    The starts from the free plate's first mode and from pressures all end at three
+    buckles along the plate; two buckles in the middle lie lower, and the parts of the
+    second mode reach them. Reference: the active-set route (another algorithm, from its
+    own starts), whose load the route's must not exceed beyond the load's resolution in
+    double precision (1e-9). Before the second mode's starts the route ended 5.7e-3
+    (1 mm) and 5.0e-4 (2 mm) above it.
+    """
+    spec = plate_case(
+        "cccc",
+        length=0.3,
+        width=0.1,
+        thickness=thickness,
+        supports="clamped",
+        nx=45,
+        ny=15,
+        zone=ObstacleSpec(zone="all"),
+    )
+    loads = {}
+    for method in ("interior-point", "active-set"):
+        with solve(spec.with_solver(method=method, certify=False), MPI.COMM_SELF) as analysis:
+            assert analysis.result.method.startswith(method)
+            assert analysis.solution is not None and analysis.solution.candidate.kkt
+            loads[method] = analysis.result.critical_load_Pa
+    assert loads["interior-point"] <= loads["active-set"] * (1.0 + 1e-9), loads
 
 
 @serial
