@@ -459,17 +459,26 @@ def _plates_commands(rows: list[dict[str, Any]]) -> str:
     return "`, then `".join(commands)
 
 
+def _routes_commands(rows: list[dict[str, Any]]) -> str:
+    """The ``bench_routes.py`` runs that wrote the rows: one per plate length and mesh."""
+    commands = []
+    for length, mesh in dict.fromkeys((r["length_m"], str(r["mesh"])) for r in rows):
+        group = [r for r in rows if (r["length_m"], str(r["mesh"])) == (length, mesh)]
+        commands.append(
+            f"python bench/bench_routes.py --length {length:g} --meshes {mesh} "
+            f"--cases {_listed(group, 'case')} --thicknesses {_listed(group, 'thickness_m')} "
+            "--json bench/results/routes.jsonl"
+        )
+    return "`, then `".join(commands)
+
+
 COMMANDS = {
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"
     ),
     "plates": lambda rows: _plates_commands(rows),
-    "routes": lambda rows: (
-        f"python bench/bench_routes.py --meshes {_listed(rows, 'mesh')} "
-        f"--cases {_listed(rows, 'case')} --thicknesses {_listed(rows, 'thickness_m')} "
-        f"--json bench/results/routes.jsonl"
-    ),
+    "routes": lambda rows: _routes_commands(rows),
 }
 
 
