@@ -5,8 +5,9 @@ For a rigid obstacle (any side, several zones) the chain is
 1. **Nested interior-point Newton** (:mod:`.interior_point`). On the coarsest mesh (a
    structured plate's cells halved, a gmsh plate's cell size doubled, while the shorter
    side keeps ``coarse_min_cells`` cells; a user's mesh has one level) the method runs
-   from a few starts (the free mode's parts on either side of the obstacle, the
-   deflection under a pressure on the whole zone and on either end): the buckle may sit
+   from a few starts (the parts of the free plate's first two modes on either side of
+   the obstacle, the deflection under a pressure on the whole zone, on either end and in
+   the middle): the buckle may sit
    almost anywhere at nearly the same load, and each start finds one arrangement (a
    start that joins the central path of one met before stops there). The
    lowest critical state is carried to the next finer mesh by interpolating its mode (a
