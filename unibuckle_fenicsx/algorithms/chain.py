@@ -407,7 +407,9 @@ def _start(newton: InteriorPointNewton, seed: str, push: Any, second: Any = None
     if seed in ("free-", "free+", "free2-", "free2+"):
         if seed.startswith("free2"):
             if second is None:
-                raise ValueError("the free plate's second mode did not converge")
+                raise ValueError(
+                    "no second free mode (SLEPc converged fewer than two positive loads)"
+                )
             mode = second
         else:
             mode = problem.solve_free().function.x.petsc_vec
