@@ -66,6 +66,7 @@ __all__ = [
     "pop_run_options",
     "push_run_options",
     "release",
+    "same_pattern",
     "set_ldl_options",
     "set_options",
     "swapped_eigenpairs",
@@ -737,6 +738,14 @@ class SymmetricFactorization(Owner):
         self.destroy()
 
 
+def same_pattern(a: PETSc.Mat, b: PETSc.Mat) -> bool:
+    """Whether ``a`` and ``b`` have one CSR nonzero pattern on every rank (collective)."""
+    ai, aj, _ = a.getValuesCSR()
+    bi, bj, _ = b.getValuesCSR()
+    same = bool(np.array_equal(ai, bi) and np.array_equal(aj, bj))
+    return bool(a.getComm().tompi4py().allreduce(same, op=MPI.LAND))
+
+
 class SharedFactorization(Owner):
     r"""One MUMPS :math:`LDL^T` (with inertia) for the matrices of one mesh that have A's pattern.
 
@@ -797,10 +806,7 @@ class SharedFactorization(Owner):
         A value copy with ``SAME_NONZERO_PATTERN`` trusts the caller: PETSc compares
         only the number of nonzeros. Collective.
         """
-        ai, aj, _ = self.matrix.getValuesCSR()
-        bi, bj, _ = mat.getValuesCSR()
-        same = bool(np.array_equal(ai, bi) and np.array_equal(aj, bj))
-        return bool(mat.getComm().tompi4py().allreduce(same, op=MPI.LAND))
+        return same_pattern(self.matrix, mat)
 
     def destroy(self) -> None:
         """Destroy the matrix and its factorisation (collective)."""

@@ -23,7 +23,13 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.eigen import Owner, SharedFactorization, SymmetricFactorization, release
+from unibuckle_fenicsx.eigen import (
+    Owner,
+    SharedFactorization,
+    SymmetricFactorization,
+    release,
+    same_pattern,
+)
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
@@ -125,10 +131,7 @@ class ShiftedMatrix(Owner):
             K.axpy(-lam, self.B, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
             K.setOption(PETSc.Mat.Option.SYMMETRIC, False)  # type: ignore[arg-type]
             self.Kt = K.transpose(PETSc.Mat())  # not in place: an output matrix
-            ki, kj, _ = K.getValuesCSR()
-            ti, tj, _ = self.Kt.getValuesCSR()
-            same = bool(np.array_equal(ki, ti) and np.array_equal(kj, tj))
-            self._symmetric_pattern = bool(K.getComm().tompi4py().allreduce(same, op=MPI.LAND))
+            self._symmetric_pattern = same_pattern(K, self.Kt)
             self.K = K
             transposed = PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN
         else:
