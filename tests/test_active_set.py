@@ -165,6 +165,26 @@ def test_multilevel_equals_single_level():
         problem.destroy()
 
 
+def test_fine_polish_solves_below_the_extrapolated_load():
+    """The fine polish's eigen solves shift below the extrapolated load, and answer.
+
+    c3 at 80x40 (levels 20x10 and 40x20): every 80x40 solve is a shifted one (none
+    falls back to target 0), and the load is the smallest eigenvalue of the returned
+    set's pencil, solved again at target 0 without an estimate.
+    """
+    problem = BucklingProblem(paper_case("c3", 80, 40))
+    problem.solve_free()
+    solver = problem.eigensolver
+    shifted, again = solver.shifted_solves, solver.unshifted_again
+    solution = solve_active_set(problem, bound_budget=0)
+    assert solution.details["fine_eigensolves"] >= 1
+    assert solver.shifted_solves - shifted == solution.details["fine_eigensolves"]
+    assert solver.unshifted_again == again
+    cold = problem.evaluate(solution.active)
+    problem.destroy()
+    assert abs(solution.load - cold.load) <= RTOL * cold.load
+
+
 def _sparse_kkt(problem: BucklingProblem, active) -> tuple[bool, float]:
     """KKT conditions of the contact set ``active`` and its load, by scipy alone.
 
