@@ -8,8 +8,10 @@ double precision fixes a load only to its ``load_resolution``
 at t/b = 1e-3), and two solves of one contact set at different shifts differ by that.
 The tolerances below were not raised to it: where a comparison of loads from different
 solves decides (the empty set against the free load), the same pair is reused instead
-(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`); elsewhere such a
-comparison can at worst deny "proven" or a tie that lies within rounding. The problem
+(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`); where a feasible
+non-KKT mode would replace the active set's KKT point, it must lie lower by more than the
+KKT point's resolution; elsewhere such a comparison can at worst deny "proven" or a tie
+that lies within rounding. The problem
 file's own tolerances (``solver.tau``, ``solver.eps_tol``) are inputs, documented with
 the solver options, not here.
 """
