@@ -176,8 +176,8 @@ def _polish(
     later ones below the previous iterate's load, the inertia proving each pair the
     smallest (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`).
     Measured on the paper's plate (c1, c2, c3), unilateral solve and certificate over one
-    free solve: at 160×80 1.96, 3.25, 3.30 → 1.76, 2.47, 2.50, at 320×160 2.69, 2.30,
-    3.60 → 2.43, 2.05, 3.03; the same loads to 1e-14. (The prolonged coarse mode as the
+    free solve: at 160×80 1.96, 3.25, 3.30 → 1.69, 2.37, 2.51, at 320×160 2.69, 2.30,
+    3.60 → 2.34, 2.02, 3.03; the same loads to 1e-14. (The prolonged coarse mode as the
     first solve's start as well saved another 0.05 s at 160×80 but changed the path on
     near-degenerate thin plates: a 4 mm SSSS plate 0.3 × 0.1 m at 90×30 took 17 fine eigen
     solves instead of 3.)
