@@ -82,7 +82,7 @@ logger = logging.getLogger(__name__)
 #: "auto" runs the interior-point route on plates whose thickness is below this fraction
 #: of the shorter side, the multilevel active set on thicker ones. Measured: at t/b = 1e-3
 #: the active set needs hundreds of eigen solves on a whole-face obstacle; on the paper's
-#: plate (t/b = 0.06, a/b = 2) the active set costs 2–3.4 free solves at 160×80 and the
+#: plate (t/b = 0.06, a/b = 2) the active set costs 1.7–2.5 free solves at 160×80 and the
 #: interior point 3.9–4.6. On long plates against a whole face the interior point is
 #: usually the faster above 0.02 too (``bench/bench_routes.py``: 0.3 × 0.1 m, t/b =
 #: 0.02–0.06, five edge and load cases: the faster on 18 of 20, median 4.1×; the active
