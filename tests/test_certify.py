@@ -10,6 +10,7 @@ proven.
 
 from __future__ import annotations
 
+import json
 from dataclasses import replace
 
 from mpi4py import MPI
@@ -167,6 +168,11 @@ def test_inactive_obstacle_is_proven():
     assert result.critical_load_Pa == pytest.approx(result.free_load_Pa, rel=1e-9)
     assert cert.global_optimum_proven
     assert cert.proven_by in ("interlacing", "psd", "enumeration", "lattice")
+    # No contact node: the largest contact force has no finite value, null in the JSON
+    # (a number or null, never a string: results.md, "The JSON file").
+    assert result.contact_nodes == 0 and cert.max_contact_force == -np.inf
+    data = json.loads(json.dumps(result.as_dict(), allow_nan=False))
+    assert data["certificate"]["max_contact_force"] is None
 
 
 @pytest.mark.parametrize("zone", [((-0.02, 0.06), (-0.03, 0.03)), ((-0.05, 0.03), (-0.05, 0.02))])

@@ -87,7 +87,7 @@ def test_help(tmp_path):
     for status in (EXIT_OK, EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED):
         assert f"\n  {status}  " in sub.stdout
     # Every flag is explained: each option of the sub-command carries a help text.
-    _, solve_parser = _parser()
+    solve_parser = _parser()[1]["solve"]
     for action in solve_parser._actions:
         assert action.help, action.option_strings
 
@@ -374,6 +374,47 @@ def test_options_that_do_not_apply_are_named(capsys):
     err = capsys.readouterr().err
     for flag in ("--complete", "--until-proven", "--penalty"):
         assert re.search(rf"warning: {flag} \(applies to --method \w+\) is ignored", err), err
+
+
+def test_options_that_auto_does_not_use_are_named(capsys):
+    """Under auto an enumeration flag waits for auto's choice; the file's method counts.
+
+    c2 at 8x4 has i = 3 (8 candidate sets): max_candidates = 4 makes auto choose the
+    active set, which leaves --complete unused; a method set in the problem (here by
+    --set) makes --complete inapplicable before the solve, as --method would.
+    """
+    args = ["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--complete", "-q"]
+    assert main([*args, "--set", "solver.max_candidates=4"]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert re.search(
+        r"warning: --complete \(applies to --method enumerate\) was not used: "
+        r"auto chose active-set \(2\^3 = 8 candidate sets",
+        err,
+    ), err
+    assert main([*args, "--set", "solver.method=active-set"]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert (
+        "warning: --complete (applies to --method enumerate) is ignored with --method active-set"
+        in err
+    ), err
+    assert main(args) == EXIT_OK  # auto enumerates: --complete applies, no warning
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_nonlinear_help_names_only_its_own_flags(capsys):
+    """The nonlinear help names no --output (it writes no fields).
+
+    An unknown flag is reported with the nonlinear usage line, not the top-level one.
+    """
+    nonlinear = _parser()[1]["nonlinear"]
+    assert "--output" not in nonlinear.format_help()
+    with pytest.raises(SystemExit) as exit_:
+        main(["nonlinear", "--case", "c1", "--output", "x"])
+    assert exit_.value.code == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("usage: unibuckle nonlinear") and "unrecognized arguments: --output" in err
+    )
 
 
 def test_candidate_parallel_under_auto_enumerates(capsys):

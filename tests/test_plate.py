@@ -196,3 +196,13 @@ def test_obstacle_zone_without_free_node(zone):
     with pytest.raises(EmptyZoneError, match=r"obstacle\.zone .* holds no free mesh node"):
         BucklingProblem(spec, MPI.COMM_WORLD)
     assert issubclass(EmptyZoneError, ValueError)
+
+
+def test_empty_circle_zone_is_named_by_its_key():
+    """A circle holding no mesh node is named obstacle.circle, the key that gave it."""
+    from unibuckle_fenicsx.config import Circle
+
+    zone = Circle(center=(0.001, 0.001), radius=0.0005)  # between the nodes of 20x10
+    spec = ProblemSpec(mesh=MeshSpec(20, 10), obstacle=ObstacleSpec(zone=zone))
+    with pytest.raises(EmptyZoneError, match=r"^obstacle\.circle circle about .* holds no free"):
+        BucklingProblem(spec, MPI.COMM_WORLD)

@@ -241,3 +241,29 @@ def test_eigen_solve_near_an_estimate_is_the_smallest(load):
     # Three times the load lies above the second eigenvalue: the pair nearest that
     # shift would not have been the smallest.
     assert np.sort(1.0 / mu[mu > 0])[1] < 3.0 * cold.load * (1.0 - 1e-3)
+
+
+def test_a_destroyed_problem_refuses_use():
+    """After solve()'s with block the problem's PETSc objects are gone: a clear error.
+
+    Before, evaluate() on it ended the process (SEGV, MPI_Abort); the result, the mode
+    and the certificate stay usable.
+    """
+    with solve(paper_case("c1", nx=8, ny=4), MPI.COMM_WORLD) as analysis:
+        active = analysis.solution.active
+        load = analysis.result.critical_load_Pa
+    assert analysis.mode.x.petsc_vec.norm() > 0.0 and analysis.result.critical_load_Pa == load
+    with pytest.raises(RuntimeError, match="BucklingProblem was destroyed"):
+        analysis.problem.evaluate(active)
+    with pytest.raises(RuntimeError, match="destroyed"):
+        analysis.problem.model  # noqa: B018 - the access itself is the test
+    analysis.problem.destroy()  # a second destroy is harmless
+
+
+@pytest.mark.parametrize("spec", [None, "c1", {"plate": {}}, 42])
+def test_solve_names_what_it_needs(spec):
+    """Not a ProblemSpec: a TypeError naming it, not an AttributeError from inside."""
+    with pytest.raises(TypeError, match=r"spec must be a ProblemSpec \(paper_case"):
+        solve(spec, MPI.COMM_WORLD)
+    with pytest.raises(TypeError, match="comm must be an MPI communicator"):
+        solve(paper_case("c1", nx=4, ny=2), "world")

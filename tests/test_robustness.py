@@ -225,6 +225,63 @@ def test_an_interrupted_constructor_prints_no_traceback(tmp_path):
     assert "Traceback" not in proc.stderr and "Exception ignored" not in proc.stderr, proc.stderr
 
 
+def test_an_interrupt_inside_a_petsc_callback_is_an_interrupt(monkeypatch, capsys):
+    """Ctrl-C while SNES calls the nonlinear path's residual: exit 130, not a PETSc error.
+
+    petsc4py turns an exception raised in a Python callback into PETSc error 101 with
+    the exception as its context; the first residual evaluation raises the interrupt
+    here, as a Ctrl-C during the load path does (measured: "PETSc/SLEPc failed: error
+    code 101", exit 3, before the fix).
+    """
+    from unibuckle_fenicsx.nonlinear.model import VonKarmanPlate
+
+    def interrupted(self, snes, x, b):
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(VonKarmanPlate, "_residual", interrupted)
+    monkeypatch.setattr(sys, "unraisablehook", sys.unraisablehook)  # main() replaces it
+    args = ["nonlinear", "--case", "c1", "--nx", "6", "--ny", "4", "-q"]
+    assert main(args) == EXIT_INTERRUPTED
+    assert "unibuckle: interrupted; nothing written" in capsys.readouterr().err
+
+
+def _imports(path: Path) -> list[str]:
+    """The top-level names of the modules ``path`` imports, in order (module level only)."""
+    import ast
+
+    names = []
+    for node in ast.parse(path.read_text()).body:
+        if isinstance(node, ast.Import):
+            names += [alias.name.split(".")[0] for alias in node.names]
+        elif isinstance(node, ast.ImportFrom) and node.module and not node.level:
+            names.append(node.module.split(".")[0])
+    return names
+
+
+def test_every_module_loads_mpi_before_petsc():
+    """Any module of the package imports cleanly as a script's first import.
+
+    The PyPI wheel's petsc4py finds libmpi only once mpi4py has loaded it, so every
+    module that imports petsc4py, slepc4py, DOLFINx, basix or UFL must find mpi4py
+    imported before, by itself or by a package above it (whose __init__ runs first).
+    Before, ``from unibuckle_fenicsx.certificate.certify import certify`` as a first
+    import failed ("libmpi.so.12: cannot open shared object file").
+    """
+    package = Path(__file__).resolve().parents[1] / "unibuckle_fenicsx"
+    needs = {"petsc4py", "slepc4py", "dolfinx", "basix", "ufl"}
+    for path in sorted(package.rglob("*.py")):
+        above = [p / "__init__.py" for p in path.parents if p.is_relative_to(package)]
+        loaded = any("mpi4py" in _imports(init) for init in above if init != path)
+        for name in _imports(path):
+            loaded = loaded or name == "mpi4py"
+            assert loaded or name not in needs, f"{path.relative_to(package)} imports {name}"
+    proc = subprocess.run(
+        [sys.executable, "-c", "from unibuckle_fenicsx.certificate.certify import certify"],
+        capture_output=True, text=True, timeout=120, env={**os.environ, "OMP_NUM_THREADS": "1"},
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+
+
 # -- names ---------------------------------------------------------------------------------
 def test_file_stem():
     assert file_stem("c1") == "c1"
@@ -407,14 +464,21 @@ def test_nonlinear_unilateral_shape_without_obstacle_names_the_flags(capsys, not
 
 
 def test_versions_name_every_library_that_took_part():
+    import petsc4py
+    import slepc4py
+
     found = versions()
-    for dist in ("mpi4py", "gmsh", "cvxpy", "clarabel", "petsc4py", "fenics-dolfinx"):
+    for dist in ("mpi4py", "gmsh", "cvxpy", "clarabel", "fenics-dolfinx"):
         try:
             expected = version(dist)
         except PackageNotFoundError:
             assert dist not in found
         else:
             assert found[dist] == expected
+    # The bindings always took part, whichever distribution installed them (the PyPI
+    # wheel dolfinx-solver-real bundles them under its own name).
+    assert found["petsc4py"] == petsc4py.__version__
+    assert found["slepc4py"] == slepc4py.__version__
 
 
 # -- an incomplete nonlinear path -----------------------------------------------------------

@@ -11,6 +11,8 @@ family's three bases come from its module.
 from __future__ import annotations
 
 import json
+import subprocess
+import sys
 from pathlib import Path
 from typing import Any
 
@@ -105,6 +107,23 @@ def test_unibuckle_schema_writes_it(tmp_path, capsys):
     assert json.loads(out.read_text()) == json_schema()
     assert main(["schema", "--keys"]) == EXIT_OK
     assert capsys.readouterr().out.split() == accepted_keys()
+
+
+def test_unibuckle_schema_into_a_pipe_closed_early(tmp_path):
+    """``unibuckle schema | head``: a reader that stops early is not an error.
+
+    The pipe is closed before the command writes (it takes a few tenths of a second to
+    start), so its write meets a closed pipe for certain: no traceback, status 0.
+    """
+    script = Path(sys.executable).parent / "unibuckle"
+    proc = subprocess.Popen(
+        [str(script), "schema"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, cwd=tmp_path
+    )
+    assert proc.stdout is not None and proc.stderr is not None
+    proc.stdout.close()  # what head does after its lines
+    err = proc.stderr.read().decode()
+    assert proc.wait(timeout=120) == EXIT_OK, err
+    assert "Traceback" not in err and "BrokenPipe" not in err, err
 
 
 def test_every_accepted_key_loads(tmp_path):

@@ -200,6 +200,8 @@ def solve(
         The analysis (result, mode, problem); the caller destroys it (or uses ``with``).
 
     Raises:
+        TypeError: ``spec`` is not a :class:`~unibuckle_fenicsx.config.ProblemSpec` or
+            ``comm`` not an MPI communicator.
         InputError: The problem is refused (before any solve, or once its mesh exists).
         NumericalError: A solve did not converge, or no admissible mode was found.
 
@@ -208,6 +210,15 @@ def solve(
         destroyed before the error propagates (collectively: every rank raises).
     """
     t0 = time.perf_counter()
+    if not isinstance(spec, ProblemSpec):
+        raise TypeError(
+            f"solve: spec must be a ProblemSpec (paper_case(...), load_toml(path), "
+            f"problem_from_dict(data)), got {type(spec).__name__}"
+        )
+    if not isinstance(comm, MPI.Comm):
+        raise TypeError(
+            f"solve: comm must be an MPI communicator (MPI.COMM_WORLD), got {type(comm).__name__}"
+        )
     if mesh is not None and candidate_parallel:
         raise InputError("candidate_parallel builds its own serial meshes: pass no mesh")
     problem = BucklingProblem(

@@ -55,6 +55,11 @@ OUTPUT_HELP = """\
 in DIR, creating DIR (not its parents) if it is missing. Both are checked before
 anything is solved: a path that cannot be written is refused (exit status 2)."""
 
+#: ... for ``nonlinear``, which writes no fields (no --output).
+JSON_HELP = """\
+--json PATH writes one file; its folder must exist. It is checked before anything
+is solved: a path that cannot be written is refused (exit status 2)."""
+
 EPILOG = f"""\
 {OUTPUT_HELP}
 
@@ -126,7 +131,7 @@ exit status:
   {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
 
-{OUTPUT_HELP}
+{JSON_HELP}
 
 Single-dash options go to PETSc under the prefixes unibuckle_nl_ (the SNES, its KSP:
 -unibuckle_nl_snes_monitor, -unibuckle_nl_snes_view), unibuckle_ (the linear eigen
@@ -160,7 +165,9 @@ def _common_flags() -> argparse.ArgumentParser:
     """Flags of every subcommand: logging and progress."""
     common = argparse.ArgumentParser(add_help=False)
     common.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
-    common.add_argument("-q", "--quiet", action="store_true", help="no progress output on stderr")
+    common.add_argument(
+        "-q", "--quiet", action="store_true", help="no progress output on stderr (warnings stay)"
+    )
     return common
 
 
@@ -199,7 +206,8 @@ def _problem_flags() -> argparse.ArgumentParser:
     return problem
 
 
-def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
+def _parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
+    """The command line's parser and its subcommands' parsers by name."""
     parser = argparse.ArgumentParser(
         prog="unibuckle",
         description=(
@@ -267,7 +275,7 @@ def _parser() -> tuple[argparse.ArgumentParser, argparse.ArgumentParser]:
     )
     k.add_argument("--keys", action="store_true", help="print the dotted keys instead")
     k.add_argument("--output", metavar="PATH", help="write to PATH instead of stdout")
-    return parser, s
+    return parser, dict(sub.choices)
 
 
 def _solve_flags(s: argparse.ArgumentParser) -> None:
@@ -433,7 +441,7 @@ _METHOD_FLAGS = {
 
 
 def _solver_changes(args: argparse.Namespace) -> tuple[dict[str, Any], list[str]]:
-    """SolverSpec changes from the flags, and the flags that do not apply to the method."""
+    """SolverSpec changes from the flags, and the method-specific flags given."""
     values = {
         "--complete": args.complete or None,
         "--until-proven": args.until_proven or None,
@@ -450,16 +458,30 @@ def _solver_changes(args: argparse.Namespace) -> tuple[dict[str, Any], list[str]
         changes["certify"] = False
     if args.bracket:
         changes["bracket"] = True
-    ignored = []
-    method = args.method or "auto"
+    given = []
     for flag, value in values.items():
-        if value is None:
+        if value is not None:
+            changes[_METHOD_FLAGS[flag][1]] = value
+            given.append(flag)
+    return changes, given
+
+
+def _unused_flags(flags: list[str], method: str, chosen: str | None = None) -> list[str]:
+    """The flags of ``flags`` that do not apply to ``method`` (the one in force).
+
+    Under "auto" a flag of the enumeration applies if auto enumerates: before the solve
+    (``chosen`` None) it is kept; after it, it is unused when ``chosen`` (the method
+    that answered) is not the enumeration.
+    """
+    unused = []
+    for flag in flags:
+        methods = _METHOD_FLAGS[flag][0]
+        if method in methods:
             continue
-        methods, name = _METHOD_FLAGS[flag]
-        changes[name] = value
-        if method not in methods and not (method == "auto" and "enumerate" in methods):
-            ignored.append(f"{flag} (applies to --method {' or '.join(methods)})")
-    return changes, ignored
+        if method == "auto" and "enumerate" in methods and chosen in (None, "enumerate"):
+            continue
+        unused.append(f"{flag} (applies to --method {' or '.join(methods)})")
+    return unused
 
 
 def _probe_folder(flag: str, folder: Path, target: Path) -> str | None:
@@ -539,12 +561,11 @@ def _logging(verbose: int, quiet: bool, rank: int) -> None:
 def main(argv: Sequence[str] | None = None) -> int:
     """Run the command line; returns the exit status."""
     argv = list(sys.argv[1:] if argv is None else argv)
-    parser, solve_parser = _parser()
+    parser, commands = _parser()
     args, rest = parser.parse_known_args(argv)
     unknown = [a for a in rest if a.startswith("--")]
-    if unknown:
-        sub = solve_parser if args.command == "solve" else parser
-        sub.error(f"unrecognized arguments: {' '.join(unknown)}")
+    if unknown:  # the subcommand's usage line, not the top-level one
+        commands[args.command].error(f"unrecognized arguments: {' '.join(unknown)}")
 
     if args.command == "schema":
         return _schema(args)
@@ -561,28 +582,50 @@ def main(argv: Sequence[str] | None = None) -> int:
     try:
         return _run(args, rest, comm)
     except KeyboardInterrupt:
-        # What the interrupt left half-built is destroyed with its traceback, when this
-        # handler ends; a destructor that assumes a finished constructor (dolfinx's
-        # LinearProblem.__del__ reads self._solver) would print "Exception ignored ...
-        # Traceback" after the one-line message.
-        sys.unraisablehook = _after_interrupt
-        if comm.rank == 0:
-            where = "nothing written"
-            if args.command == "sweep":
-                where = f"the finished points are in {args.json}; the same command resumes"
-            print(f"\nunibuckle: interrupted; {where}", file=sys.stderr, flush=True)
-        return EXIT_INTERRUPTED
+        return _interrupted(args, comm)
     except InputError as err:
         return _fail(comm, str(err))
     except NumericalError as err:
         return _fail(comm, f"{err} (no result written)", EXIT_NOT_CERTIFIED)
     except Exception as err:
+        if _chain_holds(err, KeyboardInterrupt):
+            # Ctrl-C inside a Python callback of PETSc (the nonlinear path's SNES
+            # residual): petsc4py turns it into PETSc error 101 with the interrupt as
+            # its context. An interrupt all the same.
+            return _interrupted(args, comm)
         refused = _petsc_error(err, rest)
         if refused is not None:
             return _fail(comm, *refused)
         traceback.print_exc()  # on every rank that fails: the bug may be on one
         print(BUG_REPORT, file=sys.stderr, flush=True)
         return EXIT_BUG
+
+
+def _interrupted(args: argparse.Namespace, comm: Any) -> int:
+    """Say what an interrupt (Ctrl-C) left, on rank 0; the exit status."""
+    # What the interrupt left half-built is destroyed with its traceback, when the
+    # handler ends; a destructor that assumes a finished constructor (dolfinx's
+    # LinearProblem.__del__ reads self._solver) would print "Exception ignored ...
+    # Traceback" after the one-line message.
+    sys.unraisablehook = _after_interrupt
+    if comm.rank == 0:
+        where = "nothing written"
+        if args.command == "sweep":
+            where = f"the finished points are in {args.json}; the same command resumes"
+        print(f"\nunibuckle: interrupted; {where}", file=sys.stderr, flush=True)
+    return EXIT_INTERRUPTED
+
+
+def _chain_holds(err: BaseException, kind: type[BaseException]) -> bool:
+    """Whether ``err`` or one of its causes or contexts (at most 8 deep) is a ``kind``."""
+    found: BaseException | None = err
+    for _ in range(8):
+        if found is None:
+            return False
+        if isinstance(found, kind):
+            return True
+        found = found.__cause__ or found.__context__
+    return False
 
 
 def _schema(args: argparse.Namespace) -> int:
@@ -593,7 +636,13 @@ def _schema(args: argparse.Namespace) -> int:
 
     text = "\n".join(accepted_keys()) if args.keys else json.dumps(json_schema(), indent=2)
     if not args.output:
-        print(text)
+        try:
+            print(text, flush=True)
+        except BrokenPipeError:
+            # The reader stopped early (``| head``): not an error. Python's recipe (the
+            # signal module's "Note on SIGPIPE"): stdout to devnull, so that the
+            # interpreter's last flush at exit does not fail again.
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
         return EXIT_OK
     try:
         Path(args.output).write_text(text + "\n")
@@ -655,14 +704,12 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
 
     try:
         spec = _spec_from_args(args)
-        changes, ignored = _solver_changes(args)
+        changes, flags = _solver_changes(args)
         spec = spec.with_solver(**changes)
     except (ValueError, OSError) as err:
         return fail(str(err))
-    if comm.rank == 0:
-        method = spec.solver.method
-        for flag in ignored:
-            print(f"unibuckle: warning: {flag} is ignored with --method {method}", file=sys.stderr)
+    method = spec.solver.method  # the flag's, or the problem file's
+    _warn_unused(flags, method, comm)
     _warn_plate_model(spec, comm)
     try:
         analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
@@ -678,6 +725,7 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
             except OSError as err:  # the folder went away during the solve
                 unwritten = f"--output {args.output}: {err}"
     result = analysis.result
+    _warn_unused(flags, method, comm, result)
     status = EXIT_OK
     certificate = result.certificate
     if certificate is not None and not certificate["kkt"]:
@@ -701,6 +749,26 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
     if unwritten is not None:
         return fail(f"could not write {unwritten}; the result is the summary above")
     return status
+
+
+def _warn_unused(flags: list[str], method: str, comm: Any, result: Any = None) -> None:
+    """Warn of the flags that do not apply to ``method`` (rank 0).
+
+    Before the solve (``result`` None): those that cannot apply; after it, under auto,
+    the enumeration's flags that auto's choice (``result.method``) left unused.
+    """
+    if comm.rank != 0 or (result is not None and method != "auto"):
+        return
+    if result is None:
+        for flag in _unused_flags(flags, method):
+            print(f"unibuckle: warning: {flag} is ignored with --method {method}", file=sys.stderr)
+        return
+    for flag in _unused_flags(flags, "auto", result.method):
+        print(
+            f"unibuckle: warning: {flag} was not used: auto chose {result.method} "
+            f"({result.method_chosen_by.removeprefix('auto: ')})",
+            file=sys.stderr,
+        )
 
 
 def _warn_plate_model(spec: ProblemSpec, comm: Any) -> None:

@@ -223,7 +223,7 @@ class BucklingResult:
         return result
 
     def as_dict(self, timings: bool = True) -> dict[str, Any]:
-        """JSON-ready mapping (non-finite floats become strings).
+        """JSON-ready mapping (non-finite floats become ``null``: JSON has no infinity).
 
         Args:
             timings: Keep the wall times (``*_s`` and ``seconds`` keys, the latter in
@@ -411,11 +411,17 @@ def versions() -> dict[str, str]:
         except PackageNotFoundError:
             pass
     try:
+        import petsc4py
+        import slepc4py
         from petsc4py import PETSc
         from slepc4py import SLEPc
 
         import dolfinx
 
+        # The bindings' own versions: the PyPI wheel (dolfinx-solver-real) bundles them
+        # under its own distribution name, where the loop above finds none.
+        out.setdefault("petsc4py", petsc4py.__version__)
+        out.setdefault("slepc4py", slepc4py.__version__)
         out["dolfinx"] = dolfinx.__version__
         out["PETSc"] = ".".join(str(v) for v in PETSc.Sys.getVersion())
         out["SLEPc"] = ".".join(str(v) for v in SLEPc.Sys.getVersion())
@@ -446,6 +452,9 @@ def _jsonable(obj: Any) -> Any:
     if isinstance(obj, np.integer):
         return int(obj)
     if isinstance(obj, float | np.floating):
+        # No finite value (a contact force with no contact node, an upper bound with no
+        # admissible mode): null, as the top-level upper_bound_Pa has always been,
+        # rather than a string where a reader expects a number.
         value = float(obj)
-        return value if np.isfinite(value) else str(value)
+        return value if np.isfinite(value) else None
     return obj

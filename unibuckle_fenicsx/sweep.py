@@ -439,10 +439,13 @@ def run_sweep(
         Collective on ``comm``.
     """
     if int(ranks_per_point) != ranks_per_point or ranks_per_point < 1:
-        raise InputError(f"ranks_per_point must be an integer >= 1, got {ranks_per_point!r}")
+        raise InputError(
+            f"ranks_per_point (--ranks-per-point) must be an integer >= 1, got {ranks_per_point!r}"
+        )
     if comm.size % ranks_per_point:
         raise InputError(
-            f"ranks_per_point = {ranks_per_point} must divide the number of ranks ({comm.size})"
+            f"ranks_per_point (--ranks-per-point) = {ranks_per_point} must divide the number "
+            f"of ranks ({comm.size})"
         )
     points = sweep_points(variations)
     specs = [point_problem(base, p) for p in points]  # every point checked before solving

@@ -16,6 +16,10 @@ from dataclasses import dataclass, field
 from enum import StrEnum
 from typing import TYPE_CHECKING, Any
 
+# Before any module of this package imports petsc4py or DOLFINx: mpi4py loads the MPI
+# library they link to (with the PyPI wheel, petsc4py alone fails to find libmpi).
+from mpi4py import MPI  # noqa: F401
+
 import numpy as np
 import numpy.typing as npt
 

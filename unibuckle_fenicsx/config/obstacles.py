@@ -118,6 +118,15 @@ class ObstacleSpec:
             return "rigid"
         return "bilateral" if self.side == "both" else "tensionless"
 
+    @property
+    def zone_key(self) -> str:
+        """The problem file's key of the zone: "zone", "polygon" or "circle"."""
+        if isinstance(self.zone, Polygon):
+            return "polygon"
+        if isinstance(self.zone, Circle):
+            return "circle"
+        return "zone"
+
     def describe(self) -> str:
         """Short human-readable description of the zone."""
         if isinstance(self.zone, str):

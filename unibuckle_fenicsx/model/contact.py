@@ -118,7 +118,7 @@ def check_zone_has_nodes(
     for k, (o, mask) in enumerate(zip(found, inside, strict=True)):
         if msh.comm.allreduce(int(np.count_nonzero(mask)), op=MPI.SUM) == 0:
             raise EmptyZoneError(
-                f"{_label(found, k, labels)}.zone {o.describe()} holds no free mesh node: "
+                f"{_label(found, k, labels)}.{o.zone_key} {o.describe()} holds no free mesh node: "
                 f"none of the {msh.geometry.index_map().size_global} mesh nodes lies in it; "
                 "enlarge the zone or refine the mesh"
             )
@@ -348,11 +348,12 @@ class ContactSetManager:
         if self.coordinates.shape[0] == 0:
             nx = model.mesh.topology.index_map(0).size_global
             zones = "; ".join(o.describe() for o in self.obstacles)
+            named = "/".join(dict.fromkeys(o.zone_key for o in self.obstacles))
             raise EmptyZoneError(
-                f"obstacle.zone {zones} holds no free mesh node "
-                f"({self.num_edge_fixed} zone nodes are fixed by edge supports; the mesh "
-                f"has {nx} vertices, spacing about {self._spacing():.3g} m): enlarge the "
-                "zone or refine the mesh"
+                f"obstacle.{named} {zones} holds no free mesh node ({self.num_edge_fixed} "
+                f"zone nodes are fixed by edge supports; the mesh has {nx} vertices, cells "
+                f"up to {self._spacing():.3g} m across their diagonal): enlarge the zone or "
+                "refine the mesh"
             )
         offset = int(sum(len(g) for g in gathered[: comm.rank]))
         rank_pos = np.empty(len(order), dtype=np.int64)

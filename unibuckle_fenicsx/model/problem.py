@@ -19,6 +19,7 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import dataclass, replace
+from typing import Any
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -352,8 +353,19 @@ class BucklingProblem(Owner):
             K.destroy()
         if negative or zero:
             self.model.destroy()
+            # With an obstacle the plate may still carry such a fixed part (its unilateral
+            # critical load lies higher), but the solvers and certificates here all rest
+            # on a positive definite first matrix of the pencil: say so, not that it buckles.
+            obstacle = (
+                " without its obstacle (with it, the plate may carry this fixed part, but "
+                "every solver here needs A - B_fixed positive definite, i.e. the fixed part "
+                "below the free plate's critical value)"
+                if self.spec.all_obstacles
+                else ""
+            )
             raise InputError(
-                "the fixed load alone buckles the plate (fixed_normal_stress, "
+                "the fixed load alone buckles the plate"
+                f"{obstacle} (fixed_normal_stress, "
                 "fixed_shear_stress, fixed_temperature): the stiffness less its geometric "
                 f"stiffness, A - B_fixed, has {negative} negative and {zero} zero "
                 "eigenvalue(s); lower the fixed part below its own critical value"
@@ -569,7 +581,41 @@ class BucklingProblem(Owner):
             mat.destroy()
         self._abs = None
         pop_run_options(getattr(self, "_run_options", []))
-        for name in ("eigensolver", "model"):  # absent when the constructor failed early
-            owner = getattr(self, name, None)
+        for name in ("_eigensolver", "_model"):  # absent when the constructor failed early
+            owner = self.__dict__.get(name)
             if owner is not None:
                 owner.destroy()
+        self._destroyed = True
+
+    @property
+    def model(self) -> PlateModel:
+        """The plate's forms and matrices (A, B); an error once destroyed."""
+        return self._live("_model")
+
+    @model.setter
+    def model(self, value: PlateModel) -> None:
+        self._model = value
+
+    @property
+    def eigensolver(self) -> GEPSolver:
+        """The pencil's eigen solver; an error once destroyed."""
+        return self._live("_eigensolver")
+
+    @eigensolver.setter
+    def eigensolver(self, value: GEPSolver) -> None:
+        self._eigensolver = value
+
+    def _live(self, name: str) -> Any:
+        # A destroyed PETSc object used again can end the process (SEGV, MPI_Abort):
+        # refuse with a clear error instead.
+        if self.__dict__.get("_destroyed"):
+            raise RuntimeError(
+                "this BucklingProblem was destroyed (its with block, or solve()'s, has "
+                "ended, or destroy() was called): its PETSc objects are gone; use it "
+                "inside the with block (the Analysis' result, mode and certificate stay "
+                "usable after it)"
+            )
+        try:
+            return self.__dict__[name]
+        except KeyError:
+            raise AttributeError(f"BucklingProblem has no {name.lstrip('_')} yet") from None
