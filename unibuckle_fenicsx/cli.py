@@ -588,7 +588,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     except NumericalError as err:
         return _fail(comm, f"{err} (no result written)", EXIT_NOT_CERTIFIED)
     except Exception as err:
-        if _chain_holds(err, KeyboardInterrupt):
+        if _in_chain(err, KeyboardInterrupt) is not None:
             # Ctrl-C inside a Python callback of PETSc (the nonlinear path's SNES
             # residual): petsc4py turns it into PETSc error 101 with the interrupt as
             # its context. An interrupt all the same.
@@ -616,16 +616,14 @@ def _interrupted(args: argparse.Namespace, comm: Any) -> int:
     return EXIT_INTERRUPTED
 
 
-def _chain_holds(err: BaseException, kind: type[BaseException]) -> bool:
-    """Whether ``err`` or one of its causes or contexts (at most 8 deep) is a ``kind``."""
+def _in_chain(err: BaseException, kind: type[BaseException]) -> BaseException | None:
+    """``err`` or the first of its causes or contexts (8 deep at most) that is a ``kind``."""
     found: BaseException | None = err
     for _ in range(8):
-        if found is None:
-            return False
-        if isinstance(found, kind):
-            return True
+        if found is None or isinstance(found, kind):
+            return found
         found = found.__cause__ or found.__context__
-    return False
+    return None
 
 
 def _schema(args: argparse.Namespace) -> int:
@@ -662,12 +660,8 @@ def _petsc_error(err: BaseException, options: Sequence[str]) -> tuple[str, int] 
     """
     from petsc4py import PETSc
 
-    found: BaseException | None = err
-    seen = 0
-    while found is not None and not isinstance(found, PETSc.Error) and seen < 8:
-        found = found.__cause__ or found.__context__
-        seen += 1
-    if not isinstance(found, PETSc.Error):
+    found = _in_chain(err, PETSc.Error)
+    if found is None:
         return None
     lines = [line.removeprefix("[0] ").strip() for line in str(found).splitlines()]
     reason = "; ".join(line for line in lines[1:] if line and "() at " not in line)
