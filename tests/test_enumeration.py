@@ -219,7 +219,7 @@ def test_needs_an_obstacle():
     ("zone", "message"),
     [
         (((0.01, 0.02), (0.01, 0.02)), r"\[0.01, 0.02\] x \[0.01, 0.02\] holds no free mesh node"),
-        (((0.1, 0.1), (-0.05, 0.05)), r"5 zone nodes are fixed by edge supports"),
+        (((0.1, 0.1), (-0.05, 0.05)), r"5 zone nodes are held by supports: edges or bilateral"),
     ],
 )
 def test_empty_zone(zone, message):

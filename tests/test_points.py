@@ -124,6 +124,24 @@ def test_one_sided_points_with_a_tensionless_foundation_are_refused():
         problem_from_dict(data)
 
 
+@pytest.mark.parametrize(
+    "points",
+    [
+        [PointSpec(at=(0.0, 0.5), kind="one-sided")],  # on the simply supported left edge
+        [PointSpec(at=(1.0, 0.5)), PointSpec(at=(1.0, 0.5), kind="one-sided")],  # held there
+    ],
+)
+def test_a_one_sided_point_on_a_held_node_is_named(points):
+    """A one-sided point whose node is held already restrains nothing.
+
+    The message is about the points (it named an obstacle.zone the file does not have).
+    """
+    from unibuckle_fenicsx.model.contact import EmptyZoneError
+
+    with pytest.raises(EmptyZoneError, match=r"^points: the one-sided points act on no free node"):
+        result(plate(4, aspect=2.0, points=points))
+
+
 def test_snap_distance_is_reported():
     """A point off the grid acts on the nearest node; the JSON and the summary say how far."""
     spec = plate(4, aspect=2.0, points=[PointSpec(at=(0.55, 0.5)), PointSpec(at=(1.5, 0.5))])
@@ -133,6 +151,17 @@ def test_snap_distance_is_reported():
     assert first["max_snap_distance_m"] == pytest.approx(0.05, rel=1e-12)  # node at x = 0.5
     assert second["max_snap_distance_m"] == pytest.approx(0.0, abs=1e-15)
     assert "largest snap distance 0.05 m" in out.summary()
+
+
+def test_the_summary_describes_points_in_the_file_s_units():
+    """With units = "mm-N-MPa" the points line is in mm and N/mm, as the rest of it.
+
+    A spring of 1e5 N/m at (1.5, 0.5) m is 100 N/mm at (1500, 500) mm; the JSON stays SI.
+    """
+    spring = PointSpec(at=(1.5, 0.5), kind="spring", stiffness=1.0e5)
+    out = result(replace(plate(4, aspect=2.0, points=[spring]), units="mm-N-MPa"))
+    assert "points: spring 100 N/mm at (1500, 500) mm: 1 points on 1 nodes" in out.summary()
+    assert out.details["point_restraints"][0]["restraint"] == "spring 100000 N/m at (1.5, 0.5) m"
 
 
 # -- bilateral ties ------------------------------------------------------------------------

@@ -273,6 +273,44 @@ def test_a_rise_linear_across_the_plate_is_a_stress_gradient():
     assert a.critical_temperature_K == pytest.approx(a.critical_load_factor * (T0 + g * 0.5))
 
 
+def test_a_rise_alone_has_no_buckling_coefficient(tmp_path, capsys):
+    """A rise alone (lambda a factor on it) has no buckling coefficient.
+
+    k = t lambda b^2/(pi^2 D) needs an edge stress: the JSON's k is null, and a sweep's k
+    chart is refused before anything is solved.
+    """
+    from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
+
+    out = result(steel_plate(4, HELD, {"temperature": 1.0}))
+    assert out.buckling_coefficient_k is None and out.critical_temperature_K > 0.0
+    assert out.as_dict()["buckling_coefficient_k"] is None
+    path = tmp_path / "rise.toml"
+    path.write_text(
+        "[plate]\ncorners = [[0, 0], [1, 0.5]]\nthickness = 0.002\n"
+        "[material]\nE = 2.1e11\nnu = 0.3\nthermal_expansion = 1.2e-5\n"
+        + "".join(f'[edges.{n}]\ninplane = "clamped"\n' for n in ("left", "right", "bottom", "top"))
+        + "[mesh]\nnx = 8\nny = 4\n[load]\ntemperature = 1.0\n"
+    )
+    args = ["sweep", "--config", str(path), "--vary", "plate.thickness=0.002,0.003"]
+    out_json = tmp_path / "s.jsonl"
+    assert (
+        main([*args, "--json", str(out_json), "--plot", str(tmp_path / "k.png")]) == EXIT_BAD_INPUT
+    )
+    assert "--plot draws the buckling coefficient k of edge loads" in capsys.readouterr().err
+    assert not out_json.exists()  # refused before any point was solved
+
+
+def test_the_critical_rise_is_of_the_heated_part():
+    """T = -3 K + 10 K/m y over y in [0, 0.5]: cooled below, heated above (+2 K at the top).
+
+    The critical rise is lambda times the largest rise, +2 K, not the largest magnitude
+    (the -3 K of the cooled edge: a negative "critical rise" before the fix).
+    """
+    out = result(steel_plate(8, HELD, {"temperature": [-3.0, 0.0, 10.0]}))
+    assert out.critical_temperature_K == pytest.approx(out.critical_load_factor * 2.0, rel=1e-12)
+    assert out.critical_temperature_K > 0.0
+
+
 @pytest.mark.parametrize("key", ["temperature", "fixed_temperature"])
 def test_a_rise_on_a_plate_free_in_its_plane_is_refused(key):
     """A uniform or linear rise expands a free plate without stress: refused when read."""

@@ -934,6 +934,22 @@ def _load_config(path: str, load: Any) -> Any:
 _NONLINEAR_FLAGS = ("imperfection", "shape", "control", "max_load", "max_step")
 
 
+def _check_chart(base: Any) -> None:
+    """Refuse --plot for a sweep whose scaled load has no edge stress (before any solve).
+
+    The chart draws k = t lambda b^2/(pi^2 D), a buckling coefficient of edge loads; for a
+    temperature rise alone lambda is a factor on the rise and k means nothing.
+    """
+    from unibuckle_fenicsx.config import problem_from_dict
+
+    if not any(e.loaded for e in problem_from_dict(base).plate.edges):
+        raise InputError(
+            "--plot draws the buckling coefficient k of edge loads; this problem's scaled "
+            "load is a temperature rise alone (lambda is a factor on it, k is not defined): "
+            "leave --plot out, or load an edge"
+        )
+
+
 def _sweep(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle sweep``: the grid, the JSON lines, the chart."""
     from unibuckle_fenicsx.sweep import base_mapping, parse_variation, run_sweep
@@ -956,6 +972,8 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
     try:
         variations = [parse_variation(v) for v in args.vary]
         base = _load_config(args.config, base_mapping)
+        if args.plot:
+            _check_chart(base)
         lines = run_sweep(
             base,
             variations,

@@ -10,6 +10,7 @@ import numpy as np
 
 from unibuckle_fenicsx.config import (
     UNITS,
+    PointSpec,
     ProblemSpec,
     problem_to_dict,
     stress_value,
@@ -37,7 +38,8 @@ class BucklingResult:
         free_load_Pa: lambda without obstacle (Pa).
         ratio_to_free: critical / free.
         critical_force_N_per_m: N = t lambda.
-        buckling_coefficient_k: k = N b^2 / (pi^2 D), b = plate width.
+        buckling_coefficient_k: k = N b^2 / (pi^2 D), b = plate width; None when the
+            scaled load is a temperature rise alone (lambda is then a factor on it).
         dofs: Global DOF count of (w, theta).
         mesh: [nx, ny] (a user-supplied or gmsh mesh: [number of cells]).
         eigensolves: Linear eigen solves, including the free one.
@@ -83,7 +85,7 @@ class BucklingResult:
     free_load_Pa: float
     ratio_to_free: float
     critical_force_N_per_m: float
-    buckling_coefficient_k: float
+    buckling_coefficient_k: float | None
     dofs: int
     mesh: list[int]
     eigensolves: int
@@ -137,7 +139,9 @@ class BucklingResult:
             free_load_Pa=free.load,
             ratio_to_free=load / free.load,
             critical_force_N_per_m=spec.plate.thickness * load,
-            buckling_coefficient_k=problem.buckling_coefficient(load),
+            buckling_coefficient_k=(
+                problem.buckling_coefficient(load) if _edge_loaded(spec) else None
+            ),
             dofs=problem.model.num_dofs,
             mesh=(
                 [problem.mesh.topology.index_map(2).size_global]
@@ -308,13 +312,21 @@ class BucklingResult:
         if fixed and factor:
             times = "" if factor == 1.0 else f"{factor:g} x "
             lines.append(f"fixed load (applied as is): {times}{'; '.join(fixed)}")
-        for p in self.details.get("point_restraints", []):
+        reports = self.details.get("point_restraints", [])
+        for p, restraint in zip(reports, self._point_restraints(reports), strict=True):
             lines.append(
-                f"points: {p['restraint']}: {p['points']} points on {p['nodes']} nodes, "
+                f"points: {restraint}: {p['points']} points on {p['nodes']} nodes, "
                 f"largest snap distance {p['max_snap_distance_m'] / length:.3g}"
                 f" {'m' if self.units == 'SI' else 'mm'}"
             )
         return lines
+
+    def _point_restraints(self, reports: list[dict[str, Any]]) -> list[str]:
+        """Each point restraint described in the summary's units (the JSON's are SI)."""
+        tables = (self.input or {}).get("points", [])
+        if self.units == "SI" or len(tables) != len(reports):
+            return [p["restraint"] for p in reports]
+        return [PointSpec(**table).describe(self.units) for table in tables]
 
 
 def _gap_text(gap: float) -> str:
@@ -369,13 +381,26 @@ def _load_text(load: dict[str, Any], prefix: str = "", scale: float = 1.0, unit:
     return ", ".join(parts)
 
 
+def _edge_loaded(spec: ProblemSpec) -> bool:
+    """Whether the scaled load has an edge stress.
+
+    Only then is k = t lambda b^2/(pi^2 D) a buckling coefficient: for a temperature
+    rise alone lambda is a factor on the rise.
+    """
+    return any(e.loaded for e in spec.plate.edges)
+
+
 def _critical_temperature(spec: ProblemSpec, load: float) -> float | None:
-    """The critical rise: lambda times the scaled field's largest rise over the plate."""
+    """The critical rise: lambda times the scaled field's largest rise over the plate.
+
+    The largest signed rise (the field is linear: its largest value lies on the
+    boundary's vertices): where part of the plate cools, the heated part buckles it.
+    """
     if not spec.load.thermal:
         return None
     T0, gx, gy = temperature_field(spec.load.temperature)
     rises = [T0 + gx * x + gy * y for x, y in spec.plate.boundary]
-    return load * max(rises, key=abs)
+    return load * max(rises)
 
 
 def _input(spec: ProblemSpec) -> dict[str, Any] | None:

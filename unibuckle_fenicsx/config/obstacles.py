@@ -17,6 +17,7 @@ from unibuckle_fenicsx.config.plate import (
 from unibuckle_fenicsx.config.values import (
     POINT_KINDS,
     SIDES,
+    UNITS,
     Box,
     Predicate,
     Temperature,
@@ -337,12 +338,17 @@ class PointSpec:
             )
         return points
 
-    def describe(self) -> str:
-        """Short description (for messages and the summary)."""
-        what = self.kind if self.kind != "spring" else f"spring {self.stiffness:g} N/m"
+    def describe(self, units: str = "SI") -> str:
+        """Short description (for messages and the summary), in ``units`` (:data:`UNITS`)."""
+        metres = UNITS[units][0]  # metres per length unit
+        length = "m" if metres == 1.0 else "mm"
+        what = self.kind
+        if self.kind == "spring":
+            what = f"spring {self.stiffness * metres:g} N/{length}"  # type: ignore[operator]
         if self.kind == "one-sided":
             what += f" ({self.side})"
         if self.at is not None:
-            return f"{what} at ({self.at[0]:g}, {self.at[1]:g}) m"
+            return f"{what} at ({self.at[0] / metres:g}, {self.at[1] / metres:g}) {length}"
         assert self.spacing is not None
-        return f"{what} grid of spacing {self.spacing[0]:g} x {self.spacing[1]:g} m"
+        sx, sy = (v / metres for v in self.spacing)
+        return f"{what} grid of spacing {sx:g} x {sy:g} {length}"

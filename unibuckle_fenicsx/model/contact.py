@@ -226,7 +226,7 @@ def foundation_springs(
     r"""Global W rows owned by this rank and lumped spring stiffnesses of ``foundations``.
 
     Node k of a zone gets :math:`k_f \int \varphi_k\,dx` (N/m), summed over the zones
-    holding it; nodes fixed by edge supports are left out.
+    holding it; nodes held by supports (edges, bilateral points) are left out.
 
     Note:
         Collective.
@@ -351,7 +351,8 @@ class ContactSetManager:
             named = "/".join(dict.fromkeys(o.zone_key for o in self.obstacles))
             raise EmptyZoneError(
                 f"obstacle.{named} {zones} holds no free mesh node ({self.num_edge_fixed} "
-                f"zone nodes are fixed by edge supports; the mesh has {nx} vertices, cells "
+                f"zone nodes are held by supports: edges or bilateral points; the mesh has "
+                f"{nx} vertices, cells "
                 f"up to {self._spacing():.3g} m across their diagonal): enlarge the zone or "
                 "refine the mesh"
             )

@@ -45,6 +45,7 @@ from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.contact import (
     BilateralZoneError,
     ContactSetManager,
+    EmptyZoneError,
     check_zone_has_nodes,
     foundation_springs,
     orientation,
@@ -303,6 +304,16 @@ class BucklingProblem(Owner):
         )
         try:
             self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
+        except EmptyZoneError as err:
+            if not spec.one_sided_points:
+                raise
+            raise EmptyZoneError(
+                "points: the one-sided points"
+                + (" and the obstacle zones" if spec.unilateral_obstacles else "")
+                + " act on no free node: each such node is held already (by an edge "
+                "support or a bilateral point), so the point restrains nothing; move it off "
+                "the support or leave it out"
+            ) from err
         except BilateralZoneError as err:
             if not spec.one_sided_points:
                 raise

@@ -131,7 +131,7 @@ def plot_sweep(
         colour = colours[g % len(colours)]
         label = ", ".join(f"{p} = {v:g}" for p, v in zip(others, key, strict=True))
         suffix = f" ({label})" if label else ""
-        solved = [m for m in members if "buckling_coefficient_k" in m]
+        solved = [m for m in members if m.get("buckling_coefficient_k") is not None]
         specs = [point_problem(base, m["point"]) for m in solved]
         x = np.array(
             [abscissa(s, m["point"][first.path]) for s, m in zip(specs, solved, strict=True)]
@@ -189,7 +189,7 @@ def plot_sweep(
     for style, mfc, text in markers:
         ax.plot([], [], style, color="0.2", mfc=mfc, label=text)
     # Keep the interesting range readable: very short plates have large k (aspect sweeps).
-    solved_lines = [m for m in lines if "buckling_coefficient_k" in m]
+    solved_lines = [m for m in lines if m.get("buckling_coefficient_k") is not None]
     shown = [float(m["buckling_coefficient_k"]) for m in solved_lines] + [
         float(m["buckling_coefficient_k"]) * m["free_load_Pa"] / m["critical_load_Pa"]
         for m in solved_lines
