@@ -43,6 +43,45 @@ def test_user_mesh_with_own_tags_matches_rectangle():
     assert result.mesh == [32]
 
 
+def test_a_user_mesh_s_unbalanced_load_is_refused_after_a_balanced_one():
+    """The self-equilibrium check is not skipped for a user's mesh.
+
+    The same plate (free in its plane) solved first on its own mesh, then on a user mesh
+    whose tags put the left edge's load on the bottom edge: the loads no longer balance
+    (resultant (-0.1, 0.2) N/m per Pa). The check had been cached per plate description,
+    and the second solve returned half the load, "proven".
+    """
+    spec = paper_case("c1", 8, 4)
+    with solve(spec) as analysis:
+        assert analysis.result.critical_load_Pa > 0.0
+    msh, tags = create_plate_mesh(spec.plate, MeshSpec(8, 4), MPI.COMM_WORLD)
+    swap = {1: 3, 3: 1}  # left <-> bottom
+    values = np.array([swap.get(int(v), int(v)) for v in tags.values], dtype=np.int32)
+    swapped = dolfinx.mesh.meshtags(msh, 1, tags.indices, values)
+    with pytest.raises(ValueError, match="not self-equilibrated"):
+        solve(spec, mesh=msh, facet_tags=swapped)
+
+
+def test_a_user_mesh_that_does_not_fit_the_plate_is_refused():
+    """Tags that mark no facet, or a mesh off plate.corners: a message naming it.
+
+    Tagged 5..8 instead of 1..4 the edges' loads act nowhere, and the plate was refused
+    as "in tension everywhere"; a mesh over [0, 0.4] x [0, 0.2] for the paper's plate
+    (corners [-0.1, 0.1] x [-0.05, 0.05]) was solved with its zone clipped.
+    """
+    spec = paper_case("c1", 8, 4)
+    msh, tags = create_plate_mesh(spec.plate, MeshSpec(8, 4), MPI.COMM_WORLD)
+    shifted = dolfinx.mesh.meshtags(msh, 1, tags.indices, tags.values + 4)
+    with pytest.raises(
+        ValueError, match=r"edge 'left' \(facet tag 1\) holds no facet .* \[5, 6, 7, 8\]"
+    ):
+        BucklingProblem(spec, mesh=msh, facet_tags=shifted)
+    other = replace(spec.plate, corners=((0.0, 0.0), (0.4, 0.2)))
+    big, big_tags = create_plate_mesh(other, MeshSpec(8, 4), MPI.COMM_WORLD)
+    with pytest.raises(ValueError, match=r"mesh: its bounding box .* is not plate\.corners"):
+        BucklingProblem(spec, mesh=big, facet_tags=big_tags)
+
+
 def test_user_mesh_needs_facet_tags():
     spec = paper_case("free", 4, 2)
     msh, _ = create_plate_mesh(spec.plate, spec.mesh, MPI.COMM_WORLD)

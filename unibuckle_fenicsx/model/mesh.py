@@ -25,6 +25,7 @@ from unibuckle_fenicsx.model.gmsh_mesh import HOLES_TAG, gmsh_plate_mesh, segmen
 
 __all__ = [
     "build_plate_mesh",
+    "check_user_mesh",
     "create_plate_mesh",
     "edge_facets",
     "edge_line",
@@ -94,6 +95,45 @@ def create_plate_mesh(
             "create_plate_mesh: expected len(EDGE_NAMES) == 4 (an internal invariant)"
         )
     return msh, tags
+
+
+def check_user_mesh(
+    msh: dolfinx.mesh.Mesh, facet_tags: dolfinx.mesh.MeshTags, plate: PlateSpec
+) -> None:
+    """Refuse a user mesh that does not fit ``plate`` (before any solve).
+
+    Its bounding box must be ``plate.corners`` (the zones' tolerances, the buckling
+    coefficient's width and the edge loads' directions use them), and every edge's facet
+    tag must mark facets: without them the edge's support and load act nowhere, and the
+    loads then look like tension everywhere or an unloaded plate, which is not what went
+    wrong.
+
+    Note:
+        Collective.
+    """
+    x = msh.geometry.x[: msh.geometry.index_map().size_local, :2]
+    lo = np.min(msh.comm.allgather(x.min(axis=0) if len(x) else np.full(2, np.inf)), axis=0)
+    hi = np.max(msh.comm.allgather(x.max(axis=0) if len(x) else np.full(2, -np.inf)), axis=0)
+    corners = np.array(plate.corners, dtype=float)
+    size = max(plate.length, plate.width)
+    if not np.allclose([lo, hi], corners, rtol=0.0, atol=1e-8 * size):
+        raise InputError(
+            f"mesh: its bounding box {[lo.tolist(), hi.tolist()]} is not plate.corners "
+            f"{corners.tolist()}: give the plate the mesh's corners (the zones, the "
+            "buckling coefficient's width and the edge loads' directions use them)"
+        )
+    for edge in plate.edges:
+        for tag in edge_tags(plate, edge):
+            count = msh.comm.allreduce(len(facet_tags.find(tag)), op=MPI.SUM)
+            if count == 0:
+                present = sorted(
+                    {int(v) for part in msh.comm.allgather(np.unique(facet_tags.values).tolist())
+                     for v in part}
+                )  # fmt: skip
+                raise InputError(
+                    f"edge {edge.name!r} (facet tag {tag}) holds no facet of the mesh "
+                    f"(its facet tags: {present}); give each edge its tag (EdgeSpec.tag)"
+                )
 
 
 def edge_tag(plate: PlateSpec, edge: EdgeSpec) -> int:

@@ -230,6 +230,7 @@ def solve_prestress(
     *,
     temperature: Temperature = 0.0,
     fixed: bool = False,
+    plate_mesh: bool = False,
 ) -> Prestress:
     r"""Solve the membrane problem under the unit load and return :math:`N^0`.
 
@@ -248,6 +249,11 @@ def solve_prestress(
         temperature: A temperature rise (K; or the linear field, see
             :class:`~unibuckle_fenicsx.config.LoadSpec`).
         fixed: The fixed part of the load (applied as is): no check that it compresses.
+        plate_mesh: ``msh`` and ``facet_tags`` were built from ``plate`` by the package
+            (:func:`~unibuckle_fenicsx.model.mesh.build_plate_mesh`): the self-equilibrium
+            of its loads is then checked once per process (exact edge integrals, the same
+            on every such mesh); a mesh from elsewhere, whose tags may put the loads on
+            other edges, is always checked.
 
     Returns:
         The prestress; raises ``ValueError`` if nothing is loaded, if the load is not
@@ -267,7 +273,7 @@ def solve_prestress(
         Collective.
     """
     uh, N0, thermal, pinned = _solve_membrane(
-        msh, facet_tags, plate, material, degree, petsc_options, temperature
+        msh, facet_tags, plate, material, degree, petsc_options, temperature, plate_mesh
     )
     max_compression, max_tension = _principal_extremes(msh, N0, degree)
     logger.info(
@@ -281,7 +287,7 @@ def solve_prestress(
 
         def again(higher: int) -> float:
             _, N0_higher, _, _ = _solve_membrane(
-                msh, facet_tags, plate, material, higher, petsc_options, temperature
+                msh, facet_tags, plate, material, higher, petsc_options, temperature, plate_mesh
             )
             return _principal_extremes(msh, N0_higher, higher)[0]
 
@@ -297,6 +303,7 @@ def _solve_membrane(
     degree: int,
     petsc_options: dict[str, str | bool] | None,
     temperature: Temperature,
+    plate_mesh: bool,
 ) -> tuple[dolfinx.fem.Function, ufl.core.expr.Expr, ufl.core.expr.Expr | None, bool]:
     """:func:`solve_prestress`'s solve: displacement, N0, thermal force, pinned or not."""
     t = plate.thickness
@@ -341,13 +348,16 @@ def _solve_membrane(
     pinned = not bcs
     if pinned:
         # A thermal strain is self-equilibrated. The loads of a plate checked once are
-        # not checked again: the resultants are exact edge integrals, the same on every
-        # mesh of the plate (its coarse copies, a sweep's repeated points). Decided on
-        # every rank alike (the check is collective).
+        # not checked again on a mesh the package built from it: the resultants are
+        # exact edge integrals, the same on every such mesh (its coarse copies, a
+        # sweep's repeated points). A user's mesh is checked every time: its tags decide
+        # where the loads act. Decided on every rank alike (the check is collective).
         key = repr((plate, loaded))
-        if loaded and not msh.comm.allreduce(key in _EQUILIBRATED, op=MPI.LAND):
+        known = plate_mesh and msh.comm.allreduce(key in _EQUILIBRATED, op=MPI.LAND)
+        if loaded and not known:
             _check_self_equilibrated(msh, facet_tags, ds, plate, loaded)
-            _EQUILIBRATED.add(key)
+            if plate_mesh:
+                _EQUILIBRATED.add(key)
         bcs = pin_rigid_motions(V, msh)
 
     problem = dolfinx.fem.petsc.LinearProblem(

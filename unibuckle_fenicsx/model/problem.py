@@ -51,7 +51,7 @@ from unibuckle_fenicsx.model.contact import (
     orientation,
 )
 from unibuckle_fenicsx.model.materials import reference_bending_stiffness
-from unibuckle_fenicsx.model.mesh import build_plate_mesh
+from unibuckle_fenicsx.model.mesh import build_plate_mesh, check_user_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
 from unibuckle_fenicsx.model.points import point_obstacles
 from unibuckle_fenicsx.model.prestress import solve_prestress
@@ -182,8 +182,9 @@ class BucklingProblem(Owner):
             (:data:`~unibuckle_fenicsx.eigen.RUN_EPS_PREFIXES`). The problem holds them in
             PETSc's options database until :meth:`destroy`; the command line's win.
         mesh: A quadrilateral DOLFINx mesh to use instead of ``spec.mesh`` (the
-            rectangle, or gmsh's plate); ``spec.plate.corners`` should then be its
-            bounding box (used for tolerances and the buckling coefficient's width).
+            rectangle, or gmsh's plate); ``spec.plate.corners`` must be its bounding
+            box (used for tolerances and the buckling coefficient's width), and each
+            edge's facet tag must mark facets of it (both checked).
         facet_tags: Edge markers of ``mesh``, matched by :class:`EdgeSpec` ``tag``.
 
     Attributes:
@@ -223,6 +224,7 @@ class BucklingProblem(Owner):
                 )
             if mesh.topology.cell_type != dolfinx.mesh.CellType.quadrilateral:
                 raise InputError("mesh: the MITC plate element needs a quadrilateral mesh")
+            check_user_mesh(mesh, facet_tags, spec.plate)
             self.mesh, self.facet_tags = mesh, facet_tags
             comm = mesh.comm
         else:
@@ -246,6 +248,7 @@ class BucklingProblem(Owner):
             spec.material,
             degree,
             temperature=spec.load.temperature,
+            plate_mesh=not self.custom_mesh,
         )
         #: The fixed part of the prestress (applied as is), or None.
         self.fixed_prestress = (
@@ -257,6 +260,7 @@ class BucklingProblem(Owner):
                 degree,
                 temperature=spec.load.fixed_temperature,
                 fixed=True,
+                plate_mesh=not self.custom_mesh,
             )
             if spec.has_fixed_load
             else None
