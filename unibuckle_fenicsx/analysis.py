@@ -253,7 +253,12 @@ def _analyse(
     solution: UnilateralSolution | None = None
     certificate: Certificate | None = None
     method, reason = "free", "no obstacle"
-    if problem.contact is not None:
+    if problem.contact is None:
+        # The free load is the answer: verified the smallest (one LDL^T's inertia).
+        t1 = time.perf_counter()
+        problem.verify_free()
+        problem.timings["free_check_s"] = time.perf_counter() - t1
+    else:
         method, reason = choose_method(
             spec, problem.num_constrained, t_free, candidate_parallel=candidate_parallel
         )
@@ -275,7 +280,10 @@ def _analyse(
             certificate = certify(problem, solution)
         problem.timings["certify_s"] = time.perf_counter() - t1
         if not certificate.kkt:
-            logger.warning("the %s result fails its certificate: %s", method, certificate)
+            logger.warning(
+                "the %s result fails its certificate: %s",
+                method, "; ".join(certificate.notes) or certificate.status,
+            )  # fmt: skip
     result = BucklingResult.from_solution(
         problem,
         free,

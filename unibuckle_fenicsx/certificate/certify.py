@@ -345,6 +345,12 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
             notes.append("the mode is not an eigenvector of a reduced pencil (not checked)")
     finally:
         matrix.destroy()
+    # The free load is the lower bound (interlacing), or lies above the returned load,
+    # which no smallest eigenvalue can: it is verified the pencil's smallest (one LDL^T).
+    free = problem.solve_free().load
+    below_free = cand.feasible and cand.load < free * (1.0 - ROUNDING_RTOL)
+    if global_bound and (proven_by == "interlacing" or below_free):
+        problem.verify_free()
     return Certificate(
         feasible=cand.feasible,
         feasibility_margin=cand.margin,
@@ -397,6 +403,7 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     Note:
         Collective.
     """
+    problem.verify_free()  # the bracket's lower end
     contact = problem.contact
     if contact is None or contact.stiffness is None:
         raise RuntimeError(

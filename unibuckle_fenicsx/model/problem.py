@@ -33,6 +33,7 @@ from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import (
     EIGEN_OPTIONS,
     EigenPair,
+    EigenSolveError,
     GEPSolver,
     Owner,
     SymmetricFactorization,
@@ -55,6 +56,7 @@ from unibuckle_fenicsx.model.mesh import build_plate_mesh, check_user_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
 from unibuckle_fenicsx.model.points import point_obstacles
 from unibuckle_fenicsx.model.prestress import solve_prestress
+from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
 __all__ = ["BYTES_PER_DOF", "BucklingProblem", "Candidate", "Mode", "available_memory"]
 
@@ -326,6 +328,7 @@ class BucklingProblem(Owner):
                 'obstacle zone or another point): that holds w = 0, give it kind = "bilateral"'
             ) from err
         self.free: Mode | None = None
+        self._free_verified = False  # verify_free() passed
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
         self._abs: tuple[PETSc.Mat, PETSc.Mat] | None = None  # abs_pencil(), made when needed
@@ -432,6 +435,40 @@ class BucklingProblem(Owner):
             u.x.scatter_forward()
             self.free = Mode(pair.value, u, pair)
         return self.free
+
+    def verify_free(self) -> None:
+        r"""Check that the free pair is the pencil's smallest eigenpair (once per problem).
+
+        SLEPc returns the pair nearest its target; with loose options (a tolerance of
+        1e-1 and three basis vectors) it stopped on a pair 18 % above the smallest, and
+        the free load is a lower bound of the critical load (interlacing). The inertia
+        of :math:`A - \sigma B`, :math:`\sigma` just below :math:`\lambda_{free}` (one
+        :math:`LDL^T` through the shared factorisation), counts the eigenvalues in
+        :math:`(0, \sigma)` (Sylvester's law, A SPD): there must be none.
+
+        Raises:
+            EigenSolveError: An eigenvalue lies below the free load.
+
+        Note:
+            Collective.
+        """
+        if self._free_verified:
+            return
+        free = self.solve_free()
+        sigma = free.load * (1.0 - SMALLEST_RTOL_FACTOR * self.spec.solver.eps_tol)
+        ldl = self.eigensolver.factorization
+        same, subset = PETSc.Mat.Structure.SAME_NONZERO_PATTERN, PETSc.Mat.Structure.SUBSET
+        self.model.A.copy(ldl.matrix, structure=same)
+        ldl.matrix.axpy(-sigma, self.model.B, structure=subset)  # type: ignore[arg-type]
+        below, zero, _ = ldl.factor(self)
+        if below or zero:
+            raise EigenSolveError(
+                f"the free eigen solve returned lambda = {free.load!r}, but {below + zero} "
+                "eigenvalue(s) of the pencil lie at or below it (inertia of A - sigma B): "
+                "the eigen solver stopped on a higher pair; its options "
+                "(-unibuckle_eps_tol, -unibuckle_eps_ncv, ...) are too loose"
+            )
+        self._free_verified = True
 
     def evaluate(
         self,
