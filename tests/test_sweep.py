@@ -371,3 +371,13 @@ def test_a_thin_plate_line_is_the_same_on_every_run():
             lines.append(json.dumps(analysis.result.as_dict(timings=False), sort_keys=True))
     assert lines[0] == lines[1]
     assert '"seconds"' not in lines[0]
+
+
+def test_ranks_per_point_errors_name_the_flag(tmp_path):
+    """A bad ranks_per_point names the command line's flag as well (--ranks-per-point)."""
+    from unibuckle_fenicsx.sweep import run_sweep
+
+    v = [parse_variation("material.nu=0.2,0.3")]
+    for bad, why in ((0, r"must be an integer >= 1"), (MPI.COMM_WORLD.size + 1, "must divide")):
+        with pytest.raises(ValueError, match=rf"ranks_per_point \(--ranks-per-point\).*{why}"):
+            run_sweep({}, v, tmp_path / "s.jsonl", MPI.COMM_WORLD, ranks_per_point=bad)
