@@ -942,7 +942,7 @@ def _check_chart(base: Any) -> None:
     """
     from unibuckle_fenicsx.config import problem_from_dict
 
-    if not any(e.loaded for e in problem_from_dict(base).plate.edges):
+    if not problem_from_dict(base).plate.loaded:
         raise InputError(
             "--plot draws the buckling coefficient k of edge loads; this problem's scaled "
             "load is a temperature rise alone (lambda is a factor on it, k is not defined): "

@@ -139,8 +139,9 @@ class BucklingResult:
             free_load_Pa=free.load,
             ratio_to_free=load / free.load,
             critical_force_N_per_m=spec.plate.thickness * load,
+            # k is a buckling coefficient of edge loads: none for a rise alone.
             buckling_coefficient_k=(
-                problem.buckling_coefficient(load) if _edge_loaded(spec) else None
+                problem.buckling_coefficient(load) if spec.plate.loaded else None
             ),
             dofs=problem.model.num_dofs,
             mesh=(
@@ -379,15 +380,6 @@ def _load_text(load: dict[str, Any], prefix: str = "", scale: float = 1.0, unit:
         elif value:
             parts.append(f"{key} {value / scale:g}{unit}")
     return ", ".join(parts)
-
-
-def _edge_loaded(spec: ProblemSpec) -> bool:
-    """Whether the scaled load has an edge stress.
-
-    Only then is k = t lambda b^2/(pi^2 D) a buckling coefficient: for a temperature
-    rise alone lambda is a factor on the rise.
-    """
-    return any(e.loaded for e in spec.plate.edges)
 
 
 def _critical_temperature(spec: ProblemSpec, load: float) -> float | None:

@@ -418,6 +418,11 @@ class PlateSpec:
         return replace(self, edges=tuple(e.fixed_part() for e in self.edges))
 
     @property
+    def loaded(self) -> bool:
+        """Whether an edge carries a stress per unit load (scaled by lambda)."""
+        return any(e.loaded for e in self.edges)
+
+    @property
     def fixed_loaded(self) -> bool:
         """Whether an edge carries a fixed stress."""
         return any(e.fixed_loaded for e in self.edges)

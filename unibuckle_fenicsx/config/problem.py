@@ -250,7 +250,7 @@ class ProblemSpec:
 
     def check_scaled_load(self) -> None:
         """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""
-        if not self.load.thermal and not any(e.loaded for e in self.plate.edges):
+        if not self.load.thermal and not self.plate.loaded:
             raise InputError(
                 "no load to scale: give an edge a non-zero normal_stress or shear_stress (per "
                 "unit load), or [load] temperature (a rise per unit load factor)"
