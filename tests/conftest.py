@@ -39,6 +39,10 @@ def nothing_built(monkeypatch):
     import unibuckle_fenicsx.model.problem
     import unibuckle_fenicsx.nonlinear
 
+    # Imported before the patch: its module-level "from ... import solve" would otherwise
+    # keep the refusing stand-in for the rest of the session.
+    import unibuckle_fenicsx.nonlinear.path
+
     def refuse(*args, **kwargs):
         raise AssertionError("work started before the input was refused")
 

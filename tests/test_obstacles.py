@@ -28,7 +28,7 @@ from unibuckle_fenicsx.config import (
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.model.contact import BilateralZoneError
+from unibuckle_fenicsx.errors import BilateralZoneError
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
 

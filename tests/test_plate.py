@@ -25,7 +25,7 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.errors import EmptyZoneError
 from unibuckle_fenicsx.model.materials import (
     bending_stiffness,
     navier_load_kirchhoff,

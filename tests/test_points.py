@@ -136,7 +136,7 @@ def test_a_one_sided_point_on_a_held_node_is_named(points):
 
     The message is about the points (it named an obstacle.zone the file does not have).
     """
-    from unibuckle_fenicsx.model.contact import EmptyZoneError
+    from unibuckle_fenicsx.errors import EmptyZoneError
 
     with pytest.raises(EmptyZoneError, match=r"^points: the one-sided points act on no free node"):
         result(plate(4, aspect=2.0, points=points))

@@ -316,7 +316,7 @@ def test_a_free_load_that_is_not_the_smallest_is_caught():
     (interlacing), and c3's critical load came out below the free load. Two pencil
     eigenvalues lie below the returned one.
     """
-    from unibuckle_fenicsx.eigen import EigenSolveError
+    from unibuckle_fenicsx.errors import EigenSolveError
 
     loose = {"eps_tol": 0.1, "eps_ncv": 3}
     for case in ("free", "c3"):

@@ -497,7 +497,7 @@ def test_incomplete_path_says_what_it_validated(tmp_path, capsys, monkeypatch):
         path=[{"load_Pa": 1.05 * linear, "max_w_m": 1e-3, "contact_nodes": 9}],
         stop_reason="SNES diverged at the smallest step (DIVERGED_LINE_SEARCH)",
         rejected_steps=3, constrained_nodes=171, contact_check={"satisfied": True},
-        options={}, wall_time_s=1.0,
+        options={"max_load": 1.2}, wall_time_s=1.0,
     )  # fmt: skip
 
     class Analysis:

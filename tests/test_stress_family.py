@@ -39,8 +39,8 @@ from exhaustive import (
 )
 from families import stress_family
 
-from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
 from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.errors import NoAdmissibleModeError
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
 from unibuckle_fenicsx.model.prestress import solve_prestress

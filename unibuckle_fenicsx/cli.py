@@ -27,6 +27,7 @@ from typing import TYPE_CHECKING, Any
 
 from unibuckle_fenicsx.config import METHODS
 from unibuckle_fenicsx.errors import InputError, NumericalError
+from unibuckle_fenicsx.outcome import Outcome, petsc_failure
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.config import ProblemSpec
@@ -34,15 +35,15 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = ["EXIT_BAD_INPUT", "EXIT_INTERRUPTED", "EXIT_NOT_CERTIFIED", "EXIT_OK", "main"]
 
 #: A certified critical state was found.
-EXIT_OK = 0
+EXIT_OK = Outcome.OK.exit_status
 #: The input was refused (the message names the parameter); nothing was solved.
-EXIT_BAD_INPUT = 2
+EXIT_BAD_INPUT = Outcome.REFUSED.exit_status
 #: A numerical difficulty: no certified critical state (the JSON holds what was found).
-EXIT_NOT_CERTIFIED = 3
+EXIT_NOT_CERTIFIED = Outcome.NOT_CERTIFIED.exit_status
 #: An internal error (a bug): the traceback and a request for a report.
-EXIT_BUG = 1
+EXIT_BUG = Outcome.BUG.exit_status
 #: Interrupted (Ctrl-C): 128 + SIGINT, the shell's convention.
-EXIT_INTERRUPTED = 130
+EXIT_INTERRUPTED = Outcome.INTERRUPTED.exit_status
 #: The line after the traceback of an internal error.
 BUG_REPORT = (
     "unibuckle: internal error: this is a bug in unibuckle_fenicsx, not a problem with "
@@ -581,24 +582,15 @@ def main(argv: Sequence[str] | None = None) -> int:
     _logging(args.verbose, args.quiet, comm.rank)
     try:
         return _run(args, rest, comm)
-    except KeyboardInterrupt:
-        return _interrupted(args, comm)
-    except InputError as err:
-        return _fail(comm, str(err))
-    except NumericalError as err:
-        return _fail(comm, f"{err} (no result written)", EXIT_NOT_CERTIFIED)
-    except Exception as err:
-        if _in_chain(err, KeyboardInterrupt) is not None:
-            # Ctrl-C inside a Python callback of PETSc (the nonlinear path's SNES
-            # residual): petsc4py turns it into PETSc error 101 with the interrupt as
-            # its context. An interrupt all the same.
+    except (KeyboardInterrupt, Exception) as err:
+        outcome = Outcome.of(err)
+        if outcome is Outcome.INTERRUPTED:
             return _interrupted(args, comm)
-        refused = _petsc_error(err, rest)
-        if refused is not None:
-            return _fail(comm, *refused)
-        traceback.print_exc()  # on every rank that fails: the bug may be on one
-        print(BUG_REPORT, file=sys.stderr, flush=True)
-        return EXIT_BUG
+        if outcome is Outcome.BUG:
+            traceback.print_exc()  # on every rank that fails: the bug may be on one
+            print(BUG_REPORT, file=sys.stderr, flush=True)
+            return outcome.exit_status
+        return _fail(comm, _message(err, rest), outcome.exit_status)
 
 
 def _interrupted(args: argparse.Namespace, comm: Any) -> int:
@@ -614,16 +606,6 @@ def _interrupted(args: argparse.Namespace, comm: Any) -> int:
             where = f"the finished points are in {args.json}; the same command resumes"
         print(f"\nunibuckle: interrupted; {where}", file=sys.stderr, flush=True)
     return EXIT_INTERRUPTED
-
-
-def _in_chain(err: BaseException, kind: type[BaseException]) -> BaseException | None:
-    """``err`` or the first of its causes or contexts (8 deep at most) that is a ``kind``."""
-    found: BaseException | None = err
-    for _ in range(8):
-        if found is None or isinstance(found, kind):
-            return found
-        found = found.__cause__ or found.__context__
-    return None
 
 
 def _schema(args: argparse.Namespace) -> int:
@@ -650,29 +632,17 @@ def _schema(args: argparse.Namespace) -> int:
     return EXIT_OK
 
 
-def _petsc_error(err: BaseException, options: Sequence[str]) -> tuple[str, int] | None:
-    """The message and exit status of a PETSc/SLEPc error in ``err`` (or its causes).
-
-    An error raised while an object reads its options (``*SetFromOptions``) is a bad
-    command-line option (exit 2); any other PETSc error is a numerical difficulty.
-    petsc4py reports an error inside a Cython call as a SystemError whose cause is the
-    PETSc.Error: the chain is searched.
-    """
-    from petsc4py import PETSc
-
-    found = _in_chain(err, PETSc.Error)
-    if found is None:
-        return None
-    lines = [line.removeprefix("[0] ").strip() for line in str(found).splitlines()]
-    reason = "; ".join(line for line in lines[1:] if line and "() at " not in line)
-    reason = reason or lines[0]
-    if any("SetFromOptions()" in line for line in lines):
+def _message(err: BaseException, options: Sequence[str]) -> str:
+    """The error line of a run that raised ``err`` (``options``: those given to PETSc)."""
+    failure = petsc_failure(err)
+    if failure is not None and failure.refused_option:
         given = " ".join(options) or "none"
-        return (
-            f"PETSc/SLEPc refused an option ({reason}); the options given: {given}",
-            EXIT_BAD_INPUT,
-        )
-    return f"PETSc/SLEPc failed: {reason} ({lines[0]}); no result written", EXIT_NOT_CERTIFIED
+        return f"PETSc/SLEPc refused an option ({failure.reason}); the options given: {given}"
+    if failure is not None:
+        return f"PETSc/SLEPc failed: {failure.reason} ({failure.first_line}); no result written"
+    if isinstance(err, NumericalError):
+        return f"{err} (no result written)"
+    return str(err)
 
 
 def _run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> int:
@@ -693,24 +663,14 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
     from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.io import write_fields, write_json
 
-    def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
-        return _fail(comm, message, status)
-
-    try:
-        spec = _spec_from_args(args)
-        changes, flags = _solver_changes(args)
-        spec = spec.with_solver(**changes)
-    except (ValueError, OSError) as err:
-        return fail(str(err))
+    # A refused input or a failed solve raises: main() tells the outcome.
+    spec = _spec_from_args(args)
+    changes, flags = _solver_changes(args)
+    spec = spec.with_solver(**changes)
     method = spec.solver.method  # the flag's, or the problem file's
     _warn_unused(flags, method, comm)
     _warn_plate_model(spec, comm)
-    try:
-        analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
-    except (InputError, ImportError) as err:  # ImportError: an extra is missing (gmsh)
-        return fail(str(err))
-    except NumericalError as err:
-        return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
+    analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
     unwritten = None
     with analysis:
         if args.output:
@@ -720,10 +680,8 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
                 unwritten = f"--output {args.output}: {err}"
     result = analysis.result
     _warn_unused(flags, method, comm, result)
-    status = EXIT_OK
+    outcome = Outcome.of(result)
     certificate = result.certificate
-    if certificate is not None and not certificate["kkt"]:
-        status = EXIT_NOT_CERTIFIED
     if comm.rank == 0:
         if args.json:
             try:
@@ -731,7 +689,7 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
             except OSError as err:
                 unwritten = f"--json {args.json}: {err}"
         print(result.summary(), flush=True)
-        if status != EXIT_OK:
+        if outcome is not Outcome.OK:
             notes = "; ".join((certificate or {}).get("notes", [])) or "see the certificate"
             print(
                 f"unibuckle: error: no certified critical state ({notes}); the bracket "
@@ -741,8 +699,8 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
             )
     unwritten = comm.bcast(unwritten, root=0)
     if unwritten is not None:
-        return fail(f"could not write {unwritten}; the result is the summary above")
-    return status
+        return _fail(comm, f"could not write {unwritten}; the result is the summary above")
+    return outcome.exit_status
 
 
 def _warn_unused(flags: list[str], method: str, comm: Any, result: Any = None) -> None:
@@ -780,9 +738,6 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
 
     from unibuckle_fenicsx.nonlinear import NonlinearOptions, solve_nonlinear
 
-    def fail(message: str, status: int = EXIT_BAD_INPUT) -> int:
-        return _fail(comm, message, status)
-
     try:
         options = NonlinearOptions(
             imperfection=args.imperfection,
@@ -793,26 +748,22 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
             max_step=args.max_step,
             min_step=min(1e-5, args.max_step),
         )
-        spec = _spec_from_args(args)
-    except (ValueError, OSError) as err:
+    except InputError as err:
         message = str(err)
         for name in _NONLINEAR_FLAGS:  # name the flag, not the option
             if message.startswith(name):
                 message = "--" + name.replace("_", "-") + message[len(name) :]
-        return fail(message)
+        raise InputError(message) from None
+    spec = _spec_from_args(args)
     if args.shape == "unilateral" and (args.no_obstacle or not spec.all_obstacles):
         why = "--no-obstacle removes it" if args.no_obstacle else "the problem has none"
-        return fail(
+        raise InputError(
             f"--shape unilateral takes the imperfection from the unilateral mode, which needs "
             f"an obstacle, and {why}: give --shape free (or auto)"
         )
     _warn_plate_model(spec, comm)
-    try:
-        analysis = solve_nonlinear(spec, options, comm)
-    except (InputError, ImportError) as err:
-        return fail(str(err))
-    except NumericalError as err:
-        return fail(f"{err} (no result written)", EXIT_NOT_CERTIFIED)
+    # A refused input or a failed solve raises: main() tells the outcome.
+    analysis = solve_nonlinear(spec, options, comm)
     with analysis:
         result = analysis.result
     unwritten = None
@@ -823,51 +774,16 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
             except OSError as err:
                 unwritten = f"could not write --json {args.json}: {err}"
         print(result.summary(), flush=True)
-        if not result.ok:
+        if not result.certified:
             print(
-                f"unibuckle: error: {nonlinear_verdict(result, args.max_load)}"
+                f"unibuckle: error: {result.verdict()}"
                 + (f"; the path obtained is in {args.json}" if args.json and not unwritten else ""),
                 file=sys.stderr,
             )
     unwritten = comm.bcast(unwritten, root=0)
     if unwritten is not None:
-        return fail(f"{unwritten}; the result is the summary above")
-    return EXIT_OK if result.ok else EXIT_NOT_CERTIFIED
-
-
-def nonlinear_verdict(result: Any, max_load: float) -> str:
-    """What an incomplete load path validated, and what it did not (one paragraph).
-
-    Args:
-        result: A :class:`~unibuckle_fenicsx.nonlinear.NonlinearResult` that is not ``ok``.
-        max_load: The --max-load asked for (a multiple of the linear critical load).
-    """
-    linear = result.linear_critical_load_Pa
-    validated, missing = [], []
-    for name, load in (
-        ("Southwell", result.southwell_load_Pa),
-        ("inflection", result.inflection_load_Pa),
-    ):
-        if load is None:
-            missing.append(f"the {name} load (the path stopped before it could be read)")
-        else:
-            validated.append(f"the {name} load {load:.6e} Pa ({load / linear - 1:+.1e} relative)")
-    check = result.contact_check
-    if check.get("satisfied", True):
-        validated.append("the contact conditions at the last converged state")
-    else:
-        missing.append(f"the contact conditions at the last converged state ({check})")
-    reached = result.path[-1]["load_Pa"] / linear if result.path else 0.0
-    if not result.completed:
-        missing.append(
-            f"the path from {reached:.4g} to --max-load {max_load:g} x the linear load "
-            f"({result.stop_reason})"
-        )
-    return (
-        f"the load path does not validate everything against the linear critical load "
-        f"{linear:.6e} Pa. Validated: {', '.join(validated) or 'nothing'}. Not validated: "
-        f"{', '.join(missing)}"
-    )
+        return _fail(comm, f"{unwritten}; the result is the summary above")
+    return Outcome.of(result).exit_status
 
 
 def _after_interrupt(unraisable: Any) -> None:
@@ -982,7 +898,7 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
             ranks_per_point=args.ranks_per_point,
             progress=not args.quiet,
         )
-    except (InputError, OSError, ImportError) as err:
+    except OSError as err:  # a refused input or a failed point raises: main() tells
         return fail(str(err))
     if comm.rank == 0:
         from collections import Counter
@@ -997,8 +913,8 @@ def _sweep(args: argparse.Namespace, comm: Any) -> int:
             from unibuckle_fenicsx.viz.charts import plot_sweep
 
             print(f"sweep: chart {plot_sweep(lines, variations, base, args.plot)}")
-    ok = all(line["status"] == "ok" for line in lines)
-    return EXIT_OK if ok else EXIT_NOT_CERTIFIED
+    ok = all(line["status"] == Outcome.OK for line in lines)
+    return (Outcome.OK if ok else Outcome.NOT_CERTIFIED).exit_status
 
 
 if __name__ == "__main__":

@@ -39,7 +39,7 @@ from mpi4py import MPI
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.errors import NumericalError
+from unibuckle_fenicsx.errors import EigenSolveError
 
 try:
     from petsc4py import PETSc
@@ -56,7 +56,6 @@ __all__ = [
     "LDL_OPTIONS",
     "RUN_EPS_PREFIXES",
     "EigenPair",
-    "EigenSolveError",
     "GEPSolver",
     "Owner",
     "SharedFactorization",
@@ -246,10 +245,6 @@ def pop_run_options(pushed: list[tuple[str, str]]) -> None:
     for prefix, key in pushed:
         PETSc.Options(prefix).delValue(key)
     pushed.clear()
-
-
-class EigenSolveError(NumericalError):
-    """The eigen solve did not converge."""
 
 
 @dataclass(frozen=True)

@@ -1,21 +1,35 @@
-"""One error hierarchy: what went wrong decides the exit status.
+"""Every error class of the package: what went wrong decides how a run ends.
 
 - :class:`InputError`: the user's input is wrong (a problem file, a keyword argument, a
   command-line flag). The message names the key and the allowed range; it is raised before
-  any solve. The command line exits with status 2, the sweep records the point "refused".
-- :class:`NumericalError`: a solve that did not converge or found nothing admissible. The
-  command line exits with status 3 and writes the bracket or the partial result when there
-  is one; the sweep records the point "failed" (or a more precise status).
-- Anything else is a bug: the command line exits with status 1, prints the traceback and
-  asks for a report.
+  any solve. Its subclasses say which input: :class:`EmptyZoneError` (an obstacle zone
+  holds no free mesh node), :class:`BilateralZoneError` (zones on both sides of the plate
+  share a node).
+- :class:`NumericalError`: a solve that did not converge or found nothing admissible:
+  :class:`EigenSolveError` (an eigen solve did not converge),
+  :class:`NoAdmissibleModeError` (no admissible mode with a finite load),
+  :class:`NonlinearError` (no load step of the nonlinear path converged).
+- Anything else is a bug.
 
-Both classes keep the built-in class they replace as a base (``ValueError``,
+How each ends a run (its exit status, a sweep line's status) is
+:class:`~unibuckle_fenicsx.outcome.Outcome`'s business.
+
+Both base classes keep the built-in class they replace as a base (``ValueError``,
 ``RuntimeError``), so code that catches those still works.
 """
 
 from __future__ import annotations
 
-__all__ = ["InputError", "NumericalError", "UnibuckleError"]
+__all__ = [
+    "BilateralZoneError",
+    "EigenSolveError",
+    "EmptyZoneError",
+    "InputError",
+    "NoAdmissibleModeError",
+    "NonlinearError",
+    "NumericalError",
+    "UnibuckleError",
+]
 
 
 class UnibuckleError(Exception):
@@ -26,5 +40,25 @@ class InputError(UnibuckleError, ValueError):
     """The input is wrong; the message names the key and the allowed range."""
 
 
+class EmptyZoneError(InputError):
+    """The obstacle zone holds no free mesh node."""
+
+
+class BilateralZoneError(InputError):
+    """Obstacles on opposite sides of the plate share a mesh node."""
+
+
 class NumericalError(UnibuckleError, RuntimeError):
     """A solve did not converge, or found no admissible state."""
+
+
+class EigenSolveError(NumericalError):
+    """The eigen solve did not converge."""
+
+
+class NoAdmissibleModeError(NumericalError):
+    """No admissible mode with a finite load was found (the message gives the bracket)."""
+
+
+class NonlinearError(NumericalError):
+    """The nonlinear solve failed before any load step converged."""

@@ -227,6 +227,11 @@ class BucklingResult:
         result.details.update(solution.report())
         return result
 
+    @property
+    def certified(self) -> bool:
+        """No certificate (no obstacle: the free load, verified the smallest), or a KKT one."""
+        return self.certificate is None or bool(self.certificate["kkt"])
+
     def as_dict(self, timings: bool = True) -> dict[str, Any]:
         """JSON-ready mapping (non-finite floats become ``null``: JSON has no infinity).
 

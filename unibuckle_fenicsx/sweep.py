@@ -70,6 +70,7 @@ from mpi4py import MPI
 
 from unibuckle_fenicsx.config import ProblemSpec, load_problem, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.errors import InputError, NumericalError
+from unibuckle_fenicsx.outcome import Outcome
 from unibuckle_fenicsx.progress import Progress
 
 __all__ = [
@@ -90,8 +91,8 @@ __all__ = [
 #: command line can show them while it hides the progress lines of each point's solve).
 PROGRESS = logging.getLogger("unibuckle_fenicsx.progress.sweep")
 
-#: Status of a sweep line, see the module docstring.
-STATUSES = ("ok", "not-certified", "refused", "no-admissible-mode", "eigen-failure", "failed")
+#: Status of a sweep line, see the module docstring: how its run ended.
+STATUSES = tuple(str(o) for o in Outcome if o not in (Outcome.INTERRUPTED, Outcome.BUG))
 #: Shortcut paths: name -> the coordinate (0: x, 1: y) of the second corner they set.
 SHORTCUTS = {"plate.length": 0, "plate.width": 1}
 _RANGE = re.compile(r"^\s*([^:]+):([^:]+):([^:]+)\s*$")
@@ -388,24 +389,14 @@ def _solve_point(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
 
 
 def _solve(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
-    from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
     from unibuckle_fenicsx.analysis import solve
-    from unibuckle_fenicsx.eigen import EigenSolveError
 
     try:
         with solve(spec, comm) as analysis:
             result = analysis.result
-    except InputError as err:
-        return {"status": "refused", "error": str(err)}
-    except NoAdmissibleModeError as err:
-        return {"status": "no-admissible-mode", "error": str(err)}
-    except EigenSolveError as err:
-        return {"status": "eigen-failure", "error": str(err)}
-    except NumericalError as err:
-        return {"status": "failed", "error": str(err)}
-    cert = result.certificate
-    status = "not-certified" if cert is not None and not cert["kkt"] else "ok"
-    return {"status": status, **result.as_dict(timings=False)}
+    except (InputError, NumericalError) as err:  # anything else is a bug: it stops the sweep
+        return {"status": str(Outcome.of(err)), "error": str(err)}
+    return {"status": str(Outcome.of(result)), **result.as_dict(timings=False)}
 
 
 def run_sweep(

@@ -23,12 +23,10 @@ from mpi4py import MPI  # noqa: F401
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.errors import NumericalError
-
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.model.problem import Candidate
 
-__all__ = ["NoAdmissibleModeError", "RunStatus", "UnilateralSolution", "candidate_count"]
+__all__ = ["RunStatus", "UnilateralSolution", "candidate_count"]
 
 
 class RunStatus(StrEnum):
@@ -46,10 +44,6 @@ class RunStatus(StrEnum):
     MAX_ITERATIONS = "max_iterations"
     STALLED = "stalled"
     NO_FINITE_LOAD = "no-finite-load"
-
-
-class NoAdmissibleModeError(NumericalError):
-    """No admissible mode with a finite load was found (the message gives the bracket)."""
 
 
 def candidate_count(i: int) -> int:

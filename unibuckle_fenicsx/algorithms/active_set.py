@@ -61,14 +61,13 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
-from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.tolerances import PROOF_RTOL, ROUNDING_RTOL, TWIN_RTOL

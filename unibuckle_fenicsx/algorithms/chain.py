@@ -55,7 +55,7 @@ from slepc4py import SLEPc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
 from unibuckle_fenicsx.algorithms.descent import descend
 from unibuckle_fenicsx.algorithms.interior_point import (
@@ -69,8 +69,7 @@ from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner, release, swapped_eigenpairs
-from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.model.contact import EmptyZoneError
+from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL

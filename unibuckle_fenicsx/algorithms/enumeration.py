@@ -55,12 +55,8 @@ from petsc4py import PETSc
 
 import numpy as np
 
-from unibuckle_fenicsx.algorithms import (
-    NoAdmissibleModeError,
-    UnilateralSolution,
-    candidate_count,
-)
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
+from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.progress import Progress

@@ -23,13 +23,11 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
-    "BilateralZoneError",
     "ContactSetManager",
-    "EmptyZoneError",
     "PlateDofs",
     "check_zone_has_nodes",
     "foundation_springs",
@@ -65,14 +63,6 @@ class PlateDofs(Protocol):
     def global_dofs(self, local: npt.NDArray[np.int32]) -> npt.NDArray[np.int64]:
         """Global (PETSc) indices of local W DOFs."""
         ...
-
-
-class EmptyZoneError(InputError):
-    """The obstacle zone holds no free mesh node."""
-
-
-class BilateralZoneError(InputError):
-    """Obstacles on opposite sides of the plate share a mesh node."""
 
 
 ObstacleLike = ObstacleSpec | Sequence[ObstacleSpec]

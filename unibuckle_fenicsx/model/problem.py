@@ -33,7 +33,6 @@ from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import (
     EIGEN_OPTIONS,
     EigenPair,
-    EigenSolveError,
     GEPSolver,
     Owner,
     SymmetricFactorization,
@@ -42,11 +41,9 @@ from unibuckle_fenicsx.eigen import (
     push_run_options,
     release,
 )
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.errors import BilateralZoneError, EigenSolveError, EmptyZoneError, InputError
 from unibuckle_fenicsx.model.contact import (
-    BilateralZoneError,
     ContactSetManager,
-    EmptyZoneError,
     check_zone_has_nodes,
     foundation_springs,
     orientation,

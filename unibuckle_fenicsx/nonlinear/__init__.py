@@ -21,7 +21,6 @@ _HOMES = {
     "southwell_window": "estimators",
     "VonKarmanPlate": "model",
     "NonlinearAnalysis": "path",
-    "NonlinearError": "path",
     "NonlinearOptions": "path",
     "NonlinearResult": "path",
     "PathPoint": "path",

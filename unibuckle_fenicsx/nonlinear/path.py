@@ -31,7 +31,7 @@ from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
 from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.eigen import Owner
-from unibuckle_fenicsx.errors import InputError, NumericalError
+from unibuckle_fenicsx.errors import InputError, NonlinearError
 from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
 from unibuckle_fenicsx.nonlinear.estimators import (
     inflection_load,
@@ -54,7 +54,6 @@ from unibuckle_fenicsx.tolerances import NONLINEAR_ATOL
 __all__ = [
     "SHAPES",
     "NonlinearAnalysis",
-    "NonlinearError",
     "NonlinearOptions",
     "NonlinearResult",
     "PathPoint",
@@ -62,10 +61,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-
-class NonlinearError(NumericalError):
-    """The nonlinear solve failed before any load step converged."""
 
 
 @dataclass(frozen=True)
@@ -218,13 +213,48 @@ class NonlinearResult:
     versions: dict[str, str] = field(default_factory=dict)
 
     @property
-    def ok(self) -> bool:
+    def certified(self) -> bool:
         """The path is complete, both loads were read off it, the contact holds."""
         return (
             self.completed
             and self.southwell_load_Pa is not None
             and self.inflection_load_Pa is not None
             and bool(self.contact_check.get("satisfied", True))
+        )
+
+    def verdict(self) -> str:
+        """What an incomplete load path validated, and what it did not (one paragraph).
+
+        For a result that is not :attr:`certified`; the path was asked to reach
+        ``options["max_load"]`` times the linear critical load.
+        """
+        linear = self.linear_critical_load_Pa
+        validated, missing = [], []
+        for name, load in (
+            ("Southwell", self.southwell_load_Pa),
+            ("inflection", self.inflection_load_Pa),
+        ):
+            if load is None:
+                missing.append(f"the {name} load (the path stopped before it could be read)")
+            else:
+                validated.append(
+                    f"the {name} load {load:.6e} Pa ({load / linear - 1:+.1e} relative)"
+                )
+        check = self.contact_check
+        if check.get("satisfied", True):
+            validated.append("the contact conditions at the last converged state")
+        else:
+            missing.append(f"the contact conditions at the last converged state ({check})")
+        reached = self.path[-1]["load_Pa"] / linear if self.path else 0.0
+        if not self.completed:
+            missing.append(
+                f"the path from {reached:.4g} to --max-load {self.options['max_load']:g} x the "
+                f"linear load ({self.stop_reason})"
+            )
+        return (
+            f"the load path does not validate everything against the linear critical load "
+            f"{linear:.6e} Pa. Validated: {', '.join(validated) or 'nothing'}. Not validated: "
+            f"{', '.join(missing)}"
         )
 
     def as_dict(self) -> dict[str, Any]:
