@@ -14,7 +14,7 @@ import pytest
 from unibuckle_fenicsx import EdgeSpec, MeshSpec, ObstacleSpec, PlateSpec, paper_case
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.eigen import GEPSolver
+from unibuckle_fenicsx.la.eigen import GEPSolver
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
@@ -144,7 +144,8 @@ def test_command_line_option_wins_and_defaults_do_not_leak():
     """
     from petsc4py import PETSc
 
-    from unibuckle_fenicsx.eigen import LDL_OPTIONS, SymmetricFactorization, set_options
+    from unibuckle_fenicsx.la.factor import LDL_OPTIONS, SymmetricFactorization
+    from unibuckle_fenicsx.la.options import set_options
 
     opts = PETSc.Options()
     opts.setValue("unibuckle_test_ksp_type", "gmres")  # as if given on the command line

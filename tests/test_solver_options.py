@@ -14,7 +14,7 @@ from petsc4py import PETSc
 
 import pytest
 
-import unibuckle_fenicsx.eigen as eigen
+import unibuckle_fenicsx.la.eigen as eigen
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.cases import paper_case

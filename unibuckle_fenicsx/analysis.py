@@ -15,8 +15,8 @@ from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
 from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.eigen import Owner
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
+from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.results import BucklingResult
 

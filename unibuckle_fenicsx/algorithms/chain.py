@@ -68,8 +68,10 @@ from unibuckle_fenicsx.algorithms.interior_point import (
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.eigen import Owner, release, swapped_eigenpairs
 from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
+from unibuckle_fenicsx.la.eigen import swapped_eigenpairs
+from unibuckle_fenicsx.la.options import Prefix
+from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
@@ -369,7 +371,7 @@ def _second_free_mode(problem: BucklingProblem) -> Any:
     pairs = swapped_eigenpairs(
         problem.model.A,
         problem.model.B,
-        "unibuckle_ipm_free2_",
+        Prefix.IPM_SECOND_MODE,
         which=SLEPc.EPS.Which.LARGEST_REAL,
         nev=2,
         tol=1e-8,

@@ -47,7 +47,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.arc import ArcPlane
 from unibuckle_fenicsx.algorithms.pdas import Run
-from unibuckle_fenicsx.eigen import set_options
+from unibuckle_fenicsx.la.options import Prefix, set_options
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL, ZERO_STEP
 
@@ -112,12 +112,10 @@ class _Gradient:
     need not leave the obstacle where the multiplier pulls).
     """
 
-    PREFIX = "unibuckle_descent_"
-
     def __init__(self, problem: BucklingProblem) -> None:
         self.problem = problem
         self.ksp = PETSc.KSP().create(problem.model.A.comm)
-        set_options(self.ksp, self.PREFIX, GRADIENT_OPTIONS)
+        set_options(self.ksp, Prefix.DESCENT, GRADIENT_OPTIONS)
 
     def direction(self, u: PETSc.Vec, working: npt.NDArray[np.int64]) -> PETSc.Vec:
         """The direction g for the working set ``working`` (a new vector)."""

@@ -60,15 +60,14 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
-__all__ = ["FOUNDATION_PREFIX", "pressing_nodes", "solve_foundation"]
+__all__ = ["pressing_nodes", "solve_foundation"]
 
 logger = logging.getLogger(__name__)
 
-#: Options prefix of the foundation's eigen solver.
-FOUNDATION_PREFIX = "unibuckle_foundation_"
 #: Angles sampled on the circle before the golden-section refinement.
 ARC_SAMPLES = 720
 
@@ -106,7 +105,7 @@ def solve_foundation(
     springs = contact.stiffness
     runs: dict[str, SpringIteration] = {}
     finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
-    with PenaltySolver(problem, prefix=FOUNDATION_PREFIX, eps_options=eps_options) as solver:
+    with PenaltySolver(problem, prefix=Prefix.FOUNDATION, eps_options=eps_options) as solver:
         starts = {"free": np.empty(0, np.int64), "bilateral": np.arange(contact.size)}
         for name, start in starts.items():
             run = solver.iterate_springs(

@@ -99,11 +99,11 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.eigen import Owner, release, set_options
+from unibuckle_fenicsx.la.options import Prefix, set_options
+from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = [
-    "IPM_PREFIX",
     "BarrierPoint",
     "InteriorPointNewton",
     "NewtonOptions",
@@ -112,12 +112,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-#: Options prefix of the method's own solvers (:data:`RELAX_OPTIONS`:
-#: ``-unibuckle_ipm_relax_w_ksp_view``). The Newton matrix is factorised by the mesh's
-#: shared :math:`LDL^T` (:class:`~unibuckle_fenicsx.eigen.SharedFactorization`, options
-#: prefix ``unibuckle_ldl_``).
-IPM_PREFIX = "unibuckle_ipm_"
 
 #: Smallest gap (relative to max|w|) of a pressure deflection that had to be lifted off
 #: the obstacle (:meth:`InteriorPointNewton.pressure_mode`); the margin of
@@ -307,7 +301,7 @@ class InteriorPointNewton(Owner):
     """The interior-point Newton method on one problem (owns its work vectors and solvers).
 
     The Newton matrix K and its :math:`LDL^T` are the mesh's
-    :class:`~unibuckle_fenicsx.eigen.SharedFactorization` (``problem.eigensolver``'s),
+    :class:`~unibuckle_fenicsx.la.factor.SharedFactorization` (``problem.eigensolver``'s),
     whose symbolic analysis the shifted eigen solves and the certificate reuse.
 
     Args:
@@ -323,7 +317,7 @@ class InteriorPointNewton(Owner):
         self,
         problem: BucklingProblem,
         options: NewtonOptions | None = None,
-        prefix: str = IPM_PREFIX,
+        prefix: str = Prefix.IPM,
     ) -> None:
         contact = problem.contact
         if contact is None or problem.tensionless:

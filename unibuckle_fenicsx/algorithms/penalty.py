@@ -32,7 +32,7 @@ admissible mode is one). The lower bound reported is :math:`\lambda_{free}`
 
 A is assembled once (by :class:`~unibuckle_fenicsx.model.plate.model.PlateModel`); the
 springs are added on the diagonal of a private copy :math:`A_{pen}`, which has its
-own :class:`~unibuckle_fenicsx.eigen.GEPSolver` with the options prefix
+own :class:`~unibuckle_fenicsx.la.eigen.GEPSolver` with the options prefix
 ``unibuckle_penalty_``.
 
 Note:
@@ -52,21 +52,19 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.sets import SetLog
-from unibuckle_fenicsx.eigen import (
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.la.eigen import (
     EIGEN_OPTIONS,
     EXTREME_OPTIONS,
     GEPSolver,
-    Owner,
     extreme_eigenvalues,
-    release,
 )
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.la.options import Prefix
+from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import ENERGY_TIE_RTOL
 
 __all__ = [
-    "CONDITION_PREFIX",
-    "PENALTY_PREFIX",
     "PenaltySolver",
     "PenaltyStep",
     "SpringIteration",
@@ -74,12 +72,6 @@ __all__ = [
 ]
 
 logger = logging.getLogger(__name__)
-
-#: Options prefix of the penalty eigen solver.
-PENALTY_PREFIX = "unibuckle_penalty_"
-
-#: Options prefix of the extreme-eigenvalue solvers of :meth:`PenaltySolver.condition_number`.
-CONDITION_PREFIX = "unibuckle_penalty_cond_"
 
 
 @dataclass(frozen=True)
@@ -136,7 +128,7 @@ class PenaltySolver(Owner):
         problem: A :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle.
         prefix: Options prefix of the eigen solver (``-<prefix>eps_view`` etc. apply).
         eps_options: Extra EPS options under ``prefix`` (merged into
-            :data:`~unibuckle_fenicsx.eigen.EIGEN_OPTIONS`).
+            :data:`~unibuckle_fenicsx.la.eigen.EIGEN_OPTIONS`).
 
     Attributes:
         max_diag: :math:`\max_j A_{jj}`, the unit of the relative penalty.
@@ -150,7 +142,7 @@ class PenaltySolver(Owner):
     def __init__(
         self,
         problem: BucklingProblem,
-        prefix: str = PENALTY_PREFIX,
+        prefix: str = Prefix.PENALTY,
         eps_options: dict[str, str | float | int] | None = None,
     ) -> None:
         if not isinstance(problem, BucklingProblem):
@@ -228,7 +220,7 @@ class PenaltySolver(Owner):
         The edge-constrained rows (diagonal 1, decoupled) are left out, so this is the
         spectrum of the operator that actually carries the physics; the 2-norm condition
         number of this SPD matrix is the ratio of the two values
-        (:func:`~unibuckle_fenicsx.eigen.extreme_eigenvalues`, options prefix
+        (:func:`~unibuckle_fenicsx.la.eigen.extreme_eigenvalues`, options prefix
         ``unibuckle_penalty_cond_``).
 
         Returns:
@@ -243,7 +235,7 @@ class PenaltySolver(Owner):
         sub = self.A_pen.createSubMatrix(iset, iset)
         iset.destroy()
         try:
-            return extreme_eigenvalues(sub, CONDITION_PREFIX, EXTREME_OPTIONS)
+            return extreme_eigenvalues(sub, Prefix.PENALTY_CONDITION, EXTREME_OPTIONS)
         finally:
             sub.destroy()
 

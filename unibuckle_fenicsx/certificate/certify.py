@@ -45,14 +45,14 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.foundation import pressing_nodes
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
-from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX, ShiftedMatrix
-from unibuckle_fenicsx.eigen import SymmetricFactorization
+from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
+from unibuckle_fenicsx.la.factor import SymmetricFactorization
+from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import BRACKET_GAP, PROOF_GAP, ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
 
 __all__ = [
     "BRACKET_GAP",
-    "CERTIFY_PREFIX",
     "PROOF_GAP",
     "Certificate",
     "certify",
@@ -212,7 +212,7 @@ def pencil_inertia(
         if diagonal is not None:
             K.setDiagonal(diagonal, addv=PETSc.InsertMode.ADD_VALUES)  # type: ignore[arg-type]
         K.axpy(-sigma, B, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
-        factor = SymmetricFactorization(K, CERTIFY_PREFIX)
+        factor = SymmetricFactorization(K, Prefix.CERTIFY)
         try:
             return factor.inertia()
         finally:

@@ -45,8 +45,9 @@ except ImportError as err:  # pragma: no cover
         "the SDP certificate needs cvxpy and Clarabel: pip install 'unibuckle_fenicsx[sdp]'"
     ) from err
 
-from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX, EPS, ShiftedMatrix
-from unibuckle_fenicsx.eigen import SymmetricFactorization
+from unibuckle_fenicsx.certificate.shifted import EPS, ShiftedMatrix
+from unibuckle_fenicsx.la.factor import SymmetricFactorization
+from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
 __all__ = ["SDP_SOLVER", "sector_certificate", "spn_certificate"]
@@ -127,7 +128,7 @@ def _inertia_minus(
         entries = -signs[position] * signs * N[position, :]
         K.setValues([row], rows, entries, addv=PETSc.InsertMode.ADD_VALUES)  # type: ignore[arg-type]
     K.assemble()
-    factor = SymmetricFactorization(K, CERTIFY_PREFIX + "sdp_")
+    factor = SymmetricFactorization(K, Prefix.CERTIFY + "sdp_")
     try:
         neg, zero, _ = factor.inertia()
     finally:
@@ -169,12 +170,12 @@ def _lowest_modes(problem: BucklingProblem, nev: int) -> list[PETSc.Vec]:
     """
     from slepc4py import SLEPc
 
-    from unibuckle_fenicsx.eigen import swapped_eigenpairs
+    from unibuckle_fenicsx.la.eigen import swapped_eigenpairs
 
     pairs = swapped_eigenpairs(
         problem.model.A,
         problem.model.B,
-        CERTIFY_PREFIX + "modes_",
+        Prefix.CERTIFY + "modes_",
         which=SLEPc.EPS.Which.LARGEST_REAL,
         nev=nev,
         tol=1e-12,

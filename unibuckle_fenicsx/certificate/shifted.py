@@ -8,7 +8,7 @@ constrained nodes.
 
 Note:
     Collective on the problem's communicator. The factorisations go through the mesh's
-    shared :math:`LDL^T` (:class:`~unibuckle_fenicsx.eigen.SharedFactorization`, options
+    shared :math:`LDL^T` (:class:`~unibuckle_fenicsx.la.factor.SharedFactorization`, options
     prefix ``unibuckle_ldl_``) when one is given, else under ``unibuckle_certify_``.
 """
 
@@ -23,21 +23,14 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.eigen import (
-    Owner,
-    SharedFactorization,
-    SymmetricFactorization,
-    release,
-    same_pattern,
-)
+from unibuckle_fenicsx.la.factor import SharedFactorization, SymmetricFactorization, same_pattern
+from unibuckle_fenicsx.la.options import Prefix
+from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
-__all__ = ["CERTIFY_PREFIX", "EPS", "ShiftedMatrix", "Solve", "absdot", "mirror_maps", "norm2"]
+__all__ = ["EPS", "ShiftedMatrix", "Solve", "absdot", "mirror_maps", "norm2"]
 
-#: Options prefix of the certificate's own factorisations (``-unibuckle_certify_ksp_view``):
-#: those not done by the mesh's shared :math:`LDL^T`.
-CERTIFY_PREFIX = "unibuckle_certify_"
 EPS = float(np.finfo(float).eps)
 
 
@@ -93,7 +86,7 @@ class ShiftedMatrix(Owner):
         self,
         A: PETSc.Mat,
         B: PETSc.Mat,
-        prefix: str = CERTIFY_PREFIX,
+        prefix: str = Prefix.CERTIFY,
         shared: SharedFactorization | None = None,
     ) -> None:
         for mat, name in ((A, "A"), (B, "B")):

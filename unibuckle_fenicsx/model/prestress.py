@@ -38,6 +38,7 @@ from unibuckle_fenicsx.config import (
     temperature_field,
 )
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.materials import membrane_voigt
 from unibuckle_fenicsx.model.mesh import edge_line, edge_normal_axis, edge_tags
 
@@ -365,7 +366,7 @@ def _solve_membrane(
         L,
         bcs=bcs,
         petsc_options=DIRECT_LU if petsc_options is None else petsc_options,
-        petsc_options_prefix="unibuckle_prestress_",
+        petsc_options_prefix=Prefix.PRESTRESS,
     )
     uh = problem.solve()
     if not isinstance(uh, dolfinx.fem.Function):

@@ -30,18 +30,11 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.eigen import (
-    EIGEN_OPTIONS,
-    EigenPair,
-    GEPSolver,
-    Owner,
-    SymmetricFactorization,
-    abs_matrix,
-    pop_run_options,
-    push_run_options,
-    release,
-)
 from unibuckle_fenicsx.errors import BilateralZoneError, EigenSolveError, EmptyZoneError, InputError
+from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, EigenPair, GEPSolver
+from unibuckle_fenicsx.la.factor import SymmetricFactorization, abs_matrix
+from unibuckle_fenicsx.la.options import Prefix, pop_run_options, push_run_options
+from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.contact import (
     ContactSetManager,
     check_zone_has_nodes,
@@ -58,9 +51,6 @@ from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 __all__ = ["BYTES_PER_DOF", "BucklingProblem", "Candidate", "Mode", "available_memory"]
 
 logger = logging.getLogger(__name__)
-
-#: Options prefix of the LDL^T that checks A - B_fixed (``-unibuckle_fixed_ksp_view``).
-FIXED_LOAD_PREFIX = "unibuckle_fixed_"
 
 #: Peak memory per (w, theta) DOF of a solve, measured with MUMPS on one rank: 7.8 kB at
 #: 155k DOFs, 5.8 kB at 617k (:doc:`/guide/mpi`); the estimate uses 8 kB.
@@ -178,7 +168,7 @@ class BucklingProblem(Owner):
             ``eps_view`` is ``-unibuckle_eps_view``) for this pencil and the coarser
             levels' copies, and under ``unibuckle_penalty_`` and ``unibuckle_foundation_``
             for the penalty stages and the foundation
-            (:data:`~unibuckle_fenicsx.eigen.RUN_EPS_PREFIXES`). The problem holds them in
+            (:data:`~unibuckle_fenicsx.la.options.RUN_EPS_PREFIXES`). The problem holds them in
             PETSc's options database until :meth:`destroy`; the command line's win.
         mesh: A quadrilateral DOLFINx mesh to use instead of ``spec.mesh`` (the
             rectangle, or gmsh's plate); ``spec.plate.corners`` must be its bounding
@@ -187,7 +177,7 @@ class BucklingProblem(Owner):
         facet_tags: Edge markers of ``mesh``, matched by :class:`EdgeSpec` ``tag``.
 
     Attributes:
-        eigensolver: The :class:`~unibuckle_fenicsx.eigen.GEPSolver` of the pencil.
+        eigensolver: The :class:`~unibuckle_fenicsx.la.eigen.GEPSolver` of the pencil.
         contact: The :class:`~unibuckle_fenicsx.model.contact.ContactSetManager` (None
             without obstacle).
         free: The free mode, once :meth:`solve_free` has run.
@@ -362,7 +352,7 @@ class BucklingProblem(Owner):
         """
         K = self.model.A.duplicate(copy=True)
         try:
-            with SymmetricFactorization(K, FIXED_LOAD_PREFIX) as factor:
+            with SymmetricFactorization(K, Prefix.FIXED) as factor:
                 negative, zero, _ = factor.inertia()
         finally:
             K.destroy()
@@ -483,7 +473,7 @@ class BucklingProblem(Owner):
             initial: Optional start vector of the eigen solve (e.g. a previous mode).
             near: Optional estimate of the load (e.g. that of the state Z is read
                 from): the eigen solve shifts just below it
-                (:meth:`~unibuckle_fenicsx.eigen.GEPSolver.solve`).
+                (:meth:`~unibuckle_fenicsx.la.eigen.GEPSolver.solve`).
 
         The empty set is the free plate's pencil: its candidate is made from
         :meth:`solve_free`'s pair (solved once; the same load to the last bit, so a

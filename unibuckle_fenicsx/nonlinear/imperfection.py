@@ -16,8 +16,8 @@ import dolfinx.fem.petsc
 import ufl
 
 from unibuckle_fenicsx.analysis import Analysis
-from unibuckle_fenicsx.eigen import set_options
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.la.options import Prefix, set_options
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.nonlinear.model import THETA_SUB, VonKarmanPlate
 
@@ -79,7 +79,7 @@ def _pressure_shape(problem: BucklingProblem, sign: float = 1.0) -> dolfinx.fem.
     dolfinx.fem.petsc.set_bc(f, model.bcs)
     ksp = PETSc.KSP().create(problem.comm)  # type: ignore[arg-type]
     ksp.setOperators(model.A)
-    set_options(ksp, "unibuckle_nl_shape_", SHAPE_LU)
+    set_options(ksp, Prefix.NONLINEAR_SHAPE, SHAPE_LU)
     p = dolfinx.fem.Function(model.W, name="pressure_shape")
     try:
         ksp.solve(f, p.x.petsc_vec)

@@ -56,8 +56,9 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
-from unibuckle_fenicsx.eigen import Owner, release, set_options
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.la.options import Prefix, set_options
+from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.contact import ContactSetManager
 from unibuckle_fenicsx.model.materials import bending_voigt, membrane_voigt, transverse_shear
 from unibuckle_fenicsx.model.mesh import (
@@ -362,7 +363,7 @@ class VonKarmanPlate(MixedDofs, Owner):
             snes.setVariableBounds(self._lower, self._upper)
         else:
             options.setdefault("snes_type", "newtonls")
-        set_options(snes, "unibuckle_nl_", options)
+        set_options(snes, Prefix.NONLINEAR, options)
         self.snes: PETSc.SNES | None = snes
 
     # -- set-up helpers ------------------------------------------------------------

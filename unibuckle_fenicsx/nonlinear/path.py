@@ -30,8 +30,9 @@ import numpy.typing as npt
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
 from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
-from unibuckle_fenicsx.eigen import Owner
 from unibuckle_fenicsx.errors import InputError, NonlinearError
+from unibuckle_fenicsx.la.options import Prefix
+from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
 from unibuckle_fenicsx.nonlinear.estimators import (
     inflection_load,
@@ -457,7 +458,7 @@ def _default_atol(plate: VonKarmanPlate, reference: float) -> None:
     :data:`~unibuckle_fenicsx.tolerances.NONLINEAR_ATOL` relative to the load vector at
     ``reference``.
     """
-    if PETSc.Options().hasName("unibuckle_nl_snes_atol"):
+    if PETSc.Options().hasName(f"{Prefix.NONLINEAR}snes_atol"):
         return
     if plate.snes is None:
         raise RuntimeError("_default_atol: expected plate.snes is not None (an internal invariant)")

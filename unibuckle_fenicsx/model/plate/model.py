@@ -14,8 +14,8 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import Material, PlateSpec, PointSpec
-from unibuckle_fenicsx.eigen import Owner, release
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.materials import bending_voigt, transverse_shear
 from unibuckle_fenicsx.model.mesh import edge_normal_axis, edge_tags
 from unibuckle_fenicsx.model.plate.forms import (

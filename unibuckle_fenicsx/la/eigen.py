@@ -1,4 +1,4 @@
-r"""PETSc/SLEPc solvers: the buckling pencil's smallest eigenpair, extreme eigenvalues, LDLᵀ.
+r"""The buckling pencil's smallest eigenpair, and extreme eigenvalues (SLEPc).
 
 :math:`A u = \lambda B u`, A SPD (after the edge conditions), B the geometric
 stiffness. Removed DOFs (an active contact set) get zero rows and columns with
@@ -17,10 +17,6 @@ they map to :math:`\lambda = \infty`.
   for each eigenvalue of the pencil in :math:`(0, \sigma)`, so its inertia proves
   the same.
 
-Every solver object here has a non-empty options prefix: options are pushed under it
-by :func:`set_options` (the one place that touches the global options database), so
-``-<prefix>eps_view`` and friends work from the command line.
-
 Note:
     Every object here is collective on its matrices' communicator; ``destroy()`` is
     collective.
@@ -29,61 +25,40 @@ Note:
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
 from dataclasses import dataclass
-from types import TracebackType
 from typing import Any
 
-from mpi4py import MPI
+from petsc4py import PETSc
+from slepc4py import SLEPc
 
 import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import EigenSolveError
-
-try:
-    from petsc4py import PETSc
-    from slepc4py import SLEPc
-except ImportError as err:  # pragma: no cover
-    raise ImportError(
-        "unibuckle_fenicsx.eigen needs petsc4py and slepc4py (real scalars); install "
-        "the 'fenics' extra: pip install 'unibuckle_fenicsx[fenics]'"
-    ) from err
+from unibuckle_fenicsx.la.factor import SharedFactorization
+from unibuckle_fenicsx.la.options import Options, Prefix, set_options
+from unibuckle_fenicsx.la.ownership import Owner, release
 
 __all__ = [
     "EIGEN_OPTIONS",
     "EXTREME_OPTIONS",
-    "LDL_OPTIONS",
-    "RUN_EPS_PREFIXES",
+    "NEAR_MARGIN",
+    "NEAR_NCV",
     "EigenPair",
     "GEPSolver",
-    "Owner",
-    "SharedFactorization",
-    "SymmetricFactorization",
-    "abs_matrix",
     "extreme_eigenvalues",
-    "pop_run_options",
-    "push_run_options",
-    "release",
-    "same_pattern",
-    "set_ldl_options",
-    "set_options",
     "swapped_eigenpairs",
 ]
 
 logger = logging.getLogger(__name__)
 
-Options = Mapping[str, str | float | int | bool]
-
 #: Default EPS options of :class:`GEPSolver` (overridable per solver or on the command
 #: line under the prefix). The solves at target 0 factorise with an LU; the shifted
-#: solves (``near=...``) with the mesh's :class:`SharedFactorization`, a symmetric
-#: :math:`LDL^T` whose inertia they need. Measured, an :math:`LDL^T` at target 0 too
-#: makes a free solve faster (a thin 90×30 plate: 0.22–0.33 → 0.11–0.22 s) but changes
-#: the rounding that decides between mirror-image contact sets of equal load, and with
-#: it the active set's path (a random 6×3 plate of the test families then ended at a
-#: higher KKT point; a symmetric plate on two ranks at the mirror image of the serial
-#: one).
+#: solves (``near=...``) with the mesh's
+#: :class:`~unibuckle_fenicsx.la.factor.SharedFactorization`, a symmetric :math:`LDL^T`
+#: whose inertia they need. An LU at target 0 keeps the rounding that decides between
+#: mirror-image contact sets of equal load the same on any number of ranks
+#: (:doc:`/verification/tuning`).
 EIGEN_OPTIONS: dict[str, str | float | int | bool] = {
     "eps_type": "krylovschur",
     "st_ksp_type": "preonly",
@@ -93,12 +68,11 @@ EIGEN_OPTIONS: dict[str, str | float | int | bool] = {
 }
 
 #: A solve given an estimate ``near`` of the eigenvalue shifts to ``near * (1 -
-#: NEAR_MARGIN)`` with a Krylov subspace of ``NEAR_NCV`` vectors. With the shift 0.1 %
-#: below the eigenvalue the transformed spectrum separates by a factor of about ten per
-#: 1 % gap between the two lowest loads, so a few solves converge (the contact set of a
-#: thin CCCC plate at 90×30, from a start 1e-3 off its mode: 0.22–0.27 → 0.05–0.07 s
-#: for the eigen solve).
+#: NEAR_MARGIN)`` (relative, in (0, 1)): 0.1 % below the eigenvalue the transformed
+#: spectrum separates by a factor of about ten per 1 % gap between the two lowest loads,
+#: so a few restarts converge (:doc:`/verification/tuning`).
 NEAR_MARGIN = 1e-3
+#: Krylov vectors of a shifted solve (>= 2): the wanted pair dominates after the shift.
 NEAR_NCV = 4
 
 #: Default options of :func:`extreme_eigenvalues` (the smallest eigenvalue uses them all;
@@ -110,141 +84,6 @@ EXTREME_OPTIONS: dict[str, str | float | int | bool] = {
     "st_pc_type": "lu",
     "st_pc_factor_mat_solver_type": "mumps",
 }
-
-#: Default options of :class:`SymmetricFactorization`: a MUMPS LDLᵀ (symmetric
-#: indefinite), with the settings MUMPS needs to report the inertia in parallel
-#: (ICNTL(13) = 1) and the null pivots (ICNTL(24) = 1).
-LDL_OPTIONS: dict[str, str | float | int | bool] = {
-    "ksp_type": "preonly",
-    "pc_type": "cholesky",
-    "pc_factor_mat_solver_type": "mumps",
-    "mat_mumps_icntl_13": 1,
-    "mat_mumps_icntl_24": 1,
-}
-
-
-def release(owner: object, *names: str) -> None:
-    """Destroy the PETSc/SLEPc objects held in ``owner``'s attributes ``names`` (collective).
-
-    Each is set to None afterwards, so a second call (or ``__del__`` after ``destroy``)
-    does nothing.
-    """
-    for name in names:
-        obj = getattr(owner, name, None)
-        if obj is not None:
-            obj.destroy()
-            setattr(owner, name, None)
-
-
-class Owner:
-    """A holder of PETSc/SLEPc objects: ``destroy()`` them, or use it in a ``with`` block."""
-
-    def destroy(self) -> None:
-        """Destroy the objects held (collective)."""
-        raise NotImplementedError
-
-    def __enter__(self) -> Any:
-        return self
-
-    def __exit__(
-        self,
-        exc_type: type[BaseException] | None,
-        exc: BaseException | None,
-        tb: TracebackType | None,
-    ) -> None:
-        self.destroy()
-
-
-def abs_matrix(mat: PETSc.Mat) -> PETSc.Mat:
-    """A new matrix with the entries' absolute values (the caller destroys it; collective)."""
-    out = mat.duplicate(copy=True)
-    indptr, indices, values = out.getValuesCSR()
-    out.setValuesCSR(indptr, indices, np.abs(values))  # type: ignore[arg-type]
-    out.assemble()
-    return out
-
-
-def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False) -> None:
-    """Set the options prefix of ``obj`` and default ``options``; then ``setFromOptions``.
-
-    A default is used only when the database holds no value for ``prefix + key`` (an
-    option from the command line, e.g. ``-unibuckle_eps_max_it 1000``, wins), and it is
-    removed again afterwards, so nothing leaks into other objects. Options read only when
-    the object is set up (MUMPS ICNTL settings are read at the symbolic factorisation)
-    need ``setup=True``: ``obj.setUp()`` then runs before the defaults are removed.
-
-    Args:
-        obj: A PETSc/SLEPc object with ``setOptionsPrefix`` and ``setFromOptions``.
-        prefix: Non-empty options prefix.
-        options: Option names (without prefix) and default values.
-        setup: Call ``obj.setUp()`` (its operators must be set) while the defaults are in.
-    """
-    if not prefix:
-        raise ValueError("PETSc/SLEPc objects need a non-empty options prefix")
-    obj.setOptionsPrefix(prefix)
-    opts = PETSc.Options(prefix)  # names below are relative to the prefix
-    pushed = [key for key in options if not opts.hasName(key)]
-    for key in pushed:
-        opts.setValue(key, options[key])
-    try:
-        obj.setFromOptions()
-        if setup:
-            obj.setUp()
-    finally:
-        for key in pushed:
-            opts.delValue(key)
-
-
-def set_ldl_options(ksp: PETSc.KSP, prefix: str) -> None:
-    """Make ``ksp`` a MUMPS :math:`LDL^T` with inertia (:data:`LDL_OPTIONS`), unfactorised.
-
-    :func:`set_options` with ``setup=True`` would factorise the current operator (the
-    MUMPS controls are read at the first factorisation, while the defaults are in the
-    options database); a matrix whose values are set before every factorisation (the
-    interior point's Newton matrix) does not need that one. The controls go onto the
-    factor matrix instead, which PETSc hands to MUMPS when it starts; the rest of
-    :data:`LDL_OPTIONS` goes through the database (a command-line option under
-    ``prefix`` still wins). The operator must be set. Collective.
-    """
-    mumps = {k: v for k, v in LDL_OPTIONS.items() if k.startswith("mat_mumps_icntl_")}
-    others = {k: v for k, v in LDL_OPTIONS.items() if k not in mumps}
-    set_options(ksp, prefix, others)
-    pc = ksp.getPC()
-    pc.setFactorSetUpSolverType()
-    factor = pc.getFactorMatrix()
-    for key, value in mumps.items():
-        factor.setMumpsIcntl(int(key.rsplit("_", 1)[1]), int(value))
-
-
-#: Options prefixes of the eigen solvers of one run that take the EPS options given in
-#: Python (:class:`~unibuckle_fenicsx.model.problem.BucklingProblem` ``eps_options``): the
-#: pencil on every mesh level, the penalty stages and the foundation's spring iteration.
-RUN_EPS_PREFIXES = ("unibuckle_", "unibuckle_penalty_", "unibuckle_foundation_")
-
-
-def push_run_options(options: Options | None) -> list[tuple[str, str]]:
-    """Put ``options`` in PETSc's options database under each of :data:`RUN_EPS_PREFIXES`.
-
-    Every eigen solver the run creates afterwards reads them there (its
-    ``setFromOptions``), whichever module builds it. An option the database already
-    holds (the command line's) is left alone: it wins. Returns what was put, for
-    :func:`pop_run_options`.
-    """
-    pushed: list[tuple[str, str]] = []
-    for prefix in RUN_EPS_PREFIXES:
-        opts = PETSc.Options(prefix)
-        for key, value in (options or {}).items():
-            if not opts.hasName(key):
-                opts.setValue(key, value)
-                pushed.append((prefix, key))
-    return pushed
-
-
-def pop_run_options(pushed: list[tuple[str, str]]) -> None:
-    """Remove from the options database what :func:`push_run_options` put there."""
-    for prefix, key in pushed:
-        PETSc.Options(prefix).delValue(key)
-    pushed.clear()
 
 
 @dataclass(frozen=True)
@@ -293,7 +132,7 @@ class GEPSolver(Owner):
         B: PETSc.Mat,
         *,
         indefinite: bool = False,
-        prefix: str = "unibuckle_",
+        prefix: str = Prefix.EIGEN,
         tol: float = 1e-10,
         options: Options | None = None,
     ) -> None:
@@ -391,24 +230,33 @@ class GEPSolver(Owner):
             if out is not None:
                 out.zeroEntries()
             return EigenPair(float("inf"), 0.0, 0, 0)
-        start = initial is not None and self._useful_start(initial, B)
-        eps = self.eps
-        if near is not None and near > 0.0:
-            if self._solve_below(A, B, near, initial if start else None):
-                eps = self._near
-                self.shifted_solves += 1
-            else:
-                self.unshifted_again += 1
-                logger.debug("%s: an eigenvalue below %.6g; solved at 0", self.prefix, near)
-        if eps is self.eps:
-            if self.indefinite:
-                eps.setOperators(B, A)
-            else:
-                eps.setOperators(A, B)
-            if start:
-                eps.setInitialSpace([initial])
-            eps.solve()
+        start = initial if initial is not None and self._useful_start(initial, B) else None
+        eps = self._run(A, B, start, near)
         self.solves += 1
+        return self._pair(eps, out)
+
+    def _run(
+        self, A: PETSc.Mat, B: PETSc.Mat, initial: PETSc.Vec | None, near: float | None
+    ) -> SLEPc.EPS:
+        """Solve the reduced pencil (A, B): shifted below ``near`` if that answers, else at 0."""
+        if near is not None and near > 0.0:
+            if self._solve_below(A, B, near, initial):
+                self.shifted_solves += 1
+                return self._near
+            self.unshifted_again += 1
+            logger.debug("%s: an eigenvalue below %.6g; solved at 0", self.prefix, near)
+        eps = self.eps
+        if self.indefinite:
+            eps.setOperators(B, A)
+        else:
+            eps.setOperators(A, B)
+        if initial is not None:
+            eps.setInitialSpace([initial])
+        eps.solve()
+        return eps
+
+    def _pair(self, eps: SLEPc.EPS, out: PETSc.Vec | None) -> EigenPair:
+        """The converged pair of ``eps`` (its vector into ``out``), or a load of ``inf``."""
         nconv = eps.getConverged()
         its = eps.getIterationNumber()
         if nconv < 1 and self.indefinite and self._negligible_spectrum():
@@ -688,124 +536,3 @@ def extreme_eigenvalues(
         finally:
             eps.destroy()
     return values[0], values[1]
-
-
-class SymmetricFactorization(Owner):
-    r"""Sparse :math:`LDL^T` factorisation of a symmetric (indefinite) matrix, with inertia.
-
-    A KSP ``preonly`` + PC ``cholesky`` with MUMPS (:data:`LDL_OPTIONS`); the matrix
-    must not carry PETSc's SPD flag (MUMPS would then assume a positive definite
-    matrix). Used by the global-optimality certificate: the inertia of
-    :math:`A - \lambda B` counts the pencil's eigenvalues below :math:`\lambda`.
-
-    Args:
-        mat: Symmetric matrix (referenced, not copied; keep it alive).
-        prefix: Options prefix, e.g. ``unibuckle_certify_`` (so
-            ``-unibuckle_certify_ksp_view`` works).
-        options: Options pushed under ``prefix`` (default :data:`LDL_OPTIONS`).
-
-    Note:
-        Collective. The owner must :meth:`destroy` it.
-    """
-
-    def __init__(self, mat: PETSc.Mat, prefix: str, options: Options | None = None) -> None:
-        mat.setOption(PETSc.Mat.Option.SPD, False)  # type: ignore[arg-type]
-        mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
-        self.ksp = PETSc.KSP().create(mat.comm)
-        self.ksp.setOperators(mat)
-        set_options(self.ksp, prefix, LDL_OPTIONS if options is None else options, setup=True)
-        self.prefix = prefix
-
-    def inertia(self) -> tuple[int, int, int]:
-        """(negative, zero, positive) eigenvalue counts of the factorised matrix."""
-        nneg, nzero, npos = self.ksp.getPC().getFactorMatrix().getInertia()
-        return int(nneg), int(nzero), int(npos)
-
-    def solve(self, b: PETSc.Vec, x: PETSc.Vec) -> None:
-        """Solve M x = b for x (collective)."""
-        self.ksp.solve(b, x)
-
-    def destroy(self) -> None:
-        """Destroy the KSP and its factor (collective)."""
-        release(self, "ksp")
-
-    def __del__(self) -> None:
-        self.destroy()
-
-
-def same_pattern(a: PETSc.Mat, b: PETSc.Mat) -> bool:
-    """Whether ``a`` and ``b`` have one CSR nonzero pattern on every rank (collective)."""
-    ai, aj, _ = a.getValuesCSR()
-    bi, bj, _ = b.getValuesCSR()
-    same = bool(np.array_equal(ai, bi) and np.array_equal(aj, bj))
-    return bool(a.getComm().tompi4py().allreduce(same, op=MPI.LAND))
-
-
-class SharedFactorization(Owner):
-    r"""One MUMPS :math:`LDL^T` (with inertia) for the matrices of one mesh that have A's pattern.
-
-    The interior-point Newton matrix :math:`A - \lambda B + \Sigma`, the shifted matrices
-    of the eigen solves near an estimate (:math:`A_Z - \sigma B_Z`) and the
-    certificate's :math:`A - \lambda B` all have the stiffness matrix's nonzero pattern.
-    Each user writes its values into :attr:`matrix` and calls :meth:`factor`; MUMPS's
-    symbolic analysis (the fill-reducing ordering) is done on the first call only. With a
-    matrix and a factorisation each, the three users cost three analyses per mesh:
-    measured on a thin plate at 180×60 (33 123 DOFs), 0.19 s each, as long as a numeric
-    factorisation.
-
-    The factorisation belongs to whoever called :meth:`factor` last (:meth:`holds`): a
-    user that solves with it later checks that first and factorises again if not.
-
-    Args:
-        A: The stiffness matrix (AIJ); :attr:`matrix` is a copy with its pattern.
-        prefix: Options prefix of the factorisation (:data:`LDL_OPTIONS`).
-
-    Note:
-        Collective. Owned by the problem's :class:`GEPSolver`
-        (:attr:`GEPSolver.factorization`).
-    """
-
-    def __init__(self, A: PETSc.Mat, prefix: str) -> None:
-        self.matrix = A.duplicate(copy=True)
-        self.matrix.setOption(PETSc.Mat.Option.SPD, False)  # type: ignore[arg-type]
-        self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
-        self.ksp = PETSc.KSP().create(A.comm)
-        self.ksp.setOperators(self.matrix)
-        set_ldl_options(self.ksp, prefix)
-        self.prefix = prefix
-        self._holder: object | None = None
-
-    def factor(self, holder: object) -> tuple[int, int, int]:
-        """Factorise :attr:`matrix` for ``holder``; the inertia (negative, zero, positive)."""
-        self.ksp.setOperators(self.matrix)
-        self.ksp.setUp()
-        self._holder = holder
-        return self.inertia()
-
-    def claim(self, holder: object) -> None:
-        """Record that ``holder`` factorised :attr:`matrix` through :attr:`ksp` (SLEPc's ST)."""
-        self._holder = holder
-
-    def holds(self, holder: object) -> bool:
-        """Whether the current factorisation is ``holder``'s."""
-        return self._holder is holder
-
-    def inertia(self) -> tuple[int, int, int]:
-        """(negative, zero, positive) eigenvalue counts of the factorised matrix."""
-        nneg, nzero, npos = self.ksp.getPC().getFactorMatrix().getInertia()
-        return int(nneg), int(nzero), int(npos)
-
-    def fits(self, mat: PETSc.Mat) -> bool:
-        """Whether ``mat`` has exactly :attr:`matrix`'s pattern (ask once per matrix).
-
-        A value copy with ``SAME_NONZERO_PATTERN`` trusts the caller: PETSc compares
-        only the number of nonzeros. Collective.
-        """
-        return same_pattern(self.matrix, mat)
-
-    def destroy(self) -> None:
-        """Destroy the matrix and its factorisation (collective)."""
-        release(self, "ksp", "matrix")
-
-    def __del__(self) -> None:
-        self.destroy()
