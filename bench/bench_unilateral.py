@@ -23,7 +23,7 @@ from _results import append_rows
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 
 
 def main() -> None:
@@ -43,7 +43,7 @@ def main() -> None:
         print(header)
     for nx, ny in meshes:
         for case in args.cases.split(","):
-            problem = BucklingProblem(paper_case(case, nx, ny), comm)
+            problem = build_problem(paper_case(case, nx, ny), comm)
             comm.Barrier()
             t0 = time.perf_counter()
             problem.solve_free()

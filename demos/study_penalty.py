@@ -48,7 +48,7 @@ from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver
 from unibuckle_fenicsx.certificate.certify import certify
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.viz import fields
 
 # %% [markdown]
@@ -123,7 +123,7 @@ def distance(w: np.ndarray, ref: np.ndarray) -> float:
 results: dict[str, dict[str, object]] = {}
 for zone, (nx, ny) in ZONES.items():
     t0 = time.perf_counter()
-    problem = BucklingProblem(paper_case(zone, nx, ny), comm)
+    problem = build_problem(paper_case(zone, nx, ny), comm)
     free = problem.solve_free().load
     exact = solve_active_set(problem, multilevel=False, bound_budget=EXHAUSTIVE)
     cert = certify(problem, exact)
@@ -328,7 +328,7 @@ if comm.rank == 0:
 # mode, for the zone ω_c1.
 
 # %%
-problem = BucklingProblem(paper_case("c1", *ZONES["c1"]), comm)
+problem = build_problem(paper_case("c1", *ZONES["c1"]), comm)
 problem.solve_free()
 sections = []
 pen = PenaltySolver(problem)

@@ -36,7 +36,7 @@ def active_specs():
 def nothing_built(monkeypatch):
     """Fail the test if a mesh is built or a solve starts: refusals come first."""
     import unibuckle_fenicsx.analysis
-    import unibuckle_fenicsx.model.problem
+    import unibuckle_fenicsx.model.build
     import unibuckle_fenicsx.nonlinear
 
     # Imported before the patch: its module-level "from ... import solve" would otherwise
@@ -47,7 +47,7 @@ def nothing_built(monkeypatch):
         raise AssertionError("work started before the input was refused")
 
     monkeypatch.setattr(unibuckle_fenicsx.analysis, "solve", refuse)
-    monkeypatch.setattr(unibuckle_fenicsx.model.problem, "build_plate_mesh", refuse)
+    monkeypatch.setattr(unibuckle_fenicsx.model.build, "build_plate_mesh", refuse)
     monkeypatch.setattr(unibuckle_fenicsx.nonlinear, "solve_nonlinear", refuse)
 
 

@@ -12,7 +12,7 @@ import math
 import numpy as np
 import scipy.linalg
 
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 #: Relative agreement of loads: SLEPc converges to a relative residual of eps_tol = 1e-10
 #: and LAPACK to about 1e-13 here, so 1e-8 leaves a margin of 100.
@@ -25,7 +25,7 @@ def dense(mat) -> np.ndarray:
     return np.asarray(mat.getValues(idx, idx))
 
 
-def condensed(problem: BucklingProblem):
+def condensed(problem: UnilateralProblem):
     r"""(S, B_ww, free w-DOFs, position of each constrained node among them), densely.
 
     :math:`S = A_{ww} - A_{w\theta} A_{\theta\theta}^{-1} A_{\theta w}` on the free
@@ -45,7 +45,7 @@ def condensed(problem: BucklingProblem):
 
 
 def exhaustive_minimum(
-    problem: BucklingProblem, rtol: float = RTOL
+    problem: UnilateralProblem, rtol: float = RTOL
 ) -> tuple[float, list[tuple[int, ...]], int]:
     r"""Smallest feasible :math:`\lambda(Z)` over all Z in 2^I, by dense linear algebra.
 
@@ -97,7 +97,7 @@ def exhaustive_minimum(
     return best, minimisers, len(loads)
 
 
-def dense_free_load(problem: BucklingProblem) -> float:
+def dense_free_load(problem: UnilateralProblem) -> float:
     """Smallest positive load of the whole pencil by LAPACK (``scipy.linalg.eigh``, inf if none).
 
     theta = 1/lambda below 1e-10 of the largest |theta| is round-off, not a load (LAPACK's
@@ -110,7 +110,7 @@ def dense_free_load(problem: BucklingProblem) -> float:
     return 1.0 / top if top > 1e-10 * np.abs(theta).max() else math.inf
 
 
-def dense_reduced_load(problem: BucklingProblem, active: tuple[int, ...]) -> float:
+def dense_reduced_load(problem: UnilateralProblem, active: tuple[int, ...]) -> float:
     """lambda(Z) of the pencil with the edge DOFs and the w-DOFs of Z removed, by LAPACK.
 
     No condensation (the Schur complement of :func:`exhaustive_minimum` cancels digits on
@@ -123,7 +123,7 @@ def dense_reduced_load(problem: BucklingProblem, active: tuple[int, ...]) -> flo
     return 1.0 / theta[-1] if theta[-1] > 1e-10 * np.abs(theta).max() else math.inf
 
 
-def satisfies_kkt(problem: BucklingProblem, A, B, x: np.ndarray, load: float, active) -> bool:
+def satisfies_kkt(problem: UnilateralProblem, A, B, x: np.ndarray, load: float, active) -> bool:
     """Whether the mode x (all DOFs) of the contact set ``active`` satisfies the KKT conditions.
 
     Oriented to each node's obstacle (:math:`s_k w_k`, s = +1 under an obstacle above, -1
@@ -154,7 +154,7 @@ def membrane_force_scale(spec) -> float:
     return spec.plate.thickness * max(stresses)
 
 
-def exhaustive_tensionless(problem: BucklingProblem) -> float:
+def exhaustive_tensionless(problem: UnilateralProblem) -> float:
     r"""The critical load on tensionless foundations, by trying every spring set.
 
     The load minimises :math:`R(v) = (a(v, v) + \sum_k \rho_k \max(0, s_k v_k)^2)/b(v, v)`
@@ -190,7 +190,7 @@ def exhaustive_tensionless(problem: BucklingProblem) -> float:
     return best
 
 
-def satisfies_spring_kkt(problem: BucklingProblem, A, B, x: np.ndarray, load: float) -> bool:
+def satisfies_spring_kkt(problem: UnilateralProblem, A, B, x: np.ndarray, load: float) -> bool:
     r"""Whether x (all DOFs) is stationary for the tensionless quotient at ``load``.
 
     The residual :math:`Au + \sum_k \rho_k \max(0, z_k) s_k e_k - \lambda Bu`, z the

@@ -23,7 +23,7 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 
 
 def _interior_nodes_in_box(nx, ny, length, width, box) -> int:
@@ -76,7 +76,7 @@ def active_family(count: int = 50) -> tuple[list[ProblemSpec], int]:
     """
     family, skipped = [], 0
     for spec in random_specs():
-        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        problem = build_problem(spec, MPI.COMM_SELF)
         v = problem.contact.values(problem.solve_free().function.x.petsc_vec)
         v = v / np.abs(v).max()
         problem.destroy()

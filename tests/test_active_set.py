@@ -46,7 +46,8 @@ from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.cases import paper_case, plate_case
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.config import ObstacleSpec, ProblemSpec
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 HERE = Path(__file__).resolve().parent
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
@@ -77,7 +78,7 @@ def test_random_family_matches_exhaustive_enumeration(family):
     report = []
     disagreements = {}
     for spec in family:
-        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        problem = build_problem(spec, MPI.COMM_SELF)
         problem.solve_free()
         sol = solve_active_set(problem, bound_budget=0)
         best, minimisers, _ = exhaustive_minimum(problem)
@@ -110,7 +111,7 @@ def test_lattice_bound_is_valid_and_closes(family):
     """Lower bound <= exhaustive minimum; proven optimum equals it (first 8 problems)."""
     proven = 0
     for spec in family[:8]:
-        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        problem = build_problem(spec, MPI.COMM_SELF)
         sol = solve_active_set(problem, bound_budget=512)
         best, _, _ = exhaustive_minimum(problem)
         assert sol.lower_bound <= best * (1 + 1e-10)
@@ -129,7 +130,7 @@ def paper_loads() -> dict[str, float]:
     """Active-set loads of the paper's zones at 20x10 (certified and proven on each)."""
     loads = {}
     for case in ("c1", "c2", "c3"):
-        problem = BucklingProblem(paper_case(case, 20, 10))
+        problem = build_problem(paper_case(case, 20, 10))
         free = problem.solve_free().load
         sol = solve_active_set(problem)
         cert = certify(problem, sol)
@@ -154,7 +155,7 @@ def test_paper_zones_certified_and_ordered(paper_loads):
 def test_multilevel_equals_single_level():
     """Seeding on 20x10 and polishing gives the single-level multi-seed answer (40x20)."""
     for case in ("c1", "c2"):
-        problem = BucklingProblem(paper_case(case, 40, 20))
+        problem = build_problem(paper_case(case, 40, 20))
         problem.solve_free()
         multi = solve_active_set(problem, bound_budget=0)
         single = solve_active_set(problem, multilevel=False, bound_budget=0)
@@ -172,7 +173,7 @@ def test_fine_polish_solves_below_the_extrapolated_load():
     falls back to target 0), and the load is the smallest eigenvalue of the returned
     set's pencil, solved again at target 0 without an estimate.
     """
-    problem = BucklingProblem(paper_case("c3", 80, 40))
+    problem = build_problem(paper_case("c3", 80, 40))
     problem.solve_free()
     solver = problem.eigensolver
     shifted, again = solver.shifted_solves, solver.unshifted_again
@@ -185,7 +186,7 @@ def test_fine_polish_solves_below_the_extrapolated_load():
     assert abs(solution.load - cold.load) <= RTOL * cold.load
 
 
-def _sparse_kkt(problem: BucklingProblem, active) -> tuple[bool, float]:
+def _sparse_kkt(problem: UnilateralProblem, active) -> tuple[bool, float]:
     """KKT conditions of the contact set ``active`` and its load, by scipy alone.
 
     The largest eigenvalue theta of B x = theta A x on the DOFs left after removing the
@@ -213,7 +214,7 @@ def _sparse_kkt(problem: BucklingProblem, active) -> tuple[bool, float]:
 def test_threshold_iteration_ends_at_kkt_points(active_specs):
     """From the free mode's violating sets, with thresholds: dense-checked KKT points."""
     for spec in active_specs[:10]:
-        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        problem = build_problem(spec, MPI.COMM_SELF)
         free = problem.solve_free().function.x.petsc_vec
         values = problem.contact.values(free)
         best, _, _ = exhaustive_minimum(problem)
@@ -247,8 +248,8 @@ def test_thresholds_polish_a_thin_plate_within_budget():
         zone=ObstacleSpec(zone="all"),
     )
     with (
-        BucklingProblem(spec, MPI.COMM_SELF) as fine,
-        BucklingProblem(spec.with_mesh(30, 10), MPI.COMM_SELF) as coarse,
+        build_problem(spec, MPI.COMM_SELF) as fine,
+        build_problem(spec.with_mesh(30, 10), MPI.COMM_SELF) as coarse,
     ):
         best = _distinct_kkt(_multi_seed(coarse, 100))[0]
         start = prolong(coarse, fine, best.active)
@@ -270,7 +271,7 @@ def test_prolongation_includes_midway_nodes():
 
 
 def test_bad_options_raise_before_work():
-    problem = BucklingProblem(paper_case("c2", 4, 2))
+    problem = build_problem(paper_case("c2", 4, 2))
     with pytest.raises(ValueError, match="max_iterations"):
         solve_active_set(problem, max_iterations=0)
     with pytest.raises(ValueError, match="bound_budget"):
@@ -279,7 +280,7 @@ def test_bad_options_raise_before_work():
         solve_active_set(problem, refine_margin=math.nan)
     assert problem.eigensolver.solves == 0
     problem.destroy()
-    free = BucklingProblem(paper_case("free", 4, 2))
+    free = build_problem(paper_case("free", 4, 2))
     with pytest.raises(ValueError, match="obstacle"):
         solve_active_set(free)
     free.destroy()
@@ -297,7 +298,7 @@ def test_distributed_equals_serial(case, nx, ny):
     """
     out = run_mpi(HERE / "mpi" / "active_parallel.py", 2, case, str(nx), str(ny))
     par = json.loads(out.strip().splitlines()[-1])
-    problem = BucklingProblem(paper_case(case, nx, ny), MPI.COMM_SELF)
+    problem = build_problem(paper_case(case, nx, ny), MPI.COMM_SELF)
     sol = solve_active_set(problem)
     assert abs(par["load"] - sol.load) <= RTOL * sol.load
     assert np.allclose(par["coordinates"], problem.contact.coordinates[sol.active], atol=1e-12)
@@ -322,7 +323,7 @@ MESHES = ((20, 10), (40, 20), (80, 40), (160, 80))
 def _unilateral_loads(case: str, meshes) -> np.ndarray:
     loads = []
     for nx, ny in meshes:
-        with BucklingProblem(paper_case(case, nx, ny)) as problem:
+        with build_problem(paper_case(case, nx, ny)) as problem:
             sol = solve_active_set(problem, bound_budget=0)
             assert sol.candidate.kkt
             loads.append(sol.load)

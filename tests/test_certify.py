@@ -34,7 +34,7 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.tolerances import PROOF_GAP
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
@@ -64,7 +64,7 @@ def test_lower_bound_never_exceeds_the_exhaustive_minimum(active_specs):
     family = active_specs
     proven = 0
     for spec in family:
-        with BucklingProblem(spec, MPI.COMM_SELF) as problem:
+        with build_problem(spec, MPI.COMM_SELF) as problem:
             sol = solve_active_set(problem, bound_budget=0)
             cert = certify(problem, sol)
             best, _, _ = exhaustive_minimum(problem)
@@ -90,7 +90,7 @@ def test_a_wrong_kkt_point_is_never_proven(active_specs):
     """
     family = active_specs
     spec = next(s for s in family if s.name == "random29")
-    with BucklingProblem(spec, MPI.COMM_SELF) as problem:
+    with build_problem(spec, MPI.COMM_SELF) as problem:
         sol = solve_active_set(problem, bound_budget=0)
         best, _, _ = exhaustive_minimum(problem)
         assert sol.load > best * (1 + 1e-3)  # the iteration misses the global minimum
@@ -195,7 +195,7 @@ def test_reduced_inertia_reuses_the_copositivity_factorisation():
     (``reduced_inertia`` without a matrix), at shifts below and above eigenvalues of the
     reduced pencil.
     """
-    problem = BucklingProblem(paper_case("c1", 10, 10), MPI.COMM_WORLD)
+    problem = build_problem(paper_case("c1", 10, 10), MPI.COMM_WORLD)
     try:
         load = problem.solve_free().load
         assert problem.contact is not None

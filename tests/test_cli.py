@@ -326,7 +326,7 @@ def test_unwritable_output_is_refused_before_solving(tmp_path, capsys, no_solve,
 
 def test_one_cell_and_huge_meshes_are_refused(capsys, monkeypatch):
     """--nx 1 names mesh.nx; a 100000 x 100000 mesh is refused with its memory estimate."""
-    import unibuckle_fenicsx.model.problem as problem_module
+    import unibuckle_fenicsx.model.build as build_module
 
     assert main(["solve", "--case", "free", "--nx", "1"]) == EXIT_BAD_INPUT
     assert "mesh.nx must be an integer >= 2" in capsys.readouterr().err
@@ -334,7 +334,7 @@ def test_one_cell_and_huge_meshes_are_refused(capsys, monkeypatch):
     def no_mesh(*args, **kwargs):
         raise AssertionError("the mesh was built")
 
-    monkeypatch.setattr(problem_module, "build_plate_mesh", no_mesh)
+    monkeypatch.setattr(build_module, "build_plate_mesh", no_mesh)
     assert main(["solve", "--case", "free", "--nx", "100000", "--ny", "100000"]) == 2
     err = capsys.readouterr().err
     assert "30,000,600,003 DOFs" in err and "GB" in err and "available" in err, err

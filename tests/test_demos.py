@@ -116,11 +116,11 @@ def test_section_of_free_mode_is_the_navier_shape():
     paper's mesh match it within 2 % of max |w|.
     """
     from unibuckle_fenicsx import paper_case
-    from unibuckle_fenicsx.model.problem import BucklingProblem
+    from unibuckle_fenicsx.model.build import build_problem
     from unibuckle_fenicsx.viz import fields
 
     spec = paper_case("free", 20, 20)
-    with BucklingProblem(spec, MPI.COMM_WORLD) as problem:
+    with build_problem(spec, MPI.COMM_WORLD) as problem:
         x, w = fields.section(problem, problem.solve_free().function)
     a = spec.plate.length
     assert x.shape == (21,) and np.allclose(np.diff(x), a / 20)

@@ -35,13 +35,14 @@ from unibuckle_fenicsx.algorithms.descent import _Gradient, admissible_start, de
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.config import ObstacleSpec, problem_to_dict
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 HERE = Path(__file__).resolve().parent
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 
 
-def dense_kkt(problem: BucklingProblem, active) -> bool:
+def dense_kkt(problem: UnilateralProblem, active) -> bool:
     """The KKT conditions of the contact set ``active``, by LAPACK alone.
 
     The smallest positive eigenpair of the dense pencil with the edge DOFs and the w-DOFs
@@ -58,7 +59,7 @@ def dense_kkt(problem: BucklingProblem, active) -> bool:
     return satisfies_kkt(problem, A, B, u, 1.0 / theta[-1], active)
 
 
-def _descend_from_free(problem: BucklingProblem):
+def _descend_from_free(problem: UnilateralProblem):
     """Descent from the free mode's violating set (either sign) made admissible."""
     free = problem.solve_free()  # may refuse the plate (b nowhere positive)
     v = problem.contact.values(free.function.x.petsc_vec)
@@ -69,7 +70,7 @@ def _descend_from_free(problem: BucklingProblem):
     return None, None, None
 
 
-def _check_descent(problem: BucklingProblem, start, run, steps, rtol: float = RTOL) -> None:
+def _check_descent(problem: UnilateralProblem, start, run, steps, rtol: float = RTOL) -> None:
     """Monotone, ends at a dense-checked KKT point whose load LAPACK reproduces."""
     name = problem.spec.name
     loads = [start.load] + [load for _, load, _ in run.history]
@@ -91,7 +92,7 @@ def test_descent_is_monotone_and_ends_at_kkt_points(active_specs):
     returns).
     """
     for spec in active_specs[:10]:
-        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        problem = build_problem(spec, MPI.COMM_SELF)
         start, run, steps = _descend_from_free(problem)
         assert start is not None, spec.name
         _check_descent(problem, start, run, steps)
@@ -113,7 +114,7 @@ def test_descent_on_the_stress_family(spec, kind, i):
     :data:`WARM_START_ROUNDOFF`.
     """
     try:
-        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        problem = build_problem(spec, MPI.COMM_SELF)
         start, run, steps = _descend_from_free(problem)
     except ValueError as err:  # refused (b vanishes or is nowhere positive): family test
         assert "no positive buckling load" in str(err), err
@@ -153,7 +154,7 @@ def long_clamped_spec(nx: int = 24, ny: int = 6):
 @pytest.fixture(scope="module")
 def long_clamped():
     """The solver's answer on :func:`long_clamped_spec` (cells b/6), and the problem."""
-    problem = BucklingProblem(long_clamped_spec())
+    problem = build_problem(long_clamped_spec())
     yield problem, solve_active_set(problem)
     problem.destroy()
 
@@ -190,7 +191,7 @@ def test_descent_distributed_equals_serial(tmp_path):
     chain cycles along a round-off-dependent path and may end at the mirror image).
     """
     spec = long_clamped_spec()
-    with BucklingProblem(spec, MPI.COMM_SELF) as problem:
+    with build_problem(spec, MPI.COMM_SELF) as problem:
         left = np.flatnonzero(problem.contact.coordinates[:, 0] <= 2.0)
         start, _ = admissible_start(problem, problem.evaluate(left), 100)
         assert start is not None
@@ -217,7 +218,7 @@ def _sorted(xy: np.ndarray) -> np.ndarray:
 def test_gradient_direction_leaves_the_obstacle_and_descends(active_specs):
     """g_k < 0 at the released node, g = 0 on the rest of Z, and R(u + eps g) < R(u)."""
     spec = active_specs[0]
-    with BucklingProblem(spec, MPI.COMM_SELF) as problem:
+    with build_problem(spec, MPI.COMM_SELF) as problem:
         n = problem.num_constrained
         # A contact set with a pulling node: the first of these (deterministic).
         for z in (np.arange(0, n, 2), np.arange(1, n, 2), np.arange(n // 2), np.arange(1, n)):

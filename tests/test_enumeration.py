@@ -1,7 +1,7 @@
 """The paper's enumeration (section 5.3) against an independent dense brute force.
 
 Expected values come from a dense numpy computation over *all* 2^i contact sets, written
-here independently of SLEPc, ``BucklingProblem.evaluate`` and the enumeration module:
+here independently of SLEPc, ``UnilateralProblem.evaluate`` and the enumeration module:
 Cholesky of the reduced A, symmetric eigensolve of L^-1 B L^-T, feasibility of the
 largest-mu eigenvector in both orientations. Tolerance on loads 1e-9 relative: the
 SLEPc pairs are converged to eps_tol = 1e-10 (relative residual, which bounds the
@@ -31,7 +31,8 @@ from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.config import ObstacleSpec, ProblemSpec
 from unibuckle_fenicsx.errors import EmptyZoneError
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.tolerances import LOAD_TIE_RTOL
 
 RTOL = 1e-9
@@ -57,7 +58,7 @@ def _pick(entries: list[tuple[float, tuple[int, ...]]]) -> tuple[float, tuple[in
     return min(((s, load) for load, s in entries if load <= best * (1 + LOAD_TIE_RTOL)))[::-1]
 
 
-def dense_brute_force(problem: BucklingProblem) -> dict:
+def dense_brute_force(problem: UnilateralProblem) -> dict:
     """Load and feasibility of every subset of I by dense linear algebra (serial).
 
     B acts on w only, so the rotations are condensed out once: S = A_ww - A_wt A_tt^-1
@@ -114,7 +115,7 @@ def solved() -> dict:
     """Each case: problem results of the three stopping rules and the dense reference."""
     out = {}
     for name, (spec, i) in CASES.items():
-        problem = BucklingProblem(spec, MPI.COMM_SELF)
+        problem = build_problem(spec, MPI.COMM_SELF)
         assert problem.num_constrained == i
         free = problem.solve_free().load
         runs = {}
@@ -197,7 +198,7 @@ def test_paper_rule_not_exact_on_c1_8x4(solved):
 
 def test_refuses_above_max_candidates():
     """Zone c1 on 12 x 6 has i = 25: 2^25 candidate sets, refused before any solve."""
-    problem = BucklingProblem(paper_case("c1", 12, 6), MPI.COMM_SELF)
+    problem = build_problem(paper_case("c1", 12, 6), MPI.COMM_SELF)
     assert problem.num_constrained == 25
     solves = problem.eigensolver.solves
     with pytest.raises(ValueError, match=r"33554432.*i = 25.*active-set"):
@@ -209,7 +210,7 @@ def test_refuses_above_max_candidates():
 
 
 def test_needs_an_obstacle():
-    problem = BucklingProblem(paper_case("free", 4, 2), MPI.COMM_SELF)
+    problem = build_problem(paper_case("free", 4, 2), MPI.COMM_SELF)
     with pytest.raises(ValueError, match="obstacle"):
         enumerate_contact_sets(problem)
     problem.destroy()
@@ -226,7 +227,7 @@ def test_empty_zone(zone, message):
     """A zone between nodes (8 x 4: spacing 0.025 m), or on a supported edge only."""
     spec: ProblemSpec = replace(paper_case("c1", 8, 4), obstacle=ObstacleSpec(zone=zone))
     with pytest.raises(EmptyZoneError, match=message):
-        BucklingProblem(spec, MPI.COMM_SELF)
+        build_problem(spec, MPI.COMM_SELF)
 
 
 @pytest.mark.mpi

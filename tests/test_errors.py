@@ -21,7 +21,7 @@ import pytest
 import unibuckle_fenicsx.analysis
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_BUG, EXIT_NOT_CERTIFIED, EXIT_OK, main
 from unibuckle_fenicsx.errors import InputError, NumericalError, UnibuckleError
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import Problem
 from unibuckle_fenicsx.sweep import parse_variation, run_sweep
 
 #: A small plate with a box obstacle (each point an enumeration of a few sets, ~1 s).
@@ -94,17 +94,17 @@ def test_a_failed_sweep_point_leaves_nothing_alive_and_the_others_unchanged(tmp_
     reference = tmp_path / "reference.jsonl"
     run_sweep(SMALL, [parse_variation("plate.thickness=0.004,0.006")], reference, comm)
 
-    kept: list[BucklingProblem] = []
-    solve_free = BucklingProblem.solve_free
+    kept: list[Problem] = []
+    solve_free = Problem.solve_free
 
-    def fail_one(self: BucklingProblem):  # the real solve, then a numerical failure
+    def fail_one(self: Problem):  # the real solve, then a numerical failure
         mode = solve_free(self)
         if self.spec.plate.thickness == FAILING:
             kept.append(self)
             raise NumericalError("a planted numerical failure")
         return mode
 
-    monkeypatch.setattr(BucklingProblem, "solve_free", fail_one)
+    monkeypatch.setattr(Problem, "solve_free", fail_one)
     gc.collect()
     before = _live()
     out = tmp_path / "with_failure.jsonl"

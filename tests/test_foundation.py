@@ -34,9 +34,9 @@ from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.certify import certify_foundation
 from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.contact import tributary_areas
 from unibuckle_fenicsx.model.materials import bending_stiffness
-from unibuckle_fenicsx.model.problem import BucklingProblem
 
 THICKNESS = 1e-3  # b = 1 m: t/b = 1e-3, the thin limit
 D = bending_stiffness(1.0e9, 0.3, THICKNESS)
@@ -148,7 +148,7 @@ def test_a_bilateral_foundation_goes_with_a_rigid_obstacle():
 # -- the spring term ---------------------------------------------------------------------
 def test_tributary_areas_sum_to_the_plate_area():
     spec = strip(1.5, 6, ObstacleSpec("all", foundation_stiffness=1.0))
-    with BucklingProblem(spec, MPI.COMM_WORLD) as problem:
+    with build_problem(spec, MPI.COMM_WORLD) as problem:
         areas = tributary_areas(problem.model)
         n = problem.model.Vw.dofmap.index_map.size_local
         total = MPI.COMM_WORLD.allreduce(float(areas.array[:n].sum()), op=MPI.SUM)

@@ -33,9 +33,9 @@ from unibuckle_fenicsx.config import (  # noqa: E402
     problem_from_dict,
     problem_to_dict,
 )
+from unibuckle_fenicsx.model.build import build_problem  # noqa: E402
 from unibuckle_fenicsx.model.gmsh_mesh import GMSH_OPTIONS  # noqa: E402
 from unibuckle_fenicsx.model.materials import navier_load_mindlin  # noqa: E402
-from unibuckle_fenicsx.model.problem import BucklingProblem  # noqa: E402
 from unibuckle_fenicsx.model.zones import zone_report  # noqa: E402
 
 #: The paper's plate as an outline: segment 0 bottom, 1 right, 2 top, 3 left.
@@ -201,7 +201,7 @@ def test_nx_ny_are_refused_for_a_gmsh_plate(capsys):
 def test_missing_gmsh_names_the_extra(monkeypatch, tmp_path, capsys):
     monkeypatch.setitem(sys.modules, "gmsh", None)  # import gmsh raises ImportError
     with pytest.raises(ImportError, match=r"pip install 'unibuckle_fenicsx\[gmsh\]'"):
-        BucklingProblem(paper_outline(0.02), MPI.COMM_WORLD)
+        build_problem(paper_outline(0.02), MPI.COMM_WORLD)
     path = tmp_path / "outline.toml"
     path.write_text(
         f"[plate]\noutline = {PAPER_OUTLINE}\n[edges.loaded]\nsegments = [1, 3]\n"
@@ -321,7 +321,7 @@ def test_circular_zone_is_the_circle(size):
             "obstacle": {"circle": {"center": [0.1, 0.05], "radius": r}},
         }
     )
-    with BucklingProblem(spec, MPI.COMM_WORLD) as problem:
+    with build_problem(spec, MPI.COMM_WORLD) as problem:
         (report,) = zone_report(problem.mesh, spec.all_obstacles, spec.plate, ["obstacle"])
         x = problem.mesh.geometry.x
         n_owned = problem.mesh.geometry.index_map().size_local
@@ -394,7 +394,7 @@ def test_inclined_edge_needs_soft_support_or_clamping():
         "mesh": {"size": 0.02},
     }
     with pytest.raises(ValueError, match=r"edge 'slanted' is not parallel to a coordinate axis"):
-        BucklingProblem(problem_from_dict(data), MPI.COMM_WORLD)
+        build_problem(problem_from_dict(data), MPI.COMM_WORLD)
     data["edges"]["slanted"]["support"] = "simply_supported_soft"
     with solve(problem_from_dict(data)) as analysis:
         assert analysis.result.free_load_Pa > 0
@@ -458,7 +458,7 @@ def test_geo_and_msh_files(tmp_path):
     triangles = replace(spec, plate=replace(spec.plate, file=str(tmp_path / "triangles.msh")))
     message = r"triangles\.msh: the gmsh mesh must consist of bilinear quadrilaterals .*Triangle"
     with pytest.raises(ValueError, match=message):
-        BucklingProblem(triangles, MPI.COMM_WORLD)
+        build_problem(triangles, MPI.COMM_WORLD)
 
 
 def test_file_edge_names_must_exist(tmp_path, capsys):
@@ -564,7 +564,7 @@ def test_thin_holed_plate_is_nested_over_gmsh_meshes():
     }
     loads, meshes = [], []
     for options in (ChainOptions(), ChainOptions(coarse_min_cells=10**6)):
-        with BucklingProblem(problem_from_dict(data)) as problem:
+        with build_problem(problem_from_dict(data)) as problem:
             sol = solve_unilateral(problem, options)
             assert sol.method == "interior-point" and sol.candidate.kkt
             loads.append(sol.load)

@@ -60,7 +60,8 @@ from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case, plate_case
 from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 PARALLEL = Path(__file__).parent / "mpi" / "interior_point_parallel.py"
@@ -90,7 +91,7 @@ def _thin(name: str = "ssss", nx: int = 6, ny: int = 3, **kw) -> object:
     )
 
 
-def _load_rounding(problem: BucklingProblem, cand) -> float:
+def _load_rounding(problem: UnilateralProblem, cand) -> float:
     r"""Relative resolution of a critical load in double precision.
 
     A backward-stable solve perturbs A by :math:`|E| \le \epsilon |A|`, which moves the
@@ -140,7 +141,7 @@ def test_newton_direction_solves_the_linearised_conditions(side):
     """
     spec = _thin(nx=6, ny=3)
     spec = replace(spec, obstacle=replace(spec.obstacle, side=side))
-    problem = BucklingProblem(spec, MPI.COMM_SELF)
+    problem = build_problem(spec, MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
         u = newton.pressure_mode()  # strictly inside the cone
         vec = u.x.petsc_vec
@@ -209,7 +210,7 @@ def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
     Rayleigh–Ritz value is that eigenvalue (to the rounding of the thin plate's solves,
     measured 1e-11 of it); the step along the direction lowers the barrier objective.
     """
-    problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    problem = build_problem(_thin(nx=6, ny=3), MPI.COMM_SELF)
     A, B = dense(problem.model.A), dense(problem.model.B)
     D = np.abs(B).sum(axis=1)
     P, R = np.flatnonzero(D > 0.0), np.flatnonzero(D == 0.0)
@@ -256,7 +257,7 @@ def test_negative_curvature_is_the_same_on_two_ranks(tmp_path):
     find the serial value (to the rounding of the solves, 1e-9 relative on this thin plate).
     """
     spec = _thin(nx=12, ny=4)
-    problem = BucklingProblem(spec, MPI.COMM_SELF)
+    problem = build_problem(spec, MPI.COMM_SELF)
     A, B = dense(problem.model.A), dense(problem.model.B)
     lam = 1.3 / np.sort(np.linalg.eigvals(np.linalg.solve(A, B)).real)[-2]
     with InteriorPointNewton(problem, replace(NewtonOptions(), curvature_vectors=3)) as newton:
@@ -275,8 +276,8 @@ def test_negative_curvature_is_the_same_on_two_ranks(tmp_path):
 
 @serial
 def test_prolongation_is_exact_for_q1():
-    coarse = BucklingProblem(_thin(nx=4, ny=2), MPI.COMM_SELF)
-    fine = BucklingProblem(_thin(nx=8, ny=4), MPI.COMM_SELF)
+    coarse = build_problem(_thin(nx=4, ny=2), MPI.COMM_SELF)
+    fine = build_problem(_thin(nx=8, ny=4), MPI.COMM_SELF)
     carry = Prolongation(coarse, fine)
     u = coarse.new_mode()
     u.sub(0).interpolate(lambda x: 1.0 + 2.0 * x[0] - 3.0 * x[1])
@@ -299,8 +300,8 @@ def test_lift_is_the_least_energy_correction():
     (the nodal clip's is one) it has the least energy a(c, c) (the minimum-energy
     extension of prescribed values): checked against the clip's correction.
     """
-    coarse = BucklingProblem(_thin("cs", nx=12, ny=4), MPI.COMM_SELF)
-    fine = BucklingProblem(_thin("cs", nx=24, ny=8), MPI.COMM_SELF)
+    coarse = build_problem(_thin("cs", nx=12, ny=4), MPI.COMM_SELF)
+    fine = build_problem(_thin("cs", nx=24, ny=8), MPI.COMM_SELF)
     margin = 1e-3
     with InteriorPointNewton(fine) as newton:
         start = Prolongation(coarse, fine).mode(coarse.solve_free().function)
@@ -440,7 +441,7 @@ def test_pressure_deflection_is_lifted_into_the_cone():
     The two pushes twist the plate about its free edge across an obstacle; the start is
     moved back to a gap of at least PUSH_MARGIN max|w| at every constrained node.
     """
-    problem = BucklingProblem(_twisted(9, 6), MPI.COMM_SELF)
+    problem = build_problem(_twisted(9, 6), MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
         plain = problem.new_mode("plain")
         newton._factor(0.0, None)
@@ -490,7 +491,7 @@ def test_option_under_the_prefix_reaches_the_factorisation():
     The Newton matrix is factorised by the mesh's shared LDL^T (prefix ``unibuckle_ldl_``).
     Construction does not factorise; the controls are read at the first factorisation.
     """
-    problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    problem = build_problem(_thin(nx=6, ny=3), MPI.COMM_SELF)
     prefix = f"{problem.eigensolver.prefix}ldl_"
     assert prefix == "unibuckle_ldl_"
     opts = PETSc.Options()
@@ -528,7 +529,7 @@ def test_starts_on_one_central_path_are_not_taken_further():
     (``twin_rtol = path_rtol = 0``: only bit-identical loads compare equal, whatever the
     deflections), in fewer Newton steps on the coarsest mesh.
     """
-    problem = BucklingProblem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
+    problem = build_problem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
     short = solve_unilateral(problem, ChainOptions())
     full = solve_unilateral(problem, ChainOptions(twin_rtol=0.0, path_rtol=0.0))
     coarse = [sol.details["levels"][0] for sol in (short, full)]
@@ -554,7 +555,7 @@ def test_second_free_mode_is_the_pencils_second_eigenpair():
     the second smallest positive load 1/theta. Tolerance: dense and SLEPc solves of these
     plates agree to a few 1e-8 (cond(A) ~ 1e11, ``tests/test_stress_family.py``).
     """
-    problem = BucklingProblem(_thin("ssss", nx=6, ny=3), MPI.COMM_SELF)
+    problem = build_problem(_thin("ssss", nx=6, ny=3), MPI.COMM_SELF)
     A, B = dense(problem.model.A), dense(problem.model.B)
     theta = scipy.linalg.eigh(B, A, eigvals_only=True)
     loads = np.sort(1.0 / theta[theta > 0.0])
@@ -609,7 +610,7 @@ def test_predicted_contact_set_is_the_affine_step_indicator():
     :func:`test_newton_direction_solves_the_linearised_conditions`, with pushes that
     make some gaps close and others open.
     """
-    problem = BucklingProblem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    problem = build_problem(_thin(nx=6, ny=3), MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
         u = newton.pressure_mode()
         newton._normalize(u.x.petsc_vec)
@@ -641,7 +642,7 @@ def test_predicted_contact_set_read_inside_a_run_leaves_it_unchanged():
     same steps, factorisations and loads (bit for bit) as the run without it, and the
     set read inside equals the one computed afresh from a copy of the same point.
     """
-    problem = BucklingProblem(_thin(nx=22, ny=7), MPI.COMM_SELF)
+    problem = build_problem(_thin(nx=22, ny=7), MPI.COMM_SELF)
     runs, inside, copies = [], [], []
 
     def hook(point):
@@ -695,7 +696,7 @@ def test_a_set_predicted_twice_in_a_row_is_read_before_the_barrier_problem_is_so
     where the barrier problem at 1e-9 is solved. The same contact set, its load to the
     rounding of two solves at different shifts, in fewer fine-mesh steps.
     """
-    problem = BucklingProblem(_thin("ssss", nx=60, ny=20), MPI.COMM_SELF)
+    problem = build_problem(_thin("ssss", nx=60, ny=20), MPI.COMM_SELF)
     stable = solve_unilateral(problem, ChainOptions())
     solved = solve_unilateral(problem, ChainOptions(read_stable=False))
     fine = [sol.details["levels"][-1] for sol in (stable, solved)]
@@ -717,7 +718,7 @@ def test_fine_mesh_read_early_gives_the_load_read_at_the_end():
     read off the gaps at the end (``fine_mu_min``); by default the predicted set read
     where the barrier problem at 1e-9 is solved is a KKT point, and the run stops there.
     """
-    problem = BucklingProblem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
+    problem = build_problem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
     early = solve_unilateral(problem, ChainOptions())
     late = solve_unilateral(problem, ChainOptions(read_mu=0.0))
     fine = [sol.details["levels"][-1] for sol in (early, late)]

@@ -38,7 +38,7 @@ from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions, lowrank_certificate
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.config import ObstacleSpec
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.tolerances import BRACKET_GAP, ROUNDING_RTOL
 
 pytest.importorskip("clarabel")
@@ -77,7 +77,7 @@ def test_double_double_residual_bound_holds_on_a_thin_plate():
     """
     spec = plate_case("thin", length=0.3, width=0.1, thickness=1e-4, nx=9, ny=3,
                       zone=ObstacleSpec(zone="all"))  # fmt: skip
-    with BucklingProblem(spec, MPI.COMM_SELF) as problem:
+    with build_problem(spec, MPI.COMM_SELF) as problem:
         lam = 1.1 * problem.solve_free().load
         matrix = ShiftedMatrix(problem.model.A, problem.model.B)
         matrix.factor(lam)
@@ -115,7 +115,7 @@ def _claimed(problem, candidate, excess):
 
 def _check_long(spec, i) -> dict:
     """Run the low-rank route on the KKT points of ``spec``; return what happened."""
-    with BucklingProblem(spec, MPI.COMM_SELF) as problem:
+    with build_problem(spec, MPI.COMM_SELF) as problem:
         best, minimisers, _ = exhaustive_minimum(problem)
         if not math.isfinite(best):
             return {"skipped": "no finite load"}
@@ -218,7 +218,7 @@ def test_interior_bump_on_the_thin_ssss_plate_is_not_bracketed():
                          zone=ObstacleSpec(zone="all")).with_solver(certify=False)  # fmt: skip
     with solve(clamped, MPI.COMM_SELF) as analysis:
         start = analysis.solution.active.copy()
-    with BucklingProblem(ssss, MPI.COMM_SELF) as problem:
+    with build_problem(ssss, MPI.COMM_SELF) as problem:
         end_bump = solve_active_set(problem).load
         run = iterate(problem, "interior", start, None, 200, thresholds=(1e-4, 1e-6))
         assert run.status == "kkt" and run.final is not None

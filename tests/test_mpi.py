@@ -325,11 +325,11 @@ def test_lowrank_certificate_distributed_equals_serial():
     from unibuckle_fenicsx.algorithms.active_set import solve_active_set
     from unibuckle_fenicsx.cases import plate_case
     from unibuckle_fenicsx.config import ObstacleSpec
-    from unibuckle_fenicsx.model.problem import BucklingProblem
+    from unibuckle_fenicsx.model.build import build_problem
 
     plate = plate_case("thin", length=0.3, width=0.1, thickness=1e-4, nx=30, ny=10,
                        zone=ObstacleSpec(zone="all"))  # fmt: skip
-    with BucklingProblem(plate, MPI.COMM_SELF) as problem:
+    with build_problem(plate, MPI.COMM_SELF) as problem:
         active = solve_active_set(problem).active
     serial = module.certificate(MPI.COMM_SELF, 30, 10, active)
     assert serial["method"] == "lowrank-spn" and serial["m"] >= 2, serial

@@ -29,7 +29,7 @@ from unibuckle_fenicsx.config import (
     problem_to_dict,
 )
 from unibuckle_fenicsx.errors import BilateralZoneError
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 
 
 # -- schema ------------------------------------------------------------------------------
@@ -196,7 +196,7 @@ def test_polygon_zone_equal_to_a_box_gives_the_box_result():
 
 def test_circle_zone_holds_the_nodes_of_its_disc():
     spec = replace(paper_case("free", 20, 10), obstacle=ObstacleSpec(Circle((0.0, 0.0), 0.03)))
-    with BucklingProblem(spec) as problem:
+    with build_problem(spec) as problem:
         xy = problem.contact.coordinates
     # Nodes on the 0.01 m grid within 0.03 m of the centre: 29 (x, y = 0, +-0.01, ...).
     grid = np.array([(i, j) for i in range(-3, 4) for j in range(-3, 4) if i * i + j * j <= 9])
@@ -219,4 +219,4 @@ def test_overlapping_zones_on_opposite_sides_are_refused_before_the_solve(capsys
         {"obstacles": [{"zone": [[-0.05, 0.0], [-0.05, 0.05]]}, {"zone": "all", "side": "below"}]}
     )
     with pytest.raises(BilateralZoneError):
-        BucklingProblem(spec.with_mesh(8, 4), MPI.COMM_WORLD)
+        build_problem(spec.with_mesh(8, 4), MPI.COMM_WORLD)

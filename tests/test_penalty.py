@@ -12,7 +12,7 @@ import pytest
 from unibuckle_fenicsx import paper_case
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, solve_penalty
 from unibuckle_fenicsx.certificate.certify import certify
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 
 #: Eigenvalues are solved to a relative residual of 1e-10 (SolverSpec.eps_tol), so loads
 #: compare to 1e-9 relative: an order of magnitude of margin over the solver's error.
@@ -27,7 +27,7 @@ def c1_small():
     lambda(Z) over the 2^9 = 512 contact sets Z whose reduced first mode is feasible
     (problem.evaluate), which is the critical load (paper, Lemma 5.1).
     """
-    problem = BucklingProblem(paper_case("c1", 8, 4), MPI.COMM_WORLD)
+    problem = build_problem(paper_case("c1", 8, 4), MPI.COMM_WORLD)
     free = problem.solve_free().load
     i = problem.num_constrained
     assert i == 9
@@ -101,7 +101,7 @@ def test_condition_number_matches_dense_eigenvalues():
     """
     if MPI.COMM_WORLD.size > 1:
         pytest.skip("dense comparison in serial only")
-    problem = BucklingProblem(paper_case("c2", 8, 4), MPI.COMM_SELF)
+    problem = build_problem(paper_case("c2", 8, 4), MPI.COMM_SELF)
     pen = PenaltySolver(problem)
     try:
         sol = pen.solve(1e4, condition=True)
@@ -127,7 +127,7 @@ def test_mirror_tie_is_broken_deterministically():
     penetrating set is the same for nearby penalties (12 x 6 mesh, where leaving the tie
     to rounding flips the mode at a few, run-dependent rho: demos/study_penalty.py).
     """
-    problem = BucklingProblem(paper_case("c1", 12, 6), MPI.COMM_WORLD)
+    problem = build_problem(paper_case("c1", 12, 6), MPI.COMM_WORLD)
     try:
         sets = {tuple(solve_penalty(problem, r).active) for r in (1e6, 1.01e6, 1e8)}
         assert len(sets) == 1, sets
@@ -156,7 +156,7 @@ def test_bad_options_raise(c1_small):
 
 
 def test_penalty_needs_an_obstacle():
-    problem = BucklingProblem(paper_case("free", 4, 2), MPI.COMM_WORLD)
+    problem = build_problem(paper_case("free", 4, 2), MPI.COMM_WORLD)
     try:
         with pytest.raises(ValueError, match="obstacle"):
             solve_penalty(problem, 1.0)

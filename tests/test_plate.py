@@ -26,13 +26,13 @@ from unibuckle_fenicsx.config import (
     SolverSpec,
 )
 from unibuckle_fenicsx.errors import EmptyZoneError
+from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.materials import (
     bending_stiffness,
     navier_load_kirchhoff,
     navier_load_mindlin,
     shear_modulus,
 )
-from unibuckle_fenicsx.model.problem import BucklingProblem
 
 E, NU = 1.0e9, 0.3
 #: The paper's plate (paper, section 6).
@@ -41,7 +41,7 @@ A, B, T = 0.2, 0.1, 0.006
 
 def free_load(spec: ProblemSpec, comm: MPI.Comm = MPI.COMM_WORLD) -> tuple[float, float]:
     """Free critical load (Pa) and buckling coefficient k of ``spec``."""
-    problem = BucklingProblem(spec, comm)
+    problem = build_problem(spec, comm)
     try:
         free = problem.solve_free()
         assert free.eigen.error < 1e-8, free
@@ -194,7 +194,7 @@ def test_clamped_square_plate_coefficient():
 def test_obstacle_zone_without_free_node(zone):
     spec = ProblemSpec(mesh=MeshSpec(20, 10), obstacle=ObstacleSpec(zone=zone))
     with pytest.raises(EmptyZoneError, match=r"obstacle\.zone .* holds no free mesh node"):
-        BucklingProblem(spec, MPI.COMM_WORLD)
+        build_problem(spec, MPI.COMM_WORLD)
     assert issubclass(EmptyZoneError, ValueError)
 
 
@@ -205,4 +205,4 @@ def test_empty_circle_zone_is_named_by_its_key():
     zone = Circle(center=(0.001, 0.001), radius=0.0005)  # between the nodes of 20x10
     spec = ProblemSpec(mesh=MeshSpec(20, 10), obstacle=ObstacleSpec(zone=zone))
     with pytest.raises(EmptyZoneError, match=r"^obstacle\.circle circle about .* holds no free"):
-        BucklingProblem(spec, MPI.COMM_WORLD)
+        build_problem(spec, MPI.COMM_WORLD)

@@ -1,4 +1,4 @@
-"""BucklingProblem on a user-supplied mesh, and the swapped pencil for an indefinite B."""
+"""A problem on a user-supplied mesh, and the swapped pencil for an indefinite B."""
 
 from __future__ import annotations
 
@@ -15,8 +15,8 @@ from unibuckle_fenicsx import EdgeSpec, MeshSpec, ObstacleSpec, PlateSpec, paper
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.la.eigen import GEPSolver
+from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
-from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 def test_user_mesh_with_own_tags_matches_rectangle():
@@ -75,18 +75,18 @@ def test_a_user_mesh_that_does_not_fit_the_plate_is_refused():
     with pytest.raises(
         ValueError, match=r"edge 'left' \(facet tag 1\) holds no facet .* \[5, 6, 7, 8\]"
     ):
-        BucklingProblem(spec, mesh=msh, facet_tags=shifted)
+        build_problem(spec, mesh=msh, facet_tags=shifted)
     other = replace(spec.plate, corners=((0.0, 0.0), (0.4, 0.2)))
     big, big_tags = create_plate_mesh(other, MeshSpec(8, 4), MPI.COMM_WORLD)
     with pytest.raises(ValueError, match=r"mesh: its bounding box .* is not plate\.corners"):
-        BucklingProblem(spec, mesh=big, facet_tags=big_tags)
+        build_problem(spec, mesh=big, facet_tags=big_tags)
 
 
 def test_user_mesh_needs_facet_tags():
     spec = paper_case("free", 4, 2)
     msh, _ = create_plate_mesh(spec.plate, spec.mesh, MPI.COMM_WORLD)
     with pytest.raises(ValueError, match="facet_tags"):
-        BucklingProblem(spec, mesh=msh)
+        build_problem(spec, mesh=msh)
 
 
 def test_swapped_pencil_equals_ghep():
@@ -95,7 +95,7 @@ def test_swapped_pencil_equals_ghep():
     B x = mu A x for the largest mu gives lambda = 1/mu, equal to the shift-invert GHEP
     solve of the same pencil to the eigen tolerance.
     """
-    problem = BucklingProblem(paper_case("free", 20, 10))
+    problem = build_problem(paper_case("free", 20, 10))
     ghep = problem.solve_free().load
     swapped = GEPSolver(problem.model.A, problem.model.B, indefinite=True, prefix="swapped_")
     value = swapped.solve().value
@@ -120,7 +120,7 @@ def test_indefinite_prestress_uses_swapped_pencil():
         EdgeSpec("top"),
     )
     spec = replace(paper_case("free", 20, 10), plate=PlateSpec(edges=edges))
-    problem = BucklingProblem(spec)
+    problem = build_problem(spec)
     assert problem.prestress.indefinite
     assert problem.eigensolver.indefinite
     value = problem.solve_free().load
@@ -198,7 +198,7 @@ def test_the_factorisations_of_a_mesh_share_one_symbolic_analysis():
     spec = plate_case(
         "thin", length=0.3, width=0.1, thickness=1e-3, nx=12, ny=4, zone=ObstacleSpec(zone="all")
     )
-    problem = BucklingProblem(spec, MPI.COMM_SELF)
+    problem = build_problem(spec, MPI.COMM_SELF)
     assert problem.contact is not None
     before = symbolic.getPerfInfo()["count"]
     with InteriorPointNewton(problem) as newton:
@@ -252,7 +252,7 @@ def test_eigen_solve_near_an_estimate_is_the_smallest(load):
             "shear", length=0.3, width=0.1, thickness=1e-3, load="shear", nx=12, ny=6,
             zone=ObstacleSpec(zone="all"),
         )  # fmt: skip
-    problem = BucklingProblem(spec, MPI.COMM_SELF)
+    problem = build_problem(spec, MPI.COMM_SELF)
     assert problem.contact is not None
     assert problem.eigensolver.indefinite == (load == "shear")
     zone = np.arange(problem.contact.size)
@@ -293,7 +293,7 @@ def test_a_destroyed_problem_refuses_use():
         active = analysis.solution.active
         load = analysis.result.critical_load_Pa
     assert analysis.mode.x.petsc_vec.norm() > 0.0 and analysis.result.critical_load_Pa == load
-    with pytest.raises(RuntimeError, match="BucklingProblem was destroyed"):
+    with pytest.raises(RuntimeError, match="problem was destroyed"):
         analysis.problem.evaluate(active)
     with pytest.raises(RuntimeError, match="destroyed"):
         analysis.problem.model  # noqa: B018 - the access itself is the test

@@ -46,10 +46,11 @@ from families import schema_family
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.config import problem_from_dict
 from unibuckle_fenicsx.errors import EmptyZoneError, NoAdmissibleModeError
+from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import build_plate_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
 from unibuckle_fenicsx.model.prestress import solve_prestress
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 FAMILY_SIZE = 120
 SAMPLE = 12
@@ -72,9 +73,9 @@ def _ids(items):
     ]
 
 
-def _reference(spec) -> tuple[BucklingProblem, float | None]:
+def _reference(spec) -> tuple[UnilateralProblem, float | None]:
     """A separately assembled problem, and its exhaustive minimum (None if 2^i is large)."""
-    reference = BucklingProblem(spec, MPI.COMM_SELF)
+    reference = build_problem(spec, MPI.COMM_SELF)
     i = reference.num_constrained
     if i > I_MAX:
         return reference, None

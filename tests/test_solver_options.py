@@ -1,6 +1,6 @@
 """Solver options given in Python reach every eigen solver of the run, under its prefix.
 
-``BucklingProblem(eps_options=...)`` (what ``solve(..., eps_options=...)`` passes on)
+``build_problem(eps_options=...)`` (what ``solve(..., eps_options=...)`` passes on)
 holds the options in PETSc's options database until the problem is destroyed: the
 coarse levels of the multilevel active set and the penalty stage build their own eigen
 solvers, and must read them there. The option used, ``eps_ncv`` (the Krylov subspace
@@ -18,7 +18,7 @@ import unibuckle_fenicsx.la.eigen as eigen
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 
 NCV = 17  # SLEPc chooses max(2 nev, nev + 15) = 16 for one eigenpair: 17 is ours
 
@@ -39,7 +39,7 @@ def built(monkeypatch):
 
 def test_python_options_reach_coarse_levels_and_the_penalty_stage(built):
     spec = paper_case("c1").with_mesh(16, 16)
-    with BucklingProblem(spec, MPI.COMM_WORLD, eps_options={"eps_ncv": NCV}) as problem:
+    with build_problem(spec, MPI.COMM_WORLD, eps_options={"eps_ncv": NCV}) as problem:
         fine_rows = problem.model.A.getSize()[0]
         solve_active_set(problem, max_iterations=20, coarse_min_cells=8, bound_budget=0)
         penalty_continuation(problem, None, penalties=(1.0,), max_iterations=3)
@@ -60,7 +60,7 @@ def test_the_command_line_wins_over_python_options(built):
     opts.setValue("eps_ncv", NCV + 2)
     try:
         spec = paper_case("c1").with_mesh(8, 8)
-        with BucklingProblem(spec, MPI.COMM_WORLD, eps_options={"eps_ncv": NCV}) as problem:
+        with build_problem(spec, MPI.COMM_WORLD, eps_options={"eps_ncv": NCV}) as problem:
             penalty_continuation(problem, None, penalties=(1.0,), max_iterations=3)
         penalty = {ncv for prefix, _, ncv in built if prefix == "unibuckle_penalty_"}
         assert penalty == {NCV + 2}

@@ -37,9 +37,9 @@ from unibuckle_fenicsx.config import (
     problem_from_dict,
     problem_to_dict,
 )
+from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.prestress import solve_prestress
-from unibuckle_fenicsx.model.problem import BucklingProblem
 
 #: Thin plate: the Reissner-Mindlin shear correction is O((t/b)^2) = 1e-6.
 THICKNESS = 1e-3
@@ -65,7 +65,7 @@ def bending_plate(aspect, ny, start=1.0, end=-1.0, zone=None, method="auto", deg
 
 
 def free_k(spec):
-    with BucklingProblem(spec, MPI.COMM_WORLD) as problem:
+    with build_problem(spec, MPI.COMM_WORLD) as problem:
         return problem.buckling_coefficient(problem.solve_free().load)
 
 

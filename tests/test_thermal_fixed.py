@@ -179,10 +179,10 @@ def test_a_fixed_load_that_buckles_the_plate_alone_is_refused():
     import scipy.linalg
     from exhaustive import dense
 
-    from unibuckle_fenicsx.model.problem import BucklingProblem
+    from unibuckle_fenicsx.model.build import build_problem
 
     spec = paper_case("c1", 8, 8)
-    with BucklingProblem(spec.without_obstacles(), MPI.COMM_SELF) as problem:
+    with build_problem(spec.without_obstacles(), MPI.COMM_SELF) as problem:
         A, B = dense(problem.model.A), dense(problem.model.B)
     theta = scipy.linalg.eigh(B, A, eigvals_only=True)
     below = int(np.count_nonzero(theta > 1 / 30e6))

@@ -17,7 +17,8 @@ from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.ownership import Owner
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
+from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
 from unibuckle_fenicsx.results import BucklingResult
 
 __all__ = ["Analysis", "choose_method", "solve"]
@@ -90,7 +91,7 @@ def choose_method(
 
 
 def _run_method(
-    method: str, problem: BucklingProblem, candidate_comm: MPI.Comm | None
+    method: str, problem: UnilateralProblem, candidate_comm: MPI.Comm | None
 ) -> UnilateralSolution:
     if method == "enumerate":
         from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
@@ -145,7 +146,7 @@ class Analysis(Owner):
     """
 
     result: BucklingResult
-    problem: BucklingProblem
+    problem: Problem
     solution: UnilateralSolution | None = None
     certificate: Certificate | None = None
 
@@ -189,7 +190,7 @@ def solve(
         eps_options: Extra EPS options under the prefix ``unibuckle_`` (so ``eps_view``
             is ``-unibuckle_eps_view``).
         mesh: Optional quadrilateral mesh replacing ``spec.mesh`` (with ``facet_tags``;
-            see :class:`~unibuckle_fenicsx.model.problem.BucklingProblem`).
+            see :func:`~unibuckle_fenicsx.model.build.build_problem`).
         facet_tags: Edge markers of ``mesh``.
 
     Returns:
@@ -217,7 +218,7 @@ def solve(
         )
     if mesh is not None and candidate_parallel:
         raise InputError("candidate_parallel builds its own serial meshes: pass no mesh")
-    problem = BucklingProblem(
+    problem = build_problem(
         spec,
         MPI.COMM_SELF if candidate_parallel else comm,
         eps_options,
@@ -236,7 +237,7 @@ def solve(
 
 def _analyse(
     spec: ProblemSpec,
-    problem: BucklingProblem,
+    problem: Problem,
     comm: MPI.Comm,
     candidate_parallel: bool,
     t0: float,
@@ -249,7 +250,7 @@ def _analyse(
     solution: UnilateralSolution | None = None
     certificate: Certificate | None = None
     method, reason = "free", "no obstacle"
-    if problem.contact is None:
+    if not isinstance(problem, UnilateralProblem):
         # The free load is the answer: verified the smallest (one LDL^T's inertia).
         t1 = time.perf_counter()
         problem.verify_free()

@@ -50,6 +50,8 @@ def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
     """
     import dolfinx.io
 
+    from unibuckle_fenicsx.model.problem import UnilateralProblem
+
     problem = analysis.problem
     directory = Path(directory)
     if problem.comm.rank == 0:
@@ -59,7 +61,7 @@ def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
     w_free, _ = problem.model.split(analysis.free_mode)
     w_free.name = "w_free"
     fields = [w, w_free]
-    if problem.contact is not None and analysis.solution is not None:
+    if isinstance(problem, UnilateralProblem) and analysis.solution is not None:
         fields.append(problem.contact.indicator())
         fields.append(problem.contact.node_function(analysis.solution.active))
     case = file_stem(analysis.result.case)

@@ -22,7 +22,7 @@ from unibuckle_fenicsx.model.zones import zone_report
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution
     from unibuckle_fenicsx.certificate.certify import Certificate
-    from unibuckle_fenicsx.model.problem import BucklingProblem, Mode
+    from unibuckle_fenicsx.model.problem import Mode, Problem
 
 __all__ = ["BucklingResult", "versions"]
 
@@ -51,7 +51,7 @@ class BucklingResult:
         contact_indices: Node numbers of Z (lexicographic (y, x) order of the zone).
         contact_dofs: Global W DOF indices of Z (partition-dependent numbering).
         load_resolution: How closely double precision fixes the critical load, relative
-            to it (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.load_resolution`:
+            to it (:meth:`~unibuckle_fenicsx.model.problem.Problem.load_resolution`:
             1e-9 to 1e-8 on thin plates, where the shear stiffness dominates; digits beyond
             it are rounding). None for a tensionless foundation (the springs' stiffness is
             not counted).
@@ -116,7 +116,7 @@ class BucklingResult:
     @classmethod
     def from_solution(
         cls,
-        problem: BucklingProblem,
+        problem: Problem,
         free: Mode,
         solution: UnilateralSolution | None,
         certificate: Certificate | None,
@@ -204,11 +204,11 @@ class BucklingResult:
         if solution is None or certificate is None:
             result.lower_bound_Pa = result.upper_bound_Pa = free.load
             return result
+        from unibuckle_fenicsx.model.problem import UnilateralProblem
+
+        if not isinstance(problem, UnilateralProblem):
+            raise TypeError("from_solution: a solution without an obstacle (an internal invariant)")
         contact = problem.contact
-        if contact is None:
-            raise ValueError(
-                "from_solution: the problem has no obstacle (this needs an obstacle zone)"
-            )
         active = solution.active
         rows = contact.removed_rows(active)
         result.constrained_nodes = problem.num_constrained

@@ -4,11 +4,11 @@ Relative tolerances compare computed loads (Pa) or nodal values with each other;
 eigen solver's default relative tolerance (``solver.eps_tol``, 1e-10) is the accuracy of a
 computed load, so no two loads are told apart below it. On thin plates that is not so:
 double precision fixes a load only to its ``load_resolution``
-(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.load_resolution`, 1e-9 to 1e-8
+(:meth:`~unibuckle_fenicsx.model.problem.Problem.load_resolution`, 1e-9 to 1e-8
 at t/b = 1e-3), and two solves of one contact set at different shifts differ by that.
 The tolerances below were not raised to it: where a comparison of loads from different
 solves decides (the empty set against the free load), the same pair is reused instead
-(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`); where a feasible
+(:meth:`~unibuckle_fenicsx.model.problem.UnilateralProblem.evaluate`); where a feasible
 non-KKT mode would replace the active set's KKT point, it must lie lower by more than the
 KKT point's resolution; elsewhere such a comparison can at worst deny "proven" or a tie
 that lies within rounding. The problem
@@ -25,6 +25,7 @@ __all__ = [
     "GEOMETRY_RTOL",
     "LOAD_TIE_RTOL",
     "NONLINEAR_ATOL",
+    "NULL_GEOMETRIC_STIFFNESS",
     "PRESSING_RTOL",
     "PROOF_GAP",
     "PROOF_RTOL",
@@ -94,6 +95,13 @@ BRACKET_GAP = 1e-3
 #: The smallest-eigenvalue check looks below lambda (1 - SMALLEST_RTOL_FACTOR eps_tol):
 #: a thousand eigen tolerances keep the computed load itself out of the count.
 SMALLEST_RTOL_FACTOR = 1e3
+
+# -- the problem's set-up ---------------------------------------------------------------
+
+#: A geometric stiffness B whose largest row sum is at most this fraction of the largest
+#: membrane force |N0| is round-off: B's entries are of the order of |N0| (a Q1 stiffness
+#: integral is O(1)), and a sum of such terms that cancels leaves some 1e-16 of it.
+NULL_GEOMETRIC_STIFFNESS = 1e-10
 
 # -- geometry and the nonlinear path ----------------------------------------------------
 

@@ -14,13 +14,13 @@ from mpi4py import MPI
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.config import load_problem
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 
 if sys.argv[1].endswith((".json", ".toml")):
     spec = load_problem(sys.argv[1])
 else:
     spec = paper_case(sys.argv[1], int(sys.argv[2]), int(sys.argv[3]))
-problem = BucklingProblem(spec, MPI.COMM_WORLD)
+problem = build_problem(spec, MPI.COMM_WORLD)
 sol = solve_active_set(problem)
 assert problem.contact is not None
 coords = problem.contact.coordinates[sol.active].tolist()

@@ -18,9 +18,9 @@ import numpy as np
 
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.config import load_problem
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 
-problem = BucklingProblem(load_problem(sys.argv[1]), MPI.COMM_WORLD)
+problem = build_problem(load_problem(sys.argv[1]), MPI.COMM_WORLD)
 assert problem.contact is not None
 left = np.flatnonzero(problem.contact.coordinates[:, 0] <= 2.0)
 start, _ = admissible_start(problem, problem.evaluate(left), 100)

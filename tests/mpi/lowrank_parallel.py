@@ -17,7 +17,7 @@ from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions
 from unibuckle_fenicsx.config import ObstacleSpec
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 
 #: One delta, no time budget: the same work on every partition.
 OPTIONS = BoundOptions(lowrank=LowRankOptions(deltas=(1e-3,), fallback=(), time_budget=None))
@@ -27,7 +27,7 @@ def certificate(comm: MPI.Comm, nx: int, ny: int, active: np.ndarray) -> dict:
     """The low-rank certificate of the contact set ``active`` (a thin SSSS plate)."""
     spec = plate_case("thin", length=0.3, width=0.1, thickness=1e-4, nx=nx, ny=ny,
                       zone=ObstacleSpec(zone="all"))  # fmt: skip
-    with BucklingProblem(spec, comm) as problem:
+    with build_problem(spec, comm) as problem:
         problem.solve_free()
         cand = problem.evaluate(active)
         bound = copositivity_bound(problem, cand, [], OPTIONS)

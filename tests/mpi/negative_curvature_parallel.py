@@ -17,14 +17,14 @@ from mpi4py import MPI
 
 from unibuckle_fenicsx.algorithms.interior_point import InteriorPointNewton, NewtonOptions
 from unibuckle_fenicsx.config import load_problem
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.build import build_problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from test_interior_point import at_saddle
 
 spec = load_problem(sys.argv[1])
 lam, vectors = float(sys.argv[2]), int(sys.argv[3])
-problem = BucklingProblem(spec, MPI.COMM_WORLD)
+problem = build_problem(spec, MPI.COMM_WORLD)
 with InteriorPointNewton(problem, replace(NewtonOptions(), curvature_vectors=vectors)) as newton:
     u, *_ = at_saddle(newton, lam)
     found = newton.negative_curvature(u.x.petsc_vec, lam)

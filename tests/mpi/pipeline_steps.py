@@ -32,9 +32,9 @@ from test_prestress import (
 from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.config import MeshSpec
+from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.prestress import solve_prestress
-from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 def same_on_all_ranks(comm: MPI.Comm, value: object) -> bool:
@@ -101,7 +101,7 @@ def collect(comm: MPI.Comm, nx: int, ny: int, quick: bool = False) -> dict[str, 
     out["clamped_extremes"] = [cps.max_compression, cps.max_tension]
 
     # -- assembly, contact manager, eigen solves, certificates ---------------------------
-    problem = BucklingProblem(spec, comm)
+    problem = build_problem(spec, comm)
     model, contact = problem.model, problem.contact
     assert contact is not None
     out["dofs"] = model.num_dofs

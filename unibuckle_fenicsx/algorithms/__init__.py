@@ -1,6 +1,6 @@
 """Unilateral critical-state algorithms.
 
-Each takes a :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle and
+Each takes a :class:`~unibuckle_fenicsx.model.problem.UnilateralProblem` with an obstacle and
 returns a :class:`UnilateralSolution` holding the chosen
 :class:`~unibuckle_fenicsx.model.problem.Candidate` (load, contact set and its own mode):
 

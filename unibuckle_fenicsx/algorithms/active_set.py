@@ -68,7 +68,8 @@ from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.build import build_unilateral_problem
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.tolerances import PROOF_RTOL, ROUNDING_RTOL, TWIN_RTOL
 
@@ -102,11 +103,9 @@ SEED_NAMES = ("free+", "free-", "all", "end-low", "middle", "end-high", "greedy+
 
 
 def _seeds(
-    problem: BucklingProblem, free_values: npt.NDArray[np.float64], tau: float
+    problem: UnilateralProblem, free_values: npt.NDArray[np.float64], tau: float
 ) -> list[tuple[str, npt.NDArray[np.int64]]]:
     """Seed contact sets (deduplicated, in :data:`SEED_NAMES` order)."""
-    if problem.contact is None:
-        raise ValueError("_seeds: the problem has no obstacle (this needs an obstacle zone)")
     xy = problem.contact.coordinates
     plate = problem.spec.plate
     (x0, y0), (x1, y1) = plate.corners
@@ -147,10 +146,8 @@ def _seeds(
     return out
 
 
-def _multi_seed(problem: BucklingProblem, max_iterations: int) -> list[Run]:
+def _multi_seed(problem: UnilateralProblem, max_iterations: int) -> list[Run]:
     """Run the iteration from every seed, starting from the free mode."""
-    if problem.contact is None:
-        raise ValueError("_multi_seed: the problem has no obstacle (this needs an obstacle zone)")
     free = problem.solve_free().function.x.petsc_vec
     values = problem.contact.values(free)
     runs: list[Run] = []
@@ -163,8 +160,8 @@ def _multi_seed(problem: BucklingProblem, max_iterations: int) -> list[Run]:
 
 
 def _polish(
-    problem: BucklingProblem,
-    coarse: BucklingProblem,
+    problem: UnilateralProblem,
+    coarse: UnilateralProblem,
     candidates: list[Candidate],
     budget: int,
     bests: list[float],
@@ -173,7 +170,7 @@ def _polish(
 
     With a load estimate (:func:`_estimates`) the first eigen solve shifts just below it,
     later ones below the previous iterate's load, the inertia proving each pair the
-    smallest (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`).
+    smallest (:meth:`~unibuckle_fenicsx.model.problem.UnilateralProblem.evaluate`).
     Measured on the paper's plate (c1, c2, c3), unilateral solve and certificate over one
     free solve: at 160×80 1.96, 3.25, 3.30 → 1.69, 2.37, 2.51, at 320×160 2.69, 2.30,
     3.60 → 2.34, 2.02, 3.03; the same loads to 1e-14. (The prolonged coarse mode as the
@@ -247,7 +244,7 @@ def _least_violating(runs: list[Run]) -> Candidate | None:
 
 
 def _descent(
-    problem: BucklingProblem, runs: list[Run], max_steps: int
+    problem: UnilateralProblem, runs: list[Run], max_steps: int
 ) -> tuple[Run | None, dict[str, int]]:
     """Feasible descent from the best admissible mode of ``runs`` (or one made admissible).
 
@@ -269,7 +266,7 @@ def _descent(
     return run, steps
 
 
-def _prune(problem: BucklingProblem, cand: Candidate) -> Candidate:
+def _prune(problem: UnilateralProblem, cand: Candidate) -> Candidate:
     """Release the contact nodes with (near) zero multiplier if the KKT point stays."""
     slack = cand.forces[cand.active] >= -problem.tau
     if not slack.any():
@@ -281,7 +278,7 @@ def _prune(problem: BucklingProblem, cand: Candidate) -> Candidate:
 
 
 def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fallbacks and bound in one documented sequence
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     *,
     max_iterations: int = 100,
     multilevel: bool = True,
@@ -313,8 +310,7 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
     Note:
         Collective on ``problem.comm``.
     """
-    if problem.contact is None:
-        raise InputError("solve_active_set needs a problem with an obstacle")
+    require_obstacle(problem, "solve_active_set")
     if int(max_iterations) != max_iterations or max_iterations < 1:
         raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
     if int(coarse_min_cells) != coarse_min_cells or coarse_min_cells < 2:
@@ -339,11 +335,11 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
     candidates: list[Candidate] | None = None
     bests: list[float] = []  # the lowest KKT load of each level, coarsest first
     coarse_kkt: list[Candidate] = []
-    prev: BucklingProblem | None = None
+    prev: UnilateralProblem | None = None
     coarse_runs: list[Run] = []
     for nx, ny in levels:
         try:
-            cp = BucklingProblem(spec.with_mesh(nx, ny), problem.comm)
+            cp = build_unilateral_problem(spec.with_mesh(nx, ny), problem.comm)
         except EmptyZoneError:
             continue
         tl = time.perf_counter()

@@ -18,14 +18,14 @@ from dataclasses import dataclass
 import numpy as np
 
 from unibuckle_fenicsx.algorithms.descent import descend
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 from unibuckle_fenicsx.tolerances import PROOF_RTOL
 
 __all__ = ["Bracket", "bracket", "lattice_bound"]
 
 
 def lattice_bound(
-    problem: BucklingProblem, free_load: float, upper: float, budget: int
+    problem: UnilateralProblem, free_load: float, upper: float, budget: int
 ) -> tuple[float, int, Candidate | None, bool]:
     r"""Best-first branch and bound over the subset lattice (see the module docstring).
 
@@ -42,8 +42,6 @@ def lattice_bound(
     Note:
         Collective.
     """
-    if problem.contact is None:
-        raise ValueError("lattice_bound: the problem has no obstacle (this needs an obstacle zone)")
     n = problem.contact.size
     if budget < n:
         return free_load, 0, None, False
@@ -97,7 +95,7 @@ class Bracket:
 
 
 def bracket(
-    problem: BucklingProblem, free_load: float, chosen: Candidate, budget: int, route: str
+    problem: UnilateralProblem, free_load: float, chosen: Candidate, budget: int, route: str
 ) -> Bracket:
     """Close the bracket of ``chosen`` by :func:`lattice_bound` (small zones) and interlacing.
 

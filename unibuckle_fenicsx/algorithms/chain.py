@@ -20,7 +20,7 @@ For a rigid obstacle (any side, several zones) the chain is
    (:meth:`~.interior_point.InteriorPointNewton.predicted_contact_set`), which ends the
    run if it is a KKT point; else, at the end, the nodes whose gap is at the tolerance
    ``tau``. The smallest eigenpair of the
-   pencil with Z removed (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`)
+   pencil with Z removed (:meth:`~unibuckle_fenicsx.model.problem.UnilateralProblem.evaluate`)
    is the returned critical state, checked against the KKT conditions. If it fails, a
    saddle is escaped (the lower reduced mode shows the way), the barrier is driven
    lower and the active-set iteration (:mod:`.pdas`) polishes Z; if that fails too, the
@@ -72,7 +72,8 @@ from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleMod
 from unibuckle_fenicsx.la.eigen import swapped_eigenpairs
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.la.ownership import Owner, release
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.build import build_unilateral_problem
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
@@ -342,7 +343,7 @@ def _run(
     return new, rec
 
 
-def _canonical_sign(problem: BucklingProblem, vec: Any) -> float:
+def _canonical_sign(problem: UnilateralProblem, vec: Any) -> float:
     """+1 or -1: the sign that gives ``vec`` a negative oriented value at its largest node.
 
     The largest |oriented value| (to 1e-6 of it; ties to the lowest node number) decides,
@@ -354,14 +355,13 @@ def _canonical_sign(problem: BucklingProblem, vec: Any) -> float:
     violations on either side, a near tie (an antisymmetric mode) is not decided by
     rounding, which differs with the number of ranks. Collective.
     """
-    assert problem.contact is not None
     z = problem.contact.values(vec)  # the same on every rank
     size = np.abs(z)
     first = int(np.flatnonzero(size >= size.max() * (1.0 - 1e-6))[0])
     return 1.0 if z[first] < 0.0 else -1.0
 
 
-def _second_free_mode(problem: BucklingProblem) -> Any:
+def _second_free_mode(problem: UnilateralProblem) -> Any:
     """The free plate's second buckling mode (PETSc vector; the caller destroys it).
 
     The two lowest pairs of the swapped pencil B x = theta A x (theta = 1/lambda, so that
@@ -389,7 +389,7 @@ def _second_free_mode(problem: BucklingProblem) -> Any:
 class _SecondMode(Owner):
     """The free plate's second mode (:func:`_second_free_mode`) if ``wanted``; owns it."""
 
-    def __init__(self, problem: BucklingProblem, wanted: bool) -> None:
+    def __init__(self, problem: UnilateralProblem, wanted: bool) -> None:
         self.second = _second_free_mode(problem) if wanted else None
 
     def destroy(self) -> None:
@@ -404,7 +404,6 @@ def _start(newton: InteriorPointNewton, seed: str, push: Any, second: Any = None
     "free2-" and "free2+".
     """
     problem = newton.problem
-    assert problem.contact is not None
     if seed in ("free-", "free+", "free2-", "free2+"):
         if seed.startswith("free2"):
             if second is None:
@@ -436,7 +435,7 @@ def _start(newton: InteriorPointNewton, seed: str, push: Any, second: Any = None
 
 
 def _read_contact(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     newton: InteriorPointNewton,
     point: BarrierPoint,
     level: LevelRecord,
@@ -485,7 +484,7 @@ class _Reader:
     on unchanged, and the read cost one eigen solve. Loads equal to 6e-15.
     """
 
-    problem: BucklingProblem
+    problem: UnilateralProblem
     newton: InteriorPointNewton
     level: LevelRecord
     options: ChainOptions
@@ -533,7 +532,7 @@ class _Reader:
 
 
 def _polish(
-    problem: BucklingProblem, cand: Candidate, level: LevelRecord, label: str, budget: int
+    problem: UnilateralProblem, cand: Candidate, level: LevelRecord, label: str, budget: int
 ) -> Candidate | None:
     """Active-set iteration from ``cand``'s contact set; its KKT point or best feasible."""
     t0 = time.perf_counter()
@@ -558,7 +557,7 @@ def _polish(
 
 
 def _descend(
-    problem: BucklingProblem, start: Candidate, level: LevelRecord, label: str, budget: int
+    problem: UnilateralProblem, start: Candidate, level: LevelRecord, label: str, budget: int
 ) -> Candidate:
     """Feasible descent (:mod:`.descent`) from the admissible ``start``: it cannot cycle."""
     t0 = time.perf_counter()
@@ -584,7 +583,7 @@ def _descend(
 
 
 def _critical_state(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     newton: InteriorPointNewton,
     point: BarrierPoint,
     level: LevelRecord,
@@ -662,7 +661,7 @@ class _Arrangement:
 class _Paths:
     """The barrier solutions the starts met, by barrier parameter (see :func:`_explore`)."""
 
-    problem: BucklingProblem
+    problem: UnilateralProblem
     options: ChainOptions
     #: By barrier parameter: (load, oriented values on the zone scaled to max 1) of each.
     met: dict[float, list[tuple[float, npt.NDArray[np.float64]]]] = field(default_factory=dict)
@@ -672,7 +671,6 @@ class _Paths:
 
         Collective (the values are gathered on every rank).
         """
-        assert self.problem.contact is not None
         z = self.problem.contact.values(point.mode.x.petsc_vec)  # the same on every rank
         z = z / np.abs(z).max()
         seen = self.met.setdefault(mu, [])
@@ -687,7 +685,7 @@ class _Paths:
 
 
 def _explore(
-    problem: BucklingProblem, level: LevelRecord, options: ChainOptions, carry: bool = True
+    problem: UnilateralProblem, level: LevelRecord, options: ChainOptions, carry: bool = True
 ) -> tuple[list[Candidate], list[_Arrangement]]:
     """Run the starts on ``problem``: its KKT points, and the arrangements to carry up.
 
@@ -839,7 +837,7 @@ def _refine(
     return cand, new
 
 
-def _level_record(problem: BucklingProblem) -> LevelRecord:
+def _level_record(problem: UnilateralProblem) -> LevelRecord:
     spec = problem.spec
     mesh: list[Any] = [spec.mesh.nx, spec.mesh.ny] if problem.structured else ["fine"]
     if _gmsh_levels(problem):
@@ -847,7 +845,7 @@ def _level_record(problem: BucklingProblem) -> LevelRecord:
     return LevelRecord(mesh, problem.num_constrained)
 
 
-def _gmsh_levels(problem: BucklingProblem) -> bool:
+def _gmsh_levels(problem: UnilateralProblem) -> bool:
     """Whether coarser copies of ``problem`` are meshed by gmsh at larger cell sizes."""
     spec = problem.spec
     return (
@@ -858,7 +856,7 @@ def _gmsh_levels(problem: BucklingProblem) -> bool:
     )
 
 
-def _coarser(problem: BucklingProblem, options: ChainOptions) -> list[ProblemSpec]:
+def _coarser(problem: UnilateralProblem, options: ChainOptions) -> list[ProblemSpec]:
     """The problem on coarser meshes, coarsest first.
 
     Coarser while the shorter side keeps ``coarse_min_cells`` cells. A structured
@@ -886,7 +884,7 @@ def _coarser(problem: BucklingProblem, options: ChainOptions) -> list[ProblemSpe
     return specs[::-1]
 
 
-def _report(problem: BucklingProblem, level: LevelRecord) -> None:
+def _report(problem: UnilateralProblem, level: LevelRecord) -> None:
     if problem.comm.rank == 0:
         PROGRESS.info(
             "interior point, mesh %s (i = %d): %d Newton steps, %d factorisations, "
@@ -897,7 +895,7 @@ def _report(problem: BucklingProblem, level: LevelRecord) -> None:
 
 
 def _carry(
-    problems: list[BucklingProblem],
+    problems: list[UnilateralProblem],
     k: int,
     points: list[BarrierPoint],
     level: LevelRecord,
@@ -937,7 +935,7 @@ def _carry(
 
 
 def _ascend(
-    problems: list[BucklingProblem],
+    problems: list[UnilateralProblem],
     points: list[BarrierPoint],
     levels: list[LevelRecord],
     options: ChainOptions,
@@ -957,7 +955,7 @@ def _ascend(
 
 
 def _levels(
-    problems: list[BucklingProblem], options: ChainOptions
+    problems: list[UnilateralProblem], options: ChainOptions
 ) -> tuple[list[LevelRecord], list[Candidate], Candidate | None]:
     """Explore the coarsest mesh and carry its best critical states up to the finest.
 
@@ -990,7 +988,7 @@ def _levels(
     return levels, explored, chosen
 
 
-def _fallback(problem: BucklingProblem, options: ChainOptions) -> UnilateralSolution:
+def _fallback(problem: UnilateralProblem, options: ChainOptions) -> UnilateralSolution:
     from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 
     return solve_active_set(
@@ -999,7 +997,7 @@ def _fallback(problem: BucklingProblem, options: ChainOptions) -> UnilateralSolu
 
 
 def solve_unilateral(
-    problem: BucklingProblem, options: ChainOptions | None = None
+    problem: UnilateralProblem, options: ChainOptions | None = None
 ) -> UnilateralSolution:
     """Critical state of ``problem`` (rigid obstacles) by the chain of the module docstring.
 
@@ -1017,16 +1015,17 @@ def solve_unilateral(
     Note:
         Collective on ``problem.comm``.
     """
+    require_obstacle(problem, "solve_unilateral")
     options = options or ChainOptions()
-    if problem.contact is None or problem.tensionless:
+    if problem.tensionless:
         raise ValueError("solve_unilateral needs a problem with a rigid obstacle")
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     free_load = problem.solve_free().load
-    problems: list[BucklingProblem] = []
+    problems: list[UnilateralProblem] = []
     for coarse in _coarser(problem, options):
         try:
-            problems.append(BucklingProblem(coarse, problem.comm))
+            problems.append(build_unilateral_problem(coarse, problem.comm))
         except EmptyZoneError:
             continue
     problems.append(problem)

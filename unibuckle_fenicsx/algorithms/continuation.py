@@ -31,7 +31,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 __all__ = ["COLD_PENALTIES", "WARM_PENALTIES", "penalty_continuation"]
 
@@ -44,7 +44,7 @@ WARM_PENALTIES = (1.0, 1e2, 1e4, 1e6)
 
 
 def penalty_continuation(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     start: npt.NDArray[np.int64] | None,
     *,
     penalties: tuple[float, ...] | None = None,

@@ -48,7 +48,7 @@ from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.arc import ArcPlane
 from unibuckle_fenicsx.algorithms.pdas import Run
 from unibuckle_fenicsx.la.options import Prefix, set_options
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL, ZERO_STEP
 
 __all__ = ["admissible_start", "descend"]
@@ -60,7 +60,7 @@ STEP_KINDS = ("full", "partial", "zero", "gradient")
 
 
 def admissible_start(
-    problem: BucklingProblem, start: Candidate, max_iterations: int
+    problem: UnilateralProblem, start: Candidate, max_iterations: int
 ) -> tuple[Candidate | None, int]:
     r"""An admissible eigen mode from ``start``, by adding the violating nodes to Z.
 
@@ -112,7 +112,7 @@ class _Gradient:
     need not leave the obstacle where the multiplier pulls).
     """
 
-    def __init__(self, problem: BucklingProblem) -> None:
+    def __init__(self, problem: UnilateralProblem) -> None:
         self.problem = problem
         self.ksp = PETSc.KSP().create(problem.model.A.comm)
         set_options(self.ksp, Prefix.DESCENT, GRADIENT_OPTIONS)
@@ -120,8 +120,6 @@ class _Gradient:
     def direction(self, u: PETSc.Vec, working: npt.NDArray[np.int64]) -> PETSc.Vec:
         """The direction g for the working set ``working`` (a new vector)."""
         problem = self.problem
-        if problem.contact is None:
-            raise ValueError("direction: the problem has no obstacle (this needs an obstacle zone)")
         A, B = problem.model.A, problem.model.B
         rows = np.asarray(problem.contact.removed_rows(working), dtype=PETSc.IntType)
         Aw, _ = problem.eigensolver.reduced(rows)
@@ -145,7 +143,7 @@ class _Gradient:
 
 
 def descend(
-    problem: BucklingProblem, start: Candidate, max_steps: int
+    problem: UnilateralProblem, start: Candidate, max_steps: int
 ) -> tuple[Run, dict[str, int]]:
     """Monotone feasible descent from the admissible eigen mode ``start``.
 
@@ -163,8 +161,7 @@ def descend(
     Note:
         Collective.
     """
-    if problem.contact is None:
-        raise ValueError("descend: the problem has no obstacle (this needs an obstacle zone)")
+    require_obstacle(problem, "descend")
     if not start.feasible:
         raise ValueError("descend: start must be feasible (an admissible mode)")
     n, tau = problem.contact.size, problem.tau

@@ -3,7 +3,7 @@ r"""The paper's direct method (Ayadi, section 5.3): enumerate the contact sets b
 For p = 0, 1, ..., i (i = number of constrained nodes) and every subset Z of I with
 |Z| = p, in the lexicographic order of :func:`itertools.combinations`, compute the
 smallest eigenpair of the pencil with the w-DOFs of Z removed
-(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`). The mode is *feasible*
+(:meth:`~unibuckle_fenicsx.model.problem.UnilateralProblem.evaluate`). The mode is *feasible*
 when, suitably oriented, it is negative on :math:`I \setminus Z` (tolerance tau). Keep
 the smallest feasible load and stop after the first p that produced a feasible mode
 (:math:`p^*`), or visit every p (``complete=True``) to check the paper's observation
@@ -57,7 +57,7 @@ import numpy as np
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.progress import Progress
 from unibuckle_fenicsx.tolerances import LOAD_TIE_RTOL, PROOF_RTOL
@@ -95,7 +95,7 @@ class LevelSummary:
     wall_s: float
 
 
-def _start_vector(problem: BucklingProblem) -> PETSc.Vec:
+def _start_vector(problem: UnilateralProblem) -> PETSc.Vec:
     """Seeded pseudo-random vector of the W layout, partition independent (caller destroys)."""
     vec = problem.model.A.createVecRight()
     lo, hi = vec.getOwnershipRange()
@@ -166,7 +166,7 @@ def _keep_ties(ties: list[Candidate], cand: Candidate) -> list[Candidate]:
     return [c for c in [*ties, cand] if c.load <= best * (1.0 + LOAD_TIE_RTOL)]
 
 
-def _share(problem: BucklingProblem, mine: Candidate | None, ccomm: MPI.Comm) -> Candidate:
+def _share(problem: UnilateralProblem, mine: Candidate | None, ccomm: MPI.Comm) -> Candidate:
     """The winning candidate on every candidate rank: its evaluator broadcasts the mode.
 
     Every rank holds a serial copy of the same mesh, so the DOF layouts agree.
@@ -196,7 +196,7 @@ def _finite_or_none(value: float) -> float | None:
 
 
 def enumerate_contact_sets(  # noqa: C901 - the paper's level loop with its stopping rules (section 5.3)
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     *,
     complete: bool = False,
     max_candidates: int = 100_000,
@@ -234,8 +234,7 @@ def enumerate_contact_sets(  # noqa: C901 - the paper's level loop with its stop
     Note:
         Collective on ``problem.comm`` and on ``candidate_comm``.
     """
-    if problem.contact is None:
-        raise InputError("enumerate_contact_sets needs a problem with an obstacle")
+    require_obstacle(problem, "enumerate_contact_sets")
     if (
         isinstance(max_candidates, bool)
         or int(max_candidates) != max_candidates

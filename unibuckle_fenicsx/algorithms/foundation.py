@@ -61,7 +61,7 @@ from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.options import Prefix
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
 __all__ = ["pressing_nodes", "solve_foundation"]
@@ -73,7 +73,7 @@ ARC_SAMPLES = 720
 
 
 def solve_foundation(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     *,
     max_iterations: int = 100,
     eps_options: dict[str, str | float | int] | None = None,
@@ -96,8 +96,9 @@ def solve_foundation(
     Note:
         Collective.
     """
+    require_obstacle(problem, "solve_foundation")
     contact = problem.contact
-    if contact is None or contact.stiffness is None:
+    if contact.stiffness is None:
         raise InputError("solve_foundation needs a problem with a tensionless foundation")
     if int(max_iterations) != max_iterations or max_iterations < 1:
         raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
@@ -163,7 +164,7 @@ def solve_foundation(
 
 
 def _arc_descent(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     solver: PenaltySolver,
     springs: npt.NDArray[np.float64],
     start: Candidate,
@@ -175,8 +176,6 @@ def _arc_descent(
     :data:`~unibuckle_fenicsx.tolerances.ARC_RTOL`) or MAX_ITERATIONS, and the steps taken.
     """
     contact = problem.contact
-    if contact is None:
-        raise ValueError("_arc_descent: the problem has no obstacle (this needs an obstacle zone)")
     A, B = problem.model.A, problem.model.B
     v = start.mode.x.petsc_vec.copy()
     u, Av, Au, Bv, Bu = (v.duplicate() for _ in range(5))

@@ -101,7 +101,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.la.options import Prefix, set_options
 from unibuckle_fenicsx.la.ownership import Owner, release
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import UnilateralProblem, require_obstacle
 
 __all__ = [
     "BarrierPoint",
@@ -315,12 +315,13 @@ class InteriorPointNewton(Owner):
 
     def __init__(
         self,
-        problem: BucklingProblem,
+        problem: UnilateralProblem,
         options: NewtonOptions | None = None,
         prefix: str = Prefix.IPM,
     ) -> None:
+        require_obstacle(problem, "InteriorPointNewton")
         contact = problem.contact
-        if contact is None or problem.tensionless:
+        if problem.tensionless:
             raise ValueError("InteriorPointNewton needs a problem with a rigid obstacle")
         self.problem = problem
         self.options = options or NewtonOptions()

@@ -12,7 +12,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 __all__ = [
     "Prolongation",
@@ -42,7 +42,7 @@ class Prolongation:
         Construction and every method are collective.
     """
 
-    def __init__(self, coarse: BucklingProblem, fine: BucklingProblem) -> None:
+    def __init__(self, coarse: UnilateralProblem, fine: UnilateralProblem) -> None:
         self.coarse, self.fine = coarse, fine
         self._subs = [
             (coarse.model.W.sub(sub).collapse(), fine.model.W.sub(sub).collapse()) for sub in (0, 1)
@@ -84,7 +84,7 @@ class _BilinearWeights:
 
     def __init__(
         self,
-        coarse: BucklingProblem,
+        coarse: UnilateralProblem,
         Vc: dolfinx.fem.FunctionSpace,
         Vf: dolfinx.fem.FunctionSpace,
     ) -> None:
@@ -183,13 +183,11 @@ def prolong_contact_set(
 
 
 def prolong(
-    coarse: BucklingProblem,
-    fine: BucklingProblem,
+    coarse: UnilateralProblem,
+    fine: UnilateralProblem,
     active: npt.NDArray[np.int64],
 ) -> npt.NDArray[np.int64]:
     """Contact set ``active`` of the structured ``coarse`` problem, on ``fine``'s nodes."""
-    if coarse.contact is None or fine.contact is None:
-        raise ValueError("prolong: the problem has no obstacle (this needs an obstacle zone)")
     plate = fine.spec.plate
     nx, ny = coarse.spec.mesh.nx, coarse.spec.mesh.ny
     return prolong_contact_set(

@@ -1,7 +1,7 @@
 r"""The primal-dual active-set iteration on the contact set.
 
 From a seed :math:`Z_0`, repeat: solve the reduced pencil
-(:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`, warm-started from the
+(:meth:`~unibuckle_fenicsx.model.problem.UnilateralProblem.evaluate`, warm-started from the
 previous mode; the candidate comes back oriented away from the obstacle), add the nodes of
 :math:`I \setminus Z` where the mode violates the obstacle (:math:`u_k > \tau`) and release
 the nodes of Z whose multiplier pulls (:math:`r_k > \tau \|Au\|_\infty`). It stops at a
@@ -30,7 +30,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.sets import SetLog
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 __all__ = ["Run", "iterate"]
@@ -76,7 +76,7 @@ def _mask(n: int, active: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:
 
 
 def iterate(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     seed: str,
     start: npt.NDArray[np.int64],
     initial: PETSc.Vec | None,
@@ -103,14 +103,12 @@ def iterate(
         near: An estimate of the first set's load: each eigen solve then shifts just
             below the previous iterate's load (or this estimate), the inertia proving
             that the pair is the smallest
-            (:meth:`~unibuckle_fenicsx.model.problem.BucklingProblem.evaluate`).
+            (:meth:`~unibuckle_fenicsx.model.problem.UnilateralProblem.evaluate`).
             Without it every solve is at 0.
 
     Note:
         Collective.
     """
-    if problem.contact is None:
-        raise ValueError("iterate: the problem has no obstacle (this needs an obstacle zone)")
     n = problem.contact.size
     tau = problem.tau
     run = Run(seed)

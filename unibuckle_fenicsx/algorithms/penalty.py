@@ -61,7 +61,7 @@ from unibuckle_fenicsx.la.eigen import (
 )
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.la.ownership import Owner, release
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.tolerances import ENERGY_TIE_RTOL
 
 __all__ = [
@@ -125,7 +125,7 @@ class PenaltySolver(Owner):
     r"""Penalised pencil :math:`(A + \rho_{abs} \sum_{k\in S} e_k e_k^T, B)` of a problem.
 
     Args:
-        problem: A :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle.
+        problem: A :class:`~unibuckle_fenicsx.model.problem.UnilateralProblem` with an obstacle.
         prefix: Options prefix of the eigen solver (``-<prefix>eps_view`` etc. apply).
         eps_options: Extra EPS options under ``prefix`` (merged into
             :data:`~unibuckle_fenicsx.la.eigen.EIGEN_OPTIONS`).
@@ -141,14 +141,11 @@ class PenaltySolver(Owner):
 
     def __init__(
         self,
-        problem: BucklingProblem,
+        problem: UnilateralProblem,
         prefix: str = Prefix.PENALTY,
         eps_options: dict[str, str | float | int] | None = None,
     ) -> None:
-        if not isinstance(problem, BucklingProblem):
-            raise TypeError(f"problem must be a BucklingProblem, got {type(problem).__name__}")
-        if problem.contact is None:
-            raise InputError("the penalty method needs an obstacle (the problem has none)")
+        require_obstacle(problem, "the penalty method")
         self.problem = problem
         A = problem.model.A
         diag = A.getDiagonal()
@@ -182,10 +179,6 @@ class PenaltySolver(Owner):
                 one per constrained node (i,).
             active: The spring set S (node numbers).
         """
-        if self.problem.contact is None:
-            raise ValueError(
-                "set_springs: the problem has no obstacle (this needs an obstacle zone)"
-            )
         same = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
         self.problem.model.A.copy(self.A_pen, structure=same)
         self._springs.zeroEntries()
@@ -203,8 +196,6 @@ class PenaltySolver(Owner):
         ``rho_abs``: one stiffness for every node, or one per constrained node; v_k are the
         oriented values at the constrained nodes.
         """
-        if self.problem.contact is None:
-            raise ValueError("quotient: the problem has no obstacle (this needs an obstacle zone)")
         self.problem.model.A.mult(vec, self._Av)
         self.problem.model.B.mult(vec, self._Bv)
         vals = self.problem.contact.values(vec)
@@ -356,10 +347,6 @@ class PenaltySolver(Owner):
         """
         problem = self.problem
         contact = problem.contact
-        if contact is None:
-            raise ValueError(
-                "iterate_springs: the problem has no obstacle (this needs an obstacle zone)"
-            )
         weights = np.broadcast_to(np.asarray(rho_abs, dtype=float), (contact.size,))
         if not (np.all(np.isfinite(weights)) and np.all(weights > 0.0)):
             raise InputError("rho_abs (spring stiffness) must be finite and > 0 at every node")
@@ -479,7 +466,7 @@ class PenaltySolver(Owner):
 
 
 def solve_penalty(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     rho: float,
     *,
     initial_active: npt.NDArray[np.int64] | None = None,
@@ -492,7 +479,7 @@ def solve_penalty(
     r"""Penalty method for one relative penalty ``rho`` (see the module docstring).
 
     Args:
-        problem: A :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` with an obstacle.
+        problem: A :class:`~unibuckle_fenicsx.model.problem.UnilateralProblem` with an obstacle.
         rho: Penalty relative to the largest diagonal entry of A, finite and > 0.
         initial_active: Starting spring set (default empty).
         max_iterations: Eigen solves allowed, >= 1.

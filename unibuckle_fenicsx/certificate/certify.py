@@ -48,7 +48,7 @@ from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivit
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Prefix
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 from unibuckle_fenicsx.tolerances import BRACKET_GAP, PROOF_GAP, ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
 
 __all__ = [
@@ -170,7 +170,7 @@ class Certificate:
 
 
 def reduced_inertia(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     active: npt.NDArray[np.int64],
     sigma: float,
     matrix: ShiftedMatrix | None = None,
@@ -185,10 +185,6 @@ def reduced_inertia(
     Note:
         Collective.
     """
-    if problem.contact is None:
-        raise ValueError(
-            "reduced_inertia: the problem has no obstacle (this needs an obstacle zone)"
-        )
     rows = problem.contact.removed_rows(active)
     if matrix is not None:
         return matrix.factor_reduced(rows, sigma)
@@ -221,12 +217,8 @@ def pencil_inertia(
         K.destroy()
 
 
-def _residual_off_contact(problem: BucklingProblem, candidate: Candidate) -> float:
+def _residual_off_contact(problem: UnilateralProblem, candidate: Candidate) -> float:
     r""":math:`\|r\|_2 / \|Au\|_2` with the rows of Z left out."""
-    if problem.contact is None:
-        raise ValueError(
-            "_residual_off_contact: the problem has no obstacle (this needs an obstacle zone)"
-        )
     r, _, au_2 = problem.residual(candidate.load, candidate.mode.x.petsc_vec)
     rows = problem.contact.removed_rows(candidate.active)
     r.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))  # type: ignore[arg-type]
@@ -235,7 +227,7 @@ def _residual_off_contact(problem: BucklingProblem, candidate: Candidate) -> flo
 
 
 def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the order the docstring gives
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     solution: UnilateralSolution | Candidate,
     *,
     global_bound: bool | None = None,
@@ -371,7 +363,7 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     )
 
 
-def _refuting_candidate(problem: BucklingProblem, refuting: dict[str, Any]) -> Candidate:
+def _refuting_candidate(problem: UnilateralProblem, refuting: dict[str, Any]) -> Candidate:
     """The low-rank route's refuting mode as a :class:`Candidate` (contact set: its zeros)."""
     u = problem.new_mode("refuting_mode")
     u.x.petsc_vec.array[:] = refuting["vector"]
@@ -381,7 +373,7 @@ def _refuting_candidate(problem: BucklingProblem, refuting: dict[str, Any]) -> C
     return problem.candidate(u, float(refuting["load"]), active, sign=1.0)
 
 
-def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -> Certificate:
+def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution) -> Certificate:
     r"""Certify a critical state on a tensionless foundation (:mod:`.algorithms.foundation`).
 
     With :math:`z_k = s_k u_k` the oriented mode at the foundation's nodes and
@@ -405,11 +397,8 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
     """
     problem.verify_free()  # the bracket's lower end
     contact = problem.contact
-    if contact is None or contact.stiffness is None:
-        raise RuntimeError(
-            "certify_foundation: expected contact is not None and contact.stiffness is not None "
-            "(an internal invariant)"
-        )
+    if contact.stiffness is None:
+        raise ValueError("certify_foundation: the problem has rigid obstacles, no foundation")
     cand = solution.candidate
     tau = problem.tau
     notes: list[str] = []
@@ -471,15 +460,12 @@ def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -
 
 
 def _spring_inertia(
-    problem: BucklingProblem, pressing: npt.NDArray[np.int64], sigma: float
+    problem: UnilateralProblem, pressing: npt.NDArray[np.int64], sigma: float
 ) -> tuple[int, int, int]:
     r"""Inertia of :math:`A + \sum_{k \in S} \rho_k e_k e_k^T - \sigma B` (collective)."""
     contact = problem.contact
-    if contact is None or contact.stiffness is None:
-        raise RuntimeError(
-            "_spring_inertia: expected contact is not None and contact.stiffness is not None (an "
-            "internal invariant)"
-        )
+    if contact.stiffness is None:
+        raise RuntimeError("_spring_inertia: the problem has no foundation (an internal invariant)")
     diag = problem.model.A.createVecLeft()
     try:
         rows, nodes = contact.node_rows(pressing)

@@ -62,7 +62,7 @@ from unibuckle_fenicsx.certificate.shifted import (
     mirror_maps,
     norm2,
 )
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions
@@ -164,17 +164,13 @@ def _project(z: npt.NDArray[np.float64], a: npt.NDArray[np.float64]) -> npt.NDAr
 
 
 def _search_other_nappe(
-    problem: BucklingProblem, matrix: ShiftedMatrix, a: npt.NDArray[np.float64], iterations: int
+    problem: UnilateralProblem, matrix: ShiftedMatrix, a: npt.NDArray[np.float64], iterations: int
 ) -> tuple[npt.NDArray[np.float64], float, int]:
     r"""Maximise :math:`f(w) = -w^TK^{-1}w` on :math:`\{w \ge 0, a^Tw = 1\}` (concave there).
 
     Projected gradient with Barzilai-Borwein steps and exact line search, one solve per
     iterate; stops at the first :math:`f > 0`. Returns (best w, its f, iterations).
     """
-    if problem.contact is None:
-        raise ValueError(
-            "_search_other_nappe: the problem has no obstacle (this needs an obstacle zone)"
-        )
     contact = problem.contact
     vec = problem.model.A.createVecRight()
     x = vec.duplicate()
@@ -218,7 +214,7 @@ def _search_other_nappe(
     return best[0], best[1], it
 
 
-def _predict_delta(problem: BucklingProblem, matrix: ShiftedMatrix, candidate: Candidate,
+def _predict_delta(problem: UnilateralProblem, matrix: ShiftedMatrix, candidate: Candidate,
                    safety: float) -> float:  # fmt: skip
     r"""Smallest delta at which alpha should clear ``safety`` times its rounding bound.
 
@@ -245,15 +241,13 @@ def _predict_delta(problem: BucklingProblem, matrix: ShiftedMatrix, candidate: C
 
 
 def _rank2(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     matrix: ShiftedMatrix,
     w_plus: npt.NDArray[np.float64],
     candidates: list[tuple[str, npt.NDArray[np.float64]]],
     options: BoundOptions,
 ) -> tuple[dict[str, Any], dict[str, Any] | None]:
     """Alpha for w+, then beta and gamma for each w- candidate; the first that certifies."""
-    if problem.contact is None:
-        raise ValueError("_rank2: the problem has no obstacle (this needs an obstacle zone)")
     contact = problem.contact
     vec = problem.model.A.createVecRight()
     sp = matrix.refined(contact.scatter(w_plus, vec.duplicate()))
@@ -292,7 +286,7 @@ def _rank2(
 
 
 def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (rank 2, SDP, low rank)
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     candidate: Candidate,
     others: list[Candidate] | None = None,
     options: BoundOptions | None = None,
@@ -315,10 +309,6 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
     Note:
         Collective.
     """
-    if problem.contact is None:
-        raise ValueError(
-            "copositivity_bound: the problem has no obstacle (this needs an obstacle zone)"
-        )
     opts = options or BoundOptions()
     t0 = time.perf_counter()
     notes: list[str] = []
@@ -429,7 +419,7 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
 
 
 def _lowrank(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     matrix: ShiftedMatrix,
     candidate: Candidate,
     others: list[Candidate],
@@ -458,7 +448,7 @@ def _lowrank(
 
 
 def _sdp(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     matrix: ShiftedMatrix,
     lam: float,
     neg: int,

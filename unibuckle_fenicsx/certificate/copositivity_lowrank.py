@@ -72,7 +72,7 @@ from unibuckle_fenicsx.certificate.accurate import (
     two_product,
 )
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, mirror_maps
-from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 
 __all__ = ["LowRankOptions", "LowRankOutcome", "lowrank_certificate"]
 
@@ -182,13 +182,10 @@ class _Columns:
     """Columns of U, their refined solves and G = U^T K^-1 U with an error bound."""
 
     def __init__(
-        self, problem: BucklingProblem, matrix: ShiftedMatrix, refinements: int, max_columns: int
+        self, problem: UnilateralProblem, matrix: ShiftedMatrix, refinements: int, max_columns: int
     ):
-        if problem.contact is None or matrix.K is None:
-            raise RuntimeError(
-                "__init__: expected problem.contact is not None and matrix.K is not None (an "
-                "internal invariant)"
-            )
+        if matrix.K is None:
+            raise RuntimeError("__init__: expected matrix.K is not None (an internal invariant)")
         self.problem, self.matrix, self.refinements = problem, matrix, refinements
         self.max_columns = max_columns
         self.contact = problem.contact
@@ -628,7 +625,7 @@ def _orthant(
 
 
 def _pencil_modes(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     matrix: ShiftedMatrix,
     cols: _Columns,
     lam: float,
@@ -643,8 +640,6 @@ def _pencil_modes(
     vectors with a value below ``lam`` (heuristics only: the certificate checks whatever
     columns it gets).
     """
-    if problem.contact is None:
-        raise ValueError("_pencil_modes: the problem has no obstacle (this needs an obstacle zone)")
     k = min(m + 3, cols.r + 1)
     V = [problem.solve_free().function.x.petsc_vec.copy()]
     V += [x.copy() for x in cols.x[-(k - 1) :]]
@@ -686,15 +681,13 @@ def _reaction(candidate: Candidate) -> npt.NDArray[np.float64]:
 
 
 def _sources(
-    problem: BucklingProblem, candidate: Candidate, others: list[Candidate], units: int
+    problem: UnilateralProblem, candidate: Candidate, others: list[Candidate], units: int
 ) -> list[tuple[str, npt.NDArray[np.float64]]]:
     """The first columns (oriented values on I), in order of use.
 
     With at most ``units`` constrained nodes, their unit vectors (U = I: the relaxation is
     exact, the route is the full copositivity test of the Schur complement).
     """
-    if problem.contact is None:
-        raise ValueError("_sources: the problem has no obstacle (this needs an obstacle zone)")
     i = problem.num_constrained
     if i <= units:
         return [(f"node{k}", np.eye(1, i, k)[0]) for k in range(i)]
@@ -711,7 +704,7 @@ def _sources(
 
 
 def lowrank_certificate(
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     matrix: ShiftedMatrix,
     candidate: Candidate,
     others: list[Candidate],
@@ -770,7 +763,7 @@ def lowrank_certificate(
 
 
 def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (module docstring)
-    problem: BucklingProblem,
+    problem: UnilateralProblem,
     matrix: ShiftedMatrix,
     candidate: Candidate,
     delta: float,
@@ -779,8 +772,6 @@ def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (
     out: LowRankOutcome,
 ) -> tuple[dict[str, Any], list[tuple[str, npt.NDArray[np.float64]]]]:
     """One delta: factorise, columns, cuts, pieces. Returns (record, columns to reuse)."""
-    if problem.contact is None:
-        raise ValueError("_attempt: the problem has no obstacle (this needs an obstacle zone)")
     contact = problem.contact
     lam = candidate.load * (1.0 - delta)
     neg, zero, _ = matrix.factor(lam)
@@ -882,7 +873,7 @@ def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (
 
 
 def _refuting(
-    problem: BucklingProblem, u: PETSc.Vec, values: npt.NDArray[np.float64]
+    problem: UnilateralProblem, u: PETSc.Vec, values: npt.NDArray[np.float64]
 ) -> dict[str, Any] | None:
     """The admissible mode u as a record (load = its Rayleigh quotient), if b(u, u) > 0."""
     Au, Bu = u.duplicate(), u.duplicate()

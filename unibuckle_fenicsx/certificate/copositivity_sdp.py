@@ -48,7 +48,7 @@ except ImportError as err:  # pragma: no cover
 from unibuckle_fenicsx.certificate.shifted import EPS, ShiftedMatrix
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Prefix
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 __all__ = ["SDP_SOLVER", "sector_certificate", "spn_certificate"]
 
@@ -64,13 +64,9 @@ SDP_SOLVER: dict[str, Any] = {
 
 
 def _inverse_on_constrained(
-    problem: BucklingProblem, matrix: ShiftedMatrix
+    problem: UnilateralProblem, matrix: ShiftedMatrix
 ) -> npt.NDArray[np.float64]:
     """M = [K^-1]_II by i refined solves, symmetrised."""
-    if problem.contact is None:
-        raise ValueError(
-            "_inverse_on_constrained: the problem has no obstacle (this needs an obstacle zone)"
-        )
     n = problem.num_constrained
     M = np.empty((n, n))
     vec = problem.model.A.createVecRight()
@@ -111,14 +107,11 @@ def _psd_plus_nonnegative(
 
 
 def _inertia_minus(
-    problem: BucklingProblem, matrix: ShiftedMatrix, N: npt.NDArray[np.float64]
+    problem: UnilateralProblem, matrix: ShiftedMatrix, N: npt.NDArray[np.float64]
 ) -> tuple[int, int]:
     """(negative, zero) pivots of K - N_pad, a separate MUMPS LDL^T."""
-    if problem.contact is None or matrix.K is None:
-        raise RuntimeError(
-            "_inertia_minus: expected problem.contact is not None and matrix.K is not None (an "
-            "internal invariant)"
-        )
+    if matrix.K is None:
+        raise RuntimeError("_inertia_minus: expected matrix.K is not None (an internal invariant)")
     K = matrix.K.duplicate(copy=True)
     K.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)  # type: ignore[arg-type]
     rows = problem.contact.global_rows().astype(PETSc.IntType)
@@ -137,7 +130,9 @@ def _inertia_minus(
     return neg, zero
 
 
-def spn_certificate(problem: BucklingProblem, matrix: ShiftedMatrix, lam: float) -> dict[str, Any]:
+def spn_certificate(
+    problem: UnilateralProblem, matrix: ShiftedMatrix, lam: float
+) -> dict[str, Any]:
     r"""Copositivity of the Schur complement by a PSD + nonnegative split (see above).
 
     ``matrix`` holds the factorisation of :math:`K(\lambda)`, ``lam`` its shift.
@@ -163,7 +158,7 @@ def spn_certificate(problem: BucklingProblem, matrix: ShiftedMatrix, lam: float)
     return out
 
 
-def _lowest_modes(problem: BucklingProblem, nev: int) -> list[PETSc.Vec]:
+def _lowest_modes(problem: UnilateralProblem, nev: int) -> list[PETSc.Vec]:
     """The nev lowest pencil modes with a positive load (for the sector rows).
 
     Lowest load first; the caller destroys the vectors. Collective.
@@ -193,14 +188,11 @@ def _lowest_modes(problem: BucklingProblem, nev: int) -> list[PETSc.Vec]:
 
 
 def sector_certificate(
-    problem: BucklingProblem, matrix: ShiftedMatrix, lam: float, sectors: tuple[int, ...]
+    problem: UnilateralProblem, matrix: ShiftedMatrix, lam: float, sectors: tuple[int, ...]
 ) -> dict[str, Any]:
     """Copositivity on every sector piece of the cone (two negative eigenvalues)."""
-    if problem.contact is None or not matrix.factored:
-        raise RuntimeError(
-            "sector_certificate: expected problem.contact is not None and matrix.factored (an "
-            "internal invariant)"
-        )
+    if not matrix.factored:
+        raise RuntimeError("sector_certificate: expected matrix.factored (an internal invariant)")
     neg_K = matrix.inertia()[0]
     out: dict[str, Any] = {"ok": False, "neg_K": neg_K, "lambda": lam}
     if neg_K != 2:

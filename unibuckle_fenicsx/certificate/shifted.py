@@ -26,7 +26,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.la.factor import SharedFactorization, SymmetricFactorization, same_pattern
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.la.ownership import Owner, release
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = ["EPS", "ShiftedMatrix", "Solve", "absdot", "mirror_maps", "norm2"]
@@ -289,7 +289,7 @@ class ShiftedMatrix(Owner):
 
 
 def mirror_maps(
-    problem: BucklingProblem, tol: float = GEOMETRY_RTOL
+    problem: UnilateralProblem, tol: float = GEOMETRY_RTOL
 ) -> dict[str, npt.NDArray[np.int64]]:
     """Permutations of the constrained nodes under the plate's mirror symmetries.
 
@@ -297,8 +297,6 @@ def mirror_maps(
     node set onto itself. The images of a reaction are candidates, nothing more: the
     certificate checks whatever it is given.
     """
-    if problem.contact is None:
-        raise ValueError("mirror_maps: the problem has no obstacle (this needs an obstacle zone)")
     xy = problem.contact.coordinates
     (x0, y0), (x1, y1) = problem.spec.plate.corners
     cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)

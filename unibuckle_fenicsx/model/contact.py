@@ -10,7 +10,6 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import dataclass
-from typing import Protocol
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -22,47 +21,18 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec
+from unibuckle_fenicsx.config import ObstacleSpec
 from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError
+from unibuckle_fenicsx.model.structure import NodalDofs
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
     "ContactSetManager",
-    "PlateDofs",
     "check_zone_has_nodes",
     "foundation_springs",
     "orientation",
     "tributary_areas",
 ]
-
-
-class PlateDofs(Protocol):
-    """What :class:`ContactSetManager` needs of a plate model: its w-DOFs and supports.
-
-    :class:`~unibuckle_fenicsx.model.plate.model.PlateModel` (the (w, theta) space) and the
-    von Karman model (u, w, theta) both provide it.
-    """
-
-    mesh: dolfinx.mesh.Mesh
-    plate: PlateSpec
-    W: dolfinx.fem.FunctionSpace
-    Vw: dolfinx.fem.FunctionSpace
-    w_dofs: npt.NDArray[np.int32]
-    bc_dofs: npt.NDArray[np.int32]
-
-    @property
-    def w_subspace(self) -> dolfinx.fem.FunctionSpace:
-        """The sub-space of W holding w."""
-        ...
-
-    @property
-    def num_owned_dofs(self) -> int:
-        """Owned DOFs of W on this rank."""
-        ...
-
-    def global_dofs(self, local: npt.NDArray[np.int32]) -> npt.NDArray[np.int64]:
-        """Global (PETSc) indices of local W DOFs."""
-        ...
 
 
 ObstacleLike = ObstacleSpec | Sequence[ObstacleSpec]
@@ -184,7 +154,7 @@ class _Owned:
     global_dofs: npt.NDArray[np.int64]  # W global dof of each
 
 
-def tributary_areas(model: PlateDofs) -> dolfinx.la.Vector:
+def tributary_areas(model: NodalDofs) -> dolfinx.la.Vector:
     r"""Lumped areas :math:`\int \varphi_k\,dx` of the w-space's nodes (owned and ghosts).
 
     The row sums of the Q1 mass matrix: a lumped Winkler foundation puts the spring
@@ -201,7 +171,7 @@ def tributary_areas(model: PlateDofs) -> dolfinx.la.Vector:
 
 
 def _zone_dofs(
-    model: PlateDofs, obstacle: ObstacleSpec, size: float
+    model: NodalDofs, obstacle: ObstacleSpec, size: float
 ) -> tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]:
     """(W dofs, Vw dofs) of the w-DOFs of the zone's nodes, ghosts included (not collective)."""
     dofs_W, dofs_Vw = dolfinx.fem.locate_dofs_geometrical(
@@ -211,7 +181,7 @@ def _zone_dofs(
 
 
 def foundation_springs(
-    model: PlateDofs, foundations: Sequence[ObstacleSpec]
+    model: NodalDofs, foundations: Sequence[ObstacleSpec]
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]:
     r"""Global W rows owned by this rank and lumped spring stiffnesses of ``foundations``.
 
@@ -221,7 +191,7 @@ def foundation_springs(
     Note:
         Collective.
     """
-    size = max(model.plate.length, model.plate.width)
+    size = model.extent
     areas = tributary_areas(model).array
     springs: dict[int, float] = {}
     for o in foundations:
@@ -249,7 +219,7 @@ class ContactSetManager:
     :meth:`values` returns z, :meth:`scatter` takes z.
 
     Args:
-        model: The plate model (the assembled pencil, or any :class:`PlateDofs`).
+        model: The plate model (the assembled pencil, or any :class:`NodalDofs`).
         obstacles: One obstacle or several (their zones' nodes are united; a node in
             zones on both sides raises :class:`BilateralZoneError`).
 
@@ -269,7 +239,7 @@ class ContactSetManager:
         free mesh node.
     """
 
-    def __init__(self, model: PlateDofs, obstacles: ObstacleLike) -> None:
+    def __init__(self, model: NodalDofs, obstacles: ObstacleLike) -> None:
         self.model = model
         self.obstacles = _as_tuple(obstacles)
         if not self.obstacles:
@@ -282,7 +252,7 @@ class ContactSetManager:
             )
         comm = model.mesh.comm
         Vw = model.Vw
-        size = max(model.plate.length, model.plate.width)
+        size = model.extent
         tensionless = kinds == {"tensionless"}
         areas = tributary_areas(model).array if tensionless else None
         found: dict[int, tuple[int, float]] = {}  # W dof -> (Vw dof, sign)

@@ -1,11 +1,15 @@
-r"""A set-up buckling problem: mesh, prestress, pencil, eigen solver and contact manager.
+r"""A set-up buckling problem: pencil and eigen solver, and with an obstacle its contacts.
 
-:class:`BucklingProblem` is what the algorithms work on. Its primitive is
-:meth:`BucklingProblem.evaluate`: the smallest eigenpair of the pencil with a candidate
-contact set Z removed, returned as a :class:`Candidate` that owns its mode, oriented
-towards the admissible side of the obstacle, with its values and contact forces at the
-constrained nodes. Nothing here keeps a "current" mode: whoever holds a candidate holds
-its mode.
+:class:`Problem` holds the pencil and its eigen solver; :class:`UnilateralProblem` adds
+the contact manager of the obstacles.
+
+:func:`~unibuckle_fenicsx.model.build.build_problem` makes one from a problem's
+description, stage by stage. What the algorithms work on is a :class:`UnilateralProblem`;
+its primitive is :meth:`UnilateralProblem.evaluate`: the smallest eigenpair of the pencil
+with a candidate contact set Z removed, returned as a :class:`Candidate` that owns its
+mode, oriented towards the admissible side of the obstacle, with its values and contact
+forces at the constrained nodes. Nothing here keeps a "current" mode: whoever holds a
+candidate holds its mode.
 
 The discrete critical state (:doc:`/methods/problem`): the smallest :math:`\lambda` and
 :math:`u \ne 0` with :math:`u_k \le 0` on the constrained nodes I, :math:`r = Au -
@@ -16,9 +20,7 @@ removed (paper, Lemma 5.1).
 
 from __future__ import annotations
 
-import logging
-import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 from mpi4py import MPI
@@ -30,72 +32,18 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.errors import BilateralZoneError, EigenSolveError, EmptyZoneError, InputError
-from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, EigenPair, GEPSolver
-from unibuckle_fenicsx.la.factor import SymmetricFactorization, abs_matrix
-from unibuckle_fenicsx.la.options import Prefix, pop_run_options, push_run_options
+from unibuckle_fenicsx.errors import EigenSolveError, InputError
+from unibuckle_fenicsx.la.eigen import EigenPair, GEPSolver
+from unibuckle_fenicsx.la.factor import abs_matrix
+from unibuckle_fenicsx.la.options import pop_run_options
 from unibuckle_fenicsx.la.ownership import Owner, release
-from unibuckle_fenicsx.model.contact import (
-    ContactSetManager,
-    check_zone_has_nodes,
-    foundation_springs,
-    orientation,
-)
+from unibuckle_fenicsx.model.contact import ContactSetManager, orientation
 from unibuckle_fenicsx.model.materials import reference_bending_stiffness
-from unibuckle_fenicsx.model.mesh import build_plate_mesh, check_user_mesh
-from unibuckle_fenicsx.model.plate.model import PlateModel
-from unibuckle_fenicsx.model.points import point_obstacles
-from unibuckle_fenicsx.model.prestress import solve_prestress
+from unibuckle_fenicsx.model.prestress import Prestress
+from unibuckle_fenicsx.model.structure import StructuralModel
 from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
-__all__ = ["BYTES_PER_DOF", "BucklingProblem", "Candidate", "Mode", "available_memory"]
-
-logger = logging.getLogger(__name__)
-
-#: Peak memory per (w, theta) DOF of a solve, measured with MUMPS on one rank: 7.8 kB at
-#: 155k DOFs, 5.8 kB at 617k (:doc:`/guide/mpi`); the estimate uses 8 kB.
-BYTES_PER_DOF = 8000
-
-
-def available_memory() -> int | None:
-    """Bytes of memory available to new processes (Linux ``MemAvailable``), or None."""
-    try:
-        with open("/proc/meminfo") as f:
-            for line in f:
-                if line.startswith("MemAvailable:"):
-                    return int(line.split()[1]) * 1024
-    except OSError:
-        pass
-    return None
-
-
-def _check_memory(spec: ProblemSpec, comm: MPI.Comm) -> None:
-    """Refuse a mesh whose estimated memory exceeds what the machine has (collective).
-
-    A plate meshed by gmsh is estimated at 3 DOFs per h^2 of its area (a file: not).
-    """
-    plate = spec.plate
-    if plate.file is not None:
-        return
-    if plate.meshed_by_gmsh:
-        if spec.mesh.size is None:
-            raise RuntimeError(
-                "_check_memory: expected spec.mesh.size is not None (an internal invariant)"
-            )
-        dofs = int(3 * plate.area / spec.mesh.size**2)
-        what = f"mesh.size = {spec.mesh.size:g} m on {plate.area:.3g} m^2 gives about"
-    else:
-        dofs = spec.mesh.num_dofs
-        what = f"mesh.nx x mesh.ny = {spec.mesh.nx} x {spec.mesh.ny} gives"
-    need = BYTES_PER_DOF * dofs
-    free = available_memory()
-    have = comm.allreduce(free if free is not None else -1, op=MPI.MIN)
-    if have > 0 and need > have:
-        raise InputError(
-            f"{what} {dofs:,} DOFs, which need about {need / 1e9:.3g} GB "
-            f"({BYTES_PER_DOF / 1000:.0f} kB per DOF), more than the {have / 1e9:.3g} GB "
-            "available: use a coarser mesh or more machines"
-        )
+__all__ = ["Candidate", "Mode", "Problem", "SetUp", "UnilateralProblem", "require_obstacle"]
 
 
 @dataclass(frozen=True)
@@ -117,7 +65,7 @@ class Mode:
 class Candidate:
     r"""The smallest eigenpair of the pencil with the contact set ``active`` removed.
 
-    Built by :meth:`BucklingProblem.evaluate` (or :meth:`BucklingProblem.candidate` for
+    Built by :meth:`UnilateralProblem.evaluate` (or :meth:`UnilateralProblem.candidate` for
     a mode from elsewhere, e.g. the penalty method). The candidate owns its mode.
 
     Attributes:
@@ -157,235 +105,87 @@ class Candidate:
         return self.active.tobytes()
 
 
-class BucklingProblem(Owner):
-    """Everything an algorithm needs, set up once.
-
-    Args:
-        spec: The problem.
-        comm: Communicator of the mesh (``MPI.COMM_SELF`` gives each rank its own
-            serial copy, for candidate-parallel enumeration).
-        eps_options: Extra EPS options of the run: under the prefix ``unibuckle_`` (so
-            ``eps_view`` is ``-unibuckle_eps_view``) for this pencil and the coarser
-            levels' copies, and under ``unibuckle_penalty_`` and ``unibuckle_foundation_``
-            for the penalty stages and the foundation
-            (:data:`~unibuckle_fenicsx.la.options.RUN_EPS_PREFIXES`). The problem holds them in
-            PETSc's options database until :meth:`destroy`; the command line's win.
-        mesh: A quadrilateral DOLFINx mesh to use instead of ``spec.mesh`` (the
-            rectangle, or gmsh's plate); ``spec.plate.corners`` must be its bounding
-            box (used for tolerances and the buckling coefficient's width), and each
-            edge's facet tag must mark facets of it (both checked).
-        facet_tags: Edge markers of ``mesh``, matched by :class:`EdgeSpec` ``tag``.
+@dataclass(frozen=True)
+class SetUp:
+    """The parts of a set-up problem (:func:`~unibuckle_fenicsx.model.build.build_problem`).
 
     Attributes:
+        spec: The problem (its plate's edges tagged, a mesh file's corners its bounding
+            box).
+        comm: Communicator of the mesh.
+        mesh: The quadrilateral mesh.
+        facet_tags: Its edge markers.
+        structured: The structured rectangle of ``spec.mesh`` (coarser copies exist).
+        custom_mesh: The mesh came from the user (no coarse copies can be made).
+        prestress: Membrane force per unit load.
+        fixed_prestress: The fixed part of the load (applied as is), or None.
+        model: The structural model: its forms and the pencil (A, B).
         eigensolver: The :class:`~unibuckle_fenicsx.la.eigen.GEPSolver` of the pencil.
-        contact: The :class:`~unibuckle_fenicsx.model.contact.ContactSetManager` (None
-            without obstacle).
-        free: The free mode, once :meth:`solve_free` has run.
-
-    Note:
-        Construction and :meth:`destroy` are collective on ``comm``; the problem is a
-        context manager that destroys itself on exit.
+        run_options: What the run's EPS options put in PETSc's options database
+            (:func:`~unibuckle_fenicsx.la.options.push_run_options`).
+        timings: Seconds per set-up stage.
     """
 
-    def __init__(
-        self,
-        spec: ProblemSpec,
-        comm: MPI.Comm = MPI.COMM_WORLD,
-        eps_options: dict[str, str | float | int] | None = None,
-        *,
-        mesh: dolfinx.mesh.Mesh | None = None,
-        facet_tags: dolfinx.mesh.MeshTags | None = None,
-    ) -> None:
-        t0 = time.perf_counter()
-        if spec.has_fixed_load:
-            spec.check_scaled_load()
-        self.spec = spec
-        self.timings: dict[str, float] = {}
-        #: The mesh came from the user (not spec.mesh): no coarse copies can be made.
-        self.custom_mesh = mesh is not None
-        #: The structured rectangle of spec.mesh (coarser copies exist: multilevel).
-        self.structured = mesh is None and not spec.plate.meshed_by_gmsh
-        if mesh is not None:
-            if facet_tags is None:
-                raise InputError(
-                    "facet_tags: a user mesh needs its edge facet tags (EdgeSpec.tag, or "
-                    "tags 1..4 for edges named left, right, bottom, top)"
-                )
-            if mesh.topology.cell_type != dolfinx.mesh.CellType.quadrilateral:
-                raise InputError("mesh: the MITC plate element needs a quadrilateral mesh")
-            check_user_mesh(mesh, facet_tags, spec.plate)
-            self.mesh, self.facet_tags = mesh, facet_tags
-            comm = mesh.comm
-        else:
-            _check_memory(spec, comm)
-            self.mesh, self.facet_tags, plate = build_plate_mesh(
-                spec.plate, spec.mesh, comm, spec.all_obstacles
-            )
-            # A file's edges get their tags, its corners the mesh's bounding box.
-            self.spec = spec = replace(spec, plate=plate)
-        self.comm = comm
-        obstacles = spec.all_obstacles
-        if obstacles:
-            size = max(spec.plate.length, spec.plate.width)
-            labels = [spec.obstacle_label(k) for k in range(len(obstacles))]
-            check_zone_has_nodes(self.mesh, obstacles, size, labels)
-        degree = spec.solver.prestress_degree
-        self.prestress = solve_prestress(
-            self.mesh,
-            self.facet_tags,
-            spec.plate,
-            spec.material,
-            degree,
-            temperature=spec.load.temperature,
-            plate_mesh=not self.custom_mesh,
-        )
-        #: The fixed part of the prestress (applied as is), or None.
-        self.fixed_prestress = (
-            solve_prestress(
-                self.mesh,
-                self.facet_tags,
-                spec.plate.fixed_part(),
-                spec.material,
-                degree,
-                temperature=spec.load.fixed_temperature,
-                fixed=True,
-                plate_mesh=not self.custom_mesh,
-            )
-            if spec.has_fixed_load
-            else None
-        )
-        t1 = time.perf_counter()
-        self.timings["prestress_s"] = t1 - t0
-        self.model = PlateModel(
-            self.mesh,
-            self.facet_tags,
-            spec.plate,
-            spec.material,
-            self.prestress,
-            spec.solver.shear,
-            points=spec.points,
-            fixed_prestress=self.fixed_prestress,
-            fixed_factor=spec.load.fixed_factor,
-        )
-        try:
-            self._set_up(spec, eps_options, t1)
-        except BaseException:
-            self.destroy()  # collective: every rank raises (the checks agree)
-            raise
-        self.timings["setup_s"] = time.perf_counter() - t0
+    spec: ProblemSpec
+    comm: MPI.Comm
+    mesh: dolfinx.mesh.Mesh
+    facet_tags: dolfinx.mesh.MeshTags
+    structured: bool
+    custom_mesh: bool
+    prestress: Prestress
+    fixed_prestress: Prestress | None
+    model: StructuralModel
+    eigensolver: GEPSolver
+    run_options: list[tuple[str, str]]
+    timings: dict[str, float]
 
-    def _set_up(
-        self, spec: ProblemSpec, eps_options: dict[str, str | float | int] | None, t1: float
-    ) -> None:
-        """The springs, the checks, the eigen solver and the contact sets (collective)."""
-        if spec.bilateral_foundations:
-            self.model.add_springs(*foundation_springs(self.model, spec.bilateral_foundations))
-        t2 = time.perf_counter()
-        self.timings["assembly_s"] = t2 - t1
-        self._check_geometric_stiffness()
-        if self.fixed_prestress is not None:
-            self._check_fixed_load()
-        self.eigensolver = GEPSolver(
-            self.model.A,
-            self.model.B,
-            indefinite=self.prestress.indefinite,
-            tol=spec.solver.eps_tol,
-            options={**EIGEN_OPTIONS, **(eps_options or {})},
-        )
-        unilateral = spec.unilateral_obstacles + tuple(
-            point_obstacles(self.model.points, spec.plate)
-        )
-        try:
-            self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
-        except EmptyZoneError as err:
-            if not spec.one_sided_points:
-                raise
-            raise EmptyZoneError(
-                "points: the one-sided points"
-                + (" and the obstacle zones" if spec.unilateral_obstacles else "")
-                + " act on no free node: each such node is held already (by an edge "
-                "support or a bilateral point), so the point restrains nothing; move it off "
-                "the support or leave it out"
-            ) from err
-        except BilateralZoneError as err:
-            if not spec.one_sided_points:
-                raise
-            raise BilateralZoneError(
-                "points: a one-sided point acts on a node held from the other side too (an "
-                'obstacle zone or another point): that holds w = 0, give it kind = "bilateral"'
-            ) from err
+
+class Problem(Owner):
+    """A problem set up for its solves: mesh, prestress, pencil and eigen solver.
+
+    Made by :func:`~unibuckle_fenicsx.model.build.build_problem` (without an obstacle;
+    with one it makes a :class:`UnilateralProblem`). The problem owns every PETSc object
+    of its parts (:class:`SetUp`, whose fields it has as attributes); :meth:`destroy`
+    takes back the run's options from PETSc's options database too.
+
+    Attributes:
+        free: The free mode, once :meth:`solve_free` has run.
+        tau: The relative feasibility tolerance (``spec.solver.tau``).
+
+    Note:
+        :meth:`destroy` is collective on ``comm``; the problem is a context manager that
+        destroys itself on exit.
+    """
+
+    def __init__(self, parts: SetUp) -> None:
+        self.spec = parts.spec
+        self.comm = parts.comm
+        self.mesh, self.facet_tags = parts.mesh, parts.facet_tags
+        self.structured, self.custom_mesh = parts.structured, parts.custom_mesh
+        self.prestress, self.fixed_prestress = parts.prestress, parts.fixed_prestress
+        self.model = parts.model
+        self.eigensolver = parts.eigensolver
+        self._run_options = parts.run_options
+        self.timings = parts.timings
         self.free: Mode | None = None
         self._free_verified = False  # verify_free() passed
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
         self._abs: tuple[PETSc.Mat, PETSc.Mat] | None = None  # abs_pencil(), made when needed
-        self.tau = spec.solver.tau
-        n_owned_w = self.model.Vw.dofmap.index_map.size_local
-        self._w_owned = self.model.w_dofs[:n_owned_w]
-        # Last: a refused problem leaves nothing in the options database.
-        self._run_options = push_run_options(eps_options)
-
-    def _check_geometric_stiffness(self) -> None:
-        """Refuse a B that is round-off (collective).
-
-        Its entries are of the order of the membrane force |N0| (a Q1 stiffness integral
-        is O(1)); at 1e-10 of it, b(w, w) vanishes identically on the free deflections,
-        e.g. pure shear on a mesh with a single row of free nodes (the contributions
-        above and below the row cancel), and no load buckles the plate.
-        """
-        scale = max(self.prestress.max_compression, self.prestress.max_tension)
-        b_norm = float(self.model.B.norm(PETSc.NormType.INFINITY))
-        if b_norm <= 1e-10 * scale:
-            self.model.destroy()
-            raise InputError(
-                "the plate has no positive buckling load on this mesh: the geometric "
-                f"stiffness b(w, w) vanishes on the free deflections (|B| = {b_norm:.3g} "
-                f"against |N0| = {scale:.3g} N/m); refine the mesh or check the edge loads"
-            )
-
-    def _check_fixed_load(self) -> None:
-        r"""Refuse a fixed load that buckles the plate by itself (collective).
-
-        The pencil is :math:`(A - B_{fixed}, B)`; every algorithm and the certificate need
-        its first matrix positive definite, which the inertia of its :math:`LDL^T`
-        (MUMPS) tells: no negative and no zero pivot.
-        """
-        K = self.model.A.duplicate(copy=True)
-        try:
-            with SymmetricFactorization(K, Prefix.FIXED) as factor:
-                negative, zero, _ = factor.inertia()
-        finally:
-            K.destroy()
-        if negative or zero:
-            self.model.destroy()
-            # With an obstacle the plate may still carry such a fixed part (its unilateral
-            # critical load lies higher), but the solvers and certificates here all rest
-            # on a positive definite first matrix of the pencil: say so, not that it buckles.
-            obstacle = (
-                " without its obstacle (with it, the plate may carry this fixed part, but "
-                "every solver here needs A - B_fixed positive definite, i.e. the fixed part "
-                "below the free plate's critical value)"
-                if self.spec.all_obstacles
-                else ""
-            )
-            raise InputError(
-                "the fixed load alone buckles the plate"
-                f"{obstacle} (fixed_normal_stress, "
-                "fixed_shear_stress, fixed_temperature): the stiffness less its geometric "
-                f"stiffness, A - B_fixed, has {negative} negative and {zero} zero "
-                "eigenvalue(s); lower the fixed part below its own critical value"
-            )
+        self.tau = parts.spec.solver.tau
+        n_owned_w = parts.model.Vw.dofmap.index_map.size_local
+        self._w_owned = parts.model.w_dofs[:n_owned_w]
 
     # -- primitives ----------------------------------------------------------------
     @property
     def tensionless(self) -> bool:
-        """Whether the contact nodes carry a tensionless foundation (springs), not obstacles."""
-        return self.contact is not None and self.contact.stiffness is not None
+        """Whether the contact nodes carry a tensionless foundation (none here)."""
+        return False
 
     @property
     def num_constrained(self) -> int:
-        """i, the number of constrained nodes (0 without obstacle)."""
-        return 0 if self.contact is None else self.contact.size
+        """i, the number of constrained nodes (none here)."""
+        return 0
 
     @property
     def owned_w_dofs(self) -> npt.NDArray[np.int32]:
@@ -459,93 +259,6 @@ class BucklingProblem(Owner):
                 "(-unibuckle_eps_tol, -unibuckle_eps_ncv, ...) are too loose"
             )
         self._free_verified = True
-
-    def evaluate(
-        self,
-        active: npt.NDArray[np.int64],
-        initial: PETSc.Vec | None = None,
-        near: float | None = None,
-    ) -> Candidate:
-        """Smallest eigenpair with the nodes ``active`` removed, as a :class:`Candidate`.
-
-        Args:
-            active: Contact set Z (node numbers, any order).
-            initial: Optional start vector of the eigen solve (e.g. a previous mode).
-            near: Optional estimate of the load (e.g. that of the state Z is read
-                from): the eigen solve shifts just below it
-                (:meth:`~unibuckle_fenicsx.la.eigen.GEPSolver.solve`).
-
-        The empty set is the free plate's pencil: its candidate is made from
-        :meth:`solve_free`'s pair (solved once; the same load to the last bit, so a
-        bracket on the free load closes), whatever ``initial`` and ``near`` say.
-
-        Note:
-            Collective; ``active`` must be the same on every rank.
-        """
-        if self.contact is None:
-            raise ValueError("evaluate: the problem has no obstacle (this needs an obstacle zone)")
-        active = np.unique(np.asarray(active, dtype=np.int64))
-        u = self.new_mode()
-        if not active.size:
-            free = self.solve_free()
-            free.function.x.petsc_vec.copy(u.x.petsc_vec)
-            u.x.scatter_forward()
-            return self.candidate(u, free.load, active, eigen=free.eigen)
-        pair = self.eigensolver.solve(
-            self.contact.removed_rows(active), out=u.x.petsc_vec, initial=initial, near=near
-        )
-        return self.candidate(u, pair.value, active, eigen=pair)
-
-    def candidate(
-        self,
-        u: dolfinx.fem.Function,
-        load: float,
-        active: npt.NDArray[np.int64],
-        *,
-        eigen: EigenPair | None = None,
-        sign: float | None = None,
-    ) -> Candidate:
-        r"""Make ``u`` a :class:`Candidate`: orient, scale, values and forces at I.
-
-        The one place where a mode's orientation, feasibility and contact forces are
-        computed. ``u`` is modified in place (scaled to max |w| = 1, oriented) and
-        becomes the candidate's mode.
-
-        Args:
-            u: A mode (the candidate takes ownership).
-            load: Its load (an eigenvalue, or a Rayleigh quotient).
-            active: Sorted contact set Z claimed for it.
-            eigen: SLEPc's report, if ``u`` is an eigenvector.
-            sign: Orientation to apply instead of
-                :func:`~unibuckle_fenicsx.model.contact.orientation`'s.
-
-        Note:
-            Collective.
-        """
-        if self.contact is None:
-            raise ValueError("candidate: the problem has no obstacle (this needs an obstacle zone)")
-        n = self.contact.size
-        vec = u.x.petsc_vec
-        if not np.isfinite(load):
-            zeros = np.zeros(n)
-            return Candidate(active, load, u, zeros, zeros, np.inf, False, np.inf, self.tau, eigen)
-        scale = self.max_abs_w(vec)
-        values = self.contact.values(vec) / scale
-        r, au_inf, _ = self.residual(load, vec)
-        forces = self.contact.values(r) / au_inf
-        if sign is None:
-            sign = orientation(values, forces, active, self.tau)
-        vec.scale(sign / scale)
-        u.x.scatter_forward()
-        values, forces = sign * values, sign * forces
-        free = np.ones(n, dtype=bool)
-        free[active] = False
-        margin = float(values[free].max()) if free.any() else -np.inf
-        max_force = float(forces[active].max()) if active.size else -np.inf
-        feasible = bool(values.max() <= self.tau)
-        return Candidate(
-            active, float(load), u, values, forces, margin, feasible, max_force, self.tau, eigen
-        )
 
     def residual(self, load: float, u: PETSc.Vec) -> tuple[PETSc.Vec, float, float]:
         r"""Residual :math:`r = A u - \lambda B u` with the edge-constrained pencil.
@@ -630,12 +343,12 @@ class BucklingProblem(Owner):
         self._destroyed = True
 
     @property
-    def model(self) -> PlateModel:
+    def model(self) -> StructuralModel:
         """The plate's forms and matrices (A, B); an error once destroyed."""
         return self._live("_model")
 
     @model.setter
-    def model(self, value: PlateModel) -> None:
+    def model(self, value: StructuralModel) -> None:
         self._model = value
 
     @property
@@ -652,7 +365,7 @@ class BucklingProblem(Owner):
         # refuse with a clear error instead.
         if self.__dict__.get("_destroyed"):
             raise RuntimeError(
-                "this BucklingProblem was destroyed (its with block, or solve()'s, has "
+                "this problem was destroyed (its with block, or solve()'s, has "
                 "ended, or destroy() was called): its PETSc objects are gone; use it "
                 "inside the with block (the Analysis' result, mode and certificate stay "
                 "usable after it)"
@@ -660,4 +373,123 @@ class BucklingProblem(Owner):
         try:
             return self.__dict__[name]
         except KeyError:
-            raise AttributeError(f"BucklingProblem has no {name.lstrip('_')} yet") from None
+            raise AttributeError(f"the problem has no {name.lstrip('_')} yet") from None
+
+
+class UnilateralProblem(Problem):
+    """A problem with one-sided obstacles or tensionless foundations: its contact manager.
+
+    What every unilateral algorithm and certificate works on.
+
+    Args:
+        parts: Those of :class:`Problem`.
+        contact: The :class:`~unibuckle_fenicsx.model.contact.ContactSetManager` of the
+            constrained nodes (owned by the problem; it holds no PETSc object).
+    """
+
+    def __init__(self, parts: SetUp, contact: ContactSetManager) -> None:
+        super().__init__(parts)
+        self.contact = contact
+
+    @property
+    def tensionless(self) -> bool:
+        """Whether the contact nodes carry a tensionless foundation (springs), not obstacles."""
+        return self.contact.stiffness is not None
+
+    @property
+    def num_constrained(self) -> int:
+        """i, the number of constrained nodes."""
+        return self.contact.size
+
+    def evaluate(
+        self,
+        active: npt.NDArray[np.int64],
+        initial: PETSc.Vec | None = None,
+        near: float | None = None,
+    ) -> Candidate:
+        """Smallest eigenpair with the nodes ``active`` removed, as a :class:`Candidate`.
+
+        Args:
+            active: Contact set Z (node numbers, any order).
+            initial: Optional start vector of the eigen solve (e.g. a previous mode).
+            near: Optional estimate of the load (e.g. that of the state Z is read
+                from): the eigen solve shifts just below it
+                (:meth:`~unibuckle_fenicsx.la.eigen.GEPSolver.solve`).
+
+        The empty set is the free plate's pencil: its candidate is made from
+        :meth:`solve_free`'s pair (solved once; the same load to the last bit, so a
+        bracket on the free load closes), whatever ``initial`` and ``near`` say.
+
+        Note:
+            Collective; ``active`` must be the same on every rank.
+        """
+        active = np.unique(np.asarray(active, dtype=np.int64))
+        u = self.new_mode()
+        if not active.size:
+            free = self.solve_free()
+            free.function.x.petsc_vec.copy(u.x.petsc_vec)
+            u.x.scatter_forward()
+            return self.candidate(u, free.load, active, eigen=free.eigen)
+        pair = self.eigensolver.solve(
+            self.contact.removed_rows(active), out=u.x.petsc_vec, initial=initial, near=near
+        )
+        return self.candidate(u, pair.value, active, eigen=pair)
+
+    def candidate(
+        self,
+        u: dolfinx.fem.Function,
+        load: float,
+        active: npt.NDArray[np.int64],
+        *,
+        eigen: EigenPair | None = None,
+        sign: float | None = None,
+    ) -> Candidate:
+        r"""Make ``u`` a :class:`Candidate`: orient, scale, values and forces at I.
+
+        The one place where a mode's orientation, feasibility and contact forces are
+        computed. ``u`` is modified in place (scaled to max |w| = 1, oriented) and
+        becomes the candidate's mode.
+
+        Args:
+            u: A mode (the candidate takes ownership).
+            load: Its load (an eigenvalue, or a Rayleigh quotient).
+            active: Sorted contact set Z claimed for it.
+            eigen: SLEPc's report, if ``u`` is an eigenvector.
+            sign: Orientation to apply instead of
+                :func:`~unibuckle_fenicsx.model.contact.orientation`'s.
+
+        Note:
+            Collective.
+        """
+        n = self.contact.size
+        vec = u.x.petsc_vec
+        if not np.isfinite(load):
+            zeros = np.zeros(n)
+            return Candidate(active, load, u, zeros, zeros, np.inf, False, np.inf, self.tau, eigen)
+        scale = self.max_abs_w(vec)
+        values = self.contact.values(vec) / scale
+        r, au_inf, _ = self.residual(load, vec)
+        forces = self.contact.values(r) / au_inf
+        if sign is None:
+            sign = orientation(values, forces, active, self.tau)
+        vec.scale(sign / scale)
+        u.x.scatter_forward()
+        values, forces = sign * values, sign * forces
+        free = np.ones(n, dtype=bool)
+        free[active] = False
+        margin = float(values[free].max()) if free.any() else -np.inf
+        max_force = float(forces[active].max()) if active.size else -np.inf
+        feasible = bool(values.max() <= self.tau)
+        return Candidate(
+            active, float(load), u, values, forces, margin, feasible, max_force, self.tau, eigen
+        )
+
+
+def require_obstacle(problem: object, who: str) -> None:
+    """Refuse a ``problem`` that is not a :class:`UnilateralProblem` (an algorithm's entry).
+
+    Raises:
+        InputError: ``who`` needs a problem with an obstacle, and ``problem`` has none.
+    """
+    if not isinstance(problem, UnilateralProblem):
+        raise InputError(f"{who} needs a problem with an obstacle (this one has none)")

@@ -18,7 +18,7 @@ import ufl
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.options import Prefix, set_options
-from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
 from unibuckle_fenicsx.nonlinear.model import THETA_SUB, VonKarmanPlate
 
 __all__ = ["PUSH_OFF", "check_gaps", "embed", "imperfection_shape", "to_linear_space"]
@@ -36,7 +36,7 @@ SHAPE_LU: dict[str, str | float | int | bool] = {
 
 
 def to_linear_space(
-    plate: VonKarmanPlate, x: dolfinx.fem.Function, problem: BucklingProblem
+    plate: VonKarmanPlate, x: dolfinx.fem.Function, problem: Problem
 ) -> dolfinx.fem.Function:
     """(w, theta) of the scaled state ``x`` in physical units on the linear (w, theta) space."""
     W = problem.model.W
@@ -53,7 +53,7 @@ def to_linear_space(
 
 
 def embed(
-    plate: VonKarmanPlate, shape: dolfinx.fem.Function, problem: BucklingProblem, amplitude: float
+    plate: VonKarmanPlate, shape: dolfinx.fem.Function, problem: Problem, amplitude: float
 ) -> None:
     """x0 = (0, amplitude * w / t, amplitude * theta) from a linear (w, theta) shape."""
     x0 = plate.x0
@@ -67,7 +67,7 @@ def embed(
     x0.x.scatter_forward()
 
 
-def _pressure_shape(problem: BucklingProblem, sign: float = 1.0) -> dolfinx.fem.Function:
+def _pressure_shape(problem: Problem, sign: float = 1.0) -> dolfinx.fem.Function:
     """Deflection under a uniform pressure away from the obstacles (linear plate), max |w| = 1.
 
     ``sign`` = +1 (obstacles above): downward, w <= 0; -1 (below): upward.
@@ -92,7 +92,7 @@ def _pressure_shape(problem: BucklingProblem, sign: float = 1.0) -> dolfinx.fem.
     return p
 
 
-def _orientation(problem: BucklingProblem, mode: dolfinx.fem.Function) -> float:
+def _orientation(problem: Problem, mode: dolfinx.fem.Function) -> float:
     """A partition-independent sign: that of the integral of w times an asymmetric weight."""
     (x0, y0), (x1, y1) = problem.spec.plate.corners
     xs = ufl.SpatialCoordinate(problem.mesh)
@@ -119,7 +119,7 @@ def imperfection_shape(
         Collective.
     """
     problem = linear.problem
-    contact = problem.contact if obstacle else None
+    contact = problem.contact if obstacle and isinstance(problem, UnilateralProblem) else None
     name = shape if shape != "auto" else ("unilateral" if contact is not None else "free")
     if name == "unilateral" and (contact is None or linear.solution is None):
         raise InputError('shape = "unilateral" needs a problem with its obstacle')

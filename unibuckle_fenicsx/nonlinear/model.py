@@ -439,6 +439,11 @@ class VonKarmanPlate(MixedDofs, Owner):
         """The sub-space holding w."""
         return self.W.sub(W_SUB)
 
+    @property
+    def extent(self) -> float:
+        """The plate's larger side (m)."""
+        return max(self.plate.length, self.plate.width)
+
     # -- SNES callbacks ------------------------------------------------------------
     def _assign(self, x: PETSc.Vec) -> None:
         """State function <- the (owned part of the) vector ``x``, ghosts updated."""

@@ -33,6 +33,7 @@ from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _int
 from unibuckle_fenicsx.errors import InputError, NonlinearError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.la.ownership import Owner
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
 from unibuckle_fenicsx.nonlinear.estimators import (
     inflection_load,
@@ -522,7 +523,7 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
             "the nonlinear model, which must be 1 or 2: give degree"
         )
     if linear is not None:
-        if obstacle and linear.problem.contact is None:
+        if obstacle and not isinstance(linear.problem, UnilateralProblem):
             raise InputError(
                 "linear: the analysis given was solved without the obstacle; pass one of "
                 "the problem with its obstacle (or obstacle = false)"

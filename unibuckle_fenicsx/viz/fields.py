@@ -19,7 +19,7 @@ if TYPE_CHECKING:  # pragma: no cover
     import dolfinx
 
     from unibuckle_fenicsx.config import ProblemSpec
-    from unibuckle_fenicsx.model.problem import BucklingProblem
+    from unibuckle_fenicsx.model.problem import Problem
 
 __all__ = [
     "mesh_triangles",
@@ -83,15 +83,17 @@ def zone_outlines(spec: ProblemSpec) -> list[tuple[npt.NDArray[np.float64], str]
 
 
 def problem_zone(
-    problem: BucklingProblem,
+    problem: Problem,
 ) -> tuple[tuple[float, float], tuple[float, float]] | None:
     """:func:`zone_box` of a set-up problem (a predicate zone: its nodes' bounding box)."""
-    coords = problem.contact.coordinates if problem.contact is not None else None
+    from unibuckle_fenicsx.model.problem import UnilateralProblem
+
+    coords = problem.contact.coordinates if isinstance(problem, UnilateralProblem) else None
     return zone_box(problem.spec, coords)
 
 
 def nodal_deflection(
-    problem: BucklingProblem, u: dolfinx.fem.Function
+    problem: Problem, u: dolfinx.fem.Function
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
     """Node coordinates (n, 2) and deflection w (n,) of the mode ``u``.
 
@@ -112,7 +114,7 @@ def nodal_deflection(
 
 
 def section(
-    problem: BucklingProblem,
+    problem: Problem,
     u: dolfinx.fem.Function,
     y: float = 0.0,
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]]:
@@ -181,7 +183,7 @@ def mirror_to_match(
 
 
 def mesh_triangles(
-    problem: BucklingProblem, u: dolfinx.fem.Function
+    problem: Problem, u: dolfinx.fem.Function
 ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.float64], npt.NDArray[np.int32]]:
     """Node coordinates (n, 2), deflection (n,) and triangles (2 per quadrilateral, (m, 3)).
 

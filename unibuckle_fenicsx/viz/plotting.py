@@ -35,7 +35,7 @@ from unibuckle_fenicsx.viz.fields import problem_zone
 if TYPE_CHECKING:  # pragma: no cover
     import dolfinx
 
-    from unibuckle_fenicsx.model.problem import BucklingProblem
+    from unibuckle_fenicsx.model.problem import Problem
 
 __all__ = [
     "THEME",
@@ -128,7 +128,7 @@ def _normalised(w: npt.NDArray[np.float64], tau: float) -> npt.NDArray[np.float6
 
 # -- 3-D mode ----------------------------------------------------------------------------
 def plot_mode_3d(
-    problem: BucklingProblem,
+    problem: Problem,
     mode: dolfinx.fem.Function,
     path: str | Path,
     *,

@@ -29,6 +29,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.analysis import Analysis, solve
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.io import write_fields
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.results import BucklingResult
 from unibuckle_fenicsx.viz import fields, plotting
 
@@ -250,8 +251,8 @@ def mesh_study(
                     )
             if zone is not None and mesh == contact_mesh:
                 xy, w = fields.nodal_deflection(problem, analysis.mode)
-                if problem.contact is None:
-                    raise RuntimeError("a zone without a contact manager (an internal invariant)")
+                if not isinstance(problem, UnilateralProblem):
+                    raise TypeError("a zone without a contact manager (an internal invariant)")
                 if comm.rank == 0:
                     plotting.plot_contact_set(
                         figures / "contact_set.png",
@@ -306,6 +307,8 @@ def all_constrained_load(mesh: tuple[int, int]) -> Callable[[Analysis], dict[str
         problem = analysis.problem
         if (problem.spec.mesh.nx, problem.spec.mesh.ny) != tuple(mesh):
             return {}
+        if not isinstance(problem, UnilateralProblem):
+            raise TypeError("upper_bound_hook: a problem without an obstacle")
         everything = np.arange(problem.num_constrained, dtype=np.int64)
         return {"upper_bound_all_constrained_Pa": problem.evaluate(everything).load}
 

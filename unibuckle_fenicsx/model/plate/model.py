@@ -39,6 +39,9 @@ __all__ = ["PlateModel", "edge_spring_form", "edge_support_bcs", "mitc_shear_mat
 class PlateModel(MixedDofs, Owner):
     r"""Reissner-Mindlin plate with the assembled matrices A (stiffness) and B (geometric).
 
+    A :class:`~unibuckle_fenicsx.model.structure.StructuralModel` whose constrained
+    component is the deflection w.
+
     A is the bending stiffness plus the MITC shear stiffness :math:`P^T M_s P`
     (:func:`~unibuckle_fenicsx.model.plate.spaces.mitc_shear_operator`); B is
     :math:`-\int N^0\nabla w\cdot\nabla z`. Edge-constrained DOFs have zero rows and
@@ -56,7 +59,7 @@ class PlateModel(MixedDofs, Owner):
             become zero Dirichlet conditions, springs diagonal entries of A.
         fixed_prestress: The fixed part of the load: A holds :math:`a - b_{fixed}`, so the
             pencil is :math:`(A - B_{fixed}, B)` (A need not be positive definite then:
-            :class:`~unibuckle_fenicsx.model.problem.BucklingProblem` checks it).
+            :func:`~unibuckle_fenicsx.model.build.build_problem` checks it).
         fixed_factor: Factor on the fixed prestress.
 
     Note:
@@ -155,6 +158,11 @@ class PlateModel(MixedDofs, Owner):
     def w_subspace(self) -> dolfinx.fem.FunctionSpace:
         """The sub-space of W holding w."""
         return self.W.sub(0)
+
+    @property
+    def extent(self) -> float:
+        """The plate's larger side (m)."""
+        return max(self.plate.length, self.plate.width)
 
     def split(self, u: dolfinx.fem.Function) -> tuple[dolfinx.fem.Function, dolfinx.fem.Function]:
         """Deflection and rotation of ``u`` as Functions on collapsed spaces."""
