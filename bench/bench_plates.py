@@ -55,6 +55,7 @@ from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.certify import Certificate
 from unibuckle_fenicsx.config import ObstacleSpec, problem_to_dict
+from unibuckle_fenicsx.results.record import jsonable
 
 #: name -> (edge supports, load, description of the edges)
 CASES = {
@@ -171,7 +172,7 @@ def main() -> None:
                 free_s, ratio, certify_ratio = (
                     statistics.median(column) for column in zip(*runs, strict=True)
                 )
-                levels = sol.details.get("levels", [])
+                levels = jsonable(sol.details).get("levels", [])
                 per_level = ", ".join(
                     f"{'x'.join(map(str, lv['mesh']))}: {lv['newton_steps']}/"
                     f"{lv['factorizations']}/{lv['eigensolves']}"

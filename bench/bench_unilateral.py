@@ -54,7 +54,7 @@ def main() -> None:
             t_uni = time.perf_counter() - t0
             peak = comm.allreduce(resource.getrusage(resource.RUSAGE_SELF).ru_maxrss, op=MPI.MAX)
             d = sol.details
-            solves = f"{d['fine_eigensolves']}+{d['coarse_eigensolves']}c"
+            solves = f"{d.fine_eigensolves}+{d.coarse_eigensolves}c"
             if comm.rank == 0:
                 print(
                     f"{case:5} {f'{nx}x{ny}':>8} {problem.model.num_dofs:7d} {t_free:9.2f} "
@@ -70,8 +70,8 @@ def main() -> None:
                     "free_solve_s": t_free,
                     "unilateral_s": t_uni,
                     "ratio": t_uni / t_free,
-                    "fine_eigensolves": d["fine_eigensolves"],
-                    "coarse_eigensolves": d["coarse_eigensolves"],
+                    "fine_eigensolves": d.fine_eigensolves,
+                    "coarse_eigensolves": d.coarse_eigensolves,
                     "peak_MB": peak / 1024,
                     "load_Pa": sol.load,
                     "contact_nodes": len(sol.active),

@@ -181,7 +181,7 @@ summary = {
     "buckling_coefficient_k": result.buckling_coefficient_k,
     "contact_nodes": result.contact_nodes,
     "method": result.method,
-    "certificate": {k: result.certificate[k] for k in ("kkt", "global_optimum_proven")},
+    "certificate": {k: getattr(result.certificate, k) for k in ("kkt", "global_optimum_proven")},
     "design": {k: design[k] for k in ("relative_slenderness", "psi", "reduction_factor")},
     "design_stress_MPa": design["reduced_design_stress_Pa"] / scale,
     "tie_spacing_study": [
@@ -217,7 +217,7 @@ if comm.rank == 0:
 
 # %%
 RTOL = 1e-8
-assert result.certificate["kkt"], result.certificate
+assert result.certificate.kkt, result.certificate
 assert result.critical_load_Pa >= free.critical_load_Pa * (1 - RTOL)
 assert oriented.max() <= problem.tau, oriented.max()
 assert np.abs(w_ties).max() <= 1e-12, w_ties

@@ -129,8 +129,8 @@ study.check_certified(series.results, RTOL)
 assert series.results[-1].critical_load_Pa <= upper_bound * (1 + RTOL)
 assert paper.ratio_to_free > 1 + RTOL, paper.ratio_to_free
 exact, active = stop_rule["exhaustive enumeration"], stop_rule["active-set"]
-assert exact.certificate["kkt"] and exact.certificate["global_optimum_proven"]
-assert active.certificate["kkt"]
+assert exact.certificate.kkt and exact.certificate.global_optimum_proven
+assert active.certificate.kkt
 assert abs(active.critical_load_Pa / exact.critical_load_Pa - 1) < RTOL
 paper_rule = stop_rule["paper's rule (stop at p*)"]
 assert paper_rule.critical_load_Pa >= exact.critical_load_Pa * (1 - RTOL)

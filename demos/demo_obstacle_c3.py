@@ -92,7 +92,7 @@ if comm.rank == 0:
 # %%
 study.check_certified(series.results, RTOL)
 for point in series.points:
-    tau = point.result.certificate["tolerance"]
+    tau = point.result.certificate.tolerance
     assert point.extra["max_w"] <= tau, (point.mesh, point.extra["max_w"])
 assert paper.ratio_to_free > 1 + RTOL, paper.ratio_to_free
 if comm.rank == 0:

@@ -143,7 +143,7 @@ summary = {
     "contact_nodes": result.contact_nodes,
     "method": result.method,
     "eigensolves": result.eigensolves,
-    "certificate": {k: result.certificate[k] for k in ("kkt", "global_optimum_proven")},
+    "certificate": {k: getattr(result.certificate, k) for k in ("kkt", "global_optimum_proven")},
 }
 if comm.rank == 0:
     print(result.summary())
@@ -162,7 +162,7 @@ if comm.rank == 0:
 
 # %%
 RTOL = 1e-8
-assert result.certificate["kkt"], result.certificate
+assert result.certificate.kkt, result.certificate
 assert result.critical_load_Pa >= result.free_load_Pa * (1 - RTOL)
 assert oriented.max() <= problem.tau, oriented.max()
 r = np.hypot(xy_zone[:, 0] - 0.5, xy_zone[:, 1] - 0.2)

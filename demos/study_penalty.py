@@ -129,7 +129,7 @@ for zone, (nx, ny) in ZONES.items():
     cert = certify(problem, exact)
     assert cert.kkt and cert.global_optimum_proven, cert
     ref, lam_ref = exact.candidate, exact.load
-    evals = exact.details["bound_evaluations"]
+    evals = exact.details.bound_evaluations
     w_ref = deflection(ref.mode)
     paper_rule = enumerate_contact_sets(problem, max_candidates=2**62)
     pen = PenaltySolver(problem)
@@ -155,13 +155,13 @@ for zone, (nx, ny) in ZONES.items():
                 "rho": rho,
                 "load": cold.load,
                 "gap": (lam_ref - cold.load) / lam_ref,
-                "penetration": d["penalty_max_penetration"],
-                "cond": d["penalty_condition_number"],
+                "penetration": d.penalty_max_penetration,
+                "cond": d.penalty_condition_number,
                 "solves_cold": cold.eigensolves,
                 "solves_warm": warm.eigensolves,
                 "warm_vs_cold": abs(warm.load - cold.load) / lam_ref,
                 "warm_mode_vs_cold": distance(w_warm, w),
-                "status": d["penalty_status"],
+                "status": d.penalty_status,
                 "set_size": len(cold.active),
                 "set_is_ref": bool(np.array_equal(cold.active, ref.active)),
                 "dmode_prev": np.nan if prev_w is None else distance(w, prev_w),

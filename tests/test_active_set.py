@@ -48,6 +48,7 @@ from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.config import ObstacleSpec, ProblemSpec
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import UnilateralProblem
+from unibuckle_fenicsx.results.record import jsonable
 
 HERE = Path(__file__).resolve().parent
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
@@ -85,8 +86,8 @@ def test_random_family_matches_exhaustive_enumeration(family):
         z = tuple(int(k) for k in sol.active)
         rel = abs(sol.load - best) / best
         report.append((spec.name, problem.num_constrained, rel, len(minimisers)))
-        assert best > sol.details["free_load"] * (1 + RTOL)  # the obstacle is active
-        assert certify(problem, sol).kkt, (spec.name, sol.details.get("warning"))
+        assert best > sol.details.free_load * (1 + RTOL)  # the obstacle is active
+        assert certify(problem, sol).kkt, (spec.name, jsonable(sol.details).get("warning"))
         assert sol.load >= best * (1 - RTOL)  # a feasible load is an upper bound
         assert sol.lower_bound <= best * (1 + RTOL)
         if rel > RTOL or z not in minimisers:
@@ -115,9 +116,9 @@ def test_lattice_bound_is_valid_and_closes(family):
         sol = solve_active_set(problem, bound_budget=512)
         best, _, _ = exhaustive_minimum(problem)
         assert sol.lower_bound <= best * (1 + 1e-10)
-        assert sol.lower_bound >= sol.details["free_load"] * (1 - 1e-10)
+        assert sol.lower_bound >= sol.details.free_load * (1 - 1e-10)
         assert abs(sol.load - best) <= RTOL * best
-        if sol.details["bound_search_complete"]:
+        if sol.details.bound_search_complete:
             assert sol.global_optimum_proven
         proven += sol.global_optimum_proven
         problem.destroy()
@@ -159,10 +160,10 @@ def test_multilevel_equals_single_level():
         problem.solve_free()
         multi = solve_active_set(problem, bound_budget=0)
         single = solve_active_set(problem, multilevel=False, bound_budget=0)
-        assert multi.details["levels"], "expected a coarse level"
+        assert multi.details.levels, "expected a coarse level"
         assert abs(multi.load - single.load) <= RTOL * single.load
         assert np.array_equal(multi.active, single.active)
-        assert multi.details["fine_eigensolves"] < single.details["fine_eigensolves"]
+        assert multi.details.fine_eigensolves < single.details.fine_eigensolves
         problem.destroy()
 
 
@@ -178,8 +179,8 @@ def test_fine_polish_solves_below_the_extrapolated_load():
     solver = problem.eigensolver
     shifted, again = solver.shifted_solves, solver.unshifted_again
     solution = solve_active_set(problem, bound_budget=0)
-    assert solution.details["fine_eigensolves"] >= 1
-    assert solver.shifted_solves - shifted == solution.details["fine_eigensolves"]
+    assert solution.details.fine_eigensolves >= 1
+    assert solver.shifted_solves - shifted == solution.details.fine_eigensolves
     assert solver.unshifted_again == again
     cold = problem.evaluate(solution.active)
     problem.destroy()

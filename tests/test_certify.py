@@ -50,7 +50,7 @@ def test_paper_cases_are_proven(case):
         assert cert.proven_by == "rank2-spn"
         assert cert.relative_gap <= PROOF_GAP
         assert cert.lower_bound <= analysis.result.critical_load_Pa <= cert.upper_bound
-        assert cert.copositivity["factorisations"] == 1
+        assert cert.copositivity.factorisations == 1
         assert cert.smallest_of_reduced is True  # checked on every route, proven or not
 
 
@@ -183,8 +183,8 @@ def test_off_centre_zone_is_proven_by_the_search(zone):
         cert = analysis.certificate
     assert cert.global_optimum_proven, cert
     assert cert.proven_by == "rank2-spn"
-    assert "mirror" not in cert.copositivity["margins"]["w_minus"]
-    assert np.isfinite(cert.copositivity["margins"]["beta"])
+    assert "mirror" not in cert.copositivity.margins.w_minus
+    assert np.isfinite(cert.copositivity.margins.beta)
 
 
 def test_reduced_inertia_reuses_the_copositivity_factorisation():

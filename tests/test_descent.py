@@ -169,9 +169,9 @@ def test_descent_answers_where_the_iterations_stall(long_clamped):
     above it (by 6 % here, 1.7 % at b/12).
     """
     problem, sol = long_clamped
-    fallback = sol.details["fallback"]
-    assert fallback["status"] != "kkt"  # the penalty continuation stalled
-    assert fallback["descent"]["status"] == "kkt"
+    fallback = sol.details.fallback
+    assert fallback.status != "kkt"  # the penalty continuation stalled
+    assert fallback.descent.status == "kkt"
     assert certify(problem, sol).kkt
     assert math.isfinite(sol.upper_bound)
     k = problem.buckling_coefficient(sol.load)

@@ -144,7 +144,7 @@ def test_exact_modes_match_brute_force(solved, name):
         assert tuple(sol.active) == set_ref, mode
         assert sol.global_optimum_proven and sol.lower_bound == pytest.approx(sol.load, rel=RTOL)
         assert cert.kkt, (mode, cert)
-    assert runs["complete"][0].details["monotone"] is ref["monotone"]
+    assert runs["complete"][0].details.monotone is ref["monotone"]
     assert runs["proven"][0].eigensolves <= runs["complete"][0].eigensolves
 
 
@@ -192,7 +192,7 @@ def test_paper_rule_not_exact_on_c1_8x4(solved):
     assert not ref["monotone"]
     assert sol.p_star == 2 and not sol.global_optimum_proven
     assert sol.load > 1.15 * ref["optimum"][0]
-    assert runs["complete"][0].details["monotone"] is False
+    assert runs["complete"][0].details.monotone is False
     assert list(runs["proven"][0].active) == [0, 3, 6]
 
 

@@ -142,7 +142,7 @@ def test_a_bilateral_foundation_goes_with_a_rigid_obstacle():
     }
     spec = problem_from_dict(data).with_mesh(12, 6)
     with solve(spec) as analysis:
-        assert analysis.result.method != "foundation" and analysis.result.certificate["kkt"]
+        assert analysis.result.method != "foundation" and analysis.result.certificate.kkt
 
 
 # -- the spring term ---------------------------------------------------------------------
@@ -189,7 +189,7 @@ def test_foundation_the_free_mode_turns_away_from_is_proven_inactive():
         result = analysis.result
     assert result.method == "foundation" and result.contact_nodes == 0
     assert result.critical_load_Pa == pytest.approx(result.free_load_Pa, rel=1e-10)
-    assert result.certificate["kkt"] and result.certificate["global_optimum_proven"]
+    assert result.certificate.kkt and result.certificate.global_optimum_proven
 
 
 def test_the_foundation_certificate_reads_the_typed_status_never_a_default():
@@ -203,7 +203,7 @@ def test_the_foundation_certificate_reads_the_typed_status_never_a_default():
     with solve(spec) as analysis:
         solution = analysis.solution
         assert solution is not None and solution.status is RunStatus.CONVERGED
-        assert analysis.result.details["foundation_status"] == "converged"
+        assert analysis.result.details.run.foundation_status == "converged"
         with pytest.raises(ValueError, match=r"solution\.status"):
             certify_foundation(analysis.problem, replace(solution, status=None))
         stalled = certify_foundation(
@@ -231,7 +231,7 @@ def test_tensionless_foundation_lies_between_free_and_rigid_and_grows(supports):
         free = analysis.result.buckling_coefficient_k
     with solve(replace(base, obstacle=ObstacleSpec("all"))) as analysis:
         rigid = analysis.result.buckling_coefficient_k
-        assert analysis.result.certificate["kkt"]
+        assert analysis.result.certificate.kkt
     ks = []
     for K in (1.0, 10.0, 100.0, 1e3, 1e4):
         with solve(
@@ -278,7 +278,7 @@ def test_tensionless_limit_tends_to_sixteen_thirds():
             rigid.append(analysis.result.buckling_coefficient_k)
         zone = ObstacleSpec("all", foundation_stiffness=modulus(1e4))
         with solve(replace(spec, obstacle=zone)) as analysis:
-            assert analysis.result.certificate["kkt"]
+            assert analysis.result.certificate.kkt
             soft.append(analysis.result.buckling_coefficient_k)
     for s, r in zip(soft, rigid, strict=True):
         assert s <= r * (1 + 1e-8) and s == pytest.approx(r, rel=1e-3)

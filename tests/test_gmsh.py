@@ -232,8 +232,8 @@ def test_gmsh_rectangle_reproduces_the_structured_mesh():
     assert abs(ours.free_load_Pa - structured.free_load_Pa) < 1e-3 * error
     assert abs(ours.critical_load_Pa - structured.critical_load_Pa) < 1e-3 * error
     assert ours.contact_coordinates == structured.contact_coordinates
-    assert ours.certificate["kkt"] and ours.mesh == [200]
-    assert ours.details["seeded_on"] == "fine"
+    assert ours.certificate.kkt and ours.mesh == [200]
+    assert ours.details.run.seeded_on == "fine"
 
 
 def _outline_and_structured(corners, zone, size=0.01):
@@ -295,7 +295,7 @@ def test_gmsh_rectangle_anywhere_equals_the_structured_mesh(corners, zone):
         atol=1e-12,
     )
     for report in (ours.obstacle_zones[0], grid.obstacle_zones[0]):
-        assert report["discrete_area_m2"] == pytest.approx(report["area_m2"], rel=1e-12)
+        assert report.discrete_area_m2 == pytest.approx(report.area_m2, rel=1e-12)
 
 
 @pytest.mark.parametrize("size", [0.05, 0.01])
@@ -327,8 +327,8 @@ def test_circular_zone_is_the_circle(size):
         n_owned = problem.mesh.geometry.index_map().size_local
         on_circle = np.abs(np.hypot(x[:n_owned, 0] - 0.1, x[:n_owned, 1] - 0.05) - r) < 1e-12
         count = MPI.COMM_WORLD.allreduce(int(on_circle.sum()), op=MPI.SUM)
-    assert report["area_m2"] == pytest.approx(np.pi * r**2, rel=1e-6)
-    assert 0.99 * np.pi * r**2 < report["discrete_area_m2"] <= np.pi * r**2
+    assert report.area_m2 == pytest.approx(np.pi * r**2, rel=1e-6)
+    assert 0.99 * np.pi * r**2 < report.discrete_area_m2 <= np.pi * r**2
     assert count >= 32
 
 
@@ -350,9 +350,9 @@ def test_structured_zone_off_the_grid_is_reported(tmp_path, capsys):
         summary
     )
     (report,) = json.loads(out.read_text())["obstacle_zones"]
-    assert report["area_m2"] == pytest.approx(0.007, rel=1e-12)
-    assert report["discrete_area_m2"] == pytest.approx(0.006, rel=1e-12)
-    assert report["nodes"] == 77
+    assert report.area_m2 == pytest.approx(0.007, rel=1e-12)
+    assert report.discrete_area_m2 == pytest.approx(0.006, rel=1e-12)
+    assert report.nodes == 77
 
 
 def test_unnamed_boundary_parts_are_free():
@@ -540,7 +540,7 @@ def test_holed_plate_with_an_obstacle_is_certified():
     with solve(spec) as analysis:
         result = analysis.result
         xy = analysis.problem.contact.coordinates
-    assert result.certificate["kkt"] and result.ratio_to_free >= 1 - 1e-8
+    assert result.certificate.kkt and result.ratio_to_free >= 1 - 1e-8
     assert np.hypot(xy[:, 0], xy[:, 1]).min() >= 0.15 * np.cos(np.pi / 16) - 1e-9
 
 
@@ -568,8 +568,8 @@ def test_thin_holed_plate_is_nested_over_gmsh_meshes():
             sol = solve_unilateral(problem, options)
             assert sol.method == "interior-point" and sol.candidate.kkt
             loads.append(sol.load)
-            meshes.append([level["mesh"] for level in sol.details["levels"]])
-            seeds = [link["seed"] for level in sol.details["levels"] for link in level["links"]]
+            meshes.append([level.mesh for level in sol.details.levels])
+            seeds = [link.seed for level in sol.details.levels for link in level.links]
     # On one mesh nothing is made for a finer one (central-path points to carry).
     assert not any("kept flat" in s or "lifted" in s or "after polish" in s for s in seeds)
     assert meshes == [[["h=0.0125"], ["h=0.00625"]], [["h=0.00625"]]]

@@ -62,6 +62,7 @@ from unibuckle_fenicsx.cases import paper_case, plate_case
 from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import UnilateralProblem
+from unibuckle_fenicsx.results.record import jsonable
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 PARALLEL = Path(__file__).parent / "mpi" / "interior_point_parallel.py"
@@ -368,7 +369,7 @@ def _route(spec) -> dict:
             "kkt": cert.kkt,
             "smallest": cert.smallest_of_reduced,
             "on_contact": float(np.abs(values[sol.active]).max(initial=0.0)),
-            "levels": sol.details.get("levels", []),
+            "levels": jsonable(sol.details).get("levels", []),
         }
 
 
@@ -532,7 +533,7 @@ def test_starts_on_one_central_path_are_not_taken_further():
     problem = build_problem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
     short = solve_unilateral(problem, ChainOptions())
     full = solve_unilateral(problem, ChainOptions(twin_rtol=0.0, path_rtol=0.0))
-    coarse = [sol.details["levels"][0] for sol in (short, full)]
+    coarse = [jsonable(sol.details.levels[0]) for sol in (short, full)]
     assert "met before" in [link["status"] for link in coarse[0]["links"]]
     assert "met before" not in [link["status"] for link in coarse[1]["links"]]
     assert coarse[0]["newton_steps"] < coarse[1]["newton_steps"]
@@ -699,7 +700,7 @@ def test_a_set_predicted_twice_in_a_row_is_read_before_the_barrier_problem_is_so
     problem = build_problem(_thin("ssss", nx=60, ny=20), MPI.COMM_SELF)
     stable = solve_unilateral(problem, ChainOptions())
     solved = solve_unilateral(problem, ChainOptions(read_stable=False))
-    fine = [sol.details["levels"][-1] for sol in (stable, solved)]
+    fine = [jsonable(sol.details.levels[-1]) for sol in (stable, solved)]
     labels = [[link["seed"] for link in level["links"]] for level in fine]
     assert any("(stable at 1e-09)" in label for label in labels[0])
     assert not any("stable" in label for label in labels[1])
@@ -721,7 +722,7 @@ def test_fine_mesh_read_early_gives_the_load_read_at_the_end():
     problem = build_problem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
     early = solve_unilateral(problem, ChainOptions())
     late = solve_unilateral(problem, ChainOptions(read_mu=0.0))
-    fine = [sol.details["levels"][-1] for sol in (early, late)]
+    fine = [jsonable(sol.details.levels[-1]) for sol in (early, late)]
     assert "read" in [link["status"] for link in fine[0]["links"]]
     assert "read" not in [link["status"] for link in fine[1]["links"]]
     assert fine[0]["newton_steps"] < fine[1]["newton_steps"]

@@ -229,7 +229,7 @@ def test_contact_set_below_the_knee_is_the_linear_one():
     options = NonlinearOptions(imperfection=1e-3, max_load=0.9)
     with solve_nonlinear(paper_case("c1", 12, 6), options) as analysis:
         plate, linear = analysis.plate, analysis.linear.result
-        assert linear.certificate["kkt"] and linear.contact_nodes > 0
+        assert linear.certificate.kkt and linear.contact_nodes > 0
         touching = plate.contact.coordinates[plate.contact_nodes()]
         np.testing.assert_allclose(
             touching, np.asarray(linear.contact_coordinates), rtol=0, atol=1e-12

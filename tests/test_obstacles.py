@@ -144,7 +144,7 @@ def test_obstacle_below_is_the_mirror_of_above():
     above, below = results["above"], results["below"]
     assert below.critical_load_Pa == pytest.approx(above.critical_load_Pa, rel=1e-10)
     assert below.contact_indices == above.contact_indices and above.contact_nodes == 5
-    assert below.certificate["kkt"] and below.certificate["global_optimum_proven"]
+    assert below.certificate.kkt and below.certificate.global_optimum_proven
 
 
 def _two_sided_square(side_right):
@@ -173,7 +173,7 @@ def test_obstacles_on_opposite_sides_against_the_exhaustive_minimum(side_right):
     with solve(spec) as analysis:
         result = analysis.result
         reference, minimisers, _ = exhaustive_minimum(analysis.problem)
-    assert result.constrained_nodes == 12 and result.certificate["kkt"]
+    assert result.constrained_nodes == 12 and result.certificate.kkt
     assert result.critical_load_Pa == pytest.approx(reference, rel=RTOL)
     assert tuple(result.contact_indices) in minimisers
     ratio = result.critical_load_Pa / result.free_load_Pa

@@ -56,10 +56,10 @@ def test_penalty_is_monotone_and_tends_to_the_exact_load_from_below(c1_small):
         sol = solve_penalty(problem, rho)
         assert not sol.global_optimum_proven
         assert sol.lower_bound == pytest.approx(free, rel=LOAD_RTOL)
-        assert sol.details["penalty_status"] == "converged"
+        assert sol.details.penalty_status == "converged"
         loads.append(sol.load)
         gaps.append((exact - sol.load) / exact)
-        pens.append(sol.details["penalty_max_penetration"])
+        pens.append(sol.details.penalty_max_penetration)
     loads_a = np.array(loads)
     assert np.all(np.diff(loads_a) >= -LOAD_RTOL * exact), loads
     assert np.all(loads_a <= exact * (1 + LOAD_RTOL)), (loads, exact)
@@ -89,7 +89,7 @@ def test_certificate_rejects_a_penetrating_penalty_mode(c1_small):
     """At rho = 1 the mode penetrates by ~2.5e-3 on its spring set: not feasible (tau 1e-8)."""
     problem, _, _ = c1_small
     sol = solve_penalty(problem, 1.0)
-    assert sol.details["penalty_max_penetration"] > 1e-4
+    assert sol.details.penalty_max_penetration > 1e-4
     assert not certify(problem, sol).feasible
 
 
@@ -110,10 +110,10 @@ def test_condition_number_matches_dense_eigenvalues():
         keep = np.setdiff1d(np.arange(n), problem.model.bc_dofs)
         eig = np.linalg.eigvalsh(dense[np.ix_(keep, keep)])
         details = sol.details
-        assert details["penalty_eig_min_A_pen"] == pytest.approx(eig[0], rel=1e-6)
-        assert details["penalty_eig_max_A_pen"] == pytest.approx(eig[-1], rel=1e-6)
+        assert details.penalty_eig_min_A_pen == pytest.approx(eig[0], rel=1e-6)
+        assert details.penalty_eig_max_A_pen == pytest.approx(eig[-1], rel=1e-6)
         # The springs sit on the diagonal: the largest eigenvalue is about rho_abs.
-        assert eig[-1] >= details["penalty_rho_abs"]
+        assert eig[-1] >= details.penalty_rho_abs
     finally:
         pen.destroy()
         problem.destroy()

@@ -146,10 +146,10 @@ def test_snap_distance_is_reported():
     """A point off the grid acts on the nearest node; the JSON and the summary say how far."""
     spec = plate(4, aspect=2.0, points=[PointSpec(at=(0.55, 0.5)), PointSpec(at=(1.5, 0.5))])
     out = result(spec)
-    first, second = out.details["point_restraints"]
-    assert first["points"] == first["nodes"] == 1
-    assert first["max_snap_distance_m"] == pytest.approx(0.05, rel=1e-12)  # node at x = 0.5
-    assert second["max_snap_distance_m"] == pytest.approx(0.0, abs=1e-15)
+    first, second = out.details.point_restraints
+    assert first.points == first.nodes == 1
+    assert first.max_snap_distance_m == pytest.approx(0.05, rel=1e-12)  # node at x = 0.5
+    assert second.max_snap_distance_m == pytest.approx(0.0, abs=1e-15)
     assert "largest snap distance 0.05 m" in out.summary()
 
 
@@ -161,7 +161,7 @@ def test_the_summary_describes_points_in_the_file_s_units():
     spring = PointSpec(at=(1.5, 0.5), kind="spring", stiffness=1.0e5)
     out = result(replace(plate(4, aspect=2.0, points=[spring]), units="mm-N-MPa"))
     assert "points: spring 100 N/mm at (1500, 500) mm: 1 points on 1 nodes" in out.summary()
-    assert out.details["point_restraints"][0]["restraint"] == "spring 100000 N/m at (1.5, 0.5) m"
+    assert out.details.point_restraints[0].restraint == "spring 100000 N/m at (1.5, 0.5) m"
 
 
 # -- bilateral ties ------------------------------------------------------------------------
@@ -205,7 +205,7 @@ def test_one_sided_points_against_the_hermite_plate():
     k = []
     for n in (16, 32):
         out = result(plate(n, aspect=2.0, points=points))
-        assert out.certificate["kkt"] and out.constrained_nodes == 2 and out.contact_nodes == 1
+        assert out.certificate.kkt and out.constrained_nodes == 2 and out.contact_nodes == 1
         k.append(out.buckling_coefficient_k)
     richardson = (4 * k[1] - k[0]) / 3
     assert richardson == pytest.approx(reference, rel=1e-4), (k, richardson, reference)

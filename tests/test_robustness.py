@@ -32,8 +32,8 @@ from unibuckle_fenicsx.cli import (
 )
 from unibuckle_fenicsx.config import problem_from_dict
 from unibuckle_fenicsx.config.checks import MAX_THICKNESS_RATIO, THICK_PLATE_RATIO
-from unibuckle_fenicsx.io import file_stem
-from unibuckle_fenicsx.results import versions
+from unibuckle_fenicsx.results.assemble import versions
+from unibuckle_fenicsx.results.files import file_stem
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs its own processes")

@@ -367,7 +367,7 @@ def test_a_thin_plate_line_is_the_same_on_every_run():
     for _ in range(2):
         with solve(spec) as analysis:
             assert analysis.result.method.startswith("interior-point")
-            assert analysis.result.details["levels"][0]["seconds"] > 0.0
+            assert analysis.result.details.run.levels[0].seconds > 0.0
             lines.append(json.dumps(analysis.result.as_dict(timings=False), sort_keys=True))
     assert lines[0] == lines[1]
     assert '"seconds"' not in lines[0]

@@ -167,7 +167,7 @@ def test_a_fixed_multiple_of_the_scaled_load_shifts_lambda(case):
     assert b.critical_load_factor == b.critical_load_Pa
     assert b.contact_indices == a.contact_indices
     if case == "c1":
-        assert a.contact_nodes > 0 and b.certificate["kkt"]
+        assert a.contact_nodes > 0 and b.certificate.kkt
 
 
 def test_a_fixed_load_that_buckles_the_plate_alone_is_refused():

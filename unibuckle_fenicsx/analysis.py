@@ -19,7 +19,8 @@ from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
-from unibuckle_fenicsx.results import BucklingResult
+from unibuckle_fenicsx.results.assemble import assemble_result
+from unibuckle_fenicsx.results.record import BucklingResult
 
 __all__ = ["Analysis", "choose_method", "solve"]
 
@@ -136,7 +137,7 @@ class Analysis(Owner):
     """What :func:`solve` returns: the result, the critical mode and the set-up problem.
 
     Attributes:
-        result: JSON-ready numbers (:class:`~unibuckle_fenicsx.results.BucklingResult`).
+        result: The result's records (:class:`~unibuckle_fenicsx.results.record.BucklingResult`).
         problem: The set-up problem (mesh, pencil, contact manager, free mode).
         solution: The unilateral algorithm's solution (None without obstacle).
         certificate: Its certificate (None without obstacle).
@@ -281,14 +282,13 @@ def _analyse(
                 "the %s result fails its certificate: %s",
                 method, "; ".join(certificate.notes) or certificate.status,
             )  # fmt: skip
-    result = BucklingResult.from_solution(
+    result = assemble_result(
         problem,
         free,
         solution,
         certificate,
-        method=method if solution is None else solution.method,
         wall_time_s=time.perf_counter() - t0,
         mpi_size=comm.size,
+        method_chosen_by=reason,
     )
-    result.method_chosen_by = reason
     return Analysis(result, problem, solution, certificate)

@@ -661,7 +661,7 @@ def _run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> int:
 def _solve(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle solve``: one problem, its summary, JSON and fields."""
     from unibuckle_fenicsx.analysis import solve
-    from unibuckle_fenicsx.io import write_fields, write_json
+    from unibuckle_fenicsx.results.files import write_fields, write_json
 
     # A refused input or a failed solve raises: main() tells the outcome.
     spec = _spec_from_args(args)
@@ -690,7 +690,8 @@ def _solve(args: argparse.Namespace, comm: Any) -> int:
                 unwritten = f"--json {args.json}: {err}"
         print(result.summary(), flush=True)
         if outcome is not Outcome.OK:
-            notes = "; ".join((certificate or {}).get("notes", [])) or "see the certificate"
+            notes = "; ".join([] if certificate is None else certificate.notes)
+            notes = notes or "see the certificate"
             print(
                 f"unibuckle: error: no certified critical state ({notes}); the bracket "
                 f"[{result.lower_bound_Pa}, {result.upper_bound_Pa}] Pa is "

@@ -25,12 +25,13 @@ stress's.
 from __future__ import annotations
 
 import math
-from typing import Any
+
+from msgspec import UNSET, Struct, UnsetType
 
 from unibuckle_fenicsx.config import DesignSpec, ProblemSpec, stress_ends
 from unibuckle_fenicsx.errors import InputError
 
-__all__ = ["CLAUSES", "design_output", "reduction_factor"]
+__all__ = ["CLAUSES", "DesignRecord", "design_output", "reduction_factor"]
 
 #: The clauses the design output rests on.
 CLAUSES = (
@@ -43,6 +44,38 @@ CALIBRATION = (
     "EN 1993-1-5's rho (4.2) was calibrated on plates buckling freely to both sides "
     "(bilateral buckling); it is applied here to this package's sigma_cr"
 )
+
+
+class DesignRecord(Struct, kw_only=True):
+    r"""The design quantities of a critical load (the JSON's ``design``).
+
+    Attributes:
+        yield_stress_Pa: :math:`f_y`.
+        partial_factor: :math:`\gamma_{M1}`.
+        edge: The loaded edge of the largest compression.
+        sigma_cr_Pa: :math:`\sigma_1`, that compression at the critical load.
+        clauses: The clauses applied.
+        notes: What the output rests on, and what it leaves out.
+        psi: :math:`\psi = \sigma_2/\sigma_1` along that edge.
+        relative_slenderness: :math:`ar\lambda_p` (4.3).
+        reduction_factor: :math:`
+    ho` (4.2); None for :math:`\psi < -3`.
+        reduced_design_stress_Pa: :math:`
+    ho f_y/\gamma_{M1}` (absent without
+            :math:`
+    ho`).
+    """
+
+    yield_stress_Pa: float
+    partial_factor: float
+    edge: str
+    sigma_cr_Pa: float
+    clauses: str
+    notes: list[str]
+    psi: float = 0.0
+    relative_slenderness: float = 0.0
+    reduction_factor: float | None = None
+    reduced_design_stress_Pa: float | UnsetType = UNSET
 
 
 def reduction_factor(slenderness: float, psi: float) -> float:
@@ -70,19 +103,19 @@ def _critical_edge_stress(spec: ProblemSpec, load: float) -> tuple[float, float,
     return best
 
 
-def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> dict[str, Any]:
-    """The design quantities of the critical load ``load`` (JSON-ready), see the docstring."""
+def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignRecord:
+    """The design quantities of the critical load ``load``, see the module docstring."""
     sigma1, sigma2, edge = _critical_edge_stress(spec, load)
-    out: dict[str, Any] = {
-        "yield_stress_Pa": design.yield_stress,
-        "partial_factor": design.partial_factor,
-        "edge": edge,
-        "sigma_cr_Pa": sigma1,
-        "clauses": CLAUSES,
-        "notes": [CALIBRATION],
-    }
+    out = DesignRecord(
+        yield_stress_Pa=design.yield_stress,
+        partial_factor=design.partial_factor,
+        edge=edge,
+        sigma_cr_Pa=sigma1,
+        clauses=CLAUSES,
+        notes=[CALIBRATION],
+    )
     if spec.all_obstacles or spec.one_sided_points:
-        out["notes"].append(
+        out.notes.append(
             "with an obstacle sigma_cr is the unilateral critical stress: outside the "
             "calibration of (4.2)"
         )
@@ -91,19 +124,18 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> dict[st
         for e in spec.plate.edges
     )
     if shear:
-        out["notes"].append(
+        out.notes.append(
             "the load has shear: EN 1993-1-5 section 10 (reduced stress method) would "
             "combine it; rho here is the direct stress's, with this sigma_cr"
         )
     psi = sigma2 / sigma1 + 0.0  # no -0.0
-    out["psi"] = psi
+    out.psi = psi
     slenderness = math.sqrt(design.yield_stress / sigma1)
-    out["relative_slenderness"] = slenderness
+    out.relative_slenderness = slenderness
     if psi < -3.0:
-        out["reduction_factor"] = None
-        out["notes"].append(f"psi = {psi:.3g} < -3: outside Table 4.1, no rho")
+        out.notes.append(f"psi = {psi:.3g} < -3: outside Table 4.1, no rho")
         return out
     rho = reduction_factor(slenderness, min(psi, 1.0))
-    out["reduction_factor"] = rho
-    out["reduced_design_stress_Pa"] = rho * design.yield_stress / design.partial_factor
+    out.reduction_factor = rho
+    out.reduced_design_stress_Pa = rho * design.yield_stress / design.partial_factor
     return out

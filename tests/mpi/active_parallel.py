@@ -15,6 +15,7 @@ from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.config import load_problem
 from unibuckle_fenicsx.model.build import build_problem
+from unibuckle_fenicsx.results.record import jsonable
 
 if sys.argv[1].endswith((".json", ".toml")):
     spec = load_problem(sys.argv[1])
@@ -35,7 +36,7 @@ if MPI.COMM_WORLD.rank == 0:
                 "load": sol.load,
                 "coordinates": coords,
                 "kkt": sol.candidate.kkt,
-                "fallback": sol.details.get("fallback"),
+                "fallback": jsonable(sol.details).get("fallback"),
             }
         )
     )

@@ -35,8 +35,8 @@ def run(case: str, nx: int, ny: int, complete: bool, candidate_parallel: bool) -
         "p_star": result.p_star,
         "eigensolves": result.eigensolves,
         "mode_spread": spread,
-        "kkt": result.certificate["kkt"],
-        "ranks": result.details["candidate_ranks"],
+        "kkt": result.certificate.kkt,
+        "ranks": result.details.run.candidate_ranks,
     }
 
 

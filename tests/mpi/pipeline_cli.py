@@ -2,7 +2,8 @@
 
 ``mpiexec -n P python tests/mpi/pipeline_cli.py OUTDIR -- CLI ARGS...`` runs
 ``unibuckle solve CLI ARGS --json OUTDIR/result.json --output OUTDIR/vtx`` with
-:func:`unibuckle_fenicsx.io.write_json` and :func:`unibuckle_fenicsx.io.write_fields`
+:func:`unibuckle_fenicsx.results.files.write_json` and
+:func:`unibuckle_fenicsx.results.files.write_fields`
 wrapped to count their calls per rank, and prints on rank 0 a JSON line
 ``{"status": [...], "json_writes": [...], "vtx_calls": [...]}`` (one entry per rank).
 """
@@ -15,7 +16,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
-import unibuckle_fenicsx.io as results
+import unibuckle_fenicsx.results.files as results
 from unibuckle_fenicsx.cli import main as cli_main
 
 

@@ -35,6 +35,8 @@ from unibuckle_fenicsx.config import MeshSpec
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.prestress import solve_prestress
+from unibuckle_fenicsx.results.assemble import certificate_record
+from unibuckle_fenicsx.results.record import jsonable
 
 
 def same_on_all_ranks(comm: MPI.Comm, value: object) -> bool:
@@ -148,7 +150,7 @@ def collect(comm: MPI.Comm, nx: int, ny: int, quick: bool = False) -> dict[str, 
             "values": cand.values.tolist(),
         }
         if np.isfinite(cand.load) and active:
-            entry["certificate"] = certify(problem, cand).as_dict()
+            entry["certificate"] = jsonable(certificate_record(certify(problem, cand)))
         assert same_on_all_ranks(comm, entry), name
         candidates[name] = entry
     out["candidates"] = candidates

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 from enum import StrEnum
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING
 
 # Before any module of this package imports petsc4py or DOLFINx: mpi4py loads the MPI
 # library they link to (with the PyPI wheel, petsc4py alone fails to find libmpi).
@@ -24,6 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.algorithms.records import MethodDetails
     from unibuckle_fenicsx.model.problem import Candidate
 
 __all__ = ["RunStatus", "UnilateralSolution", "candidate_count"]
@@ -69,13 +70,16 @@ class UnilateralSolution:
             tolerance), or the search was exhaustive.
         upper_bound: The load of an admissible mode (``inf`` if the method found none,
             e.g. the penalty method, whose modes penetrate).
+        details: The algorithm's record of its run (None for a bare candidate).
+        route: The links that answered, in order (the method alone when it answered by
+            itself; the interior point's polish or descent, or its active-set fallback,
+            after it).
         kkt_points: Other KKT points met (distinct contact sets), for the certificate.
         p_star: Size of the contact set at which enumeration stopped (None otherwise).
         lower_bound_by: What proves ``lower_bound``: "enumeration", "lattice", or None when
             it is the free load (interlacing: the obstacle never lowers the load).
         status: How the method's iteration ended, for methods whose certificate depends on
             it (the foundation's spring-set iteration); None for the others.
-        details: Method-specific, JSON-ready information.
     """
 
     candidate: Candidate
@@ -84,25 +88,16 @@ class UnilateralSolution:
     lower_bound: float
     global_optimum_proven: bool
     upper_bound: float
+    details: MethodDetails | None = None
+    route: list[str] = field(default_factory=list)
     kkt_points: list[Candidate] = field(default_factory=list)
     p_star: int | None = None
     lower_bound_by: str | None = None
     status: RunStatus | None = None
-    details: dict[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
-        # The chain still hands ``lower_bound_by`` over in ``details``: lift it to the field.
-        if self.lower_bound_by is None and "lower_bound_by" in self.details:
-            self.lower_bound_by = str(self.details.pop("lower_bound_by"))
-
-    def report(self) -> dict[str, Any]:
-        """``details`` with the typed fields under their JSON keys (the output's "details")."""
-        out: dict[str, Any] = dict(self.details)
-        if self.lower_bound_by is not None:
-            out["lower_bound_by"] = self.lower_bound_by
-        if self.status is not None and self.method == "foundation":
-            out["foundation_status"] = str(self.status)
-        return out
+        if not self.route:
+            self.route = [self.method]
 
     @property
     def load(self) -> float:

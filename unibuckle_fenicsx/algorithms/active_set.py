@@ -56,10 +56,10 @@ from __future__ import annotations
 import logging
 import math
 import time
-from typing import Any
 
 import numpy as np
 import numpy.typing as npt
+from msgspec import UNSET, UnsetType
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
@@ -67,6 +67,13 @@ from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
+from unibuckle_fenicsx.algorithms.records import (
+    ActiveSetDetails,
+    ActiveSetLevel,
+    DescentRecord,
+    Fallback,
+    KktPoint,
+)
 from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.model.build import build_unilateral_problem
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
@@ -324,12 +331,13 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
     solves0 = problem.eigensolver.solves
     free_load = problem.solve_free().load
     spec = problem.spec
-    details: dict[str, Any] = {"free_load": free_load}
+    seeded_on: list[int] | str
+    fallback: Fallback | UnsetType = UNSET
     structured = multilevel and problem.structured  # coarse copies need spec.mesh
     levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
     coarse_solves = 0
     penalty_solves = 0  # the penalty solver has its own eigen solver
-    level_log: list[dict[str, Any]] = []
+    level_log: list[ActiveSetLevel] = []
 
     # -- coarse levels: seeds on the coarsest, then polish upwards --------------------
     candidates: list[Candidate] | None = None
@@ -360,14 +368,14 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
             bests.append(best)
             coarse_kkt = kkt
         level_log.append(
-            {
-                "mesh": [nx, ny],
-                "constrained_nodes": cp.num_constrained,
-                "eigensolves": cp.eigensolver.solves,
-                "wall_time_s": time.perf_counter() - tl,
-                "runs": [r.summary() for r in runs],
-                "kkt_loads": [s.load for s in kkt],
-            }
+            ActiveSetLevel(
+                mesh=[nx, ny],
+                constrained_nodes=cp.num_constrained,
+                eigensolves=cp.eigensolver.solves,
+                wall_time_s=time.perf_counter() - tl,
+                runs=[r.summary() for r in runs],
+                kkt_loads=[s.load for s in kkt],
+            )
         )
         if problem.comm.rank == 0:
             PROGRESS.info(
@@ -388,10 +396,10 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
     # -- finest level -------------------------------------------------------------
     if candidates is not None and prev is not None:
         runs = _polish(problem, prev, candidates, min(max_iterations, POLISH_ITERATIONS), bests)
-        details["seeded_on"] = [prev.spec.mesh.nx, prev.spec.mesh.ny]
+        seeded_on = [prev.spec.mesh.nx, prev.spec.mesh.ny]
     else:
         runs = _multi_seed(problem, max_iterations)
-        details["seeded_on"] = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
+        seeded_on = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
     if prev is not None:
         prev.destroy()
 
@@ -405,11 +413,9 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
         )
         runs.append(run)
         kkt = _distinct_kkt(runs)
-        details["fallback"] = {
-            "method": "penalty continuation",
-            "penalty_eigensolves": penalty_solves,
-            "status": run.status,
-        }
+        fallback = Fallback(
+            method="penalty continuation", penalty_eigensolves=penalty_solves, status=run.status
+        )
         warnings.append(
             f"the active-set iteration stalled; penalty continuation ({penalty_solves} "
             f"eigen solves) ended {'at a KKT point' if run.status == 'kkt' else run.status}"
@@ -420,11 +426,10 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
         if last is not None:
             runs.append(last)
             kkt = _distinct_kkt(runs)
-            details["fallback"]["descent"] = {
-                "eigensolves": last.iterations,
-                "status": last.status,
-                "steps": steps,
-            }
+            if isinstance(fallback, Fallback):
+                fallback.descent = DescentRecord(
+                    eigensolves=last.iterations, status=last.status, steps=steps
+                )
             warnings.append(
                 f"feasible descent ({last.iterations} eigen solves) ended "
                 f"{'at a KKT point' if last.status == 'kkt' else last.status}"
@@ -472,25 +477,25 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
     bound_evals, complete = closed.evaluations, closed.complete
 
     groups = _twin_groups(kkt)
-    details.update(
-        {
-            "levels": level_log,
-            "runs": [r.summary() for r in runs],
-            "kkt_points": [{"load": s.load, "contact_nodes": len(s.active)} for s in kkt],
-            "twins": [[[int(k) for k in s.active] for s in g] for g in groups if len(g) > 1],
-            "coarse_kkt_loads": [s.load for s in coarse_kkt],
-            "fine_eigensolves": problem.eigensolver.solves - solves0,
-            "coarse_eigensolves": coarse_solves,
-            "penalty_eigensolves": penalty_solves,
-            "bound_evaluations": bound_evals,
-            "bound_search_complete": complete,
-            "wall_time_s": time.perf_counter() - t0,
-        }
+    for w in warnings:
+        logger.warning("active-set: %s", w)
+    details = ActiveSetDetails(
+        free_load=free_load,
+        seeded_on=seeded_on,
+        fallback=fallback,
+        levels=level_log,
+        runs=[r.summary() for r in runs],
+        kkt_points=[KktPoint(load=s.load, contact_nodes=len(s.active)) for s in kkt],
+        twins=[[[int(k) for k in s.active] for s in g] for g in groups if len(g) > 1],
+        coarse_kkt_loads=[s.load for s in coarse_kkt],
+        fine_eigensolves=problem.eigensolver.solves - solves0,
+        coarse_eigensolves=coarse_solves,
+        penalty_eigensolves=penalty_solves,
+        bound_evaluations=bound_evals,
+        bound_search_complete=complete,
+        wall_time_s=time.perf_counter() - t0,
+        warning="; ".join(warnings) if warnings else UNSET,
     )
-    if warnings:
-        details["warning"] = "; ".join(warnings)
-        for w in warnings:
-            logger.warning("active-set: %s", w)
     return UnilateralSolution(
         candidate=chosen,
         method="active-set",

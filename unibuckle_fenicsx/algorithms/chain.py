@@ -34,8 +34,8 @@ Tensionless foundations run their spring-set iteration (:mod:`.foundation`); sma
 zones are enumerated (:mod:`.enumeration`; :func:`~unibuckle_fenicsx.analysis.choose_method`
 decides).
 
-Every link leaves a typed record (:class:`LinkRecord`); the solution's ``method`` names
-the route that answered.
+Every link leaves a typed record (:class:`~.records.LinkRecord`); the solution's
+``route`` names the links that answered.
 
 Note:
     Collective on the problem's communicator.
@@ -54,6 +54,7 @@ from slepc4py import SLEPc
 
 import numpy as np
 import numpy.typing as npt
+from msgspec import UNSET
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
@@ -67,6 +68,12 @@ from unibuckle_fenicsx.algorithms.interior_point import (
 )
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
 from unibuckle_fenicsx.algorithms.pdas import iterate
+from unibuckle_fenicsx.algorithms.records import (
+    ActiveSetDetails,
+    InteriorPointDetails,
+    LevelRecord,
+    LinkRecord,
+)
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.eigen import swapped_eigenpairs
@@ -77,7 +84,7 @@ from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, requir
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
-__all__ = ["THIN_PLATE", "ChainOptions", "LevelRecord", "LinkRecord", "solve_unilateral"]
+__all__ = ["THIN_PLATE", "ChainOptions", "MeshLevel", "solve_unilateral"]
 
 logger = logging.getLogger(__name__)
 
@@ -217,37 +224,8 @@ class ChainOptions:
 
 
 @dataclass
-class LinkRecord:
-    """One run of one link of the chain.
-
-    Attributes:
-        link: "interior-point", "evaluate", "active-set polish", "fallback".
-        seed: The start (or level) it ran from.
-        status: How it ended.
-        steps: Newton steps or active-set iterates.
-        factorizations: Numeric factorisations (interior point).
-        eigensolves: Eigen solves.
-        seconds: Wall time.
-        load: The load it ended with (None if none).
-        contact_nodes: |Z| (None if no contact set was read).
-        kkt: It ended at a KKT point.
-    """
-
-    link: str
-    seed: str
-    status: str
-    steps: int = 0
-    factorizations: int = 0
-    eigensolves: int = 0
-    seconds: float = 0.0
-    load: float | None = None
-    contact_nodes: int | None = None
-    kkt: bool = False
-
-
-@dataclass
-class LevelRecord:
-    """What the chain did on one mesh.
+class MeshLevel:
+    """What the chain does on one mesh, as it goes (its record: :meth:`record`).
 
     Attributes:
         mesh: [nx, ny] (structured), ["h=<cell size>"] (meshed by gmsh) or ["fine"] (a
@@ -255,13 +233,14 @@ class LevelRecord:
         constrained_nodes: i on this mesh.
         links: The runs on it.
         seconds: Wall time on it (set-up included).
+        best_admissible: The admissible mode with the lowest load met on this mesh (not
+            in the record).
     """
 
-    mesh: list[Any]
+    mesh: list[int | str]
     constrained_nodes: int
     links: list[LinkRecord] = field(default_factory=list)
     seconds: float = 0.0
-    #: The admissible mode with the lowest load met on this mesh (not in the record).
     best_admissible: Candidate | None = field(default=None, repr=False)
 
     def offer(self, cand: Candidate | None) -> None:
@@ -286,17 +265,17 @@ class LevelRecord:
         """Eigen solves on this mesh."""
         return sum(r.eigensolves for r in self.links)
 
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready mapping."""
-        return {
-            "mesh": self.mesh,
-            "constrained_nodes": self.constrained_nodes,
-            "newton_steps": self.newton_steps,
-            "factorizations": self.factorizations,
-            "eigensolves": self.eigensolves,
-            "seconds": self.seconds,
-            "links": [vars(r) for r in self.links],
-        }
+    def record(self) -> LevelRecord:
+        """The level's record."""
+        return LevelRecord(
+            mesh=self.mesh,
+            constrained_nodes=self.constrained_nodes,
+            newton_steps=self.newton_steps,
+            factorizations=self.factorizations,
+            eigensolves=self.eigensolves,
+            seconds=self.seconds,
+            links=self.links,
+        )
 
 
 #: Newton settings of the coarsest mesh's starts (see :func:`_explore`).
@@ -318,7 +297,7 @@ def _newton_link(seed: str, record: NewtonRecord) -> LinkRecord:
 def _run(
     newton: InteriorPointNewton,
     point: BarrierPoint,
-    level: LevelRecord,
+    level: MeshLevel,
     label: str,
     options: ChainOptions,
     *,
@@ -438,7 +417,7 @@ def _read_contact(
     problem: UnilateralProblem,
     newton: InteriorPointNewton,
     point: BarrierPoint,
-    level: LevelRecord,
+    level: MeshLevel,
     label: str,
     active: npt.NDArray[np.int64] | None = None,
 ) -> Candidate:
@@ -486,7 +465,7 @@ class _Reader:
 
     problem: UnilateralProblem
     newton: InteriorPointNewton
-    level: LevelRecord
+    level: MeshLevel
     options: ChainOptions
     label: str = ""
     armed: bool = False
@@ -532,7 +511,7 @@ class _Reader:
 
 
 def _polish(
-    problem: UnilateralProblem, cand: Candidate, level: LevelRecord, label: str, budget: int
+    problem: UnilateralProblem, cand: Candidate, level: MeshLevel, label: str, budget: int
 ) -> Candidate | None:
     """Active-set iteration from ``cand``'s contact set; its KKT point or best feasible."""
     t0 = time.perf_counter()
@@ -557,7 +536,7 @@ def _polish(
 
 
 def _descend(
-    problem: UnilateralProblem, start: Candidate, level: LevelRecord, label: str, budget: int
+    problem: UnilateralProblem, start: Candidate, level: MeshLevel, label: str, budget: int
 ) -> Candidate:
     """Feasible descent (:mod:`.descent`) from the admissible ``start``: it cannot cycle."""
     t0 = time.perf_counter()
@@ -586,7 +565,7 @@ def _critical_state(
     problem: UnilateralProblem,
     newton: InteriorPointNewton,
     point: BarrierPoint,
-    level: LevelRecord,
+    level: MeshLevel,
     label: str,
     options: ChainOptions,
     carry: bool = True,
@@ -685,7 +664,7 @@ class _Paths:
 
 
 def _explore(
-    problem: UnilateralProblem, level: LevelRecord, options: ChainOptions, carry: bool = True
+    problem: UnilateralProblem, level: MeshLevel, options: ChainOptions, carry: bool = True
 ) -> tuple[list[Candidate], list[_Arrangement]]:
     """Run the starts on ``problem``: its KKT points, and the arrangements to carry up.
 
@@ -766,7 +745,7 @@ def _explore(
 def _central(
     newton: InteriorPointNewton,
     point: BarrierPoint,
-    level: LevelRecord,
+    level: MeshLevel,
     options: ChainOptions,
     label: str,
     mu: float,
@@ -787,7 +766,7 @@ def _central(
 def _refine(
     carry: Prolongation,
     point: BarrierPoint,
-    level: LevelRecord,
+    level: MeshLevel,
     options: ChainOptions,
     last: bool,
     mu: float,
@@ -837,12 +816,12 @@ def _refine(
     return cand, new
 
 
-def _level_record(problem: UnilateralProblem) -> LevelRecord:
+def _level_record(problem: UnilateralProblem) -> MeshLevel:
     spec = problem.spec
-    mesh: list[Any] = [spec.mesh.nx, spec.mesh.ny] if problem.structured else ["fine"]
+    mesh: list[int | str] = [spec.mesh.nx, spec.mesh.ny] if problem.structured else ["fine"]
     if _gmsh_levels(problem):
         mesh = [f"h={spec.mesh.size:.3g}"]
-    return LevelRecord(mesh, problem.num_constrained)
+    return MeshLevel(mesh, problem.num_constrained)
 
 
 def _gmsh_levels(problem: UnilateralProblem) -> bool:
@@ -884,7 +863,7 @@ def _coarser(problem: UnilateralProblem, options: ChainOptions) -> list[ProblemS
     return specs[::-1]
 
 
-def _report(problem: UnilateralProblem, level: LevelRecord) -> None:
+def _report(problem: UnilateralProblem, level: MeshLevel) -> None:
     if problem.comm.rank == 0:
         PROGRESS.info(
             "interior point, mesh %s (i = %d): %d Newton steps, %d factorisations, "
@@ -898,7 +877,7 @@ def _carry(
     problems: list[UnilateralProblem],
     k: int,
     points: list[BarrierPoint],
-    level: LevelRecord,
+    level: MeshLevel,
     options: ChainOptions,
     mu: float,
     label: str,
@@ -937,7 +916,7 @@ def _carry(
 def _ascend(
     problems: list[UnilateralProblem],
     points: list[BarrierPoint],
-    levels: list[LevelRecord],
+    levels: list[MeshLevel],
     options: ChainOptions,
     mu: float,
     label: str,
@@ -956,7 +935,7 @@ def _ascend(
 
 def _levels(
     problems: list[UnilateralProblem], options: ChainOptions
-) -> tuple[list[LevelRecord], list[Candidate], Candidate | None]:
+) -> tuple[list[MeshLevel], list[Candidate], Candidate | None]:
     """Explore the coarsest mesh and carry its best critical states up to the finest.
 
     The states are carried on the central path at ``level_mu``, where the contact lines
@@ -1046,40 +1025,41 @@ def solve_unilateral(
     if chosen is None or not chosen.kkt:
         logger.warning("interior point: no KKT point on the fine mesh; the active-set chain runs")
         solution = _fallback(problem, options)
-        solution.details["interior_point_levels"] = [lv.as_dict() for lv in levels]
-        solution.method = "active-set (after interior point)"
+        if isinstance(solution.details, ActiveSetDetails):
+            solution.details.interior_point_levels = [lv.record() for lv in levels]
+        solution.method = "interior-point"
+        solution.route = ["interior-point", *solution.route]
         solution.eigensolves += other_solves
         return solution
 
     closed = bracket(problem, free_load, chosen, options.bound_budget, "interior-point")
     chosen, lower, proven = closed.chosen, closed.lower, closed.proven
-    route = "interior-point"
+    route = ["interior-point"]
     for link in ("active-set polish", "feasible descent"):
         if any(r.link == link and r.kkt for r in levels[-1].links):
-            route += f" + {link}"
-    details: dict[str, Any] = {
-        "free_load": free_load,
-        "route": route,
-        "levels": [lv.as_dict() for lv in levels],
-        "coarse_kkt_loads": sorted(c.load for c in explored),
-        "fine_eigensolves": problem.eigensolver.solves - solves0,
-        "coarse_eigensolves": other_solves,
-        "bound_evaluations": closed.evaluations,
-        "bound_search_complete": closed.complete,
-        "lower_bound_by": "lattice" if closed.evaluations else "interlacing",
-        "wall_time_s": time.perf_counter() - t0,
-    }
-    if closed.warning:
-        details["warning"] = closed.warning
+            route.append(link.replace(" ", "-"))
+    details = InteriorPointDetails(
+        free_load=free_load,
+        levels=[lv.record() for lv in levels],
+        coarse_kkt_loads=sorted(c.load for c in explored),
+        fine_eigensolves=problem.eigensolver.solves - solves0,
+        coarse_eigensolves=other_solves,
+        bound_evaluations=closed.evaluations,
+        bound_search_complete=closed.complete,
+        wall_time_s=time.perf_counter() - t0,
+        warning=closed.warning or UNSET,
+    )
     if not math.isfinite(chosen.load):
         raise NoAdmissibleModeError("the interior-point route ended without a finite load")
     return UnilateralSolution(
         candidate=chosen,
-        method=route,
+        method="interior-point",
         eigensolves=problem.eigensolver.solves - solves0 + other_solves,
         lower_bound=min(lower, chosen.load),
         global_optimum_proven=proven,
         upper_bound=chosen.load if chosen.feasible else math.inf,
         kkt_points=[chosen],
         details=details,
+        route=route,
+        lower_bound_by="lattice" if closed.evaluations else "interlacing",
     )

@@ -31,6 +31,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.pdas import Run, iterate
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver
+from unibuckle_fenicsx.algorithms.records import PenaltyDetails
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 __all__ = ["COLD_PENALTIES", "WARM_PENALTIES", "penalty_continuation"]
@@ -80,9 +81,10 @@ def penalty_continuation(
             )
             solves += sol.eigensolves
             springs = sol.active
+            status = sol.details.penalty_status if isinstance(sol.details, PenaltyDetails) else ""
             logger.debug(
                 "penalty continuation rho=%g: %s, %d solves, R = %.10g, |S| = %d",
-                rho, sol.details["penalty_status"], sol.eigensolves, sol.load, len(springs),
+                rho, status, sol.eigensolves, sol.load, len(springs),
             )  # fmt: skip
         if springs is None:
             raise ValueError("penalties must not be empty")

@@ -56,6 +56,7 @@ from petsc4py import PETSc
 import numpy as np
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
+from unibuckle_fenicsx.algorithms.records import EnumerationDetails
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
@@ -335,24 +336,24 @@ def enumerate_contact_sets(  # noqa: C901 - the paper's level loop with its stop
     eigensolves = int(ccomm.allreduce(problem.eigensolver.solves - solves0, op=MPI.SUM))
 
     monotone, violations = _monotonicity(levels) if complete else (None, [])
-    details = {
-        "constrained_nodes": i,
-        "candidate_count": count,
-        "candidates_evaluated": sum(lv.candidates for lv in levels),
-        "candidate_ranks": size,
-        "complete": complete,
-        "until_proven": until_proven,
-        "p_optimum": len(chosen),
-        "lambda_by_p": [_finite_or_none(lv.best_load) for lv in levels],
-        "feasible_by_p": [lv.feasible for lv in levels],
-        "candidates_by_p": [lv.candidates for lv in levels],
-        "lambda_min_by_p": [_finite_or_none(lv.load_min) for lv in levels],
-        "wall_by_p_s": [lv.wall_s for lv in levels],
-        "monotone": monotone,
-        "monotone_violations": violations,
-        "lower_bound_interlacing": with_feasible[0].load_min,
-        "enumeration_wall_s": time.perf_counter() - t_start,
-    }
+    details = EnumerationDetails(
+        constrained_nodes=i,
+        candidate_count=count,
+        candidates_evaluated=sum(lv.candidates for lv in levels),
+        candidate_ranks=size,
+        complete=complete,
+        until_proven=until_proven,
+        p_optimum=len(chosen),
+        lambda_by_p=[_finite_or_none(lv.best_load) for lv in levels],
+        feasible_by_p=[lv.feasible for lv in levels],
+        candidates_by_p=[lv.candidates for lv in levels],
+        lambda_min_by_p=[_finite_or_none(lv.load_min) for lv in levels],
+        wall_by_p_s=[lv.wall_s for lv in levels],
+        monotone=monotone,
+        monotone_violations=violations,
+        lower_bound_interlacing=with_feasible[0].load_min,
+        enumeration_wall_s=time.perf_counter() - t_start,
+    )
     if problem.comm.rank == 0 and rank == 0:
         logger.info(
             "enumeration: lambda = %.9e, |Z| = %d, p* = %d, lower bound %.9e (%s), %d eigen solves",

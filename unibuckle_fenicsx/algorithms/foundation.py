@@ -59,6 +59,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
+from unibuckle_fenicsx.algorithms.records import FoundationDetails
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
@@ -136,17 +137,18 @@ def solve_foundation(
     load = candidate.load
     proven = status is RunStatus.CONVERGED and not candidate.active.size
     proven = proven and load <= lower * (1.0 + TWIN_RTOL)
-    details = {
-        "foundation_start": name,
-        "foundation_arc_steps": arc_steps,
-        "foundation_iterations": {n: len(r.steps) for n, r in runs.items()},
-        "foundation_loads": {n: r.candidate.load for n, r in runs.items()},
-        "foundation_statuses": {n: r.status for n, r in runs.items()},
-        "foundation_pressing_nodes": int(candidate.active.size),
-        "foundation_max_penetration": max(float(candidate.values.max()), 0.0),
-        "foundation_spring_range_N_per_m": [float(springs.min()), float(springs.max())],
-        "foundation_history": [s.quotient for s in best.steps],
-    }
+    details = FoundationDetails(
+        foundation_start=name,
+        foundation_arc_steps=arc_steps,
+        foundation_iterations={n: len(r.steps) for n, r in runs.items()},
+        foundation_loads={n: r.candidate.load for n, r in runs.items()},
+        foundation_statuses={n: str(r.status) for n, r in runs.items()},
+        foundation_pressing_nodes=int(candidate.active.size),
+        foundation_max_penetration=max(float(candidate.values.max()), 0.0),
+        foundation_spring_range_N_per_m=[float(springs.min()), float(springs.max())],
+        foundation_history=[s.quotient for s in best.steps],
+        foundation_status=str(status),
+    )
     logger.info(
         "foundation: lambda = %.10g (start %s, %s, %d pressing nodes, %d eigen solves)",
         load, name, status, candidate.active.size, solves,

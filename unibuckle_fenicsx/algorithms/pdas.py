@@ -21,7 +21,6 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass, field
-from typing import Any
 
 from petsc4py import PETSc
 
@@ -29,6 +28,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus
+from unibuckle_fenicsx.algorithms.records import RunSummary
 from unibuckle_fenicsx.algorithms.sets import SetLog
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
@@ -56,17 +56,17 @@ class Run:
     best_feasible: Candidate | None = None
     history: list[tuple[int, float, bool]] = field(default_factory=list)
 
-    def summary(self) -> dict[str, Any]:
-        """JSON-ready summary."""
+    def summary(self) -> RunSummary:
+        """The run's record."""
         final = self.final
-        return {
-            "seed": self.seed,
-            "status": self.status,
-            "iterations": self.iterations,
-            "load": None if final is None or not math.isfinite(final.load) else final.load,
-            "contact_nodes": None if final is None else len(final.active),
-            "kkt": bool(final is not None and final.kkt),
-        }
+        return RunSummary(
+            seed=self.seed,
+            status=str(self.status),
+            iterations=self.iterations,
+            load=None if final is None or not math.isfinite(final.load) else final.load,
+            contact_nodes=None if final is None else len(final.active),
+            kkt=bool(final is not None and final.kkt),
+        )
 
 
 def _mask(n: int, active: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:

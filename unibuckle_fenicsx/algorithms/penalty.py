@@ -51,6 +51,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms.records import PenaltyDetails
 from unibuckle_fenicsx.algorithms.sets import SetLog
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.eigen import (
@@ -283,25 +284,25 @@ class PenaltySolver(Owner):
             label=f"penalty rho={rho:.3g}",
         )
         step = it.step
-        details: dict[str, object] = {
-            "penalty_rho": float(rho),
-            "penalty_rho_abs": rho_abs,
-            "penalty_max_diag_A": self.max_diag,
-            "penalty_status": it.status,
-            "penalty_cycle_length": it.cycle_length,
-            "penalty_iterations": len(it.steps),
-            "penalty_orientation_ties": it.ties,
-            "penalty_max_penetration": step.penetration,
-            "penalty_penetrating_set": [int(k) for k in step.penetrating],
-            "penalty_springs": [int(k) for k in step.springs],
-            "penalty_eigenvalue": step.load,
-            "penalty_history": [s.quotient for s in it.steps],
-        }
+        details = PenaltyDetails(
+            penalty_rho=float(rho),
+            penalty_rho_abs=rho_abs,
+            penalty_max_diag_A=self.max_diag,
+            penalty_status=it.status,
+            penalty_cycle_length=it.cycle_length,
+            penalty_iterations=len(it.steps),
+            penalty_orientation_ties=it.ties,
+            penalty_max_penetration=step.penetration,
+            penalty_penetrating_set=[int(k) for k in step.penetrating],
+            penalty_springs=[int(k) for k in step.springs],
+            penalty_eigenvalue=step.load,
+            penalty_history=[s.quotient for s in it.steps],
+        )
         if condition:
             lo, hi = self.condition_number()
-            details["penalty_eig_min_A_pen"] = lo
-            details["penalty_eig_max_A_pen"] = hi
-            details["penalty_condition_number"] = hi / lo
+            details.penalty_eig_min_A_pen = lo
+            details.penalty_eig_max_A_pen = hi
+            details.penalty_condition_number = hi / lo
         return UnilateralSolution(
             candidate=it.candidate,
             method="penalty",

@@ -35,7 +35,6 @@ from __future__ import annotations
 import logging
 import math
 from dataclasses import dataclass, field
-from typing import Any
 
 from petsc4py import PETSc
 
@@ -45,6 +44,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.foundation import pressing_nodes
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
+from unibuckle_fenicsx.certificate.records import CopositivityRecord, Refuting
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Prefix
@@ -121,7 +121,7 @@ class Certificate:
     relative_gap: float
     global_optimum_proven: bool
     proven_by: str
-    copositivity: dict[str, Any] | None = None
+    copositivity: CopositivityRecord | None = None
     notes: tuple[str, ...] = field(default_factory=tuple)
     max_contact_value: float = 0.0
     refuting_mode: Candidate | None = None
@@ -142,31 +142,8 @@ class Certificate:
         """m: pencil eigenvalues below the shifts tried (None if no factorisation ran)."""
         if self.copositivity is None:
             return None
-        m = self.copositivity.get("negative_eigenvalues")
+        m = self.copositivity.negative_eigenvalues
         return None if m is None else int(m)
-
-    def as_dict(self) -> dict[str, Any]:
-        """JSON-ready mapping."""
-        return {
-            "feasible": self.feasible,
-            "feasibility_margin": self.feasibility_margin,
-            "max_contact_force": self.max_contact_force,
-            "max_contact_value": self.max_contact_value,
-            "relative_residual": self.relative_residual,
-            "tolerance": self.tolerance,
-            "kkt": self.kkt,
-            "smallest_of_reduced": self.smallest_of_reduced,
-            "lower_bound_Pa": self.lower_bound,
-            "upper_bound_Pa": self.upper_bound,
-            "relative_gap": self.relative_gap,
-            "global_optimum_proven": self.global_optimum_proven,
-            "proven_by": self.proven_by,
-            "status": self.status,
-            "negative_eigenvalues": self.negative_eigenvalues,
-            "refuting_load_Pa": None if self.refuting_mode is None else self.refuting_mode.load,
-            "copositivity": self.copositivity,
-            "notes": list(self.notes),
-        }
 
 
 def reduced_inertia(
@@ -285,7 +262,7 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     # No stated proof: the lower bound is the free load, by interlacing.
     proven_by = solution.lower_bound_by or "interlacing"
     algorithm_proof = solution.global_optimum_proven
-    record: dict[str, Any] | None = None
+    record: CopositivityRecord | None = None
     refuting: Candidate | None = None
     # One matrix for the copositivity attempt and the smallest-eigenvalue check, both
     # factorised through the mesh's shared LDL^T (its symbolic analysis done once).
@@ -297,15 +274,16 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
             if options is None and not problem.spec.solver.bracket:
                 options = BoundOptions(lowrank=None)  # the low-rank route on request only
             bound = copositivity_bound(problem, cand, solution.kkt_points, options, matrix)
-            record = {
-                "method": bound.method,
-                "delta": bound.delta,
-                "margins": bound.margins,
-                "negative_eigenvalues": bound.negative_eigenvalues,
-                **{k: bound.timings[k] for k in ("factorisations", "solves")},
-                "time_s": bound.timings["total_s"],
-                "lowrank": bound.lowrank,
-            }
+            record = CopositivityRecord(
+                method=bound.method,
+                delta=bound.delta,
+                margins=bound.margins,
+                negative_eigenvalues=bound.negative_eigenvalues,
+                factorisations=int(bound.timings["factorisations"]),
+                solves=int(bound.timings["solves"]),
+                time_s=bound.timings["total_s"],
+                lowrank=bound.lowrank,
+            )
             notes += list(bound.notes)
             if bound.refuting is not None:
                 refuting = _refuting_candidate(problem, bound.refuting)
@@ -363,14 +341,14 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     )
 
 
-def _refuting_candidate(problem: UnilateralProblem, refuting: dict[str, Any]) -> Candidate:
+def _refuting_candidate(problem: UnilateralProblem, refuting: Refuting) -> Candidate:
     """The low-rank route's refuting mode as a :class:`Candidate` (contact set: its zeros)."""
     u = problem.new_mode("refuting_mode")
-    u.x.petsc_vec.array[:] = refuting["vector"]
+    u.x.petsc_vec.array[:] = refuting.vector
     u.x.scatter_forward()
-    values = np.asarray(refuting["values"])
+    values = np.asarray(refuting.values)
     active = np.flatnonzero(values >= -problem.tau).astype(np.int64)
-    return problem.candidate(u, float(refuting["load"]), active, sign=1.0)
+    return problem.candidate(u, float(refuting.load), active, sign=1.0)
 
 
 def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution) -> Certificate:

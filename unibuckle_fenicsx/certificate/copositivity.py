@@ -52,9 +52,25 @@ from typing import TYPE_CHECKING, Any
 
 from mpi4py import MPI
 
+import msgspec
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.certificate.records import (
+    AttemptRecord,
+    LowRankMargins,
+    LowRankRecord,
+    Margins,
+    NoMargins,
+    PsdMargins,
+    Rank2Margins,
+    Rank2Record,
+    Rank2Try,
+    Refuting,
+    SdpRecord,
+    SearchRecord,
+    SectorRecord,
+)
 from unibuckle_fenicsx.certificate.shifted import (
     EPS,
     ShiftedMatrix,
@@ -121,20 +137,19 @@ class LowerBound:
             negative eigenvalues of K there).
         lowrank: The low-rank route's record (None if it did not run).
         refuting: An admissible mode with a lower load than the KKT point's, met by the
-            low-rank route (load, oriented values at I, owned entries of the W-vector),
-            or None.
+            low-rank route, or None.
     """
 
     value: float | None
     method: str
     delta: float | None
-    margins: dict[str, Any] = field(default_factory=dict)
-    attempts: tuple[dict[str, Any], ...] = ()
+    margins: Margins = field(default_factory=NoMargins)
+    attempts: tuple[AttemptRecord, ...] = ()
     notes: tuple[str, ...] = ()
     timings: dict[str, float] = field(default_factory=dict)
     negative_eigenvalues: int | None = None
-    lowrank: dict[str, Any] | None = None
-    refuting: dict[str, Any] | None = None
+    lowrank: LowRankRecord | None = None
+    refuting: Refuting | None = None
 
 
 def _reaction(candidate: Candidate) -> npt.NDArray[np.float64]:
@@ -246,7 +261,7 @@ def _rank2(
     w_plus: npt.NDArray[np.float64],
     candidates: list[tuple[str, npt.NDArray[np.float64]]],
     options: BoundOptions,
-) -> tuple[dict[str, Any], dict[str, Any] | None]:
+) -> tuple[Rank2Record, Rank2Margins | None]:
     """Alpha for w+, then beta and gamma for each w- candidate; the first that certifies."""
     contact = problem.contact
     vec = problem.model.A.createVecRight()
@@ -254,13 +269,10 @@ def _rank2(
     a_val, alpha_err = ShiftedMatrix.bilinear(sp, sp)
     alpha = -a_val
     scale_p = norm2(sp.x) * norm2(sp.w)
-    record: dict[str, Any] = {"alpha": alpha, "alpha_err": alpha_err}
-    record["alpha_ok"] = bool(
-        alpha > options.safety * alpha_err and alpha > options.rel_margin * scale_p
-    )
-    record["tried"] = []
+    alpha_ok = bool(alpha > options.safety * alpha_err and alpha > options.rel_margin * scale_p)
+    record = Rank2Record(alpha=alpha, alpha_err=alpha_err, alpha_ok=alpha_ok, tried=[])
     found = None
-    if record["alpha_ok"]:
+    if alpha_ok:
         for name, w_minus in candidates:
             sm = matrix.refined(contact.scatter(w_minus, vec.duplicate()))
             b_val, beta_err = ShiftedMatrix.bilinear(sm, sm)
@@ -274,11 +286,13 @@ def _rank2(
                 and gamma > options.safety * gamma_err
                 and (alpha - alpha_err) * (beta - beta_err) > gamma_err**2
             )
-            entry = {"w_minus": name, "beta": beta, "beta_err": beta_err, "gamma": gamma,
-                     "gamma_err": gamma_err, "ok": bool(ok)}  # fmt: skip
-            record["tried"].append(entry)
+            entry = Rank2Try(w_minus=name, beta=beta, beta_err=beta_err, gamma=gamma,
+                             gamma_err=gamma_err, ok=bool(ok))  # fmt: skip
+            record.tried.append(entry)
             if ok:
-                found = {"alpha": alpha, "alpha_err": alpha_err, **entry, "c": 1.0 / gamma}
+                found = Rank2Margins(
+                    alpha=alpha, alpha_err=alpha_err, **msgspec.structs.asdict(entry), c=1.0 / gamma
+                )
                 break
     sp.destroy()
     vec.destroy()
@@ -312,7 +326,7 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
     opts = options or BoundOptions()
     t0 = time.perf_counter()
     notes: list[str] = []
-    attempts: list[dict[str, Any]] = []
+    attempts: list[AttemptRecord] = []
     phi = problem.contact.values(problem.solve_free().function.x.petsc_vec)
     w_plus = _reaction(candidate)
     sigma = float(phi @ w_plus)
@@ -336,8 +350,8 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
     result: LowerBound | None = None
     m: int | None = None
     several = False  # two or more pencil eigenvalues below some shift tried
-    lowrank: dict[str, Any] | None = None
-    refuting: dict[str, Any] | None = None
+    lowrank: LowRankRecord | None = None
+    refuting: Refuting | None = None
     try:
         if not w_plus.max() > 0:
             notes.append("the KKT point has no contact force (w+ = 0)")
@@ -346,46 +360,50 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
         for delta in deltas:
             lam = candidate.load * (1.0 - delta)
             neg, zero, pos = matrix.factor(lam)
-            attempt: dict[str, Any] = {"delta": delta, "inertia": [neg, zero, pos]}
+            attempt = AttemptRecord(delta=delta, inertia=[neg, zero, pos])
             attempts.append(attempt)
             m = neg if m is None else m
             several |= neg >= 2
             if zero:
-                attempt["why"] = "K(lambda_lb) is singular"
+                attempt.why = "K(lambda_lb) is singular"
                 continue
             if neg == 0:
-                result = LowerBound(lam, "psd", delta, {"inertia": [neg, zero, pos]})
+                result = LowerBound(lam, "psd", delta, PsdMargins(inertia=[neg, zero, pos]))
                 notes.append("A - lambda_lb B is positive definite: the obstacle is inactive")
                 break
             if neg == 1 and w_plus.max() > 0:
                 record, found = _rank2(problem, matrix, w_plus, w_minus, opts)
-                attempt["rank2"] = record
-                if found is None and record["alpha_ok"] and (a > 0).any():
+                attempt.rank2 = record
+                if found is None and record.alpha_ok and (a > 0).any():
                     w, f, its = _search_other_nappe(problem, matrix, a, opts.search_iterations)
-                    attempt["search"] = {"iterations": its, "f": f}
+                    attempt.search = SearchRecord(iterations=its, f=f)
                     if f > 0:
                         record, found = _rank2(problem, matrix, w_plus, [("search", w)], opts)
-                        attempt["rank2_search"] = record
+                        attempt.rank2_search = record
                 if found is not None:
                     result = LowerBound(lam, "rank2-spn", delta, found)
                     break
                 continue
             if neg >= 2:
                 route = _sdp(problem, matrix, lam, neg, opts, notes)
-                attempt["sdp"] = route
-                if route.get("ok"):
-                    method = route.pop("method")
-                    result = LowerBound(lam, method, delta, route)
+                attempt.sdp = route
+                sectors = route.sectors
+                if route.ok:
+                    result = LowerBound(lam, "sdp-spn", delta, route)
                     break
-                if route.get("unavailable") or route.get("too_large"):
+                if isinstance(sectors, SectorRecord) and sectors.ok:
+                    result = LowerBound(lam, "sdp-sectors", delta, sectors)
+                    break
+                if route.unavailable is True or route.too_large is True:
                     break
         if result is None and several and opts.lowrank is not None:
             outcome = _lowrank(problem, matrix, candidate, others or [], opts.lowrank, notes)
             if outcome is not None:
                 lowrank, refuting = outcome.record(), outcome.refuting
                 if outcome.value is not None:
-                    margins = {"r": outcome.r, "pieces": outcome.pieces,
-                               "margin": outcome.margin, "m": outcome.m}  # fmt: skip
+                    margins = LowRankMargins(
+                        r=outcome.r, pieces=outcome.pieces, margin=outcome.margin, m=outcome.m
+                    )
                     result = LowerBound(outcome.value, "lowrank-spn", outcome.delta, margins)
     finally:
         timings = {  # the slowest rank's, so that the record is the same on every rank
@@ -454,7 +472,7 @@ def _sdp(
     neg: int,
     opts: BoundOptions,
     notes: list[str],
-) -> dict[str, Any]:
+) -> SdpRecord:
     """The SDP routes for two or more negative eigenvalues (optional extra "sdp")."""
     i = problem.num_constrained
     if i > opts.sdp_max_constrained:
@@ -468,7 +486,7 @@ def _sdp(
                 else ": the low-rank bracket runs on request (solver.bracket = true, --bracket)"
             )
         )
-        return {"too_large": True}
+        return SdpRecord(too_large=True)
     try:
         from unibuckle_fenicsx.certificate import copositivity_sdp
     except ImportError as err:
@@ -476,13 +494,8 @@ def _sdp(
             f"{neg} pencil eigenvalues lie below the load: the SDP route needs the 'sdp' "
             f"extra (pip install 'unibuckle_fenicsx[sdp]'): {err}"
         )
-        return {"unavailable": True}
+        return SdpRecord(unavailable=True)
     route = copositivity_sdp.spn_certificate(problem, matrix, lam)
-    if not route.get("ok") and neg == 2 and route.get("neg_S") == 2:
-        sectors = copositivity_sdp.sector_certificate(problem, matrix, lam, opts.sectors)
-        route = {**route, "sectors": sectors}
-        if sectors.get("ok"):
-            return {"ok": True, "method": "sdp-sectors", **sectors}
-    if route.get("ok"):
-        route["method"] = "sdp-spn"
+    if not route.ok and neg == 2 and route.neg_S == 2:
+        route.sectors = copositivity_sdp.sector_certificate(problem, matrix, lam, opts.sectors)
     return route

@@ -64,6 +64,7 @@ from petsc4py import PETSc
 
 import numpy as np
 import numpy.typing as npt
+from msgspec import UNSET
 
 from unibuckle_fenicsx.certificate.accurate import (
     AccurateResidual,
@@ -71,6 +72,7 @@ from unibuckle_fenicsx.certificate.accurate import (
     gamma,
     two_product,
 )
+from unibuckle_fenicsx.certificate.records import LowRankAttempt, LowRankRecord, Refuting
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, mirror_maps
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 
@@ -155,9 +157,9 @@ class LowRankOutcome:
     r: int = 0
     pieces: int = 0
     margin: float = -math.inf
-    attempts: list[dict[str, Any]] = field(default_factory=list)
+    attempts: list[LowRankAttempt] = field(default_factory=list)
     why: str = ""
-    refuting: dict[str, Any] | None = None
+    refuting: Refuting | None = None
     solves: int = 0
     _deadline: tuple[float, MPI.Comm] | None = None
 
@@ -168,14 +170,19 @@ class LowRankOutcome:
         end, comm = self._deadline
         return bool(comm.allreduce(time.perf_counter() > end, op=MPI.LOR))
 
-    def record(self) -> dict[str, Any]:
-        """JSON-ready summary (without the refuting mode's vector)."""
-        out = {k: getattr(self, k) for k in ("value", "delta", "m", "r", "pieces", "margin")}
-        out["why"] = self.why
-        out["attempts"] = self.attempts
-        if self.refuting is not None:
-            out["refuting_load"] = self.refuting["load"]
-        return out
+    def record(self) -> LowRankRecord:
+        """The route's record (without the refuting mode's vector)."""
+        return LowRankRecord(
+            value=self.value,
+            delta=self.delta,
+            m=self.m,
+            r=self.r,
+            pieces=self.pieces,
+            margin=self.margin,
+            why=self.why,
+            attempts=self.attempts,
+            refuting_load=UNSET if self.refuting is None else self.refuting.load,
+        )
 
 
 class _Columns:
@@ -340,7 +347,7 @@ def _inertia(
 
 
 #: Clarabel's settings for the SPN programs (tight: the margin scales like delta).
-SPN_SETTINGS: dict[str, Any] = {
+SPN_SETTINGS: dict[str, bool | float | int] = {
     "verbose": False,
     "tol_gap_abs": 1e-12,
     "tol_gap_rel": 1e-12,
@@ -570,12 +577,23 @@ def _split_piece(
     return pieces
 
 
+@dataclass
+class _OrthantStats:
+    """What :func:`_orthant` met: pieces, margins, the best SDP margin, why it stopped."""
+
+    best_t: float | None = None
+    margin: float | None = None
+    pieces: int = 0
+    f: float | None = None
+    stopped: str | None = None
+
+
 def _orthant(
     Gs: npt.NDArray[np.float64],
     Es: npt.NDArray[np.float64],
     m: int,
     opts: LowRankOptions,
-    stats: dict[str, Any],
+    stats: _OrthantStats,
     near: float,
     out_of_time: Any,
 ) -> tuple[bool, npt.NDArray[np.float64] | None]:
@@ -592,7 +610,7 @@ def _orthant(
         return False, np.eye(r)[int(np.argmin(np.diag(S)))]
     queue = [np.eye(r)]  # dyadic vertices: midpoints stay exact
     done = 0
-    stats["best_t"] = math.inf
+    stats.best_t = math.inf
     while queue:
         V = queue.pop()
         # Columns scaled by powers of two (exact: the piece is the same cone).
@@ -605,22 +623,22 @@ def _orthant(
             margin = _check_piece(Gs, Es, Vn, N, m, opts.margin_factor)
             ok = margin > 1.0
             if ok:
-                stats["margin"] = min(stats.get("margin", math.inf), margin)
-        stats["best_t"] = min(stats["best_t"], t)
+                stats.margin = min(math.inf if stats.margin is None else stats.margin, margin)
+        stats.best_t = min(stats.best_t, t)
         if ok:
             done += 1
-            stats["pieces"] = done + len(queue)
+            stats.pieces = done + len(queue)
             continue
         f, z = _simplex_min(Ps, _starts(Ps, dual))
-        stats["f"] = f
+        stats.f = f
         if f < near:
             return False, Vn @ z
         if done + len(queue) + 2 > opts.max_pieces or out_of_time():
-            stats["pieces"] = done + len(queue) + 1
-            stats["stopped"] = "time" if out_of_time() else "pieces"
+            stats.pieces = done + len(queue) + 1
+            stats.stopped = "time" if out_of_time() else "pieces"
             return False, None
         queue += _split_piece(V, Vn, Ps, z)
-    stats["pieces"] = done
+    stats.pieces = done
     return True, None
 
 
@@ -741,23 +759,24 @@ def lowrank_certificate(
         attempt, sources = _attempt(problem, matrix, candidate, delta, sources, opts, out)
         out.attempts.append(attempt)
         if out.refuting is not None:
-            out.why = attempt["why"]
+            out.why = attempt.why
             break
-        if attempt["proven"]:
+        if attempt.proven:
             out.value, out.delta = candidate.load * (1.0 - delta), delta
-            out.pieces, out.margin = attempt["pieces"], attempt["margin"]
-            out.r = attempt["r"]
+            out.pieces, out.margin = attempt.pieces, attempt.margin
+            out.r = attempt.r
             fallback = []
         elif out.value is not None:
             break  # the previous (larger) delta stands
         else:
             queue, fallback = fallback, []  # nothing verified: larger deltas
     if out.value is None and out.refuting is None:
-        last = out.attempts[-1] if out.attempts else {}
-        out.why = str(last.get("why", "no delta tried"))
-        out.r = int(last.get("r", 0))
-        out.pieces = int(last.get("pieces", 0))
-        out.margin = float(last.get("best_t") or -math.inf)
+        out.why = "no delta tried"
+        if out.attempts:
+            last = out.attempts[-1]
+            best_t = last.best_t if isinstance(last.best_t, float) else None
+            out.why, out.r, out.pieces = last.why, last.r, last.pieces
+            out.margin = float(best_t or -math.inf)
     out.solves = matrix.solves
     return out
 
@@ -770,19 +789,18 @@ def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (
     sources: list[tuple[str, npt.NDArray[np.float64]]],
     opts: LowRankOptions,
     out: LowRankOutcome,
-) -> tuple[dict[str, Any], list[tuple[str, npt.NDArray[np.float64]]]]:
+) -> tuple[LowRankAttempt, list[tuple[str, npt.NDArray[np.float64]]]]:
     """One delta: factorise, columns, cuts, pieces. Returns (record, columns to reuse)."""
     contact = problem.contact
     lam = candidate.load * (1.0 - delta)
     neg, zero, _ = matrix.factor(lam)
     out.m = neg
-    attempt: dict[str, Any] = {"delta": delta, "m": neg, "proven": False, "r": 0,
-                               "pieces": 0, "margin": -math.inf, "why": ""}  # fmt: skip
+    attempt = LowRankAttempt(delta=delta, m=neg)
     if zero:
-        attempt["why"] = "K is singular at this shift"
+        attempt.why = "K is singular at this shift"
         return attempt, sources
     if neg < 2:
-        attempt["why"] = f"K has {neg} negative eigenvalue(s): the other routes apply"
+        attempt.why = f"K has {neg} negative eigenvalue(s): the other routes apply"
         return attempt, sources
     cols = _Columns(problem, matrix, opts.refinements, opts.max_columns)
     try:
@@ -798,29 +816,30 @@ def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (
             dg = 1.0 / _pow2(np.sqrt(np.maximum(np.abs(np.diag(G)), np.diag(E))))
             Gs, Es = G * dg[:, None] * dg[None, :], E * dg[:, None] * dg[None, :]
             gneg, _, gmargin = _inertia(Gs, Es, opts.margin_factor)
-            attempt.update(r=len(use), columns=cols.r, cuts=cuts, G_negative=gneg,
-                           G_margin=gmargin)  # fmt: skip
+            attempt.r, attempt.columns, attempt.cuts = len(use), cols.r, cuts
+            attempt.G_negative, attempt.G_margin = gneg, gmargin
             if gneg != neg or gmargin <= 1.0:
-                attempt["why"] = (
+                attempt.why = (
                     f"G has {gneg} negative eigenvalues, K {neg}: K is not positive "
                     "definite on ker U^T (the columns miss a negative direction)"
                 )
                 break
-            stats: dict[str, Any] = {}
+            stats = _OrthantStats()
             proven, ys = _orthant(Gs, Es, neg, opts, stats, near, out.out_of_time)
-            attempt.update(pieces=int(stats.get("pieces", 0)), best_t=stats.get("best_t"))
+            attempt.pieces, attempt.best_t = stats.pieces, stats.best_t
             if proven:
-                attempt.update(proven=True, margin=stats.get("margin", math.inf), why="")
+                attempt.proven = True
+                attempt.margin = math.inf if stats.margin is None else stats.margin
+                attempt.why = ""
                 break
             if ys is None:
                 budget = (
-                    "the time budget"
-                    if stats.get("stopped") == "time"
-                    else f"{opts.max_pieces} pieces"
+                    "the time budget" if stats.stopped == "time" else f"{opts.max_pieces} pieces"
                 )
-                attempt["why"] = (
+                best_t = -math.inf if stats.best_t is None else stats.best_t
+                attempt.why = (
                     f"S is not proven copositive within {budget} (best SDP margin "
-                    f"{stats.get('best_t', -math.inf):.3g}, {cuts} cuts)"
+                    f"{best_t:.3g}, {cuts} cuts)"
                 )
                 break
             y = ys / dg  # G_s = D G D, S_s = D^-1 S D^-1: y = D^-1 y_s
@@ -830,19 +849,19 @@ def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (
             scale = problem.max_abs_w(u)
             values = contact.values(u) / scale
             admissible = bool(values.max() <= problem.tau)
-            if admissible and stats.get("f", -1.0) < 0.0:
+            if admissible and (-1.0 if stats.f is None else stats.f) < 0.0:
                 refuting = _refuting(problem, u, values)
-                if refuting is not None and refuting["load"] < candidate.load:
+                if refuting is not None and refuting.load < candidate.load:
                     out.refuting = refuting
             u.destroy()
             if out.refuting is not None:
-                attempt["why"] = (
-                    f"refuted: an admissible mode has the load {out.refuting['load']:.10g} "
+                attempt.why = (
+                    f"refuted: an admissible mode has the load {out.refuting.load:.10g} "
                     f"< {lam:.10g}"
                 )
                 break
             if out.out_of_time():
-                attempt["why"] = f"the time budget ({cuts} cuts)"
+                attempt.why = f"the time budget ({cuts} cuts)"
                 break
             grown = False
             if not admissible and cuts < opts.max_cuts:
@@ -859,7 +878,7 @@ def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (
                 if near > 0.0:
                     near = 0.0  # no tightening cut there: partition instead
                     continue
-                attempt["why"] = (
+                attempt.why = (
                     f"budget: {cuts} cuts"
                     if cuts >= opts.max_cuts
                     else "a cut repeats a column or leaves G nearly singular"
@@ -874,7 +893,7 @@ def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (
 
 def _refuting(
     problem: UnilateralProblem, u: PETSc.Vec, values: npt.NDArray[np.float64]
-) -> dict[str, Any] | None:
+) -> Refuting | None:
     """The admissible mode u as a record (load = its Rayleigh quotient), if b(u, u) > 0."""
     Au, Bu = u.duplicate(), u.duplicate()
     problem.model.A.mult(u, Au)
@@ -884,4 +903,4 @@ def _refuting(
     Bu.destroy()
     if not b > 0:
         return None
-    return {"load": a / b, "values": values, "vector": u.array_r.copy()}
+    return Refuting(load=a / b, values=values, vector=np.array(u.array_r, dtype=np.float64))

@@ -31,12 +31,12 @@ from __future__ import annotations
 
 import math
 import warnings
-from typing import Any
 
 from petsc4py import PETSc
 
 import numpy as np
 import numpy.typing as npt
+from msgspec import UnsetType
 
 try:
     import cvxpy as cp
@@ -45,6 +45,7 @@ except ImportError as err:  # pragma: no cover
         "the SDP certificate needs cvxpy and Clarabel: pip install 'unibuckle_fenicsx[sdp]'"
     ) from err
 
+from unibuckle_fenicsx.certificate.records import SdpRecord, SectorPiece, SectorRecord, SectorTry
 from unibuckle_fenicsx.certificate.shifted import EPS, ShiftedMatrix
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Prefix
@@ -53,7 +54,7 @@ from unibuckle_fenicsx.model.problem import UnilateralProblem
 __all__ = ["SDP_SOLVER", "sector_certificate", "spn_certificate"]
 
 #: Interior-point solver and tight tolerances (the margin t scales like delta).
-SDP_SOLVER: dict[str, Any] = {
+SDP_SOLVER: dict[str, str | float | int] = {
     "solver": "CLARABEL",
     "tol_gap_abs": 1e-13,
     "tol_gap_rel": 1e-13,
@@ -130,9 +131,7 @@ def _inertia_minus(
     return neg, zero
 
 
-def spn_certificate(
-    problem: UnilateralProblem, matrix: ShiftedMatrix, lam: float
-) -> dict[str, Any]:
+def spn_certificate(problem: UnilateralProblem, matrix: ShiftedMatrix, lam: float) -> SdpRecord:
     r"""Copositivity of the Schur complement by a PSD + nonnegative split (see above).
 
     ``matrix`` holds the factorisation of :math:`K(\lambda)`, ``lam`` its shift.
@@ -143,18 +142,18 @@ def spn_certificate(
     S = np.linalg.inv(_inverse_on_constrained(problem, matrix))
     S = 0.5 * (S + S.T)
     neg_S = int((np.linalg.eigvalsh(S) < 0).sum())
-    out: dict[str, Any] = {"ok": False, "neg_K": neg_K, "neg_S": neg_S, "lambda": lam}
+    out = SdpRecord(ok=False, neg_K=neg_K, neg_S=neg_S, lam=lam)
     if neg_S != neg_K:
-        out["why"] = "K_FF is not positive definite (neg(K) != neg(S))"
+        out.why = "K_FF is not positive definite (neg(K) != neg(S))"
         return out
     t, eig_min, N, status = _psd_plus_nonnegative(S)
     n = S.shape[0]
-    out.update(t=t, eig_min=eig_min, status=status)
+    out.t, out.eig_min, out.status = t, eig_min, status
     if not eig_min > 1e3 * n * EPS:
-        out["why"] = "S - N is not positive definite with margin"
+        out.why = "S - N is not positive definite with margin"
         return out
-    out["neg_zero_K_minus_N"] = list(_inertia_minus(problem, matrix, N))
-    out["ok"] = out["neg_zero_K_minus_N"] == [0, 0]
+    out.neg_zero_K_minus_N = list(_inertia_minus(problem, matrix, N))
+    out.ok = out.neg_zero_K_minus_N == [0, 0]
     return out
 
 
@@ -189,14 +188,14 @@ def _lowest_modes(problem: UnilateralProblem, nev: int) -> list[PETSc.Vec]:
 
 def sector_certificate(
     problem: UnilateralProblem, matrix: ShiftedMatrix, lam: float, sectors: tuple[int, ...]
-) -> dict[str, Any]:
+) -> SectorRecord:
     """Copositivity on every sector piece of the cone (two negative eigenvalues)."""
     if not matrix.factored:
         raise RuntimeError("sector_certificate: expected matrix.factored (an internal invariant)")
     neg_K = matrix.inertia()[0]
-    out: dict[str, Any] = {"ok": False, "neg_K": neg_K, "lambda": lam}
+    out = SectorRecord(ok=False, neg_K=neg_K, lam=lam)
     if neg_K != 2:
-        out["why"] = "the sector split is implemented for two negative eigenvalues"
+        out.why = "the sector split is implemented for two negative eigenvalues"
         return out
     n = problem.num_constrained
     rows: list[PETSc.Vec] = []
@@ -219,7 +218,7 @@ def sector_certificate(
     for s in solves:
         s.destroy()
     for count in sectors:
-        pieces: list[dict[str, Any]] = []
+        pieces: list[SectorPiece] = []
         for k in range(count):
             ta, tb = 2 * math.pi * k / count, 2 * math.pi * (k + 1) / count
             T = np.zeros((n + 2, r))
@@ -232,16 +231,21 @@ def sector_certificate(
                 int((eig < 0).sum()) != neg_K
                 or np.abs(eig).min() <= 1e3 * r * EPS * np.abs(eig).max()
             ):
-                pieces.append({"ok": False, "why": "K is not definite on the piece's kernel"})
+                pieces.append(SectorPiece(ok=False, why="K is not definite on the piece's kernel"))
                 break
             t, eig_min, _, status = _psd_plus_nonnegative(np.linalg.inv(H))
-            pieces.append({"t": t, "eig_min": eig_min, "status": status,
-                           "ok": bool(eig_min > 1e3 * r * EPS)})  # fmt: skip
-            if not pieces[-1]["ok"]:
+            piece = SectorPiece(
+                t=t, eig_min=eig_min, status=status, ok=bool(eig_min > 1e3 * r * EPS)
+            )
+            pieces.append(piece)
+            if not piece.ok:
                 break
-        out.setdefault("tries", []).append({"sectors": count, "pieces": pieces})
-        if len(pieces) == count and all(p["ok"] for p in pieces):
-            out.update(ok=True, sectors=count, eig_min=min(float(p["eig_min"]) for p in pieces))
+        if isinstance(out.tries, UnsetType):
+            out.tries = []
+        out.tries.append(SectorTry(sectors=count, pieces=pieces))
+        if len(pieces) == count and all(p.ok for p in pieces):
+            out.ok, out.sectors = True, count
+            out.eig_min = min(float(p.eig_min) for p in pieces if isinstance(p.eig_min, float))
             return out
-    out["why"] = "a sector piece is not certified"
+    out.why = "a sector piece is not certified"
     return out

@@ -27,17 +27,37 @@ import dolfinx
 
 import numpy as np
 import numpy.typing as npt
+from msgspec import Struct
 
 from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec, PointSpec
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
+    "PointReport",
     "SnappedPoints",
     "point_bcs",
     "point_obstacles",
     "point_springs",
     "snap_points",
 ]
+
+
+class PointReport(Struct, kw_only=True):
+    """The points of one restraint on the mesh (the JSON's ``details.point_restraints``).
+
+    Attributes:
+        restraint: The restraint, described.
+        kind: Its kind ("bilateral", "one-sided", "spring").
+        points: Points given.
+        nodes: Distinct mesh nodes they act on.
+        max_snap_distance_m: The largest distance from a point to its node.
+    """
+
+    restraint: str
+    kind: str
+    points: int
+    nodes: int
+    max_snap_distance_m: float
 
 
 @dataclass(frozen=True)
@@ -61,15 +81,15 @@ class SnappedPoints:
         """The distinct nodes (m, 2)."""
         return np.unique(self.nodes, axis=0)
 
-    def report(self) -> dict[str, object]:
-        """JSON-ready summary: what, how many points and nodes, the largest snap distance."""
-        return {
-            "restraint": self.spec.describe(),
-            "kind": self.spec.kind,
-            "points": len(self.points),
-            "nodes": len(self.unique_nodes),
-            "max_snap_distance_m": float(self.distances.max()),
-        }
+    def report(self) -> PointReport:
+        """What, how many points and nodes, the largest snap distance."""
+        return PointReport(
+            restraint=self.spec.describe(),
+            kind=self.spec.kind,
+            points=len(self.points),
+            nodes=len(self.unique_nodes),
+            max_snap_distance_m=float(self.distances.max()),
+        )
 
     def matches(self, x: npt.NDArray[np.float64], tol: float) -> npt.NDArray[np.bool_]:
         """Mask of the coordinates ``x`` (3, n) lying on one of the nodes (within ``tol``)."""

@@ -21,11 +21,30 @@ import dolfinx
 
 import numpy as np
 import numpy.typing as npt
+from msgspec import Struct
 
 from unibuckle_fenicsx.config import Circle, ObstacleSpec, PlateSpec, Polygon
 from unibuckle_fenicsx.geometry import disc_polygon, intersection_area, polygon_area
 
-__all__ = ["cell_areas", "zone_area", "zone_report"]
+__all__ = ["ZoneReport", "cell_areas", "zone_area", "zone_report"]
+
+
+class ZoneReport(Struct, kw_only=True):
+    """An obstacle's zone on the plate against its discrete zone on the mesh.
+
+    Attributes:
+        obstacle: The obstacle's label in the problem file.
+        zone: The zone, described.
+        area_m2: The zone's part on the plate (None if unknown: a predicate zone).
+        discrete_area_m2: The cells with every node in the closed zone.
+        nodes: Mesh nodes in the closed zone, edge nodes included.
+    """
+
+    obstacle: str
+    zone: str
+    area_m2: float | None
+    discrete_area_m2: float
+    nodes: int
 
 
 def _shape(zone: Any) -> npt.NDArray[np.float64] | None:
@@ -79,14 +98,11 @@ def zone_report(
     obstacles: Sequence[ObstacleSpec],
     plate: PlateSpec,
     labels: Sequence[str],
-) -> list[dict[str, Any]]:
+) -> list[ZoneReport]:
     """Per obstacle: the zone's area, the discrete zone's area and its mesh nodes.
 
     Returns:
-        One mapping per obstacle: ``obstacle`` (its label), ``zone`` (described),
-        ``area_m2`` (the zone's part on the plate, None if unknown), ``discrete_area_m2``
-        (the cells with every node in the closed zone), ``nodes`` (mesh nodes in the
-        closed zone, edge nodes included).
+        One report per obstacle.
 
     Note:
         Collective.
@@ -101,12 +117,12 @@ def zone_report(
         inside = obstacle.contains(x.T, size)
         whole = inside[nodes].all(axis=1)
         report.append(
-            {
-                "obstacle": label,
-                "zone": obstacle.describe(),
-                "area_m2": zone_area(obstacle, plate),
-                "discrete_area_m2": comm.allreduce(float(areas[whole].sum()), op=MPI.SUM),
-                "nodes": comm.allreduce(int(np.count_nonzero(inside[:n_owned])), op=MPI.SUM),
-            }
+            ZoneReport(
+                obstacle=label,
+                zone=obstacle.describe(),
+                area_m2=zone_area(obstacle, plate),
+                discrete_area_m2=comm.allreduce(float(areas[whole].sum()), op=MPI.SUM),
+                nodes=comm.allreduce(int(np.count_nonzero(inside[:n_owned])), op=MPI.SUM),
+            )
         )
     return report

@@ -50,7 +50,7 @@ from unibuckle_fenicsx.nonlinear.model import (
     displacement_axis,
 )
 from unibuckle_fenicsx.progress import LOGGER
-from unibuckle_fenicsx.results import versions
+from unibuckle_fenicsx.results.assemble import versions
 from unibuckle_fenicsx.tolerances import NONLINEAR_ATOL
 
 __all__ = [
@@ -536,10 +536,13 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
     timings = {"linear_s": time.perf_counter() - t0}
     result = linear.result
     reference = result.critical_load_Pa if obstacle else result.free_load_Pa
-    certificate = result.certificate or {}
     how = "free" if not obstacle else result.method
     if obstacle:
-        how += ", KKT" if certificate.get("kkt") else ", NOT certified"
+        how += (
+            ", KKT"
+            if result.certificate is not None and result.certificate.kkt
+            else ", NOT certified"
+        )
     label = f"{spec.name} delta/t={options.imperfection:g}"
     plate = None
     try:

@@ -28,9 +28,9 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.analysis import Analysis, solve
 from unibuckle_fenicsx.config import ProblemSpec
-from unibuckle_fenicsx.io import write_fields
 from unibuckle_fenicsx.model.problem import UnilateralProblem
-from unibuckle_fenicsx.results import BucklingResult
+from unibuckle_fenicsx.results.files import write_fields
+from unibuckle_fenicsx.results.record import BucklingResult
 from unibuckle_fenicsx.viz import fields, plotting
 
 __all__ = [
@@ -325,9 +325,9 @@ def check_certified(results: Sequence[BucklingResult], rtol: float) -> None:
     for r in results:
         cert = r.certificate
         # Explicit raises, not assert statements: the check must hold under python -O too.
-        if cert is None or not cert["kkt"]:
+        if cert is None or not cert.kkt:
             raise AssertionError(f"{r.mesh}: certificate fails: {cert}")
-        if not (cert["global_optimum_proven"] or cert["smallest_of_reduced"]):
+        if not (cert.global_optimum_proven or cert.smallest_of_reduced):
             raise AssertionError(f"{r.mesh}: neither proven nor the smallest eigenvalue: {cert}")
         if r.critical_load_Pa < r.free_load_Pa * (1 - rtol):
             raise AssertionError(f"{r.mesh}: load below the free load ({r.ratio_to_free})")

@@ -9,7 +9,7 @@ from typing import TYPE_CHECKING
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.analysis import Analysis
-    from unibuckle_fenicsx.results import BucklingResult
+    from unibuckle_fenicsx.results.record import BucklingResult
 
 __all__ = ["file_stem", "write_fields", "write_json"]
 

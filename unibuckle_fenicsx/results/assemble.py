@@ -1,0 +1,247 @@
+"""The result of a solve, read off the live problem: the one place that turns objects into records.
+
+:func:`assemble_result` reads the set-up problem, its free mode, the algorithm's solution
+and its certificate, and returns a :class:`~.record.BucklingResult` that holds none of
+them. It is collective (the contact DOFs are gathered); the records it builds are the
+same on every rank.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import TYPE_CHECKING, Any
+
+from unibuckle_fenicsx.config import (
+    ProblemSpec,
+    problem_to_dict,
+    stress_value,
+    temperature_field,
+)
+from unibuckle_fenicsx.config.checks import plate_model_note
+from unibuckle_fenicsx.model.problem import UnilateralProblem
+from unibuckle_fenicsx.model.zones import zone_report
+from unibuckle_fenicsx.results.record import (
+    BucklingResult,
+    CertificateRecord,
+    EdgeLoad,
+    ResultDetails,
+)
+
+if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.algorithms import UnilateralSolution
+    from unibuckle_fenicsx.certificate.certify import Certificate
+    from unibuckle_fenicsx.model.problem import Mode, Problem
+
+__all__ = ["assemble_result", "certificate_record", "versions"]
+
+
+def assemble_result(
+    problem: Problem,
+    free: Mode,
+    solution: UnilateralSolution | None,
+    certificate: Certificate | None,
+    *,
+    wall_time_s: float,
+    mpi_size: int,
+    method_chosen_by: str = "",
+) -> BucklingResult:
+    """The result of ``problem``'s free mode and unilateral ``solution`` (None: no obstacle).
+
+    Note:
+        Collective on the problem's communicator (gathers the contact DOFs).
+    """
+    spec = problem.spec
+    load = free.load if solution is None else solution.load
+    result = BucklingResult(
+        case=spec.name,
+        method="free" if solution is None else solution.method,
+        route=["free"] if solution is None else list(solution.route),
+        critical_load_Pa=load,
+        free_load_Pa=free.load,
+        ratio_to_free=load / free.load,
+        critical_force_N_per_m=spec.plate.thickness * load,
+        # k is a buckling coefficient of edge loads: none for a rise alone.
+        buckling_coefficient_k=(problem.buckling_coefficient(load) if spec.plate.loaded else None),
+        dofs=problem.model.num_dofs,
+        mesh=(
+            [problem.mesh.topology.index_map(2).size_global]
+            if not problem.structured
+            else [spec.mesh.nx, spec.mesh.ny]
+        ),
+        eigensolves=1 + (0 if solution is None else solution.eigensolves),
+        wall_time_s=wall_time_s,
+        timings={**problem.timings, "total_s": wall_time_s},
+        mpi_size=mpi_size,
+        method_chosen_by=method_chosen_by,
+        details=_details(problem, free),
+        edge_loads={e.name: _edge_load(e) for e in spec.plate.edges},
+        critical_load_factor=load,
+        critical_temperature_K=_critical_temperature(spec, load),
+        units=spec.units,
+        input=_input(spec),
+        versions=versions(),
+    )
+    if not problem.tensionless:
+        mode = free.function if solution is None else solution.candidate.mode
+        result.load_resolution = problem.load_resolution(mode.x.petsc_vec, load)
+    if spec.design is not None:
+        from unibuckle_fenicsx.design import design_output
+
+        result.design = design_output(spec, spec.design, load)
+    if spec.all_obstacles:
+        labels = [spec.obstacle_label(k) for k in range(len(spec.all_obstacles))]
+        result.obstacle_zones = zone_report(problem.mesh, spec.all_obstacles, spec.plate, labels)
+    if solution is None or certificate is None:
+        result.lower_bound_Pa = result.upper_bound_Pa = free.load
+        return result
+    _contact(result, problem, solution)
+    result.lower_bound_Pa = certificate.lower_bound
+    result.upper_bound_Pa = (
+        certificate.upper_bound if math.isfinite(certificate.upper_bound) else None
+    )
+    result.certificate = certificate_record(certificate)
+    if solution.details is not None:
+        result.details.run = solution.details
+    if solution.lower_bound_by is not None:
+        result.details.lower_bound_by = solution.lower_bound_by
+    return result
+
+
+def _details(problem: Problem, free: Mode) -> ResultDetails:
+    """The free solve's report and the model's notes."""
+    spec = problem.spec
+    details = ResultDetails(
+        free_eigen_error=free.eigen.error, free_eigen_iterations=free.eigen.iterations
+    )
+    if problem.model.points:
+        details.point_restraints = [g.report() for g in problem.model.points]
+    if spec.gapped_obstacles:
+        details.gapped_obstacles = (
+            f"{len(spec.gapped_obstacles)} obstacle(s) with a gap left out of the linear "
+            "critical state (an infinitesimal buckle does not reach them); unibuckle "
+            "nonlinear follows the plate onto them"
+        )
+    note = plate_model_note(spec.plate)
+    if note is not None:
+        details.plate_model = note
+    return details
+
+
+def _contact(result: BucklingResult, problem: Problem, solution: UnilateralSolution) -> None:
+    """The contact set of ``solution`` into ``result`` (collective: the DOFs are gathered)."""
+    if not isinstance(problem, UnilateralProblem):
+        raise TypeError("assemble_result: a solution without an obstacle (an internal invariant)")
+    contact = problem.contact
+    active = solution.active
+    rows = contact.removed_rows(active)
+    result.constrained_nodes = problem.num_constrained
+    result.contact_nodes = len(active)
+    result.p_star = solution.p_star
+    result.contact_indices = [int(k) for k in active]
+    result.contact_coordinates = contact.coordinates[active].tolist()
+    result.contact_dofs = sorted(
+        int(r) for part in problem.comm.allgather(rows.tolist()) for r in part
+    )
+
+
+def certificate_record(cert: Certificate) -> CertificateRecord:
+    """The record of the live certificate ``cert`` (its refuting mode's load only)."""
+    return CertificateRecord(
+        feasible=cert.feasible,
+        feasibility_margin=cert.feasibility_margin,
+        max_contact_force=cert.max_contact_force,
+        max_contact_value=cert.max_contact_value,
+        relative_residual=cert.relative_residual,
+        tolerance=cert.tolerance,
+        kkt=cert.kkt,
+        smallest_of_reduced=cert.smallest_of_reduced,
+        lower_bound_Pa=cert.lower_bound,
+        upper_bound_Pa=cert.upper_bound,
+        relative_gap=cert.relative_gap,
+        global_optimum_proven=cert.global_optimum_proven,
+        proven_by=cert.proven_by,
+        status=cert.status,
+        negative_eigenvalues=cert.negative_eigenvalues,
+        refuting_load_Pa=None if cert.refuting_mode is None else cert.refuting_mode.load,
+        copositivity=cert.copositivity,
+        notes=list(cert.notes),
+    )
+
+
+def _edge_load(edge: Any) -> EdgeLoad:
+    """An edge's stresses per unit load, and its fixed part's when it has one."""
+    load = EdgeLoad(
+        normal_stress=stress_value(edge.normal_stress),
+        shear_stress=stress_value(edge.shear_stress),
+    )
+    if edge.fixed_loaded:
+        load.fixed_normal_stress = stress_value(edge.fixed_normal_stress)
+        load.fixed_shear_stress = stress_value(edge.fixed_shear_stress)
+    return load
+
+
+def _critical_temperature(spec: ProblemSpec, load: float) -> float | None:
+    """The critical rise: lambda times the scaled field's largest rise over the plate.
+
+    The largest signed rise (the field is linear: its largest value lies on the
+    boundary's vertices): where part of the plate cools, the heated part buckles it.
+    """
+    if not spec.load.thermal:
+        return None
+    T0, gx, gy = temperature_field(spec.load.temperature)
+    rises = [T0 + gx * x + gy * y for x, y in spec.plate.boundary]
+    return load * max(rises)
+
+
+def _input(spec: ProblemSpec) -> dict[str, Any] | None:
+    try:
+        return problem_to_dict(spec)
+    except ValueError:  # a predicate zone
+        return None
+
+
+def versions() -> dict[str, str]:
+    """Versions of the package and of the libraries that computed the result."""
+    import platform
+    from importlib.metadata import PackageNotFoundError, version
+
+    import numpy as np
+
+    out = {"python": platform.python_version(), "numpy": np.__version__}
+    # Distributions that can take part in a result (installed ones only): meshing (gmsh),
+    # MPI, the SDP certificate (cvxpy, clarabel), the dense references (scipy).
+    dists = (
+        "unibuckle_fenicsx",
+        "fenics-dolfinx",
+        "petsc4py",
+        "slepc4py",
+        "fenics-basix",
+        "mpi4py",
+        "gmsh",
+        "cvxpy",
+        "clarabel",
+        "scipy",
+    )
+    for dist in dists:
+        try:
+            out[dist] = version(dist)
+        except PackageNotFoundError:
+            pass
+    try:
+        import petsc4py
+        import slepc4py
+        from petsc4py import PETSc
+        from slepc4py import SLEPc
+
+        import dolfinx
+
+        # The bindings' own versions: the PyPI wheel (dolfinx-solver-real) bundles them
+        # under its own distribution name, where the loop above finds none.
+        out.setdefault("petsc4py", petsc4py.__version__)
+        out.setdefault("slepc4py", slepc4py.__version__)
+        out["dolfinx"] = dolfinx.__version__
+        out["PETSc"] = ".".join(str(v) for v in PETSc.Sys.getVersion())
+        out["SLEPc"] = ".".join(str(v) for v in SLEPc.Sys.getVersion())
+    except ImportError:  # pragma: no cover
+        pass
+    return out

@@ -1,0 +1,412 @@
+"""What a solve returns: :class:`BucklingResult`, typed records all the way down.
+
+The result holds numbers, names and records (the certificate's, each edge's load, the
+obstacle zones', the design output, the algorithm's record of its run), never a live
+object: :mod:`.assemble` reads them off a live problem, :mod:`.files` writes them. Its
+JSON form (:meth:`BucklingResult.as_dict`) is ``msgspec.to_builtins`` of the records, with
+non-finite numbers written as ``null`` and the algorithm's record flattened into
+``details``.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Any
+
+import numpy as np
+from msgspec import UNSET, Struct, UnsetType, to_builtins
+
+from unibuckle_fenicsx.algorithms.records import MethodDetails
+from unibuckle_fenicsx.certificate.records import CopositivityRecord
+from unibuckle_fenicsx.config import UNITS, PointSpec
+from unibuckle_fenicsx.design import DesignRecord
+from unibuckle_fenicsx.model.points import PointReport
+from unibuckle_fenicsx.model.zones import ZoneReport
+
+__all__ = ["BucklingResult", "CertificateRecord", "EdgeLoad", "ResultDetails", "jsonable"]
+
+#: An edge stress as a problem file writes it: a number, or [start, end] (linear).
+Stress = float | list[float]
+
+
+class EdgeLoad(Struct, kw_only=True):
+    """An edge's stresses per unit load (tension > 0), and its fixed part's (Pa)."""
+
+    normal_stress: Stress
+    shear_stress: Stress
+    fixed_normal_stress: Stress | UnsetType = UNSET
+    fixed_shear_stress: Stress | UnsetType = UNSET
+
+
+class CertificateRecord(Struct, kw_only=True):
+    r"""What was verified about the returned critical state (the JSON's ``certificate``).
+
+    The record of a :class:`~unibuckle_fenicsx.certificate.certify.Certificate`; its
+    fields mean what the certificate's attributes of the same names mean.
+
+    Attributes:
+        feasible: The mode does not cross the obstacle.
+        feasibility_margin: Largest value off Z, relative to max|w|.
+        max_contact_force: Largest force on Z, relative to :math:`\|Au\|_\infty`.
+        max_contact_value: Largest |u| on Z, relative to max|w|.
+        relative_residual: :math:`\|r\ \text{off}\ Z\|_2 / \|Au\|_2`.
+        tolerance: :math:`\tau`.
+        kkt: The KKT conditions hold.
+        smallest_of_reduced: The load is the reduced pencil's smallest eigenvalue (None
+            if not checked).
+        lower_bound_Pa: Verified lower bound.
+        upper_bound_Pa: Load of an admissible mode (None if none).
+        relative_gap: (upper - lower) / upper (None if no upper bound).
+        global_optimum_proven: The gap closes.
+        proven_by: What gave the lower bound.
+        status: proven, bracketed, kkt-only or not-kkt.
+        negative_eigenvalues: m, pencil eigenvalues below the shifts tried.
+        refuting_load_Pa: An admissible mode's lower load that refutes the returned one.
+        copositivity: The copositivity certificate's record (None if it did not run).
+        notes: What failed or was skipped, in words.
+    """
+
+    feasible: bool
+    feasibility_margin: float
+    max_contact_force: float
+    max_contact_value: float
+    relative_residual: float
+    tolerance: float
+    kkt: bool
+    smallest_of_reduced: bool | None
+    lower_bound_Pa: float
+    upper_bound_Pa: float
+    relative_gap: float
+    global_optimum_proven: bool
+    proven_by: str
+    status: str
+    negative_eigenvalues: int | None
+    refuting_load_Pa: float | None
+    copositivity: CopositivityRecord | None
+    notes: list[str]
+
+
+class ResultDetails(Struct, kw_only=True):
+    """The JSON's ``details``: the free solve, the model's notes, the algorithm's record.
+
+    Attributes:
+        free_eigen_error: SLEPc's relative residual of the free pair.
+        free_eigen_iterations: Its Krylov-Schur restarts.
+        point_restraints: The point restraints on the mesh.
+        gapped_obstacles: Why obstacles with a gap were left out.
+        plate_model: The plate lies outside the plate model's usual range.
+        run: The algorithm's record of its run (flattened into ``details`` in the
+            JSON).
+        lower_bound_by: What proves the algorithm's lower bound.
+    """
+
+    free_eigen_error: float
+    free_eigen_iterations: int
+    point_restraints: list[PointReport] | UnsetType = UNSET
+    gapped_obstacles: str | UnsetType = UNSET
+    plate_model: str | UnsetType = UNSET
+    run: MethodDetails | UnsetType = UNSET
+    lower_bound_by: str | UnsetType = UNSET
+
+
+class BucklingResult(Struct, kw_only=True):
+    """Critical state of one problem.
+
+    Attributes:
+        case: Problem name.
+        method: The method that ran ("free", "enumerate", "active-set",
+            "interior-point", "penalty", "foundation").
+        route: The links that answered, in order (the method alone, or e.g.
+            ["interior-point", "active-set-polish"]).
+        critical_load_Pa: lambda, the critical compressive stress (Pa).
+        free_load_Pa: lambda without obstacle (Pa).
+        ratio_to_free: critical / free.
+        critical_force_N_per_m: N = t lambda.
+        buckling_coefficient_k: k = N b^2 / (pi^2 D), b = plate width; None when the
+            scaled load is a temperature rise alone (lambda is then a factor on it).
+        dofs: Global DOF count of (w, theta).
+        mesh: [nx, ny] (a user-supplied or gmsh mesh: [number of cells]).
+        eigensolves: Linear eigen solves, including the free one.
+        wall_time_s: Wall time of the whole solve (set-up included).
+        constrained_nodes: i, nodes in the closed obstacle zone with free deflection.
+        contact_nodes: |Z|.
+        p_star: Enumeration: the contact-set size where it stopped.
+        contact_coordinates: Coordinates of Z, (|Z|, 2).
+        contact_indices: Node numbers of Z (lexicographic (y, x) order of the zone).
+        contact_dofs: Global W DOF indices of Z (partition-dependent numbering).
+        load_resolution: How closely double precision fixes the critical load, relative
+            to it (:meth:`~unibuckle_fenicsx.model.problem.Problem.load_resolution`);
+            digits beyond it are rounding. None for a tensionless foundation (the
+            springs' stiffness is not counted).
+        lower_bound_Pa / upper_bound_Pa: Verified bracket of the critical load (the upper
+            bound is the load of an admissible mode; None if the method found none).
+        certificate: The certificate's record (None without obstacle).
+        details: The free solve, the model's notes, the algorithm's record.
+        timings: Seconds per phase.
+        mpi_size: Ranks used.
+        method_chosen_by: Why this method ran ("given", or the "auto" rule's reason).
+        edge_loads: Per edge, its normal and shear stress per unit load (tension > 0).
+        critical_load_factor: lambda, the factor on the scaled part of the load (the
+            same number as critical_load_Pa; with a fixed part, N = N_fixed + lambda
+            N_scaled).
+        critical_temperature_K: With a temperature rise in the scaled load: lambda times
+            its largest rise over the plate (the uniform rise's critical value).
+        design: With ``[design]``: EN 1993-1-5's quantities of this sigma_cr.
+        units: The unit system the summary prints in (the numbers here are SI).
+        input: The problem solved, every key with the value used, in SI (None for a
+            predicate zone).
+        versions: Versions of the package and of the libraries that computed the result.
+        obstacle_zones: Per obstacle, the zone's area on the plate against the discrete
+            zone's and its node count.
+    """
+
+    case: str
+    method: str
+    route: list[str]
+    critical_load_Pa: float
+    free_load_Pa: float
+    ratio_to_free: float
+    critical_force_N_per_m: float
+    buckling_coefficient_k: float | None
+    dofs: int
+    mesh: list[int]
+    eigensolves: int
+    wall_time_s: float
+    constrained_nodes: int = 0
+    contact_nodes: int = 0
+    p_star: int | None = None
+    contact_coordinates: list[list[float]] = []
+    contact_indices: list[int] = []
+    contact_dofs: list[int] = []
+    load_resolution: float | None = None
+    lower_bound_Pa: float | None = None
+    upper_bound_Pa: float | None = None
+    certificate: CertificateRecord | None = None
+    details: ResultDetails
+    timings: dict[str, float] = {}
+    mpi_size: int = 1
+    method_chosen_by: str = ""
+    edge_loads: dict[str, EdgeLoad] = {}
+    critical_load_factor: float | None = None
+    critical_temperature_K: float | None = None
+    design: DesignRecord | None = None
+    units: str = "SI"
+    input: dict[str, Any] | None = None
+    versions: dict[str, str] = {}
+    obstacle_zones: list[ZoneReport] = []
+
+    @property
+    def certified(self) -> bool:
+        """No certificate (no obstacle: the free load, verified the smallest), or a KKT one."""
+        return self.certificate is None or self.certificate.kkt
+
+    def as_dict(self, timings: bool = True) -> dict[str, Any]:
+        """JSON-ready mapping (non-finite floats become ``null``: JSON has no infinity).
+
+        The fields in their order, ``details`` holding the algorithm's record's fields
+        after the free solve's and the model's.
+
+        Args:
+            timings: Keep the wall times (``*_s`` and ``seconds`` keys, the latter in
+                the interior point's level records; ``timings``) and the "auto" rule's
+                reason, which quotes a measured time; without them the mapping is the same
+                on every run (for files kept under version control).
+        """
+        data = jsonable(self)
+        details = data["details"]
+        data["details"] = {
+            k: v for key, value in details.items() for k, v in _flat(key, value).items()
+        }
+        return data if timings else _without_timings(data)
+
+    def summary(self) -> str:
+        """Lines for the terminal: the result, the load it is a multiple of, the model."""
+        scale, unit = UNITS[self.units][1:]
+        z = ""
+        if self.constrained_nodes:
+            cert = self.certificate
+            z = (
+                f"  i={self.constrained_nodes} |Z|={self.contact_nodes}"
+                f"  KKT={'yes' if cert is not None and cert.kkt else 'NO'}  {_verified(cert)}"
+            )
+        loaded = [
+            f"{name} {_load_text(load)}"
+            for name, load in self.edge_loads.items()
+            if _load_text(load)
+        ]
+        extra = "".join(f"\n  {line}" for line in self._model_lines())
+        extra += "".join(f"\n  {text}" for text in map(_zone_text, self.obstacle_zones) if text)
+        if loaded:
+            head = (
+                f"lambda_c = {self.critical_load_Pa / scale:.6e} {unit} "
+                f"({self.critical_load_Pa / self.free_load_Pa:.4f} x free "
+                f"{self.free_load_Pa / scale:.6e} {unit}), "
+                f"k = {self.buckling_coefficient_k:.4f}"
+            )
+            second = f"\n  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}"
+        else:  # a temperature rise alone is scaled: lambda is a factor on it
+            head = (
+                f"lambda_c = {self.critical_load_Pa:.6e} (factor on the temperature rise; "
+                f"{self.critical_load_Pa / self.free_load_Pa:.4f} x free "
+                f"{self.free_load_Pa:.6e})"
+            )
+            second = ""
+        return (
+            f"{self.case}: {head}, method {self.method}{z}, "
+            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{second}{extra}"
+        )
+
+    def _model_lines(self) -> list[str]:
+        """Summary lines of what the model holds beyond plate, edges and obstacle."""
+        length, scale, unit = UNITS[self.units]
+        lines = []
+        if isinstance(self.details.gapped_obstacles, str):
+            lines.append(self.details.gapped_obstacles)
+        load = (self.input or {}).get("load", {})
+        if self.critical_temperature_K is not None:
+            lines.append(
+                f"temperature rise per unit lambda {load.get('temperature')}: critical rise "
+                f"{self.critical_temperature_K:.6g} K"
+            )
+        fixed = [
+            f"{name} {_load_text(edge, True, scale, ' ' + unit)}"
+            for name, edge in self.edge_loads.items()
+            if not isinstance(edge.fixed_normal_stress, UnsetType)
+        ]
+        if load.get("fixed_temperature"):
+            fixed.append(f"temperature rise {load['fixed_temperature']} K")
+        if self.design is not None:
+            lines.append(_design_line(self.design, scale, unit))
+        factor = load.get("fixed_factor", 1.0)
+        if fixed and factor:
+            times = "" if factor == 1.0 else f"{factor:g} x "
+            lines.append(f"fixed load (applied as is): {times}{'; '.join(fixed)}")
+        reports = self.details.point_restraints
+        reports = [] if isinstance(reports, UnsetType) else reports
+        for p, restraint in zip(reports, self._point_restraints(reports), strict=True):
+            lines.append(
+                f"points: {restraint}: {p.points} points on {p.nodes} nodes, "
+                f"largest snap distance {p.max_snap_distance_m / length:.3g}"
+                f" {'m' if self.units == 'SI' else 'mm'}"
+            )
+        return lines
+
+    def _point_restraints(self, reports: list[PointReport]) -> list[str]:
+        """Each point restraint described in the summary's units (the JSON's are SI)."""
+        tables = (self.input or {}).get("points", [])
+        if self.units == "SI" or len(tables) != len(reports):
+            return [p.restraint for p in reports]
+        return [PointSpec(**table).describe(self.units) for table in tables]
+
+
+def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
+    """The summary line of the design output."""
+    rho = d.reduction_factor
+    reduced = d.reduced_design_stress_Pa
+    return (
+        f"EN 1993-1-5: sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit} ({d.edge}), "
+        f"psi = {d.psi:.3g}, slenderness {d.relative_slenderness:.4g}, rho = "
+        + (
+            f"{rho:.4g}, rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
+            if rho is not None and isinstance(reduced, float)
+            else "none (psi < -3)"
+        )
+        + " (4.2) calibrated on bilateral plates"
+    )
+
+
+def _gap_text(gap: float) -> str:
+    """The relative gap rounded up to one significant digit: 8.1e-05 -> "9e-05"."""
+    if gap <= 0:
+        return "0"
+    exponent = math.floor(math.log10(gap))
+    digit = math.ceil(round(gap / 10.0**exponent, 9))
+    if digit >= 10:
+        digit, exponent = 1, exponent + 1
+    return f"{digit}e{exponent:+03d}"
+
+
+def _verified(cert: CertificateRecord | None) -> str:
+    """What the certificate verified, for the summary line."""
+    if cert is None:
+        return "proven=no (KKT only)"
+    m = cert.negative_eigenvalues
+    below = f", m={m}" if m is not None else ""
+    gap = cert.relative_gap
+    if cert.global_optimum_proven:
+        return f"proven=yes ({cert.proven_by}, gap {float(gap or 0):.1e}{below})"
+    if cert.status == "bracketed" and isinstance(gap, float):
+        return f"proven=no, bracketed to {_gap_text(gap)} ({cert.proven_by}{below})"
+    refuted = cert.refuting_load_Pa
+    if refuted is not None:
+        return f"proven=no, refuted: an admissible mode has {refuted:.6e} Pa"
+    return f"proven=no (KKT only{below})"
+
+
+def _zone_text(zone: ZoneReport) -> str:
+    """A line on a discrete zone that differs from its zone by more than 1e-6, or ''."""
+    area, discrete = zone.area_m2, zone.discrete_area_m2
+    if area is None or area <= 0.0 or abs(discrete - area) <= 1e-6 * area:
+        return ""
+    return (
+        f"{zone.obstacle} zone on the mesh: the cells with every node in it cover "
+        f"{discrete / area:.2%} of its area ({zone.nodes} nodes); the obstacle acts on "
+        "the mesh nodes in the zone"
+    )
+
+
+def _load_text(load: EdgeLoad, fixed: bool = False, scale: float = 1.0, unit: str = "") -> str:
+    """The edge stresses of ``load`` (``fixed``: its fixed ones, in ``unit``)."""
+    parts = []
+    values = (
+        (load.fixed_normal_stress, load.fixed_shear_stress)
+        if fixed
+        else (load.normal_stress, load.shear_stress)
+    )
+    for key, value in zip(("normal", "shear"), values, strict=True):
+        if isinstance(value, list | tuple):
+            if any(value):
+                parts.append(f"{key} {value[0] / scale:g} to {value[1] / scale:g}{unit} (linear)")
+        elif isinstance(value, float | int) and value:
+            parts.append(f"{key} {value / scale:g}{unit}")
+    return ", ".join(parts)
+
+
+def jsonable(record: Any) -> Any:
+    """A record (or any mapping or list of them) as JSON-ready builtins, null for non-finite."""
+    return _finite(to_builtins(record, enc_hook=_numpy))
+
+
+def _flat(key: str, value: Any) -> dict[str, Any]:
+    """A ``details`` entry as the JSON's keys: the algorithm's record spread out."""
+    return value if key == "run" else {key: value}
+
+
+def _numpy(obj: Any) -> Any:
+    """NumPy scalars and arrays as Python numbers and lists (``to_builtins``'s hook)."""
+    if isinstance(obj, np.generic | np.ndarray):
+        return obj.tolist()
+    raise NotImplementedError(f"{type(obj).__name__} has no JSON form")
+
+
+def _finite(obj: Any) -> Any:
+    """Non-finite floats as None: JSON has no infinity (an upper bound with no mode)."""
+    if isinstance(obj, dict):
+        return {k: _finite(v) for k, v in obj.items()}
+    if isinstance(obj, list):
+        return [_finite(v) for v in obj]
+    if isinstance(obj, float) and not math.isfinite(obj):
+        return None
+    return obj
+
+
+def _without_timings(obj: Any) -> Any:
+    if isinstance(obj, dict):
+        return {
+            k: _without_timings(v)
+            for k, v in obj.items()
+            if not (k.endswith("_s") or k in ("timings", "method_chosen_by", "seconds"))
+        }
+    if isinstance(obj, list):
+        return [_without_timings(v) for v in obj]
+    return obj
