@@ -49,13 +49,13 @@ from test_stress_family import FAMILY, _check
 
 from unibuckle_fenicsx.algorithms.chain import ChainOptions, _second_free_mode, solve_unilateral
 from unibuckle_fenicsx.algorithms.interior_point import (
-    PUSH_MARGIN,
     BarrierPoint,
     InteriorPointNewton,
     NewtonOptions,
     NewtonStatus,
-    _StallWatch,
 )
+from unibuckle_fenicsx.algorithms.interior_point.newton import StallWatch
+from unibuckle_fenicsx.algorithms.interior_point.options import PUSH_MARGIN
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case, plate_case
@@ -144,30 +144,30 @@ def test_newton_direction_solves_the_linearised_conditions(side):
     spec = replace(spec, obstacle=replace(spec.obstacle, side=side))
     problem = build_problem(spec, MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
-        u = newton.pressure_mode()  # strictly inside the cone
+        u = newton.starts.pressure_mode()  # strictly inside the cone
         vec = u.x.petsc_vec
         vec.scale(0.7)  # not normalised: F_n != 0
         A, B = dense(problem.model.A), dense(problem.model.B)
         x = vec.array.copy()
         n = x.size
-        rows = newton._dofs
+        rows = newton.kernel.dofs
         E = np.zeros((n, rows.size))
-        E[rows, np.arange(rows.size)] = newton._signs
+        E[rows, np.arange(rows.size)] = newton.kernel.signs
         gap = -E.T @ x
         assert gap.min() > 0
         rng = np.random.default_rng(7)
         nu = rng.uniform(0.5, 2.0, rows.size) * np.abs(A @ x).max() * 1e-3
         lam = 0.5 * problem.solve_free().load  # K positive definite: no regularisation
         mu_abs = float(np.mean(nu * gap))
-        problem.model.A.mult(vec, newton._Au)
-        problem.model.B.mult(vec, newton._Bu)
-        newton._Au.copy(newton._Fu)
-        newton._Fu.axpy(-lam, newton._Bu)
-        newton._add_zone(newton._Fu, nu)
-        step = newton.direction(vec, lam, nu, gap, mu_abs)
+        problem.model.A.mult(vec, newton.kernel.Au)
+        problem.model.B.mult(vec, newton.kernel.Bu)
+        newton.kernel.Au.copy(newton.kernel.Fu)
+        newton.kernel.Fu.axpy(-lam, newton.kernel.Bu)
+        newton.kernel.add_zone(newton.kernel.Fu, nu)
+        step = newton.kernel.direction(vec, lam, nu, gap, mu_abs)
         assert step is not None
         dlam, dz, dnu = step
-        du = newton._du.array.copy()
+        du = newton.kernel.du.array.copy()
     problem.destroy()
     delta = _dense_newton_step(A, B, E, x, lam, nu, mu_abs)
     scale = np.abs(delta[:n]).max()
@@ -186,15 +186,15 @@ def at_saddle(newton: InteriorPointNewton, lam: float) -> tuple:
     (mu/g) and absolute barrier parameter. Collective (also used by
     ``tests/mpi/negative_curvature_parallel.py``).
     """
-    u = newton.pressure_mode()  # strictly inside the cone
+    u = newton.starts.pressure_mode()  # strictly inside the cone
     vec = u.x.petsc_vec
-    newton._normalize(vec)  # leaves Bu in newton._Bu
-    gap = -newton.oriented(vec)
+    newton.kernel.normalize(vec)  # leaves Bu in newton.kernel.Bu
+    gap = -newton.kernel.oriented(vec)
     w_max = float(vec.norm(PETSc.NormType.INFINITY))
-    mu_abs = 1e-6 * lam * float(newton._Bu.norm(PETSc.NormType.INFINITY)) * w_max
+    mu_abs = 1e-6 * lam * float(newton.kernel.Bu.norm(PETSc.NormType.INFINITY)) * w_max
     nu = mu_abs / gap
-    newton._residual(vec, lam, nu)
-    assert newton.direction(vec, lam, nu, gap, mu_abs) is not None
+    newton.kernel.residual(vec, lam, nu)
+    assert newton.kernel.direction(vec, lam, nu, gap, mu_abs) is not None
     return u, gap, nu, mu_abs
 
 
@@ -224,17 +224,17 @@ def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
         u, gap, nu, mu_abs = at_saddle(newton, lam)
         vec = u.x.petsc_vec
         x = vec.array.copy()
-        assert newton._last_correction > 0.0  # the unmodified K had the wrong inertia
-        du = newton._du.array.copy()
-        found = newton.negative_curvature(vec, lam)
+        assert newton.kernel.last_correction > 0.0  # the unmodified K had the wrong inertia
+        du = newton.kernel.du.array.copy()
+        found = newton.curvature.find(vec, lam)
         assert found is not None
         theta, d, curvature = found[0], found[1].array.copy(), found[2]
-        assert np.array_equal(newton._du.array, du)  # the Newton direction is kept
-        phi0 = newton._merit(vec, mu_abs)
-        assert newton._curvature_step(vec, lam, gap, mu_abs) is not None
-        phi1 = newton._merit(vec, mu_abs)
+        assert np.array_equal(newton.kernel.du.array, du)  # the Newton direction is kept
+        phi0 = newton.kernel.merit(vec, mu_abs)
+        assert newton.curvature.step(vec, lam, gap, mu_abs) is not None
+        phi1 = newton.kernel.merit(vec, mu_abs)
         sigma = np.zeros(x.size)
-        sigma[newton._dofs] = nu / gap
+        sigma[newton.kernel.dofs] = nu / gap
     problem.destroy()
     K = A - lam * B + np.diag(sigma)
     S = K[np.ix_(P, P)] - K[np.ix_(P, R)] @ np.linalg.solve(K[np.ix_(R, R)], K[np.ix_(R, P)])
@@ -263,7 +263,7 @@ def test_negative_curvature_is_the_same_on_two_ranks(tmp_path):
     lam = 1.3 / np.sort(np.linalg.eigvals(np.linalg.solve(A, B)).real)[-2]
     with InteriorPointNewton(problem, replace(NewtonOptions(), curvature_vectors=3)) as newton:
         u, *_ = at_saddle(newton, lam)
-        found = newton.negative_curvature(u.x.petsc_vec, lam)
+        found = newton.curvature.find(u.x.petsc_vec, lam)
         assert found is not None
     problem.destroy()
     path = tmp_path / "plate.json"
@@ -306,20 +306,20 @@ def test_lift_is_the_least_energy_correction():
     margin = 1e-3
     with InteriorPointNewton(fine) as newton:
         start = Prolongation(coarse, fine).mode(coarse.solve_free().function)
-        newton.relax(start.x.petsc_vec, "deflection")
-        newton.relax(start.x.petsc_vec, "rotations")
+        newton.starts.relax(start.x.petsc_vec, "deflection")
+        newton.starts.relax(start.x.petsc_vec, "rotations")
         amplitude = fine.max_abs_w(start.x.petsc_vec)
         lifted, clipped = fine.new_mode(), fine.new_mode()
         for target in (lifted, clipped):
             target.x.array[:] = start.x.array
-        moved = newton.lift(lifted, margin)
+        moved = newton.starts.lift(lifted, margin)
         assert moved > 0
         # The clip at the same (fixed) limit as the lift's first correction.
-        z0 = newton.oriented(start.x.petsc_vec)
+        z0 = newton.kernel.oriented(start.x.petsc_vec)
         near = z0 > -margin * amplitude
         vec = clipped.x.petsc_vec
-        vec.array[newton._dofs[near]] = newton._signs[near] * (-margin * amplitude)
-        gap = -newton.oriented(lifted.x.petsc_vec)
+        vec.array[newton.kernel.dofs[near]] = newton.kernel.signs[near] * (-margin * amplitude)
+        gap = -newton.kernel.oriented(lifted.x.petsc_vec)
         assert gap.min() >= margin * fine.max_abs_w(lifted.x.petsc_vec) * (1 - 1e-9)
 
         def energy(c):
@@ -445,14 +445,14 @@ def test_pressure_deflection_is_lifted_into_the_cone():
     problem = build_problem(_twisted(9, 6), MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
         plain = problem.new_mode("plain")
-        newton._factor(0.0, None)
-        newton._rhs.zeroEntries()
-        newton._add_zone(newton._rhs, -np.ones(newton.contact.size))
-        newton.ksp.solve(newton._rhs, plain.x.petsc_vec)
-        assert newton.oriented(plain.x.petsc_vec).max() > 0.0  # crosses an obstacle
-        push = newton.pressure_mode()
+        newton.kernel.factor(0.0, None)
+        newton.kernel.rhs.zeroEntries()
+        newton.kernel.add_zone(newton.kernel.rhs, -np.ones(newton.kernel.contact.size))
+        newton.kernel.ksp.solve(newton.kernel.rhs, plain.x.petsc_vec)
+        assert newton.kernel.oriented(plain.x.petsc_vec).max() > 0.0  # crosses an obstacle
+        push = newton.starts.pressure_mode()
         vec = push.x.petsc_vec
-        gap = -newton.oriented(vec)
+        gap = -newton.kernel.oriented(vec)
         assert gap.min() >= PUSH_MARGIN * problem.max_abs_w(vec) * (1 - 1e-12)
     problem.destroy()
 
@@ -499,9 +499,9 @@ def test_option_under_the_prefix_reaches_the_factorisation():
     opts[f"{prefix}mat_mumps_icntl_14"] = 57
     try:
         with InteriorPointNewton(problem) as newton:
-            assert newton.factorizations == 0
-            newton.pressure_mode()  # one factorisation of A
-            factor = newton.ksp.getPC().getFactorMatrix()
+            assert newton.kernel.factorizations == 0
+            newton.starts.pressure_mode()  # one factorisation of A
+            factor = newton.kernel.ksp.getPC().getFactorMatrix()
             assert factor.getMumpsIcntl(14) == 57
             assert (factor.getMumpsIcntl(13), factor.getMumpsIcntl(24)) == (1, 1)
             assert factor.getInertia()[0] == 0  # A is positive definite
@@ -512,13 +512,13 @@ def test_option_under_the_prefix_reaches_the_factorisation():
 
 def test_stall_watch_counts_steps_without_halving():
     """The run stops after ``stall_steps`` steps in which the residual did not halve."""
-    watch = _StallWatch(3)
+    watch = StallWatch(3)
     # 1.0 sets the best; 0.6, 0.9, 0.51 do not halve it: the third of them stalls.
     assert [watch.stalled(r) for r in (1.0, 0.6, 0.9, 0.51)] == [False, False, False, True]
-    watch = _StallWatch(3)
+    watch = StallWatch(3)
     # Halving (0.5, then 0.2) resets the count.
     assert not any(watch.stalled(r) for r in (1.0, 0.8, 0.5, 0.45, 0.2, 0.15, 0.19))
-    assert not any(_StallWatch(0).stalled(1.0) for _ in range(50))
+    assert not any(StallWatch(0).stalled(1.0) for _ in range(50))
 
 
 @serial
@@ -613,19 +613,19 @@ def test_predicted_contact_set_is_the_affine_step_indicator():
     """
     problem = build_problem(_thin(nx=6, ny=3), MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
-        u = newton.pressure_mode()
-        newton._normalize(u.x.petsc_vec)
+        u = newton.starts.pressure_mode()
+        newton.kernel.normalize(u.x.petsc_vec)
         x = u.x.petsc_vec.array.copy()
         A, B = dense(problem.model.A), dense(problem.model.B)
-        n, rows = x.size, newton._dofs
+        n, rows = x.size, newton.kernel.dofs
         E = np.zeros((n, rows.size))
-        E[rows, np.arange(rows.size)] = newton._signs
+        E[rows, np.arange(rows.size)] = newton.kernel.signs
         gap = -E.T @ x
         rng = np.random.default_rng(3)
         nu = rng.uniform(0.01, 3.0, rows.size) * np.abs(A @ x).max() * 1e-2
         lam = 0.5 * problem.solve_free().load  # K positive definite: no regularisation
         active = newton.predicted_contact_set(BarrierPoint(u, lam, nu, 1e-9))
-        positions = newton.contact.owned_positions
+        positions = newton.kernel.contact.owned_positions
     problem.destroy()
     dz = E.T @ _dense_newton_step(A, B, E, x, lam, nu, 0.0)[:n]
     ratio = dz / gap
@@ -655,8 +655,8 @@ def test_predicted_contact_set_read_inside_a_run_leaves_it_unchanged():
 
     with InteriorPointNewton(problem) as newton:
         for on_solved in (None, hook):
-            newton.forget_corrections()
-            _, record = newton.solve(newton.pressure_mode(), mu=1e-2, mu_min=1e-12,
+            newton.kernel.forget_corrections()
+            _, record = newton.solve(newton.starts.pressure_mode(), mu=1e-2, mu_min=1e-12,
                                      on_solved=on_solved)  # fmt: skip
             runs.append(record)
         fresh = [newton.predicted_contact_set(point) for point in copies]

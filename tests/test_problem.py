@@ -202,7 +202,7 @@ def test_the_factorisations_of_a_mesh_share_one_symbolic_analysis():
     assert problem.contact is not None
     before = symbolic.getPerfInfo()["count"]
     with InteriorPointNewton(problem) as newton:
-        newton.pressure_mode()  # a factorisation of A: the analysis
+        newton.starts.pressure_mode()  # a factorisation of A: the analysis
     active = np.arange(problem.contact.size)[::3]
     cold = problem.evaluate(active)
     warm = problem.evaluate(active, initial=cold.mode.x.petsc_vec, near=cold.load * (1 + 1e-5))

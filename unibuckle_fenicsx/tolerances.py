@@ -21,14 +21,18 @@ from __future__ import annotations
 __all__ = [
     "ARC_RTOL",
     "BRACKET_GAP",
+    "DIVISION_FLOOR",
     "ENERGY_TIE_RTOL",
+    "EXHAUSTED_NORM",
     "GEOMETRY_RTOL",
     "LOAD_TIE_RTOL",
+    "MERIT_RTOL",
     "NONLINEAR_ATOL",
     "NULL_GEOMETRIC_STIFFNESS",
     "PRESSING_RTOL",
     "PROOF_GAP",
     "PROOF_RTOL",
+    "RESIDUAL_ROUNDING",
     "ROUNDING_RTOL",
     "SAME_DIRECTION",
     "SMALLEST_RTOL_FACTOR",
@@ -82,6 +86,22 @@ ARC_RTOL = 1e-12
 #: simply supported, 24x8 and 36x12, k_f = 3e6 to 1e9 N/m^3), 4 ended at loads 8e-6 to
 #: 5.8e-5 apart on 1 and 2 ranks; at 1e-10, 1e-9 (ROUNDING_RTOL) or 1e-8 all 24 agree.
 PRESSING_RTOL = ROUNDING_RTOL
+
+# -- the interior point ------------------------------------------------------------------
+
+#: The rounding level of the interior point's residual :math:`F_u` is this many units of
+#: double precision of :math:`(|A| + \lambda|B|)|u|`: the matrix-vector products sum
+#: tens of terms per row, each rounded, with margin.
+RESIDUAL_ROUNDING = 100.0
+#: A line search accepts a barrier objective that rises by at most this fraction of its
+#: value (the objective's own rounding: a sum over the zone's nodes of logarithms).
+MERIT_RTOL = 1e-10
+#: The interior point bounds a step's change of the load by a multiple of the load
+#: divided by the predicted change, never by less than this (no division by zero).
+DIVISION_FLOOR = 1e-300
+#: A Krylov vector whose metric norm falls below this fraction of its norm before the
+#: orthogonalisation is rounding only: the space is exhausted.
+EXHAUSTED_NORM = 1e-20
 
 # -- the certificate ---------------------------------------------------------------------
 

@@ -27,7 +27,7 @@ lam, vectors = float(sys.argv[2]), int(sys.argv[3])
 problem = build_problem(spec, MPI.COMM_WORLD)
 with InteriorPointNewton(problem, replace(NewtonOptions(), curvature_vectors=vectors)) as newton:
     u, *_ = at_saddle(newton, lam)
-    found = newton.negative_curvature(u.x.petsc_vec, lam)
+    found = newton.curvature.find(u.x.petsc_vec, lam)
     assert found is not None
 problem.destroy()
 if MPI.COMM_WORLD.rank == 0:

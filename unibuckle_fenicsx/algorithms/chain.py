@@ -17,7 +17,7 @@ For a rigid obstacle (any side, several zones) the chain is
 2. **Contact set and exact eigenpair.** The fine barrier solution gives the contact set
    Z: first where the barrier problem at ``read_mu`` is solved, the nodes that the
    Newton step for a zero barrier parameter closes by more than half their gap
-   (:meth:`~.interior_point.InteriorPointNewton.predicted_contact_set`), which ends the
+   (:meth:`~.interior_point.newton.InteriorPointNewton.predicted_contact_set`), which ends the
    run if it is a KKT point; else, at the end, the nodes whose gap is at the tolerance
    ``tau``. The smallest eigenpair of the
    pencil with Z removed (:meth:`~unibuckle_fenicsx.model.problem.UnilateralProblem.evaluate`)
@@ -148,7 +148,7 @@ class ChainOptions:
         read_mu: On the fine mesh, the contact set is first read when the barrier
             problem at this parameter (or the first one below it) is solved, from the
             predicted gaps and pushes
-            (:meth:`~.interior_point.InteriorPointNewton.predicted_contact_set`); a
+            (:meth:`~.interior_point.newton.InteriorPointNewton.predicted_contact_set`); a
             KKT point there ends the run (0: read only at ``fine_mu_min``).
         read_stable: ... and, below ``read_mu``, as soon as two Newton steps in a row
             predict the same set (each prediction one more solve with the next step's
@@ -393,8 +393,8 @@ def _start(newton: InteriorPointNewton, seed: str, push: Any, second: Any = None
         else:
             mode = problem.solve_free().function.x.petsc_vec
         sign = _canonical_sign(problem, mode)
-        u = newton.negative_part(mode, sign if seed.endswith("-") else -sign)
-        return newton.make_interior(u, push=push)
+        u = newton.starts.negative_part(mode, sign if seed.endswith("-") else -sign)
+        return newton.starts.make_interior(u, push=push)
     if seed == "pressure":
         u = problem.new_mode("start")
         push.x.petsc_vec.copy(u.x.petsc_vec)
@@ -410,7 +410,7 @@ def _start(newton: InteriorPointNewton, seed: str, push: Any, second: Any = None
         raise ValueError(f"unknown interior-point start {seed!r}")
     a, b = windows[seed]
     weights = np.where((c >= a) & (c <= b), 1.0, 0.01)
-    return newton.pressure_mode(weights)
+    return newton.starts.pressure_mode(weights)
 
 
 def _read_contact(
@@ -423,7 +423,8 @@ def _read_contact(
 ) -> Candidate:
     """The exact critical state of the contact set ``active`` read off ``point``.
 
-    Default: the nodes at the tolerance (:meth:`~.interior_point.InteriorPointNewton.contact_set`).
+    Default: the nodes at the tolerance
+    (:meth:`~.interior_point.newton.InteriorPointNewton.contact_set`).
     """
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
@@ -618,7 +619,7 @@ def _critical_state(
             return polished, point
         if polished is not None and polished.kkt:
             # The barrier point that goes with it, for the next mesh.
-            fresh = newton.from_candidate(polished, options.level_mu)
+            fresh = newton.starts.from_candidate(polished, options.level_mu)
             fresh, _ = _run(
                 newton, fresh, level, label + " (after polish)", options,
                 mu=fresh.mu, mu_min=point.mu,
@@ -697,7 +698,7 @@ def _explore(
     # start jumped past the lowest (CCCC at 90x30 ended 1.8e-4 higher).
     wanted = any(seed.startswith("free2") for seed in options.seeds)
     with InteriorPointNewton(problem, EXPLORE) as newton, _SecondMode(problem, wanted) as modes:
-        push = newton.pressure_mode()
+        push = newton.starts.pressure_mode()
         for seed in options.seeds:
             try:
                 start = _start(newton, seed, push, modes.second)
@@ -777,9 +778,9 @@ def _refine(
     """Carry ``point`` to the finer mesh (``carry``) and solve the barrier problem there.
 
     The interpolated mode is relaxed into the fine mesh's discrete Kirchhoff kernel
-    (:meth:`~.interior_point.InteriorPointNewton.relax`), the nodes it brings too close
+    (:meth:`~.interior_point.starts.Starts.relax`), the nodes it brings too close
     to the obstacle are moved back by the least-energy correction
-    (:meth:`~.interior_point.InteriorPointNewton.lift`), then the method runs from
+    (:meth:`~.interior_point.starts.Starts.lift`), then the method runs from
     the barrier parameter ``mu``: to ``mu`` on an intermediate mesh, to ``fine_mu_min``
     on the fine one, whose critical state is read. ``newton``: the method on ``fine``
     (the caller's, kept for the level's other arrangements: its factorisation's symbolic
@@ -787,11 +788,11 @@ def _refine(
     """
     fine = carry.fine
     mode = carry.mode(point.mode)
-    newton.forget_corrections()
+    newton.kernel.forget_corrections()
     try:
-        newton.relax(mode.x.petsc_vec, "deflection")
-        newton.relax(mode.x.petsc_vec, "rotations")
-        newton.lift(mode, options.clip_margin)
+        newton.starts.relax(mode.x.petsc_vec, "deflection")
+        newton.starts.relax(mode.x.petsc_vec, "rotations")
+        newton.starts.lift(mode, options.clip_margin)
         reader = _Reader(fine, newton, level, options) if last else None
         new, rec = newton.solve(
             mode,
