@@ -140,7 +140,7 @@ def test_two_eigenvalues_below_needs_the_sdp_route():
         assert cert.global_optimum_proven, cert
         assert cert.proven_by in ("sdp-spn", "sdp-sectors"), cert
         assert cert.relative_gap <= PROOF_GAP
-        assert inertia["method"] == cert.proven_by
+        assert inertia.method == cert.proven_by
 
 
 def test_no_certify_skips_the_proof():
@@ -248,6 +248,6 @@ def test_a_bound_verified_at_the_proof_gap_proves_the_optimum():
     )
     with solve(spec, MPI.COMM_SELF) as analysis:
         cert = analysis.result.certificate
-    assert cert["proven_by"] == "rank2-spn"
-    assert cert["relative_gap"] == pytest.approx(PROOF_GAP, rel=1e-6)
-    assert cert["status"] == "proven" and cert["global_optimum_proven"]
+    assert cert.proven_by == "rank2-spn"
+    assert cert.relative_gap == pytest.approx(PROOF_GAP, rel=1e-6)
+    assert cert.status == "proven" and cert.global_optimum_proven

@@ -101,14 +101,14 @@ def test_uniform_compression():
     """Uniform: psi = 1, sigma_cr = lambda_c; slenderness, rho, rho f_y / gamma_M1 by hand."""
     out = result(plate({"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}))
     d = out.design
-    assert d["sigma_cr_Pa"] == out.critical_load_Pa and d["psi"] == 1.0
+    assert d.sigma_cr_Pa == out.critical_load_Pa and d.psi == 1.0
     slenderness = math.sqrt(355e6 / out.critical_load_Pa)
-    assert d["relative_slenderness"] == pytest.approx(slenderness, rel=1e-14)
+    assert d.relative_slenderness == pytest.approx(slenderness, rel=1e-14)
     rho = min(1.0, (slenderness - 0.22) / slenderness**2) if slenderness > 0.5 + 0.03**0.5 else 1
-    assert d["reduction_factor"] == pytest.approx(rho, rel=1e-14)
-    assert d["reduced_design_stress_Pa"] == pytest.approx(rho * 355e6 / 1.1, rel=1e-14)
-    assert "calibrated on plates buckling freely to both sides" in d["notes"][0]
-    assert "4.4(2), eq. (4.2)" in d["clauses"]
+    assert d.reduction_factor == pytest.approx(rho, rel=1e-14)
+    assert d.reduced_design_stress_Pa == pytest.approx(rho * 355e6 / 1.1, rel=1e-14)
+    assert "calibrated on plates buckling freely to both sides" in d.notes[0]
+    assert "4.4(2), eq. (4.2)" in d.clauses
     assert "EN 1993-1-5: sigma_cr" in out.summary()
 
 
@@ -125,6 +125,6 @@ def test_stress_gradient_obstacle_shear_and_fixed_part():
     lam = out.critical_load_Pa
     sigma1, sigma2 = 20e6 + lam, -20e6  # compression positive, at y = 0 and y = b
     d = out.design
-    assert d["sigma_cr_Pa"] == pytest.approx(sigma1, rel=1e-14)
-    assert d["psi"] == pytest.approx(sigma2 / sigma1, rel=1e-14)
-    assert any("unilateral" in n for n in d["notes"]) and any("section 10" in n for n in d["notes"])
+    assert d.sigma_cr_Pa == pytest.approx(sigma1, rel=1e-14)
+    assert d.psi == pytest.approx(sigma2 / sigma1, rel=1e-14)
+    assert any("unilateral" in n for n in d.notes) and any("section 10" in n for n in d.notes)

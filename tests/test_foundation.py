@@ -240,8 +240,8 @@ def test_tensionless_foundation_lies_between_free_and_rigid_and_grows(supports):
             result = analysis.result
         assert result.method == "foundation"
         cert = result.certificate
-        assert cert["kkt"] and cert["smallest_of_reduced"], (K, cert)
-        assert cert["relative_residual"] < 1e-6
+        assert cert.kkt and cert.smallest_of_reduced, (K, cert)
+        assert cert.relative_residual < 1e-6
         ks.append(result.buckling_coefficient_k)
     assert free < ks[0], (free, ks)
     assert all(x < y for x, y in itertools.pairwise(ks)), ks

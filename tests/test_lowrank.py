@@ -144,8 +144,8 @@ def _check_long(spec, i) -> dict:
                         assert out.value <= best * (1 + RTOL), where
                     if out.refuting is not None:
                         report["refuted"] += 1
-                        assert best * (1 - RTOL) <= out.refuting["load"] < cand.load, where
-                        assert out.refuting["values"].max() <= problem.tau, where
+                        assert best * (1 - RTOL) <= out.refuting.load < cand.load, where
+                        assert out.refuting.values.max() <= problem.tau, where
         finally:
             matrix.destroy()
     return report

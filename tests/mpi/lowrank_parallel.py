@@ -18,6 +18,7 @@ from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivit
 from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions
 from unibuckle_fenicsx.config import ObstacleSpec
 from unibuckle_fenicsx.model.build import build_problem
+from unibuckle_fenicsx.results.record import jsonable
 
 #: One delta, no time budget: the same work on every partition.
 OPTIONS = BoundOptions(lowrank=LowRankOptions(deltas=(1e-3,), fallback=(), time_budget=None))
@@ -31,7 +32,7 @@ def certificate(comm: MPI.Comm, nx: int, ny: int, active: np.ndarray) -> dict:
         problem.solve_free()
         cand = problem.evaluate(active)
         bound = copositivity_bound(problem, cand, [], OPTIONS)
-        lowrank = bound.lowrank or {}
+        lowrank = jsonable(bound.lowrank) or {}
         return {
             "load": cand.load,
             "value": bound.value,
