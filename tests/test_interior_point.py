@@ -47,13 +47,14 @@ from conftest import run_mpi
 from exhaustive import dense
 from test_stress_family import FAMILY, _check
 
-from unibuckle_fenicsx.algorithms.chain import ChainOptions, _second_free_mode, solve_unilateral
+from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_interior_point
 from unibuckle_fenicsx.algorithms.interior_point import (
     BarrierPoint,
     InteriorPointNewton,
     NewtonOptions,
     NewtonStatus,
 )
+from unibuckle_fenicsx.algorithms.interior_point.explore import second_free_mode
 from unibuckle_fenicsx.algorithms.interior_point.newton import StallWatch
 from unibuckle_fenicsx.algorithms.interior_point.options import PUSH_MARGIN
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
@@ -531,8 +532,8 @@ def test_starts_on_one_central_path_are_not_taken_further():
     deflections), in fewer Newton steps on the coarsest mesh.
     """
     problem = build_problem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
-    short = solve_unilateral(problem, ChainOptions())
-    full = solve_unilateral(problem, ChainOptions(twin_rtol=0.0, path_rtol=0.0))
+    short = solve_interior_point(problem, ChainOptions())
+    full = solve_interior_point(problem, ChainOptions(twin_rtol=0.0, path_rtol=0.0))
     coarse = [jsonable(sol.details.levels[0]) for sol in (short, full)]
     assert "met before" in [link["status"] for link in coarse[0]["links"]]
     assert "met before" not in [link["status"] for link in coarse[1]["links"]]
@@ -561,7 +562,7 @@ def test_second_free_mode_is_the_pencils_second_eigenpair():
     theta = scipy.linalg.eigh(B, A, eigvals_only=True)
     loads = np.sort(1.0 / theta[theta > 0.0])
     assert loads[1] > loads[0] * (1.0 + 1e-3)  # a simple second eigenvalue
-    vec = _second_free_mode(problem)
+    vec = second_free_mode(problem)
     assert vec is not None
     x = vec.array.copy()
     vec.destroy()
@@ -698,8 +699,8 @@ def test_a_set_predicted_twice_in_a_row_is_read_before_the_barrier_problem_is_so
     rounding of two solves at different shifts, in fewer fine-mesh steps.
     """
     problem = build_problem(_thin("ssss", nx=60, ny=20), MPI.COMM_SELF)
-    stable = solve_unilateral(problem, ChainOptions())
-    solved = solve_unilateral(problem, ChainOptions(read_stable=False))
+    stable = solve_interior_point(problem, ChainOptions())
+    solved = solve_interior_point(problem, ChainOptions(read_stable=False))
     fine = [jsonable(sol.details.levels[-1]) for sol in (stable, solved)]
     labels = [[link["seed"] for link in level["links"]] for level in fine]
     assert any("(stable at 1e-09)" in label for label in labels[0])
@@ -720,8 +721,8 @@ def test_fine_mesh_read_early_gives_the_load_read_at_the_end():
     where the barrier problem at 1e-9 is solved is a KKT point, and the run stops there.
     """
     problem = build_problem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
-    early = solve_unilateral(problem, ChainOptions())
-    late = solve_unilateral(problem, ChainOptions(read_mu=0.0))
+    early = solve_interior_point(problem, ChainOptions())
+    late = solve_interior_point(problem, ChainOptions(read_mu=0.0))
     fine = [jsonable(sol.details.levels[-1]) for sol in (early, late)]
     assert "read" in [link["status"] for link in fine[0]["links"]]
     assert "read" not in [link["status"] for link in fine[1]["links"]]

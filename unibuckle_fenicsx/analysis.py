@@ -107,10 +107,10 @@ def _run_method(
             until_proven=options.until_proven or options.method == "auto",
         )
     if method == "interior-point":
-        from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_unilateral
+        from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_interior_point
 
         options = problem.spec.solver
-        return solve_unilateral(
+        return solve_interior_point(
             problem,
             ChainOptions(max_iterations=options.max_iterations, bound_budget=options.bound_budget),
         )

@@ -56,6 +56,7 @@ from __future__ import annotations
 import logging
 import math
 import time
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -284,90 +285,53 @@ def _prune(problem: UnilateralProblem, cand: Candidate) -> Candidate:
     return cand
 
 
-def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fallbacks and bound in one documented sequence
-    problem: UnilateralProblem,
-    *,
-    max_iterations: int = 100,
-    multilevel: bool = True,
-    coarse_min_cells: int = 8,
-    refine_margin: float = 0.02,
-    bound_budget: int = 64,
-) -> UnilateralSolution:
-    """Unilateral critical load by a multi-seed primal-dual active-set method.
+@dataclass
+class _Coarse:
+    """What the coarser levels leave for the fine one (:func:`_coarse_levels`)."""
 
-    Args:
-        problem: A set-up problem with an obstacle (its free mode is computed if absent).
-        max_iterations: Iterates per seed and level, >= 1.
-        multilevel: Run the seeds on coarser meshes and polish the best contact sets
-            level by level (only for the structured plate mesh, when a coarser level
-            with at least ``coarse_min_cells`` cells across exists).
-        coarse_min_cells: Fewest cells along the shorter side of the coarsest level, >= 2.
-        refine_margin: Coarse KKT points within this relative load of the best are
-            refined, >= 0.
-        bound_budget: Evaluations allowed for the lattice lower bound, >= 0 (the search
-            runs only if the budget covers at least the i singletons).
-
-    Returns:
-        The best KKT point found (or, flagged in ``details["warning"]``, the best
-        feasible mode), with its bracket.
-
-    Raises:
-        RuntimeError: No seed produced a feasible mode.
-
-    Note:
-        Collective on ``problem.comm``.
-    """
-    require_obstacle(problem, "solve_active_set")
-    if int(max_iterations) != max_iterations or max_iterations < 1:
-        raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
-    if int(coarse_min_cells) != coarse_min_cells or coarse_min_cells < 2:
-        raise InputError(f"coarse_min_cells must be an integer >= 2, got {coarse_min_cells!r}")
-    if not (math.isfinite(refine_margin) and refine_margin >= 0):
-        raise InputError(f"refine_margin must be a finite number >= 0, got {refine_margin!r}")
-    if int(bound_budget) != bound_budget or bound_budget < 0:
-        raise InputError(f"bound_budget must be an integer >= 0, got {bound_budget!r}")
-
-    t0 = time.perf_counter()
-    solves0 = problem.eigensolver.solves
-    free_load = problem.solve_free().load
-    spec = problem.spec
-    seeded_on: list[int] | str
-    fallback: Fallback | UnsetType = UNSET
-    structured = multilevel and problem.structured  # coarse copies need spec.mesh
-    levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
-    coarse_solves = 0
-    penalty_solves = 0  # the penalty solver has its own eigen solver
-    level_log: list[ActiveSetLevel] = []
-
-    # -- coarse levels: seeds on the coarsest, then polish upwards --------------------
     candidates: list[Candidate] | None = None
-    bests: list[float] = []  # the lowest KKT load of each level, coarsest first
-    coarse_kkt: list[Candidate] = []
-    prev: UnilateralProblem | None = None
-    coarse_runs: list[Run] = []
+    bests: list[float] = field(default_factory=list)  # lowest KKT load per level
+    kkt: list[Candidate] = field(default_factory=list)
+    last: UnilateralProblem | None = None  # the finest coarse problem (the caller's)
+    runs: list[Run] = field(default_factory=list)  # the seeded level's
+    log: list[ActiveSetLevel] = field(default_factory=list)
+    solves: int = 0
+
+
+def _coarse_levels(
+    problem: UnilateralProblem,
+    levels: list[tuple[int, int]],
+    max_iterations: int,
+    refine_margin: float,
+) -> _Coarse:
+    """Seeds on the coarsest level, then the best contact sets polished level by level.
+
+    The finest coarse problem is left alive in the result (:attr:`_Coarse.last`, for
+    the fine level's polish); the caller destroys it. Collective.
+    """
+    coarse = _Coarse()
     for nx, ny in levels:
         try:
-            cp = build_unilateral_problem(spec.with_mesh(nx, ny), problem.comm)
+            cp = build_unilateral_problem(problem.spec.with_mesh(nx, ny), problem.comm)
         except EmptyZoneError:
             continue
         tl = time.perf_counter()
-        if candidates is None:
-            coarse_runs = _multi_seed(cp, max_iterations)
-            runs = coarse_runs
+        if coarse.candidates is None:
+            coarse.runs = _multi_seed(cp, max_iterations)
+            runs = coarse.runs
         else:
-            if prev is None:
-                raise RuntimeError(
-                    "solve_active_set: expected prev is not None (an internal invariant)"
-                )
-            runs = _polish(cp, prev, candidates, min(max_iterations, POLISH_ITERATIONS), bests)
+            if coarse.last is None:
+                raise RuntimeError("_coarse_levels: a polish without a coarser level")
+            budget = min(max_iterations, POLISH_ITERATIONS)
+            runs = _polish(cp, coarse.last, coarse.candidates, budget, coarse.bests)
         kkt = _distinct_kkt(runs)
         groups = _twin_groups(kkt)
         if groups:
             best = groups[0][0].load
-            candidates = [g[0] for g in groups if g[0].load <= best * (1 + refine_margin)]
-            bests.append(best)
-            coarse_kkt = kkt
-        level_log.append(
+            coarse.candidates = [g[0] for g in groups if g[0].load <= best * (1 + refine_margin)]
+            coarse.bests.append(best)
+            coarse.kkt = kkt
+        coarse.log.append(
             ActiveSetLevel(
                 mesh=[nx, ny],
                 constrained_nodes=cp.num_constrained,
@@ -385,59 +349,74 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
                 f", best lambda = {kkt[0].load:.9e}" if kkt else "",
                 cp.eigensolver.solves, time.perf_counter() - tl,
             )  # fmt: skip
-        coarse_solves += cp.eigensolver.solves
-        if prev is not None:
-            prev.destroy()
-        prev = cp
+        coarse.solves += cp.eigensolver.solves
+        if coarse.last is not None:
+            coarse.last.destroy()
+        coarse.last = cp
         if not groups:
             # Nothing to refine: fall back to seeding on the fine level.
-            candidates = None
-            bests.clear()
-    # -- finest level -------------------------------------------------------------
-    if candidates is not None and prev is not None:
-        runs = _polish(problem, prev, candidates, min(max_iterations, POLISH_ITERATIONS), bests)
-        seeded_on = [prev.spec.mesh.nx, prev.spec.mesh.ny]
-    else:
-        runs = _multi_seed(problem, max_iterations)
-        seeded_on = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
-    if prev is not None:
-        prev.destroy()
+            coarse.candidates = None
+            coarse.bests.clear()
+    return coarse
 
-    kkt = _distinct_kkt(runs)
-    warnings: list[str] = []
-    if not kkt:
-        # The iteration stalled on this mesh: penalty continuation, started from the free
-        # plate (on thin plates a stalled contact set is a poorer start).
-        run, penalty_solves = penalty_continuation(
-            problem, None, max_iterations=PENALTY_BUDGET * max_iterations
-        )
-        runs.append(run)
-        kkt = _distinct_kkt(runs)
-        fallback = Fallback(
-            method="penalty continuation", penalty_eigensolves=penalty_solves, status=run.status
-        )
+
+@dataclass
+class _Fallbacks:
+    """What ran when the fine level's iteration stalled (:func:`_fall_back`)."""
+
+    record: Fallback | UnsetType = UNSET
+    penalty_solves: int = 0  # the penalty solver has its own eigen solver
+    route: list[str] = field(default_factory=list)
+
+
+def _fall_back(
+    problem: UnilateralProblem, runs: list[Run], max_iterations: int, warnings: list[str]
+) -> _Fallbacks:
+    """The penalty continuation, then the feasible descent, while no run is at a KKT point.
+
+    Their runs are appended to ``runs``, what they did to ``warnings``. Collective.
+    """
+    out = _Fallbacks()
+    if _distinct_kkt(runs):
+        return out
+    # The iteration stalled on this mesh: penalty continuation, started from the free
+    # plate (on thin plates a stalled contact set is a poorer start).
+    run, out.penalty_solves = penalty_continuation(
+        problem, None, max_iterations=PENALTY_BUDGET * max_iterations
+    )
+    runs.append(run)
+    out.route.append("penalty-continuation")
+    out.record = record = Fallback(
+        method="penalty continuation", penalty_eigensolves=out.penalty_solves, status=run.status
+    )
+    warnings.append(
+        f"the active-set iteration stalled; penalty continuation ({out.penalty_solves} "
+        f"eigen solves) ended {'at a KKT point' if run.status == 'kkt' else run.status}"
+    )
+    if _distinct_kkt(runs):
+        return out
+    # Both stalled: the feasible descent cannot cycle (docs: methods/active_set).
+    last, steps = _descent(problem, runs, DESCENT_BUDGET * max_iterations)
+    if last is not None:
+        runs.append(last)
+        out.route.append("feasible-descent")
+        record.descent = DescentRecord(eigensolves=last.iterations, status=last.status, steps=steps)
         warnings.append(
-            f"the active-set iteration stalled; penalty continuation ({penalty_solves} "
-            f"eigen solves) ended {'at a KKT point' if run.status == 'kkt' else run.status}"
+            f"feasible descent ({last.iterations} eigen solves) ended "
+            f"{'at a KKT point' if last.status == 'kkt' else last.status}"
         )
-    if not kkt:
-        # Both stalled: the feasible descent cannot cycle (docs: methods/active_set).
-        last, steps = _descent(problem, runs, DESCENT_BUDGET * max_iterations)
-        if last is not None:
-            runs.append(last)
-            kkt = _distinct_kkt(runs)
-            if isinstance(fallback, Fallback):
-                fallback.descent = DescentRecord(
-                    eigensolves=last.iterations, status=last.status, steps=steps
-                )
-            warnings.append(
-                f"feasible descent ({last.iterations} eigen solves) ended "
-                f"{'at a KKT point' if last.status == 'kkt' else last.status}"
-            )
+    return out
+
+
+def _choose(
+    problem: UnilateralProblem, runs: list[Run], kkt: list[Candidate], warnings: list[str]
+) -> Candidate:
+    """The lowest KKT point, unless a feasible mode lies lower; else the best there is.
+
+    Raises:
+        NoAdmissibleModeError: No run met a mode with a finite load.
+    """
     feasible = [r.best_feasible for r in runs if r.best_feasible is not None]
-    cycles = [r.seed for r in runs + coarse_runs if r.status is RunStatus.CYCLE]
-    if cycles:
-        warnings.append(f"active-set iteration cycled from seed(s) {cycles}")
     if kkt:
         chosen = _twin_groups(kkt)[0][0]
         best_feasible = min(feasible, key=lambda s: s.load)
@@ -466,44 +445,118 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
         warnings.append(
             "no admissible mode was found; returning the least violating one (no upper bound)"
         )
-    if chosen.kkt:
-        chosen = _prune(problem, chosen)
+    return _prune(problem, chosen) if chosen.kkt else chosen
 
+
+def _check_options(
+    max_iterations: int, coarse_min_cells: int, refine_margin: float, bound_budget: int
+) -> None:
+    """Refuse settings out of range, naming them."""
+    if int(max_iterations) != max_iterations or max_iterations < 1:
+        raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    if int(coarse_min_cells) != coarse_min_cells or coarse_min_cells < 2:
+        raise InputError(f"coarse_min_cells must be an integer >= 2, got {coarse_min_cells!r}")
+    if not (math.isfinite(refine_margin) and refine_margin >= 0):
+        raise InputError(f"refine_margin must be a finite number >= 0, got {refine_margin!r}")
+    if int(bound_budget) != bound_budget or bound_budget < 0:
+        raise InputError(f"bound_budget must be an integer >= 0, got {bound_budget!r}")
+
+
+def solve_active_set(
+    problem: UnilateralProblem,
+    *,
+    max_iterations: int = 100,
+    multilevel: bool = True,
+    coarse_min_cells: int = 8,
+    refine_margin: float = 0.02,
+    bound_budget: int = 64,
+) -> UnilateralSolution:
+    """Unilateral critical load by a multi-seed primal-dual active-set method.
+
+    Args:
+        problem: A set-up problem with an obstacle (its free mode is computed if absent).
+        max_iterations: Iterates per seed and level, >= 1.
+        multilevel: Run the seeds on coarser meshes and polish the best contact sets
+            level by level (only for the structured plate mesh, when a coarser level
+            with at least ``coarse_min_cells`` cells across exists).
+        coarse_min_cells: Fewest cells along the shorter side of the coarsest level, >= 2.
+        refine_margin: Coarse KKT points within this relative load of the best are
+            refined, >= 0.
+        bound_budget: Evaluations allowed for the lattice lower bound, >= 0 (the search
+            runs only if the budget covers at least the i singletons).
+
+    Returns:
+        The best KKT point found (or, flagged in the record's ``warning``, the best
+        feasible mode), with its bracket.
+
+    Raises:
+        NoAdmissibleModeError: No seed produced a mode with a finite load.
+
+    Note:
+        Collective on ``problem.comm``.
+    """
+    require_obstacle(problem, "solve_active_set")
+    _check_options(max_iterations, coarse_min_cells, refine_margin, bound_budget)
+    t0 = time.perf_counter()
+    solves0 = problem.eigensolver.solves
+    free_load = problem.solve_free().load
+    spec = problem.spec
+    structured = multilevel and problem.structured  # coarse copies need spec.mesh
+    levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
+    coarse = _coarse_levels(problem, levels, max_iterations, refine_margin)
+    # -- finest level -------------------------------------------------------------
+    seeded_on: list[int] | str
+    if coarse.candidates is not None and coarse.last is not None:
+        budget = min(max_iterations, POLISH_ITERATIONS)
+        runs = _polish(problem, coarse.last, coarse.candidates, budget, coarse.bests)
+        seeded_on = [coarse.last.spec.mesh.nx, coarse.last.spec.mesh.ny]
+    else:
+        runs = _multi_seed(problem, max_iterations)
+        seeded_on = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
+    if coarse.last is not None:
+        coarse.last.destroy()
+    warnings: list[str] = []
+    fallbacks = _fall_back(problem, runs, max_iterations, warnings)
+    kkt = _distinct_kkt(runs)
+    cycles = [r.seed for r in runs + coarse.runs if r.status is RunStatus.CYCLE]
+    if cycles:
+        warnings.append(f"active-set iteration cycled from seed(s) {cycles}")
+    chosen = _choose(problem, runs, kkt, warnings)
     # -- bounds ---------------------------------------------------------------------
     closed = bracket(problem, free_load, chosen, bound_budget, "active-set")
     if closed.warning:
         warnings.append(closed.warning)
     chosen, lower, proven = closed.chosen, closed.lower, closed.proven
-    bound_evals, complete = closed.evaluations, closed.complete
-
     groups = _twin_groups(kkt)
     for w in warnings:
         logger.warning("active-set: %s", w)
     details = ActiveSetDetails(
         free_load=free_load,
         seeded_on=seeded_on,
-        fallback=fallback,
-        levels=level_log,
+        fallback=fallbacks.record,
+        levels=coarse.log,
         runs=[r.summary() for r in runs],
         kkt_points=[KktPoint(load=s.load, contact_nodes=len(s.active)) for s in kkt],
         twins=[[[int(k) for k in s.active] for s in g] for g in groups if len(g) > 1],
-        coarse_kkt_loads=[s.load for s in coarse_kkt],
+        coarse_kkt_loads=[s.load for s in coarse.kkt],
         fine_eigensolves=problem.eigensolver.solves - solves0,
-        coarse_eigensolves=coarse_solves,
-        penalty_eigensolves=penalty_solves,
-        bound_evaluations=bound_evals,
-        bound_search_complete=complete,
+        coarse_eigensolves=coarse.solves,
+        penalty_eigensolves=fallbacks.penalty_solves,
+        bound_evaluations=closed.evaluations,
+        bound_search_complete=closed.complete,
         wall_time_s=time.perf_counter() - t0,
         warning="; ".join(warnings) if warnings else UNSET,
     )
+    extra = coarse.solves + fallbacks.penalty_solves
     return UnilateralSolution(
         candidate=chosen,
         method="active-set",
-        eigensolves=problem.eigensolver.solves - solves0 + coarse_solves + penalty_solves,
+        eigensolves=problem.eigensolver.solves - solves0 + extra,
         lower_bound=min(lower, chosen.load),
         global_optimum_proven=proven,
         upper_bound=chosen.load if chosen.feasible else math.inf,
         kkt_points=kkt,
-        lower_bound_by="lattice" if bound_evals else "interlacing",
+        lower_bound_by="lattice" if closed.evaluations else "interlacing",
         details=details,
+        route=["active-set", *fallbacks.route],
     )

@@ -46,722 +46,44 @@ from __future__ import annotations
 import logging
 import math
 import time
-from collections.abc import Callable
-from dataclasses import dataclass, field, replace
-from typing import Any
+from dataclasses import replace
 
-from slepc4py import SLEPc
-
-import numpy as np
-import numpy.typing as npt
 from msgspec import UNSET
 
-from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
-from unibuckle_fenicsx.algorithms.descent import descend
-from unibuckle_fenicsx.algorithms.interior_point import (
-    BarrierPoint,
-    InteriorPointNewton,
-    NewtonOptions,
-    NewtonRecord,
-    NewtonStatus,
+from unibuckle_fenicsx.algorithms.interior_point.explore import explore
+from unibuckle_fenicsx.algorithms.interior_point.links import (
+    MeshLevel,
+    Reader,
+    critical_state,
+    descend_from,
+    newton_link,
 )
+from unibuckle_fenicsx.algorithms.interior_point.newton import InteriorPointNewton
+from unibuckle_fenicsx.algorithms.interior_point.options import BarrierPoint, ChainOptions
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
-from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.algorithms.records import (
     ActiveSetDetails,
     InteriorPointDetails,
-    LevelRecord,
     LinkRecord,
 )
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
-from unibuckle_fenicsx.la.eigen import swapped_eigenpairs
-from unibuckle_fenicsx.la.options import Prefix
-from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.build import build_unilateral_problem
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
-from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
-__all__ = ["THIN_PLATE", "ChainOptions", "MeshLevel", "solve_unilateral"]
+__all__ = ["THIN_PLATE", "ChainOptions", "solve_interior_point"]
 
 logger = logging.getLogger(__name__)
 
 #: "auto" runs the interior-point route on plates whose thickness is below this fraction
-#: of the shorter side, the multilevel active set on thicker ones. Measured: at t/b = 1e-3
-#: the active set needs hundreds of eigen solves on a whole-face obstacle; on the paper's
-#: plate (t/b = 0.06, a/b = 2) the active set costs 1.7–2.5 free solves at 160×80 and the
-#: interior point 3.9–4.6. On long plates against a whole face the interior point is
-#: usually the faster above 0.02 too (``bench/bench_routes.py``: 0.3 × 0.1 m, t/b =
-#: 0.02–0.06, five edge and load cases: the faster on 18 of 20, median 4.1×; the active
-#: set needs 212–1133 eigen solves), but the two routes end at different critical
-#: states on some of them, either one lower; the threshold stays where the answers of
-#: ``auto`` have been (the documentation's benchmarks page, "Which route").
+#: of the shorter side, the multilevel active set on thicker ones: on thin plates the
+#: active set needs hundreds of eigen solves against a whole face, and 0.02 is where the
+#: answers of "auto" have been (:doc:`/verification/tuning`, and the benchmarks' "Which
+#: route").
 THIN_PLATE = 0.02
-
-
-@dataclass(frozen=True)
-class ChainOptions:
-    """Settings of the chain.
-
-    Attributes:
-        coarse_min_cells: Fewest cells along the shorter side of the coarsest mesh.
-            Measured on the five thin plates of ``bench/bench_plates.py`` at 90×30
-            (coarsest 22×7 at 4–7): at 3 (an 11×3 exploration mesh) SSSS took 3.9 free
-            solves instead of 5.5, but loaded edges clamped and CCCC ended at higher
-            critical states (9.2e-6 and 1.8e-4 above): 11×3 cells rank the
-            arrangements wrongly; at 8 (exploring on 45×15) every plate was slower
-            (SSSS 7.5, shear 44.9 free solves) and CCCC ended higher.
-        seeds: Starts of the interior-point method on the coarsest mesh: "free-" and
-            "free+" (the free mode's parts on either side of the obstacle), "pressure"
-            (the deflection under a pressure on the whole zone), "end-low", "middle",
-            "end-high" (a pressure on a third of the plate's longer side), "free2-" and
-            "free2+" (the parts of the free plate's second mode). The three pressures
-            on a third cost up to 57 % of the coarsest mesh's Newton steps (unloaded
-            edges clamped at 90×30: 324 against 140 without them) and found no lower
-            critical state on 191 random plates, but without them the design chart's
-            thin plate with clamped loaded edges at a/b = 2.75 (cells of b/12) ends
-            6.8e-5 higher. The second mode's parts reach an arrangement no other start
-            does (on a clamped 0.3 × 0.1 m plate against a whole face: two buckles in
-            the middle, the ends flat or with a small buckle, where the other starts end
-            at three buckles): at 90×30 its critical state lies 2.1e-5 (t = 0.1 mm),
-            1.8e-4 (1 mm) and 9.2e-5 (2 mm) below theirs, and 2.3e-6 at 180×60 (0.1
-            mm); both arrangements are then carried to the fine mesh, which doubles
-            the time on those plates (``bench/bench_plates.py``).
-        compare_mu: Barrier parameter at which the starts are compared.
-        explore_mu_min: Barrier parameter at which the starts' contact sets are read.
-        twin_rtol: Starts whose barrier solutions' loads at ``compare_mu``, or at a
-            barrier parameter passed on the way to ``explore_mu_min``, agree to this
-            (relative) lead to the same arrangement.
-        path_rtol: ... or agree to this and their deflections on the zone (scaled
-            to a largest value of 1) to ``path_shape_tol``: a barrier problem solved to
-            a residual of about ten times its parameter fixes the load to only about
-            that (measured on the coarsest mesh of a thin plate with clamped unloaded
-            edges at 1e-6: starts on one central path 1e-8 to 2.5e-6 apart in load and
-            1e-5 to 2e-4 in deflection, two arrangements 3e-4 and 0.9).
-        path_shape_tol: See ``path_rtol``.
-        level_mu: Barrier parameter of the central-path point carried from one mesh to
-            the next.
-        flat_mu: ... and of the second try when the first ends at no KKT point.
-        fine_mu_min: ... and the fine mesh, before its contact set is read.
-        read_mu: On the fine mesh, the contact set is first read when the barrier
-            problem at this parameter (or the first one below it) is solved, from the
-            predicted gaps and pushes
-            (:meth:`~.interior_point.newton.InteriorPointNewton.predicted_contact_set`); a
-            KKT point there ends the run (0: read only at ``fine_mu_min``).
-        read_stable: ... and, below ``read_mu``, as soon as two Newton steps in a row
-            predict the same set (each prediction one more solve with the next step's
-            factorisation). Measured on the five thin plates of
-            ``bench/bench_plates.py`` (fine-mesh steps / factorisations / eigen
-            solves): SSSS 7/9/1 → 6/8/1 at 90×30 and 10/12/1 → 8/10/1 at 180×60,
-            loaded edges clamped 26/35/2 → 22/31/2 at 90×30, shear 82/121/5 →
-            78/117/5 at 90×30; a set predicted twice that is not the answer costs one
-            eigen solve (CCCC 28/36/1 → 28/36/2 at 90×30). The robustness sweep (350
-            plates): the same routes and contact sets, 22701 → 22533 factorisations,
-            10272 → 10283 eigen solves, the loads within each plate's resolution.
-        last_mu_min: ... once more when that contact set is not a KKT point.
-        clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
-            (the least-energy correction lifts those closer to the obstacle to it).
-            Measured, 1e-6 → 1e-5 (fine-mesh steps on the five thin plates of
-            ``bench/bench_plates.py``): CCCC 28 → 26 and 33 → 30, shear 78 → 56 and
-            79 → 61, unloaded edges clamped at 180×60 38 → 33, none longer; but the
-            robustness sweep took 0.35 % more factorisations (43 plates more, 20 fewer)
-            and the sheared column face of ``demos/demo_column.py`` fell back to the
-            active-set chain (3.9 → 4.9 s, the same load): not adopted. 1e-4: better at
-            90×30, worse at 180×60 (shear 79 → 135 fine steps).
-        max_steps: Newton steps per run.
-        escapes: Saddle escapes allowed per run.
-        escape_mu: Barrier parameter the run restarts with after an escape (small: a
-            larger one would lift the flattened buckle again).
-        refine_margin: Critical states within this (relative) of the lowest on a mesh
-            are carried to the next.
-        arrangements: ... at most this many.
-        polish_iterations: Active-set iterates allowed to polish a contact set.
-        quick_polish_iterations: ... on the first try of the fine mesh.
-        descent_steps: Eigen solves allowed to the feasible descent after a polish that
-            ends at an admissible mode short of a KKT point.
-        descent_budget: Eigen solves (per ``max_iterations``) of the last descent, from
-            the lowest admissible mode met, when the fine mesh ended at no KKT point.
-        max_iterations: Iterates per seed of the fallback active-set method.
-        bound_budget: Eigen solves of the lattice lower bound (small zones).
-    """
-
-    coarse_min_cells: int = 6
-    seeds: tuple[str, ...] = (
-        "free-",
-        "free+",
-        "pressure",
-        "end-low",
-        "middle",
-        "end-high",
-        "free2-",
-        "free2+",
-    )
-    compare_mu: float = 1e-4
-    explore_mu_min: float = 1e-14
-    twin_rtol: float = 1e-7
-    path_rtol: float = 1e-4
-    path_shape_tol: float = 1e-2
-    level_mu: float = 1e-6
-    flat_mu: float = 1e-10
-    fine_mu_min: float = 1e-14
-    read_mu: float = 1e-9
-    read_stable: bool = True
-    last_mu_min: float = 1e-14
-    clip_margin: float = 1e-6
-    max_steps: int = 100
-    escapes: int = 3
-    escape_mu: float = 1e-10
-    refine_margin: float = 2e-3
-    arrangements: int = 3
-    polish_iterations: int = 25
-    quick_polish_iterations: int = 5
-    descent_steps: int = 50
-    descent_budget: int = 1
-    max_iterations: int = 100
-    bound_budget: int = 64
-
-
-@dataclass
-class MeshLevel:
-    """What the chain does on one mesh, as it goes (its record: :meth:`record`).
-
-    Attributes:
-        mesh: [nx, ny] (structured), ["h=<cell size>"] (meshed by gmsh) or ["fine"] (a
-            user's mesh or a mesh file).
-        constrained_nodes: i on this mesh.
-        links: The runs on it.
-        seconds: Wall time on it (set-up included).
-        best_admissible: The admissible mode with the lowest load met on this mesh (not
-            in the record).
-    """
-
-    mesh: list[int | str]
-    constrained_nodes: int
-    links: list[LinkRecord] = field(default_factory=list)
-    seconds: float = 0.0
-    best_admissible: Candidate | None = field(default=None, repr=False)
-
-    def offer(self, cand: Candidate | None) -> None:
-        """Keep ``cand`` if it is admissible with a lower load than the best so far."""
-        if cand is None or not cand.feasible or not math.isfinite(cand.load):
-            return
-        if self.best_admissible is None or cand.load < self.best_admissible.load:
-            self.best_admissible = cand
-
-    @property
-    def newton_steps(self) -> int:
-        """Interior-point Newton steps on this mesh."""
-        return sum(r.steps for r in self.links if r.link == "interior-point")
-
-    @property
-    def factorizations(self) -> int:
-        """Numeric factorisations on this mesh."""
-        return sum(r.factorizations for r in self.links)
-
-    @property
-    def eigensolves(self) -> int:
-        """Eigen solves on this mesh."""
-        return sum(r.eigensolves for r in self.links)
-
-    def record(self) -> LevelRecord:
-        """The level's record."""
-        return LevelRecord(
-            mesh=self.mesh,
-            constrained_nodes=self.constrained_nodes,
-            newton_steps=self.newton_steps,
-            factorizations=self.factorizations,
-            eigensolves=self.eigensolves,
-            seconds=self.seconds,
-            links=self.links,
-        )
-
-
-#: Newton settings of the coarsest mesh's starts (see :func:`_explore`).
-EXPLORE = NewtonOptions(plain_first=False, metric="stiffness", stall_steps=0)
-
-
-def _newton_link(seed: str, record: NewtonRecord) -> LinkRecord:
-    return LinkRecord(
-        "interior-point",
-        seed,
-        record.status.value,
-        steps=record.steps,
-        factorizations=record.factorizations,
-        seconds=record.seconds,
-        load=record.load,
-    )
-
-
-def _run(
-    newton: InteriorPointNewton,
-    point: BarrierPoint,
-    level: MeshLevel,
-    label: str,
-    options: ChainOptions,
-    *,
-    mu: float,
-    mu_min: float,
-    keep_push: bool = True,
-    on_solved: Callable[[BarrierPoint], NewtonStatus | None] | None = None,
-    on_step: Callable[[BarrierPoint], NewtonStatus | None] | None = None,
-) -> tuple[BarrierPoint, NewtonRecord]:
-    """Continue the method from ``point`` (updated in place) and record the run."""
-    new, rec = newton.solve(
-        point.mode,
-        load=point.load,
-        push=point.push if keep_push else None,
-        mu=mu,
-        mu_min=mu_min,
-        max_steps=options.max_steps,
-        on_solved=on_solved,
-        on_step=on_step,
-    )
-    level.links.append(_newton_link(label, rec))
-    return new, rec
-
-
-def _canonical_sign(problem: UnilateralProblem, vec: Any) -> float:
-    """+1 or -1: the sign that gives ``vec`` a negative oriented value at its largest node.
-
-    The largest |oriented value| (to 1e-6 of it; ties to the lowest node number) decides,
-    so that the eigen solver's arbitrary sign of the free mode does not, and a plate with
-    the obstacle below starts as the mirror image of the one above (measured: under
-    shear at 90x30 the face below took 92 fine Newton steps instead of 48, the free-mode
-    starts being taken in the other order; now the same steps on every mesh). Unlike
-    :func:`~unibuckle_fenicsx.model.contact.orientation`, which compares the largest
-    violations on either side, a near tie (an antisymmetric mode) is not decided by
-    rounding, which differs with the number of ranks. Collective.
-    """
-    z = problem.contact.values(vec)  # the same on every rank
-    size = np.abs(z)
-    first = int(np.flatnonzero(size >= size.max() * (1.0 - 1e-6))[0])
-    return 1.0 if z[first] < 0.0 else -1.0
-
-
-def _second_free_mode(problem: UnilateralProblem) -> Any:
-    """The free plate's second buckling mode (PETSc vector; the caller destroys it).
-
-    The two lowest pairs of the swapped pencil B x = theta A x (theta = 1/lambda, so that
-    an indefinite B is handled as everywhere else); None when SLEPc converges fewer.
-    Collective.
-    """
-    pairs = swapped_eigenpairs(
-        problem.model.A,
-        problem.model.B,
-        Prefix.IPM_SECOND_MODE,
-        which=SLEPc.EPS.Which.LARGEST_REAL,
-        nev=2,
-        tol=1e-8,
-        vectors=True,
-    )
-    second = None
-    for k, (theta, vec) in enumerate(pairs):
-        if k == 1 and theta > 0.0:
-            second = vec
-        elif vec is not None:
-            vec.destroy()
-    return second
-
-
-class _SecondMode(Owner):
-    """The free plate's second mode (:func:`_second_free_mode`) if ``wanted``; owns it."""
-
-    def __init__(self, problem: UnilateralProblem, wanted: bool) -> None:
-        self.second = _second_free_mode(problem) if wanted else None
-
-    def destroy(self) -> None:
-        """Destroy the mode (collective)."""
-        release(self, "second")
-
-
-def _start(newton: InteriorPointNewton, seed: str, push: Any, second: Any = None) -> Any:
-    """The start ``seed`` on ``newton``'s problem, strictly inside the cone.
-
-    ``second``: the free plate's second mode (:func:`_second_free_mode`), for the seeds
-    "free2-" and "free2+".
-    """
-    problem = newton.problem
-    if seed in ("free-", "free+", "free2-", "free2+"):
-        if seed.startswith("free2"):
-            if second is None:
-                raise ValueError(
-                    "no second free mode (SLEPc converged fewer than two positive loads)"
-                )
-            mode = second
-        else:
-            mode = problem.solve_free().function.x.petsc_vec
-        sign = _canonical_sign(problem, mode)
-        u = newton.starts.negative_part(mode, sign if seed.endswith("-") else -sign)
-        return newton.starts.make_interior(u, push=push)
-    if seed == "pressure":
-        u = problem.new_mode("start")
-        push.x.petsc_vec.copy(u.x.petsc_vec)
-        u.x.scatter_forward()
-        return u
-    xy = problem.contact.coordinates
-    (x0, y0), (x1, y1) = problem.spec.plate.corners
-    axis = 0 if x1 - x0 >= y1 - y0 else 1
-    lo, hi = (x0, x1) if axis == 0 else (y0, y1)
-    c = (xy[:, axis] - lo) / (hi - lo)
-    windows = {"end-low": (0.0, 1 / 3), "middle": (1 / 3, 2 / 3), "end-high": (2 / 3, 1.0)}
-    if seed not in windows:
-        raise ValueError(f"unknown interior-point start {seed!r}")
-    a, b = windows[seed]
-    weights = np.where((c >= a) & (c <= b), 1.0, 0.01)
-    return newton.starts.pressure_mode(weights)
-
-
-def _read_contact(
-    problem: UnilateralProblem,
-    newton: InteriorPointNewton,
-    point: BarrierPoint,
-    level: MeshLevel,
-    label: str,
-    active: npt.NDArray[np.int64] | None = None,
-) -> Candidate:
-    """The exact critical state of the contact set ``active`` read off ``point``.
-
-    Default: the nodes at the tolerance
-    (:meth:`~.interior_point.newton.InteriorPointNewton.contact_set`).
-    """
-    t0 = time.perf_counter()
-    solves0 = problem.eigensolver.solves
-    active = newton.contact_set(point) if active is None else active
-    cand = problem.evaluate(active, initial=point.mode.x.petsc_vec, near=point.load)
-    level.offer(cand)
-    level.links.append(
-        LinkRecord(
-            "evaluate",
-            label,
-            "kkt" if cand.kkt else "not-kkt",
-            eigensolves=problem.eigensolver.solves - solves0,
-            seconds=time.perf_counter() - t0,
-            load=cand.load if math.isfinite(cand.load) else None,
-            contact_nodes=len(active),
-            kkt=cand.kkt,
-        )
-    )
-    return cand
-
-
-@dataclass
-class _Reader:
-    """Reads the fine mesh's critical state before its runs reach ``fine_mu_min``.
-
-    Called by a run each time it has solved a barrier problem (``on_solved``); once per
-    run (:meth:`arm`), at the first parameter at or below ``read_mu``, it evaluates the
-    predicted contact set and ends the run when that is a KKT point. With
-    ``read_stable`` it is also called at the steps in between (:meth:`step`, ``on_step``
-    of the run), and evaluates the predicted set as soon as two steps in a row predict
-    the same one. No set is evaluated twice. Measured on the five
-    thin plates of ``bench/bench_plates.py`` (fine-mesh Newton steps / factorisations /
-    eigen solves): SSSS 11/12/1 → 7/9/1 at 90×30 and 15/16/1 → 10/12/1 at 180×60,
-    loaded edges clamped 42/67/3 → 39/65/3 and 33/35/2 → 21/25/2, CCCC 34/41/1 →
-    28/36/1 at 90×30; where the set read at 1e-9 is not a KKT point (the runs that end
-    by an escape or a polish: unloaded edges clamped, shear, CCCC at 180×60) the run goes
-    on unchanged, and the read cost one eigen solve. Loads equal to 6e-15.
-    """
-
-    problem: UnilateralProblem
-    newton: InteriorPointNewton
-    level: MeshLevel
-    options: ChainOptions
-    label: str = ""
-    armed: bool = False
-    found: Candidate | None = None
-    #: The set predicted at the run's previous step (:meth:`step`), and the sets evaluated.
-    previous: npt.NDArray[np.int64] | None = None
-    tried: list[npt.NDArray[np.int64]] = field(default_factory=list)
-
-    def arm(self, label: str) -> _Reader:
-        """Ready for the next run (labelled ``label``); returns itself, the hook."""
-        self.label, self.armed = label, self.options.read_mu > 0.0
-        self.previous = None
-        return self
-
-    def __call__(self, point: BarrierPoint) -> NewtonStatus | None:
-        """Where the run has solved a barrier problem (``on_solved``)."""
-        if not self.armed or point.mu > self.options.read_mu:
-            return None
-        self.armed = False
-        return self._read(point, self.newton.predicted_contact_set(point), "predicted")
-
-    def step(self, point: BarrierPoint) -> NewtonStatus | None:
-        """At a step in between (``on_step``): read a set predicted twice in a row."""
-        if not (self.armed and self.options.read_stable) or point.mu > self.options.read_mu:
-            return None
-        active, self.previous = self.previous, self.newton.predicted_contact_set(point)
-        if active is None or not np.array_equal(active, self.previous):
-            return None
-        return self._read(point, active, "stable")
-
-    def _read(
-        self, point: BarrierPoint, active: npt.NDArray[np.int64], how: str
-    ) -> NewtonStatus | None:
-        if any(np.array_equal(active, other) for other in self.tried):
-            return None
-        self.tried.append(active)
-        label = f"{self.label} ({how} at {point.mu:.0e})"
-        cand = _read_contact(self.problem, self.newton, point, self.level, label, active)
-        if not cand.kkt:
-            return None
-        self.armed, self.found = False, cand
-        return NewtonStatus.READ
-
-
-def _polish(
-    problem: UnilateralProblem, cand: Candidate, level: MeshLevel, label: str, budget: int
-) -> Candidate | None:
-    """Active-set iteration from ``cand``'s contact set; its KKT point or best feasible."""
-    t0 = time.perf_counter()
-    solves0 = problem.eigensolver.solves
-    run = iterate(problem, label, cand.active, cand.mode.x.petsc_vec, budget, near=cand.load)
-    final = run.final if run.status is RunStatus.KKT else run.best_feasible
-    level.offer(final)
-    level.links.append(
-        LinkRecord(
-            "active-set polish",
-            label,
-            run.status,
-            steps=run.iterations,
-            eigensolves=problem.eigensolver.solves - solves0,
-            seconds=time.perf_counter() - t0,
-            load=None if final is None else final.load,
-            contact_nodes=None if final is None else len(final.active),
-            kkt=final is not None and final.kkt,
-        )
-    )
-    return final
-
-
-def _descend(
-    problem: UnilateralProblem, start: Candidate, level: MeshLevel, label: str, budget: int
-) -> Candidate:
-    """Feasible descent (:mod:`.descent`) from the admissible ``start``: it cannot cycle."""
-    t0 = time.perf_counter()
-    solves0 = problem.eigensolver.solves
-    run, _ = descend(problem, start, budget)
-    final = run.final if run.status is RunStatus.KKT else run.best_feasible
-    assert final is not None
-    level.offer(final)
-    level.links.append(
-        LinkRecord(
-            "feasible descent",
-            label,
-            run.status,
-            steps=run.iterations,
-            eigensolves=problem.eigensolver.solves - solves0,
-            seconds=time.perf_counter() - t0,
-            load=final.load,
-            contact_nodes=len(final.active),
-            kkt=final.kkt,
-        )
-    )
-    return final
-
-
-def _critical_state(
-    problem: UnilateralProblem,
-    newton: InteriorPointNewton,
-    point: BarrierPoint,
-    level: MeshLevel,
-    label: str,
-    options: ChainOptions,
-    carry: bool = True,
-    quick: bool = False,
-    reader: _Reader | None = None,
-) -> tuple[Candidate | None, BarrierPoint]:
-    """Read the contact set off ``point``; escape a saddle, drive the barrier lower, polish.
-
-    Returns the KKT point (or None) and the barrier point it belongs to (recomputed
-    after a polish only when ``carry``: it goes on to a finer mesh). ``quick``: a
-    short polish and no descent (a second try follows). Saddles are escaped on every
-    try: measured, the escape answers the fine mesh's first try where a second try
-    from the coarsest mesh cost more (clamped unloaded edges at 90×30: 47 fine steps
-    and 11 eigen solves, plus 55 steps at 45×15, against 42 and 6; the same load to
-    6e-11, lower).
-    """
-    cand = _read_contact(problem, newton, point, level, label)
-    if cand.kkt:
-        return cand, point
-    for attempt in range(options.escapes):
-        saddle = not cand.feasible and cand.load < point.load * (1.0 - ROUNDING_RTOL)
-        if not (saddle and newton.escape(point, cand.mode.x.petsc_vec)):
-            break
-        tag = f"{label} (escape {attempt + 1})"
-        point, _ = _run(
-            newton, point, level, tag, options, keep_push=False,
-            mu=max(point.mu, options.escape_mu), mu_min=max(point.mu, options.fine_mu_min),
-        )  # fmt: skip
-        cand = _read_contact(problem, newton, point, level, tag)
-        if cand.kkt:
-            return cand, point
-    if point.mu > options.last_mu_min:
-        tag = label + " (lower barrier)"
-        point, _ = _run(
-            newton, point, level, tag, options, mu=point.mu, mu_min=options.last_mu_min,
-            on_solved=None if reader is None else reader.arm(tag),
-            on_step=None if reader is None else reader.step,
-        )  # fmt: skip
-        if reader is not None and reader.found is not None:
-            return reader.found, point
-        cand = _read_contact(problem, newton, point, level, tag)
-        if cand.kkt:
-            return cand, point
-    if math.isfinite(cand.load):
-        budget = options.quick_polish_iterations if quick else options.polish_iterations
-        polished = _polish(problem, cand, level, label, budget)
-        if polished is not None and polished.feasible and not polished.kkt and not quick:
-            polished = _descend(problem, polished, level, label, options.descent_steps)
-        if polished is not None and polished.kkt and not carry:
-            return polished, point
-        if polished is not None and polished.kkt:
-            # The barrier point that goes with it, for the next mesh.
-            fresh = newton.starts.from_candidate(polished, options.level_mu)
-            fresh, _ = _run(
-                newton, fresh, level, label + " (after polish)", options,
-                mu=fresh.mu, mu_min=point.mu,
-            )  # fmt: skip
-            return polished, fresh
-    return None, point
-
-
-@dataclass
-class _Arrangement:
-    """A critical state being carried up the meshes: its barrier points and load."""
-
-    load: float
-    point: BarrierPoint  # on the central path at level_mu
-    flat: BarrierPoint  # on the coarsest mesh, at flat_mu
-
-
-@dataclass
-class _Paths:
-    """The barrier solutions the starts met, by barrier parameter (see :func:`_explore`)."""
-
-    problem: UnilateralProblem
-    options: ChainOptions
-    #: By barrier parameter: (load, oriented values on the zone scaled to max 1) of each.
-    met: dict[float, list[tuple[float, npt.NDArray[np.float64]]]] = field(default_factory=dict)
-
-    def met_before(self, mu: float, point: BarrierPoint) -> bool:
-        """Whether a start met ``point`` (solved at ``mu``) before (else it is remembered).
-
-        Collective (the values are gathered on every rank).
-        """
-        z = self.problem.contact.values(point.mode.x.petsc_vec)  # the same on every rank
-        z = z / np.abs(z).max()
-        seen = self.met.setdefault(mu, [])
-        for load, other in seen:
-            if math.isclose(point.load, load, rel_tol=self.options.twin_rtol):
-                return True
-            if math.isclose(point.load, load, rel_tol=self.options.path_rtol):
-                if np.abs(z - other).max() <= self.options.path_shape_tol:
-                    return True
-        seen.append((point.load, z))
-        return False
-
-
-def _explore(
-    problem: UnilateralProblem, level: MeshLevel, options: ChainOptions, carry: bool = True
-) -> tuple[list[Candidate], list[_Arrangement]]:
-    """Run the starts on ``problem``: its KKT points, and the arrangements to carry up.
-
-    The distinct KKT points within ``refine_margin`` of the lowest (at most
-    ``arrangements``) are carried, each as its barrier point on the central path at
-    ``level_mu`` and at ``flat_mu`` (see :func:`_levels`). Without ``carry`` (``problem``
-    is the only mesh) no barrier point is made for a finer mesh: measured on a plate
-    meshed by gmsh (i = 3430), those runs took 230 of the 560 Newton steps.
-
-    A start whose barrier solution at ``compare_mu``, or at a barrier parameter passed
-    on the way down to ``explore_mu_min`` (every start passes the same ones), has the
-    load of one met before (relative ``twin_rtol``), or its load to ``path_rtol`` and
-    its deflection on the zone to ``path_shape_tol``, is on the central path of the
-    same arrangement and is not taken further. Measured on the five plates of
-    ``bench/bench_plates.py`` at 90×30: the loads alone, 2–30 % fewer Newton steps on
-    the coarsest mesh (SSSS 223 → 156, unloaded edges clamped 376 → 324); with the
-    deflections, starts stop at the first parameter below ``compare_mu`` instead of
-    up to 56 steps later (SSSS 157 → 139, loaded edges clamped 161 → 127, unloaded
-    edges clamped 324 → 184, CCCC 123 → 105); the same fine steps, loads within the
-    thin plates' rounding (1e-9).
-    """
-    found: list[tuple[Candidate, BarrierPoint]] = []
-    paths = _Paths(problem, options)
-
-    def on_solved(point: BarrierPoint) -> NewtonStatus | None:
-        return NewtonStatus.MET_BEFORE if paths.met_before(point.mu, point) else None
-
-    # Damped steps (a stiffness-scaled correction that decays from step to step) keep
-    # each start near its own arrangement: measured, with the finer meshes' settings a
-    # start jumped past the lowest (CCCC at 90x30 ended 1.8e-4 higher).
-    wanted = any(seed.startswith("free2") for seed in options.seeds)
-    with InteriorPointNewton(problem, EXPLORE) as newton, _SecondMode(problem, wanted) as modes:
-        push = newton.starts.pressure_mode()
-        for seed in options.seeds:
-            try:
-                start = _start(newton, seed, push, modes.second)
-                point, rec = newton.solve(
-                    start, mu=1e-2, mu_min=options.compare_mu, max_steps=options.max_steps
-                )
-            except (ValueError, FloatingPointError) as err:
-                level.links.append(LinkRecord("interior-point", seed, f"no start: {err}"))
-                continue
-            level.links.append(_newton_link(seed, rec))
-            if rec.status is not NewtonStatus.CONVERGED:
-                continue
-            if paths.met_before(options.compare_mu, point):
-                level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
-                continue
-            point, rec = _run(
-                newton, point, level, seed, options,
-                mu=point.mu, mu_min=options.explore_mu_min,
-                on_solved=on_solved,
-            )  # fmt: skip
-            if rec.status is not NewtonStatus.CONVERGED:
-                continue
-            if paths.met_before(point.mu, point):
-                level.links.append(LinkRecord("interior-point", seed, "same as a previous start"))
-                continue
-            cand, point = _critical_state(problem, newton, point, level, seed, options, carry)
-            if point.mu == options.explore_mu_min:
-                paths.met_before(point.mu, point)  # where an escape ended
-            if cand is not None:
-                found.append((cand, point))
-        found.sort(key=lambda cp: cp[0].load)
-        carried: list[_Arrangement] = []
-        for cand, point in found if carry else []:
-            far = cand.load > found[0][0].load * (1.0 + options.refine_margin)
-            twin = any(math.isclose(cand.load, a.load, rel_tol=options.twin_rtol) for a in carried)
-            if far or twin or len(carried) == options.arrangements:
-                continue
-            tag = f"{cand.load:.10g}"
-            flat = _central(newton, point, level, options, f"{tag}, kept flat", options.flat_mu)
-            lifted = _central(newton, point, level, options, f"{tag}, lifted", options.level_mu)
-            carried.append(_Arrangement(cand.load, lifted, flat))
-    return [c for c, _ in found], carried
-
-
-def _central(
-    newton: InteriorPointNewton,
-    point: BarrierPoint,
-    level: MeshLevel,
-    options: ChainOptions,
-    label: str,
-    mu: float,
-) -> BarrierPoint:
-    r"""The point of the central path at ``mu`` near ``point`` (what is carried up).
-
-    On the central path the push is :math:`\mu/g` node by node, so a finer mesh can
-    start from the interpolated mode alone, at the same barrier parameter. The mode is
-    copied: ``point`` is left as it was.
-    """
-    start = BarrierPoint(newton.problem.new_mode("central"), point.load, point.push, point.mu)
-    point.mode.x.petsc_vec.copy(start.mode.x.petsc_vec)
-    start.mode.x.scatter_forward()
-    lifted, _ = _run(newton, start, level, label, options, mu=mu, mu_min=mu)
-    return lifted
 
 
 def _refine(
@@ -793,7 +115,7 @@ def _refine(
         newton.starts.relax(mode.x.petsc_vec, "deflection")
         newton.starts.relax(mode.x.petsc_vec, "rotations")
         newton.starts.lift(mode, options.clip_margin)
-        reader = _Reader(fine, newton, level, options) if last else None
+        reader = Reader(fine, newton, level, options) if last else None
         new, rec = newton.solve(
             mode,
             mu=mu,
@@ -805,13 +127,13 @@ def _refine(
     except (ValueError, FloatingPointError) as err:
         level.links.append(LinkRecord("interior-point", label, f"failed: {err}"))
         return None, None
-    level.links.append(_newton_link(label, rec))
+    level.links.append(newton_link(label, rec))
     if not last:
         return None, new
     assert reader is not None
     if reader.found is not None:
         return reader.found, new
-    cand, new = _critical_state(
+    cand, new = critical_state(
         fine, newton, new, level, label, options, carry=False, quick=quick, reader=reader
     )
     return cand, new
@@ -946,7 +268,7 @@ def _levels(
     """
     levels = [_level_record(p) for p in problems]
     tl = time.perf_counter()
-    explored, carried = _explore(problems[0], levels[0], options, carry=len(problems) > 1)
+    explored, carried = explore(problems[0], levels[0], options, carry=len(problems) > 1)
     levels[0].seconds = time.perf_counter() - tl
     _report(problems[0], levels[0])
     if len(problems) == 1 or not carried:
@@ -976,7 +298,7 @@ def _fallback(problem: UnilateralProblem, options: ChainOptions) -> UnilateralSo
     )
 
 
-def solve_unilateral(
+def solve_interior_point(
     problem: UnilateralProblem, options: ChainOptions | None = None
 ) -> UnilateralSolution:
     """Critical state of ``problem`` (rigid obstacles) by the chain of the module docstring.
@@ -995,10 +317,10 @@ def solve_unilateral(
     Note:
         Collective on ``problem.comm``.
     """
-    require_obstacle(problem, "solve_unilateral")
+    require_obstacle(problem, "solve_interior_point")
     options = options or ChainOptions()
     if problem.tensionless:
-        raise ValueError("solve_unilateral needs a problem with a rigid obstacle")
+        raise ValueError("solve_interior_point needs a problem with a rigid obstacle")
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     free_load = problem.solve_free().load
@@ -1020,7 +342,7 @@ def solve_unilateral(
         # The lowest admissible mode met, taken to a critical state by the feasible
         # descent (monotone: it cannot cycle), before anything starts afresh.
         budget = options.descent_budget * options.max_iterations
-        final = _descend(problem, levels[-1].best_admissible, levels[-1], "fallback", budget)
+        final = descend_from(problem, levels[-1].best_admissible, levels[-1], "fallback", budget)
         if final.kkt:
             chosen = final
     if chosen is None or not chosen.kkt:

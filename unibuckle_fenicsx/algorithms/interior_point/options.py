@@ -18,9 +18,11 @@ import numpy as np
 import numpy.typing as npt
 
 __all__ = [
+    "EXPLORE",
     "PUSH_MARGIN",
     "RELAX_OPTIONS",
     "BarrierPoint",
+    "ChainOptions",
     "NewtonOptions",
     "NewtonRecord",
     "NewtonStatus",
@@ -201,3 +203,106 @@ class NewtonRecord:
     load: float = math.nan
     mu: float = math.nan
     history: list[tuple[float, float, float, float]] = field(default_factory=list)
+
+
+@dataclass(frozen=True)
+class ChainOptions:
+    """Settings of the interior point's nested route (:mod:`unibuckle_fenicsx.algorithms.chain`).
+
+    The measurements behind the defaults are on :doc:`/verification/tuning`.
+
+    Attributes:
+        coarse_min_cells: Fewest cells along the shorter side of the coarsest mesh
+            (>= 2): fewer rank the arrangements of the buckles wrongly, more make the
+            exploration slow.
+        seeds: Starts of the interior-point method on the coarsest mesh: "free-" and
+            "free+" (the free mode's parts on either side of the obstacle), "pressure"
+            (the deflection under a pressure on the whole zone), "end-low", "middle",
+            "end-high" (a pressure on a third of the plate's longer side), "free2-" and
+            "free2+" (the parts of the free plate's second mode): each reaches
+            arrangements of the buckles the others may miss.
+        start_mu: Barrier parameter the starts begin with (large: the start lies well
+            inside the cone, where the barrier is smooth).
+        compare_mu: Barrier parameter at which the starts are compared.
+        explore_mu_min: Barrier parameter at which the starts' contact sets are read.
+        twin_rtol: Starts whose barrier solutions' loads at ``compare_mu``, or at a
+            barrier parameter passed on the way to ``explore_mu_min``, agree to this
+            (relative) lead to the same arrangement.
+        path_rtol: ... or agree to this and their deflections on the zone (scaled
+            to a largest value of 1) to ``path_shape_tol``: a barrier problem solved to
+            a residual of about ten times its parameter fixes the load to only about
+            that.
+        path_shape_tol: See ``path_rtol``.
+        level_mu: Barrier parameter of the central-path point carried from one mesh to
+            the next.
+        flat_mu: ... and of the second try when the first ends at no KKT point.
+        fine_mu_min: ... and the fine mesh, before its contact set is read.
+        read_mu: On the fine mesh, the contact set is first read when the barrier
+            problem at this parameter (or the first one below it) is solved, from the
+            predicted gaps and pushes
+            (:meth:`~.newton.InteriorPointNewton.predicted_contact_set`); a KKT point
+            there ends the run (0: read only at ``fine_mu_min``).
+        read_stable: ... and, below ``read_mu``, as soon as two Newton steps in a row
+            predict the same set (each prediction one more solve with the next step's
+            factorisation).
+        last_mu_min: ... once more when that contact set is not a KKT point.
+        clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
+            (the least-energy correction lifts those closer to the obstacle to it).
+        max_steps: Newton steps per run.
+        escapes: Saddle escapes allowed per run.
+        escape_mu: Barrier parameter the run restarts with after an escape (small: a
+            larger one would lift the flattened buckle again).
+        refine_margin: Critical states within this (relative) of the lowest on a mesh
+            are carried to the next.
+        arrangements: ... at most this many.
+        polish_iterations: Active-set iterates allowed to polish a contact set.
+        quick_polish_iterations: ... on the first try of the fine mesh.
+        descent_steps: Eigen solves allowed to the feasible descent after a polish that
+            ends at an admissible mode short of a KKT point.
+        descent_budget: Eigen solves (per ``max_iterations``) of the last descent, from
+            the lowest admissible mode met, when the fine mesh ended at no KKT point.
+        max_iterations: Iterates per seed of the fallback active-set method.
+        bound_budget: Eigen solves of the lattice lower bound (small zones).
+    """
+
+    coarse_min_cells: int = 6
+    seeds: tuple[str, ...] = (
+        "free-",
+        "free+",
+        "pressure",
+        "end-low",
+        "middle",
+        "end-high",
+        "free2-",
+        "free2+",
+    )
+    start_mu: float = 1e-2
+    compare_mu: float = 1e-4
+    explore_mu_min: float = 1e-14
+    twin_rtol: float = 1e-7
+    path_rtol: float = 1e-4
+    path_shape_tol: float = 1e-2
+    level_mu: float = 1e-6
+    flat_mu: float = 1e-10
+    fine_mu_min: float = 1e-14
+    read_mu: float = 1e-9
+    read_stable: bool = True
+    last_mu_min: float = 1e-14
+    clip_margin: float = 1e-6
+    max_steps: int = 100
+    escapes: int = 3
+    escape_mu: float = 1e-10
+    refine_margin: float = 2e-3
+    arrangements: int = 3
+    polish_iterations: int = 25
+    quick_polish_iterations: int = 5
+    descent_steps: int = 50
+    descent_budget: int = 1
+    max_iterations: int = 100
+    bound_budget: int = 64
+
+
+#: Newton settings of the coarsest mesh's starts: damped steps (a stiffness-scaled
+#: correction that decays from step to step) keep each start near its own arrangement,
+#: and a start is never stopped as stalled (:func:`~.explore.explore`).
+EXPLORE = NewtonOptions(plain_first=False, metric="stiffness", stall_steps=0)

@@ -1,0 +1,349 @@
+r"""The links of the interior point's route on one mesh: runs, reads, polish, descent.
+
+A run continues the interior-point method from a barrier point (:func:`run_from`); the
+contact set read off a barrier point gives an exact critical state (:func:`read_contact`,
+and :class:`Reader` reads it early on the fine mesh); where that is no KKT point a
+saddle is escaped, the barrier driven lower, the set polished by the active-set
+iteration and the feasible descent run (:func:`critical_state`). Every link leaves a
+:class:`~unibuckle_fenicsx.algorithms.records.LinkRecord` in its mesh's
+:class:`MeshLevel`.
+
+Note:
+    Collective on the problem's communicator.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.algorithms import RunStatus
+from unibuckle_fenicsx.algorithms.descent import descend
+from unibuckle_fenicsx.algorithms.interior_point.newton import Hook, InteriorPointNewton
+from unibuckle_fenicsx.algorithms.interior_point.options import (
+    BarrierPoint,
+    ChainOptions,
+    NewtonRecord,
+    NewtonStatus,
+)
+from unibuckle_fenicsx.algorithms.pdas import iterate
+from unibuckle_fenicsx.algorithms.records import LevelRecord, LinkRecord
+from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
+
+__all__ = [
+    "MeshLevel",
+    "Reader",
+    "critical_state",
+    "descend_from",
+    "newton_link",
+    "polish",
+    "read_contact",
+    "run_from",
+]
+
+
+@dataclass
+class MeshLevel:
+    """What the chain does on one mesh, as it goes (its record: :meth:`record`).
+
+    Attributes:
+        mesh: [nx, ny] (structured), ["h=<cell size>"] (meshed by gmsh) or ["fine"] (a
+            user's mesh or a mesh file).
+        constrained_nodes: i on this mesh.
+        links: The runs on it.
+        seconds: Wall time on it (set-up included).
+        best_admissible: The admissible mode with the lowest load met on this mesh (not
+            in the record).
+    """
+
+    mesh: list[int | str]
+    constrained_nodes: int
+    links: list[LinkRecord] = field(default_factory=list)
+    seconds: float = 0.0
+    best_admissible: Candidate | None = field(default=None, repr=False)
+
+    def offer(self, cand: Candidate | None) -> None:
+        """Keep ``cand`` if it is admissible with a lower load than the best so far."""
+        if cand is None or not cand.feasible or not math.isfinite(cand.load):
+            return
+        if self.best_admissible is None or cand.load < self.best_admissible.load:
+            self.best_admissible = cand
+
+    @property
+    def newton_steps(self) -> int:
+        """Interior-point Newton steps on this mesh."""
+        return sum(r.steps for r in self.links if r.link == "interior-point")
+
+    @property
+    def factorizations(self) -> int:
+        """Numeric factorisations on this mesh."""
+        return sum(r.factorizations for r in self.links)
+
+    @property
+    def eigensolves(self) -> int:
+        """Eigen solves on this mesh."""
+        return sum(r.eigensolves for r in self.links)
+
+    def record(self) -> LevelRecord:
+        """The level's record."""
+        return LevelRecord(
+            mesh=self.mesh,
+            constrained_nodes=self.constrained_nodes,
+            newton_steps=self.newton_steps,
+            factorizations=self.factorizations,
+            eigensolves=self.eigensolves,
+            seconds=self.seconds,
+            links=self.links,
+        )
+
+
+def newton_link(seed: str, record: NewtonRecord) -> LinkRecord:
+    """The link record of an interior-point run from ``seed``."""
+    return LinkRecord(
+        "interior-point",
+        seed,
+        record.status.value,
+        steps=record.steps,
+        factorizations=record.factorizations,
+        seconds=record.seconds,
+        load=record.load,
+    )
+
+
+def run_from(
+    newton: InteriorPointNewton,
+    point: BarrierPoint,
+    level: MeshLevel,
+    label: str,
+    options: ChainOptions,
+    *,
+    mu: float,
+    mu_min: float,
+    keep_push: bool = True,
+    on_solved: Hook | None = None,
+    on_step: Hook | None = None,
+) -> tuple[BarrierPoint, NewtonRecord]:
+    """Continue the method from ``point`` (updated in place) and record the run."""
+    new, rec = newton.solve(
+        point.mode,
+        load=point.load,
+        push=point.push if keep_push else None,
+        mu=mu,
+        mu_min=mu_min,
+        max_steps=options.max_steps,
+        on_solved=on_solved,
+        on_step=on_step,
+    )
+    level.links.append(newton_link(label, rec))
+    return new, rec
+
+
+def read_contact(
+    problem: UnilateralProblem,
+    newton: InteriorPointNewton,
+    point: BarrierPoint,
+    level: MeshLevel,
+    label: str,
+    active: npt.NDArray[np.int64] | None = None,
+) -> Candidate:
+    """The exact critical state of the contact set ``active`` read off ``point``.
+
+    Default: the nodes at the tolerance (:meth:`~.newton.InteriorPointNewton.contact_set`).
+    """
+    t0 = time.perf_counter()
+    solves0 = problem.eigensolver.solves
+    active = newton.contact_set(point) if active is None else active
+    cand = problem.evaluate(active, initial=point.mode.x.petsc_vec, near=point.load)
+    level.offer(cand)
+    level.links.append(
+        LinkRecord(
+            "evaluate",
+            label,
+            "kkt" if cand.kkt else "not-kkt",
+            eigensolves=problem.eigensolver.solves - solves0,
+            seconds=time.perf_counter() - t0,
+            load=cand.load if math.isfinite(cand.load) else None,
+            contact_nodes=len(active),
+            kkt=cand.kkt,
+        )
+    )
+    return cand
+
+
+@dataclass
+class Reader:
+    """Reads the fine mesh's critical state before its runs reach ``fine_mu_min``.
+
+    Called by a run each time it has solved a barrier problem (``on_solved``); once per
+    run (:meth:`arm`), at the first parameter at or below ``read_mu``, it evaluates the
+    predicted contact set and ends the run when that is a KKT point. With
+    ``read_stable`` it is also called at the steps in between (:meth:`step`, ``on_step``
+    of the run), and evaluates the predicted set as soon as two steps in a row predict
+    the same one. No set is evaluated twice; where the set read is not a KKT point the
+    run goes on unchanged, at the cost of one eigen solve.
+    """
+
+    problem: UnilateralProblem
+    newton: InteriorPointNewton
+    level: MeshLevel
+    options: ChainOptions
+    label: str = ""
+    armed: bool = False
+    found: Candidate | None = None
+    #: The set predicted at the run's previous step (:meth:`step`), and the sets evaluated.
+    previous: npt.NDArray[np.int64] | None = None
+    tried: list[npt.NDArray[np.int64]] = field(default_factory=list)
+
+    def arm(self, label: str) -> Reader:
+        """Ready for the next run (labelled ``label``); returns itself, the hook."""
+        self.label, self.armed = label, self.options.read_mu > 0.0
+        self.previous = None
+        return self
+
+    def __call__(self, point: BarrierPoint) -> NewtonStatus | None:
+        """Where the run has solved a barrier problem (``on_solved``)."""
+        if not self.armed or point.mu > self.options.read_mu:
+            return None
+        self.armed = False
+        return self._read(point, self.newton.predicted_contact_set(point), "predicted")
+
+    def step(self, point: BarrierPoint) -> NewtonStatus | None:
+        """At a step in between (``on_step``): read a set predicted twice in a row."""
+        if not (self.armed and self.options.read_stable) or point.mu > self.options.read_mu:
+            return None
+        active, self.previous = self.previous, self.newton.predicted_contact_set(point)
+        if active is None or not np.array_equal(active, self.previous):
+            return None
+        return self._read(point, active, "stable")
+
+    def _read(
+        self, point: BarrierPoint, active: npt.NDArray[np.int64], how: str
+    ) -> NewtonStatus | None:
+        if any(np.array_equal(active, other) for other in self.tried):
+            return None
+        self.tried.append(active)
+        label = f"{self.label} ({how} at {point.mu:.0e})"
+        cand = read_contact(self.problem, self.newton, point, self.level, label, active)
+        if not cand.kkt:
+            return None
+        self.armed, self.found = False, cand
+        return NewtonStatus.READ
+
+
+def polish(
+    problem: UnilateralProblem, cand: Candidate, level: MeshLevel, label: str, budget: int
+) -> Candidate | None:
+    """Active-set iteration from ``cand``'s contact set; its KKT point or best feasible."""
+    t0 = time.perf_counter()
+    solves0 = problem.eigensolver.solves
+    run = iterate(problem, label, cand.active, cand.mode.x.petsc_vec, budget, near=cand.load)
+    final = run.final if run.status is RunStatus.KKT else run.best_feasible
+    level.offer(final)
+    level.links.append(
+        LinkRecord(
+            "active-set polish",
+            label,
+            run.status,
+            steps=run.iterations,
+            eigensolves=problem.eigensolver.solves - solves0,
+            seconds=time.perf_counter() - t0,
+            load=None if final is None else final.load,
+            contact_nodes=None if final is None else len(final.active),
+            kkt=final is not None and final.kkt,
+        )
+    )
+    return final
+
+
+def descend_from(
+    problem: UnilateralProblem, start: Candidate, level: MeshLevel, label: str, budget: int
+) -> Candidate:
+    """Feasible descent (:mod:`.descent`) from the admissible ``start``: it cannot cycle."""
+    t0 = time.perf_counter()
+    solves0 = problem.eigensolver.solves
+    run, _ = descend(problem, start, budget)
+    final = run.final if run.status is RunStatus.KKT else run.best_feasible
+    assert final is not None
+    level.offer(final)
+    level.links.append(
+        LinkRecord(
+            "feasible descent",
+            label,
+            run.status,
+            steps=run.iterations,
+            eigensolves=problem.eigensolver.solves - solves0,
+            seconds=time.perf_counter() - t0,
+            load=final.load,
+            contact_nodes=len(final.active),
+            kkt=final.kkt,
+        )
+    )
+    return final
+
+
+def critical_state(
+    problem: UnilateralProblem,
+    newton: InteriorPointNewton,
+    point: BarrierPoint,
+    level: MeshLevel,
+    label: str,
+    options: ChainOptions,
+    carry: bool = True,
+    quick: bool = False,
+    reader: Reader | None = None,
+) -> tuple[Candidate | None, BarrierPoint]:
+    """Read the contact set off ``point``; escape a saddle, drive the barrier lower, polish.
+
+    Returns the KKT point (or None) and the barrier point it belongs to (recomputed
+    after a polish only when ``carry``: it goes on to a finer mesh). ``quick``: a
+    short polish and no descent (a second try follows). Saddles are escaped on every
+    try: an escape costs less than a second try from the coarsest mesh.
+    """
+    cand = read_contact(problem, newton, point, level, label)
+    if cand.kkt:
+        return cand, point
+    for attempt in range(options.escapes):
+        saddle = not cand.feasible and cand.load < point.load * (1.0 - ROUNDING_RTOL)
+        if not (saddle and newton.escape(point, cand.mode.x.petsc_vec)):
+            break
+        tag = f"{label} (escape {attempt + 1})"
+        point, _ = run_from(
+            newton, point, level, tag, options, keep_push=False,
+            mu=max(point.mu, options.escape_mu), mu_min=max(point.mu, options.fine_mu_min),
+        )  # fmt: skip
+        cand = read_contact(problem, newton, point, level, tag)
+        if cand.kkt:
+            return cand, point
+    if point.mu > options.last_mu_min:
+        tag = label + " (lower barrier)"
+        point, _ = run_from(
+            newton, point, level, tag, options, mu=point.mu, mu_min=options.last_mu_min,
+            on_solved=None if reader is None else reader.arm(tag),
+            on_step=None if reader is None else reader.step,
+        )  # fmt: skip
+        if reader is not None and reader.found is not None:
+            return reader.found, point
+        cand = read_contact(problem, newton, point, level, tag)
+        if cand.kkt:
+            return cand, point
+    if math.isfinite(cand.load):
+        budget = options.quick_polish_iterations if quick else options.polish_iterations
+        polished = polish(problem, cand, level, label, budget)
+        if polished is not None and polished.feasible and not polished.kkt and not quick:
+            polished = descend_from(problem, polished, level, label, options.descent_steps)
+        if polished is not None and polished.kkt and not carry:
+            return polished, point
+        if polished is not None and polished.kkt:
+            # The barrier point that goes with it, for the next mesh.
+            fresh = newton.starts.from_candidate(polished, options.level_mu)
+            fresh, _ = run_from(
+                newton, fresh, level, label + " (after polish)", options,
+                mu=fresh.mu, mu_min=point.mu,
+            )  # fmt: skip
+            return polished, fresh
+    return None, point
