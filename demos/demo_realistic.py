@@ -37,7 +37,7 @@ from mpi4py import MPI
 import numpy as np
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import problem_from_dict
+from unibuckle_fenicsx.spec import problem_from_dict
 from unibuckle_fenicsx.viz import fields, study
 
 warnings.filterwarnings("error")  # demos run warning-free

@@ -60,10 +60,10 @@ from unibuckle_fenicsx.algorithms.interior_point.options import PUSH_MARGIN
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case, plate_case
-from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.results.record import jsonable
+from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 PARALLEL = Path(__file__).parent / "mpi" / "interior_point_parallel.py"

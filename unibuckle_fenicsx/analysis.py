@@ -1,4 +1,4 @@
-"""High-level entry point: :func:`solve` a :class:`~unibuckle_fenicsx.config.ProblemSpec`."""
+"""High-level entry point: :func:`solve` a :class:`~unibuckle_fenicsx.spec.ProblemSpec`."""
 
 from __future__ import annotations
 
@@ -14,13 +14,13 @@ import dolfinx
 from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
 from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
 from unibuckle_fenicsx.results.assemble import assemble_result
 from unibuckle_fenicsx.results.record import BucklingResult
+from unibuckle_fenicsx.spec import ProblemSpec
 
 __all__ = ["Analysis", "choose_method", "solve"]
 
@@ -198,7 +198,7 @@ def solve(
         The analysis (result, mode, problem); the caller destroys it (or uses ``with``).
 
     Raises:
-        TypeError: ``spec`` is not a :class:`~unibuckle_fenicsx.config.ProblemSpec` or
+        TypeError: ``spec`` is not a :class:`~unibuckle_fenicsx.spec.ProblemSpec` or
             ``comm`` not an MPI communicator.
         InputError: The problem is refused (before any solve, or once its mesh exists).
         NumericalError: A solve did not converge, or no admissible mode was found.

@@ -28,8 +28,8 @@ import math
 
 from msgspec import UNSET, Struct, UnsetType
 
-from unibuckle_fenicsx.config import DesignSpec, ProblemSpec, stress_ends
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
 
 __all__ = ["CLAUSES", "DesignRecord", "design_output", "reduction_factor"]
 

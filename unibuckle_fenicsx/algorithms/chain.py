@@ -68,11 +68,11 @@ from unibuckle_fenicsx.algorithms.records import (
     InteriorPointDetails,
     LinkRecord,
 )
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.model.build import build_unilateral_problem
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+from unibuckle_fenicsx.spec import ProblemSpec
 
 __all__ = ["THIN_PLATE", "ChainOptions", "solve_interior_point"]
 

@@ -31,7 +31,6 @@ from petsc4py import PETSc
 
 import dolfinx
 
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError
 from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
@@ -48,6 +47,7 @@ from unibuckle_fenicsx.model.prestress import Prestress, solve_prestress
 from unibuckle_fenicsx.model.problem import Problem, SetUp, UnilateralProblem
 from unibuckle_fenicsx.model.resources import check_memory
 from unibuckle_fenicsx.model.structure import StructuralModel
+from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.tolerances import NULL_GEOMETRIC_STIFFNESS
 
 __all__ = [

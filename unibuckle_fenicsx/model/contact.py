@@ -21,9 +21,9 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import ObstacleSpec
 from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError
 from unibuckle_fenicsx.model.structure import NodalDofs
+from unibuckle_fenicsx.spec import ObstacleSpec
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [

@@ -31,7 +31,6 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.errors import EigenSolveError, InputError
 from unibuckle_fenicsx.la.eigen import EigenPair, GEPSolver
 from unibuckle_fenicsx.la.factor import abs_matrix
@@ -41,6 +40,7 @@ from unibuckle_fenicsx.model.contact import ContactSetManager, orientation
 from unibuckle_fenicsx.model.materials import reference_bending_stiffness
 from unibuckle_fenicsx.model.prestress import Prestress
 from unibuckle_fenicsx.model.structure import StructuralModel
+from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
 __all__ = ["Candidate", "Mode", "Problem", "SetUp", "UnilateralProblem", "require_obstacle"]

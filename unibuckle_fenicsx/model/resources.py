@@ -9,8 +9,8 @@ from __future__ import annotations
 
 from mpi4py import MPI
 
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec import ProblemSpec
 
 __all__ = ["BYTES_PER_DOF", "available_memory", "check_memory"]
 

@@ -23,8 +23,8 @@ import numpy as np
 import numpy.typing as npt
 from msgspec import Struct
 
-from unibuckle_fenicsx.config import Circle, ObstacleSpec, PlateSpec, Polygon
 from unibuckle_fenicsx.geometry import disc_polygon, intersection_area, polygon_area
+from unibuckle_fenicsx.spec import Circle, ObstacleSpec, PlateSpec, Polygon
 
 __all__ = ["ZoneReport", "cell_areas", "zone_area", "zone_report"]
 

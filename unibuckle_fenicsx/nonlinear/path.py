@@ -29,7 +29,6 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
-from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.errors import InputError, NonlinearError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.la.ownership import Owner
@@ -51,6 +50,7 @@ from unibuckle_fenicsx.nonlinear.model import (
 )
 from unibuckle_fenicsx.progress import LOGGER
 from unibuckle_fenicsx.results.assemble import versions
+from unibuckle_fenicsx.spec import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.tolerances import NONLINEAR_ATOL
 
 __all__ = [

@@ -11,13 +11,6 @@ from __future__ import annotations
 import math
 from typing import TYPE_CHECKING, Any
 
-from unibuckle_fenicsx.config import (
-    ProblemSpec,
-    problem_to_dict,
-    stress_value,
-    temperature_field,
-)
-from unibuckle_fenicsx.config.checks import plate_model_note
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.model.zones import zone_report
 from unibuckle_fenicsx.results.record import (
@@ -26,6 +19,13 @@ from unibuckle_fenicsx.results.record import (
     EdgeLoad,
     ResultDetails,
 )
+from unibuckle_fenicsx.spec import (
+    ProblemSpec,
+    problem_to_dict,
+    stress_value,
+    temperature_field,
+)
+from unibuckle_fenicsx.spec.checks import plate_model_note
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution

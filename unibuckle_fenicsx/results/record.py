@@ -18,10 +18,10 @@ from msgspec import UNSET, Struct, UnsetType, to_builtins
 
 from unibuckle_fenicsx.algorithms.records import MethodDetails
 from unibuckle_fenicsx.certificate.records import CopositivityRecord
-from unibuckle_fenicsx.config import UNITS, PointSpec
 from unibuckle_fenicsx.design import DesignRecord
 from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
+from unibuckle_fenicsx.spec import UNITS, PointSpec
 
 __all__ = ["BucklingResult", "CertificateRecord", "EdgeLoad", "ResultDetails", "jsonable"]
 

@@ -27,10 +27,10 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.analysis import Analysis, solve
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.results.files import write_fields
 from unibuckle_fenicsx.results.record import BucklingResult
+from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.viz import fields, plotting
 
 __all__ = [
