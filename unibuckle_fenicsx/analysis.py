@@ -34,7 +34,7 @@ def choose_method(
 
     "auto" enumerates (with ``until_proven``: exact) when the 2^i candidate sets are at
     most ``max_candidates`` and their estimated time, 2^i times ``solve_time_s`` (the
-    measured time of one eigen solve), is at most ``enumeration_budget_s``; otherwise it
+    timed free eigen solve), is at most ``enumeration_budget_s``; otherwise it
     runs the active-set method. "enumerate" alone follows the paper's stopping rule.
 
     Raises:

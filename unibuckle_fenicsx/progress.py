@@ -1,7 +1,7 @@
 """Progress of long runs, as ``logging`` lines on the logger ``unibuckle_fenicsx.progress``.
 
 The command line shows them on stderr (``-q`` hides them). :class:`Progress` rate-limits
-the lines of a loop and estimates the time left from the measured rate; asked for a bar
+the lines of a loop and estimates the time left from the rate so far; asked for a bar
 (the sweep), it draws one with tqdm (the ``progress`` extra) instead of the lines, and
 falls back to the lines, saying so, when tqdm is not installed.
 """

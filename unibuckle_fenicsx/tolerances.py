@@ -81,10 +81,7 @@ ARC_RTOL = 1e-12
 #: A node presses the tensionless foundation when it moves towards it by more than this
 #: fraction of max|w|. An eigenvector's nodal values carry rounding of some 1e-10 of
 #: max|w|, so with 0 a node lying on the foundation (a node of an edge line, a nodal line of
-#: the mode) pressed or not with the number of ranks, and the spring-set iteration took
-#: another path: measured on 24 plates (0.3 x 0.1 m, t = 1 mm, loaded edges clamped or
-#: simply supported, 24x8 and 36x12, k_f = 3e6 to 1e9 N/m^3), 4 ended at loads 8e-6 to
-#: 5.8e-5 apart on 1 and 2 ranks; at 1e-10, 1e-9 (ROUNDING_RTOL) or 1e-8 all 24 agree.
+#: the mode) presses or not with the number of ranks (:doc:`/verification/tuning`).
 PRESSING_RTOL = ROUNDING_RTOL
 
 # -- the interior point ------------------------------------------------------------------

@@ -178,13 +178,8 @@ def _polish(
 
     With a load estimate (:func:`_estimates`) the first eigen solve shifts just below it,
     later ones below the previous iterate's load, the inertia proving each pair the
-    smallest (:meth:`~unibuckle_fenicsx.model.problem.UnilateralProblem.evaluate`).
-    Measured on the paper's plate (c1, c2, c3), unilateral solve and certificate over one
-    free solve: at 160×80 1.96, 3.25, 3.30 → 1.69, 2.37, 2.51, at 320×160 2.69, 2.30,
-    3.60 → 2.34, 2.02, 3.03; the same loads to 1e-14. (The prolonged coarse mode as the
-    first solve's start as well saved another 0.05 s at 160×80 but changed the path on
-    near-degenerate thin plates: a 4 mm SSSS plate 0.3 × 0.1 m at 90×30 took 17 fine eigen
-    solves instead of 3.)
+    smallest (:meth:`~unibuckle_fenicsx.model.problem.UnilateralProblem.evaluate`): a
+    shifted solve converges in a few restarts (:doc:`/verification/tuning`).
 
     If no prolonged set reaches a KKT point, the best one (the first) is iterated once
     more from its prolongation with the looser :data:`THRESHOLDS` first.
@@ -448,6 +443,27 @@ def _choose(
     return _prune(problem, chosen) if chosen.kkt else chosen
 
 
+def _fine_level(
+    problem: UnilateralProblem, coarse: _Coarse, max_iterations: int
+) -> tuple[list[Run], list[int] | str]:
+    """The fine mesh's runs: the coarse sets polished, or the seeds; and what seeded them.
+
+    Destroys the finest coarse problem. Collective.
+    """
+    spec = problem.spec
+    seeded_on: list[int] | str
+    if coarse.candidates is not None and coarse.last is not None:
+        budget = min(max_iterations, POLISH_ITERATIONS)
+        runs = _polish(problem, coarse.last, coarse.candidates, budget, coarse.bests)
+        seeded_on = [coarse.last.spec.mesh.nx, coarse.last.spec.mesh.ny]
+    else:
+        runs = _multi_seed(problem, max_iterations)
+        seeded_on = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
+    if coarse.last is not None:
+        coarse.last.destroy()
+    return runs, seeded_on
+
+
 def _check_options(
     max_iterations: int, coarse_min_cells: int, refine_margin: float, bound_budget: int
 ) -> None:
@@ -504,17 +520,7 @@ def solve_active_set(
     structured = multilevel and problem.structured  # coarse copies need spec.mesh
     levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
     coarse = _coarse_levels(problem, levels, max_iterations, refine_margin)
-    # -- finest level -------------------------------------------------------------
-    seeded_on: list[int] | str
-    if coarse.candidates is not None and coarse.last is not None:
-        budget = min(max_iterations, POLISH_ITERATIONS)
-        runs = _polish(problem, coarse.last, coarse.candidates, budget, coarse.bests)
-        seeded_on = [coarse.last.spec.mesh.nx, coarse.last.spec.mesh.ny]
-    else:
-        runs = _multi_seed(problem, max_iterations)
-        seeded_on = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
-    if coarse.last is not None:
-        coarse.last.destroy()
+    runs, seeded_on = _fine_level(problem, coarse, max_iterations)
     warnings: list[str] = []
     fallbacks = _fall_back(problem, runs, max_iterations, warnings)
     kkt = _distinct_kkt(runs)

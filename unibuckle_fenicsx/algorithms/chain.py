@@ -290,6 +290,31 @@ def _levels(
     return levels, explored, chosen
 
 
+def _nested(
+    problem: UnilateralProblem, options: ChainOptions
+) -> tuple[list[MeshLevel], list[Candidate], Candidate | None, int]:
+    """The route over ``problem``'s coarser copies and itself (:func:`_levels`).
+
+    Returns the levels, the coarsest mesh's KKT points, the fine mesh's critical state
+    (or None), and the coarser meshes' eigen solves; the copies are destroyed.
+    Collective.
+    """
+    problems: list[UnilateralProblem] = []
+    for coarse in _coarser(problem, options):
+        try:
+            problems.append(build_unilateral_problem(coarse, problem.comm))
+        except EmptyZoneError:
+            continue
+    problems.append(problem)
+    try:
+        levels, explored, chosen = _levels(problems, options)
+    finally:
+        other_solves = sum(p.eigensolver.solves for p in problems[:-1])
+        for p in problems[:-1]:
+            p.destroy()
+    return levels, explored, chosen, other_solves
+
+
 def _fallback(problem: UnilateralProblem, options: ChainOptions) -> UnilateralSolution:
     from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 
@@ -324,20 +349,7 @@ def solve_interior_point(
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     free_load = problem.solve_free().load
-    problems: list[UnilateralProblem] = []
-    for coarse in _coarser(problem, options):
-        try:
-            problems.append(build_unilateral_problem(coarse, problem.comm))
-        except EmptyZoneError:
-            continue
-    problems.append(problem)
-    try:
-        levels, explored, chosen = _levels(problems, options)
-    finally:
-        other_solves = sum(p.eigensolver.solves for p in problems[:-1])
-        for p in problems[:-1]:
-            p.destroy()
-
+    levels, explored, chosen, other_solves = _nested(problem, options)
     if (chosen is None or not chosen.kkt) and levels and levels[-1].best_admissible is not None:
         # The lowest admissible mode met, taken to a critical state by the feasible
         # descent (monotone: it cannot cycle), before anything starts afresh.

@@ -138,8 +138,46 @@ class _Gradient:
             v.destroy()
         return g
 
+    def arc(self, u: PETSc.Vec, working: npt.NDArray[np.int64]) -> _Arc:
+        """The arc from ``u`` along the direction g for ``working`` (collective)."""
+        model = self.problem.model
+        d = self.direction(u, working)
+        arc = _Arc(model.A, model.B, u, d)
+        d.destroy()
+        return arc
+
     def destroy(self) -> None:
+        """Destroy the solver (collective)."""
         self.ksp.destroy()
+
+
+def _blocking(
+    problem: UnilateralProblem, arc: _Arc, trial: npt.NDArray[np.int64]
+) -> tuple[float, npt.NDArray[np.int64]]:
+    """The angle of the arc at which the first free node reaches the obstacle, and those nodes.
+
+    Nodes that the end of the arc puts above the obstacle beyond the tolerance block it;
+    the nodes within :data:`~unibuckle_fenicsx.tolerances.ZERO_STEP` of the step of the
+    first are blocked with it. Collective.
+    """
+    n, tau = problem.contact.size, problem.tau
+    free = np.ones(n, dtype=bool)
+    free[trial] = False
+    e1 = problem.contact.values(arc.e1)
+    e2 = np.zeros(n)
+    if arc.phi_max > 0.0 and arc.e2 is not None:
+        e2 = problem.contact.values(arc.e2)
+    end = math.cos(arc.phi_max) * e1 + math.sin(arc.phi_max) * e2
+    target = arc.point(arc.phi_max)
+    scale = problem.max_abs_w(target) or 1.0
+    target.destroy()
+    rising = free & (e2 > 0.0) & (end > tau * scale)
+    angle = np.full(n, np.inf)
+    angle[rising] = np.arctan2(np.maximum(-e1[rising], 0.0), e2[rising])
+    phi_b = float(angle.min()) if rising.any() else math.inf
+    zero = ZERO_STEP * arc.phi_max
+    blocked = np.flatnonzero(rising & (angle <= max(phi_b, zero)))
+    return phi_b, blocked
 
 
 def descend(
@@ -184,30 +222,12 @@ def descend(
             if by_gradient:
                 steps["gradient"] += 1
                 gradient = gradient or _Gradient(problem)  # rarely needed: made on first use
-                d = gradient.direction(u, trial)
-                arc = _Arc(A, B, u, d)
-                d.destroy()
+                arc = gradient.arc(u, trial)
             else:
                 cand = problem.evaluate(trial, initial=u)
                 arc = _Arc(A, B, u, cand.mode.x.petsc_vec)
-            free = np.ones(n, dtype=bool)
-            free[trial] = False
-            e1 = problem.contact.values(arc.e1)
-            e2 = np.zeros(n)
-            if arc.phi_max > 0.0 and arc.e2 is not None:
-                e2 = problem.contact.values(arc.e2)
-            # Nodes that the end of the arc puts above the obstacle beyond the tolerance.
-            end = math.cos(arc.phi_max) * e1 + math.sin(arc.phi_max) * e2
-            target = arc.point(arc.phi_max)
-            scale = problem.max_abs_w(target) or 1.0
-            target.destroy()
-            rising = free & (e2 > 0.0) & (end > tau * scale)
-            angle = np.full(n, np.inf)
-            angle[rising] = np.arctan2(np.maximum(-e1[rising], 0.0), e2[rising])
-            phi_b = float(angle.min()) if rising.any() else math.inf
-            zero = ZERO_STEP * arc.phi_max
-            blocked = np.flatnonzero(rising & (angle <= max(phi_b, zero)))
-            if phi_b <= zero:
+            phi_b, blocked = _blocking(problem, arc, trial)
+            if phi_b <= ZERO_STEP * arc.phi_max:
                 # Zero step: released nodes that would cross at once stay in W, nodes
                 # already at the obstacle join it; the others are released. When every
                 # eigen step towards a release is a zero step, release the most pulling

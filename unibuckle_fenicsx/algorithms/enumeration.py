@@ -196,53 +196,14 @@ def _finite_or_none(value: float) -> float | None:
     return value if math.isfinite(value) else None
 
 
-def enumerate_contact_sets(  # noqa: C901 - the paper's level loop with its stopping rules (section 5.3)
-    problem: UnilateralProblem,
-    *,
-    complete: bool = False,
-    max_candidates: int = 100_000,
-    candidate_comm: MPI.Comm | None = None,
-    until_proven: bool = False,
-) -> UnilateralSolution:
-    r"""Critical load by the paper's enumeration of contact sets (section 5.3).
-
-    Args:
-        problem: A set-up problem with an obstacle.
-        complete: Visit every size p = 0..i instead of stopping after the first p with
-            a feasible mode; reports :math:`\lambda(p)` per p and whether it is
-            monotone, and proves the global optimum.
-        max_candidates: Refuse (``ValueError``, before any solve) when the number of
-            candidate sets that may be visited, :math:`2^i`, exceeds this.
-        candidate_comm: Split the candidate sets of each p round-robin over this
-            communicator's ranks; every rank must hold its own serial copy of the
-            problem (``problem.comm`` of size 1). ``None``: evaluate every candidate
-            on ``problem.comm`` (which may distribute the mesh).
-        until_proven: Do not stop at :math:`p^*` (the paper's rule) but after the first
-            size q at which the interlacing bound proves the best feasible load found
-            globally optimal (see the module docstring).
-
-    Returns:
-        The solution, its candidate on every rank. ``eigensolves`` counts the solves of
-        all candidate ranks. ``details`` holds, per visited p, the candidates, the feasible
-        count, :math:`\lambda(p)` (``lambda_by_p``) and the smallest load of any set
-        (``lambda_min_by_p``); ``monotone`` (complete mode; ``None`` otherwise).
-
-    Raises:
-        ValueError: No obstacle, bad ``max_candidates``, too many candidates, or a
-            distributed problem with ``candidate_comm``.
-        NoAdmissibleModeError: No contact set gives a feasible mode.
-
-    Note:
-        Collective on ``problem.comm`` and on ``candidate_comm``.
-    """
-    require_obstacle(problem, "enumerate_contact_sets")
+def _check(problem: UnilateralProblem, max_candidates: int, ccomm: MPI.Comm) -> None:
+    """Refuse a bad ``max_candidates``, too many candidate sets, or a distributed copy."""
     if (
         isinstance(max_candidates, bool)
         or int(max_candidates) != max_candidates
         or max_candidates < 1
     ):
         raise InputError(f"max_candidates must be an integer >= 1, got {max_candidates!r}")
-    ccomm = MPI.COMM_SELF if candidate_comm is None else candidate_comm
     if ccomm.size > 1 and problem.comm.size > 1:
         raise InputError(
             "candidate_comm needs a serial copy of the problem on every rank "
@@ -258,62 +219,72 @@ def enumerate_contact_sets(  # noqa: C901 - the paper's level loop with its stop
             "(or a coarser mesh, a smaller zone, or a larger --max-candidates)"
         )
 
-    rank, size = ccomm.rank, ccomm.size
-    t_start = time.perf_counter()
-    solves0 = problem.eigensolver.solves
-    start = _start_vector(problem)
-    levels: list[LevelSummary] = []
-    kept: list[Candidate | None] = []  # per level: this rank's candidate of its best set
-    talk = rank == 0 and problem.comm.rank == 0
-    try:
-        for p in range(i + 1):
-            t0 = time.perf_counter()
-            loads: list[float] = []
-            feasible: list[tuple[float, tuple[int, ...]]] = []
-            ties: list[Candidate] = []  # feasible candidates within LOAD_TIE_RTOL of the best
-            n = 0
-            progress = Progress(f"enumeration p = {p}", math.comb(i, p), enabled=talk)
-            for j, combo in enumerate(itertools.combinations(range(i), p)):
-                n += 1
-                progress.update(j)
-                if j % size != rank:
-                    continue
-                cand = problem.evaluate(np.asarray(combo, dtype=np.int64), initial=start)
-                loads.append(cand.load)
-                if cand.feasible:
-                    feasible.append((cand.load, combo))
-                    ties = _keep_ties(ties, cand)
-            level = _reduce_level(p, n, loads, feasible, time.perf_counter() - t0, ccomm)
-            levels.append(level)
-            kept.append(
-                next((c for c in ties if tuple(c.active) == level.best_set), None)
-                if level.best_set is not None
-                else None
-            )
-            if talk:
-                PROGRESS.info(
-                    "enumeration p = %d done: %d sets, %d feasible, lambda(p) = %.9e, "
-                    "min lambda = %.9e (%.2f s); %d of %d sets visited",
-                    p,
-                    n,
-                    level.feasible,
-                    level.best_load,
-                    level.load_min,
-                    level.wall_s,
-                    sum(lv.candidates for lv in levels),
-                    count,
-                )
-            if complete:
-                continue
-            if until_proven:
-                found = min((lv.best_load for lv in levels), default=math.inf)
-                if math.isfinite(found) and level.load_kth >= found * (1.0 - PROOF_RTOL):
-                    break
-            elif level.best_set is not None:
-                break
-    finally:
-        start.destroy()
 
+def _level(
+    problem: UnilateralProblem, p: int, start: PETSc.Vec, ccomm: MPI.Comm, talk: bool
+) -> tuple[LevelSummary, Candidate | None]:
+    """Every contact set of size ``p`` (this rank's share): the level, this rank's best.
+
+    Collective on ``problem.comm`` and ``ccomm``.
+    """
+    i = problem.contact.size
+    t0 = time.perf_counter()
+    loads: list[float] = []
+    feasible: list[tuple[float, tuple[int, ...]]] = []
+    ties: list[Candidate] = []  # feasible candidates within LOAD_TIE_RTOL of the best
+    n = 0
+    progress = Progress(f"enumeration p = {p}", math.comb(i, p), enabled=talk)
+    for j, combo in enumerate(itertools.combinations(range(i), p)):
+        n += 1
+        progress.update(j)
+        if j % ccomm.size != ccomm.rank:
+            continue
+        cand = problem.evaluate(np.asarray(combo, dtype=np.int64), initial=start)
+        loads.append(cand.load)
+        if cand.feasible:
+            feasible.append((cand.load, combo))
+            ties = _keep_ties(ties, cand)
+    level = _reduce_level(p, n, loads, feasible, time.perf_counter() - t0, ccomm)
+    mine = (
+        next((c for c in ties if tuple(c.active) == level.best_set), None)
+        if level.best_set is not None
+        else None
+    )
+    return level, mine
+
+
+def _stop(levels: list[LevelSummary], complete: bool, until_proven: bool) -> bool:
+    """Whether the enumeration stops after the last level (section 5.3; module docstring)."""
+    level = levels[-1]
+    if complete:
+        return False
+    if until_proven:
+        found = min((lv.best_load for lv in levels), default=math.inf)
+        return math.isfinite(found) and level.load_kth >= found * (1.0 - PROOF_RTOL)
+    return level.best_set is not None
+
+
+def _solution(
+    problem: UnilateralProblem,
+    levels: list[LevelSummary],
+    kept: list[Candidate | None],
+    ccomm: MPI.Comm,
+    complete: bool,
+    until_proven: bool,
+    t_start: float,
+    solves0: int,
+) -> UnilateralSolution:
+    """The best admissible set over the sizes visited, its bound and the record.
+
+    Raises:
+        NoAdmissibleModeError: No size had a set with an admissible mode.
+
+    Note:
+        Collective on ``problem.comm`` and ``ccomm``.
+    """
+    i = problem.contact.size
+    count = candidate_count(i)
+    rank, size = ccomm.rank, ccomm.size
     with_feasible = [lv for lv in levels if lv.best_set is not None]
     if not with_feasible:
         raise NoAdmissibleModeError(
@@ -375,3 +346,79 @@ def enumerate_contact_sets(  # noqa: C901 - the paper's level loop with its stop
         lower_bound_by="enumeration",
         details=details,
     )
+
+
+def enumerate_contact_sets(
+    problem: UnilateralProblem,
+    *,
+    complete: bool = False,
+    max_candidates: int = 100_000,
+    candidate_comm: MPI.Comm | None = None,
+    until_proven: bool = False,
+) -> UnilateralSolution:
+    r"""Critical load by the paper's enumeration of contact sets (section 5.3).
+
+    Args:
+        problem: A set-up problem with an obstacle.
+        complete: Visit every size p = 0..i instead of stopping after the first p with
+            a feasible mode; reports :math:`\lambda(p)` per p and whether it is
+            monotone, and proves the global optimum.
+        max_candidates: Refuse (``ValueError``, before any solve) when the number of
+            candidate sets that may be visited, :math:`2^i`, exceeds this.
+        candidate_comm: Split the candidate sets of each p round-robin over this
+            communicator's ranks; every rank must hold its own serial copy of the
+            problem (``problem.comm`` of size 1). ``None``: evaluate every candidate
+            on ``problem.comm`` (which may distribute the mesh).
+        until_proven: Do not stop at :math:`p^*` (the paper's rule) but after the first
+            size q at which the interlacing bound proves the best feasible load found
+            globally optimal (see the module docstring).
+
+    Returns:
+        The solution, its candidate on every rank. ``eigensolves`` counts the solves of
+        all candidate ranks. ``details`` holds, per visited p, the candidates, the feasible
+        count, :math:`\lambda(p)` (``lambda_by_p``) and the smallest load of any set
+        (``lambda_min_by_p``); ``monotone`` (complete mode; ``None`` otherwise).
+
+    Raises:
+        ValueError: No obstacle, bad ``max_candidates``, too many candidates, or a
+            distributed problem with ``candidate_comm``.
+        NoAdmissibleModeError: No contact set gives a feasible mode.
+
+    Note:
+        Collective on ``problem.comm`` and on ``candidate_comm``.
+    """
+    require_obstacle(problem, "enumerate_contact_sets")
+    ccomm = MPI.COMM_SELF if candidate_comm is None else candidate_comm
+    _check(problem, max_candidates, ccomm)
+    i = problem.contact.size
+    count = candidate_count(i)
+    t_start = time.perf_counter()
+    solves0 = problem.eigensolver.solves
+    start = _start_vector(problem)
+    levels: list[LevelSummary] = []
+    kept: list[Candidate | None] = []  # per level: this rank's candidate of its best set
+    talk = ccomm.rank == 0 and problem.comm.rank == 0
+    try:
+        for p in range(i + 1):
+            level, mine = _level(problem, p, start, ccomm, talk)
+            levels.append(level)
+            kept.append(mine)
+            if talk:
+                PROGRESS.info(
+                    "enumeration p = %d done: %d sets, %d feasible, lambda(p) = %.9e, "
+                    "min lambda = %.9e (%.2f s); %d of %d sets visited",
+                    p,
+                    level.candidates,
+                    level.feasible,
+                    level.best_load,
+                    level.load_min,
+                    level.wall_s,
+                    sum(lv.candidates for lv in levels),
+                    count,
+                )
+            if _stop(levels, complete, until_proven):
+                break
+    finally:
+        start.destroy()
+
+    return _solution(problem, levels, kept, ccomm, complete, until_proven, t_start, solves0)

@@ -27,15 +27,8 @@ Bounds: :math:`\lambda_{free} \le \lambda_f` (the spring term is non-negative), 
 returned load, a value of the quotient, is an upper bound of :math:`\lambda_f`. The
 iteration starts from the free plate (no springs) and from every spring active (the
 bilateral foundation's mode); the smallest quotient is returned. The quotient has
-several local minima on long plates, and each start finds one. Measured on 24 plates
-(0.3 × 0.1 m, t = 1 mm, loaded edges clamped or simply supported, 24×8 and 36×12,
-k_f = 3e6 to 1e9 N/m³): the arc descent (below) from every start that cycles, not only
-from the best one, lowered 2 answers (by 5.4e-7 and 5.9e-6) and raised none, for 8 %
-more eigen solves. A third start (the nodes the free mode presses when turned towards
-the foundation) lowered 2 more (by 7.8e-5 and 1.4e-4) but cost 57 % more eigen solves
-there, and on the thin plate of ``bench/bench_plates.py`` (t = 0.1 mm, SSSS, 90×30)
-30–90 % more free solves (k_f = 1e2, 1e4, 1e6 N/m³: 4.7, 36.9, 49.0 → 6.3, 49.6, 79.8)
-for the same loads: not adopted.
+several local minima on long plates, and each start finds one; the arc descent (below)
+runs from every start that cycles (:doc:`/verification/tuning`).
 
 The iteration on S need not decrease the quotient, and it can cycle. When a start
 reaches no fixed point, an *arc descent* takes over from its best iterate v: with S the
@@ -71,6 +64,9 @@ logger = logging.getLogger(__name__)
 
 #: Angles sampled on the circle before the golden-section refinement.
 ARC_SAMPLES = 720
+#: Golden-section steps in the bracket around the best sample: 0.618^60 of a sample's
+#: spacing, below the rounding of an angle.
+GOLDEN_STEPS = 60
 
 
 def solve_foundation(
@@ -110,21 +106,7 @@ def solve_foundation(
     with PenaltySolver(problem, prefix=Prefix.FOUNDATION, eps_options=eps_options) as solver:
         starts = {"free": np.empty(0, np.int64), "bilateral": np.arange(contact.size)}
         for name, start in starts.items():
-            run = solver.iterate_springs(
-                springs,
-                initial_active=start,
-                max_iterations=max_iterations,
-                lower_bound=lower,
-                label=f"foundation ({name} start)",
-                threshold=PRESSING_RTOL,
-            )
-            runs[name] = run
-            final, status, arc_steps = run.candidate, run.status, 0
-            if status is not RunStatus.CONVERGED and math.isfinite(final.load):
-                final, status, arc_steps = _arc_descent(
-                    problem, solver, springs, final, max_iterations
-                )
-            finals[name] = (final, status, arc_steps)
+            runs[name], finals[name] = _from_start(solver, name, start, lower, max_iterations)
         # The smallest quotient; within TWIN_RTOL of it (mirror images, whose loads differ
         # by rounding that changes with the ranks) the earlier start, the free plate first.
         lowest = min(final.load for final, _, _ in finals.values())
@@ -162,7 +144,73 @@ def solve_foundation(
         upper_bound=load if math.isfinite(load) else math.inf,
         status=status,
         details=details,
+        route=["foundation", "arc-descent"] if arc_steps else ["foundation"],
     )
+
+
+def _from_start(
+    solver: PenaltySolver,
+    name: str,
+    start: npt.NDArray[np.int64],
+    lower: float,
+    max_iterations: int,
+) -> tuple[SpringIteration, tuple[Candidate, RunStatus, int]]:
+    """The spring-set iteration from ``start``, then the arc descent if it has no fixed point.
+
+    Returns the iteration, and (mode, how it ended, arc steps). Collective.
+    """
+    problem = solver.problem
+    springs = problem.contact.stiffness
+    assert springs is not None
+    run = solver.iterate_springs(
+        springs,
+        initial_active=start,
+        max_iterations=max_iterations,
+        lower_bound=lower,
+        label=f"foundation ({name} start)",
+        threshold=PRESSING_RTOL,
+    )
+    final, status, arc_steps = run.candidate, run.status, 0
+    if status is not RunStatus.CONVERGED and math.isfinite(final.load):
+        final, status, arc_steps = _arc_descent(problem, solver, springs, final, max_iterations)
+    return run, (final, status, arc_steps)
+
+
+def _arc_minimum(
+    a: npt.NDArray[np.float64],
+    b: npt.NDArray[np.float64],
+    z_v: npt.NDArray[np.float64],
+    z_u: npt.NDArray[np.float64],
+    springs: npt.NDArray[np.float64],
+) -> tuple[float, float]:
+    r"""The angle :math:`\theta` minimising the spring quotient on the arc, and its value.
+
+    On :math:`\cos\theta\, v + \sin\theta\, u` the quotient is a ratio of quadratic forms
+    (``a``, ``b``: the 2x2 forms' entries vv, vu, uu) plus the springs of the nodes pressed
+    (``z_v``, ``z_u``: the oriented values); sampled at :data:`ARC_SAMPLES` angles, then a
+    golden-section search in the bracket around the best sample.
+    """
+
+    def quotient(theta: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+        c, s = np.cos(theta), np.sin(theta)
+        num = c * c * a[0] + 2 * c * s * a[1] + s * s * a[2]
+        den = c * c * b[0] + 2 * c * s * b[1] + s * s * b[2]
+        z = np.outer(c, z_v) + np.outer(s, z_u)
+        num = num + (springs * np.maximum(z, 0.0) ** 2).sum(axis=1)
+        return np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), np.inf)
+
+    grid = np.linspace(0.0, 2.0 * np.pi, ARC_SAMPLES, endpoint=False)
+    k = int(np.argmin(quotient(grid)))
+    lo, hi = grid[k] - 2 * np.pi / ARC_SAMPLES, grid[k] + 2 * np.pi / ARC_SAMPLES
+    golden = 0.5 * (np.sqrt(5.0) - 1.0)
+    for _ in range(GOLDEN_STEPS):
+        m1, m2 = hi - golden * (hi - lo), lo + golden * (hi - lo)
+        if quotient(np.array([m1]))[0] <= quotient(np.array([m2]))[0]:
+            hi = m2
+        else:
+            lo = m1
+    theta = 0.5 * (lo + hi)
+    return float(theta), float(quotient(np.array([theta]))[0])
 
 
 def _arc_descent(
@@ -209,34 +257,7 @@ def _arc_descent(
             B.mult(u, Bu)
             a = np.array([v.dot(Av), v.dot(Au), u.dot(Au)], dtype=float)
             b = np.array([v.dot(Bv), v.dot(Bu), u.dot(Bu)], dtype=float)
-            z_u = contact.values(u)
-
-            def quotient(
-                theta: npt.NDArray[np.float64],
-                a: npt.NDArray[np.float64] = a,
-                b: npt.NDArray[np.float64] = b,
-                z_v: npt.NDArray[np.float64] = z_v,
-                z_u: npt.NDArray[np.float64] = z_u,
-            ) -> npt.NDArray[np.float64]:
-                c, s = np.cos(theta), np.sin(theta)
-                num = c * c * a[0] + 2 * c * s * a[1] + s * s * a[2]
-                den = c * c * b[0] + 2 * c * s * b[1] + s * s * b[2]
-                z = np.outer(c, z_v) + np.outer(s, z_u)
-                num = num + (springs * np.maximum(z, 0.0) ** 2).sum(axis=1)
-                return np.where(den > 0.0, num / np.where(den > 0.0, den, 1.0), np.inf)
-
-            grid = np.linspace(0.0, 2.0 * np.pi, ARC_SAMPLES, endpoint=False)
-            k = int(np.argmin(quotient(grid)))
-            lo, hi = grid[k] - 2 * np.pi / ARC_SAMPLES, grid[k] + 2 * np.pi / ARC_SAMPLES
-            golden = 0.5 * (np.sqrt(5.0) - 1.0)
-            for _ in range(60):  # golden section in the bracket around the best sample
-                m1, m2 = hi - golden * (hi - lo), lo + golden * (hi - lo)
-                if quotient(np.array([m1]))[0] <= quotient(np.array([m2]))[0]:
-                    hi = m2
-                else:
-                    lo = m1
-            theta = 0.5 * (lo + hi)
-            q_new = float(quotient(np.array([theta]))[0])
+            theta, q_new = _arc_minimum(a, b, z_v, contact.values(u), springs)
             if not q_new < q * (1.0 - ARC_RTOL):
                 status = RunStatus.CONVERGED
                 break

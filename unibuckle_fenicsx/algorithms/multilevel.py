@@ -31,8 +31,8 @@ class Prolongation:
     the coarse values are gathered on every rank; from any other mesh dolfinx's
     non-matching interpolation does it (its point-ownership data computed once and
     shared by w and theta). Hand-written because that general route locates every
-    fine node in the coarse mesh's cells: measured at 90×30 → 180×60, 0.2 s to set up
-    and 0.24 s per mode (a sixth of a free solve each), against milliseconds here.
+    fine node in the coarse mesh's cells, a hundred times slower
+    (:doc:`/verification/tuning`).
 
     Args:
         coarse: The coarse problem.

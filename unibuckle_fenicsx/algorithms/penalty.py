@@ -43,7 +43,7 @@ from __future__ import annotations
 
 import logging
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from petsc4py import PETSc
 
@@ -120,6 +120,47 @@ class SpringIteration:
 
 def _key(nodes: npt.NDArray[np.int64]) -> tuple[int, ...]:
     return tuple(int(k) for k in nodes)
+
+
+@dataclass
+class _Iteration:
+    """The state of one spring-set iteration (:meth:`PenaltySolver.iterate_springs`)."""
+
+    weights: npt.NDArray[np.float64]
+    active: npt.NDArray[np.int64]
+    lower_bound: float | None
+    best: PETSc.Vec | None = None
+    best_q: float = math.inf
+    best_step: int = -1
+    previous: PETSc.Vec | None = None
+    seen: SetLog = field(default_factory=SetLog)
+    steps: list[PenaltyStep] = field(default_factory=list)
+    status: RunStatus = RunStatus.MAX_ITERATIONS
+    cycle_length: int = 0
+    ties: int = 0
+
+
+def _orientation(
+    vals: npt.NDArray[np.float64],
+    weights: npt.NDArray[np.float64],
+    tie_rtol: float,
+    threshold: float,
+) -> tuple[float, bool]:
+    """The sign that penetrates less (spring energy), and whether the two tied.
+
+    On a tie (e.g. the antisymmetric free mode under a zone symmetric about x = 0: both
+    orientations penetrate alike, and the two unilateral modes are mirror images with
+    equal loads) rounding would decide, and the choice would flip with tiny changes of
+    rho; the lexicographically smaller penetrating set is taken instead (the
+    enumeration's tie rule).
+    """
+    up = float(np.sum(weights * np.maximum(vals, 0.0) ** 2))
+    down = float(np.sum(weights * np.maximum(-vals, 0.0) ** 2))
+    if abs(up - down) > tie_rtol * (up + down):
+        return (1.0 if up < down else -1.0), False
+    plus = _key(np.flatnonzero(vals > threshold))
+    minus = _key(np.flatnonzero(-vals > threshold))
+    return (1.0 if plus <= minus else -1.0), True
 
 
 class PenaltySolver(Owner):
@@ -313,7 +354,7 @@ class PenaltySolver(Owner):
             details=details,
         )
 
-    def iterate_springs(  # noqa: C901 - one spring-set iteration: orientation, tie rule, cycle and best iterate
+    def iterate_springs(
         self,
         rho_abs: float | npt.NDArray[np.float64],
         *,
@@ -346,8 +387,29 @@ class PenaltySolver(Owner):
         Note:
             Collective.
         """
-        problem = self.problem
-        contact = problem.contact
+        weights, active = self._check_iteration(
+            rho_abs, initial_active, max_iterations, threshold, tie_rtol
+        )
+        run = _Iteration(weights, active, lower_bound)
+        for it in range(int(max_iterations)):
+            if self._spring_step(run, it, threshold, tie_rtol, label):
+                break
+        if run.status is RunStatus.MAX_ITERATIONS:
+            logger.warning(
+                "%s: no fixed point after %d solves (-max_iterations)", label, max_iterations
+            )
+        return self._spring_result(run)
+
+    def _check_iteration(
+        self,
+        rho_abs: float | npt.NDArray[np.float64],
+        initial_active: npt.NDArray[np.int64] | None,
+        max_iterations: int,
+        threshold: float,
+        tie_rtol: float,
+    ) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int64]]:
+        """The nodal springs and the first spring set; settings out of range refused."""
+        contact = self.problem.contact
         weights = np.broadcast_to(np.asarray(rho_abs, dtype=float), (contact.size,))
         if not (np.all(np.isfinite(weights)) and np.all(weights > 0.0)):
             raise InputError("rho_abs (spring stiffness) must be finite and > 0 at every node")
@@ -361,101 +423,86 @@ class PenaltySolver(Owner):
         active = np.unique(np.asarray([] if initial_active is None else initial_active, np.int64))
         if active.size and (active.min() < 0 or active.max() >= i):
             raise InputError(f"initial_active must hold node numbers in [0, {i}), got {active}")
+        return weights, active
 
-        vec = self._work
-        best: PETSc.Vec | None = None
-        best_q = math.inf
-        best_step = -1
-        previous: PETSc.Vec | None = None
-        seen = SetLog()
-        steps: list[PenaltyStep] = []
-        status = RunStatus.MAX_ITERATIONS
-        cycle_length = 0
-        ties = 0
-        for it in range(int(max_iterations)):
-            seen.visit(active, it)
-            self.set_springs(weights, active)
-            pair = self.gep.solve(out=vec, initial=previous)
-            self.solves += 1
-            if lower_bound is None and not active.size:
-                lower_bound = pair.value
-            wmax = problem.max_abs_w(vec)
-            vals = contact.values(vec) / wmax
-            up = float(np.sum(weights * np.maximum(vals, 0.0) ** 2))
-            down = float(np.sum(weights * np.maximum(-vals, 0.0) ** 2))
-            if abs(up - down) > tie_rtol * (up + down):
-                sign = 1.0 if up < down else -1.0
+    def _spring_step(
+        self, run: _Iteration, it: int, threshold: float, tie_rtol: float, label: str
+    ) -> bool:
+        """One eigen solve with the springs of ``run.active``; whether the iteration ends."""
+        problem, vec = self.problem, self._work
+        run.seen.visit(run.active, it)
+        self.set_springs(run.weights, run.active)
+        pair = self.gep.solve(out=vec, initial=run.previous)
+        self.solves += 1
+        if run.lower_bound is None and not run.active.size:
+            run.lower_bound = pair.value
+        wmax = problem.max_abs_w(vec)
+        vals = problem.contact.values(vec) / wmax
+        sign, tie = _orientation(vals, run.weights, tie_rtol, threshold)
+        run.ties += tie
+        vec.scale(sign / wmax)
+        vals = sign * vals
+        q = self.quotient(vec, run.weights)
+        penetrating = np.flatnonzero(vals > threshold).astype(np.int64)
+        run.steps.append(
+            PenaltyStep(run.active, pair.value, q, max(float(vals.max()), 0.0), penetrating)
+        )
+        logger.debug(
+            "%s it %d: |S|=%d lambda_S=%.10g R=%.10g penetration %.3g",
+            label, it, run.active.size, pair.value, q, run.steps[-1].penetration,
+        )  # fmt: skip
+        if q < run.best_q:
+            run.best_q, run.best_step = q, it
+            if run.best is None:
+                run.best = vec.copy()
             else:
-                # Tie (e.g. the antisymmetric free mode under a zone symmetric about x = 0:
-                # both orientations penetrate alike, and the two unilateral modes are
-                # mirror images with equal loads). Decided by rounding, the choice would
-                # flip with tiny changes of rho; take the lexicographically smaller
-                # penetrating set instead (the enumeration's tie rule).
-                plus = _key(np.flatnonzero(vals > threshold))
-                minus = _key(np.flatnonzero(-vals > threshold))
-                sign = 1.0 if plus <= minus else -1.0
-                ties += 1
-            vec.scale(sign / wmax)
-            vals = sign * vals
-            q = self.quotient(vec, weights)
-            penetrating = np.flatnonzero(vals > threshold).astype(np.int64)
-            steps.append(
-                PenaltyStep(active, pair.value, q, max(float(vals.max()), 0.0), penetrating)
-            )
-            logger.debug(
-                "%s it %d: |S|=%d lambda_S=%.10g R=%.10g penetration %.3g",
-                label, it, active.size, pair.value, q, steps[-1].penetration,
-            )  # fmt: skip
-            if q < best_q:
-                best_q, best_step = q, it
-                if best is None:
-                    best = vec.copy()
-                else:
-                    vec.copy(best)
-            if previous is None:
-                previous = vec.copy()
-            else:
-                vec.copy(previous)
-            if np.array_equal(penetrating, active):
-                status = RunStatus.CONVERGED
-                break
-            if penetrating in seen:
-                status = RunStatus.CYCLE
-                cycle_length = seen.cycle_length(penetrating, it)
-                logger.warning(
-                    "%s: the penetrating set cycles (length %d) after %d solves; "
-                    "returning the iterate with the smallest penalised quotient",
-                    label, cycle_length, it + 1,
-                )  # fmt: skip
-                break
-            active = penetrating
-        if status is RunStatus.MAX_ITERATIONS:
+                vec.copy(run.best)
+        if run.previous is None:
+            run.previous = vec.copy()
+        else:
+            vec.copy(run.previous)
+        if np.array_equal(penetrating, run.active):
+            run.status = RunStatus.CONVERGED
+            return True
+        if penetrating in run.seen:
+            run.status = RunStatus.CYCLE
+            run.cycle_length = run.seen.cycle_length(penetrating, it)
             logger.warning(
-                "%s: no fixed point after %d solves (-max_iterations)", label, max_iterations
-            )
-        if best is None:
+                "%s: the penetrating set cycles (length %d) after %d solves; "
+                "returning the iterate with the smallest penalised quotient",
+                label, run.cycle_length, it + 1,
+            )  # fmt: skip
+            return True
+        run.active = penetrating
+        return False
+
+    def _spring_result(self, run: _Iteration) -> SpringIteration:
+        """The iterate with the smallest quotient as the result; the work vectors freed."""
+        problem = self.problem
+        if run.best is None:
             # Every iterate had b(v, v) <= 0 (an infinite penalised quotient): the load
             # grows without bound with rho, no admissible mode buckles. Keep the last.
-            best, best_step = vec.copy(), len(steps) - 1
-            status = RunStatus.NO_FINITE_LOAD
-        if previous is not None:
-            previous.destroy()
+            run.best, run.best_step = self._work.copy(), len(run.steps) - 1
+            run.status = RunStatus.NO_FINITE_LOAD
+        if run.previous is not None:
+            run.previous.destroy()
         u = problem.new_mode()
-        best.copy(u.x.petsc_vec)
+        run.best.copy(u.x.petsc_vec)
         u.x.scatter_forward()
-        best.destroy()
-        step = steps[best_step]
+        run.best.destroy()
+        step = run.steps[run.best_step]
         # Oriented and scaled above: the iteration's own orientation minimises R_rho.
         candidate = problem.candidate(u, step.quotient, step.penetrating, sign=1.0)
-        if status is not RunStatus.CONVERGED:
+        if run.status is not RunStatus.CONVERGED:
             # Leave A_pen with the springs of the returned mode, for condition().
-            self.set_springs(weights, step.springs)
+            self.set_springs(run.weights, step.springs)
+        lower_bound = run.lower_bound
         if lower_bound is None:
             fresh = problem.free is None
             lower_bound = problem.solve_free().load
             self.solves += int(fresh)
         return SpringIteration(
-            candidate, steps, step, status, cycle_length, ties, float(lower_bound)
+            candidate, run.steps, step, run.status, run.cycle_length, run.ties, float(lower_bound)
         )
 
     def destroy(self) -> None:

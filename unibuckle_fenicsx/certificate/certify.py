@@ -203,7 +203,7 @@ def _residual_off_contact(problem: UnilateralProblem, candidate: Candidate) -> f
     return float(r.norm()) / au_2  # type: ignore[arg-type]
 
 
-def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the order the docstring gives
+def certify(
     problem: UnilateralProblem,
     solution: UnilateralSolution | Candidate,
     *,
@@ -238,10 +238,90 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     if global_bound is None:
         global_bound = problem.spec.solver.certify
     cand = solution.candidate
-    tau = problem.tau
-    notes: list[str] = []
     if not math.isfinite(cand.load):
         raise ValueError("certify: the candidate has no finite load")
+    notes: list[str] = []
+    kkt, residual, on_contact = _local(problem, cand, notes)
+    br = _Bracket.of(solution, notes)
+    algorithm_proof = solution.global_optimum_proven
+    smallest: bool | None = None
+    # One matrix for the copositivity attempt and the smallest-eigenvalue check, both
+    # factorised through the mesh's shared LDL^T (its symbolic analysis done once).
+    matrix = ShiftedMatrix(
+        problem.model.A, problem.model.B, shared=problem.eigensolver.factorization
+    )
+    try:
+        if not algorithm_proof and global_bound and kkt and cand.eigen is not None:
+            _copositivity(problem, solution, options, matrix, br)
+        elif not algorithm_proof and not global_bound:
+            br.notes.append("global certification skipped (solver.certify = false)")
+        if check_smallest and global_bound and cand.eigen is not None:
+            smallest = _smallest(problem, cand, matrix, br.notes)
+        elif cand.eigen is None:
+            br.notes.append("the mode is not an eigenvector of a reduced pencil (not checked)")
+    finally:
+        matrix.destroy()
+    gap = (br.upper - br.lower) / br.upper if math.isfinite(br.upper) else math.inf
+    closed = _within(gap, PROOF_GAP)
+    proven = bool(kkt and closed and (algorithm_proof or br.proven_by != "interlacing"))
+    # The free load is the lower bound (interlacing), or lies above the returned load,
+    # which no smallest eigenvalue can: it is verified the pencil's smallest (one LDL^T).
+    free = problem.solve_free().load
+    below_free = cand.feasible and cand.load < free * (1.0 - ROUNDING_RTOL)
+    if global_bound and (br.proven_by == "interlacing" or below_free):
+        problem.verify_free()
+    return Certificate(
+        feasible=cand.feasible,
+        feasibility_margin=cand.margin,
+        max_contact_force=cand.max_force,
+        max_contact_value=on_contact,
+        relative_residual=residual,
+        tolerance=problem.tau,
+        kkt=bool(kkt),
+        smallest_of_reduced=smallest,
+        lower_bound=br.lower,
+        upper_bound=br.upper,
+        relative_gap=gap,
+        global_optimum_proven=proven,
+        proven_by=br.proven_by,
+        copositivity=br.record,
+        notes=tuple(br.notes),
+        refuting_mode=br.refuting,
+    )
+
+
+@dataclass
+class _Bracket:
+    """The bracket of a certificate as it is built, with what proves its lower end."""
+
+    lower: float
+    upper: float
+    proven_by: str
+    notes: list[str]
+    record: CopositivityRecord | None = None
+    refuting: Candidate | None = None
+
+    @classmethod
+    def of(cls, solution: UnilateralSolution, notes: list[str]) -> _Bracket:
+        """The algorithm's bracket, the candidate's load its upper end if it may be."""
+        cand = solution.candidate
+        # Only the eigenvalue of a reduced pencil whose mode is admissible bounds the
+        # critical load from above (a penalised quotient lies below it).
+        upper = solution.upper_bound
+        if cand.eigen is not None and cand.feasible:
+            upper = min(upper, cand.load)
+        elif not cand.feasible:
+            notes.append("the mode crosses the obstacle: its load is not an upper bound")
+        # No stated proof: the lower bound is the free load, by interlacing.
+        proven_by = solution.lower_bound_by or "interlacing"
+        return cls(min(solution.lower_bound, upper), upper, proven_by, notes)
+
+
+def _local(
+    problem: UnilateralProblem, cand: Candidate, notes: list[str]
+) -> tuple[bool, float, float]:
+    """The KKT conditions of ``cand``: (kkt, residual off Z, largest value on Z)."""
+    tau = problem.tau
     residual = _residual_off_contact(problem, cand)
     # The mode must vanish on Z (checked, not assumed: a mode from elsewhere than an
     # eigen solve of the reduced pencil need not).
@@ -251,94 +331,57 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     )
     if on_contact > tau:
         notes.append(f"the mode does not vanish on the contact set (max |u_Z| = {on_contact:.3g})")
-    # Only the eigenvalue of a reduced pencil whose mode is admissible bounds the critical
-    # load from above (a penalised quotient lies below it).
-    upper = solution.upper_bound
-    if cand.eigen is not None and cand.feasible:
-        upper = min(upper, cand.load)
-    elif not cand.feasible:
-        notes.append("the mode crosses the obstacle: its load is not an upper bound")
-    lower = min(solution.lower_bound, upper)
-    # No stated proof: the lower bound is the free load, by interlacing.
-    proven_by = solution.lower_bound_by or "interlacing"
-    algorithm_proof = solution.global_optimum_proven
-    record: CopositivityRecord | None = None
-    refuting: Candidate | None = None
-    # One matrix for the copositivity attempt and the smallest-eigenvalue check, both
-    # factorised through the mesh's shared LDL^T (its symbolic analysis done once).
-    matrix = ShiftedMatrix(
-        problem.model.A, problem.model.B, shared=problem.eigensolver.factorization
+    return bool(kkt), residual, on_contact
+
+
+def _copositivity(
+    problem: UnilateralProblem,
+    solution: UnilateralSolution,
+    options: BoundOptions | None,
+    matrix: ShiftedMatrix,
+    br: _Bracket,
+) -> None:
+    """The copositivity certificate's bound (and refuting mode) into the bracket ``br``."""
+    cand = solution.candidate
+    if options is None and not problem.spec.solver.bracket:
+        options = BoundOptions(lowrank=None)  # the low-rank route on request only
+    bound = copositivity_bound(problem, cand, solution.kkt_points, options, matrix)
+    br.record = CopositivityRecord(
+        method=bound.method,
+        delta=bound.delta,
+        margins=bound.margins,
+        negative_eigenvalues=bound.negative_eigenvalues,
+        factorisations=int(bound.timings["factorisations"]),
+        solves=int(bound.timings["solves"]),
+        time_s=bound.timings["total_s"],
+        lowrank=bound.lowrank,
     )
-    try:
-        if not algorithm_proof and global_bound and kkt and cand.eigen is not None:
-            if options is None and not problem.spec.solver.bracket:
-                options = BoundOptions(lowrank=None)  # the low-rank route on request only
-            bound = copositivity_bound(problem, cand, solution.kkt_points, options, matrix)
-            record = CopositivityRecord(
-                method=bound.method,
-                delta=bound.delta,
-                margins=bound.margins,
-                negative_eigenvalues=bound.negative_eigenvalues,
-                factorisations=int(bound.timings["factorisations"]),
-                solves=int(bound.timings["solves"]),
-                time_s=bound.timings["total_s"],
-                lowrank=bound.lowrank,
+    br.notes += list(bound.notes)
+    if bound.refuting is not None:
+        br.refuting = refuting = _refuting_candidate(problem, bound.refuting)
+        if refuting.feasible:
+            br.upper = min(br.upper, refuting.load)
+            br.notes.append(
+                f"refuted: an admissible mode has the load {refuting.load!r} < "
+                f"{cand.load!r} (Certificate.refuting_mode)"
             )
-            notes += list(bound.notes)
-            if bound.refuting is not None:
-                refuting = _refuting_candidate(problem, bound.refuting)
-                if refuting.feasible:
-                    upper = min(upper, refuting.load)
-                    notes.append(
-                        f"refuted: an admissible mode has the load {refuting.load!r} < "
-                        f"{cand.load!r} (Certificate.refuting_mode)"
-                    )
-            if bound.value is not None and bound.value > lower:
-                lower, proven_by = min(bound.value, upper), bound.method
-            lower = min(lower, upper)
-        elif not algorithm_proof and not global_bound:
-            notes.append("global certification skipped (solver.certify = false)")
-        gap = (upper - lower) / upper if math.isfinite(upper) else math.inf
-        closed = _within(gap, PROOF_GAP)
-        proven = bool(kkt and closed and (algorithm_proof or proven_by != "interlacing"))
-        smallest: bool | None = None
-        if check_smallest and global_bound and cand.eigen is not None:
-            sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
-            neg, _, _ = reduced_inertia(problem, cand.active, sigma, matrix)
-            smallest = neg == 0
-            if not smallest:
-                notes.append(
-                    f"the reduced pencil has {neg} eigenvalue(s) below the returned load: "
-                    "not its smallest eigenpair"
-                )
-        elif cand.eigen is None:
-            notes.append("the mode is not an eigenvector of a reduced pencil (not checked)")
-    finally:
-        matrix.destroy()
-    # The free load is the lower bound (interlacing), or lies above the returned load,
-    # which no smallest eigenvalue can: it is verified the pencil's smallest (one LDL^T).
-    free = problem.solve_free().load
-    below_free = cand.feasible and cand.load < free * (1.0 - ROUNDING_RTOL)
-    if global_bound and (proven_by == "interlacing" or below_free):
-        problem.verify_free()
-    return Certificate(
-        feasible=cand.feasible,
-        feasibility_margin=cand.margin,
-        max_contact_force=cand.max_force,
-        max_contact_value=on_contact,
-        relative_residual=residual,
-        tolerance=tau,
-        kkt=bool(kkt),
-        smallest_of_reduced=smallest,
-        lower_bound=lower,
-        upper_bound=upper,
-        relative_gap=gap,
-        global_optimum_proven=proven,
-        proven_by=proven_by,
-        copositivity=record,
-        notes=tuple(notes),
-        refuting_mode=refuting,
-    )
+    if bound.value is not None and bound.value > br.lower:
+        br.lower, br.proven_by = min(bound.value, br.upper), bound.method
+    br.lower = min(br.lower, br.upper)
+
+
+def _smallest(
+    problem: UnilateralProblem, cand: Candidate, matrix: ShiftedMatrix, notes: list[str]
+) -> bool:
+    """Whether the load is the reduced pencil's smallest eigenvalue (inertia)."""
+    sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
+    neg, _, _ = reduced_inertia(problem, cand.active, sigma, matrix)
+    if neg:
+        notes.append(
+            f"the reduced pencil has {neg} eigenvalue(s) below the returned load: "
+            "not its smallest eigenpair"
+        )
+    return neg == 0
 
 
 def _refuting_candidate(problem: UnilateralProblem, refuting: Refuting) -> Candidate:

@@ -299,7 +299,7 @@ def _rank2(
     return record, found
 
 
-def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (rank 2, SDP, low rank)
+def copositivity_bound(
     problem: UnilateralProblem,
     candidate: Candidate,
     others: list[Candidate] | None = None,
@@ -327,19 +327,7 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
     t0 = time.perf_counter()
     notes: list[str] = []
     attempts: list[AttemptRecord] = []
-    phi = problem.contact.values(problem.solve_free().function.x.petsc_vec)
-    w_plus = _reaction(candidate)
-    sigma = float(phi @ w_plus)
-    w_minus: list[tuple[str, npt.NDArray[np.float64]]] = []
-    for k, other in enumerate(others or []):
-        w = _reaction(other)
-        if w.max() > 0 and float(phi @ w) * sigma < 0:
-            w_minus.append((f"kkt{k} ({other.load:.10g})", w))
-    for name, perm in mirror_maps(problem).items():
-        image = w_plus[perm]
-        if float(phi @ image) * sigma < 0:
-            w_minus.append((f"mirror-{name}", image))
-    a = -np.sign(sigma) * phi  # normalisation a'w = 1 of the other nappe
+    nappes = _Nappes.of(problem, candidate, others or [])
     own = matrix is None
     if matrix is None:
         matrix = ShiftedMatrix(
@@ -353,7 +341,7 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
     lowrank: LowRankRecord | None = None
     refuting: Refuting | None = None
     try:
-        if not w_plus.max() > 0:
+        if not nappes.w_plus.max() > 0:
             notes.append("the KKT point has no contact force (w+ = 0)")
         predicted = _predict_delta(problem, matrix, candidate, opts.safety)
         deltas = [d for d in opts.deltas if d >= opts.slack * predicted] or [opts.deltas[-1]]
@@ -364,38 +352,9 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
             attempts.append(attempt)
             m = neg if m is None else m
             several |= neg >= 2
-            if zero:
-                attempt.why = "K(lambda_lb) is singular"
-                continue
-            if neg == 0:
-                result = LowerBound(lam, "psd", delta, PsdMargins(inertia=[neg, zero, pos]))
-                notes.append("A - lambda_lb B is positive definite: the obstacle is inactive")
+            result, stop = _at_shift(problem, matrix, nappes, lam, attempt, opts, notes)
+            if stop:
                 break
-            if neg == 1 and w_plus.max() > 0:
-                record, found = _rank2(problem, matrix, w_plus, w_minus, opts)
-                attempt.rank2 = record
-                if found is None and record.alpha_ok and (a > 0).any():
-                    w, f, its = _search_other_nappe(problem, matrix, a, opts.search_iterations)
-                    attempt.search = SearchRecord(iterations=its, f=f)
-                    if f > 0:
-                        record, found = _rank2(problem, matrix, w_plus, [("search", w)], opts)
-                        attempt.rank2_search = record
-                if found is not None:
-                    result = LowerBound(lam, "rank2-spn", delta, found)
-                    break
-                continue
-            if neg >= 2:
-                route = _sdp(problem, matrix, lam, neg, opts, notes)
-                attempt.sdp = route
-                sectors = route.sectors
-                if route.ok:
-                    result = LowerBound(lam, "sdp-spn", delta, route)
-                    break
-                if isinstance(sectors, SectorRecord) and sectors.ok:
-                    result = LowerBound(lam, "sdp-sectors", delta, sectors)
-                    break
-                if route.unavailable is True or route.too_large is True:
-                    break
         if result is None and several and opts.lowrank is not None:
             outcome = _lowrank(problem, matrix, candidate, others or [], opts.lowrank, notes)
             if outcome is not None:
@@ -434,6 +393,89 @@ def copositivity_bound(  # noqa: C901 - the delta grid with its three routes (ra
         lowrank,
         refuting,
     )
+
+
+@dataclass(frozen=True)
+class _Nappes:
+    r"""The cone's two nappes as the certificate sees them.
+
+    Attributes:
+        w_plus: The KKT point's reaction (scaled to max 1).
+        w_minus: Candidates for the other nappe: other KKT points' reactions and the
+            mirror images of ``w_plus`` that lie there.
+        a: The other nappe's normalisation :math:`a^Tw = 1`.
+    """
+
+    w_plus: npt.NDArray[np.float64]
+    w_minus: list[tuple[str, npt.NDArray[np.float64]]]
+    a: npt.NDArray[np.float64]
+
+    @classmethod
+    def of(
+        cls, problem: UnilateralProblem, candidate: Candidate, others: list[Candidate]
+    ) -> _Nappes:
+        """The nappes of ``candidate``, with the free mode telling them apart."""
+        phi = problem.contact.values(problem.solve_free().function.x.petsc_vec)
+        w_plus = _reaction(candidate)
+        sigma = float(phi @ w_plus)
+        w_minus: list[tuple[str, npt.NDArray[np.float64]]] = []
+        for k, other in enumerate(others):
+            w = _reaction(other)
+            if w.max() > 0 and float(phi @ w) * sigma < 0:
+                w_minus.append((f"kkt{k} ({other.load:.10g})", w))
+        for name, perm in mirror_maps(problem).items():
+            image = w_plus[perm]
+            if float(phi @ image) * sigma < 0:
+                w_minus.append((f"mirror-{name}", image))
+        return cls(w_plus, w_minus, -np.sign(sigma) * phi)
+
+
+def _at_shift(
+    problem: UnilateralProblem,
+    matrix: ShiftedMatrix,
+    nappes: _Nappes,
+    lam: float,
+    attempt: AttemptRecord,
+    opts: BoundOptions,
+    notes: list[str],
+) -> tuple[LowerBound | None, bool]:
+    """The routes at the shift ``lam`` (K factorised there): a bound, and whether to stop.
+
+    The inertia decides: K positive definite proves the bound; one negative eigenvalue
+    the rank-2 route (with the other nappe searched when no w- certifies); two or more
+    the SDP routes. What each found goes into ``attempt``.
+    """
+    delta = attempt.delta
+    neg, zero, pos = attempt.inertia
+    w_plus, a = nappes.w_plus, nappes.a
+    if zero:
+        attempt.why = "K(lambda_lb) is singular"
+        return None, False
+    if neg == 0:
+        notes.append("A - lambda_lb B is positive definite: the obstacle is inactive")
+        return LowerBound(lam, "psd", delta, PsdMargins(inertia=[neg, zero, pos])), True
+    if neg == 1 and w_plus.max() > 0:
+        record, found = _rank2(problem, matrix, w_plus, nappes.w_minus, opts)
+        attempt.rank2 = record
+        if found is None and record.alpha_ok and (a > 0).any():
+            w, f, its = _search_other_nappe(problem, matrix, a, opts.search_iterations)
+            attempt.search = SearchRecord(iterations=its, f=f)
+            if f > 0:
+                record, found = _rank2(problem, matrix, w_plus, [("search", w)], opts)
+                attempt.rank2_search = record
+        if found is not None:
+            return LowerBound(lam, "rank2-spn", delta, found), True
+        return None, False
+    if neg >= 2:
+        route = _sdp(problem, matrix, lam, neg, opts, notes)
+        attempt.sdp = route
+        sectors = route.sectors
+        if route.ok:
+            return LowerBound(lam, "sdp-spn", delta, route), True
+        if isinstance(sectors, SectorRecord) and sectors.ok:
+            return LowerBound(lam, "sdp-sectors", delta, sectors), True
+        return None, route.unavailable is True or route.too_large is True
+    return None, False
 
 
 def _lowrank(

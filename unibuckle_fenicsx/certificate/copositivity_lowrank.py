@@ -781,7 +781,55 @@ def lowrank_certificate(
     return out
 
 
-def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (module docstring)
+def _cut(
+    problem: UnilateralProblem,
+    cols: _Columns,
+    use: list[int],
+    coef: npt.NDArray[np.float64],
+    candidate: Candidate,
+    lam: float,
+    stats: _OrthantStats,
+    opts: LowRankOptions,
+    out: LowRankOutcome,
+    cuts: int,
+) -> tuple[str | None, bool]:
+    """The mode :math:`u = -K^{-1}USy` of a point y the pieces could not prove: a cut.
+
+    An admissible u with a lower quotient refutes the KKT point (``out.refuting``); else
+    its positive part (or, if that repeats a column or leaves G singular, the unit
+    vectors of its most violated nodes: all of them, the full SDP) becomes a column.
+
+    Returns:
+        Why the attempt stops (refuted, out of time), or None; and whether a column was
+        added.
+    """
+    u = cols.combination(coef)  # -K^-1 U S y
+    scale = problem.max_abs_w(u)
+    values = problem.contact.values(u) / scale
+    admissible = bool(values.max() <= problem.tau)
+    if admissible and (-1.0 if stats.f is None else stats.f) < 0.0:
+        refuting = _refuting(problem, u, values)
+        if refuting is not None and refuting.load < candidate.load:
+            out.refuting = refuting
+    u.destroy()
+    if out.refuting is not None:
+        return (
+            f"refuted: an admissible mode has the load {out.refuting.load:.10g} < {lam:.10g}"
+        ), False
+    if out.out_of_time():
+        return f"the time budget ({cuts} cuts)", False
+    if admissible or cuts >= opts.max_cuts:
+        return None, False
+    order = np.argsort(-values)[: opts.unit_cuts]
+    units = [(f"cut{cuts}-node{k}", np.eye(1, len(values), k)[0])
+             for k in order if values[k] > 0]  # fmt: skip
+    for item in [(f"cut{cuts}", values), *units]:
+        if cols.add([item]) and _select(cols, use, opts) != use:
+            return None, True
+    return None, False
+
+
+def _attempt(
     problem: UnilateralProblem,
     matrix: ShiftedMatrix,
     candidate: Candidate,
@@ -791,7 +839,6 @@ def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (
     out: LowRankOutcome,
 ) -> tuple[LowRankAttempt, list[tuple[str, npt.NDArray[np.float64]]]]:
     """One delta: factorise, columns, cuts, pieces. Returns (record, columns to reuse)."""
-    contact = problem.contact
     lam = candidate.load * (1.0 - delta)
     neg, zero, _ = matrix.factor(lam)
     out.m = neg
@@ -842,38 +889,12 @@ def _attempt(  # noqa: C901 - columns, pieces and cuts of one low-rank attempt (
                     f"{best_t:.3g}, {cuts} cuts)"
                 )
                 break
-            y = ys / dg  # G_s = D G D, S_s = D^-1 S D^-1: y = D^-1 y_s
             coef = np.zeros(cols.r)
-            coef[use] = -np.linalg.solve(G, y)
-            u = cols.combination(coef)  # -K^-1 U S y
-            scale = problem.max_abs_w(u)
-            values = contact.values(u) / scale
-            admissible = bool(values.max() <= problem.tau)
-            if admissible and (-1.0 if stats.f is None else stats.f) < 0.0:
-                refuting = _refuting(problem, u, values)
-                if refuting is not None and refuting.load < candidate.load:
-                    out.refuting = refuting
-            u.destroy()
-            if out.refuting is not None:
-                attempt.why = (
-                    f"refuted: an admissible mode has the load {out.refuting.load:.10g} "
-                    f"< {lam:.10g}"
-                )
+            coef[use] = -np.linalg.solve(G, ys / dg)  # G_s = D G D, S_s = D^-1 S D^-1
+            why, grown = _cut(problem, cols, use, coef, candidate, lam, stats, opts, out, cuts)
+            if why is not None:
+                attempt.why = why
                 break
-            if out.out_of_time():
-                attempt.why = f"the time budget ({cuts} cuts)"
-                break
-            grown = False
-            if not admissible and cuts < opts.max_cuts:
-                # The positive part of u; if it repeats a column or leaves G singular, the
-                # unit vectors of its most violated nodes (all of them: the full SDP).
-                order = np.argsort(-values)[: opts.unit_cuts]
-                units = [(f"cut{cuts}-node{k}", np.eye(1, len(values), k)[0])
-                         for k in order if values[k] > 0]  # fmt: skip
-                for item in [(f"cut{cuts}", values), *units]:
-                    if cols.add([item]) and _select(cols, use, opts) != use:
-                        grown = True
-                        break
             if not grown:
                 if near > 0.0:
                     near = 0.0  # no tightening cut there: partition instead

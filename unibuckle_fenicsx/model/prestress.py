@@ -56,7 +56,7 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
-#: A compression below this fraction of the largest tension is measured again at one
+#: A compression below this fraction of the largest tension is computed again at one
 #: degree more (:func:`solve_prestress`): it may be the in-plane solve's discretisation
 #: error on a plate in tension everywhere.
 NEAR_TENSION = 1e-2
@@ -265,7 +265,7 @@ def solve_prestress(
     along the loaded edge, whose exact field a degree-1 displacement cannot represent)
     shows a compression of the solve's discretisation error, 0.6 % of the tension on a
     0.4 × 0.1 m plate at 40×10 cells: a compression below :data:`NEAR_TENSION` of the
-    tension is therefore measured again at one degree more, and taken for that error
+    tension is therefore computed again at one degree more, and taken for that error
     when it falls there to a tenth or less (a real compression stays); the eigen solve
     would otherwise look for a load factor of the order of the inverse of the noise
     and not converge.
@@ -391,7 +391,7 @@ def _refuse_tension(
 ) -> None:
     """Raise if the plate is in tension everywhere (:func:`solve_prestress`'s check).
 
-    A compression below :data:`NEAR_TENSION` of the tension is measured again at one
+    A compression below :data:`NEAR_TENSION` of the tension is computed again at one
     degree more (``again``) and refused if it is the discretisation error there.
     """
     noise = ""

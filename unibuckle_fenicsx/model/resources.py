@@ -1,6 +1,6 @@
 """The memory a solve will need, against what the machine has: refused before any mesh.
 
-Hand-written: the estimate is the package's own (a measured peak per DOF), and the
+Hand-written: the estimate is the package's own (a peak per DOF from its solves), and the
 machine's free memory is Linux's ``MemAvailable`` (the standard library has no portable
 call for it; without /proc/meminfo no check is made).
 """
@@ -15,7 +15,7 @@ from unibuckle_fenicsx.spec import ProblemSpec
 __all__ = ["BYTES_PER_DOF", "available_memory", "check_memory"]
 
 #: Peak memory per (w, theta) DOF of a solve with MUMPS on one rank, rounded up from the
-#: measured 5.8-7.8 kB (:doc:`/guide/mpi`).
+#: 5.8-7.8 kB of :doc:`/verification/tuning`.
 BYTES_PER_DOF = 8000
 
 

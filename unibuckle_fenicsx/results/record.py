@@ -209,7 +209,7 @@ class BucklingResult(Struct, kw_only=True):
         Args:
             timings: Keep the wall times (``*_s`` and ``seconds`` keys, the latter in
                 the interior point's level records; ``timings``) and the "auto" rule's
-                reason, which quotes a measured time; without them the mapping is the same
+                reason, which quotes a timed solve; without them the mapping is the same
                 on every run (for files kept under version control).
         """
         data = jsonable(self)

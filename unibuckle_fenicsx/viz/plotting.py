@@ -25,7 +25,7 @@ from __future__ import annotations
 import os
 from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, TypedDict
 
 import numpy as np
 import numpy.typing as npt
@@ -48,8 +48,24 @@ __all__ = [
     "plot_southwell",
 ]
 
+class Theme(TypedDict):
+    """The look of every figure: sizes, fonts and colours."""
+
+    window_size: tuple[int, int]  # pyvista, pixels
+    font_size: int  # pyvista text
+    cmap: str
+    figsize: tuple[float, float]  # matplotlib, inches
+    dpi: int
+    mpl_font_size: int
+    warp: float  # 3-D height (m) of |w| = 1 (plate 0.2 m x 0.1 m)
+    obstacle_color: str
+    contact_color: str
+    free_color: str
+    unilateral_color: str
+
+
 #: The one theme of every figure (overridable module constant).
-THEME: dict[str, Any] = {
+THEME: Theme = {
     "window_size": (1400, 900),  # pyvista, pixels
     "font_size": 18,  # pyvista text
     "cmap": "coolwarm",

@@ -68,7 +68,7 @@ class StudyPoint:
     result: BucklingResult
     section: Section | None = None
     free_section: Section | None = None
-    extra: dict[str, Any] = field(default_factory=dict)
+    extra: dict[str, float] = field(default_factory=dict)
 
     @property
     def label(self) -> str:
@@ -202,7 +202,7 @@ def mesh_study(
     keep: Sequence[tuple[int, int]],
     output: Path | None = None,
     contact_mesh: tuple[int, int] | None = None,
-    at_each: Callable[[Analysis], dict[str, Any]] | None = None,
+    at_each: Callable[[Analysis], dict[str, float]] | None = None,
 ) -> MeshStudy:
     """Solve the same problem on each mesh of ``specs`` (see the module docstring).
 

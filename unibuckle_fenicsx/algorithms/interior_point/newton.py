@@ -231,12 +231,12 @@ class InteriorPointNewton(Owner):
             on_step=on_step,
         )
         for step in range(max_steps + 1):
-            measured = self._measure(run, step)
-            status = NewtonStatus.BREAKDOWN if measured is None else self._barrier(run, measured)
+            residuals = self._measure(run, step)
+            status = NewtonStatus.BREAKDOWN if residuals is None else self._barrier(run, residuals)
             if status is None and step == max_steps:
                 status = NewtonStatus.MAX_STEPS
-            if status is None and measured is not None:
-                status = self._advance(run, measured, step)
+            if status is None and residuals is not None:
+                status = self._advance(run, residuals, step)
             if status is not None:
                 run.record.status = status
                 break
