@@ -48,6 +48,7 @@ __all__ = [
     "plot_southwell",
 ]
 
+
 class Theme(TypedDict):
     """The look of every figure: sizes, fonts and colours."""
 
