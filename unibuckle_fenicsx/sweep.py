@@ -399,6 +399,47 @@ def _solve(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
     return {"status": str(Outcome.of(result)), **result.as_dict(timings=False)}
 
 
+def _check_ranks(ranks_per_point: int, comm: MPI.Comm) -> None:
+    """Refuse a ``ranks_per_point`` that is not a divisor of the ranks."""
+    if int(ranks_per_point) != ranks_per_point or ranks_per_point < 1:
+        raise InputError(
+            f"ranks_per_point (--ranks-per-point) must be an integer >= 1, got {ranks_per_point!r}"
+        )
+    if comm.size % ranks_per_point:
+        raise InputError(
+            f"ranks_per_point (--ranks-per-point) = {ranks_per_point} must divide the number "
+            f"of ranks ({comm.size})"
+        )
+
+
+def _resume(
+    path: Path, points: list[dict[str, float]], specs: list[ProblemSpec], comm: MPI.Comm
+) -> tuple[dict[int, dict[str, Any]], int]:
+    """The lines of ``path`` kept and the stale ones' count, on every rank.
+
+    See :func:`_done_points`.
+
+    Raises:
+        InputError: ``path`` cannot be made or holds another sweep (before any solve).
+
+    Note:
+        Collective.
+    """
+    error = None
+    done: dict[int, dict[str, Any]] = {}
+    stale = 0
+    if comm.rank == 0:
+        try:
+            path.parent.mkdir(parents=True, exist_ok=True)
+            done, stale = _done_points(path, points, [point_input(spec) for spec in specs])
+        except (ValueError, OSError) as err:
+            error = str(err)
+    error, done, stale = comm.bcast((error, done, stale), root=0)
+    if error is not None:
+        raise InputError(error)
+    return done, stale
+
+
 def run_sweep(
     base: Mapping[str, Any],
     variations: Sequence[Variation],
@@ -429,30 +470,11 @@ def run_sweep(
     Note:
         Collective on ``comm``.
     """
-    if int(ranks_per_point) != ranks_per_point or ranks_per_point < 1:
-        raise InputError(
-            f"ranks_per_point (--ranks-per-point) must be an integer >= 1, got {ranks_per_point!r}"
-        )
-    if comm.size % ranks_per_point:
-        raise InputError(
-            f"ranks_per_point (--ranks-per-point) = {ranks_per_point} must divide the number "
-            f"of ranks ({comm.size})"
-        )
+    _check_ranks(ranks_per_point, comm)
     points = sweep_points(variations)
     specs = [point_problem(base, p) for p in points]  # every point checked before solving
     path = Path(out)
-    error = None
-    done: dict[int, dict[str, Any]] = {}
-    stale = 0
-    if comm.rank == 0:
-        try:
-            path.parent.mkdir(parents=True, exist_ok=True)
-            done, stale = _done_points(path, points, [point_input(spec) for spec in specs])
-        except (ValueError, OSError) as err:
-            error = str(err)
-    error, done, stale = comm.bcast((error, done, stale), root=0)
-    if error is not None:
-        raise InputError(error)
+    done, stale = _resume(path, points, specs, comm)
     todo = [k for k in range(len(points)) if k not in done]
     groups = comm.size // ranks_per_point
     color = comm.rank // ranks_per_point

@@ -100,6 +100,52 @@ def _group_key(line: Mapping[str, Any], others: Sequence[str]) -> tuple[float, .
     return tuple(line["point"][p] for p in others)
 
 
+def _certificate_mark(ax: Any, x: float, k: float, cert: Mapping[str, Any], colour: str) -> None:
+    """A point's marker: proven, bracketed (with its gap), KKT only or not certified."""
+    if not cert.get("kkt"):
+        ax.plot(x, k, "x", color=colour, ms=7)
+    elif cert.get("global_optimum_proven"):
+        ax.plot(x, k, "o", color=colour, ms=6)
+    elif cert.get("status") == "bracketed":
+        ax.plot(x, k, "D", color=colour, ms=5)
+        ax.annotate(f"{float(cert['relative_gap']):.0e}", (x, k),
+                    textcoords="offset points", xytext=(4, 4), fontsize=6,
+                    color=colour)  # fmt: skip
+    else:
+        ax.plot(x, k, "o", mfc="white", color=colour, ms=6)
+
+
+def _exact_curves(
+    ax: Any,
+    base: Mapping[str, Any],
+    first: Variation,
+    others: Mapping[str, float],
+    abscissa: Any,
+    suffix: str,
+) -> None:
+    """The thin plate's exact k (bilateral, and unilateral where known) along ``first``."""
+    dense = np.linspace(min(first.values), max(first.values), 400)
+    refs: list[tuple[float, float | None, float | None]] = []
+    kind = ""
+    for value in dense:
+        point = {first.path: float(value), **others}
+        try:
+            spec = point_problem(base, point)
+        except ValueError:
+            continue
+        bil, uni, what = reference_k(spec)
+        kind = what or kind
+        refs.append((abscissa(spec, float(value)), bil, uni))
+    for col, style, name in ((1, ":", "bilateral"), (2, "-.", "unilateral")):
+        pts = [(r[0], r[col]) for r in refs if r[col] is not None]
+        if pts:
+            xs, ys = np.array(pts).T
+            o = np.argsort(xs)
+            what = kind if col == 2 else "exact"
+            label = f"{name}, thin plate ({what}){suffix}"
+            ax.plot(xs[o], ys[o], style, color="0.35", lw=1.2, label=label)
+
+
 def plot_sweep(
     lines: Sequence[Mapping[str, Any]],
     variations: Sequence[Variation],
@@ -146,39 +192,10 @@ def plot_sweep(
             idx = [int(i) for i in order if unilateral[i]]
             ax.plot(x[idx], k[idx], "--", color=colour, lw=1.0, label=f"unilateral{suffix}")
             for i in idx:
-                cert = solved[i]["certificate"]
-                if not cert.get("kkt"):
-                    ax.plot(x[i], k[i], "x", color=colour, ms=7)
-                elif cert.get("global_optimum_proven"):
-                    ax.plot(x[i], k[i], "o", color=colour, ms=6)
-                elif cert.get("status") == "bracketed":
-                    ax.plot(x[i], k[i], "D", color=colour, ms=5)
-                    ax.annotate(f"{float(cert['relative_gap']):.0e}", (x[i], k[i]),
-                                textcoords="offset points", xytext=(4, 4), fontsize=6,
-                                color=colour)  # fmt: skip
-                else:
-                    ax.plot(x[i], k[i], "o", mfc="white", color=colour, ms=6)
+                _certificate_mark(ax, x[i], k[i], solved[i]["certificate"], colour)
         # Exact curves on a fine grid of the swept number.
-        dense = np.linspace(min(first.values), max(first.values), 400)
-        refs: list[tuple[float, float | None, float | None]] = []
-        kind = ""
-        for value in dense:
-            point = {first.path: float(value), **dict(zip(others, key, strict=True))}
-            try:
-                spec = point_problem(base, point)
-            except ValueError:
-                continue
-            bil, uni, what = reference_k(spec)
-            kind = what or kind
-            refs.append((abscissa(spec, float(value)), bil, uni))
-        for col, style, name in ((1, ":", "bilateral"), (2, "-.", "unilateral")):
-            pts = [(r[0], r[col]) for r in refs if r[col] is not None]
-            if pts:
-                xs, ys = np.array(pts).T
-                o = np.argsort(xs)
-                what = kind if col == 2 else "exact"
-                label = f"{name}, thin plate ({what}){suffix}"
-                ax.plot(xs[o], ys[o], style, color="0.35", lw=1.2, label=label)
+        point = dict(zip(others, key, strict=True))
+        _exact_curves(ax, base, first, point, abscissa, suffix)
     # Legend entries for the certificate markers.
     markers = (
         ("o", "0.2", "proven optimal"),

@@ -189,62 +189,12 @@ def plot_mode_3d(
     font = _font_file()
     plotter = pv.Plotter(off_screen=True, window_size=THEME["window_size"])
     plotter.set_background("white")
-    plotter.add_mesh(
-        warped,
-        scalars="w / max|w|",
-        cmap=THEME["cmap"],
-        clim=(-1.0, 1.0),
-        show_edges=grid.n_cells <= 2500,
-        edge_color="gray",
-        line_width=0.5,
-        show_scalar_bar=False,
-    )
-    bar = plotter.add_scalar_bar(
-        title="w (normalised)",
-        vertical=True,
-        position_x=0.87,
-        position_y=0.2,
-        height=0.6,
-        width=0.06,
-        title_font_size=THEME["font_size"],
-        label_font_size=THEME["font_size"] - 2,
-        color="black",
-        fmt="%.1f",
-        n_labels=5,
-    )
-    if font is not None:
-        for prop in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
-            prop.SetFontFamily(_VTK_FONT_FILE)
-            prop.SetFontFile(font)
+    _add_surface(plotter, grid, warped, font)
     # Flat reference outline of the plate at w = 0.
     (px0, py0), (px1, py1) = problem.spec.plate.corners
     plate_outline = pv.Rectangle([[px0, py0, 0.0], [px1, py0, 0.0], [px1, py1, 0.0]])
     plotter.add_mesh(plate_outline.extract_feature_edges(), color="gray", line_width=1.5)
-    box = problem_zone(problem) if show_zone else None
-    # An obstacle above is drawn just above w = 0, one below just below it.
-    sides = {o.side for o in problem.spec.all_obstacles}
-    below = sides == {"below"}
-    lift = (-0.02 if below else 0.02) * warp
-    legend: list[tuple[str, str]] = []
-    if box is not None:
-        (x0, x1), (y0, y1) = box
-        plane = pv.Rectangle([[x0, y0, lift], [x1, y0, lift], [x1, y1, lift]])
-        plotter.add_mesh(plane, color=THEME["obstacle_color"], opacity=0.2)
-        plotter.add_mesh(plane.extract_feature_edges(), color="black", line_width=4)
-        text = {
-            frozenset({"above"}): "obstacle zone (w <= 0 there)",
-            frozenset({"below"}): "obstacle zone below (w >= 0 there)",
-        }.get(frozenset(sides), "obstacle zones (both sides)")
-        legend.append((text, "#303030"))
-    cxy = np.asarray(contact_coordinates if contact_coordinates is not None else [], dtype=float)
-    cxy = cxy.reshape(-1, 2)
-    if len(cxy):
-        pts = np.column_stack([cxy[:, 0], cxy[:, 1], np.full(len(cxy), 0.5 * lift)])
-        plotter.add_points(
-            pts, color=THEME["contact_color"], point_size=12, render_points_as_spheres=True
-        )
-    if box is not None:
-        legend.append((f"contact nodes: {len(cxy)}", "black"))
+    legend = _add_obstacle(plotter, problem, show_zone, warp, contact_coordinates)
     if legend:
         plotter.add_legend(
             labels=[[label, color] for label, color in legend],
@@ -274,6 +224,77 @@ def plot_mode_3d(
     plotter.screenshot(str(path))
     plotter.close()
     return path
+
+
+def _add_surface(plotter: Any, grid: Any, warped: Any, font: str | None) -> None:
+    """The warped mode coloured by w / max|w|, and its colour bar."""
+    plotter.add_mesh(
+        warped,
+        scalars="w / max|w|",
+        cmap=THEME["cmap"],
+        clim=(-1.0, 1.0),
+        show_edges=grid.n_cells <= 2500,
+        edge_color="gray",
+        line_width=0.5,
+        show_scalar_bar=False,
+    )
+    bar = plotter.add_scalar_bar(
+        title="w (normalised)",
+        vertical=True,
+        position_x=0.87,
+        position_y=0.2,
+        height=0.6,
+        width=0.06,
+        title_font_size=THEME["font_size"],
+        label_font_size=THEME["font_size"] - 2,
+        color="black",
+        fmt="%.1f",
+        n_labels=5,
+    )
+    if font is not None:
+        for prop in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
+            prop.SetFontFamily(_VTK_FONT_FILE)
+            prop.SetFontFile(font)
+
+
+def _add_obstacle(
+    plotter: Any,
+    problem: Problem,
+    show_zone: bool,
+    warp: float,
+    contact_coordinates: npt.ArrayLike | None,
+) -> list[tuple[str, str]]:
+    """The obstacle zone (a translucent plane just off w = 0) and the contact nodes.
+
+    Returns the legend's entries.
+    """
+    pv = _pyvista()
+    box = problem_zone(problem) if show_zone else None
+    # An obstacle above is drawn just above w = 0, one below just below it.
+    sides = {o.side for o in problem.spec.all_obstacles}
+    below = sides == {"below"}
+    lift = (-0.02 if below else 0.02) * warp
+    legend: list[tuple[str, str]] = []
+    if box is not None:
+        (x0, x1), (y0, y1) = box
+        plane = pv.Rectangle([[x0, y0, lift], [x1, y0, lift], [x1, y1, lift]])
+        plotter.add_mesh(plane, color=THEME["obstacle_color"], opacity=0.2)
+        plotter.add_mesh(plane.extract_feature_edges(), color="black", line_width=4)
+        text = {
+            frozenset({"above"}): "obstacle zone (w <= 0 there)",
+            frozenset({"below"}): "obstacle zone below (w >= 0 there)",
+        }.get(frozenset(sides), "obstacle zones (both sides)")
+        legend.append((text, "#303030"))
+    cxy = np.asarray(contact_coordinates if contact_coordinates is not None else [], dtype=float)
+    cxy = cxy.reshape(-1, 2)
+    if len(cxy):
+        pts = np.column_stack([cxy[:, 0], cxy[:, 1], np.full(len(cxy), 0.5 * lift)])
+        plotter.add_points(
+            pts, color=THEME["contact_color"], point_size=12, render_points_as_spheres=True
+        )
+    if box is not None:
+        legend.append((f"contact nodes: {len(cxy)}", "black"))
+    return legend
 
 
 # -- section A -------------------------------------------------------------------------
@@ -519,6 +540,30 @@ def plot_contact_map(
 
 
 # -- convergence -----------------------------------------------------------------------
+def _reference_errors(
+    ax: Any,
+    studies: Mapping[str, Sequence[tuple[int, int, float]]],
+    reference: float,
+    reference_label: str,
+    markers: str,
+) -> None:
+    """The free studies' errors against ``reference``, dotted, on the log axes ``ax``."""
+    for k, (label, rows) in enumerate(studies.items()):
+        if label.startswith("free"):
+            rows = sorted(rows)
+            nx = np.array([r[0] for r in rows], dtype=float)
+            err = np.abs(np.array([r[2] for r in rows]) - reference) / reference
+            ax.loglog(
+                nx,
+                err,
+                ":",
+                marker=markers[k % len(markers)],
+                color=f"C{k}",
+                mfc="none",
+                label=f"{label}: error vs {reference_label}",
+            )
+
+
 def plot_convergence(
     path: str | Path,
     studies: Mapping[str, Sequence[tuple[int, int, float]]],
@@ -576,20 +621,7 @@ def plot_convergence(
             )
     if reference is not None:
         ax0.axhline(reference / 1e6, color="k", ls="--", lw=1.0, label=reference_label)
-        for k, (label, rows) in enumerate(studies.items()):
-            if label.startswith("free"):
-                rows = sorted(rows)
-                nx = np.array([r[0] for r in rows], dtype=float)
-                err = np.abs(np.array([r[2] for r in rows]) - reference) / reference
-                ax1.loglog(
-                    nx,
-                    err,
-                    ":",
-                    marker=markers[k % len(markers)],
-                    color=f"C{k}",
-                    mfc="none",
-                    label=f"{label}: error vs {reference_label}",
-                )
+        _reference_errors(ax1, studies, reference, reference_label, markers)
     all_nx = sorted({r[0] for rows in studies.values() for r in rows})
     ny_of = {r[0]: r[1] for rows in studies.values() for r in rows}
     ticks = [f"{n}×{ny_of[n]}" for n in all_nx]
