@@ -63,7 +63,7 @@ import numpy.typing as npt
 from msgspec import UNSET, UnsetType
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
-from unibuckle_fenicsx.algorithms.bounds import bracket
+from unibuckle_fenicsx.algorithms.bounds import Bracket, bracket
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
 from unibuckle_fenicsx.algorithms.multilevel import mesh_levels, prolong
@@ -464,6 +464,36 @@ def _fine_level(
     return runs, seeded_on
 
 
+def _details(
+    problem: UnilateralProblem,
+    free_load: float,
+    seeded_on: list[int] | str,
+    coarse: _Coarse,
+    fallbacks: _Fallbacks,
+    runs: list[Run],
+    kkt: list[Candidate],
+    closed: Bracket,
+) -> ActiveSetDetails:
+    """The run's record (its fine eigen solves, time and warning filled in by the caller)."""
+    groups = _twin_groups(kkt)
+    return ActiveSetDetails(
+        free_load=free_load,
+        seeded_on=seeded_on,
+        fallback=fallbacks.record,
+        levels=coarse.log,
+        runs=[r.summary() for r in runs],
+        kkt_points=[KktPoint(load=s.load, contact_nodes=len(s.active)) for s in kkt],
+        twins=[[[int(k) for k in s.active] for s in g] for g in groups if len(g) > 1],
+        coarse_kkt_loads=[s.load for s in coarse.kkt],
+        fine_eigensolves=0,
+        coarse_eigensolves=coarse.solves,
+        penalty_eigensolves=fallbacks.penalty_solves,
+        bound_evaluations=closed.evaluations,
+        bound_search_complete=closed.complete,
+        wall_time_s=0.0,
+    )
+
+
 def _check_options(
     max_iterations: int, coarse_min_cells: int, refine_margin: float, bound_budget: int
 ) -> None:
@@ -533,26 +563,12 @@ def solve_active_set(
     if closed.warning:
         warnings.append(closed.warning)
     chosen, lower, proven = closed.chosen, closed.lower, closed.proven
-    groups = _twin_groups(kkt)
     for w in warnings:
         logger.warning("active-set: %s", w)
-    details = ActiveSetDetails(
-        free_load=free_load,
-        seeded_on=seeded_on,
-        fallback=fallbacks.record,
-        levels=coarse.log,
-        runs=[r.summary() for r in runs],
-        kkt_points=[KktPoint(load=s.load, contact_nodes=len(s.active)) for s in kkt],
-        twins=[[[int(k) for k in s.active] for s in g] for g in groups if len(g) > 1],
-        coarse_kkt_loads=[s.load for s in coarse.kkt],
-        fine_eigensolves=problem.eigensolver.solves - solves0,
-        coarse_eigensolves=coarse.solves,
-        penalty_eigensolves=fallbacks.penalty_solves,
-        bound_evaluations=closed.evaluations,
-        bound_search_complete=closed.complete,
-        wall_time_s=time.perf_counter() - t0,
-        warning="; ".join(warnings) if warnings else UNSET,
-    )
+    details = _details(problem, free_load, seeded_on, coarse, fallbacks, runs, kkt, closed)
+    details.fine_eigensolves = problem.eigensolver.solves - solves0
+    details.wall_time_s = time.perf_counter() - t0
+    details.warning = "; ".join(warnings) if warnings else UNSET
     extra = coarse.solves + fallbacks.penalty_solves
     return UnilateralSolution(
         candidate=chosen,

@@ -38,6 +38,7 @@ Note:
 from __future__ import annotations
 
 import math
+from dataclasses import dataclass
 
 from petsc4py import PETSc
 
@@ -210,16 +211,14 @@ def descend(
         return run, dict.fromkeys(STEP_KINDS, 0)
     u = start.mode.x.petsc_vec.copy()
     gradient: _Gradient | None = None
-    working = start.active
-    release = _pulling(start, n, tau)
-    by_gradient = False
+    sets = _Sets(start.active, _pulling(start, n, tau))
     steps = dict.fromkeys(STEP_KINDS, 0)
     try:
         for step in range(max_steps):
             run.iterations = step + 1
-            trial = np.setdiff1d(working, release)
+            trial = np.setdiff1d(sets.working, sets.release)
             cand: Candidate | None = None
-            if by_gradient:
+            if sets.by_gradient:
                 steps["gradient"] += 1
                 gradient = gradient or _Gradient(problem)  # rarely needed: made on first use
                 arc = gradient.arc(u, trial)
@@ -228,20 +227,11 @@ def descend(
                 arc = _Arc(A, B, u, cand.mode.x.petsc_vec)
             phi_b, blocked = _blocking(problem, arc, trial)
             if phi_b <= ZERO_STEP * arc.phi_max:
-                # Zero step: released nodes that would cross at once stay in W, nodes
-                # already at the obstacle join it; the others are released. When every
-                # eigen step towards a release is a zero step, release the most pulling
-                # node along the gradient instead (which leaves the obstacle there).
                 arc.destroy()
                 steps["zero"] += 1
-                had = release.size > 0
-                working = np.union1d(working, blocked)
-                release = np.setdiff1d(release, blocked)
-                if had and release.size == 0:
-                    if by_gradient:
-                        run.status = RunStatus.STALLED
-                        break
-                    release, by_gradient = _pulling(run.final, n, tau, largest=True), True
+                if sets.blocked_at_once(blocked, run.final, n, tau):
+                    run.status = RunStatus.STALLED
+                    break
                 continue
             full = phi_b >= arc.phi_max
             u.destroy()
@@ -250,27 +240,70 @@ def descend(
                 arc.destroy()
                 steps["full"] += 1
                 u = cand.mode.x.petsc_vec.copy()
-                working, by_gradient = trial, False
-                run.final = cand
-                run.history.append((len(trial), cand.load, cand.feasible))
-                if cand.feasible:
-                    run.best_feasible = cand
-                if cand.kkt:
-                    run.status = RunStatus.KKT
+                if sets.reached(run, cand, trial, n, tau):
                     break
-                release = _pulling(cand, n, tau)
                 continue
             steps["partial"] += 1
             u = arc.point(arc.phi_max if full else phi_b)
             arc.destroy()
-            working = trial if full else np.union1d(trial, blocked)
-            release = np.empty(0, dtype=np.int64)
-            by_gradient = False
+            sets.working = trial if full else np.union1d(trial, blocked)
+            sets.release = np.empty(0, dtype=np.int64)
+            sets.by_gradient = False
     finally:
         u.destroy()
         if gradient is not None:
             gradient.destroy()
     return run, steps
+
+
+@dataclass
+class _Sets:
+    """The descent's working set W, the nodes to release from it, and how the next arc is made.
+
+    Attributes:
+        working: Nodes held at the obstacle (global contact indices).
+        release: Nodes of ``working`` released at the next step.
+        by_gradient: Whether the next arc follows the gradient instead of an eigen solve.
+    """
+
+    working: npt.NDArray[np.int64]
+    release: npt.NDArray[np.int64]
+    by_gradient: bool = False
+
+    def blocked_at_once(
+        self, blocked: npt.NDArray[np.int64], final: Candidate | None, n: int, tau: float
+    ) -> bool:
+        """A zero step: update the sets and say whether the descent has stalled.
+
+        Released nodes that would cross at once stay in W, nodes already at the obstacle
+        join it; the others are released. When every eigen step towards a release is a
+        zero step, the most pulling node of ``final`` is released along the gradient
+        instead (which leaves the obstacle there); when that too is a zero step, the
+        descent has stalled.
+        """
+        had = self.release.size > 0
+        self.working = np.union1d(self.working, blocked)
+        self.release = np.setdiff1d(self.release, blocked)
+        if had and self.release.size == 0:
+            if self.by_gradient:
+                return True
+            self.release, self.by_gradient = _pulling(final, n, tau, largest=True), True
+        return False
+
+    def reached(
+        self, run: Run, cand: Candidate, trial: npt.NDArray[np.int64], n: int, tau: float
+    ) -> bool:
+        """A full step to ``cand``, the eigenvector of ``trial``: record it, say if it is KKT."""
+        self.working, self.by_gradient = trial, False
+        run.final = cand
+        run.history.append((len(trial), cand.load, cand.feasible))
+        if cand.feasible:
+            run.best_feasible = cand
+        if cand.kkt:
+            run.status = RunStatus.KKT
+            return True
+        self.release = _pulling(cand, n, tau)
+        return False
 
 
 def _pulling(

@@ -75,6 +75,23 @@ def _mask(n: int, active: npt.NDArray[np.int64]) -> npt.NDArray[np.bool_]:
     return m
 
 
+def _changes(
+    cand: Candidate, inz: npt.NDArray[np.bool_], stages: list[float], stage: int
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.bool_], int]:
+    """The nodes to add and to release at the first threshold from ``stage`` that has any.
+
+    A point that is KKT at a threshold moves on to the next (tighter) one; the last is
+    the tolerance itself. Returns (add, release, the threshold's stage).
+    """
+    while True:
+        level = stages[stage]
+        add = ~inz & (cand.values > level)
+        release = inz & (cand.forces > level)
+        if add.any() or release.any() or stage == len(stages) - 1:
+            return add, release, stage
+        stage += 1
+
+
 def iterate(
     problem: UnilateralProblem,
     seed: str,
@@ -136,14 +153,10 @@ def iterate(
             run.status = RunStatus.KKT
             break
         inz = _mask(n, active)
-        while True:
-            level = stages[stage]
-            add = ~inz & (cand.values > level)
-            release = inz & (cand.forces > level)
-            if add.any() or release.any() or stage == len(stages) - 1:
-                break
-            # KKT at this threshold: tighten it (same contact set and mode).
-            stage, damped = stage + 1, False
+        add, release, tighter = _changes(cand, inz, stages, stage)
+        if tighter != stage:
+            # KKT at the looser thresholds: tightened (same contact set and mode).
+            stage, damped = tighter, False
             seen.clear()
         if (greedy or damped) and add.any():
             add &= cand.values >= cand.values[add].max() * (1.0 - ROUNDING_RTOL)

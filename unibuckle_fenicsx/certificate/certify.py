@@ -203,6 +203,22 @@ def _residual_off_contact(problem: UnilateralProblem, candidate: Candidate) -> f
     return float(r.norm()) / au_2  # type: ignore[arg-type]
 
 
+def _as_solution(
+    problem: UnilateralProblem, solution: UnilateralSolution | Candidate
+) -> UnilateralSolution:
+    """A bare candidate as a solution with the interlacing bracket [lambda_free, lambda]."""
+    if not isinstance(solution, Candidate):
+        return solution
+    return UnilateralSolution(
+        candidate=solution,
+        method="candidate",
+        eigensolves=0,
+        lower_bound=problem.solve_free().load,
+        global_optimum_proven=False,
+        upper_bound=solution.load if solution.feasible else math.inf,
+    )
+
+
 def certify(
     problem: UnilateralProblem,
     solution: UnilateralSolution | Candidate,
@@ -226,15 +242,7 @@ def certify(
     Note:
         Collective.
     """
-    if isinstance(solution, Candidate):
-        solution = UnilateralSolution(
-            candidate=solution,
-            method="candidate",
-            eigensolves=0,
-            lower_bound=problem.solve_free().load,
-            global_optimum_proven=False,
-            upper_bound=solution.load if solution.feasible else math.inf,
-        )
+    solution = _as_solution(problem, solution)
     if global_bound is None:
         global_bound = problem.spec.solver.certify
     cand = solution.candidate
@@ -425,18 +433,8 @@ def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution)
     notes: list[str] = []
     if not math.isfinite(cand.load):
         raise ValueError("certify_foundation: the candidate has no finite load")
-    u = cand.mode.x.petsc_vec
-    scale = problem.max_abs_w(u)
-    z = contact.values(u) / scale
+    z, residual = _spring_residual(problem, cand)
     pressing = pressing_nodes(z, 1.0)  # as the solver counts them
-    r, _, au_2 = problem.residual(cand.load, u)
-    spring = u.duplicate()
-    try:
-        contact.scatter(contact.stiffness * np.maximum(z, 0.0) * scale, spring)
-        r.axpy(1.0, spring)
-    finally:
-        spring.destroy()
-    residual = float(r.norm()) / au_2  # type: ignore[arg-type]
     status = solution.status
     if status is None:
         raise ValueError(
@@ -478,6 +476,28 @@ def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution)
         proven_by="interlacing",
         notes=tuple(notes),
     )
+
+
+def _spring_residual(
+    problem: UnilateralProblem, cand: Candidate
+) -> tuple[npt.NDArray[np.float64], float]:
+    r"""The oriented values (max|w| = 1) and :math:`\|r_f\|_2/\|Au\|_2` of the spring quotient.
+
+    Collective.
+    """
+    contact = problem.contact
+    assert contact.stiffness is not None
+    u = cand.mode.x.petsc_vec
+    scale = problem.max_abs_w(u)
+    z = contact.values(u) / scale
+    r, _, au_2 = problem.residual(cand.load, u)
+    spring = u.duplicate()
+    try:
+        contact.scatter(contact.stiffness * np.maximum(z, 0.0) * scale, spring)
+        r.axpy(1.0, spring)
+    finally:
+        spring.destroy()
+    return z, float(r.norm()) / au_2  # type: ignore[arg-type]
 
 
 def _spring_inertia(

@@ -81,7 +81,7 @@ from unibuckle_fenicsx.certificate.shifted import (
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 
 if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions
+    from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions, LowRankOutcome
 
 __all__ = ["BoundOptions", "LowerBound", "copositivity_bound"]
 
@@ -333,8 +333,7 @@ def copositivity_bound(
         matrix = ShiftedMatrix(
             problem.model.A, problem.model.B, shared=problem.eigensolver.factorization
         )
-    factorisations0, solves0 = matrix.factorisations, matrix.solves
-    factor_s0, solve_s0 = matrix.factor_s, matrix.solve_s
+    start = (matrix.factorisations, matrix.solves, matrix.factor_s, matrix.solve_s)
     result: LowerBound | None = None
     m: int | None = None
     several = False  # two or more pencil eigenvalues below some shift tried
@@ -359,19 +358,9 @@ def copositivity_bound(
             outcome = _lowrank(problem, matrix, candidate, others or [], opts.lowrank, notes)
             if outcome is not None:
                 lowrank, refuting = outcome.record(), outcome.refuting
-                if outcome.value is not None:
-                    margins = LowRankMargins(
-                        r=outcome.r, pieces=outcome.pieces, margin=outcome.margin, m=outcome.m
-                    )
-                    result = LowerBound(outcome.value, "lowrank-spn", outcome.delta, margins)
+                result = _lowrank_bound(outcome)
     finally:
-        timings = {  # the slowest rank's, so that the record is the same on every rank
-            "total_s": problem.comm.allreduce(time.perf_counter() - t0, op=MPI.MAX),
-            "factor_s": problem.comm.allreduce(matrix.factor_s - factor_s0, op=MPI.MAX),
-            "solve_s": problem.comm.allreduce(matrix.solve_s - solve_s0, op=MPI.MAX),
-            "factorisations": matrix.factorisations - factorisations0,
-            "solves": matrix.solves - solves0,
-        }
+        timings = _timings(problem, matrix, t0, start)
         if own:
             matrix.destroy()
     if result is None:
@@ -393,6 +382,31 @@ def copositivity_bound(
         lowrank,
         refuting,
     )
+
+
+def _lowrank_bound(outcome: LowRankOutcome) -> LowerBound | None:
+    """The low-rank route's verified bound, if it found one."""
+    if outcome.value is None:
+        return None
+    margins = LowRankMargins(r=outcome.r, pieces=outcome.pieces, margin=outcome.margin, m=outcome.m)
+    return LowerBound(outcome.value, "lowrank-spn", outcome.delta, margins)
+
+
+def _timings(
+    problem: UnilateralProblem,
+    matrix: ShiftedMatrix,
+    t0: float,
+    start: tuple[int, int, float, float],
+) -> dict[str, float]:
+    """Seconds and counts since ``start``: the slowest rank's, the same on every rank."""
+    factorisations0, solves0, factor_s0, solve_s0 = start
+    return {
+        "total_s": problem.comm.allreduce(time.perf_counter() - t0, op=MPI.MAX),
+        "factor_s": problem.comm.allreduce(matrix.factor_s - factor_s0, op=MPI.MAX),
+        "solve_s": problem.comm.allreduce(matrix.solve_s - solve_s0, op=MPI.MAX),
+        "factorisations": matrix.factorisations - factorisations0,
+        "solves": matrix.solves - solves0,
+    }
 
 
 @dataclass(frozen=True)

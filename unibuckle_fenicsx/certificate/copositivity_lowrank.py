@@ -781,6 +781,23 @@ def lowrank_certificate(
     return out
 
 
+def _scaled_gram(
+    cols: _Columns, use: list[int]
+) -> tuple[
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+]:
+    """G of the columns ``use``, its scaling D (powers of two: exact), D G D and D E D.
+
+    E is G's error bound.
+    """
+    G, E = cols.gram(use)
+    dg = 1.0 / _pow2(np.sqrt(np.maximum(np.abs(np.diag(G)), np.diag(E))))
+    return G, dg, G * dg[:, None] * dg[None, :], E * dg[:, None] * dg[None, :]
+
+
 def _cut(
     problem: UnilateralProblem,
     cols: _Columns,
@@ -859,9 +876,7 @@ def _attempt(
         near = opts.near
         while True:
             use = _select(cols, use, opts)
-            G, E = cols.gram(use)
-            dg = 1.0 / _pow2(np.sqrt(np.maximum(np.abs(np.diag(G)), np.diag(E))))
-            Gs, Es = G * dg[:, None] * dg[None, :], E * dg[:, None] * dg[None, :]
+            G, dg, Gs, Es = _scaled_gram(cols, use)
             gneg, _, gmargin = _inertia(Gs, Es, opts.margin_factor)
             attempt.r, attempt.columns, attempt.cuts = len(use), cols.r, cuts
             attempt.G_negative, attempt.G_margin = gneg, gmargin

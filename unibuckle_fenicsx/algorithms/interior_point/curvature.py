@@ -113,22 +113,7 @@ class NegativeCurvature(Owner):
         by2 = dot(kernel.Bu, kernel.y2)
         if by2 == 0.0:
             return None
-        source, size = probe, 0
-        for v in basis:
-            work.pointwiseMult(metric, source)
-            kernel.ksp.solve(work, v)
-            v.axpy(-dot(kernel.Bu, v) / by2, kernel.y2)  # tangent
-            work.pointwiseMult(metric, v)
-            before = dot(work, v)
-            for w in basis[:size]:  # M-orthogonal to the previous vectors
-                work.pointwiseMult(metric, w)
-                v.axpy(-dot(work, v), w)
-            work.pointwiseMult(metric, v)
-            norm2 = dot(work, v)
-            if not norm2 > EXHAUSTED_NORM * before:  # the space is exhausted: rounding only
-                break
-            v.scale(1.0 / math.sqrt(norm2))
-            source, size = v, size + 1
+        size = self._basis(probe, metric, work, basis, by2)
         if size == 0:
             return None
         # The projected pencil (V^T K V, V^T M V), with K v = K_delta v - delta M v.
@@ -159,6 +144,37 @@ class NegativeCurvature(Owner):
         work.pointwiseMult(metric, d)
         curvature = dot(d, kernel.trial) - delta * dot(d, work)
         return float(theta[0]), d, curvature
+
+    def _basis(
+        self,
+        probe: PETSc.Vec,
+        metric: PETSc.Vec,
+        work: PETSc.Vec,
+        basis: list[PETSc.Vec],
+        by2: float,
+    ) -> int:
+        r"""The M-orthonormal Krylov basis of :math:`K_\delta^{-1}M` on the tangent space.
+
+        Started from ``probe``; returns its size (it stops where the space is exhausted).
+        """
+        kernel = self.kernel
+        source, size = probe, 0
+        for v in basis:
+            work.pointwiseMult(metric, source)
+            kernel.ksp.solve(work, v)
+            v.axpy(-dot(kernel.Bu, v) / by2, kernel.y2)  # tangent
+            work.pointwiseMult(metric, v)
+            before = dot(work, v)
+            for w in basis[:size]:  # M-orthogonal to the previous vectors
+                work.pointwiseMult(metric, w)
+                v.axpy(-dot(work, v), w)
+            work.pointwiseMult(metric, v)
+            norm2 = dot(work, v)
+            if not norm2 > EXHAUSTED_NORM * before:  # the space is exhausted: rounding only
+                break
+            v.scale(1.0 / math.sqrt(norm2))
+            source, size = v, size + 1
+        return size
 
     def step(
         self, u: PETSc.Vec, lam: float, gap: npt.NDArray[np.float64], mu_abs: float
