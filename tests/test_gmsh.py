@@ -563,7 +563,7 @@ def test_thin_holed_plate_is_nested_over_gmsh_meshes():
         "obstacle": {"zone": "all", "side": "below"},
     }
     loads, meshes = [], []
-    for options in (ChainOptions(), ChainOptions(coarse_min_cells=10**6)):
+    for options in (ChainOptions(), ChainOptions(explore_min_cells=10**6)):
         with BucklingProblem(problem_from_dict(data)) as problem:
             sol = solve_unilateral(problem, options)
             assert sol.method == "interior-point" and sol.candidate.kkt
