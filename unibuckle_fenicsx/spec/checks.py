@@ -7,8 +7,6 @@ each raises :class:`~unibuckle_fenicsx.errors.InputError` naming the keys
 
 from __future__ import annotations
 
-from typing import TYPE_CHECKING
-
 import numpy as np
 
 from unibuckle_fenicsx.errors import InputError
@@ -22,9 +20,6 @@ from unibuckle_fenicsx.spec.plate import (
     PlateSpec,
     Polygon,
 )
-
-if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.spec.problem import ProblemSpec
 
 __all__ = [
     "FEATURE_RATIO",
@@ -61,7 +56,7 @@ def plate_model_note(plate: PlateSpec) -> str | None:
     )
 
 
-def check_supports(spec: ProblemSpec) -> None:
+def check_supports(plate: PlateSpec, foundation: bool) -> None:
     """Refuse supports that leave a rigid-body motion of the deflection (a mechanism).
 
     With no clamped edge, the supported boundary must not lie on one straight line
@@ -71,11 +66,14 @@ def check_supports(spec: ProblemSpec) -> None:
     An edge given by a facet tag of a user mesh is taken to hold the plate; for a gmsh
     file only "every part free" is checked (its geometry is known once meshed).
 
+    Args:
+        plate: The plate and its edges.
+        foundation: Whether a bilateral foundation holds the plate.
+
     Raises:
-        ValueError: Naming ``edges.*.support``.
+        InputError: Naming ``edges.*.support``.
     """
-    plate = spec.plate
-    if spec.bilateral_foundations:
+    if foundation:
         return
     held = [e for e in plate.edges if e.support != "free"]
     if any(e.support == "clamped" for e in held):

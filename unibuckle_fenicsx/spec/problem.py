@@ -75,7 +75,7 @@ class ProblemSpec(Table, frozen=True):
                     point.locations(self.plate)
                 except InputError as err:
                     raise InputError(f"points[{k}]{str(err)[len('points') :]}") from None
-        check_supports(self)
+        check_supports(self.plate, bool(self.bilateral_foundations))
         self._check_obstacles()
 
     def _check_mesh(self) -> None:
