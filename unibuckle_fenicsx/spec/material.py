@@ -9,6 +9,7 @@ from typing import Annotated, ClassVar
 import numpy as np
 from msgspec import Meta
 
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.laminate import laminate
 from unibuckle_fenicsx.spec.base import Matrix3, Rule, Table, unit
 
@@ -89,6 +90,8 @@ class Material(Table, frozen=True):
     @classmethod
     def from_plies(cls, plies: Sequence[Ply], shear_correction: float = 5.0 / 6.0) -> Material:
         """The laminate of ``plies`` (bottom first), E and nu its in-plane constants."""
+        if not plies:
+            raise InputError("material.plies: a laminate needs at least one ply")
         E, nu = laminate(plies).engineering_constants()
         return cls(E=E, nu=nu, shear_correction=shear_correction, plies=tuple(plies))
 
