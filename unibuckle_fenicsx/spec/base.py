@@ -10,7 +10,7 @@ the rules between the table's fields.
 A refusal names the key and what it must be. :func:`reason` words it from the field's
 annotation and the value found (unknown or missing keys, the range, the type), at the
 location of msgspec's error (its ``$.plate.holes[1]``, :func:`location`), never from
-msgspec's own wording. A :class:`Rule` names a field of its table; where that table lies
+msgspec's own wording. A rule's ``FieldError`` names a field of its table; where that table lies
 in a file (``obstacles[1]``) the loader says.
 """
 
@@ -29,7 +29,7 @@ import msgspec
 import numpy as np
 from msgspec import Meta, Struct
 
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.errors import FieldError, InputError
 
 #: Unit systems of a problem file: name -> (metres per length unit, pascals per stress
 #: unit, stress unit's name). Forces are in N in both.
@@ -89,18 +89,6 @@ def temperature_field(value: Temperature) -> tuple[float, float, float]:
 CONVERTING: contextvars.ContextVar[bool] = contextvars.ContextVar("converting", default=False)
 
 
-class Rule(InputError):
-    """A rule between the fields of one table, broken: ``field`` ("" the table) ``text``.
-
-    ``str()`` names the table by its key in code (``obstacle.gap``); the loader names it
-    where it lies in the file (``obstacles[1].gap``).
-    """
-
-    def __init__(self, table: Table, field: str, text: str) -> None:
-        self.field, self.text = field, text
-        super().__init__(f"{join(table.key(), field) if field else f'[{table.key()}]'}{text}")
-
-
 class Table(Struct, frozen=True, forbid_unknown_fields=True):
     """A table of the problem file: frozen, unknown keys forbidden, checked when built."""
 
@@ -121,11 +109,11 @@ class Table(Struct, frozen=True, forbid_unknown_fields=True):
         for name in self.__struct_fields__:
             bad = next((v for v in _floats(getattr(self, name)) if not math.isfinite(v)), None)
             if bad is not None:
-                raise Rule(self, name, f" must be a finite number, got {bad!r}")
+                raise FieldError(self.key(), name, f" must be a finite number, got {bad!r}")
         self.check()
 
     def check(self) -> None:
-        """The rules between this table's fields (each raises :class:`Rule`)."""
+        """The rules between this table's fields (each raises a ``FieldError``)."""
 
     def key(self) -> str:
         """This table's key in messages when it is built in code."""

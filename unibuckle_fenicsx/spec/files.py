@@ -26,13 +26,12 @@ from typing import Any
 
 import msgspec
 
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.errors import FieldError, InputError
 from unibuckle_fenicsx.laminate import laminate
 from unibuckle_fenicsx.spec.base import (
     CONVERTING,
     DIMENSIONS,
     UNITS,
-    Rule,
     Stress,
     bare,
     element,
@@ -288,7 +287,7 @@ def _message(err: msgspec.ValidationError, api: Any, prefix: list[str | int] | N
     """The message of msgspec's ``err`` converting ``api``, naming the file's key."""
     steps = [*(prefix or []), *location(err)]
     cause = err.__cause__
-    if isinstance(cause, Rule):
+    if isinstance(cause, FieldError):
         where = _file_key([*steps, *([cause.field] if cause.field else [])], api)
         return (where if cause.field else f"[{where}]") + cause.text
     if isinstance(cause, InputError):
