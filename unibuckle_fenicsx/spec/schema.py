@@ -27,6 +27,9 @@ def json_schema() -> dict[str, Any]:
         node["description"] = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0]
         hidden = {*cls.CODE_ONLY, cls.__struct_config__.tag_field}  # the Python API's
         node["properties"] = {k: v for k, v in node["properties"].items() if k not in hidden}
+        for prop in node["properties"].values():  # absent, in a file: TOML has no null
+            if "default" in prop and prop["default"] is None:
+                del prop["default"]
         node["required"] = [k for k in node.get("required", []) if k not in hidden]
     vertices = defs.pop("Polygon")["properties"]["vertices"]
     top = list(defs["ProblemSpec"]["properties"].items())
