@@ -355,3 +355,15 @@ def test_each_method_reads_its_options_from_the_solver_table(capsys):
     assert spec.options(Method.PENALTY) == PenaltyOptions()
     with pytest.raises(ValueError, match=r"solver\.max_candidates must be an integer >= 1"):
         EnumerateOptions(max_candidates=0)
+
+
+def test_other_units_leave_a_list_of_the_wrong_length_to_be_refused():
+    """Converting [T0, dT/dx, dT/dy] per entry must not cut a list of four entries."""
+    data = {
+        "units": "mm-N-MPa",
+        "material": {"E": 1e3, "nu": 0.3, "thermal_expansion": 1e-5},
+        "edges": {"left": {"inplane": "clamped"}},
+        "load": {"temperature": [1.0, 2.0, 3.0, 4.0]},
+    }
+    with pytest.raises(ValueError, match=r"load\.temperature must be a number \(K\) or \[T0"):
+        problem_from_dict(data)

@@ -213,7 +213,7 @@ def metadata(tp: Any, name: str) -> Any:
     return None
 
 
-def _table_of(tp: Any, value: Any, field: str | None = None) -> Any:
+def table_of(tp: Any, value: Any, field: str | None = None) -> Any:
     """The table of ``tp`` (a union: by ``value``'s tag, else having ``field``), or None."""
     tables = [bare(m) for m in members(tp) if is_table(m)]
     tag = value.get("shape") if isinstance(value, Mapping) else None
@@ -231,7 +231,7 @@ def walk(tp: Any, value: Any, steps: list[str | int]) -> tuple[Any, Any]:
         except (KeyError, IndexError, TypeError):
             child = None
         if isinstance(key, str):
-            table = _table_of(tp, value, key)
+            table = table_of(tp, value, key)
             tp = hints(table).get(key, Any) if table is not None else Any
         else:
             lists = [bare(m) for m in members(tp) if typing.get_origin(bare(m)) is tuple]
@@ -263,7 +263,7 @@ def location(err: msgspec.ValidationError) -> list[str | int]:
 
 def reason(key: str, value: Any, tp: Any) -> str:
     """Why ``value`` is not a ``tp`` at ``key``: unknown or missing keys, range, or type."""
-    table = _table_of(tp, value)
+    table = table_of(tp, value)
     if table is not None and isinstance(value, Mapping):
         where = f"[{key}]" if key else "[top] (the file's top level)"
         fields = table.__struct_fields__

@@ -33,17 +33,16 @@ from unibuckle_fenicsx.spec.base import (
     DIMENSIONS,
     UNITS,
     Stress,
-    bare,
     element,
     form,
     hints,
-    is_table,
     join,
     location,
     members,
     metadata,
     plain,
     reason,
+    table_of,
     walk,
 )
 from unibuckle_fenicsx.spec.material import Ply
@@ -116,21 +115,23 @@ def scaled(value: Any, tp: Any, units: str, sign: int) -> Any:
     """
     if units == "SI":
         return value
-    table = _table(tp, value)
+    table = table_of(tp, value)
     if isinstance(value, Mapping) and table is not None:
         fields = hints(table)
         return {
             k: scaled(v, fields[k], units, sign) if k in fields else v for k, v in value.items()
         }
     entries = next((element(m) for m in members(tp) if element(m) is not None), None)
-    if isinstance(value, list) and entries is not None and _table(entries, None) is not None:
+    if isinstance(value, list) and entries is not None and table_of(entries, None) is not None:
         return [scaled(v, entries, units, sign) for v in value]
     dims = DIMENSIONS.get(metadata(tp, "unit"))
     if dims is None:
         return value
     if isinstance(dims, list):  # one unit per entry, or the first for a number
-        if isinstance(value, list):
-            return [_times(v, _factor(d, units, sign)) for v, d in zip(value, dims, strict=False)]
+        if isinstance(value, list):  # of another length: left for the Structs to refuse
+            if len(value) != len(dims):
+                return value
+            return [_times(v, _factor(d, units, sign)) for v, d in zip(value, dims, strict=True)]
         dims = dims[0]
     return _times(value, _factor(dims, units, sign))
 
@@ -144,14 +145,6 @@ def _factor(dims: tuple[int, int], units: str, sign: int) -> float:
     p, q = dims
     up = (length ** max(p, 0) * stress ** max(q, 0)) ** sign
     return up / (length ** max(-p, 0) * stress ** max(-q, 0)) ** sign
-
-
-def _table(tp: Any, value: Any) -> Any:
-    """The table type of ``tp`` (a union's: by ``value``'s tag), or None."""
-    tables = [bare(m) for m in members(tp) if is_table(m)]
-    tag = value.get("shape") if isinstance(value, Mapping) else None
-    found = [m for m in tables if m.__struct_config__.tag == tag] or tables
-    return found[0] if found else None
 
 
 def _times(value: Any, factor: float) -> Any:
