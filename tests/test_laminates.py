@@ -138,10 +138,18 @@ PLY = {"thickness": 0.001, "angle": 0.0, **GLASS}
             {},
             r"material\.plies: the stack is not symmetric",
         ),
-        ({"plies": [PLY], "E": 1e9}, {}, r"\[material\] with plies takes shear_correction only"),
+        (
+            {"plies": [PLY], "E": 1e9},
+            {},
+            r"material\.E and material\.nu of a laminate are its in-plane constants",
+        ),
         ({"plies": [{**PLY, "nu12": 3.0}]}, {}, r"material\.plies\[0\]\.nu12 must satisfy"),
         ({"plies": [{**PLY, "G23": 0}]}, {}, r"material\.plies\[0\]\.G23 must be > 0 Pa"),
-        ({"plies": [{k: v for k, v in PLY.items() if k != "G13"}]}, {}, r"needs \['G13'\]"),
+        (
+            {"plies": [{k: v for k, v in PLY.items() if k != "G13"}]},
+            {},
+            r"\[material\.plies\[0\]\] needs 'G13'",
+        ),
         ({"plies": []}, {}, r"material\.plies must be a list of tables"),
         (
             {"plies": [PLY]},

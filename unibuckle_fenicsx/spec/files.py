@@ -267,7 +267,10 @@ def _laminate(api: dict[str, Any]) -> dict[str, Any]:
     except msgspec.ValidationError as err:
         raise InputError(_message(err, api, ["material", "plies"])) from None
     if not plies:
-        return api
+        raise InputError(
+            "material.plies must be a list of tables ([[material.plies]] in TOML), at least "
+            "one, got []"
+        )
     E, nu = laminate(plies).engineering_constants()
     api["material"] = {"E": E, "nu": nu, **material}
     plate = api.get("plate")

@@ -91,7 +91,9 @@ class Material(Table, frozen=True):
     def from_plies(cls, plies: Sequence[Ply], shear_correction: float = 5.0 / 6.0) -> Material:
         """The laminate of ``plies`` (bottom first), E and nu its in-plane constants."""
         if not plies:
-            raise InputError("material.plies: a laminate needs at least one ply")
+            raise InputError(
+                f"material.plies must be a list of tables, at least one, got {plies!r}"
+            )
         E, nu = laminate(plies).engineering_constants()
         return cls(E=E, nu=nu, shear_correction=shear_correction, plies=tuple(plies))
 

@@ -320,11 +320,11 @@ class PlateSpec(Table, frozen=True):
             if e.tag is not None or self.file is not None:
                 continue
             where = f"edges.{e.name}"
+            allowed = [*EDGE_NAMES, HOLES] if self.holes else list(EDGE_NAMES)
+            if self.outline is None and e.name not in allowed:
+                raise InputError(f"unknown key(s) [{e.name!r}] in [edges]; allowed: {allowed}")
             if e.name == HOLES:
                 _check_holes_edge(e, bool(self.holes))
-            elif self.outline is None and e.name not in EDGE_NAMES:
-                allowed = [*EDGE_NAMES, HOLES] if self.holes else list(EDGE_NAMES)
-                raise InputError(f"unknown key(s) [{e.name!r}] in [edges]; allowed: {allowed}")
             elif (self.outline is None) != (e.segments is None):
                 raise InputError(
                     f"{where}.segments names segments of plate.outline, which this plate does "
