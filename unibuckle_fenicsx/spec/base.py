@@ -313,7 +313,10 @@ _SIGNS = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
 def _range(tp: Any) -> str:
     """The range of ``tp``'s Meta: "> 0 m", "in (-1, 0.5)", "a list of at least 3 entries"."""
     if (size := metadata(tp, "min_length")) is not None:
-        return f"a list of at least {size} entries"
+        text = (
+            "string of at least {} characters" if bare(tp) is str else "list of at least {} entries"
+        )
+        return "a " + text.format(size)
     bounds = {op: v for op in _SIGNS if (v := metadata(tp, op)) is not None}
     suffix = f" {metadata(tp, 'unit')}" if metadata(tp, "unit") else ""
     if len(bounds) == 2:  # an interval

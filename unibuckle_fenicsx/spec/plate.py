@@ -131,7 +131,7 @@ class EdgeSpec(Table, frozen=True):
 
     def key(self) -> str:
         """``edges.NAME``."""
-        return f"edges.{self.name}"
+        return f"edges.{self.name}" if self.name else "edges"
 
     def check(self) -> None:
         """The rules between this table's fields."""
