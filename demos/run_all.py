@@ -92,7 +92,7 @@ def _table(rows: list[list[str]]) -> tuple[str, str]:
 
 def _compare_cases(paper: dict[str, dict[str, Any]], figures: Path) -> list[str]:
     """Section A of every case on the paper's mesh, and the paper's comparisons."""
-    from unibuckle_fenicsx.cases import paper_case
+    from unibuckle_fenicsx.spec.cases import paper_case
     from unibuckle_fenicsx.viz import plotting
     from unibuckle_fenicsx.viz.fields import mirror_to_match, zone_box
 

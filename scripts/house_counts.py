@@ -42,7 +42,9 @@ def _module(path: Path) -> str:
     return ".".join(parts)
 
 
-def _long_defs(trees: dict[Path, ast.Module]) -> tuple[list[tuple[str, int]], list[tuple[str, int]]]:
+def _long_defs(
+    trees: dict[Path, ast.Module],
+) -> tuple[list[tuple[str, int]], list[tuple[str, int]]]:
     functions, classes = [], []
     for path, tree in trees.items():
         rel = path.relative_to(ROOT)

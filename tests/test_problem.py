@@ -2,21 +2,20 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 from mpi4py import MPI
 
 import dolfinx
 
 import numpy as np
 import pytest
+from msgspec.structs import replace
 
 from unibuckle_fenicsx import EdgeSpec, MeshSpec, ObstacleSpec, PlateSpec, paper_case
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.la.eigen import GEPSolver
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
+from unibuckle_fenicsx.spec.cases import plate_case
 
 
 def test_user_mesh_with_own_tags_matches_rectangle():

@@ -23,7 +23,6 @@ import pytest
 from conftest import ROOT, run_mpi
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK
 from unibuckle_fenicsx.spec import (
     MeshSpec,
@@ -32,6 +31,7 @@ from unibuckle_fenicsx.spec import (
     problem_from_dict,
     problem_to_dict,
 )
+from unibuckle_fenicsx.spec.cases import plate_case
 from unibuckle_fenicsx.sweep import (
     Variation,
     parse_variation,

@@ -7,7 +7,6 @@ first use.
 
 from typing import Any
 
-from unibuckle_fenicsx.cases import CASES, paper_case
 from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
@@ -18,6 +17,7 @@ from unibuckle_fenicsx.spec import (
     SolverSpec,
     load_toml,
 )
+from unibuckle_fenicsx.spec.cases import CASES, paper_case
 
 __version__ = "0.1.0"
 

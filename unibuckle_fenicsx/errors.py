@@ -2,9 +2,9 @@
 
 - :class:`InputError`: the user's input is wrong (a problem file, a keyword argument, a
   command-line flag). The message names the key and the allowed range; it is raised before
-  any solve. Its subclasses say which input: :class:`EmptyZoneError` (an obstacle zone
-  holds no free mesh node), :class:`BilateralZoneError` (zones on both sides of the plate
-  share a node).
+  any solve. Its subclasses say which input: :class:`FieldError` (a rule between the
+  fields of one table is broken), :class:`EmptyZoneError` (an obstacle zone holds no free
+  mesh node), :class:`BilateralZoneError` (zones on both sides of the plate share a node).
 - :class:`NumericalError`: a solve that did not converge or found nothing admissible:
   :class:`EigenSolveError` (an eigen solve did not converge),
   :class:`NoAdmissibleModeError` (no admissible mode with a finite load),
@@ -24,6 +24,7 @@ __all__ = [
     "BilateralZoneError",
     "EigenSolveError",
     "EmptyZoneError",
+    "FieldError",
     "InputError",
     "NoAdmissibleModeError",
     "NonlinearError",
@@ -46,6 +47,19 @@ class EmptyZoneError(InputError):
 
 class BilateralZoneError(InputError):
     """Obstacles on opposite sides of the plate share a mesh node."""
+
+
+class FieldError(InputError):
+    """A rule between the fields of one table of a problem, broken at ``field`` ("": the table).
+
+    The message names the field by the table's key in code (``obstacle.gap``); the loader
+    of a file, which knows where the table lies, names it there (``obstacles[1].gap``).
+    """
+
+    def __init__(self, table: str, field: str, text: str) -> None:
+        self.field, self.text = field, text
+        where = f"[{table}]" if not field else f"{table}.{field}" if table else field
+        super().__init__(where + text)
 
 
 class NumericalError(UnibuckleError, RuntimeError):

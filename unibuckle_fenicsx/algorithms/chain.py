@@ -4,7 +4,7 @@ For a rigid obstacle (any side, several zones) the chain is
 
 1. **Nested interior-point Newton** (:mod:`.interior_point`). On the coarsest mesh (a
    structured plate's cells halved, a gmsh plate's cell size doubled, while the shorter
-   side keeps ``coarse_min_cells`` cells; a user's mesh has one level) the method runs
+   side keeps ``explore_min_cells`` cells; a user's mesh has one level) the method runs
    from a few starts (the parts of the free plate's first two modes on either side of
    the obstacle, the deflection under a pressure on the whole zone, on either end and in
    the middle): the buckle may sit
@@ -46,9 +46,9 @@ from __future__ import annotations
 import logging
 import math
 import time
-from dataclasses import replace
 
 from msgspec import UNSET
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
@@ -161,7 +161,7 @@ def _gmsh_levels(problem: UnilateralProblem) -> bool:
 def _coarser(problem: UnilateralProblem, options: ChainOptions) -> list[ProblemSpec]:
     """The problem on coarser meshes, coarsest first.
 
-    Coarser while the shorter side keeps ``coarse_min_cells`` cells. A structured
+    Coarser while the shorter side keeps ``explore_min_cells`` cells. A structured
     rectangle's cells are halved (:func:`~.multilevel.mesh_levels`); a plate meshed by
     gmsh (outline, holes) is meshed again at twice the cell size, and again (the meshes
     are not nested: :class:`~.multilevel.Prolongation` interpolates between any two). A
@@ -170,14 +170,14 @@ def _coarser(problem: UnilateralProblem, options: ChainOptions) -> list[ProblemS
     """
     spec = problem.spec
     if problem.structured:
-        levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, options.coarse_min_cells)
+        levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, options.explore_min_cells)
         return [spec.with_mesh(nx, ny) for nx, ny in levels]
     if not _gmsh_levels(problem):
         return []
     assert spec.mesh.size is not None
     side, size = min(spec.plate.length, spec.plate.width), spec.mesh.size
     specs: list[ProblemSpec] = []
-    while side / (2.0 * size) >= options.coarse_min_cells:
+    while side / (2.0 * size) >= options.explore_min_cells:
         size *= 2.0
         try:
             specs.append(replace(spec, mesh=replace(spec.mesh, size=size)))
@@ -209,7 +209,7 @@ def _carry(
 ) -> tuple[list[Candidate], list[BarrierPoint]]:
     """Carry every point from ``problems[k - 1]`` to ``problems[k]``.
 
-    On an intermediate mesh the points whose loads lie more than ``refine_margin`` above
+    On an intermediate mesh the points whose loads lie more than ``carry_margin`` above
     the lowest are dropped (the meshes rank the arrangements better as they get finer);
     on the finest, the KKT points met are returned. ``newtons``: the method on each mesh
     (created here when missing), shared by the arrangements and tries.
@@ -230,7 +230,7 @@ def _carry(
             carried.append(new)
     if carried:
         lowest = min(p.load for p in carried)
-        carried = [p for p in carried if p.load <= lowest * (1.0 + options.refine_margin)]
+        carried = [p for p in carried if p.load <= lowest * (1.0 + options.carry_margin)]
     level.seconds += time.perf_counter() - tl
     _report(problems[k], level)
     return found, carried

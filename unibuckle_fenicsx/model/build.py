@@ -24,12 +24,14 @@ takes the same branch) before the error propagates.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 
 from mpi4py import MPI
 from petsc4py import PETSc
 
 import dolfinx
+
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError
 from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver

@@ -185,7 +185,7 @@ def explore(
 ) -> tuple[list[Candidate], list[Arrangement]]:
     """Run the starts on ``problem``: its KKT points, and the arrangements to carry up.
 
-    The distinct KKT points within ``refine_margin`` of the lowest (at most
+    The distinct KKT points within ``carry_margin`` of the lowest (at most
     ``arrangements``) are carried, each as its barrier point on the central path at
     ``level_mu`` and at ``flat_mu`` (see :mod:`unibuckle_fenicsx.algorithms.chain`).
     Without ``carry`` (``problem`` is the only mesh) no barrier point is made for a finer
@@ -244,7 +244,7 @@ def explore(
         found.sort(key=lambda cp: cp[0].load)
         carried: list[Arrangement] = []
         for cand, point in found if carry else []:
-            far = cand.load > found[0][0].load * (1.0 + options.refine_margin)
+            far = cand.load > found[0][0].load * (1.0 + options.carry_margin)
             twin = any(math.isclose(cand.load, a.load, rel_tol=options.twin_rtol) for a in carried)
             if far or twin or len(carried) == options.arrangements:
                 continue

@@ -212,9 +212,10 @@ class ChainOptions:
     The measurements behind the defaults are on :doc:`/verification/tuning`.
 
     Attributes:
-        coarse_min_cells: Fewest cells along the shorter side of the coarsest mesh
-            (>= 2): fewer rank the arrangements of the buckles wrongly, more make the
-            exploration slow.
+        explore_min_cells: Fewest cells along the shorter side of the coarsest mesh, where
+            the starts are explored (>= 2): fewer rank the arrangements of the buckles
+            wrongly, more make the exploration slow (the active set's multilevel has its
+            own, ``coarse_min_cells`` of :func:`~.active_set.solve_active_set`).
         seeds: Starts of the interior-point method on the coarsest mesh: "free-" and
             "free+" (the free mode's parts on either side of the obstacle), "pressure"
             (the deflection under a pressure on the whole zone), "end-low", "middle",
@@ -252,8 +253,8 @@ class ChainOptions:
         escapes: Saddle escapes allowed per run.
         escape_mu: Barrier parameter the run restarts with after an escape (small: a
             larger one would lift the flattened buckle again).
-        refine_margin: Critical states within this (relative) of the lowest on a mesh
-            are carried to the next.
+        carry_margin: Critical states within this (relative) of the lowest on a mesh
+            are carried to the next (the active set's ``refine_margin`` is its own).
         arrangements: ... at most this many.
         polish_iterations: Active-set iterates allowed to polish a contact set.
         quick_polish_iterations: ... on the first try of the fine mesh.
@@ -265,7 +266,7 @@ class ChainOptions:
         bound_budget: Eigen solves of the lattice lower bound (small zones).
     """
 
-    coarse_min_cells: int = 6
+    explore_min_cells: int = 6
     seeds: tuple[str, ...] = (
         "free-",
         "free+",
@@ -292,7 +293,7 @@ class ChainOptions:
     max_steps: int = 100
     escapes: int = 3
     escape_mu: float = 1e-10
-    refine_margin: float = 2e-3
+    carry_margin: float = 2e-3
     arrangements: int = 3
     polish_iterations: int = 25
     quick_polish_iterations: int = 5
