@@ -13,6 +13,7 @@ import dolfinx
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
 from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
+from unibuckle_fenicsx.algorithms.registry import FOUNDATION, entry
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.ownership import Owner
@@ -20,7 +21,7 @@ from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
 from unibuckle_fenicsx.results.assemble import assemble_result
 from unibuckle_fenicsx.results.record import BucklingResult
-from unibuckle_fenicsx.spec import ProblemSpec
+from unibuckle_fenicsx.spec import Method, ProblemSpec
 
 __all__ = ["Analysis", "choose_method", "solve"]
 
@@ -34,11 +35,15 @@ def choose_method(
 
     "auto" enumerates (with ``until_proven``: exact) when the 2^i candidate sets are at
     most ``max_candidates`` and their estimated time, 2^i times ``solve_time_s`` (the
-    timed free eigen solve), is at most ``enumeration_budget_s``; otherwise it
-    runs the active-set method. "enumerate" alone follows the paper's stopping rule.
+    timed free eigen solve), is at most ``enumeration_budget_s``; otherwise it runs
+    the interior-point method on thin plates (thickness below ``THIN_PLATE`` of the
+    shorter side) and the active-set method on the others. "enumerate" alone follows
+    the paper's stopping rule. A tensionless foundation runs its spring-set iteration
+    (:data:`~.algorithms.registry.FOUNDATION`). The name returned is a key of
+    :data:`~.algorithms.registry.REGISTRY`.
 
     Raises:
-        ValueError: ``candidate_parallel`` with a method other than enumeration, or with
+        InputError: ``candidate_parallel`` with a method other than enumeration, or with
             more candidate sets than ``max_candidates``.
     """
     options = spec.solver
@@ -48,16 +53,16 @@ def choose_method(
                 "--candidate-parallel splits the enumeration's candidate sets; a tensionless "
                 "foundation is solved by its spring-set iteration: drop --candidate-parallel"
             )
-        return "foundation", "tensionless foundation: spring-set iteration"
+        return FOUNDATION, "tensionless foundation: spring-set iteration"
     count = candidate_count(i)
     # 2^i in words a reader can take in (2^2581 has 777 digits).
     shown = str(count) if i <= 64 else f"10^{int(i * math.log10(2))}"
     estimate = math.inf if i > 1000 else count * solve_time_s
     if candidate_parallel:
-        if options.method not in ("auto", "enumerate"):
+        if options.method not in (Method.AUTO, Method.ENUMERATE):
             raise InputError(
                 f"--candidate-parallel splits the enumeration's candidate sets: it needs "
-                f'method "enumerate" or "auto", not {options.method!r}'
+                f'method "enumerate" or "auto", not \'{options.method}\''
             )
         if count > options.max_candidates:
             raise InputError(
@@ -66,13 +71,14 @@ def choose_method(
                 f"{options.max_candidates}: drop --candidate-parallel (the active-set "
                 "method distributes the mesh instead)"
             )
-        return "enumerate", f"--candidate-parallel: 2^{i} = {shown} candidate sets"
-    if options.method != "auto":
+        return Method.ENUMERATE, f"--candidate-parallel: 2^{i} = {shown} candidate sets"
+    if options.method != Method.AUTO:
         return options.method, "given"
     plate = spec.plate
     slenderness = plate.thickness / min(plate.length, plate.width)
-    local = "interior-point" if slenderness < THIN_PLATE else "active-set"
-    why = f"t/b = {slenderness:.3g} {'<' if local == 'interior-point' else '>='} {THIN_PLATE:g}"
+    thin = slenderness < THIN_PLATE
+    local = Method.INTERIOR_POINT if thin else Method.ACTIVE_SET
+    why = f"t/b = {slenderness:.3g} {'<' if thin else '>='} {THIN_PLATE:g}"
     if count > options.max_candidates:
         return local, (
             f"auto: 2^{i} = {shown} candidate sets exceed max_candidates = "
@@ -84,52 +90,11 @@ def choose_method(
             f"({solve_time_s:.3g} s per eigen solve), above enumeration_budget_s = "
             f"{options.enumeration_budget_s:g}; {why}"
         )
-    return "enumerate", (
+    return Method.ENUMERATE, (
         f"auto: 2^{i} = {shown} candidate sets, about {estimate:.3g} s "
         f"({solve_time_s:.3g} s per eigen solve), within enumeration_budget_s = "
         f"{options.enumeration_budget_s:g}"
     )
-
-
-def _run_method(
-    method: str, problem: UnilateralProblem, candidate_comm: MPI.Comm | None
-) -> UnilateralSolution:
-    if method == "enumerate":
-        from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
-
-        options = problem.spec.solver
-        return enumerate_contact_sets(
-            problem,
-            complete=options.complete,
-            max_candidates=options.max_candidates,
-            candidate_comm=candidate_comm,
-            # "auto" must be exact: the paper's stopping rule is not (docs: methods/enumeration).
-            until_proven=options.until_proven or options.method == "auto",
-        )
-    if method == "interior-point":
-        from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_interior_point
-
-        options = problem.spec.solver
-        return solve_interior_point(
-            problem,
-            ChainOptions(max_iterations=options.max_iterations, bound_budget=options.bound_budget),
-        )
-    if method == "active-set":
-        from unibuckle_fenicsx.algorithms.active_set import solve_active_set
-
-        options = problem.spec.solver
-        return solve_active_set(
-            problem, max_iterations=options.max_iterations, bound_budget=options.bound_budget
-        )
-    if method == "penalty":
-        from unibuckle_fenicsx.algorithms.penalty import solve_penalty
-
-        return solve_penalty(problem, problem.spec.solver.penalty)
-    if method == "foundation":
-        from unibuckle_fenicsx.algorithms.foundation import solve_foundation
-
-        return solve_foundation(problem, max_iterations=problem.spec.solver.max_iterations)
-    raise InputError(f"unknown method {method!r}")
 
 
 @dataclass
@@ -264,7 +229,7 @@ def _analyse(
             "i = %d constrained nodes; method %s (%s)", problem.num_constrained, method, reason
         )
         t1 = time.perf_counter()
-        solution = _run_method(method, problem, comm if candidate_parallel else None)
+        solution = entry(method).solve(problem, comm if candidate_parallel else None)
         problem.timings["unilateral_s"] = time.perf_counter() - t1
         if not math.isfinite(solution.load):
             raise NoAdmissibleModeError(
@@ -272,7 +237,7 @@ def _analyse(
                 f"lambda_free = {free.load!r} Pa"
             )
         t1 = time.perf_counter()
-        if method == "foundation":
+        if method == FOUNDATION:
             certificate = certify_foundation(problem, solution)
         else:
             certificate = certify(problem, solution)

@@ -59,7 +59,13 @@ from unibuckle_fenicsx.spec.plate import (
 )
 from unibuckle_fenicsx.spec.problem import ProblemSpec
 from unibuckle_fenicsx.spec.schema import accepted_keys, json_schema
-from unibuckle_fenicsx.spec.solver import METHODS, OPTIONS, Method, SolverSpec
+from unibuckle_fenicsx.spec.solver import (
+    METHODS,
+    OPTIONS,
+    FoundationOptions,
+    Method,
+    SolverSpec,
+)
 
 __all__ = [
     "CASES",
@@ -73,6 +79,7 @@ __all__ = [
     "Circle",
     "DesignSpec",
     "EdgeSpec",
+    "FoundationOptions",
     "LoadSpec",
     "Material",
     "MeshSpec",

@@ -140,6 +140,17 @@ class PenaltyOptions(Table, frozen=True):
     penalty: Penalty = default("penalty")
 
 
+class FoundationOptions(Table, frozen=True):
+    """The options of a tensionless foundation's spring-set iteration.
+
+    No :class:`Method` names it: a problem whose obstacle is a tensionless foundation
+    runs it under "auto" (meanings: :class:`SolverSpec`).
+    """
+
+    KEY: ClassVar[str] = "solver"
+    max_iterations: Iterations = default("max_iterations")
+
+
 #: Each method's options Struct: the ``[solver]`` options it reads.
 OPTIONS: dict[Method, type[Table]] = {
     Method.AUTO: AutoOptions,

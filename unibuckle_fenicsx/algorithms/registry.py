@@ -1,0 +1,168 @@
+"""Each unilateral method once: what runs it, the options it reads, the links it may take.
+
+:class:`~unibuckle_fenicsx.spec.Method` names the methods a problem file and the command
+line may choose, and :data:`~unibuckle_fenicsx.spec.OPTIONS` gives each its options
+Struct, the ``[solver]`` keys it reads: the schema's choices, the command line's
+``--method`` choices and the flags that apply to each method are made from them (the
+command line reads them there, so that building its parser imports no PETSc).
+:data:`REGISTRY` adds what the problem's description cannot hold without importing the
+algorithms: the function that runs each method on a
+:class:`~unibuckle_fenicsx.model.problem.UnilateralProblem`, and the links its route may
+take (a result's ``route`` starts with the method and takes only those).
+:func:`unibuckle_fenicsx.analysis.solve` runs the method through it.
+
+"auto" chooses among the others (:func:`unibuckle_fenicsx.analysis.choose_method`) and
+runs nothing of its own. A tensionless foundation's spring-set iteration is chosen by the
+problem, never named in a file: it is registered under :data:`FOUNDATION` and is no
+:class:`~unibuckle_fenicsx.spec.Method`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from mpi4py import MPI
+
+import msgspec
+
+from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+from unibuckle_fenicsx.algorithms.chain import solve_interior_point
+from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
+from unibuckle_fenicsx.algorithms.foundation import solve_foundation
+from unibuckle_fenicsx.algorithms.interior_point.options import ChainOptions
+from unibuckle_fenicsx.algorithms.penalty import solve_penalty
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.model.problem import UnilateralProblem
+from unibuckle_fenicsx.spec import OPTIONS, FoundationOptions, Method, SolverSpec
+from unibuckle_fenicsx.spec.base import Table
+from unibuckle_fenicsx.spec.solver import (
+    ActiveSetOptions,
+    EnumerateOptions,
+    InteriorPointOptions,
+    PenaltyOptions,
+)
+
+__all__ = ["FOUNDATION", "REGISTRY", "MethodEntry", "entry"]
+
+#: The name of a tensionless foundation's spring-set iteration (a result's ``method``).
+FOUNDATION = "foundation"
+
+
+@dataclass(frozen=True)
+class MethodEntry:
+    """One method of the registry.
+
+    Attributes:
+        name: The method's name (a result's ``method``): a :class:`Method` value, or
+            :data:`FOUNDATION`.
+        options: Its options Struct: the ``[solver]`` keys it reads, with their defaults.
+        run: Runs it on a problem with those options; the third argument is the
+            communicator over which the enumeration splits its candidate sets (None:
+            each rank holds a part of the mesh; the other methods take None only).
+        links: The links its route may take (the first is the method itself, with which
+            every route starts).
+    """
+
+    name: str
+    options: type[Table]
+    run: Callable[[UnilateralProblem, Any, MPI.Comm | None], UnilateralSolution]
+    links: tuple[str, ...]
+
+    def options_of(self, solver: SolverSpec) -> Any:
+        """This method's options as ``solver`` (the problem's ``[solver]``) sets them."""
+        return msgspec.convert(solver, self.options, from_attributes=True)
+
+    def solve(
+        self, problem: UnilateralProblem, candidate_comm: MPI.Comm | None = None
+    ) -> UnilateralSolution:
+        """Run this method on ``problem`` with the options of its ``[solver]`` table.
+
+        Collective on ``problem``'s communicator.
+        """
+        return self.run(problem, self.options_of(problem.spec.solver), candidate_comm)
+
+
+def _enumerate(
+    problem: UnilateralProblem, options: EnumerateOptions, candidate_comm: MPI.Comm | None
+) -> UnilateralSolution:
+    return enumerate_contact_sets(
+        problem,
+        complete=options.complete,
+        max_candidates=options.max_candidates,
+        candidate_comm=candidate_comm,
+        # "auto" must be exact: the paper's stopping rule is not (docs: methods/enumeration).
+        until_proven=options.until_proven or problem.spec.solver.method == Method.AUTO,
+    )
+
+
+def _interior_point(
+    problem: UnilateralProblem, options: InteriorPointOptions, _: MPI.Comm | None
+) -> UnilateralSolution:
+    chain = ChainOptions(max_iterations=options.max_iterations, bound_budget=options.bound_budget)
+    return solve_interior_point(problem, chain)
+
+
+def _active_set(
+    problem: UnilateralProblem, options: ActiveSetOptions, _: MPI.Comm | None
+) -> UnilateralSolution:
+    return solve_active_set(
+        problem, max_iterations=options.max_iterations, bound_budget=options.bound_budget
+    )
+
+
+def _penalty(
+    problem: UnilateralProblem, options: PenaltyOptions, _: MPI.Comm | None
+) -> UnilateralSolution:
+    return solve_penalty(problem, options.penalty)
+
+
+def _foundation(
+    problem: UnilateralProblem, options: FoundationOptions, _: MPI.Comm | None
+) -> UnilateralSolution:
+    return solve_foundation(problem, max_iterations=options.max_iterations)
+
+
+#: Every method that runs, by name (``auto`` is a choice among them, not one of them).
+REGISTRY: dict[str, MethodEntry] = {
+    e.name: e
+    for e in (
+        MethodEntry(Method.ENUMERATE, OPTIONS[Method.ENUMERATE], _enumerate, ("enumerate",)),
+        MethodEntry(
+            Method.INTERIOR_POINT,
+            OPTIONS[Method.INTERIOR_POINT],
+            _interior_point,
+            # A polish or a descent after it, or the active set's route when it fails.
+            (
+                "interior-point",
+                "active-set-polish",
+                "feasible-descent",
+                "active-set",
+                "penalty-continuation",
+            ),
+        ),
+        MethodEntry(
+            Method.ACTIVE_SET,
+            OPTIONS[Method.ACTIVE_SET],
+            _active_set,
+            # Its fallbacks (:func:`.active_set.solve_active_set`) after it.
+            ("active-set", "penalty-continuation", "feasible-descent"),
+        ),
+        MethodEntry(Method.PENALTY, OPTIONS[Method.PENALTY], _penalty, ("penalty",)),
+        MethodEntry(FOUNDATION, FoundationOptions, _foundation, ("foundation", "arc-descent")),
+    )
+}
+
+
+def entry(name: str) -> MethodEntry:
+    """The registry's entry of the method ``name``.
+
+    Raises:
+        InputError: ``name`` is no method that runs ("auto" chooses one first).
+    """
+    try:
+        return REGISTRY[name]
+    except KeyError:
+        raise InputError(f"unknown method {name!r}: one of {', '.join(REGISTRY)} runs") from None
