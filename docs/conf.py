@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import sys
+import tomllib
 from pathlib import Path
 
 HERE = Path(__file__).resolve().parent
@@ -12,6 +13,8 @@ sys.path.insert(0, str(HERE.parent))
 # mpi4py first: the PyPI wheels of petsc4py and DOLFINx find the MPI library that
 # mpi4py loads, and autodoc may import any module of the package first.
 from mpi4py import MPI  # noqa: E402, F401
+
+from unibuckle_docs import MATHJAX_PATH, quickstart_numbers  # noqa: E402
 
 import unibuckle_fenicsx  # noqa: E402
 
@@ -34,7 +37,13 @@ source_suffix = {".md": "markdown", ".rst": "restructuredtext"}
 exclude_patterns = ["_build", "_generated", "Thumbs.db", ".DS_Store"]
 templates_path = ["_templates"]
 
-myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist"]
+myst_enable_extensions = ["dollarmath", "amsmath", "colon_fence", "deflist", "substitution"]
+# Numbers quoted on several pages, from one source each: docs/numbers.toml (the test count,
+# the make times) and the quickstart's stored output (figures/quickstart/, by make demo).
+myst_substitutions = {
+    **tomllib.loads((HERE / "numbers.toml").read_text()),
+    **{f"qs_{key}": value for key, value in quickstart_numbers().items()},
+}
 myst_heading_anchors = 3
 
 autosummary_generate = True
@@ -49,9 +58,14 @@ napoleon_google_docstring = True
 napoleon_numpy_docstring = False
 napoleon_use_ivar = True
 
+# MathJax from a local copy (docs/_ext/unibuckle_docs.py copies it into _static): the
+# site renders its equations without a network.
+mathjax_path = MATHJAX_PATH
+
 html_theme = "furo"
 html_title = f"unibuckle_fenicsx {release}"
-html_static_path: list[str] = []
+html_static_path = ["_static"]
+html_css_files = ["unibuckle.css"]
 
 # The figures live in the repository's figures/ (written by `make demo`).
 html_extra_path: list[str] = []

@@ -14,6 +14,10 @@ Markdown files under ``docs/_generated/`` (not kept in git), which the pages inc
   line, as the bench scripts' ``--json FILE`` writes them), with the command that
   reproduces it.
 
+The site loads no script from the network: MathJax comes from the ``django-static-mathjax``
+wheel of the ``docs`` extra (MathJax 3.2.2, the same files as the npm package), copied into
+``_static/mathjax`` when the site is written (:func:`copy_mathjax`).
+
 The functions are importable without Sphinx (``tests/test_docs.py`` uses them).
 """
 
@@ -640,6 +644,55 @@ def demo_pages() -> dict[str, str]:
 
 
 # --------------------------------------------------------------------------------------
+# The quickstart's numbers
+# --------------------------------------------------------------------------------------
+
+#: The output ``make demo`` stores for the quickstart (``demos/run_all.py``).
+QUICKSTART = ROOT / "figures" / "quickstart"
+
+_SUMMARY = re.compile(
+    r"lambda_c = (?P<load>\S+) Pa \((?P<ratio>\S+) x free (?P<free>\S+) Pa\), "
+    r"k = (?P<k>\S+), method (?P<method>\S+)\s+i=(?P<i>\d+) \|Z\|=(?P<z>\d+)\s+"
+    r"KKT=(?P<kkt>\w+)\s+proven=(?P<proven>\w+) \(KKT only, m=(?P<m>\d+)\), "
+    r"(?P<solves>\d+) eigensolves, (?P<seconds>\S+) s"
+)
+_BOUND = re.compile(r"lies between (?P<lower>\S+) Pa .* and (?P<upper>\S+) Pa")
+_DESIGN = re.compile(r"slenderness (?P<slenderness>\S+), rho = (?P<rho>\S+), ")
+_ZONE = re.compile(r"cover (?P<cover>\S+)% of its area \((?P<nodes>\d+) nodes\)")
+
+
+def quickstart_numbers(folder: Path = QUICKSTART) -> dict[str, str]:
+    """The numbers the quickstart's text quotes, read off the output it shows.
+
+    ``{name: text}`` for MyST substitutions (``{{ name }}`` in the page): the loads in MPa,
+    the ratio, k, the node counts, the zone's cover, the design output, and two numbers
+    worked out from them by hand's formulas (the load over the yield stress of the problem
+    file, the relative slenderness at the lower bound, EN 1993-1-5 (4.3)).
+    """
+    import tomllib
+
+    text = (folder / "output.txt").read_text()
+    found: dict[str, str] = {}
+    for pattern in (_SUMMARY, _BOUND, _DESIGN, _ZONE):
+        match = pattern.search(text)
+        if match is None:
+            raise ValueError(f"{folder / 'output.txt'}: no match for {pattern.pattern!r}")
+        found.update(match.groupdict())
+    problem = tomllib.loads((ROOT / "demos" / "plate.toml").read_text())
+    fy = float(problem["design"]["yield_stress"])
+    mpa = {key: float(found[key]) / 1e6 for key in ("load", "free", "lower", "upper")}
+    return {
+        **found,
+        **{f"{key}_MPa": f"{value:.0f}" for key, value in mpa.items()},
+        "fy_MPa": f"{fy / 1e6:.0f}",
+        "load_over_fy": f"{float(found['load']) / fy:.1f}",
+        "slenderness_lower": f"{math.sqrt(fy / float(found['lower'])):.2f}",
+        "k_free": f"{float(found['k']) / float(found['ratio']):.2f}",
+        "rise_percent": f"{100 * (float(found['ratio']) - 1):.0f}",
+    }
+
+
+# --------------------------------------------------------------------------------------
 # Sphinx
 # --------------------------------------------------------------------------------------
 
@@ -661,11 +714,57 @@ def _builder_inited(app: Any) -> None:
     write_all()
 
 
+#: The parts of MathJax's ``es5`` build the pages use: the TeX and MathML input with its
+#: extensions (loaded on demand, e.g. ``\boldsymbol``), the CommonHTML output and its
+#: fonts, the context menu and the assistive MathML. Not copied: the SVG output and the
+#: speech rule engine's maps (4 MB, for the menu's speech option only).
+MATHJAX_PARTS = ("tex-mml-chtml.js", "input", "output/chtml", "ui", "a11y")
+#: Where the pages load it from (``conf.py``'s ``mathjax_path``, under ``_static``).
+MATHJAX_PATH = "mathjax/tex-mml-chtml.js"
+
+
+def mathjax_source() -> Path:
+    """The ``es5`` directory of the installed MathJax (the ``django-static-mathjax`` wheel)."""
+    try:
+        import mathjax  # type: ignore[import-not-found]
+    except ImportError as err:
+        raise RuntimeError(
+            "MathJax is not installed: pip install -e '.[docs]' (django-static-mathjax)"
+        ) from err
+    es5 = Path(mathjax.__file__).parent / "static" / "mathjax" / "es5"
+    if not (es5 / "tex-mml-chtml.js").is_file():
+        raise RuntimeError(f"no MathJax build at {es5} (django-static-mathjax changed layout)")
+    return es5
+
+
+def copy_mathjax(outdir: Path) -> Path:
+    """Copy :data:`MATHJAX_PARTS` and MathJax's licence into ``outdir/_static/mathjax``."""
+    import shutil
+
+    source = mathjax_source()
+    target = outdir / "_static" / "mathjax"
+    for part in MATHJAX_PARTS:
+        src, dst = source / part, target / part
+        if src.is_dir():
+            shutil.copytree(src, dst, dirs_exist_ok=True)
+        else:
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, dst)
+    shutil.copy2(source.parent / "LICENSE", target / "LICENSE")
+    return target
+
+
+def _build_finished(app: Any, exception: Exception | None) -> None:
+    if exception is None and app.builder.format == "html":
+        copy_mathjax(Path(app.outdir))
+
+
 def setup(app: Any) -> dict[str, Any]:
     """Sphinx extension entry point."""
     if str(ROOT) not in sys.path:
         sys.path.insert(0, str(ROOT))
     app.connect("builder-inited", _builder_inited)
+    app.connect("build-finished", _build_finished)
     # The package's docstrings write absolute values and set sizes as plain |w|, |Z|.
     app.connect("autodoc-process-docstring", _process_docstring)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
