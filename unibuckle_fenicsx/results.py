@@ -254,6 +254,8 @@ class BucklingResult:
             for name, load in self.edge_loads.items()
             if _load_text(load)
         ]
+        bound = self._bound_line(scale, unit)
+        bound = f"\n  {bound}" if bound else ""
         extra = "".join(f"\n  {line}" for line in self._model_lines())
         extra += "".join(f"\n  {text}" for text in map(_zone_text, self.obstacle_zones) if text)
         if loaded:
@@ -273,7 +275,34 @@ class BucklingResult:
             second = ""
         return (
             f"{self.case}: {head}, method {self.method}{z}, "
-            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{second}{extra}"
+            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{bound}{second}{extra}"
+        )
+
+    def _bound_line(self, scale: float, unit: str) -> str:
+        """Where the critical load lies when it is not proven: the verified bracket.
+
+        The printed load is that of an admissible mode, so the critical load is at most
+        it; the verified lower bound is the safe value (the free plate's load when nothing
+        closer was verified; ``--bracket`` may raise it). Empty when proven.
+        """
+        cert = self.certificate or {}
+        if not self.constrained_nodes or cert.get("global_optimum_proven"):
+            return ""
+        lower, upper = self.lower_bound_Pa, self.upper_bound_Pa
+        if lower is None:
+            return ""
+        by = cert.get("proven_by")
+        how = "the free plate's, by interlacing" if by == "interlacing" else f"by {by}"
+        high = "no admissible mode" if upper is None else f"{upper / scale:.6e} {unit}"
+        # Two or more pencil eigenvalues below: only the low-rank bracket may do better.
+        m = cert.get("negative_eigenvalues")
+        hint = ""
+        if by == "interlacing" and m is not None and m >= 2:
+            tried = (self.input or {}).get("solver", {}).get("bracket")
+            hint = "; --bracket verified no higher bound" if tried else "; --bracket may raise it"
+        return (
+            f"not proven: the critical load lies between {lower / scale:.6e} {unit} "
+            f"(verified lower bound, {how}) and {high}{hint}"
         )
 
     def _model_lines(self) -> list[str]:
