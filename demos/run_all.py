@@ -21,8 +21,10 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -41,6 +43,12 @@ DEMOS = (
     "demo_realistic.py",  # figures/realistic/; no row in the table
     "demo_column.py",  # figures/column/; no row in the table
 )
+#: The quickstart's runs (docs/guide/quickstart.md shows their output): the README's first
+#: problem file, as a user runs it, without and with --bracket.
+QUICKSTART = {
+    "output.txt": ["solve", "--config", "demos/plate.toml", "--json", "plate.json"],
+    "output_bracket.txt": ["solve", "--config", "demos/plate.toml", "--bracket"],
+}
 CASES = ("free", "c1", "c2", "c3")
 COLUMNS = (
     "case",
@@ -138,6 +146,38 @@ def _compare_cases(paper: dict[str, dict[str, Any]], figures: Path) -> list[str]
     return [name for name, ok in checks.items() if not ok]
 
 
+#: The wall time of a summary line: the one part of the output that changes between runs.
+_WALL_TIME = re.compile(r"eigensolves, [0-9.]+ s")
+
+
+def quickstart(figures: Path, env: dict[str, str]) -> list[str]:
+    """Run the quickstart's commands and keep their output in ``figures/quickstart/``.
+
+    The commands run as a user types them (the ``unibuckle`` of this Python, in the
+    repository's root; the JSON goes to a scratch directory). A stored output is rewritten
+    only when more than its wall time changed, so that ``make demo`` leaves an unchanged
+    answer untouched. Returns the commands that failed.
+    """
+    out = figures / "quickstart"
+    out.mkdir(parents=True, exist_ok=True)
+    unibuckle = str(Path(sys.executable).with_name("unibuckle"))
+    failed = []
+    with tempfile.TemporaryDirectory() as scratch:
+        for name, args in QUICKSTART.items():
+            argv = [unibuckle] + [str(Path(scratch, a)) if a.endswith(".json") else a for a in args]
+            proc = subprocess.run(argv, capture_output=True, text=True, env=env, cwd=ROOT)
+            if proc.returncode != 0:
+                failed.append(" ".join(["unibuckle", *args]))
+                print(proc.stdout, proc.stderr, sep="\n", file=sys.stderr)
+                continue
+            path = out / name
+            old = path.read_text() if path.exists() else ""
+            if _WALL_TIME.sub("", old) != _WALL_TIME.sub("", proc.stdout):
+                path.write_text(proc.stdout)
+            print(f"unibuckle {' '.join(args)}:\n{proc.stdout}", flush=True)
+    return failed
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the demos; return the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -155,6 +195,11 @@ def main(argv: list[str] | None = None) -> int:
     env = {**os.environ, "PYVISTA_OFF_SCREEN": "true", "OMP_NUM_THREADS": "1"}
     failed = []
     t_all = time.perf_counter()
+    if not args.coarse:  # the quickstart's plate is the README's, as it is
+        t0 = time.perf_counter()
+        bad = quickstart(figures, env)
+        print(f"quickstart: {'ok' if not bad else 'FAILED'} in {time.perf_counter() - t0:.1f} s")
+        failed += bad
     for demo in DEMOS:
         cmd = [sys.executable, str(ROOT / "demos" / demo), "--figures", str(figures)]
         if args.coarse:
