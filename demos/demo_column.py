@@ -119,6 +119,7 @@ with solve(spec, comm) as analysis:
             analysis.mode,
             figures / "mode.png",
             contact_coordinates=result.contact_coordinates,
+            contact_pressing=fields.pressing(result),
             title=title,
             tau=problem.tau,
         )
@@ -130,6 +131,7 @@ with solve(spec, comm) as analysis:
             boundary=spec.plate.boundary,
             zones=fields.zone_outlines(spec),
             contact_coordinates=result.contact_coordinates,
+            contact_pressing=fields.pressing(result),
             title=f"contact map: w / max|w|, contact nodes, tie bars at {TIE_SPACING:g} mm",
             tau=problem.tau,
             ties=ties,

@@ -105,6 +105,7 @@ with solve(spec, comm) as analysis:
             analysis.mode,
             figures / "mode.png",
             contact_coordinates=result.contact_coordinates,
+            contact_pressing=fields.pressing(result),
             title=title,
             tau=problem.tau,
         )
@@ -120,6 +121,7 @@ with solve(spec, comm) as analysis:
             holes=[circle_points(hole.center, hole.radius)],
             zones=fields.zone_outlines(spec),
             contact_coordinates=result.contact_coordinates,
+            contact_pressing=fields.pressing(result),
             title="contact map: mode w / max|w| and the nodes resting on the concrete",
             tau=problem.tau,
         )

@@ -36,6 +36,7 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
         pngs[f"{case}/convergence.png"] = conv
         pngs[f"{case}/section_A.png"] = line
         pngs[f"{case}/contact_set.png"] = line
+        pngs[f"{case}/contact_force.png"] = line
         for mesh in COARSE:
             pngs[f"{case}/mode_{mesh}.png"] = (h3, w3)
     for name in ("ssss", "loaded_edges_clamped"):  # charts.plot_sweep: 7.5 x 5 in at 150 dpi

@@ -77,6 +77,15 @@ class BucklingResult:
             (:func:`versions`).
         obstacle_zones: Per obstacle, the zone's area on the plate against the discrete
             zone's and its node count (:func:`~unibuckle_fenicsx.model.zones.zone_report`).
+        contact_force: The obstacle's push on the plate at each contact node, in the
+            order of ``contact_indices``: ``{"unit": "N/m", "push": [...],
+            "resolution": r}``. A linear buckling mode has no amplitude: the push is that
+            of the mode scaled to max |w| = 1 m (the nodal force ``-(A u - lambda B u)_k``,
+            in N per metre of the largest deflection). ``resolution``: the push double
+            precision cannot tell from zero (``load_resolution`` times the largest nodal
+            force of A u, N/m); a node whose push exceeds it *presses* the obstacle, the
+            others only *touch* it (zero deflection, no force). None without a rigid
+            obstacle (a tensionless foundation's springs are not contact forces).
     """
 
     case: str
@@ -112,6 +121,7 @@ class BucklingResult:
     input: dict[str, Any] | None = None
     versions: dict[str, str] = field(default_factory=dict)
     obstacle_zones: list[dict[str, Any]] = field(default_factory=list)
+    contact_force: dict[str, Any] | None = None
 
     @classmethod
     def from_solution(
@@ -225,6 +235,8 @@ class BucklingResult:
         )
         result.certificate = certificate.as_dict()
         result.details.update(solution.report())
+        if not problem.tensionless:
+            result.contact_force = _contact_force(problem, solution, result.load_resolution)
         return result
 
     def as_dict(self, timings: bool = True) -> dict[str, Any]:
@@ -357,6 +369,26 @@ class BucklingResult:
         if self.units == "SI" or len(tables) != len(reports):
             return [p["restraint"] for p in reports]
         return [PointSpec(**table).describe(self.units) for table in tables]
+
+
+def _contact_force(
+    problem: BucklingProblem, solution: UnilateralSolution, resolution: float | None
+) -> dict[str, Any]:
+    """The obstacle's push at each contact node of the returned mode (N/m; collective).
+
+    The mode is scaled to max |w| = 1 and oriented away from the obstacle, so the
+    residual ``r = A u - lambda B u`` at a contact node is the obstacle's reaction on it
+    with the sign of a pull: the push is ``-s_k r_k`` (``s_k`` the node's obstacle side).
+    """
+    if problem.contact is None:  # pragma: no cover (from_solution checked it)
+        raise ValueError("_contact_force: the problem has no obstacle")
+    r, au_inf, _ = problem.residual(solution.load, solution.candidate.mode.x.petsc_vec)
+    push = -problem.contact.values(r)[solution.active]
+    return {
+        "unit": "N/m",
+        "push": [float(f) for f in push],
+        "resolution": None if resolution is None else float(resolution * au_inf),
+    }
 
 
 def _gap_text(gap: float) -> str:

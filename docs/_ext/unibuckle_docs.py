@@ -555,15 +555,33 @@ DEMOS = {
     "free_plate": ("demo_free_plate.py", ["free/mode_20x20.png", "free/convergence.png"]),
     "obstacle_c1": (
         "demo_obstacle_c1.py",
-        ["c1/mode_20x20.png", "c1/section_A.png", "c1/contact_set.png", "c1/convergence.png"],
+        [
+            "c1/mode_20x20.png",
+            "c1/section_A.png",
+            "c1/contact_set.png",
+            "c1/contact_force.png",
+            "c1/convergence.png",
+        ],
     ),
     "obstacle_c2": (
         "demo_obstacle_c2.py",
-        ["c2/mode_20x20.png", "c2/section_A.png", "c2/contact_set.png", "c2/convergence.png"],
+        [
+            "c2/mode_20x20.png",
+            "c2/section_A.png",
+            "c2/contact_set.png",
+            "c2/contact_force.png",
+            "c2/convergence.png",
+        ],
     ),
     "obstacle_c3": (
         "demo_obstacle_c3.py",
-        ["c3/mode_20x20.png", "c3/section_A.png", "c3/contact_set.png", "c3/convergence.png"],
+        [
+            "c3/mode_20x20.png",
+            "c3/section_A.png",
+            "c3/contact_set.png",
+            "c3/contact_force.png",
+            "c3/convergence.png",
+        ],
     ),
     "garland": (
         "demo_garland.py",
