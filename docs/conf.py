@@ -14,7 +14,7 @@ sys.path.insert(0, str(HERE.parent))
 # mpi4py loads, and autodoc may import any module of the package first.
 from mpi4py import MPI  # noqa: E402, F401
 
-from unibuckle_docs import MATHJAX_PATH, quickstart_numbers  # noqa: E402
+from unibuckle_docs import MATHJAX_PATH, intersphinx_mapping, quickstart_numbers  # noqa: E402
 
 import unibuckle_fenicsx  # noqa: E402
 
@@ -30,6 +30,7 @@ extensions = [
     "sphinx.ext.autosummary",
     "sphinx.ext.napoleon",
     "sphinx.ext.mathjax",
+    "sphinx.ext.intersphinx",
     "unibuckle_docs",  # docs/_ext: the generated CLI, schema and benchmark pages
 ]
 
@@ -61,6 +62,26 @@ napoleon_use_ivar = True
 # MathJax from a local copy (docs/_ext/unibuckle_docs.py copies it into _static): the
 # site renders its equations without a network.
 mathjax_path = MATHJAX_PATH
+
+# Links to DOLFINx, NumPy, petsc4py, Python, ... The build has no network: the inventories
+# are written from a table of the objects the pages name (docs/_ext/unibuckle_docs.py,
+# INVENTORIES); the links go to the projects' online documentation.
+intersphinx_mapping = intersphinx_mapping()
+# Type hints as the package writes them (module aliases) resolve to their full names.
+_ALIASES = {
+    "npt.NDArray": "numpy.typing.NDArray",
+    "npt.ArrayLike": "numpy.typing.ArrayLike",
+    "np.float64": "numpy.float64",
+    "np.int64": "numpy.int64",
+    "np.int32": "numpy.int32",
+    "np.bool_": "numpy.bool",
+    "PETSc.Mat": "petsc4py.PETSc.Mat",
+    "PETSc.Vec": "petsc4py.PETSc.Vec",
+    "MPI.Comm": "mpi4py.MPI.Comm",
+    "Path": "pathlib.Path",
+}
+napoleon_type_aliases = _ALIASES
+autodoc_type_aliases = _ALIASES
 
 html_theme = "furo"
 html_title = f"unibuckle_fenicsx {release}"

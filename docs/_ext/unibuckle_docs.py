@@ -514,29 +514,91 @@ def bench_rows(path: Path) -> list[dict[str, Any]]:
     return rows
 
 
+#: The columns each results file's table shows, with their headers (words and units);
+#: every other scalar is in the file. A file not listed shows every scalar column.
+BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
+    "plates": [
+        ("case", "plate"),
+        ("mesh", "mesh"),
+        ("i", "i"),
+        ("contact_nodes", "\\|Z\\|"),
+        ("route", "route"),
+        ("levels", "per level: steps / factorisations / eigen solves"),
+        ("ratio", "time (free solves)"),
+        ("cli_ratio", "`unibuckle solve` (free solves)"),
+        ("m", "m"),
+        ("certificate", "certificate"),
+        ("k", "k"),
+        ("load_Pa", "λ_c (Pa)"),
+    ],
+    "certify": [
+        ("case", "case"),
+        ("mesh", "mesh"),
+        ("i", "i"),
+        ("contact_nodes", "\\|Z\\|"),
+        ("proven_by", "proven by"),
+        ("relative_gap", "gap"),
+        ("factorisations", "factorisations"),
+        ("solves", "solves"),
+        ("ratio", "certificate time (free solves)"),
+        ("load_Pa", "λ_c (Pa)"),
+    ],
+    "routes": [
+        ("case", "plate"),
+        ("mesh", "mesh"),
+        ("t_over_b", "t/b"),
+        ("auto", "auto's route"),
+        ("ip_ratio", "interior point (free solves)"),
+        ("ip_eigensolves", "its eigen solves"),
+        ("as_ratio", "active set (free solves)"),
+        ("as_eigensolves", "its eigen solves"),
+        ("load_difference", "load difference (AS − IP)/IP"),
+    ],
+}
+#: Long texts shown as numbered notes under the table (the cell holds the note's
+#: number and the text up to its first colon).
+BENCH_NOTES = {"plates": "certificate"}
+
+
 def bench_page(path: Path) -> str:
-    """A Markdown table of a results file's scalar columns, with its command."""
+    """A Markdown table of a results file's chosen columns, with its command and notes."""
     rows = bench_rows(path)
     name = path.stem
-    columns = list(
-        dict.fromkeys(
+    columns = BENCH_COLUMNS.get(name) or [
+        (key, key)
+        for key in dict.fromkeys(
             key
             for row in rows
             for key, value in row.items()
             if not isinstance(value, dict | list) and not key.endswith("_records")
         )
-    )
+    ]
     command = COMMANDS[name](rows) if name in COMMANDS else f"see bench/{name}.py"
+    noted = BENCH_NOTES.get(name)
+    notes: dict[str, int] = {}
     lines = [
         f"Reproduce with `{command}` (one JSON line per row, appended to the file). "
-        f"Generated from `bench/results/{path.name}` ({len(rows)} rows) when these pages "
-        "were built.",
+        f"Generated from `bench/results/{path.name}` ({len(rows)} rows; every number of a "
+        "row is in the file) when these pages were built.",
         "",
-        "| " + " | ".join(columns) + " |",
+        "| " + " | ".join(header for _, header in columns) + " |",
         "|" + "---|" * len(columns),
     ]
     for row in rows:
-        lines.append("| " + " | ".join(_format(row.get(c)) for c in columns) + " |")
+        cells = []
+        for key, _ in columns:
+            value = row.get(key)
+            if key == noted and isinstance(value, str) and value:
+                number = notes.setdefault(value, len(notes) + 1)
+                cells.append(f"{_cell(value.split(':', 1)[0])} ({number})")
+            else:
+                cells.append(_format(value))
+        lines.append("| " + " | ".join(cells) + " |")
+    if notes:
+        lines += [""] + [f"({number}) {_cell(text)}" for text, number in notes.items()]
+        lines = lines[: -len(notes)] + [
+            f"({number}) {_cell(text)}\n" for text, number in notes.items()
+        ]
     return "\n".join(lines) + "\n"
 
 
@@ -646,11 +708,31 @@ def percent_to_myst(source: str) -> str:
     return "\n\n".join(out) + "\n"
 
 
+#: Where ``make demo`` keeps each demo's printed output (``demos/run_all.py``).
+OUTPUTS = ROOT / "figures" / "output"
+
+
 def demo_pages() -> dict[str, str]:
-    """``{demo_<name>.md: page}``: the script rendered, then its stored figures."""
+    """``{demo_<name>.md: page}``: a download link, the script, its output and figures.
+
+    The output is the one ``make demo`` stored (``figures/output/<script>.txt``); the
+    build runs nothing.
+    """
     pages = {}
     for name, (script, figures) in DEMOS.items():
-        text = percent_to_myst((ROOT / "demos" / script).read_text())
+        text = (
+            f"{{download}}`Download the script demos/{script} <../../demos/{script}>` "
+            f"(run it with `python demos/{script}`; all demos: `make demo`).\n\n"
+        )
+        text += percent_to_myst((ROOT / "demos" / script).read_text())
+        output = OUTPUTS / script.replace(".py", ".txt")
+        if output.exists():
+            text += (
+                "\n## Output\n\nWhat the script printed when `make demo` last ran it "
+                f"(`figures/output/{output.name}`):\n\n"
+                f"```{{literalinclude}} ../../figures/output/{output.name}\n"
+                ":language: text\n```\n"
+            )
         text += (
             f"\n## Figures\n\nWritten by `python demos/{script}` (all demos: `make demo`), "
             "as stored in the repository's `figures/`:\n\n"
@@ -659,6 +741,182 @@ def demo_pages() -> dict[str, str]:
             text += f"![{fig}](../../figures/{fig})\n\n"
         pages[f"demo_{name}.md"] = text
     return pages
+
+
+def gallery() -> str:
+    """The demos' thumbnail gallery: each demo's first figure, linked to its page."""
+    cells = []
+    for name, (script, figures) in DEMOS.items():
+        cells.append(
+            f"```{{figure}} ../../figures/{figures[0]}\n:target: {name}.html\n"
+            f":alt: {name}\n\n[{name.replace('_', ' ')}]({name}.md): `demos/{script}`\n```\n"
+        )
+    return "::::{container} gallery\n\n" + "\n".join(cells) + "\n::::\n"
+
+
+# --------------------------------------------------------------------------------------
+# Links to other projects' documentation, offline (intersphinx)
+# --------------------------------------------------------------------------------------
+
+#: The other projects' objects the pages and docstrings name, with their pages: the
+#: intersphinx inventories (``objects.inv``) the build would download, written here from
+#: this table instead, since the build has no network. Each entry: (role, page and
+#: anchor under the project's base address). Private paths that type hints produce
+#: (``numpy._typing._array_like.NDArray``, ``dolfinx.fem.function.Function``) point to
+#: the public object's page.
+INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
+    "python": (
+        "https://docs.python.org/3/",
+        {
+            "collections.abc.Callable": ("class", "library/collections.abc.html#$"),
+            "collections.abc.Iterator": ("class", "library/collections.abc.html#$"),
+            "collections.abc.Mapping": ("class", "library/collections.abc.html#$"),
+            "collections.abc.Sequence": ("class", "library/collections.abc.html#$"),
+            "pathlib.Path": ("class", "library/pathlib.html#$"),
+            "argparse.ArgumentParser": ("class", "library/argparse.html#$"),
+            "argparse.Namespace": ("class", "library/argparse.html#$"),
+        },
+    ),
+    "numpy": (
+        "https://numpy.org/doc/stable/",
+        {
+            "numpy.ndarray": ("class", "reference/generated/numpy.ndarray.html#$"),
+            "numpy.float64": ("class", "reference/arrays.scalars.html#$"),
+            "numpy.int64": ("class", "reference/arrays.scalars.html#$"),
+            "numpy.int32": ("class", "reference/arrays.scalars.html#$"),
+            "numpy.bool": ("class", "reference/arrays.scalars.html#$"),
+            "numpy.bool_": ("class", "reference/arrays.scalars.html#numpy.bool"),
+            "numpy.typing.NDArray": ("data", "reference/typing.html#$"),
+            "numpy.typing.ArrayLike": ("data", "reference/typing.html#$"),
+            "numpy._typing._array_like.NDArray": (
+                "data",
+                "reference/typing.html#numpy.typing.NDArray",
+            ),
+            "numpy._typing._array_like.ArrayLike": (
+                "data",
+                "reference/typing.html#numpy.typing.ArrayLike",
+            ),
+        },
+    ),
+    "petsc4py": (
+        "https://petsc.org/release/petsc4py/",
+        {
+            f"petsc4py.PETSc.{name}": ("class", f"reference/petsc4py.PETSc.{name}.html#$")
+            for name in ("Vec", "Mat", "KSP", "PC", "Options", "Viewer")
+        },
+    ),
+    "slepc4py": (
+        "https://slepc.upv.es/slepc4py-current/docs/apiref/",
+        {"slepc4py.SLEPc.EPS": ("class", "slepc4py.SLEPc.EPS-class.html")},
+    ),
+    "mpi4py": (
+        "https://mpi4py.readthedocs.io/en/stable/",
+        {"mpi4py.MPI.Comm": ("class", "reference/mpi4py.MPI.Comm.html#$")},
+    ),
+    "dolfinx": (
+        "https://docs.fenicsproject.org/dolfinx/v0.11.0/python/",
+        {
+            "dolfinx.fem.Function": ("class", "generated/dolfinx.fem.html#$"),
+            "dolfinx.fem.function.Function": (
+                "class",
+                "generated/dolfinx.fem.html#dolfinx.fem.Function",
+            ),
+            "dolfinx.fem.FunctionSpace": ("class", "generated/dolfinx.fem.html#$"),
+            "dolfinx.fem.function.FunctionSpace": (
+                "class",
+                "generated/dolfinx.fem.html#dolfinx.fem.FunctionSpace",
+            ),
+            "dolfinx.fem.Constant": ("class", "generated/dolfinx.fem.html#$"),
+            "dolfinx.fem.function.Constant": (
+                "class",
+                "generated/dolfinx.fem.html#dolfinx.fem.Constant",
+            ),
+            "dolfinx.fem.DirichletBC": ("class", "generated/dolfinx.fem.html#$"),
+            "dolfinx.fem.bcs.DirichletBC": (
+                "class",
+                "generated/dolfinx.fem.html#dolfinx.fem.DirichletBC",
+            ),
+            "dolfinx.mesh.Mesh": ("class", "generated/dolfinx.mesh.html#$"),
+            "dolfinx.mesh.MeshTags": ("class", "generated/dolfinx.mesh.html#$"),
+            "dolfinx.la.Vector": ("class", "generated/dolfinx.la.html#$"),
+            "dolfinx.io.gmsh.model_to_mesh": ("function", "generated/dolfinx.io.gmsh.html#$"),
+        },
+    ),
+    "ufl": (
+        "https://docs.fenicsproject.org/ufl/main/",
+        {
+            "ufl.core.expr.Expr": ("class", "api-doc/ufl.core.html#$"),
+            "ufl.form.Form": ("class", "api-doc/ufl.html#$"),
+            "ufl.argument.Argument": ("class", "api-doc/ufl.html#$"),
+        },
+    ),
+    "msgspec": (
+        "https://jcristharif.com/msgspec/",
+        {
+            "msgspec.Struct": ("class", "api.html#$"),
+            "msgspec.Meta": ("class", "api.html#$"),
+            "msgspec.UnsetType": ("class", "api.html#$"),
+            "msgspec.convert": ("function", "api.html#$"),
+        },
+    ),
+}
+
+
+def write_inventory(project: str, out: Path = GENERATED / "inventories") -> Path:
+    """Write ``project``'s :data:`INVENTORIES` entry as an intersphinx ``objects.inv``.
+
+    Sphinx's inventory format, version 2: four header lines, then zlib-compressed lines
+    ``name domain:role priority uri display`` (``$`` in the uri stands for the name).
+    """
+    import zlib
+
+    _, objects = INVENTORIES[project]
+    header = (
+        "# Sphinx inventory version 2\n"
+        f"# Project: {project}\n"
+        "# Version: \n"
+        "# The remainder of this file is compressed using zlib.\n"
+    )
+    body = "".join(f"{name} py:{role} 1 {uri} -\n" for name, (role, uri) in sorted(objects.items()))
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / f"{project}.inv"
+    data = header.encode() + zlib.compress(body.encode())
+    if not path.exists() or path.read_bytes() != data:
+        path.write_bytes(data)
+    return path
+
+
+def intersphinx_mapping() -> dict[str, tuple[str, str]]:
+    """``conf.py``'s ``intersphinx_mapping``: each project's address and local inventory."""
+    return {name: (base, str(write_inventory(name))) for name, (base, _) in INVENTORIES.items()}
+
+
+# --------------------------------------------------------------------------------------
+# The public API
+# --------------------------------------------------------------------------------------
+
+
+def public_names() -> list[str]:
+    """The package's public names: ``unibuckle_fenicsx.__all__`` (not ``__version__``)."""
+    import unibuckle_fenicsx
+
+    return [name for name in unibuckle_fenicsx.__all__ if not name.startswith("_")]
+
+
+def api_public_page() -> str:
+    """An autosummary table of :func:`public_names`, for ``reference/api.rst`` to include.
+
+    Generated from ``__all__``, so a name the package adds, moves or drops follows here
+    without an edit (its page comes from the object's docstring, wherever it lives).
+    """
+    lines = [
+        ".. autosummary::",
+        "   :toctree: _autosummary",
+        "   :nosignatures:",
+        "",
+    ]
+    lines += [f"   unibuckle_fenicsx.{name}" for name in public_names()]
+    return "\n".join(lines) + "\n"
 
 
 # --------------------------------------------------------------------------------------
@@ -718,7 +976,14 @@ def quickstart_numbers(folder: Path = QUICKSTART) -> dict[str, str]:
 def write_all(out: Path = GENERATED) -> list[Path]:
     """Write every generated page under ``out``; unchanged files are left untouched."""
     out.mkdir(parents=True, exist_ok=True)
-    pages = {**cli_pages(), "schema.md": schema_page(), **bench_pages(), **demo_pages()}
+    pages = {
+        **cli_pages(),
+        "schema.md": schema_page(),
+        **bench_pages(),
+        **demo_pages(),
+        "gallery.md": gallery(),
+        "api_public.rst": api_public_page(),
+    }
     written = []
     for name, text in pages.items():
         path = out / name
