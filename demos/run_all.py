@@ -225,7 +225,7 @@ def main(argv: list[str] | None = None) -> int:
         status = "ok" if proc.returncode == 0 else f"FAILED ({proc.returncode})"
         print(f"{demo}: {status} in {elapsed:.1f} s", flush=True)
         if proc.returncode == 0 and not args.coarse:
-            keep_output(figures / "output" / demo.replace(".py", ".txt"), proc.stdout)
+            keep_output(figures / "stdout" / demo.replace(".py", ".txt"), proc.stdout)
         if proc.returncode != 0:
             failed.append(demo)
             print(proc.stdout[-4000:], proc.stderr[-4000:], sep="\n", file=sys.stderr)

@@ -709,13 +709,13 @@ def percent_to_myst(source: str) -> str:
 
 
 #: Where ``make demo`` keeps each demo's printed output (``demos/run_all.py``).
-OUTPUTS = ROOT / "figures" / "output"
+OUTPUTS = ROOT / "figures" / "stdout"
 
 
 def demo_pages() -> dict[str, str]:
     """``{demo_<name>.md: page}``: a download link, the script, its output and figures.
 
-    The output is the one ``make demo`` stored (``figures/output/<script>.txt``); the
+    The output is the one ``make demo`` stored (``figures/stdout/<script>.txt``); the
     build runs nothing.
     """
     pages = {}
@@ -729,8 +729,8 @@ def demo_pages() -> dict[str, str]:
         if output.exists():
             text += (
                 "\n## Output\n\nWhat the script printed when `make demo` last ran it "
-                f"(`figures/output/{output.name}`):\n\n"
-                f"```{{literalinclude}} ../../figures/output/{output.name}\n"
+                f"(`figures/stdout/{output.name}`):\n\n"
+                f"```{{literalinclude}} ../../figures/stdout/{output.name}\n"
                 ":language: text\n```\n"
             )
         text += (
