@@ -7,7 +7,7 @@ PY := $(VENV)/bin/python
 export PYVISTA_OFF_SCREEN := true
 export OMP_NUM_THREADS := 1
 
-.PHONY: setup demo test test-all lint bench docs docs-check docs-nitpicky clean
+.PHONY: setup demo test test-all lint bench docs docs-check clean
 
 setup:
 	@bash scripts/setup-venv.sh $(VENV)
@@ -29,19 +29,14 @@ lint: setup
 bench: setup
 	$(PY) bench/bench_unilateral.py
 
-# Warnings are errors; the build runs no solve (the CLI help, the schema, the demo pages
+# Warnings are errors and every cross-reference must resolve (-n: the external ones through
+# the offline inventories of docs/_ext/unibuckle_docs.py); the build runs no solve (the CLI help, the schema, the demo pages
 # and the bench tables are generated from the package and the stored results).
 docs: setup
 	@$(PY) -c 'import sphinx, myst_parser, furo, mathjax' 2>/dev/null || $(PY) -m pip install --quiet -e '.[docs]'
 	@rm -rf docs/reference/_autosummary  # regenerated: a moved module leaves no stale page
-	$(PY) -m sphinx -W --keep-going -q -b html docs docs/_build/html
+	$(PY) -m sphinx -n -W --keep-going -q -b html docs docs/_build/html
 	@$(PY) scripts/check_site.py docs/_build/html
-
-# The nitpicky build: every cross-reference resolved (the external ones through the offline
-# inventories of docs/_ext/unibuckle_docs.py); prints the unresolved ones, not yet -W.
-docs-nitpicky: setup
-	$(PY) -m sphinx -n --keep-going -q -b html -w docs/_build/nitpicky.txt docs docs/_build/html-nitpicky || true
-	@grep -c "reference target not found" docs/_build/nitpicky.txt || true
 
 # The built site opened offline in headless Chromium (apt-get install chromium): every
 # equation typeset with the network off, and a screenshot per page kind to look at.

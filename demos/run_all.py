@@ -42,6 +42,7 @@ DEMOS = (
     "demo_nonlinear.py",  # figures/nonlinear/; no row in the table
     "demo_realistic.py",  # figures/realistic/; no row in the table
     "demo_column.py",  # figures/column/; no row in the table
+    "study_ties.py",  # figures/ties/: k against the tie spacing; no row in the table
 )
 #: The quickstart's runs (docs/guide/quickstart.md shows their output): the README's first
 #: problem file, as a user runs it, without and with --bracket.
@@ -214,7 +215,9 @@ def main(argv: list[str] | None = None) -> int:
         print(f"quickstart: {'ok' if not bad else 'FAILED'} in {time.perf_counter() - t0:.1f} s")
         failed += bad
     for demo in DEMOS:
-        cmd = [sys.executable, str(ROOT / "demos" / demo), "--figures", str(figures)]
+        # Relative to the repository when inside it: the outputs print figures/... paths.
+        where = figures.relative_to(ROOT) if figures.is_relative_to(ROOT) else figures
+        cmd = [sys.executable, str(ROOT / "demos" / demo), "--figures", str(where)]
         if args.coarse:
             cmd.append("--coarse")
         if args.output is not None and demo.startswith("demo_"):

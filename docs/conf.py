@@ -14,7 +14,12 @@ sys.path.insert(0, str(HERE.parent))
 # mpi4py loads, and autodoc may import any module of the package first.
 from mpi4py import MPI  # noqa: E402, F401
 
-from unibuckle_docs import MATHJAX_PATH, intersphinx_mapping, quickstart_numbers  # noqa: E402
+from unibuckle_docs import (  # noqa: E402
+    MATHJAX_PATH,
+    intersphinx_mapping,
+    public_callables,
+    quickstart_numbers,
+)
 
 import unibuckle_fenicsx  # noqa: E402
 
@@ -49,6 +54,9 @@ myst_heading_anchors = 3
 
 autosummary_generate = True
 autosummary_imported_members = False
+# The public names are documented once, on the API page (docs/reference/api.rst): the
+# module pages leave them out (docs/_templates/autosummary/module.rst).
+autosummary_context = {"public": public_callables()}
 autodoc_member_order = "bysource"
 # Classes and functions are not headings of the navigation: with them the furo sidebar of
 # every page holds the whole API, and the build takes twice as long.
@@ -67,7 +75,8 @@ mathjax_path = MATHJAX_PATH
 # are written from a table of the objects the pages name (docs/_ext/unibuckle_docs.py,
 # INVENTORIES); the links go to the projects' online documentation.
 intersphinx_mapping = intersphinx_mapping()
-# Type hints as the package writes them (module aliases) resolve to their full names.
+# Types in docstrings as the package writes them (module aliases) resolve to full names;
+# type hints keep their aliases, which the inventories list too.
 _ALIASES = {
     "npt.NDArray": "numpy.typing.NDArray",
     "npt.ArrayLike": "numpy.typing.ArrayLike",
@@ -81,7 +90,13 @@ _ALIASES = {
     "Path": "pathlib.Path",
 }
 napoleon_type_aliases = _ALIASES
-autodoc_type_aliases = _ALIASES
+# msgspec's bounds in the schema's type hints (Annotated[float, Meta(gt=0)]) are
+# rendered as words beside the type: they name no object.
+# Private names (a leading underscore: a base class, a helper) are not documented.
+nitpick_ignore_regex = [
+    ("py:class", r"(gt|ge|lt|le|min_length|max_length)=.*"),
+    ("py:(class|func|meth|attr|data)", r"(.*\.)?_\w+"),
+]
 
 html_theme = "furo"
 html_title = f"unibuckle_fenicsx {release}"

@@ -161,3 +161,27 @@ def test_realistic_plate_by_another_algorithm():
         stress = analysis.result.critical_load_Pa / 1e6  # MPa
     assert stored["method"] == "interior-point"
     assert stress == pytest.approx(stored["critical_stress_MPa"], rel=1e-9)
+
+
+def test_tie_spacing_table_is_the_study_s():
+    """The table of the real-plates page is study_ties.py's stored sweep, to its digits.
+
+    And the study's plate without ties is Navier's long SSSS plate, k = 4 (the mesh's
+    error at b/16 within 1 %); with the obstacle and no ties, the thin-plate limit 9/2
+    (an end buckle that touches down; verification/thin_plates) within 1 %.
+    """
+    import re
+
+    rows = json.loads((FIGURES / "ties" / "results.json").read_text())["rows"]
+    page = (ROOT / "docs" / "verification" / "real_plates_restraints.md").read_text()
+    cells = {
+        label: [float(x) for x in re.findall(r"\| ([0-9.]+)", line)]
+        for line in page.splitlines()
+        for label in ("against the obstacle", "bilateral (no obstacle)")
+        if line.startswith(f"| k, {label}")
+    }
+    assert [round(r["k"], 2) for r in rows] == cells["against the obstacle"]
+    assert [round(r["k_bilateral"], 2) for r in rows] == cells["bilateral (no obstacle)"]
+    none = rows[-1]
+    assert none["k_bilateral"] == pytest.approx(4.0, rel=0.01)
+    assert none["k"] == pytest.approx(4.5, rel=0.01)

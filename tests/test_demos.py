@@ -51,6 +51,7 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
     pngs["column/mode.png"] = (h3, w3)  # demo_column
     pngs["column/contact_map.png"] = line
     pngs["column/tie_spacing.png"] = (750, 1125)  # charts.plot_sweep
+    pngs["ties/tie_spacing_study.png"] = (750, 1125)  # study_ties: charts.plot_sweep
     return pngs
 
 
@@ -74,7 +75,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for demo in (
         "demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3",
-        "demo_garland", "demo_nonlinear", "demo_realistic", "demo_column",
+        "demo_garland", "demo_nonlinear", "demo_realistic", "demo_column", "study_ties",
     ):  # fmt: skip
         assert f"{demo}.py: ok" in proc.stdout
     assert "lambda/lambda_free" in proc.stdout and "eigen solves" in proc.stdout

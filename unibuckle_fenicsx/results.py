@@ -55,8 +55,10 @@ class BucklingResult:
             1e-9 to 1e-8 on thin plates, where the shear stiffness dominates; digits beyond
             it are rounding). None for a tensionless foundation (the springs' stiffness is
             not counted).
-        lower_bound_Pa / upper_bound_Pa: Verified bracket of the critical load (the upper
-            bound is the load of an admissible mode; None if the method found none).
+        lower_bound_Pa: Verified lower bound of the critical load (Pa): no admissible
+            mode has a lower load.
+        upper_bound_Pa: The load of an admissible mode (Pa), so an upper bound of the
+            critical load; None if the method found none.
         certificate: :class:`~unibuckle_fenicsx.certificate.certify.Certificate` as a dict.
         details: Method-specific information.
         timings: Seconds per phase.

@@ -672,6 +672,7 @@ DEMOS = {
         "demo_column.py",
         ["column/mode.png", "column/contact_map.png", "column/tie_spacing.png"],
     ),
+    "ties": ("study_ties.py", ["ties/tie_spacing_study.png"]),
 }
 
 
@@ -773,8 +774,14 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
             "collections.abc.Mapping": ("class", "library/collections.abc.html#$"),
             "collections.abc.Sequence": ("class", "library/collections.abc.html#$"),
             "pathlib.Path": ("class", "library/pathlib.html#$"),
+            "Path": ("class", "library/pathlib.html#pathlib.Path"),
             "argparse.ArgumentParser": ("class", "library/argparse.html#$"),
             "argparse.Namespace": ("class", "library/argparse.html#$"),
+            "enum.Enum": ("class", "library/enum.html#$"),
+            "enum.StrEnum": ("class", "library/enum.html#$"),
+            "logging.Logger": ("class", "library/logging.html#$"),
+            "math.fsum": ("function", "library/math.html#$"),
+            "itertools.combinations": ("function", "library/itertools.html#$"),
         },
     ),
     "numpy": (
@@ -786,23 +793,32 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
             "numpy.int32": ("class", "reference/arrays.scalars.html#$"),
             "numpy.bool": ("class", "reference/arrays.scalars.html#$"),
             "numpy.bool_": ("class", "reference/arrays.scalars.html#numpy.bool"),
-            "numpy.typing.NDArray": ("data", "reference/typing.html#$"),
-            "numpy.typing.ArrayLike": ("data", "reference/typing.html#$"),
+            "numpy.typing.NDArray": ("class", "reference/typing.html#$"),
+            "numpy.typing.ArrayLike": ("class", "reference/typing.html#$"),
             "numpy._typing._array_like.NDArray": (
-                "data",
+                "class",
                 "reference/typing.html#numpy.typing.NDArray",
             ),
             "numpy._typing._array_like.ArrayLike": (
-                "data",
+                "class",
                 "reference/typing.html#numpy.typing.ArrayLike",
             ),
+            # The aliases the package's type hints use (import numpy as np, ... as npt).
+            "npt.NDArray": ("class", "reference/typing.html#numpy.typing.NDArray"),
+            "npt.ArrayLike": ("class", "reference/typing.html#numpy.typing.ArrayLike"),
+            "np.ndarray": ("class", "reference/generated/numpy.ndarray.html#numpy.ndarray"),
+            "np.float64": ("class", "reference/arrays.scalars.html#numpy.float64"),
+            "np.int64": ("class", "reference/arrays.scalars.html#numpy.int64"),
+            "np.int32": ("class", "reference/arrays.scalars.html#numpy.int32"),
+            "np.bool_": ("class", "reference/arrays.scalars.html#numpy.bool"),
         },
     ),
     "petsc4py": (
         "https://petsc.org/release/petsc4py/",
         {
-            f"petsc4py.PETSc.{name}": ("class", f"reference/petsc4py.PETSc.{name}.html#$")
+            f"{prefix}PETSc.{name}": ("class", f"reference/petsc4py.PETSc.{name}.html")
             for name in ("Vec", "Mat", "KSP", "PC", "Options", "Viewer")
+            for prefix in ("petsc4py.", "")  # as the hints write it: from petsc4py import PETSc
         },
     ),
     "slepc4py": (
@@ -811,7 +827,10 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
     ),
     "mpi4py": (
         "https://mpi4py.readthedocs.io/en/stable/",
-        {"mpi4py.MPI.Comm": ("class", "reference/mpi4py.MPI.Comm.html#$")},
+        {
+            "mpi4py.MPI.Comm": ("class", "reference/mpi4py.MPI.Comm.html"),
+            "MPI.Comm": ("class", "reference/mpi4py.MPI.Comm.html"),
+        },
     ),
     "dolfinx": (
         "https://docs.fenicsproject.org/dolfinx/v0.11.0/python/",
@@ -848,6 +867,8 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
             "ufl.core.expr.Expr": ("class", "api-doc/ufl.core.html#$"),
             "ufl.form.Form": ("class", "api-doc/ufl.html#$"),
             "ufl.argument.Argument": ("class", "api-doc/ufl.html#$"),
+            "ufl.Argument": ("class", "api-doc/ufl.html#ufl.argument.Argument"),
+            "ufl.Form": ("class", "api-doc/ufl.html#ufl.form.Form"),
         },
     ),
     "msgspec": (
@@ -877,7 +898,12 @@ def write_inventory(project: str, out: Path = GENERATED / "inventories") -> Path
         "# Version: \n"
         "# The remainder of this file is compressed using zlib.\n"
     )
-    body = "".join(f"{name} py:{role} 1 {uri} -\n" for name, (role, uri) in sorted(objects.items()))
+    # A class entry is also written as py:type: Sphinx 9 refers to type aliases so.
+    body = "".join(
+        f"{name} py:{kind} 1 {uri} -\n"
+        for name, (role, uri) in sorted(objects.items())
+        for kind in ((role, "type") if role == "class" else (role,))
+    )
     out.mkdir(parents=True, exist_ok=True)
     path = out / f"{project}.inv"
     data = header.encode() + zlib.compress(body.encode())
@@ -896,6 +922,13 @@ def intersphinx_mapping() -> dict[str, tuple[str, str]]:
 # --------------------------------------------------------------------------------------
 
 
+def public_callables() -> list[str]:
+    """The public classes and functions (their pages are the API page's stubs)."""
+    import unibuckle_fenicsx
+
+    return [n for n in public_names() if callable(getattr(unibuckle_fenicsx, n))]
+
+
 def public_names() -> list[str]:
     """The package's public names: ``unibuckle_fenicsx.__all__`` (not ``__version__``)."""
     import unibuckle_fenicsx
@@ -907,16 +940,65 @@ def api_public_page() -> str:
     """An autosummary table of :func:`public_names`, for ``reference/api.rst`` to include.
 
     Generated from ``__all__``, so a name the package adds, moves or drops follows here
-    without an edit (its page comes from the object's docstring, wherever it lives).
+    without an edit (its page comes from the object's docstring, wherever it lives). The
+    stub pages are written by :func:`write_public_stubs` (autosummary does not read an
+    included file). Data (``CASES``) have no docstring of their own: they are listed with
+    their defining module's description instead.
     """
-    lines = [
-        ".. autosummary::",
-        "   :toctree: _autosummary",
-        "   :nosignatures:",
-        "",
-    ]
-    lines += [f"   unibuckle_fenicsx.{name}" for name in public_names()]
+    import unibuckle_fenicsx
+
+    lines = [".. autosummary::", "   :toctree: _autosummary", "   :nosignatures:", ""]
+    data = []
+    for name in public_names():
+        if callable(getattr(unibuckle_fenicsx, name)):
+            lines.append(f"   unibuckle_fenicsx.{name}")
+        else:
+            data.append(name)
+    for name in data:
+        home = _home_module(name)
+        lines += ["", f"``{name}``: :data:`{home}.{name}` (see :mod:`{home}`)."]
     return "\n".join(lines) + "\n"
+
+
+def _home_module(name: str) -> str:
+    """The module that defines the public data ``name`` (where its ``#:`` comment is)."""
+    import importlib
+    import pkgutil
+
+    import unibuckle_fenicsx
+
+    for info in pkgutil.iter_modules(unibuckle_fenicsx.__path__, "unibuckle_fenicsx."):
+        module = importlib.import_module(info.name)
+        if name in getattr(module, "__all__", ()) and name in vars(module):
+            value = vars(module)[name]
+            if value is getattr(unibuckle_fenicsx, name):
+                return info.name
+    return "unibuckle_fenicsx"
+
+
+def write_public_stubs(out: Path) -> list[Path]:
+    """The autosummary stub page of each public class and function, under ``out``."""
+    import inspect
+
+    import unibuckle_fenicsx
+
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name in public_names():
+        obj = getattr(unibuckle_fenicsx, name)
+        if not callable(obj):
+            continue
+        full = f"unibuckle_fenicsx.{name}"
+        if inspect.isclass(obj):
+            body = f".. autoclass:: {name}\n   :members:\n   :show-inheritance:\n"
+        else:
+            body = f".. autofunction:: {name}\n"
+        text = f"{full}\n{'=' * len(full)}\n\n.. currentmodule:: unibuckle_fenicsx\n\n{body}"
+        path = out / f"{full}.rst"
+        if not path.exists() or path.read_text() != text:
+            path.write_text(text)
+        written.append(path)
+    return written
 
 
 # --------------------------------------------------------------------------------------
@@ -995,6 +1077,7 @@ def write_all(out: Path = GENERATED) -> list[Path]:
 
 def _builder_inited(app: Any) -> None:
     write_all()
+    write_public_stubs(ROOT / "docs" / "reference" / "_autosummary")
 
 
 #: The parts of MathJax's ``es5`` build the pages use: the TeX and MathML input with its
@@ -1050,6 +1133,8 @@ def setup(app: Any) -> dict[str, Any]:
     app.connect("build-finished", _build_finished)
     # The package's docstrings write absolute values and set sizes as plain |w|, |Z|.
     app.connect("autodoc-process-docstring", _process_docstring)
+    # After intersphinx (priority 500): names the package's pages hold under another name.
+    app.connect("missing-reference", _missing_reference, priority=900)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
 
 
@@ -1071,3 +1156,158 @@ def escape_bars(line: str) -> str:
 
 def _process_docstring(app: Any, what: str, name: str, obj: Any, options: Any, lines: list[str]):
     lines[:] = [escape_bars(line) for line in lines]
+    if what in ("attribute", "data", "property"):
+        lines[:] = prose_type_restored(lines, name)
+
+
+_BUILTIN_TYPES = {"int", "float", "str", "bool", "bytes", "None", "dict", "list", "tuple", "set"}
+
+
+def _is_type(text: str, name: str) -> bool:
+    """Whether ``text`` reads as a type expression in the module of the object ``name``.
+
+    A type is words joined by ``.``, ``[ ]``, ``,`` and ``|``; a single word must be a
+    builtin type, a name of the object's module, or start with a module of its own
+    (``numpy.``): otherwise it is prose ("m", "Kind", "the zone").
+    """
+    import importlib
+
+    t = text.strip()
+    if not re.fullmatch(r"[\w.\[\], |]+", t):
+        return False
+    if re.search(r"\w \w", t.replace(" | ", "|").replace(", ", ",")):
+        return False
+    words = re.findall(r"[A-Za-z_][\w.]*", t)
+    module = None
+    parts = name.split(".")
+    for cut in range(len(parts), 0, -1):
+        try:
+            module = importlib.import_module(".".join(parts[:cut]))
+            break
+        except ImportError:
+            continue
+    for word in words:
+        head = word.split(".")[0]
+        if word in _BUILTIN_TYPES or head in ("numpy", "np", "npt", "typing", "collections"):
+            continue
+        if module is not None and hasattr(module, head):
+            continue
+        return False
+    return True
+
+
+def prose_type_restored(lines: list[str], name: str) -> list[str]:
+    """Undo napoleon's reading of an attribute's opening words as its type.
+
+    Napoleon takes the text before the first colon of an attribute's or property's
+    docstring as its type (``int: the count.``); the package's docstrings open with prose
+    there ("The plate's area (m^2): ..."), which became a type nobody can link. Such a
+    ``:type:`` line is put back in front of the description.
+    """
+    for k, line in enumerate(lines):
+        if line.startswith(":type: ") and not _is_type(line[len(":type: ") :], name):
+            prose = line[len(":type: ") :].strip()
+            rest = [ln for j, ln in enumerate(lines) if j != k]
+            while rest and not rest[-1].strip():
+                rest.pop()
+            first = next((j for j, ln in enumerate(rest) if ln.strip()), None)
+            if first is None:
+                return [prose]
+            rest[first] = f"{prose}: {rest[first]}"
+            return rest
+    return lines
+
+
+# --------------------------------------------------------------------------------------
+# References the package's own pages do not hold under the name used
+# --------------------------------------------------------------------------------------
+
+
+def _python_objects(env: Any) -> dict[str, Any]:
+    return dict(env.get_domain("py").objects)
+
+
+def reference_candidates(target: str, objects: dict[str, Any], module: str | None) -> list[str]:
+    """Documented names that ``target`` may mean, best first.
+
+    - ``unibuckle_fenicsx.spec.ProblemSpec`` (re-exported by a package): the object's
+      public name (``unibuckle_fenicsx.ProblemSpec``) or its defining module's name;
+    - a bare name (``ProblemSpec``, ``CASES``, ``ShiftedMatrix.bilinear``): the one
+      documented object whose name ends with it, the one in ``module`` first.
+    """
+    import importlib
+
+    found: list[str] = []
+    if target.startswith("unibuckle_fenicsx."):
+        parts = target.split(".")
+        for cut in range(len(parts) - 1, 0, -1):
+            try:
+                obj: Any = importlib.import_module(".".join(parts[:cut]))
+            except ImportError:
+                continue
+            try:
+                for attr in parts[cut:]:
+                    obj = getattr(obj, attr)
+            except AttributeError:
+                break
+            import unibuckle_fenicsx
+
+            found += [
+                f"unibuckle_fenicsx.{n}"
+                for n in public_names()
+                if getattr(unibuckle_fenicsx, n) is obj
+            ]
+            home = getattr(obj, "__module__", None)
+            qual = getattr(obj, "__qualname__", None)
+            if home and qual:
+                found.append(f"{home}.{qual}")
+            else:  # data (a tuple, a dict): the package's one object of that name
+                last = "." + parts[-1]
+                found += [n for n in objects if n.endswith(last) and n.startswith("unibuckle")]
+            break
+    else:
+        suffix = "." + target
+        matches = [n for n in objects if n.endswith(suffix) or n == target]
+        local = [n for n in matches if module and n.startswith(module + ".")]
+        public = [n for n in matches if n.count(".") == 1]
+        found += local or public or (matches if len(matches) == 1 else [])
+    return [n for n in dict.fromkeys(found) if n in objects]
+
+
+def _missing_reference(app: Any, env: Any, node: Any, contnode: Any) -> Any:
+    """Resolve what the py domain missed: re-exported and bare names, quoted hints."""
+    from docutils import nodes
+    from sphinx.util.nodes import make_refnode
+
+    if node.get("refdomain") != "py":
+        return None
+    target = str(node.get("reftarget", ""))
+    if target == "TypeAliasForwardRef":
+        # Sphinx's wrapper of a hint it could not evaluate: TypeAliasForwardRef('x.Y').
+        # Drop the wrapper and its parentheses; the inner name is a reference of its own.
+        parent, index = node.parent, node.parent.index(node)
+        siblings = parent.children
+        if index + 3 < len(siblings) and siblings[index + 1].astext() == "(":
+            parent.replace(siblings[index + 1], nodes.Text(""))
+            after = siblings[index + 3]
+            if isinstance(after, nodes.Text) and after.astext().startswith(")"):
+                parent.replace(after, nodes.Text(after.astext()[1:]))
+        return nodes.inline("", "")
+    bare = target.strip("'\"‘’")
+    if bare != target:  # a quoted hint: the name inside the quotes
+        node = node.deepcopy()
+        node["reftarget"] = bare
+        contnode = contnode.deepcopy()
+        contnode.children = [nodes.Text(bare)]
+        from sphinx.ext import intersphinx
+
+        resolved = intersphinx.missing_reference(app, env, node, contnode)
+        if resolved is not None:
+            return resolved
+    objects = _python_objects(env)
+    for name in reference_candidates(bare, objects, node.get("py:module")):
+        entry = objects[name]
+        return make_refnode(
+            app.builder, node["refdoc"], entry.docname, entry.node_id, contnode, name
+        )
+    return None

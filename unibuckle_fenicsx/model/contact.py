@@ -75,6 +75,7 @@ class BilateralZoneError(InputError):
     """Obstacles on opposite sides of the plate share a mesh node."""
 
 
+#: One obstacle, or several of them (a sequence).
 ObstacleLike = ObstacleSpec | Sequence[ObstacleSpec]
 
 
