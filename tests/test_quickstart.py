@@ -88,6 +88,12 @@ def test_stored_output_agrees_with_independent_formulas() -> None:
     assert 100.0 <= float(numbers["cover"]) <= 100 * largest, (numbers["cover"], largest)
 
 
+def test_no_substitution_inside_code() -> None:
+    """MyST substitutes nothing inside a code span: a number there would print {{ ... }}."""
+    spans = re.findall(r"`[^`\n]*`", PAGE)
+    assert not [span for span in spans if "{{" in span], spans
+
+
 def test_page_substitutions_exist() -> None:
     used = set(re.findall(r"\{\{ qs_(\w+) \}\}", PAGE))
     assert used, "the page quotes no number of the run"

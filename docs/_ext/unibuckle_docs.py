@@ -594,11 +594,9 @@ def bench_page(path: Path) -> str:
             else:
                 cells.append(_format(value))
         lines.append("| " + " | ".join(cells) + " |")
-    if notes:
-        lines += [""] + [f"({number}) {_cell(text)}" for text, number in notes.items()]
-        lines = lines[: -len(notes)] + [
-            f"({number}) {_cell(text)}\n" for text, number in notes.items()
-        ]
+    for text, number in notes.items():
+        flags = re.sub(r"(?<![\w`])(--[\w-]+|\w+\.\w+ = \w+)", r"`\1`", _cell(text))
+        lines += ["", f"({number}) {flags}"]
     return "\n".join(lines) + "\n"
 
 
@@ -721,11 +719,16 @@ def demo_pages() -> dict[str, str]:
     """
     pages = {}
     for name, (script, figures) in DEMOS.items():
-        text = (
+        download = (
             f"{{download}}`Download the script demos/{script} <../../demos/{script}>` "
             f"(run it with `python demos/{script}`; all demos: `make demo`).\n\n"
         )
-        text += percent_to_myst((ROOT / "demos" / script).read_text())
+        body = percent_to_myst((ROOT / "demos" / script).read_text())
+        if body.startswith("# "):  # under the page's title
+            title, _, rest = body.partition("\n")
+            text = f"{title}\n\n{download}{rest.lstrip()}"
+        else:
+            text = download + body
         output = OUTPUTS / script.replace(".py", ".txt")
         if output.exists():
             text += (
