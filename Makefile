@@ -22,8 +22,8 @@ test-all: setup
 	$(PY) -m pytest -n auto --dist loadfile tests -m "convergence or stress or slow or demo or not (convergence or stress or slow or demo)"
 
 lint: setup
-	$(VENV)/bin/ruff check unibuckle_fenicsx tests demos bench docs
-	$(VENV)/bin/ruff format --check unibuckle_fenicsx tests demos bench docs
+	$(VENV)/bin/ruff check unibuckle_fenicsx tests demos bench docs scripts
+	$(VENV)/bin/ruff format --check unibuckle_fenicsx tests demos bench docs scripts
 	$(VENV)/bin/mypy unibuckle_fenicsx
 
 bench: setup
