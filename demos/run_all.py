@@ -149,8 +149,9 @@ def _compare_cases(paper: dict[str, dict[str, Any]], figures: Path) -> list[str]
 
 #: The wall time of a summary line: the one part of the output that changes between runs.
 _WALL_TIME = re.compile(r"eigensolves, [0-9.]+ s")
-#: Any time in seconds a demo prints ("12.3 s", "in 4 s").
-_SECONDS = re.compile(r"\b[0-9]+(\.[0-9]+)? ?s\b")
+#: Any time in seconds a demo prints ("12.3 s", "in 4 s"), and a table's last column of
+#: two-decimal seconds (demo_nonlinear's "time (s)").
+_SECONDS = re.compile(r"\b[0-9]+(\.[0-9]+)? ?s\b|  +[0-9]+\.[0-9]{2}$", re.M)
 
 
 def keep_output(path: Path, text: str) -> bool:
