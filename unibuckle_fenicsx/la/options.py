@@ -26,7 +26,7 @@ __all__ = [
     "set_options",
 ]
 
-#: Option names (without prefix) and default values.
+#: PETSc/SLEPc options as a mapping: option name (without its prefix) to value.
 Options = Mapping[str, str | float | int | bool]
 
 

@@ -203,7 +203,7 @@ class Problem(Owner):
         return float(self.comm.allreduce(local, op=MPI.MAX))
 
     def solve_free(self) -> Mode:
-        """Smallest eigenpair without obstacle (computed once, then :attr:`free`).
+        """Smallest eigenpair without obstacle (computed once, then ``free``).
 
         Note:
             Collective.

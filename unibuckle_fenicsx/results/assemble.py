@@ -16,6 +16,7 @@ from unibuckle_fenicsx.model.zones import zone_report
 from unibuckle_fenicsx.results.record import (
     BucklingResult,
     CertificateRecord,
+    ContactForce,
     EdgeLoad,
     ResultDetails,
 )
@@ -94,7 +95,7 @@ def assemble_result(
     if solution is None or certificate is None:
         result.lower_bound_Pa = result.upper_bound_Pa = free.load
         return result
-    _contact(result, problem, solution)
+    unilateral = _contact(result, problem, solution)
     result.lower_bound_Pa = certificate.lower_bound
     result.upper_bound_Pa = (
         certificate.upper_bound if math.isfinite(certificate.upper_bound) else None
@@ -104,6 +105,8 @@ def assemble_result(
         result.details.run = solution.details
     if solution.lower_bound_by is not None:
         result.details.lower_bound_by = solution.lower_bound_by
+    if not problem.tensionless:
+        result.contact_force = _contact_force(unilateral, solution, result.load_resolution)
     return result
 
 
@@ -127,8 +130,13 @@ def _details(problem: Problem, free: Mode) -> ResultDetails:
     return details
 
 
-def _contact(result: BucklingResult, problem: Problem, solution: UnilateralSolution) -> None:
-    """The contact set of ``solution`` into ``result`` (collective: the DOFs are gathered)."""
+def _contact(
+    result: BucklingResult, problem: Problem, solution: UnilateralSolution
+) -> UnilateralProblem:
+    """The contact set of ``solution`` into ``result`` (collective: the DOFs are gathered).
+
+    Returns ``problem``, which has an obstacle.
+    """
     if not isinstance(problem, UnilateralProblem):
         raise TypeError("assemble_result: a solution without an obstacle (an internal invariant)")
     contact = problem.contact
@@ -141,6 +149,24 @@ def _contact(result: BucklingResult, problem: Problem, solution: UnilateralSolut
     result.contact_coordinates = contact.coordinates[active].tolist()
     result.contact_dofs = sorted(
         int(r) for part in problem.comm.allgather(rows.tolist()) for r in part
+    )
+    return problem
+
+
+def _contact_force(
+    problem: UnilateralProblem, solution: UnilateralSolution, resolution: float | None
+) -> ContactForce:
+    """The obstacle's push at each contact node of the returned mode (N/m; collective).
+
+    The mode is scaled to max |w| = 1 and oriented away from the obstacle, so the
+    residual ``r = A u - lambda B u`` at a contact node is the obstacle's reaction on it
+    with the sign of a pull: the push is ``-s_k r_k`` (``s_k`` the node's obstacle side).
+    """
+    r, au_inf, _ = problem.residual(solution.load, solution.candidate.mode.x.petsc_vec)
+    push = -problem.contact.values(r)[solution.active]
+    return ContactForce(
+        push=[float(f) for f in push],
+        resolution=None if resolution is None else float(resolution * au_inf),
     )
 
 

@@ -23,7 +23,14 @@ from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
 from unibuckle_fenicsx.spec import UNITS, PointSpec
 
-__all__ = ["BucklingResult", "CertificateRecord", "EdgeLoad", "ResultDetails", "jsonable"]
+__all__ = [
+    "BucklingResult",
+    "CertificateRecord",
+    "ContactForce",
+    "EdgeLoad",
+    "ResultDetails",
+    "jsonable",
+]
 
 #: An edge stress as a problem file writes it: a number, or [start, end] (linear).
 Stress = float | list[float]
@@ -36,6 +43,27 @@ class EdgeLoad(Struct, kw_only=True):
     shear_stress: Stress
     fixed_normal_stress: Stress | UnsetType = UNSET
     fixed_shear_stress: Stress | UnsetType = UNSET
+
+
+class ContactForce(Struct, kw_only=True):
+    """The obstacle's push on the plate at each contact node (the JSON's ``contact_force``).
+
+    A linear buckling mode has no amplitude: the push is that of the mode scaled to
+    max |w| = 1 m (the nodal force ``-(A u - lambda B u)_k``, in N per metre of the
+    largest deflection).
+
+    Attributes:
+        unit: "N/m".
+        push: The push at each contact node, in the order of ``contact_indices``.
+        resolution: The push double precision cannot tell from zero (``load_resolution``
+            times the largest nodal force of A u, N/m); a node whose push exceeds it
+            *presses* the obstacle, the others only *touch* it (zero deflection, no
+            force). None when the load's resolution is unknown.
+    """
+
+    unit: str = "N/m"
+    push: list[float]
+    resolution: float | None
 
 
 class CertificateRecord(Struct, kw_only=True):
@@ -138,8 +166,10 @@ class BucklingResult(Struct, kw_only=True):
             to it (:meth:`~unibuckle_fenicsx.model.problem.Problem.load_resolution`);
             digits beyond it are rounding. None for a tensionless foundation (the
             springs' stiffness is not counted).
-        lower_bound_Pa / upper_bound_Pa: Verified bracket of the critical load (the upper
-            bound is the load of an admissible mode; None if the method found none).
+        lower_bound_Pa: Verified lower bound of the critical load (Pa): no admissible
+            mode has a lower load.
+        upper_bound_Pa: The load of an admissible mode (Pa), so an upper bound of the
+            critical load; None if the method found none.
         certificate: The certificate's record (None without obstacle).
         details: The free solve, the model's notes, the algorithm's record.
         timings: Seconds per phase.
@@ -158,6 +188,9 @@ class BucklingResult(Struct, kw_only=True):
         versions: Versions of the package and of the libraries that computed the result.
         obstacle_zones: Per obstacle, the zone's area on the plate against the discrete
             zone's and its node count.
+        contact_force: The obstacle's push at each contact node (:class:`ContactForce`);
+            None without a rigid obstacle (a tensionless foundation's springs are not
+            contact forces).
     """
 
     case: str
@@ -194,6 +227,7 @@ class BucklingResult(Struct, kw_only=True):
     input: dict[str, Any] | None = None
     versions: dict[str, str] = {}
     obstacle_zones: list[ZoneReport] = []
+    contact_force: ContactForce | None = None
 
     @property
     def certified(self) -> bool:
@@ -234,6 +268,8 @@ class BucklingResult(Struct, kw_only=True):
             for name, load in self.edge_loads.items()
             if _load_text(load)
         ]
+        bound = self._bound_line(scale, unit)
+        bound = f"\n  {bound}" if bound else ""
         extra = "".join(f"\n  {line}" for line in self._model_lines())
         extra += "".join(f"\n  {text}" for text in map(_zone_text, self.obstacle_zones) if text)
         if loaded:
@@ -253,7 +289,34 @@ class BucklingResult(Struct, kw_only=True):
             second = ""
         return (
             f"{self.case}: {head}, method {self.method}{z}, "
-            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{second}{extra}"
+            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{bound}{second}{extra}"
+        )
+
+    def _bound_line(self, scale: float, unit: str) -> str:
+        """Where the critical load lies when it is not proven: the verified bracket.
+
+        The printed load is that of an admissible mode, so the critical load is at most
+        it; the verified lower bound is the safe value (the free plate's load when nothing
+        closer was verified; ``--bracket`` may raise it). Empty when proven.
+        """
+        cert = self.certificate
+        if not self.constrained_nodes or cert is None or cert.global_optimum_proven:
+            return ""
+        lower, upper = self.lower_bound_Pa, self.upper_bound_Pa
+        if lower is None:
+            return ""
+        by = cert.proven_by
+        how = "the free plate's, by interlacing" if by == "interlacing" else f"by {by}"
+        high = "no admissible mode" if upper is None else f"{upper / scale:.6e} {unit}"
+        # Two or more pencil eigenvalues below: only the low-rank bracket may do better.
+        m = cert.negative_eigenvalues
+        hint = ""
+        if by == "interlacing" and m is not None and m >= 2:
+            tried = (self.input or {}).get("solver", {}).get("bracket")
+            hint = "; --bracket verified no higher bound" if tried else "; --bracket may raise it"
+        return (
+            f"not proven: the critical load lies between {lower / scale:.6e} {unit} "
+            f"(verified lower bound, {how}) and {high}{hint}"
         )
 
     def _model_lines(self) -> list[str]:
