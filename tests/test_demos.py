@@ -69,7 +69,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     env = {**os.environ, "PYVISTA_OFF_SCREEN": "true", "OMP_NUM_THREADS": "1"}
     cmd = [sys.executable, str(ROOT / "demos" / "run_all.py"), "--coarse"]
     cmd += ["--figures", str(figures), "--output", str(vtx)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env, cwd=ROOT)
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for demo in (
         "demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3",

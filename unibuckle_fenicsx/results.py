@@ -68,6 +68,9 @@ class BucklingResult:
             N_scaled).
         critical_temperature_K: With a temperature rise in the scaled load: lambda times
             its largest rise over the plate (the uniform rise's critical value).
+        critical_total_temperature_K: With a fixed temperature rise: the largest total
+            rise over the plate at the critical state, the fixed rise (times
+            ``fixed_factor``) plus lambda times the scaled one.
         design: With ``[design]``: the relative slenderness and the reduction factor of
             EN 1993-1-5 from this sigma_cr (:func:`~unibuckle_fenicsx.design.design_output`).
         units: The unit system the summary prints in (the numbers here are SI).
@@ -107,6 +110,7 @@ class BucklingResult:
     edge_loads: dict[str, dict[str, Any]] = field(default_factory=dict)
     critical_load_factor: float | None = None
     critical_temperature_K: float | None = None
+    critical_total_temperature_K: float | None = None
     design: dict[str, Any] | None = None
     units: str = "SI"
     input: dict[str, Any] | None = None
@@ -174,6 +178,7 @@ class BucklingResult:
             },
             critical_load_factor=load,
             critical_temperature_K=_critical_temperature(spec, load),
+            critical_total_temperature_K=_total_temperature(spec, load),
             units=spec.units,
             input=_input(spec),
             versions=versions(),
@@ -295,6 +300,11 @@ class BucklingResult:
         ]
         if load.get("fixed_temperature"):
             fixed.append(f"temperature rise {load['fixed_temperature']} K")
+        if self.critical_total_temperature_K is not None:
+            lines.append(
+                "total temperature rise at the critical state (the fixed rise and lambda "
+                f"times the scaled one): {self.critical_total_temperature_K:.6g} K"
+            )
         if self.design is not None:
             d = self.design
             rho = d["reduction_factor"]
@@ -305,20 +315,32 @@ class BucklingResult:
                     f"{rho:.4g}, rho f_y/gamma_M1 = {d['reduced_design_stress_Pa'] / scale:.4g} "
                     f"{unit}"
                     if rho is not None
-                    else "none (psi < -3)"
+                    else f"none (psi outside {d['table']})"
                 )
-                + " (4.2) calibrated on bilateral plates"
+                + f"; {d['element']} element"
+                + (f" (free edge {d['free_edge']})" if d.get("free_edge") else "")
+                + ", 4.4(2) calibrated on bilateral plates"
             )
         factor = load.get("fixed_factor", 1.0)
         if fixed and factor:
             times = "" if factor == 1.0 else f"{factor:g} x "
             lines.append(f"fixed load (applied as is): {times}{'; '.join(fixed)}")
         reports = self.details.get("point_restraints", [])
+        name = "m" if self.units == "SI" else "mm"
         for p, restraint in zip(reports, self._point_restraints(reports), strict=True):
+            idle = p.get("restraining_nothing", [])
+            shown = ", ".join(f"({x / length:g}, {y / length:g})" for x, y in idle[:3])
             lines.append(
                 f"points: {restraint}: {p['points']} points on {p['nodes']} nodes, "
-                f"largest snap distance {p['max_snap_distance_m'] / length:.3g}"
-                f" {'m' if self.units == 'SI' else 'mm'}"
+                f"largest snap distance {p['max_snap_distance_m'] / length:.3g} {name}"
+                + (
+                    f"; {len(idle)} on a node held already (by an edge support or a "
+                    f"bilateral point), restraining nothing: {shown}"
+                    + (", ..." if len(idle) > 3 else "")
+                    + f" {name}"
+                    if idle
+                    else ""
+                )
             )
         return lines
 
@@ -393,6 +415,24 @@ def _critical_temperature(spec: ProblemSpec, load: float) -> float | None:
     T0, gx, gy = temperature_field(spec.load.temperature)
     rises = [T0 + gx * x + gy * y for x, y in spec.plate.boundary]
     return load * max(rises)
+
+
+def _total_temperature(spec: ProblemSpec, load: float) -> float | None:
+    """With a fixed rise: the largest total rise at the critical state (K), else None.
+
+    ``fixed_factor`` times the fixed field plus lambda times the scaled one: a linear
+    field, largest on a vertex of the boundary.
+    """
+    if not (spec.load.fixed_thermal and spec.load.fixed_factor):
+        return None
+    fixed = temperature_field(spec.load.fixed_temperature)
+    scaled = temperature_field(spec.load.temperature)
+    factor = spec.load.fixed_factor
+    return max(
+        factor * (fixed[0] + fixed[1] * x + fixed[2] * y)
+        + load * (scaled[0] + scaled[1] * x + scaled[2] * y)
+        for x, y in spec.plate.boundary
+    )
 
 
 def _input(spec: ProblemSpec) -> dict[str, Any] | None:

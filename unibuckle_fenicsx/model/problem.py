@@ -29,7 +29,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import ProblemSpec
+from unibuckle_fenicsx.config import ProblemSpec, temperature_field
 from unibuckle_fenicsx.eigen import (
     EIGEN_OPTIONS,
     EigenPair,
@@ -54,7 +54,7 @@ from unibuckle_fenicsx.model.contact import (
 from unibuckle_fenicsx.model.materials import reference_bending_stiffness
 from unibuckle_fenicsx.model.mesh import build_plate_mesh, check_user_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
-from unibuckle_fenicsx.model.points import point_obstacles
+from unibuckle_fenicsx.model.points import one_sided_conflicts, point_obstacles
 from unibuckle_fenicsx.model.prestress import solve_prestress
 from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
@@ -109,6 +109,25 @@ def _check_memory(spec: ProblemSpec, comm: MPI.Comm) -> None:
             f"({BYTES_PER_DOF / 1000:.0f} kB per DOF), more than the {have / 1e9:.3g} GB "
             "available: use a coarser mesh or more machines"
         )
+
+
+def _cooling_hint(spec: ProblemSpec) -> str:
+    """A clause naming ``load.temperature`` when the scaled rise cools the plate, or ""."""
+    if not spec.load.thermal:
+        return ""
+    T0, gx, gy = temperature_field(spec.load.temperature)
+    if max(T0 + gx * x + gy * y for x, y in spec.plate.boundary) > 0.0:
+        return ""
+    return (
+        f"; load.temperature = {spec.load.temperature!r} K per unit load is a cooling "
+        "(no rise > 0 anywhere): it puts a plate held in its plane in tension, which no "
+        "positive load factor buckles; give a rise (load.temperature > 0)"
+    )
+
+
+def _points_label(spec: ProblemSpec, indices: list[int]) -> str:
+    """``points[k] (what)`` for each index, for messages, in the file's units."""
+    return ", ".join(f"points[{k}] ({spec.points[k].describe(spec.units)})" for k in indices)
 
 
 @dataclass(frozen=True)
@@ -313,8 +332,9 @@ class BucklingProblem(Owner):
         except EmptyZoneError as err:
             if not spec.one_sided_points:
                 raise
+            one_sided = [k for k, p in enumerate(spec.points) if p.kind == "one-sided"]
             raise EmptyZoneError(
-                "points: the one-sided points"
+                f"{_points_label(spec, one_sided)}: the one-sided points"
                 + (" and the obstacle zones" if spec.unilateral_obstacles else "")
                 + " act on no free node: each such node is held already (by an edge "
                 "support or a bilateral point), so the point restrains nothing; move it off "
@@ -323,9 +343,11 @@ class BucklingProblem(Owner):
         except BilateralZoneError as err:
             if not spec.one_sided_points:
                 raise
+            clash = one_sided_conflicts(self.model.points, spec.unilateral_obstacles, spec.plate)
             raise BilateralZoneError(
-                "points: a one-sided point acts on a node held from the other side too (an "
-                'obstacle zone or another point): that holds w = 0, give it kind = "bilateral"'
+                f"{_points_label(spec, clash) if clash else 'points'}: a one-sided point acts "
+                "on a node held from the other side too (an obstacle zone or another point): "
+                'that holds w = 0, give it kind = "bilateral"'
             ) from err
         self.free: Mode | None = None
         self._free_verified = False  # verify_free() passed
@@ -429,7 +451,7 @@ class BucklingProblem(Owner):
                     "the plate has no positive buckling load on this mesh: the geometric "
                     "stiffness b(w, w) is nowhere positive on the free deflections (edge "
                     "loads in tension, or the supports fix every deflection DOF); check the "
-                    "edge loads, refine the mesh or free an edge"
+                    "edge loads, refine the mesh or free an edge" + _cooling_hint(self.spec)
                 )
             u.x.petsc_vec.scale(1.0 / self.max_abs_w(u.x.petsc_vec))
             u.x.scatter_forward()
