@@ -49,6 +49,7 @@ import numpy as np
 from unibuckle_fenicsx import paper_case
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.nonlinear import NonlinearOptions, solve_nonlinear, southwell_window
+from unibuckle_fenicsx.results import record
 from unibuckle_fenicsx.viz import fields, plotting, study
 from unibuckle_fenicsx.viz.fields import zone_box
 
@@ -201,25 +202,14 @@ if comm.rank == 0:
         written.append(figures / "deformed_c1.png")
     for path in written:
         print(f"wrote {path}")
-    (figures / "results.json").write_text(
-        json.dumps(
-            {
-                "mesh": list(MESH),
-                "linear_critical_load_Pa": lam_c,
-                "free_load_Pa": lam_free,
-                "study": [  # without the paths and the wall times (the file is versioned)
-                    {
-                        k: v
-                        for k, v in r.as_dict().items()
-                        if k not in ("path", "versions", "timings", "wall_time_s")
-                    }
-                    for r in rows
-                ],
-            },
-            indent=2,
-        )
-        + "\n"
-    )
+    summary = {
+        "mesh": list(MESH),
+        "linear_critical_load_Pa": lam_c,
+        "free_load_Pa": lam_free,
+        # Without the paths (the file is versioned): a record, the same on any machine.
+        "study": [{k: v for k, v in r.as_dict().items() if k != "path"} for r in rows],
+    }
+    (figures / "results.json").write_text(json.dumps(record(summary), indent=2) + "\n")
 
 # %% [markdown]
 # ## Checks

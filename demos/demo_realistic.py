@@ -38,6 +38,7 @@ import numpy as np
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.config import problem_from_dict
+from unibuckle_fenicsx.results import record
 from unibuckle_fenicsx.viz import fields, study
 
 warnings.filterwarnings("error")  # demos run warning-free
@@ -150,7 +151,7 @@ if comm.rank == 0:
     for key, value in summary.items():
         print(f"  {key}: {value}")
     figures.mkdir(parents=True, exist_ok=True)
-    (figures / "results.json").write_text(json.dumps(summary, indent=2) + "\n")
+    (figures / "results.json").write_text(json.dumps(record(summary), indent=2) + "\n")
 
 # %% [markdown]
 # ## Checks

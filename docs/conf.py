@@ -53,5 +53,5 @@ html_theme = "furo"
 html_title = f"unibuckle_fenicsx {release}"
 html_static_path: list[str] = []
 
-# The figures live in the repository's figures/ (written by `make demo`).
+# The figures live in the repository's figures/ (written by `make figures`).
 html_extra_path: list[str] = []

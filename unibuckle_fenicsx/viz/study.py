@@ -29,7 +29,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.analysis import Analysis, solve
 from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.io import write_fields
-from unibuckle_fenicsx.results import BucklingResult
+from unibuckle_fenicsx.results import BucklingResult, record
 from unibuckle_fenicsx.viz import fields, plotting
 
 __all__ = [
@@ -149,15 +149,17 @@ class MeshStudy:
         )
 
     def write_json(self, path: Path, **extra: Any) -> Path:
-        """``{"case", "results": [...], **extra}`` as JSON, without wall times (rank 0).
+        """``{"case", "results": [...], **extra}`` as a record (:func:`record`, rank 0).
 
-        The file is the same on every run of the same problem, so that it can be kept
-        under version control (the figures directory); the times are printed instead.
+        The file is the same on every run of the same problem, on any machine (up to a
+        last digit that lies at a rounding boundary), so that it can be kept under
+        version control (the figures directory); the times and eigen-solve counts are
+        printed instead.
         """
         path.parent.mkdir(parents=True, exist_ok=True)
         results = [r.as_dict(timings=False) for r in self.results]
         summary = {"case": self.name, **extra, "results": results}
-        path.write_text(json.dumps(summary, indent=2) + "\n")
+        path.write_text(json.dumps(record(summary), indent=2) + "\n")
         return path
 
     def finish(
@@ -289,7 +291,12 @@ def demo_arguments(description: str) -> argparse.Namespace:
         default=os.environ.get("UNIBUCKLE_DEMO_COARSE") == "1",
         help="tiny meshes (for the tests)",
     )
-    parser.add_argument("--figures", type=Path, default=Path("figures"), help="PNG directory")
+    parser.add_argument(
+        "--figures",
+        type=Path,
+        default=Path("output") / "figures",
+        help="the figures' directory (the repository keeps its own in figures/)",
+    )
     parser.add_argument("--output", type=Path, default=None, help="VTX (ParaView) directory")
     args, _ = parser.parse_known_args()
     return args
