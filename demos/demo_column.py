@@ -43,10 +43,10 @@ from mpi4py import MPI
 import numpy as np
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.design import reduction_factor
 from unibuckle_fenicsx.model.materials import bending_stiffness
 from unibuckle_fenicsx.results import record
+from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.sweep import Variation, run_sweep
 from unibuckle_fenicsx.viz import fields, study
 

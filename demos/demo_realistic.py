@@ -37,8 +37,8 @@ from mpi4py import MPI
 import numpy as np
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import problem_from_dict
 from unibuckle_fenicsx.results import record
+from unibuckle_fenicsx.spec import problem_from_dict
 from unibuckle_fenicsx.viz import fields, study
 
 warnings.filterwarnings("error")  # demos run warning-free

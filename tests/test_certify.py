@@ -25,7 +25,8 @@ from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certificate.certify import certify, reduced_inertia
 from unibuckle_fenicsx.certificate.copositivity import copositivity_bound
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
     MeshSpec,
@@ -34,7 +35,6 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.tolerances import PROOF_GAP
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
@@ -226,7 +226,7 @@ def test_a_bound_verified_at_the_proof_gap_proves_the_optimum():
     and below the right part) whose bound closes there: "proven" either way, not
     "bracketed" by the last bit of the gap.
     """
-    from unibuckle_fenicsx.config import problem_from_dict
+    from unibuckle_fenicsx.spec import problem_from_dict
 
     spec = problem_from_dict(
         {

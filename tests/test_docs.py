@@ -1,7 +1,7 @@
 """The documentation's generated pages say what the program does.
 
 - The TOML reference (``docs/_ext/unibuckle_docs.py``, generated when the site is built)
-  lists every key the loader accepts: those of ``unibuckle_fenicsx.config.accepted_keys``
+  lists every key the loader accepts: those of ``unibuckle_fenicsx.spec.accepted_keys``
   where the package has it, and, independently of the page's own source, every key of
   the bad-input family's base files (which hold every key of the schema); and each key
   it lists is one the loader accepts (no "unknown key" error when a file gives it).
@@ -24,8 +24,8 @@ from typing import Any
 
 import pytest
 
-from unibuckle_fenicsx import config
-from unibuckle_fenicsx.config import problem_from_dict
+from unibuckle_fenicsx import spec
+from unibuckle_fenicsx.spec import problem_from_dict
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT / "docs" / "_ext"))
@@ -89,8 +89,8 @@ def test_reference_lists_every_accepted_key() -> None:
     listed = _listed()
     keys, _ = unibuckle_docs.accepted_keys()
     assert {_edge_name(key) for key in keys} <= listed
-    if hasattr(config, "accepted_keys"):
-        assert {_edge_name(key) for key in config.accepted_keys()} <= listed
+    if hasattr(spec, "accepted_keys"):
+        assert {_edge_name(key) for key in spec.accepted_keys()} <= listed
 
 
 def test_reference_lists_every_key_of_the_bad_input_bases() -> None:
@@ -227,8 +227,8 @@ def test_schema_page_from_a_json_schema(monkeypatch: pytest.MonkeyPatch) -> None
             }
         },
     }
-    monkeypatch.setattr(config, "json_schema", lambda: schema, raising=False)
-    monkeypatch.setattr(config, "accepted_keys", lambda: ["mesh.nx"], raising=False)
+    monkeypatch.setattr(spec, "json_schema", lambda: schema, raising=False)
+    monkeypatch.setattr(spec, "accepted_keys", lambda: ["mesh.nx"], raising=False)
     page = unibuckle_docs.schema_page()
     assert "| `mesh.nx` | integer | ≥ 2 | `20` | Cells. |" in page
     assert "1 keys." in page

@@ -28,12 +28,12 @@ import pytest
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.model.materials import bending_stiffness
+from unibuckle_fenicsx.spec import (
     PointSpec,
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.model.materials import bending_stiffness
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate, isotropic
@@ -153,8 +153,8 @@ def test_a_one_sided_point_on_a_held_node_is_named(points, index):
 
 def test_a_one_sided_point_held_from_the_other_side_is_named():
     """A stud above inside a zone below: w = 0 there, refused naming points[1]."""
-    from unibuckle_fenicsx.config import ObstacleSpec
     from unibuckle_fenicsx.model.contact import BilateralZoneError
+    from unibuckle_fenicsx.spec import ObstacleSpec
 
     free = replace(STUD, at=(1.5, 0.5))
     spec = replace(
@@ -172,7 +172,7 @@ def test_points_on_held_nodes_are_reported():
     Before, the summary said "1 points on 1 nodes" and nothing else: a mistyped coordinate
     went unnoticed. A grid over the whole plate has its edge points on the supports.
     """
-    from unibuckle_fenicsx.config import EdgeSpec
+    from unibuckle_fenicsx.spec import EdgeSpec
 
     spec = plate(4, aspect=2.0)
     edges = tuple(

@@ -53,12 +53,12 @@ from families import schema_family
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import problem_from_dict
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.mesh import build_plate_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
 from unibuckle_fenicsx.model.prestress import solve_prestress
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import problem_from_dict
 
 FAMILY_SIZE = 120
 SAMPLE = 12
@@ -140,7 +140,7 @@ def _design_by_hand(data: dict) -> tuple[str, str | None] | str:
 
 def test_the_design_element_of_every_family_file():
     """[design] on each file: the element, or the refusal, as worked out by hand."""
-    from unibuckle_fenicsx.config.checks import design_element
+    from unibuckle_fenicsx.spec.checks import design_element
 
     seen = set()
     for data, _ in FAMILY:

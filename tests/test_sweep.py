@@ -24,7 +24,7 @@ from conftest import ROOT, paused_sweep, run_mpi
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.spec import (
     MeshSpec,
     ObstacleSpec,
     load_toml,

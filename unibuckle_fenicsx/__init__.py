@@ -8,7 +8,7 @@ first use.
 from typing import Any
 
 from unibuckle_fenicsx.cases import CASES, paper_case
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
     MeshSpec,

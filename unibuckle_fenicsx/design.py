@@ -6,7 +6,7 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
 
 - 4.4(2): the relative plate slenderness :math:`\bar\lambda_p = \sqrt{f_y/\sigma_{cr}}`;
 - the element, from the plate's edges parallel to the direct stress (its *unloaded*
-  edges, :func:`~unibuckle_fenicsx.config.checks.design_element`): both supported, an
+  edges, :func:`~unibuckle_fenicsx.spec.checks.design_element`): both supported, an
   **internal** compression element, :math:`\rho = (\bar\lambda_p - 0.055(3 + \psi))/
   \bar\lambda_p^2 \le 1` above :math:`\bar\lambda_p = 0.5 + \sqrt{0.085 - 0.055\psi}`
   (eq. (4.2)) and Table 4.1 (:math:`1 \ge \psi \ge -3`); one free, an **outstand**,
@@ -34,8 +34,6 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from unibuckle_fenicsx.config import DesignSpec, ProblemSpec, stress_ends
-from unibuckle_fenicsx.config.checks import DesignElement, design_element
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     buckling_factor,
@@ -43,6 +41,8 @@ from unibuckle_fenicsx.en1993 import (
     reduction_factor,
     table_row,
 )
+from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
+from unibuckle_fenicsx.spec.checks import DesignElement, design_element
 
 __all__ = ["CLAUSES", "clauses", "design_output", "reduction_factor"]
 

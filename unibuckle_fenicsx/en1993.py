@@ -20,7 +20,7 @@ loaded edge, :math:`\sigma_1` the larger compression. The tables' buckling facto
 :math:`\sigma_{cr}`; the slenderness here is :math:`\bar\lambda_p = \sqrt{f_y/\sigma_{cr}}`
 (4.4(2)) with this package's :math:`\sigma_{cr}`. The formulas are a few lines each and
 no maintained library implements them for a given :math:`\sigma_{cr}`, hence this module;
-it has no dependency, so that the problem checks (:mod:`unibuckle_fenicsx.config`) can
+it has no dependency, so that the problem checks (:mod:`unibuckle_fenicsx.spec`) can
 refuse, before any solve, a stress ratio outside the tables.
 """
 

@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.model.zones import zone_report
+from unibuckle_fenicsx.spec import (
     UNITS,
     PointSpec,
     ProblemSpec,
@@ -16,8 +17,7 @@ from unibuckle_fenicsx.config import (
     stress_value,
     temperature_field,
 )
-from unibuckle_fenicsx.config.checks import plate_model_note
-from unibuckle_fenicsx.model.zones import zone_report
+from unibuckle_fenicsx.spec.checks import plate_model_note
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution
@@ -145,7 +145,7 @@ class BucklingResult:
             EN 1993-1-5 from this sigma_cr (:func:`~unibuckle_fenicsx.design.design_output`).
         units: The unit system the summary prints in (the numbers here are SI).
         input: The problem solved, every key with the value used, in SI
-            (:func:`~unibuckle_fenicsx.config.problem_to_dict`; None for a predicate zone).
+            (:func:`~unibuckle_fenicsx.spec.problem_to_dict`; None for a predicate zone).
         versions: Versions of the package and of the libraries that computed the result
             (:func:`versions`).
         obstacle_zones: Per obstacle, the zone's area on the plate against the discrete

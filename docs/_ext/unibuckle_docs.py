@@ -5,8 +5,8 @@ Markdown files under ``docs/_generated/`` (not kept in git), which the pages inc
 
 - ``cli_<command>.md``: ``unibuckle <command> --help``, from the package's argparse parser;
 - ``schema.md``: every key of the problem file, from
-  :func:`unibuckle_fenicsx.config.json_schema` (its types, defaults, ranges and
-  descriptions) and :func:`unibuckle_fenicsx.config.accepted_keys`; where the installed
+  :func:`unibuckle_fenicsx.spec.json_schema` (its types, defaults, ranges and
+  descriptions) and :func:`unibuckle_fenicsx.spec.accepted_keys`; where the installed
   package does not have them yet, from the loader itself (see :func:`loader_keys`);
 - ``demo_<name>.md``: each demo (a jupytext percent script) as a page, with the figures
   ``make figures`` stored in ``figures/`` (the build executes no demo);
@@ -88,7 +88,7 @@ _PROBE = "__unibuckle_docs_probe__"
 
 def _allowed(data: Mapping[str, Any], where: str) -> list[str] | None:
     """The keys the loader allows in table ``where``, read off its unknown-key error."""
-    from unibuckle_fenicsx.config import problem_from_dict
+    from unibuckle_fenicsx.spec import problem_from_dict
 
     try:
         problem_from_dict(data)
@@ -107,7 +107,7 @@ def loader_keys() -> list[str]:
     """Every dotted key the loader accepts, asked of the loader table by table.
 
     The fallback of :func:`accepted_keys` for a package without
-    ``unibuckle_fenicsx.config.accepted_keys``: the loader checks each table's keys against
+    ``unibuckle_fenicsx.spec.accepted_keys``: the loader checks each table's keys against
     a list of allowed names and names that list when a key is unknown, so a probe key in
     each table (a nested table inside a minimal valid file) reads the list the loader
     itself uses. List-valued tables are written ``name[]`` (``plate.holes[].radius``).
@@ -159,20 +159,20 @@ def loader_keys() -> list[str]:
 
 def json_schema() -> dict[str, Any] | None:
     """The package's JSON Schema of the problem file, or None where it has none."""
-    from unibuckle_fenicsx import config
+    from unibuckle_fenicsx import spec
 
-    make = getattr(config, "json_schema", None)
+    make = getattr(spec, "json_schema", None)
     return make() if callable(make) else None
 
 
 def accepted_keys() -> tuple[list[str], str]:
     """(every dotted key the loader accepts, where the list comes from)."""
-    from unibuckle_fenicsx import config
+    from unibuckle_fenicsx import spec
 
-    listed = getattr(config, "accepted_keys", None)
+    listed = getattr(spec, "accepted_keys", None)
     if callable(listed):
-        return list(listed()), "unibuckle_fenicsx.config.accepted_keys()"
-    return loader_keys(), "the loader's own unknown-key check (unibuckle_fenicsx.config)"
+        return list(listed()), "unibuckle_fenicsx.spec.accepted_keys()"
+    return loader_keys(), "the loader's own unknown-key check (unibuckle_fenicsx.spec)"
 
 
 def _resolve(node: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -285,7 +285,7 @@ def schema_page() -> str:
     if schema is not None:
         described = dict(schema_rows(schema))
         lines += [
-            f"Generated from `unibuckle_fenicsx.config.json_schema()` and {source} when "
+            f"Generated from `unibuckle_fenicsx.spec.json_schema()` and {source} when "
             "these pages were built.",
             "",
             "| key | type | range | default | description |",
@@ -387,13 +387,13 @@ def arg_docs(cls: type) -> dict[str, str]:
 
 def _described() -> dict[str, str]:
     """Dotted key -> its meaning, from the docstrings of the classes the tables fill."""
-    from unibuckle_fenicsx import config
+    from unibuckle_fenicsx import spec
 
     keys, _ = accepted_keys()
     docs = {
-        prefix: arg_docs(getattr(config, name))
+        prefix: arg_docs(getattr(spec, name))
         for prefix, name in TABLE_CLASSES.items()
-        if hasattr(config, name)
+        if hasattr(spec, name)
     }
     described = {}
     for key in keys:
@@ -409,7 +409,7 @@ def _described() -> dict[str, str]:
 
 def _defaults() -> dict[str, Any]:
     """Dotted key -> the value the loader fills in for the paper's plate with c1's zone."""
-    from unibuckle_fenicsx.config import problem_from_dict, problem_to_dict
+    from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
 
     data = problem_to_dict(problem_from_dict({"obstacle": {"zone": "all"}}))
     flat: dict[str, Any] = {}

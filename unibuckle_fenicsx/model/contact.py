@@ -22,8 +22,8 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec import ObstacleSpec, PlateSpec
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [

@@ -22,8 +22,8 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import Circle, ObstacleSpec, PlateSpec, Polygon
 from unibuckle_fenicsx.geometry import disc_polygon, intersection_area, polygon_area
+from unibuckle_fenicsx.spec import Circle, ObstacleSpec, PlateSpec, Polygon
 
 __all__ = ["cell_areas", "zone_area", "zone_report"]
 

@@ -29,7 +29,6 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
-from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.eigen import Owner
 from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
@@ -50,6 +49,7 @@ from unibuckle_fenicsx.nonlinear.model import (
 from unibuckle_fenicsx.nonlinear.verdict import judge
 from unibuckle_fenicsx.progress import LOGGER
 from unibuckle_fenicsx.results import versions
+from unibuckle_fenicsx.spec import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.tolerances import NONLINEAR_ATOL
 
 __all__ = [

@@ -30,7 +30,7 @@ from typing import Any
 
 import numpy as np
 
-from unibuckle_fenicsx.config import EDGE_NAMES, UNITS, ProblemSpec
+from unibuckle_fenicsx.spec import EDGE_NAMES, UNITS, ProblemSpec
 from unibuckle_fenicsx.sweep import Variation, point_problem
 
 __all__ = ["plot_sweep", "reference_k"]

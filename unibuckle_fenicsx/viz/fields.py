@@ -18,8 +18,8 @@ from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 if TYPE_CHECKING:  # pragma: no cover
     import dolfinx
 
-    from unibuckle_fenicsx.config import ProblemSpec
     from unibuckle_fenicsx.model.problem import BucklingProblem
+    from unibuckle_fenicsx.spec import ProblemSpec
 
 __all__ = [
     "mesh_triangles",
@@ -61,8 +61,8 @@ def zone_outlines(spec: ProblemSpec) -> list[tuple[npt.NDArray[np.float64], str]
     "all" gives the plate's outer boundary (its outline, or its bounding box), a circle
     96 points; a predicate zone has no outline and is left out.
     """
-    from unibuckle_fenicsx.config import Circle, Polygon
     from unibuckle_fenicsx.geometry import circle_points
+    from unibuckle_fenicsx.spec import Circle, Polygon
 
     out = []
     for obstacle in spec.all_obstacles:

@@ -27,9 +27,9 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.analysis import Analysis, solve
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.io import write_fields
 from unibuckle_fenicsx.results import BucklingResult, record
+from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.viz import fields, plotting
 
 __all__ = [

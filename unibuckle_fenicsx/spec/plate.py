@@ -14,17 +14,6 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config.checks import check_features, check_thickness
-from unibuckle_fenicsx.config.values import (
-    BENDING_SUPPORTS,
-    HOLES,
-    INPLANE_SUPPORTS,
-    _choice,
-    _integer,
-    _number,
-    _stress,
-    stress_ends,
-)
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import (
     circle_points,
@@ -35,6 +24,17 @@ from unibuckle_fenicsx.geometry import (
     polygon_area,
     polygon_inside,
     polygons_disjoint,
+)
+from unibuckle_fenicsx.spec.checks import check_features, check_thickness
+from unibuckle_fenicsx.spec.values import (
+    BENDING_SUPPORTS,
+    HOLES,
+    INPLANE_SUPPORTS,
+    _choice,
+    _integer,
+    _number,
+    _stress,
+    stress_ends,
 )
 
 
