@@ -102,3 +102,91 @@ def test_make_demo_writes_outside_the_repository_s_figures(tmp_path):
     (figures / "c1" / "results.json").write_text(json.dumps(data))
     (differ,) = run_all.compare_records(figures, stored)
     assert "1 difference(s): .results[0].critical_load_Pa: 14400000.0 against 14445630.0" in differ
+
+
+#: Section A of the free mode of the paper's plate (20 x 20) from two runs of the same
+#: code on this machine: OpenBLAS's default kernel on one thread (W_A), its Sandybridge
+#: kernel on two (W_B). They differ by 1e-13 at most; the PNGs drawn from them differed
+#: in 49 pixels (matplotlib's path simplification drops a nearly collinear vertex or not).
+X = [
+    -0.1,
+    -0.09000000000000001,
+    -0.08,
+    -0.07,
+    -0.060000000000000005,
+    -0.05,
+    -0.04000000000000001,
+    -0.03,
+    -0.020000000000000004,
+    -0.010000000000000009,
+    5.55111512312578e-19,
+    0.009999999999999997,
+    0.01999999999999999,
+    0.030000000000000002,
+    0.04000000000000001,
+    0.04999999999999999,
+    0.060000000000000005,
+    0.07,
+    0.07999999999999999,
+    0.09,
+    0.1,
+]
+W_A = [
+    0.0,
+    -0.3090169943768054,
+    -0.587785252293067,
+    -0.8090169943744233,
+    -0.9510565162950946,
+    -1.0,
+    -0.9510565162953614,
+    -0.8090169943751331,
+    -0.5877852522926099,
+    -0.3090169943743379,
+    9.106129127009649e-13,
+    0.30901699437512675,
+    0.5877852522922695,
+    0.8090169943752222,
+    0.9510565162962542,
+    0.9999999999997384,
+    0.9510565162931756,
+    0.8090169943741848,
+    0.5877852522934043,
+    0.3090169943765128,
+    0.0,
+]
+W_B = [
+    0.0,
+    -0.30901699437680985,
+    -0.5877852522930749,
+    -0.8090169943744318,
+    -0.9510565162950995,
+    -1.0,
+    -0.9510565162953559,
+    -0.8090169943751245,
+    -0.5877852522926027,
+    -0.3090169943743366,
+    8.996004112207978e-13,
+    0.30901699437509783,
+    0.5877852522922191,
+    0.8090169943751497,
+    0.9510565162961631,
+    0.9999999999996346,
+    0.9510565162930698,
+    0.8090169943740895,
+    0.587785252293332,
+    0.3090169943764742,
+    0.0,
+]
+
+
+def test_a_figure_of_numbers_that_differ_in_rounding_is_the_same_file(tmp_path):
+    """Section A drawn from W_A and from W_B: the same PNG (the data at eight digits)."""
+    pytest.importorskip("matplotlib")
+    from unibuckle_fenicsx.viz.plotting import plot_section
+
+    assert max(abs(a - b) for a, b in zip(W_A, W_B, strict=True)) < 2e-13
+    paths = [
+        plot_section(tmp_path / f"{k}.png", X, w, X, w, zone_x=(-0.04, 0.04))
+        for k, w in enumerate((W_A, W_B))
+    ]
+    assert paths[0].read_bytes() == paths[1].read_bytes()

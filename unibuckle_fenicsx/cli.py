@@ -24,7 +24,7 @@ import sys
 import traceback
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.spec import METHODS
@@ -602,6 +602,14 @@ def main(argv: Sequence[str] | None = None) -> int:
     return ending.finish(status, raised or bool(_PENDING))
 
 
+def _abort(comm: Any, status: int, message: str | None) -> NoReturn:
+    """Print ``message`` and end every rank of ``comm`` with ``status`` (``MPI_Abort``)."""
+    if message is not None:
+        print(f"unibuckle: error: {message}", file=sys.stderr, flush=True)
+    comm.Abort(status)
+    os._exit(status)  # MPI_Abort does not return; had it, this process ends all the same
+
+
 def _guarded_run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> tuple[int, bool]:
     """The exit status of :func:`_run`, and whether this rank raised (it may be alone)."""
     try:
@@ -673,9 +681,7 @@ class _Ending:
             waited = time.monotonic() + FAILURE_WAIT_S
             while not request.Test():
                 if time.monotonic() > waited:
-                    if message is not None:
-                        print(f"unibuckle: error: {message}", file=sys.stderr, flush=True)
-                    comm.Abort(status)
+                    _abort(comm, status, message)
                 time.sleep(0.01)
         else:
             request.Wait()

@@ -7,6 +7,7 @@ from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from unibuckle_fenicsx.model.zones import zone_report
 from unibuckle_fenicsx.spec import (
@@ -24,7 +25,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.certificate.certify import Certificate
     from unibuckle_fenicsx.model.problem import BucklingProblem, Mode
 
-__all__ = ["RECORD_DIGITS", "BucklingResult", "record", "versions"]
+__all__ = ["RECORD_DIGITS", "BucklingResult", "record", "rounded", "versions"]
 
 #: Significant digits of the numbers a record keeps (:func:`record`): the loads carry
 #: about ten (the eigen solver's tolerance, 1e-10) and double precision fixes them to
@@ -87,6 +88,22 @@ def record(data: Any, *, contact: bool = True) -> Any:
     if isinstance(data, float):
         return _rounded(data, abs(data))
     return data
+
+
+def rounded(values: Any) -> npt.NDArray[np.float64]:
+    """``values`` (an array) to :data:`RECORD_DIGITS` significant digits of the largest.
+
+    What a figure draws: an antialiased line moves a pixel's shade for a change of
+    1e-13 in its data, so a figure of the full numbers differs between machines where
+    one of the rounded numbers does not.
+    """
+    array = np.asarray(values, dtype=float)
+    finite = np.abs(array[np.isfinite(array)])
+    scale = float(finite.max()) if finite.size else 0.0
+    if scale == 0.0:
+        return array
+    decimals = RECORD_DIGITS - 1 - math.floor(math.log10(scale))
+    return np.round(array, decimals) + 0.0
 
 
 def _rounded(value: float, scale: float) -> float:
