@@ -80,6 +80,11 @@ def test_a_record_keeps_what_the_problem_fixes(c1):
     # A coordinate's rounding beside the plate's size is zero: -0.09999999999999999 and
     # 2.8e-19 in a section are -0.1 and 0.0.
     assert record([-0.09999999999999999, 2.77555756156289e-19, 0.1]) == [-0.1, 0.0, 0.1]
+    # A normalised mode's largest value is 1 within rounding: 0.9999999999997 on one
+    # machine, 1.0000000000002 on another (c2's section in the second environment was
+    # kept to eight decimals, 0.01464486, against seven, 0.0146449, before).
+    low, high = (record([0.014644861, -0.9999999999997]), record([0.014644861, -1.0000000000002]))
+    assert low == high == [0.0146449, -1.0]
 
 
 def test_make_demo_writes_outside_the_repository_s_figures(tmp_path):

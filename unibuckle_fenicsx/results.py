@@ -102,16 +102,24 @@ def rounded(values: Any) -> npt.NDArray[np.float64]:
     scale = float(finite.max()) if finite.size else 0.0
     if scale == 0.0:
         return array
-    decimals = RECORD_DIGITS - 1 - math.floor(math.log10(scale))
-    return np.round(array, decimals) + 0.0
+    return np.round(array, _decimals(scale)) + 0.0
+
+
+def _decimals(scale: float) -> int:
+    """Decimals that keep :data:`RECORD_DIGITS` significant digits of ``scale`` (> 0).
+
+    Of ``scale`` itself at those digits: a normalised mode's largest value is 1 within
+    rounding, 0.9999999999997 on one machine and 1.0000000000002 on another, and both
+    must give the same decimals.
+    """
+    return RECORD_DIGITS - 1 - math.floor(math.log10(float(f"{scale:.{RECORD_DIGITS - 1}e}")))
 
 
 def _rounded(value: float, scale: float) -> float:
     """``value`` to :data:`RECORD_DIGITS` significant digits of ``scale`` (0.0 for -0.0)."""
     if not math.isfinite(value) or scale == 0.0:
         return value
-    decimals = RECORD_DIGITS - 1 - math.floor(math.log10(scale))
-    return round(value, decimals) + 0.0
+    return round(value, _decimals(scale)) + 0.0
 
 
 @dataclass

@@ -406,7 +406,7 @@ def plot_contact_set(
     """
     plt = _pyplot()
     path = _prepare(path)
-    xy = np.asarray(xy, dtype=float)
+    xy, w = rounded(xy), rounded(w)  # the records' digits: the same picture on any machine
     (px0, py0), (px1, py1) = corners
     fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
     _mode_bands(fig, ax, xy, w, tau)
