@@ -35,13 +35,11 @@
 # %%
 from __future__ import annotations
 
-import json
 import math
 import warnings
 
 from mpi4py import MPI
 
-from unibuckle_fenicsx.results import record
 from unibuckle_fenicsx.sweep import parse_variation, point_problem, run_sweep
 from unibuckle_fenicsx.viz import study
 from unibuckle_fenicsx.viz.charts import plot_sweep, reference_k
@@ -108,8 +106,7 @@ for name, base in bases.items():
     comm.Barrier()
     lines[name] = run_sweep(base, [VARY], out, comm, progress=False)
     if comm.rank == 0:  # records (thin plates: no contact set), the same on any machine
-        text = "".join(json.dumps(record(line, contact=False)) + "\n" for line in lines[name])
-        out.write_text(text)
+        study.write_record(out, lines[name], contact=False)
     title = {
         "ssss": "SSSS plate under uniaxial compression",
         "loaded_edges_clamped": "loaded edges clamped, unloaded edges simply supported",

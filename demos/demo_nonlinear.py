@@ -38,7 +38,6 @@
 # %%
 from __future__ import annotations
 
-import json
 import time
 import warnings
 
@@ -46,10 +45,8 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx import paper_case
-from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx import paper_case, solve
 from unibuckle_fenicsx.nonlinear import NonlinearOptions, solve_nonlinear, southwell_window
-from unibuckle_fenicsx.results import record
 from unibuckle_fenicsx.viz import fields, plotting, study
 from unibuckle_fenicsx.viz.fields import zone_box
 
@@ -209,7 +206,7 @@ if comm.rank == 0:
         # Without the paths (the file is versioned): a record, the same on any machine.
         "study": [{k: v for k, v in r.as_dict().items() if k != "path"} for r in rows],
     }
-    (figures / "results.json").write_text(json.dumps(record(summary), indent=2) + "\n")
+    study.write_record(figures / "results.json", summary)
 
 # %% [markdown]
 # ## Checks

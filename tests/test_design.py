@@ -15,6 +15,7 @@ formulas between, typed in from the tables.
 from __future__ import annotations
 
 import math
+from pathlib import Path
 
 from mpi4py import MPI
 
@@ -313,6 +314,25 @@ def test_an_outline_plate_is_refused():
     }
     with pytest.raises(ValueError, match=r"design: .* this plate is given by its outline"):
         problem_from_dict(data)
+
+
+def test_a_rectangle_with_a_hole_is_classified_by_its_edges():
+    """The README's plate (clamped all round, a 40 mm hole): an internal element, a note.
+
+    Its unloaded edges (bottom, top) are clamped: internal, Table 4.1. At sigma_cr = 1.753e9
+    Pa (the README's load), psi = 1: lambda_p = sqrt(3.55e8/1.753e9) = 0.45 <= 0.673, rho = 1
+    by eq. (4.2); the output says that 4.4 describes plates without openings.
+    """
+    from unibuckle_fenicsx import load_toml
+    from unibuckle_fenicsx.design import design_output
+
+    spec = load_toml(Path(__file__).resolve().parents[1] / "demos" / "plate.toml")
+    assert spec.plate.holes
+    out = design_output(spec, spec.design, 1.753e9)
+    assert (out["element"], out["free_edge"], out["psi"]) == ("internal", None, 1.0)
+    assert out["relative_slenderness"] == pytest.approx(math.sqrt(3.55e8 / 1.753e9), rel=1e-14)
+    assert out["reduction_factor"] == 1.0
+    assert any("without openings" in note for note in out["notes"]), out["notes"]
 
 
 def test_psi_outside_the_table_with_a_fixed_part_gives_no_rho():

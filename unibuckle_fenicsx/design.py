@@ -17,7 +17,9 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
   :math:`\sigma_1` the larger compression.
 
 What the clause does not describe is refused when the problem is built (both unloaded
-edges free, biaxial stress, a temperature rise, a plate that is not a rectangle, ...).
+edges free, biaxial stress, a temperature rise, a plate that is not a rectangle, ...);
+a rectangle with holes is classified by its edges, and the output notes that the
+clause describes plates without openings.
 Here :math:`\sigma_{cr}` is the critical state this package computes: the largest
 compressive normal stress on a loaded edge at the critical load (the fixed part plus
 :math:`\lambda_c` times the scaled one), and :math:`\psi` the stress ratio along that
@@ -108,6 +110,12 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> dict[st
         "clauses": clauses(element, at_free),
         "notes": [CALIBRATION],
     }
+    if spec.plate.holes:
+        out["notes"].append(
+            "the plate has holes (plate.holes): 4.4 describes a plate without openings; "
+            "the element is the rectangle's, and sigma_cr (computed with the holes) "
+            "includes their effect"
+        )
     if spec.all_obstacles or spec.one_sided_points:
         out["notes"].append(
             "with an obstacle sigma_cr is the unilateral critical stress: outside the "

@@ -185,7 +185,7 @@ class NonlinearResult:
             gaps closed (same mesh); None otherwise, or if that solve failed.
         verdict: The verdict in words (:func:`~unibuckle_fenicsx.nonlinear.verdict.judge`).
         contact_check: The contact conditions at the last state (see
-            :meth:`NonlinearAnalysis.contact_check`).
+            :func:`contact_check`).
         options: The options used.
         wall_time_s: Total wall time (linear solve included).
         timings: Seconds per phase.

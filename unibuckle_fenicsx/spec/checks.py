@@ -331,7 +331,7 @@ def design_element(spec: ProblemSpec) -> DesignElement:
 
     Raises:
         InputError: What clause 4.4 does not describe, naming the keys: a plate that is
-            not the rectangle (outline, holes, file), a temperature rise, normal stress in
+            not a rectangle (outline, file), a temperature rise, normal stress in
             both directions (biaxial), both unloaded edges free, a free edge on springs,
             an unloaded edge held in its plane (a transverse stress), a stress ratio
             outside the table.
@@ -342,15 +342,13 @@ def design_element(spec: ProblemSpec) -> DesignElement:
         if plate.outline is not None
         else "is a gmsh file"
         if plate.file is not None
-        else "has holes"
-        if plate.holes
         else ""
     )
     if why:
         raise InputError(
             f"design: EN 1993-1-5 4.4 describes a rectangular plate element by its two "
-            f"unloaded edges; this plate {why} (plate.outline, plate.holes, plate.file): "
-            "leave [design] out"
+            f"unloaded edges; this plate {why} (plate.outline, plate.file): leave [design] "
+            "out, or give the rectangle's plate.corners"
         )
     thermal = load.thermal or (load.fixed_thermal and load.fixed_factor != 0.0)
     if thermal:

@@ -156,11 +156,8 @@ class MeshStudy:
         version control (the figures directory); the times and eigen-solve counts are
         printed instead.
         """
-        path.parent.mkdir(parents=True, exist_ok=True)
         results = [r.as_dict(timings=False) for r in self.results]
-        summary = {"case": self.name, **extra, "results": results}
-        path.write_text(json.dumps(record(summary), indent=2) + "\n")
-        return path
+        return write_record(path, {"case": self.name, **extra, "results": results})
 
     def finish(
         self,
@@ -193,6 +190,30 @@ class MeshStudy:
             section_A={"x": x.tolist(), "w": w.tolist()},
             **extra,
         )
+
+
+def write_record(path: Path, data: Any, *, contact: bool = True) -> Path:
+    """Write ``data`` at ``path`` as a record (:func:`~unibuckle_fenicsx.results.record`).
+
+    A record is the same on every machine (eight significant digits, no times or
+    eigen-solve counts), so that it can be kept under version control and compared
+    between runs. Call it on one rank.
+
+    Args:
+        path: A ``.json`` file (``data`` indented), or a ``.jsonl`` file (``data`` a
+            sequence of mappings, one line each, as :func:`~unibuckle_fenicsx.sweep.run_sweep`
+            writes them).
+        data: A JSON value (``BucklingResult.as_dict()``, a sweep's lines, a summary).
+        contact: Keep the contact sets; ``False`` on thin plates, where nodes flat on the
+            obstacle with no contact force fall in or out of the set with rounding.
+    """
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.suffix == ".jsonl":
+        text = "".join(json.dumps(record(line, contact=contact)) + "\n" for line in data)
+    else:
+        text = json.dumps(record(data, contact=contact), indent=2) + "\n"
+    path.write_text(text)
+    return path
 
 
 def mesh_study(
@@ -245,6 +266,7 @@ def mesh_study(
                         analysis.mode,
                         figures / f"mode_{point.label}.png",
                         contact_coordinates=result.contact_coordinates,
+                        contact_pressing=fields.pressing(result),
                         title=f"{_title(name)}, {point.label} mesh: "
                         f"λ = {result.critical_load_Pa / 1e6:.4f} MPa{ratio}",
                         show_zone=zone is not None,
@@ -263,9 +285,21 @@ def mesh_study(
                         zone=zone,
                         constrained=problem.contact.coordinates,
                         contact_coordinates=result.contact_coordinates,
+                        contact_pressing=fields.pressing(result),
                         title=f"{_title(name)}: contact set on the {point.label} mesh",
                         tau=problem.tau,
                     )
+                    force = result.contact_force
+                    if force is not None and force["resolution"] is not None:
+                        plotting.plot_contact_force(
+                            figures / "contact_force.png",
+                            result.contact_coordinates,
+                            force["push"],
+                            force["resolution"],
+                            corners=spec.plate.corners,
+                            zone=zone,
+                            title=f"{_title(name)}: the obstacle's push, {point.label} mesh",
+                        )
             if output is not None:
                 write_fields(analysis, output / name / point.label)
             if at_each is not None:
