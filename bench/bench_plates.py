@@ -53,7 +53,7 @@ from msgspec.structs import replace
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.certificate.certify import Certificate
-from unibuckle_fenicsx.results.record import jsonable
+from unibuckle_fenicsx.results.records import jsonable
 from unibuckle_fenicsx.spec import ObstacleSpec, problem_to_dict
 from unibuckle_fenicsx.spec.cases import plate_case
 

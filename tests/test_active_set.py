@@ -46,7 +46,7 @@ from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import UnilateralProblem
-from unibuckle_fenicsx.results.record import jsonable
+from unibuckle_fenicsx.results.records import jsonable
 from unibuckle_fenicsx.spec import ObstacleSpec, ProblemSpec
 from unibuckle_fenicsx.spec.cases import paper_case, plate_case
 

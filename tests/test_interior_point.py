@@ -62,7 +62,7 @@ from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import UnilateralProblem
-from unibuckle_fenicsx.results.record import jsonable
+from unibuckle_fenicsx.results.records import jsonable
 from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.spec.cases import paper_case, plate_case
 

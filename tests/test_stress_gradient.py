@@ -29,7 +29,7 @@ from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.prestress import solve_prestress
-from unibuckle_fenicsx.results.record import jsonable
+from unibuckle_fenicsx.results.records import jsonable
 from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,

@@ -20,7 +20,7 @@ from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
 from unibuckle_fenicsx.results.assemble import assemble_result
-from unibuckle_fenicsx.results.record import BucklingResult
+from unibuckle_fenicsx.results.records import BucklingResult
 from unibuckle_fenicsx.spec import Method, ProblemSpec
 
 __all__ = ["Analysis", "choose_method", "solve"]
@@ -102,7 +102,7 @@ class Analysis(Owner):
     """What :func:`solve` returns: the result, the critical mode and the set-up problem.
 
     Attributes:
-        result: The result's records (:class:`~unibuckle_fenicsx.results.record.BucklingResult`).
+        result: The result's records (:class:`~unibuckle_fenicsx.results.records.BucklingResult`).
         problem: The set-up problem (mesh, pencil, contact manager, free mode).
         solution: The unilateral algorithm's solution (None without obstacle).
         certificate: Its certificate (None without obstacle).

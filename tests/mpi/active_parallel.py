@@ -13,7 +13,7 @@ from mpi4py import MPI
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.model.build import build_problem
-from unibuckle_fenicsx.results.record import jsonable
+from unibuckle_fenicsx.results.records import jsonable
 from unibuckle_fenicsx.spec import load_problem
 from unibuckle_fenicsx.spec.cases import paper_case
 

@@ -16,7 +16,7 @@ import numpy as np
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions
 from unibuckle_fenicsx.model.build import build_problem
-from unibuckle_fenicsx.results.record import jsonable
+from unibuckle_fenicsx.results.records import jsonable
 from unibuckle_fenicsx.spec import ObstacleSpec
 from unibuckle_fenicsx.spec.cases import plate_case
 

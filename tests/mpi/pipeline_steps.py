@@ -34,7 +34,7 @@ from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.prestress import solve_prestress
 from unibuckle_fenicsx.results.assemble import certificate_record
-from unibuckle_fenicsx.results.record import jsonable
+from unibuckle_fenicsx.results.records import jsonable
 from unibuckle_fenicsx.spec import MeshSpec
 from unibuckle_fenicsx.spec.cases import paper_case
 

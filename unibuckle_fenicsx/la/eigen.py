@@ -34,7 +34,7 @@ from slepc4py import SLEPc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.errors import EigenSolveError
+from unibuckle_fenicsx.errors import EigenSolveError, InputError
 from unibuckle_fenicsx.la.factor import SharedFactorization
 from unibuckle_fenicsx.la.options import Options, Prefix, set_options
 from unibuckle_fenicsx.la.ownership import Owner, release
@@ -108,6 +108,33 @@ def _is_zero(B: PETSc.Mat) -> bool:
     return bool(B.norm(PETSc.NormType.INFINITY) == 0.0)  # type: ignore[arg-type]
 
 
+#: The spectral transformation's solves must be exact: a KSP "preonly" with one of these.
+DIRECT_PCS = ("lu", "cholesky")
+
+
+def _require_direct_solve(eps: SLEPc.EPS, prefix: str) -> None:
+    r"""Refuse an iterative solve in the spectral transformation (options from the user).
+
+    The inverse of :math:`A - \sigma B` is applied inside Krylov-Schur and its
+    factorisation's inertia proves which eigenvalue is the smallest: an inexact inner
+    solve (e.g. ``-<prefix>st_ksp_type gmres -<prefix>st_pc_type jacobi``) stops with
+    "KSPSolve has not converged", and SLEPc then fails in its clean-up with "Operation
+    done in wrong order". Raises :class:`~unibuckle_fenicsx.errors.InputError` naming the
+    options; the caller destroys the EPS.
+    """
+    ksp = eps.getST().getKSP()
+    ksp_type, pc_type = ksp.getType(), ksp.getPC().getType()
+    if ksp_type == "preonly" and pc_type in DIRECT_PCS:
+        return
+    raise InputError(
+        f"-{prefix}st_ksp_type {ksp_type} -{prefix}st_pc_type {pc_type}: the eigen solver's "
+        "shift-and-invert here needs a direct factorisation (an iterative inner solve is "
+        "inexact, and so are the transformed spectrum and the eigenvalue; it stops with "
+        f"'KSPSolve has not converged'): give -{prefix}st_ksp_type preonly with "
+        f"-{prefix}st_pc_type {' or '.join(DIRECT_PCS)} (the default: lu with MUMPS)"
+    )
+
+
 class GEPSolver(Owner):
     """Smallest eigenpair of :math:`(A, B)` with optional removed DOFs.
 
@@ -164,6 +191,11 @@ class GEPSolver(Owner):
         self._options = dict(EIGEN_OPTIONS if options is None else options)
         set_options(eps, prefix, self._options)
         self.eps = eps
+        try:
+            _require_direct_solve(eps, prefix)
+        except InputError:
+            self.destroy()  # collective: every rank reads the same options
+            raise
         self._near: SLEPc.EPS | None = None  # the shifted solves' EPS, made when needed
         self._ldl: SharedFactorization | None = None  # made when needed
         self.shifted_solves = 0  # solves at a shift below an estimate (near=...)

@@ -44,7 +44,7 @@ from unibuckle_fenicsx.model.contact import (
 )
 from unibuckle_fenicsx.model.mesh import build_plate_mesh, check_user_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
-from unibuckle_fenicsx.model.points import point_obstacles
+from unibuckle_fenicsx.model.points import one_sided_conflicts, point_obstacles
 from unibuckle_fenicsx.model.prestress import Prestress, solve_prestress
 from unibuckle_fenicsx.model.problem import Problem, SetUp, UnilateralProblem
 from unibuckle_fenicsx.model.resources import check_memory
@@ -290,8 +290,9 @@ def build_contact(model: PlateModel, spec: ProblemSpec) -> ContactSetManager | N
     except EmptyZoneError as err:
         if not spec.one_sided_points:
             raise
+        one_sided = [k for k, p in enumerate(spec.points) if p.kind == "one-sided"]
         raise EmptyZoneError(
-            "points: the one-sided points"
+            f"{_points_label(spec, one_sided)}: the one-sided points"
             + (" and the obstacle zones" if spec.unilateral_obstacles else "")
             + " act on no free node: each such node is held already (by an edge "
             "support or a bilateral point), so the point restrains nothing; move it off "
@@ -300,10 +301,17 @@ def build_contact(model: PlateModel, spec: ProblemSpec) -> ContactSetManager | N
     except BilateralZoneError as err:
         if not spec.one_sided_points:
             raise
+        clash = one_sided_conflicts(model.points, spec.unilateral_obstacles, spec.plate)
         raise BilateralZoneError(
-            "points: a one-sided point acts on a node held from the other side too (an "
-            'obstacle zone or another point): that holds w = 0, give it kind = "bilateral"'
+            f"{_points_label(spec, clash) if clash else 'points'}: a one-sided point acts "
+            "on a node held from the other side too (an obstacle zone or another point): "
+            'that holds w = 0, give it kind = "bilateral"'
         ) from err
+
+
+def _points_label(spec: ProblemSpec, indices: list[int]) -> str:
+    """``points[k] (what)`` for each index, for messages, in the file's units."""
+    return ", ".join(f"points[{k}] ({spec.points[k].describe(spec.units)})" for k in indices)
 
 
 def build_problem(

@@ -40,10 +40,24 @@ from unibuckle_fenicsx.model.contact import ContactSetManager, orientation
 from unibuckle_fenicsx.model.materials import reference_bending_stiffness
 from unibuckle_fenicsx.model.prestress import Prestress
 from unibuckle_fenicsx.model.structure import StructuralModel
-from unibuckle_fenicsx.spec import ProblemSpec
+from unibuckle_fenicsx.spec import ProblemSpec, temperature_field
 from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
 __all__ = ["Candidate", "Mode", "Problem", "SetUp", "UnilateralProblem", "require_obstacle"]
+
+
+def _cooling_hint(spec: ProblemSpec) -> str:
+    """A clause naming ``load.temperature`` when the scaled rise cools the plate, or ""."""
+    if not spec.load.thermal:
+        return ""
+    T0, gx, gy = temperature_field(spec.load.temperature)
+    if max(T0 + gx * x + gy * y for x, y in spec.plate.boundary) > 0.0:
+        return ""
+    return (
+        f"; load.temperature = {spec.load.temperature!r} K per unit load is a cooling "
+        "(no rise > 0 anywhere): it puts a plate held in its plane in tension, which no "
+        "positive load factor buckles; give a rise (load.temperature > 0)"
+    )
 
 
 @dataclass(frozen=True)
@@ -216,7 +230,7 @@ class Problem(Owner):
                     "the plate has no positive buckling load on this mesh: the geometric "
                     "stiffness b(w, w) is nowhere positive on the free deflections (edge "
                     "loads in tension, or the supports fix every deflection DOF); check the "
-                    "edge loads, refine the mesh or free an edge"
+                    "edge loads, refine the mesh or free an edge" + _cooling_hint(self.spec)
                 )
             u.x.petsc_vec.scale(1.0 / self.max_abs_w(u.x.petsc_vec))
             u.x.scatter_forward()

@@ -206,22 +206,37 @@ class VonKarmanPlate(MixedDofs, Owner):
         self.spec = spec
         self.plate = spec.plate
         self.control = control
-        self.thickness = t = spec.plate.thickness
+        self.thickness = spec.plate.thickness
         loaded = [e for e in spec.plate.edges if e.loaded]
         if not loaded:
             raise InputError(
                 "no edge is loaded: give at least one edge a non-zero normal_stress or shear_stress"
             )
         self._displacement_axis = displacement_axis(spec.plate, control)
-
         if mesh is None or facet_tags is None:
             mesh, facet_tags, plate = build_plate_mesh(
                 spec.plate, spec.mesh, comm, spec.all_obstacles
             )
             self.plate = plate
         self.mesh, self.facet_tags = mesh, facet_tags
-        msh = self.mesh
-        self.comm = msh.comm
+        self.comm = mesh.comm
+        self._spaces(degree)
+        self._edge_values: list[tuple[dolfinx.fem.Constant, float]] = []
+        self.bcs = self.bending_bcs + self._inplane_bcs()
+        self.x = dolfinx.fem.Function(self.W, name="state")
+        self.x0 = dolfinx.fem.Function(self.W, name="imperfection")
+        self.load = dolfinx.fem.Constant(mesh, 0.0)
+        ks = self._forms(loaded)
+        self._matrices(ks)
+        self.contact = (
+            ContactSetManager(self, spec.all_obstacles) if obstacle and spec.all_obstacles else None
+        )
+        self.snes: PETSc.SNES | None = self._snes(snes_options)
+
+    # -- set-up stages -------------------------------------------------------------
+    def _spaces(self, degree: int) -> None:
+        """The mixed space (u, w, theta), its w part, the supports' and points' conditions."""
+        msh, spec = self.mesh, self.spec
         cell = msh.basix_cell().name
         elements = [
             basix.ufl.element("Lagrange", cell, degree, shape=(2,)),
@@ -246,12 +261,13 @@ class VonKarmanPlate(MixedDofs, Owner):
                 [bc.dof_indices()[0] for bc in self.bending_bcs] or [np.empty(0, np.int32)]
             )
         ).astype(np.int32)
-        self._edge_values: list[tuple[dolfinx.fem.Constant, float]] = []
-        self.bcs = self.bending_bcs + self._inplane_bcs()
 
-        self.x = dolfinx.fem.Function(self.W, name="state")
-        self.x0 = dolfinx.fem.Function(self.W, name="imperfection")
-        self.load = dolfinx.fem.Constant(msh, 0.0)
+    def _forms(self, loaded: list[EdgeSpec]) -> float | npt.NDArray[np.float64]:
+        """The energy's residual and Jacobian forms, the load's scale, the end shortening.
+
+        Returns the transverse shear stiffness (N/m; a laminate's 2x2), for the MITC matrix.
+        """
+        spec, msh, t = self.spec, self.mesh, self.thickness
         D = bending_voigt(spec.material, t)
         self.energy_scale = float(D[0, 0])  # N m
         Cm = membrane_voigt(spec.material, t)
@@ -283,7 +299,7 @@ class VonKarmanPlate(MixedDofs, Owner):
             for e in loaded
             for tag in edge_tags(self.plate, e)
         ]
-        if control == "load":
+        if self.control == "load":
             for traction, tag in tractions:
                 Pi = Pi - (self.load * t / self.energy_scale) * ufl.inner(traction, u) * ds(tag)
         v, dx_ = ufl.TestFunction(self.W), ufl.TrialFunction(self.W)
@@ -314,13 +330,17 @@ class VonKarmanPlate(MixedDofs, Owner):
             )
             for e in loaded
         ]
+        return ks
 
+    def _matrices(self, ks: float | npt.NDArray[np.float64]) -> None:
+        """The MITC shear matrix, the points' springs, the Jacobian and the work vectors."""
+        t = self.thickness
         scale = dolfinx.fem.Function(self.W)
         scale.x.array[:] = 1.0
         scale.x.array[self.w_dofs] = t
         self.Ks: PETSc.Mat | None = None
-        if spec.solver.shear == "mitc":
-            Ks = mitc_shear_matrix(
+        if self.spec.solver.shear == "mitc":
+            self.Ks = mitc_shear_matrix(
                 self.W,
                 self.bc_dofs,
                 ks / self.energy_scale,
@@ -328,7 +348,6 @@ class VonKarmanPlate(MixedDofs, Owner):
                 theta_sub=THETA_SUB,
                 column_scale=scale.x.petsc_vec,
             )
-            self.Ks = Ks
         self._add_point_springs(t)
         self.J: PETSc.Mat | None = dolfinx.fem.petsc.create_matrix(self.J_form)
         self._merged = False
@@ -337,9 +356,12 @@ class VonKarmanPlate(MixedDofs, Owner):
         self._d: PETSc.Vec | None = self._xs.duplicate()
         self._Kd: PETSc.Vec | None = self._xs.duplicate()
 
-        self.contact = (
-            ContactSetManager(self, spec.all_obstacles) if obstacle and spec.all_obstacles else None
-        )
+    def _snes(self, snes_options: Mapping[str, str | float | int | bool] | None) -> PETSc.SNES:
+        """The SNES of the path, with the obstacle's bounds (a variational inequality)."""
+        xs = self._xs
+        if xs is None:
+            raise RuntimeError("_snes: the work vectors come first (an internal invariant)")
+        t = self.thickness
         snes = PETSc.SNES().create(self.comm)
         snes.setFunction(self._residual, self.b)
         snes.setJacobian(self._jacobian, self.J)
@@ -348,8 +370,8 @@ class VonKarmanPlate(MixedDofs, Owner):
         self._upper: PETSc.Vec | None = None
         if self.contact is not None:
             options.setdefault("snes_type", "vinewtonrsls")
-            self._lower = self._xs.duplicate()
-            self._upper = self._xs.duplicate()
+            self._lower = xs.duplicate()
+            self._upper = xs.duplicate()
             self._lower.set(PETSc.NINFINITY)
             self._upper.set(PETSc.INFINITY)
             # Obstacle above: w <= g (upper bound); below: w >= -g (lower bound); w/t here.
@@ -364,7 +386,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         else:
             options.setdefault("snes_type", "newtonls")
         set_options(snes, Prefix.NONLINEAR, options)
-        self.snes: PETSc.SNES | None = snes
+        return snes
 
     # -- set-up helpers ------------------------------------------------------------
     def _inplane_bcs(self) -> list[dolfinx.fem.DirichletBC]:

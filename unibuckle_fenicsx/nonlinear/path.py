@@ -26,10 +26,11 @@ import dolfinx.fem.petsc
 
 import numpy as np
 import numpy.typing as npt
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
-from unibuckle_fenicsx.errors import InputError, NonlinearError
+from unibuckle_fenicsx.errors import InputError, NonlinearError, NumericalError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import UnilateralProblem
@@ -48,6 +49,7 @@ from unibuckle_fenicsx.nonlinear.model import (
     VonKarmanPlate,
     displacement_axis,
 )
+from unibuckle_fenicsx.nonlinear.verdict import judge
 from unibuckle_fenicsx.progress import LOGGER
 from unibuckle_fenicsx.results.assemble import versions
 from unibuckle_fenicsx.spec import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
@@ -174,6 +176,12 @@ class NonlinearResult:
         constrained_nodes: Zone nodes with w <= g imposed (g the obstacle's gap).
         contact_load_Pa: The load of the first state on the path with a node on the
             obstacle (None if none): with a gap, where the plate reaches the obstacle.
+        gapped: An obstacle with a gap was imposed: the linear load is the free plate's
+            (the linear state leaves the gapped obstacle out), and the knee lies between
+            it and ``unilateral_load_Pa`` (:mod:`~unibuckle_fenicsx.nonlinear.verdict`).
+        unilateral_load_Pa: With ``gapped``: the linear unilateral critical load with the
+            gaps closed (same mesh); None otherwise, or if that solve failed.
+        verdict: The verdict in words (:func:`~unibuckle_fenicsx.nonlinear.verdict.judge`).
         contact_check: The contact conditions at the last state (see
             :func:`contact_check`).
         options: The options used.
@@ -209,6 +217,9 @@ class NonlinearResult:
     options: dict[str, Any]
     wall_time_s: float
     contact_load_Pa: float | None = None
+    gapped: bool = False
+    unilateral_load_Pa: float | None = None
+    verdict: str = ""
     timings: dict[str, float] = field(default_factory=dict)
     mpi_size: int = 1
     units: str = "SI"
@@ -216,47 +227,36 @@ class NonlinearResult:
 
     @property
     def certified(self) -> bool:
-        """The path is complete, both loads were read off it, the contact holds."""
-        return (
-            self.completed
-            and self.southwell_load_Pa is not None
-            and self.inflection_load_Pa is not None
-            and bool(self.contact_check.get("satisfied", True))
-        )
+        """The path is complete, both loads were read off it and agree, the contact holds.
 
-    def verdict(self) -> str:
-        """What an incomplete load path validated, and what it did not (one paragraph).
+        Agree: within :data:`~unibuckle_fenicsx.tolerances.KNEE_RTOL` of the linear load;
+        with a gap, between the free load and the unilateral one with the gaps closed
+        (:func:`~unibuckle_fenicsx.nonlinear.verdict.judge`).
+        """
+        return judge(self).ok
+
+    def shortfall(self) -> str:
+        """What an unsuccessful load path validated, and what it did not (one paragraph).
 
         For a result that is not :attr:`certified`; the path was asked to reach
-        ``options["max_load"]`` times the linear critical load.
+        ``options["max_load"]`` times the linear critical load
+        (:func:`~unibuckle_fenicsx.nonlinear.verdict.judge`).
         """
+        verdict = judge(self)
+        validated, missing = ", ".join(verdict.validated), ", ".join(verdict.missing)
         linear = self.linear_critical_load_Pa
-        validated, missing = [], []
-        for name, load in (
-            ("Southwell", self.southwell_load_Pa),
-            ("inflection", self.inflection_load_Pa),
-        ):
-            if load is None:
-                missing.append(f"the {name} load (the path stopped before it could be read)")
-            else:
-                validated.append(
-                    f"the {name} load {load:.6e} Pa ({load / linear - 1:+.1e} relative)"
-                )
-        check = self.contact_check
-        if check.get("satisfied", True):
-            validated.append("the contact conditions at the last converged state")
-        else:
-            missing.append(f"the contact conditions at the last converged state ({check})")
-        reached = self.path[-1]["load_Pa"] / linear if self.path else 0.0
-        if not self.completed:
-            missing.append(
-                f"the path from {reached:.4g} to --max-load {self.options['max_load']:g} x the "
-                f"linear load ({self.stop_reason})"
+        if verdict.gap:
+            closed = self.unilateral_load_Pa
+            return (
+                f"with a gap the knee lies between the free load {linear:.6e} Pa and the "
+                "unilateral load with the gaps closed "
+                + ("(not computed)" if closed is None else f"{closed:.6e} Pa")
+                + "; the load path is not consistent with them. Consistent: "
+                f"{validated or 'nothing'}. Not consistent: {missing}"
             )
         return (
             f"the load path does not validate everything against the linear critical load "
-            f"{linear:.6e} Pa. Validated: {', '.join(validated) or 'nothing'}. Not validated: "
-            f"{', '.join(missing)}"
+            f"{linear:.6e} Pa. Validated: {validated or 'nothing'}. Not validated: {missing}"
         )
 
     def as_dict(self) -> dict[str, Any]:
@@ -264,21 +264,30 @@ class NonlinearResult:
         return asdict(self)
 
     def summary(self) -> str:
-        """Two lines for the terminal."""
+        """Lines for the terminal: the loads, the path, the verdict."""
         scale, unit = UNITS[self.units][1:]
 
         def load(value: float | None, ratio: float | None) -> str:
             if value is None or ratio is None:
                 return "not found"
-            return f"{value / scale:.6e} {unit} ({ratio:.4f} x linear)"
+            return f"{value / scale:.6e} {unit} ({ratio:.4f} x {reference})"
 
+        gap = self.obstacle and self.gapped
+        reference = "free" if gap else "linear"
         last = self.path[-1]
         where = "with obstacle" if self.obstacle else "without obstacle"
+        linear = f"linear {self.linear_critical_load_Pa / scale:.6e} {unit}"
+        if gap:
+            closed = self.unilateral_load_Pa
+            linear = (
+                f"linear: free {self.linear_critical_load_Pa / scale:.6e} {unit} (the gapped "
+                "obstacle left out), unilateral with the gaps closed "
+                + ("not computed" if closed is None else f"{closed / scale:.6e} {unit}")
+            )
         return (
             f"{self.case} ({where}, delta/t = {self.imperfection:g}, {self.control} control): "
             f"Southwell {load(self.southwell_load_Pa, self.southwell_ratio)}, inflection "
-            f"{load(self.inflection_load_Pa, self.inflection_ratio)}; linear "
-            f"{self.linear_critical_load_Pa / scale:.6e} {unit}\n"
+            f"{load(self.inflection_load_Pa, self.inflection_ratio)}; {linear}\n"
             f"  path: {len(self.path) - 1} steps ({self.rejected_steps} rejected) to "
             f"lambda = {last['load_Pa'] / scale:.6e} {unit}, max|w|/t = "
             f"{last['max_w_m'] / self.thickness_m:.4g}, {last['contact_nodes']} contact "
@@ -286,10 +295,11 @@ class NonlinearResult:
             + (
                 f"\n  the plate reaches the obstacle at lambda = "
                 f"{self.contact_load_Pa / scale:.6e} {unit} "
-                f"({self.contact_load_Pa / self.linear_critical_load_Pa:.4f} x linear)"
+                f"({self.contact_load_Pa / self.linear_critical_load_Pa:.4f} x {reference})"
                 if self.contact_load_Pa is not None and self.obstacle
                 else ""
             )
+            + f"\n  {judge(self).summary(self)}"
         )
 
 
@@ -544,8 +554,14 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
             else ", NOT certified"
         )
     label = f"{spec.name} delta/t={options.imperfection:g}"
+    gapped = obstacle and bool(spec.gapped_obstacles)
     plate = None
+    closed: float | None = None
     try:
+        if gapped:
+            t1 = time.perf_counter()
+            closed = _gaps_closed_load(spec, linear)
+            timings["gaps_closed_s"] = time.perf_counter() - t1
         t1 = time.perf_counter()
         plate = VonKarmanPlate(
             spec,
@@ -607,6 +623,8 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
         rejected_steps=rejected,
         constrained_nodes=0 if plate.contact is None else plate.contact.size,
         contact_load_Pa=next((q.load_Pa for q in path if q.contact_nodes), None),
+        gapped=gapped,
+        unilateral_load_Pa=closed,
         contact_check=check,
         options={**asdict(options), "degree": degree},
         wall_time_s=time.perf_counter() - t0,
@@ -615,4 +633,27 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
         units=spec.units,
         versions=versions(),
     )
+    nl.verdict = judge(nl).summary(nl)
     return NonlinearAnalysis(nl, plate, linear, owns_linear)
+
+
+def _gaps_closed_load(spec: ProblemSpec, linear: Analysis) -> float | None:
+    """The linear unilateral critical load with every gap closed (g = 0), same mesh.
+
+    The upper end of where the knee of a plate with a gapped obstacle lies; None when
+    that solve finds no certified state (the verdict then says it is unknown). Collective.
+    """
+    closed = replace(
+        spec,
+        obstacle=None if spec.obstacle is None else replace(spec.obstacle, gap=0.0),
+        obstacles=tuple(replace(o, gap=0.0) for o in spec.obstacles),
+    )
+    problem = linear.problem
+    try:
+        with solve_linear(
+            closed, problem.comm, mesh=problem.mesh, facet_tags=problem.facet_tags
+        ) as analysis:
+            return analysis.result.critical_load_Pa
+    except NumericalError as err:
+        logger.warning("%s: the unilateral load with the gaps closed: %s", spec.name, err)
+        return None

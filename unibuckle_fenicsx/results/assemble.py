@@ -13,7 +13,7 @@ from typing import TYPE_CHECKING, Any
 
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.model.zones import zone_report
-from unibuckle_fenicsx.results.record import (
+from unibuckle_fenicsx.results.records import (
     BucklingResult,
     CertificateRecord,
     ContactForce,
@@ -78,6 +78,7 @@ def assemble_result(
         edge_loads={e.name: _edge_load(e) for e in spec.plate.edges},
         critical_load_factor=load,
         critical_temperature_K=_critical_temperature(spec, load),
+        critical_total_temperature_K=_total_temperature(spec, load),
         units=spec.units,
         input=_input(spec),
         versions=versions(),
@@ -217,6 +218,24 @@ def _critical_temperature(spec: ProblemSpec, load: float) -> float | None:
     T0, gx, gy = temperature_field(spec.load.temperature)
     rises = [T0 + gx * x + gy * y for x, y in spec.plate.boundary]
     return load * max(rises)
+
+
+def _total_temperature(spec: ProblemSpec, load: float) -> float | None:
+    """With a fixed rise: the largest total rise at the critical state (K), else None.
+
+    ``fixed_factor`` times the fixed field plus lambda times the scaled one: a linear
+    field, largest on a vertex of the boundary.
+    """
+    if not (spec.load.fixed_thermal and spec.load.fixed_factor):
+        return None
+    fixed = temperature_field(spec.load.fixed_temperature)
+    scaled = temperature_field(spec.load.temperature)
+    factor = spec.load.fixed_factor
+    return max(
+        factor * (fixed[0] + fixed[1] * x + fixed[2] * y)
+        + load * (scaled[0] + scaled[1] * x + scaled[2] * y)
+        for x, y in spec.plate.boundary
+    )
 
 
 def _input(spec: ProblemSpec) -> dict[str, Any] | None:

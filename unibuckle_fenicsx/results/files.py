@@ -11,7 +11,7 @@ import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.analysis import Analysis
-    from unibuckle_fenicsx.results.record import BucklingResult
+    from unibuckle_fenicsx.results.records import BucklingResult
 
 __all__ = ["file_stem", "write_fields", "write_json"]
 

@@ -181,6 +181,9 @@ class BucklingResult(Struct, kw_only=True):
             N_scaled).
         critical_temperature_K: With a temperature rise in the scaled load: lambda times
             its largest rise over the plate (the uniform rise's critical value).
+        critical_total_temperature_K: With a fixed temperature rise: the largest total
+            rise over the plate at the critical state, the fixed rise (times
+            ``fixed_factor``) plus lambda times the scaled one.
         design: With ``[design]``: EN 1993-1-5's quantities of this sigma_cr.
         units: The unit system the summary prints in (the numbers here are SI).
         input: The problem solved, every key with the value used, in SI (None for a
@@ -222,6 +225,7 @@ class BucklingResult(Struct, kw_only=True):
     edge_loads: dict[str, EdgeLoad] = {}
     critical_load_factor: float | None = None
     critical_temperature_K: float | None = None
+    critical_total_temperature_K: float | None = None
     design: DesignRecord | None = None
     units: str = "SI"
     input: dict[str, Any] | None = None
@@ -338,6 +342,11 @@ class BucklingResult(Struct, kw_only=True):
         ]
         if load.get("fixed_temperature"):
             fixed.append(f"temperature rise {load['fixed_temperature']} K")
+        if self.critical_total_temperature_K is not None:
+            lines.append(
+                "total temperature rise at the critical state (the fixed rise and lambda "
+                f"times the scaled one): {self.critical_total_temperature_K:.6g} K"
+            )
         if self.design is not None:
             lines.append(_design_line(self.design, scale, unit))
         factor = load.get("fixed_factor", 1.0)
@@ -346,11 +355,12 @@ class BucklingResult(Struct, kw_only=True):
             lines.append(f"fixed load (applied as is): {times}{'; '.join(fixed)}")
         reports = self.details.point_restraints
         reports = [] if isinstance(reports, UnsetType) else reports
+        name = "m" if self.units == "SI" else "mm"
         for p, restraint in zip(reports, self._point_restraints(reports), strict=True):
             lines.append(
                 f"points: {restraint}: {p.points} points on {p.nodes} nodes, "
-                f"largest snap distance {p.max_snap_distance_m / length:.3g}"
-                f" {'m' if self.units == 'SI' else 'mm'}"
+                f"largest snap distance {p.max_snap_distance_m / length:.3g} {name}"
+                + _idle_text(p.restraining_nothing, length, name)
             )
         return lines
 
@@ -360,6 +370,17 @@ class BucklingResult(Struct, kw_only=True):
         if self.units == "SI" or len(tables) != len(reports):
             return [p.restraint for p in reports]
         return [PointSpec(**table).describe(self.units) for table in tables]
+
+
+def _idle_text(idle: list[list[float]], length: float, name: str) -> str:
+    """The summary's words on points that restrain nothing ('' if none)."""
+    if not idle:
+        return ""
+    shown = ", ".join(f"({x / length:g}, {y / length:g})" for x, y in idle[:3])
+    return (
+        f"; {len(idle)} on a node held already (by an edge support or a bilateral point), "
+        f"restraining nothing: {shown}" + (", ..." if len(idle) > 3 else "") + f" {name}"
+    )
 
 
 def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
@@ -372,9 +393,11 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
         + (
             f"{rho:.4g}, rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
             if rho is not None and isinstance(reduced, float)
-            else "none (psi < -3)"
+            else f"none (psi outside {d.table})"
         )
-        + " (4.2) calibrated on bilateral plates"
+        + f"; {d.element} element"
+        + (f" (free edge {d.free_edge})" if d.free_edge else "")
+        + ", 4.4(2) calibrated on bilateral plates"
     )
 
 
