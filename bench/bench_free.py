@@ -218,6 +218,7 @@ def main() -> None:
         row: dict[str, object] = {
             "plate": plate,
             "mesh": f"{nx}x{ny}",
+            "repeat": args.repeat,
             **best,
             "plain_s": min(r["plain_s"] for r in plain),
             "plain_proof_s": min(r["plain_proof_s"] for r in plain),
@@ -237,7 +238,8 @@ def main() -> None:
         row["cli_runs_s"] = [c[0] for c in cli]
         row["baseline_cli_runs_s"] = [c[0] for c in baseline]
         if comm.rank == 0:
-            cell = {k: "-" if row[k] is None else f"{row[k]:.2f}" for k in row if k.endswith("_s")}
+            timed = ("cli_s", "total_s", "baseline_cli_s", "baseline_total_s")
+            cell = {k: "-" if row[k] is None else f"{row[k]:.2f}" for k in timed}
             print(
                 f"| {plate} | {nx}x{ny} | {row['dofs']} | {row['package_s']:.2f} "
                 f"| {row['estimate_s']:.2f} | {row['factorisations']} | {row['solves']} "

@@ -110,6 +110,8 @@ def main() -> None:
             )  # recount: the proof record keeps the last shift's count
             row = {
                 "plate": what,
+                "seed": args.seed,
+                "cells": args.cells,
                 "mesh": f"{spec.mesh.nx}x{spec.mesh.ny}",
                 "dofs": int(problem.model.A.getSize()[0]),
                 "indefinite": problem.prestress.indefinite,

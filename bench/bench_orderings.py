@@ -191,6 +191,7 @@ def main() -> None:
                             "kind": kind,
                             "ordering": name,
                             "ranks": comm.size,
+                            "repeat": args.repeat,
                             **_time_factor(mat, pc_type, ORDERINGS[name], args.repeat),
                         }
                         row["free_s"] = row["analysis_s"] + row["numeric_s"] + 10 * row["solve_s"]

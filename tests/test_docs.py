@@ -56,6 +56,7 @@ PAGES = [
     "demos/index.md",
     "verification/index.md",
     "verification/benchmarks.md",
+    "verification/floor.md",
     "changelog.md",
 ]
 
@@ -146,6 +147,16 @@ def test_bench_page_renders_its_results_file() -> None:
     page = unibuckle_docs.bench_page(path)
     assert "python bench/bench_plates.py --meshes" in page
     assert len(re.findall(r"^\| (?!case)", page, flags=re.M)) == len(rows)
+
+
+@pytest.mark.parametrize("name", ["free", "free_estimates", "orderings"])
+def test_the_floor_pages_name_their_commands(name: str) -> None:
+    """The floor's tables (verification/floor) name the command that wrote each row."""
+    path = ROOT / "bench" / "results" / f"{name}.jsonl"
+    rows = unibuckle_docs.bench_rows(path)
+    page = unibuckle_docs.bench_page(path)
+    assert f"python bench/bench_{name}.py --" in page and "see bench/" not in page
+    assert len(re.findall(r"^\| (?!plate)", page, flags=re.M)) == len(rows)
 
 
 def test_demo_pages_render_every_demo_with_its_figures() -> None:

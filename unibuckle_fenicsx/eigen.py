@@ -159,32 +159,35 @@ ORDERINGS = {"amd": 0, "amf": 2, "scotch": 3, "pord": 4, "metis": 5, "qamd": 6}
 #: The ordering of a matrix below :data:`NESTED_DISSECTION_ROWS` rows, by kind: the
 #: plate's (w, theta) matrices (the pencil's factorisations, the stiffness's LU) by
 #: approximate minimum fill, the membrane stiffness of the prestress by approximate
-#: minimum degree; each has the least fill of the orderings whose analysis costs
-#: little, measured on :doc:`/verification/orderings`.
+#: minimum degree; of the orderings whose analysis costs little, each gives the
+#: fastest factorisation there (measured on :doc:`/verification/floor`).
 ORDERING_BELOW = {"plate": "amf", "membrane": "amd"}
-#: Rows from which a factorisation is ordered by nested dissection (METIS) instead: its
-#: analysis costs more than the numeric factorisation it saves below (measured on
-#: :doc:`/verification/orderings`).
-NESTED_DISSECTION_ROWS = 400_000
+#: Rows from which a factorisation is ordered by nested dissection (METIS) instead, by
+#: whether its analysis serves one numeric factorisation or many (the eigen solves of a
+#: route's contact sets, the interior point's Newton steps): METIS's analysis costs more
+#: than one numeric factorisation on the package's matrices, and saves a fraction of
+#: each (measured on :doc:`/verification/floor`).
+NESTED_DISSECTION_ROWS = {False: 400_000, True: 100_000}
 
 
-def mumps_ordering(rows: int, kind: str = "plate") -> int:
+def mumps_ordering(rows: int, kind: str = "plate", reused: bool = False) -> int:
     """MUMPS ICNTL(7) for a matrix of ``rows`` rows of ``kind`` ("plate" or "membrane").
 
-    METIS from :data:`NESTED_DISSECTION_ROWS` rows, else :data:`ORDERING_BELOW`'s. The
-    option ``-<prefix>mat_mumps_icntl_7`` (e.g. ``-unibuckle_ldl_mat_mumps_icntl_7 5``)
+    METIS from :data:`NESTED_DISSECTION_ROWS` rows (``reused``: for an analysis that
+    serves many numeric factorisations), else :data:`ORDERING_BELOW`'s. The option
+    ``-<prefix>mat_mumps_icntl_7`` (e.g. ``-unibuckle_ldl_mat_mumps_icntl_7 5``)
     overrides it for one factorisation.
     """
-    if rows >= NESTED_DISSECTION_ROWS:
+    if rows >= NESTED_DISSECTION_ROWS[reused]:
         return ORDERINGS["metis"]
     return ORDERINGS[ORDERING_BELOW[kind]]
 
 
 def ordering_options(
-    mat: PETSc.Mat, key: str = "mat_mumps_icntl_7", kind: str = "plate"
+    mat: PETSc.Mat, key: str = "mat_mumps_icntl_7", kind: str = "plate", reused: bool = False
 ) -> dict[str, int]:
-    """``{key: mumps_ordering(rows of mat, kind)}``: the ordering as a default option."""
-    return {key: mumps_ordering(int(mat.getSize()[0]), kind)}
+    """``{key: mumps_ordering(rows of mat, ...)}``: the ordering as a default option."""
+    return {key: mumps_ordering(int(mat.getSize()[0]), kind, reused)}
 
 
 def release(owner: object, *names: str) -> None:
@@ -223,14 +226,13 @@ def _without_zeros(mat: PETSc.Mat, values: Any, csr: Any) -> PETSc.Mat:
     """An AIJ matrix with ``mat``'s layout: ``values`` at its local CSR rows ``csr``, zeros out."""
     indptr, indices, _ = csr
     keep = values != 0.0
-    rows = np.repeat(np.arange(indptr.size - 1), np.diff(indptr))
-    counts = np.bincount(rows[keep], minlength=indptr.size - 1)
+    kept = np.concatenate(([0], np.cumsum(keep)))  # kept entries before each entry
     new = (
-        np.concatenate(([0], np.cumsum(counts))).astype(PETSc.IntType),
+        kept[indptr].astype(PETSc.IntType),
         indices[keep].astype(PETSc.IntType),
         values[keep],
     )
-    out = PETSc.Mat().createAIJ(mat.getSizes(), csr=new, comm=mat.comm)  # type: ignore[arg-type]
+    out = PETSc.Mat().createAIJWithArrays(mat.getSizes(), new, comm=mat.comm)  # type: ignore[arg-type]
     out.setOption(PETSc.Mat.Option.SYMMETRIC, mat.isSymmetricKnown()[1])  # type: ignore[arg-type]
     return out
 
@@ -298,7 +300,7 @@ def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False)
             obj.setUp()
 
 
-def set_ldl_options(ksp: PETSc.KSP, prefix: str) -> None:
+def set_ldl_options(ksp: PETSc.KSP, prefix: str, reused: bool = False) -> None:
     """Make ``ksp`` a MUMPS :math:`LDL^T` with inertia (:data:`LDL_OPTIONS`), unfactorised.
 
     :func:`set_options` with ``setup=True`` would factorise the current operator (the
@@ -308,9 +310,10 @@ def set_ldl_options(ksp: PETSc.KSP, prefix: str) -> None:
     factor matrix instead, which PETSc hands to MUMPS when it starts; the rest of
     :data:`LDL_OPTIONS` goes through the database (a command-line option under
     ``prefix`` still wins). The ordering is :func:`mumps_ordering`'s for the operator's
-    size. The operator must be set. Collective.
+    size (``reused``: for an analysis that serves many numeric factorisations). The
+    operator must be set. Collective.
     """
-    options = {**ordering_options(ksp.getOperators()[0]), **LDL_OPTIONS}
+    options = {**ordering_options(ksp.getOperators()[0], reused=reused), **LDL_OPTIONS}
     mumps = {k: v for k, v in options.items() if k.startswith("mat_mumps_icntl_")}
     others = {k: v for k, v in options.items() if k not in mumps}
     set_options(ksp, prefix, others)
@@ -412,6 +415,9 @@ class GEPSolver(Owner):
         prefix: Options prefix, non-empty; ``-<prefix>eps_view`` and friends apply.
         tol: EPS tolerance.
         options: Options pushed under ``prefix`` (default :data:`EIGEN_OPTIONS`).
+        reused: Many solves will follow (the contact sets of a route): the analyses of
+            its factorisations serve many numeric ones, which orders them by METIS from
+            fewer rows (:func:`mumps_ordering`). False for the free plate alone.
 
     Attributes:
         solves: Eigen solves performed so far.
@@ -429,9 +435,11 @@ class GEPSolver(Owner):
         prefix: str = "unibuckle_",
         tol: float = 1e-10,
         options: Options | None = None,
+        reused: bool = True,
     ) -> None:
         if not prefix:
             raise ValueError("GEPSolver needs a non-empty options prefix")
+        self.reused = reused
         self.A = A
         self.B = compact(B)  # owned: its products cost a fifth of B's
         self.indefinite = indefinite
@@ -545,7 +553,8 @@ class GEPSolver(Owner):
             if start:
                 eps.setInitialSpace([initial])
             # The ordering, read at the first (symbolic) factorisation of the LU.
-            with option_defaults(self.prefix, ordering_options(A, "st_mat_mumps_icntl_7")):
+            key = "st_mat_mumps_icntl_7"
+            with option_defaults(self.prefix, ordering_options(A, key, reused=self.reused)):
                 eps.solve()
         self.solves += 1
         nconv = eps.getConverged()
@@ -587,7 +596,7 @@ class GEPSolver(Owner):
         the certificate on the same problem: one symbolic analysis per mesh.
         """
         if self._ldl is None:
-            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_")
+            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_", self.reused)
         return self._ldl
 
     def _near_eps(self) -> SLEPc.EPS:
@@ -1068,19 +1077,21 @@ class SharedFactorization(Owner):
     Args:
         A: The stiffness matrix (AIJ); :attr:`matrix` is a copy with its pattern.
         prefix: Options prefix of the factorisation (:data:`LDL_OPTIONS`).
+        reused: Its analysis will serve many numeric factorisations (a route's), for
+            the ordering (:func:`mumps_ordering`).
 
     Note:
         Collective. Owned by the problem's :class:`GEPSolver`
         (:attr:`GEPSolver.factorization`).
     """
 
-    def __init__(self, A: PETSc.Mat, prefix: str) -> None:
+    def __init__(self, A: PETSc.Mat, prefix: str, reused: bool = False) -> None:
         self.matrix = A.duplicate(copy=True)
         self.matrix.setOption(PETSc.Mat.Option.SPD, False)  # type: ignore[arg-type]
         self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
         self.ksp = PETSc.KSP().create(A.comm)
         self.ksp.setOperators(self.matrix)
-        set_ldl_options(self.ksp, prefix)
+        set_ldl_options(self.ksp, prefix, reused)
         self.prefix = prefix
         self._holder: object | None = None
 

@@ -1,7 +1,7 @@
 """The free solve shifted near a coarse-mesh estimate, on a distributed mesh.
 
 ``mpiexec -n P python tests/mpi/free_estimate.py`` prints, on rank 0, the paper's free
-load at 40x20 (its estimate made at 10x5: the threshold is lowered to this small mesh)
+load at 48x24 (its estimate made at 12x6: the threshold is lowered to this small mesh)
 and the number of shifts its proof took; ``tests/test_free_solve.py`` compares 1 and 2
 ranks.
 """
@@ -15,7 +15,7 @@ from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.problem import BucklingProblem
 
 problem_module.FREE_ESTIMATE_DOFS = 0
-with BucklingProblem(paper_case("free", 40, 20), MPI.COMM_WORLD) as problem:
+with BucklingProblem(paper_case("free", 48, 24), MPI.COMM_WORLD) as problem:
     load = problem.solve_free().load
     proof = problem.free_proof
     assert proof is not None

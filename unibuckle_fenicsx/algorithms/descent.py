@@ -137,7 +137,8 @@ class _Gradient:
         rhs.assemble()
         g = u.duplicate()
         self.ksp.setOperators(Aw)
-        with option_defaults(self.PREFIX, ordering_options(Aw)):  # read at the analysis
+        # The ordering is read at the analysis, which serves every later direction.
+        with option_defaults(self.PREFIX, ordering_options(Aw, reused=True)):
             self.ksp.solve(rhs, g)
         for v in (au, bu, rhs):
             v.destroy()

@@ -73,9 +73,14 @@ ESTIMATE_PREFIX = "unibuckle_estimate_"
 #: each side (a sixteenth of the DOFs; its load lies within a few tenths of a percent
 #: of the fine one on a mesh that resolves the mode).
 FREE_ESTIMATE_COARSENING = 4
-#: Meshes of at least this many (w, theta) DOFs get a coarse estimate of their free load;
-#: on smaller ones the solve at target 0 costs little more than the coarse problem.
-FREE_ESTIMATE_DOFS = 20_000
+#: Meshes of at least this many (w, theta) DOFs get a coarse estimate of their free load:
+#: from there the estimate and the shifted solve cost less than the solve at target 0
+#: and its check (measured: at 5 673 DOFs 0.076 against 0.091 s, at 2 583 0.050 against
+#: 0.033 s; :doc:`/verification/floor`).
+FREE_ESTIMATE_DOFS = 5_000
+#: ... and whose coarse mesh keeps at least this many cells across (a structured one:
+#: with fewer the coarse load lies tens of percent off and the shifts miss).
+FREE_ESTIMATE_CELLS = 6
 
 #: Peak memory per (w, theta) DOF of a solve, measured with MUMPS on one rank: 7.8 kB at
 #: 155k DOFs, 5.8 kB at 617k (:doc:`/guide/mpi`); the estimate uses 8 kB.
@@ -310,15 +315,16 @@ class BucklingProblem(Owner):
         self._check_geometric_stiffness()
         if self.fixed_prestress is not None:
             self._check_fixed_load()
+        unilateral = spec.unilateral_obstacles + tuple(
+            point_obstacles(self.model.points, spec.plate)
+        )
         self.eigensolver = GEPSolver(
             self.model.A,
             self.model.B,
             indefinite=self.prestress.indefinite,
             tol=spec.solver.eps_tol,
             options={**EIGEN_OPTIONS, **(eps_options or {})},
-        )
-        unilateral = spec.unilateral_obstacles + tuple(
-            point_obstacles(self.model.points, spec.plate)
+            reused=bool(unilateral),  # a route's contact sets: many factorisations
         )
         try:
             self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
@@ -345,7 +351,8 @@ class BucklingProblem(Owner):
         self._free_verified = False  # the free pair was proven the smallest
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
-        self._abs: tuple[PETSc.Mat, PETSc.Mat] | None = None  # abs_pencil(), made when needed
+        self._abs_A: PETSc.Mat | None = None  # abs_pencil(), made when needed
+        self._abs_B: PETSc.Mat | None = None
         self.tau = spec.solver.tau
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         self._w_owned = self.model.w_dofs[:n_owned_w]
@@ -483,7 +490,7 @@ class BucklingProblem(Owner):
         try:
             if self.structured:
                 nx, ny = spec.mesh.nx // k, spec.mesh.ny // k
-                if min(nx, ny) < 2:
+                if min(nx, ny) < FREE_ESTIMATE_CELLS:
                     return ()
                 coarse = free.with_mesh(nx, ny)
             elif spec.plate.file is None and spec.mesh.size is not None:
@@ -655,7 +662,9 @@ class BucklingProblem(Owner):
         Note:
             Collective.
         """
-        abs_A, _ = self.abs_pencil()
+        if self._abs_A is None:  # |B| is not needed here
+            self._abs_A = abs_matrix(self.model.A)
+        abs_A = self._abs_A
         size, product = u.duplicate(), u.duplicate()
         size.array[:] = np.abs(u.array_r)
         abs_A.mult(size, product)
@@ -672,9 +681,11 @@ class BucklingProblem(Owner):
         Shared by :meth:`load_resolution` and the interior-point method's residual floor;
         A and B are not changed after set-up. Owned by the problem. Collective.
         """
-        if self._abs is None:
-            self._abs = (abs_matrix(self.model.A), abs_matrix(self.model.B))
-        return self._abs
+        if self._abs_A is None:
+            self._abs_A = abs_matrix(self.model.A)
+        if self._abs_B is None:
+            self._abs_B = abs_matrix(self.model.B)
+        return self._abs_A, self._abs_B
 
     # -- reporting ------------------------------------------------------------------
     def buckling_coefficient(self, load: float) -> float:
@@ -688,10 +699,7 @@ class BucklingProblem(Owner):
 
     def destroy(self) -> None:
         """Destroy the PETSc/SLEPc objects (collective) and take back the run's options."""
-        release(self, "_r", "_Bu")
-        for mat in getattr(self, "_abs", None) or ():
-            mat.destroy()
-        self._abs = None
+        release(self, "_r", "_Bu", "_abs_A", "_abs_B")
         pop_run_options(getattr(self, "_run_options", []))
         for name in ("_eigensolver", "_model"):  # absent when the constructor failed early
             owner = self.__dict__.get(name)
