@@ -48,8 +48,8 @@ from _results import append_rows, print_header
 from bench_plates import _spec
 
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.config import problem_to_dict
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import problem_to_dict
 
 #: The plates of the floor: the paper's, and the thin plate 0.3 x 0.1 x 1e-4 m (SSSS,
 #: bench_plates.py's) without its obstacle.

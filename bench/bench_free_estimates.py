@@ -34,9 +34,9 @@ from _results import append_rows, print_header
 
 import unibuckle_fenicsx.model.problem as problem_module
 from unibuckle_fenicsx.cases import LOADS, plate_case
-from unibuckle_fenicsx.config import PlateSpec
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import PlateSpec
 
 SUPPORTS = ("simply_supported", "clamped", "simply_supported_soft")
 SHORT = {"simply_supported": "S", "clamped": "C", "simply_supported_soft": "s"}
