@@ -153,6 +153,25 @@ def test_a_pair_found_above_the_shift_asks_for_more_pairs(paper):
 
 
 @serial
+def test_two_below_the_shift_and_a_nearer_pair_above_ask_for_five(paper):
+    """Two eigenvalues below the shift, lambda_3 nearer to it: five pairs are asked for.
+
+    The estimate 1.5 lambda_1 (lambda_3 = 1.57 lambda_1, LAPACK on this plate): the shift
+    1.515 lambda_1 counts lambda_1 and lambda_2 below it, the two nearest pairs are
+    lambda_3's and lambda_2's, so the solve asks again for 2 k + 1 = 5 pairs with a
+    larger Krylov subspace (the subspace's bound must grow with it, or SLEPc refuses the
+    dimensions); the same factorisation then proves lambda_1.
+    """
+    problem, (first, second) = paper
+    (third,) = lowest_loads(problem, 3)[2:]
+    assert abs(third - 1.515 * first) < abs(1.515 * first - second)
+    pair, proof, solves = smallest(problem, (1.5 * first,))
+    assert proof is not None and proof.below == 2 and len(proof.shifts) == 1
+    assert solves == 2
+    assert pair.value == pytest.approx(first, rel=RTOL)
+
+
+@serial
 def test_shifts_above_the_load_are_lowered_and_refactorised(paper, monkeypatch):
     """Shifts above lambda_1 are lowered, the pencil factorised again, until one lies below.
 

@@ -767,7 +767,9 @@ class GEPSolver(Owner):
             return None, below
         # As many pairs as lie below the shift; then, if pairs above it lay nearer, more.
         for wanted in (below, 2 * below + 1) if below else (1,):
-            eps.setDimensions(wanted, max(self._free_ncv, 2 * wanted))
+            ncv = max(self._free_ncv, 2 * wanted)
+            # mpd with ncv: left unset it keeps its first value, below ncv - nev.
+            eps.setDimensions(wanted, ncv, ncv)
             eps.solve()
             self.solves += 1
             loads = [self._load(eps.getEigenvalue(k).real) for k in range(eps.getConverged())]
