@@ -35,9 +35,16 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import EigenSolveError, InputError
-from unibuckle_fenicsx.la.factor import SharedFactorization
-from unibuckle_fenicsx.la.options import Options, Prefix, set_options
+from unibuckle_fenicsx.la.factor import SharedFactorization, compact
+from unibuckle_fenicsx.la.options import (
+    Options,
+    Prefix,
+    option_defaults,
+    ordering_options,
+    set_options,
+)
 from unibuckle_fenicsx.la.ownership import Owner, release
+from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
 __all__ = [
     "EIGEN_OPTIONS",
@@ -46,7 +53,9 @@ __all__ = [
     "NEAR_NCV",
     "EigenPair",
     "GEPSolver",
+    "SmallestProof",
     "extreme_eigenvalues",
+    "lowest_eigenvalues",
     "swapped_eigenpairs",
 ]
 
@@ -75,6 +84,25 @@ NEAR_MARGIN = 1e-3
 #: Krylov vectors of a shifted solve (>= 2): the wanted pair dominates after the shift.
 NEAR_NCV = 4
 
+#: The smallest eigenpair of the whole pencil given estimates of its lowest eigenvalues
+#: (:meth:`GEPSolver.smallest`; a coarser mesh's) shifts first to ``FREE_ABOVE`` above the
+#: estimate of the lowest and at most ``FREE_GAP_SHARE`` of the way to the second: above
+#: the lowest eigenvalue (a coarse mesh's load lies above the fine one, or within a few
+#: tenths of a percent below it), below the second, so that the inertia of one
+#: factorisation proves the pair the smallest. Each later try lies further below the
+#: estimate (:data:`FREE_BELOW`, times the estimate).
+FREE_ABOVE = 0.01
+FREE_GAP_SHARE = 1.0 / 3.0
+FREE_BELOW = (0.99, 0.96, 0.84)
+#: The free solve asks for as many pairs as the inertia counts eigenvalues below its
+#: shift, up to this many (a long plate's lowest loads lie within a percent or two of
+#: each other, closer than the coarse mesh's error); more, and the shift is lowered.
+FREE_MAX_BELOW = 8
+#: Krylov subspace of the free solve's shifted Krylov-Schur: a shift within a few percent
+#: of the lowest eigenvalue separates it from the second by a factor of five or more, and
+#: a few solves converge.
+FREE_NCV = 4
+
 #: Default options of :func:`extreme_eigenvalues` (the smallest eigenvalue uses them all;
 #: the largest only ``eps_type`` and ``eps_max_it``).
 EXTREME_OPTIONS: dict[str, str | float | int | bool] = {
@@ -101,6 +129,28 @@ class EigenPair:
     error: float
     iterations: int
     converged: int
+
+
+@dataclass(frozen=True)
+class SmallestProof:
+    r"""Why an eigenpair is the smallest of its pencil: the inertia of one factorisation.
+
+    Sylvester's law of inertia (A positive definite): :math:`A - \sigma B` has as many
+    negative eigenvalues as the pencil has eigenvalues in :math:`(0, \sigma)`.
+
+    Attributes:
+        shift: :math:`\sigma` of the factorisation that proves it.
+        below: Eigenvalues of the pencil below ``shift`` by that inertia: 1 when the
+            shift lies above the pair's eigenvalue (no other lies below the shift), 0
+            when it lies at or just below it (none lies lower).
+        shifts: Every shift factorised, in order (the last is ``shift``).
+        solves: Eigen solves (Krylov-Schur runs) it took.
+    """
+
+    shift: float
+    below: int
+    shifts: tuple[float, ...]
+    solves: int
 
 
 def _is_zero(B: PETSc.Mat) -> bool:
@@ -139,12 +189,19 @@ class GEPSolver(Owner):
     """Smallest eigenpair of :math:`(A, B)` with optional removed DOFs.
 
     Args:
-        A: Stiffness matrix, SPD (owned by the caller; not modified).
-        B: Geometric stiffness matrix (owned by the caller; not modified).
+        A: Stiffness matrix, SPD (owned by the caller; not modified; its values may
+            change between solves, see :meth:`operators_changed`).
+        B: Geometric stiffness matrix (owned by the caller; not modified, and not
+            changed afterwards: the solver keeps a
+            :func:`~unibuckle_fenicsx.la.factor.compact` copy, :attr:`B`).
         indefinite: B is indefinite: solve the swapped pencil.
         prefix: Options prefix, non-empty; ``-<prefix>eps_view`` and friends apply.
         tol: EPS tolerance.
         options: Options pushed under ``prefix`` (default :data:`EIGEN_OPTIONS`).
+        reused: Many solves will follow (the contact sets of a route): the analyses of
+            its factorisations serve many numeric ones, which orders them by METIS from
+            fewer rows (:func:`~unibuckle_fenicsx.la.options.mumps_ordering`). False for
+            the free plate alone.
 
     Attributes:
         solves: Eigen solves performed so far.
@@ -162,15 +219,19 @@ class GEPSolver(Owner):
         prefix: str = Prefix.EIGEN,
         tol: float = 1e-10,
         options: Options | None = None,
+        reused: bool = True,
     ) -> None:
         if not prefix:
             raise ValueError("GEPSolver needs a non-empty options prefix")
-        self.A, self.B = A, B
+        self.reused = reused
+        self.A = A
+        self.B = compact(B)  # owned: its products cost a fifth of B's
         self.indefinite = indefinite
         self._norm_ratio: float | None = None
         self._radius: float | None = None
         self._Bx: PETSc.Vec | None = None
         self.prefix = prefix
+        self.tol = tol
         self._Aw: PETSc.Mat | None = None
         self._Bw: PETSc.Mat | None = None
         self.solves = 0
@@ -197,6 +258,8 @@ class GEPSolver(Owner):
             self.destroy()  # collective: every rank reads the same options
             raise
         self._near: SLEPc.EPS | None = None  # the shifted solves' EPS, made when needed
+        self._free: SLEPc.EPS | None = None  # the smallest pair's EPS, made when needed
+        self._free_ncv = FREE_NCV  # its Krylov subspace for one pair (the options')
         self._ldl: SharedFactorization | None = None  # made when needed
         self.shifted_solves = 0  # solves at a shift below an estimate (near=...)
         self.unshifted_again = 0  # ... of which an eigenvalue lay below the shift
@@ -284,7 +347,10 @@ class GEPSolver(Owner):
             eps.setOperators(A, B)
         if initial is not None:
             eps.setInitialSpace([initial])
-        eps.solve()
+        # The ordering, read at the first (symbolic) factorisation of the LU.
+        key = "st_mat_mumps_icntl_7"
+        with option_defaults(self.prefix, ordering_options(A, key, reused=self.reused)):
+            eps.solve()
         return eps
 
     def _pair(self, eps: SLEPc.EPS, out: PETSc.Vec | None) -> EigenPair:
@@ -328,48 +394,49 @@ class GEPSolver(Owner):
         the certificate on the same problem: one symbolic analysis per mesh.
         """
         if self._ldl is None:
-            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_")
+            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_", self.reused)
         return self._ldl
 
     def _near_eps(self) -> SLEPc.EPS:
-        """The shifted solves' EPS (prefix ``<prefix>near_``), made on first use.
+        """The shifted solves' EPS (prefix ``<prefix>near_``), made on first use."""
+        if self._near is None:
+            self._near = self._shifted_eps(self.prefix + "near_", NEAR_NCV)
+        return self._near
+
+    def _shifted_eps(self, prefix: str, ncv: int) -> SLEPc.EPS:
+        """A Krylov-Schur EPS whose spectral transformation solves with the shared LDLᵀ.
 
         Its spectral transformation shifts the first operator in place and solves with
         the :attr:`factorization`'s KSP: the operator passed is that factorisation's
-        matrix, filled by :meth:`_solve_below` before each solve.
+        matrix, filled by :meth:`_shift_to` before each solve. It takes the EPS options
+        (not the ``st_`` ones: its solver is the shared one) under ``prefix``.
         """
-        if self._near is None:
-            eps = SLEPc.EPS().create(self.A.comm)
-            eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-            eps.setDimensions(1, NEAR_NCV)
-            eps.setTolerances(self.eps.getTolerances()[0])
-            eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
-            st = eps.getST()
-            st.setType(SLEPc.ST.Type.SINVERT)
-            # The EPS options only: its spectral transformation's own solver is replaced.
-            eps_only = {k: v for k, v in self._options.items() if not k.startswith("st_")}
-            set_options(eps, self.prefix + "near_", eps_only)
-            st.setMatMode(SLEPc.ST.MatMode.INPLACE)
-            st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-            st.setKSP(self.factorization.ksp)
-            self._near = eps
-        return self._near
+        eps = SLEPc.EPS().create(self.A.comm)
+        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+        eps.setDimensions(1, ncv)
+        eps.setTolerances(self.eps.getTolerances()[0])
+        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
+        st = eps.getST()
+        st.setType(SLEPc.ST.Type.SINVERT)
+        eps_only = {k: v for k, v in self._options.items() if not k.startswith("st_")}
+        set_options(eps, prefix, eps_only)
+        st.setMatMode(SLEPc.ST.MatMode.INPLACE)
+        st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        st.setKSP(self.factorization.ksp)
+        return eps
 
-    def _solve_below(
-        self, A: PETSc.Mat, B: PETSc.Mat, near: float, initial: PETSc.Vec | None
-    ) -> bool:
-        r"""Solve at the shift :data:`NEAR_MARGIN` below ``near``; whether that answers.
+    def _shift_to(
+        self, eps: SLEPc.EPS, A: PETSc.Mat, B: PETSc.Mat, shift: float, initial: PETSc.Vec | None
+    ) -> int:
+        r"""Factorise the pencil (A, B) shifted to ``shift`` for ``eps``; eigenvalues below it.
 
-        False when the inertia of :math:`A - \sigma B` (the shared
-        :attr:`factorization`) shows an eigenvalue below the shift :math:`\sigma` (the
-        pair found would be the nearest to it, not necessarily the smallest), or when
-        nothing converged. Collective.
+        The first operator goes into the shared matrix (A's pattern), which the spectral
+        transformation shifts in place and factorises (numeric only, after the first
+        analysis): :math:`A - \sigma B`, or for the swapped pencil :math:`B - A/\sigma`,
+        whose positive eigenvalues count the pencil's eigenvalues in :math:`(0,
+        \sigma)`. Returns that count (the inertia). Collective.
         """
-        eps = self._near_eps()
         ldl = self.factorization
-        shift = near * (1.0 - NEAR_MARGIN)
-        # The first operator goes into the shared matrix (A's pattern), which the
-        # spectral transformation shifts in place and factorises: numeric only.
         if self.indefinite:
             ldl.matrix.zeroEntries()
             ldl.matrix.axpy(1.0, B, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)  # type: ignore[arg-type]
@@ -384,11 +451,152 @@ class GEPSolver(Owner):
         eps.setUp()
         ldl.claim(self)
         negative, _, positive = ldl.inertia()
-        below = positive if self.indefinite else negative
-        if int(below) != 0:
+        return int(positive if self.indefinite else negative)
+
+    def _solve_below(
+        self, A: PETSc.Mat, B: PETSc.Mat, near: float, initial: PETSc.Vec | None
+    ) -> bool:
+        r"""Solve at the shift :data:`NEAR_MARGIN` below ``near``; whether that answers.
+
+        False when the inertia of :math:`A - \sigma B` (the shared
+        :attr:`factorization`) shows an eigenvalue below the shift :math:`\sigma` (the
+        pair found would be the nearest to it, not necessarily the smallest), or when
+        nothing converged. Collective.
+        """
+        eps = self._near_eps()
+        if self._shift_to(eps, A, B, near * (1.0 - NEAR_MARGIN), initial) != 0:
             return False
         eps.solve()
         return eps.getConverged() >= 1
+
+    def count_below(self, shift: float) -> int:
+        r"""Eigenvalues of the whole pencil in :math:`(0, \sigma)`, by an inertia.
+
+        The inertia of :math:`A - \sigma B` (Sylvester's law, A positive definite): one
+        numeric :math:`LDL^T` through the shared :attr:`factorization`. Negative pivots
+        only: a null one means an eigenvalue within MUMPS's null-pivot threshold of
+        :math:`\sigma`, which on a small or stiff pencil is the computed eigenvalue
+        itself. Collective.
+        """
+        ldl = self.factorization
+        same, subset = PETSc.Mat.Structure.SAME_NONZERO_PATTERN, PETSc.Mat.Structure.SUBSET
+        self.A.copy(ldl.matrix, structure=same)  # type: ignore[arg-type]
+        ldl.matrix.axpy(-shift, self.B, structure=subset)  # type: ignore[arg-type]
+        negative, _, _ = ldl.factor(self)
+        return int(negative)
+
+    def smallest(
+        self, out: PETSc.Vec | None = None, estimate: tuple[float, ...] = ()
+    ) -> tuple[EigenPair, SmallestProof | None]:
+        r"""The smallest eigenpair of the whole pencil (nothing removed), with its proof.
+
+        Given ``estimate``, the lowest eigenvalues of a coarser mesh's pencil (ascending,
+        the same on every rank), the pencil is factorised once at a shift :math:`\sigma`
+        just above the lowest (:data:`FREE_ABOVE`, below the second) by the shared
+        :math:`LDL^T`, and Krylov-Schur solves at that target with it. The inertia counts
+        the eigenvalues below :math:`\sigma` (Sylvester's law) and proves the pair the
+        smallest (:class:`SmallestProof`):
+
+        - k of them (1 to :data:`FREE_MAX_BELOW`): Krylov-Schur asks for the k pairs
+          nearest :math:`\sigma` (then 2k + 1, if some lay above it); once k lie below
+          it they are every eigenvalue there (B-orthogonal vectors), and the lowest is
+          the pencil's smallest (a Ritz value below the shift lies at or below its
+          eigenvalue, Rayleigh-Ritz, so the load found is never above it);
+        - none: the pair found is the nearest above :math:`\sigma`, and one more
+          factorisation just below its eigenvalue (:data:`SMALLEST_RTOL_FACTOR` times the
+          tolerance) must show none there either.
+
+        More than :data:`FREE_MAX_BELOW` below :math:`\sigma`, or fewer pairs found below
+        it than lie there: the next shift lies below the estimate (:data:`FREE_BELOW`)
+        and the pencil is factorised again. If no shift proves it (or nothing converges,
+        or there is no estimate) the pair comes from :meth:`solve` at target 0 (a MUMPS
+        LU), unproven: the caller checks it (:meth:`count_below`).
+
+        The EPS takes the options under :attr:`prefix` (``-unibuckle_eps_tol``,
+        ``-unibuckle_eps_ncv``, ...; the Krylov subspace defaults to :data:`FREE_NCV`),
+        the factorisation those of :attr:`factorization` (``<prefix>ldl_``).
+
+        Args:
+            out: Vector receiving the eigenvector.
+            estimate: Estimates of the lowest eigenvalues, ascending (empty: none).
+
+        Returns:
+            The pair (as :meth:`solve`'s) and its proof, or None for the pair at target 0.
+
+        Note:
+            Collective.
+        """
+        shifts: list[float] = []
+        solves = self.solves
+        if estimate and estimate[0] > 0.0 and not _is_zero(self.B):
+            lowest = estimate[0]
+            above = FREE_ABOVE
+            if len(estimate) > 1 and estimate[1] > lowest:
+                above = min(above, FREE_GAP_SHARE * (estimate[1] / lowest - 1.0))
+            rtol = SMALLEST_RTOL_FACTOR * self.tol
+            for shift in (lowest * (1.0 + above), *(lowest * f for f in FREE_BELOW)):
+                shifts.append(shift)
+                found = self._smallest_at(shift, out, rtol, shifts)
+                if found is None:
+                    break  # nothing converged, or a lower eigenvalue was passed over
+                pair, below = found
+                if pair is not None:
+                    proof = SmallestProof(shifts[-1], below, tuple(shifts), self.solves - solves)
+                    return pair, proof
+            logger.debug("%s: no shift %s proved the smallest pair", self.prefix, shifts)
+        return self.solve(out=out), None
+
+    def _smallest_at(
+        self, shift: float, out: PETSc.Vec | None, rtol: float, shifts: list[float]
+    ) -> tuple[EigenPair | None, int] | None:
+        """One try of :meth:`smallest` at ``shift``: (the proven pair or None, count below).
+
+        None when the tries should stop: nothing converged, or the pencil has an
+        eigenvalue below the one found and above the shift (Krylov-Schur passed over
+        it). Collective.
+        """
+        if self._free is None:
+            self._free = self._shifted_eps(self.prefix, FREE_NCV)
+            self._free_ncv = int(self._free.getDimensions()[1])
+        eps = self._free
+        below = self._shift_to(eps, self.A, self.B, shift, None)
+        if below > FREE_MAX_BELOW:
+            return None, below
+        # As many pairs as lie below the shift; then, if pairs above it lay nearer, more.
+        for wanted in (below, 2 * below + 1) if below else (1,):
+            ncv = max(self._free_ncv, 2 * wanted)
+            # mpd with ncv: left unset it keeps its first value, below ncv - nev.
+            eps.setDimensions(wanted, ncv, ncv)
+            eps.solve()
+            self.solves += 1
+            loads = [self._load(eps.getEigenvalue(k).real) for k in range(eps.getConverged())]
+            if not loads:
+                return None
+            under = [k for k, load in enumerate(loads) if load <= shift * (1.0 - rtol)]
+            if below and len(under) >= below:
+                return self._indexed_pair(eps, min(under, key=loads.__getitem__), out), below
+        if below:
+            return None, below  # pairs nearer the shift lay above it: lower the shift
+        pair = self._indexed_pair(eps, 0, out)
+        check = pair.value * (1.0 - rtol)
+        if check <= shift:
+            return pair, below  # the first inertia covers it
+        shifts.append(check)
+        if self.count_below(check) != 0:
+            return None
+        return pair, 0
+
+    def _load(self, theta: float) -> float:
+        """The load of an eigenvalue of the EPS's pencil (1/theta for the swapped one)."""
+        return 1.0 / theta if self.indefinite else theta
+
+    def _indexed_pair(self, eps: SLEPc.EPS, index: int, out: PETSc.Vec | None) -> EigenPair:
+        """Converged pair ``index`` of ``eps`` as a load (its vector into ``out``)."""
+        value = self._load(eps.getEigenvalue(index).real)
+        if out is not None:
+            eps.getEigenvector(index, out)
+        error = eps.computeError(index)
+        return EigenPair(float(value), float(error), eps.getIterationNumber(), eps.getConverged())
 
     def operators_changed(self) -> None:
         """Forget the scales cached from A and B (call after changing them in place)."""
@@ -460,7 +668,7 @@ class GEPSolver(Owner):
 
     def destroy(self) -> None:
         """Destroy the EPS and work matrices (collective)."""
-        release(self, "eps", "_near", "_ldl", "_Aw", "_Bw", "_Bx")
+        release(self, "eps", "_near", "_free", "_ldl", "_Aw", "_Bw", "_Bx", "B")
 
     def __del__(self) -> None:
         self.destroy()
@@ -510,7 +718,8 @@ def swapped_eigenpairs(
         eps.setTolerances(tol)
         eps.getST().setType(SLEPc.ST.Type.SHIFT)
         set_options(eps, prefix, EIGEN_OPTIONS)
-        eps.solve()
+        with option_defaults(prefix, ordering_options(A, "st_mat_mumps_icntl_7")):
+            eps.solve()
         pairs: list[tuple[float, PETSc.Vec | None]] = []
         for k in range(min(nev, eps.getConverged())):
             v = A.createVecRight() if vectors else None
@@ -518,6 +727,33 @@ def swapped_eigenpairs(
         return pairs
     finally:
         eps.destroy()
+
+
+def lowest_eigenvalues(
+    A: PETSc.Mat, B: PETSc.Mat, prefix: str, *, count: int = 2, tol: float = 1e-6
+) -> tuple[float, ...]:
+    r"""The pencil's lowest positive eigenvalues :math:`\lambda` (at most ``count``, ascending).
+
+    For estimates (a coarser mesh's, for :meth:`GEPSolver.smallest`): no proof that they
+    are the lowest, and a loose default tolerance (1e-6, far below the few percent by
+    which the estimate's mesh differs). The largest :math:`\mu = 1/\lambda` of the
+    swapped pencil (:func:`swapped_eigenpairs`, B semidefinite or indefinite alike).
+
+    Args:
+        A: Stiffness matrix (SPD; not modified).
+        B: Geometric stiffness (not modified).
+        prefix: Options prefix.
+        count: Eigenvalues wanted.
+        tol: EPS tolerance.
+
+    Returns:
+        The converged positive eigenvalues (empty if none converged).
+
+    Note:
+        Collective.
+    """
+    pairs = swapped_eigenpairs(A, B, prefix, which=SLEPc.EPS.Which.LARGEST_REAL, nev=count, tol=tol)
+    return tuple(sorted(1.0 / theta for theta, _ in pairs if theta > 0.0))
 
 
 def extreme_eigenvalues(
@@ -561,7 +797,8 @@ def extreme_eigenvalues(
                 eps.getST().setType(SLEPc.ST.Type.SINVERT)
                 used = dict(options)
             set_options(eps, prefix, used)
-            eps.solve()
+            with option_defaults(prefix, ordering_options(mat, "st_mat_mumps_icntl_7")):
+                eps.solve()
             if eps.getConverged() < 1:
                 raise EigenSolveError(f"SLEPc ({prefix}): the {which} eigenvalue did not converge")
             values.append(float(eps.getEigenvalue(0).real))

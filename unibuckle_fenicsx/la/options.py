@@ -11,16 +11,23 @@ Python caller gives a run's eigen solvers stay in the database for the run
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from enum import StrEnum
 from typing import Any
 
 from petsc4py import PETSc
 
 __all__ = [
+    "NESTED_DISSECTION_ROWS",
+    "ORDERINGS",
+    "ORDERING_BELOW",
     "RUN_EPS_PREFIXES",
     "Options",
     "Prefix",
+    "mumps_ordering",
+    "option_defaults",
+    "ordering_options",
     "pop_run_options",
     "push_run_options",
     "set_options",
@@ -45,6 +52,8 @@ class Prefix(StrEnum):
     PRESTRESS = "unibuckle_prestress_"
     #: The :math:`LDL^T` that checks that a fixed load alone does not buckle the plate.
     FIXED = "unibuckle_fixed_"
+    #: The coarse mesh's eigen solve that estimates the free load (the free solve's shift).
+    ESTIMATE = "unibuckle_estimate_"
     #: The certificate's own factorisations (``sdp_`` and ``modes_`` appended by the SDP).
     CERTIFY = "unibuckle_certify_"
     #: The interior point's relaxation solves (``relax_w_``, ``relax_theta_`` appended).
@@ -71,14 +80,69 @@ class Prefix(StrEnum):
 RUN_EPS_PREFIXES = (Prefix.EIGEN, Prefix.PENALTY, Prefix.FOUNDATION)
 
 
+#: MUMPS's sequential fill-reducing orderings, by name (ICNTL(7)).
+ORDERINGS = {"amd": 0, "amf": 2, "scotch": 3, "pord": 4, "metis": 5, "qamd": 6}
+
+#: The ordering of a matrix below :data:`NESTED_DISSECTION_ROWS` rows, by kind: the
+#: plate's (w, theta) matrices (the pencil's factorisations, the stiffness's LU) by
+#: approximate minimum fill, the membrane stiffness of the prestress by approximate
+#: minimum degree; of the orderings whose analysis costs little, each gives the
+#: fastest factorisation there (measured on :doc:`/verification/floor`).
+ORDERING_BELOW = {"plate": "amf", "membrane": "amd"}
+#: Rows from which a factorisation is ordered by nested dissection (METIS) instead, by
+#: whether its analysis serves one numeric factorisation or many (the eigen solves of a
+#: route's contact sets, the interior point's Newton steps): METIS's analysis costs more
+#: than one numeric factorisation on the package's matrices, and saves a fraction of
+#: each (measured on :doc:`/verification/floor`).
+NESTED_DISSECTION_ROWS = {False: 400_000, True: 100_000}
+
+
+def mumps_ordering(rows: int, kind: str = "plate", reused: bool = False) -> int:
+    """MUMPS ICNTL(7) for a matrix of ``rows`` rows of ``kind`` ("plate" or "membrane").
+
+    METIS from :data:`NESTED_DISSECTION_ROWS` rows (``reused``: for an analysis that
+    serves many numeric factorisations), else :data:`ORDERING_BELOW`'s. The option
+    ``-<prefix>mat_mumps_icntl_7`` (e.g. ``-unibuckle_ldl_mat_mumps_icntl_7 5``)
+    overrides it for one factorisation.
+    """
+    if rows >= NESTED_DISSECTION_ROWS[reused]:
+        return ORDERINGS["metis"]
+    return ORDERINGS[ORDERING_BELOW[kind]]
+
+
+def ordering_options(
+    mat: PETSc.Mat, key: str = "mat_mumps_icntl_7", kind: str = "plate", reused: bool = False
+) -> dict[str, int]:
+    """``{key: mumps_ordering(rows of mat, ...)}``: the ordering as a default option."""
+    return {key: mumps_ordering(int(mat.getSize()[0]), kind, reused)}
+
+
+@contextmanager
+def option_defaults(prefix: str, options: Options) -> Iterator[None]:
+    """Put ``options`` in PETSc's options database under ``prefix`` for the block's duration.
+
+    A default goes in only where the database holds no value for ``prefix + key`` (an
+    option from the command line, e.g. ``-unibuckle_eps_max_it 1000``, wins), and it is
+    removed again on leaving the block, so nothing leaks into other objects.
+    """
+    opts = PETSc.Options(prefix)  # names below are relative to the prefix
+    pushed = [key for key in options if not opts.hasName(key)]
+    for key in pushed:
+        opts.setValue(key, options[key])
+    try:
+        yield
+    finally:
+        for key in pushed:
+            opts.delValue(key)
+
+
 def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False) -> None:
     """Set the options prefix of ``obj`` and default ``options``; then ``setFromOptions``.
 
-    A default is used only when the database holds no value for ``prefix + key`` (an
-    option from the command line, e.g. ``-unibuckle_eps_max_it 1000``, wins), and it is
-    removed again afterwards, so nothing leaks into other objects. Options read only when
-    the object is set up (MUMPS ICNTL settings are read at the symbolic factorisation)
-    need ``setup=True``: ``obj.setUp()`` then runs before the defaults are removed.
+    The defaults are in the database only during the call (:func:`option_defaults`: a
+    value already there wins). Options read only when the object is set up (MUMPS ICNTL
+    settings are read at the symbolic factorisation) need ``setup=True``: ``obj.setUp()``
+    then runs before the defaults are removed.
 
     Args:
         obj: A PETSc/SLEPc object with ``setOptionsPrefix`` and ``setFromOptions``.
@@ -89,17 +153,10 @@ def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False)
     if not prefix:
         raise ValueError("PETSc/SLEPc objects need a non-empty options prefix")
     obj.setOptionsPrefix(prefix)
-    opts = PETSc.Options(prefix)  # names below are relative to the prefix
-    pushed = [key for key in options if not opts.hasName(key)]
-    for key in pushed:
-        opts.setValue(key, options[key])
-    try:
+    with option_defaults(prefix, options):
         obj.setFromOptions()
         if setup:
             obj.setUp()
-    finally:
-        for key in pushed:
-            opts.delValue(key)
 
 
 def push_run_options(options: Options | None) -> list[tuple[str, str]]:

@@ -23,6 +23,8 @@ takes the same branch) before the error propagates.
 
 from __future__ import annotations
 
+import functools
+import logging
 import time
 from dataclasses import dataclass
 
@@ -33,8 +35,8 @@ import dolfinx
 
 from msgspec.structs import replace
 
-from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError
-from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver
+from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError, NumericalError
+from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver, lowest_eigenvalues
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Options, Prefix, push_run_options
 from unibuckle_fenicsx.model.contact import (
@@ -52,6 +54,8 @@ from unibuckle_fenicsx.model.structure import StructuralModel
 from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.tolerances import NULL_GEOMETRIC_STIFFNESS
 
+logger = logging.getLogger(__name__)
+
 __all__ = [
     "PlacedMesh",
     "build_contact",
@@ -60,6 +64,7 @@ __all__ = [
     "build_problem",
     "build_unilateral_problem",
     "check_pencil",
+    "free_estimate",
     "place_mesh",
     "solve_prestresses",
 ]
@@ -255,9 +260,17 @@ def check_pencil(
 
 
 def build_eigensolver(
-    model: StructuralModel, prestress: Prestress, spec: ProblemSpec, eps_options: Options | None
+    model: StructuralModel,
+    prestress: Prestress,
+    spec: ProblemSpec,
+    eps_options: Options | None,
+    reused: bool = False,
 ) -> GEPSolver:
     """Stage 5: the pencil's eigen solver (the caller destroys it).
+
+    ``reused``: the problem has one-sided obstacles or points, whose route's contact
+    sets make many factorisations (their ordering:
+    :func:`~unibuckle_fenicsx.la.options.mumps_ordering`).
 
     Note:
         Collective.
@@ -268,7 +281,60 @@ def build_eigensolver(
         indefinite=prestress.indefinite,
         tol=spec.solver.eps_tol,
         options={**EIGEN_OPTIONS, **(eps_options or {})},
+        reused=reused,
     )
+
+
+#: The free solve's shift comes from the plate on a mesh this many times coarser along
+#: each side (a sixteenth of the DOFs; its load lies within a few tenths of a percent
+#: of the fine one on a mesh that resolves the mode).
+FREE_ESTIMATE_COARSENING = 4
+#: Meshes of at least this many (w, theta) DOFs get a coarse estimate of their free load:
+#: from there the estimate and the shifted solve cost less than the solve at target 0
+#: and its check (:doc:`/verification/floor`).
+FREE_ESTIMATE_DOFS = 5_000
+#: ... and whose coarse mesh keeps at least this many cells across (a structured one:
+#: with fewer the coarse load lies tens of percent off and the shifts miss).
+FREE_ESTIMATE_CELLS = 6
+
+
+def free_estimate(placed: PlacedMesh, dofs: int) -> tuple[float, ...]:
+    """The free pencil's two lowest eigenvalues on a coarser mesh, or () if none is made.
+
+    The plate as it is without its one-sided obstacles and points (the free pencil keeps
+    the bilateral foundations and points), on a mesh :data:`FREE_ESTIMATE_COARSENING`
+    times coarser; () below :data:`FREE_ESTIMATE_DOFS` (``dofs``: the fine pencil's
+    rows), for a user's mesh or a file, and when the coarse plate is refused (a feature
+    smaller than its cells, no buckling load there). What
+    :meth:`~unibuckle_fenicsx.model.problem.Problem.solve_free` shifts by.
+
+    Note:
+        Collective.
+    """
+    spec, k = placed.spec, FREE_ESTIMATE_COARSENING
+    if placed.custom or dofs < FREE_ESTIMATE_DOFS:
+        return ()
+    free = replace(
+        spec,
+        obstacle=None,
+        obstacles=spec.bilateral_foundations,
+        points=tuple(p for p in spec.points if p.kind != "one-sided"),
+    )
+    try:
+        if placed.structured:
+            nx, ny = spec.mesh.nx // k, spec.mesh.ny // k
+            if min(nx, ny) < FREE_ESTIMATE_CELLS:
+                return ()
+            coarse = free.with_mesh(nx, ny)
+        elif spec.plate.file is None and spec.mesh.size is not None:
+            coarse = replace(free, mesh=replace(spec.mesh, size=k * spec.mesh.size))
+        else:
+            return ()
+        with build_problem(coarse, placed.comm) as problem:
+            return lowest_eigenvalues(problem.model.A, problem.model.B, Prefix.ESTIMATE)
+    except (InputError, NumericalError) as err:
+        logger.debug("no coarse estimate of the free load: %s", err)
+        return ()
 
 
 def build_contact(model: PlateModel, spec: ProblemSpec) -> ContactSetManager | None:
@@ -364,7 +430,8 @@ def build_problem(
     spec = placed.spec
     try:
         check_pencil(model, prestress, fixed, with_obstacle=bool(spec.all_obstacles))
-        eigensolver = build_eigensolver(model, prestress, spec, eps_options)
+        unilateral = spec.unilateral_obstacles + tuple(point_obstacles(model.points, spec.plate))
+        eigensolver = build_eigensolver(model, prestress, spec, eps_options, bool(unilateral))
         try:
             contact = build_contact(model, spec)
         except BaseException:
@@ -387,6 +454,7 @@ def build_problem(
         # Last: a refused problem leaves nothing in the options database.
         run_options=push_run_options(eps_options),
         timings={"prestress_s": t1 - t0, "assembly_s": t2 - t1},
+        estimate=functools.partial(free_estimate, placed, int(model.A.getSize()[0])),
     )
     problem = Problem(parts) if contact is None else UnilateralProblem(parts, contact)
     problem.timings["setup_s"] = time.perf_counter() - t0

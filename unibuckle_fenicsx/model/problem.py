@@ -20,6 +20,7 @@ removed (paper, Lemma 5.1).
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
@@ -32,7 +33,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import EigenSolveError, InputError
-from unibuckle_fenicsx.la.eigen import EigenPair, GEPSolver
+from unibuckle_fenicsx.la.eigen import EigenPair, GEPSolver, SmallestProof
 from unibuckle_fenicsx.la.factor import abs_matrix
 from unibuckle_fenicsx.la.options import pop_run_options
 from unibuckle_fenicsx.la.ownership import Owner, release
@@ -138,6 +139,9 @@ class SetUp:
         run_options: What the run's EPS options put in PETSc's options database
             (:func:`~unibuckle_fenicsx.la.options.push_run_options`).
         timings: Seconds per set-up stage.
+        estimate: Estimates of the pencil's lowest eigenvalues for the free solve's shift
+            (:func:`~unibuckle_fenicsx.model.build.free_estimate`; () if none), made
+            when first asked for. Collective.
     """
 
     spec: ProblemSpec
@@ -152,6 +156,7 @@ class SetUp:
     eigensolver: GEPSolver
     run_options: list[tuple[str, str]]
     timings: dict[str, float]
+    estimate: Callable[[], tuple[float, ...]] = tuple
 
 
 class Problem(Owner):
@@ -179,13 +184,17 @@ class Problem(Owner):
         self.prestress, self.fixed_prestress = parts.prestress, parts.fixed_prestress
         self.model = parts.model
         self.eigensolver = parts.eigensolver
+        self._estimate = parts.estimate
         self._run_options = parts.run_options
         self.timings = parts.timings
         self.free: Mode | None = None
-        self._free_verified = False  # verify_free() passed
+        #: Why the free pair is the smallest, if its solve proved it (:meth:`solve_free`).
+        self.free_proof: SmallestProof | None = None
+        self._free_verified = False  # the free pair was proven the smallest
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
-        self._abs: tuple[PETSc.Mat, PETSc.Mat] | None = None  # abs_pencil(), made when needed
+        self._abs_A: PETSc.Mat | None = None  # abs_pencil(), made when needed
+        self._abs_B: PETSc.Mat | None = None
         self.tau = parts.spec.solver.tau
         n_owned_w = parts.model.Vw.dofmap.index_map.size_local
         self._w_owned = parts.model.w_dofs[:n_owned_w]
@@ -219,12 +228,22 @@ class Problem(Owner):
     def solve_free(self) -> Mode:
         """Smallest eigenpair without obstacle (computed once, then ``free``).
 
+        Where the set-up can make an estimate of the pencil's lowest eigenvalues (a
+        coarser mesh's: :func:`~unibuckle_fenicsx.model.build.free_estimate`), it sets
+        the eigen solve's shift, and the inertia of its one factorisation proves the pair
+        the smallest (:meth:`~unibuckle_fenicsx.la.eigen.GEPSolver.smallest`;
+        :attr:`free_proof`). Otherwise (or if no shift proves it) the solve runs at
+        target 0 and :meth:`verify_free` checks the pair when it matters.
+
         Note:
             Collective.
         """
         if self.free is None:
             u = self.new_mode("free_mode")
-            pair = self.eigensolver.solve(out=u.x.petsc_vec)
+            pair, self.free_proof = self.eigensolver.smallest(
+                out=u.x.petsc_vec, estimate=self._estimate()
+            )
+            self._free_verified = self.free_proof is not None
             if not np.isfinite(pair.value):
                 raise InputError(
                     "the plate has no positive buckling load on this mesh: the geometric "
@@ -245,7 +264,9 @@ class Problem(Owner):
         the free load is a lower bound of the critical load (interlacing). The inertia
         of :math:`A - \sigma B`, :math:`\sigma` just below :math:`\lambda_{free}` (one
         :math:`LDL^T` through the shared factorisation), counts the eigenvalues in
-        :math:`(0, \sigma)` (Sylvester's law, A SPD): there must be none.
+        :math:`(0, \sigma)` (Sylvester's law, A SPD): there must be none. A free pair
+        that its shifted solve proved the smallest (:attr:`free_proof`) needs nothing
+        more.
 
         Raises:
             EigenSolveError: An eigenvalue lies below the free load.
@@ -253,18 +274,13 @@ class Problem(Owner):
         Note:
             Collective.
         """
+        free = self.solve_free()
         if self._free_verified:
             return
-        free = self.solve_free()
         sigma = free.load * (1.0 - SMALLEST_RTOL_FACTOR * self.spec.solver.eps_tol)
-        ldl = self.eigensolver.factorization
-        same, subset = PETSc.Mat.Structure.SAME_NONZERO_PATTERN, PETSc.Mat.Structure.SUBSET
-        self.model.A.copy(ldl.matrix, structure=same)
-        ldl.matrix.axpy(-sigma, self.model.B, structure=subset)  # type: ignore[arg-type]
-        # Negative pivots only: a null one means an eigenvalue within MUMPS's null-pivot
-        # threshold of sigma, which on a small or stiff pencil is the free one itself
-        # (the reduced pencils' check in the certificate reads the inertia alike).
-        below, _, _ = ldl.factor(self)
+        # Negative pivots only (the reduced pencils' check in the certificate reads the
+        # inertia alike).
+        below = self.eigensolver.count_below(sigma)
         if below:
             raise EigenSolveError(
                 f"the free eigen solve returned lambda = {free.load!r}, but {below} "
@@ -312,7 +328,9 @@ class Problem(Owner):
         Note:
             Collective.
         """
-        abs_A, _ = self.abs_pencil()
+        if self._abs_A is None:  # |B| is not needed here
+            self._abs_A = abs_matrix(self.model.A)
+        abs_A = self._abs_A
         size, product = u.duplicate(), u.duplicate()
         size.array[:] = np.abs(u.array_r)
         abs_A.mult(size, product)
@@ -329,9 +347,11 @@ class Problem(Owner):
         Shared by :meth:`load_resolution` and the interior-point method's residual floor;
         A and B are not changed after set-up. Owned by the problem. Collective.
         """
-        if self._abs is None:
-            self._abs = (abs_matrix(self.model.A), abs_matrix(self.model.B))
-        return self._abs
+        if self._abs_A is None:
+            self._abs_A = abs_matrix(self.model.A)
+        if self._abs_B is None:
+            self._abs_B = abs_matrix(self.model.B)
+        return self._abs_A, self._abs_B
 
     # -- reporting ------------------------------------------------------------------
     def buckling_coefficient(self, load: float) -> float:
@@ -345,10 +365,7 @@ class Problem(Owner):
 
     def destroy(self) -> None:
         """Destroy the PETSc/SLEPc objects (collective) and take back the run's options."""
-        release(self, "_r", "_Bu")
-        for mat in getattr(self, "_abs", None) or ():
-            mat.destroy()
-        self._abs = None
+        release(self, "_r", "_Bu", "_abs_A", "_abs_B")
         pop_run_options(getattr(self, "_run_options", []))
         for name in ("_eigensolver", "_model"):  # absent when the constructor failed early
             owner = self.__dict__.get(name)
