@@ -5,15 +5,42 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Protocol
 
 import numpy as np
 
 if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.analysis import Analysis
+    import dolfinx
+
+    from unibuckle_fenicsx.algorithms import UnilateralSolution
+    from unibuckle_fenicsx.model.problem import Problem
     from unibuckle_fenicsx.results.records import BucklingResult
 
-__all__ = ["file_stem", "write_fields", "write_json"]
+__all__ = ["Solved", "file_stem", "write_fields", "write_json"]
+
+
+class Solved(Protocol):
+    """What :func:`write_fields` reads of a solve (:class:`~unibuckle_fenicsx.analysis.Analysis`).
+
+    Attributes:
+        result: The result's records.
+        problem: The set-up problem (its mesh, model and contact manager).
+        solution: The unilateral solution (None without obstacle).
+    """
+
+    result: BucklingResult
+    problem: Problem
+    solution: UnilateralSolution | None
+
+    @property
+    def mode(self) -> dolfinx.fem.Function:
+        """The critical mode (w, theta)."""
+        ...
+
+    @property
+    def free_mode(self) -> dolfinx.fem.Function:
+        """The free plate's mode."""
+        ...
 
 
 def write_json(result: BucklingResult, path: str | Path) -> Path:
@@ -35,7 +62,7 @@ def file_stem(name: str) -> str:
     return stem or "plate"
 
 
-def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
+def write_fields(analysis: Solved, directory: str | Path) -> list[Path]:
     """Write the mode, the free mode, the obstacle zone and the contact set for viewing.
 
     ``<case>`` is the problem's name made a safe file name (:func:`file_stem`). Files,
