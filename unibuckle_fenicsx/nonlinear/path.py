@@ -52,6 +52,7 @@ from unibuckle_fenicsx.nonlinear.model import (
 from unibuckle_fenicsx.nonlinear.verdict import judge
 from unibuckle_fenicsx.progress import LOGGER
 from unibuckle_fenicsx.results.assemble import versions
+from unibuckle_fenicsx.results.records import BucklingResult
 from unibuckle_fenicsx.spec import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.tolerances import NONLINEAR_ATOL
 
@@ -476,7 +477,7 @@ def _default_atol(plate: VonKarmanPlate, reference: float) -> None:
     plate.snes.setTolerances(atol=NONLINEAR_ATOL * plate.unit_load_norm * reference)
 
 
-def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path with cleanup on every exit
+def solve_nonlinear(
     spec: ProblemSpec,
     options: NonlinearOptions | None = None,
     comm: MPI.Comm = MPI.COMM_WORLD,
@@ -504,42 +505,7 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
     """
     t0 = time.perf_counter()
     options = NonlinearOptions() if options is None else options
-    if spec.load.thermal or spec.has_fixed_load:
-        raise InputError(
-            "the nonlinear analysis models edge loads scaled by lambda only: temperature "
-            "rises ([load]) and fixed loads (fixed_normal_stress, fixed_shear_stress) are "
-            "not in its energy"
-        )
-    if any(o.foundation_stiffness is not None for o in spec.all_obstacles):
-        raise InputError(
-            "the nonlinear analysis models rigid obstacles only, not Winkler foundations "
-            "(foundation_stiffness)"
-        )
-    obstacle = options.obstacle and bool(spec.all_obstacles)
-    if obstacle and len({o.side for o in spec.all_obstacles}) > 1:
-        raise InputError(
-            "the nonlinear analysis needs every obstacle on one side of the plate (all "
-            "above or all below): the imperfection is pushed off them by a uniform pressure"
-        )
-    if options.shape == "unilateral" and not obstacle:
-        raise InputError(
-            'shape = "unilateral" needs a problem with an obstacle (and obstacle = true)'
-        )
-    displacement_axis(spec.plate, options.control)
-    degree = options.degree if options.degree is not None else spec.solver.prestress_degree
-    if degree not in (1, 2):
-        raise InputError(
-            f"solver.prestress_degree = {degree} sets the in-plane displacement degree of "
-            "the nonlinear model, which must be 1 or 2: give degree"
-        )
-    if linear is not None:
-        if obstacle and not isinstance(linear.problem, UnilateralProblem):
-            raise InputError(
-                "linear: the analysis given was solved without the obstacle; pass one of "
-                "the problem with its obstacle (or obstacle = false)"
-            )
-        if linear.problem.spec.mesh != spec.mesh or linear.problem.spec.plate != spec.plate:
-            raise InputError("linear: the analysis given is of another plate or mesh")
+    obstacle, degree = _checked(spec, options, linear)
     owns_linear = linear is None
     if linear is None:
         linear = solve_linear(spec if obstacle else spec.without_obstacles(), comm)
@@ -591,6 +557,86 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
         if owns_linear:
             linear.destroy()
         raise NonlinearError(f"{spec.name}: no load step converged: {why}")
+    nl = _result(
+        spec, options, plate, (path, completed, why, rejected), (result, reference, how),
+        obstacle=obstacle, shape=shape_name, degree=degree, gapped=gapped, closed=closed,
+        timings=timings, t0=t0, comm=comm,
+    )  # fmt: skip
+    nl.verdict = judge(nl).summary(nl)
+    return NonlinearAnalysis(nl, plate, linear, owns_linear)
+
+
+def _checked(
+    spec: ProblemSpec, options: NonlinearOptions, linear: Analysis | None
+) -> tuple[bool, int]:
+    """Refuse what the nonlinear model does not hold (before any solve).
+
+    Returns whether the obstacle is imposed, and the in-plane displacement's degree.
+    """
+    if spec.load.thermal or spec.has_fixed_load:
+        raise InputError(
+            "the nonlinear analysis models edge loads scaled by lambda only: temperature "
+            "rises ([load]) and fixed loads (fixed_normal_stress, fixed_shear_stress) are "
+            "not in its energy"
+        )
+    if any(o.foundation_stiffness is not None for o in spec.all_obstacles):
+        raise InputError(
+            "the nonlinear analysis models rigid obstacles only, not Winkler foundations "
+            "(foundation_stiffness)"
+        )
+    obstacle = options.obstacle and bool(spec.all_obstacles)
+    if obstacle and len({o.side for o in spec.all_obstacles}) > 1:
+        raise InputError(
+            "the nonlinear analysis needs every obstacle on one side of the plate (all "
+            "above or all below): the imperfection is pushed off them by a uniform pressure"
+        )
+    if options.shape == "unilateral" and not obstacle:
+        raise InputError(
+            'shape = "unilateral" needs a problem with an obstacle (and obstacle = true)'
+        )
+    displacement_axis(spec.plate, options.control)
+    degree = options.degree if options.degree is not None else spec.solver.prestress_degree
+    if degree not in (1, 2):
+        raise InputError(
+            f"solver.prestress_degree = {degree} sets the in-plane displacement degree of "
+            "the nonlinear model, which must be 1 or 2: give degree"
+        )
+    if linear is not None:
+        if obstacle and not isinstance(linear.problem, UnilateralProblem):
+            raise InputError(
+                "linear: the analysis given was solved without the obstacle; pass one of "
+                "the problem with its obstacle (or obstacle = false)"
+            )
+        if linear.problem.spec.mesh != spec.mesh or linear.problem.spec.plate != spec.plate:
+            raise InputError("linear: the analysis given is of another plate or mesh")
+    return obstacle, degree
+
+
+def _result(
+    spec: ProblemSpec,
+    options: NonlinearOptions,
+    plate: VonKarmanPlate,
+    traced: tuple[list[PathPoint], bool, str, int],
+    linear: tuple[BucklingResult, float, str],
+    *,
+    obstacle: bool,
+    shape: str,
+    degree: int,
+    gapped: bool,
+    closed: float | None,
+    timings: dict[str, float],
+    t0: float,
+    comm: MPI.Comm,
+) -> NonlinearResult:
+    """The result of a traced path: its loads read off it, the contact check, the record.
+
+    ``traced``: the path, whether it completed, why it stopped, the rejected steps;
+    ``linear``: the linear result, the reference load and how it was obtained;
+    ``shape``: the imperfection's shape, by name.
+    Collective (the contact check).
+    """
+    path, completed, why, rejected = traced
+    result, reference, how = linear
     loads = np.array([q.load_Pa for q in path])
     max_w = np.array([q.max_w_m for q in path])
     knee = inflection_load(loads, max_w)
@@ -607,7 +653,7 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
         obstacle=obstacle,
         control=options.control,
         imperfection=options.imperfection,
-        imperfection_shape=shape_name,
+        imperfection_shape=shape,
         thickness_m=spec.plate.thickness,
         linear_critical_load_Pa=reference,
         free_load_Pa=result.free_load_Pa,
@@ -633,8 +679,7 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
         units=spec.units,
         versions=versions(),
     )
-    nl.verdict = judge(nl).summary(nl)
-    return NonlinearAnalysis(nl, plate, linear, owns_linear)
+    return nl
 
 
 def _gaps_closed_load(spec: ProblemSpec, linear: Analysis) -> float | None:
