@@ -135,6 +135,29 @@ def _membrane_matrix(problem: Problem) -> PETSc.Mat:
     return K
 
 
+def _matrices(problem, estimate: float, kinds: list[str]) -> dict[str, tuple[PETSc.Mat, str]]:
+    """The matrices of ``kinds`` to factorise, each with its PC type.
+
+    The caller destroys those that are not A.
+    """
+    A, B = problem.model.A, problem.model.B
+    matrices: dict[str, tuple[PETSc.Mat, str]] = {}
+    if "pencil_ldl" in kinds:
+        K = A.duplicate(copy=True)
+        K.axpy(-1.01 * estimate, B, structure=PETSc.Mat.Structure.SUBSET)
+        K.setOption(PETSc.Mat.Option.SPD, False)
+        K.setOption(PETSc.Mat.Option.SYMMETRIC, True)
+        matrices["pencil_ldl"] = (K, "cholesky")
+    if "stiffness_lu" in kinds:
+        matrices["stiffness_lu"] = (A, "lu")
+    if {"prestress_lu", "prestress_cholesky"} & set(kinds):
+        membrane = _membrane_matrix(problem)
+        for kind, pc_type in (("prestress_lu", "lu"), ("prestress_cholesky", "cholesky")):
+            if kind in kinds:
+                matrices[kind] = (membrane, pc_type)
+    return matrices
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--plates", default="paper,thin")
@@ -164,25 +187,8 @@ def main() -> None:
             with build_problem(make(nx, ny), comm) as problem:
                 with build_problem(make(max(2, nx // 4), max(2, ny // 4)), comm) as coarse:
                     estimate = coarse.solve_free().load
-                A, B = problem.model.A, problem.model.B
-                matrices: dict[str, tuple[PETSc.Mat, str]] = {}
-                kinds = args.kinds.split(",")
-                if "pencil_ldl" in kinds:
-                    K = A.duplicate(copy=True)
-                    K.axpy(-1.01 * estimate, B, structure=PETSc.Mat.Structure.SUBSET)
-                    K.setOption(PETSc.Mat.Option.SPD, False)
-                    K.setOption(PETSc.Mat.Option.SYMMETRIC, True)
-                    matrices["pencil_ldl"] = (K, "cholesky")
-                if "stiffness_lu" in kinds:
-                    matrices["stiffness_lu"] = (A, "lu")
-                if {"prestress_lu", "prestress_cholesky"} & set(kinds):
-                    membrane = _membrane_matrix(problem)
-                    for kind, pc_type in (
-                        ("prestress_lu", "lu"),
-                        ("prestress_cholesky", "cholesky"),
-                    ):
-                        if kind in kinds:
-                            matrices[kind] = (membrane, pc_type)
+                A = problem.model.A
+                matrices = _matrices(problem, estimate, args.kinds.split(","))
                 for kind, (mat, pc_type) in matrices.items():
                     for name in args.orderings.split(","):
                         row = {

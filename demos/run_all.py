@@ -266,6 +266,27 @@ def parser() -> argparse.ArgumentParser:
     return parser
 
 
+def run_demo(demo: str, args: argparse.Namespace, figures: Path, env: dict[str, str]) -> bool:
+    """Run one demo, keep its output (a full run), say how it went; whether it succeeded."""
+    # Relative to the repository when inside it: the outputs print figures/... paths.
+    where = figures.relative_to(ROOT) if figures.is_relative_to(ROOT) else figures
+    cmd = [sys.executable, str(ROOT / "demos" / demo), "--figures", str(where)]
+    if args.coarse:
+        cmd.append("--coarse")
+    if args.output is not None and demo.startswith("demo_"):
+        cmd += ["--output", str(args.output.resolve())]
+    t0 = time.perf_counter()
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
+    elapsed = time.perf_counter() - t0
+    status = "ok" if proc.returncode == 0 else f"FAILED ({proc.returncode})"
+    print(f"{demo}: {status} in {elapsed:.1f} s", flush=True)
+    if proc.returncode == 0 and not args.coarse:
+        keep_output(figures / "stdout" / demo.replace(".py", ".txt"), proc.stdout)
+    if proc.returncode != 0:
+        print(proc.stdout[-4000:], proc.stderr[-4000:], sep="\n", file=sys.stderr)
+    return proc.returncode == 0
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the demos; return the exit status."""
     args = parser().parse_args(argv)
@@ -279,24 +300,7 @@ def main(argv: list[str] | None = None) -> int:
         bad = quickstart(figures, env)
         print(f"quickstart: {'ok' if not bad else 'FAILED'} in {time.perf_counter() - t0:.1f} s")
         failed += bad
-    for demo in DEMOS:
-        # Relative to the repository when inside it: the outputs print figures/... paths.
-        where = figures.relative_to(ROOT) if figures.is_relative_to(ROOT) else figures
-        cmd = [sys.executable, str(ROOT / "demos" / demo), "--figures", str(where)]
-        if args.coarse:
-            cmd.append("--coarse")
-        if args.output is not None and demo.startswith("demo_"):
-            cmd += ["--output", str(args.output.resolve())]
-        t0 = time.perf_counter()
-        proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
-        elapsed = time.perf_counter() - t0
-        status = "ok" if proc.returncode == 0 else f"FAILED ({proc.returncode})"
-        print(f"{demo}: {status} in {elapsed:.1f} s", flush=True)
-        if proc.returncode == 0 and not args.coarse:
-            keep_output(figures / "stdout" / demo.replace(".py", ".txt"), proc.stdout)
-        if proc.returncode != 0:
-            failed.append(demo)
-            print(proc.stdout[-4000:], proc.stderr[-4000:], sep="\n", file=sys.stderr)
+    failed += [demo for demo in DEMOS if not run_demo(demo, args, figures, env)]
 
     rows, studies, paper = [], {}, {}
     for case in CASES:

@@ -540,34 +540,40 @@ def _check_outputs(args: argparse.Namespace) -> str | None:
     """
     files = [("--json", args.json), ("--plot", getattr(args, "plot", None))]  # plot: sweep
     for flag, value in files:
-        if not value:
-            continue
-        path = Path(value)
-        folder = path.parent
-        if path.is_dir():
-            return f"{flag}: {path} is a directory; give a file name"
-        if not folder.is_dir():
-            return _missing_folder(flag, folder)
-        if path.exists():
-            try:  # appending nothing leaves the file as it is
-                with path.open("ab"):
-                    pass
-            except OSError as err:
-                return f"{flag}: cannot write {path} ({err.strerror or err})"
-        elif problem := _probe_folder(flag, folder, path):
+        if value and (problem := _check_file(flag, Path(value))):
             return problem
     if getattr(args, "output", None):  # solve only
-        directory = Path(args.output)
-        if directory.exists() and not directory.is_dir():
-            return f"--output: {directory} is not a directory"
-        folder = directory
-        if not directory.exists():
-            folder = directory.parent
-            if not folder.is_dir():
-                return _missing_folder("--output", folder) + " (--output creates one folder)"
-        if problem := _probe_folder("--output", folder, directory):
-            return problem
+        return _check_directory(Path(args.output))
     return None
+
+
+def _check_file(flag: str, path: Path) -> str | None:
+    """Why the file ``path`` of ``flag`` cannot be written, or None (nothing left behind)."""
+    folder = path.parent
+    if path.is_dir():
+        return f"{flag}: {path} is a directory; give a file name"
+    if not folder.is_dir():
+        return _missing_folder(flag, folder)
+    if not path.exists():
+        return _probe_folder(flag, folder, path)
+    try:  # appending nothing leaves the file as it is
+        with path.open("ab"):
+            pass
+    except OSError as err:
+        return f"{flag}: cannot write {path} ({err.strerror or err})"
+    return None
+
+
+def _check_directory(directory: Path) -> str | None:
+    """Why --output ``directory`` cannot be made or written, or None (nothing left behind)."""
+    if directory.exists() and not directory.is_dir():
+        return f"--output: {directory} is not a directory"
+    folder = directory
+    if not directory.exists():
+        folder = directory.parent
+        if not folder.is_dir():
+            return _missing_folder("--output", folder) + " (--output creates one folder)"
+    return _probe_folder("--output", folder, directory)
 
 
 def _logging(verbose: int, quiet: bool, rank: int) -> None:

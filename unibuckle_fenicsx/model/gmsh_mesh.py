@@ -358,7 +358,7 @@ def _quadrilaterals_only(gmsh: Any, hint: str = "") -> None:
         )
 
 
-def gmsh_plate_mesh(  # noqa: C901 - gmsh's session on rank 0, its errors, and the broadcast, in one place
+def gmsh_plate_mesh(
     plate: PlateSpec,
     spec: MeshSpec,
     comm: MPI.Comm = MPI.COMM_WORLD,
@@ -386,38 +386,8 @@ def gmsh_plate_mesh(  # noqa: C901 - gmsh's session on rank 0, its errors, and t
     Note:
         Collective.
     """
-    error: str | None = None
-    gmsh = None
-    if comm.rank == 0:
-        try:
-            gmsh = import_gmsh()
-        except ImportError as err:
-            error = f"ImportError: {err}"
-    error = comm.bcast(error, root=0)
-    if error is not None:
-        raise ImportError(error.removeprefix("ImportError: "))
-    if comm.rank == 0:
-        if gmsh is None:
-            raise RuntimeError("gmsh_plate_mesh: expected gmsh is not None (an internal invariant)")
-        if plate.file is None and spec.size is None:
-            raise RuntimeError(
-                "gmsh_plate_mesh: expected spec.size is not None (an internal invariant)"
-            )
-        gmsh.initialize(interruptible=False)
-        try:
-            for key, value in GMSH_OPTIONS.items():
-                gmsh.option.setNumber(key, value)
-            if plate.file is not None:
-                _mesh_file(gmsh, plate, spec)
-            else:
-                size = float(spec.size or 0.0)  # checked above
-                _mesh_built(gmsh, plate, size, zone_curves(obstacles, size))
-        except ValueError as err:
-            error = str(err) if plate.file is None else f"plate.file {plate.file}: {err}"
-        except Exception as err:  # gmsh raises plain Exceptions
-            error = f"gmsh failed to mesh the plate: {err}"
-        if error is not None:
-            gmsh.finalize()
+    gmsh = _import_on_root(comm)
+    error = _mesh_on_root(gmsh, plate, spec, obstacles) if comm.rank == 0 else None
     error = comm.bcast(error, root=0)
     if error is not None:
         raise InputError(error)
@@ -439,6 +409,57 @@ def gmsh_plate_mesh(  # noqa: C901 - gmsh's session on rank 0, its errors, and t
         tags = dolfinx.mesh.meshtags(msh, fdim, empty, empty)
     groups = {name: int(g.tag) for name, g in data.physical_groups.items() if g.dim == 1}
     return msh, tags, groups
+
+
+def _import_on_root(comm: MPI.Comm) -> Any:
+    """Gmsh on rank 0 (None on the others); an ImportError on every rank if it is missing.
+
+    Collective.
+    """
+    error: str | None = None
+    gmsh = None
+    if comm.rank == 0:
+        try:
+            gmsh = import_gmsh()
+        except ImportError as err:
+            error = str(err)
+    error = comm.bcast(error, root=0)
+    if error is not None:
+        raise ImportError(error)
+    return gmsh
+
+
+def _mesh_on_root(
+    gmsh: Any, plate: PlateSpec, spec: MeshSpec, obstacles: Sequence[ObstacleSpec]
+) -> str | None:
+    """Mesh the plate in a new gmsh session (rank 0); why it failed, or None.
+
+    On a failure the session is closed; on success it stays open for the mesh to be
+    distributed.
+    """
+    if gmsh is None:
+        raise RuntimeError("gmsh_plate_mesh: expected gmsh is not None (an internal invariant)")
+    if plate.file is None and spec.size is None:
+        raise RuntimeError(
+            "gmsh_plate_mesh: expected spec.size is not None (an internal invariant)"
+        )
+    gmsh.initialize(interruptible=False)
+    error: str | None = None
+    try:
+        for key, value in GMSH_OPTIONS.items():
+            gmsh.option.setNumber(key, value)
+        if plate.file is not None:
+            _mesh_file(gmsh, plate, spec)
+        else:
+            size = float(spec.size or 0.0)  # checked above
+            _mesh_built(gmsh, plate, size, zone_curves(obstacles, size))
+    except ValueError as err:
+        error = str(err) if plate.file is None else f"plate.file {plate.file}: {err}"
+    except Exception as err:  # gmsh raises plain Exceptions
+        error = f"gmsh failed to mesh the plate: {err}"
+    if error is not None:
+        gmsh.finalize()
+    return error
 
 
 def _mesh_file(gmsh: Any, plate: PlateSpec, spec: MeshSpec) -> None:

@@ -336,20 +336,7 @@ def _solve_membrane(
     for term in terms[1:]:
         L = L + term
 
-    bcs: list[dolfinx.fem.DirichletBC] = []
-    fdim = msh.topology.dim - 1
-    for e in plate.edges:
-        if e.inplane == "free":
-            continue
-        for tag in edge_tags(plate, e):
-            facets = facet_tags.find(tag)
-            components: tuple[int, ...] = (0, 1)
-            if e.inplane == "roller":
-                components = (edge_normal_axis(msh, facet_tags, tag, e.name),)
-            for c in components:
-                Vc, _ = V.sub(c).collapse()
-                dofs = dolfinx.fem.locate_dofs_topological((V.sub(c), Vc), fdim, facets)
-                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
+    bcs = _inplane_bcs(V, msh, facet_tags, plate)
     pinned = not bcs
     if pinned:
         # A thermal strain is self-equilibrated. The loads of a plate checked once are
@@ -387,6 +374,30 @@ def _solve_membrane(
     if thermal is not None:
         N0 = N0 - thermal
     return uh, N0, thermal, pinned
+
+
+def _inplane_bcs(
+    V: dolfinx.fem.FunctionSpace,
+    msh: dolfinx.mesh.Mesh,
+    facet_tags: dolfinx.mesh.MeshTags,
+    plate: PlateSpec,
+) -> list[dolfinx.fem.DirichletBC]:
+    """The edges' in-plane conditions: "clamped" both components, "roller" the normal one."""
+    bcs: list[dolfinx.fem.DirichletBC] = []
+    fdim = msh.topology.dim - 1
+    for e in plate.edges:
+        if e.inplane == "free":
+            continue
+        for tag in edge_tags(plate, e):
+            facets = facet_tags.find(tag)
+            components: tuple[int, ...] = (0, 1)
+            if e.inplane == "roller":
+                components = (edge_normal_axis(msh, facet_tags, tag, e.name),)
+            for c in components:
+                Vc, _ = V.sub(c).collapse()
+                dofs = dolfinx.fem.locate_dofs_topological((V.sub(c), Vc), fdim, facets)
+                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
+    return bcs
 
 
 def _refuse_tension(
