@@ -16,6 +16,8 @@ from unibuckle_fenicsx.spec import (
     ProblemSpec,
     SolverSpec,
     load_toml,
+    problem_from_dict,
+    problem_to_dict,
 )
 from unibuckle_fenicsx.spec.cases import CASES, paper_case
 
@@ -33,6 +35,8 @@ __all__ = [
     "__version__",
     "load_toml",
     "paper_case",
+    "problem_from_dict",
+    "problem_to_dict",
     "solve",
 ]
 

@@ -36,6 +36,7 @@ __all__ = [
     "triangulate",
 ]
 
+#: A polygon's vertices (m), in order: a sequence of (x, y) pairs or an (n, 2) array.
 Vertices = Sequence[Sequence[float]] | npt.NDArray[np.float64]
 #: A circle (center, radius), or a polygon's vertices (n, 2).
 Shape = tuple[Sequence[float], float] | npt.NDArray[np.float64]

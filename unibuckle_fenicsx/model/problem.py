@@ -417,7 +417,7 @@ class BucklingProblem(Owner):
         return float(self.comm.allreduce(local, op=MPI.MAX))
 
     def solve_free(self) -> Mode:
-        """Smallest eigenpair without obstacle (computed once, then :attr:`free`).
+        """Smallest eigenpair without obstacle (computed once, then ``free``).
 
         Note:
             Collective.
