@@ -31,6 +31,7 @@ import pytest
 from msgspec import structs
 
 from unibuckle_fenicsx.algorithms import RunStatus
+from unibuckle_fenicsx.algorithms.foundation import solve_foundation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.certificate.certify import certify_foundation
 from unibuckle_fenicsx.model.build import build_problem
@@ -147,6 +148,16 @@ def test_a_bilateral_foundation_goes_with_a_rigid_obstacle():
 
 
 # -- the spring term ---------------------------------------------------------------------
+def test_a_bad_iteration_count_is_refused_before_any_solve():
+    # max_iterations is the [solver] key's (an integer >= 1): refused naming it, no eigen solve.
+    spec = strip(1.5, 6, ObstacleSpec("all", foundation_stiffness=1.0))
+    with build_problem(spec, MPI.COMM_WORLD) as problem:
+        for bad in (0, 2.5, True):
+            with pytest.raises(ValueError, match=r"max_iterations must be an integer >= 1"):
+                solve_foundation(problem, max_iterations=bad)
+        assert problem.eigensolver.solves == 0
+
+
 def test_tributary_areas_sum_to_the_plate_area():
     spec = strip(1.5, 6, ObstacleSpec("all", foundation_stiffness=1.0))
     with build_problem(spec, MPI.COMM_WORLD) as problem:

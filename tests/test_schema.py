@@ -100,6 +100,18 @@ def test_the_schema_file_is_the_packages():
     assert json.loads(SCHEMA_FILE.read_text()) == json_schema()
 
 
+def test_every_key_says_what_it_means():
+    # Each key of the schema (and so each row of the reference page) carries the meaning
+    # its Struct's docstring gives it, the file's own forms (edges, polygon, circle) too.
+    schema = json_schema()
+    for name, table in schema["$defs"].items():
+        for key, node in table.get("properties", {}).items():
+            assert node.get("description"), f"{name}.{key} has no description"
+    tau = schema["$defs"]["SolverSpec"]["properties"]["tau"]["description"]
+    assert tau.startswith("Relative feasibility/contact tolerance")
+    assert "[edges.NAME]" in schema["$defs"]["ProblemSpec"]["properties"]["edges"]["description"]
+
+
 def test_unibuckle_schema_writes_it(tmp_path, capsys):
     out = tmp_path / "schema.json"
     assert main(["schema", "--output", str(out)]) == EXIT_OK

@@ -61,6 +61,7 @@ from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.progress import Progress
+from unibuckle_fenicsx.spec.solver import EnumerateOptions
 from unibuckle_fenicsx.tolerances import LOAD_TIE_RTOL, PROOF_RTOL
 
 __all__ = ["LevelSummary", "enumerate_contact_sets"]
@@ -388,6 +389,7 @@ def enumerate_contact_sets(
         Collective on ``problem.comm`` and on ``candidate_comm``.
     """
     require_obstacle(problem, "enumerate_contact_sets")
+    EnumerateOptions(max_candidates=max_candidates)  # the [solver] key's range
     ccomm = MPI.COMM_SELF if candidate_comm is None else candidate_comm
     _check(problem, max_candidates, ccomm)
     i = problem.contact.size

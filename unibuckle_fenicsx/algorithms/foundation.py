@@ -56,6 +56,7 @@ from unibuckle_fenicsx.algorithms.records import FoundationDetails
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
+from unibuckle_fenicsx.spec.solver import FoundationOptions
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
 __all__ = ["pressing_nodes", "solve_foundation"]
@@ -97,8 +98,7 @@ def solve_foundation(
     contact = problem.contact
     if contact.stiffness is None:
         raise InputError("solve_foundation needs a problem with a tensionless foundation")
-    if int(max_iterations) != max_iterations or max_iterations < 1:
-        raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    FoundationOptions(max_iterations=max_iterations)  # the [solver] key's range
     lower = problem.solve_free().load
     springs = contact.stiffness
     runs: dict[str, SpringIteration] = {}

@@ -51,7 +51,12 @@ Vertices = Annotated[
 
 
 class Circle(Table, frozen=True, tag_field="shape", tag="circle"):
-    """A circular zone: the closed disc of ``radius`` about ``center`` (m)."""
+    """A circular zone: the closed disc of ``radius`` about ``center``.
+
+    Args:
+        center: The centre [x, y] (m).
+        radius: The radius (m), > 0.
+    """
 
     KEY: ClassVar[str] = "circle"
     center: Annotated[Point, unit("m")]
@@ -59,7 +64,11 @@ class Circle(Table, frozen=True, tag_field="shape", tag="circle"):
 
 
 class Polygon(Table, frozen=True, tag_field="shape", tag="polygon"):
-    """A polygonal zone: the closed simple polygon of ``vertices`` (m), at least three."""
+    """A polygonal zone: the closed simple polygon of ``vertices``.
+
+    Args:
+        vertices: The vertices [[x, y], ...] (m), at least three, of a simple polygon.
+    """
 
     KEY: ClassVar[str] = "polygon"
     vertices: Vertices

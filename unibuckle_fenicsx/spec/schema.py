@@ -2,17 +2,21 @@
 
 :func:`msgspec.json.schema` writes the Structs' form; :func:`json_schema` turns it into
 the file's (the edge tables under ``edges``, an obstacle's ``polygon`` and ``circle``
-keys, a hole's ``outline``: :mod:`~unibuckle_fenicsx.spec.files`).
+keys, a hole's ``outline``: :mod:`~unibuckle_fenicsx.spec.files`) and gives each key the
+description its Struct's docstring gives it (its ``Args:`` entry: msgspec reads a field's
+description only from its ``Meta``, and the docstring is where the API documents it).
 """
 
 from __future__ import annotations
 
 import inspect
+import re
 from typing import Any
 
 import msgspec
 
 from unibuckle_fenicsx.spec.base import bare, element, hints, is_table, members
+from unibuckle_fenicsx.spec.plate import PlateSpec
 from unibuckle_fenicsx.spec.problem import ProblemSpec
 
 __all__ = ["accepted_keys", "json_schema"]
@@ -25,6 +29,9 @@ def json_schema() -> dict[str, Any]:
     for name, cls in _tables(ProblemSpec).items():
         node = defs[name]
         node["description"] = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0]
+        for key, text in field_docs(cls).items():
+            if key in node["properties"]:
+                node["properties"][key]["description"] = text
         hidden = {*cls.CODE_ONLY, cls.__struct_config__.tag_field}  # the Python API's
         node["properties"] = {k: v for k, v in node["properties"].items() if k not in hidden}
         for prop in node["properties"].values():  # absent, in a file: TOML has no null
@@ -34,7 +41,11 @@ def json_schema() -> dict[str, Any]:
     vertices = defs.pop("Polygon")["properties"]["vertices"]
     top = list(defs["ProblemSpec"]["properties"].items())
     at = [k for k, _ in top].index("material") + 1
-    edges = {"type": "object", "additionalProperties": {"$ref": "#/$defs/EdgeSpec"}}
+    edges = {
+        "type": "object",
+        "additionalProperties": {"$ref": "#/$defs/EdgeSpec"},
+        "description": "The [edges.NAME] tables. " + field_docs(PlateSpec)["edges"],
+    }
     defs["ProblemSpec"]["properties"] = dict([*top[:at], ("edges", edges), *top[at:]])
     plate = defs["PlateSpec"]["properties"]
     circle = {"$ref": "#/$defs/Circle"}
@@ -45,14 +56,29 @@ def json_schema() -> dict[str, Any]:
     zone["anyOf"] = [a for a in zone["anyOf"] if "discriminator" not in a]
     defs["ObstacleSpec"]["properties"] = {
         "zone": zone,
-        "polygon": vertices,
-        "circle": circle,
+        "polygon": vertices | {"description": "The zone: a polygon [[x, y], ...] (m)."},
+        "circle": circle | {"description": "The zone: a circle {center, radius} (m)."},
         **obstacle,
     }
     defs["Material"]["required"] = []  # a laminate's E and nu are its plies'
     head = {"$schema": "https://json-schema.org/draft/2020-12/schema"}
     head["title"] = "unibuckle_fenicsx problem file"
     return msgspec.json.decode(msgspec.json.encode(head | schema))  # JSON's lists
+
+
+def field_docs(cls: type) -> dict[str, str]:
+    """Each field's entry in the ``Args:`` section of ``cls``'s docstring (Google style)."""
+    found: dict[str, str] = {}
+    section = inspect.cleandoc(cls.__doc__ or "").partition("\nArgs:\n")[2]
+    for line in section.splitlines():
+        if line and not line.startswith(" "):  # the next section
+            break
+        if match := re.match(r"    (\w+): (.*)", line):
+            name = match[1]
+            found[name] = match[2]
+        elif found and line.strip():
+            found[name] += " " + line.strip()
+    return found
 
 
 def _tables(cls: Any, found: dict[str, Any] | None = None) -> dict[str, Any]:

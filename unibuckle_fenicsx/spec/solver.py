@@ -1,9 +1,10 @@
 """The methods and their options: the ``[solver]`` table.
 
-:class:`Method` names each unilateral method once: the file's choices, the command line's
-and the dispatch read it. :class:`SolverSpec` is the ``[solver]`` table, every option
+:class:`Method` names each unilateral method once: the file's choices and the command
+line's read it. :class:`SolverSpec` is the ``[solver]`` table, every option
 once with its range and default; each method's own options Struct (:data:`OPTIONS`)
-holds the options that method reads, typed and defaulted from it.
+holds the options that method reads, typed and defaulted from it; the algorithms check
+their arguments of the same name with it.
 """
 
 from __future__ import annotations
