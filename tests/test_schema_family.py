@@ -169,14 +169,14 @@ def _check_design(data: dict, load: float) -> None:
     from unibuckle_fenicsx.design import design_output
 
     d = design_output(spec, spec.design, load)
-    lam = math.sqrt(DESIGN["yield_stress"] / d["sigma_cr_Pa"])
+    lam = math.sqrt(DESIGN["yield_stress"] / d.sigma_cr_Pa)
     if expected[0] == "internal":
-        rho = (lam - 0.055 * (3 + d["psi"])) / lam**2
-        rho = 1.0 if lam <= 0.5 + math.sqrt(0.085 - 0.055 * d["psi"]) else min(1.0, rho)
+        rho = (lam - 0.055 * (3 + d.psi)) / lam**2
+        rho = 1.0 if lam <= 0.5 + math.sqrt(0.085 - 0.055 * d.psi) else min(1.0, rho)
     else:
         rho = 1.0 if lam <= 0.748 else min(1.0, (lam - 0.188) / lam**2)
-    assert d["element"] == expected[0]
-    assert d["reduction_factor"] == pytest.approx(rho, rel=1e-14), data["name"]
+    assert d.element == expected[0]
+    assert d.reduction_factor == pytest.approx(rho, rel=1e-14), data["name"]
 
 
 def _check(data: dict, features: list[str]) -> None:
