@@ -90,7 +90,7 @@ NEAR_NCV = 4
 #: the lowest eigenvalue (a coarse mesh's load lies above the fine one, or within a few
 #: tenths of a percent below it), below the second, so that the inertia of one
 #: factorisation proves the pair the smallest. Each later try lies further below the
-#: estimate (:data:`FREE_BELOW`, times the estimate).
+#: estimate (``FREE_BELOW``, times the estimate).
 FREE_ABOVE = 0.01
 FREE_GAP_SHARE = 1.0 / 3.0
 FREE_BELOW = (0.99, 0.96, 0.84)
@@ -193,7 +193,7 @@ class GEPSolver(Owner):
             change between solves, see :meth:`operators_changed`).
         B: Geometric stiffness matrix (owned by the caller; not modified, and not
             changed afterwards: the solver keeps a
-            :func:`~unibuckle_fenicsx.la.factor.compact` copy, :attr:`B`).
+            :func:`~unibuckle_fenicsx.la.factor.compact` copy, ``B``).
         indefinite: B is indefinite: solve the swapped pencil.
         prefix: Options prefix, non-empty; ``-<prefix>eps_view`` and friends apply.
         tol: EPS tolerance.
@@ -507,12 +507,12 @@ class GEPSolver(Owner):
           tolerance) must show none there either.
 
         More than :data:`FREE_MAX_BELOW` below :math:`\sigma`, or fewer pairs found below
-        it than lie there: the next shift lies below the estimate (:data:`FREE_BELOW`)
+        it than lie there: the next shift lies below the estimate (``FREE_BELOW``)
         and the pencil is factorised again. If no shift proves it (or nothing converges,
         or there is no estimate) the pair comes from :meth:`solve` at target 0 (a MUMPS
         LU), unproven: the caller checks it (:meth:`count_below`).
 
-        The EPS takes the options under :attr:`prefix` (``-unibuckle_eps_tol``,
+        The EPS takes the options under ``prefix`` (``-unibuckle_eps_tol``,
         ``-unibuckle_eps_ncv``, ...; the Krylov subspace defaults to :data:`FREE_NCV`),
         the factorisation those of :attr:`factorization` (``<prefix>ldl_``).
 

@@ -158,7 +158,7 @@ def mark_held(
     snapped: Sequence[SnappedPoints],
     plate: PlateSpec,
 ) -> list[SnappedPoints]:
-    """``snapped`` with :attr:`SnappedPoints.held` set: the points that restrain nothing.
+    """``snapped`` with ``SnappedPoints.held`` set: the points that restrain nothing.
 
     A point's node is held when an edge support holds its w (``edge_dofs``: the local W
     DOFs of the edge conditions; ``w_dofs`` maps Vw's local DOFs to W's); a spring's or a

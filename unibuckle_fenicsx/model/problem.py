@@ -232,7 +232,7 @@ class Problem(Owner):
         coarser mesh's: :func:`~unibuckle_fenicsx.model.build.free_estimate`), it sets
         the eigen solve's shift, and the inertia of its one factorisation proves the pair
         the smallest (:meth:`~unibuckle_fenicsx.la.eigen.GEPSolver.smallest`;
-        :attr:`free_proof`). Otherwise (or if no shift proves it) the solve runs at
+        ``free_proof``). Otherwise (or if no shift proves it) the solve runs at
         target 0 and :meth:`verify_free` checks the pair when it matters.
 
         Note:
@@ -265,7 +265,7 @@ class Problem(Owner):
         of :math:`A - \sigma B`, :math:`\sigma` just below :math:`\lambda_{free}` (one
         :math:`LDL^T` through the shared factorisation), counts the eigenvalues in
         :math:`(0, \sigma)` (Sylvester's law, A SPD): there must be none. A free pair
-        that its shifted solve proved the smallest (:attr:`free_proof`) needs nothing
+        that its shifted solve proved the smallest (``free_proof``) needs nothing
         more.
 
         Raises:

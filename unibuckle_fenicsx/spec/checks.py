@@ -213,7 +213,7 @@ class DesignElement:
         """Which end (0 start, 1 end) of a loaded edge lies on the free edge, or None.
 
         A loaded edge runs from its end with the smaller coordinate to the larger, so its
-        start lies on the first edge of :attr:`unloaded` (bottom, or left).
+        start lies on the first edge of ``unloaded`` (bottom, or left).
         """
         if self.free_edge is None:
             return None

@@ -151,7 +151,7 @@ class MeshStudy:
         )
 
     def write_json(self, path: Path, **extra: Any) -> Path:
-        """``{"case", "results": [...], **extra}`` as a record (:func:`record`, rank 0).
+        """``{"case", "results": [...], **extra}`` as a record (:func:`write_record`, rank 0).
 
         The file is the same on every run of the same problem, on any machine (up to a
         last digit that lies at a rounding boundary), so that it can be kept under
