@@ -15,13 +15,18 @@ from unibuckle_fenicsx.spec.base import Matrix3, Table, unit
 
 Modulus = Annotated[float, unit("Pa", gt=0)]
 
+#: The largest fibre angle magnitude accepted (degrees): one turn.
+MAX_PLY_ANGLE = 360.0
+
 
 class Ply(Table, frozen=True):
     r"""One orthotropic ply of a laminate (:mod:`~unibuckle_fenicsx.laminate`).
 
     Args:
         thickness: Ply thickness (m), > 0.
-        angle: Fibre angle from the x axis, counter-clockwise (degrees).
+        angle: Fibre angle from the x axis, counter-clockwise (degrees), in [-360, 360]:
+            one turn either way covers every angle; a larger value is a typing error (a
+            ply at 1e300 degrees has no meaningful cosine).
         E1: Young's modulus along the fibres (Pa), > 0.
         E2: Young's modulus across the fibres (Pa), > 0.
         G12: In-plane shear modulus (Pa), > 0.
@@ -33,7 +38,7 @@ class Ply(Table, frozen=True):
 
     KEY: ClassVar[str] = "material.plies"
     thickness: Annotated[float, unit("m", gt=0)]
-    angle: float
+    angle: Annotated[float, unit("degrees", ge=-MAX_PLY_ANGLE, le=MAX_PLY_ANGLE)]
     E1: Modulus
     E2: Modulus
     G12: Modulus

@@ -226,7 +226,10 @@ class PointSpec(Table, frozen=True):
             cone at the point: w <= 0 with ``side`` "above", w >= 0 "below"), "spring" (a
             spring of ``stiffness`` N/m to w = 0).
         stiffness: The spring's stiffness (N/m), > 0, for ``kind = "spring"`` only.
-        side: "above" (the default) or "below", for ``kind = "one-sided"`` only.
+        side: "above" (w <= 0 at the point) or "below" (w >= 0), for ``kind =
+            "one-sided"`` only, where it is required: the side decides which half of the
+            plate's deflections the point forbids, and no default is sound for both a
+            stud under the plate and a bolt head over it.
     """
 
     KEY: ClassVar[str] = "points"
@@ -264,17 +267,22 @@ class PointSpec(Table, frozen=True):
                 if self.kind == "spring"
                 else f' belongs to kind = "spring", not "{self.kind}"',
             )
-        if self.side not in (None, "above") and self.kind != "one-sided":
+        if self.kind == "one-sided" and self.side is None:
+            raise FieldError(
+                self.key(),
+                "side",
+                ': kind = "one-sided" needs side = "above" (the point holds the plate from '
+                'above: w <= 0) or "below" (from below: w >= 0)',
+            )
+        if self.side is not None and self.kind != "one-sided":
             raise FieldError(
                 self.key(), "side", f' belongs to kind = "one-sided", not "{self.kind}"'
             )
-        if self.kind == "one-sided" and self.side is None:
-            force_setattr(self, "side", "above")
 
     @property
     def sign(self) -> float:
-        """+1 for a one-sided point above (w <= 0 admissible), -1 below."""
-        return 1.0 if self.side == "above" else -1.0
+        """+1 for a one-sided point above (w <= 0 admissible), -1 below, 0 for other kinds."""
+        return {"above": 1.0, "below": -1.0}.get(self.side or "", 0.0)
 
     def locations(self, plate: PlateSpec) -> npt.NDArray[np.float64]:
         """The points (n, 2) (m): ``at``, or the grid's points inside the plate.

@@ -10,7 +10,7 @@ from msgspec.structs import force_setattr, replace
 
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.spec.base import UNITS, Table, stress_ends
-from unibuckle_fenicsx.spec.checks import check_features, check_supports
+from unibuckle_fenicsx.spec.checks import check_features, check_supports, design_element
 from unibuckle_fenicsx.spec.material import Material
 from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
 from unibuckle_fenicsx.spec.plate import MeshSpec, PlateSpec
@@ -150,7 +150,11 @@ class ProblemSpec(Table, frozen=True):
                 )
 
     def _check_design(self) -> None:
-        """The design output needs a compressive normal edge stress (its sigma_cr)."""
+        """The design output needs a compressive normal edge stress (its sigma_cr).
+
+        And a plate that EN 1993-1-5 4.4 describes: an internal or an outstand element
+        (:func:`~unibuckle_fenicsx.spec.checks.design_element` says which, or refuses).
+        """
         if self.design is None:
             return
         compressed = any(
@@ -162,6 +166,7 @@ class ProblemSpec(Table, frozen=True):
                 "design: the EN 1993-1-5 output takes sigma_cr as a compressive normal edge "
                 "stress, and this load has none (give a loaded edge normal_stress < 0)"
             )
+        design_element(self)
 
     def check_scaled_load(self) -> None:
         """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""
