@@ -8,7 +8,7 @@ each raises :class:`~unibuckle_fenicsx.errors.InputError` naming the keys
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import TYPE_CHECKING
+from typing import Protocol
 
 import numpy as np
 
@@ -16,6 +16,7 @@ from unibuckle_fenicsx.en1993 import INTERNAL, OUTSTAND, psi_range, table_row
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import Shape, collinear, narrowest_neck, segment_lengths, shape_gap
 from unibuckle_fenicsx.spec.base import stress_ends
+from unibuckle_fenicsx.spec.obstacles import LoadSpec
 from unibuckle_fenicsx.spec.plate import (
     EDGE_NAMES,
     HOLES,
@@ -25,9 +26,6 @@ from unibuckle_fenicsx.spec.plate import (
     PlateSpec,
     Polygon,
 )
-
-if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.spec.problem import ProblemSpec
 
 __all__ = [
     "FEATURE_RATIO",
@@ -246,7 +244,20 @@ def _edge(plate: PlateSpec, name: str) -> _Edge:
     return _Edge(name)
 
 
-def design_element(spec: ProblemSpec) -> DesignElement:
+class _Problem(Protocol):
+    """What :func:`design_element` reads of a :class:`~unibuckle_fenicsx.spec.ProblemSpec`.
+
+    (``spec.problem`` imports this module: a protocol, not an import of it.)
+    """
+
+    @property
+    def plate(self) -> PlateSpec: ...
+
+    @property
+    def load(self) -> LoadSpec: ...
+
+
+def design_element(spec: _Problem) -> DesignElement:
     """Classify the plate for the design output (EN 1993-1-5 4.4(2)), or refuse it.
 
     The direct stress acts across the edges given a normal stress (scaled or fixed); the
