@@ -38,10 +38,10 @@ import sys
 import time
 from collections import defaultdict
 from collections.abc import Callable
-from dataclasses import replace
 from typing import Any
 
 from _results import append_rows, print_header
+from msgspec.structs import replace
 
 STAGES = (
     "setup", "free solve", "coarse levels", "fine IP", "fine LDL", "fine eigen",
