@@ -51,10 +51,12 @@ STAGES = (
 
 def _install_timers(acc: dict[tuple[str, int], list[float]]) -> None:
     """Wrap the route's functions: ``acc[(stage, DOFs)] = [process seconds, calls]``."""
-    from unibuckle_fenicsx import analysis, eigen
-    from unibuckle_fenicsx.algorithms import chain, interior_point
+    from unibuckle_fenicsx import analysis
+    from unibuckle_fenicsx.algorithms import chain
+    from unibuckle_fenicsx.algorithms.interior_point import explore, newton
     from unibuckle_fenicsx.certificate import certify
-    from unibuckle_fenicsx.model import problem
+    from unibuckle_fenicsx.la import factor
+    from unibuckle_fenicsx.model import build, problem
 
     def wrap(owner: Any, name: str, stage: str, dofs: Callable[..., int]) -> None:
         inner = getattr(owner, name)
@@ -74,14 +76,16 @@ def _install_timers(acc: dict[tuple[str, int], list[float]]) -> None:
     def size(mat: Any) -> int:
         return int(mat.getSize()[0])
 
-    wrap(problem.BucklingProblem, "__init__", "setup", lambda *a: 0)
-    wrap(problem.BucklingProblem, "solve_free", "free solve", lambda p: size(p.model.A))
-    wrap(problem.BucklingProblem, "evaluate", "eigen", lambda p, *a: size(p.model.A))
-    wrap(interior_point.InteriorPointNewton, "solve", "IP", lambda n, *a: size(n.A))
-    wrap(eigen.SharedFactorization, "factor", "LDL", lambda f, *a: size(f.matrix))
-    wrap(chain, "_explore", "coarsest", lambda p, *a: size(p.model.A))
-    wrap(certify, "certify", "certificate", lambda *a: 0)
-    analysis.certify = certify.certify  # the name analysis imported
+    wrap(build, "build_problem", "setup", lambda *a, **k: 0)
+    wrap(problem.Problem, "solve_free", "free solve", lambda p: size(p.model.A))
+    wrap(problem.UnilateralProblem, "evaluate", "eigen", lambda p, *a, **k: size(p.model.A))
+    wrap(newton.InteriorPointNewton, "solve", "IP", lambda n, *a, **k: size(n.kernel.A))
+    wrap(factor.SharedFactorization, "factor", "LDL", lambda f, *a: size(f.matrix))
+    wrap(explore, "explore", "coarsest", lambda p, *a, **k: size(p.model.A))
+    wrap(certify, "certify", "certificate", lambda *a, **k: 0)
+    # The names imported elsewhere, bound before the wrapping.
+    analysis.certify, analysis.build_problem = certify.certify, build.build_problem
+    chain.explore = explore.explore
 
 
 def worker(case: str, nx: int, ny: int, free: bool) -> None:
@@ -100,13 +104,11 @@ def worker(case: str, nx: int, ny: int, free: bool) -> None:
     c0 = time.process_time()
     with solve(spec, MPI.COMM_WORLD) as run:
         result, solution = run.result, run.solution
-        levels = [] if solution is None else solution.details.get("levels", [])
+        levels = [] if solution is None else getattr(solution.details, "levels", [])
         row = {
             "dofs": result.dofs,
             "load_Pa": result.critical_load_Pa,
-            "levels": [
-                [lv["mesh"], lv.get("newton_steps"), lv.get("factorizations")] for lv in levels
-            ],
+            "levels": [[lv.mesh, lv.newton_steps, lv.factorizations] for lv in levels],
         }
     row["total"] = time.process_time() - c0
     row["stages"] = [[stage, n, t, calls] for (stage, n), (t, calls) in acc.items()]
