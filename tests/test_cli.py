@@ -17,7 +17,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED, EXIT_OK, _parser, main
+from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED, EXIT_OK, build_parser, main
 from unibuckle_fenicsx.model.materials import navier_load_mindlin
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
@@ -85,7 +85,7 @@ def test_help(tmp_path):
     for status in (EXIT_OK, EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED):
         assert f"\n  {status}  " in sub.stdout
     # Every flag is explained: each option of the sub-command carries a help text.
-    solve_parser = _parser()[1]["solve"]
+    solve_parser = build_parser()[1]["solve"]
     for action in solve_parser._actions:
         assert action.help, action.option_strings
 
@@ -190,7 +190,7 @@ def test_negative_numbers_in_exponent_form_are_values(value, capsys):
 
     argparse took ``-1e-3`` for an option ("expected one argument"); ``-0.001`` worked.
     """
-    parser, _ = _parser()
+    parser, _ = build_parser()
     args, rest = parser.parse_known_args(["nonlinear", "--case", "c1", "--imperfection", value])
     assert args.imperfection == float(value) and rest == []
     assert main(["nonlinear", "--case", "c1", "--imperfection", value]) == EXIT_BAD_INPUT
@@ -203,14 +203,14 @@ def test_negative_numbers_in_exponent_form_are_values(value, capsys):
 
 def test_set_changes_the_value_at_its_dotted_path():
     """--set PATH=VALUE changes that value of the problem, read as the kind found there."""
-    from unibuckle_fenicsx.cli import _spec_from_args
+    from unibuckle_fenicsx.cli.problem import spec_from_args
     from unibuckle_fenicsx.spec.cases import paper_case
 
-    parser, _ = _parser()
+    parser, _ = build_parser()
     args = parser.parse_args(
         ["solve", "--case", "c1", "--set", "solver.tau=1e-9", "--set", "solver.method=penalty"]
     )
-    spec = _spec_from_args(args)
+    spec = spec_from_args(args)
     assert spec.solver.tau == 1e-9 and spec.solver.method == "penalty"
     assert paper_case("c1").solver.tau != 1e-9  # the value was changed, not already there
     assert spec.plate == paper_case("c1").plate  # and nothing else
@@ -238,14 +238,14 @@ def test_nonlinear_flag_defaults_are_the_options_defaults():
     """
     import dataclasses
 
-    from unibuckle_fenicsx.cli import _NONLINEAR_DEFAULTS
+    from unibuckle_fenicsx.cli.flags import NONLINEAR_DEFAULTS
     from unibuckle_fenicsx.nonlinear import CONTROLS, SHAPES, NonlinearOptions
 
     fields = {f.name: f.default for f in dataclasses.fields(NonlinearOptions)}
-    assert _NONLINEAR_DEFAULTS == {k: fields[k] for k in _NONLINEAR_DEFAULTS}
-    parser, _ = _parser()
+    assert NONLINEAR_DEFAULTS == {k: fields[k] for k in NONLINEAR_DEFAULTS}
+    parser, _ = build_parser()
     args = parser.parse_args(["nonlinear", "--case", "c1"])
-    assert {k: getattr(args, k) for k in _NONLINEAR_DEFAULTS} == _NONLINEAR_DEFAULTS
+    assert {k: getattr(args, k) for k in NONLINEAR_DEFAULTS} == NONLINEAR_DEFAULTS
     choices = {
         a.dest: tuple(a.choices)
         for sub in parser._subparsers._group_actions[0].choices.values()
@@ -421,7 +421,7 @@ def test_nonlinear_help_names_only_its_own_flags(capsys):
 
     An unknown flag is reported with the nonlinear usage line, not the top-level one.
     """
-    nonlinear = _parser()[1]["nonlinear"]
+    nonlinear = build_parser()[1]["nonlinear"]
     assert "--output" not in nonlinear.format_help()
     with pytest.raises(SystemExit) as exit_:
         main(["nonlinear", "--case", "c1", "--output", "x"])

@@ -31,7 +31,7 @@ from conftest import run_mpi
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
 
-CLI = Path(__file__).resolve().parents[1] / "unibuckle_fenicsx" / "cli.py"
+CLI = Path(__file__).resolve().parents[1] / "unibuckle_fenicsx" / "cli" / "__main__.py"
 GAP = 0.003  # m: half the paper plate's thickness
 DATA = {"mesh": {"nx": 8, "ny": 8}, "obstacle": {"zone": "all", "gap": GAP}}
 

@@ -1,0 +1,68 @@
+"""``unibuckle nonlinear``: the load path of the imperfect plate against the obstacle."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from pathlib import Path
+from typing import Any
+
+from unibuckle_fenicsx.cli.flags import NONLINEAR_FLAGS
+from unibuckle_fenicsx.cli.problem import spec_from_args, warn_plate_model
+from unibuckle_fenicsx.cli.status import report_failure
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.outcome import Outcome
+
+
+def nonlinear_command(args: argparse.Namespace, comm: Any) -> int:
+    """``unibuckle nonlinear``: the load path, the Southwell and inflection loads."""
+    import json
+
+    from unibuckle_fenicsx.nonlinear import NonlinearOptions, solve_nonlinear
+
+    try:
+        options = NonlinearOptions(
+            imperfection=args.imperfection,
+            shape=args.shape,
+            control=args.control,
+            obstacle=not args.no_obstacle,
+            max_load=args.max_load,
+            max_step=args.max_step,
+            min_step=min(1e-5, args.max_step),
+        )
+    except InputError as err:
+        message = str(err)
+        for name in NONLINEAR_FLAGS:  # name the flag, not the option
+            if message.startswith(name):
+                message = "--" + name.replace("_", "-") + message[len(name) :]
+        raise InputError(message) from None
+    spec = spec_from_args(args)
+    if args.shape == "unilateral" and (args.no_obstacle or not spec.all_obstacles):
+        why = "--no-obstacle removes it" if args.no_obstacle else "the problem has none"
+        raise InputError(
+            f"--shape unilateral takes the imperfection from the unilateral mode, which needs "
+            f"an obstacle, and {why}: give --shape free (or auto)"
+        )
+    warn_plate_model(spec, comm)
+    # A refused input or a failed solve raises: main() tells the outcome.
+    analysis = solve_nonlinear(spec, options, comm)
+    with analysis:
+        result = analysis.result
+    unwritten = None
+    if comm.rank == 0:
+        if args.json:
+            try:
+                Path(args.json).write_text(json.dumps(result.as_dict(), indent=2) + "\n")
+            except OSError as err:
+                unwritten = f"could not write --json {args.json}: {err}"
+        print(result.summary(), flush=True)
+        if not result.certified:
+            print(
+                f"unibuckle: error: {result.shortfall()}"
+                + (f"; the path obtained is in {args.json}" if args.json and not unwritten else ""),
+                file=sys.stderr,
+            )
+    unwritten = comm.bcast(unwritten, root=0)
+    if unwritten is not None:
+        return report_failure(comm, f"{unwritten}; the result is the summary above")
+    return Outcome.of(result).exit_status

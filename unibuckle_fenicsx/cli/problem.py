@@ -1,0 +1,68 @@
+"""The problem a run solves: ``--case`` or ``--config``, ``--nx``/``--ny`` and ``--set``."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from collections.abc import Sequence
+from typing import TYPE_CHECKING, Any
+
+from unibuckle_fenicsx.errors import InputError
+
+if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.spec import ProblemSpec
+
+
+def warn_plate_model(spec: ProblemSpec, comm: Any) -> None:
+    """A warning on stderr when the plate lies outside the plate model's usual range."""
+    from unibuckle_fenicsx.spec.checks import plate_model_note
+
+    note = plate_model_note(spec.plate)
+    if note is not None and comm.rank == 0:
+        print(f"unibuckle: warning: {note}", file=sys.stderr)
+
+
+def spec_from_args(args: argparse.Namespace) -> ProblemSpec:
+    """The problem of --case or --config, with --nx/--ny applied."""
+    from unibuckle_fenicsx.spec import load_problem
+    from unibuckle_fenicsx.spec.cases import paper_case
+
+    spec = paper_case(args.case) if args.case else load_config(args.config, load_problem)
+    if args.settings:
+        spec = _with_settings(spec, args.settings)
+    if args.nx is not None or args.ny is not None:
+        spec = spec.with_mesh(
+            spec.mesh.nx if args.nx is None else args.nx,
+            spec.mesh.ny if args.ny is None else args.ny,
+        )
+    return spec
+
+
+def _with_settings(spec: ProblemSpec, settings: Sequence[str]) -> ProblemSpec:
+    """``spec`` with the ``--set PATH=VALUE`` changes (dotted paths of the problem file).
+
+    Raises:
+        ValueError: A setting without '=', a path the problem file does not have, or a
+            value the schema refuses (the message names the path).
+    """
+    from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
+    from unibuckle_fenicsx.sweep import set_text
+
+    data = problem_to_dict(spec, units=spec.units)
+    for setting in settings:
+        path, sep, text = setting.partition("=")
+        if not sep or not path.strip():
+            raise InputError(f"--set {setting!r}: give PATH=VALUE, e.g. solver.tau=1e-9")
+        set_text(data, path.strip(), text.strip())
+    try:
+        return problem_from_dict(data, name=spec.name)
+    except ValueError as err:
+        raise InputError(f"--set {' '.join(settings)}: {err}") from None
+
+
+def load_config(path: str, load: Any) -> Any:
+    """``load(path)``, an unreadable file named with its option (ValueError)."""
+    try:
+        return load(path)
+    except OSError as err:
+        raise InputError(f"--config {path}: cannot read it ({err.strerror or err})") from None

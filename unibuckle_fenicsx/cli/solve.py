@@ -1,0 +1,78 @@
+"""``unibuckle solve``: one problem, its summary, JSON and fields."""
+
+from __future__ import annotations
+
+import argparse
+import sys
+from typing import Any
+
+from unibuckle_fenicsx.cli.flags import solver_changes, unused_flags
+from unibuckle_fenicsx.cli.problem import spec_from_args, warn_plate_model
+from unibuckle_fenicsx.cli.status import report_failure
+from unibuckle_fenicsx.outcome import Outcome
+
+
+def solve_command(args: argparse.Namespace, comm: Any) -> int:
+    """``unibuckle solve``: one problem, its summary, JSON and fields."""
+    from unibuckle_fenicsx.analysis import solve
+    from unibuckle_fenicsx.results.files import write_fields, write_json
+
+    # A refused input or a failed solve raises: main() tells the outcome.
+    spec = spec_from_args(args)
+    changes, flags = solver_changes(args)
+    spec = spec.with_solver(**changes)
+    method = spec.solver.method  # the flag's, or the problem file's
+    _warn_unused(flags, method, comm)
+    warn_plate_model(spec, comm)
+    analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
+    unwritten = None
+    with analysis:
+        if args.output:
+            try:
+                write_fields(analysis, args.output)
+            except OSError as err:  # the folder went away during the solve
+                unwritten = f"--output {args.output}: {err}"
+    result = analysis.result
+    _warn_unused(flags, method, comm, result)
+    outcome = Outcome.of(result)
+    certificate = result.certificate
+    if comm.rank == 0:
+        if args.json:
+            try:
+                write_json(result, args.json)
+            except OSError as err:
+                unwritten = f"--json {args.json}: {err}"
+        print(result.summary(), flush=True)
+        if outcome is not Outcome.OK:
+            notes = "; ".join([] if certificate is None else certificate.notes)
+            notes = notes or "see the certificate"
+            print(
+                f"unibuckle: error: no certified critical state ({notes}); the bracket "
+                f"[{result.lower_bound_Pa}, {result.upper_bound_Pa}] Pa is "
+                + (f"in {args.json}" if args.json and unwritten is None else "above"),
+                file=sys.stderr,
+            )
+    unwritten = comm.bcast(unwritten, root=0)
+    if unwritten is not None:
+        return report_failure(comm, f"could not write {unwritten}; the result is the summary above")
+    return outcome.exit_status
+
+
+def _warn_unused(flags: list[str], method: str, comm: Any, result: Any = None) -> None:
+    """Warn of the flags that do not apply to ``method`` (rank 0).
+
+    Before the solve (``result`` None): those that cannot apply; after it, under auto,
+    the enumeration's flags that auto's choice (``result.method``) left unused.
+    """
+    if comm.rank != 0 or (result is not None and method != "auto"):
+        return
+    if result is None:
+        for flag in unused_flags(flags, method):
+            print(f"unibuckle: warning: {flag} is ignored with --method {method}", file=sys.stderr)
+        return
+    for flag in unused_flags(flags, "auto", result.method):
+        print(
+            f"unibuckle: warning: {flag} was not used: auto chose {result.method} "
+            f"({result.method_chosen_by.removeprefix('auto: ')})",
+            file=sys.stderr,
+        )

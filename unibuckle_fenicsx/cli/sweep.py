@@ -1,0 +1,79 @@
+"""``unibuckle sweep``: a problem over a grid of values (one JSON line per point)."""
+
+from __future__ import annotations
+
+import argparse
+import logging
+from typing import Any
+
+from unibuckle_fenicsx.cli.problem import load_config
+from unibuckle_fenicsx.cli.status import report_failure
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.outcome import Outcome
+
+
+def _check_chart(base: Any) -> None:
+    """Refuse --plot for a sweep whose scaled load has no edge stress (before any solve).
+
+    The chart draws k = t lambda b^2/(pi^2 D), a buckling coefficient of edge loads; for a
+    temperature rise alone lambda is a factor on the rise and k means nothing.
+    """
+    from unibuckle_fenicsx.spec import problem_from_dict
+
+    if not problem_from_dict(base).plate.loaded:
+        raise InputError(
+            "--plot draws the buckling coefficient k of edge loads; this problem's scaled "
+            "load is a temperature rise alone (lambda is a factor on it, k is not defined): "
+            "leave --plot out, or load an edge"
+        )
+
+
+def sweep_command(args: argparse.Namespace, comm: Any) -> int:
+    """``unibuckle sweep``: the grid, the JSON lines, the chart."""
+    from unibuckle_fenicsx.sweep import base_mapping, parse_variation, run_sweep
+
+    def fail(message: str) -> int:
+        return report_failure(comm, message)
+
+    if args.plot and comm.rank == 0:
+        try:
+            import matplotlib as mpl  # noqa: F401
+        except ImportError:
+            return fail("--plot needs matplotlib: pip install 'unibuckle_fenicsx[demo]'")
+    # Each point's own progress lines and warnings would interleave with the sweep's
+    # (the warnings are in the point's JSON line, under details).
+    if args.verbose == 0:
+        logging.getLogger("unibuckle_fenicsx").setLevel(logging.ERROR)
+        logging.getLogger("unibuckle_fenicsx.progress").setLevel(logging.ERROR)
+        sweep_lines = logging.getLogger("unibuckle_fenicsx.progress.sweep")
+        sweep_lines.setLevel(logging.ERROR if args.quiet or comm.rank else logging.INFO)
+    try:
+        variations = [parse_variation(v) for v in args.vary]
+        base = load_config(args.config, base_mapping)
+        if args.plot:
+            _check_chart(base)
+        lines = run_sweep(
+            base,
+            variations,
+            args.json,
+            comm,
+            ranks_per_point=args.ranks_per_point,
+            progress=not args.quiet,
+        )
+    except OSError as err:  # a refused input or a failed point raises: main() tells
+        return fail(str(err))
+    if comm.rank == 0:
+        from collections import Counter
+
+        counts = Counter(line["status"] for line in lines)
+        print(
+            f"sweep: {len(lines)} points in {args.json}: "
+            + ", ".join(f"{n} {status}" for status, n in sorted(counts.items())),
+            flush=True,
+        )
+        if args.plot:
+            from unibuckle_fenicsx.viz.charts import plot_sweep
+
+            print(f"sweep: chart {plot_sweep(lines, variations, base, args.plot)}")
+    ok = all(line["status"] == Outcome.OK for line in lines)
+    return (Outcome.OK if ok else Outcome.NOT_CERTIFIED).exit_status
