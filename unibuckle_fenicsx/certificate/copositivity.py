@@ -460,19 +460,30 @@ def _split(
     options: SplitOptions,
     notes: list[str],
 ) -> Any:
-    """The split route, unless its estimated cost exceeds ``options.max_cost`` (then None)."""
-    from unibuckle_fenicsx.certificate.copositivity_split import estimate_cost, split_certificate
+    """The split route, unless its estimated cost exceeds ``options.max_cost``.
+
+    Then its outcome says so (``skipped``, the estimate and why), with no attempt.
+    """
+    from unibuckle_fenicsx.certificate.copositivity_split import (
+        SplitOutcome,
+        column_sources,
+        estimate_cost,
+        split_certificate,
+    )
 
     m = matrix.inertia()[0]
-    cost = estimate_cost(problem, candidate, others, m, options)
+    sources = column_sources(problem, candidate, others, options)
+    cost = estimate_cost(problem, sources, m, options)
     if options.max_cost is not None and cost > options.max_cost:
-        notes.append(
-            f"{m} pencil eigenvalues lie below the load: the split bracket's estimated cost "
-            f"({cost:.1f} free solves) exceeds {options.max_cost:g}, so it runs on request "
-            "only (solver.bracket = true, --bracket)"
+        why = (
+            f"the split bracket's estimated cost ({cost:.1f} free solves) exceeds "
+            f"{options.max_cost:g}: it runs on request only (solver.bracket = true, --bracket)"
         )
-        return None
-    outcome = split_certificate(problem, matrix, candidate, others, options)
+        notes.append(f"{m} pencil eigenvalues lie below the load: {why}")
+        skipped = SplitOutcome(m=m, why=why, estimated_cost=cost)
+        skipped.skipped = True
+        return skipped
+    outcome = split_certificate(problem, matrix, candidate, others, options, sources)
     outcome.estimated_cost = cost
     if outcome.value is None:
         notes.append(

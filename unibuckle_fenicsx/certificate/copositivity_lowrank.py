@@ -882,13 +882,15 @@ def search_deltas(
     fallback: tuple[float, ...],
     attempt: Callable[[float], dict[str, Any]],
     stop: Callable[[], bool] | None = None,
+    proceed: Callable[[dict[str, Any]], bool] | None = None,
 ) -> None:
     """Relative distances below ``load`` tried in order while verified (both bracket routes).
 
-    After a success the next (smaller) delta is tried; after a failure the search stops
-    if something is verified, else goes on with ``fallback`` (larger deltas). A refuting
-    mode (``out.refuting``) ends it. Fills ``out``'s value, delta, pieces, margin, r, why
-    and attempts from the records ``attempt(delta)`` returns.
+    After a success the next (smaller) delta is tried (if ``proceed(record)`` says so);
+    after a failure the search stops if something is verified, else goes on with
+    ``fallback`` (larger deltas). A refuting mode (``out.refuting``) ends it. Fills
+    ``out``'s value, delta, pieces, margin, r, why and attempts from the records
+    ``attempt(delta)`` returns.
     """
     queue, rest = list(deltas), list(fallback)
     while queue and not (stop is not None and stop()):
@@ -902,6 +904,8 @@ def search_deltas(
             out.value, out.delta = load * (1.0 - delta), delta
             out.pieces, out.margin, out.r = record["pieces"], record["margin"], record["r"]
             rest = []
+            if proceed is not None and not proceed(record):
+                break
         elif out.value is not None:
             break  # the previous (larger) delta stands
         else:

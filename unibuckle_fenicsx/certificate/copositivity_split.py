@@ -74,7 +74,7 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 from mpi4py import MPI
@@ -97,7 +97,8 @@ from unibuckle_fenicsx.certificate.copositivity_lowrank import (
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, mirror_maps, rayleigh
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 
-__all__ = ["SplitOptions", "SplitOutcome", "estimate_cost", "split_certificate"]
+__all__ = ["Sources", "SplitOptions", "SplitOutcome", "column_sources", "estimate_cost",
+           "split_certificate"]  # fmt: skip
 
 Array = npt.NDArray[np.float64]
 
@@ -110,6 +111,13 @@ class SplitOptions:
         deltas: Relative distances below the load tried in this order while they are
             verified (one factorisation each); the gap reported is the last verified.
         fallback: Tried in this order when the first of ``deltas`` fails.
+        next_margin: After a verified delta the next one is tried only if every piece's
+            verified margin (eigenvalue over error bound) was at least this: the margins
+            shrink about as delta does, so a smaller one would fail on rounding (None:
+            always try it).
+        max_rounding: An attempt stops after this many pieces failed on rounding only
+            (verified margin between 0 and 1: the bound on G's error, not the form, is
+            what fails; a smaller piece does not help).
         max_columns: Columns (without the m negative-space vectors) at most: each costs
             two right-hand sides of a batched solve per delta.
         max_rounds: Rounds of new columns (cuts and translates) per delta.
@@ -138,8 +146,10 @@ class SplitOptions:
             every translation from the start (the lines do not describe them).
     """
 
-    deltas: tuple[float, ...] = (1e-4,)
-    fallback: tuple[float, ...] = (1e-3, 1e-2)
+    deltas: tuple[float, ...] = (1e-3, 1e-4)
+    fallback: tuple[float, ...] = (1e-2,)
+    next_margin: float | None = 20.0
+    max_rounding: int = 24
     max_columns: int = 360
     max_rounds: int = 8
     per_round: int = 12
@@ -158,8 +168,8 @@ class SplitOptions:
     @classmethod
     def thorough(cls) -> SplitOptions:
         """On request (``solver.bracket``): down to 1e-6, larger budgets, no cost limit."""
-        return cls(deltas=(1e-4, 1e-5, 1e-6), fallback=(1e-3, 1e-2), max_columns=480,
-                   max_rounds=16, max_pieces=4000, max_cost=None)  # fmt: skip
+        return cls(deltas=(1e-3, 1e-4, 1e-5, 1e-6), fallback=(1e-2,), next_margin=None,
+                   max_columns=480, max_rounds=16, max_pieces=1000, max_cost=None)  # fmt: skip
 
 
 @dataclass
@@ -168,15 +178,17 @@ class SplitOutcome(LowRankOutcome):
 
     The low-rank route's record (value, delta, m, columns r, pieces, margin, attempts,
     why, refuting mode, right-hand sides solved), plus the estimated cost
-    (:func:`estimate_cost`, when the caller computed it).
+    (:func:`estimate_cost`, when the caller computed it) and whether the route was
+    skipped for it (``skipped``: not run by default).
     """
 
     estimated_cost: float | None = None
+    skipped: bool = False
 
     def record(self) -> dict[str, Any]:
         """JSON-ready summary (without the refuting mode's vector)."""
         out = super().record()
-        out.update(solves=self.solves, estimated_cost=self.estimated_cost)
+        out.update(solves=self.solves, estimated_cost=self.estimated_cost, skipped=self.skipped)
         return out
 
 
@@ -203,6 +215,7 @@ class _Basis:
         self.dnorm = np.zeros(0)
         self.G = np.zeros((0, 0))
         self.E = np.zeros((0, 0))
+        self._abs: Array | None = None
         self.names: list[str] = []
         self.values: list[Array] = []
 
@@ -210,6 +223,13 @@ class _Basis:
     def X(self) -> Array:
         """The solves K^-1 [W, M] (owned rows)."""
         return self._store["X"][:, : self.q]
+
+    @property
+    def absG(self) -> Array:
+        """|G| (kept until the columns change)."""
+        if self._abs is None or self._abs.shape != self.G.shape:
+            self._abs = np.abs(self.G)
+        return self._abs
 
     @property
     def r(self) -> int:
@@ -326,8 +346,8 @@ def _negative_space(
     Block inverse iteration :math:`V \leftarrow K^{-1}BV` with the factorised K (block
     m + 3, from the free mode, ``start`` and seeded random vectors), orthonormalised by
     Cholesky QR, then Rayleigh-Ritz on (A, B) (A-orthonormal Ritz vectors); more
-    iterations (up to three times ``iterations``) while fewer than m Ritz values lie below
-    ``lam``. None if they never do.
+    iterations (up to three times ``iterations``; checked after the first when ``start``
+    is given) while fewer than m Ritz values lie below ``lam``. None if they never do.
     Heuristic only: the certificate checks whatever W it gets.
     """
     comm = problem.comm
@@ -352,9 +372,10 @@ def _negative_space(
         return V
 
     V = orthonormal(V)
+    checked = 1 if start is not None else iterations  # a previous block is nearly there
     for it in range(3 * iterations):
         V = orthonormal(matrix.solve_block(_block_product(B, V)))
-        if it + 1 < iterations:
+        if it + 1 < checked:
             continue
         AV, BV = _block_product(A, V), _block_product(B, V)
         Am = np.asarray(comm.allreduce(V.T @ AV, op=MPI.SUM))
@@ -527,13 +548,13 @@ def _dual(H: Array, c: Array, iterations: int, start: list[int] | None = None) -
     mu = np.zeros(r)
     scale = max(float(np.abs(c).max(initial=0.0)), 1e-300)
 
+    ridge = 1e-14 * float(np.abs(np.diag(H)).max(initial=0.0))
+
     def solve(idx: npt.NDArray[np.int64]) -> Array:
-        sub = H[np.ix_(idx, idx)]
+        sub = H[idx[:, None], idx]
+        sub.flat[:: len(idx) + 1] += ridge
         try:
-            return np.asarray(
-                np.linalg.solve(sub + 1e-14 * np.trace(sub) * np.eye(len(idx)), c[idx]),
-                dtype=np.float64,
-            )
+            return np.asarray(np.linalg.solve(sub, c[idx]), dtype=np.float64)
         except np.linalg.LinAlgError:
             return np.asarray(np.linalg.lstsq(sub, c[idx], rcond=None)[0], dtype=np.float64)
 
@@ -580,6 +601,8 @@ class _Relaxation:
     G_MW: Array
     H: Array
     metric: Array  # -S_W: the z-space's angles
+    cache: dict[bytes, tuple[float, Array, float]] = field(default_factory=dict)
+    used: set[int] = field(default_factory=set)  # columns in some mu met
 
     @classmethod
     def of(cls, basis: _Basis) -> _Relaxation:
@@ -598,13 +621,28 @@ class _Relaxation:
 
         ``near``: the mu of a nearby direction (its support starts the active set).
         """
-        c = self.G_MW @ (self.S_W @ z)
-        start = None if near is None else [int(a) for a in np.flatnonzero(near > 0)]
-        mu = _dual(self.H, c, iterations, start) if len(c) else np.zeros(0)
-        num, den = float(mu @ c), float(mu @ self.H @ mu)
-        t = num / den if num > 0 and den > 0 else 0.0
         norm = float(z @ self.metric @ z)
-        return (float(z @ self.S_W @ z) + t * num) / norm, mu, t
+        key = np.round(z / math.sqrt(norm), 12).tobytes()  # a generator shared by pieces
+        if key in self.cache:
+            return self.cache[key]
+        c = self.G_MW @ (self.S_W @ z)
+        best: tuple[float, Array, float] | None = None
+        # A nearby direction's active set first (a few steps); from scratch if that
+        # leaves the bound at or below zero (the start may hold it at a poor point).
+        starts = [None] if near is None else [[int(a) for a in np.flatnonzero(near > 0)], None]
+        for start in starts:
+            mu = _dual(self.H, c, iterations, start) if len(c) else np.zeros(0)
+            num, den = float(mu @ c), float(mu @ self.H @ mu)
+            t = num / den if num > 0 and den > 0 else 0.0
+            value = (float(z @ self.S_W @ z) + t * num) / norm
+            if best is None or value > best[0]:
+                best = (value, mu, t)
+            if best[0] > 0:
+                break
+        assert best is not None
+        self.cache[key] = best
+        self.used.update(int(j) for j in np.flatnonzero(best[1] > 0))
+        return best
 
 
 # -- one piece ------------------------------------------------------------------------------
@@ -617,13 +655,18 @@ def _combined(basis: _Basis, mus: list[Array], factor: float) -> tuple[Array, Ar
     """
     m = basis.m
     k = len(mus)
-    C = np.zeros((m + basis.r, m + k))
-    C[:m, :m] = np.eye(m)
-    C[m:, m:] = np.column_stack(mus)
-    G1 = C.T @ basis.G @ C
+    Mu = np.column_stack(mus)
+    G, E, absG = basis.G, basis.E, basis.absG
+    G1, E1 = np.empty((m + k, m + k)), np.empty((m + k, m + k))
+    # C = [[I, 0], [0, Mu]] >= 0, by blocks: |C'(G + dG)C - fl(C'GC)| <= C'|dG|C plus the
+    # rounding of the products (at most m + r terms each).
+    for out, mat in ((G1, G), (E1, E + gamma(2 * (m + basis.r) + 2) * absG)):
+        out[:m, :m] = mat[:m, :m]
+        out[:m, m:] = mat[:m, m:] @ Mu
+        out[m:, :m] = out[:m, m:].T
+        out[m:, m:] = Mu.T @ mat[m:, m:] @ Mu
     G1 = 0.5 * (G1 + G1.T)
-    size = 2 * (m + basis.r) + 4
-    E1 = (C.T @ basis.E @ C + gamma(size) * (C.T @ np.abs(basis.G) @ C)) * (1 + gamma(size))
+    E1 *= 1 + gamma(2 * (m + basis.r) + 4)
     dg = 1.0 / _pow2(np.sqrt(np.maximum(np.abs(np.diag(G1)), np.diag(E1))))
     G1s, E1s = G1 * dg[:, None] * dg[None, :], E1 * dg[:, None] * dg[None, :]
     neg, _, gmargin = _inertia(G1s, E1s, factor)
@@ -786,20 +829,31 @@ COST_MODEL = {"factorisation": 0.3, "rhs_per_solve": 500.0, "pieces": 40.0,
               "piece": 0.02, "reference_dofs": 8463.0, "exponent": 1.3}  # fmt: skip
 
 
-def estimate_cost(
-    problem: BucklingProblem,
-    candidate: Candidate,
-    others: list[Candidate],
-    m: int,
-    opts: SplitOptions,
-) -> float:
+@dataclass
+class Sources:
+    """The zone's patterns and the columns they give for one KKT point (see :func:`_sources`)."""
+
+    patterns: _Patterns
+    first: list[tuple[str, Array]]
+    movable: list[tuple[str, Array]]
+
+
+def column_sources(
+    problem: BucklingProblem, candidate: Candidate, others: list[Candidate], opts: SplitOptions
+) -> Sources:
+    """The first columns and the patterns translated on demand (no solve)."""
+    patterns = _Patterns(problem)
+    first, movable = _sources(patterns, candidate, others, opts)
+    return Sources(patterns, first, movable)
+
+
+def estimate_cost(problem: BucklingProblem, sources: Sources, m: int, opts: SplitOptions) -> float:
     """The split route's expected time in free eigen solves, from counts only (no clock).
 
     One attempt: a factorisation, the right-hand sides (the negative space's block
     iterations, then two per column) and the pieces, by :data:`COST_MODEL`.
     """
-    first, _ = _sources(_Patterns(problem), candidate, others, opts)
-    columns = min(len(first), opts.max_columns)
+    columns = min(len(sources.first), opts.max_columns)
     rhs = (m + 3) * (opts.mode_iterations + 1) + 2 * (m + columns)
     n = float(problem.model.A.getSize()[0])
     model = COST_MODEL
@@ -814,6 +868,7 @@ def split_certificate(
     candidate: Candidate,
     others: list[Candidate],
     opts: SplitOptions | None = None,
+    sources: Sources | None = None,
 ) -> SplitOutcome:
     r"""A verified lower bound just below ``candidate``'s load, or a refuting mode.
 
@@ -828,6 +883,7 @@ def split_certificate(
         candidate: The KKT point whose load is bracketed.
         others: Further KKT points met (their reactions become columns).
         opts: Distances and budgets (default :class:`SplitOptions`).
+        sources: :func:`column_sources` for this point, if the caller has them.
 
     Note:
         Collective.
@@ -835,14 +891,18 @@ def split_certificate(
     opts = opts or SplitOptions()
     out = SplitOutcome()
     solves0 = matrix.solves
-    patterns = _Patterns(problem)
-    first, movable = _sources(patterns, candidate, others, opts)
-    state: dict[str, Any] = {"columns": first, "movable": movable, "start": None}
+    if sources is None:
+        sources = column_sources(problem, candidate, others, opts)
+    patterns = sources.patterns
+    state: dict[str, Any] = {"columns": sources.first, "movable": sources.movable, "start": None}
 
     def attempt(delta: float) -> dict[str, Any]:
         return _attempt(problem, matrix, candidate, delta, patterns, state, opts, out)
 
-    search_deltas(out, candidate.load, opts.deltas, opts.fallback, attempt)
+    def proceed(record: dict[str, Any]) -> bool:
+        return opts.next_margin is None or float(record["margin"]) >= opts.next_margin
+
+    search_deltas(out, candidate.load, opts.deltas, opts.fallback, attempt, proceed=proceed)
     out.solves = matrix.solves - solves0
     return out
 
@@ -881,7 +941,7 @@ def _normalised(items: list[tuple[str, Array]], have: list[Array]) -> list[tuple
     return out
 
 
-def _attempt(  # noqa: C901 - negative space, columns, pieces and new columns of one delta (module docstring)
+def _attempt(
     problem: BucklingProblem,
     matrix: ShiftedMatrix,
     candidate: Candidate,
@@ -921,72 +981,37 @@ def _attempt(  # noqa: C901 - negative space, columns, pieces and new columns of
         return attempt
     basis.add(_scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
     relax = _Relaxation.of(basis)
-    iterations = 4 * neg + 40
     # (generators, times bisected)
-    pieces: list[tuple[Array, int, Array | None]] = [
-        (np.diag(np.array(s)), 0, None) for s in itertools.product((1.0, -1.0), repeat=neg)
+    # (generators, times bisected, the combinations its parent tried)
+    pieces: list[tuple[Array, int, list[Array]]] = [
+        (np.diag(np.array(s)), 0, []) for s in itertools.product((1.0, -1.0), repeat=neg)
     ]
-    proven_pieces, examined, rounds = 0, 0, 0
+    proven_pieces, examined, rounds, rounding = 0, 0, 0, 0
     margin = math.inf
     why = ""
     while pieces:
         if examined >= opts.max_pieces:
             why = f"the z-space is not covered within {opts.max_pieces} pieces"
             break
-        V, level, near = pieces.pop()
+        V, level, inherited = pieces.pop()
         examined += 1
-        z = _centre(V, relax.metric)
-        b, mu, t = relax.bound(z, iterations, near)
-        uncovered: tuple[Array, Array, float] | None = None
-        if b <= 0:
-            uncovered = (z, mu, t)
-        else:
-            # One column M mu whose cap holds every generator (mu of the centre, then of
-            # the generators that fall outside); then the combinations together.
-            mus = [mu / mu.max()] if mu.max(initial=0.0) > 0 else []
-            done = False
-            tried = 0
-            while tried < len(mus) and tried < opts.max_combinations:
-                ok, piece_margin, outside = _in_cap(basis, V, mus[tried], opts.margin_factor)
-                tried += 1
-                if ok:
-                    done = True
-                    margin = min(margin, piece_margin)
-                    break
-                if outside is None:
-                    continue
-                bw, muw, tw = relax.bound(V[:, outside], iterations, mu)
-                if bw <= 0:
-                    uncovered = (V[:, outside], muw, tw)
-                    break
-                if muw.max(initial=0.0) > 0:
-                    muw = muw / muw.max()
-                    if not any(float(np.abs(muw - q).max()) <= 1e-6 for q in mus):
-                        mus.append(muw)
-            if not done and uncovered is None and len(mus) >= 2:
-                ok, piece_margin, _ = _piece_check(
-                    basis, V, mus[: opts.max_combinations], opts.margin_factor, False
-                )
-                if ok:
-                    done = True
-                    margin = min(margin, piece_margin)
-            if not done and uncovered is None and mus and level >= opts.sdp_depth:
-                # The columns of every combination met, each on its own (the relaxation
-                # with all of them is at least as strong as any combination), and the SDP.
-                weight = np.max(np.column_stack(mus), axis=1)
-                support = np.argsort(-weight)[: opts.max_individual]
-                support = support[weight[support] > 1e-3]
-                units = [np.eye(1, basis.r, int(j))[0] for j in support]
-                ok, piece_margin, _ = _piece_check(basis, V, units, opts.margin_factor, True)
-                if ok:
-                    done = True
-                    margin = min(margin, piece_margin)
-            if done:
-                proven_pieces += 1
-                continue
-        if uncovered is None:
-            pieces += [(half, level + 1, mu) for half in _bisect(V, relax.metric)]
+        proof = _prove_piece(basis, relax, V, level, inherited, opts)
+        if proof.margin is not None:
+            proven_pieces += 1
+            margin = min(margin, proof.margin)
             continue
+        uncovered = proof.uncovered
+        rounding += proof.rounding
+        if rounding >= opts.max_rounding:
+            why = (
+                f"rounding: {rounding} pieces failed on the error bound of G alone (their "
+                "margins shrink with delta)"
+            )
+            break
+        if uncovered is None:
+            pieces += [(half, level + 1, proof.tried) for half in _bisect(V, relax.metric)]
+            continue
+        b = uncovered[3]
         # The relaxation itself fails at a direction: refute, or new columns there.
         if rounds >= opts.max_rounds or basis.room == 0:
             why = (
@@ -994,7 +1019,7 @@ def _attempt(  # noqa: C901 - negative space, columns, pieces and new columns of
                 f"(dual bound {min(b, 0.0):.3g}; {rounds} rounds, {basis.r} columns)"
             )
             break
-        found = _new_columns(problem, basis, relax, patterns, state, candidate, uncovered, opts)
+        found = _new_columns(problem, basis, relax, patterns, state, candidate, uncovered[:3], opts)
         if out.refuting is None and found.get("refuting") is not None:
             out.refuting = found["refuting"]
         if out.refuting is not None:
@@ -1009,13 +1034,97 @@ def _attempt(  # noqa: C901 - negative space, columns, pieces and new columns of
             break
         basis.add(_scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
         state["columns"] = list(state["columns"]) + items
+        used = relax.used
         relax = _Relaxation.of(basis)
+        relax.used |= used
         rounds += 1
-        pieces.append((V, level, None))
+        pieces.append((V, level, []))
     proven = not pieces and not why
+    if proven:
+        # The next (smaller) distance starts from the columns the duals used here and
+        # their neighbours along the plate: the others answered no direction.
+        kept = [(basis.names[basis.m + j], basis.values[j]) for j in sorted(relax.used)]
+        near = [(f"{name}{sign:+d}", patterns.translate(values, sign))
+                for name, values in kept for sign in (-1, 1)]  # fmt: skip
+        state["columns"] = kept + near
     attempt.update(proven=proven, r=basis.r, pieces=proven_pieces, examined=examined,
                    rounds=rounds, why=why, margin=margin if proven else -math.inf)  # fmt: skip
     return attempt
+
+
+@dataclass
+class _Proof:
+    """A piece's outcome.
+
+    Proven (its margin), or a direction that the columns do not cover (z, mu, t, bound),
+    or neither (split it); ``tried``: the combinations met.
+    """
+
+    margin: float | None = None
+    uncovered: tuple[Array, Array, float, float] | None = None
+    tried: list[Array] = field(default_factory=list)
+    rounding: bool = False  # a check failed on its error bound only
+
+
+def _prove_piece(
+    basis: _Basis,
+    relax: _Relaxation,
+    V: Array,
+    level: int,
+    inherited: list[Array],
+    opts: SplitOptions,
+) -> _Proof:
+    """One column M mu whose cap holds every generator, else the combinations together.
+
+    First the combinations the parent piece met (a half often lies in one of their caps:
+    no dual to solve); then mu of the centre, then of the generators that fall outside;
+    then the combinations together (Z-matrix N), and on small pieces their columns one by
+    one with the SPN program.
+    """
+    iterations = 4 * basis.m + 40
+    for mu in inherited[:2]:
+        ok, piece_margin, _ = _in_cap(basis, V, mu, opts.margin_factor)
+        if ok:
+            return _Proof(margin=piece_margin, tried=inherited)
+    z = _centre(V, relax.metric)
+    b, mu, t = relax.bound(z, iterations, inherited[0] if inherited else None)
+    if b <= 0:
+        return _Proof(uncovered=(z, mu, t, b))
+    mus = [mu / mu.max()] if mu.max(initial=0.0) > 0 else []
+    tried = 0
+    rounding = False
+    while tried < len(mus) and tried < opts.max_combinations:
+        ok, piece_margin, outside = _in_cap(basis, V, mus[tried], opts.margin_factor)
+        tried += 1
+        if ok:
+            return _Proof(margin=piece_margin, tried=mus)
+        rounding |= 0.0 < piece_margin <= 1.0
+        if outside is None:
+            continue
+        bw, muw, tw = relax.bound(V[:, outside], iterations, mu)
+        if bw <= 0:
+            return _Proof(uncovered=(V[:, outside], muw, tw, bw))
+        if muw.max(initial=0.0) > 0:
+            muw = muw / muw.max()
+            if not any(float(np.abs(muw - q).max()) <= 1e-6 for q in mus):
+                mus.append(muw)
+    if len(mus) >= 2:
+        ok, piece_margin, _ = _piece_check(
+            basis, V, mus[: opts.max_combinations], opts.margin_factor, False
+        )
+        if ok:
+            return _Proof(margin=piece_margin, tried=mus)
+    if mus and level >= opts.sdp_depth:
+        # The columns of every combination met, each on its own (the relaxation with all
+        # of them is at least as strong as any combination), and the SDP.
+        weight = np.max(np.column_stack(mus), axis=1)
+        support = np.argsort(-weight)[: opts.max_individual]
+        support = support[weight[support] > 1e-3]
+        units = [np.eye(1, basis.r, int(j))[0] for j in support]
+        ok, piece_margin, _ = _piece_check(basis, V, units, opts.margin_factor, True)
+        if ok:
+            return _Proof(margin=piece_margin, tried=mus)
+    return _Proof(tried=mus, rounding=rounding)
 
 
 def _new_columns(

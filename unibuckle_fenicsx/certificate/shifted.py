@@ -15,6 +15,7 @@ Note:
 from __future__ import annotations
 
 import time
+import weakref
 from dataclasses import dataclass
 
 from mpi4py import MPI
@@ -373,6 +374,11 @@ class ShiftedMatrix(Owner):
         self.destroy()
 
 
+_MIRRORS: weakref.WeakKeyDictionary[BucklingProblem, dict[str, npt.NDArray[np.int64]]] = (
+    weakref.WeakKeyDictionary()
+)
+
+
 def mirror_maps(
     problem: BucklingProblem, tol: float = GEOMETRY_RTOL
 ) -> dict[str, npt.NDArray[np.int64]]:
@@ -380,8 +386,17 @@ def mirror_maps(
 
     A reflection (about x = centre, y = centre, or both) appears only when it maps the
     node set onto itself. The images of a reaction are candidates, nothing more: the
-    certificate checks whatever it is given.
+    certificate checks whatever it is given. Computed once per problem (default ``tol``).
     """
+    if tol == GEOMETRY_RTOL and problem in _MIRRORS:
+        return _MIRRORS[problem]
+    maps = _mirror_maps(problem, tol)
+    if tol == GEOMETRY_RTOL:
+        _MIRRORS[problem] = maps
+    return maps
+
+
+def _mirror_maps(problem: BucklingProblem, tol: float) -> dict[str, npt.NDArray[np.int64]]:
     if problem.contact is None:
         raise ValueError("mirror_maps: the problem has no obstacle (this needs an obstacle zone)")
     xy = problem.contact.coordinates
