@@ -166,6 +166,19 @@ def test_split_bound_is_sound_sample(spec, i):
 
 
 @serial
+def test_pieces_waiting_while_columns_are_added():
+    """Long plate 10 of the family: new columns arrive while pieces wait on the stack.
+
+    Those pieces carry their parent's combinations, shorter than the grown basis; they
+    must be read with zero weight on the new columns (the route once stopped there with a
+    shape error). Sound as the others (asserted in :func:`_check`).
+    """
+    spec, i = FAMILY[10]
+    report = _check(spec, i)
+    assert report["tried"] >= 1, report
+
+
+@serial
 @pytest.mark.slow
 def test_split_bound_is_sound_on_the_families():
     """>= 200 problems with m >= 2 (long plates, sliding buckles), none unsound.

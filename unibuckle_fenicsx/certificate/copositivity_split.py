@@ -1082,6 +1082,9 @@ def _prove_piece(
     one with the SPN program.
     """
     iterations = 4 * basis.m + 40
+    # A piece waiting while columns were added has its parent's shorter mu: the same
+    # combinations, with zero weight on the new columns.
+    inherited = [np.pad(mu, (0, basis.r - len(mu))) for mu in inherited]
     for mu in inherited[:2]:
         ok, piece_margin, _ = _in_cap(basis, V, mu, opts.margin_factor)
         if ok:
