@@ -14,7 +14,8 @@ mode and a new certificate); the table gives
   the rule that turns it on by default, at most 3);
 - ``certificate / free``: the certificate's time (continuations included) over the cold
   free solve's, in one process, the median of ``--repeat`` runs (their values in the
-  JSON row's ``ratios``);
+  JSON row's ``ratios``); ``route / free``: the global bound's routes alone (the split
+  route and the rank-2 attempts before it), the same run's;
 - ``continued``: the loads of the refuting modes the solve continued from.
 
 With ``--bracket`` the certificate runs as asked for (``solver.bracket``: distances down
@@ -59,20 +60,21 @@ def main() -> None:
             f"MPI ranks: {comm.size}; bracket asked for: {args.bracket}",
             ("case", "mesh", "m", "lambda_c (Pa)", "lower bound (Pa)", "gap", "status",
              "distances", "r", "pieces", "rhs", "estimated cost", "certificate / free",
-             "continued"),
+             "route / free", "continued"),
         )  # fmt: skip
     for nx, ny in meshes:
         for name in args.cases.split(","):
             spec = _spec(name, nx, ny, "above")
             if args.bracket:
                 spec = spec.with_solver(bracket=True)
-            ratios = []
+            ratios, routes = [], []
             for _ in range(args.repeat):
                 with solve(spec, comm) as analysis:
                     r, cert, sol = analysis.result, analysis.certificate, analysis.solution
                     assert cert is not None and sol is not None
                     t = analysis.problem.timings
                     ratios.append(t["certify_s"] / t["free_solve_s"])
+                    routes.append((cert.copositivity or {}).get("time_s", 0.0) / t["free_solve_s"])
             split = (cert.copositivity or {}).get("split") or {}
             row = {
                 "case": name,
@@ -93,13 +95,14 @@ def main() -> None:
                 "free_solve_s": t["free_solve_s"],
                 "certify_ratio": statistics.median(ratios),
                 "ratios": ratios,
+                "route_ratio": statistics.median(routes),
                 "continued": [c["from_load"] for c in sol.details.get("continued", [])],
             }
             if comm.rank == 0:
                 print(
                     "| {case} | {mesh} | {m} | {load_Pa:.6f} | {lower_bound_Pa:.6f} | "
                     "{relative_gap:.1e} | {status} | {distances} | {r} | {pieces} | {rhs} | "
-                    "{est} | **{certify_ratio:.2f}** | {continued} |".format(
+                    "{est} | **{certify_ratio:.2f}** | {route_ratio:.2f} | {continued} |".format(
                         **row,
                         est="-" if row["estimated_cost"] is None
                         else f"{row['estimated_cost']:.2f}",
