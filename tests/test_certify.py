@@ -144,13 +144,25 @@ def test_two_eigenvalues_below_needs_the_sdp_route():
 
 
 def test_no_certify_skips_the_proof():
+    """Unproven, the summary prints the verified bracket: [free load, returned load].
+
+    Interlacing makes the free load a lower bound, the returned mode's load (admissible)
+    an upper one; the screen says so, not only the JSON.
+    """
     spec = paper_case("c1", 20, 20).with_solver(certify=False)
     with solve(spec) as analysis:
         cert = analysis.certificate
+        result = analysis.result
     assert cert.kkt and not cert.global_optimum_proven
     assert cert.copositivity is None and cert.smallest_of_reduced is None
     assert any("skipped" in note for note in cert.notes)
-    assert cert.lower_bound == pytest.approx(analysis.result.free_load_Pa)
+    assert cert.lower_bound == pytest.approx(result.free_load_Pa)
+    line = result.summary().splitlines()[1]
+    assert line == (
+        f"  not proven: the critical load lies between {result.free_load_Pa:.6e} Pa "
+        "(verified lower bound, the free plate's, by interlacing) and "
+        f"{result.critical_load_Pa:.6e} Pa"
+    ), result.summary()
 
 
 def test_inactive_obstacle_is_proven():

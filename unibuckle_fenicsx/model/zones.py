@@ -83,7 +83,7 @@ def zone_report(
     """Per obstacle: the zone's area, the discrete zone's area and its mesh nodes.
 
     Returns:
-        One mapping per obstacle: ``obstacle`` (its label), ``zone`` (described),
+        One mapping per obstacle, with ``obstacle`` (its label), ``zone`` (described),
         ``area_m2`` (the zone's part on the plate, None if unknown), ``discrete_area_m2``
         (the cells with every node in the closed zone), ``nodes`` (mesh nodes in the
         closed zone, edge nodes included).

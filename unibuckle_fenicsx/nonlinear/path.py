@@ -178,7 +178,7 @@ class NonlinearResult:
         contact_load_Pa: The load of the first state on the path with a node on the
             obstacle (None if none): with a gap, where the plate reaches the obstacle.
         contact_check: The contact conditions at the last state (see
-            :meth:`NonlinearAnalysis.contact_check`).
+            :func:`contact_check`).
         options: The options used.
         wall_time_s: Total wall time (linear solve included).
         timings: Seconds per phase.

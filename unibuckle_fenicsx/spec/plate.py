@@ -99,7 +99,7 @@ class EdgeSpec:
             ("roller" fixes the normal displacement only).
         normal_stress: Normal edge stress per unit load (Pa/Pa), tension positive;
             the paper's compressed edges have -1. A pair ``(start, end)`` varies
-            linearly along the edge (:func:`~unibuckle_fenicsx.model.mesh.edge_lines` gives
+            linearly along the edge (:func:`~unibuckle_fenicsx.model.mesh.edge_line` gives
             the direction): in-plane bending is ``(1, -1)``, the stress-gradient ratio
             of design codes is :math:`\psi` = end/start.
         shear_stress: Tangential edge stress per unit load (Pa/Pa), along the

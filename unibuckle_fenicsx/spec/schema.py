@@ -336,7 +336,7 @@ def validate_document(data: Mapping[str, Any]) -> str | None:
     """Check the TOML-shaped ``data`` against :class:`ProblemFile`.
 
     Returns:
-        None, or the schema's message for a value out of its bounds: the caller's checks
+        None, or the schema's message for a value out of its bounds; the caller's checks
         give a more precise one (with the unit); this one is their fallback.
 
     Raises:
