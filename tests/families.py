@@ -260,7 +260,7 @@ def _long_plate(rng, name, aspect, nx, ny, supports, load, whole: float):
     t/b log-uniform in [1e-3, 3e-2], the face over the whole plate (probability
     ``whole``) or a strip, above (0.7) or below; solved by the active set.
     """
-    from unibuckle_fenicsx.cases import plate_case
+    from unibuckle_fenicsx.spec.cases import plate_case
 
     width = 0.1
     length = aspect * width

@@ -37,7 +37,6 @@ from exhaustive import RTOL, exhaustive_minimum
 from families import long_plate_family, translated_family
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.copositivity_split import (
     SplitOptions,
     _Basis,
@@ -49,6 +48,7 @@ from unibuckle_fenicsx.certificate.copositivity_split import (
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import ObstacleSpec
+from unibuckle_fenicsx.spec.cases import plate_case
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 pytest.importorskip("clarabel")

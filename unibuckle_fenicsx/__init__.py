@@ -7,7 +7,6 @@ first use.
 
 from typing import Any
 
-from unibuckle_fenicsx.cases import CASES, paper_case
 from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
@@ -20,6 +19,7 @@ from unibuckle_fenicsx.spec import (
     problem_from_dict,
     problem_to_dict,
 )
+from unibuckle_fenicsx.spec.cases import CASES, paper_case
 
 __version__ = "0.1.0"
 
