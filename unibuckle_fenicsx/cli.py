@@ -350,9 +350,8 @@ def _solve_flags(s: argparse.ArgumentParser) -> None:
     s.add_argument(
         "--bracket",
         action="store_true",
-        help="run the verified bracket when several pencil eigenvalues lie below the load "
-        "(long plates) whatever its cost, down to 1e-6 (by default: where it costs at most "
-        "3 free solves)",
+        help="also try the low-rank verified bracket when several pencil eigenvalues lie "
+        "below the load (thin long plates; tens of free solves' time)",
     )
     s.add_argument(
         "--penalty",

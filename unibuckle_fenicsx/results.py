@@ -535,12 +535,6 @@ def _verified(cert: dict[str, Any]) -> str:
     refuted = cert.get("refuting_load_Pa")
     if isinstance(refuted, float):
         return f"proven=no, refuted: an admissible mode has {refuted:.6e} Pa"
-    split = (cert.get("copositivity") or {}).get("split") or {}
-    if split.get("skipped"):
-        return (
-            f"proven=no (KKT only{below}; not bracketed by default here: estimated cost "
-            f"{split.get('estimated_cost', 0.0):.1f} free solves, --bracket runs it)"
-        )
     return f"proven=no (KKT only{below})"
 
 

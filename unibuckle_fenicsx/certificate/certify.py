@@ -45,7 +45,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.foundation import pressing_nodes
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
-from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX, ShiftedMatrix, rayleigh
+from unibuckle_fenicsx.certificate.shifted import CERTIFY_PREFIX, ShiftedMatrix
 from unibuckle_fenicsx.eigen import SymmetricFactorization
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import BRACKET_GAP, PROOF_GAP, ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
@@ -302,8 +302,8 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     )
     try:
         if not algorithm_proof and global_bound and kkt and cand.eigen is not None:
-            if options is None:
-                options = _bound_options(problem.spec.solver.bracket)
+            if options is None and not problem.spec.solver.bracket:
+                options = BoundOptions(lowrank=None)  # the low-rank route on request only
             bound = copositivity_bound(problem, cand, solution.kkt_points, options, matrix)
             record = {
                 "method": bound.method,
@@ -312,16 +312,12 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
                 "negative_eigenvalues": bound.negative_eigenvalues,
                 **{k: bound.timings[k] for k in ("factorisations", "solves")},
                 "time_s": bound.timings["total_s"],
-                "free_solve_s": problem.timings.get("free_solve_s"),
-                "split": bound.split,
                 "lowrank": bound.lowrank,
             }
             notes += list(bound.notes)
             if bound.refuting is not None:
                 refuting = _refuting_candidate(problem, bound.refuting)
-                if not (refuting.feasible and refuting.load < cand.load):
-                    refuting = None
-                if refuting is not None:
+                if refuting.feasible:
                     upper = min(upper, refuting.load)
                     notes.append(
                         f"refuted: an admissible mode has the load {refuting.load!r} < "
@@ -375,34 +371,14 @@ def certify(  # noqa: C901 - KKT, inertia and the bound routes checked in the or
     )
 
 
-def _bound_options(bracket: bool) -> BoundOptions:
-    """By default the split route within its cost limit; on request, thorough, then low rank."""
-    from unibuckle_fenicsx.certificate.copositivity_split import SplitOptions
-
-    if bracket:
-        return BoundOptions(split=SplitOptions.thorough())
-    return BoundOptions(lowrank=None)
-
-
 def _refuting_candidate(problem: BucklingProblem, refuting: dict[str, Any]) -> Candidate:
-    """The route's refuting mode as a :class:`Candidate` (contact set: its zeros).
-
-    The mode is set to exactly zero at the nodes within tau of the obstacle (its contact
-    set), so that it lies in that set's subspace (a start for the feasible descent), and
-    its load is its Rayleigh quotient after that.
-    """
-    assert problem.contact is not None
+    """The low-rank route's refuting mode as a :class:`Candidate` (contact set: its zeros)."""
     u = problem.new_mode("refuting_mode")
-    vec = u.x.petsc_vec
-    vec.array[:] = refuting["vector"]
-    values = problem.contact.values(vec) / problem.max_abs_w(vec)
-    active = np.flatnonzero(values >= -problem.tau).astype(np.int64)
-    rows = problem.contact.removed_rows(active)
-    vec.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))
-    vec.assemble()
+    u.x.petsc_vec.array[:] = refuting["vector"]
     u.x.scatter_forward()
-    load = rayleigh(problem, vec)
-    return problem.candidate(u, math.inf if load is None else load, active, sign=1.0)
+    values = np.asarray(refuting["values"])
+    active = np.flatnonzero(values >= -problem.tau).astype(np.int64)
+    return problem.candidate(u, float(refuting["load"]), active, sign=1.0)
 
 
 def certify_foundation(problem: BucklingProblem, solution: UnilateralSolution) -> Certificate:

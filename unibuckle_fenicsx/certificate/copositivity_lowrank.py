@@ -56,7 +56,6 @@ from __future__ import annotations
 
 import math
 import time
-from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -72,10 +71,10 @@ from unibuckle_fenicsx.certificate.accurate import (
     gamma,
     two_product,
 )
-from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, mirror_maps, rayleigh
+from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, mirror_maps
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 
-__all__ = ["LowRankOptions", "LowRankOutcome", "lowrank_certificate", "search_deltas"]
+__all__ = ["LowRankOptions", "LowRankOutcome", "lowrank_certificate"]
 
 
 @dataclass(frozen=True)
@@ -742,13 +741,30 @@ def lowrank_certificate(
         budget = max(opts.time_budget * free_s, opts.min_time_s)
         out._deadline = (time.perf_counter() + budget, problem.comm)
     sources = _sources(problem, candidate, others, opts.unit_columns)
-
-    def attempt(delta: float) -> dict[str, Any]:
-        nonlocal sources
-        record, sources = _attempt(problem, matrix, candidate, delta, sources, opts, out)
-        return record
-
-    search_deltas(out, candidate.load, opts.deltas, opts.fallback, attempt, out.out_of_time)
+    queue = list(opts.deltas)
+    fallback = list(opts.fallback)
+    while queue and not out.out_of_time():
+        delta = queue.pop(0)
+        attempt, sources = _attempt(problem, matrix, candidate, delta, sources, opts, out)
+        out.attempts.append(attempt)
+        if out.refuting is not None:
+            out.why = attempt["why"]
+            break
+        if attempt["proven"]:
+            out.value, out.delta = candidate.load * (1.0 - delta), delta
+            out.pieces, out.margin = attempt["pieces"], attempt["margin"]
+            out.r = attempt["r"]
+            fallback = []
+        elif out.value is not None:
+            break  # the previous (larger) delta stands
+        else:
+            queue, fallback = fallback, []  # nothing verified: larger deltas
+    if out.value is None and out.refuting is None:
+        last = out.attempts[-1] if out.attempts else {}
+        out.why = str(last.get("why", "no delta tried"))
+        out.r = int(last.get("r", 0))
+        out.pieces = int(last.get("pieces", 0))
+        out.margin = float(last.get("best_t") or -math.inf)
     out.solves = matrix.solves
     return out
 
@@ -869,50 +885,12 @@ def _refuting(
     problem: BucklingProblem, u: PETSc.Vec, values: npt.NDArray[np.float64]
 ) -> dict[str, Any] | None:
     """The admissible mode u as a record (load = its Rayleigh quotient), if b(u, u) > 0."""
-    load = rayleigh(problem, u)
-    if load is None:
+    Au, Bu = u.duplicate(), u.duplicate()
+    problem.model.A.mult(u, Au)
+    problem.model.B.mult(u, Bu)
+    a, b = u.dot(Au).real, u.dot(Bu).real
+    Au.destroy()
+    Bu.destroy()
+    if not b > 0:
         return None
-    return {"load": load, "values": values, "vector": u.array_r.copy()}
-
-
-def search_deltas(
-    out: Any,
-    load: float,
-    deltas: tuple[float, ...],
-    fallback: tuple[float, ...],
-    attempt: Callable[[float], dict[str, Any]],
-    stop: Callable[[], bool] | None = None,
-    proceed: Callable[[dict[str, Any]], bool] | None = None,
-) -> None:
-    """Relative distances below ``load`` tried in order while verified (both bracket routes).
-
-    After a success the next (smaller) delta is tried (if ``proceed(record)`` says so);
-    after a failure the search stops if something is verified, else goes on with
-    ``fallback`` (larger deltas). A refuting mode (``out.refuting``) ends it. Fills
-    ``out``'s value, delta, pieces, margin, r, why and attempts from the records
-    ``attempt(delta)`` returns.
-    """
-    queue, rest = list(deltas), list(fallback)
-    while queue and not (stop is not None and stop()):
-        delta = queue.pop(0)
-        record = attempt(delta)
-        out.attempts.append(record)
-        if out.refuting is not None:
-            out.why = record["why"]
-            break
-        if record["proven"]:
-            out.value, out.delta = load * (1.0 - delta), delta
-            out.pieces, out.margin, out.r = record["pieces"], record["margin"], record["r"]
-            rest = []
-            if proceed is not None and not proceed(record):
-                break
-        elif out.value is not None:
-            break  # the previous (larger) delta stands
-        else:
-            queue, rest = rest, []  # nothing verified: larger deltas
-    if out.value is None and out.refuting is None:
-        last = out.attempts[-1] if out.attempts else {}
-        out.why = str(last.get("why", "no delta tried"))
-        out.r = int(last.get("r", 0))
-        out.pieces = int(last.get("pieces", 0))
-        out.margin = float(last.get("best_t") or -math.inf)
+    return {"load": a / b, "values": values, "vector": u.array_r.copy()}
