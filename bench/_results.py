@@ -11,6 +11,15 @@ from collections.abc import Iterable, Mapping
 from typing import Any
 
 
+def parse_plates(parser: Any) -> tuple[Any, list[tuple[int, int]]]:
+    """(arguments, meshes) of a plate benchmark's ``--meshes`` and ``--repeat`` (>= 1)."""
+    args, _ = parser.parse_known_args()
+    if args.repeat < 1:
+        parser.error(f"--repeat must be at least 1, got {args.repeat}")
+    meshes = [(int(a), int(b)) for a, b in (m.split("x") for m in args.meshes.split(","))]
+    return args, meshes
+
+
 def print_header(title: str, columns: Iterable[str]) -> None:
     """Print ``title`` and the head of a Markdown table with ``columns``."""
     names = list(columns)

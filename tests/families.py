@@ -240,39 +240,68 @@ def long_plate_family(count: int, seed: int = 20261207, max_constrained: int = 1
     (above or below). Each item is (spec, i). Whether two or more pencil eigenvalues lie
     below the critical load is for the caller to check (it depends on the solution).
     """
-    from unibuckle_fenicsx.spec.cases import plate_case
-
     rng = np.random.default_rng(seed)
     found = []
     while len(found) < count:
         aspect = float(rng.uniform(2.5, 4.5))
-        width, ny = 0.1, int(rng.integers(2, 4))
+        ny = int(rng.integers(2, 4))
         nx = int(np.clip(round(aspect * ny * rng.uniform(0.8, 1.2)), 5, 10))
         supports = LONG_SUPPORTS[int(rng.integers(0, len(LONG_SUPPORTS)))]
         load = "shear" if rng.random() < 0.2 and ny == 3 else "uniaxial"
-        length = aspect * width
-        if rng.random() < 0.5:
-            zone: str | tuple = "all"
-        else:
-            x0, x1 = np.sort(rng.uniform(0, length, 2))
-            zone = ((float(x0), float(x1)), (0.0, width))
-        side = "above" if rng.random() < 0.7 else "below"
-        spec = plate_case(
-            f"long{len(found)}",
-            length=length,
-            width=width,
-            thickness=width * float(10 ** rng.uniform(-3.0, np.log10(3e-2))),
-            supports=supports,
-            load=load,
-            nx=nx,
-            ny=ny,
-            zone=ObstacleSpec(zone=zone, side=side),
-            solver=SolverSpec(method="active-set"),
-        )
-        edges = spec.plate.edges
-        i = _constrained_nodes(edges, length, width, nx, ny, zone)
-        if 4 <= i <= max_constrained:
-            found.append((spec, i))
+        item = _long_plate(rng, f"long{len(found)}", aspect, nx, ny, supports, load, 0.5)
+        if 4 <= item[1] <= max_constrained:
+            found.append(item)
+    return found
+
+
+def _long_plate(rng, name, aspect, nx, ny, supports, load, whole: float):
+    """(spec, i) of one long plate of width 0.1 m.
+
+    t/b log-uniform in [1e-3, 3e-2], the face over the whole plate (probability
+    ``whole``) or a strip, above (0.7) or below; solved by the active set.
+    """
+    from unibuckle_fenicsx.spec.cases import plate_case
+
+    width = 0.1
+    length = aspect * width
+    if rng.random() < whole:
+        zone: str | tuple = "all"
+    else:
+        x0, x1 = np.sort(rng.uniform(0, length, 2))
+        zone = ((float(x0), float(x1)), (0.0, width))
+    side = "above" if rng.random() < 0.7 else "below"
+    spec = plate_case(
+        name,
+        length=length,
+        width=width,
+        thickness=width * float(10 ** rng.uniform(-3.0, np.log10(3e-2))),
+        supports=supports,
+        load=load,
+        nx=nx,
+        ny=ny,
+        zone=ObstacleSpec(zone=zone, side=side),
+        solver=SolverSpec(method="active-set"),
+    )
+    return spec, _constrained_nodes(spec.plate.edges, length, width, nx, ny, zone)
+
+
+def translated_family(count: int, seed: int = 20260611, max_constrained: int = 14):
+    """The first ``count`` very long plates with one row of free nodes (a/b 4-7, ny = 2).
+
+    Their buckles slide along the row: families of nearly equal critical states
+    translated along the plate, small enough for exhaustive enumeration (i = nx - 1 at
+    most ``max_constrained`` on a whole-face obstacle, fewer on a strip). Each item is
+    (spec, i); supports as in :func:`long_plate_family`, uniaxial compression.
+    """
+    rng = np.random.default_rng(seed)
+    found = []
+    while len(found) < count:
+        aspect = float(rng.uniform(4.0, 7.0))
+        nx = int(rng.integers(8, max_constrained + 2))
+        supports = LONG_SUPPORTS[int(rng.integers(0, len(LONG_SUPPORTS)))]
+        item = _long_plate(rng, f"slide{len(found)}", aspect, nx, 2, supports, "uniaxial", 0.7)
+        if 4 <= item[1] <= max_constrained:
+            found.append(item)
     return found
 
 

@@ -97,6 +97,34 @@ def choose_method(
     )
 
 
+#: Times a refuted answer is continued from its refuting mode (each time certified again).
+MAX_CONTINUATIONS = 3
+
+
+def _continue(
+    problem: UnilateralProblem, solution: UnilateralSolution, certificate: Certificate
+) -> tuple[UnilateralSolution, Certificate]:
+    """While the certificate refutes the answer, continue the solve from its refuting mode.
+
+    A refuting mode is admissible with a load below the answer's: the feasible descent
+    from it (:func:`~unibuckle_fenicsx.algorithms.descent.continue_from`) never raises
+    the load, so the answer never ends above it; the new answer is certified again.
+    """
+    from unibuckle_fenicsx.algorithms.descent import continue_from
+
+    for _ in range(MAX_CONTINUATIONS):
+        start = certificate.refuting_mode
+        if start is None:
+            break
+        logger.info(
+            "the certificate refutes the load %.10g (an admissible mode has %.10g): "
+            "continuing from that mode", solution.load, start.load,
+        )  # fmt: skip
+        solution = continue_from(problem, solution, start, problem.spec.solver.max_iterations)
+        certificate = certify(problem, solution)
+    return solution, certificate
+
+
 @dataclass
 class Analysis(Owner):
     """What :func:`solve` returns: the result, the critical mode and the set-up problem.
@@ -241,6 +269,7 @@ def _analyse(
             certificate = certify_foundation(problem, solution)
         else:
             certificate = certify(problem, solution)
+            solution, certificate = _continue(problem, solution, certificate)
         problem.timings["certify_s"] = time.perf_counter() - t1
         if not certificate.kkt:
             logger.warning(

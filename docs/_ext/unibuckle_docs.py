@@ -291,6 +291,19 @@ def _routes_commands(rows: list[dict[str, Any]]) -> str:
     return "`, then `".join(commands)
 
 
+def _bracket_commands(rows: list[dict[str, Any]]) -> str:
+    """The ``bench_bracket.py`` runs that wrote the rows: by default, then as asked for."""
+    commands = []
+    for asked in dict.fromkeys(bool(r.get("bracket")) for r in rows):
+        group = [r for r in rows if bool(r.get("bracket")) == asked]
+        commands.append(
+            f"python bench/bench_bracket.py --meshes {_listed(group, 'mesh')} "
+            f"--cases {_listed(group, 'case')}{' --bracket' if asked else ''} "
+            "--json bench/results/bracket.jsonl"
+        )
+    return "`, then `".join(commands)
+
+
 def _free_commands(rows: list[dict[str, Any]]) -> str:
     """The ``bench_free.py`` run that wrote the rows (one per plate)."""
     meshes = ",".join(f"{r['plate']}={r['mesh']}" for r in rows)
@@ -317,6 +330,7 @@ def _orderings_commands(rows: list[dict[str, Any]]) -> str:
 
 
 COMMANDS = {
+    "bracket": lambda rows: _bracket_commands(rows),
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"

@@ -24,7 +24,7 @@ import numpy as np
 import numpy.typing as npt
 
 if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.algorithms.records import MethodDetails
+    from unibuckle_fenicsx.algorithms.records import ContinuedRecord, MethodDetails
     from unibuckle_fenicsx.model.problem import Candidate
 
 __all__ = ["RunStatus", "UnilateralSolution", "candidate_count"]
@@ -80,6 +80,8 @@ class UnilateralSolution:
             it is the free load (interlacing: the obstacle never lowers the load).
         status: How the method's iteration ended, for methods whose certificate depends on
             it (the foundation's spring-set iteration); None for the others.
+        continued: The continuations from refuting modes
+            (:func:`~unibuckle_fenicsx.algorithms.descent.continue_from`), in order.
     """
 
     candidate: Candidate
@@ -94,6 +96,7 @@ class UnilateralSolution:
     p_star: int | None = None
     lower_bound_by: str | None = None
     status: RunStatus | None = None
+    continued: list[ContinuedRecord] = field(default_factory=list)
 
     def __post_init__(self) -> None:
         if not self.route:

@@ -45,14 +45,15 @@ from petsc4py import PETSc
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms import RunStatus
+from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.arc import ArcPlane
 from unibuckle_fenicsx.algorithms.pdas import Run
+from unibuckle_fenicsx.algorithms.records import ContinuedRecord
 from unibuckle_fenicsx.la.options import Prefix, option_defaults, ordering_options, set_options
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL, ZERO_STEP
 
-__all__ = ["admissible_start", "descend"]
+__all__ = ["admissible_start", "continue_from", "descend"]
 
 #: Options of the gradient release's solve (prefix ``unibuckle_descent_``).
 GRADIENT_OPTIONS = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
@@ -191,7 +192,8 @@ def descend(
     Args:
         problem: The problem (with an obstacle).
         start: An admissible candidate (``start.feasible``); its contact set is the
-            first working set.
+            first working set. It need not be an eigen mode (a refuting mode is a
+            Rayleigh quotient): the first step then goes to its contact set's eigen mode.
         max_steps: Solves allowed (eigen and gradient), >= 1.
 
     Returns:
@@ -208,7 +210,7 @@ def descend(
     n, tau = problem.contact.size, problem.tau
     A, B = problem.model.A, problem.model.B
     run = Run("descent", best_feasible=start, final=start)
-    if start.kkt:
+    if start.kkt and start.eigen is not None:  # else not an eigenpair: one step at least
         run.status = RunStatus.KKT
         return run, dict.fromkeys(STEP_KINDS, 0)
     u = start.mode.x.petsc_vec.copy()
@@ -319,3 +321,51 @@ def _pulling(
     if largest and pull.any():
         pull &= forces >= forces[pull].max() * (1.0 - ROUNDING_RTOL)
     return cand.active[pull].astype(np.int64)
+
+
+def continue_from(
+    problem: UnilateralProblem, solution: UnilateralSolution, start: Candidate, max_steps: int
+) -> UnilateralSolution:
+    """The solve continued from ``start``, an admissible mode below the returned load.
+
+    A certificate that meets such a mode (a *refuting* mode: the returned KKT point is
+    not the global minimum) hands it back; the feasible descent from it never raises the
+    load, so the answer becomes a KKT point (or admissible mode) at or below ``start``'s
+    load. The returned point joins the other KKT points met; the continuation is
+    recorded in ``solution.continued``.
+
+    Args:
+        problem: The problem.
+        solution: The algorithm's answer that ``start`` refutes.
+        start: The admissible mode (``start.feasible``, its contact set where it vanishes).
+        max_steps: Solves allowed for the descent, >= 1.
+
+    Note:
+        Collective.
+    """
+    run, steps = descend(problem, start, max_steps)
+    final = run.final if run.status is RunStatus.KKT else run.best_feasible
+    if final is None or not final.feasible or final.load > start.load:
+        final = start  # R never rises along the descent; rounding aside, keep the start
+    record = ContinuedRecord(
+        from_load=start.load,
+        to_load=final.load,
+        status=str(run.status),
+        steps=run.iterations,
+        refuted_load=solution.load,
+    )
+    return UnilateralSolution(
+        candidate=final,
+        method=solution.method,
+        eigensolves=solution.eigensolves + run.iterations - steps.get("gradient", 0),
+        lower_bound=min(solution.lower_bound, final.load),
+        global_optimum_proven=False,
+        upper_bound=min(solution.upper_bound, final.load),
+        kkt_points=[*solution.kkt_points, solution.candidate],
+        p_star=solution.p_star,
+        lower_bound_by=solution.lower_bound_by,
+        status=solution.status,
+        details=solution.details,
+        route=list(solution.route),
+        continued=[*solution.continued, record],
+    )

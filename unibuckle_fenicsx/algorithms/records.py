@@ -14,6 +14,7 @@ from msgspec import UNSET, Struct, UnsetType
 __all__ = [
     "ActiveSetDetails",
     "ActiveSetLevel",
+    "ContinuedRecord",
     "DescentRecord",
     "EnumerationDetails",
     "Fallback",
@@ -26,6 +27,25 @@ __all__ = [
     "PenaltyDetails",
     "RunSummary",
 ]
+
+
+class ContinuedRecord(Struct, kw_only=True):
+    """One continuation of the solve from a certificate's refuting mode (feasible descent).
+
+    Attributes:
+        from_load: The refuting mode's load (Pa).
+        to_load: The load the descent ended at (Pa), at most ``from_load``.
+        status: How the descent ended (a :class:`~unibuckle_fenicsx.algorithms.RunStatus`
+            value).
+        steps: Its solves (eigen and gradient).
+        refuted_load: The refuted answer's load (Pa).
+    """
+
+    from_load: float
+    to_load: float
+    status: str
+    steps: int
+    refuted_load: float
 
 
 class RunSummary(Struct, kw_only=True):

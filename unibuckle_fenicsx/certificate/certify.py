@@ -45,7 +45,7 @@ from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.foundation import pressing_nodes
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.records import CopositivityRecord, Refuting
-from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
+from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, rayleigh
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
@@ -351,8 +351,8 @@ def _copositivity(
 ) -> None:
     """The copositivity certificate's bound (and refuting mode) into the bracket ``br``."""
     cand = solution.candidate
-    if options is None and not problem.spec.solver.bracket:
-        options = BoundOptions(lowrank=None)  # the low-rank route on request only
+    if options is None:
+        options = _bound_options(problem.spec.solver.bracket)
     bound = copositivity_bound(problem, cand, solution.kkt_points, options, matrix)
     br.record = CopositivityRecord(
         method=bound.method,
@@ -362,12 +362,15 @@ def _copositivity(
         factorisations=int(bound.timings["factorisations"]),
         solves=int(bound.timings["solves"]),
         time_s=bound.timings["total_s"],
+        free_solve_s=problem.timings.get("free_solve_s"),
+        split=bound.split,
         lowrank=bound.lowrank,
     )
     br.notes += list(bound.notes)
     if bound.refuting is not None:
-        br.refuting = refuting = _refuting_candidate(problem, bound.refuting)
-        if refuting.feasible:
+        refuting = _refuting_candidate(problem, bound.refuting)
+        if refuting.feasible and refuting.load < cand.load:
+            br.refuting = refuting
             br.upper = min(br.upper, refuting.load)
             br.notes.append(
                 f"refuted: an admissible mode has the load {refuting.load!r} < "
@@ -392,14 +395,33 @@ def _smallest(
     return neg == 0
 
 
+def _bound_options(bracket: bool) -> BoundOptions:
+    """By default the split route within its cost limit; on request, thorough, then low rank."""
+    from unibuckle_fenicsx.certificate.copositivity_split import SplitOptions
+
+    if bracket:
+        return BoundOptions(split=SplitOptions.thorough())
+    return BoundOptions(lowrank=None)
+
+
 def _refuting_candidate(problem: UnilateralProblem, refuting: Refuting) -> Candidate:
-    """The low-rank route's refuting mode as a :class:`Candidate` (contact set: its zeros)."""
+    """The route's refuting mode as a :class:`Candidate` (contact set: its zeros).
+
+    The mode is set to exactly zero at the nodes within tau of the obstacle (its contact
+    set), so that it lies in that set's subspace (a start for the feasible descent), and
+    its load is its Rayleigh quotient after that.
+    """
     u = problem.new_mode("refuting_mode")
-    u.x.petsc_vec.array[:] = refuting.vector
-    u.x.scatter_forward()
-    values = np.asarray(refuting.values)
+    vec = u.x.petsc_vec
+    vec.array[:] = refuting.vector
+    values = problem.contact.values(vec) / problem.max_abs_w(vec)
     active = np.flatnonzero(values >= -problem.tau).astype(np.int64)
-    return problem.candidate(u, float(refuting.load), active, sign=1.0)
+    rows = problem.contact.removed_rows(active)
+    vec.setValues(rows.astype(PETSc.IntType), np.zeros(len(rows)))
+    vec.assemble()
+    u.x.scatter_forward()
+    load = rayleigh(problem, vec)
+    return problem.candidate(u, math.inf if load is None else load, active, sign=1.0)
 
 
 def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution) -> Certificate:

@@ -70,6 +70,7 @@ from unibuckle_fenicsx.certificate.records import (
     SdpRecord,
     SearchRecord,
     SectorRecord,
+    SplitRecord,
 )
 from unibuckle_fenicsx.certificate.shifted import (
     EPS,
@@ -82,6 +83,7 @@ from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions, LowRankOutcome
+    from unibuckle_fenicsx.certificate.copositivity_split import SplitOptions, SplitOutcome
 
 __all__ = ["BoundOptions", "LowerBound", "copositivity_bound"]
 
@@ -100,8 +102,11 @@ class BoundOptions:
         sdp_max_constrained: The SDP routes run when i is at most this (dense i x i
             semidefinite programs: seconds at i = 50, inaccurate beyond about 80).
         sectors: Sector counts tried by the sector SDP route (two negative eigenvalues).
-        lowrank: Budgets of the low-rank route (two or more negative eigenvalues, any
-            i; :mod:`unibuckle_fenicsx.certificate.copositivity_lowrank`); None skips it.
+        split: Budgets of the split route (two or more negative eigenvalues, any i;
+            :mod:`unibuckle_fenicsx.certificate.copositivity_split`); None skips it.
+        lowrank: Budgets of the low-rank route, tried when the split route proves nothing
+            and refutes nothing (:mod:`unibuckle_fenicsx.certificate.copositivity_lowrank`);
+            None skips it.
     """
 
     deltas: tuple[float, ...] = (1e-9, 2e-9, 5e-9, 1e-8, 2e-8, 5e-8, 1e-7, 2e-7, 5e-7, 1e-6)
@@ -111,6 +116,7 @@ class BoundOptions:
     search_iterations: int = 100
     sdp_max_constrained: int = 60
     sectors: tuple[int, ...] = (3, 4, 8)
+    split: SplitOptions | None = field(default_factory=lambda: _split_options())
     lowrank: LowRankOptions | None = field(default_factory=lambda: _lowrank_options())
 
 
@@ -120,13 +126,20 @@ def _lowrank_options() -> LowRankOptions:
     return LowRankOptions()
 
 
+def _split_options() -> SplitOptions:
+    from unibuckle_fenicsx.certificate.copositivity_split import SplitOptions
+
+    return SplitOptions()
+
+
 @dataclass(frozen=True)
 class LowerBound:
     """The outcome of :func:`copositivity_bound`.
 
     Attributes:
         value: The verified lower bound (None if no route succeeded).
-        method: "psd", "rank2-spn", "sdp-spn", "sdp-sectors", "lowrank-spn", or "none".
+        method: "psd", "rank2-spn", "sdp-spn", "sdp-sectors", "split-spn", "lowrank-spn",
+            or "none".
         delta: Relative distance of ``value`` below the load.
         margins: The verified quantities (alpha, beta, gamma and their error bounds, or
             the SDP's smallest eigenvalue).
@@ -136,8 +149,9 @@ class LowerBound:
         negative_eigenvalues: m, the pencil eigenvalues below the first shift tried (the
             negative eigenvalues of K there).
         lowrank: The low-rank route's record (None if it did not run).
+        split: The split route's record (None if it did not run).
         refuting: An admissible mode with a lower load than the KKT point's, met by the
-            low-rank route, or None.
+            split or low-rank route, or None.
     """
 
     value: float | None
@@ -150,6 +164,7 @@ class LowerBound:
     negative_eigenvalues: int | None = None
     lowrank: LowRankRecord | None = None
     refuting: Refuting | None = None
+    split: SplitRecord | None = None
 
 
 def _reaction(candidate: Candidate) -> npt.NDArray[np.float64]:
@@ -338,6 +353,7 @@ def copositivity_bound(
     m: int | None = None
     several = False  # two or more pencil eigenvalues below some shift tried
     lowrank: LowRankRecord | None = None
+    split: SplitRecord | None = None
     refuting: Refuting | None = None
     try:
         if not nappes.w_plus.max() > 0:
@@ -354,11 +370,15 @@ def copositivity_bound(
             result, stop = _at_shift(problem, matrix, nappes, lam, attempt, opts, notes)
             if stop:
                 break
-        if result is None and several and opts.lowrank is not None:
+        if result is None and several and opts.split is not None:
+            found = _split(problem, matrix, candidate, others or [], opts.split, notes)
+            split, refuting = found.record(), found.refuting
+            result = _route_bound(found, "split-spn")
+        if result is None and refuting is None and several and opts.lowrank is not None:
             outcome = _lowrank(problem, matrix, candidate, others or [], opts.lowrank, notes)
             if outcome is not None:
                 lowrank, refuting = outcome.record(), outcome.refuting
-                result = _lowrank_bound(outcome)
+                result = _route_bound(outcome, "lowrank-spn")
     finally:
         timings = _timings(problem, matrix, t0, start)
         if own:
@@ -381,15 +401,16 @@ def copositivity_bound(
         m,
         lowrank,
         refuting,
+        split,
     )
 
 
-def _lowrank_bound(outcome: LowRankOutcome) -> LowerBound | None:
-    """The low-rank route's verified bound, if it found one."""
+def _route_bound(outcome: LowRankOutcome, method: str) -> LowerBound | None:
+    """The split or low-rank route's verified bound (``method``), if it found one."""
     if outcome.value is None:
         return None
     margins = LowRankMargins(r=outcome.r, pieces=outcome.pieces, margin=outcome.margin, m=outcome.m)
-    return LowerBound(outcome.value, "lowrank-spn", outcome.delta, margins)
+    return LowerBound(outcome.value, method, outcome.delta, margins)
 
 
 def _timings(
@@ -492,6 +513,49 @@ def _at_shift(
     return None, False
 
 
+def _split(
+    problem: UnilateralProblem,
+    matrix: ShiftedMatrix,
+    candidate: Candidate,
+    others: list[Candidate],
+    options: SplitOptions,
+    notes: list[str],
+) -> SplitOutcome:
+    """The split route, unless its estimated cost exceeds ``options.max_cost``.
+
+    Then its outcome says so (``skipped``, the estimate and why), with no attempt.
+    """
+    from unibuckle_fenicsx.certificate.copositivity_split import (
+        SplitOutcome,
+        column_sources,
+        estimate_cost,
+        split_certificate,
+    )
+
+    m = matrix.inertia()[0]
+    sources = column_sources(problem, candidate, others, options)
+    cost = estimate_cost(problem, sources, m, options)
+    if options.max_cost is not None and cost > options.max_cost:
+        why = (
+            f"the split bracket's estimated cost ({cost:.1f} free solves) exceeds "
+            f"{options.max_cost:g}: it runs on request only (solver.bracket = true, --bracket)"
+        )
+        notes.append(f"{m} pencil eigenvalues lie below the load: {why}")
+        skipped = SplitOutcome(m=m, why=why, estimated_cost=cost)
+        skipped.skipped = True
+        return skipped
+    outcome = split_certificate(problem, matrix, candidate, others, options, sources)
+    outcome.estimated_cost = cost
+    if outcome.value is None:
+        notes.append(
+            f"split certificate: no verified bound (m = {outcome.m} pencil eigenvalues "
+            f"below, {outcome.r} columns, {outcome.pieces} pieces): {outcome.why}"
+        )
+    elif outcome.why:
+        notes.append(f"split certificate: {outcome.why}")
+    return outcome
+
+
 def _lowrank(
     problem: UnilateralProblem,
     matrix: ShiftedMatrix,
@@ -537,9 +601,9 @@ def _sdp(
             f"apply, and the full SDP route is limited to i <= {opts.sdp_max_constrained} "
             f"constrained nodes (here {i})"
             + (
-                ": the low-rank route runs"
-                if opts.lowrank is not None
-                else ": the low-rank bracket runs on request (solver.bracket = true, --bracket)"
+                ": the split (or low-rank) route applies"
+                if opts.split is not None or opts.lowrank is not None
+                else ": the split bracket runs on request (solver.bracket = true, --bracket)"
             )
         )
         return SdpRecord(too_large=True)

@@ -56,6 +56,7 @@ from __future__ import annotations
 
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -73,10 +74,16 @@ from unibuckle_fenicsx.certificate.accurate import (
     two_product,
 )
 from unibuckle_fenicsx.certificate.records import LowRankAttempt, LowRankRecord, Refuting
-from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, mirror_maps
+from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, mirror_maps, rayleigh
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
 
-__all__ = ["LowRankOptions", "LowRankOutcome", "lowrank_certificate"]
+__all__ = [
+    "LowRankOptions",
+    "LowRankOutcome",
+    "factor_at",
+    "lowrank_certificate",
+    "search_deltas",
+]
 
 
 @dataclass(frozen=True)
@@ -568,6 +575,11 @@ def _split_piece(
                 pieces.append(W)
             return pieces
     a, b = np.unravel_index(np.argmin(Ps + np.eye(r) * 1e300), Ps.shape)
+    return _halves(V, int(a), int(b))
+
+
+def _halves(V: npt.NDArray[np.float64], a: int, b: int) -> list[npt.NDArray[np.float64]]:
+    """The two halves of the cone piece V (columns: generators) cut at the middle of a, b."""
     mid = 0.5 * (V[:, a] + V[:, b])
     pieces = []
     for k in (a, b):
@@ -752,31 +764,13 @@ def lowrank_certificate(
         budget = max(opts.time_budget * free_s, opts.min_time_s)
         out._deadline = (time.perf_counter() + budget, problem.comm)
     sources = _sources(problem, candidate, others, opts.unit_columns)
-    queue = list(opts.deltas)
-    fallback = list(opts.fallback)
-    while queue and not out.out_of_time():
-        delta = queue.pop(0)
-        attempt, sources = _attempt(problem, matrix, candidate, delta, sources, opts, out)
-        out.attempts.append(attempt)
-        if out.refuting is not None:
-            out.why = attempt.why
-            break
-        if attempt.proven:
-            out.value, out.delta = candidate.load * (1.0 - delta), delta
-            out.pieces, out.margin = attempt.pieces, attempt.margin
-            out.r = attempt.r
-            fallback = []
-        elif out.value is not None:
-            break  # the previous (larger) delta stands
-        else:
-            queue, fallback = fallback, []  # nothing verified: larger deltas
-    if out.value is None and out.refuting is None:
-        out.why = "no delta tried"
-        if out.attempts:
-            last = out.attempts[-1]
-            best_t = last.best_t if isinstance(last.best_t, float) else None
-            out.why, out.r, out.pieces = last.why, last.r, last.pieces
-            out.margin = float(best_t or -math.inf)
+
+    def attempt(delta: float) -> LowRankAttempt:
+        nonlocal sources
+        record, sources = _attempt(problem, matrix, candidate, delta, sources, opts, out)
+        return record
+
+    search_deltas(out, candidate.load, opts.deltas, opts.fallback, attempt, out.out_of_time)
     out.solves = matrix.solves
     return out
 
@@ -856,15 +850,9 @@ def _attempt(
     out: LowRankOutcome,
 ) -> tuple[LowRankAttempt, list[tuple[str, npt.NDArray[np.float64]]]]:
     """One delta: factorise, columns, cuts, pieces. Returns (record, columns to reuse)."""
-    lam = candidate.load * (1.0 - delta)
-    neg, zero, _ = matrix.factor(lam)
-    out.m = neg
-    attempt = LowRankAttempt(delta=delta, m=neg)
-    if zero:
-        attempt.why = "K is singular at this shift"
-        return attempt, sources
-    if neg < 2:
-        attempt.why = f"K has {neg} negative eigenvalue(s): the other routes apply"
+    attempt, lam = factor_at(matrix, candidate.load, delta, out, LowRankAttempt)
+    neg = attempt.m
+    if attempt.why:
         return attempt, sources
     cols = _Columns(problem, matrix, opts.refinements, opts.max_columns)
     try:
@@ -927,16 +915,75 @@ def _attempt(
         cols.destroy()
 
 
+def factor_at[A: LowRankAttempt](
+    matrix: ShiftedMatrix, load: float, delta: float, out: LowRankOutcome, kind: type[A]
+) -> tuple[A, float]:
+    """K factorised at ``load (1 - delta)``: the attempt's record (of type ``kind``) and the shift.
+
+    The record's ``why`` says when no bracket route applies there (K singular, or fewer
+    than two negative eigenvalues); ``out.m`` is the negative eigenvalues (both routes).
+    """
+    lam = load * (1.0 - delta)
+    neg, zero, _ = matrix.factor(lam)
+    out.m = neg
+    attempt = kind(delta=delta, m=neg)
+    if zero:
+        attempt.why = "K is singular at this shift"
+    elif neg < 2:
+        attempt.why = f"K has {neg} negative eigenvalue(s): the other routes apply"
+    return attempt, lam
+
+
 def _refuting(
     problem: UnilateralProblem, u: PETSc.Vec, values: npt.NDArray[np.float64]
 ) -> Refuting | None:
     """The admissible mode u as a record (load = its Rayleigh quotient), if b(u, u) > 0."""
-    Au, Bu = u.duplicate(), u.duplicate()
-    problem.model.A.mult(u, Au)
-    problem.model.B.mult(u, Bu)
-    a, b = u.dot(Au).real, u.dot(Bu).real
-    Au.destroy()
-    Bu.destroy()
-    if not b > 0:
+    load = rayleigh(problem, u)
+    if load is None:
         return None
-    return Refuting(load=a / b, values=values, vector=np.array(u.array_r, dtype=np.float64))
+    return Refuting(load=load, values=values, vector=np.array(u.array_r, dtype=np.float64))
+
+
+def search_deltas(
+    out: LowRankOutcome,
+    load: float,
+    deltas: tuple[float, ...],
+    fallback: tuple[float, ...],
+    attempt: Callable[[float], LowRankAttempt],
+    stop: Callable[[], bool] | None = None,
+    proceed: Callable[[LowRankAttempt], bool] | None = None,
+) -> None:
+    """Relative distances below ``load`` tried in order while verified (both bracket routes).
+
+    After a success the next (smaller) delta is tried (if ``proceed(record)`` says so);
+    after a failure the search stops if something is verified, else goes on with
+    ``fallback`` (larger deltas). A refuting mode (``out.refuting``) ends it. Fills
+    ``out``'s value, delta, pieces, margin, r, why and attempts from the records
+    ``attempt(delta)`` returns (the split route.s
+    :class:`~unibuckle_fenicsx.certificate.records.SplitAttempt` among them).
+    """
+    queue, rest = list(deltas), list(fallback)
+    while queue and not (stop is not None and stop()):
+        delta = queue.pop(0)
+        record = attempt(delta)
+        out.attempts.append(record)
+        if out.refuting is not None:
+            out.why = record.why
+            break
+        if record.proven:
+            out.value, out.delta = load * (1.0 - delta), delta
+            out.pieces, out.margin, out.r = record.pieces, record.margin, record.r
+            rest = []
+            if proceed is not None and not proceed(record):
+                break
+        elif out.value is not None:
+            break  # the previous (larger) delta stands
+        else:
+            queue, rest = rest, []  # nothing verified: larger deltas
+    if out.value is None and out.refuting is None:
+        out.why = "no delta tried"
+        if out.attempts:
+            last = out.attempts[-1]
+            best_t = last.best_t if isinstance(last.best_t, float) else None
+            out.why, out.r, out.pieces = last.why, last.r, last.pieces
+            out.margin = float(best_t or -math.inf)

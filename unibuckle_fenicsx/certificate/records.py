@@ -32,6 +32,8 @@ __all__ = [
     "SectorPiece",
     "SectorRecord",
     "SectorTry",
+    "SplitAttempt",
+    "SplitRecord",
 ]
 
 
@@ -214,6 +216,34 @@ class LowRankRecord(Struct, kw_only=True):
     refuting_load: float | UnsetType = UNSET
 
 
+class SplitAttempt(LowRankAttempt, kw_only=True):
+    """One shift of the split route: the low-rank route's fields it fills, and its rounds.
+
+    Attributes:
+        rounds: Rounds of new columns (cuts and translates) added.
+        examined: Pieces of the z-space examined (proven or bisected).
+    """
+
+    rounds: int = 0
+    examined: int | UnsetType = UNSET
+
+
+class SplitRecord(LowRankRecord, kw_only=True):
+    """The split route's record: the low-rank route's, its cost and whether it was skipped.
+
+    Its ``attempts`` are :class:`SplitAttempt` records.
+
+    Attributes:
+        solves: Triangular solve pairs used.
+        estimated_cost: Its estimated cost in free solves (None if not estimated).
+        skipped: Not run: the estimated cost exceeds the default limit.
+    """
+
+    solves: int = 0
+    estimated_cost: float | None = None
+    skipped: bool = False
+
+
 class SearchRecord(Struct, kw_only=True):
     r"""The search of the other nappe for a :math:`w_-`: its iterations and best f."""
 
@@ -252,13 +282,16 @@ class CopositivityRecord(Struct, kw_only=True):
 
     Attributes:
         method: The route that gave the bound ("psd", "rank2-spn", "sdp-spn",
-            "sdp-sectors", "lowrank-spn") or "none".
+            "sdp-sectors", "split-spn", "lowrank-spn") or "none".
         delta: Relative distance of the bound below the load (None if none).
         margins: The route's verified quantities.
         negative_eigenvalues: m, pencil eigenvalues below the first shift tried.
         factorisations: Numeric factorisations.
         solves: Triangular solve pairs.
         time_s: Seconds (the slowest rank's).
+        free_solve_s: Seconds of the free eigensolve (None if not timed), the unit of
+            the split route's estimated cost.
+        split: The split route's record (None if it did not run).
         lowrank: The low-rank route's record (None if it did not run).
     """
 
@@ -269,12 +302,14 @@ class CopositivityRecord(Struct, kw_only=True):
     factorisations: int
     solves: int
     time_s: float
+    free_solve_s: float | None = None
+    split: SplitRecord | None = None
     lowrank: LowRankRecord | None
 
 
 @dataclass(frozen=True)
 class Refuting:
-    """An admissible mode with a load below the KKT point's, met by the low-rank route.
+    """An admissible mode with a load below the KKT point's, met by the split or low-rank route.
 
     Attributes:
         load: Its Rayleigh quotient.

@@ -106,6 +106,8 @@ def assemble_result(
         result.details.run = solution.details
     if solution.lower_bound_by is not None:
         result.details.lower_bound_by = solution.lower_bound_by
+    if solution.continued:
+        result.details.continued = solution.continued
     if not problem.tensionless:
         result.contact_force = _contact_force(unilateral, solution, result.load_resolution)
     return result

@@ -16,7 +16,7 @@ from typing import Any
 import numpy as np
 from msgspec import UNSET, Struct, UnsetType, to_builtins
 
-from unibuckle_fenicsx.algorithms.records import MethodDetails
+from unibuckle_fenicsx.algorithms.records import ContinuedRecord, MethodDetails
 from unibuckle_fenicsx.certificate.records import CopositivityRecord
 from unibuckle_fenicsx.design import DesignRecord
 from unibuckle_fenicsx.model.points import PointReport
@@ -126,6 +126,7 @@ class ResultDetails(Struct, kw_only=True):
         run: The algorithm's record of its run (flattened into ``details`` in the
             JSON).
         lower_bound_by: What proves the algorithm's lower bound.
+        continued: The continuations from a certificate's refuting modes.
     """
 
     free_eigen_error: float
@@ -135,6 +136,7 @@ class ResultDetails(Struct, kw_only=True):
     plate_model: str | UnsetType = UNSET
     run: MethodDetails | UnsetType = UNSET
     lower_bound_by: str | UnsetType = UNSET
+    continued: list[ContinuedRecord] | UnsetType = UNSET
 
 
 class BucklingResult(Struct, kw_only=True):
@@ -426,6 +428,12 @@ def _verified(cert: CertificateRecord | None) -> str:
     refuted = cert.refuting_load_Pa
     if refuted is not None:
         return f"proven=no, refuted: an admissible mode has {refuted:.6e} Pa"
+    split = cert.copositivity.split if cert.copositivity is not None else None
+    if split is not None and split.skipped:
+        return (
+            f"proven=no (KKT only{below}; not bracketed by default here: estimated cost "
+            f"{split.estimated_cost or 0.0:.1f} free solves, --bracket runs it)"
+        )
     return f"proven=no (KKT only{below})"
 
 

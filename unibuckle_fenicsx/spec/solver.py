@@ -70,9 +70,10 @@ class SolverSpec(Table, frozen=True):
             (it runs when the budget covers the i singletons).
         certify: Verify the result's global optimality (:doc:`/methods/certificates`);
             off for speed studies.
-        bracket: Also try the low-rank verified bracket when two or more pencil
-            eigenvalues lie below the load (:doc:`/methods/certificates`): tens of free
-            solves' time on a thin plate, so off by default.
+        bracket: Run the verified bracket when two or more pencil eigenvalues lie below
+            the load whatever its cost, with smaller distances and larger budgets
+            (:doc:`/methods/certificates`); by default it runs only where its estimated
+            cost is at most 3 free solves (the summary says when it did not).
         penalty: Penalty stiffness rho for ``method="penalty"`` (relative to the largest
             diagonal entry of A), > 0.
         prestress_degree: Lagrange degree of the in-plane displacement, >= 1.
