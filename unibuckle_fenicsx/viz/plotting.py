@@ -39,6 +39,8 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "THEME",
+    "annotate",
+    "coloured_surface",
     "plot_contact_map",
     "plot_contact_set",
     "plot_convergence",
@@ -127,6 +129,79 @@ def _normalised(w: npt.NDArray[np.float64], tau: float) -> npt.NDArray[np.float6
 
 
 # -- 3-D mode ----------------------------------------------------------------------------
+def annotate(plotter: Any, legend: Sequence[tuple[str, str]], title: str, font: str | None) -> None:
+    """The legend (label, colour) at the lower left and the title at the upper left."""
+    if legend:
+        plotter.add_legend(
+            labels=[[label, color] for label, color in legend],
+            bcolor="white",
+            border=True,
+            size=(0.3, 0.1),
+            loc="lower left",
+            face="rectangle",
+        )
+    if title:
+        plotter.add_text(
+            title,
+            position="upper_left",
+            font_size=THEME["font_size"] - 2,
+            color="black",
+            font_file=font,
+        )
+
+
+def coloured_surface(
+    pv: Any,
+    surface: Any,
+    scalars: str,
+    title: str,
+    *,
+    edges: bool,
+    line_width: float = 0.5,
+    ambient: float = 0.0,
+) -> tuple[Any, str | None]:
+    """An off-screen plotter with ``surface`` coloured by ``scalars`` in [-1, 1] and its bar.
+
+    ``ambient``: VTK's ambient light coefficient (0 to 1), so that walls seen at a grazing
+    angle keep their colour.
+
+    Returns:
+        The plotter (the caller closes it) and the font file of its text (or None).
+    """
+    font = _font_file()
+    plotter = pv.Plotter(off_screen=True, window_size=THEME["window_size"])
+    plotter.set_background("white")
+    plotter.add_mesh(
+        surface,
+        scalars=scalars,
+        cmap=THEME["cmap"],
+        clim=(-1.0, 1.0),
+        show_edges=edges,
+        edge_color="gray",
+        line_width=line_width,
+        show_scalar_bar=False,
+        ambient=ambient,
+    )
+    bar = plotter.add_scalar_bar(
+        title=title,
+        vertical=True,
+        position_x=0.87,
+        position_y=0.2,
+        height=0.6,
+        width=0.06,
+        title_font_size=THEME["font_size"],
+        label_font_size=THEME["font_size"] - 2,
+        color="black",
+        fmt="%.1f",
+        n_labels=5,
+    )
+    if font is not None:
+        for prop in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
+            prop.SetFontFamily(_VTK_FONT_FILE)
+            prop.SetFontFile(font)
+    return plotter, font
+
+
 def plot_mode_3d(
     problem: BucklingProblem,
     mode: dolfinx.fem.Function,
@@ -169,36 +244,9 @@ def plot_mode_3d(
     warp = THEME["warp"] * scale
     warped = grid.warp_by_scalar("w / max|w|", factor=warp)
 
-    font = _font_file()
-    plotter = pv.Plotter(off_screen=True, window_size=THEME["window_size"])
-    plotter.set_background("white")
-    plotter.add_mesh(
-        warped,
-        scalars="w / max|w|",
-        cmap=THEME["cmap"],
-        clim=(-1.0, 1.0),
-        show_edges=grid.n_cells <= 2500,
-        edge_color="gray",
-        line_width=0.5,
-        show_scalar_bar=False,
+    plotter, font = coloured_surface(
+        pv, warped, "w / max|w|", "w (normalised)", edges=grid.n_cells <= 2500
     )
-    bar = plotter.add_scalar_bar(
-        title="w (normalised)",
-        vertical=True,
-        position_x=0.87,
-        position_y=0.2,
-        height=0.6,
-        width=0.06,
-        title_font_size=THEME["font_size"],
-        label_font_size=THEME["font_size"] - 2,
-        color="black",
-        fmt="%.1f",
-        n_labels=5,
-    )
-    if font is not None:
-        for prop in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
-            prop.SetFontFamily(_VTK_FONT_FILE)
-            prop.SetFontFile(font)
     # Flat reference outline of the plate at w = 0.
     (px0, py0), (px1, py1) = problem.spec.plate.corners
     plate_outline = pv.Rectangle([[px0, py0, 0.0], [px1, py0, 0.0], [px1, py1, 0.0]])
@@ -228,23 +276,7 @@ def plot_mode_3d(
         )
     if box is not None:
         legend.append((f"contact nodes: {len(cxy)}", "black"))
-    if legend:
-        plotter.add_legend(
-            labels=[[label, color] for label, color in legend],
-            bcolor="white",
-            border=True,
-            size=(0.3, 0.1),
-            loc="lower left",
-            face="rectangle",
-        )
-    if title:
-        plotter.add_text(
-            title,
-            position="upper_left",
-            font_size=THEME["font_size"] - 2,
-            color="black",
-            font_file=font,
-        )
+    annotate(plotter, legend, title, font)
     plotter.add_axes(
         xlabel="x", ylabel="y", zlabel="w", color="black", viewport=(0.72, 0.0, 0.86, 0.18)
     )
