@@ -133,3 +133,18 @@ def test_section_figure_is_written(tmp_path):
         assert np.abs(data.displacement).max() == pytest.approx(1.0)
         path = plot_section_mode_3d(data, tmp_path / "box.png", title="box")
     assert path.stat().st_size > 10_000
+
+
+def test_core_over_part_of_the_length():
+    """Fewer constrained directions, a wider cone: free <= part of the length <= whole length."""
+    loads = []
+    for span in (None, (0.0, 0.1)):
+        params = _parameters("box", mesh_size=0.05, length=0.2, core_span=span)
+        with build_section(params, MPI.COMM_SELF) as sec:
+            x = sec.constraints.coordinates[:, 0]
+            assert (x.max() <= 0.1 + 1e-12) if span else (x.max() > 0.1)
+            loads.append(solve_active_set(sec.problem, multilevel=False).load)
+            free = sec.problem.solve_free().load
+    whole, part = loads
+    assert free <= part * (1 + 1e-9) and part <= whole * (1 + 1e-9), (free, part, whole)
+    assert part < whole  # the buckle moves to the uncovered half
