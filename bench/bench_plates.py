@@ -54,7 +54,7 @@ from _results import append_rows, print_header
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.certify import Certificate
-from unibuckle_fenicsx.config import ObstacleSpec, problem_to_dict
+from unibuckle_fenicsx.spec import ObstacleSpec, problem_to_dict
 
 #: name -> (edge supports, load, description of the edges)
 CASES = {

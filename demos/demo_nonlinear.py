@@ -46,8 +46,7 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx import paper_case
-from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx import paper_case, solve
 from unibuckle_fenicsx.nonlinear import NonlinearOptions, solve_nonlinear, southwell_window
 from unibuckle_fenicsx.viz import fields, plotting, study
 from unibuckle_fenicsx.viz.fields import zone_box

@@ -34,8 +34,7 @@ import warnings
 
 from mpi4py import MPI
 
-from unibuckle_fenicsx import SolverSpec, paper_case
-from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx import SolverSpec, paper_case, solve
 from unibuckle_fenicsx.viz import study
 
 warnings.filterwarnings("error")  # demos run warning-free

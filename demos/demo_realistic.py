@@ -36,8 +36,7 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import problem_from_dict
+from unibuckle_fenicsx import problem_from_dict, solve
 from unibuckle_fenicsx.viz import fields, study
 
 warnings.filterwarnings("error")  # demos run warning-free
@@ -105,21 +104,28 @@ with solve(spec, comm) as analysis:
             analysis.mode,
             figures / "mode.png",
             contact_coordinates=result.contact_coordinates,
+            contact_pressing=fields.pressing(result),
             title=title,
             tau=problem.tau,
         )
         hole = spec.plate.holes[0]
-        from unibuckle_fenicsx.geometry import circle_points
-
+        turn = np.linspace(0.0, 2 * np.pi, 97)[:-1]
+        circle = np.column_stack(
+            [
+                hole.center[0] + hole.radius * np.cos(turn),
+                hole.center[1] + hole.radius * np.sin(turn),
+            ]
+        )
         map_png = plotting.plot_contact_map(
             figures / "contact_map.png",
             xy,
             w,
             triangles,
             boundary=spec.plate.boundary,
-            holes=[circle_points(hole.center, hole.radius)],
+            holes=[circle],
             zones=fields.zone_outlines(spec),
             contact_coordinates=result.contact_coordinates,
+            contact_pressing=fields.pressing(result),
             title="contact map: mode w / max|w| and the nodes resting on the concrete",
             tau=problem.tau,
         )

@@ -21,8 +21,10 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import re
 import subprocess
 import sys
+import tempfile
 import time
 from pathlib import Path
 from typing import Any
@@ -40,7 +42,14 @@ DEMOS = (
     "demo_nonlinear.py",  # figures/nonlinear/; no row in the table
     "demo_realistic.py",  # figures/realistic/; no row in the table
     "demo_column.py",  # figures/column/; no row in the table
+    "study_ties.py",  # figures/ties/: k against the tie spacing; no row in the table
 )
+#: The quickstart's runs (docs/guide/quickstart.md shows their output): the README's first
+#: problem file, as a user runs it, without and with --bracket.
+QUICKSTART = {
+    "output.txt": ["solve", "--config", "demos/plate.toml", "--json", "plate.json"],
+    "output_bracket.txt": ["solve", "--config", "demos/plate.toml", "--bracket"],
+}
 CASES = ("free", "c1", "c2", "c3")
 COLUMNS = (
     "case",
@@ -92,7 +101,7 @@ def _table(rows: list[list[str]]) -> tuple[str, str]:
 
 def _compare_cases(paper: dict[str, dict[str, Any]], figures: Path) -> list[str]:
     """Section A of every case on the paper's mesh, and the paper's comparisons."""
-    from unibuckle_fenicsx.cases import paper_case
+    from unibuckle_fenicsx import paper_case
     from unibuckle_fenicsx.viz import plotting
     from unibuckle_fenicsx.viz.fields import mirror_to_match, zone_box
 
@@ -138,6 +147,52 @@ def _compare_cases(paper: dict[str, dict[str, Any]], figures: Path) -> list[str]
     return [name for name, ok in checks.items() if not ok]
 
 
+#: The wall time of a summary line: the one part of the output that changes between runs.
+_WALL_TIME = re.compile(r"eigensolves, [0-9.]+ s")
+#: Any time in seconds a demo prints ("12.3 s", "in 4 s"), and a table's last column of
+#: two-decimal seconds (demo_nonlinear's "time (s)").
+_SECONDS = re.compile(r"\b[0-9]+(\.[0-9]+)? ?s\b|  +[0-9]+\.[0-9]{2}$", re.M)
+
+
+def keep_output(path: Path, text: str) -> bool:
+    """Store a demo's printed output at ``path`` (its page shows it); True if written.
+
+    An output that differs from the stored one only in its times is not rewritten, so
+    that ``make demo`` leaves unchanged answers untouched.
+    """
+    old = path.read_text() if path.exists() else None
+    if old is not None and _SECONDS.sub("", old) == _SECONDS.sub("", text):
+        return False
+    path.parent.mkdir(parents=True, exist_ok=True)
+    path.write_text(text)
+    return True
+
+
+def quickstart(figures: Path, env: dict[str, str]) -> list[str]:
+    """Run the quickstart's commands and keep their output in ``figures/quickstart/``.
+
+    The commands run as a user types them (the ``unibuckle`` of this Python, in the
+    repository's root; the JSON goes to a scratch directory). A stored output is rewritten
+    only when more than its times changed (:func:`keep_output`). Returns the commands
+    that failed.
+    """
+    out = figures / "quickstart"
+    out.mkdir(parents=True, exist_ok=True)
+    unibuckle = str(Path(sys.executable).with_name("unibuckle"))
+    failed = []
+    with tempfile.TemporaryDirectory() as scratch:
+        for name, args in QUICKSTART.items():
+            argv = [unibuckle] + [str(Path(scratch, a)) if a.endswith(".json") else a for a in args]
+            proc = subprocess.run(argv, capture_output=True, text=True, env=env, cwd=ROOT)
+            if proc.returncode != 0:
+                failed.append(" ".join(["unibuckle", *args]))
+                print(proc.stdout, proc.stderr, sep="\n", file=sys.stderr)
+                continue
+            keep_output(out / name, proc.stdout)
+            print(f"unibuckle {' '.join(args)}:\n{proc.stdout}", flush=True)
+    return failed
+
+
 def main(argv: list[str] | None = None) -> int:
     """Run the demos; return the exit status."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -155,8 +210,15 @@ def main(argv: list[str] | None = None) -> int:
     env = {**os.environ, "PYVISTA_OFF_SCREEN": "true", "OMP_NUM_THREADS": "1"}
     failed = []
     t_all = time.perf_counter()
+    if not args.coarse:  # the quickstart's plate is the README's, as it is
+        t0 = time.perf_counter()
+        bad = quickstart(figures, env)
+        print(f"quickstart: {'ok' if not bad else 'FAILED'} in {time.perf_counter() - t0:.1f} s")
+        failed += bad
     for demo in DEMOS:
-        cmd = [sys.executable, str(ROOT / "demos" / demo), "--figures", str(figures)]
+        # Relative to the repository when inside it: the outputs print figures/... paths.
+        where = figures.relative_to(ROOT) if figures.is_relative_to(ROOT) else figures
+        cmd = [sys.executable, str(ROOT / "demos" / demo), "--figures", str(where)]
         if args.coarse:
             cmd.append("--coarse")
         if args.output is not None and demo.startswith("demo_"):
@@ -166,6 +228,8 @@ def main(argv: list[str] | None = None) -> int:
         elapsed = time.perf_counter() - t0
         status = "ok" if proc.returncode == 0 else f"FAILED ({proc.returncode})"
         print(f"{demo}: {status} in {elapsed:.1f} s", flush=True)
+        if proc.returncode == 0 and not args.coarse:
+            keep_output(figures / "stdout" / demo.replace(".py", ".txt"), proc.stdout)
         if proc.returncode != 0:
             failed.append(demo)
             print(proc.stdout[-4000:], proc.stderr[-4000:], sep="\n", file=sys.stderr)
@@ -187,13 +251,10 @@ def main(argv: list[str] | None = None) -> int:
         print(text)
         (figures / "results.md").write_text(md + "\n")
     if studies:
-        from unibuckle_fenicsx.model.materials import navier_load_mindlin
         from unibuckle_fenicsx.viz import plotting
 
-        free = json.loads((figures / "free" / "results.json").read_text())
-        reference = free.get("reference_Pa") if "free" in studies else None
-        if reference is None:
-            reference, _ = navier_load_mindlin(1.0e9, 0.3, 0.006, 0.2, 0.1)
+        # The Navier load demo_free_plate.py worked out (its results.json).
+        reference = paper["free"].get("reference_Pa") if "free" in paper else None
         path = plotting.plot_convergence(
             figures / "convergence.png",
             studies,

@@ -13,7 +13,8 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import (
     EDGE_NAMES,
     EdgeSpec,
     Material,
@@ -23,7 +24,6 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 def _interior_nodes_in_box(nx, ny, length, width, box) -> int:
@@ -486,7 +486,7 @@ def schema_family(count: int, seed: int = 20260301) -> list[tuple[dict, list[str
     zones on both sides of the plate) are drawn again: refusing them is the bad-input
     family's concern.
     """
-    from unibuckle_fenicsx.config import problem_from_dict
+    from unibuckle_fenicsx.spec import problem_from_dict
 
     rng = np.random.default_rng(seed)
     found: list[tuple[dict, list[str]]] = []

@@ -28,7 +28,7 @@ from typing import Any
 import pytest
 
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
-from unibuckle_fenicsx.config import problem_from_dict
+from unibuckle_fenicsx.spec import problem_from_dict
 
 SAMPLE_STEP = 8
 #: The family's size: keys (and numbers inside list values) and bad values in all.
@@ -367,7 +367,7 @@ def test_every_key_is_in_the_family():
     """The bases hold every key of the schema (a new key must join them); the counts."""
     from dataclasses import fields
 
-    from unibuckle_fenicsx.config import (
+    from unibuckle_fenicsx.spec import (
         OBSTACLE_KEYS,
         PLY_KEYS,
         DesignSpec,

@@ -25,7 +25,8 @@ from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certificate.certify import certify, reduced_inertia
 from unibuckle_fenicsx.certificate.copositivity import copositivity_bound
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
     MeshSpec,
@@ -34,7 +35,6 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.tolerances import PROOF_GAP
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
@@ -144,13 +144,25 @@ def test_two_eigenvalues_below_needs_the_sdp_route():
 
 
 def test_no_certify_skips_the_proof():
+    """Unproven, the summary prints the verified bracket: [free load, returned load].
+
+    Interlacing makes the free load a lower bound, the returned mode's load (admissible)
+    an upper one; the screen says so, not only the JSON.
+    """
     spec = paper_case("c1", 20, 20).with_solver(certify=False)
     with solve(spec) as analysis:
         cert = analysis.certificate
+        result = analysis.result
     assert cert.kkt and not cert.global_optimum_proven
     assert cert.copositivity is None and cert.smallest_of_reduced is None
     assert any("skipped" in note for note in cert.notes)
-    assert cert.lower_bound == pytest.approx(analysis.result.free_load_Pa)
+    assert cert.lower_bound == pytest.approx(result.free_load_Pa)
+    line = result.summary().splitlines()[1]
+    assert line == (
+        f"  not proven: the critical load lies between {result.free_load_Pa:.6e} Pa "
+        "(verified lower bound, the free plate's, by interlacing) and "
+        f"{result.critical_load_Pa:.6e} Pa"
+    ), result.summary()
 
 
 def test_inactive_obstacle_is_proven():
@@ -226,7 +238,7 @@ def test_a_bound_verified_at_the_proof_gap_proves_the_optimum():
     and below the right part) whose bound closes there: "proven" either way, not
     "bracketed" by the last bit of the gap.
     """
-    from unibuckle_fenicsx.config import problem_from_dict
+    from unibuckle_fenicsx.spec import problem_from_dict
 
     spec = problem_from_dict(
         {

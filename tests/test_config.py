@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from unibuckle_fenicsx.cases import CASES, paper_case
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.spec import (
     EDGE_NAMES,
     EdgeSpec,
     Material,

@@ -36,6 +36,7 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
         pngs[f"{case}/convergence.png"] = conv
         pngs[f"{case}/section_A.png"] = line
         pngs[f"{case}/contact_set.png"] = line
+        pngs[f"{case}/contact_force.png"] = line
         for mesh in COARSE:
             pngs[f"{case}/mode_{mesh}.png"] = (h3, w3)
     for name in ("ssss", "loaded_edges_clamped"):  # charts.plot_sweep: 7.5 x 5 in at 150 dpi
@@ -50,6 +51,7 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
     pngs["column/mode.png"] = (h3, w3)  # demo_column
     pngs["column/contact_map.png"] = line
     pngs["column/tie_spacing.png"] = (750, 1125)  # charts.plot_sweep
+    pngs["ties/tie_spacing_study.png"] = (750, 1125)  # study_ties: charts.plot_sweep
     return pngs
 
 
@@ -73,7 +75,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for demo in (
         "demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3",
-        "demo_garland", "demo_nonlinear", "demo_realistic", "demo_column",
+        "demo_garland", "demo_nonlinear", "demo_realistic", "demo_column", "study_ties",
     ):  # fmt: skip
         assert f"{demo}.py: ok" in proc.stdout
     assert "lambda/lambda_free" in proc.stdout and "eigen solves" in proc.stdout
@@ -138,3 +140,44 @@ def test_zone_box_of_the_paper_cases():
     assert zone_box(paper_case("c1")) == ((-0.04, 0.04), (-0.05, 0.05))
     assert zone_box(paper_case("c2")) == ((-0.04, 0.04), (-0.02, 0.02))
     assert zone_box(paper_case("c3")) == ((-0.1, 0.1), (-0.05, 0.05))
+
+
+#: The modules the demos may import from, besides the names of ``unibuckle_fenicsx``'s
+#: ``__all__``: the public modules of the API page (docs/reference/api.rst).
+PUBLIC_MODULES = (
+    "unibuckle_fenicsx.sweep",
+    "unibuckle_fenicsx.nonlinear",
+    "unibuckle_fenicsx.viz",
+    "unibuckle_fenicsx.viz.plotting",
+    "unibuckle_fenicsx.viz.charts",
+    "unibuckle_fenicsx.viz.fields",
+    "unibuckle_fenicsx.viz.study",
+)
+#: Scripts that study an algorithm itself and call it directly (not a user's workflow).
+ALGORITHM_STUDIES = ("study_penalty.py",)
+
+
+@pytest.mark.parametrize(
+    "script",
+    sorted(p.name for p in (ROOT / "demos").glob("*.py") if p.name not in ALGORITHM_STUDIES),
+)
+def test_demos_use_the_public_api(script):
+    """A demo imports only the package's public names and modules (what a user would)."""
+    import ast
+
+    import unibuckle_fenicsx
+
+    tree = ast.parse((ROOT / "demos" / script).read_text())
+    for node in ast.walk(tree):
+        if isinstance(node, ast.ImportFrom) and (node.module or "").startswith("unibuckle"):
+            if node.module == "unibuckle_fenicsx":
+                names = {alias.name for alias in node.names}
+                assert names <= set(unibuckle_fenicsx.__all__), (script, names)
+            else:
+                assert node.module in PUBLIC_MODULES, (script, node.module)
+        elif isinstance(node, ast.Import):
+            for alias in node.names:
+                assert not alias.name.startswith("unibuckle") or alias.name in (
+                    "unibuckle_fenicsx",
+                    *PUBLIC_MODULES,
+                ), (script, alias.name)

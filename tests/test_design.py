@@ -17,8 +17,8 @@ from mpi4py import MPI
 import pytest
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.design import reduction_factor
+from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
 
 
 def plate(edges, *, obstacle=None, design=None, **extra):

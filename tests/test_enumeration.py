@@ -29,9 +29,9 @@ from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certificate.certify import certify
-from unibuckle_fenicsx.config import ObstacleSpec, ProblemSpec
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import ObstacleSpec, ProblemSpec
 from unibuckle_fenicsx.tolerances import LOAD_TIE_RTOL
 
 RTOL = 1e-9

@@ -132,7 +132,7 @@ def test_a_sweep_point_refused_by_the_solver_is_refused(tmp_path):
 
 
 def test_input_errors_are_value_errors_for_old_callers():
-    from unibuckle_fenicsx.config import problem_from_dict
+    from unibuckle_fenicsx.spec import problem_from_dict
 
     with pytest.raises(ValueError, match=r"plate\.thickness"):
         problem_from_dict({"plate": {"thickness": 0.0}})

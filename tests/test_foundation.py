@@ -33,10 +33,10 @@ from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.certify import certify_foundation
-from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.model.contact import tributary_areas
 from unibuckle_fenicsx.model.materials import bending_stiffness
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
 
 THICKNESS = 1e-3  # b = 1 m: t/b = 1e-3, the thin limit
 D = bending_stiffness(1.0e9, 0.3, THICKNESS)

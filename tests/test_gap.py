@@ -24,7 +24,7 @@ import pytest
 from conftest import run_mpi
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
 
 CLI = Path(__file__).resolve().parents[1] / "unibuckle_fenicsx" / "cli.py"
 GAP = 0.003  # m: half the paper plate's thickness

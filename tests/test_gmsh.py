@@ -26,17 +26,17 @@ from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_unilateral  #
 from unibuckle_fenicsx.analysis import solve  # noqa: E402
 from unibuckle_fenicsx.cases import paper_case  # noqa: E402
 from unibuckle_fenicsx.cli import main as cli_main  # noqa: E402
-from unibuckle_fenicsx.config import (  # noqa: E402
+from unibuckle_fenicsx.model.gmsh_mesh import GMSH_OPTIONS  # noqa: E402
+from unibuckle_fenicsx.model.materials import navier_load_mindlin  # noqa: E402
+from unibuckle_fenicsx.model.problem import BucklingProblem  # noqa: E402
+from unibuckle_fenicsx.model.zones import zone_report  # noqa: E402
+from unibuckle_fenicsx.spec import (  # noqa: E402
     Circle,
     Polygon,
     load_toml,
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.model.gmsh_mesh import GMSH_OPTIONS  # noqa: E402
-from unibuckle_fenicsx.model.materials import navier_load_mindlin  # noqa: E402
-from unibuckle_fenicsx.model.problem import BucklingProblem  # noqa: E402
-from unibuckle_fenicsx.model.zones import zone_report  # noqa: E402
 
 #: The paper's plate as an outline: segment 0 bottom, 1 right, 2 top, 3 left.
 PAPER_OUTLINE = [[-0.1, -0.05], [0.1, -0.05], [0.1, 0.05], [-0.1, 0.05]]

@@ -59,8 +59,8 @@ from unibuckle_fenicsx.algorithms.interior_point import (
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case, plate_case
-from unibuckle_fenicsx.config import ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 PARALLEL = Path(__file__).parent / "mpi" / "interior_point_parallel.py"

@@ -38,9 +38,9 @@ import pytest
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.config import Material, Ply, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.laminate import laminate
 from unibuckle_fenicsx.model.materials import bending_voigt, membrane_voigt, shear_stiffness
+from unibuckle_fenicsx.spec import Material, Ply, problem_from_dict, problem_to_dict
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate

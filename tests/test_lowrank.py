@@ -37,8 +37,8 @@ from unibuckle_fenicsx.certificate.accurate import AccurateResidual, two_product
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions, lowrank_certificate
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
-from unibuckle_fenicsx.config import ObstacleSpec
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import ObstacleSpec
 from unibuckle_fenicsx.tolerances import BRACKET_GAP, ROUNDING_RTOL
 
 pytest.importorskip("clarabel")

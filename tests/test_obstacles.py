@@ -20,7 +20,9 @@ from exhaustive import RTOL, exhaustive_minimum
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case, plate_case
 from unibuckle_fenicsx.cli import main as cli_main
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.model.contact import BilateralZoneError
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import (
     Circle,
     ObstacleSpec,
     Polygon,
@@ -28,8 +30,6 @@ from unibuckle_fenicsx.config import (
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.model.contact import BilateralZoneError
-from unibuckle_fenicsx.model.problem import BucklingProblem
 
 
 # -- schema ------------------------------------------------------------------------------

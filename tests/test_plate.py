@@ -16,15 +16,6 @@ import numpy as np
 import pytest
 
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.config import (
-    EdgeSpec,
-    Material,
-    MeshSpec,
-    ObstacleSpec,
-    PlateSpec,
-    ProblemSpec,
-    SolverSpec,
-)
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.materials import (
     bending_stiffness,
@@ -33,6 +24,15 @@ from unibuckle_fenicsx.model.materials import (
     shear_modulus,
 )
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import (
+    EdgeSpec,
+    Material,
+    MeshSpec,
+    ObstacleSpec,
+    PlateSpec,
+    ProblemSpec,
+    SolverSpec,
+)
 
 E, NU = 1.0e9, 0.3
 #: The paper's plate (paper, section 6).
@@ -200,7 +200,7 @@ def test_obstacle_zone_without_free_node(zone):
 
 def test_empty_circle_zone_is_named_by_its_key():
     """A circle holding no mesh node is named obstacle.circle, the key that gave it."""
-    from unibuckle_fenicsx.config import Circle
+    from unibuckle_fenicsx.spec import Circle
 
     zone = Circle(center=(0.001, 0.001), radius=0.0005)  # between the nodes of 20x10
     spec = ProblemSpec(mesh=MeshSpec(20, 10), obstacle=ObstacleSpec(zone=zone))

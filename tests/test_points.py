@@ -28,12 +28,12 @@ import pytest
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.model.materials import bending_stiffness
+from unibuckle_fenicsx.spec import (
     PointSpec,
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.model.materials import bending_stiffness
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate, isotropic

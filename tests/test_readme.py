@@ -1,9 +1,9 @@
 """The README's first problem file, its command and its Python example run as written.
 
-The problem file and the command are taken from the README's first ``toml`` and ``sh``
-blocks that name ``plate.toml``, the example from its first ``python`` block; only the
-cell size is coarsened (0.01 m to 0.025 m) so that the test stays fast. What is asserted
-holds for every plate (no number of the code under test is an expected value): the
+The problem file and the command are taken from the README's first ``toml`` block and
+its ``sh`` block that names ``demos/plate.toml``, the example from its first ``python``
+block; only the cell size is coarsened (0.01 m to 0.025 m) so that the test stays fast.
+What is asserted holds for every plate (no number of the code under test is an expected value): the
 critical load with an obstacle is at least the free one (interlacing: removing degrees
 of freedom never lowers the smallest eigenvalue), and the answer satisfies its KKT
 certificate (the CLI's exit status 0 says so, and the JSON's certificate).
@@ -36,9 +36,10 @@ def test_readme_is_short() -> None:
 def test_first_problem_file_and_command(tmp_path: Path) -> None:
     toml = _blocks("toml")[0]
     assert "size = 0.01 " in toml, "the test coarsens the README's mesh.size = 0.01"
-    (tmp_path / "plate.toml").write_text(toml.replace("size = 0.01 ", "size = 0.025"))
+    (tmp_path / "demos").mkdir()
+    (tmp_path / "demos" / "plate.toml").write_text(toml.replace("size = 0.01 ", "size = 0.025"))
     lines = [line for block in _blocks("sh") for line in block.splitlines()]
-    command = next(line for line in lines if "--config plate.toml" in line)
+    command = next(line for line in lines if "--config demos/plate.toml" in line)
     argv = shlex.split(command)
     assert argv[0] == ".venv/bin/unibuckle"
     argv[0] = str(Path(sys.executable).with_name("unibuckle"))

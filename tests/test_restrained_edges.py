@@ -35,8 +35,8 @@ from scipy.optimize import brentq
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.config import EdgeSpec, ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.model.materials import bending_stiffness
+from unibuckle_fenicsx.spec import EdgeSpec, ObstacleSpec, problem_from_dict, problem_to_dict
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate, isotropic

@@ -30,10 +30,10 @@ from unibuckle_fenicsx.cli import (
     EXIT_OK,
     main,
 )
-from unibuckle_fenicsx.config import problem_from_dict
-from unibuckle_fenicsx.config.checks import MAX_THICKNESS_RATIO, THICK_PLATE_RATIO
 from unibuckle_fenicsx.io import file_stem
 from unibuckle_fenicsx.results import versions
+from unibuckle_fenicsx.spec import problem_from_dict
+from unibuckle_fenicsx.spec.checks import MAX_THICKNESS_RATIO, THICK_PLATE_RATIO
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs its own processes")

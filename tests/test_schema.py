@@ -1,9 +1,9 @@
 """The published schema of a problem file: the file in the repository, the CLI, the keys.
 
 The JSON Schema in ``schema/unibuckle-problem.schema.json`` must be the package's
-(:func:`~unibuckle_fenicsx.config.json_schema`), every key of
-:func:`~unibuckle_fenicsx.config.accepted_keys` must load, and the JSON ``input`` echo
-(:func:`~unibuckle_fenicsx.config.problem_to_dict`) must pass the schema. The documents
+(:func:`~unibuckle_fenicsx.spec.json_schema`), every key of
+:func:`~unibuckle_fenicsx.spec.accepted_keys` must load, and the JSON ``input`` echo
+(:func:`~unibuckle_fenicsx.spec.problem_to_dict`) must pass the schema. The documents
 below are problems written for this test (README, "Problem files"); the bad-input
 family's three bases come from its module.
 """
@@ -21,13 +21,13 @@ from conftest import ROOT
 from test_bad_input_family import BASES
 
 from unibuckle_fenicsx.cli import EXIT_OK, main
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.spec import (
     accepted_keys,
     json_schema,
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.config.schema import validate_document
+from unibuckle_fenicsx.spec.schema import validate_document
 
 SCHEMA_FILE = ROOT / "schema" / "unibuckle-problem.schema.json"
 

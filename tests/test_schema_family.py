@@ -45,12 +45,12 @@ from families import schema_family
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import problem_from_dict
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.mesh import build_plate_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
 from unibuckle_fenicsx.model.prestress import solve_prestress
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import problem_from_dict
 
 FAMILY_SIZE = 120
 SAMPLE = 12

@@ -17,12 +17,12 @@ import math
 import numpy as np
 import pytest
 
-from unibuckle_fenicsx.config import Material
 from unibuckle_fenicsx.eigen import GEPSolver
 from unibuckle_fenicsx.model.materials import bending_stiffness
 from unibuckle_fenicsx.model.shell.geometry import box_mesh, tube_mesh
 from unibuckle_fenicsx.model.shell.model import ShellModel, end_supports
 from unibuckle_fenicsx.model.shell.prestress import solve_section_prestress
+from unibuckle_fenicsx.spec import Material
 
 pytestmark = pytest.mark.convergence
 
@@ -127,7 +127,7 @@ def _plate_with_obstacle(unloaded: str, n: int) -> float:
     """A face as a plate: its k at a/b = 3, b/t = 100, whole-plate obstacle, SS loaded edges."""
     from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.cases import plate_case
-    from unibuckle_fenicsx.config import ObstacleSpec
+    from unibuckle_fenicsx.spec import ObstacleSpec
 
     spec = plate_case(
         "face", length=0.6, width=0.2, thickness=0.002, nx=3 * n, ny=n, material=STEEL,

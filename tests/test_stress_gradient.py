@@ -26,7 +26,10 @@ from scipy.optimize import minimize_scalar
 from test_prestress import n0_at_quadrature_points
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.model.mesh import create_plate_mesh
+from unibuckle_fenicsx.model.prestress import solve_prestress
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
     MeshSpec,
@@ -37,9 +40,6 @@ from unibuckle_fenicsx.config import (
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.model.mesh import create_plate_mesh
-from unibuckle_fenicsx.model.prestress import solve_prestress
-from unibuckle_fenicsx.model.problem import BucklingProblem
 
 #: Thin plate: the Reissner-Mindlin shear correction is O((t/b)^2) = 1e-6.
 THICKNESS = 1e-3

@@ -25,7 +25,7 @@ from conftest import ROOT, run_mpi
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.spec import (
     MeshSpec,
     ObstacleSpec,
     load_toml,
@@ -381,3 +381,17 @@ def test_ranks_per_point_errors_name_the_flag(tmp_path):
     for bad, why in ((0, r"must be an integer >= 1"), (MPI.COMM_WORLD.size + 1, "must divide")):
         with pytest.raises(ValueError, match=rf"ranks_per_point \(--ranks-per-point\).*{why}"):
             run_sweep({}, v, tmp_path / "s.jsonl", MPI.COMM_WORLD, ranks_per_point=bad)
+
+
+def test_chart_axes_name_the_swept_number_in_words():
+    """An axis reads "tie spacing (m)", not the dotted key ``points.0.spacing``."""
+    from unibuckle_fenicsx.viz.charts import axis_label
+
+    base = {"units": "SI", "points": [{"kind": "bilateral", "spacing": 0.5}]}
+    assert axis_label("points.0.spacing", base) == "tie spacing (m)"
+    assert axis_label("points.0.spacing", {**base, "units": "mm-N-MPa"}) == "tie spacing (mm)"
+    assert axis_label("plate.thickness", base) == "plate thickness (m)"
+    assert axis_label("edges.top.rotational_stiffness", base) == (
+        "rotational stiffness of the top edge (N·m/(m·rad))"
+    )
+    assert axis_label("obstacle.foundation_stiffness", base) == "foundation modulus (Pa/m)"

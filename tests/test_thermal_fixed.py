@@ -35,8 +35,8 @@ import pytest
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import paper_case
-from unibuckle_fenicsx.config import LoadSpec, Material, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.model.materials import bending_stiffness, navier_load_mindlin
+from unibuckle_fenicsx.spec import LoadSpec, Material, problem_from_dict, problem_to_dict
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate, isotropic

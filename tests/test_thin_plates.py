@@ -26,7 +26,7 @@ import pytest
 
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
-from unibuckle_fenicsx.config import ObstacleSpec
+from unibuckle_fenicsx.spec import ObstacleSpec
 
 #: name -> (supports, load, thin-plate k)
 CASES = {

@@ -8,7 +8,7 @@ first use.
 from typing import Any
 
 from unibuckle_fenicsx.cases import CASES, paper_case
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
     MeshSpec,
@@ -17,6 +17,8 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
     load_toml,
+    problem_from_dict,
+    problem_to_dict,
 )
 
 __version__ = "0.1.0"
@@ -33,6 +35,8 @@ __all__ = [
     "__version__",
     "load_toml",
     "paper_case",
+    "problem_from_dict",
+    "problem_to_dict",
     "solve",
 ]
 

@@ -1,4 +1,4 @@
-"""High-level entry point: :func:`solve` a :class:`~unibuckle_fenicsx.config.ProblemSpec`."""
+"""High-level entry point: :func:`solve` a :class:`~unibuckle_fenicsx.spec.ProblemSpec`."""
 
 from __future__ import annotations
 
@@ -18,11 +18,11 @@ from unibuckle_fenicsx.algorithms import (
 )
 from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.results import BucklingResult
+from unibuckle_fenicsx.spec import ProblemSpec
 
 __all__ = ["Analysis", "choose_method", "solve"]
 
@@ -200,7 +200,7 @@ def solve(
         The analysis (result, mode, problem); the caller destroys it (or uses ``with``).
 
     Raises:
-        TypeError: ``spec`` is not a :class:`~unibuckle_fenicsx.config.ProblemSpec` or
+        TypeError: ``spec`` is not a :class:`~unibuckle_fenicsx.spec.ProblemSpec` or
             ``comm`` not an MPI communicator.
         InputError: The problem is refused (before any solve, or once its mesh exists).
         NumericalError: A solve did not converge, or no admissible mode was found.

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 from collections.abc import Mapping
 
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec import (
     EDGE_NAMES,
     EdgeSpec,
     Material,
@@ -14,12 +15,11 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.errors import InputError
 
 __all__ = ["CASES", "LOADS", "paper_case", "plate_case"]
 
 #: Edge stresses per unit load of the loads :func:`plate_case` knows, in
-#: :data:`~unibuckle_fenicsx.config.EDGE_NAMES` order, as (normal, shear) pairs: uniaxial
+#: :data:`~unibuckle_fenicsx.spec.EDGE_NAMES` order, as (normal, shear) pairs: uniaxial
 #: compression along x; pure shear (a uniform sigma_xy = 1 state: the shear stress along
 #: the counter-clockwise tangent is +1 on x = const and -1 on y = const); and both.
 LOADS: dict[str, tuple[tuple[float, float], ...]] = {

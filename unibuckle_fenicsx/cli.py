@@ -25,11 +25,11 @@ from collections.abc import Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any
 
-from unibuckle_fenicsx.config import METHODS
 from unibuckle_fenicsx.errors import InputError, NumericalError
+from unibuckle_fenicsx.spec import METHODS
 
 if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.config import ProblemSpec
+    from unibuckle_fenicsx.spec import ProblemSpec
 
 __all__ = ["EXIT_BAD_INPUT", "EXIT_INTERRUPTED", "EXIT_NOT_CERTIFIED", "EXIT_OK", "main"]
 
@@ -151,7 +151,7 @@ class _Formatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaults
 
 def _solver_default(name: str) -> str:
     """``(default D, or the file's)`` for the solver field ``name`` (schema default D)."""
-    from unibuckle_fenicsx.config import SolverSpec
+    from unibuckle_fenicsx.spec import SolverSpec
 
     value = getattr(SolverSpec(), name)
     return (
@@ -630,7 +630,7 @@ def _schema(args: argparse.Namespace) -> int:
     """``unibuckle schema``: the JSON Schema of a problem file, or its dotted keys."""
     import json
 
-    from unibuckle_fenicsx.config import accepted_keys, json_schema
+    from unibuckle_fenicsx.spec import accepted_keys, json_schema
 
     text = "\n".join(accepted_keys()) if args.keys else json.dumps(json_schema(), indent=2)
     if not args.output:
@@ -767,7 +767,7 @@ def _warn_unused(flags: list[str], method: str, comm: Any, result: Any = None) -
 
 def _warn_plate_model(spec: ProblemSpec, comm: Any) -> None:
     """A warning on stderr when the plate lies outside the plate model's usual range."""
-    from unibuckle_fenicsx.config.checks import plate_model_note
+    from unibuckle_fenicsx.spec.checks import plate_model_note
 
     note = plate_model_note(spec.plate)
     if note is not None and comm.rank == 0:
@@ -887,7 +887,7 @@ def _fail(comm: Any, message: str, status: int = EXIT_BAD_INPUT) -> int:
 def _spec_from_args(args: argparse.Namespace) -> ProblemSpec:
     """The problem of --case or --config, with --nx/--ny applied."""
     from unibuckle_fenicsx.cases import paper_case
-    from unibuckle_fenicsx.config import load_problem
+    from unibuckle_fenicsx.spec import load_problem
 
     spec = paper_case(args.case) if args.case else _load_config(args.config, load_problem)
     if args.settings:
@@ -907,7 +907,7 @@ def _with_settings(spec: ProblemSpec, settings: Sequence[str]) -> ProblemSpec:
         ValueError: A setting without '=', a path the problem file does not have, or a
             value the schema refuses (the message names the path).
     """
-    from unibuckle_fenicsx.config import problem_from_dict, problem_to_dict
+    from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
     from unibuckle_fenicsx.sweep import set_text
 
     data = problem_to_dict(spec, units=spec.units)
@@ -940,7 +940,7 @@ def _check_chart(base: Any) -> None:
     The chart draws k = t lambda b^2/(pi^2 D), a buckling coefficient of edge loads; for a
     temperature rise alone lambda is a factor on the rise and k means nothing.
     """
-    from unibuckle_fenicsx.config import problem_from_dict
+    from unibuckle_fenicsx.spec import problem_from_dict
 
     if not problem_from_dict(base).plate.loaded:
         raise InputError(

@@ -27,8 +27,8 @@ from __future__ import annotations
 import math
 from typing import Any
 
-from unibuckle_fenicsx.config import DesignSpec, ProblemSpec, stress_ends
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
 
 __all__ = ["CLAUSES", "design_output", "reduction_factor"]
 

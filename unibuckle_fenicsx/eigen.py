@@ -74,6 +74,7 @@ __all__ = [
 
 logger = logging.getLogger(__name__)
 
+#: PETSc/SLEPc options as a mapping: option name (without its prefix) to value.
 Options = Mapping[str, str | float | int | bool]
 
 #: Default EPS options of :class:`GEPSolver` (overridable per solver or on the command
@@ -752,7 +753,7 @@ class SharedFactorization(Owner):
     The interior-point Newton matrix :math:`A - \lambda B + \Sigma`, the shifted matrices
     of the eigen solves near an estimate (:math:`A_Z - \sigma B_Z`) and the
     certificate's :math:`A - \lambda B` all have the stiffness matrix's nonzero pattern.
-    Each user writes its values into :attr:`matrix` and calls :meth:`factor`; MUMPS's
+    Each user writes its values into ``matrix`` and calls :meth:`factor`; MUMPS's
     symbolic analysis (the fill-reducing ordering) is done on the first call only. With a
     matrix and a factorisation each, the three users cost three analyses per mesh:
     measured on a thin plate at 180×60 (33 123 DOFs), 0.19 s each, as long as a numeric
@@ -762,7 +763,7 @@ class SharedFactorization(Owner):
     user that solves with it later checks that first and factorises again if not.
 
     Args:
-        A: The stiffness matrix (AIJ); :attr:`matrix` is a copy with its pattern.
+        A: The stiffness matrix (AIJ); ``matrix`` is a copy with its pattern.
         prefix: Options prefix of the factorisation (:data:`LDL_OPTIONS`).
 
     Note:
@@ -781,14 +782,14 @@ class SharedFactorization(Owner):
         self._holder: object | None = None
 
     def factor(self, holder: object) -> tuple[int, int, int]:
-        """Factorise :attr:`matrix` for ``holder``; the inertia (negative, zero, positive)."""
+        """Factorise ``matrix`` for ``holder``; the inertia (negative, zero, positive)."""
         self.ksp.setOperators(self.matrix)
         self.ksp.setUp()
         self._holder = holder
         return self.inertia()
 
     def claim(self, holder: object) -> None:
-        """Record that ``holder`` factorised :attr:`matrix` through :attr:`ksp` (SLEPc's ST)."""
+        """Record that ``holder`` factorised ``matrix`` through ``ksp`` (SLEPc's ST)."""
         self._holder = holder
 
     def holds(self, holder: object) -> bool:
@@ -801,7 +802,7 @@ class SharedFactorization(Owner):
         return int(nneg), int(nzero), int(npos)
 
     def fits(self, mat: PETSc.Mat) -> bool:
-        """Whether ``mat`` has exactly :attr:`matrix`'s pattern (ask once per matrix).
+        """Whether ``mat`` has exactly ``matrix``'s pattern (ask once per matrix).
 
         A value copy with ``SAME_NONZERO_PATTERN`` trusts the caller: PETSc compares
         only the number of nonzeros. Collective.

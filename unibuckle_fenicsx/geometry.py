@@ -31,6 +31,7 @@ __all__ = [
     "triangulate",
 ]
 
+#: A polygon's vertices (m), in order: a sequence of (x, y) pairs or an (n, 2) array.
 Vertices = Sequence[Sequence[float]] | npt.NDArray[np.float64]
 
 

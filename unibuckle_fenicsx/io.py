@@ -7,6 +7,8 @@ import re
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.analysis import Analysis
     from unibuckle_fenicsx.results import BucklingResult
@@ -38,7 +40,9 @@ def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
 
     ``<case>`` is the problem's name made a safe file name (:func:`file_stem`). Files,
     for ParaView (ADIOS2 VTX reader): ``<case>_w.bp`` (w, w_free, obstacle_zone,
-    contact on the Q1 space) and ``<case>_theta.bp`` (the rotation); and the same fields
+    contact and contact_force on the Q1 space: the obstacle's push at each contact node,
+    N per metre of the mode's largest deflection, as the JSON's ``contact_force``) and
+    ``<case>_theta.bp`` (the rotation); and the same fields
     as VTK, ``<case>.pvd`` (with ``.pvtu``/``.vtu`` pieces), which ParaView and
     ``pyvista.read`` open without ADIOS2.
 
@@ -62,6 +66,12 @@ def write_fields(analysis: Analysis, directory: str | Path) -> list[Path]:
     if problem.contact is not None and analysis.solution is not None:
         fields.append(problem.contact.indicator())
         fields.append(problem.contact.node_function(analysis.solution.active))
+        force = analysis.result.contact_force
+        if force is not None:  # the obstacle's push (N/m), zero off the contact set
+            push = np.asarray(force["push"], dtype=float)
+            fields.append(
+                problem.contact.node_function(analysis.solution.active, "contact_force", push)
+            )
     case = file_stem(analysis.result.case)
     paths = [directory / f"{case}_w.bp", directory / f"{case}_theta.bp"]
     for path, funcs in ((paths[0], fields), (paths[1], [theta])):

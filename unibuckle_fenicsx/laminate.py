@@ -45,7 +45,7 @@ __all__ = ["Laminate", "PlyLike", "laminate", "ply_reduced_stiffness"]
 
 
 class PlyLike(Protocol):
-    """What :func:`laminate` needs of a ply (:class:`~unibuckle_fenicsx.config.Ply`)."""
+    """What :func:`laminate` needs of a ply (:class:`~unibuckle_fenicsx.spec.Ply`)."""
 
     @property
     def thickness(self) -> float:

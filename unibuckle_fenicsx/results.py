@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.model.zones import zone_report
+from unibuckle_fenicsx.spec import (
     UNITS,
     PointSpec,
     ProblemSpec,
@@ -16,8 +17,7 @@ from unibuckle_fenicsx.config import (
     stress_value,
     temperature_field,
 )
-from unibuckle_fenicsx.config.checks import plate_model_note
-from unibuckle_fenicsx.model.zones import zone_report
+from unibuckle_fenicsx.spec.checks import plate_model_note
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution
@@ -55,8 +55,10 @@ class BucklingResult:
             1e-9 to 1e-8 on thin plates, where the shear stiffness dominates; digits beyond
             it are rounding). None for a tensionless foundation (the springs' stiffness is
             not counted).
-        lower_bound_Pa / upper_bound_Pa: Verified bracket of the critical load (the upper
-            bound is the load of an admissible mode; None if the method found none).
+        lower_bound_Pa: Verified lower bound of the critical load (Pa): no admissible
+            mode has a lower load.
+        upper_bound_Pa: The load of an admissible mode (Pa), so an upper bound of the
+            critical load; None if the method found none.
         certificate: :class:`~unibuckle_fenicsx.certificate.certify.Certificate` as a dict.
         details: Method-specific information.
         timings: Seconds per phase.
@@ -72,11 +74,20 @@ class BucklingResult:
             EN 1993-1-5 from this sigma_cr (:func:`~unibuckle_fenicsx.design.design_output`).
         units: The unit system the summary prints in (the numbers here are SI).
         input: The problem solved, every key with the value used, in SI
-            (:func:`~unibuckle_fenicsx.config.problem_to_dict`; None for a predicate zone).
+            (:func:`~unibuckle_fenicsx.spec.problem_to_dict`; None for a predicate zone).
         versions: Versions of the package and of the libraries that computed the result
             (:func:`versions`).
         obstacle_zones: Per obstacle, the zone's area on the plate against the discrete
             zone's and its node count (:func:`~unibuckle_fenicsx.model.zones.zone_report`).
+        contact_force: The obstacle's push on the plate at each contact node, in the
+            order of ``contact_indices``: ``{"unit": "N/m", "push": [...],
+            "resolution": r}``. A linear buckling mode has no amplitude: the push is that
+            of the mode scaled to max |w| = 1 m (the nodal force ``-(A u - lambda B u)_k``,
+            in N per metre of the largest deflection). ``resolution``: the push double
+            precision cannot tell from zero (``load_resolution`` times the largest nodal
+            force of A u, N/m); a node whose push exceeds it *presses* the obstacle, the
+            others only *touch* it (zero deflection, no force). None without a rigid
+            obstacle (a tensionless foundation's springs are not contact forces).
     """
 
     case: str
@@ -112,6 +123,7 @@ class BucklingResult:
     input: dict[str, Any] | None = None
     versions: dict[str, str] = field(default_factory=dict)
     obstacle_zones: list[dict[str, Any]] = field(default_factory=list)
+    contact_force: dict[str, Any] | None = None
 
     @classmethod
     def from_solution(
@@ -225,6 +237,8 @@ class BucklingResult:
         )
         result.certificate = certificate.as_dict()
         result.details.update(solution.report())
+        if not problem.tensionless:
+            result.contact_force = _contact_force(problem, solution, result.load_resolution)
         return result
 
     def as_dict(self, timings: bool = True) -> dict[str, Any]:
@@ -254,6 +268,8 @@ class BucklingResult:
             for name, load in self.edge_loads.items()
             if _load_text(load)
         ]
+        bound = self._bound_line(scale, unit)
+        bound = f"\n  {bound}" if bound else ""
         extra = "".join(f"\n  {line}" for line in self._model_lines())
         extra += "".join(f"\n  {text}" for text in map(_zone_text, self.obstacle_zones) if text)
         if loaded:
@@ -273,7 +289,34 @@ class BucklingResult:
             second = ""
         return (
             f"{self.case}: {head}, method {self.method}{z}, "
-            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{second}{extra}"
+            f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{bound}{second}{extra}"
+        )
+
+    def _bound_line(self, scale: float, unit: str) -> str:
+        """Where the critical load lies when it is not proven: the verified bracket.
+
+        The printed load is that of an admissible mode, so the critical load is at most
+        it; the verified lower bound is the safe value (the free plate's load when nothing
+        closer was verified; ``--bracket`` may raise it). Empty when proven.
+        """
+        cert = self.certificate or {}
+        if not self.constrained_nodes or cert.get("global_optimum_proven"):
+            return ""
+        lower, upper = self.lower_bound_Pa, self.upper_bound_Pa
+        if lower is None:
+            return ""
+        by = cert.get("proven_by")
+        how = "the free plate's, by interlacing" if by == "interlacing" else f"by {by}"
+        high = "no admissible mode" if upper is None else f"{upper / scale:.6e} {unit}"
+        # Two or more pencil eigenvalues below: only the low-rank bracket may do better.
+        m = cert.get("negative_eigenvalues")
+        hint = ""
+        if by == "interlacing" and m is not None and m >= 2:
+            tried = (self.input or {}).get("solver", {}).get("bracket")
+            hint = "; --bracket verified no higher bound" if tried else "; --bracket may raise it"
+        return (
+            f"not proven: the critical load lies between {lower / scale:.6e} {unit} "
+            f"(verified lower bound, {how}) and {high}{hint}"
         )
 
     def _model_lines(self) -> list[str]:
@@ -328,6 +371,26 @@ class BucklingResult:
         if self.units == "SI" or len(tables) != len(reports):
             return [p["restraint"] for p in reports]
         return [PointSpec(**table).describe(self.units) for table in tables]
+
+
+def _contact_force(
+    problem: BucklingProblem, solution: UnilateralSolution, resolution: float | None
+) -> dict[str, Any]:
+    """The obstacle's push at each contact node of the returned mode (N/m; collective).
+
+    The mode is scaled to max |w| = 1 and oriented away from the obstacle, so the
+    residual ``r = A u - lambda B u`` at a contact node is the obstacle's reaction on it
+    with the sign of a pull: the push is ``-s_k r_k`` (``s_k`` the node's obstacle side).
+    """
+    if problem.contact is None:  # pragma: no cover (from_solution checked it)
+        raise ValueError("_contact_force: the problem has no obstacle")
+    r, au_inf, _ = problem.residual(solution.load, solution.candidate.mode.x.petsc_vec)
+    push = -problem.contact.values(r)[solution.active]
+    return {
+        "unit": "N/m",
+        "push": [float(f) for f in push],
+        "resolution": None if resolution is None else float(resolution * au_inf),
+    }
 
 
 def _gap_text(gap: float) -> str:

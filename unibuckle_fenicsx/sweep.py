@@ -68,9 +68,9 @@ from typing import Any
 
 from mpi4py import MPI
 
-from unibuckle_fenicsx.config import ProblemSpec, load_problem, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.progress import Progress
+from unibuckle_fenicsx.spec import ProblemSpec, load_problem, problem_from_dict, problem_to_dict
 
 __all__ = [
     "STATUSES",

@@ -5,14 +5,18 @@ Markdown files under ``docs/_generated/`` (not kept in git), which the pages inc
 
 - ``cli_<command>.md``: ``unibuckle <command> --help``, from the package's argparse parser;
 - ``schema.md``: every key of the problem file, from
-  :func:`unibuckle_fenicsx.config.json_schema` (its types, defaults, ranges and
-  descriptions) and :func:`unibuckle_fenicsx.config.accepted_keys`; where the installed
+  :func:`unibuckle_fenicsx.spec.json_schema` (its types, defaults, ranges and
+  descriptions) and :func:`unibuckle_fenicsx.spec.accepted_keys`; where the installed
   package does not have them yet, from the loader itself (see :func:`loader_keys`);
 - ``demo_<name>.md``: each demo (a jupytext percent script) as a page, with the figures
   ``make demo`` stored in ``figures/`` (the build executes no demo);
 - ``bench_<name>.md``: a table per file ``bench/results/<name>.jsonl`` (one JSON object a
   line, as the bench scripts' ``--json FILE`` writes them), with the command that
   reproduces it.
+
+The site loads no script from the network: MathJax comes from the ``django-static-mathjax``
+wheel of the ``docs`` extra (MathJax 3.2.2, the same files as the npm package), copied into
+``_static/mathjax`` when the site is written (:func:`copy_mathjax`).
 
 The functions are importable without Sphinx (``tests/test_docs.py`` uses them).
 """
@@ -88,7 +92,7 @@ _PROBE = "__unibuckle_docs_probe__"
 
 def _allowed(data: Mapping[str, Any], where: str) -> list[str] | None:
     """The keys the loader allows in table ``where``, read off its unknown-key error."""
-    from unibuckle_fenicsx.config import problem_from_dict
+    from unibuckle_fenicsx.spec import problem_from_dict
 
     try:
         problem_from_dict(data)
@@ -107,7 +111,7 @@ def loader_keys() -> list[str]:
     """Every dotted key the loader accepts, asked of the loader table by table.
 
     The fallback of :func:`accepted_keys` for a package without
-    ``unibuckle_fenicsx.config.accepted_keys``: the loader checks each table's keys against
+    ``unibuckle_fenicsx.spec.accepted_keys``: the loader checks each table's keys against
     a list of allowed names and names that list when a key is unknown, so a probe key in
     each table (a nested table inside a minimal valid file) reads the list the loader
     itself uses. List-valued tables are written ``name[]`` (``plate.holes[].radius``).
@@ -159,20 +163,20 @@ def loader_keys() -> list[str]:
 
 def json_schema() -> dict[str, Any] | None:
     """The package's JSON Schema of the problem file, or None where it has none."""
-    from unibuckle_fenicsx import config
+    from unibuckle_fenicsx import spec
 
-    make = getattr(config, "json_schema", None)
+    make = getattr(spec, "json_schema", None)
     return make() if callable(make) else None
 
 
 def accepted_keys() -> tuple[list[str], str]:
     """(every dotted key the loader accepts, where the list comes from)."""
-    from unibuckle_fenicsx import config
+    from unibuckle_fenicsx import spec
 
-    listed = getattr(config, "accepted_keys", None)
+    listed = getattr(spec, "accepted_keys", None)
     if callable(listed):
-        return list(listed()), "unibuckle_fenicsx.config.accepted_keys()"
-    return loader_keys(), "the loader's own unknown-key check (unibuckle_fenicsx.config)"
+        return list(listed()), "unibuckle_fenicsx.spec.accepted_keys()"
+    return loader_keys(), "the loader's own unknown-key check (unibuckle_fenicsx.spec)"
 
 
 def _resolve(node: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -285,7 +289,7 @@ def schema_page() -> str:
     if schema is not None:
         described = dict(schema_rows(schema))
         lines += [
-            f"Generated from `unibuckle_fenicsx.config.json_schema()` and {source} when "
+            f"Generated from `unibuckle_fenicsx.spec.json_schema()` and {source} when "
             "these pages were built.",
             "",
             "| key | type | range | default | description |",
@@ -387,13 +391,13 @@ def arg_docs(cls: type) -> dict[str, str]:
 
 def _described() -> dict[str, str]:
     """Dotted key -> its meaning, from the docstrings of the classes the tables fill."""
-    from unibuckle_fenicsx import config
+    from unibuckle_fenicsx import spec
 
     keys, _ = accepted_keys()
     docs = {
-        prefix: arg_docs(getattr(config, name))
+        prefix: arg_docs(getattr(spec, name))
         for prefix, name in TABLE_CLASSES.items()
-        if hasattr(config, name)
+        if hasattr(spec, name)
     }
     described = {}
     for key in keys:
@@ -409,7 +413,7 @@ def _described() -> dict[str, str]:
 
 def _defaults() -> dict[str, Any]:
     """Dotted key -> the value the loader fills in for the paper's plate with c1's zone."""
-    from unibuckle_fenicsx.config import problem_from_dict, problem_to_dict
+    from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
 
     data = problem_to_dict(problem_from_dict({"obstacle": {"zone": "all"}}))
     flat: dict[str, Any] = {}
@@ -510,29 +514,89 @@ def bench_rows(path: Path) -> list[dict[str, Any]]:
     return rows
 
 
+#: The columns each results file's table shows, with their headers (words and units);
+#: every other scalar is in the file. A file not listed shows every scalar column.
+BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
+    "plates": [
+        ("case", "plate"),
+        ("mesh", "mesh"),
+        ("i", "i"),
+        ("contact_nodes", "\\|Z\\|"),
+        ("route", "route"),
+        ("levels", "per level: steps / factorisations / eigen solves"),
+        ("ratio", "time (free solves)"),
+        ("cli_ratio", "`unibuckle solve` (free solves)"),
+        ("m", "m"),
+        ("certificate", "certificate"),
+        ("k", "k"),
+        ("load_Pa", "λ_c (Pa)"),
+    ],
+    "certify": [
+        ("case", "case"),
+        ("mesh", "mesh"),
+        ("i", "i"),
+        ("contact_nodes", "\\|Z\\|"),
+        ("proven_by", "proven by"),
+        ("relative_gap", "gap"),
+        ("factorisations", "factorisations"),
+        ("solves", "solves"),
+        ("ratio", "certificate time (free solves)"),
+        ("load_Pa", "λ_c (Pa)"),
+    ],
+    "routes": [
+        ("case", "plate"),
+        ("mesh", "mesh"),
+        ("t_over_b", "t/b"),
+        ("auto", "auto's route"),
+        ("ip_ratio", "interior point (free solves)"),
+        ("ip_eigensolves", "its eigen solves"),
+        ("as_ratio", "active set (free solves)"),
+        ("as_eigensolves", "its eigen solves"),
+        ("load_difference", "load difference (AS − IP)/IP"),
+    ],
+}
+#: Long texts shown as numbered notes under the table (the cell holds the note's
+#: number and the text up to its first colon).
+BENCH_NOTES = {"plates": "certificate"}
+
+
 def bench_page(path: Path) -> str:
-    """A Markdown table of a results file's scalar columns, with its command."""
+    """A Markdown table of a results file's chosen columns, with its command and notes."""
     rows = bench_rows(path)
     name = path.stem
-    columns = list(
-        dict.fromkeys(
+    columns = BENCH_COLUMNS.get(name) or [
+        (key, key)
+        for key in dict.fromkeys(
             key
             for row in rows
             for key, value in row.items()
             if not isinstance(value, dict | list) and not key.endswith("_records")
         )
-    )
+    ]
     command = COMMANDS[name](rows) if name in COMMANDS else f"see bench/{name}.py"
+    noted = BENCH_NOTES.get(name)
+    notes: dict[str, int] = {}
     lines = [
         f"Reproduce with `{command}` (one JSON line per row, appended to the file). "
-        f"Generated from `bench/results/{path.name}` ({len(rows)} rows) when these pages "
-        "were built.",
+        f"Generated from `bench/results/{path.name}` ({len(rows)} rows; every number of a "
+        "row is in the file) when these pages were built.",
         "",
-        "| " + " | ".join(columns) + " |",
+        "| " + " | ".join(header for _, header in columns) + " |",
         "|" + "---|" * len(columns),
     ]
     for row in rows:
-        lines.append("| " + " | ".join(_format(row.get(c)) for c in columns) + " |")
+        cells = []
+        for key, _ in columns:
+            value = row.get(key)
+            if key == noted and isinstance(value, str) and value:
+                number = notes.setdefault(value, len(notes) + 1)
+                cells.append(f"{_cell(value.split(':', 1)[0])} ({number})")
+            else:
+                cells.append(_format(value))
+        lines.append("| " + " | ".join(cells) + " |")
+    for text, number in notes.items():
+        flags = re.sub(r"(?<![\w`])(--[\w-]+|\w+\.\w+ = \w+)", r"`\1`", _cell(text))
+        lines += ["", f"({number}) {flags}"]
     return "\n".join(lines) + "\n"
 
 
@@ -551,15 +615,33 @@ DEMOS = {
     "free_plate": ("demo_free_plate.py", ["free/mode_20x20.png", "free/convergence.png"]),
     "obstacle_c1": (
         "demo_obstacle_c1.py",
-        ["c1/mode_20x20.png", "c1/section_A.png", "c1/contact_set.png", "c1/convergence.png"],
+        [
+            "c1/mode_20x20.png",
+            "c1/section_A.png",
+            "c1/contact_set.png",
+            "c1/contact_force.png",
+            "c1/convergence.png",
+        ],
     ),
     "obstacle_c2": (
         "demo_obstacle_c2.py",
-        ["c2/mode_20x20.png", "c2/section_A.png", "c2/contact_set.png", "c2/convergence.png"],
+        [
+            "c2/mode_20x20.png",
+            "c2/section_A.png",
+            "c2/contact_set.png",
+            "c2/contact_force.png",
+            "c2/convergence.png",
+        ],
     ),
     "obstacle_c3": (
         "demo_obstacle_c3.py",
-        ["c3/mode_20x20.png", "c3/section_A.png", "c3/contact_set.png", "c3/convergence.png"],
+        [
+            "c3/mode_20x20.png",
+            "c3/section_A.png",
+            "c3/contact_set.png",
+            "c3/contact_force.png",
+            "c3/convergence.png",
+        ],
     ),
     "garland": (
         "demo_garland.py",
@@ -588,6 +670,7 @@ DEMOS = {
         "demo_column.py",
         ["column/mode.png", "column/contact_map.png", "column/tie_spacing.png"],
     ),
+    "ties": ("study_ties.py", ["ties/tie_spacing_study.png"]),
 }
 
 
@@ -624,11 +707,36 @@ def percent_to_myst(source: str) -> str:
     return "\n\n".join(out) + "\n"
 
 
+#: Where ``make demo`` keeps each demo's printed output (``demos/run_all.py``).
+OUTPUTS = ROOT / "figures" / "stdout"
+
+
 def demo_pages() -> dict[str, str]:
-    """``{demo_<name>.md: page}``: the script rendered, then its stored figures."""
+    """``{demo_<name>.md: page}``: a download link, the script, its output and figures.
+
+    The output is the one ``make demo`` stored (``figures/stdout/<script>.txt``); the
+    build runs nothing.
+    """
     pages = {}
     for name, (script, figures) in DEMOS.items():
-        text = percent_to_myst((ROOT / "demos" / script).read_text())
+        download = (
+            f"{{download}}`Download the script demos/{script} <../../demos/{script}>` "
+            f"(run it with `python demos/{script}`; all demos: `make demo`).\n\n"
+        )
+        body = percent_to_myst((ROOT / "demos" / script).read_text())
+        if body.startswith("# "):  # under the page's title
+            title, _, rest = body.partition("\n")
+            text = f"{title}\n\n{download}{rest.lstrip()}"
+        else:
+            text = download + body
+        output = OUTPUTS / script.replace(".py", ".txt")
+        if output.exists():
+            text += (
+                "\n## Output\n\nWhat the script printed when `make demo` last ran it "
+                f"(`figures/stdout/{output.name}`):\n\n"
+                f"```{{literalinclude}} ../../figures/stdout/{output.name}\n"
+                ":language: text\n```\n"
+            )
         text += (
             f"\n## Figures\n\nWritten by `python demos/{script}` (all demos: `make demo`), "
             "as stored in the repository's `figures/`:\n\n"
@@ -639,6 +747,312 @@ def demo_pages() -> dict[str, str]:
     return pages
 
 
+def gallery() -> str:
+    """The demos' thumbnail gallery: each demo's first figure, linked to its page."""
+    cells = []
+    for name, (script, figures) in DEMOS.items():
+        cells.append(
+            f"```{{figure}} ../../figures/{figures[0]}\n:target: {name}.html\n"
+            f":alt: {name}\n\n[{name.replace('_', ' ')}]({name}.md): `demos/{script}`\n```\n"
+        )
+    return "::::{container} gallery\n\n" + "\n".join(cells) + "\n::::\n"
+
+
+# --------------------------------------------------------------------------------------
+# Links to other projects' documentation, offline (intersphinx)
+# --------------------------------------------------------------------------------------
+
+#: The other projects' objects the pages and docstrings name, with their pages: the
+#: intersphinx inventories (``objects.inv``) the build would download, written here from
+#: this table instead, since the build has no network. Each entry: (role, page and
+#: anchor under the project's base address). Private paths that type hints produce
+#: (``numpy._typing._array_like.NDArray``, ``dolfinx.fem.function.Function``) point to
+#: the public object's page.
+INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
+    "python": (
+        "https://docs.python.org/3/",
+        {
+            "collections.abc.Callable": ("class", "library/collections.abc.html#$"),
+            "collections.abc.Iterator": ("class", "library/collections.abc.html#$"),
+            "collections.abc.Mapping": ("class", "library/collections.abc.html#$"),
+            "collections.abc.Sequence": ("class", "library/collections.abc.html#$"),
+            "pathlib.Path": ("class", "library/pathlib.html#$"),
+            "Path": ("class", "library/pathlib.html#pathlib.Path"),
+            "argparse.ArgumentParser": ("class", "library/argparse.html#$"),
+            "argparse.Namespace": ("class", "library/argparse.html#$"),
+            "enum.Enum": ("class", "library/enum.html#$"),
+            "enum.StrEnum": ("class", "library/enum.html#$"),
+            "logging.Logger": ("class", "library/logging.html#$"),
+            "math.fsum": ("function", "library/math.html#$"),
+            "itertools.combinations": ("function", "library/itertools.html#$"),
+        },
+    ),
+    "numpy": (
+        "https://numpy.org/doc/stable/",
+        {
+            "numpy.ndarray": ("class", "reference/generated/numpy.ndarray.html#$"),
+            "numpy.float64": ("class", "reference/arrays.scalars.html#$"),
+            "numpy.int64": ("class", "reference/arrays.scalars.html#$"),
+            "numpy.int32": ("class", "reference/arrays.scalars.html#$"),
+            "numpy.bool": ("class", "reference/arrays.scalars.html#$"),
+            "numpy.bool_": ("class", "reference/arrays.scalars.html#numpy.bool"),
+            "numpy.typing.NDArray": ("class", "reference/typing.html#$"),
+            "numpy.typing.ArrayLike": ("class", "reference/typing.html#$"),
+            "numpy._typing._array_like.NDArray": (
+                "class",
+                "reference/typing.html#numpy.typing.NDArray",
+            ),
+            "numpy._typing._array_like.ArrayLike": (
+                "class",
+                "reference/typing.html#numpy.typing.ArrayLike",
+            ),
+            # The aliases the package's type hints use (import numpy as np, ... as npt).
+            "npt.NDArray": ("class", "reference/typing.html#numpy.typing.NDArray"),
+            "npt.ArrayLike": ("class", "reference/typing.html#numpy.typing.ArrayLike"),
+            "np.ndarray": ("class", "reference/generated/numpy.ndarray.html#numpy.ndarray"),
+            "np.float64": ("class", "reference/arrays.scalars.html#numpy.float64"),
+            "np.int64": ("class", "reference/arrays.scalars.html#numpy.int64"),
+            "np.int32": ("class", "reference/arrays.scalars.html#numpy.int32"),
+            "np.bool_": ("class", "reference/arrays.scalars.html#numpy.bool"),
+        },
+    ),
+    "petsc4py": (
+        "https://petsc.org/release/petsc4py/",
+        {
+            f"{prefix}PETSc.{name}": ("class", f"reference/petsc4py.PETSc.{name}.html")
+            for name in ("Vec", "Mat", "KSP", "PC", "Options", "Viewer")
+            for prefix in ("petsc4py.", "")  # as the hints write it: from petsc4py import PETSc
+        },
+    ),
+    "slepc4py": (
+        "https://slepc.upv.es/slepc4py-current/docs/apiref/",
+        {"slepc4py.SLEPc.EPS": ("class", "slepc4py.SLEPc.EPS-class.html")},
+    ),
+    "mpi4py": (
+        "https://mpi4py.readthedocs.io/en/stable/",
+        {
+            "mpi4py.MPI.Comm": ("class", "reference/mpi4py.MPI.Comm.html"),
+            "MPI.Comm": ("class", "reference/mpi4py.MPI.Comm.html"),
+        },
+    ),
+    "dolfinx": (
+        "https://docs.fenicsproject.org/dolfinx/v0.11.0/python/",
+        {
+            "dolfinx.fem.Function": ("class", "generated/dolfinx.fem.html#$"),
+            "dolfinx.fem.function.Function": (
+                "class",
+                "generated/dolfinx.fem.html#dolfinx.fem.Function",
+            ),
+            "dolfinx.fem.FunctionSpace": ("class", "generated/dolfinx.fem.html#$"),
+            "dolfinx.fem.function.FunctionSpace": (
+                "class",
+                "generated/dolfinx.fem.html#dolfinx.fem.FunctionSpace",
+            ),
+            "dolfinx.fem.Constant": ("class", "generated/dolfinx.fem.html#$"),
+            "dolfinx.fem.function.Constant": (
+                "class",
+                "generated/dolfinx.fem.html#dolfinx.fem.Constant",
+            ),
+            "dolfinx.fem.DirichletBC": ("class", "generated/dolfinx.fem.html#$"),
+            "dolfinx.fem.bcs.DirichletBC": (
+                "class",
+                "generated/dolfinx.fem.html#dolfinx.fem.DirichletBC",
+            ),
+            "dolfinx.mesh.Mesh": ("class", "generated/dolfinx.mesh.html#$"),
+            "dolfinx.mesh.MeshTags": ("class", "generated/dolfinx.mesh.html#$"),
+            "dolfinx.la.Vector": ("class", "generated/dolfinx.la.html#$"),
+            "dolfinx.io.gmsh.model_to_mesh": ("function", "generated/dolfinx.io.gmsh.html#$"),
+        },
+    ),
+    "ufl": (
+        "https://docs.fenicsproject.org/ufl/main/",
+        {
+            "ufl.core.expr.Expr": ("class", "api-doc/ufl.core.html#$"),
+            "ufl.form.Form": ("class", "api-doc/ufl.html#$"),
+            "ufl.argument.Argument": ("class", "api-doc/ufl.html#$"),
+            "ufl.Argument": ("class", "api-doc/ufl.html#ufl.argument.Argument"),
+            "ufl.Form": ("class", "api-doc/ufl.html#ufl.form.Form"),
+        },
+    ),
+    "msgspec": (
+        "https://jcristharif.com/msgspec/",
+        {
+            "msgspec.Struct": ("class", "api.html#$"),
+            "msgspec.Meta": ("class", "api.html#$"),
+            "msgspec.UnsetType": ("class", "api.html#$"),
+            "msgspec.convert": ("function", "api.html#$"),
+        },
+    ),
+}
+
+
+def write_inventory(project: str, out: Path = GENERATED / "inventories") -> Path:
+    """Write ``project``'s :data:`INVENTORIES` entry as an intersphinx ``objects.inv``.
+
+    Sphinx's inventory format, version 2: four header lines, then zlib-compressed lines
+    ``name domain:role priority uri display`` (``$`` in the uri stands for the name).
+    """
+    import zlib
+
+    _, objects = INVENTORIES[project]
+    header = (
+        "# Sphinx inventory version 2\n"
+        f"# Project: {project}\n"
+        "# Version: \n"
+        "# The remainder of this file is compressed using zlib.\n"
+    )
+    # A class entry is also written as py:type: Sphinx 9 refers to type aliases so.
+    body = "".join(
+        f"{name} py:{kind} 1 {uri} -\n"
+        for name, (role, uri) in sorted(objects.items())
+        for kind in ((role, "type") if role == "class" else (role,))
+    )
+    out.mkdir(parents=True, exist_ok=True)
+    path = out / f"{project}.inv"
+    data = header.encode() + zlib.compress(body.encode())
+    if not path.exists() or path.read_bytes() != data:
+        path.write_bytes(data)
+    return path
+
+
+def intersphinx_mapping() -> dict[str, tuple[str, str]]:
+    """``conf.py``'s ``intersphinx_mapping``: each project's address and local inventory."""
+    return {name: (base, str(write_inventory(name))) for name, (base, _) in INVENTORIES.items()}
+
+
+# --------------------------------------------------------------------------------------
+# The public API
+# --------------------------------------------------------------------------------------
+
+
+def public_callables() -> list[str]:
+    """The public classes and functions (their pages are the API page's stubs)."""
+    import unibuckle_fenicsx
+
+    return [n for n in public_names() if callable(getattr(unibuckle_fenicsx, n))]
+
+
+def public_names() -> list[str]:
+    """The package's public names: ``unibuckle_fenicsx.__all__`` (not ``__version__``)."""
+    import unibuckle_fenicsx
+
+    return [name for name in unibuckle_fenicsx.__all__ if not name.startswith("_")]
+
+
+def api_public_page() -> str:
+    """An autosummary table of :func:`public_names`, for ``reference/api.rst`` to include.
+
+    Generated from ``__all__``, so a name the package adds, moves or drops follows here
+    without an edit (its page comes from the object's docstring, wherever it lives). The
+    stub pages are written by :func:`write_public_stubs` (autosummary does not read an
+    included file). Data (``CASES``) have no docstring of their own: they are listed with
+    their defining module's description instead.
+    """
+    import unibuckle_fenicsx
+
+    lines = [".. autosummary::", "   :toctree: _autosummary", "   :nosignatures:", ""]
+    data = []
+    for name in public_names():
+        if callable(getattr(unibuckle_fenicsx, name)):
+            lines.append(f"   unibuckle_fenicsx.{name}")
+        else:
+            data.append(name)
+    for name in data:
+        home = _home_module(name)
+        lines += ["", f"``{name}``: :data:`{home}.{name}` (see :mod:`{home}`)."]
+    return "\n".join(lines) + "\n"
+
+
+def _home_module(name: str) -> str:
+    """The module that defines the public data ``name`` (where its ``#:`` comment is)."""
+    import importlib
+    import pkgutil
+
+    import unibuckle_fenicsx
+
+    for info in pkgutil.iter_modules(unibuckle_fenicsx.__path__, "unibuckle_fenicsx."):
+        module = importlib.import_module(info.name)
+        if name in getattr(module, "__all__", ()) and name in vars(module):
+            value = vars(module)[name]
+            if value is getattr(unibuckle_fenicsx, name):
+                return info.name
+    return "unibuckle_fenicsx"
+
+
+def write_public_stubs(out: Path) -> list[Path]:
+    """The autosummary stub page of each public class and function, under ``out``."""
+    import inspect
+
+    import unibuckle_fenicsx
+
+    out.mkdir(parents=True, exist_ok=True)
+    written = []
+    for name in public_names():
+        obj = getattr(unibuckle_fenicsx, name)
+        if not callable(obj):
+            continue
+        full = f"unibuckle_fenicsx.{name}"
+        if inspect.isclass(obj):
+            body = f".. autoclass:: {name}\n   :members:\n   :show-inheritance:\n"
+        else:
+            body = f".. autofunction:: {name}\n"
+        text = f"{full}\n{'=' * len(full)}\n\n.. currentmodule:: unibuckle_fenicsx\n\n{body}"
+        path = out / f"{full}.rst"
+        if not path.exists() or path.read_text() != text:
+            path.write_text(text)
+        written.append(path)
+    return written
+
+
+# --------------------------------------------------------------------------------------
+# The quickstart's numbers
+# --------------------------------------------------------------------------------------
+
+#: The output ``make demo`` stores for the quickstart (``demos/run_all.py``).
+QUICKSTART = ROOT / "figures" / "quickstart"
+
+_SUMMARY = re.compile(
+    r"lambda_c = (?P<load>\S+) Pa \((?P<ratio>\S+) x free (?P<free>\S+) Pa\), "
+    r"k = (?P<k>\S+), method (?P<method>\S+)\s+i=(?P<i>\d+) \|Z\|=(?P<z>\d+)\s+"
+    r"KKT=(?P<kkt>\w+)\s+proven=(?P<proven>\w+) \(KKT only, m=(?P<m>\d+)\), "
+    r"(?P<solves>\d+) eigensolves, (?P<seconds>\S+) s"
+)
+_BOUND = re.compile(r"lies between (?P<lower>\S+) Pa .* and (?P<upper>\S+) Pa")
+_DESIGN = re.compile(r"slenderness (?P<slenderness>\S+), rho = (?P<rho>\S+), ")
+_ZONE = re.compile(r"cover (?P<cover>\S+)% of its area \((?P<nodes>\d+) nodes\)")
+
+
+def quickstart_numbers(folder: Path = QUICKSTART) -> dict[str, str]:
+    """The numbers the quickstart's text quotes, read off the output it shows.
+
+    ``{name: text}`` for MyST substitutions (``{{ name }}`` in the page): the loads in MPa,
+    the ratio, k, the node counts, the zone's cover, the design output, and two numbers
+    worked out from them by hand's formulas (the load over the yield stress of the problem
+    file, the relative slenderness at the lower bound, EN 1993-1-5 (4.3)).
+    """
+    import tomllib
+
+    text = (folder / "output.txt").read_text()
+    found: dict[str, str] = {}
+    for pattern in (_SUMMARY, _BOUND, _DESIGN, _ZONE):
+        match = pattern.search(text)
+        if match is None:
+            raise ValueError(f"{folder / 'output.txt'}: no match for {pattern.pattern!r}")
+        found.update(match.groupdict())
+    problem = tomllib.loads((ROOT / "demos" / "plate.toml").read_text())
+    fy = float(problem["design"]["yield_stress"])
+    mpa = {key: float(found[key]) / 1e6 for key in ("load", "free", "lower", "upper")}
+    return {
+        **found,
+        **{f"{key}_MPa": f"{value:.0f}" for key, value in mpa.items()},
+        "fy_MPa": f"{fy / 1e6:.0f}",
+        "load_over_fy": f"{float(found['load']) / fy:.1f}",
+        "slenderness_lower": f"{math.sqrt(fy / float(found['lower'])):.2f}",
+        "k_free": f"{float(found['k']) / float(found['ratio']):.2f}",
+        "rise_percent": f"{100 * (float(found['ratio']) - 1):.0f}",
+    }
+
+
 # --------------------------------------------------------------------------------------
 # Sphinx
 # --------------------------------------------------------------------------------------
@@ -647,7 +1061,14 @@ def demo_pages() -> dict[str, str]:
 def write_all(out: Path = GENERATED) -> list[Path]:
     """Write every generated page under ``out``; unchanged files are left untouched."""
     out.mkdir(parents=True, exist_ok=True)
-    pages = {**cli_pages(), "schema.md": schema_page(), **bench_pages(), **demo_pages()}
+    pages = {
+        **cli_pages(),
+        "schema.md": schema_page(),
+        **bench_pages(),
+        **demo_pages(),
+        "gallery.md": gallery(),
+        "api_public.rst": api_public_page(),
+    }
     written = []
     for name, text in pages.items():
         path = out / name
@@ -659,6 +1080,52 @@ def write_all(out: Path = GENERATED) -> list[Path]:
 
 def _builder_inited(app: Any) -> None:
     write_all()
+    write_public_stubs(ROOT / "docs" / "reference" / "_autosummary")
+
+
+#: The parts of MathJax's ``es5`` build the pages use: the TeX and MathML input with its
+#: extensions (loaded on demand, e.g. ``\boldsymbol``), the CommonHTML output and its
+#: fonts, the context menu and the assistive MathML. Not copied: the SVG output and the
+#: speech rule engine's maps (4 MB, for the menu's speech option only).
+MATHJAX_PARTS = ("tex-mml-chtml.js", "input", "output/chtml", "ui", "a11y")
+#: Where the pages load it from (``conf.py``'s ``mathjax_path``, under ``_static``).
+MATHJAX_PATH = "mathjax/tex-mml-chtml.js"
+
+
+def mathjax_source() -> Path:
+    """The ``es5`` directory of the installed MathJax (the ``django-static-mathjax`` wheel)."""
+    try:
+        import mathjax  # type: ignore[import-not-found]
+    except ImportError as err:
+        raise RuntimeError(
+            "MathJax is not installed: pip install -e '.[docs]' (django-static-mathjax)"
+        ) from err
+    es5 = Path(mathjax.__file__).parent / "static" / "mathjax" / "es5"
+    if not (es5 / "tex-mml-chtml.js").is_file():
+        raise RuntimeError(f"no MathJax build at {es5} (django-static-mathjax changed layout)")
+    return es5
+
+
+def copy_mathjax(outdir: Path) -> Path:
+    """Copy :data:`MATHJAX_PARTS` and MathJax's licence into ``outdir/_static/mathjax``."""
+    import shutil
+
+    source = mathjax_source()
+    target = outdir / "_static" / "mathjax"
+    for part in MATHJAX_PARTS:
+        src, dst = source / part, target / part
+        if src.is_dir():
+            shutil.copytree(src, dst, dirs_exist_ok=True)
+        else:
+            dst.parent.mkdir(parents=True, exist_ok=True)
+            shutil.copy2(src, dst)
+    shutil.copy2(source.parent / "LICENSE", target / "LICENSE")
+    return target
+
+
+def _build_finished(app: Any, exception: Exception | None) -> None:
+    if exception is None and app.builder.format == "html":
+        copy_mathjax(Path(app.outdir))
 
 
 def setup(app: Any) -> dict[str, Any]:
@@ -666,8 +1133,11 @@ def setup(app: Any) -> dict[str, Any]:
     if str(ROOT) not in sys.path:
         sys.path.insert(0, str(ROOT))
     app.connect("builder-inited", _builder_inited)
+    app.connect("build-finished", _build_finished)
     # The package's docstrings write absolute values and set sizes as plain |w|, |Z|.
     app.connect("autodoc-process-docstring", _process_docstring)
+    # After intersphinx (priority 500): names the package's pages hold under another name.
+    app.connect("missing-reference", _missing_reference, priority=900)
     return {"parallel_read_safe": True, "parallel_write_safe": True}
 
 
@@ -689,3 +1159,158 @@ def escape_bars(line: str) -> str:
 
 def _process_docstring(app: Any, what: str, name: str, obj: Any, options: Any, lines: list[str]):
     lines[:] = [escape_bars(line) for line in lines]
+    if what in ("attribute", "data", "property"):
+        lines[:] = prose_type_restored(lines, name)
+
+
+_BUILTIN_TYPES = {"int", "float", "str", "bool", "bytes", "None", "dict", "list", "tuple", "set"}
+
+
+def _is_type(text: str, name: str) -> bool:
+    """Whether ``text`` reads as a type expression in the module of the object ``name``.
+
+    A type is words joined by ``.``, ``[ ]``, ``,`` and ``|``; a single word must be a
+    builtin type, a name of the object's module, or start with a module of its own
+    (``numpy.``): otherwise it is prose ("m", "Kind", "the zone").
+    """
+    import importlib
+
+    t = text.strip()
+    if not re.fullmatch(r"[\w.\[\], |]+", t):
+        return False
+    if re.search(r"\w \w", t.replace(" | ", "|").replace(", ", ",")):
+        return False
+    words = re.findall(r"[A-Za-z_][\w.]*", t)
+    module = None
+    parts = name.split(".")
+    for cut in range(len(parts), 0, -1):
+        try:
+            module = importlib.import_module(".".join(parts[:cut]))
+            break
+        except ImportError:
+            continue
+    for word in words:
+        head = word.split(".")[0]
+        if word in _BUILTIN_TYPES or head in ("numpy", "np", "npt", "typing", "collections"):
+            continue
+        if module is not None and hasattr(module, head):
+            continue
+        return False
+    return True
+
+
+def prose_type_restored(lines: list[str], name: str) -> list[str]:
+    """Undo napoleon's reading of an attribute's opening words as its type.
+
+    Napoleon takes the text before the first colon of an attribute's or property's
+    docstring as its type (``int: the count.``); the package's docstrings open with prose
+    there ("The plate's area (m^2): ..."), which became a type nobody can link. Such a
+    ``:type:`` line is put back in front of the description.
+    """
+    for k, line in enumerate(lines):
+        if line.startswith(":type: ") and not _is_type(line[len(":type: ") :], name):
+            prose = line[len(":type: ") :].strip()
+            rest = [ln for j, ln in enumerate(lines) if j != k]
+            while rest and not rest[-1].strip():
+                rest.pop()
+            first = next((j for j, ln in enumerate(rest) if ln.strip()), None)
+            if first is None:
+                return [prose]
+            rest[first] = f"{prose}: {rest[first]}"
+            return rest
+    return lines
+
+
+# --------------------------------------------------------------------------------------
+# References the package's own pages do not hold under the name used
+# --------------------------------------------------------------------------------------
+
+
+def _python_objects(env: Any) -> dict[str, Any]:
+    return dict(env.get_domain("py").objects)
+
+
+def reference_candidates(target: str, objects: dict[str, Any], module: str | None) -> list[str]:
+    """Documented names that ``target`` may mean, best first.
+
+    - ``unibuckle_fenicsx.spec.ProblemSpec`` (re-exported by a package): the object's
+      public name (``unibuckle_fenicsx.ProblemSpec``) or its defining module's name;
+    - a bare name (``ProblemSpec``, ``CASES``, ``ShiftedMatrix.bilinear``): the one
+      documented object whose name ends with it, the one in ``module`` first.
+    """
+    import importlib
+
+    found: list[str] = []
+    if target.startswith("unibuckle_fenicsx."):
+        parts = target.split(".")
+        for cut in range(len(parts) - 1, 0, -1):
+            try:
+                obj: Any = importlib.import_module(".".join(parts[:cut]))
+            except ImportError:
+                continue
+            try:
+                for attr in parts[cut:]:
+                    obj = getattr(obj, attr)
+            except AttributeError:
+                break
+            import unibuckle_fenicsx
+
+            found += [
+                f"unibuckle_fenicsx.{n}"
+                for n in public_names()
+                if getattr(unibuckle_fenicsx, n) is obj
+            ]
+            home = getattr(obj, "__module__", None)
+            qual = getattr(obj, "__qualname__", None)
+            if home and qual:
+                found.append(f"{home}.{qual}")
+            else:  # data (a tuple, a dict): the package's one object of that name
+                last = "." + parts[-1]
+                found += [n for n in objects if n.endswith(last) and n.startswith("unibuckle")]
+            break
+    else:
+        suffix = "." + target
+        matches = [n for n in objects if n.endswith(suffix) or n == target]
+        local = [n for n in matches if module and n.startswith(module + ".")]
+        public = [n for n in matches if n.count(".") == 1]
+        found += local or public or (matches if len(matches) == 1 else [])
+    return [n for n in dict.fromkeys(found) if n in objects]
+
+
+def _missing_reference(app: Any, env: Any, node: Any, contnode: Any) -> Any:
+    """Resolve what the py domain missed: re-exported and bare names, quoted hints."""
+    from docutils import nodes
+    from sphinx.util.nodes import make_refnode
+
+    if node.get("refdomain") != "py":
+        return None
+    target = str(node.get("reftarget", ""))
+    if target == "TypeAliasForwardRef":
+        # Sphinx's wrapper of a hint it could not evaluate: TypeAliasForwardRef('x.Y').
+        # Drop the wrapper and its parentheses; the inner name is a reference of its own.
+        parent, index = node.parent, node.parent.index(node)
+        siblings = parent.children
+        if index + 3 < len(siblings) and siblings[index + 1].astext() == "(":
+            parent.replace(siblings[index + 1], nodes.Text(""))
+            after = siblings[index + 3]
+            if isinstance(after, nodes.Text) and after.astext().startswith(")"):
+                parent.replace(after, nodes.Text(after.astext()[1:]))
+        return nodes.inline("", "")
+    bare = target.strip("'\"‘’")
+    if bare != target:  # a quoted hint: the name inside the quotes
+        node = node.deepcopy()
+        node["reftarget"] = bare
+        contnode = contnode.deepcopy()
+        contnode.children = [nodes.Text(bare)]
+        from sphinx.ext import intersphinx
+
+        resolved = intersphinx.missing_reference(app, env, node, contnode)
+        if resolved is not None:
+            return resolved
+    objects = _python_objects(env)
+    for name in reference_candidates(bare, objects, node.get("py:module")):
+        entry = objects[name]
+        return make_refnode(
+            app.builder, node["refdoc"], entry.docname, entry.node_id, contnode, name
+        )
+    return None

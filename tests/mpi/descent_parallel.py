@@ -17,8 +17,8 @@ from mpi4py import MPI
 import numpy as np
 
 from unibuckle_fenicsx.algorithms.descent import admissible_start, descend
-from unibuckle_fenicsx.config import load_problem
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import load_problem
 
 problem = BucklingProblem(load_problem(sys.argv[1]), MPI.COMM_WORLD)
 assert problem.contact is not None

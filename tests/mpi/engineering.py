@@ -13,7 +13,7 @@ from typing import Any
 from mpi4py import MPI
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import problem_from_dict
+from unibuckle_fenicsx.spec import problem_from_dict
 
 #: Result keys compared between serial and parallel runs (those present).
 KEYS = (

@@ -13,7 +13,7 @@ from mpi4py import MPI
 import numpy as np
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.config import load_problem
+from unibuckle_fenicsx.spec import load_problem
 
 spec = load_problem(sys.argv[1])
 with solve(spec, MPI.COMM_WORLD) as analysis:

@@ -16,8 +16,8 @@ import numpy as np
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions
-from unibuckle_fenicsx.config import ObstacleSpec
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import ObstacleSpec
 
 #: One delta, no time budget: the same work on every partition.
 OPTIONS = BoundOptions(lowrank=LowRankOptions(deltas=(1e-3,), fallback=(), time_budget=None))

@@ -16,8 +16,8 @@ from pathlib import Path
 from mpi4py import MPI
 
 from unibuckle_fenicsx.algorithms.interior_point import InteriorPointNewton, NewtonOptions
-from unibuckle_fenicsx.config import load_problem
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import load_problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from test_interior_point import at_saddle

@@ -31,10 +31,10 @@ from test_prestress import (
 
 from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certificate.certify import certify
-from unibuckle_fenicsx.config import MeshSpec
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.prestress import solve_prestress
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec import MeshSpec
 
 
 def same_on_all_ranks(comm: MPI.Comm, value: object) -> bool:

@@ -40,9 +40,12 @@ class ArcPlane:
         d: The second direction.
 
     Attributes:
-        e1, e2: The basis (new vectors, owned); ``e2`` is None when d lies within
+        e1: The basis's first vector (new, owned).
+        e2: Its second (new, owned); None when d lies within
             :data:`~unibuckle_fenicsx.tolerances.SAME_DIRECTION` of u (no plane).
-        b11, b12, b22: :math:`b(e_i, e_j)` (0 without a plane).
+        b11: :math:`b(e_1, e_1)`.
+        b12: :math:`b(e_1, e_2)` (0 without a plane).
+        b22: :math:`b(e_2, e_2)` (0 without a plane).
 
     Note:
         Collective; :meth:`destroy` frees the basis.

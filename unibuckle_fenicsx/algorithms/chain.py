@@ -67,12 +67,12 @@ from unibuckle_fenicsx.algorithms.interior_point import (
 )
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
 from unibuckle_fenicsx.algorithms.pdas import iterate
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import Owner, release, swapped_eigenpairs
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 __all__ = ["THIN_PLATE", "ChainOptions", "LevelRecord", "LinkRecord", "solve_unilateral"]

@@ -88,7 +88,7 @@ def solve_foundation(
         eps_options: Extra EPS options under ``unibuckle_foundation_``.
 
     Returns:
-        The solution: its candidate's load is the quotient of the returned mode, its
+        The solution; its candidate's load is the quotient of the returned mode, its
         ``active`` set the nodes pressing the foundation; ``lower_bound`` =
         :math:`\lambda_{free}`, ``upper_bound`` = the load; proven optimal only when
         the free mode, turned away from the foundation, presses nothing (then the two

@@ -279,7 +279,7 @@ class PenaltySolver(Owner):
                 [0, 1); 0 leaves ties to rounding (for studying its effect).
 
         Returns:
-            The solution: its candidate's ``load`` is :math:`R_\rho` of the returned mode
+            The solution; its candidate's ``load`` is :math:`R_\rho` of the returned mode
             (a stationary value of the penalised quotient; <= the critical load if it is
             the global minimum, which is not proven), its ``active`` set the penetrating
             set (where the springs act); ``lower_bound`` = :math:`\lambda_{free}`,

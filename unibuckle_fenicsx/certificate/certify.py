@@ -24,7 +24,7 @@ at most :data:`~unibuckle_fenicsx.tolerances.BRACKET_GAP` (the load is then know
 accuracy: no admissible mode has a load below the lower bound), otherwise "KKT only".
 The smallest-eigenvalue check runs on every route, proven or not. When the low-rank
 route meets an admissible mode with a lower load than the KKT point's, the point is
-refuted: the certificate hands that mode back (:attr:`Certificate.refuting_mode`) and its
+refuted: the certificate hands that mode back (``Certificate.refuting_mode``) and its
 load becomes the upper bound.
 
 Every check here is collective on the problem's communicator.

@@ -22,8 +22,8 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec import ObstacleSpec, PlateSpec
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
@@ -75,6 +75,7 @@ class BilateralZoneError(InputError):
     """Obstacles on opposite sides of the plate share a mesh node."""
 
 
+#: One obstacle, or several of them (a sequence).
 ObstacleLike = ObstacleSpec | Sequence[ObstacleSpec]
 
 
@@ -441,14 +442,24 @@ class ContactSetManager:
         return self.node_function(np.arange(self.size, dtype=np.int64), "obstacle_zone")
 
     def node_function(
-        self, active: npt.NDArray[np.int64], name: str = "contact"
+        self,
+        active: npt.NDArray[np.int64],
+        name: str = "contact",
+        values: npt.NDArray[np.float64] | None = None,
     ) -> dolfinx.fem.Function:
-        """Function on the w-space: 1 at the nodes ``active``, 0 elsewhere."""
+        """Function on the w-space: ``values`` (default 1) at the nodes ``active``, 0 elsewhere.
+
+        ``values`` holds one number per node of ``active``, in its order.
+        """
         f = dolfinx.fem.Function(self.model.Vw, name=name)
         inverse = np.full(self.model.num_owned_dofs, -1, dtype=np.int64)
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         inverse[self.model.w_dofs[:n_owned_w]] = np.arange(n_owned_w)
-        mask = np.isin(self._owned.positions, active)
-        f.x.array[inverse[self._owned.local_dofs[mask]]] = 1.0
+        active = np.asarray(active, dtype=np.int64)
+        by_node = np.zeros(self.size)
+        by_node[active] = 1.0 if values is None else np.asarray(values, dtype=float)
+        owned = self._owned.positions
+        mask = np.isin(owned, active)
+        f.x.array[inverse[self._owned.local_dofs[mask]]] = by_node[owned[mask]]
         f.x.scatter_forward()
         return f

@@ -40,10 +40,10 @@ import dolfinx.io.gmsh
 
 import numpy as np
 
-from unibuckle_fenicsx.config import EDGE_NAMES, Circle, MeshSpec, ObstacleSpec, PlateSpec, Polygon
-from unibuckle_fenicsx.config.checks import FEATURE_RATIO, plate_features
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import distance_to_polygon
+from unibuckle_fenicsx.spec import EDGE_NAMES, Circle, MeshSpec, ObstacleSpec, PlateSpec, Polygon
+from unibuckle_fenicsx.spec.checks import FEATURE_RATIO, plate_features
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [

@@ -7,8 +7,8 @@ import math
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import Material
 from unibuckle_fenicsx.laminate import laminate
+from unibuckle_fenicsx.spec import Material
 
 __all__ = [
     "bending_stiffness",

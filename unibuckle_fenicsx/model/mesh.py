@@ -12,7 +12,9 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.model.gmsh_mesh import HOLES_TAG, gmsh_plate_mesh, segment_tag
+from unibuckle_fenicsx.spec import (
     EDGE_NAMES,
     HOLES,
     EdgeSpec,
@@ -20,8 +22,6 @@ from unibuckle_fenicsx.config import (
     ObstacleSpec,
     PlateSpec,
 )
-from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.model.gmsh_mesh import HOLES_TAG, gmsh_plate_mesh, segment_tag
 
 __all__ = [
     "build_plate_mesh",

@@ -1,6 +1,6 @@
 r"""Point restraints on the mesh: bolts, tie bars and studs at points of the plate.
 
-Each point of a :class:`~unibuckle_fenicsx.config.PointSpec` acts on the deflection DOF
+Each point of a :class:`~unibuckle_fenicsx.spec.PointSpec` acts on the deflection DOF
 of the mesh node nearest to it; the distance from the point to that node (the *snap
 distance*) is reported. A point that is not a node could be held exactly by a
 multi-point constraint on the w-DOFs of its cell (w(p) as the bilinear combination of
@@ -28,7 +28,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import ObstacleSpec, PlateSpec, PointSpec
+from unibuckle_fenicsx.spec import ObstacleSpec, PlateSpec, PointSpec
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
@@ -42,7 +42,7 @@ __all__ = [
 
 @dataclass(frozen=True)
 class SnappedPoints:
-    """The points of one :class:`~unibuckle_fenicsx.config.PointSpec` on the mesh.
+    """The points of one :class:`~unibuckle_fenicsx.spec.PointSpec` on the mesh.
 
     Attributes:
         spec: The restraint.

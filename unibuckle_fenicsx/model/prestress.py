@@ -30,16 +30,16 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.model.materials import membrane_voigt
+from unibuckle_fenicsx.model.mesh import edge_line, edge_normal_axis, edge_tags
+from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
     PlateSpec,
     Temperature,
     temperature_field,
 )
-from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.model.materials import membrane_voigt
-from unibuckle_fenicsx.model.mesh import edge_line, edge_normal_axis, edge_tags
 
 __all__ = [
     "DIRECT_LU",
@@ -247,7 +247,7 @@ def solve_prestress(
         petsc_options: KSP options (default :data:`DIRECT_LU`), prefix
             ``unibuckle_prestress_``.
         temperature: A temperature rise (K; or the linear field, see
-            :class:`~unibuckle_fenicsx.config.LoadSpec`).
+            :class:`~unibuckle_fenicsx.spec.LoadSpec`).
         fixed: The fixed part of the load (applied as is): no check that it compresses.
         plate_mesh: ``msh`` and ``facet_tags`` were built from ``plate`` by the package
             (:func:`~unibuckle_fenicsx.model.mesh.build_plate_mesh`): the self-equilibrium

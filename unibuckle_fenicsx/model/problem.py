@@ -29,7 +29,6 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.eigen import (
     EIGEN_OPTIONS,
     EigenPair,
@@ -56,6 +55,7 @@ from unibuckle_fenicsx.model.mesh import build_plate_mesh, check_user_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
 from unibuckle_fenicsx.model.points import point_obstacles
 from unibuckle_fenicsx.model.prestress import solve_prestress
+from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
 __all__ = ["BYTES_PER_DOF", "BucklingProblem", "Candidate", "Mode", "available_memory"]
@@ -416,7 +416,7 @@ class BucklingProblem(Owner):
         return float(self.comm.allreduce(local, op=MPI.MAX))
 
     def solve_free(self) -> Mode:
-        """Smallest eigenpair without obstacle (computed once, then :attr:`free`).
+        """Smallest eigenpair without obstacle (computed once, then ``free``).
 
         Note:
             Collective.

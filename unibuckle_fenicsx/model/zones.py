@@ -22,8 +22,8 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import Circle, ObstacleSpec, PlateSpec, Polygon
 from unibuckle_fenicsx.geometry import disc_polygon, intersection_area, polygon_area
+from unibuckle_fenicsx.spec import Circle, ObstacleSpec, PlateSpec, Polygon
 
 __all__ = ["cell_areas", "zone_area", "zone_report"]
 
@@ -83,7 +83,7 @@ def zone_report(
     """Per obstacle: the zone's area, the discrete zone's area and its mesh nodes.
 
     Returns:
-        One mapping per obstacle: ``obstacle`` (its label), ``zone`` (described),
+        One mapping per obstacle, with ``obstacle`` (its label), ``zone`` (described),
         ``area_m2`` (the zone's part on the plate, None if unknown), ``discrete_area_m2``
         (the cells with every node in the closed zone), ``nodes`` (mesh nodes in the
         closed zone, edge nodes included).

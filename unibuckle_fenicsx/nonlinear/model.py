@@ -21,7 +21,7 @@ with the membrane and bending stiffnesses of the linear model and :math:`K_s = P
 its MITC shear stiffness (:func:`~unibuckle_fenicsx.model.plate.model.mitc_shear_matrix`):
 the shear energy is quadratic, so :math:`K_s` is assembled once and adds
 :math:`K_s(x - x_0)` to the residual and :math:`K_s` to the Jacobian. The edge supports
-and the edge loads are those of the same :class:`~unibuckle_fenicsx.config.ProblemSpec`.
+and the edge loads are those of the same :class:`~unibuckle_fenicsx.spec.ProblemSpec`.
 
 The obstacle (:math:`w \le g` at the zone's nodes, the nodes of
 :class:`~unibuckle_fenicsx.model.contact.ContactSetManager`, g the obstacle's gap, 0 by
@@ -55,7 +55,6 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
 from unibuckle_fenicsx.eigen import Owner, release, set_options
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.contact import ContactSetManager
@@ -77,6 +76,7 @@ from unibuckle_fenicsx.model.plate.spaces import MixedDofs
 from unibuckle_fenicsx.model.points import point_bcs, point_springs, snap_points
 from unibuckle_fenicsx.model.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
 from unibuckle_fenicsx.nonlinear.choices import CONTROLS
+from unibuckle_fenicsx.spec import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
 
 __all__ = [
     "CONTROLS",

@@ -29,7 +29,6 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
-from unibuckle_fenicsx.config import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.eigen import Owner
 from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
@@ -49,6 +48,7 @@ from unibuckle_fenicsx.nonlinear.model import (
 )
 from unibuckle_fenicsx.progress import LOGGER
 from unibuckle_fenicsx.results import versions
+from unibuckle_fenicsx.spec import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
 from unibuckle_fenicsx.tolerances import NONLINEAR_ATOL
 
 __all__ = [
@@ -178,7 +178,7 @@ class NonlinearResult:
         contact_load_Pa: The load of the first state on the path with a node on the
             obstacle (None if none): with a gap, where the plate reaches the obstacle.
         contact_check: The contact conditions at the last state (see
-            :meth:`NonlinearAnalysis.contact_check`).
+            :func:`contact_check`).
         options: The options used.
         wall_time_s: Total wall time (linear solve included).
         timings: Seconds per phase.

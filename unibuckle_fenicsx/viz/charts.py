@@ -30,10 +30,10 @@ from typing import Any
 
 import numpy as np
 
-from unibuckle_fenicsx.config import EDGE_NAMES, UNITS, ProblemSpec
+from unibuckle_fenicsx.spec import EDGE_NAMES, UNITS, ProblemSpec
 from unibuckle_fenicsx.sweep import Variation, point_problem
 
-__all__ = ["plot_sweep", "reference_k"]
+__all__ = ["axis_label", "plot_sweep", "reference_k"]
 
 _SS = ("simply_supported", "simply_supported_soft")
 
@@ -85,15 +85,68 @@ def reference_k(spec: ProblemSpec) -> tuple[float | None, float | None, str]:
 def _unit(path: str, units: str) -> str:
     length = "mm" if units == "mm-N-MPa" else "m"
     stress = UNITS[units][2]
+    last = path.rsplit(".", 1)[-1]
     if path in ("plate.length", "plate.width", "mesh.size", "plate.thickness"):
         return length
     if path.startswith(("plate.corners", "obstacle.zone", "obstacle.tolerance", "obstacle.gap")):
         return length
     if path.startswith("points.") and path.split(".")[2] in ("at", "spacing", "offset", "region"):
         return length
-    if path == "material.E":
+    if path in ("material.E", "material.G") or last.endswith("_stress"):
         return stress
-    return "-"
+    # Per unit length of edge: N m/m/rad (rotational) and N/m/m (translational).
+    if last == "rotational_stiffness":
+        return "N·m/(m·rad)"
+    if last == "translational_stiffness":
+        return stress
+    if last == "foundation_stiffness":
+        return f"{stress}/{length}"
+    if last == "stiffness" and path.startswith("points."):
+        return f"N/{length}"
+    if last in ("temperature", "fixed_temperature"):
+        return "K"
+    return ""
+
+
+#: The swept number in words, by the last part of its dotted path (the chart's axis).
+_WORDS = {
+    "thickness": "plate thickness",
+    "size": "cell size",
+    "E": "Young's modulus E",
+    "nu": "Poisson's ratio ν",
+    "rotational_stiffness": "rotational stiffness of the {edge} edge",
+    "translational_stiffness": "translational stiffness of the {edge} edge",
+    "normal_stress": "normal stress on the {edge} edge",
+    "shear_stress": "shear stress on the {edge} edge",
+    "foundation_stiffness": "foundation modulus",
+    "gap": "gap to the obstacle",
+    "fixed_factor": "factor on the fixed load",
+    "stiffness": "{kind} stiffness",
+    "spacing": "{kind} spacing",
+    "angle": "ply angle",
+}
+
+
+def axis_label(path: str, base: Mapping[str, Any]) -> str:
+    """The swept number in words with its unit, e.g. "tie spacing (m)", for a chart's axis.
+
+    A point row is named by its kind ("bilateral" points are ties); a key the table does
+    not know is shown as its dotted path.
+    """
+    parts = path.split(".")
+    words = _WORDS.get(parts[-1], path)
+    edge = parts[1] if parts[0] == "edges" and len(parts) > 2 else ""
+    kind = "point"
+    if parts[0] == "points" and len(parts) > 2 and parts[1].isdigit():
+        points = base.get("points") or []
+        index = int(parts[1])
+        if index < len(points):
+            kind = {"bilateral": "tie", "one-sided": "one-sided support", "spring": "spring"}.get(
+                str(points[index].get("kind", "bilateral")), "point"
+            )
+    text = words.format(edge=edge, kind=kind)
+    unit = _unit(path, str(base.get("units", "SI")))
+    return f"{text} ({unit})" if unit else text
 
 
 def _group_key(line: Mapping[str, Any], others: Sequence[str]) -> tuple[float, ...]:
@@ -117,7 +170,6 @@ def plot_sweep(
     first = variations[0]
     others = [v.path for v in variations[1:]]
     aspect = first.path in ("plate.length", "plate.width")
-    units = str(base.get("units", "SI"))
 
     def abscissa(spec: ProblemSpec, value: float) -> float:
         return spec.plate.length / spec.plate.width if aspect else value
@@ -197,9 +249,11 @@ def plot_sweep(
     if shown:
         low, high = min(shown), max(shown)
         ax.set_ylim(0.9 * low, min(1.05 * high, 2.5 * low) if aspect else 1.05 * high)
-    ax.set_xlabel("aspect ratio a/b" if aspect else f"{first.path} ({_unit(first.path, units)})")
+    ax.set_xlabel("aspect ratio a/b" if aspect else axis_label(first.path, base))
     ax.set_ylabel(r"buckling coefficient $k = N b^2 / (\pi^2 D)$")
-    ax.set_title(title or f"{base.get('name', 'plate')}: k against {first.path}")
+    ax.set_title(
+        title or f"{base.get('name', 'plate')}: k against the {axis_label(first.path, base)}"
+    )
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()

@@ -18,13 +18,15 @@ from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 if TYPE_CHECKING:  # pragma: no cover
     import dolfinx
 
-    from unibuckle_fenicsx.config import ProblemSpec
     from unibuckle_fenicsx.model.problem import BucklingProblem
+    from unibuckle_fenicsx.results import BucklingResult
+    from unibuckle_fenicsx.spec import ProblemSpec
 
 __all__ = [
     "mesh_triangles",
     "mirror_to_match",
     "nodal_deflection",
+    "pressing",
     "problem_zone",
     "section",
     "zone_box",
@@ -61,8 +63,8 @@ def zone_outlines(spec: ProblemSpec) -> list[tuple[npt.NDArray[np.float64], str]
     "all" gives the plate's outer boundary (its outline, or its bounding box), a circle
     96 points; a predicate zone has no outline and is left out.
     """
-    from unibuckle_fenicsx.config import Circle, Polygon
     from unibuckle_fenicsx.geometry import circle_points
+    from unibuckle_fenicsx.spec import Circle, Polygon
 
     out = []
     for obstacle in spec.all_obstacles:
@@ -198,3 +200,17 @@ def mesh_triangles(
     quads = cells[:, [0, 1, 3, 2]]  # counter-clockwise
     triangles = np.vstack([quads[:, [0, 1, 2]], quads[:, [0, 2, 3]]]).astype(np.int32)
     return xy, w.x.array.real.copy(), triangles
+
+
+def pressing(result: BucklingResult) -> npt.NDArray[np.bool_] | None:
+    """Whether each contact node presses the obstacle, in the order of the contact set.
+
+    A node presses when the obstacle's push on it exceeds the push double precision can
+    tell from zero (``result.contact_force["resolution"]``); the others only touch it:
+    zero deflection and no force (on thin plates against a whole face, most of them).
+    None when the result has no contact force (no rigid obstacle).
+    """
+    force = result.contact_force
+    if force is None or force.get("resolution") is None:
+        return None
+    return np.asarray(force["push"], dtype=float) > float(force["resolution"])

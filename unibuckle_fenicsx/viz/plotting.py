@@ -40,7 +40,9 @@ if TYPE_CHECKING:  # pragma: no cover
 __all__ = [
     "THEME",
     "annotate",
+    "colour_scale",
     "coloured_surface",
+    "plot_contact_force",
     "plot_contact_map",
     "plot_contact_set",
     "plot_convergence",
@@ -54,7 +56,9 @@ __all__ = [
 THEME: dict[str, Any] = {
     "window_size": (1400, 900),  # pyvista, pixels
     "font_size": 18,  # pyvista text
-    "cmap": "coolwarm",
+    "cmap": "coolwarm",  # a mode of both signs: diverging, 0 neutral
+    "cmap_one_signed": "Blues",  # a one-signed mode: sequential, white at 0 to max|w|
+    "cmap_force": "magma_r",  # the contact force, sequential on a log scale
     "figsize": (9.0, 5.0),  # matplotlib, inches
     "dpi": 130,
     "mpl_font_size": 12,
@@ -128,6 +132,25 @@ def _normalised(w: npt.NDArray[np.float64], tau: float) -> npt.NDArray[np.float6
     return out
 
 
+#: A mode whose other sign stays below this fraction of max|w| is drawn as one-signed.
+ONE_SIGNED_RTOL = 1e-2
+
+
+def colour_scale(wn: npt.NDArray[np.float64]) -> tuple[str, tuple[float, float]]:
+    """(colour map, limits) for a normalised deflection ``wn`` (max |wn| = 1).
+
+    A one-signed mode (a unilateral mode against a whole-plate obstacle, say) gets the
+    sequential map from 0 to its sign's extreme, so the whole scale shows it; a mode of
+    both signs the diverging map on [-1, 1], 0 neutral. Parts of the other sign below
+    :data:`ONE_SIGNED_RTOL` are drawn as 0.
+    """
+    if wn.size and wn.min() >= -ONE_SIGNED_RTOL:
+        return THEME["cmap_one_signed"], (0.0, 1.0)
+    if wn.size and wn.max() <= ONE_SIGNED_RTOL:
+        return f"{THEME['cmap_one_signed']}_r", (-1.0, 0.0)
+    return THEME["cmap"], (-1.0, 1.0)
+
+
 # -- 3-D mode ----------------------------------------------------------------------------
 def annotate(plotter: Any, legend: Sequence[tuple[str, str]], title: str, font: str | None) -> None:
     """The legend (label, colour) at the lower left and the title at the upper left."""
@@ -159,11 +182,14 @@ def coloured_surface(
     edges: bool,
     line_width: float = 0.5,
     ambient: float = 0.0,
+    cmap: str | None = None,
+    clim: tuple[float, float] = (-1.0, 1.0),
 ) -> tuple[Any, str | None]:
     """An off-screen plotter with ``surface`` coloured by ``scalars`` in [-1, 1] and its bar.
 
     ``ambient``: VTK's ambient light coefficient (0 to 1), so that walls seen at a grazing
-    angle keep their colour.
+    angle keep their colour; ``cmap`` and ``clim`` as :func:`colour_scale` gives them
+    (default: the theme's diverging map on [-1, 1]).
 
     Returns:
         The plotter (the caller closes it) and the font file of its text (or None).
@@ -174,8 +200,8 @@ def coloured_surface(
     plotter.add_mesh(
         surface,
         scalars=scalars,
-        cmap=THEME["cmap"],
-        clim=(-1.0, 1.0),
+        cmap=THEME["cmap"] if cmap is None else cmap,
+        clim=clim,
         show_edges=edges,
         edge_color="gray",
         line_width=line_width,
@@ -208,20 +234,26 @@ def plot_mode_3d(
     path: str | Path,
     *,
     contact_coordinates: npt.ArrayLike | None = None,
+    contact_pressing: npt.ArrayLike | None = None,
     title: str = "",
     show_zone: bool = True,
     tau: float = 0.0,
 ) -> Path:
     """Warped 3-D surface of the mode, with the obstacle zone and the contact nodes.
 
-    The surface is coloured by w / max|w|; the obstacle is a translucent grey plane just
-    above w = 0 over its zone, outlined in black; contact nodes (|Z|) are black spheres.
+    The surface is coloured by w / max|w| (:func:`colour_scale`: sequential for a
+    one-signed mode); the obstacle is a translucent grey plane just above w = 0 over its
+    zone, outlined in black; contact nodes (|Z|) are black spheres where they press the
+    obstacle and white ones where they only touch it (``contact_pressing``).
 
     Args:
         problem: The solved problem (serial).
         mode: The mode (w, theta) to draw.
         path: PNG to write.
         contact_coordinates: (|Z|, 2) coordinates of the contact set.
+        contact_pressing: (|Z|,) whether each contact node presses the obstacle (its
+            push above the load's resolution, :func:`~unibuckle_fenicsx.viz.fields.pressing`);
+            None draws every contact node alike.
         title: Text at the top left.
         show_zone: Draw the obstacle zone (if the problem has one).
         tau: Relative deflections below this are drawn as zero.
@@ -237,7 +269,9 @@ def plot_mode_3d(
     path = _prepare(path)
     w, _ = problem.model.split(mode)
     grid = pv.UnstructuredGrid(*dolfinx.plot.vtk_mesh(w.function_space))  # type: ignore[arg-type]
-    grid.point_data["w / max|w|"] = _normalised(w.x.array.real, tau)
+    wn = _normalised(w.x.array.real, tau)
+    cmap, clim = colour_scale(wn)
+    grid.point_data["w / max|w|"] = np.clip(wn, *clim)
     grid.set_active_scalars("w / max|w|")
     # The theme's sizes are for the paper's 0.2 m plate; others are scaled alike.
     scale = max(problem.spec.plate.length, problem.spec.plate.width) / 0.2
@@ -245,7 +279,13 @@ def plot_mode_3d(
     warped = grid.warp_by_scalar("w / max|w|", factor=warp)
 
     plotter, font = coloured_surface(
-        pv, warped, "w / max|w|", "w (normalised)", edges=grid.n_cells <= 2500
+        pv,
+        warped,
+        "w / max|w|",
+        "w (normalised)",
+        edges=grid.n_cells <= 2500,
+        cmap=cmap,
+        clim=clim,
     )
     # Flat reference outline of the plate at w = 0.
     (px0, py0), (px1, py1) = problem.spec.plate.corners
@@ -269,13 +309,16 @@ def plot_mode_3d(
         legend.append((text, "#303030"))
     cxy = np.asarray(contact_coordinates if contact_coordinates is not None else [], dtype=float)
     cxy = cxy.reshape(-1, 2)
-    if len(cxy):
-        pts = np.column_stack([cxy[:, 0], cxy[:, 1], np.full(len(cxy), 0.5 * lift)])
-        plotter.add_points(
-            pts, color=THEME["contact_color"], point_size=12, render_points_as_spheres=True
-        )
-    if box is not None:
+    presses = _pressing_mask(contact_pressing, len(cxy))
+    for mask, colour in ((presses, THEME["contact_color"]), (~presses, "white")):
+        if mask.any():
+            pts = np.column_stack([cxy[mask, 0], cxy[mask, 1], np.full(mask.sum(), 0.5 * lift)])
+            plotter.add_points(pts, color=colour, point_size=12, render_points_as_spheres=True)
+    if box is not None and contact_pressing is None:
         legend.append((f"contact nodes: {len(cxy)}", "black"))
+    elif box is not None:
+        legend.append((f"pressing the obstacle: {int(presses.sum())}", "black"))
+        legend.append((f"touching, no force: {int((~presses).sum())}", "#a0a0a0"))
     annotate(plotter, legend, title, font)
     plotter.add_axes(
         xlabel="x", ylabel="y", zlabel="w", color="black", viewport=(0.72, 0.0, 0.86, 0.18)
@@ -364,33 +407,77 @@ def _mode_bands(
     tau: float,
     triangles: npt.ArrayLike | None = None,
 ) -> None:
-    """Filled bands of w / max|w| (centred on 0, ±0.1, ...: 0 is neutral) and a colour bar.
+    """Filled bands of w / max|w| and a colour bar (:func:`colour_scale`).
 
-    ``triangles`` (the cells') keeps holes empty; without it the nodes are triangulated.
+    A mode of both signs: bands centred on 0, ±0.1, ... (0 neutral); a one-signed mode:
+    the sequential map from 0 to its extreme. ``triangles`` (the cells') keeps holes
+    empty; without it the nodes are triangulated.
     """
-    levels = np.linspace(-1.05, 1.05, 22)
+    wn = _normalised(np.asarray(w), tau)
+    cmap, (low, high) = colour_scale(wn)
+    if (low, high) == (-1.0, 1.0):
+        levels, ticks = np.linspace(-1.05, 1.05, 22), np.linspace(-1, 1, 5)
+    else:
+        levels, ticks = np.linspace(low, high, 11), np.linspace(low, high, 5)
     tri = () if triangles is None else (np.asarray(triangles),)
     cs = ax.tricontourf(
-        xy[:, 0], xy[:, 1], *tri, _normalised(np.asarray(w), tau), levels=levels,
-        cmap=THEME["cmap"],
+        xy[:, 0], xy[:, 1], *tri, np.clip(wn, low, high), levels=levels, cmap=cmap,
     )  # fmt: skip
-    cbar = fig.colorbar(cs, ax=ax, shrink=0.8, ticks=np.linspace(-1, 1, 5))
+    cbar = fig.colorbar(cs, ax=ax, shrink=0.8, ticks=ticks)
     cbar.set_label("w / max|w|")
 
 
+def _pressing_mask(pressing: npt.ArrayLike | None, n: int) -> npt.NDArray[np.bool_]:
+    """``pressing`` as a boolean array of ``n`` (None: every node presses)."""
+    if pressing is None:
+        return np.ones(n, dtype=bool)
+    mask = np.asarray(pressing, dtype=bool).reshape(-1)
+    if mask.size != n:
+        raise ValueError(f"contact_pressing has {mask.size} entries for {n} contact nodes")
+    return mask
+
+
 def _contact_markers(
-    ax: Any, coordinates: npt.ArrayLike, sizes: tuple[float, float], many: int
+    ax: Any,
+    coordinates: npt.ArrayLike,
+    sizes: tuple[float, float],
+    many: int,
+    pressing: npt.ArrayLike | None = None,
 ) -> None:
-    """The contact set Z as black dots (the smaller size from ``many`` nodes on)."""
+    """The contact set Z (the smaller size from ``many`` nodes on).
+
+    Without ``pressing``: black dots. With it: the nodes that press the obstacle as black
+    dots, those that only touch it (zero deflection, no force) as open circles.
+    """
     z = np.atleast_2d(np.asarray(coordinates, dtype=float))
     nz = z.shape[0] if z.size else 0
-    if nz:
-        ax.plot(z[:, 0], z[:, 1], "o", ms=sizes[0] if nz < many else sizes[1], mfc="black",
-                mec="white", mew=0.5, label=f"contact set Z ({nz})")  # fmt: skip
+    if not nz:
+        return
+    ms = sizes[0] if nz < many else sizes[1]
+    if pressing is None:
+        ax.plot(z[:, 0], z[:, 1], "o", ms=ms, mfc="black", mec="white", mew=0.5,
+                label=f"contact set Z ({nz})")  # fmt: skip
+        return
+    mask = _pressing_mask(pressing, nz)
+    ax.plot(z[mask, 0], z[mask, 1], "o", ms=ms, mfc="black", mec="white", mew=0.5,
+            label=f"pressing the obstacle ({int(mask.sum())})")  # fmt: skip
+    ax.plot(z[~mask, 0], z[~mask, 1], "o", ms=ms, mfc="none", mec="black", mew=0.8,
+            label=f"touching, no force ({int((~mask).sum())})")  # fmt: skip
 
 
-def _finish_top_view(plt: Any, fig: Any, ax: Any, path: Path, title: str) -> Path:
-    """Equal axes in metres, the title, the legend below the plot; write and close."""
+def _finish_top_view(
+    plt: Any,
+    fig: Any,
+    ax: Any,
+    path: Path,
+    title: str,
+    corners: tuple[tuple[float, float], tuple[float, float]] | None = None,
+) -> Path:
+    """Equal axes in metres (over ``corners``), the title, the legend below; write, close."""
+    if corners is not None:
+        (px0, py0), (px1, py1) = corners
+        ax.set_xlim(px0, px1)
+        ax.set_ylim(py0, py1)
     ax.set_aspect("equal")
     ax.set_xlabel("x (m)")
     ax.set_ylabel("y (m)")
@@ -411,6 +498,7 @@ def plot_contact_set(
     zone: tuple[tuple[float, float], tuple[float, float]] | None,
     constrained: npt.ArrayLike,
     contact_coordinates: npt.ArrayLike,
+    contact_pressing: npt.ArrayLike | None = None,
     title: str = "",
     tau: float = 0.0,
 ) -> Path:
@@ -424,6 +512,9 @@ def plot_contact_set(
         zone: The obstacle zone's box (:func:`~unibuckle_fenicsx.viz.fields.zone_box`).
         constrained: (i, 2) coordinates of the constrained nodes I.
         contact_coordinates: (|Z|, 2) coordinates of the contact set.
+        contact_pressing: (|Z|,) whether each contact node presses the obstacle
+            (:func:`~unibuckle_fenicsx.viz.fields.pressing`): filled where it does, open
+            where it only touches; None draws every contact node filled.
         title: Axes title.
         tau: Relative deflections below this are drawn as zero.
 
@@ -433,7 +524,6 @@ def plot_contact_set(
     plt = _pyplot()
     path = _prepare(path)
     xy = np.asarray(xy, dtype=float)
-    (px0, py0), (px1, py1) = corners
     fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
     _mode_bands(fig, ax, xy, w, tau)
     if zone is not None:
@@ -462,10 +552,67 @@ def plot_contact_set(
             alpha=0.6 if dense else 1.0,
             label=f"constrained nodes I ({len(cxy)})",
         )
-    _contact_markers(ax, contact_coordinates, sizes=(5, 3), many=500)
-    ax.set_xlim(px0, px1)
-    ax.set_ylim(py0, py1)
-    return _finish_top_view(plt, fig, ax, path, title)
+    _contact_markers(ax, contact_coordinates, sizes=(5, 3), many=500, pressing=contact_pressing)
+    return _finish_top_view(plt, fig, ax, path, title, corners)
+
+
+# -- contact force ---------------------------------------------------------------------
+def plot_contact_force(
+    path: str | Path,
+    contact_coordinates: npt.ArrayLike,
+    push: npt.ArrayLike,
+    resolution: float,
+    *,
+    corners: tuple[tuple[float, float], tuple[float, float]],
+    zone: tuple[tuple[float, float], tuple[float, float]] | None = None,
+    title: str = "",
+) -> Path:
+    """Top view of the obstacle's push at each contact node, on a logarithmic scale.
+
+    Pressing nodes (push above ``resolution``) are coloured by their push (N/m: N per
+    metre of the mode's largest deflection, the JSON's ``contact_force``) over the six
+    decades below the largest; nodes that only touch (zero deflection, no force) are open
+    circles.
+
+    Args:
+        path: PNG to write.
+        contact_coordinates: (|Z|, 2) coordinates of the contact nodes.
+        push: (|Z|,) the obstacle's push at each (N/m).
+        resolution: The push double precision cannot tell from zero (N/m).
+        corners: The plate's corners.
+        zone: The obstacle zone's box, drawn dashed.
+        title: Axes title.
+
+    Returns:
+        The written path.
+    """
+    from matplotlib.colors import LogNorm
+
+    plt = _pyplot()
+    path = _prepare(path)
+    z = np.asarray(contact_coordinates, dtype=float).reshape(-1, 2)
+    f = np.asarray(push, dtype=float).reshape(-1)
+    presses = f > resolution
+    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    (px0, py0), (px1, py1) = corners
+    ax.add_patch(plt.Rectangle((px0, py0), px1 - px0, py1 - py0, fill=False, ec="black", lw=1))
+    if zone is not None:
+        (x0, x1), (y0, y1) = zone
+        ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, ec="dimgray",
+                                   lw=2.0, ls="--", label="obstacle zone"))  # fmt: skip
+    ms = 16 if len(z) < 500 else 5
+    if presses.any():
+        top = float(f[presses].max())
+        dots = ax.scatter(z[presses, 0], z[presses, 1], c=f[presses], s=ms,
+                          cmap=THEME["cmap_force"], norm=LogNorm(top * 1e-6, top),
+                          label=f"pressing the obstacle ({int(presses.sum())})")  # fmt: skip
+        bar = fig.colorbar(dots, ax=ax, shrink=0.8, extend="min")
+        bar.set_label("push per node (N/m of the largest deflection)")
+    if (~presses).any():
+        touching = f"touching, no force ({int((~presses).sum())})"
+        ax.scatter(z[~presses, 0], z[~presses, 1], s=ms, facecolors="none", edgecolors="black",
+                   linewidths=0.6, label=touching)  # fmt: skip
+    return _finish_top_view(plt, fig, ax, path, title, corners)
 
 
 # -- contact map on the plate's own mesh -------------------------------------------------
@@ -479,6 +626,7 @@ def plot_contact_map(
     holes: Sequence[npt.ArrayLike] = (),
     zones: Sequence[tuple[npt.ArrayLike, str]] = (),
     contact_coordinates: npt.ArrayLike = (),
+    contact_pressing: npt.ArrayLike | None = None,
     title: str = "",
     tau: float = 0.0,
     ties: npt.ArrayLike = (),
@@ -496,6 +644,8 @@ def plot_contact_map(
         zones: (outline, side) of each obstacle zone
             (:func:`~unibuckle_fenicsx.viz.fields.zone_outlines`); dashed, labelled by side.
         contact_coordinates: (|Z|, 2) coordinates of the contact set.
+        contact_pressing: (|Z|,) whether each contact node presses the obstacle: filled
+            where it does, open where it only touches; None draws every node filled.
         title: Axes title.
         tau: Relative deflections below this are drawn as zero.
         ties: (k, 2) nodes of point restraints (bolts, tie bars), drawn as crosses.
@@ -525,7 +675,7 @@ def plot_contact_map(
         ax.plot(ring[:, 0], ring[:, 1], ls, color="dimgray", lw=2.5,
                 label=None if side in shown else label)  # fmt: skip
         shown.add(side)
-    _contact_markers(ax, contact_coordinates, sizes=(4, 2.5), many=300)
+    _contact_markers(ax, contact_coordinates, sizes=(4, 2.5), many=300, pressing=contact_pressing)
     lo, hi = xy.min(axis=0), xy.max(axis=0)
     pad = 0.02 * float((hi - lo).max())
     ax.set_xlim(lo[0] - pad, hi[0] + pad)

@@ -27,9 +27,9 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.analysis import Analysis, solve
-from unibuckle_fenicsx.config import ProblemSpec
 from unibuckle_fenicsx.io import write_fields
 from unibuckle_fenicsx.results import BucklingResult
+from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.viz import fields, plotting
 
 __all__ = [
@@ -243,6 +243,7 @@ def mesh_study(
                         analysis.mode,
                         figures / f"mode_{point.label}.png",
                         contact_coordinates=result.contact_coordinates,
+                        contact_pressing=fields.pressing(result),
                         title=f"{_title(name)}, {point.label} mesh: "
                         f"λ = {result.critical_load_Pa / 1e6:.4f} MPa{ratio}",
                         show_zone=zone is not None,
@@ -261,9 +262,21 @@ def mesh_study(
                         zone=zone,
                         constrained=problem.contact.coordinates,
                         contact_coordinates=result.contact_coordinates,
+                        contact_pressing=fields.pressing(result),
                         title=f"{_title(name)}: contact set on the {point.label} mesh",
                         tau=problem.tau,
                     )
+                    force = result.contact_force
+                    if force is not None and force["resolution"] is not None:
+                        plotting.plot_contact_force(
+                            figures / "contact_force.png",
+                            result.contact_coordinates,
+                            force["push"],
+                            force["resolution"],
+                            corners=spec.plate.corners,
+                            zone=zone,
+                            title=f"{_title(name)}: the obstacle's push, {point.label} mesh",
+                        )
             if output is not None:
                 write_fields(analysis, output / name / point.label)
             if at_each is not None:

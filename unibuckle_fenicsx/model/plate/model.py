@@ -13,7 +13,6 @@ import ufl
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import Material, PlateSpec, PointSpec
 from unibuckle_fenicsx.eigen import Owner, release
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.materials import bending_voigt, transverse_shear
@@ -32,6 +31,7 @@ from unibuckle_fenicsx.model.plate.spaces import (
 )
 from unibuckle_fenicsx.model.points import point_bcs, point_springs, snap_points
 from unibuckle_fenicsx.model.prestress import Prestress, material_constant
+from unibuckle_fenicsx.spec import Material, PlateSpec, PointSpec
 
 __all__ = ["PlateModel", "edge_spring_form", "edge_support_bcs", "mitc_shear_matrix"]
 
@@ -229,7 +229,7 @@ def edge_spring_form(
 
     The second variation of :math:`\tfrac12\int k_r (\theta\cdot n)^2 + k_t w^2\,ds` over the
     edges with a ``rotational_stiffness`` :math:`k_r` or a ``translational_stiffness``
-    :math:`k_t` (:class:`~unibuckle_fenicsx.config.EdgeSpec`); n is the outward normal,
+    :math:`k_t` (:class:`~unibuckle_fenicsx.spec.EdgeSpec`); n is the outward normal,
     so :math:`\theta\cdot n` is the rotation about the edge. The springs act on the
     DOFs the support leaves free (the loader refuses the others); assembled with the
     supports' Dirichlet rows, they do not touch the fixed ones.

@@ -26,10 +26,10 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.active_set import POLISH_ITERATIONS, THRESHOLDS, solve_active_set
 from unibuckle_fenicsx.algorithms.pdas import iterate
-from unibuckle_fenicsx.config import SolverSpec
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.shell.core import CoreConstraints
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
+from unibuckle_fenicsx.spec import SolverSpec
 
 __all__ = ["prolong_directions", "solve_section"]
 

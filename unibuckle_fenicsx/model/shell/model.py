@@ -26,7 +26,6 @@ import ufl
 
 import numpy as np
 
-from unibuckle_fenicsx.config import Material
 from unibuckle_fenicsx.eigen import Owner, release
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.materials import (
@@ -46,6 +45,7 @@ from unibuckle_fenicsx.model.shell.forms import (
     shear_form,
 )
 from unibuckle_fenicsx.model.shell.geometry import END_FINISH, END_START, SectionMesh
+from unibuckle_fenicsx.spec import Material
 
 __all__ = [
     "DOFS_PER_NODE",

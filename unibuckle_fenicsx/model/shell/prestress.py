@@ -27,7 +27,6 @@ import ufl
 
 import numpy as np
 
-from unibuckle_fenicsx.config import Material
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.materials import membrane_voigt
 from unibuckle_fenicsx.model.prestress import DIRECT_LU, material_constant
@@ -39,6 +38,7 @@ from unibuckle_fenicsx.model.shell.model import (
     shell_stiffness_form,
     support_bcs,
 )
+from unibuckle_fenicsx.spec import Material
 
 __all__ = ["PRESTRESS_PREFIX", "SectionPrestress", "depth_coordinate", "solve_section_prestress"]
 

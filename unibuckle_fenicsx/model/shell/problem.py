@@ -22,7 +22,13 @@ import dolfinx
 
 import numpy as np
 
-from unibuckle_fenicsx.config import (
+from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, GEPSolver, Owner, release
+from unibuckle_fenicsx.model.contact import ContactSetManager, _Owned
+from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.model.shell.core import CoreConstraints
+from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE, ShellModel, chop_roundoff
+from unibuckle_fenicsx.model.shell.prestress import SectionPrestress
+from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
     MeshSpec,
@@ -31,12 +37,6 @@ from unibuckle_fenicsx.config import (
     ProblemSpec,
     SolverSpec,
 )
-from unibuckle_fenicsx.eigen import EIGEN_OPTIONS, GEPSolver, Owner, release
-from unibuckle_fenicsx.model.contact import ContactSetManager, _Owned
-from unibuckle_fenicsx.model.problem import BucklingProblem
-from unibuckle_fenicsx.model.shell.core import CoreConstraints
-from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE, ShellModel, chop_roundoff
-from unibuckle_fenicsx.model.shell.prestress import SectionPrestress
 
 __all__ = ["RotatedPencil", "SectionContact", "SectionProblem"]
 

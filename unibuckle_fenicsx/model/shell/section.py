@@ -27,7 +27,6 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config import Material, SolverSpec
 from unibuckle_fenicsx.eigen import Owner
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import Candidate
@@ -37,6 +36,7 @@ from unibuckle_fenicsx.model.shell.geometry import SectionMesh, section_mesh
 from unibuckle_fenicsx.model.shell.model import ENDS, ShellModel, end_supports
 from unibuckle_fenicsx.model.shell.prestress import SectionPrestress, solve_section_prestress
 from unibuckle_fenicsx.model.shell.problem import SectionProblem
+from unibuckle_fenicsx.spec import Material, SolverSpec
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = ["GEOMETRIC", "Section", "SectionParameters", "build_section", "figure_data"]

@@ -9,12 +9,17 @@ from typing import Any, Literal
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config.plate import (
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.geometry import (
+    points_in_circle,
+    points_in_polygon,
+)
+from unibuckle_fenicsx.spec.plate import (
     Circle,
     PlateSpec,
     Polygon,
 )
-from unibuckle_fenicsx.config.values import (
+from unibuckle_fenicsx.spec.values import (
     POINT_KINDS,
     SIDES,
     UNITS,
@@ -27,11 +32,6 @@ from unibuckle_fenicsx.config.values import (
     _pair,
     _temperature,
     temperature_field,
-)
-from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.geometry import (
-    points_in_circle,
-    points_in_polygon,
 )
 
 

@@ -8,11 +8,11 @@ from typing import Any
 
 import numpy as np
 
-from unibuckle_fenicsx.config.values import (
-    _number,
-)
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.laminate import laminate
+from unibuckle_fenicsx.spec.values import (
+    _number,
+)
 
 
 @dataclass(frozen=True)

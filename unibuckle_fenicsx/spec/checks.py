@@ -1,7 +1,7 @@
 """Checks of a whole problem that no single key can make: supports, plate model, geometry.
 
-Run by :class:`~unibuckle_fenicsx.config.ProblemSpec` and
-:class:`~unibuckle_fenicsx.config.PlateSpec` when they are built, before any mesh: each
+Run by :class:`~unibuckle_fenicsx.spec.ProblemSpec` and
+:class:`~unibuckle_fenicsx.spec.PlateSpec` when they are built, before any mesh: each
 raises :class:`~unibuckle_fenicsx.errors.InputError` naming the keys (or, for
 :func:`plate_model_note`, returns a warning). numpy only; the config classes import this
 module, so it reads their fields and imports them for type checking only.
@@ -15,13 +15,13 @@ from typing import TYPE_CHECKING, TypeGuard, cast
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config.values import EDGE_NAMES, HOLES
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import distance_to_polygon
+from unibuckle_fenicsx.spec.values import EDGE_NAMES, HOLES
 
 if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.config.plate import Circle, PlateSpec, Polygon
-    from unibuckle_fenicsx.config.problem import ProblemSpec
+    from unibuckle_fenicsx.spec.plate import Circle, PlateSpec, Polygon
+    from unibuckle_fenicsx.spec.problem import ProblemSpec
 
 __all__ = [
     "FEATURE_RATIO",
@@ -249,7 +249,7 @@ def check_features(plate: PlateSpec, mesh_size: float | None) -> None:
 
 
 def _is_circle(hole: Circle | Polygon) -> TypeGuard[Circle]:
-    """A circular hole (:class:`~unibuckle_fenicsx.config.plate.Circle`: it has a radius).
+    """A circular hole (:class:`~unibuckle_fenicsx.spec.plate.Circle`: it has a radius).
 
     Read from its fields, not its class: the config classes import these checks.
     """

@@ -9,18 +9,18 @@ converted to SI when read, and results are printed in its stress unit.
 
 Modules:
 
-- :mod:`~unibuckle_fenicsx.config.schema`: the schema of a problem file on msgspec
+- :mod:`~unibuckle_fenicsx.spec.schema`: the schema of a problem file on msgspec
   (types, bounds, choices, unknown keys; error locations such as
   ``obstacles[1].circle.radius``), :func:`json_schema` and :func:`accepted_keys`. Its
   docstring gives the measurements that chose msgspec over pydantic and cattrs, and
   what stays checked by hand.
-- :mod:`~unibuckle_fenicsx.config.values`, :mod:`~unibuckle_fenicsx.config.material`,
-  :mod:`~unibuckle_fenicsx.config.plate`, :mod:`~unibuckle_fenicsx.config.obstacles`,
-  :mod:`~unibuckle_fenicsx.config.problem`: the frozen dataclasses of the Python API.
+- :mod:`~unibuckle_fenicsx.spec.values`, :mod:`~unibuckle_fenicsx.spec.material`,
+  :mod:`~unibuckle_fenicsx.spec.plate`, :mod:`~unibuckle_fenicsx.spec.obstacles`,
+  :mod:`~unibuckle_fenicsx.spec.problem`: the frozen dataclasses of the Python API.
   They check their values in ``__post_init__`` (they are built in code too, without a
   file) and the rules no schema knows: geometry, the edge-load rule, material matrices.
-- :mod:`~unibuckle_fenicsx.config.units`: a file's numbers to SI and back.
-- :mod:`~unibuckle_fenicsx.config.loading` and :mod:`~unibuckle_fenicsx.config.writing`:
+- :mod:`~unibuckle_fenicsx.spec.units`: a file's numbers to SI and back.
+- :mod:`~unibuckle_fenicsx.spec.loading` and :mod:`~unibuckle_fenicsx.spec.writing`:
   a TOML-shaped mapping (or a TOML file, or a JSON result) to a :class:`ProblemSpec`,
   and back (the JSON ``input`` echo: ``problem_from_dict(problem_to_dict(spec)) ==
   spec``).
@@ -31,16 +31,16 @@ naming the key and the allowed range before any mesh or matrix is built.
 
 from __future__ import annotations
 
-from unibuckle_fenicsx.config.loading import (
+from unibuckle_fenicsx.spec.loading import (
     OBSTACLE_KEYS,
     PLY_KEYS,
     load_problem,
     load_toml,
     problem_from_dict,
 )
-from unibuckle_fenicsx.config.material import Material, Ply
-from unibuckle_fenicsx.config.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
-from unibuckle_fenicsx.config.plate import (
+from unibuckle_fenicsx.spec.material import Material, Ply
+from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
+from unibuckle_fenicsx.spec.plate import (
     Circle,
     EdgeSpec,
     MeshSpec,
@@ -48,9 +48,9 @@ from unibuckle_fenicsx.config.plate import (
     Polygon,
     paper_edges,
 )
-from unibuckle_fenicsx.config.problem import ProblemSpec, SolverSpec
-from unibuckle_fenicsx.config.schema import accepted_keys, json_schema
-from unibuckle_fenicsx.config.values import (
+from unibuckle_fenicsx.spec.problem import ProblemSpec, SolverSpec
+from unibuckle_fenicsx.spec.schema import accepted_keys, json_schema
+from unibuckle_fenicsx.spec.values import (
     BENDING_SUPPORTS,
     EDGE_NAMES,
     HOLES,
@@ -69,7 +69,7 @@ from unibuckle_fenicsx.config.values import (
     stress_ends,
     temperature_field,
 )
-from unibuckle_fenicsx.config.writing import problem_to_dict, stress_value
+from unibuckle_fenicsx.spec.writing import problem_to_dict, stress_value
 
 __all__ = [
     "BENDING_SUPPORTS",

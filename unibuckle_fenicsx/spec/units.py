@@ -5,7 +5,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from typing import Any
 
-from unibuckle_fenicsx.config.values import (
+from unibuckle_fenicsx.spec.values import (
     UNITS,
     _number,
 )

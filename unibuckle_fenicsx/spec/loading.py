@@ -10,9 +10,10 @@ from dataclasses import replace
 from pathlib import Path
 from typing import Any
 
-from unibuckle_fenicsx.config.material import Material, Ply
-from unibuckle_fenicsx.config.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
-from unibuckle_fenicsx.config.plate import (
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec.material import Material, Ply
+from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
+from unibuckle_fenicsx.spec.plate import (
     Circle,
     EdgeSpec,
     MeshSpec,
@@ -21,16 +22,15 @@ from unibuckle_fenicsx.config.plate import (
     _polygon,
     paper_edges,
 )
-from unibuckle_fenicsx.config.problem import ProblemSpec, SolverSpec
-from unibuckle_fenicsx.config.schema import validate_document
-from unibuckle_fenicsx.config.units import _to_si
-from unibuckle_fenicsx.config.values import (
+from unibuckle_fenicsx.spec.problem import ProblemSpec, SolverSpec
+from unibuckle_fenicsx.spec.schema import validate_document
+from unibuckle_fenicsx.spec.units import _to_si
+from unibuckle_fenicsx.spec.values import (
     EDGE_NAMES,
     HOLES,
     UNITS,
     _choice,
 )
-from unibuckle_fenicsx.errors import InputError
 
 
 def _edge_tables(given: Mapping[str, Any], names: tuple[str, ...]) -> dict[str, Any]:

@@ -14,17 +14,6 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.config.checks import check_features, check_thickness
-from unibuckle_fenicsx.config.values import (
-    BENDING_SUPPORTS,
-    HOLES,
-    INPLANE_SUPPORTS,
-    _choice,
-    _integer,
-    _number,
-    _stress,
-    stress_ends,
-)
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import (
     circle_points,
@@ -35,6 +24,17 @@ from unibuckle_fenicsx.geometry import (
     polygon_area,
     polygon_inside,
     polygons_disjoint,
+)
+from unibuckle_fenicsx.spec.checks import check_features, check_thickness
+from unibuckle_fenicsx.spec.values import (
+    BENDING_SUPPORTS,
+    HOLES,
+    INPLANE_SUPPORTS,
+    _choice,
+    _integer,
+    _number,
+    _stress,
+    stress_ends,
 )
 
 
@@ -99,7 +99,7 @@ class EdgeSpec:
             ("roller" fixes the normal displacement only).
         normal_stress: Normal edge stress per unit load (Pa/Pa), tension positive;
             the paper's compressed edges have -1. A pair ``(start, end)`` varies
-            linearly along the edge (:func:`~unibuckle_fenicsx.model.mesh.edge_lines` gives
+            linearly along the edge (:func:`~unibuckle_fenicsx.model.mesh.edge_line` gives
             the direction): in-plane bending is ``(1, -1)``, the stress-gradient ratio
             of design codes is :math:`\psi` = end/start.
         shear_stress: Tangential edge stress per unit load (Pa/Pa), along the

@@ -4,20 +4,20 @@ from __future__ import annotations
 
 from typing import Any
 
-from unibuckle_fenicsx.config.material import Material
-from unibuckle_fenicsx.config.obstacles import ObstacleSpec, PointSpec
-from unibuckle_fenicsx.config.plate import (
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec.material import Material
+from unibuckle_fenicsx.spec.obstacles import ObstacleSpec, PointSpec
+from unibuckle_fenicsx.spec.plate import (
     Circle,
     PlateSpec,
     Polygon,
 )
-from unibuckle_fenicsx.config.problem import ProblemSpec
-from unibuckle_fenicsx.config.units import _to_si
-from unibuckle_fenicsx.config.values import (
+from unibuckle_fenicsx.spec.problem import ProblemSpec
+from unibuckle_fenicsx.spec.units import _to_si
+from unibuckle_fenicsx.spec.values import (
     UNITS,
     _choice,
 )
-from unibuckle_fenicsx.errors import InputError
 
 
 def _plate_table(plate: PlateSpec) -> dict[str, Any]:

@@ -6,14 +6,15 @@ import math
 from dataclasses import dataclass, field, replace
 from typing import Any
 
-from unibuckle_fenicsx.config.checks import check_features, check_supports
-from unibuckle_fenicsx.config.material import Material
-from unibuckle_fenicsx.config.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
-from unibuckle_fenicsx.config.plate import (
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec.checks import check_features, check_supports
+from unibuckle_fenicsx.spec.material import Material
+from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
+from unibuckle_fenicsx.spec.plate import (
     MeshSpec,
     PlateSpec,
 )
-from unibuckle_fenicsx.config.values import (
+from unibuckle_fenicsx.spec.values import (
     METHODS,
     UNITS,
     _boolean,
@@ -22,7 +23,6 @@ from unibuckle_fenicsx.config.values import (
     _number,
     stress_ends,
 )
-from unibuckle_fenicsx.errors import InputError
 
 
 @dataclass(frozen=True)

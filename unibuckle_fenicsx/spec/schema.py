@@ -20,7 +20,7 @@ gives one line with the location: ``Expected `float` > 0.0 - at
 enum value 'up' - at `$.obstacles[0].side```; pydantic gives the same content over four
 lines with a documentation link per error; cattrs says ``invalid value @
 $.obstacles[1].circle`` for the radius (no bound) and accepted the string "5" for a float.
-In the package, ``python -X importtime -c "import unibuckle_fenicsx.config"`` gives this
+In the package, ``python -X importtime -c "import unibuckle_fenicsx.spec"`` gives this
 module 75-138 ms cumulative, msgspec's import 59-109 ms of it (three runs, under load).
 
 What stays by hand, and why. The schema knows types, numeric bounds, choices and keys. It
@@ -29,8 +29,8 @@ plate and disjoint, outline segments named once, an edge name the plate has), th
 edge-load rule (edges that give no stress carry none once any edge or ``[load]`` gives
 one), the unit systems (a file's numbers converted to SI), the positive definite
 material matrices and symmetric laminates, and the mechanism checks
-(:mod:`unibuckle_fenicsx.config.checks`). Those live in the frozen dataclasses of the Python
-API (:mod:`~unibuckle_fenicsx.config.plate` and its siblings), which are also built
+(:mod:`unibuckle_fenicsx.spec.checks`). Those live in the frozen dataclasses of the Python
+API (:mod:`~unibuckle_fenicsx.spec.plate` and its siblings), which are also built
 directly in code, without a file, and so check their own values too. A bound violated
 in a file is reported by the dataclass's check, which gives the unit (``plate.thickness
 must be > 0 m, got -1.0``); the schema's own message is the fallback.
@@ -336,7 +336,7 @@ def validate_document(data: Mapping[str, Any]) -> str | None:
     """Check the TOML-shaped ``data`` against :class:`ProblemFile`.
 
     Returns:
-        None, or the schema's message for a value out of its bounds: the caller's checks
+        None, or the schema's message for a value out of its bounds; the caller's checks
         give a more precise one (with the unit); this one is their fallback.
 
     Raises:
