@@ -9,7 +9,7 @@ A square box (b = d = 0.2 m, t = 2 mm: b/t = 100, L = 3b) or a circular tube (R 
 t = 1 mm: R/t = 100, L = R), steel, simply supported ends, a rigid core over the whole
 length. One process: the set-up (mesh, prestress, assembly, change of basis), the free
 eigen solve (min of ``--repeat`` solves of the same pencil), and the unilateral solve
-(:func:`~unibuckle_fenicsx.model.shell.levels.solve_section`: the active-set seeds on a
+(:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`: the active-set seeds on a
 section ``--levels`` times coarser, the contact set polished level by level), then the
 certificate. Prints one Markdown row; ``--json FILE`` appends it.
 
@@ -38,7 +38,7 @@ def run(shape: str, size: float, levels: int, repeat: int, corner_cell: float | 
 
     from unibuckle_fenicsx.certificate.certify import certify
     from unibuckle_fenicsx.eigen import GEPSolver
-    from unibuckle_fenicsx.model.shell.levels import solve_section
+    from unibuckle_fenicsx.model.shell.levels import solve_levels
     from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
 
     geometry = (
@@ -64,7 +64,7 @@ def run(shape: str, size: float, levels: int, repeat: int, corner_cell: float | 
             solver.destroy()
         dofs, cells = section.model.num_dofs, section.mesh.cells_around
     t1 = time.perf_counter()
-    fine, solution = solve_section(params, levels=levels)
+    fine, solution = solve_levels(params, levels=levels)
     unilateral = time.perf_counter() - t1
     with fine:
         t2 = time.perf_counter()

@@ -149,7 +149,7 @@ def test_core_restrains_the_box_corners():
     face as a plate against a rigid face with simply supported unloaded edges and with
     clamped ones (the package's plate solver, same cells across the face).
     """
-    from unibuckle_fenicsx.model.shell.levels import solve_section
+    from unibuckle_fenicsx.model.shell.levels import solve_levels
     from unibuckle_fenicsx.model.shell.section import SectionParameters
 
     n = 16
@@ -157,7 +157,7 @@ def test_core_restrains_the_box_corners():
         "box", width=0.2, depth=0.2, thickness=0.002, length=0.6, E=STEEL.E, nu=STEEL.nu,
         mesh_size=0.2 / n, ends="simply_supported", core=True, corner_cell=0.002,
     )  # fmt: skip
-    section, solution = solve_section(params, levels=1)
+    section, solution = solve_levels(params, levels=1)
     with section:
         k_box = section.buckling_coefficient(solution.load)
         assert solution.candidate.kkt

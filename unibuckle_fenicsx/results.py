@@ -216,30 +216,40 @@ class BucklingResult:
         if solution is None or certificate is None:
             result.lower_bound_Pa = result.upper_bound_Pa = free.load
             return result
+        result.record_contact(problem, solution, certificate)
+        return result
+
+    def record_contact(
+        self, problem: BucklingProblem, solution: UnilateralSolution, certificate: Certificate
+    ) -> None:
+        """Fill in the contact set, the bracket, the certificate and the contact forces.
+
+        Note:
+            Collective on the problem's communicator (gathers the contact DOFs).
+        """
         contact = problem.contact
         if contact is None:
             raise ValueError(
-                "from_solution: the problem has no obstacle (this needs an obstacle zone)"
+                "record_contact: the problem has no obstacle (this needs an obstacle zone)"
             )
         active = solution.active
         rows = contact.removed_rows(active)
-        result.constrained_nodes = problem.num_constrained
-        result.contact_nodes = len(active)
-        result.p_star = solution.p_star
-        result.contact_indices = [int(k) for k in active]
-        result.contact_coordinates = contact.coordinates[active].tolist()
-        result.contact_dofs = sorted(
+        self.constrained_nodes = problem.num_constrained
+        self.contact_nodes = len(active)
+        self.p_star = solution.p_star
+        self.contact_indices = [int(k) for k in active]
+        self.contact_coordinates = contact.coordinates[active].tolist()
+        self.contact_dofs = sorted(
             int(r) for part in problem.comm.allgather(rows.tolist()) for r in part
         )
-        result.lower_bound_Pa = certificate.lower_bound
-        result.upper_bound_Pa = (
+        self.lower_bound_Pa = certificate.lower_bound
+        self.upper_bound_Pa = (
             certificate.upper_bound if math.isfinite(certificate.upper_bound) else None
         )
-        result.certificate = certificate.as_dict()
-        result.details.update(solution.report())
+        self.certificate = certificate.as_dict()
+        self.details.update(solution.report())
         if not problem.tensionless:
-            result.contact_force = _contact_force(problem, solution, result.load_resolution)
-        return result
+            self.contact_force = _contact_force(problem, solution, self.load_resolution)
 
     def as_dict(self, timings: bool = True) -> dict[str, Any]:
         """JSON-ready mapping (non-finite floats become ``null``: JSON has no infinity).

@@ -31,7 +31,7 @@ from unibuckle_fenicsx.model.shell.core import CoreConstraints
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import SolverSpec
 
-__all__ = ["prolong_directions", "solve_section"]
+__all__ = ["prolong_directions", "solve_levels"]
 
 logger = logging.getLogger(__name__)
 
@@ -68,7 +68,7 @@ def prolong_directions(
     return np.flatnonzero(out).astype(np.int64)
 
 
-def solve_section(
+def solve_levels(
     parameters: SectionParameters,
     *,
     levels: int = 2,
@@ -93,7 +93,7 @@ def solve_section(
         Collective on ``comm``.
     """
     if not parameters.core:
-        raise InputError("solve_section needs a section with core = true")
+        raise InputError("solve_levels needs a section with core = true")
     if int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
     t0 = time.perf_counter()
@@ -112,7 +112,7 @@ def solve_section(
         )
         problem = section.problem
         if problem.contact is None or section.constraints is None:
-            raise RuntimeError("solve_section: a core section without constraints")
+            raise RuntimeError("solve_levels: a core section without constraints")
         polished = None
         if prev is not None and best is not None and prev.constraints is not None:
             z = prolong_directions(best.active, prev.constraints, section.constraints)
@@ -156,7 +156,7 @@ def solve_section(
             prev.destroy()
         prev, best = section, polished
     if section is None or best is None:
-        raise RuntimeError("solve_section: no level ran")
+        raise RuntimeError("solve_levels: no level ran")
     best.details.update(
         {
             "levels": log,
