@@ -26,6 +26,23 @@ from unibuckle_fenicsx.spec import (
 )
 
 
+def tension_somewhere(nx: int, ny: int) -> ProblemSpec:
+    """The paper's free plate with its left edge clamped in plane, the right one compressed.
+
+    Poisson's effect puts part of the plate in tension: B is indefinite (the swapped
+    pencil).
+    """
+    edges = (
+        EdgeSpec("left", inplane="clamped"),
+        EdgeSpec("right", normal_stress=-1.0),
+        EdgeSpec("bottom"),
+        EdgeSpec("top"),
+    )
+    return ProblemSpec(
+        name="tension_somewhere", plate=PlateSpec(edges=edges), mesh=MeshSpec(nx, ny)
+    )
+
+
 def _interior_nodes_in_box(nx, ny, length, width, box) -> int:
     xs = np.linspace(0, length, nx + 1)[1:-1]
     ys = np.linspace(0, width, ny + 1)[1:-1]

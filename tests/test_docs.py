@@ -61,6 +61,7 @@ PAGES = [
     "verification/interior_point_route.md",
     "verification/interior_point_saddles.md",
     "verification/interior_point_costs.md",
+    "verification/floor.md",
     "changelog.md",
     "history/2026-11-27.md",
 ]
@@ -151,6 +152,16 @@ def test_bench_page_renders_its_results_file() -> None:
     rows = unibuckle_docs.bench_rows(path)
     page = unibuckle_docs.bench_page(path)
     assert "python bench/bench_plates.py --meshes" in page
+    assert len(re.findall(r"^\| ", page, flags=re.M)) == len(rows) + 1  # and the header
+
+
+@pytest.mark.parametrize("name", ["free", "free_estimates", "orderings"])
+def test_the_floor_pages_name_their_commands(name: str) -> None:
+    """The floor's tables (verification/floor) name the command that wrote each row."""
+    path = ROOT / "bench" / "results" / f"{name}.jsonl"
+    rows = unibuckle_docs.bench_rows(path)
+    page = unibuckle_docs.bench_page(path)
+    assert f"python bench/bench_{name}.py --" in page and "see bench/" not in page
     assert len(re.findall(r"^\| ", page, flags=re.M)) == len(rows) + 1  # and the header
 
 

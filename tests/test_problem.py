@@ -10,8 +10,9 @@ import dolfinx
 
 import numpy as np
 import pytest
+from families import tension_somewhere
 
-from unibuckle_fenicsx import EdgeSpec, MeshSpec, ObstacleSpec, PlateSpec, paper_case
+from unibuckle_fenicsx import MeshSpec, ObstacleSpec, paper_case
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.eigen import GEPSolver
@@ -113,14 +114,7 @@ def test_indefinite_prestress_uses_swapped_pencil():
     plate in tension. The load found must be the one GHEP shift-invert finds on the same
     pencil here.
     """
-    edges = (
-        EdgeSpec("left", inplane="clamped"),
-        EdgeSpec("right", normal_stress=-1.0),
-        EdgeSpec("bottom"),
-        EdgeSpec("top"),
-    )
-    spec = replace(paper_case("free", 20, 10), plate=PlateSpec(edges=edges))
-    problem = BucklingProblem(spec)
+    problem = BucklingProblem(tension_somewhere(20, 10))
     assert problem.prestress.indefinite
     assert problem.eigensolver.indefinite
     value = problem.solve_free().load

@@ -29,7 +29,8 @@ Note:
 from __future__ import annotations
 
 import logging
-from collections.abc import Mapping
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 from dataclasses import dataclass
 from types import TracebackType
 from typing import Any
@@ -40,6 +41,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import NumericalError
+from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
 try:
     from petsc4py import PETSc
@@ -54,15 +56,24 @@ __all__ = [
     "EIGEN_OPTIONS",
     "EXTREME_OPTIONS",
     "LDL_OPTIONS",
+    "NESTED_DISSECTION_ROWS",
+    "ORDERINGS",
+    "ORDERING_BELOW",
     "RUN_EPS_PREFIXES",
     "EigenPair",
     "EigenSolveError",
     "GEPSolver",
     "Owner",
     "SharedFactorization",
+    "SmallestProof",
     "SymmetricFactorization",
     "abs_matrix",
+    "compact",
     "extreme_eigenvalues",
+    "lowest_eigenvalues",
+    "mumps_ordering",
+    "option_defaults",
+    "ordering_options",
     "pop_run_options",
     "push_run_options",
     "release",
@@ -103,6 +114,25 @@ EIGEN_OPTIONS: dict[str, str | float | int | bool] = {
 NEAR_MARGIN = 1e-3
 NEAR_NCV = 4
 
+#: The smallest eigenpair of the whole pencil given estimates of its lowest eigenvalues
+#: (:meth:`GEPSolver.smallest`; a coarser mesh's) shifts first to ``FREE_ABOVE`` above the
+#: estimate of the lowest and at most ``FREE_GAP_SHARE`` of the way to the second: above
+#: the lowest eigenvalue (a coarse mesh's load lies above the fine one, or within a few
+#: tenths of a percent below it), below the second, so that the inertia of one
+#: factorisation proves the pair the smallest. Each later try lies further below the
+#: estimate (:data:`FREE_BELOW`, times the estimate).
+FREE_ABOVE = 0.01
+FREE_GAP_SHARE = 1.0 / 3.0
+FREE_BELOW = (0.99, 0.96, 0.84)
+#: The free solve asks for as many pairs as the inertia counts eigenvalues below its
+#: shift, up to this many (a long plate's lowest loads lie within a percent or two of
+#: each other, closer than the coarse mesh's error); more, and the shift is lowered.
+FREE_MAX_BELOW = 8
+#: Krylov subspace of the free solve's shifted Krylov-Schur: a shift within a few percent
+#: of the lowest eigenvalue separates it from the second by a factor of five or more, and
+#: a few solves converge.
+FREE_NCV = 4
+
 #: Default options of :func:`extreme_eigenvalues` (the smallest eigenvalue uses them all;
 #: the largest only ``eps_type`` and ``eps_max_it``).
 EXTREME_OPTIONS: dict[str, str | float | int | bool] = {
@@ -123,6 +153,42 @@ LDL_OPTIONS: dict[str, str | float | int | bool] = {
     "mat_mumps_icntl_13": 1,
     "mat_mumps_icntl_24": 1,
 }
+
+#: MUMPS's sequential fill-reducing orderings, by name (ICNTL(7)).
+ORDERINGS = {"amd": 0, "amf": 2, "scotch": 3, "pord": 4, "metis": 5, "qamd": 6}
+
+#: The ordering of a matrix below :data:`NESTED_DISSECTION_ROWS` rows, by kind: the
+#: plate's (w, theta) matrices (the pencil's factorisations, the stiffness's LU) by
+#: approximate minimum fill, the membrane stiffness of the prestress by approximate
+#: minimum degree; of the orderings whose analysis costs little, each gives the
+#: fastest factorisation there (measured on :doc:`/verification/floor`).
+ORDERING_BELOW = {"plate": "amf", "membrane": "amd"}
+#: Rows from which a factorisation is ordered by nested dissection (METIS) instead, by
+#: whether its analysis serves one numeric factorisation or many (the eigen solves of a
+#: route's contact sets, the interior point's Newton steps): METIS's analysis costs more
+#: than one numeric factorisation on the package's matrices, and saves a fraction of
+#: each (measured on :doc:`/verification/floor`).
+NESTED_DISSECTION_ROWS = {False: 400_000, True: 100_000}
+
+
+def mumps_ordering(rows: int, kind: str = "plate", reused: bool = False) -> int:
+    """MUMPS ICNTL(7) for a matrix of ``rows`` rows of ``kind`` ("plate" or "membrane").
+
+    METIS from :data:`NESTED_DISSECTION_ROWS` rows (``reused``: for an analysis that
+    serves many numeric factorisations), else :data:`ORDERING_BELOW`'s. The option
+    ``-<prefix>mat_mumps_icntl_7`` (e.g. ``-unibuckle_ldl_mat_mumps_icntl_7 5``)
+    overrides it for one factorisation.
+    """
+    if rows >= NESTED_DISSECTION_ROWS[reused]:
+        return ORDERINGS["metis"]
+    return ORDERINGS[ORDERING_BELOW[kind]]
+
+
+def ordering_options(
+    mat: PETSc.Mat, key: str = "mat_mumps_icntl_7", kind: str = "plate", reused: bool = False
+) -> dict[str, int]:
+    """``{key: mumps_ordering(rows of mat, ...)}``: the ordering as a default option."""
+    return {key: mumps_ordering(int(mat.getSize()[0]), kind, reused)}
 
 
 def release(owner: object, *names: str) -> None:
@@ -157,23 +223,68 @@ class Owner:
         self.destroy()
 
 
-def abs_matrix(mat: PETSc.Mat) -> PETSc.Mat:
-    """A new matrix with the entries' absolute values (the caller destroys it; collective)."""
-    out = mat.duplicate(copy=True)
-    indptr, indices, values = out.getValuesCSR()
-    out.setValuesCSR(indptr, indices, np.abs(values))  # type: ignore[arg-type]
-    out.assemble()
+def _without_zeros(mat: PETSc.Mat, values: Any, csr: Any) -> PETSc.Mat:
+    """An AIJ matrix with ``mat``'s layout: ``values`` at its local CSR rows ``csr``, zeros out."""
+    indptr, indices, _ = csr
+    keep = values != 0.0
+    kept = np.concatenate(([0], np.cumsum(keep)))  # kept entries before each entry
+    new = (
+        kept[indptr].astype(PETSc.IntType),
+        indices[keep].astype(PETSc.IntType),
+        values[keep],
+    )
+    out = PETSc.Mat().createAIJWithArrays(mat.getSizes(), new, comm=mat.comm)  # type: ignore[arg-type]
+    out.setOption(PETSc.Mat.Option.SYMMETRIC, mat.isSymmetricKnown()[1])  # type: ignore[arg-type]
     return out
+
+
+def abs_matrix(mat: PETSc.Mat) -> PETSc.Mat:
+    """A new matrix with the entries' absolute values, without stored zeros.
+
+    The caller destroys it. Collective.
+    """
+    csr = mat.getValuesCSR()
+    return _without_zeros(mat, np.abs(csr[2]), csr)
+
+
+def compact(mat: PETSc.Mat) -> PETSc.Mat:
+    """A copy of ``mat`` without its stored zeros (the same products, to the last bit).
+
+    The geometric stiffness B is assembled in the three-field pattern of the stiffness
+    matrix, of which only the deflection block is nonzero (a tenth of the entries);
+    its products, in every step of an eigen solve, cost a fifth as much compacted. The
+    caller destroys it. Collective.
+    """
+    csr = mat.getValuesCSR()
+    return _without_zeros(mat, csr[2], csr)
+
+
+@contextmanager
+def option_defaults(prefix: str, options: Options) -> Iterator[None]:
+    """Put ``options`` in PETSc's options database under ``prefix`` for the block's duration.
+
+    A default goes in only where the database holds no value for ``prefix + key`` (an
+    option from the command line, e.g. ``-unibuckle_eps_max_it 1000``, wins), and it is
+    removed again on leaving the block, so nothing leaks into other objects.
+    """
+    opts = PETSc.Options(prefix)  # names below are relative to the prefix
+    pushed = [key for key in options if not opts.hasName(key)]
+    for key in pushed:
+        opts.setValue(key, options[key])
+    try:
+        yield
+    finally:
+        for key in pushed:
+            opts.delValue(key)
 
 
 def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False) -> None:
     """Set the options prefix of ``obj`` and default ``options``; then ``setFromOptions``.
 
-    A default is used only when the database holds no value for ``prefix + key`` (an
-    option from the command line, e.g. ``-unibuckle_eps_max_it 1000``, wins), and it is
-    removed again afterwards, so nothing leaks into other objects. Options read only when
-    the object is set up (MUMPS ICNTL settings are read at the symbolic factorisation)
-    need ``setup=True``: ``obj.setUp()`` then runs before the defaults are removed.
+    The defaults are in the database only during the call (:func:`option_defaults`: a
+    value already there wins). Options read only when the object is set up (MUMPS ICNTL
+    settings are read at the symbolic factorisation) need ``setup=True``: ``obj.setUp()``
+    then runs before the defaults are removed.
 
     Args:
         obj: A PETSc/SLEPc object with ``setOptionsPrefix`` and ``setFromOptions``.
@@ -184,20 +295,13 @@ def set_options(obj: Any, prefix: str, options: Options, *, setup: bool = False)
     if not prefix:
         raise ValueError("PETSc/SLEPc objects need a non-empty options prefix")
     obj.setOptionsPrefix(prefix)
-    opts = PETSc.Options(prefix)  # names below are relative to the prefix
-    pushed = [key for key in options if not opts.hasName(key)]
-    for key in pushed:
-        opts.setValue(key, options[key])
-    try:
+    with option_defaults(prefix, options):
         obj.setFromOptions()
         if setup:
             obj.setUp()
-    finally:
-        for key in pushed:
-            opts.delValue(key)
 
 
-def set_ldl_options(ksp: PETSc.KSP, prefix: str) -> None:
+def set_ldl_options(ksp: PETSc.KSP, prefix: str, reused: bool = False) -> None:
     """Make ``ksp`` a MUMPS :math:`LDL^T` with inertia (:data:`LDL_OPTIONS`), unfactorised.
 
     :func:`set_options` with ``setup=True`` would factorise the current operator (the
@@ -206,10 +310,13 @@ def set_ldl_options(ksp: PETSc.KSP, prefix: str) -> None:
     interior point's Newton matrix) does not need that one. The controls go onto the
     factor matrix instead, which PETSc hands to MUMPS when it starts; the rest of
     :data:`LDL_OPTIONS` goes through the database (a command-line option under
-    ``prefix`` still wins). The operator must be set. Collective.
+    ``prefix`` still wins). The ordering is :func:`mumps_ordering`'s for the operator's
+    size (``reused``: for an analysis that serves many numeric factorisations). The
+    operator must be set. Collective.
     """
-    mumps = {k: v for k, v in LDL_OPTIONS.items() if k.startswith("mat_mumps_icntl_")}
-    others = {k: v for k, v in LDL_OPTIONS.items() if k not in mumps}
+    options = {**ordering_options(ksp.getOperators()[0], reused=reused), **LDL_OPTIONS}
+    mumps = {k: v for k, v in options.items() if k.startswith("mat_mumps_icntl_")}
+    others = {k: v for k, v in options.items() if k not in mumps}
     set_options(ksp, prefix, others)
     pc = ksp.getPC()
     pc.setFactorSetUpSolverType()
@@ -270,6 +377,28 @@ class EigenPair:
     converged: int
 
 
+@dataclass(frozen=True)
+class SmallestProof:
+    r"""Why an eigenpair is the smallest of its pencil: the inertia of one factorisation.
+
+    Sylvester's law of inertia (A positive definite): :math:`A - \sigma B` has as many
+    negative eigenvalues as the pencil has eigenvalues in :math:`(0, \sigma)`.
+
+    Attributes:
+        shift: :math:`\sigma` of the factorisation that proves it.
+        below: Eigenvalues of the pencil below ``shift`` by that inertia: 1 when the
+            shift lies above the pair's eigenvalue (no other lies below the shift), 0
+            when it lies at or just below it (none lies lower).
+        shifts: Every shift factorised, in order (the last is ``shift``).
+        solves: Eigen solves (Krylov-Schur runs) it took.
+    """
+
+    shift: float
+    below: int
+    shifts: tuple[float, ...]
+    solves: int
+
+
 def _is_zero(B: PETSc.Mat) -> bool:
     """Whether B has no non-zero entry (collective)."""
     return bool(B.norm(PETSc.NormType.INFINITY) == 0.0)  # type: ignore[arg-type]
@@ -279,12 +408,17 @@ class GEPSolver(Owner):
     """Smallest eigenpair of :math:`(A, B)` with optional removed DOFs.
 
     Args:
-        A: Stiffness matrix, SPD (owned by the caller; not modified).
-        B: Geometric stiffness matrix (owned by the caller; not modified).
+        A: Stiffness matrix, SPD (owned by the caller; not modified; its values may
+            change between solves, see :meth:`operators_changed`).
+        B: Geometric stiffness matrix (owned by the caller; not modified, and not
+            changed afterwards: the solver keeps a :func:`compact` copy, :attr:`B`).
         indefinite: B is indefinite: solve the swapped pencil.
         prefix: Options prefix, non-empty; ``-<prefix>eps_view`` and friends apply.
         tol: EPS tolerance.
         options: Options pushed under ``prefix`` (default :data:`EIGEN_OPTIONS`).
+        reused: Many solves will follow (the contact sets of a route): the analyses of
+            its factorisations serve many numeric ones, which orders them by METIS from
+            fewer rows (:func:`mumps_ordering`). False for the free plate alone.
 
     Attributes:
         solves: Eigen solves performed so far.
@@ -302,15 +436,19 @@ class GEPSolver(Owner):
         prefix: str = "unibuckle_",
         tol: float = 1e-10,
         options: Options | None = None,
+        reused: bool = True,
     ) -> None:
         if not prefix:
             raise ValueError("GEPSolver needs a non-empty options prefix")
-        self.A, self.B = A, B
+        self.reused = reused
+        self.A = A
+        self.B = compact(B)  # owned: its products cost a fifth of B's
         self.indefinite = indefinite
         self._norm_ratio: float | None = None
         self._radius: float | None = None
         self._Bx: PETSc.Vec | None = None
         self.prefix = prefix
+        self.tol = tol
         self._Aw: PETSc.Mat | None = None
         self._Bw: PETSc.Mat | None = None
         self.solves = 0
@@ -332,6 +470,8 @@ class GEPSolver(Owner):
         set_options(eps, prefix, self._options)
         self.eps = eps
         self._near: SLEPc.EPS | None = None  # the shifted solves' EPS, made when needed
+        self._free: SLEPc.EPS | None = None  # the smallest pair's EPS, made when needed
+        self._free_ncv = FREE_NCV  # its Krylov subspace for one pair (the options')
         self._ldl: SharedFactorization | None = None  # made when needed
         self.shifted_solves = 0  # solves at a shift below an estimate (near=...)
         self.unshifted_again = 0  # ... of which an eigenvalue lay below the shift
@@ -413,7 +553,10 @@ class GEPSolver(Owner):
                 eps.setOperators(A, B)
             if start:
                 eps.setInitialSpace([initial])
-            eps.solve()
+            # The ordering, read at the first (symbolic) factorisation of the LU.
+            key = "st_mat_mumps_icntl_7"
+            with option_defaults(self.prefix, ordering_options(A, key, reused=self.reused)):
+                eps.solve()
         self.solves += 1
         nconv = eps.getConverged()
         its = eps.getIterationNumber()
@@ -454,48 +597,49 @@ class GEPSolver(Owner):
         the certificate on the same problem: one symbolic analysis per mesh.
         """
         if self._ldl is None:
-            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_")
+            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_", self.reused)
         return self._ldl
 
     def _near_eps(self) -> SLEPc.EPS:
-        """The shifted solves' EPS (prefix ``<prefix>near_``), made on first use.
+        """The shifted solves' EPS (prefix ``<prefix>near_``), made on first use."""
+        if self._near is None:
+            self._near = self._shifted_eps(self.prefix + "near_", NEAR_NCV)
+        return self._near
+
+    def _shifted_eps(self, prefix: str, ncv: int) -> SLEPc.EPS:
+        """A Krylov-Schur EPS whose spectral transformation solves with the shared LDLᵀ.
 
         Its spectral transformation shifts the first operator in place and solves with
         the :attr:`factorization`'s KSP: the operator passed is that factorisation's
-        matrix, filled by :meth:`_solve_below` before each solve.
+        matrix, filled by :meth:`_shift_to` before each solve. It takes the EPS options
+        (not the ``st_`` ones: its solver is the shared one) under ``prefix``.
         """
-        if self._near is None:
-            eps = SLEPc.EPS().create(self.A.comm)
-            eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-            eps.setDimensions(1, NEAR_NCV)
-            eps.setTolerances(self.eps.getTolerances()[0])
-            eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
-            st = eps.getST()
-            st.setType(SLEPc.ST.Type.SINVERT)
-            # The EPS options only: its spectral transformation's own solver is replaced.
-            eps_only = {k: v for k, v in self._options.items() if not k.startswith("st_")}
-            set_options(eps, self.prefix + "near_", eps_only)
-            st.setMatMode(SLEPc.ST.MatMode.INPLACE)
-            st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-            st.setKSP(self.factorization.ksp)
-            self._near = eps
-        return self._near
+        eps = SLEPc.EPS().create(self.A.comm)
+        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+        eps.setDimensions(1, ncv)
+        eps.setTolerances(self.eps.getTolerances()[0])
+        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
+        st = eps.getST()
+        st.setType(SLEPc.ST.Type.SINVERT)
+        eps_only = {k: v for k, v in self._options.items() if not k.startswith("st_")}
+        set_options(eps, prefix, eps_only)
+        st.setMatMode(SLEPc.ST.MatMode.INPLACE)
+        st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        st.setKSP(self.factorization.ksp)
+        return eps
 
-    def _solve_below(
-        self, A: PETSc.Mat, B: PETSc.Mat, near: float, initial: PETSc.Vec | None
-    ) -> bool:
-        r"""Solve at the shift :data:`NEAR_MARGIN` below ``near``; whether that answers.
+    def _shift_to(
+        self, eps: SLEPc.EPS, A: PETSc.Mat, B: PETSc.Mat, shift: float, initial: PETSc.Vec | None
+    ) -> int:
+        r"""Factorise the pencil (A, B) shifted to ``shift`` for ``eps``; eigenvalues below it.
 
-        False when the inertia of :math:`A - \sigma B` (the shared
-        :attr:`factorization`) shows an eigenvalue below the shift :math:`\sigma` (the
-        pair found would be the nearest to it, not necessarily the smallest), or when
-        nothing converged. Collective.
+        The first operator goes into the shared matrix (A's pattern), which the spectral
+        transformation shifts in place and factorises (numeric only, after the first
+        analysis): :math:`A - \sigma B`, or for the swapped pencil :math:`B - A/\sigma`,
+        whose positive eigenvalues count the pencil's eigenvalues in :math:`(0,
+        \sigma)`. Returns that count (the inertia). Collective.
         """
-        eps = self._near_eps()
         ldl = self.factorization
-        shift = near * (1.0 - NEAR_MARGIN)
-        # The first operator goes into the shared matrix (A's pattern), which the
-        # spectral transformation shifts in place and factorises: numeric only.
         if self.indefinite:
             ldl.matrix.zeroEntries()
             ldl.matrix.axpy(1.0, B, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)  # type: ignore[arg-type]
@@ -510,11 +654,152 @@ class GEPSolver(Owner):
         eps.setUp()
         ldl.claim(self)
         negative, _, positive = ldl.inertia()
-        below = positive if self.indefinite else negative
-        if int(below) != 0:
+        return int(positive if self.indefinite else negative)
+
+    def _solve_below(
+        self, A: PETSc.Mat, B: PETSc.Mat, near: float, initial: PETSc.Vec | None
+    ) -> bool:
+        r"""Solve at the shift :data:`NEAR_MARGIN` below ``near``; whether that answers.
+
+        False when the inertia of :math:`A - \sigma B` (the shared
+        :attr:`factorization`) shows an eigenvalue below the shift :math:`\sigma` (the
+        pair found would be the nearest to it, not necessarily the smallest), or when
+        nothing converged. Collective.
+        """
+        eps = self._near_eps()
+        if self._shift_to(eps, A, B, near * (1.0 - NEAR_MARGIN), initial) != 0:
             return False
         eps.solve()
         return eps.getConverged() >= 1
+
+    def count_below(self, shift: float) -> int:
+        r"""Eigenvalues of the whole pencil in :math:`(0, \sigma)`, by an inertia.
+
+        The inertia of :math:`A - \sigma B` (Sylvester's law, A positive definite): one
+        numeric :math:`LDL^T` through the shared :attr:`factorization`. Negative pivots
+        only: a null one means an eigenvalue within MUMPS's null-pivot threshold of
+        :math:`\sigma`, which on a small or stiff pencil is the computed eigenvalue
+        itself. Collective.
+        """
+        ldl = self.factorization
+        same, subset = PETSc.Mat.Structure.SAME_NONZERO_PATTERN, PETSc.Mat.Structure.SUBSET
+        self.A.copy(ldl.matrix, structure=same)  # type: ignore[arg-type]
+        ldl.matrix.axpy(-shift, self.B, structure=subset)  # type: ignore[arg-type]
+        negative, _, _ = ldl.factor(self)
+        return int(negative)
+
+    def smallest(
+        self, out: PETSc.Vec | None = None, estimate: tuple[float, ...] = ()
+    ) -> tuple[EigenPair, SmallestProof | None]:
+        r"""The smallest eigenpair of the whole pencil (nothing removed), with its proof.
+
+        Given ``estimate``, the lowest eigenvalues of a coarser mesh's pencil (ascending,
+        the same on every rank), the pencil is factorised once at a shift :math:`\sigma`
+        just above the lowest (:data:`FREE_ABOVE`, below the second) by the shared
+        :math:`LDL^T`, and Krylov-Schur solves at that target with it. The inertia counts
+        the eigenvalues below :math:`\sigma` (Sylvester's law) and proves the pair the
+        smallest (:class:`SmallestProof`):
+
+        - k of them (1 to :data:`FREE_MAX_BELOW`): Krylov-Schur asks for the k pairs
+          nearest :math:`\sigma` (then 2k + 1, if some lay above it); once k lie below
+          it they are every eigenvalue there (B-orthogonal vectors), and the lowest is
+          the pencil's smallest (a Ritz value below the shift lies at or below its
+          eigenvalue, Rayleigh-Ritz, so the load found is never above it);
+        - none: the pair found is the nearest above :math:`\sigma`, and one more
+          factorisation just below its eigenvalue (:data:`SMALLEST_RTOL_FACTOR` times the
+          tolerance) must show none there either.
+
+        More than :data:`FREE_MAX_BELOW` below :math:`\sigma`, or fewer pairs found below
+        it than lie there: the next shift lies below the estimate (:data:`FREE_BELOW`)
+        and the pencil is factorised again. If no shift proves it (or nothing converges,
+        or there is no estimate) the pair comes from :meth:`solve` at target 0 (a MUMPS
+        LU), unproven: the caller checks it (:meth:`count_below`).
+
+        The EPS takes the options under :attr:`prefix` (``-unibuckle_eps_tol``,
+        ``-unibuckle_eps_ncv``, ...; the Krylov subspace defaults to :data:`FREE_NCV`),
+        the factorisation those of :attr:`factorization` (``<prefix>ldl_``).
+
+        Args:
+            out: Vector receiving the eigenvector.
+            estimate: Estimates of the lowest eigenvalues, ascending (empty: none).
+
+        Returns:
+            The pair (as :meth:`solve`'s) and its proof, or None for the pair at target 0.
+
+        Note:
+            Collective.
+        """
+        shifts: list[float] = []
+        solves = self.solves
+        if estimate and estimate[0] > 0.0 and not _is_zero(self.B):
+            lowest = estimate[0]
+            above = FREE_ABOVE
+            if len(estimate) > 1 and estimate[1] > lowest:
+                above = min(above, FREE_GAP_SHARE * (estimate[1] / lowest - 1.0))
+            rtol = SMALLEST_RTOL_FACTOR * self.tol
+            for shift in (lowest * (1.0 + above), *(lowest * f for f in FREE_BELOW)):
+                shifts.append(shift)
+                found = self._smallest_at(shift, out, rtol, shifts)
+                if found is None:
+                    break  # nothing converged, or a lower eigenvalue was passed over
+                pair, below = found
+                if pair is not None:
+                    proof = SmallestProof(shifts[-1], below, tuple(shifts), self.solves - solves)
+                    return pair, proof
+            logger.debug("%s: no shift %s proved the smallest pair", self.prefix, shifts)
+        return self.solve(out=out), None
+
+    def _smallest_at(
+        self, shift: float, out: PETSc.Vec | None, rtol: float, shifts: list[float]
+    ) -> tuple[EigenPair | None, int] | None:
+        """One try of :meth:`smallest` at ``shift``: (the proven pair or None, count below).
+
+        None when the tries should stop: nothing converged, or the pencil has an
+        eigenvalue below the one found and above the shift (Krylov-Schur passed over
+        it). Collective.
+        """
+        if self._free is None:
+            self._free = self._shifted_eps(self.prefix, FREE_NCV)
+            self._free_ncv = int(self._free.getDimensions()[1])
+        eps = self._free
+        below = self._shift_to(eps, self.A, self.B, shift, None)
+        if below > FREE_MAX_BELOW:
+            return None, below
+        # As many pairs as lie below the shift; then, if pairs above it lay nearer, more.
+        for wanted in (below, 2 * below + 1) if below else (1,):
+            ncv = max(self._free_ncv, 2 * wanted)
+            # mpd with ncv: left unset it keeps its first value, below ncv - nev.
+            eps.setDimensions(wanted, ncv, ncv)
+            eps.solve()
+            self.solves += 1
+            loads = [self._load(eps.getEigenvalue(k).real) for k in range(eps.getConverged())]
+            if not loads:
+                return None
+            under = [k for k, load in enumerate(loads) if load <= shift * (1.0 - rtol)]
+            if below and len(under) >= below:
+                return self._pair(eps, min(under, key=loads.__getitem__), out), below
+        if below:
+            return None, below  # pairs nearer the shift lay above it: lower the shift
+        pair = self._pair(eps, 0, out)
+        check = pair.value * (1.0 - rtol)
+        if check <= shift:
+            return pair, below  # the first inertia covers it
+        shifts.append(check)
+        if self.count_below(check) != 0:
+            return None
+        return pair, 0
+
+    def _load(self, theta: float) -> float:
+        """The load of an eigenvalue of the EPS's pencil (1/theta for the swapped one)."""
+        return 1.0 / theta if self.indefinite else theta
+
+    def _pair(self, eps: SLEPc.EPS, index: int, out: PETSc.Vec | None) -> EigenPair:
+        """Converged pair ``index`` of ``eps`` as a load (its vector into ``out``)."""
+        value = self._load(eps.getEigenvalue(index).real)
+        if out is not None:
+            eps.getEigenvector(index, out)
+        error = eps.computeError(index)
+        return EigenPair(float(value), float(error), eps.getIterationNumber(), eps.getConverged())
 
     def operators_changed(self) -> None:
         """Forget the scales cached from A and B (call after changing them in place)."""
@@ -586,7 +871,7 @@ class GEPSolver(Owner):
 
     def destroy(self) -> None:
         """Destroy the EPS and work matrices (collective)."""
-        release(self, "eps", "_near", "_ldl", "_Aw", "_Bw", "_Bx")
+        release(self, "eps", "_near", "_free", "_ldl", "_Aw", "_Bw", "_Bx", "B")
 
     def __del__(self) -> None:
         self.destroy()
@@ -636,7 +921,8 @@ def swapped_eigenpairs(
         eps.setTolerances(tol)
         eps.getST().setType(SLEPc.ST.Type.SHIFT)
         set_options(eps, prefix, EIGEN_OPTIONS)
-        eps.solve()
+        with option_defaults(prefix, ordering_options(A, "st_mat_mumps_icntl_7")):
+            eps.solve()
         pairs: list[tuple[float, PETSc.Vec | None]] = []
         for k in range(min(nev, eps.getConverged())):
             v = A.createVecRight() if vectors else None
@@ -644,6 +930,33 @@ def swapped_eigenpairs(
         return pairs
     finally:
         eps.destroy()
+
+
+def lowest_eigenvalues(
+    A: PETSc.Mat, B: PETSc.Mat, prefix: str, *, count: int = 2, tol: float = 1e-6
+) -> tuple[float, ...]:
+    r"""The pencil's lowest positive eigenvalues :math:`\lambda` (at most ``count``, ascending).
+
+    For estimates (a coarser mesh's, for :meth:`GEPSolver.smallest`): no proof that they
+    are the lowest, and a loose default tolerance (1e-6, far below the few percent by
+    which the estimate's mesh differs). The largest :math:`\mu = 1/\lambda` of the
+    swapped pencil (:func:`swapped_eigenpairs`, B semidefinite or indefinite alike).
+
+    Args:
+        A: Stiffness matrix (SPD; not modified).
+        B: Geometric stiffness (not modified).
+        prefix: Options prefix.
+        count: Eigenvalues wanted.
+        tol: EPS tolerance.
+
+    Returns:
+        The converged positive eigenvalues (empty if none converged).
+
+    Note:
+        Collective.
+    """
+    pairs = swapped_eigenpairs(A, B, prefix, which=SLEPc.EPS.Which.LARGEST_REAL, nev=count, tol=tol)
+    return tuple(sorted(1.0 / theta for theta, _ in pairs if theta > 0.0))
 
 
 def extreme_eigenvalues(
@@ -687,7 +1000,8 @@ def extreme_eigenvalues(
                 eps.getST().setType(SLEPc.ST.Type.SINVERT)
                 used = dict(options)
             set_options(eps, prefix, used)
-            eps.solve()
+            with option_defaults(prefix, ordering_options(mat, "st_mat_mumps_icntl_7")):
+                eps.solve()
             if eps.getConverged() < 1:
                 raise EigenSolveError(f"SLEPc ({prefix}): the {which} eigenvalue did not converge")
             values.append(float(eps.getEigenvalue(0).real))
@@ -719,7 +1033,8 @@ class SymmetricFactorization(Owner):
         mat.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
         self.ksp = PETSc.KSP().create(mat.comm)
         self.ksp.setOperators(mat)
-        set_options(self.ksp, prefix, LDL_OPTIONS if options is None else options, setup=True)
+        defaults = {**ordering_options(mat), **(LDL_OPTIONS if options is None else options)}
+        set_options(self.ksp, prefix, defaults, setup=True)
         self.prefix = prefix
 
     def inertia(self) -> tuple[int, int, int]:
@@ -765,19 +1080,21 @@ class SharedFactorization(Owner):
     Args:
         A: The stiffness matrix (AIJ); ``matrix`` is a copy with its pattern.
         prefix: Options prefix of the factorisation (:data:`LDL_OPTIONS`).
+        reused: Its analysis will serve many numeric factorisations (a route's), for
+            the ordering (:func:`mumps_ordering`).
 
     Note:
         Collective. Owned by the problem's :class:`GEPSolver`
         (:attr:`GEPSolver.factorization`).
     """
 
-    def __init__(self, A: PETSc.Mat, prefix: str) -> None:
+    def __init__(self, A: PETSc.Mat, prefix: str, reused: bool = False) -> None:
         self.matrix = A.duplicate(copy=True)
         self.matrix.setOption(PETSc.Mat.Option.SPD, False)  # type: ignore[arg-type]
         self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
         self.ksp = PETSc.KSP().create(A.comm)
         self.ksp.setOperators(self.matrix)
-        set_ldl_options(self.ksp, prefix)
+        set_ldl_options(self.ksp, prefix, reused)
         self.prefix = prefix
         self._holder: object | None = None
 

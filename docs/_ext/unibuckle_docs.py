@@ -476,11 +476,43 @@ def _routes_commands(rows: list[dict[str, Any]]) -> str:
     return "`, then `".join(commands)
 
 
+def _free_commands(rows: list[dict[str, Any]]) -> str:
+    """The ``bench_free.py`` run that wrote the rows (one per plate)."""
+    meshes = ",".join(f"{r['plate']}={r['mesh']}" for r in rows)
+    flags = " --cli" if any(r.get("cli_s") is not None for r in rows) else ""
+    if any(r.get("baseline_cli_s") is not None for r in rows):
+        flags += " --baseline PYTHON_OF_19a5414"
+    return (
+        f"python bench/bench_free.py --plates {_listed(rows, 'plate')} --meshes {meshes} "
+        f"--repeat {max(r['repeat'] for r in rows)}{flags} --json bench/results/free.jsonl"
+    )
+
+
+def _orderings_commands(rows: list[dict[str, Any]]) -> str:
+    """The ``bench_orderings.py`` runs that wrote the rows: one per plate and repeat count."""
+    commands = []
+    for plate, repeat in dict.fromkeys((r["plate"], r["repeat"]) for r in rows):
+        group = [r for r in rows if (r["plate"], r["repeat"]) == (plate, repeat)]
+        commands.append(
+            f"python bench/bench_orderings.py --plates {plate} --meshes {_listed(group, 'mesh')} "
+            f"--orderings {_listed(group, 'ordering')} --kinds {_listed(group, 'kind')} "
+            f"--repeat {repeat} --json bench/results/orderings.jsonl"
+        )
+    return "`, then `".join(commands)
+
+
 COMMANDS = {
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"
     ),
+    "free": lambda rows: _free_commands(rows),
+    "free_estimates": lambda rows: (
+        f"python bench/bench_free_estimates.py --count {len(rows)} "
+        f"--cells {_listed(rows, 'cells')} --seed {_listed(rows, 'seed')} "
+        "--json bench/results/free_estimates.jsonl"
+    ),
+    "orderings": lambda rows: _orderings_commands(rows),
     "plates": lambda rows: _plates_commands(rows),
     "routes": lambda rows: _routes_commands(rows),
 }
@@ -553,6 +585,47 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("as_ratio", "active set (free solves)"),
         ("as_eigensolves", "its eigen solves"),
         ("load_difference", "load difference (AS − IP)/IP"),
+    ],
+    "free": [
+        ("plate", "plate"),
+        ("mesh", "mesh"),
+        ("dofs", "DOFs"),
+        ("package_s", "free solve and proof (s)"),
+        ("estimate_s", "of which the estimate (s)"),
+        ("factorisations", "factorisations"),
+        ("solves", "solves"),
+        ("plain_s", "plain SLEPc (s)"),
+        ("plain_proof_s", "plain SLEPc with the proof (s)"),
+        ("floor_ratio", "free solve / plain with proof"),
+        ("cli_s", "`unibuckle solve` (s)"),
+        ("total_s", "its total_s"),
+        ("baseline_cli_s", "before (s)"),
+        ("baseline_total_s", "its total_s"),
+        ("package_load", "λ_free (Pa)"),
+        ("plain_proof_rdiff", "plain with proof: load − λ_free (rel.)"),
+    ],
+    "free_estimates": [
+        ("plate", "plate"),
+        ("mesh", "mesh"),
+        ("indefinite", "B indefinite"),
+        ("coarse_error", "coarse load error"),
+        ("gap", "λ₂/λ₁ − 1"),
+        ("first_below", "below the first shift"),
+        ("factorisations", "factorisations"),
+        ("agrees", "load as at target 0"),
+    ],
+    "orderings": [
+        ("plate", "plate"),
+        ("dofs", "rows"),
+        ("kind", "matrix"),
+        ("ordering", "ordering"),
+        ("analysis_s", "analysis (CPU s)"),
+        ("numeric_s", "numeric (CPU s)"),
+        ("solve_s", "solve (CPU s)"),
+        ("free_s", "analysis + numeric + 10 solves"),
+        ("factor_entries", "entries in the factors"),
+        ("flops", "operations"),
+        ("memory_MB", "memory (MB)"),
     ],
 }
 #: Long texts shown as numbered notes under the table (the cell holds the note's

@@ -47,7 +47,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.arc import ArcPlane
 from unibuckle_fenicsx.algorithms.pdas import Run
-from unibuckle_fenicsx.eigen import set_options
+from unibuckle_fenicsx.eigen import option_defaults, ordering_options, set_options
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL, ZERO_STEP
 
@@ -137,7 +137,9 @@ class _Gradient:
         rhs.assemble()
         g = u.duplicate()
         self.ksp.setOperators(Aw)
-        self.ksp.solve(rhs, g)
+        # The ordering is read at the analysis, which serves every later direction.
+        with option_defaults(self.PREFIX, ordering_options(Aw, reused=True)):
+            self.ksp.solve(rhs, g)
         for v in (au, bu, rhs):
             v.destroy()
         return g

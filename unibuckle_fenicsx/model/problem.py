@@ -35,13 +35,15 @@ from unibuckle_fenicsx.eigen import (
     EigenSolveError,
     GEPSolver,
     Owner,
+    SmallestProof,
     SymmetricFactorization,
     abs_matrix,
+    lowest_eigenvalues,
     pop_run_options,
     push_run_options,
     release,
 )
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.model.contact import (
     BilateralZoneError,
     ContactSetManager,
@@ -64,6 +66,21 @@ logger = logging.getLogger(__name__)
 
 #: Options prefix of the LDL^T that checks A - B_fixed (``-unibuckle_fixed_ksp_view``).
 FIXED_LOAD_PREFIX = "unibuckle_fixed_"
+#: Options prefix of the coarse mesh's eigen solve that estimates the free load.
+ESTIMATE_PREFIX = "unibuckle_estimate_"
+
+#: The free solve's shift comes from the plate on a mesh this many times coarser along
+#: each side (a sixteenth of the DOFs; its load lies within a few tenths of a percent
+#: of the fine one on a mesh that resolves the mode).
+FREE_ESTIMATE_COARSENING = 4
+#: Meshes of at least this many (w, theta) DOFs get a coarse estimate of their free load:
+#: from there the estimate and the shifted solve cost less than the solve at target 0
+#: and its check (measured: at 5 673 DOFs 0.076 against 0.091 s, at 2 583 0.050 against
+#: 0.033 s; :doc:`/verification/floor`).
+FREE_ESTIMATE_DOFS = 5_000
+#: ... and whose coarse mesh keeps at least this many cells across (a structured one:
+#: with fewer the coarse load lies tens of percent off and the shifts miss).
+FREE_ESTIMATE_CELLS = 6
 
 #: Peak memory per (w, theta) DOF of a solve, measured with MUMPS on one rank: 7.8 kB at
 #: 155k DOFs, 5.8 kB at 617k (:doc:`/guide/mpi`); the estimate uses 8 kB.
@@ -298,15 +315,16 @@ class BucklingProblem(Owner):
         self._check_geometric_stiffness()
         if self.fixed_prestress is not None:
             self._check_fixed_load()
+        unilateral = spec.unilateral_obstacles + tuple(
+            point_obstacles(self.model.points, spec.plate)
+        )
         self.eigensolver = GEPSolver(
             self.model.A,
             self.model.B,
             indefinite=self.prestress.indefinite,
             tol=spec.solver.eps_tol,
             options={**EIGEN_OPTIONS, **(eps_options or {})},
-        )
-        unilateral = spec.unilateral_obstacles + tuple(
-            point_obstacles(self.model.points, spec.plate)
+            reused=bool(unilateral),  # a route's contact sets: many factorisations
         )
         try:
             self.contact = ContactSetManager(self.model, unilateral) if unilateral else None
@@ -328,10 +346,13 @@ class BucklingProblem(Owner):
                 'obstacle zone or another point): that holds w = 0, give it kind = "bilateral"'
             ) from err
         self.free: Mode | None = None
-        self._free_verified = False  # verify_free() passed
+        #: Why the free pair is the smallest, if its solve proved it (:meth:`solve_free`).
+        self.free_proof: SmallestProof | None = None
+        self._free_verified = False  # the free pair was proven the smallest
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
-        self._abs: tuple[PETSc.Mat, PETSc.Mat] | None = None  # abs_pencil(), made when needed
+        self._abs_A: PETSc.Mat | None = None  # abs_pencil(), made when needed
+        self._abs_B: PETSc.Mat | None = None
         self.tau = spec.solver.tau
         n_owned_w = self.model.Vw.dofmap.index_map.size_local
         self._w_owned = self.model.w_dofs[:n_owned_w]
@@ -418,12 +439,23 @@ class BucklingProblem(Owner):
     def solve_free(self) -> Mode:
         """Smallest eigenpair without obstacle (computed once, then ``free``).
 
+        On a mesh of at least :data:`FREE_ESTIMATE_DOFS` DOFs that can be coarsened (the
+        structured rectangle, or gmsh's plate at a larger cell size), the pencil's lowest
+        eigenvalues on a mesh :data:`FREE_ESTIMATE_COARSENING` times coarser set the
+        eigen solve's shift, and the inertia of its one factorisation proves the pair the
+        smallest (:meth:`~unibuckle_fenicsx.eigen.GEPSolver.smallest`;
+        :attr:`free_proof`). Otherwise (or if no shift proves it) the solve runs at
+        target 0 and :meth:`verify_free` checks the pair when it matters.
+
         Note:
             Collective.
         """
         if self.free is None:
             u = self.new_mode("free_mode")
-            pair = self.eigensolver.solve(out=u.x.petsc_vec)
+            pair, self.free_proof = self.eigensolver.smallest(
+                out=u.x.petsc_vec, estimate=self._free_estimate()
+            )
+            self._free_verified = self.free_proof is not None
             if not np.isfinite(pair.value):
                 raise InputError(
                     "the plate has no positive buckling load on this mesh: the geometric "
@@ -436,6 +468,41 @@ class BucklingProblem(Owner):
             self.free = Mode(pair.value, u, pair)
         return self.free
 
+    def _free_estimate(self) -> tuple[float, ...]:
+        """The free pencil's two lowest eigenvalues on a coarser mesh, or () if none is made.
+
+        The plate as it is without its one-sided obstacles and points (the free pencil
+        keeps the bilateral foundations and points), on a mesh
+        :data:`FREE_ESTIMATE_COARSENING` times coarser; () below
+        :data:`FREE_ESTIMATE_DOFS`, for a user's mesh or a file, and when the coarse
+        plate is refused (a feature smaller than its cells, no buckling load there).
+        Collective.
+        """
+        spec, k = self.spec, FREE_ESTIMATE_COARSENING
+        if self.custom_mesh or int(self.model.A.getSize()[0]) < FREE_ESTIMATE_DOFS:
+            return ()
+        free = replace(
+            spec,
+            obstacle=None,
+            obstacles=spec.bilateral_foundations,
+            points=tuple(p for p in spec.points if p.kind != "one-sided"),
+        )
+        try:
+            if self.structured:
+                nx, ny = spec.mesh.nx // k, spec.mesh.ny // k
+                if min(nx, ny) < FREE_ESTIMATE_CELLS:
+                    return ()
+                coarse = free.with_mesh(nx, ny)
+            elif spec.plate.file is None and spec.mesh.size is not None:
+                coarse = replace(free, mesh=replace(spec.mesh, size=k * spec.mesh.size))
+            else:
+                return ()
+            with BucklingProblem(coarse, self.comm) as problem:
+                return lowest_eigenvalues(problem.model.A, problem.model.B, ESTIMATE_PREFIX)
+        except (InputError, NumericalError) as err:
+            logger.debug("no coarse estimate of the free load: %s", err)
+            return ()
+
     def verify_free(self) -> None:
         r"""Check that the free pair is the pencil's smallest eigenpair (once per problem).
 
@@ -444,7 +511,9 @@ class BucklingProblem(Owner):
         the free load is a lower bound of the critical load (interlacing). The inertia
         of :math:`A - \sigma B`, :math:`\sigma` just below :math:`\lambda_{free}` (one
         :math:`LDL^T` through the shared factorisation), counts the eigenvalues in
-        :math:`(0, \sigma)` (Sylvester's law, A SPD): there must be none.
+        :math:`(0, \sigma)` (Sylvester's law, A SPD): there must be none. A free pair
+        that its shifted solve proved the smallest (:attr:`free_proof`) needs nothing
+        more.
 
         Raises:
             EigenSolveError: An eigenvalue lies below the free load.
@@ -452,18 +521,13 @@ class BucklingProblem(Owner):
         Note:
             Collective.
         """
+        free = self.solve_free()
         if self._free_verified:
             return
-        free = self.solve_free()
         sigma = free.load * (1.0 - SMALLEST_RTOL_FACTOR * self.spec.solver.eps_tol)
-        ldl = self.eigensolver.factorization
-        same, subset = PETSc.Mat.Structure.SAME_NONZERO_PATTERN, PETSc.Mat.Structure.SUBSET
-        self.model.A.copy(ldl.matrix, structure=same)
-        ldl.matrix.axpy(-sigma, self.model.B, structure=subset)  # type: ignore[arg-type]
-        # Negative pivots only: a null one means an eigenvalue within MUMPS's null-pivot
-        # threshold of sigma, which on a small or stiff pencil is the free one itself
-        # (the reduced pencils' check in the certificate reads the inertia alike).
-        below, _, _ = ldl.factor(self)
+        # Negative pivots only (the reduced pencils' check in the certificate reads the
+        # inertia alike).
+        below = self.eigensolver.count_below(sigma)
         if below:
             raise EigenSolveError(
                 f"the free eigen solve returned lambda = {free.load!r}, but {below} "
@@ -598,7 +662,9 @@ class BucklingProblem(Owner):
         Note:
             Collective.
         """
-        abs_A, _ = self.abs_pencil()
+        if self._abs_A is None:  # |B| is not needed here
+            self._abs_A = abs_matrix(self.model.A)
+        abs_A = self._abs_A
         size, product = u.duplicate(), u.duplicate()
         size.array[:] = np.abs(u.array_r)
         abs_A.mult(size, product)
@@ -615,9 +681,11 @@ class BucklingProblem(Owner):
         Shared by :meth:`load_resolution` and the interior-point method's residual floor;
         A and B are not changed after set-up. Owned by the problem. Collective.
         """
-        if self._abs is None:
-            self._abs = (abs_matrix(self.model.A), abs_matrix(self.model.B))
-        return self._abs
+        if self._abs_A is None:
+            self._abs_A = abs_matrix(self.model.A)
+        if self._abs_B is None:
+            self._abs_B = abs_matrix(self.model.B)
+        return self._abs_A, self._abs_B
 
     # -- reporting ------------------------------------------------------------------
     def buckling_coefficient(self, load: float) -> float:
@@ -631,10 +699,7 @@ class BucklingProblem(Owner):
 
     def destroy(self) -> None:
         """Destroy the PETSc/SLEPc objects (collective) and take back the run's options."""
-        release(self, "_r", "_Bu")
-        for mat in getattr(self, "_abs", None) or ():
-            mat.destroy()
-        self._abs = None
+        release(self, "_r", "_Bu", "_abs_A", "_abs_B")
         pop_run_options(getattr(self, "_run_options", []))
         for name in ("_eigensolver", "_model"):  # absent when the constructor failed early
             owner = self.__dict__.get(name)
