@@ -174,13 +174,16 @@ class SectionProblem(BucklingProblem):
             indefinite=prestress.indefinite,
             tol=solver.eps_tol,
             options={**EIGEN_OPTIONS, **(eps_options or {})},
+            reused=constraints is not None,  # the contact sets: many factorisations
         )
         self.contact = SectionContact(pencil, constraints) if constraints is not None else None
         self.free = None
+        self.free_proof = None
         self._free_verified = False
         self._r: PETSc.Vec | None = None
         self._Bu: PETSc.Vec | None = None
-        self._abs: tuple[PETSc.Mat, PETSc.Mat] | None = None
+        self._abs_A: PETSc.Mat | None = None
+        self._abs_B: PETSc.Mat | None = None
         self.tau = solver.tau
         n_owned = model.W.dofmap.index_map.size_local
         translations = np.arange(n_owned * DOFS_PER_NODE, dtype=np.int32).reshape(-1, 6)[:, :3]
