@@ -88,15 +88,15 @@ DRILLING_FACTOR = 1e-3
 #: from the frame's square roots is far higher, at no gain on a flat rectangle.)
 GAUSS_2X2 = {"quadrature_degree": 2}
 
-Expr = ufl.core.expr.Expr
 
-
-def split(U: Expr) -> tuple[Expr, Expr]:
+def split(U: ufl.core.expr.Expr) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr]:
     """Displacement u and rotation vector omega of a 6-vector of the section space."""
     return ufl.as_vector([U[0], U[1], U[2]]), ufl.as_vector([U[3], U[4], U[5]])
 
 
-def cell_frame(msh: dolfinx.mesh.Mesh) -> tuple[Expr, Expr, Expr]:
+def cell_frame(
+    msh: dolfinx.mesh.Mesh,
+) -> tuple[ufl.core.expr.Expr, ufl.core.expr.Expr, ufl.core.expr.Expr]:
     r"""Orthonormal frame :math:`(e_1, e_2, n)` of each cell, from its Jacobian.
 
     :math:`e_1` along the first reference direction, :math:`e_2` the second made
@@ -120,25 +120,25 @@ class ShellFields:
         self.frame = (self.e1, self.e2)
 
 
-def _d(f: Expr, e: Expr) -> Expr:
+def _d(f: ufl.core.expr.Expr, e: ufl.core.expr.Expr) -> ufl.core.expr.Expr:
     """Derivative of the field f along the (cellwise constant) direction e."""
     return ufl.dot(ufl.grad(f), e)
 
 
-def membrane_strain(U: Expr, f: ShellFields) -> Expr:
+def membrane_strain(U: ufl.core.expr.Expr, f: ShellFields) -> ufl.core.expr.Expr:
     r""":math:`\varepsilon_{\alpha\beta} = \mathrm{sym}(e_\alpha\cdot\partial_\beta u)` (2x2)."""
     u, _ = split(U)
     g = ufl.as_matrix([[ufl.dot(a, _d(u, b)) for b in f.frame] for a in f.frame])
     return ufl.sym(g)
 
 
-def fibre_rotation(U: Expr, f: ShellFields) -> Expr:
+def fibre_rotation(U: ufl.core.expr.Expr, f: ShellFields) -> ufl.core.expr.Expr:
     r"""Rotation of the normal fibre :math:`\beta_\alpha = (n\times\omega)\cdot e_\alpha`."""
     _, omega = split(U)
     return ufl.as_vector([ufl.dot(ufl.cross(f.n, omega), a) for a in f.frame])
 
 
-def curvature(U: Expr, f: ShellFields) -> Expr:
+def curvature(U: ufl.core.expr.Expr, f: ShellFields) -> ufl.core.expr.Expr:
     r""":math:`\kappa_{\alpha\beta} = \mathrm{sym}\,\partial_\beta\beta_\alpha` (2x2, 1/m)."""
     _, omega = split(U)
     g = ufl.as_matrix(
@@ -147,21 +147,23 @@ def curvature(U: Expr, f: ShellFields) -> Expr:
     return ufl.sym(g)
 
 
-def shear_strain(U: Expr, f: ShellFields) -> Expr:
+def shear_strain(U: ufl.core.expr.Expr, f: ShellFields) -> ufl.core.expr.Expr:
     r""":math:`\gamma_\alpha = \partial_\alpha w - \beta_\alpha` (before the MITC tying)."""
     u, _ = split(U)
     beta = fibre_rotation(U, f)
     return ufl.as_vector([ufl.dot(f.n, _d(u, a)) - beta[k] for k, a in enumerate(f.frame)])
 
 
-def drilling_strain(U: Expr, f: ShellFields) -> Expr:
+def drilling_strain(U: ufl.core.expr.Expr, f: ShellFields) -> ufl.core.expr.Expr:
     r""":math:`\omega\cdot n - \tfrac12(\partial_1 u_2 - \partial_2 u_1)`."""
     u, omega = split(U)
     rot = ufl.dot(f.e2, _d(u, f.e1)) - ufl.dot(f.e1, _d(u, f.e2))
     return ufl.dot(omega, f.n) - 0.5 * rot
 
 
-def membrane_force(U: Expr, f: ShellFields, C: npt.NDArray[np.float64]) -> Expr:
+def membrane_force(
+    U: ufl.core.expr.Expr, f: ShellFields, C: npt.NDArray[np.float64]
+) -> ufl.core.expr.Expr:
     r"""Membrane stress resultant :math:`N = C_m\varepsilon` (N/m), 2x2 in the cell frame."""
     return voigt_to_ufl(C, membrane_strain(U, f))
 
@@ -170,12 +172,16 @@ def _dx() -> ufl.Measure:
     return ufl.Measure("dx", metadata=GAUSS_2X2)
 
 
-def membrane_form(U: Expr, V: Expr, f: ShellFields, C: npt.NDArray[np.float64]) -> ufl.Form:
+def membrane_form(
+    U: ufl.core.expr.Expr, V: ufl.core.expr.Expr, f: ShellFields, C: npt.NDArray[np.float64]
+) -> ufl.Form:
     r""":math:`\int N(\varepsilon(u)):\varepsilon(v)` with the 3x3 Voigt :math:`C_m` (N/m)."""
     return ufl.inner(membrane_force(U, f, C), membrane_strain(V, f)) * _dx()
 
 
-def bending_form(U: Expr, V: Expr, f: ShellFields, D: npt.NDArray[np.float64]) -> ufl.Form:
+def bending_form(
+    U: ufl.core.expr.Expr, V: ufl.core.expr.Expr, f: ShellFields, D: npt.NDArray[np.float64]
+) -> ufl.Form:
     r""":math:`\int M(\kappa(u)):\kappa(v)` with the 3x3 Voigt D (N m)."""
     return ufl.inner(voigt_to_ufl(D, curvature(U, f)), curvature(V, f)) * _dx()
 
@@ -195,7 +201,7 @@ def _tying_measure(direction: int) -> ufl.Measure:
     return ufl.Measure("dx", metadata=metadata)
 
 
-def shear_form(U: Expr, V: Expr, f: ShellFields, ks: float) -> ufl.Form:
+def shear_form(U: ufl.core.expr.Expr, V: ufl.core.expr.Expr, f: ShellFields, ks: float) -> ufl.Form:
     r"""MITC4 shear energy :math:`\int \kappa_s G t\, \gamma^{MITC}(u)\cdot\gamma^{MITC}(v)`.
 
     Each covariant component on its tying line (module docstring); rectangular cells.
@@ -205,13 +211,20 @@ def shear_form(U: Expr, V: Expr, f: ShellFields, ks: float) -> ufl.Form:
     return k * gu[0] * gv[0] * _tying_measure(0) + k * gu[1] * gv[1] * _tying_measure(1)
 
 
-def drilling_form(U: Expr, V: Expr, f: ShellFields, kd: float) -> ufl.Form:
+def drilling_form(
+    U: ufl.core.expr.Expr, V: ufl.core.expr.Expr, f: ShellFields, kd: float
+) -> ufl.Form:
     r""":math:`\int k_d\,\delta(u)\delta(v)` with the drilling strain :math:`\delta`, kd in N/m."""
     return material_constant(kd, f.n) * drilling_strain(U, f) * drilling_strain(V, f) * _dx()
 
 
 def geometric_form(
-    U: Expr, V: Expr, f: ShellFields, N0: Expr, *, donnell: bool = False
+    U: ufl.core.expr.Expr,
+    V: ufl.core.expr.Expr,
+    f: ShellFields,
+    N0: ufl.core.expr.Expr,
+    *,
+    donnell: bool = False,
 ) -> ufl.Form:
     r""":math:`b(u,v) = -\int N^0_{\alpha\beta}\,\partial_\alpha u\cdot\partial_\beta v`.
 

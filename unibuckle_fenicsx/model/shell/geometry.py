@@ -3,7 +3,7 @@ r"""Section meshes: a box, a circular tube and one flat face, as quadrilateral s
 The member's axis is x, from the loaded end x = 0 to the loaded end x = L; the section
 lies in the (y, z) plane, centred on the axis. Each mesh is a DOLFINx mesh of
 quadrilaterals of topological dimension 2 and geometric dimension 3, made from numpy
-arrays by :func:`dolfinx.mesh.create_mesh` (no gmsh: the surfaces are structured).
+arrays by ``dolfinx.mesh.create_mesh`` (no gmsh: the surfaces are structured).
 Every cell is a rectangle: its first reference direction runs along x, its second
 around the section (counter-clockwise seen from +x), so its normal
 :math:`e_x \times t_s` points into the section (toward a core). The shell element
