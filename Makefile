@@ -1,4 +1,6 @@
-# make demo : set up .venv (first time) and reproduce the paper's cases, writing figures/
+# make demo : set up .venv (first time) and reproduce the paper's cases, writing output/figures/
+#             (not under version control) and comparing its records with figures/
+# make figures : the same into figures/, the repository's (for the documentation)
 # make test : set up .venv (first time) and run the test suite (ruff, mypy, pytest)
 # make docs : set up .venv and the docs extra, build the site into docs/_build/html (-W)
 # make docs-check : open the built site offline in headless Chromium (equations, screenshots)
@@ -7,13 +9,16 @@ PY := $(VENV)/bin/python
 export PYVISTA_OFF_SCREEN := true
 export OMP_NUM_THREADS := 1
 
-.PHONY: setup demo test test-all lint bench docs docs-check clean
+.PHONY: setup demo figures test test-all lint bench docs docs-check clean
 
 setup:
 	@bash scripts/setup-venv.sh $(VENV)
 
 demo: setup
 	$(PY) demos/run_all.py
+
+figures: setup
+	$(PY) demos/run_all.py --figures figures
 
 test: setup lint
 	$(PY) -m pytest -n auto --dist loadfile tests

@@ -38,7 +38,6 @@
 # %%
 from __future__ import annotations
 
-import json
 import time
 import warnings
 
@@ -200,25 +199,14 @@ if comm.rank == 0:
         written.append(figures / "deformed_c1.png")
     for path in written:
         print(f"wrote {path}")
-    (figures / "results.json").write_text(
-        json.dumps(
-            {
-                "mesh": list(MESH),
-                "linear_critical_load_Pa": lam_c,
-                "free_load_Pa": lam_free,
-                "study": [  # without the paths and the wall times (the file is versioned)
-                    {
-                        k: v
-                        for k, v in r.as_dict().items()
-                        if k not in ("path", "versions", "timings", "wall_time_s")
-                    }
-                    for r in rows
-                ],
-            },
-            indent=2,
-        )
-        + "\n"
-    )
+    summary = {
+        "mesh": list(MESH),
+        "linear_critical_load_Pa": lam_c,
+        "free_load_Pa": lam_free,
+        # Without the paths (the file is versioned): a record, the same on any machine.
+        "study": [{k: v for k, v in r.as_dict().items() if k != "path"} for r in rows],
+    }
+    study.write_record(figures / "results.json", summary)
 
 # %% [markdown]
 # ## Checks

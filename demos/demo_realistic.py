@@ -29,7 +29,6 @@
 # %%
 from __future__ import annotations
 
-import json
 import warnings
 
 from mpi4py import MPI
@@ -155,8 +154,7 @@ if comm.rank == 0:
     print(result.summary())
     for key, value in summary.items():
         print(f"  {key}: {value}")
-    figures.mkdir(parents=True, exist_ok=True)
-    (figures / "results.json").write_text(json.dumps(summary, indent=2) + "\n")
+    study.write_record(figures / "results.json", summary)
 
 # %% [markdown]
 # ## Checks

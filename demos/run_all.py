@@ -14,6 +14,14 @@ so their loads are ordered, and "the noticeable changing of the obstacle [c1 to 
 slightly affected [...] the buckling critical load" (we require below 2 %).
 It exits non-zero if a demo or a check fails. ``make demo`` runs it with the default (paper) sizes;
 ``--coarse`` (or ``UNIBUCKLE_DEMO_COARSE=1``) runs tiny meshes for the tests.
+
+``DIR`` is ``output/figures`` by default (not under version control: a run leaves the
+repository as it was); the figures kept in the repository (``figures/``, which the
+documentation shows) are written by ``make figures`` (``--figures figures``). A run into
+another folder ends by comparing its JSON records with the repository's
+(:func:`compare_records`): they agree to their stored resolution on any machine, and
+any difference is listed. The figures themselves may differ in pixels between machines
+(README, "What may differ").
 """
 
 from __future__ import annotations
@@ -61,9 +69,15 @@ COLUMNS = (
     "i",
     "|Z|",
     "method",
-    "eigen solves",
     "certificate",
 )
+#: The figures kept in the repository (written by ``make figures``).
+STORED = ROOT / "figures"
+#: Where ``make demo`` writes (``output/`` is not under version control).
+OUTPUT = ROOT / "output" / "figures"
+#: Numbers of two records agree within this (relative): a record keeps eight significant
+#: digits, so a number that lies at a rounding boundary may change its last one.
+RECORD_RTOL = 1e-6
 
 
 def _row(r: dict[str, Any]) -> list[str]:
@@ -83,7 +97,6 @@ def _row(r: dict[str, Any]) -> list[str]:
         str(r["constrained_nodes"]),
         str(r["contact_nodes"]),
         r["method"],
-        str(r["eigensolves"]),
         verdict,
     ]
 
@@ -98,6 +111,47 @@ def _table(rows: list[list[str]]) -> tuple[str, str]:
     md = ["| " + " | ".join(header) + " |", "|" + "|".join("---" for _ in COLUMNS) + "|"]
     md += ["| " + " | ".join(row) + " |" for row in rows]
     return "\n".join(lines), "\n".join(md)
+
+
+def _differences(a: Any, b: Any, where: str = "") -> list[str]:
+    """Where two records differ (numbers beyond :data:`RECORD_RTOL`)."""
+    if isinstance(a, dict) and isinstance(b, dict):
+        out = [f"{where}.{k}: only in one" for k in sorted(set(a) ^ set(b))]
+        for k in sorted(set(a) & set(b)):
+            out += _differences(a[k], b[k], f"{where}.{k}")
+        return out
+    if isinstance(a, list) and isinstance(b, list):
+        if len(a) != len(b):
+            return [f"{where}: {len(a)} entries against {len(b)}"]
+        pairs = enumerate(zip(a, b, strict=True))
+        return [d for k, (x, y) in pairs for d in _differences(x, y, f"{where}[{k}]")]
+    numbers = (int, float)
+    if isinstance(a, numbers) and isinstance(b, numbers) and not isinstance(a, bool):
+        if abs(a - b) <= RECORD_RTOL * max(abs(a), abs(b)):
+            return []
+    elif a == b:
+        return []
+    return [f"{where}: {a!r} against {b!r}"]
+
+
+def compare_records(figures: Path, stored: Path = STORED) -> list[str]:
+    """The JSON records of ``figures`` that differ from those kept in ``stored``."""
+    out = []
+    for path in sorted([*figures.rglob("*.json"), *figures.rglob("*.jsonl")]):
+        kept = stored / path.relative_to(figures)
+        if not kept.exists():
+            continue
+        if path.suffix == ".jsonl":
+            new = [json.loads(line) for line in path.read_text().splitlines() if line.strip()]
+            old = [json.loads(line) for line in kept.read_text().splitlines() if line.strip()]
+        else:
+            new, old = json.loads(path.read_text()), json.loads(kept.read_text())
+        found = _differences(new, old)
+        if found:
+            shown = "; ".join(found[:5]) + ("; ..." if len(found) > 5 else "")
+            name = kept.relative_to(ROOT) if kept.is_relative_to(ROOT) else kept
+            out.append(f"{name}: {len(found)} difference(s): {shown}")
+    return out
 
 
 def _compare_cases(paper: dict[str, dict[str, Any]], figures: Path) -> list[str]:
@@ -136,7 +190,7 @@ def _compare_cases(paper: dict[str, dict[str, Any]], figures: Path) -> list[str]
         f"\npaper's mesh: lambda_c2/lambda_c1 - 1 = {change:.2e}, "
         f"lambda_c3/lambda_c1 - 1 = {load['c3'] / load['c1'] - 1:.2e}"
     )
-    rtol = 1e-8
+    rtol = 1e-7  # the records' eight digits
     checks = {
         "free <= c2 <= c1 <= c3 (nested zones)": load["free"] <= load["c2"] * (1 + rtol)
         and load["c2"] <= load["c1"] * (1 + rtol)
@@ -194,8 +248,8 @@ def quickstart(figures: Path, env: dict[str, str]) -> list[str]:
     return failed
 
 
-def main(argv: list[str] | None = None) -> int:
-    """Run the demos; return the exit status."""
+def parser() -> argparse.ArgumentParser:
+    """The command line (``--figures`` defaults to :data:`OUTPUT`)."""
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument(
         "--coarse",
@@ -203,9 +257,19 @@ def main(argv: list[str] | None = None) -> int:
         default=os.environ.get("UNIBUCKLE_DEMO_COARSE") == "1",
         help="tiny meshes (for tests)",
     )
-    parser.add_argument("--figures", type=Path, default=ROOT / "figures", help="PNG directory")
+    parser.add_argument(
+        "--figures",
+        type=Path,
+        default=OUTPUT,
+        help="the figures' and records' directory (make figures: figures, the repository's)",
+    )
     parser.add_argument("--output", type=Path, default=None, help="also write VTX files here")
-    args = parser.parse_args(argv)
+    return parser
+
+
+def main(argv: list[str] | None = None) -> int:
+    """Run the demos; return the exit status."""
+    args = parser().parse_args(argv)
     figures = args.figures.resolve()
 
     env = {**os.environ, "PYVISTA_OFF_SCREEN": "true", "OMP_NUM_THREADS": "1"}
@@ -266,6 +330,12 @@ def main(argv: list[str] | None = None) -> int:
         print(f"\nwrote {path.relative_to(figures.parent) if path.is_relative_to(ROOT) else path}")
     if set(paper) == set(CASES):
         failed += _compare_cases(paper, figures)
+    if figures != STORED.resolve() and not args.coarse:
+        differ = compare_records(figures)
+        print(
+            "\nrecords against the repository's figures/: "
+            + ("the same" if not differ else "\n  ".join(["differ:", *differ]))
+        )
     print(f"total {time.perf_counter() - t_all:.1f} s")
     if failed:
         print(f"failed demos: {', '.join(failed)}", file=sys.stderr)

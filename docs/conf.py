@@ -103,5 +103,5 @@ html_title = f"unibuckle_fenicsx {release}"
 html_static_path = ["_static"]
 html_css_files = ["unibuckle.css"]
 
-# The figures live in the repository's figures/ (written by `make demo`).
+# The figures live in the repository's figures/ (written by `make figures`).
 html_extra_path: list[str] = []

@@ -2,8 +2,8 @@ r"""The bad-input family: every key of the problem file given a bad value, and b
 
 Five base problem files hold every key of the schema (README, "Problem files"): a
 rectangle with an anisotropic material, every edge key, three obstacles (box, polygon,
-circle) and every solver key; a bilateral foundation; an outline with holes, segments
-and a cell size; restrained edges, fixed and thermal loads, design output, point
+circle), every solver key and design output; a bilateral foundation; an outline with
+holes, segments and a cell size; restrained edges, fixed and thermal loads, point
 restraints and a gapped obstacle; a laminate. Each of their values, and each number
 inside a list value, is replaced in turn by a value of the wrong type (a string, a
 boolean, a list, a table), by nan, inf or -inf, and by values out of its range
@@ -32,7 +32,7 @@ from unibuckle_fenicsx.spec import problem_from_dict
 
 SAMPLE_STEP = 8
 #: The family's size: keys (and numbers inside list values) and bad values in all.
-KEYS, VALUES = 211, 1407
+KEYS, VALUES = 211, 1416
 
 _D = 1e9 * 0.006**3 / 12 / (1 - 0.09)
 _Q = [[1.0, 0.3, 0.0], [0.3, 1.0, 0.0], [0.0, 0.0, 0.35]]
@@ -59,6 +59,7 @@ RECTANGLE = {
         "top": {"support": "free"},
     },
     "mesh": {"nx": 8, "ny": 4},
+    "design": {"yield_stress": 3.55e8, "partial_factor": 1.1},
     "obstacles": [
         {"zone": [[0.05, 0.1], [0.0, 0.1]], "side": "above", "tolerance": 1e-9},
         {"polygon": [[0.12, 0.02], [0.18, 0.02], [0.15, 0.08]], "side": "above"},
@@ -134,7 +135,6 @@ FEATURES = {
         },
     },
     "load": {"temperature": 1.0, "fixed_temperature": 0.5, "fixed_factor": 0.5},
-    "design": {"yield_stress": 3.55e8, "partial_factor": 1.1},
     "points": [
         {"at": [0.15, 0.05], "kind": "spring", "stiffness": 1.0e5},
         {"spacing": [0.1, 0.05], "offset": [0.05, 0.0], "region": [[0.0, 0.3], [0.0, 0.1]]},
@@ -183,6 +183,7 @@ OUT_OF_RANGE: dict[str, list[Any]] = {
     "G13": [-1.0],
     "G23": [0.0],
     "nu12": [4.0],  # |nu12| < sqrt(E1/E2) = 3.74 for a positive definite ply
+    "angle": [1e300, 361.0, -400.0],  # |angle| <= 360 degrees
     "rotational_stiffness": [-1.0],
     "translational_stiffness": [-1.0],
     "yield_stress": [0.0, -1.0],
@@ -344,6 +345,79 @@ def _check_key(tmp_path, capsys, cases):
         # The key, or an entry of its value (key[i][j]), not a key below it (key[i].sub).
         pattern = rf"(?<![\w.\[]){re.escape(name)}(?!\w)(?!(\[\d+\])+\.)"
         assert re.search(pattern, err), f"{value!r}: {name!r} not in {err}"
+
+
+#: Values each valid for its key alone that a rule between keys refuses: (label, base,
+#: {path: value} (None: the key left out), the key the message must name). The design
+#: output's element (EN 1993-1-5 4.4: internal or outstand, or not described) and a
+#: one-sided point's side.
+RULES: list[tuple[str, str, dict[tuple, Any], str]] = [
+    (
+        "design: both unloaded edges free",
+        "rectangle",
+        {("edges", "bottom", "support"): "free"},
+        "edges.bottom.support",
+    ),
+    (
+        "design: an unloaded edge on springs",
+        "rectangle",
+        {("edges", "top", "translational_stiffness"): 1e6},
+        "edges.top.translational_stiffness",
+    ),
+    (
+        "design: an unloaded edge held in its plane",
+        "rectangle",
+        {("edges", "bottom", "inplane"): "roller"},
+        "edges.bottom.inplane",
+    ),
+    (
+        "design: biaxial normal stress",
+        "rectangle",
+        {("edges", "bottom", "normal_stress"): -0.5},
+        "edges.bottom.normal_stress",
+    ),
+    (
+        "design: psi below Table 4.2's row",
+        "rectangle",
+        {
+            ("edges", "left", "normal_stress"): [-1.0, 2.0],
+            ("edges", "right", "normal_stress"): [-1.0, 2.0],
+        },
+        "edges.left.normal_stress",
+    ),
+    (
+        "design: a temperature rise",
+        "features",
+        {("design",): {"yield_stress": 3.55e8}},
+        "load.temperature",
+    ),
+    ("design: an outline", "outline", {("design",): {"yield_stress": 3.55e8}}, "plate.outline"),
+    (
+        "a one-sided point without its side",
+        "features",
+        {("points", 2, "side"): None},
+        "points[2].side",
+    ),
+]  # fmt: skip
+
+
+def _changed(base: dict, changes: dict[tuple, Any]) -> dict:
+    data = json.loads(json.dumps(base))
+    for path, value in changes.items():
+        node = data
+        for part in path[:-1]:
+            node = node[part]
+        if value is None:
+            del node[path[-1]]
+        else:
+            node[path[-1]] = value
+    return data
+
+
+@pytest.mark.parametrize(("label", "base", "changes", "name"), RULES, ids=[r[0] for r in RULES])
+def test_rules_between_keys(tmp_path, capsys, nothing_built, label, base, changes, name):
+    """Each value valid alone, refused by a rule between keys: exit 2, the key named."""
+    _check_key(tmp_path, capsys, [(changes, _changed(BASES[base], changes), name)])
 
 
 SAMPLE = CASES[::SAMPLE_STEP]

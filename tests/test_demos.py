@@ -73,7 +73,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     env = {**os.environ, "PYVISTA_OFF_SCREEN": "true", "OMP_NUM_THREADS": "1"}
     cmd = [sys.executable, str(ROOT / "demos" / "run_all.py"), "--coarse"]
     cmd += ["--figures", str(figures), "--output", str(vtx)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=900, env=env, cwd=ROOT)
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
     assert proc.returncode == 0, proc.stdout + proc.stderr
     for demo in (
         "demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3",
@@ -81,7 +81,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
         "demo_sections",
     ):  # fmt: skip
         assert f"{demo}.py: ok" in proc.stdout
-    assert "lambda/lambda_free" in proc.stdout and "eigen solves" in proc.stdout
+    assert "lambda/lambda_free" in proc.stdout and "certificate" in proc.stdout
     assert "check free <= c2 <= c1 <= c3 (nested zones): ok" in proc.stdout
     table = (figures / "results.md").read_text().splitlines()
     assert len(table) == 2 + 2 * len(CASES)  # header, rule, paper + refined mesh per case
@@ -98,14 +98,15 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
 
     column = json.loads((figures / "column" / "results.json").read_text())
     assert column["certificate"]["kkt"] and 0.0 < column["design"]["reduction_factor"] <= 1.0
-    assert column["critical_stress_MPa"] >= column["free_stress_MPa"] * (1 - 1e-8)
+    assert column["critical_stress_MPa"] >= column["free_stress_MPa"] * (1 - 1e-7)
     assert all(row["status"] == "ok" for row in column["tie_spacing_study"])
 
     for case in CASES:
         data = json.loads((figures / case / "results.json").read_text())
         for r in data["results"]:
-            # Interlacing: the obstacle never lowers the load (README, "The problem").
-            assert r["critical_load_Pa"] >= r["free_load_Pa"] * (1 - 1e-8)
+            # Interlacing: the obstacle never lowers the load (README, "The problem"), up
+            # to the records' eight digits.
+            assert r["critical_load_Pa"] >= r["free_load_Pa"] * (1 - 1e-7)
         for mesh in COARSE:
             assert (vtx / case / mesh / f"{case}_w.bp").exists()
 

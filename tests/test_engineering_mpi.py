@@ -49,7 +49,6 @@ PROBLEMS = {
         },
         "mesh": {"nx": 12, "ny": 6},
         "obstacle": {"zone": "all"},
-        "design": {"yield_stress": 3.55e8, "partial_factor": 1.1},
     },
     "laminate (45/-45/-45/45), obstacle": {
         "plate": {"corners": [[0.0, 0.0], [2.0, 1.0]]},
@@ -82,9 +81,13 @@ PROBLEMS = {
             {"spacing": 0.55, "region": [[0.0, 2.0], [0.5, 0.5]]},
             {"at": [1.5, 0.25], "kind": "spring", "stiffness": 1.0e6},
             {"at": [0.5, 0.75], "kind": "one-sided", "side": "below"},
-            {"at": [1.25, 0.75], "kind": "one-sided"},  # four nodes at the same distance
-            {"spacing": [1.0, 1.0], "offset": [0.5, 0.5], "kind": "one-sided"},
+            # Four nodes at the same distance:
+            {"at": [1.25, 0.75], "kind": "one-sided", "side": "above"},
+            {"spacing": [1.0, 1.0], "offset": [0.5, 0.5], "kind": "one-sided", "side": "above"},
         ],
+        # An internal element (unloaded edges simply supported); the edge on springs of
+        # the first problem is neither supported nor free (refused).
+        "design": {"yield_stress": 3.55e8, "partial_factor": 1.1},
     },
 }
 

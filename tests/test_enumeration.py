@@ -260,7 +260,7 @@ def test_cli_enumerate_json(tmp_path: Path):
     exe = Path(sys.executable).parent / "unibuckle"
     cmd = [str(exe), "solve", "--case", "c2", "--nx", "8", "--ny", "4"]
     cmd += ["--method", "enumerate", "--json", str(out)]
-    proc = subprocess.run(cmd, capture_output=True, text=True, timeout=300, cwd=tmp_path)
+    proc = subprocess.run(cmd, capture_output=True, text=True, cwd=tmp_path)
     assert proc.returncode == 0, proc.stderr
     data = json.loads(out.read_text())
     # c2 on 8 x 4: i = 3 nodes (x = -0.025, 0, 0.025 on y = 0); the dense brute force

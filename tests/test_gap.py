@@ -10,7 +10,12 @@ Expected values:
   symmetry x -> -x, w -> -w), so its largest upward deflection is max |w|, and the plate
   reaches a whole-plate obstacle above at gap g at the first step where the free path's
   max |w| reaches g;
-- at the end, w <= g at every zone node and the obstacle only pushes (contact check).
+- at the end, w <= g at every zone node and the obstacle only pushes (contact check);
+- the knee of the gapped path lies between the free load (the linear state's) and the
+  linear unilateral load with the gap closed, computed here by a separate linear solve
+  of the same plate with ``gap = 0``: the obstacle stiffens the plate only once reached.
+  With a gap no linear load is the answer, so the verdict validates none; a load 8 %
+  above the linear one (the issue's small-gap run) is never called validated.
 """
 
 from __future__ import annotations
@@ -78,6 +83,66 @@ def test_the_path_reaches_the_obstacle_across_its_gap():
     assert check["satisfied"] and check["max_zone_w_m"] <= 0.0 and check["contact_nodes"] > 0
     assert gapped.path[-1]["max_w_m"] < free.path[-1]["max_w_m"]  # the obstacle holds it
     assert "the plate reaches the obstacle at lambda" in gapped.summary()
+
+
+def test_the_gapped_knee_lies_between_the_free_and_the_gap_closed_loads():
+    gapped, free = _paths()
+    closed_data = {**DATA, "obstacle": {"zone": "all", "gap": 0.0}}
+    with solve(problem_from_dict(closed_data), MPI.COMM_WORLD) as analysis:
+        closed = analysis.result.critical_load_Pa
+    assert gapped.gapped and not free.gapped
+    assert gapped.unilateral_load_Pa == pytest.approx(closed, rel=1e-10)
+    assert gapped.linear_critical_load_Pa == free.linear_critical_load_Pa < closed
+    for load in (gapped.southwell_load_Pa, gapped.inflection_load_Pa):
+        assert gapped.linear_critical_load_Pa * 0.99 <= load <= closed * 1.01
+    assert gapped.ok and "with a gap the knee lies between the free load" in gapped.verdict
+    assert "no linear load is validated" in gapped.summary()
+    assert "x free" in gapped.summary() and "gaps closed" in gapped.summary()
+
+
+def _hand_result(southwell, inflection, *, gap=False, closed=None, linear=1.5e4):
+    """A complete path with these loads read off it (a NonlinearResult by hand)."""
+    from unibuckle_fenicsx.nonlinear import NonlinearResult
+
+    return NonlinearResult(
+        case="plate", mesh=[12, 6], dofs=1, obstacle=True, control="load", imperfection=1e-3,
+        imperfection_shape="unilateral", thickness_m=2e-4, linear_critical_load_Pa=linear,
+        free_load_Pa=linear, linear_method="free", southwell_load_Pa=southwell,
+        southwell_points=5, inflection_load_Pa=inflection, southwell_ratio=southwell / linear,
+        inflection_ratio=inflection / linear, completed=True,
+        path=[{"load_Pa": 0.0, "max_w_m": 2e-7, "contact_nodes": 0, "end_shortening_m": 0.0},
+              {"load_Pa": 1.2 * linear, "max_w_m": 1e-4, "contact_nodes": 6,
+               "end_shortening_m": 1e-6}],
+        stop_reason="reached 1.2 x the linear critical load", rejected_steps=0,
+        constrained_nodes=91, contact_check={"satisfied": True}, options={"max_load": 1.2},
+        wall_time_s=1.0, gapped=gap, unilateral_load_Pa=closed,
+    )  # fmt: skip
+
+
+def test_a_load_8_percent_away_is_never_validated(capsys):
+    """The issue's run (gap 4e-6 m = 0.02 t): Southwell 8.6 %, inflection 13.6 % above.
+
+    Without the gap known, those loads were compared with the free load alone and the
+    run exited 0; a path whose loads lie 8 % from the linear load validates nothing.
+    """
+    from unibuckle_fenicsx.cli import nonlinear_verdict
+
+    linear = 1.503291e4
+    plain = _hand_result(1.632729e4, 1.707346e4, linear=linear)
+    assert not plain.ok
+    text = nonlinear_verdict(plain, 1.2)
+    validated, _, missing = text.partition("Not validated:")
+    assert "Validated: the contact conditions" in validated and "Southwell" not in validated
+    assert "the Southwell load 1.632729e+04 Pa (+8.6e-02 relative): more than 1% from" in missing
+    # With the gap known: between the free load and the gap-closed one, consistent.
+    gapped = _hand_result(1.632729e4, 1.707346e4, gap=True, closed=1.70949e4, linear=linear)
+    assert gapped.ok
+    summary = gapped.summary()
+    assert "no linear load is validated" in summary and "validated:" not in summary
+    # Above the gap-closed load: not consistent, exit 3's message says so.
+    above = _hand_result(1.632729e4, 1.25 * linear, gap=True, closed=1.70949e4, linear=linear)
+    assert not above.ok
+    assert "Not consistent: the inflection load" in nonlinear_verdict(above, 1.2)
 
 
 @pytest.mark.mpi

@@ -143,6 +143,13 @@ PLY = {"thickness": 0.001, "angle": 0.0, **GLASS}
         ({"plies": [{**PLY, "G23": 0}]}, {}, r"material\.plies\[0\]\.G23 must be > 0 Pa"),
         ({"plies": [{k: v for k, v in PLY.items() if k != "G13"}]}, {}, r"needs \['G13'\]"),
         ({"plies": []}, {}, r"material\.plies must be a list of tables"),
+        # A fibre angle of 1e300 degrees ran (its cosine is rounding): one turn either way.
+        (
+            {"plies": [{**PLY, "angle": 1e300}]},
+            {},
+            r"material\.plies\[0\]\.angle must lie in \[-360, 360\] degrees, got 1e\+300",
+        ),
+        ({"plies": [PLY, {**PLY, "angle": -361.0}, PLY]}, {}, r"material\.plies\[1\]\.angle"),
         (
             {"plies": [PLY]},
             {"thickness": 0.002},

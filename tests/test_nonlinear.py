@@ -306,7 +306,7 @@ def test_cli_nonlinear_no_step_converges(tmp_path):
     cmd += ["--nx", "8", "--ny", "4", "--json", str(out), "-q"]
     cmd += ["-unibuckle_nl_snes_max_it", "1", "-unibuckle_nl_snes_atol", "0"]
     env = {**os.environ, "OMP_NUM_THREADS": "1"}
-    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT, timeout=300)
+    proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
     assert proc.returncode == 3, proc.stdout + proc.stderr
     assert "no load step converged" in proc.stderr and "converged reason" in proc.stderr
     assert not out.exists()

@@ -102,6 +102,9 @@ def test_point_tables_are_read_converted_and_written_back():
         ({"at": [1, 0.5], "kind": "spring"}, r'points\[0\]\.stiffness: kind = "spring" needs'),
         ({"at": [1, 0.5], "stiffness": 5.0}, r'points\[0\]\.stiffness belongs to kind = "spring"'),
         ({"at": [1, 0.5], "side": "below"}, r'points\[0\]\.side belongs to kind = "one-sided"'),
+        ({"at": [1, 0.5], "side": "above"}, r'points\[0\]\.side belongs to kind = "one-sided"'),
+        # It took "above" silently.
+        ({"at": [1, 0.5], "kind": "one-sided"}, r'points\[0\]\.side: kind = "one-sided" needs'),
         ({"at": [1, 0.5], "kind": "glued"}, r"points\[0\]\.kind must be one of"),
         ({"at": [1, 0.5], "offset": [0, 0]}, r"points\[0\]\.offset belongs to a grid"),
         ({"at": [4, 0.5]}, r"points\[0\]\.at \[4\.0, 0\.5\] lies outside the plate"),
@@ -118,28 +121,85 @@ def test_bad_points_are_refused(table, match):
 def test_one_sided_points_with_a_tensionless_foundation_are_refused():
     data = {
         "obstacle": {"zone": "all", "foundation_stiffness": 1e6},
-        "points": [{"at": [0.0, 0.0], "kind": "one-sided"}],
+        "points": [{"at": [0.0, 0.0], "kind": "one-sided", "side": "above"}],
     }
     with pytest.raises(ValueError, match=r"points: one-sided points .* tensionless foundation"):
         problem_from_dict(data)
 
 
+STUD = PointSpec(at=(1.0, 0.5), kind="one-sided", side="above")
+
+
 @pytest.mark.parametrize(
-    "points",
+    ("points", "index"),
     [
-        [PointSpec(at=(0.0, 0.5), kind="one-sided")],  # on the simply supported left edge
-        [PointSpec(at=(1.0, 0.5)), PointSpec(at=(1.0, 0.5), kind="one-sided")],  # held there
+        ([replace(STUD, at=(0.0, 0.5))], 0),  # on the simply supported left edge
+        ([PointSpec(at=(1.0, 0.5)), STUD], 1),  # held there by a bilateral point
     ],
 )
-def test_a_one_sided_point_on_a_held_node_is_named(points):
-    """A one-sided point whose node is held already restrains nothing.
+def test_a_one_sided_point_on_a_held_node_is_named(points, index):
+    """A one-sided point whose node is held already restrains nothing: named by its index.
 
-    The message is about the points (it named an obstacle.zone the file does not have).
+    The message is about the points (it named an obstacle.zone the file does not have,
+    then "points" without saying which).
     """
     from unibuckle_fenicsx.model.contact import EmptyZoneError
 
-    with pytest.raises(EmptyZoneError, match=r"^points: the one-sided points act on no free node"):
+    at = f"{points[index].at[0]:g}, 0.5"
+    match = rf"^points\[{index}\] \(one-sided \(above\) at \({at}\) m\): the one-sided points act"
+    with pytest.raises(EmptyZoneError, match=match):
         result(plate(4, aspect=2.0, points=points))
+
+
+def test_a_one_sided_point_held_from_the_other_side_is_named():
+    """A stud above inside a zone below: w = 0 there, refused naming points[1]."""
+    from unibuckle_fenicsx.model.contact import BilateralZoneError
+    from unibuckle_fenicsx.spec import ObstacleSpec
+
+    free = replace(STUD, at=(1.5, 0.5))
+    spec = replace(
+        plate(4, aspect=2.0, points=[free, STUD]),
+        obstacle=ObstacleSpec(zone=((0.5, 1.25), (0.0, 1.0)), side="below"),
+    )
+    match = r"^points\[1\] \(one-sided \(above\) at \(1, 0\.5\) m\): a one-sided point acts"
+    with pytest.raises(BilateralZoneError, match=match):
+        result(spec)
+
+
+def test_points_on_held_nodes_are_reported():
+    """A tie on the clamped bottom edge, a spring on a tie: restraining nothing, said so.
+
+    Before, the summary said "1 points on 1 nodes" and nothing else: a mistyped coordinate
+    went unnoticed. A grid over the whole plate has its edge points on the supports.
+    """
+    from unibuckle_fenicsx.spec import EdgeSpec
+
+    spec = plate(4, aspect=2.0)
+    edges = tuple(
+        replace(e, support="clamped") if e.name == "bottom" else e for e in spec.plate.edges
+    )
+    assert any(e == EdgeSpec("bottom", support="clamped") for e in edges)
+    points = [
+        PointSpec(at=(0.5, 0.0)),  # on the clamped edge
+        PointSpec(at=(1.0, 0.5)),  # a tie inside
+        PointSpec(at=(1.0, 0.5), kind="spring", stiffness=1e5),  # on the tie's node
+        PointSpec(spacing=(1.0, 0.5)),  # x = 0, 1, 2; y = 0, 0.5, 1: 8 of 9 on an edge
+        PointSpec(at=(1.5, 0.5), kind="spring", stiffness=1e5),  # restrains
+    ]
+    spec = replace(spec, plate=replace(spec.plate, edges=edges), points=tuple(points))
+    out = result(spec)
+    reports = out.details["point_restraints"]
+    idle = [r["restraining_nothing"] for r in reports]
+    assert idle[0] == [[0.5, 0.0]] and idle[1] == [] and idle[2] == [[1.0, 0.5]]
+    on_edges = {(x, y) for x in (0.0, 1.0, 2.0) for y in (0.0, 0.5, 1.0)} - {(1.0, 0.5)}
+    assert {tuple(p) for p in idle[3]} == on_edges and idle[4] == []
+    text = out.summary()
+    assert (
+        "bilateral at (0.5, 0) m: 1 points on 1 nodes, largest snap distance 0 m; 1 on a "
+        "node held already (by an edge support or a bilateral point), restraining nothing: "
+        "(0.5, 0) m" in text
+    )
+    assert "8 on a node held already" in text and ", ..." in text
 
 
 def test_snap_distance_is_reported():
@@ -201,7 +261,7 @@ def test_one_sided_points_against_the_hermite_plate():
     mask = np.zeros((33, 17), dtype=bool)
     mask[8, 8] = mask[24, 8] = True
     reference = bfs.unilateral_load(mask)[0] / (math.pi**2 * D)
-    points = [PointSpec(at=(x, 0.5), kind="one-sided") for x in (0.5, 1.5)]
+    points = [PointSpec(at=(x, 0.5), kind="one-sided", side="above") for x in (0.5, 1.5)]
     k = []
     for n in (16, 32):
         out = result(plate(n, aspect=2.0, points=points))

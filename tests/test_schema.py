@@ -42,7 +42,7 @@ LAMINATE = {
     "edges": {
         "left": {"normal_stress": -1.0, "fixed_normal_stress": -1e6, "fixed_shear_stress": 0.0},
         "right": {"normal_stress": -1.0, "rotational_stiffness": 10.0},
-        "top": {"support": "free", "translational_stiffness": 1e6},
+        "top": {"support": "free"},
     },
     "load": {"temperature": 0.0, "fixed_temperature": 0.0, "fixed_factor": 1.0},
     "design": {"yield_stress": 355e6, "partial_factor": 1.0},
@@ -122,7 +122,7 @@ def test_unibuckle_schema_into_a_pipe_closed_early(tmp_path):
     assert proc.stdout is not None and proc.stderr is not None
     proc.stdout.close()  # what head does after its lines
     err = proc.stderr.read().decode()
-    assert proc.wait(timeout=120) == EXIT_OK, err
+    assert proc.wait() == EXIT_OK, err
     assert "Traceback" not in err and "BrokenPipe" not in err, err
 
 

@@ -19,6 +19,13 @@ tensionless and bilateral foundations, methods auto, active-set and enumerate
 A problem with no admissible mode must be reported so (NoAdmissibleModeError), and the
 exhaustive search must agree.
 
+The design output (``[design]``, EN 1993-1-5 4.4) is added to every file of the family:
+the element it is (internal: both edges parallel to the direct stress supported;
+outstand: one free) or the refusal (a plate that is not the rectangle, biaxial or no
+compressive normal stress, both such edges free, a stress ratio outside the table) is
+worked out here by hand from the file's tables and compared with the package's; where it
+is accepted, the sample's solves check the reduction factor against eq. (4.2) or (4.3).
+
 The default run takes the first :data:`SAMPLE` problems; ``-m stress`` runs all
 :data:`FAMILY_SIZE`.
 """
@@ -26,6 +33,7 @@ The default run takes the first :data:`SAMPLE` problems; ``-m stress`` runs all
 from __future__ import annotations
 
 import math
+import re
 from types import SimpleNamespace
 
 from mpi4py import MPI
@@ -92,6 +100,85 @@ def _plate_model(spec) -> SimpleNamespace:
     return SimpleNamespace(model=PlateModel(msh, tags, plate, spec.material, prestress))
 
 
+DESIGN = {"yield_stress": 3.55e8, "partial_factor": 1.0}
+
+
+def _design_by_hand(data: dict) -> tuple[str, str | None] | str:
+    """The family file's EN 1993-1-5 element (kind, free edge), or the refusal's words.
+
+    The family's rectangles carry a uniform state (sxx on left/right, syy on bottom/top)
+    with sxx + y-gradient [sxx - 0.5, sxx + 0.5] on left/right; supports at random; no
+    in-plane supports, springs or temperatures.
+    """
+    edges = data["edges"]
+
+    def ends(name):
+        value = edges[name].get("normal_stress", 0.0)
+        return list(value) if isinstance(value, list) else [value, value]
+
+    if min(min(ends(name)) for name in edges) >= 0.0:
+        return "compressive normal edge stress"
+    if "corners" not in data["plate"]:
+        return "plate.outline"
+    along_x = any(any(ends(n)) for n in ("left", "right"))
+    if along_x and any(any(ends(n)) for n in ("bottom", "top")):
+        return "normal stress in both directions"
+    loaded, unloaded = (("left", "right"), ("bottom", "top"))
+    if not along_x:
+        loaded, unloaded = unloaded, loaded
+    free = [n for n in unloaded if edges[n]["support"] == "free"]
+    if len(free) == 2:
+        return 'are both "free"'
+    compression = [-v for v in ends(loaded[0])]  # both loaded edges carry the same
+    k = int(compression[1] > compression[0])  # the end of sigma_1 (0 start, 1 end)
+    psi = compression[1 - k] / compression[k]
+    at_supported = bool(free) and psi != 1.0 and unloaded[k] != free[0]
+    if psi < (-1.0 if at_supported else -3.0):
+        return "stress ratio psi"
+    return ("outstand", free[0]) if free else ("internal", None)
+
+
+def test_the_design_element_of_every_family_file():
+    """[design] on each file: the element, or the refusal, as worked out by hand."""
+    from unibuckle_fenicsx.spec.checks import design_element
+
+    seen = set()
+    for data, _ in FAMILY:
+        expected = _design_by_hand(data)
+        with_design = {**data, "design": DESIGN}
+        if isinstance(expected, str):
+            with pytest.raises(ValueError, match=re.escape(expected)):
+                problem_from_dict(with_design)
+            seen.add(expected)
+            continue
+        element = design_element(problem_from_dict(with_design))
+        assert (element.kind, element.free_edge) == expected, data["name"]
+        seen.add(expected[0])
+    # The family draws each case (the refusals' words, and both elements).
+    assert seen >= {
+        "plate.outline", "normal stress in both directions", "internal", "outstand",
+    }, seen  # fmt: skip
+
+
+def _check_design(data: dict, load: float) -> None:
+    """The sample's accepted [design]: rho against eq. (4.2) or (4.3) by hand."""
+    expected = _design_by_hand(data)
+    if isinstance(expected, str):
+        return
+    spec = problem_from_dict({**data, "design": DESIGN})
+    from unibuckle_fenicsx.design import design_output
+
+    d = design_output(spec, spec.design, load)
+    lam = math.sqrt(DESIGN["yield_stress"] / d["sigma_cr_Pa"])
+    if expected[0] == "internal":
+        rho = (lam - 0.055 * (3 + d["psi"])) / lam**2
+        rho = 1.0 if lam <= 0.5 + math.sqrt(0.085 - 0.055 * d["psi"]) else min(1.0, rho)
+    else:
+        rho = 1.0 if lam <= 0.748 else min(1.0, (lam - 0.188) / lam**2)
+    assert d["element"] == expected[0]
+    assert d["reduction_factor"] == pytest.approx(rho, rel=1e-14), data["name"]
+
+
 def _check(data: dict, features: list[str]) -> None:
     spec = problem_from_dict(data)
     where = f"{spec.name} ({', '.join(features)})"
@@ -128,6 +215,7 @@ def _check(data: dict, features: list[str]) -> None:
         result, cert = analysis.result, analysis.certificate
         assert cert is not None and cert.kkt, (where, cert)
         load = result.critical_load_Pa
+        _check_design(data, load)
         x = analysis.mode.x.array.copy()
         active = tuple(int(k) for k in analysis.solution.active)
     assert result.lower_bound_Pa <= load * (1 + RTOL), where

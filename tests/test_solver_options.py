@@ -67,3 +67,34 @@ def test_the_command_line_wins_over_python_options(built):
         assert opts.getInt("eps_ncv") == NCV + 2  # still the command line's
     finally:
         opts.delValue("eps_ncv")
+
+
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs its own process")
+def test_an_iterative_shift_and_invert_is_refused_with_the_reason(tmp_path):
+    """``-unibuckle_st_ksp_type gmres -unibuckle_st_pc_type jacobi``: exit 2, and why.
+
+    Before, Krylov-Schur stopped in the inner solve ("KSPSolve has not converged") and
+    SLEPc then failed in its clean-up: "PETSc/SLEPc failed: Operation done in wrong
+    order; Need to call MatDenseRestoreSubMatrix() first", exit 3, without saying that
+    the shift-and-invert needs a direct factorisation. The console script runs in its own
+    process: the options go to PETSc's database at its start.
+    """
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    script = Path(sys.executable).parent / "unibuckle"
+    options = ["-unibuckle_st_ksp_type", "gmres", "-unibuckle_st_pc_type", "jacobi"]
+    proc = subprocess.run(
+        [str(script), "solve", "--case", "c1", "--nx", "8", "--ny", "8", *options],
+        capture_output=True, text=True, env={**os.environ, "OMP_NUM_THREADS": "1"},
+        cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == 2, proc.stderr
+    assert proc.stderr.startswith(
+        "unibuckle: error: -unibuckle_st_ksp_type gmres -unibuckle_st_pc_type jacobi: the "
+        "eigen solver's shift-and-invert here needs a direct factorisation"
+    ), proc.stderr
+    assert "-unibuckle_st_ksp_type preonly" in proc.stderr and "wrong order" not in proc.stderr
+    assert "Traceback" not in proc.stderr and proc.stdout == ""

@@ -311,6 +311,40 @@ def test_the_critical_rise_is_of_the_heated_part():
     assert out.critical_temperature_K > 0.0
 
 
+def test_the_total_critical_rise_with_a_fixed_rise():
+    """A fixed 0.2 K and lambda x 1 K, uniform: the total rise at the critical state.
+
+    The same uniform field as the scaled rise alone, so the total critical rise is that
+    plate's critical rise (here it is compared with a separate solve of the rise alone);
+    before, the output gave only lambda x 1 K. A fixed_factor of 0.5 halves the fixed
+    part and leaves the total.
+    """
+    alone = result(steel_plate(8, HELD, {"temperature": 1.0}))
+    assert alone.critical_total_temperature_K is None
+    for load in (
+        {"temperature": 1.0, "fixed_temperature": 0.2},
+        {"temperature": 1.0, "fixed_temperature": 0.2, "fixed_factor": 0.5},
+    ):
+        both = result(steel_plate(8, HELD, load))
+        total = both.critical_total_temperature_K
+        assert total == pytest.approx(alone.critical_temperature_K, rel=1e-9)
+        assert total == pytest.approx(
+            load.get("fixed_factor", 1.0) * 0.2 + both.critical_load_factor, rel=1e-12
+        )
+        assert "total temperature rise at the critical state" in both.summary()
+        assert f"{total:.6g} K" in both.summary()
+        assert both.as_dict()["critical_total_temperature_K"] == total
+
+
+def test_a_cooling_names_load_temperature():
+    """A uniform cooling, two edges held in their plane: no buckling, and the key named."""
+    rollers = {"left": {"inplane": "clamped"}, "right": {"inplane": "clamped"}}
+    with pytest.raises(ValueError, match=r"load\.temperature = -1\.0 K per unit load is a cooling"):
+        result(steel_plate(4, rollers, {"temperature": -1.0}))
+    with pytest.raises(ValueError, match=r"reverse the sign of .* or of load\.temperature"):
+        result(steel_plate(4, HELD, {"temperature": -1.0}))
+
+
 @pytest.mark.parametrize("key", ["temperature", "fixed_temperature"])
 def test_a_rise_on_a_plate_free_in_its_plane_is_refused(key):
     """A uniform or linear rise expands a free plate without stress: refused when read."""

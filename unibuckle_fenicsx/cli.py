@@ -19,11 +19,12 @@ from __future__ import annotations
 import argparse
 import logging
 import os
+import re
 import sys
 import traceback
 from collections.abc import Sequence
 from pathlib import Path
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, NoReturn
 
 from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.spec import METHODS
@@ -139,6 +140,20 @@ solves) and unibuckle_prestress_.
 """
 
 
+#: A negative number as a value, exponent form included (``-1e-3``, ``-2.5E+4``): argparse
+#: 3.13 reads ``-1e-3`` as an unknown option ("expected one argument") because its own
+#: pattern has no exponent; the package has no option that looks like a number.
+NEGATIVE_NUMBER = re.compile(r"^-(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?$")
+
+
+class _Parser(argparse.ArgumentParser):
+    """argparse's parser, reading a negative number in exponent form as a value."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self._negative_number_matcher = NEGATIVE_NUMBER
+
+
 class _Formatter(argparse.RawDescriptionHelpFormatter, argparse.ArgumentDefaultsHelpFormatter):
     """Epilogs as written; each option's default appended to its help (when it has one)."""
 
@@ -161,9 +176,9 @@ def _solver_default(name: str) -> str:
     )
 
 
-def _common_flags() -> argparse.ArgumentParser:
+def _common_flags() -> _Parser:
     """Flags of every subcommand: logging and progress."""
-    common = argparse.ArgumentParser(add_help=False)
+    common = _Parser(add_help=False)
     common.add_argument("-v", "--verbose", action="count", default=0, help="log more (-vv: debug)")
     common.add_argument(
         "-q", "--quiet", action="store_true", help="no progress output on stderr (warnings stay)"
@@ -171,11 +186,11 @@ def _common_flags() -> argparse.ArgumentParser:
     return common
 
 
-def _problem_flags() -> argparse.ArgumentParser:
+def _problem_flags() -> _Parser:
     """Flags naming one problem (solve, nonlinear): its source, mesh, --set and --json."""
     from unibuckle_fenicsx.cases import CASES
 
-    problem = argparse.ArgumentParser(add_help=False)
+    problem = _Parser(add_help=False)
     src = problem.add_mutually_exclusive_group(required=True)
     src.add_argument(
         "--case",
@@ -208,7 +223,7 @@ def _problem_flags() -> argparse.ArgumentParser:
 
 def _parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.ArgumentParser]]:
     """The command line's parser and its subcommands' parsers by name."""
-    parser = argparse.ArgumentParser(
+    parser = _Parser(
         prog="unibuckle",
         description=(
             "Unilateral buckling of thin plates (Reissner-Mindlin, MITC4): the critical "
@@ -364,7 +379,7 @@ def _solve_flags(s: argparse.ArgumentParser) -> None:
     )
 
 
-def _nonlinear_parser(sub: Any, parents: list[argparse.ArgumentParser]) -> None:
+def _nonlinear_parser(sub: Any, parents: list[_Parser]) -> None:
     """The ``nonlinear`` subcommand's arguments (defaults: :class:`NonlinearOptions`)."""
     from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
 
@@ -573,32 +588,110 @@ def main(argv: Sequence[str] | None = None) -> int:
     from mpi4py import MPI  # before petsc4py: loads libmpi
 
     comm = MPI.COMM_WORLD
+    _PENDING.clear()
     # The outputs first: a path that cannot be written is refused before PETSc, DOLFINx
     # and the problem are even loaded.
     problem = comm.bcast(_check_outputs(args) if comm.rank == 0 else None, root=0)
     if problem is not None:
-        return _fail(comm, problem)
+        if comm.rank == 0:
+            print(f"unibuckle: error: {problem}", file=sys.stderr)
+        return EXIT_BAD_INPUT
     _logging(args.verbose, args.quiet, comm.rank)
+    ending = _Ending(comm)
+    status, raised = _guarded_run(args, rest, comm)
+    return ending.finish(status, raised or bool(_PENDING))
+
+
+def _abort(comm: Any, status: int, message: str | None) -> NoReturn:
+    """Print ``message`` and end every rank of ``comm`` with ``status`` (``MPI_Abort``)."""
+    if message is not None:
+        print(f"unibuckle: error: {message}", file=sys.stderr, flush=True)
+    comm.Abort(status)
+    os._exit(status)  # MPI_Abort does not return; had it, this process ends all the same
+
+
+def _guarded_run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> tuple[int, bool]:
+    """The exit status of :func:`_run`, and whether this rank raised (it may be alone)."""
     try:
-        return _run(args, rest, comm)
+        return _run(args, rest, comm), False
     except KeyboardInterrupt:
-        return _interrupted(args, comm)
+        return _interrupted(args, comm), True
     except InputError as err:
-        return _fail(comm, str(err))
+        return _fail(comm, str(err)), True
     except NumericalError as err:
-        return _fail(comm, f"{err} (no result written)", EXIT_NOT_CERTIFIED)
+        return _fail(comm, f"{err} (no result written)", EXIT_NOT_CERTIFIED), True
     except Exception as err:
         if _in_chain(err, KeyboardInterrupt) is not None:
             # Ctrl-C inside a Python callback of PETSc (the nonlinear path's SNES
             # residual): petsc4py turns it into PETSc error 101 with the interrupt as
             # its context. An interrupt all the same.
-            return _interrupted(args, comm)
+            return _interrupted(args, comm), True
         refused = _petsc_error(err, rest)
         if refused is not None:
-            return _fail(comm, *refused)
+            return _fail(comm, *refused), True
         traceback.print_exc()  # on every rank that fails: the bug may be on one
         print(BUG_REPORT, file=sys.stderr, flush=True)
-        return EXIT_BUG
+        return EXIT_BUG, True
+
+
+#: Seconds a rank that failed waits for the others at the end of the run before it
+#: aborts it: ranks that fail together (a collective check, a collective solve) arrive
+#: within a fraction of this; a rank that fails alone leaves the others blocked in their
+#: next collective call, which only MPI_Abort ends.
+FAILURE_WAIT_S = 5.0
+#: This rank's error messages of the run, printed once at its end (:class:`_Ending`).
+_PENDING: list[tuple[int, str]] = []
+
+
+class _Ending:
+    """The end of a run on every rank: one message, one exit status, no rank left waiting.
+
+    Every rank ends the run with one collective call (on a duplicate of the communicator,
+    so that no message of the computation can match it): a reduction that finds the
+    first rank with a non-zero status. That rank prints its error message; every rank
+    returns its status. A rank that failed (an exception, an error message) does not
+    block on it: if the others do not arrive within :data:`FAILURE_WAIT_S` (they wait in a
+    collective call of the computation that the failed rank will not make), it prints its
+    message and aborts the run with its status (``MPI_Abort``: mpiexec ends every rank and
+    exits with that status). Serial runs print the message and return.
+    """
+
+    def __init__(self, comm: Any) -> None:
+        self.comm = comm
+        self.dup = comm.Dup() if comm.size > 1 else None  # collective
+
+    def finish(self, status: int, failed: bool) -> int:
+        """The run's exit status on this rank (collective, or an abort: see the class)."""
+        import time
+
+        from mpi4py import MPI
+
+        import numpy as np
+
+        message = _PENDING[-1][1] if _PENDING else None
+        if self.dup is None:
+            if message is not None:
+                print(f"unibuckle: error: {message}", file=sys.stderr, flush=True)
+            return status
+        comm, dup = self.comm, self.dup
+        mine = np.array([comm.rank if status != EXIT_OK else comm.size], dtype=np.int64)
+        first = np.empty(1, dtype=np.int64)
+        request = dup.Iallreduce(mine, first, op=MPI.MIN)
+        if failed:
+            waited = time.monotonic() + FAILURE_WAIT_S
+            while not request.Test():
+                if time.monotonic() > waited:
+                    _abort(comm, status, message)
+                time.sleep(0.01)
+        else:
+            request.Wait()
+        leader = int(first[0])
+        if leader < comm.size:
+            status = dup.bcast(status, root=leader)
+            if comm.rank == leader and message is not None:
+                print(f"unibuckle: error: {message}", file=sys.stderr, flush=True)
+        dup.Free()
+        return int(status)
 
 
 def _interrupted(args: argparse.Namespace, comm: Any) -> int:
@@ -836,37 +929,30 @@ def _nonlinear(args: argparse.Namespace, comm: Any) -> int:
 
 
 def nonlinear_verdict(result: Any, max_load: float) -> str:
-    """What an incomplete load path validated, and what it did not (one paragraph).
+    """What an unsuccessful load path validated, and what it did not (one paragraph).
 
     Args:
         result: A :class:`~unibuckle_fenicsx.nonlinear.NonlinearResult` that is not ``ok``.
         max_load: The --max-load asked for (a multiple of the linear critical load).
     """
-    linear = result.linear_critical_load_Pa
-    validated, missing = [], []
-    for name, load in (
-        ("Southwell", result.southwell_load_Pa),
-        ("inflection", result.inflection_load_Pa),
-    ):
-        if load is None:
-            missing.append(f"the {name} load (the path stopped before it could be read)")
-        else:
-            validated.append(f"the {name} load {load:.6e} Pa ({load / linear - 1:+.1e} relative)")
-    check = result.contact_check
-    if check.get("satisfied", True):
-        validated.append("the contact conditions at the last converged state")
-    else:
-        missing.append(f"the contact conditions at the last converged state ({check})")
-    reached = result.path[-1]["load_Pa"] / linear if result.path else 0.0
-    if not result.completed:
-        missing.append(
-            f"the path from {reached:.4g} to --max-load {max_load:g} x the linear load "
-            f"({result.stop_reason})"
+    from unibuckle_fenicsx.nonlinear.verdict import judge
+
+    verdict = judge(result, max_load)
+    validated, missing = ", ".join(verdict.validated), ", ".join(verdict.missing)
+    if verdict.gap:
+        closed = result.unilateral_load_Pa
+        return (
+            "with a gap the knee lies between the free load "
+            f"{result.linear_critical_load_Pa:.6e} Pa and the unilateral load with the gaps "
+            "closed "
+            + ("(not computed)" if closed is None else f"{closed:.6e} Pa")
+            + f"; the load path is not consistent with them. Consistent: {validated or 'nothing'}."
+            f" Not consistent: {missing}"
         )
     return (
         f"the load path does not validate everything against the linear critical load "
-        f"{linear:.6e} Pa. Validated: {', '.join(validated) or 'nothing'}. Not validated: "
-        f"{', '.join(missing)}"
+        f"{result.linear_critical_load_Pa:.6e} Pa. Validated: {validated or 'nothing'}. "
+        f"Not validated: {missing}"
     )
 
 
@@ -878,9 +964,12 @@ def _after_interrupt(unraisable: Any) -> None:
 
 
 def _fail(comm: Any, message: str, status: int = EXIT_BAD_INPUT) -> int:
-    """Print the error on rank 0 and return the exit status."""
-    if comm.rank == 0:
-        print(f"unibuckle: error: {message}", file=sys.stderr)
+    """Record the error message (printed once, at the end of the run) and return the status.
+
+    The rank that prints it is the first with a non-zero status (:class:`_Ending`): rank 0
+    when the ranks fail together, the failing one when it fails alone.
+    """
+    _PENDING.append((status, message))
     return status
 
 

@@ -40,7 +40,7 @@ from mpi4py import MPI
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.errors import NumericalError
+from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
 try:
@@ -120,7 +120,7 @@ NEAR_NCV = 4
 #: the lowest eigenvalue (a coarse mesh's load lies above the fine one, or within a few
 #: tenths of a percent below it), below the second, so that the inertia of one
 #: factorisation proves the pair the smallest. Each later try lies further below the
-#: estimate (:data:`FREE_BELOW`, times the estimate).
+#: estimate (``FREE_BELOW``, times the estimate).
 FREE_ABOVE = 0.01
 FREE_GAP_SHARE = 1.0 / 3.0
 FREE_BELOW = (0.99, 0.96, 0.84)
@@ -404,6 +404,33 @@ def _is_zero(B: PETSc.Mat) -> bool:
     return bool(B.norm(PETSc.NormType.INFINITY) == 0.0)  # type: ignore[arg-type]
 
 
+#: The spectral transformation's solves must be exact: a KSP "preonly" with one of these.
+DIRECT_PCS = ("lu", "cholesky")
+
+
+def _require_direct_solve(eps: SLEPc.EPS, prefix: str) -> None:
+    r"""Refuse an iterative solve in the spectral transformation (options from the user).
+
+    The inverse of :math:`A - \sigma B` is applied inside Krylov-Schur and its
+    factorisation's inertia proves which eigenvalue is the smallest: an inexact inner
+    solve (e.g. ``-<prefix>st_ksp_type gmres -<prefix>st_pc_type jacobi``) stops with
+    "KSPSolve has not converged", and SLEPc then fails in its clean-up with "Operation
+    done in wrong order". Raises :class:`~unibuckle_fenicsx.errors.InputError` naming the
+    options; the caller destroys the EPS.
+    """
+    ksp = eps.getST().getKSP()
+    ksp_type, pc_type = ksp.getType(), ksp.getPC().getType()
+    if ksp_type == "preonly" and pc_type in DIRECT_PCS:
+        return
+    raise InputError(
+        f"-{prefix}st_ksp_type {ksp_type} -{prefix}st_pc_type {pc_type}: the eigen solver's "
+        "shift-and-invert here needs a direct factorisation (an iterative inner solve is "
+        "inexact, and so are the transformed spectrum and the eigenvalue; it stops with "
+        f"'KSPSolve has not converged'): give -{prefix}st_ksp_type preonly with "
+        f"-{prefix}st_pc_type {' or '.join(DIRECT_PCS)} (the default: lu with MUMPS)"
+    )
+
+
 class GEPSolver(Owner):
     """Smallest eigenpair of :math:`(A, B)` with optional removed DOFs.
 
@@ -411,7 +438,7 @@ class GEPSolver(Owner):
         A: Stiffness matrix, SPD (owned by the caller; not modified; its values may
             change between solves, see :meth:`operators_changed`).
         B: Geometric stiffness matrix (owned by the caller; not modified, and not
-            changed afterwards: the solver keeps a :func:`compact` copy, :attr:`B`).
+            changed afterwards: the solver keeps a :func:`compact` copy, ``B``).
         indefinite: B is indefinite: solve the swapped pencil.
         prefix: Options prefix, non-empty; ``-<prefix>eps_view`` and friends apply.
         tol: EPS tolerance.
@@ -469,6 +496,11 @@ class GEPSolver(Owner):
         self._options = dict(EIGEN_OPTIONS if options is None else options)
         set_options(eps, prefix, self._options)
         self.eps = eps
+        try:
+            _require_direct_solve(eps, prefix)
+        except InputError:
+            self.destroy()  # collective: every rank reads the same options
+            raise
         self._near: SLEPc.EPS | None = None  # the shifted solves' EPS, made when needed
         self._free: SLEPc.EPS | None = None  # the smallest pair's EPS, made when needed
         self._free_ncv = FREE_NCV  # its Krylov subspace for one pair (the options')
@@ -710,12 +742,12 @@ class GEPSolver(Owner):
           tolerance) must show none there either.
 
         More than :data:`FREE_MAX_BELOW` below :math:`\sigma`, or fewer pairs found below
-        it than lie there: the next shift lies below the estimate (:data:`FREE_BELOW`)
+        it than lie there: the next shift lies below the estimate (``FREE_BELOW``)
         and the pencil is factorised again. If no shift proves it (or nothing converges,
         or there is no estimate) the pair comes from :meth:`solve` at target 0 (a MUMPS
         LU), unproven: the caller checks it (:meth:`count_below`).
 
-        The EPS takes the options under :attr:`prefix` (``-unibuckle_eps_tol``,
+        The EPS takes the options under ``prefix`` (``-unibuckle_eps_tol``,
         ``-unibuckle_eps_ncv``, ...; the Krylov subspace defaults to :data:`FREE_NCV`),
         the factorisation those of :attr:`factorization` (``<prefix>ldl_``).
 

@@ -7,6 +7,7 @@ from dataclasses import asdict, dataclass, field
 from typing import TYPE_CHECKING, Any
 
 import numpy as np
+import numpy.typing as npt
 
 from unibuckle_fenicsx.model.zones import zone_report
 from unibuckle_fenicsx.spec import (
@@ -24,7 +25,102 @@ if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.certificate.certify import Certificate
     from unibuckle_fenicsx.model.problem import BucklingProblem, Mode
 
-__all__ = ["BucklingResult", "versions"]
+__all__ = ["RECORD_DIGITS", "BucklingResult", "record", "rounded", "versions"]
+
+#: Significant digits of the numbers a record keeps (:func:`record`): the loads carry
+#: about ten (the eigen solver's tolerance, 1e-10) and double precision fixes them to
+#: 1e-13 on the paper's plate, 1e-9 to 1e-8 on thin ones (``load_resolution``); mode
+#: values about eight. Eight keeps what every quantity carries and drops its rounding.
+RECORD_DIGITS = 8
+#: What a record leaves out: what depends on the machine (its BLAS kernels and threads,
+#: the rank count, the clock), not on the problem. The algorithm's path (counts of eigen
+#: solves and factorisations, the sets and loads it visited: on symmetric or thin
+#: plates rounding decides between contact sets of equal load), round-off diagnostics
+#: (residuals, margins, the load's resolution), times, versions, the rank count and the
+#: partition's DOF numbering.
+RUN_DEPENDENT = frozenset(
+    {
+        "eigensolves", "details", "timings", "wall_time_s", "method_chosen_by", "versions",
+        "mpi_size", "contact_dofs", "load_resolution", "rejected_steps", "solves_cold",
+        "solves_warm", "max_free_residual", "max_complementarity", "max_zone_w_m",
+        "free_eigen_error", "free_eigen_iterations",
+    }
+)  # fmt: skip
+#: Of a certificate, the verdict (its margins and residuals are round-off).
+CERTIFICATE_VERDICT = (
+    "feasible", "kkt", "smallest_of_reduced", "global_optimum_proven", "proven_by", "status",
+    "negative_eigenvalues", "tolerance",
+)  # fmt: skip
+#: The contact set's keys, left out of a record with ``contact=False`` (the contact
+#: force lists its pushes in the order of the set).
+CONTACT_KEYS = ("contact_nodes", "contact_coordinates", "contact_indices", "contact_force")
+
+
+def record(data: Any, *, contact: bool = True) -> Any:
+    """``data`` (a result's JSON mapping, or any JSON value) as a record for version control.
+
+    The same on every machine up to its last digit: the keys of :data:`RUN_DEPENDENT`
+    left out at any depth, a certificate reduced to its verdict
+    (:data:`CERTIFICATE_VERDICT`), every number rounded to :data:`RECORD_DIGITS`
+    significant digits, those of a list of numbers to the digits of its largest (a
+    coordinate's rounding, 3e-19 beside 0.1, is then 0). A number that lies within its
+    noise of a rounding boundary may still change its last digit between machines.
+
+    Args:
+        data: A JSON value (``BucklingResult.as_dict()``, a sweep's line, a demo's summary).
+        contact: Keep the contact set; on thin plates nodes with both a zero deflection
+            and a zero contact force (DESIGN: degenerate complementarity) fall in or out
+            of it with rounding, at the same load: ``False`` leaves it out.
+    """
+    if isinstance(data, dict):
+        out = {}
+        for key, value in data.items():
+            if key in RUN_DEPENDENT or (not contact and key in CONTACT_KEYS):
+                continue
+            if key == "certificate" and isinstance(value, dict):
+                value = {k: value[k] for k in CERTIFICATE_VERDICT if k in value}
+            out[key] = record(value, contact=contact)
+        return out
+    if isinstance(data, list | tuple):
+        numbers = [v for v in data if isinstance(v, float)]
+        if numbers and len(numbers) == len(data):
+            return [_rounded(v, max(abs(x) for x in numbers)) for v in numbers]
+        return [record(v, contact=contact) for v in data]
+    if isinstance(data, float):
+        return _rounded(data, abs(data))
+    return data
+
+
+def rounded(values: Any) -> npt.NDArray[np.float64]:
+    """``values`` (an array) to :data:`RECORD_DIGITS` significant digits of the largest.
+
+    What a figure draws: an antialiased line moves a pixel's shade for a change of
+    1e-13 in its data, so a figure of the full numbers differs between machines where
+    one of the rounded numbers does not.
+    """
+    array = np.asarray(values, dtype=float)
+    finite = np.abs(array[np.isfinite(array)])
+    scale = float(finite.max()) if finite.size else 0.0
+    if scale == 0.0:
+        return array
+    return np.round(array, _decimals(scale)) + 0.0
+
+
+def _decimals(scale: float) -> int:
+    """Decimals that keep :data:`RECORD_DIGITS` significant digits of ``scale`` (> 0).
+
+    Of ``scale`` itself at those digits: a normalised mode's largest value is 1 within
+    rounding, 0.9999999999997 on one machine and 1.0000000000002 on another, and both
+    must give the same decimals.
+    """
+    return RECORD_DIGITS - 1 - math.floor(math.log10(float(f"{scale:.{RECORD_DIGITS - 1}e}")))
+
+
+def _rounded(value: float, scale: float) -> float:
+    """``value`` to :data:`RECORD_DIGITS` significant digits of ``scale`` (0.0 for -0.0)."""
+    if not math.isfinite(value) or scale == 0.0:
+        return value
+    return round(value, _decimals(scale)) + 0.0
 
 
 @dataclass
@@ -70,6 +166,9 @@ class BucklingResult:
             N_scaled).
         critical_temperature_K: With a temperature rise in the scaled load: lambda times
             its largest rise over the plate (the uniform rise's critical value).
+        critical_total_temperature_K: With a fixed temperature rise: the largest total
+            rise over the plate at the critical state, the fixed rise (times
+            ``fixed_factor``) plus lambda times the scaled one.
         design: With ``[design]``: the relative slenderness and the reduction factor of
             EN 1993-1-5 from this sigma_cr (:func:`~unibuckle_fenicsx.design.design_output`).
         units: The unit system the summary prints in (the numbers here are SI).
@@ -118,6 +217,7 @@ class BucklingResult:
     edge_loads: dict[str, dict[str, Any]] = field(default_factory=dict)
     critical_load_factor: float | None = None
     critical_temperature_K: float | None = None
+    critical_total_temperature_K: float | None = None
     design: dict[str, Any] | None = None
     units: str = "SI"
     input: dict[str, Any] | None = None
@@ -186,6 +286,7 @@ class BucklingResult:
             },
             critical_load_factor=load,
             critical_temperature_K=_critical_temperature(spec, load),
+            critical_total_temperature_K=_total_temperature(spec, load),
             units=spec.units,
             input=_input(spec),
             versions=versions(),
@@ -348,6 +449,11 @@ class BucklingResult:
         ]
         if load.get("fixed_temperature"):
             fixed.append(f"temperature rise {load['fixed_temperature']} K")
+        if self.critical_total_temperature_K is not None:
+            lines.append(
+                "total temperature rise at the critical state (the fixed rise and lambda "
+                f"times the scaled one): {self.critical_total_temperature_K:.6g} K"
+            )
         if self.design is not None:
             d = self.design
             rho = d["reduction_factor"]
@@ -358,20 +464,32 @@ class BucklingResult:
                     f"{rho:.4g}, rho f_y/gamma_M1 = {d['reduced_design_stress_Pa'] / scale:.4g} "
                     f"{unit}"
                     if rho is not None
-                    else "none (psi < -3)"
+                    else f"none (psi outside {d['table']})"
                 )
-                + " (4.2) calibrated on bilateral plates"
+                + f"; {d['element']} element"
+                + (f" (free edge {d['free_edge']})" if d.get("free_edge") else "")
+                + ", 4.4(2) calibrated on bilateral plates"
             )
         factor = load.get("fixed_factor", 1.0)
         if fixed and factor:
             times = "" if factor == 1.0 else f"{factor:g} x "
             lines.append(f"fixed load (applied as is): {times}{'; '.join(fixed)}")
         reports = self.details.get("point_restraints", [])
+        name = "m" if self.units == "SI" else "mm"
         for p, restraint in zip(reports, self._point_restraints(reports), strict=True):
+            idle = p.get("restraining_nothing", [])
+            shown = ", ".join(f"({x / length:g}, {y / length:g})" for x, y in idle[:3])
             lines.append(
                 f"points: {restraint}: {p['points']} points on {p['nodes']} nodes, "
-                f"largest snap distance {p['max_snap_distance_m'] / length:.3g}"
-                f" {'m' if self.units == 'SI' else 'mm'}"
+                f"largest snap distance {p['max_snap_distance_m'] / length:.3g} {name}"
+                + (
+                    f"; {len(idle)} on a node held already (by an edge support or a "
+                    f"bilateral point), restraining nothing: {shown}"
+                    + (", ..." if len(idle) > 3 else "")
+                    + f" {name}"
+                    if idle
+                    else ""
+                )
             )
         return lines
 
@@ -466,6 +584,24 @@ def _critical_temperature(spec: ProblemSpec, load: float) -> float | None:
     T0, gx, gy = temperature_field(spec.load.temperature)
     rises = [T0 + gx * x + gy * y for x, y in spec.plate.boundary]
     return load * max(rises)
+
+
+def _total_temperature(spec: ProblemSpec, load: float) -> float | None:
+    """With a fixed rise: the largest total rise at the critical state (K), else None.
+
+    ``fixed_factor`` times the fixed field plus lambda times the scaled one: a linear
+    field, largest on a vertex of the boundary.
+    """
+    if not (spec.load.fixed_thermal and spec.load.fixed_factor):
+        return None
+    fixed = temperature_field(spec.load.fixed_temperature)
+    scaled = temperature_field(spec.load.temperature)
+    factor = spec.load.fixed_factor
+    return max(
+        factor * (fixed[0] + fixed[1] * x + fixed[2] * y)
+        + load * (scaled[0] + scaled[1] * x + scaled[2] * y)
+        for x, y in spec.plate.boundary
+    )
 
 
 def _input(spec: ProblemSpec) -> dict[str, Any] | None:

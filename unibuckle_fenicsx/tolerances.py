@@ -23,6 +23,7 @@ __all__ = [
     "BRACKET_GAP",
     "ENERGY_TIE_RTOL",
     "GEOMETRY_RTOL",
+    "KNEE_RTOL",
     "LOAD_TIE_RTOL",
     "NONLINEAR_ATOL",
     "PRESSING_RTOL",
@@ -104,3 +105,9 @@ GEOMETRY_RTOL = 1e-9
 #: SNES absolute tolerance of the von Kármán path, relative to the load vector at the
 #: reference load: the residual of a converged state in double precision, with margin.
 NONLINEAR_ATOL = 1e-11
+#: A load read off the nonlinear path (Southwell, inflection) agrees with a linear load
+#: within this: the knee of the imperfect plate lies within O(delta) of the critical load,
+#: measured 1e-4 at delta/t = 1e-3 and 3e-3 at 1e-2 on the paper's plate; 1 % leaves
+#: a margin for other plates and larger imperfections and still refuses a load that is
+#: another buckling load (the next mode, the free load beside the unilateral one).
+KNEE_RTOL = 1e-2

@@ -9,7 +9,7 @@ Markdown files under ``docs/_generated/`` (not kept in git), which the pages inc
   descriptions) and :func:`unibuckle_fenicsx.spec.accepted_keys`; where the installed
   package does not have them yet, from the loader itself (see :func:`loader_keys`);
 - ``demo_<name>.md``: each demo (a jupytext percent script) as a page, with the figures
-  ``make demo`` stored in ``figures/`` (the build executes no demo);
+  ``make figures`` stored in ``figures/`` (the build executes no demo);
 - ``bench_<name>.md``: a table per file ``bench/results/<name>.jsonl`` (one JSON object a
   line, as the bench scripts' ``--json FILE`` writes them), with the command that
   reproduces it.
@@ -683,7 +683,7 @@ def bench_pages() -> dict[str, str]:
 # --------------------------------------------------------------------------------------
 
 #: Each demo page: its script and the figures it writes (stored in figures/ by
-#: ``make demo``; the pages show them, the build runs nothing).
+#: ``make figures``; the pages show them, the build runs nothing).
 DEMOS = {
     "free_plate": ("demo_free_plate.py", ["free/mode_20x20.png", "free/convergence.png"]),
     "obstacle_c1": (
@@ -759,7 +759,7 @@ DEMOS = {
 def percent_to_myst(source: str) -> str:
     """A jupytext percent script as MyST Markdown: markdown cells as text, code as code.
 
-    Not executed: the demos take minutes (``make demo`` runs them and stores the figures).
+    Not executed: the demos take minutes (``make figures`` runs them and stores the figures).
     """
     cells: list[tuple[str, list[str]]] = []
     lines = source.splitlines()
@@ -820,8 +820,8 @@ def demo_pages() -> dict[str, str]:
                 ":language: text\n```\n"
             )
         text += (
-            f"\n## Figures\n\nWritten by `python demos/{script}` (all demos: `make demo`), "
-            "as stored in the repository's `figures/`:\n\n"
+            f"\n## Figures\n\nWritten by `python demos/{script} --figures figures` (all demos: "
+            "`make figures`), as stored in the repository's `figures/`:\n\n"
         )
         for fig in figures:
             text += f"![{fig}](../../figures/{fig})\n\n"

@@ -16,12 +16,19 @@ cell size) has a snap distance of zero.
 
 Ties (a point equidistant from two nodes) go to the node with the smaller (y, x), so
 the choice does not depend on the partition.
+
+A point whose node is held already restrains nothing: on an edge whose support holds w
+(a mistyped coordinate, or the edge points of a grid), or, for a spring or a one-sided
+point, on a bilateral point's node. :func:`mark_held` finds them; the result's JSON
+(``details.point_restraints[k].restraining_nothing``) and its summary list them.
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, field, replace
+
+from mpi4py import MPI
 
 import dolfinx
 
@@ -33,6 +40,8 @@ from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
     "SnappedPoints",
+    "mark_held",
+    "one_sided_conflicts",
     "point_bcs",
     "point_obstacles",
     "point_springs",
@@ -49,12 +58,22 @@ class SnappedPoints:
         points: The requested points (n, 2) (m).
         nodes: The mesh node each acts on (n, 2) (m), same on all ranks.
         distances: The snap distances (n,) (m).
+        held: Per point, whether its node is held already (:func:`mark_held`): the point
+            restrains nothing; all False until marked.
     """
 
     spec: PointSpec
     points: npt.NDArray[np.float64]
     nodes: npt.NDArray[np.float64]
     distances: npt.NDArray[np.float64]
+    held: npt.NDArray[np.bool_] = field(default_factory=lambda: np.zeros(0, dtype=bool))
+
+    @property
+    def idle_points(self) -> npt.NDArray[np.float64]:
+        """The requested points (k, 2) (m) whose node is held already: they restrain nothing."""
+        if self.held.size != len(self.points):
+            return np.empty((0, 2))
+        return self.points[self.held]
 
     @property
     def unique_nodes(self) -> npt.NDArray[np.float64]:
@@ -69,6 +88,7 @@ class SnappedPoints:
             "points": len(self.points),
             "nodes": len(self.unique_nodes),
             "max_snap_distance_m": float(self.distances.max()),
+            "restraining_nothing": self.idle_points.tolist(),
         }
 
     def matches(self, x: npt.NDArray[np.float64], tol: float) -> npt.NDArray[np.bool_]:
@@ -105,6 +125,69 @@ def snap_points(
         distances = np.array([c[3] for c in chosen], dtype=float)
         distances[distances <= GEOMETRY_RTOL * size] = 0.0  # rounding of coordinates, not a snap
         out.append(SnappedPoints(spec, wanted, nodes, distances))
+    return out
+
+
+def mark_held(
+    Vw: dolfinx.fem.FunctionSpace,
+    w_dofs: npt.NDArray[np.int32],
+    edge_dofs: npt.NDArray[np.int32],
+    snapped: Sequence[SnappedPoints],
+    plate: PlateSpec,
+) -> list[SnappedPoints]:
+    """``snapped`` with ``SnappedPoints.held`` set: the points that restrain nothing.
+
+    A point's node is held when an edge support holds its w (``edge_dofs``: the local W
+    DOFs of the edge conditions; ``w_dofs`` maps Vw's local DOFs to W's); a spring's or a
+    one-sided point's also when a bilateral point holds it (w = 0 there already).
+    Collective; the same on every rank.
+    """
+    comm = Vw.mesh.comm
+    tol = node_tolerance(plate)
+    n_owned = Vw.dofmap.index_map.size_local
+    xy = Vw.tabulate_dof_coordinates()[:n_owned, :2]
+    held_xy = xy[np.isin(w_dofs[:n_owned], edge_dofs)]
+    bilateral = [g.unique_nodes for g in snapped if g.spec.kind == "bilateral"]
+    tied = np.concatenate(bilateral) if bilateral else np.empty((0, 2))
+    out = []
+    for g in snapped:
+        on_edge = np.zeros(len(g.nodes), dtype=np.int8)
+        if len(held_xy):
+            d = np.abs(g.nodes[:, None, :] - held_xy[None, :, :]).max(axis=2)
+            on_edge[:] = (d <= tol).any(axis=1)
+        comm.Allreduce(MPI.IN_PLACE, on_edge, op=MPI.MAX)
+        held = on_edge.astype(bool)
+        if g.spec.kind != "bilateral" and len(tied):
+            held |= (np.abs(g.nodes[:, None, :] - tied[None, :, :]).max(axis=2) <= tol).any(axis=1)
+        out.append(replace(g, held=held))
+    return out
+
+
+def one_sided_conflicts(
+    snapped: Sequence[SnappedPoints], obstacles: Sequence[ObstacleSpec], plate: PlateSpec
+) -> list[int]:
+    """Indices of the one-sided points with a node held from the other side too.
+
+    The other side: an obstacle zone of the other ``side``, or a one-sided point of the
+    other side on the same node (together they hold w = 0 there). Serial (the snapped
+    nodes are the same on every rank).
+    """
+    tol = node_tolerance(plate)
+    size = max(plate.length, plate.width)
+    out = []
+    for k, g in enumerate(snapped):
+        if g.spec.kind != "one-sided":
+            continue
+        nodes = g.unique_nodes
+        x = np.vstack([nodes.T, np.zeros(len(nodes))])
+        clash = any(
+            o.side not in (g.spec.side, "both") and o.contains(x, size).any() for o in obstacles
+        )
+        for other in snapped:
+            if other.spec.kind == "one-sided" and other.spec.side != g.spec.side:
+                clash = clash or bool(other.matches(x, tol).any())
+        if clash:
+            out.append(k)
     return out
 
 

@@ -411,8 +411,8 @@ def _refuse_tension(
         raise InputError(
             "the load puts the plate in tension everywhere (largest compressive membrane "
             f"force {compression:.3g} N/m against tension {tension:.3g} N/m{noise}): no "
-            "buckling under a positive load; reverse the sign of normal_stress"
-            + (" or of the temperature rise" if thermal else "")
+            "buckling under a positive load; reverse the sign of the edges' normal_stress"
+            + (" or of load.temperature (a negative rise, a cooling)" if thermal else "")
         )
 
 

@@ -55,9 +55,9 @@ from unibuckle_fenicsx.model.contact import (
 from unibuckle_fenicsx.model.materials import reference_bending_stiffness
 from unibuckle_fenicsx.model.mesh import build_plate_mesh, check_user_mesh
 from unibuckle_fenicsx.model.plate.model import PlateModel
-from unibuckle_fenicsx.model.points import point_obstacles
+from unibuckle_fenicsx.model.points import one_sided_conflicts, point_obstacles
 from unibuckle_fenicsx.model.prestress import solve_prestress
-from unibuckle_fenicsx.spec import ProblemSpec
+from unibuckle_fenicsx.spec import ProblemSpec, temperature_field
 from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
 __all__ = ["BYTES_PER_DOF", "BucklingProblem", "Candidate", "Mode", "available_memory"]
@@ -126,6 +126,25 @@ def _check_memory(spec: ProblemSpec, comm: MPI.Comm) -> None:
             f"({BYTES_PER_DOF / 1000:.0f} kB per DOF), more than the {have / 1e9:.3g} GB "
             "available: use a coarser mesh or more machines"
         )
+
+
+def _cooling_hint(spec: ProblemSpec) -> str:
+    """A clause naming ``load.temperature`` when the scaled rise cools the plate, or ""."""
+    if not spec.load.thermal:
+        return ""
+    T0, gx, gy = temperature_field(spec.load.temperature)
+    if max(T0 + gx * x + gy * y for x, y in spec.plate.boundary) > 0.0:
+        return ""
+    return (
+        f"; load.temperature = {spec.load.temperature!r} K per unit load is a cooling "
+        "(no rise > 0 anywhere): it puts a plate held in its plane in tension, which no "
+        "positive load factor buckles; give a rise (load.temperature > 0)"
+    )
+
+
+def _points_label(spec: ProblemSpec, indices: list[int]) -> str:
+    """``points[k] (what)`` for each index, for messages, in the file's units."""
+    return ", ".join(f"points[{k}] ({spec.points[k].describe(spec.units)})" for k in indices)
 
 
 @dataclass(frozen=True)
@@ -331,8 +350,9 @@ class BucklingProblem(Owner):
         except EmptyZoneError as err:
             if not spec.one_sided_points:
                 raise
+            one_sided = [k for k, p in enumerate(spec.points) if p.kind == "one-sided"]
             raise EmptyZoneError(
-                "points: the one-sided points"
+                f"{_points_label(spec, one_sided)}: the one-sided points"
                 + (" and the obstacle zones" if spec.unilateral_obstacles else "")
                 + " act on no free node: each such node is held already (by an edge "
                 "support or a bilateral point), so the point restrains nothing; move it off "
@@ -341,9 +361,11 @@ class BucklingProblem(Owner):
         except BilateralZoneError as err:
             if not spec.one_sided_points:
                 raise
+            clash = one_sided_conflicts(self.model.points, spec.unilateral_obstacles, spec.plate)
             raise BilateralZoneError(
-                "points: a one-sided point acts on a node held from the other side too (an "
-                'obstacle zone or another point): that holds w = 0, give it kind = "bilateral"'
+                f"{_points_label(spec, clash) if clash else 'points'}: a one-sided point acts "
+                "on a node held from the other side too (an obstacle zone or another point): "
+                'that holds w = 0, give it kind = "bilateral"'
             ) from err
         self.free: Mode | None = None
         #: Why the free pair is the smallest, if its solve proved it (:meth:`solve_free`).
@@ -444,7 +466,7 @@ class BucklingProblem(Owner):
         eigenvalues on a mesh :data:`FREE_ESTIMATE_COARSENING` times coarser set the
         eigen solve's shift, and the inertia of its one factorisation proves the pair the
         smallest (:meth:`~unibuckle_fenicsx.eigen.GEPSolver.smallest`;
-        :attr:`free_proof`). Otherwise (or if no shift proves it) the solve runs at
+        ``free_proof``). Otherwise (or if no shift proves it) the solve runs at
         target 0 and :meth:`verify_free` checks the pair when it matters.
 
         Note:
@@ -461,7 +483,7 @@ class BucklingProblem(Owner):
                     "the plate has no positive buckling load on this mesh: the geometric "
                     "stiffness b(w, w) is nowhere positive on the free deflections (edge "
                     "loads in tension, or the supports fix every deflection DOF); check the "
-                    "edge loads, refine the mesh or free an edge"
+                    "edge loads, refine the mesh or free an edge" + _cooling_hint(self.spec)
                 )
             u.x.petsc_vec.scale(1.0 / self.max_abs_w(u.x.petsc_vec))
             u.x.scatter_forward()
@@ -512,7 +534,7 @@ class BucklingProblem(Owner):
         of :math:`A - \sigma B`, :math:`\sigma` just below :math:`\lambda_{free}` (one
         :math:`LDL^T` through the shared factorisation), counts the eigenvalues in
         :math:`(0, \sigma)` (Sylvester's law, A SPD): there must be none. A free pair
-        that its shifted solve proved the smallest (:attr:`free_proof`) needs nothing
+        that its shifted solve proved the smallest (``free_proof``) needs nothing
         more.
 
         Raises:

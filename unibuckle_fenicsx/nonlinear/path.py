@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 from typing import Any
 
 from mpi4py import MPI
@@ -46,6 +46,7 @@ from unibuckle_fenicsx.nonlinear.model import (
     VonKarmanPlate,
     displacement_axis,
 )
+from unibuckle_fenicsx.nonlinear.verdict import judge
 from unibuckle_fenicsx.progress import LOGGER
 from unibuckle_fenicsx.results import versions
 from unibuckle_fenicsx.spec import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
@@ -177,6 +178,12 @@ class NonlinearResult:
         constrained_nodes: Zone nodes with w <= g imposed (g the obstacle's gap).
         contact_load_Pa: The load of the first state on the path with a node on the
             obstacle (None if none): with a gap, where the plate reaches the obstacle.
+        gapped: An obstacle with a gap was imposed: the linear load is the free plate's
+            (the linear state leaves the gapped obstacle out), and the knee lies between
+            it and ``unilateral_load_Pa`` (:mod:`~unibuckle_fenicsx.nonlinear.verdict`).
+        unilateral_load_Pa: With ``gapped``: the linear unilateral critical load with the
+            gaps closed (same mesh); None otherwise, or if that solve failed.
+        verdict: The verdict in words (:func:`~unibuckle_fenicsx.nonlinear.verdict.judge`).
         contact_check: The contact conditions at the last state (see
             :func:`contact_check`).
         options: The options used.
@@ -212,6 +219,9 @@ class NonlinearResult:
     options: dict[str, Any]
     wall_time_s: float
     contact_load_Pa: float | None = None
+    gapped: bool = False
+    unilateral_load_Pa: float | None = None
+    verdict: str = ""
     timings: dict[str, float] = field(default_factory=dict)
     mpi_size: int = 1
     units: str = "SI"
@@ -219,34 +229,43 @@ class NonlinearResult:
 
     @property
     def ok(self) -> bool:
-        """The path is complete, both loads were read off it, the contact holds."""
-        return (
-            self.completed
-            and self.southwell_load_Pa is not None
-            and self.inflection_load_Pa is not None
-            and bool(self.contact_check.get("satisfied", True))
-        )
+        """The path is complete, both loads were read off it and agree, the contact holds.
+
+        Agree: within :data:`~unibuckle_fenicsx.tolerances.KNEE_RTOL` of the linear load;
+        with a gap, between the free load and the unilateral one with the gaps closed
+        (:func:`~unibuckle_fenicsx.nonlinear.verdict.judge`).
+        """
+        return judge(self).ok
 
     def as_dict(self) -> dict[str, Any]:
         """JSON-ready mapping."""
         return asdict(self)
 
     def summary(self) -> str:
-        """Two lines for the terminal."""
+        """Lines for the terminal: the loads, the path, the verdict."""
         scale, unit = UNITS[self.units][1:]
 
         def load(value: float | None, ratio: float | None) -> str:
             if value is None or ratio is None:
                 return "not found"
-            return f"{value / scale:.6e} {unit} ({ratio:.4f} x linear)"
+            return f"{value / scale:.6e} {unit} ({ratio:.4f} x {reference})"
 
+        gap = self.obstacle and self.gapped
+        reference = "free" if gap else "linear"
         last = self.path[-1]
         where = "with obstacle" if self.obstacle else "without obstacle"
+        linear = f"linear {self.linear_critical_load_Pa / scale:.6e} {unit}"
+        if gap:
+            closed = self.unilateral_load_Pa
+            linear = (
+                f"linear: free {self.linear_critical_load_Pa / scale:.6e} {unit} (the gapped "
+                "obstacle left out), unilateral with the gaps closed "
+                + ("not computed" if closed is None else f"{closed / scale:.6e} {unit}")
+            )
         return (
             f"{self.case} ({where}, delta/t = {self.imperfection:g}, {self.control} control): "
             f"Southwell {load(self.southwell_load_Pa, self.southwell_ratio)}, inflection "
-            f"{load(self.inflection_load_Pa, self.inflection_ratio)}; linear "
-            f"{self.linear_critical_load_Pa / scale:.6e} {unit}\n"
+            f"{load(self.inflection_load_Pa, self.inflection_ratio)}; {linear}\n"
             f"  path: {len(self.path) - 1} steps ({self.rejected_steps} rejected) to "
             f"lambda = {last['load_Pa'] / scale:.6e} {unit}, max|w|/t = "
             f"{last['max_w_m'] / self.thickness_m:.4g}, {last['contact_nodes']} contact "
@@ -254,10 +273,11 @@ class NonlinearResult:
             + (
                 f"\n  the plate reaches the obstacle at lambda = "
                 f"{self.contact_load_Pa / scale:.6e} {unit} "
-                f"({self.contact_load_Pa / self.linear_critical_load_Pa:.4f} x linear)"
+                f"({self.contact_load_Pa / self.linear_critical_load_Pa:.4f} x {reference})"
                 if self.contact_load_Pa is not None and self.obstacle
                 else ""
             )
+            + f"\n  {judge(self).summary(self)}"
         )
 
 
@@ -509,8 +529,14 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
     if obstacle:
         how += ", KKT" if certificate.get("kkt") else ", NOT certified"
     label = f"{spec.name} delta/t={options.imperfection:g}"
+    gapped = obstacle and bool(spec.gapped_obstacles)
     plate = None
+    closed: float | None = None
     try:
+        if gapped:
+            t1 = time.perf_counter()
+            closed = _gaps_closed_load(spec, linear)
+            timings["gaps_closed_s"] = time.perf_counter() - t1
         t1 = time.perf_counter()
         plate = VonKarmanPlate(
             spec,
@@ -572,6 +598,8 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
         rejected_steps=rejected,
         constrained_nodes=0 if plate.contact is None else plate.contact.size,
         contact_load_Pa=next((q.load_Pa for q in path if q.contact_nodes), None),
+        gapped=gapped,
+        unilateral_load_Pa=closed,
         contact_check=check,
         options={**asdict(options), "degree": degree},
         wall_time_s=time.perf_counter() - t0,
@@ -580,4 +608,27 @@ def solve_nonlinear(  # noqa: C901 - linear solve, plate, imperfection and path 
         units=spec.units,
         versions=versions(),
     )
+    nl.verdict = judge(nl).summary(nl)
     return NonlinearAnalysis(nl, plate, linear, owns_linear)
+
+
+def _gaps_closed_load(spec: ProblemSpec, linear: Analysis) -> float | None:
+    """The linear unilateral critical load with every gap closed (g = 0), same mesh.
+
+    The upper end of where the knee of a plate with a gapped obstacle lies; None when
+    that solve finds no certified state (the verdict then says it is unknown). Collective.
+    """
+    closed = replace(
+        spec,
+        obstacle=None if spec.obstacle is None else replace(spec.obstacle, gap=0.0),
+        obstacles=tuple(replace(o, gap=0.0) for o in spec.obstacles),
+    )
+    problem = linear.problem
+    try:
+        with solve_linear(
+            closed, problem.comm, mesh=problem.mesh, facet_tags=problem.facet_tags
+        ) as analysis:
+            return analysis.result.critical_load_Pa
+    except NumericalError as err:
+        logger.warning("%s: the unilateral load with the gaps closed: %s", spec.name, err)
+        return None

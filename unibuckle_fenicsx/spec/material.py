@@ -14,6 +14,9 @@ from unibuckle_fenicsx.spec.values import (
     _number,
 )
 
+#: The largest fibre angle magnitude accepted (degrees): one turn.
+MAX_PLY_ANGLE = 360.0
+
 
 @dataclass(frozen=True)
 class Ply:
@@ -21,7 +24,9 @@ class Ply:
 
     Args:
         thickness: Ply thickness (m), > 0.
-        angle: Fibre angle from the x axis, counter-clockwise (degrees).
+        angle: Fibre angle from the x axis, counter-clockwise (degrees), in [-360, 360]:
+            one turn either way covers every angle; a larger value is a typing error (a
+            ply at 1e300 degrees has no meaningful cosine).
         E1: Young's modulus along the fibres (Pa), > 0.
         E2: Young's modulus across the fibres (Pa), > 0.
         G12: In-plane shear modulus (Pa), > 0.
@@ -49,6 +54,11 @@ class Ply:
             object.__setattr__(self, name, value)
         for name in ("angle", "nu12"):
             object.__setattr__(self, name, _number(f"material.plies.{name}", getattr(self, name)))
+        if not abs(self.angle) <= MAX_PLY_ANGLE:
+            raise InputError(
+                f"material.plies.angle must lie in [-{MAX_PLY_ANGLE:g}, {MAX_PLY_ANGLE:g}] "
+                f"degrees, got {self.angle!r}"
+            )
         if not abs(self.nu12) < math.sqrt(self.E1 / self.E2):
             raise InputError(
                 f"material.plies.nu12 must satisfy |nu12| < sqrt(E1/E2) = "

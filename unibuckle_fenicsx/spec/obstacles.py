@@ -246,7 +246,10 @@ class PointSpec:
             obstacle's cone at the point: w <= 0 with ``side`` "above", w >= 0
             "below"), "spring" (a spring of ``stiffness`` N/m to w = 0).
         stiffness: The spring's stiffness (N/m), > 0, for ``kind = "spring"`` only.
-        side: "above" or "below", for ``kind = "one-sided"`` only.
+        side: "above" (w <= 0 at the point) or "below" (w >= 0), for ``kind =
+            "one-sided"`` only, where it is required: the side decides which half of the
+            plate's deflections the point forbids, and no default is sound for both a
+            stud under the plate and a bolt head over it.
     """
 
     at: tuple[float, float] | None = None
@@ -255,7 +258,7 @@ class PointSpec:
     region: Box | None = None
     kind: str = "bilateral"
     stiffness: float | None = None
-    side: str = "above"
+    side: str | None = None
 
     def __post_init__(self) -> None:
         where = "points"
@@ -291,14 +294,20 @@ class PointSpec:
             object.__setattr__(self, "stiffness", float(self.stiffness))
         elif self.stiffness is not None:
             raise InputError(f'{where}.stiffness belongs to kind = "spring", not "{self.kind}"')
-        _choice(f"{where}.side", self.side, ("above", "below"))
-        if self.side != "above" and self.kind != "one-sided":
-            raise InputError(f'{where}.side belongs to kind = "one-sided", not "{self.kind}"')
+        if self.kind == "one-sided" and self.side is None:
+            raise InputError(
+                f'{where}.side: kind = "one-sided" needs side = "above" (the point holds the '
+                'plate from above: w <= 0) or "below" (from below: w >= 0)'
+            )
+        if self.side is not None:
+            _choice(f"{where}.side", self.side, ("above", "below"))
+            if self.kind != "one-sided":
+                raise InputError(f'{where}.side belongs to kind = "one-sided", not "{self.kind}"')
 
     @property
     def sign(self) -> float:
-        """+1 for a one-sided point above (w <= 0 admissible), -1 below."""
-        return 1.0 if self.side == "above" else -1.0
+        """+1 for a one-sided point above (w <= 0 admissible), -1 below, 0 for other kinds."""
+        return {"above": 1.0, "below": -1.0}.get(self.side or "", 0.0)
 
     def locations(self, plate: PlateSpec) -> npt.NDArray[np.float64]:
         """The points (n, 2) (m): ``at``, or the grid's points inside the plate.

@@ -7,7 +7,7 @@ from dataclasses import dataclass, field, replace
 from typing import Any
 
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.spec.checks import check_features, check_supports
+from unibuckle_fenicsx.spec.checks import check_features, check_supports, design_element
 from unibuckle_fenicsx.spec.material import Material
 from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
 from unibuckle_fenicsx.spec.plate import (
@@ -233,7 +233,11 @@ class ProblemSpec:
                 )
 
     def _check_design(self) -> None:
-        """The design output needs a compressive normal edge stress (its sigma_cr)."""
+        """The design output needs a compressive normal edge stress (its sigma_cr).
+
+        And a plate that EN 1993-1-5 4.4 describes: an internal or an outstand element
+        (:func:`~unibuckle_fenicsx.spec.checks.design_element` says which, or refuses).
+        """
         if self.design is None:
             return
         if not isinstance(self.design, DesignSpec):
@@ -247,6 +251,7 @@ class ProblemSpec:
                 "design: the EN 1993-1-5 output takes sigma_cr as a compressive normal edge "
                 "stress, and this load has none (give a loaded edge normal_stress < 0)"
             )
+        design_element(self)
 
     def check_scaled_load(self) -> None:
         """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""

@@ -88,7 +88,7 @@ class PlyTable(_Table, frozen=True):
     """``[[material.plies]]``: one orthotropic ply, bottom first."""
 
     thickness: Positive
-    angle: float
+    angle: Annotated[float, Meta(ge=-360.0, le=360.0)]
     E1: Positive
     E2: Positive
     G12: Positive

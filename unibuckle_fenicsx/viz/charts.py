@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from unibuckle_fenicsx.results import rounded
 from unibuckle_fenicsx.spec import EDGE_NAMES, UNITS, ProblemSpec
 from unibuckle_fenicsx.sweep import Variation, point_problem
 
@@ -188,8 +189,9 @@ def plot_sweep(
         x = np.array(
             [abscissa(s, m["point"][first.path]) for s, m in zip(specs, solved, strict=True)]
         )
-        k = np.array([m["buckling_coefficient_k"] for m in solved], dtype=float)
-        k_free = k * np.array([m["free_load_Pa"] / m["critical_load_Pa"] for m in solved])
+        # The records' digits (results.rounded): the same picture on every machine.
+        k = rounded([m["buckling_coefficient_k"] for m in solved])
+        k_free = rounded(k * np.array([m["free_load_Pa"] / m["critical_load_Pa"] for m in solved]))
         order = np.argsort(x)
         ax.plot(x[order], k_free[order], "-", color=colour, lw=1.0, marker=".",
                 label=f"bilateral{suffix}")  # fmt: skip

@@ -30,6 +30,7 @@ from typing import TYPE_CHECKING, Any
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.results import rounded
 from unibuckle_fenicsx.viz.fields import problem_zone
 
 if TYPE_CHECKING:  # pragma: no cover
@@ -365,6 +366,11 @@ def plot_section(
     """
     plt = _pyplot()
     path = _prepare(path)
+    # At the records' digits: the same picture on every machine (results.rounded).
+    x_free, w_free, x_unilateral, w_unilateral = map(
+        rounded, (x_free, w_free, x_unilateral, w_unilateral)
+    )
+    extra = [(rounded(xe), rounded(we), label) for xe, we, label in extra]
     fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
     ax.axhline(0.0, color="lightgray", lw=1.0, zorder=0)
     ax.plot(x_free, w_free, "-o", ms=3.5, color=THEME["free_color"], label=labels[0])
@@ -523,7 +529,7 @@ def plot_contact_set(
     """
     plt = _pyplot()
     path = _prepare(path)
-    xy = np.asarray(xy, dtype=float)
+    xy, w = rounded(xy), rounded(w)  # the records' digits: the same picture on any machine
     fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
     _mode_bands(fig, ax, xy, w, tau)
     if zone is not None:
@@ -727,7 +733,7 @@ def plot_convergence(
     for k, (label, rows) in enumerate(studies.items()):
         rows = sorted(rows)
         nx = np.array([r[0] for r in rows], dtype=float)
-        lam = np.array([r[2] for r in rows], dtype=float)
+        lam = rounded([r[2] for r in rows])  # the records' digits: the same on every machine
         ax0.plot(nx, lam / 1e6, "-", label=label, **style[k])
         if len(rows) >= 2:
             diff = np.abs(lam[:-1] - lam[-1]) / lam[-1]

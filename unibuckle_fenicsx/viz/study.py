@@ -28,7 +28,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.analysis import Analysis, solve
 from unibuckle_fenicsx.io import write_fields
-from unibuckle_fenicsx.results import BucklingResult
+from unibuckle_fenicsx.results import BucklingResult, record
 from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.viz import fields, plotting
 
@@ -149,16 +149,15 @@ class MeshStudy:
         )
 
     def write_json(self, path: Path, **extra: Any) -> Path:
-        """``{"case", "results": [...], **extra}`` as JSON, without wall times (rank 0).
+        """``{"case", "results": [...], **extra}`` as a record (:func:`write_record`, rank 0).
 
-        The file is the same on every run of the same problem, so that it can be kept
-        under version control (the figures directory); the times are printed instead.
+        The file is the same on every run of the same problem, on any machine (up to a
+        last digit that lies at a rounding boundary), so that it can be kept under
+        version control (the figures directory); the times and eigen-solve counts are
+        printed instead.
         """
-        path.parent.mkdir(parents=True, exist_ok=True)
         results = [r.as_dict(timings=False) for r in self.results]
-        summary = {"case": self.name, **extra, "results": results}
-        path.write_text(json.dumps(summary, indent=2) + "\n")
-        return path
+        return write_record(path, {"case": self.name, **extra, "results": results})
 
     def finish(
         self,
@@ -191,6 +190,30 @@ class MeshStudy:
             section_A={"x": x.tolist(), "w": w.tolist()},
             **extra,
         )
+
+
+def write_record(path: Path, data: Any, *, contact: bool = True) -> Path:
+    """Write ``data`` at ``path`` as a record (:func:`~unibuckle_fenicsx.results.record`).
+
+    A record is the same on every machine (eight significant digits, no times or
+    eigen-solve counts), so that it can be kept under version control and compared
+    between runs. Call it on one rank.
+
+    Args:
+        path: A ``.json`` file (``data`` indented), or a ``.jsonl`` file (``data`` a
+            sequence of mappings, one line each, as :func:`~unibuckle_fenicsx.sweep.run_sweep`
+            writes them).
+        data: A JSON value (``BucklingResult.as_dict()``, a sweep's lines, a summary).
+        contact: Keep the contact sets; ``False`` on thin plates, where nodes flat on the
+            obstacle with no contact force fall in or out of the set with rounding.
+    """
+    path.parent.mkdir(parents=True, exist_ok=True)
+    if path.suffix == ".jsonl":
+        text = "".join(json.dumps(record(line, contact=contact)) + "\n" for line in data)
+    else:
+        text = json.dumps(record(data, contact=contact), indent=2) + "\n"
+    path.write_text(text)
+    return path
 
 
 def mesh_study(
@@ -302,7 +325,12 @@ def demo_arguments(description: str) -> argparse.Namespace:
         default=os.environ.get("UNIBUCKLE_DEMO_COARSE") == "1",
         help="tiny meshes (for the tests)",
     )
-    parser.add_argument("--figures", type=Path, default=Path("figures"), help="PNG directory")
+    parser.add_argument(
+        "--figures",
+        type=Path,
+        default=Path("output") / "figures",
+        help="the figures' directory (the repository keeps its own in figures/)",
+    )
     parser.add_argument("--output", type=Path, default=None, help="VTX (ParaView) directory")
     args, _ = parser.parse_known_args()
     return args

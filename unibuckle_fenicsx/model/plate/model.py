@@ -29,7 +29,7 @@ from unibuckle_fenicsx.model.plate.spaces import (
     create_shear_space,
     mitc_shear_operator,
 )
-from unibuckle_fenicsx.model.points import point_bcs, point_springs, snap_points
+from unibuckle_fenicsx.model.points import mark_held, point_bcs, point_springs, snap_points
 from unibuckle_fenicsx.model.prestress import Prestress, material_constant
 from unibuckle_fenicsx.spec import Material, PlateSpec, PointSpec
 
@@ -84,9 +84,17 @@ class PlateModel(MixedDofs, Owner):
         self.W = create_plate_space(msh)
         self.Vw, map_w = self.W.sub(0).collapse()
         self.w_dofs = np.asarray(map_w[0], dtype=np.int32)  # Vw local dof -> W local dof
-        #: The point restraints on the mesh (snapped to nodes).
-        self.points = snap_points(self.Vw, plate, points)
-        self.bcs = self._edge_bcs(facet_tags) + point_bcs(self.W, self.Vw, self.points, plate)
+        edge_bcs = self._edge_bcs(facet_tags)
+        edge_dofs = [bc.dof_indices()[0] for bc in edge_bcs] or [np.empty(0, np.int32)]
+        #: The point restraints on the mesh (snapped to nodes; those on held nodes marked).
+        self.points = mark_held(
+            self.Vw,
+            self.w_dofs,
+            np.concatenate(edge_dofs),
+            snap_points(self.Vw, plate, points),
+            plate,
+        )
+        self.bcs = edge_bcs + point_bcs(self.W, self.Vw, self.points, plate)
         self.bc_dofs = np.unique(
             np.concatenate([bc.dof_indices()[0] for bc in self.bcs] or [np.empty(0, np.int32)])
         ).astype(np.int32)
