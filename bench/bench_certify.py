@@ -20,7 +20,7 @@ from mpi4py import MPI
 from _results import append_rows
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import paper_case
+from unibuckle_fenicsx.spec.cases import paper_case
 
 #: The JSON keys of a row, in the table's order.
 JSON_KEYS = (

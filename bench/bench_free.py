@@ -47,9 +47,9 @@ from slepc4py import SLEPc
 from _results import append_rows, print_header
 from bench_plates import _spec
 
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import problem_to_dict
+from unibuckle_fenicsx.spec.cases import paper_case
 
 #: The plates of the floor: the paper's, and the thin plate 0.3 x 0.1 x 1e-4 m (SSSS,
 #: bench_plates.py's) without its obstacle.

@@ -25,18 +25,18 @@ from __future__ import annotations
 
 import argparse
 import math
-from dataclasses import replace
 
 from mpi4py import MPI
 
 import numpy as np
 from _results import append_rows, print_header
+from msgspec.structs import replace
 
 import unibuckle_fenicsx.model.problem as problem_module
-from unibuckle_fenicsx.cases import LOADS, plate_case
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import PlateSpec
+from unibuckle_fenicsx.spec.cases import LOADS, plate_case
 
 SUPPORTS = ("simply_supported", "clamped", "simply_supported_soft")
 SHORT = {"simply_supported": "S", "clamped": "C", "simply_supported_soft": "s"}

@@ -44,17 +44,17 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import replace
 from pathlib import Path
 
 from mpi4py import MPI
 
 from _results import append_rows, print_header
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.certify import Certificate
 from unibuckle_fenicsx.spec import ObstacleSpec, problem_to_dict
+from unibuckle_fenicsx.spec.cases import plate_case
 
 #: name -> (edge supports, load, description of the edges)
 CASES = {

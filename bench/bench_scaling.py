@@ -36,7 +36,7 @@ def worker(case: str, nx: int, ny: int, method: str) -> None:
     from mpi4py import MPI
 
     from unibuckle_fenicsx.analysis import solve
-    from unibuckle_fenicsx.cases import paper_case
+    from unibuckle_fenicsx.spec.cases import paper_case
 
     comm = MPI.COMM_WORLD
     spec = paper_case(case, nx, ny)

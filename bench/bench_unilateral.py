@@ -22,8 +22,8 @@ from mpi4py import MPI
 from _results import append_rows
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec.cases import paper_case
 
 
 def main() -> None:

@@ -40,10 +40,18 @@ def nothing_built(monkeypatch):
     import unibuckle_fenicsx.model.problem
     import unibuckle_fenicsx.nonlinear
 
+    # Modules that bind analysis.solve when imported: imported here, before it is
+    # replaced (imported while it is, they would keep the replacement for the session's
+    # later tests), and their names replaced for this test only.
+    import unibuckle_fenicsx.nonlinear.path
+    import unibuckle_fenicsx.viz.study
+
     def refuse(*args, **kwargs):
         raise AssertionError("work started before the input was refused")
 
     monkeypatch.setattr(unibuckle_fenicsx.analysis, "solve", refuse)
+    monkeypatch.setattr(unibuckle_fenicsx.nonlinear.path, "solve_linear", refuse)
+    monkeypatch.setattr(unibuckle_fenicsx.viz.study, "solve", refuse)
     monkeypatch.setattr(unibuckle_fenicsx.model.problem, "build_plate_mesh", refuse)
     monkeypatch.setattr(unibuckle_fenicsx.nonlinear, "solve_nonlinear", refuse)
 

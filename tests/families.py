@@ -240,7 +240,7 @@ def long_plate_family(count: int, seed: int = 20261207, max_constrained: int = 1
     (above or below). Each item is (spec, i). Whether two or more pencil eigenvalues lie
     below the critical load is for the caller to check (it depends on the solution).
     """
-    from unibuckle_fenicsx.cases import plate_case
+    from unibuckle_fenicsx.spec.cases import plate_case
 
     rng = np.random.default_rng(seed)
     found = []

@@ -43,10 +43,10 @@ from unibuckle_fenicsx.algorithms.active_set import (
 )
 from unibuckle_fenicsx.algorithms.multilevel import prolong, prolong_contact_set
 from unibuckle_fenicsx.algorithms.pdas import iterate
-from unibuckle_fenicsx.cases import paper_case, plate_case
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import ObstacleSpec, ProblemSpec
+from unibuckle_fenicsx.spec.cases import paper_case, plate_case
 
 HERE = Path(__file__).resolve().parent
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")

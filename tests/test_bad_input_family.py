@@ -439,7 +439,7 @@ def test_bad_values_family(tmp_path, capsys, nothing_built, label, cases):
 
 def test_every_key_is_in_the_family():
     """The bases hold every key of the schema (a new key must join them); the counts."""
-    from dataclasses import fields
+    from msgspec.structs import fields
 
     from unibuckle_fenicsx.spec import (
         OBSTACLE_KEYS,

@@ -18,10 +18,10 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 from exhaustive import exhaustive_minimum
+from msgspec import structs
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certificate.certify import certify, reduced_inertia
 from unibuckle_fenicsx.certificate.copositivity import copositivity_bound
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
@@ -35,6 +35,7 @@ from unibuckle_fenicsx.spec import (
     ProblemSpec,
     SolverSpec,
 )
+from unibuckle_fenicsx.spec.cases import paper_case
 from unibuckle_fenicsx.tolerances import PROOF_GAP
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
@@ -171,7 +172,7 @@ def test_inactive_obstacle_is_proven():
     The free mode is admissible, so its load is an upper bound, and interlacing makes it
     a lower bound too.
     """
-    spec = replace(
+    spec = structs.replace(
         paper_case("c1", 20, 20), obstacle=ObstacleSpec(zone=((0.02, 0.08), (-0.03, 0.03)))
     )
     with solve(spec) as analysis:
@@ -190,7 +191,7 @@ def test_inactive_obstacle_is_proven():
 @pytest.mark.parametrize("zone", [((-0.02, 0.06), (-0.03, 0.03)), ((-0.05, 0.03), (-0.05, 0.02))])
 def test_off_centre_zone_is_proven_by_the_search(zone):
     """No mirror symmetry: w- comes from the search in the other nappe."""
-    spec = replace(paper_case("c1", 20, 20), obstacle=ObstacleSpec(zone=zone))
+    spec = structs.replace(paper_case("c1", 20, 20), obstacle=ObstacleSpec(zone=zone))
     with solve(spec.with_solver(method="active-set")) as analysis:
         cert = analysis.certificate
     assert cert.global_optimum_proven, cert

@@ -203,8 +203,8 @@ def test_negative_numbers_in_exponent_form_are_values(value, capsys):
 
 def test_set_changes_the_value_at_its_dotted_path():
     """--set PATH=VALUE changes that value of the problem, read as the kind found there."""
-    from unibuckle_fenicsx.cases import paper_case
     from unibuckle_fenicsx.cli import _spec_from_args
+    from unibuckle_fenicsx.spec.cases import paper_case
 
     parser, _ = _parser()
     args = parser.parse_args(

@@ -15,12 +15,11 @@ Expected values are not taken from the code that writes them:
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 from mpi4py import MPI
 
 import numpy as np
 import pytest
+from msgspec.structs import replace
 
 from unibuckle_fenicsx import paper_case, solve
 from unibuckle_fenicsx.io import write_fields

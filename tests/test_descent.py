@@ -32,10 +32,10 @@ from test_stress_family import FAMILY, _reference
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.descent import _Gradient, admissible_start, descend
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import ObstacleSpec, problem_to_dict
+from unibuckle_fenicsx.spec.cases import plate_case
 
 HERE = Path(__file__).resolve().parent
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")

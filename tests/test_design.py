@@ -83,7 +83,7 @@ def test_design_keys_are_read_converted_and_written_back():
     [
         ({"yield_stress": 0.0}, {}, r"design\.yield_stress must be > 0 Pa"),
         ({"yield_stress": 355.0, "partial_factor": -1}, {}, r"design\.partial_factor must be > 0"),
-        ({"partial_factor": 1.0}, {}, r"\[design\] needs yield_stress"),
+        ({"partial_factor": 1.0}, {}, r"\[design\] needs 'yield_stress'"),
         ({"yield_stress": 355.0, "gamma": 1.0}, {}, r"unknown key\(s\) \['gamma'\] in \[design\]"),
     ],
 )

@@ -16,7 +16,6 @@ import json
 import math
 import subprocess
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 from mpi4py import MPI
@@ -24,14 +23,15 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 from conftest import ROOT, run_mpi
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import ObstacleSpec, ProblemSpec
+from unibuckle_fenicsx.spec.cases import paper_case
 from unibuckle_fenicsx.tolerances import LOAD_TIE_RTOL
 
 RTOL = 1e-9

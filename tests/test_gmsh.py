@@ -11,12 +11,12 @@ from __future__ import annotations
 
 import json
 import sys
-from dataclasses import replace
 
 from mpi4py import MPI
 
 import numpy as np
 import pytest
+from msgspec.structs import replace
 
 gmsh = pytest.importorskip("gmsh")
 
@@ -24,7 +24,6 @@ from rm_triangles import holed_plate_load, navier_check  # noqa: E402
 
 from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_unilateral  # noqa: E402
 from unibuckle_fenicsx.analysis import solve  # noqa: E402
-from unibuckle_fenicsx.cases import paper_case  # noqa: E402
 from unibuckle_fenicsx.cli import main as cli_main  # noqa: E402
 from unibuckle_fenicsx.model.gmsh_mesh import GMSH_OPTIONS  # noqa: E402
 from unibuckle_fenicsx.model.materials import navier_load_mindlin  # noqa: E402
@@ -37,6 +36,7 @@ from unibuckle_fenicsx.spec import (  # noqa: E402
     problem_from_dict,
     problem_to_dict,
 )
+from unibuckle_fenicsx.spec.cases import paper_case  # noqa: E402
 
 #: The paper's plate as an outline: segment 0 bottom, 1 right, 2 top, 3 left.
 PAPER_OUTLINE = [[-0.1, -0.05], [0.1, -0.05], [0.1, 0.05], [-0.1, 0.05]]
@@ -563,7 +563,7 @@ def test_thin_holed_plate_is_nested_over_gmsh_meshes():
         "obstacle": {"zone": "all", "side": "below"},
     }
     loads, meshes = [], []
-    for options in (ChainOptions(), ChainOptions(coarse_min_cells=10**6)):
+    for options in (ChainOptions(), ChainOptions(explore_min_cells=10**6)):
         with BucklingProblem(problem_from_dict(data)) as problem:
             sol = solve_unilateral(problem, options)
             assert sol.method == "interior-point" and sol.candidate.kkt

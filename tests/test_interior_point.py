@@ -45,6 +45,7 @@ import pytest
 import scipy.linalg
 from conftest import run_mpi
 from exhaustive import dense
+from msgspec import structs
 from test_stress_family import FAMILY, _check
 
 from unibuckle_fenicsx.algorithms.chain import ChainOptions, _second_free_mode, solve_unilateral
@@ -58,9 +59,9 @@ from unibuckle_fenicsx.algorithms.interior_point import (
 )
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import paper_case, plate_case
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.spec.cases import paper_case, plate_case
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 PARALLEL = Path(__file__).parent / "mpi" / "interior_point_parallel.py"
@@ -139,7 +140,7 @@ def test_newton_direction_solves_the_linearised_conditions(side):
     :math:`s_k^2\nu_k/g_k = \nu_k/g_k` whatever the sign :math:`s_k` of the side.
     """
     spec = _thin(nx=6, ny=3)
-    spec = replace(spec, obstacle=replace(spec.obstacle, side=side))
+    spec = structs.replace(spec, obstacle=structs.replace(spec.obstacle, side=side))
     problem = BucklingProblem(spec, MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
         u = newton.pressure_mode()  # strictly inside the cone
@@ -339,7 +340,7 @@ def test_lift_is_the_least_energy_correction():
     ("spec", "kind", "i"), FAMILY[:SAMPLE], ids=[s.name for s, *_ in FAMILY[:SAMPLE]]
 )
 def test_route_equals_exhaustive_minimum_sample(spec, kind, i):
-    route = replace(spec, solver=replace(spec.solver, method="interior-point"))
+    route = structs.replace(spec, solver=structs.replace(spec.solver, method="interior-point"))
     _check(route, kind, i, KNOWN_LOCAL_MINIMA)
 
 
@@ -349,7 +350,7 @@ def test_route_equals_exhaustive_minimum_sample(spec, kind, i):
     ("spec", "kind", "i"), FAMILY[SAMPLE:], ids=[s.name for s, *_ in FAMILY[SAMPLE:]]
 )
 def test_route_equals_exhaustive_minimum_family(spec, kind, i):
-    route = replace(spec, solver=replace(spec.solver, method="interior-point"))
+    route = structs.replace(spec, solver=structs.replace(spec.solver, method="interior-point"))
     _check(route, kind, i, KNOWN_LOCAL_MINIMA)
 
 
@@ -395,7 +396,7 @@ def test_obstacle_below_is_the_mirror_image():
     at another contact set of equal load.
     """
     spec = _thin("shear", nx=24, ny=8, load="shear")
-    below = replace(spec, obstacle=replace(spec.obstacle, side="below"))
+    below = structs.replace(spec, obstacle=structs.replace(spec.obstacle, side="below"))
     above, under = _route(spec), _route(below)
     for report in (above, under):
         assert report["method"] == "interior-point", report["method"]

@@ -32,13 +32,13 @@ from families import long_plate_family
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.accurate import AccurateResidual, two_product, two_sum
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions, lowrank_certificate
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import ObstacleSpec
+from unibuckle_fenicsx.spec.cases import plate_case
 from unibuckle_fenicsx.tolerances import BRACKET_GAP, ROUNDING_RTOL
 
 pytest.importorskip("clarabel")

@@ -323,9 +323,9 @@ def test_lowrank_certificate_distributed_equals_serial():
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     from unibuckle_fenicsx.algorithms.active_set import solve_active_set
-    from unibuckle_fenicsx.cases import plate_case
     from unibuckle_fenicsx.model.problem import BucklingProblem
     from unibuckle_fenicsx.spec import ObstacleSpec
+    from unibuckle_fenicsx.spec.cases import plate_case
 
     plate = plate_case("thin", length=0.3, width=0.1, thickness=1e-4, nx=30, ny=10,
                        zone=ObstacleSpec(zone="all"))  # fmt: skip

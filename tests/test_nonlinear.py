@@ -36,7 +36,6 @@ import pytest
 from conftest import ROOT, run_mpi
 
 from unibuckle_fenicsx import paper_case
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.cli import main as cli_main
 from unibuckle_fenicsx.nonlinear import (
     NonlinearOptions,
@@ -45,6 +44,7 @@ from unibuckle_fenicsx.nonlinear import (
     southwell_load,
 )
 from unibuckle_fenicsx.nonlinear import path as nl_path
+from unibuckle_fenicsx.spec.cases import plate_case
 
 HERE = Path(__file__).resolve().parent
 #: The issue's acceptance: knee within 1 % of the linear load at delta/t = 1e-3.
@@ -354,7 +354,7 @@ def test_delta_study_on_the_paper_mesh():
     distance to it shrinks from delta/t = 1e-2 to 1e-4 (the knee converges as
     delta -> 0).
     """
-    from dataclasses import replace
+    from msgspec.structs import replace
 
     from unibuckle_fenicsx.analysis import solve
 

@@ -9,16 +9,14 @@ LAPACK, nothing of the package's algorithms).
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 from mpi4py import MPI
 
 import numpy as np
 import pytest
 from exhaustive import RTOL, exhaustive_minimum
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import paper_case, plate_case
 from unibuckle_fenicsx.cli import main as cli_main
 from unibuckle_fenicsx.model.contact import BilateralZoneError
 from unibuckle_fenicsx.model.problem import BucklingProblem
@@ -30,6 +28,7 @@ from unibuckle_fenicsx.spec import (
     problem_from_dict,
     problem_to_dict,
 )
+from unibuckle_fenicsx.spec.cases import paper_case, plate_case
 
 
 # -- schema ------------------------------------------------------------------------------
@@ -93,7 +92,7 @@ def test_polygon_and_circle_tables():
             {"polygon": [[0, 0], [1, "a"], [1, 0]]},
             r"obstacles\[1\]\.polygon\[1\]\[1\] must be a number",
         ),
-        ({"circle": {"center": [0, 0]}}, r"obstacles\[1\]\.circle needs center"),
+        ({"circle": {"center": [0, 0]}}, r"\[obstacles\[1\]\.circle\] needs 'radius'"),
         (
             {"circle": {"center": [0, 0], "radius": -1}},
             r"obstacles\[1\]\.circle\.radius must be > 0",

@@ -15,7 +15,6 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.materials import (
     bending_stiffness,
@@ -33,6 +32,7 @@ from unibuckle_fenicsx.spec import (
     ProblemSpec,
     SolverSpec,
 )
+from unibuckle_fenicsx.spec.cases import paper_case
 
 E, NU = 1.0e9, 0.3
 #: The paper's plate (paper, section 6).

@@ -18,22 +18,22 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 from mpi4py import MPI
 
 import numpy as np
 import pytest
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.model.materials import bending_stiffness
 from unibuckle_fenicsx.spec import (
     PointSpec,
     problem_from_dict,
     problem_to_dict,
 )
+from unibuckle_fenicsx.spec.cases import plate_case
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate, isotropic
@@ -95,7 +95,7 @@ def test_point_tables_are_read_converted_and_written_back():
 @pytest.mark.parametrize(
     "table, match",
     [
-        ({}, r"\[\[points\]\] needs at = \[x, y\].*or spacing"),
+        ({}, r"\[points\[0\]\] needs at = \[x, y\].*or spacing"),
         ({"at": [1, 0.5], "spacing": 1}, r"exactly one of them"),
         ({"spacing": 0}, r"points\[0\]\.spacing must be > 0 m"),
         ({"spacing": [1, "a"]}, r"points\[0\]\.spacing\[1\] must be a number"),

@@ -15,10 +15,10 @@ import ufl
 import numpy as np
 import pytest
 
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.prestress import solve_prestress
 from unibuckle_fenicsx.spec import EdgeSpec, Material, MeshSpec, PlateSpec
+from unibuckle_fenicsx.spec.cases import paper_case
 
 T = 0.006
 MATERIAL = Material(E=1.0e9, nu=0.3)

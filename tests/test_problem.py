@@ -2,8 +2,6 @@
 
 from __future__ import annotations
 
-from dataclasses import replace
-
 from mpi4py import MPI
 
 import dolfinx
@@ -11,13 +9,14 @@ import dolfinx
 import numpy as np
 import pytest
 from families import tension_somewhere
+from msgspec.structs import replace
 
 from unibuckle_fenicsx import MeshSpec, ObstacleSpec, paper_case
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.eigen import GEPSolver
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec.cases import plate_case
 
 
 def test_user_mesh_with_own_tags_matches_rectangle():

@@ -24,19 +24,19 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 from mpi4py import MPI
 
 import numpy as np
 import pytest
+from msgspec.structs import replace
 from scipy.optimize import brentq
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.model.materials import bending_stiffness
 from unibuckle_fenicsx.spec import EdgeSpec, ObstacleSpec, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.spec.cases import plate_case
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate, isotropic

@@ -126,8 +126,8 @@ def test_one_sided_axisymmetric_buckle_is_five_thirds():
 def _plate_with_obstacle(unloaded: str, n: int) -> float:
     """A face as a plate: its k at a/b = 3, b/t = 100, whole-plate obstacle, SS loaded edges."""
     from unibuckle_fenicsx.analysis import solve
-    from unibuckle_fenicsx.cases import plate_case
     from unibuckle_fenicsx.spec import ObstacleSpec
+    from unibuckle_fenicsx.spec.cases import plate_case
 
     spec = plate_case(
         "face", length=0.6, width=0.2, thickness=0.002, nx=3 * n, ny=n, material=STEEL,

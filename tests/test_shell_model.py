@@ -28,7 +28,6 @@ import ufl
 import numpy as np
 import pytest
 
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.eigen import GEPSolver, SymmetricFactorization
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.materials import bending_stiffness
@@ -55,6 +54,7 @@ from unibuckle_fenicsx.model.shell.model import (
 from unibuckle_fenicsx.model.shell.prestress import solve_section_prestress
 from unibuckle_fenicsx.model.shell.section import SectionParameters
 from unibuckle_fenicsx.spec import Material
+from unibuckle_fenicsx.spec.cases import paper_case
 
 #: The paper's plate (paper, section 6), and a steel box of b/t = 100.
 PAPER = Material(E=1.0e9, nu=0.3)

@@ -17,8 +17,8 @@ import pytest
 import unibuckle_fenicsx.eigen as eigen
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.continuation import penalty_continuation
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec.cases import paper_case
 
 NCV = 17  # SLEPc chooses max(2 nev, nev + 15) = 16 for one eigenpair: 17 is ours
 

@@ -22,7 +22,6 @@ import pytest
 from conftest import ROOT, paused_sweep, run_mpi
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK
 from unibuckle_fenicsx.spec import (
     MeshSpec,
@@ -31,6 +30,7 @@ from unibuckle_fenicsx.spec import (
     problem_from_dict,
     problem_to_dict,
 )
+from unibuckle_fenicsx.spec.cases import plate_case
 from unibuckle_fenicsx.sweep import (
     Variation,
     parse_variation,

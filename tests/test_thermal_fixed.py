@@ -26,17 +26,17 @@ from __future__ import annotations
 
 import math
 import sys
-from dataclasses import replace
 from pathlib import Path
 
 from mpi4py import MPI
 
 import pytest
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.materials import bending_stiffness, navier_load_mindlin
 from unibuckle_fenicsx.spec import LoadSpec, Material, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.spec.cases import paper_case
 
 sys.path.insert(0, str(Path(__file__).parent))
 from hermite_plate import HermitePlate, isotropic

@@ -25,8 +25,8 @@ from mpi4py import MPI
 import pytest
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.spec import ObstacleSpec
+from unibuckle_fenicsx.spec.cases import plate_case
 
 #: name -> (supports, load, thin-plate k)
 CASES = {

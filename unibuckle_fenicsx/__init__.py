@@ -9,7 +9,6 @@ first use, as do the sections' ``SectionParameters``
 
 from typing import Any
 
-from unibuckle_fenicsx.cases import CASES, paper_case
 from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
@@ -22,6 +21,7 @@ from unibuckle_fenicsx.spec import (
     problem_from_dict,
     problem_to_dict,
 )
+from unibuckle_fenicsx.spec.cases import CASES, paper_case
 
 __version__ = "0.1.0"
 

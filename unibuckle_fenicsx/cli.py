@@ -27,7 +27,7 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Any, NoReturn
 
 from unibuckle_fenicsx.errors import InputError, NumericalError
-from unibuckle_fenicsx.spec import METHODS
+from unibuckle_fenicsx.spec import METHODS, OPTIONS
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.spec import ProblemSpec
@@ -188,7 +188,7 @@ def _common_flags() -> _Parser:
 
 def _problem_flags() -> _Parser:
     """Flags naming one problem (solve, nonlinear): its source, mesh, --set and --json."""
-    from unibuckle_fenicsx.cases import CASES
+    from unibuckle_fenicsx.spec.cases import CASES
 
     problem = _Parser(add_help=False)
     src = problem.add_mutually_exclusive_group(required=True)
@@ -443,15 +443,22 @@ _NONLINEAR_DEFAULTS: dict[str, Any] = {
 }
 
 
-#: Flags that matter only for some methods: flag -> (methods, SolverSpec field).
+#: Flags that matter only for some methods: flag -> (the methods whose options Struct
+#: reads its SolverSpec field, the field).
 _METHOD_FLAGS = {
-    "--complete": (("enumerate",), "complete"),
-    "--until-proven": (("enumerate",), "until_proven"),
-    "--max-candidates": (("enumerate", "auto"), "max_candidates"),
-    "--enumeration-budget": (("auto",), "enumeration_budget_s"),
-    "--max-iterations": (("active-set", "interior-point", "auto"), "max_iterations"),
-    "--bound-budget": (("active-set", "interior-point", "auto"), "bound_budget"),
-    "--penalty": (("penalty",), "penalty"),
+    flag: (
+        tuple(m.value for m, options in OPTIONS.items() if field in options.__struct_fields__),
+        field,
+    )
+    for flag, field in {
+        "--complete": "complete",
+        "--until-proven": "until_proven",
+        "--max-candidates": "max_candidates",
+        "--enumeration-budget": "enumeration_budget_s",
+        "--max-iterations": "max_iterations",
+        "--bound-budget": "bound_budget",
+        "--penalty": "penalty",
+    }.items()
 }
 
 
@@ -975,8 +982,8 @@ def _fail(comm: Any, message: str, status: int = EXIT_BAD_INPUT) -> int:
 
 def _spec_from_args(args: argparse.Namespace) -> ProblemSpec:
     """The problem of --case or --config, with --nx/--ny applied."""
-    from unibuckle_fenicsx.cases import paper_case
     from unibuckle_fenicsx.spec import load_problem
+    from unibuckle_fenicsx.spec.cases import paper_case
 
     spec = paper_case(args.case) if args.case else _load_config(args.config, load_problem)
     if args.settings:

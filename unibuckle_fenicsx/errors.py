@@ -15,7 +15,7 @@ Both classes keep the built-in class they replace as a base (``ValueError``,
 
 from __future__ import annotations
 
-__all__ = ["InputError", "NumericalError", "UnibuckleError"]
+__all__ = ["FieldError", "InputError", "NumericalError", "UnibuckleError"]
 
 
 class UnibuckleError(Exception):
@@ -24,6 +24,19 @@ class UnibuckleError(Exception):
 
 class InputError(UnibuckleError, ValueError):
     """The input is wrong; the message names the key and the allowed range."""
+
+
+class FieldError(InputError):
+    """A rule between the fields of one table of a problem, broken at ``field`` ("": the table).
+
+    The message names the field by the table's key in code (``obstacle.gap``); the loader
+    of a file, which knows where the table lies, names it there (``obstacles[1].gap``).
+    """
+
+    def __init__(self, table: str, field: str, text: str) -> None:
+        self.field, self.text = field, text
+        where = f"[{table}]" if not field else f"{table}.{field}" if table else field
+        super().__init__(where + text)
 
 
 class NumericalError(UnibuckleError, RuntimeError):

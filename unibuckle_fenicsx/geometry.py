@@ -10,6 +10,7 @@ first); segment k runs from vertex k to vertex k + 1.
 
 from __future__ import annotations
 
+import math
 from collections.abc import Sequence
 
 import numpy as np
@@ -18,21 +19,27 @@ import numpy.typing as npt
 __all__ = [
     "circle_points",
     "clip_polygon",
+    "collinear",
     "disc_polygon",
     "distance_to_polygon",
     "intersection_area",
     "is_convex",
     "is_simple",
+    "narrowest_neck",
     "points_in_circle",
     "points_in_polygon",
     "polygon_area",
     "polygon_inside",
     "polygons_disjoint",
+    "segment_lengths",
+    "shape_gap",
     "triangulate",
 ]
 
 #: A polygon's vertices (m), in order: a sequence of (x, y) pairs or an (n, 2) array.
 Vertices = Sequence[Sequence[float]] | npt.NDArray[np.float64]
+#: A circle (center, radius), or a polygon's vertices (n, 2).
+Shape = tuple[Sequence[float], float] | npt.NDArray[np.float64]
 
 
 def polygon_area(vertices: Vertices) -> float:
@@ -259,3 +266,38 @@ def disc_polygon(center: Sequence[float], radius: float, n: int = 4096) -> npt.N
     """
     scale = np.sqrt(2.0 * np.pi / (n * np.sin(2.0 * np.pi / n)))
     return circle_points(center, radius * scale, n)
+
+
+def collinear(points: npt.NDArray[np.float64], size: float) -> bool:
+    """Whether the points (n, 2) lie on one straight line (within 1e-9 of ``size``)."""
+    if len(points) < 3:
+        return True
+    s = np.linalg.svd(points - points[0], compute_uv=False)
+    return bool(s.size < 2 or s[1] <= 1e-9 * size * math.sqrt(len(points)))
+
+
+def segment_lengths(vertices: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    """The lengths of the polygon's segments (segment k from vertex k to k + 1)."""
+    return np.linalg.norm(np.roll(vertices, -1, axis=0) - vertices, axis=1)
+
+
+def narrowest_neck(v: npt.NDArray[np.float64]) -> float:
+    """Smallest distance of a vertex to a segment not adjacent to it (a narrow neck)."""
+    n = len(v)
+    best = math.inf
+    for k in range(n):
+        for j in (j for j in range(n) if j not in (k, (k - 1) % n)):
+            segment = np.array([v[j], v[(j + 1) % n]])
+            best = min(best, float(distance_to_polygon(v[k : k + 1], segment)[0]))
+    return best
+
+
+def shape_gap(a: Shape, b: Shape) -> float:
+    """Distance between the boundaries of two disjoint shapes (circles or polygons)."""
+    if isinstance(a, tuple) and isinstance(b, tuple):
+        return math.dist(a[0], b[0]) - a[1] - b[1]
+    if isinstance(b, tuple):
+        return shape_gap(b, a)
+    if isinstance(a, tuple):
+        return float(distance_to_polygon(np.array([a[0]]), b)[0]) - a[1]
+    return float(min(distance_to_polygon(a, b).min(), distance_to_polygon(b, a).min()))

@@ -6,8 +6,7 @@ Markdown files under ``docs/_generated/`` (not kept in git), which the pages inc
 - ``cli_<command>.md``: ``unibuckle <command> --help``, from the package's argparse parser;
 - ``schema.md``: every key of the problem file, from
   :func:`unibuckle_fenicsx.spec.json_schema` (its types, defaults, ranges and
-  descriptions) and :func:`unibuckle_fenicsx.spec.accepted_keys`; where the installed
-  package does not have them yet, from the loader itself (see :func:`loader_keys`);
+  descriptions) and :func:`unibuckle_fenicsx.spec.accepted_keys`;
 - ``demo_<name>.md``: each demo (a jupytext percent script) as a page, with the figures
   ``make figures`` stored in ``figures/`` (the build executes no demo);
 - ``bench_<name>.md``: a table per file ``bench/results/<name>.jsonl`` (one JSON object a
@@ -86,97 +85,20 @@ def cli_pages() -> dict[str, str]:
 # The problem file's schema
 # --------------------------------------------------------------------------------------
 
+
 #: A key that no table accepts: the loader's unknown-key check names the allowed ones.
-_PROBE = "__unibuckle_docs_probe__"
-
-
-def _allowed(data: Mapping[str, Any], where: str) -> list[str] | None:
-    """The keys the loader allows in table ``where``, read off its unknown-key error."""
-    from unibuckle_fenicsx.spec import problem_from_dict
-
-    try:
-        problem_from_dict(data)
-    except ValueError as err:
-        match = re.search(
-            r"unknown key\(s\) \['" + _PROBE + r"'\] in \[" + re.escape(where) + r"\]; "
-            r"allowed: (\[.*\])",
-            str(err),
-        )
-        if match:
-            return list(json.loads(match.group(1).replace("'", '"')))
-    return None
-
-
-def loader_keys() -> list[str]:
-    """Every dotted key the loader accepts, asked of the loader table by table.
-
-    The fallback of :func:`accepted_keys` for a package without
-    ``unibuckle_fenicsx.spec.accepted_keys``: the loader checks each table's keys against
-    a list of allowed names and names that list when a key is unknown, so a probe key in
-    each table (a nested table inside a minimal valid file) reads the list the loader
-    itself uses. List-valued tables are written ``name[]`` (``plate.holes[].radius``).
-    """
-    probe = {_PROBE: 1}
-    rect = {"corners": [[0.0, 0.0], [0.2, 0.1]], "thickness": 0.006}
-    tables: dict[str, dict[str, Any]] = {
-        "": probe,
-        "plate": {"plate": probe},
-        "plate.holes[]": {"plate": {**rect, "holes": [probe]}},
-        "material": {"material": probe},
-        "material.plies[]": {"material": {"plies": [probe]}},
-        "edges.left": {"edges": {"left": probe}},
-        "mesh": {"mesh": probe},
-        "obstacle": {"obstacle": probe},
-        "obstacle.circle": {"obstacle": {"circle": probe}},
-        "obstacles[]": {"obstacles": [probe]},
-        "obstacles[].circle": {"obstacles": [{"circle": probe}]},
-        "points[]": {"points": [probe]},
-        "load": {"load": probe},
-        "design": {"design": probe},
-        "solver": {"solver": probe},
-    }
-    where = {
-        "": "top",
-        "plate.holes[]": "plate.holes[0]",
-        "material.plies[]": "material.plies[0]",
-        "obstacles[]": "obstacles[0]",
-        "obstacles[].circle": "obstacles[0].circle",
-        "points[]": "points[0]",
-    }
-    keys: list[str] = []
-    for table, data in tables.items():
-        allowed = _allowed(data, where.get(table, table))
-        if allowed is None:
-            raise RuntimeError(f"the loader did not name the keys of [{table or 'top'}]")
-        for key in allowed:
-            if table == "edges.left":
-                keys.append(f"edges.<name>.{key}")
-                continue
-            dotted = f"{table}.{key}" if table else key
-            if dotted.removesuffix("[]") in {t.removesuffix("[]") for t in tables} or (
-                dotted in ("edges",)
-            ):
-                continue  # a table: its keys are listed as its own rows
-            keys.append(dotted)
-    return keys
-
-
-def json_schema() -> dict[str, Any] | None:
-    """The package's JSON Schema of the problem file, or None where it has none."""
+def json_schema() -> dict[str, Any]:
+    """The package's JSON Schema of the problem file."""
     from unibuckle_fenicsx import spec
 
-    make = getattr(spec, "json_schema", None)
-    return make() if callable(make) else None
+    return spec.json_schema()
 
 
 def accepted_keys() -> tuple[list[str], str]:
     """(every dotted key the loader accepts, where the list comes from)."""
     from unibuckle_fenicsx import spec
 
-    listed = getattr(spec, "accepted_keys", None)
-    if callable(listed):
-        return list(listed()), "unibuckle_fenicsx.spec.accepted_keys()"
-    return loader_keys(), "the loader's own unknown-key check (unibuckle_fenicsx.spec)"
+    return list(spec.accepted_keys()), "unibuckle_fenicsx.spec.accepted_keys()"
 
 
 def _resolve(node: Mapping[str, Any], root: Mapping[str, Any]) -> Mapping[str, Any]:
@@ -282,80 +204,44 @@ def _cell(text: Any) -> str:
 
 
 def schema_page() -> str:
-    """The TOML reference as Markdown: one row per key the loader accepts."""
+    """The TOML reference as Markdown: one row per key the loader accepts.
+
+    Types, ranges, defaults and descriptions are the JSON Schema's, which the package
+    generates from its Structs (the descriptions from their docstrings).
+    """
     keys, source = accepted_keys()
     schema = json_schema()
-    lines = []
-    if schema is not None:
-        described = dict(schema_rows(schema))
-        lines += [
-            f"Generated from `unibuckle_fenicsx.spec.json_schema()` and {source} when "
-            "these pages were built.",
-            "",
-            "| key | type | range | default | description |",
-            "|---|---|---|---|---|",
-        ]
-        for key in keys:
-            node = described.get(key, {})
-            default = node.get("default", "")
-            lines.append(
-                "| `{}` | {} | {} | {} | {} |".format(
-                    key,
-                    _cell(_type(node, schema)) if node else "",
-                    _cell(_range(node)),
-                    f"`{json.dumps(default)}`" if "default" in node else _cell(default),
-                    _cell(node.get("description", "")),
-                )
+    described = dict(schema_rows(schema))
+    lines = [
+        f"Generated from `unibuckle_fenicsx.spec.json_schema()` and {source} when "
+        "these pages were built.",
+        "",
+        "| key | type | range | default | description |",
+        "|---|---|---|---|---|",
+    ]
+    for key in keys:
+        node = described.get(key, {})
+        default = node.get("default", "")
+        lines.append(
+            "| `{}` | {} | {} | {} | {} |".format(
+                key,
+                _cell(_type(node, schema)) if node else "",
+                _cell(_range(node)),
+                f"`{json.dumps(default)}`" if "default" in node else _cell(default),
+                _cell(_myst(node.get("description", ""))),
             )
-        lines += [
-            "",
-            "## The JSON Schema",
-            "",
-            "```json",
-            json.dumps(schema, indent=2, default=str),
-            "```",
-        ]
-    else:
-        defaults = _defaults()
-        described = _described()
-        lines += [
-            f"Generated from {source} when these pages were built: the keys from the "
-            "loader's unknown-key check, each one's meaning from the docstring of the "
-            "class it fills (parent key's where it has none), its default the value the "
-            "loader fills in for a file that omits it (the paper's plate; empty where it "
-            "has none). Examples of every table: {doc}`../guide/plate`.",
-            "",
-            "| key | default | meaning |",
-            "|---|---|---|",
-        ]
-        for key in keys:
-            default = defaults.get(key)
-            lines.append(
-                "| `{}` | {} | {} |".format(
-                    key,
-                    "" if default is None else f"`{json.dumps(default)}`",
-                    _cell(described.get(key, "")),
-                )
-            )
-    lines += ["", f"{len(keys)} keys."]
+        )
+    lines += [
+        "",
+        "## The JSON Schema",
+        "",
+        "```json",
+        json.dumps(schema, indent=2, default=str),
+        "```",
+        "",
+        f"{len(keys)} keys.",
+    ]
     return "\n".join(lines) + "\n"
-
-
-#: The class each table of the problem file fills, by its dotted prefix.
-TABLE_CLASSES = {
-    "": "ProblemSpec",
-    "plate": "PlateSpec",
-    "material": "Material",
-    "material.plies[]": "Ply",
-    "edges.<name>": "EdgeSpec",
-    "mesh": "MeshSpec",
-    "obstacle": "ObstacleSpec",
-    "obstacles[]": "ObstacleSpec",
-    "points[]": "PointSpec",
-    "load": "LoadSpec",
-    "design": "DesignSpec",
-    "solver": "SolverSpec",
-}
 
 
 def _myst(text: str) -> str:
@@ -363,77 +249,6 @@ def _myst(text: str) -> str:
     text = re.sub(r":math:`([^`]*)`", r"$\1$", text)
     text = re.sub(r":[\w:]+:`~?([^`]*)`", r"`\1`", text)
     return re.sub(r"``([^`]+)``", r"`\1`", text)
-
-
-def arg_docs(cls: type) -> dict[str, str]:
-    """``{argument: its description}`` from the ``Args:`` section of a Google docstring."""
-    import inspect
-
-    doc = inspect.getdoc(cls) or ""
-    found: dict[str, str] = {}
-    inside, name = False, None
-    for line in doc.splitlines():
-        if line.strip() in ("Args:", "Attributes:"):
-            inside = True
-            continue
-        if inside:
-            if line and not line.startswith(" "):
-                inside = False
-                continue
-            match = re.match(r"^    (\w+)(?: \([^)]*\))?: (.*)$", line)
-            if match:
-                name = match.group(1)
-                found[name] = match.group(2)
-            elif name and line.startswith("        "):
-                found[name] += " " + line.strip()
-    return {key: _myst(text) for key, text in found.items()}
-
-
-def _described() -> dict[str, str]:
-    """Dotted key -> its meaning, from the docstrings of the classes the tables fill."""
-    from unibuckle_fenicsx import spec
-
-    keys, _ = accepted_keys()
-    docs = {
-        prefix: arg_docs(getattr(spec, name))
-        for prefix, name in TABLE_CLASSES.items()
-        if hasattr(spec, name)
-    }
-    described = {}
-    for key in keys:
-        parts = key.split(".")
-        for cut in range(len(parts) - 1, -1, -1):  # the table's own class, then a parent's
-            prefix, name = ".".join(parts[:cut]), parts[cut]
-            text = docs.get(prefix, {}).get(name.removesuffix("[]"))
-            if text:
-                described[key] = text
-                break
-    return described
-
-
-def _defaults() -> dict[str, Any]:
-    """Dotted key -> the value the loader fills in for the paper's plate with c1's zone."""
-    from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
-
-    data = problem_to_dict(problem_from_dict({"obstacle": {"zone": "all"}}))
-    flat: dict[str, Any] = {}
-
-    def walk(value: Any, path: str) -> None:
-        if isinstance(value, Mapping):
-            for key, sub in value.items():
-                if path == "edges":
-                    walk(sub, "edges.<name>")
-                    continue
-                walk(sub, f"{path}.{key}" if path else key)
-        elif value is not None and (path not in flat):
-            flat[path] = value
-
-    walk(data, "")
-    # Not defaults: the zone is the probe's, and an edge's normal stress depends on the
-    # edge (the paper's unit compression on left and right only, see the guide).
-    for key in ("obstacle.zone", "edges.<name>.normal_stress"):
-        flat.pop(key, None)
-    return flat
 
 
 # --------------------------------------------------------------------------------------

@@ -12,9 +12,9 @@ import sys
 from mpi4py import MPI
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import load_problem
+from unibuckle_fenicsx.spec.cases import paper_case
 
 if sys.argv[1].endswith((".json", ".toml")):
     spec = load_problem(sys.argv[1])

@@ -16,7 +16,7 @@ from mpi4py import MPI
 import numpy as np
 
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.cases import paper_case
+from unibuckle_fenicsx.spec.cases import paper_case
 
 
 def run(case: str, nx: int, ny: int, complete: bool, candidate_parallel: bool) -> dict:

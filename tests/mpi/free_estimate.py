@@ -11,8 +11,8 @@ from __future__ import annotations
 from mpi4py import MPI
 
 import unibuckle_fenicsx.model.problem as problem_module
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.model.problem import BucklingProblem
+from unibuckle_fenicsx.spec.cases import paper_case
 
 problem_module.FREE_ESTIMATE_DOFS = 0
 with BucklingProblem(paper_case("free", 48, 24), MPI.COMM_WORLD) as problem:

@@ -13,11 +13,11 @@ from mpi4py import MPI
 
 import numpy as np
 
-from unibuckle_fenicsx.cases import plate_case
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import ObstacleSpec
+from unibuckle_fenicsx.spec.cases import plate_case
 
 #: One delta, no time budget: the same work on every partition.
 OPTIONS = BoundOptions(lowrank=LowRankOptions(deltas=(1e-3,), fallback=(), time_budget=None))

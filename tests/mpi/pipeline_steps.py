@@ -29,12 +29,12 @@ from test_prestress import (
     strip_average,
 )
 
-from unibuckle_fenicsx.cases import paper_case
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
 from unibuckle_fenicsx.model.prestress import solve_prestress
 from unibuckle_fenicsx.model.problem import BucklingProblem
 from unibuckle_fenicsx.spec import MeshSpec
+from unibuckle_fenicsx.spec.cases import paper_case
 
 
 def same_on_all_ranks(comm: MPI.Comm, value: object) -> bool:

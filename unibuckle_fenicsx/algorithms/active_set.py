@@ -71,6 +71,7 @@ from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.contact import EmptyZoneError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+from unibuckle_fenicsx.spec.solver import ActiveSetOptions
 from unibuckle_fenicsx.tolerances import PROOF_RTOL, ROUNDING_RTOL, TWIN_RTOL
 
 __all__ = ["SEED_NAMES", "solve_active_set"]
@@ -316,14 +317,12 @@ def solve_active_set(  # noqa: C901 - the multilevel driver: levels, polish, fal
     """
     if problem.contact is None:
         raise InputError("solve_active_set needs a problem with an obstacle")
-    if int(max_iterations) != max_iterations or max_iterations < 1:
-        raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    # The [solver] keys' ranges, from their one description:
+    ActiveSetOptions(max_iterations=max_iterations, bound_budget=bound_budget)
     if int(coarse_min_cells) != coarse_min_cells or coarse_min_cells < 2:
         raise InputError(f"coarse_min_cells must be an integer >= 2, got {coarse_min_cells!r}")
     if not (math.isfinite(refine_margin) and refine_margin >= 0):
         raise InputError(f"refine_margin must be a finite number >= 0, got {refine_margin!r}")
-    if int(bound_budget) != bound_budget or bound_budget < 0:
-        raise InputError(f"bound_budget must be an integer >= 0, got {bound_budget!r}")
 
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves

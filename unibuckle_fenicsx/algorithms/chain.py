@@ -4,7 +4,7 @@ For a rigid obstacle (any side, several zones) the chain is
 
 1. **Nested interior-point Newton** (:mod:`.interior_point`). On the coarsest mesh (a
    structured plate's cells halved, a gmsh plate's cell size doubled, while the shorter
-   side keeps ``coarse_min_cells`` cells; a user's mesh has one level) the method runs
+   side keeps ``explore_min_cells`` cells; a user's mesh has one level) the method runs
    from a few starts (the parts of the free plate's first two modes on either side of
    the obstacle, the deflection under a pressure on the whole zone, on either end and in
    the middle): the buckle may sit
@@ -47,13 +47,14 @@ import logging
 import math
 import time
 from collections.abc import Callable
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 from typing import Any
 
 from slepc4py import SLEPc
 
 import numpy as np
 import numpy.typing as npt
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.algorithms import NoAdmissibleModeError, RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.bounds import bracket
@@ -97,7 +98,9 @@ class ChainOptions:
     """Settings of the chain.
 
     Attributes:
-        coarse_min_cells: Fewest cells along the shorter side of the coarsest mesh.
+        explore_min_cells: Fewest cells along the shorter side of the coarsest mesh, where
+            the starts are explored (the active set's multilevel has its own,
+            ``coarse_min_cells`` of :func:`~.active_set.solve_active_set`).
             Measured on the five thin plates of ``bench/bench_plates.py`` at 90×30
             (coarsest 22×7 at 4–7): at 3 (an 11×3 exploration mesh) SSSS took 3.9 free
             solves instead of 5.5, but loaded edges clamped and CCCC ended at higher
@@ -165,8 +168,8 @@ class ChainOptions:
         escapes: Saddle escapes allowed per run.
         escape_mu: Barrier parameter the run restarts with after an escape (small: a
             larger one would lift the flattened buckle again).
-        refine_margin: Critical states within this (relative) of the lowest on a mesh
-            are carried to the next.
+        carry_margin: Critical states within this (relative) of the lowest on a mesh
+            are carried to the next (the active set's ``refine_margin`` is its own).
         arrangements: ... at most this many.
         polish_iterations: Active-set iterates allowed to polish a contact set.
         quick_polish_iterations: ... on the first try of the fine mesh.
@@ -178,7 +181,7 @@ class ChainOptions:
         bound_budget: Eigen solves of the lattice lower bound (small zones).
     """
 
-    coarse_min_cells: int = 6
+    explore_min_cells: int = 6
     seeds: tuple[str, ...] = (
         "free-",
         "free+",
@@ -204,7 +207,7 @@ class ChainOptions:
     max_steps: int = 100
     escapes: int = 3
     escape_mu: float = 1e-10
-    refine_margin: float = 2e-3
+    carry_margin: float = 2e-3
     arrangements: int = 3
     polish_iterations: int = 25
     quick_polish_iterations: int = 5
@@ -690,7 +693,7 @@ def _explore(
 ) -> tuple[list[Candidate], list[_Arrangement]]:
     """Run the starts on ``problem``: its KKT points, and the arrangements to carry up.
 
-    The distinct KKT points within ``refine_margin`` of the lowest (at most
+    The distinct KKT points within ``carry_margin`` of the lowest (at most
     ``arrangements``) are carried, each as its barrier point on the central path at
     ``level_mu`` and at ``flat_mu`` (see :func:`_levels`). Without ``carry`` (``problem``
     is the only mesh) no barrier point is made for a finer mesh: measured on a plate
@@ -753,7 +756,7 @@ def _explore(
         found.sort(key=lambda cp: cp[0].load)
         carried: list[_Arrangement] = []
         for cand, point in found if carry else []:
-            far = cand.load > found[0][0].load * (1.0 + options.refine_margin)
+            far = cand.load > found[0][0].load * (1.0 + options.carry_margin)
             twin = any(math.isclose(cand.load, a.load, rel_tol=options.twin_rtol) for a in carried)
             if far or twin or len(carried) == options.arrangements:
                 continue
@@ -860,7 +863,7 @@ def _gmsh_levels(problem: BucklingProblem) -> bool:
 def _coarser(problem: BucklingProblem, options: ChainOptions) -> list[ProblemSpec]:
     """The problem on coarser meshes, coarsest first.
 
-    Coarser while the shorter side keeps ``coarse_min_cells`` cells. A structured
+    Coarser while the shorter side keeps ``explore_min_cells`` cells. A structured
     rectangle's cells are halved (:func:`~.multilevel.mesh_levels`); a plate meshed by
     gmsh (outline, holes) is meshed again at twice the cell size, and again (the meshes
     are not nested: :class:`~.multilevel.Prolongation` interpolates between any two). A
@@ -869,14 +872,14 @@ def _coarser(problem: BucklingProblem, options: ChainOptions) -> list[ProblemSpe
     """
     spec = problem.spec
     if problem.structured:
-        levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, options.coarse_min_cells)
+        levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, options.explore_min_cells)
         return [spec.with_mesh(nx, ny) for nx, ny in levels]
     if not _gmsh_levels(problem):
         return []
     assert spec.mesh.size is not None
     side, size = min(spec.plate.length, spec.plate.width), spec.mesh.size
     specs: list[ProblemSpec] = []
-    while side / (2.0 * size) >= options.coarse_min_cells:
+    while side / (2.0 * size) >= options.explore_min_cells:
         size *= 2.0
         try:
             specs.append(replace(spec, mesh=replace(spec.mesh, size=size)))
@@ -908,7 +911,7 @@ def _carry(
 ) -> tuple[list[Candidate], list[BarrierPoint]]:
     """Carry every point from ``problems[k - 1]`` to ``problems[k]``.
 
-    On an intermediate mesh the points whose loads lie more than ``refine_margin`` above
+    On an intermediate mesh the points whose loads lie more than ``carry_margin`` above
     the lowest are dropped (the meshes rank the arrangements better as they get finer);
     on the finest, the KKT points met are returned. ``newtons``: the method on each mesh
     (created here when missing), shared by the arrangements and tries.
@@ -929,7 +932,7 @@ def _carry(
             carried.append(new)
     if carried:
         lowest = min(p.load for p in carried)
-        carried = [p for p in carried if p.load <= lowest * (1.0 + options.refine_margin)]
+        carried = [p for p in carried if p.load <= lowest * (1.0 + options.carry_margin)]
     level.seconds += time.perf_counter() - tl
     _report(problems[k], level)
     return found, carried

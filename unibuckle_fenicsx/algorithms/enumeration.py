@@ -64,6 +64,7 @@ from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.progress import Progress
+from unibuckle_fenicsx.spec.solver import EnumerateOptions
 from unibuckle_fenicsx.tolerances import LOAD_TIE_RTOL, PROOF_RTOL
 
 __all__ = ["LevelSummary", "enumerate_contact_sets"]
@@ -240,12 +241,7 @@ def enumerate_contact_sets(  # noqa: C901 - the paper's level loop with its stop
     """
     if problem.contact is None:
         raise InputError("enumerate_contact_sets needs a problem with an obstacle")
-    if (
-        isinstance(max_candidates, bool)
-        or int(max_candidates) != max_candidates
-        or max_candidates < 1
-    ):
-        raise InputError(f"max_candidates must be an integer >= 1, got {max_candidates!r}")
+    EnumerateOptions(max_candidates=max_candidates)  # the [solver] key's range
     ccomm = MPI.COMM_SELF if candidate_comm is None else candidate_comm
     if ccomm.size > 1 and problem.comm.size > 1:
         raise InputError(

@@ -61,6 +61,7 @@ from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import BucklingProblem, Candidate
+from unibuckle_fenicsx.spec.solver import ActiveSetOptions
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
 __all__ = ["FOUNDATION_PREFIX", "pressing_nodes", "solve_foundation"]
@@ -100,8 +101,7 @@ def solve_foundation(
     contact = problem.contact
     if contact is None or contact.stiffness is None:
         raise InputError("solve_foundation needs a problem with a tensionless foundation")
-    if int(max_iterations) != max_iterations or max_iterations < 1:
-        raise InputError(f"max_iterations must be an integer >= 1, got {max_iterations!r}")
+    ActiveSetOptions(max_iterations=max_iterations)  # the [solver] key's range
     lower = problem.solve_free().load
     springs = contact.stiffness
     runs: dict[str, SpringIteration] = {}

@@ -3,7 +3,6 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import replace
 
 from mpi4py import MPI
 
@@ -11,6 +10,7 @@ import dolfinx
 
 import numpy as np
 import numpy.typing as npt
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.gmsh_mesh import HOLES_TAG, gmsh_plate_mesh, segment_tag

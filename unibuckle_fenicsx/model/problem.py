@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from typing import Any
 
 from mpi4py import MPI
@@ -28,6 +28,7 @@ import dolfinx
 
 import numpy as np
 import numpy.typing as npt
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.eigen import (
     EIGEN_OPTIONS,

@@ -15,7 +15,7 @@ from __future__ import annotations
 
 import logging
 import time
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import asdict, dataclass, field
 from typing import Any
 
 from mpi4py import MPI
@@ -26,6 +26,7 @@ import dolfinx.fem.petsc
 
 import numpy as np
 import numpy.typing as npt
+from msgspec import structs
 
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.analysis import solve as solve_linear
@@ -618,10 +619,10 @@ def _gaps_closed_load(spec: ProblemSpec, linear: Analysis) -> float | None:
     The upper end of where the knee of a plate with a gapped obstacle lies; None when
     that solve finds no certified state (the verdict then says it is unknown). Collective.
     """
-    closed = replace(
+    closed = structs.replace(
         spec,
-        obstacle=None if spec.obstacle is None else replace(spec.obstacle, gap=0.0),
-        obstacles=tuple(replace(o, gap=0.0) for o in spec.obstacles),
+        obstacle=None if spec.obstacle is None else structs.replace(spec.obstacle, gap=0.0),
+        obstacles=tuple(structs.replace(o, gap=0.0) for o in spec.obstacles),
     )
     problem = linear.problem
     try:

@@ -1,4 +1,11 @@
-r"""Problem description: frozen dataclasses, the schema of a problem file, the loader.
+r"""The description of a problem: one tree of frozen msgspec Structs, read from a file.
+
+:class:`ProblemSpec` and the tables below it (:class:`PlateSpec`, :class:`Material`,
+:class:`ObstacleSpec`, ...) are the Python API and the problem file's schema at once:
+their annotations hold each key's type, range, choices and unit, ``__post_init__`` the
+rules between keys (:mod:`~unibuckle_fenicsx.spec.base`). A bad value raises
+:class:`~unibuckle_fenicsx.errors.InputError` (a ``ValueError``) naming the key and the
+allowed range, before any mesh or matrix is built.
 
 The computation is in SI units (m, N, Pa). The load is *one* scalar :math:`\lambda`: the
 membrane traction on a loaded edge is :math:`\lambda\, t\, (\sigma_n n + \tau_s s)` with
@@ -7,60 +14,20 @@ membrane traction on a loaded edge is :math:`\lambda\, t\, (\sigma_n n + \tau_s 
 file may be written in another consistent system (``units``, :data:`UNITS`); it is
 converted to SI when read, and results are printed in its stress unit.
 
-Modules:
-
-- :mod:`~unibuckle_fenicsx.spec.schema`: the schema of a problem file on msgspec
-  (types, bounds, choices, unknown keys; error locations such as
-  ``obstacles[1].circle.radius``), :func:`json_schema` and :func:`accepted_keys`. Its
-  docstring gives the measurements that chose msgspec over pydantic and cattrs, and
-  what stays checked by hand.
-- :mod:`~unibuckle_fenicsx.spec.values`, :mod:`~unibuckle_fenicsx.spec.material`,
-  :mod:`~unibuckle_fenicsx.spec.plate`, :mod:`~unibuckle_fenicsx.spec.obstacles`,
-  :mod:`~unibuckle_fenicsx.spec.problem`: the frozen dataclasses of the Python API.
-  They check their values in ``__post_init__`` (they are built in code too, without a
-  file) and the rules no schema knows: geometry, the edge-load rule, material matrices.
-- :mod:`~unibuckle_fenicsx.spec.units`: a file's numbers to SI and back.
-- :mod:`~unibuckle_fenicsx.spec.loading` and :mod:`~unibuckle_fenicsx.spec.writing`:
-  a TOML-shaped mapping (or a TOML file, or a JSON result) to a :class:`ProblemSpec`,
-  and back (the JSON ``input`` echo: ``problem_from_dict(problem_to_dict(spec)) ==
-  spec``).
-
-A bad value raises :class:`~unibuckle_fenicsx.errors.InputError` (a ``ValueError``)
-naming the key and the allowed range before any mesh or matrix is built.
+Modules, each importing only those above it: :mod:`~unibuckle_fenicsx.spec.base` (the
+Struct base, units, messages), :mod:`~unibuckle_fenicsx.spec.plate`,
+:mod:`~unibuckle_fenicsx.spec.material`, :mod:`~unibuckle_fenicsx.spec.obstacles`,
+:mod:`~unibuckle_fenicsx.spec.solver` (the methods and their options),
+:mod:`~unibuckle_fenicsx.spec.checks` (rules across tables),
+:mod:`~unibuckle_fenicsx.spec.problem`, :mod:`~unibuckle_fenicsx.spec.files` (a file read
+and written), :mod:`~unibuckle_fenicsx.spec.schema` (its JSON Schema) and
+:mod:`~unibuckle_fenicsx.spec.cases` (the paper's cases).
 """
 
 from __future__ import annotations
 
-from unibuckle_fenicsx.spec.loading import (
-    OBSTACLE_KEYS,
-    PLY_KEYS,
-    load_problem,
-    load_toml,
-    problem_from_dict,
-)
-from unibuckle_fenicsx.spec.material import Material, Ply
-from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
-from unibuckle_fenicsx.spec.plate import (
-    Circle,
-    EdgeSpec,
-    MeshSpec,
-    PlateSpec,
-    Polygon,
-    paper_edges,
-)
-from unibuckle_fenicsx.spec.problem import ProblemSpec, SolverSpec
-from unibuckle_fenicsx.spec.schema import accepted_keys, json_schema
-from unibuckle_fenicsx.spec.values import (
-    BENDING_SUPPORTS,
-    EDGE_NAMES,
-    HOLES,
-    INPLANE_SUPPORTS,
-    METHODS,
-    POINT_KINDS,
-    SIDES,
+from unibuckle_fenicsx.spec.base import (
     UNITS,
-    Box,
-    Predicate,
     Temperature,
     _boolean,
     _choice,
@@ -69,32 +36,52 @@ from unibuckle_fenicsx.spec.values import (
     stress_ends,
     temperature_field,
 )
-from unibuckle_fenicsx.spec.writing import problem_to_dict, stress_value
+from unibuckle_fenicsx.spec.cases import CASES, paper_case, plate_case
+from unibuckle_fenicsx.spec.files import (
+    OBSTACLE_KEYS,
+    PLY_KEYS,
+    load_problem,
+    load_toml,
+    problem_from_dict,
+    problem_to_dict,
+    stress_value,
+)
+from unibuckle_fenicsx.spec.material import Material, Ply
+from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
+from unibuckle_fenicsx.spec.plate import (
+    EDGE_NAMES,
+    HOLES,
+    Circle,
+    EdgeSpec,
+    MeshSpec,
+    PlateSpec,
+    Polygon,
+)
+from unibuckle_fenicsx.spec.problem import ProblemSpec
+from unibuckle_fenicsx.spec.schema import accepted_keys, json_schema
+from unibuckle_fenicsx.spec.solver import METHODS, OPTIONS, Method, SolverSpec
 
 __all__ = [
-    "BENDING_SUPPORTS",
+    "CASES",
     "EDGE_NAMES",
     "HOLES",
-    "INPLANE_SUPPORTS",
     "METHODS",
     "OBSTACLE_KEYS",
+    "OPTIONS",
     "PLY_KEYS",
-    "POINT_KINDS",
-    "SIDES",
     "UNITS",
-    "Box",
     "Circle",
     "DesignSpec",
     "EdgeSpec",
     "LoadSpec",
     "Material",
     "MeshSpec",
+    "Method",
     "ObstacleSpec",
     "PlateSpec",
     "Ply",
     "PointSpec",
     "Polygon",
-    "Predicate",
     "ProblemSpec",
     "SolverSpec",
     "Temperature",
@@ -106,7 +93,8 @@ __all__ = [
     "json_schema",
     "load_problem",
     "load_toml",
-    "paper_edges",
+    "paper_case",
+    "plate_case",
     "problem_from_dict",
     "problem_to_dict",
     "stress_ends",

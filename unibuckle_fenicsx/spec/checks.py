@@ -1,29 +1,31 @@
-"""Checks of a whole problem that no single key can make: supports, plate model, geometry.
+"""Checks of a whole problem that no single key can make: supports and gmsh's features.
 
-Run by :class:`~unibuckle_fenicsx.spec.ProblemSpec` and
-:class:`~unibuckle_fenicsx.spec.PlateSpec` when they are built, before any mesh: each
-raises :class:`~unibuckle_fenicsx.errors.InputError` naming the keys (or, for
-:func:`plate_model_note`, returns a warning). numpy only; the config classes import this
-module, so it reads their fields and imports them for type checking only.
+Run by :class:`~unibuckle_fenicsx.spec.ProblemSpec` when it is built, before any mesh:
+each raises :class:`~unibuckle_fenicsx.errors.InputError` naming the keys
+(:func:`plate_model_note` returns a warning instead).
 """
 
 from __future__ import annotations
 
-import math
 from dataclasses import dataclass
-from typing import TYPE_CHECKING, TypeGuard, cast
+from typing import Protocol
 
 import numpy as np
-import numpy.typing as npt
 
 from unibuckle_fenicsx.en1993 import INTERNAL, OUTSTAND, psi_range, table_row
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.geometry import distance_to_polygon
-from unibuckle_fenicsx.spec.values import EDGE_NAMES, HOLES, stress_ends
-
-if TYPE_CHECKING:  # pragma: no cover
-    from unibuckle_fenicsx.spec.plate import Circle, PlateSpec, Polygon
-    from unibuckle_fenicsx.spec.problem import ProblemSpec
+from unibuckle_fenicsx.geometry import Shape, collinear, narrowest_neck, segment_lengths, shape_gap
+from unibuckle_fenicsx.spec.base import stress_ends
+from unibuckle_fenicsx.spec.obstacles import LoadSpec
+from unibuckle_fenicsx.spec.plate import (
+    EDGE_NAMES,
+    HOLES,
+    MAX_THICKNESS_RATIO,
+    THICK_PLATE_RATIO,
+    Circle,
+    PlateSpec,
+    Polygon,
+)
 
 __all__ = [
     "FEATURE_RATIO",
@@ -33,18 +35,11 @@ __all__ = [
     "DesignElement",
     "check_features",
     "check_supports",
-    "check_thickness",
     "design_element",
     "plate_features",
     "plate_model_note",
 ]
 
-#: Above this thickness over the plate's smaller side, a warning: Reissner-Mindlin
-#: theory (transverse shear, plane sections, no thickness stretch) is the usual model of
-#: moderately thick plates up to t/b of about 0.2.
-THICK_PLATE_RATIO = 0.2
-#: Above this thickness over the plate's smaller side the body is not a plate: refused.
-MAX_THICKNESS_RATIO = 0.5
 #: Gmsh plates: a hole, a ligament or an outline segment shorter than mesh.size over
 #: this is refused (gmsh's quadrilaterals cannot be graded down to it reliably: a hole of
 #: radius 1e-4 m or a ligament of 2e-4 m at mesh.size = 0.01 m leave triangles).
@@ -53,33 +48,11 @@ FEATURE_RATIO = 100.0
 TOUCH_TOLERANCE = 1e-9
 
 
-def _smaller_side(plate: PlateSpec) -> float:
-    return min(plate.length, plate.width)
-
-
-def check_thickness(plate: PlateSpec) -> None:
-    """Refuse a plate thicker than :data:`MAX_THICKNESS_RATIO` times its smaller side.
-
-    The sides are those of the rectangle or of the outline's bounding box (a gmsh file's
-    are known only once meshed: not checked).
-    """
-    if plate.file is not None:
-        return
-    b = _smaller_side(plate)
-    if plate.thickness > MAX_THICKNESS_RATIO * b:
-        raise InputError(
-            f"plate.thickness = {plate.thickness:g} m is {plate.thickness / b:.3g} times the "
-            f"plate's smaller side {b:g} m: not a plate; plate.thickness must be at most "
-            f"{MAX_THICKNESS_RATIO:g} times it (Reissner-Mindlin theory is a model of plates "
-            f"up to t/b of about {THICK_PLATE_RATIO:g})"
-        )
-
-
 def plate_model_note(plate: PlateSpec) -> str | None:
     """A warning when t/b exceeds :data:`THICK_PLATE_RATIO`, else None."""
     if plate.file is not None:
         return None
-    b = _smaller_side(plate)
+    b = min(plate.length, plate.width)
     ratio = plate.thickness / b
     if ratio <= THICK_PLATE_RATIO:
         return None
@@ -91,16 +64,7 @@ def plate_model_note(plate: PlateSpec) -> str | None:
     )
 
 
-def _collinear(points: npt.NDArray[np.float64], size: float) -> bool:
-    """Whether the points (n, 2) lie on one straight line (within 1e-9 of ``size``)."""
-    if len(points) < 3:
-        return True
-    d = points - points[0]
-    s = np.linalg.svd(d, compute_uv=False)
-    return bool(s.size < 2 or s[1] <= 1e-9 * size * math.sqrt(len(points)))
-
-
-def check_supports(spec: ProblemSpec) -> None:
+def check_supports(plate: PlateSpec, foundation: bool) -> None:
     """Refuse supports that leave a rigid-body motion of the deflection (a mechanism).
 
     With no clamped edge, the supported boundary must not lie on one straight line
@@ -110,11 +74,14 @@ def check_supports(spec: ProblemSpec) -> None:
     An edge given by a facet tag of a user mesh is taken to hold the plate; for a gmsh
     file only "every part free" is checked (its geometry is known once meshed).
 
+    Args:
+        plate: The plate and its edges.
+        foundation: Whether a bilateral foundation holds the plate.
+
     Raises:
-        ValueError: Naming ``edges.*.support``.
+        InputError: Naming ``edges.*.support``.
     """
-    plate = spec.plate
-    if spec.bilateral_foundations:
+    if foundation:
         return
     held = [e for e in plate.edges if e.support != "free"]
     if any(e.support == "clamped" for e in held):
@@ -125,9 +92,9 @@ def check_supports(spec: ProblemSpec) -> None:
     points: list[tuple[float, float]] = []
     for e in held:
         if e.name == HOLES and plate.holes:
-            if any(_is_circle(h) for h in plate.holes):
+            if any(isinstance(h, Circle) for h in plate.holes):
                 return
-            points += [v for h in plate.holes for v in h.vertices]  # type: ignore[union-attr]
+            points += [v for h in plate.holes if isinstance(h, Polygon) for v in h.vertices]
         elif e.segments is not None and plate.outline is not None:
             v = plate.outline
             points += [v[k] for k in e.segments] + [v[(k + 1) % len(v)] for k in e.segments]
@@ -139,7 +106,7 @@ def check_supports(spec: ProblemSpec) -> None:
                 "bottom": [(x0, y0), (x1, y0)],
                 "top": [(x0, y1), (x1, y1)],
             }[e.name]
-    if held and not _collinear(np.asarray(points, dtype=float), size):
+    if held and not collinear(np.asarray(points, dtype=float), size):
         return
     if not held:
         what = "every boundary part is free"
@@ -153,28 +120,6 @@ def check_supports(spec: ProblemSpec) -> None:
     )
 
 
-def _polygon_gap(a: npt.NDArray[np.float64], b: npt.NDArray[np.float64]) -> float:
-    """Distance between the boundaries of two disjoint polygons (vertex to segment)."""
-    return float(min(distance_to_polygon(a, b).min(), distance_to_polygon(b, a).min()))
-
-
-def _segment_lengths(v: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-    return np.linalg.norm(np.roll(v, -1, axis=0) - v, axis=1)
-
-
-def _neck(v: npt.NDArray[np.float64]) -> float:
-    """Smallest distance of a vertex to a segment not adjacent to it (a narrow neck)."""
-    n = len(v)
-    best = math.inf
-    for k in range(n):
-        others = [j for j in range(n) if j not in (k, (k - 1) % n)]
-        for j in others:
-            seg = np.array([v[j], v[(j + 1) % n]])
-            d = float(distance_to_polygon(v[k : k + 1], seg)[0])
-            best = min(best, d)
-    return best
-
-
 def plate_features(plate: PlateSpec) -> list[tuple[float, str]]:
     """The smallest lengths gmsh must resolve, each with the keys it comes from.
 
@@ -185,38 +130,26 @@ def plate_features(plate: PlateSpec) -> list[tuple[float, str]]:
     outer = np.asarray(plate.boundary, dtype=float)
     out: list[tuple[float, str]] = []
     if plate.outline is not None:
-        k = int(np.argmin(_segment_lengths(outer)))
-        out.append((float(_segment_lengths(outer)[k]), f"plate.outline segment {k}"))
+        k = int(np.argmin(segment_lengths(outer)))
+        out.append((float(segment_lengths(outer)[k]), f"plate.outline segment {k}"))
         if len(outer) > 3:
-            out.append((_neck(outer), "plate.outline (its narrowest neck)"))
-    shapes: list[tuple[str, Circle | None, npt.NDArray[np.float64]]] = []
+            out.append((narrowest_neck(outer), "plate.outline (its narrowest neck)"))
+    shapes: list[tuple[str, Shape]] = []
     for k, hole in enumerate(plate.holes):
         where = f"plate.holes[{k}]"
-        if _is_circle(hole):
+        shape: Shape
+        if isinstance(hole, Circle):
+            shape = (hole.center, hole.radius)
             out.append((2.0 * hole.radius, f"{where}.radius = {hole.radius:g} m (its diameter)"))
-            gap = float(distance_to_polygon(np.array([hole.center]), outer)[0]) - hole.radius
-            shapes.append((where, hole, np.empty((0, 2))))
         else:
-            v = np.asarray(cast("Polygon", hole).vertices, dtype=float)
-            j = int(np.argmin(_segment_lengths(v)))
-            out.append((float(_segment_lengths(v)[j]), f"{where}.outline segment {j}"))
-            gap = _polygon_gap(v, outer)
-            shapes.append((where, None, v))
-        out.append((gap, f"the gap between {where} and the plate's edge"))
-    for j in range(len(shapes)):
-        for k in range(j):
-            (wa, ca, va), (wb, cb, vb) = shapes[k], shapes[j]
-            if ca is not None and cb is not None:
-                gap = math.dist(ca.center, cb.center) - ca.radius - cb.radius
-            elif ca is not None or cb is not None:
-                circle = ca if ca is not None else cb
-                poly = vb if ca is not None else va
-                assert circle is not None
-                gap = float(distance_to_polygon(np.array([circle.center]), poly)[0])
-                gap -= circle.radius
-            else:
-                gap = _polygon_gap(va, vb)
-            out.append((gap, f"the gap between {wa} and {wb}"))
+            shape = np.asarray(hole.vertices, dtype=float)
+            j = int(np.argmin(segment_lengths(shape)))
+            out.append((float(segment_lengths(shape)[j]), f"{where}.outline segment {j}"))
+        out.append((shape_gap(shape, outer), f"the gap between {where} and the plate's edge"))
+        out += [
+            (shape_gap(other, shape), f"the gap between {w} and {where}") for w, other in shapes
+        ]
+        shapes.append((where, shape))
     return sorted(out, key=lambda item: item[0])
 
 
@@ -250,14 +183,6 @@ def check_features(plate: PlateSpec, mesh_size: float | None) -> None:
                 "m: gmsh cannot grade its quadrilaterals from mesh.size down to it; give a "
                 "smaller mesh.size or a larger feature"
             )
-
-
-def _is_circle(hole: Circle | Polygon) -> TypeGuard[Circle]:
-    """A circular hole (:class:`~unibuckle_fenicsx.spec.plate.Circle`: it has a radius).
-
-    Read from its fields, not its class: the config classes import these checks.
-    """
-    return hasattr(hole, "radius")
 
 
 #: The rectangle's edges in pairs of opposite edges, and the coordinate each pair's edges
@@ -319,7 +244,20 @@ def _edge(plate: PlateSpec, name: str) -> _Edge:
     return _Edge(name)
 
 
-def design_element(spec: ProblemSpec) -> DesignElement:
+class _Problem(Protocol):
+    """What :func:`design_element` reads of a :class:`~unibuckle_fenicsx.spec.ProblemSpec`.
+
+    (``spec.problem`` imports this module: a protocol, not an import of it.)
+    """
+
+    @property
+    def plate(self) -> PlateSpec: ...
+
+    @property
+    def load(self) -> LoadSpec: ...
+
+
+def design_element(spec: _Problem) -> DesignElement:
     """Classify the plate for the design output (EN 1993-1-5 4.4(2)), or refuse it.
 
     The direct stress acts across the edges given a normal stress (scaled or fixed); the

@@ -3,109 +3,106 @@
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass
-from typing import Any, Literal
+import typing
+from collections.abc import Callable
+from typing import TYPE_CHECKING, Annotated, ClassVar, Literal
 
 import numpy as np
 import numpy.typing as npt
+from msgspec import Meta
+from msgspec.structs import force_setattr
 
-from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.geometry import (
-    points_in_circle,
-    points_in_polygon,
-)
-from unibuckle_fenicsx.spec.plate import (
-    Circle,
-    PlateSpec,
-    Polygon,
-)
-from unibuckle_fenicsx.spec.values import (
-    POINT_KINDS,
-    SIDES,
+from unibuckle_fenicsx.errors import FieldError, InputError
+from unibuckle_fenicsx.geometry import points_in_circle, points_in_polygon
+from unibuckle_fenicsx.spec.base import (
     UNITS,
     Box,
-    Predicate,
+    Point,
+    Table,
     Temperature,
-    _box,
-    _choice,
-    _number,
-    _pair,
-    _temperature,
+    plain,
     temperature_field,
+    unit,
 )
+from unibuckle_fenicsx.spec.plate import Circle, PlateSpec, Polygon
+
+Side = Literal["above", "below", "both"]
+#: Sides of an obstacle: "above" (on the +w side: w <= 0 in its zone), "below" (w >= 0);
+#: "both" only for a foundation (a bilateral Winkler foundation, springs everywhere).
+SIDES: tuple[str, ...] = typing.get_args(Side)
+Kind = Literal["bilateral", "one-sided", "spring"]
+#: Kinds of point restraint: w = 0, the obstacle's cone at the point, or a spring.
+POINT_KINDS: tuple[str, ...] = typing.get_args(Kind)
+Predicate = Callable[[npt.NDArray[np.float64]], npt.NDArray[np.bool_]]
+if TYPE_CHECKING:  # a predicate zone (code only); a grid's spacing once built: a pair
+    Zone = Literal["all"] | Box | Polygon | Circle | Predicate
+    Spacing = tuple[float, float]
+else:
+    Zone = Literal["all"] | Box | Polygon | Circle
+    Spacing = float | tuple[float, float]
+Boxed = Annotated[Box, Meta(extra={"unit": "m"})]
 
 
-@dataclass(frozen=True)
-class ObstacleSpec:
+class ObstacleSpec(Table, frozen=True):
     r"""Rigid flat obstacle, or Winkler foundation, on one side of the plate over a zone.
 
     With ``side = "above"`` the deflection must satisfy w <= 0 at every mesh node of the
-    closed zone; with ``"below"``, w >= 0. With a ``foundation_stiffness`` :math:`k_f`
-    the obstacle is a tensionless (compression-only) Winkler foundation instead: the
-    plate may press into it, against a pressure :math:`k_f w` (above; :math:`-k_f w`
-    below), and lift off it freely; :math:`k_f \to \infty` is the rigid obstacle.
-    ``side = "both"`` is then a bilateral foundation (springs in tension too).
+    closed zone; with ``"below"``, w >= 0. With a ``foundation_stiffness`` :math:`k_f` the
+    obstacle is a tensionless (compression-only) Winkler foundation instead: the plate may
+    press into it, against a pressure :math:`k_f w` (above; :math:`-k_f w` below), and
+    lift off it freely; :math:`k_f \to \infty` is the rigid obstacle. ``side = "both"``
+    is then a bilateral foundation (springs in tension too).
 
     Args:
-        zone: ``"all"`` (the whole closed plate), a box ``((xmin, xmax), (ymin, ymax))``,
-            a :class:`Polygon`, a :class:`Circle`, or a predicate ``f(x) -> bool array``
-            on coordinates of shape (3, n).
-        tolerance: Geometric tolerance (m) for a node to count as inside a box, polygon
-            or circle; ``None`` uses 1e-8 times the plate size.
+        zone: ``"all"`` (the whole closed plate), a box ``((xmin, xmax), (ymin, ymax))``
+            (m), a :class:`Polygon` (the file's ``polygon = [[x, y], ...]``), a
+            :class:`Circle` (``circle = {center, radius}``), or in code a predicate
+            ``f(x) -> bool array`` on coordinates of shape (3, n).
         side: One of :data:`SIDES`: where the obstacle lies (w, the deflection, is
             positive towards "above"); "both" only with a foundation.
-        foundation_stiffness: Winkler modulus :math:`k_f` (N/m^3, Pa/m), > 0; ``None``
-            for a rigid obstacle. The springs are lumped at the zone's nodes: node k
-            carries :math:`k_f \int \varphi_k\,dx` (its tributary area).
+        foundation_stiffness: Winkler modulus :math:`k_f` (N/m^3, Pa/m), > 0; ``None`` for
+            a rigid obstacle. The springs are lumped at the zone's nodes: node k carries
+            :math:`k_f \int \varphi_k\,dx` (its tributary area).
+        tolerance: Geometric tolerance (m), >= 0, for a node to count as inside a box,
+            polygon or circle; ``None`` uses 1e-8 times the plate size.
         gap: Clearance g (m) >= 0 between the flat plate and a rigid obstacle: w <= g
-            (above), w >= -g (below). The nonlinear analysis follows the plate onto it;
-            the linear critical state ignores an obstacle with a gap (an infinitesimal
-            buckle does not reach it).
+            (above), w >= -g (below). The nonlinear analysis follows the plate onto it; the
+            linear critical state ignores an obstacle with a gap (an infinitesimal buckle
+            does not reach it).
     """
 
-    zone: Literal["all"] | Box | Polygon | Circle | Predicate = "all"
-    tolerance: float | None = None
-    side: str = "above"
-    foundation_stiffness: float | None = None
-    gap: float = 0.0
+    KEY: ClassVar[str] = "obstacle"
+    CALLABLE: ClassVar[tuple[str, ...]] = ("zone",)
+    zone: Annotated[
+        Zone, Meta(extra={"unit": "m", "form": '"all" or [[xmin, xmax], [ymin, ymax]]'})
+    ] = "all"
+    side: Side = "above"
+    foundation_stiffness: Annotated[float, unit("N/m^3", gt=0)] | None = None
+    tolerance: Annotated[float, unit("m", ge=0)] | None = None
+    gap: Annotated[float, unit("m", ge=0)] = 0.0
 
-    def __post_init__(self) -> None:
-        if isinstance(self.zone, str):
-            if self.zone != "all":
-                raise InputError(
-                    f'obstacle.zone must be "all", [[xmin, xmax], [ymin, ymax]] or a '
-                    f"callable, got {self.zone!r}"
-                )
-        elif isinstance(self.zone, Polygon | Circle):
-            pass
-        elif not callable(self.zone):
-            object.__setattr__(self, "zone", _box("obstacle.zone", self.zone))
-        if self.tolerance is not None and not _number("obstacle.tolerance", self.tolerance) >= 0:
-            raise InputError(f"obstacle.tolerance must be >= 0 m, got {self.tolerance!r}")
-        if self.foundation_stiffness is not None:
-            if not _number("obstacle.foundation_stiffness", self.foundation_stiffness) > 0.0:
-                raise InputError(
-                    "obstacle.foundation_stiffness (Winkler modulus) must be > 0 N/m^3, got "
-                    f"{self.foundation_stiffness!r}; leave it out for a rigid obstacle"
-                )
-            object.__setattr__(self, "foundation_stiffness", float(self.foundation_stiffness))
+    def check(self) -> None:
+        """The rules between this table's fields."""
+        if isinstance(self.zone, tuple) and any(lo > hi for lo, hi in self.zone):
+            raise FieldError(
+                self.key(), "zone", f" needs xmin <= xmax and ymin <= ymax, got {self.zone!r}"
+            )
         if self.side == "both" and self.foundation_stiffness is None:
-            raise InputError(
-                'obstacle.side = "both": a rigid obstacle on both sides of the plate is a '
-                "bilateral support (w = 0 in the zone), not an obstacle; give an edge its "
-                '[edges.NAME] support (e.g. support = "simply_supported"), or one side '
-                '("above" or "below"); "both" is for a foundation (foundation_stiffness)'
+            raise FieldError(
+                self.key(),
+                "side",
+                ' = "both": a rigid obstacle on both sides of the plate is a bilateral support '
+                "(w = 0 in the zone), not an obstacle; give an edge its [edges.NAME] support "
+                '(e.g. support = "simply_supported"), or one side ("above" or "below"); "both" '
+                "is for a foundation (foundation_stiffness)",
             )
-        _choice("obstacle.side", self.side, SIDES)
-        gap = _number("obstacle.gap", self.gap)
-        if not gap >= 0.0:
-            raise InputError(f"obstacle.gap must be >= 0 m, got {gap!r}")
-        if gap and self.foundation_stiffness is not None:
-            raise InputError(
-                "obstacle.gap: a gap is modelled for rigid obstacles only, not for a "
-                "foundation (foundation_stiffness)"
+        if self.gap and self.foundation_stiffness is not None:
+            raise FieldError(
+                self.key(),
+                "gap",
+                ": a gap is modelled for rigid obstacles only, not for a foundation "
+                "(foundation_stiffness)",
             )
-        object.__setattr__(self, "gap", gap)
 
     @property
     def sign(self) -> float:
@@ -122,24 +119,21 @@ class ObstacleSpec:
     @property
     def zone_key(self) -> str:
         """The problem file's key of the zone: "zone", "polygon" or "circle"."""
-        if isinstance(self.zone, Polygon):
-            return "polygon"
-        if isinstance(self.zone, Circle):
-            return "circle"
-        return "zone"
+        return self.zone.KEY if isinstance(self.zone, Polygon | Circle) else "zone"
 
     def describe(self) -> str:
         """Short human-readable description of the zone."""
-        if isinstance(self.zone, str):
+        zone = self.zone
+        if isinstance(zone, str):
             return "whole plate"
-        if isinstance(self.zone, Polygon):
-            return f"polygon of {len(self.zone.vertices)} vertices"
-        if isinstance(self.zone, Circle):
-            (cx, cy), r = self.zone.center, self.zone.radius
+        if isinstance(zone, Polygon):
+            return f"polygon of {len(zone.vertices)} vertices"
+        if isinstance(zone, Circle):
+            (cx, cy), r = zone.center, zone.radius
             return f"circle about ({cx:g}, {cy:g}) of radius {r:g}"
-        if callable(self.zone):
-            return f"predicate {getattr(self.zone, '__name__', 'zone')}"
-        (x0, x1), (y0, y1) = self.zone
+        if callable(zone):
+            return f"predicate {getattr(zone, '__name__', 'zone')}"
+        (x0, x1), (y0, y1) = zone
         return f"[{x0:g}, {x1:g}] x [{y0:g}, {y1:g}]"
 
     def contains(self, x: npt.NDArray[np.float64], size: float) -> npt.NDArray[np.bool_]:
@@ -147,18 +141,19 @@ class ObstacleSpec:
 
         Args:
             x: Point coordinates, shape (3, n).
-            size: Plate size, scales the default tolerance.
+            size: Plate size (m), scales the default tolerance.
         """
-        if isinstance(self.zone, str):
+        zone = self.zone
+        if isinstance(zone, str):
             return np.ones(x.shape[1], dtype=bool)
         tol = 1e-8 * size if self.tolerance is None else self.tolerance
-        if isinstance(self.zone, Polygon):
-            return points_in_polygon(x[:2].T, self.zone.vertices, tol)
-        if isinstance(self.zone, Circle):
-            return points_in_circle(x[:2].T, self.zone.center, self.zone.radius, tol)
-        if callable(self.zone):
-            return np.asarray(self.zone(x), dtype=bool)
-        (x0, x1), (y0, y1) = self.zone
+        if isinstance(zone, Polygon):
+            return points_in_polygon(x[:2].T, zone.vertices, tol)
+        if isinstance(zone, Circle):
+            return points_in_circle(x[:2].T, zone.center, zone.radius, tol)
+        if callable(zone):
+            return np.asarray(zone(x), dtype=bool)
+        (x0, x1), (y0, y1) = zone
         return (x[0] >= x0 - tol) & (x[0] <= x1 + tol) & (x[1] >= y0 - tol) & (x[1] <= y1 + tol)
 
     def same_zone(self, other: ObstacleSpec) -> bool:
@@ -166,36 +161,29 @@ class ObstacleSpec:
         return self.zone is other.zone or (not callable(self.zone) and self.zone == other.zone)
 
 
-@dataclass(frozen=True)
-class LoadSpec:
-    r"""The load besides the edge stresses: temperature rises, scaled and fixed.
+class LoadSpec(Table, frozen=True):
+    r"""The load besides the edge stresses: temperature rises, scaled and fixed (``[load]``).
 
     The prestress is :math:`N = N_{fixed} + \lambda N_{scaled}`: the scaled part is the
     edges' ``normal_stress`` and ``shear_stress`` (per unit load) with ``temperature``;
     the fixed part, applied as is, the edges' ``fixed_normal_stress`` and
     ``fixed_shear_stress`` (Pa) with ``fixed_temperature``, times ``fixed_factor``. A
-    temperature rise :math:`\Delta T` gives the free thermal strain
-    :math:`\alpha\Delta T I` (``[material] thermal_expansion``), which the edges'
-    in-plane conditions turn into a prestress. The buckling pencil is
-    :math:`(A - B_{fixed}, B_{scaled})`.
+    rise :math:`\Delta T` gives the free thermal strain :math:`\alpha\Delta T I`
+    (``[material] thermal_expansion``), which the edges' in-plane conditions turn into a
+    prestress. The buckling pencil is :math:`(A - B_{fixed}, B_{scaled})`.
 
     Args:
         temperature: The rise per unit load factor: a number (K, uniform) or
             ``(T0, dTdx, dTdy)``, the linear field :math:`T_0 + T_{,x} x + T_{,y} y` (K, K/m).
         fixed_temperature: A rise applied as is, the same forms.
-        fixed_factor: A factor on the whole fixed part (the fixed edge stresses and
-            ``fixed_temperature``), 1 by default: a sweep over it draws an interaction
-            curve with one ``--vary``; 0 switches the fixed part off.
+        fixed_factor: A factor on the whole fixed part, 1 by default (the fixed part as
+            given): a sweep over it draws an interaction curve; 0 switches it off.
     """
 
-    temperature: Temperature = 0.0
-    fixed_temperature: Temperature = 0.0
+    KEY: ClassVar[str] = "load"
+    temperature: Annotated[Temperature, Meta(extra={"unit": "K, K/m"})] = 0.0
+    fixed_temperature: Annotated[Temperature, Meta(extra={"unit": "K, K/m"})] = 0.0
     fixed_factor: float = 1.0
-
-    def __post_init__(self) -> None:
-        for name in ("temperature", "fixed_temperature"):
-            object.__setattr__(self, name, _temperature(f"load.{name}", getattr(self, name)))
-        object.__setattr__(self, "fixed_factor", _number("load.fixed_factor", self.fixed_factor))
 
     @property
     def thermal(self) -> bool:
@@ -208,30 +196,22 @@ class LoadSpec:
         return any(temperature_field(self.fixed_temperature))
 
 
-@dataclass(frozen=True)
-class DesignSpec:
-    r"""Design output by EN 1993-1-5 (:mod:`~unibuckle_fenicsx.design`).
+class DesignSpec(Table, frozen=True):
+    r"""Design output by EN 1993-1-5 (:mod:`~unibuckle_fenicsx.design`; ``[design]``).
 
     Args:
         yield_stress: :math:`f_y` (Pa), > 0.
-        partial_factor: :math:`\gamma_{M1}`, > 0 (1.0, the recommended value of
-            EN 1993-1-1, 6.1).
+        partial_factor: :math:`\gamma_{M1}`, > 0; 1.0, the recommended value of EN 1993-1-1,
+            6.1.
     """
 
-    yield_stress: float
-    partial_factor: float = 1.0
-
-    def __post_init__(self) -> None:
-        for name, unit in (("yield_stress", " Pa"), ("partial_factor", "")):
-            value = _number(f"design.{name}", getattr(self, name))
-            if not value > 0.0:
-                raise InputError(f"design.{name} must be > 0{unit}, got {value!r}")
-            object.__setattr__(self, name, value)
+    KEY: ClassVar[str] = "design"
+    yield_stress: Annotated[float, unit("Pa", gt=0)]
+    partial_factor: Annotated[float, Meta(gt=0)] = 1.0
 
 
-@dataclass(frozen=True)
-class PointSpec:
-    r"""Point restraints: one point, or a grid of them (bolts, tie bars, studs).
+class PointSpec(Table, frozen=True):
+    r"""Point restraints: one point, or a grid of them (bolts, tie bars, studs; ``[[points]]``).
 
     Each point acts on the mesh node nearest to it (the snap distance is reported).
 
@@ -240,11 +220,11 @@ class PointSpec:
         spacing: The grid's spacing (sx, sy) (m), > 0 (a number: the same in x and y).
         offset: A point of the grid (m); default the region's lower-left corner.
         region: The box ((xmin, xmax), (ymin, ymax)) (m) holding the grid's points (a
-            degenerate side gives a line); default the plate's bounding box. Points
-            outside the plate (or in a hole) are left out.
-        kind: One of :data:`POINT_KINDS`: "bilateral" (w = 0), "one-sided" (the
-            obstacle's cone at the point: w <= 0 with ``side`` "above", w >= 0
-            "below"), "spring" (a spring of ``stiffness`` N/m to w = 0).
+            degenerate side gives a line); default the plate's bounding box. Points outside
+            the plate (or in a hole) are left out.
+        kind: One of :data:`POINT_KINDS`: "bilateral" (w = 0), "one-sided" (the obstacle's
+            cone at the point: w <= 0 with ``side`` "above", w >= 0 "below"), "spring" (a
+            spring of ``stiffness`` N/m to w = 0).
         stiffness: The spring's stiffness (N/m), > 0, for ``kind = "spring"`` only.
         side: "above" (w <= 0 at the point) or "below" (w >= 0), for ``kind =
             "one-sided"`` only, where it is required: the side decides which half of the
@@ -252,57 +232,52 @@ class PointSpec:
             stud under the plate and a bolt head over it.
     """
 
-    at: tuple[float, float] | None = None
-    spacing: tuple[float, float] | None = None
-    offset: tuple[float, float] | None = None
-    region: Box | None = None
-    kind: str = "bilateral"
-    stiffness: float | None = None
-    side: str | None = None
+    KEY: ClassVar[str] = "points"
+    kind: Kind = "bilateral"
+    at: Annotated[Point, unit("m")] | None = None
+    spacing: (
+        Annotated[Spacing, Meta(extra={"unit": "m", "form": "a number or [sx, sy]"})] | None
+    ) = None
+    offset: Annotated[Point, unit("m")] | None = None
+    region: Boxed | None = None
+    stiffness: Annotated[float, unit("N/m", gt=0)] | None = None
+    side: Literal["above", "below"] | None = None
 
-    def __post_init__(self) -> None:
-        where = "points"
-        _choice(f"{where}.kind", self.kind, POINT_KINDS)
+    def check(self) -> None:
+        """The rules between this table's fields."""
         if (self.at is None) == (self.spacing is None):
-            raise InputError(
-                "[[points]] needs at = [x, y] (one point) or spacing = s or [sx, sy] (a "
-                "grid, with optional offset and region): exactly one of them"
+            raise FieldError(
+                self.key(),
+                "",
+                " needs at = [x, y] (one point) or spacing = s or [sx, sy] (a grid, with "
+                "optional offset and region): exactly one of them",
             )
-        if self.at is not None:
-            object.__setattr__(self, "at", _pair(f"{where}.at", self.at))
-            for name in ("offset", "region"):
-                if getattr(self, name) is not None:
-                    raise InputError(f"{where}.{name} belongs to a grid (spacing), not to at")
-        else:
-            spacing: Any = self.spacing
-            if not isinstance(spacing, list | tuple):
-                spacing = (spacing, spacing)
-            pair = _pair(f"{where}.spacing", spacing)
-            if min(pair) <= 0.0:
-                raise InputError(f"{where}.spacing must be > 0 m, got {self.spacing!r}")
-            object.__setattr__(self, "spacing", pair)
-            if self.offset is not None:
-                object.__setattr__(self, "offset", _pair(f"{where}.offset", self.offset))
-            if self.region is not None:
-                object.__setattr__(self, "region", _box(f"{where}.region", self.region))
-        if self.kind == "spring":
-            if self.stiffness is None or not _number(f"{where}.stiffness", self.stiffness) > 0:
-                raise InputError(
-                    f'{where}.stiffness: kind = "spring" needs a stiffness > 0 N/m, got '
-                    f"{self.stiffness!r}"
-                )
-            object.__setattr__(self, "stiffness", float(self.stiffness))
-        elif self.stiffness is not None:
-            raise InputError(f'{where}.stiffness belongs to kind = "spring", not "{self.kind}"')
+        if self.at is not None and (self.offset, self.region) != (None, None):
+            name = "offset" if self.offset is not None else "region"
+            raise FieldError(self.key(), name, " belongs to a grid (spacing), not to at")
+        if isinstance(self.spacing, float | int):  # the same in x and y
+            force_setattr(self, "spacing", (self.spacing, self.spacing))
+        if self.spacing is not None and min(self.spacing) <= 0.0:
+            raise FieldError(self.key(), "spacing", f" must be > 0 m, got {plain(self.spacing)!r}")
+        if (self.kind == "spring") != (self.stiffness is not None):
+            raise FieldError(
+                self.key(),
+                "stiffness",
+                f': kind = "spring" needs a stiffness > 0 N/m, got {self.stiffness!r}'
+                if self.kind == "spring"
+                else f' belongs to kind = "spring", not "{self.kind}"',
+            )
         if self.kind == "one-sided" and self.side is None:
-            raise InputError(
-                f'{where}.side: kind = "one-sided" needs side = "above" (the point holds the '
-                'plate from above: w <= 0) or "below" (from below: w >= 0)'
+            raise FieldError(
+                self.key(),
+                "side",
+                ': kind = "one-sided" needs side = "above" (the point holds the plate from '
+                'above: w <= 0) or "below" (from below: w >= 0)',
             )
-        if self.side is not None:
-            _choice(f"{where}.side", self.side, ("above", "below"))
-            if self.kind != "one-sided":
-                raise InputError(f'{where}.side belongs to kind = "one-sided", not "{self.kind}"')
+        if self.side is not None and self.kind != "one-sided":
+            raise FieldError(
+                self.key(), "side", f' belongs to kind = "one-sided", not "{self.kind}"'
+            )
 
     @property
     def sign(self) -> float:
@@ -313,18 +288,15 @@ class PointSpec:
         """The points (n, 2) (m): ``at``, or the grid's points inside the plate.
 
         Raises:
-            ValueError: ``at`` outside the plate, or a grid with no point in it.
+            InputError: ``at`` outside the plate, or a grid with no point in it.
         """
-        size = max(plate.length, plate.width)
-        tol = 1e-9 * size
+        tol = 1e-9 * max(plate.length, plate.width)
         if self.at is not None:
             points = np.array([self.at])
         else:
             assert self.spacing is not None
-            region = (
-                self.region if self.region is not None else tuple(zip(*plate.corners, strict=True))
-            )
-            offset = self.offset if self.offset is not None else (region[0][0], region[1][0])
+            region = self.region or tuple(zip(*plate.corners, strict=True))
+            offset = self.offset or (region[0][0], region[1][0])
             axes = []
             for (lo, hi), step, start in zip(region, self.spacing, offset, strict=True):
                 first = math.ceil((lo - start - tol) / step)
@@ -339,19 +311,18 @@ class PointSpec:
         inside = plate.contains(points, tol) if plate.file is None else np.ones(len(points), bool)
         if self.at is not None and not inside.all():
             raise InputError(f"points.at {list(self.at)} lies outside the plate (or in a hole)")
-        points = points[inside]
-        if not len(points):
+        if not inside.any():
             raise InputError(
-                f"points: the grid of spacing {list(self.spacing or ())} holds no point of "
-                "the plate; check spacing, offset and region"
+                f"points: the grid of spacing {list(self.spacing or ())} holds no point of the "
+                "plate; check spacing, offset and region"
             )
-        return points
+        return points[inside]
 
     def describe(self, units: str = "SI") -> str:
         """Short description (for messages and the summary), in ``units`` (:data:`UNITS`)."""
         metres = UNITS[units][0]  # metres per length unit
         length = "m" if metres == 1.0 else "mm"
-        what = self.kind
+        what: str = self.kind
         if self.kind == "spring":
             what = f"spring {self.stiffness * metres:g} N/{length}"  # type: ignore[operator]
         if self.kind == "one-sided":

@@ -1,20 +1,19 @@
-"""The plate: rectangle, outline, holes or gmsh file; its edges and its mesh.
-
-The geometry rules (a simple outline, holes inside and disjoint, segments named once)
-are checked here by hand: no schema library knows them.
-"""
+"""The plate: rectangle, outline, holes or gmsh file; its edges and its mesh."""
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field, replace
+import typing
 from pathlib import Path
-from typing import Any
+from typing import Annotated, ClassVar, Literal
 
+import msgspec
 import numpy as np
 import numpy.typing as npt
+from msgspec import Meta
+from msgspec.structs import force_setattr, replace
 
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.errors import FieldError, InputError
 from unibuckle_fenicsx.geometry import (
     circle_points,
     distance_to_polygon,
@@ -25,182 +24,148 @@ from unibuckle_fenicsx.geometry import (
     polygon_inside,
     polygons_disjoint,
 )
-from unibuckle_fenicsx.spec.checks import check_features, check_thickness
-from unibuckle_fenicsx.spec.values import (
-    BENDING_SUPPORTS,
-    HOLES,
-    INPLANE_SUPPORTS,
-    _choice,
-    _integer,
-    _number,
-    _stress,
-    stress_ends,
-)
+from unibuckle_fenicsx.spec.base import Point, Stress, Table, stress_ends, unit
+
+#: Edge names of a rectangular plate, in facet-tag order 1..4.
+EDGE_NAMES = ("left", "right", "bottom", "top")
+#: Name of the holes' boundary part in ``[edges.*]``.
+HOLES = "holes"
+Support = Literal["simply_supported", "simply_supported_soft", "clamped", "free"]
+Inplane = Literal["free", "clamped", "roller"]
+#: Transverse (bending) conditions. "simply_supported" is the *hard* support of a
+#: Reissner-Mindlin plate (w = 0 and tangential rotation = 0); "soft" fixes w only.
+BENDING_SUPPORTS: tuple[str, ...] = typing.get_args(Support)
+#: In-plane conditions for the prestress solve ("roller": the normal displacement only).
+INPLANE_SUPPORTS: tuple[str, ...] = typing.get_args(Inplane)
+#: Above this thickness over the plate's smaller side, a warning: Reissner-Mindlin
+#: theory (transverse shear, plane sections, no thickness stretch) is the usual model of
+#: moderately thick plates up to t/b of about 0.2.
+THICK_PLATE_RATIO = 0.2
+#: Above this thickness over the plate's smaller side the body is not a plate: refused.
+MAX_THICKNESS_RATIO = 0.5
+
+Length = Annotated[float, unit("m", gt=0)]
+Vertices = Annotated[
+    tuple[Point, ...], Meta(min_length=3, extra={"unit": "m", "form": "[[x, y], ...] (3 or more)"})
+]
 
 
-@dataclass(frozen=True)
-class Circle:
-    """A circular zone: the closed disc of ``radius`` about ``center`` (m)."""
+class Circle(Table, frozen=True, tag_field="shape", tag="circle"):
+    """A circular zone: the closed disc of ``radius`` about ``center``.
 
-    center: tuple[float, float]
-    radius: float
+    Args:
+        center: The centre [x, y] (m).
+        radius: The radius (m), > 0.
+    """
 
-    def __post_init__(self) -> None:
-        try:
-            cx, cy = self.center
-        except (TypeError, ValueError):
-            raise InputError(f"circle.center must be [x, y], got {self.center!r}") from None
-        object.__setattr__(
-            self, "center", (_number("circle.center", cx), _number("circle.center", cy))
-        )
-        if not _number("circle.radius", self.radius) > 0.0:
-            raise InputError(f"circle.radius must be > 0 m, got {self.radius!r}")
-        object.__setattr__(self, "radius", float(self.radius))
+    KEY: ClassVar[str] = "circle"
+    center: Annotated[Point, unit("m")]
+    radius: Length
 
 
-@dataclass(frozen=True)
-class Polygon:
-    """A polygonal zone: the closed simple polygon of ``vertices`` (m), at least three."""
+class Polygon(Table, frozen=True, tag_field="shape", tag="polygon"):
+    """A polygonal zone: the closed simple polygon of ``vertices``.
 
-    vertices: tuple[tuple[float, float], ...]
+    Args:
+        vertices: The vertices [[x, y], ...] (m), at least three, of a simple polygon.
+    """
 
-    def __post_init__(self) -> None:
-        object.__setattr__(self, "vertices", _polygon("polygon", self.vertices))
+    KEY: ClassVar[str] = "polygon"
+    vertices: Vertices
+
+    def check(self) -> None:
+        """The rules between this table's fields."""
+        if (why := polygon_fault(self.vertices)) is not None:
+            raise FieldError(self.key(), "vertices", why)
 
 
-def _polygon(name: str, value: Any) -> tuple[tuple[float, float], ...]:
-    """A simple polygon of at least three vertices [[x, y], ...] with a non-zero area."""
-    if not isinstance(value, list | tuple) or len(value) < 3:
-        raise InputError(f"{name} must be a list of at least 3 points [[x, y], ...], got {value!r}")
-    vertices = []
-    for point in value:
-        if not isinstance(point, list | tuple) or len(point) != 2:
-            raise InputError(f"{name}: each vertex must be a point [x, y], got {point!r}")
-        vertices.append((_number(name, point[0]), _number(name, point[1])))
+def polygon_fault(vertices: tuple[Point, ...]) -> str | None:
+    """Why ``vertices`` are not a simple polygon with an area, or None."""
     if not is_simple(vertices):
-        raise InputError(
-            f"{name} must be a simple polygon (no repeated vertex, no self-intersection), "
-            f"got {value!r}"
-        )
+        return " must be a simple polygon (no repeated vertex, no self-intersection)"
     size = float(np.ptp(np.asarray(vertices), axis=0).max())
     if abs(polygon_area(vertices)) <= 1e-12 * size * size:
-        raise InputError(f"{name} has no area (collinear vertices), got {value!r}")
-    return tuple(vertices)
+        return " has no area (collinear vertices)"
+    return None
 
 
-@dataclass(frozen=True)
-class EdgeSpec:
-    r"""Conditions on one edge part.
+Segments = Annotated[
+    tuple[Annotated[int, Meta(ge=0)], ...],
+    Meta(min_length=1, extra={"form": "a list of outline segments [k, ...]"}),
+]
+
+
+class EdgeSpec(Table, frozen=True):
+    r"""Conditions on one edge part (the file's ``[edges.NAME]``).
 
     Args:
         name: Edge name; for the rectangle one of :data:`EDGE_NAMES`.
         support: Transverse condition, one of :data:`BENDING_SUPPORTS`.
-        inplane: In-plane condition for the prestress, one of :data:`INPLANE_SUPPORTS`
-            ("roller" fixes the normal displacement only).
-        normal_stress: Normal edge stress per unit load (Pa/Pa), tension positive;
-            the paper's compressed edges have -1. A pair ``(start, end)`` varies
-            linearly along the edge (:func:`~unibuckle_fenicsx.model.mesh.edge_line` gives
-            the direction): in-plane bending is ``(1, -1)``, the stress-gradient ratio
-            of design codes is :math:`\psi` = end/start.
+        inplane: In-plane condition for the prestress, one of :data:`INPLANE_SUPPORTS`.
+        normal_stress: Normal edge stress per unit load (Pa/Pa), tension positive; the
+            paper's compressed edges have -1. A pair ``(start, end)`` varies linearly along
+            the edge (:func:`~unibuckle_fenicsx.model.mesh.edge_line` gives the direction):
+            in-plane bending is ``(1, -1)``, the stress-gradient ratio of design codes is
+            :math:`\psi` = end/start.
         shear_stress: Tangential edge stress per unit load (Pa/Pa), along the
             counter-clockwise tangent; a number or a pair, as ``normal_stress``.
-        tag: Facet tag of this edge in a user-supplied mesh; ``None`` for the
-            rectangle (tags 1..4 in :data:`EDGE_NAMES` order).
+        rotational_stiffness: Elastic restraint of the rotation about the edge, :math:`k_r`
+            (N m per m per rad, i.e. N), >= 0: the energy :math:`\tfrac12\int k_r
+            (\theta\cdot n)^2\,ds` on an edge whose support leaves that rotation free (not
+            "clamped"). 0: none; :math:`k_r \to \infty`: clamped.
+        translational_stiffness: Elastic support of the deflection along the edge,
+            :math:`k_t` (N/m per m, i.e. N/m^2), >= 0: :math:`\tfrac12\int k_t w^2\,ds` on
+            an edge whose support is "free". :math:`k_t \to \infty`: the soft simple support.
+        fixed_normal_stress: Normal edge stress (Pa) applied as is, not scaled by the load
+            factor (the fixed part of the load, :class:`LoadSpec`); a number or a pair.
+        fixed_shear_stress: Tangential edge stress (Pa) applied as is.
         segments: The outline segments forming this boundary part (segment k runs from
             vertex k to vertex k + 1), for a plate given by its ``outline``.
-        rotational_stiffness: Elastic restraint of the rotation about the edge,
-            :math:`k_r` (N m per m per rad, i.e. N), >= 0: the energy
-            :math:`\tfrac12\int k_r (\theta\cdot n)^2\,ds`, on an edge whose support leaves
-            that rotation free (not "clamped"). 0: none; :math:`k_r \to \infty`: clamped.
-        translational_stiffness: Elastic support of the deflection along the edge,
-            :math:`k_t` (N/m per m, i.e. N/m^2), >= 0: :math:`\tfrac12\int k_t w^2\,ds`,
-            on an edge whose support leaves w free ("free"). :math:`k_t \to \infty`:
-            the soft simple support.
-        fixed_normal_stress: Normal edge stress (Pa) applied as is, not scaled by the
-            load factor (the fixed part of the load, :class:`LoadSpec`); a number or a
-            pair, as ``normal_stress``.
-        fixed_shear_stress: Tangential edge stress (Pa) applied as is.
+        tag: Facet tag of this edge in a user-supplied mesh (the Python API only); ``None``
+            for the rectangle (tags 1..4 in :data:`EDGE_NAMES` order).
     """
 
-    name: str
-    support: str = "simply_supported"
-    inplane: str = "free"
-    normal_stress: float | tuple[float, float] = 0.0
-    shear_stress: float | tuple[float, float] = 0.0
-    tag: int | None = None
-    segments: tuple[int, ...] | None = None
-    rotational_stiffness: float = 0.0
-    translational_stiffness: float = 0.0
-    fixed_normal_stress: float | tuple[float, float] = 0.0
-    fixed_shear_stress: float | tuple[float, float] = 0.0
+    CODE_ONLY: ClassVar[tuple[str, ...]] = ("name", "tag")
+    name: Annotated[str, Meta(min_length=1)]
+    support: Support = "simply_supported"
+    inplane: Inplane = "free"
+    normal_stress: Stress = 0.0
+    shear_stress: Stress = 0.0
+    rotational_stiffness: Annotated[float, unit("N", ge=0)] = 0.0  # N in every system
+    translational_stiffness: Annotated[float, unit("N/m^2", ge=0)] = 0.0
+    fixed_normal_stress: Annotated[Stress, unit("Pa")] = 0.0
+    fixed_shear_stress: Annotated[Stress, unit("Pa")] = 0.0
+    segments: Segments | None = None
+    tag: Annotated[int, Meta(ge=0)] | None = None
 
-    def __post_init__(self) -> None:
-        where = f"edges.{self.name}"
-        if not isinstance(self.name, str) or not self.name:
-            raise InputError(f"edge names must be non-empty strings, got {self.name!r}")
-        _choice(f"{where}.support", self.support, BENDING_SUPPORTS)
-        _choice(f"{where}.inplane", self.inplane, INPLANE_SUPPORTS)
-        for name in ("normal_stress", "shear_stress", "fixed_normal_stress", "fixed_shear_stress"):
-            object.__setattr__(self, name, _stress(f"{where}.{name}", getattr(self, name)))
-        if self.tag is not None:
-            _integer(f"{where}.tag", self.tag, 0)
-        if self.segments is not None:
-            if not isinstance(self.segments, list | tuple) or not self.segments:
-                raise InputError(
-                    f"{where}.segments must be a non-empty list of outline segment numbers "
-                    f"[k, ...], got {self.segments!r}"
-                )
-            segments = tuple(_integer(f"{where}.segments", k, 0) for k in self.segments)
-            if len(set(segments)) != len(segments):
-                raise InputError(f"{where}.segments repeats a segment: {list(segments)}")
-            object.__setattr__(self, "segments", segments)
-        self._check_springs(where)
+    def key(self) -> str:
+        """``edges.NAME``."""
+        return f"edges.{self.name}" if self.name else "edges"
 
-    def _check_springs(self, where: str) -> None:
-        """The edge springs: finite, >= 0, on DOFs the support leaves free."""
-        for name in ("rotational_stiffness", "translational_stiffness"):
-            if not _number(f"{where}.{name}", getattr(self, name)) >= 0.0:
-                raise InputError(
-                    f"{where}.{name} must be >= 0 (0: no spring), got {getattr(self, name)!r}"
-                )
-            object.__setattr__(self, name, float(getattr(self, name)))
+    def check(self) -> None:
+        """The rules between this table's fields."""
+        if self.segments is not None and len(set(self.segments)) != len(self.segments):
+            raise FieldError(self.key(), "segments", f" repeats a segment: {list(self.segments)}")
         if self.rotational_stiffness > 0.0 and self.support == "clamped":
-            raise InputError(
-                f'{where}.rotational_stiffness: support = "clamped" fixes the rotation '
-                "already; a rotational spring needs a support that leaves it free "
-                '("simply_supported", "simply_supported_soft" or "free")'
+            raise FieldError(
+                self.key(),
+                "rotational_stiffness",
+                ': support = "clamped" fixes the rotation already; a rotational spring '
+                'needs a support that leaves it free ("simply_supported", '
+                '"simply_supported_soft" or "free")',
             )
         if self.translational_stiffness > 0.0 and self.support != "free":
-            raise InputError(
-                f'{where}.translational_stiffness: support = "{self.support}" fixes the '
-                'deflection already; an elastically supported edge has support = "free"'
+            raise FieldError(
+                self.key(),
+                "translational_stiffness",
+                f': support = "{self.support}" fixes the deflection already; an elastically '
+                'supported edge has support = "free"',
             )
 
     @property
     def springs(self) -> bool:
         """Whether the edge carries a rotational or a translational spring."""
         return self.rotational_stiffness > 0.0 or self.translational_stiffness > 0.0
-
-    @property
-    def loaded(self) -> bool:
-        r"""Whether this edge carries a traction (belongs to :math:`\gamma_1`)."""
-        return any(v != 0.0 for v in (*self.normal_ends, *self.shear_ends))
-
-    @property
-    def fixed_loaded(self) -> bool:
-        """Whether the edge carries a fixed traction."""
-        ends = (*stress_ends(self.fixed_normal_stress), *stress_ends(self.fixed_shear_stress))
-        return any(v != 0.0 for v in ends)
-
-    def fixed_part(self) -> EdgeSpec:
-        """This edge with its fixed stresses as the stresses (and no fixed part)."""
-        return replace(
-            self,
-            normal_stress=self.fixed_normal_stress,
-            shear_stress=self.fixed_shear_stress,
-            fixed_normal_stress=0.0,
-            fixed_shear_stress=0.0,
-        )
 
     @property
     def normal_ends(self) -> tuple[float, float]:
@@ -213,6 +178,17 @@ class EdgeSpec:
         return stress_ends(self.shear_stress)
 
     @property
+    def loaded(self) -> bool:
+        r"""Whether this edge carries a traction (belongs to :math:`\gamma_1`)."""
+        return any(v != 0.0 for v in (*self.normal_ends, *self.shear_ends))
+
+    @property
+    def fixed_loaded(self) -> bool:
+        """Whether the edge carries a fixed traction."""
+        ends = (*stress_ends(self.fixed_normal_stress), *stress_ends(self.fixed_shear_stress))
+        return any(v != 0.0 for v in ends)
+
+    @property
     def uniform(self) -> bool:
         """Whether both stresses are constant along the edge."""
         return all(a == b for a, b in (self.normal_ends, self.shear_ends))
@@ -220,6 +196,16 @@ class EdgeSpec:
     def max_stress(self) -> float:
         """The largest absolute edge stress per unit load (normal or shear, either end)."""
         return max(abs(v) for v in (*self.normal_ends, *self.shear_ends))
+
+    def fixed_part(self) -> EdgeSpec:
+        """This edge with its fixed stresses as the stresses (and no fixed part)."""
+        return replace(
+            self,
+            normal_stress=self.fixed_normal_stress,
+            shear_stress=self.fixed_shear_stress,
+            fixed_normal_stress=0.0,
+            fixed_shear_stress=0.0,
+        )
 
 
 def paper_edges() -> tuple[EdgeSpec, ...]:
@@ -232,9 +218,8 @@ def paper_edges() -> tuple[EdgeSpec, ...]:
     )
 
 
-@dataclass(frozen=True)
-class PlateSpec:
-    """Geometry and edge conditions of the plate.
+class PlateSpec(Table, frozen=True):
+    """Geometry and edge conditions of the plate (the file's ``[plate]`` and ``[edges.*]``).
 
     The plate is the rectangle of ``corners`` (a structured mesh), or, meshed by gmsh
     with quadrilaterals, the polygon ``outline``, the rectangle or the outline with
@@ -244,137 +229,129 @@ class PlateSpec:
         corners: Opposite corners ``((x0, y0), (x1, y1))`` of the rectangle (m); for an
             outline, its bounding box (set from it); for a file, its bounding box once
             meshed.
-        thickness: Plate thickness t = 2 epsilon (m), > 0.
+        thickness: Plate thickness t = 2 epsilon (m), > 0, at most
+            :data:`MAX_THICKNESS_RATIO` times the smaller side.
         edges: One :class:`EdgeSpec` per edge part: the rectangle's are named as in
-            :data:`EDGE_NAMES`, an outline's parts by their ``segments``, a file's by
-            its physical groups of dimension 1; the part ``holes`` is the holes'
-            boundary. Boundary parts not named are free.
+            :data:`EDGE_NAMES`, an outline's parts by their ``segments``, a file's by its
+            physical groups of dimension 1; the part ``holes`` is the holes' boundary.
+            Boundary parts not named are free.
         outline: A simple polygon [(x, y), ...] (m), at least three vertices; segment k
             runs from vertex k to vertex k + 1 (the last back to the first).
-        holes: :class:`Circle` or :class:`Polygon` holes inside the plate, disjoint.
+        holes: :class:`Circle` or :class:`Polygon` holes inside the plate, disjoint (in a
+            file a table with center and radius, or with outline).
         file: A gmsh ``.geo`` (meshed with quadrilaterals) or ``.msh`` (its
             quadrilaterals) file with a physical surface and named physical curves.
     """
 
-    corners: tuple[tuple[float, float], tuple[float, float]] = ((-0.1, -0.05), (0.1, 0.05))
-    thickness: float = 0.006
-    edges: tuple[EdgeSpec, ...] = field(default_factory=paper_edges)
-    outline: tuple[tuple[float, float], ...] | None = None
-    holes: tuple[Circle | Polygon, ...] = ()
+    KEY: ClassVar[str] = "plate"
+    CODE_ONLY: ClassVar[tuple[str, ...]] = ("edges",)
+    thickness: Length = 0.006
+    corners: Annotated[
+        tuple[Point, Point], Meta(extra={"unit": "m", "form": "[[x0, y0], [x1, y1]]"})
+    ] = ((-0.1, -0.05), (0.1, 0.05))
+    outline: Vertices | None = None
     file: str | None = None
+    holes: tuple[Circle | Polygon, ...] = ()
+    edges: tuple[EdgeSpec, ...] = msgspec.field(default_factory=paper_edges)
 
-    def __post_init__(self) -> None:
-        if not _number("plate.thickness", self.thickness) > 0.0:
-            raise InputError(f"plate.thickness must be > 0 m, got {self.thickness!r}")
-        object.__setattr__(self, "thickness", float(self.thickness))
+    def check(self) -> None:
+        """The rules between this table's fields."""
         if self.outline is not None:
-            outline = _polygon("plate.outline", self.outline)
-            object.__setattr__(self, "outline", outline)
-            v = np.asarray(outline)
-            lo, hi = v.min(axis=0), v.max(axis=0)
-            object.__setattr__(
-                self, "corners", ((float(lo[0]), float(lo[1])), (float(hi[0]), float(hi[1])))
+            if (why := polygon_fault(self.outline)) is not None:
+                raise FieldError(self.key(), "outline", why)
+            v = np.asarray(self.outline)
+            lo, hi = v.min(axis=0).tolist(), v.max(axis=0).tolist()
+            force_setattr(self, "corners", ((lo[0], lo[1]), (hi[0], hi[1])))
+        (x0, y0), (x1, y1) = self.corners
+        if not (x1 > x0 and y1 > y0):
+            raise FieldError(
+                self.key(),
+                "corners",
+                " must satisfy x1 > x0 and y1 > y0 (a non-degenerate rectangle), got "
+                f"{self.corners!r}",
             )
-        try:
-            (x0, y0), (x1, y1) = self.corners
-        except (TypeError, ValueError):
-            raise InputError(
-                f"plate.corners must be [[x0, y0], [x1, y1]], got {self.corners!r}"
-            ) from None
-        corners = (
-            (_number("plate.corners", x0), _number("plate.corners", y0)),
-            (_number("plate.corners", x1), _number("plate.corners", y1)),
-        )
-        object.__setattr__(self, "corners", corners)
-        if not (corners[1][0] > corners[0][0] and corners[1][1] > corners[0][1]):
-            raise InputError(
-                "plate.corners must satisfy x1 > x0 and y1 > y0 (a non-degenerate "
-                f"rectangle), got {self.corners!r}"
-            )
-        object.__setattr__(self, "edges", tuple(self.edges))
         names = [e.name for e in self.edges]
         if len(set(names)) != len(names):
-            raise InputError(f"plate.edges: duplicate edge names {names}")
+            raise FieldError(self.key(), "edges", f": duplicate edge names {names}")
         self._check_file()
         self._check_holes()
         self._check_edges()
-        check_thickness(self)
+        b = min(self.length, self.width)
+        if self.file is None and self.thickness > MAX_THICKNESS_RATIO * b:
+            raise FieldError(
+                self.key(),
+                "thickness",
+                f" = {self.thickness:g} m is {self.thickness / b:.3g} times the plate's smaller "
+                f"side {b:g} m: not a plate; plate.thickness must be at most "
+                f"{MAX_THICKNESS_RATIO:g} times it (Reissner-Mindlin theory is a model of "
+                f"plates up to t/b of about {THICK_PLATE_RATIO:g})",
+            )
 
     def _check_file(self) -> None:
         if self.file is None:
             return
-        if not isinstance(self.file, str) or Path(self.file).suffix.lower() not in (
-            ".geo",
-            ".msh",
-        ):
-            raise InputError(f"plate.file must be a gmsh .geo or .msh file, got {self.file!r}")
+        if Path(self.file).suffix.lower() not in (".geo", ".msh"):
+            raise FieldError(
+                self.key(), "file", f" must be a gmsh .geo or .msh file, got {self.file!r}"
+            )
         if self.outline is not None or self.holes:
-            raise InputError("plate.file: give a file, or an outline and holes, not both")
+            raise FieldError(self.key(), "file", ": give a file, or an outline and holes, not both")
         if not Path(self.file).is_file():
-            raise InputError(f"plate.file: no such file {self.file!r}")
+            raise FieldError(self.key(), "file", f": no such file {self.file!r}")
 
     def _check_holes(self) -> None:
-        holes = tuple(self.holes)
-        object.__setattr__(self, "holes", holes)
         outer = self.boundary
-        for k, hole in enumerate(holes):
-            where = f"plate.holes[{k}]"
+        for k, hole in enumerate(self.holes):
             if isinstance(hole, Circle):
                 center = np.array([hole.center])
-                inside = (
-                    bool(points_in_polygon(center, outer)[0])
-                    and float(distance_to_polygon(center, outer)[0]) > hole.radius
+                inside = bool(points_in_polygon(center, outer)[0]) and (
+                    float(distance_to_polygon(center, outer)[0]) > hole.radius
                 )
-            elif isinstance(hole, Polygon):
-                inside = polygon_inside(hole.vertices, outer)
             else:
-                raise InputError(f"{where} must be a Circle or a Polygon, got {hole!r}")
+                inside = polygon_inside(hole.vertices, outer)
             if not inside:
-                raise InputError(f"{where} must lie inside the plate, without touching its edge")
+                raise FieldError(
+                    self.key(),
+                    f"holes[{k}]",
+                    " must lie inside the plate, without touching its edge",
+                )
             for j in range(k):
-                if not _disjoint(holes[j], hole):
-                    raise InputError(f"plate.holes[{j}] and {where} overlap or touch")
-        check_features(self, None)  # touching within rounding (a tangent hole)
+                if not _disjoint(self.holes[j], hole):
+                    raise FieldError(
+                        self.key(), f"holes[{j}]", f" and plate.holes[{k}] overlap or touch"
+                    )
 
     def _check_edges(self) -> None:
-        count = len(self.outline) if self.outline is not None else 0
+        """Each edge part's name or segments belong to this plate."""
         used: dict[int, str] = {}
+        count = len(self.outline) if self.outline is not None else 0
         for e in self.edges:
-            where = f"edges.{e.name}"
-            if e.name == HOLES and e.tag is None:
-                if not self.holes:
-                    raise InputError(f"{where}: the plate has no holes (plate.holes)")
-                if e.segments is not None:
-                    raise InputError(f"{where}: the holes' boundary takes no segments")
-                if not e.uniform:
-                    raise InputError(
-                        f"{where}: a linear [start, end] stress needs a straight edge; give "
-                        "the holes a number"
-                    )
+            if e.tag is not None or self.file is not None:
                 continue
-            if e.segments is not None:
-                if self.outline is None:
-                    raise InputError(
-                        f"{where}.segments names segments of plate.outline, which this "
-                        "plate does not have"
-                    )
-                for k in e.segments:
-                    if k >= count:
-                        raise InputError(
-                            f"{where}.segments: {k} is not a segment of the outline (0 to "
-                            f"{count - 1}: segment k runs from vertex k to vertex k + 1)"
-                        )
-                    if k in used:
-                        raise InputError(
-                            f"{where}.segments: segment {k} is already in edges.{used[k]}"
-                        )
-                    used[k] = e.name
-            elif self.outline is not None and e.tag is None:
+            where = f"edges.{e.name}"
+            allowed = [*EDGE_NAMES, HOLES] if self.holes else list(EDGE_NAMES)
+            if self.outline is None and e.name not in allowed:
+                raise InputError(f"unknown key(s) [{e.name!r}] in [edges]; allowed: {allowed}")
+            if e.name == HOLES:
+                _check_holes_edge(e, bool(self.holes))
+            elif (self.outline is None) != (e.segments is None):
                 raise InputError(
-                    f"{where}: a plate given by its outline names its boundary parts by "
-                    f"segments = [k, ...] (outline segments 0 to {count - 1}), or "
-                    f"{HOLES!r} for the holes"
+                    f"{where}.segments names segments of plate.outline, which this plate does "
+                    "not have"
+                    if self.outline is None
+                    else f"{where}: a plate given by its outline names its boundary parts by "
+                    f"segments = [k, ...] (outline segments 0 to {count - 1}), or {HOLES!r} for "
+                    "the holes"
                 )
+            for k in e.segments or ():
+                if k >= count:
+                    raise InputError(
+                        f"{where}.segments: {k} is not a segment of the outline (0 to "
+                        f"{count - 1}: segment k runs from vertex k to vertex k + 1)"
+                    )
+                if k in used:
+                    raise InputError(f"{where}.segments: segment {k} is already in edges.{used[k]}")
+                used[k] = e.name
 
     @property
     def meshed_by_gmsh(self) -> bool:
@@ -382,11 +359,8 @@ class PlateSpec:
         return self.outline is not None or bool(self.holes) or self.file is not None
 
     @property
-    def boundary(self) -> tuple[tuple[float, float], ...]:
-        """The outer boundary as a polygon: the outline, or the rectangle's four corners.
-
-        For a file, the bounding box.
-        """
+    def boundary(self) -> tuple[Point, ...]:
+        """The outer boundary as a polygon: the outline, or the rectangle's (a file's box)."""
         if self.outline is not None:
             return self.outline
         (x0, y0), (x1, y1) = self.corners
@@ -413,10 +387,6 @@ class PlateSpec:
         """Extent in y (m)."""
         return self.corners[1][1] - self.corners[0][1]
 
-    def fixed_part(self) -> PlateSpec:
-        """The plate with its edges' fixed stresses as the stresses (for the fixed prestress)."""
-        return replace(self, edges=tuple(e.fixed_part() for e in self.edges))
-
     @property
     def loaded(self) -> bool:
         """Whether an edge carries a stress per unit load (scaled by lambda)."""
@@ -426,6 +396,10 @@ class PlateSpec:
     def fixed_loaded(self) -> bool:
         """Whether an edge carries a fixed stress."""
         return any(e.fixed_loaded for e in self.edges)
+
+    def fixed_part(self) -> PlateSpec:
+        """The plate with its edges' fixed stresses as the stresses (for the fixed prestress)."""
+        return replace(self, edges=tuple(e.fixed_part() for e in self.edges))
 
     def contains(self, points: npt.NDArray[np.float64], tol: float) -> npt.NDArray[np.bool_]:
         """Mask of the points (n, 2) in the closed plate (within ``tol``), not in a hole.
@@ -450,39 +424,41 @@ class PlateSpec:
         raise KeyError(f"plate has no edge {name!r}; edges: {[e.name for e in self.edges]}")
 
 
-@dataclass(frozen=True)
-class MeshSpec:
-    """Structured quadrilateral mesh of the rectangle.
+def _check_holes_edge(e: EdgeSpec, holes: bool) -> None:
+    """The holes' boundary part: the plate has holes, no segments, a uniform stress."""
+    where = f"edges.{e.name}"
+    if not holes:
+        raise InputError(f"{where}: the plate has no holes (plate.holes)")
+    if e.segments is not None:
+        raise InputError(f"{where}: the holes' boundary takes no segments")
+    if not e.uniform:
+        raise InputError(
+            f"{where}: a linear [start, end] stress needs a straight edge; give the holes a number"
+        )
+
+
+class MeshSpec(Table, frozen=True):
+    """Structured quadrilateral mesh of the rectangle, or the cell size of gmsh's.
 
     Args:
         nx: Cells along x, >= 2 (one cell cannot carry a buckle).
         ny: Cells along y, >= 2.
-        size: The cell size the file asked for (m), or None when it gave nx and ny;
-            nx and ny are then :meth:`cells_for` of the plate (recorded so that a file
-            written back, e.g. a sweep point, keeps asking for the size).
+        size: The cell size (m), > 0, or None. A rectangle's nx and ny are then
+            :meth:`cells_for` of the plate (set by :class:`ProblemSpec`); a plate meshed by
+            gmsh needs it (its characteristic length), but for a ``.msh`` file.
     """
 
-    nx: int = 20
-    ny: int = 20
-    size: float | None = None
-
-    def __post_init__(self) -> None:
-        for name in ("nx", "ny"):
-            object.__setattr__(self, name, _integer(f"mesh.{name}", getattr(self, name), 2))
-        if self.size is not None:
-            if not _number("mesh.size", self.size) > 0.0:
-                raise InputError(f"mesh.size must be > 0 m, got {self.size!r}")
-            object.__setattr__(self, "size", float(self.size))
+    KEY: ClassVar[str] = "mesh"
+    nx: Annotated[int, Meta(ge=2)] = 20
+    ny: Annotated[int, Meta(ge=2)] = 20
+    size: Length | None = None
 
     @staticmethod
     def cells_for(length: float, width: float, size: float) -> tuple[int, int]:
         """Cells (nx, ny) of side at most ``size`` on a ``length`` x ``width`` plate (>= 2)."""
-        if not _number("mesh.size", size) > 0.0:
-            raise InputError(f"mesh.size must be > 0 m, got {size!r}")
         # 1e-9: a size that divides the side exactly gives that many cells, not one more.
-        return tuple(  # type: ignore[return-value]
-            max(2, math.ceil(side / size * (1.0 - 1e-9))) for side in (length, width)
-        )
+        nx, ny = (max(2, math.ceil(side / size * (1.0 - 1e-9))) for side in (length, width))
+        return nx, ny
 
     @property
     def num_dofs(self) -> int:
@@ -494,11 +470,10 @@ def _disjoint(a: Circle | Polygon, b: Circle | Polygon) -> bool:
     """Whether two holes neither overlap nor touch (a circle as a 256-gon, to 1e-4 r)."""
     if isinstance(a, Circle) and isinstance(b, Circle):
         return math.dist(a.center, b.center) > a.radius + b.radius
-    pa, pb = (_hole_polygon(h) for h in (a, b))
+    pa, pb = (
+        circle_points(h.center, h.radius, 256)
+        if isinstance(h, Circle)
+        else np.asarray(h.vertices, dtype=float)
+        for h in (a, b)
+    )
     return polygons_disjoint(pa, pb)
-
-
-def _hole_polygon(hole: Circle | Polygon) -> npt.NDArray[np.float64]:
-    if isinstance(hole, Circle):
-        return circle_points(hole.center, hole.radius, 256)
-    return np.asarray(hole.vertices, dtype=float)

@@ -66,7 +66,7 @@ def zone_outlines(spec: ProblemSpec) -> list[tuple[npt.NDArray[np.float64], str]
     from unibuckle_fenicsx.geometry import circle_points
     from unibuckle_fenicsx.spec import Circle, Polygon
 
-    out = []
+    out: list[tuple[npt.NDArray[np.float64], str]] = []
     for obstacle in spec.all_obstacles:
         zone = obstacle.zone
         if isinstance(zone, str):

@@ -5,21 +5,16 @@ from __future__ import annotations
 from collections.abc import Mapping
 
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.spec import (
-    EDGE_NAMES,
-    EdgeSpec,
-    Material,
-    MeshSpec,
-    ObstacleSpec,
-    PlateSpec,
-    ProblemSpec,
-    SolverSpec,
-)
+from unibuckle_fenicsx.spec.material import Material
+from unibuckle_fenicsx.spec.obstacles import ObstacleSpec
+from unibuckle_fenicsx.spec.plate import EDGE_NAMES, EdgeSpec, MeshSpec, PlateSpec, Support
+from unibuckle_fenicsx.spec.problem import ProblemSpec
+from unibuckle_fenicsx.spec.solver import SolverSpec
 
 __all__ = ["CASES", "LOADS", "paper_case", "plate_case"]
 
 #: Edge stresses per unit load of the loads :func:`plate_case` knows, in
-#: :data:`~unibuckle_fenicsx.spec.EDGE_NAMES` order, as (normal, shear) pairs: uniaxial
+#: :data:`~unibuckle_fenicsx.spec.plate.EDGE_NAMES` order, as (normal, shear) pairs: uniaxial
 #: compression along x; pure shear (a uniform sigma_xy = 1 state: the shear stress along
 #: the counter-clockwise tangent is +1 on x = const and -1 on y = const); and both.
 LOADS: dict[str, tuple[tuple[float, float], ...]] = {
@@ -64,7 +59,7 @@ def plate_case(
     length: float,
     width: float,
     thickness: float,
-    supports: str | Mapping[str, str] = "simply_supported",
+    supports: Support | Mapping[str, Support] = "simply_supported",
     load: str = "uniaxial",
     nx: int,
     ny: int,

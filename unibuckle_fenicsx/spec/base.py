@@ -1,0 +1,373 @@
+r"""The base of every table: a frozen msgspec Struct that checks itself, and its messages.
+
+A table's fields carry their types, ranges and choices as annotations
+(``Annotated[float, Meta(gt=0, extra={"unit": "m"})]``, ``Literal``, enums). msgspec
+checks them when a file is read (:func:`msgspec.convert`); :class:`Table` has msgspec
+check them when a table is built in code: each rule is written once, in the annotation.
+``__post_init__`` adds what no annotation says: finite numbers, and :meth:`Table.check`,
+the rules between the table's fields.
+
+A refusal names the key and what it must be. :func:`reason` words it from the field's
+annotation and the value found (unknown or missing keys, the range, the type), at the
+location of msgspec's error (its ``$.plate.holes[1]``, :func:`location`), never from
+msgspec's own wording. A rule's ``FieldError`` names a field of its table; where that table lies
+in a file (``obstacles[1]``) the loader says.
+"""
+
+from __future__ import annotations
+
+import contextvars
+import enum
+import functools
+import math
+import types
+import typing
+from collections.abc import Iterator, Mapping
+from typing import Annotated, Any, ClassVar, Literal, Union
+
+import msgspec
+import numpy as np
+from msgspec import Meta, Struct
+
+from unibuckle_fenicsx.errors import FieldError, InputError
+
+#: Unit systems of a problem file: name -> (metres per length unit, pascals per stress
+#: unit, stress unit's name). Forces are in N in both.
+UNITS: dict[str, tuple[float, float, str]] = {
+    "SI": (1.0, 1.0, "Pa"),
+    "mm-N-MPa": (1e-3, 1e6, "MPa"),
+}
+Units = Literal["SI", "mm-N-MPa"]
+#: The units of fields (``Meta(extra={"unit": ...})``) that a unit system converts, as
+#: powers (p, q) of its length L and stress S: a value is ``(L**p * S**q)`` SI units.
+#: A list: one per entry of a list value (the first for a number).
+DIMENSIONS: dict[str, Any] = {
+    "m": (1, 0),
+    "Pa": (0, 1),
+    "N/m": (1, 1),  # = Pa m
+    "N/m^2": (0, 1),
+    "N/m^3": (-1, 1),
+    "N m": (3, 1),  # = Pa m^3
+    "K, K/m": [(0, 0), (-1, 0), (-1, 0)],  # a rise, or [T0, dT/dx, dT/dy]
+}
+
+
+def unit(name: str, **bounds: Any) -> Meta:
+    """The Meta of a field in the unit ``name`` (with its bounds)."""
+    return Meta(**bounds, extra={"unit": name})
+
+
+Point = tuple[float, float]
+Box = tuple[tuple[float, float], tuple[float, float]]
+#: An edge stress: a number, or [start, end] (linear along the edge).
+Stress = float | tuple[float, float]
+#: A temperature rise: a number (K), or [T0, dT/dx, dT/dy] (K, K/m), a linear field.
+Temperature = float | tuple[float, float, float]
+Matrix3 = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
+#: How messages write these types (a union's members hold no Meta: msgspec 0.22 crashes
+#: on a bounded number beside a list in a union).
+FORMS: dict[Any, str] = {
+    Point: "a point [x, y]",
+    Box: "a box [[xmin, xmax], [ymin, ymax]]",
+    Stress: "a number or a pair [start, end] (linear along the edge)",
+    Temperature: "a number (K) or [T0, dT/dx, dT/dy] (K, K/m)",
+    Matrix3: "a 3x3 matrix [[a, b, c], [d, e, f], [g, h, i]]",
+}
+
+
+def stress_ends(value: Stress) -> tuple[float, float]:
+    """(start, end) of an edge stress: the pair itself, or the number twice."""
+    return (value, value) if isinstance(value, float | int) else value
+
+
+def temperature_field(value: Temperature) -> tuple[float, float, float]:
+    """(T0, dT/dx, dT/dy) of a temperature rise."""
+    return (value, 0.0, 0.0) if isinstance(value, float | int) else value
+
+
+#: Set while :func:`msgspec.convert` builds tables: their fields are checked already.
+CONVERTING: contextvars.ContextVar[bool] = contextvars.ContextVar("converting", default=False)
+
+
+class Table(Struct, frozen=True, forbid_unknown_fields=True):
+    """A table of the problem file: frozen, unknown keys forbidden, checked when built."""
+
+    #: The key that names this table in messages when it is built in code.
+    KEY: ClassVar[str] = ""
+    #: Fields that may hold a function (in code only: no file can write one).
+    CALLABLE: ClassVar[tuple[str, ...]] = ()
+    #: Fields of the Python API that a file's table does not have, and keys it has besides.
+    CODE_ONLY: ClassVar[tuple[str, ...]] = ()
+    FILE_ONLY: ClassVar[tuple[str, ...]] = ()
+
+    def __post_init__(self) -> None:
+        if not CONVERTING.get():
+            for name, tp in hints(type(self)).items():
+                value = getattr(self, name)
+                if not (name in self.CALLABLE and callable(value)):
+                    msgspec.structs.force_setattr(self, name, checked(value, tp, self.key(), name))
+        for name in self.__struct_fields__:
+            bad = next((v for v in _floats(getattr(self, name)) if not math.isfinite(v)), None)
+            if bad is not None:
+                raise FieldError(self.key(), name, f" must be a finite number, got {bad!r}")
+        self.check()
+
+    def check(self) -> None:
+        """The rules between this table's fields (each raises a ``FieldError``)."""
+
+    def key(self) -> str:
+        """This table's key in messages when it is built in code."""
+        return self.KEY
+
+    @classmethod
+    def file_keys(cls) -> list[str]:
+        """The keys of this table in a file."""
+        fields = [f for f in cls.__struct_fields__ if f not in cls.CODE_ONLY]
+        return fields + list(cls.FILE_ONLY)
+
+
+@functools.cache
+def hints(cls: type) -> dict[str, Any]:
+    """A Struct's field types, with their Meta."""
+    found = typing.get_type_hints(cls, include_extras=True)
+    return {name: found[name] for name in cls.__struct_fields__}  # type: ignore[attr-defined]
+
+
+def plain(value: Any) -> Any:
+    """``value`` with numpy scalars and arrays as Python numbers and lists."""
+    if isinstance(value, np.ndarray | np.generic):
+        return value.tolist()
+    if isinstance(value, list | tuple):
+        return [plain(v) for v in value]
+    if isinstance(value, Mapping):
+        return {k: plain(v) for k, v in value.items()}
+    return value
+
+
+def checked(value: Any, tp: Any, key: str, name: str) -> Any:
+    """``value`` converted to the field type ``tp`` by msgspec, or refused naming the key."""
+    try:
+        return msgspec.convert(plain(value), tp)
+    except msgspec.ValidationError as err:
+        steps = location(err)
+        field_type, found = walk(tp, value, steps)
+        where = join(key, name)
+        for s in steps:
+            where = join(where, s)
+        raise InputError(reason(where, found, field_type)) from None
+
+
+def _floats(value: Any) -> Iterator[float]:
+    if isinstance(value, float):
+        yield value
+    elif isinstance(value, tuple):
+        for v in value:
+            yield from _floats(v)
+
+
+def join(key: str, step: str | int) -> str:
+    """The key ``step`` below ``key``: ``plate`` + ``holes`` -> ``plate.holes``, + 1 -> ``[1]``."""
+    if isinstance(step, int):
+        return f"{key}[{step}]"
+    return f"{key}.{step}" if key and step else key or step
+
+
+# -- types -----------------------------------------------------------------------------
+
+
+def bare(tp: Any) -> Any:
+    """``tp`` without its Annotated metadata."""
+    while typing.get_origin(tp) is Annotated:
+        tp = typing.get_args(tp)[0]
+    return tp
+
+
+def members(tp: Any) -> list[Any]:
+    """The members of a union (each with its own Meta), or ``[tp]``."""
+    if typing.get_origin(bare(tp)) in (Union, types.UnionType):
+        return [m for a in typing.get_args(bare(tp)) for m in members(a)]
+    return [tp]
+
+
+def is_table(tp: Any) -> bool:
+    """Whether ``tp`` is a table (a Struct)."""
+    return isinstance(bare(tp), type) and issubclass(bare(tp), Struct)
+
+
+def element(tp: Any) -> Any:
+    """The entries' type of a list type ``tuple[X, ...]``, or None."""
+    args = typing.get_args(bare(tp))
+    return args[0] if typing.get_origin(bare(tp)) is tuple and args[-1:] == (...,) else None
+
+
+def metadata(tp: Any, name: str) -> Any:
+    """The ``Meta`` attribute (or ``extra`` entry) ``name`` of ``tp`` or of its union's."""
+    while typing.get_origin(tp) is Annotated:
+        for meta in reversed(typing.get_args(tp)[1:]):
+            found = (meta.extra or {}).get(name, getattr(meta, name, None))
+            if found is not None:
+                return found
+        tp = typing.get_args(tp)[0]
+    if typing.get_origin(tp) in (Union, types.UnionType):
+        return next((m for a in typing.get_args(tp) if (m := metadata(a, name)) is not None), None)
+    return None
+
+
+def table_of(tp: Any, value: Any, field: str | None = None) -> Any:
+    """The table of ``tp`` (a union: by ``value``'s tag, else having ``field``), or None."""
+    tables = [bare(m) for m in members(tp) if is_table(m)]
+    tag = value.get("shape") if isinstance(value, Mapping) else None
+    for table in tables:
+        if table.__struct_config__.tag == tag or field in table.__struct_fields__:
+            return table
+    return tables[0] if tables else None
+
+
+def walk(tp: Any, value: Any, steps: list[str | int]) -> tuple[Any, Any]:
+    """The type and value at ``steps`` (field names and indices) below ``tp``, ``value``."""
+    for key in steps:
+        try:
+            child = value[key]
+        except (KeyError, IndexError, TypeError):
+            child = None
+        if isinstance(key, str):
+            table = table_of(tp, value, key)
+            tp = hints(table).get(key, Any) if table is not None else Any
+        else:
+            lists = [bare(m) for m in members(tp) if typing.get_origin(bare(m)) is tuple]
+            args = typing.get_args(lists[0]) if lists else ()
+            if lists and element(lists[0]) is not None:
+                tp = element(lists[0])
+            else:
+                tp = args[key] if key < len(args) else Any
+        value = child
+    return tp, value
+
+
+def location(err: msgspec.ValidationError) -> list[str | int]:
+    """The steps of msgspec's error location: ``$.obstacles[1].zone`` -> obstacles, 1, zone."""
+    text = str(err)
+    if " - at `$" not in text:
+        return []
+    steps: list[str | int] = []
+    for part in text.rpartition(" - at `$")[2][:-1].replace("[", ".[").split("."):
+        if part.startswith("["):
+            steps.append(int(part[1:-1]) if part[1:-1].isdigit() else part)
+        elif part:
+            steps.append(part)
+    return steps
+
+
+# -- messages --------------------------------------------------------------------------
+
+
+def reason(key: str, value: Any, tp: Any) -> str:
+    """Why ``value`` is not a ``tp`` at ``key``: unknown or missing keys, range, or type."""
+    table = table_of(tp, value)
+    if table is not None and isinstance(value, Mapping):
+        where = f"[{key}]" if key else "[top] (the file's top level)"
+        fields = table.__struct_fields__
+        tag = table.__struct_config__.tag_field
+        unknown = [k for k in value if k not in fields and k != tag]
+        if unknown:
+            return f"unknown key(s) {unknown} in {where}; allowed: {table.file_keys()}"
+        missing = [
+            k for k in fields[: len(fields) - len(table.__struct_defaults__)] if k not in value
+        ]
+        if missing:
+            return f"{where} needs {', '.join(map(repr, missing))}"
+    for m in members(tp):  # the right type, out of its range
+        if bare(m) is not type(None) and not is_table(m) and _converts(value, bare(m)):
+            text = form(m) if bare(m) is int else _range(m)
+            return f"{key} must {'lie' if text.startswith('in ') else 'be'} {text}, got {value!r}"
+    kinds = {_kind(bare(m)) for m in members(tp)}
+    got = "" if _kind(value) in kinds else f" ({_kind(value)})"
+    return f"{key or 'the file'} must be {form(tp)}, got {value!r}{got}"
+
+
+def form(tp: Any) -> str:
+    """How a message writes the type ``tp``: a number, one of (...), a list of ...."""
+    b = bare(tp)
+    given = metadata(tp, "form") or FORMS.get(b)
+    if given:
+        return str(given)
+    if typing.get_origin(b) in (Union, types.UnionType):
+        return " or ".join(form(m) for m in members(b) if bare(m) is not type(None))
+    if b is int:
+        return f"an integer {_range(tp)}".rstrip()
+    if typing.get_origin(b) is Literal:
+        return f"one of {typing.get_args(b)}"
+    if isinstance(b, type) and issubclass(b, enum.Enum):
+        return f"one of {tuple(m.value for m in b)}"
+    if typing.get_origin(b) is tuple:
+        entries = element(b) or typing.get_args(b)[0]
+        return "a list of tables" if is_table(entries) else f"a list, each entry {form(entries)}"
+    return (
+        "a table" if is_table(b) else {float: "a number", bool: "true or false"}.get(b, "a string")
+    )
+
+
+_SIGNS = {"gt": ">", "ge": ">=", "lt": "<", "le": "<="}
+
+
+def _range(tp: Any) -> str:
+    """The range of ``tp``'s Meta: "> 0 m", "in (-1, 0.5)", "a list of at least 3 entries"."""
+    if (size := metadata(tp, "min_length")) is not None:
+        text = (
+            "string of at least {} characters" if bare(tp) is str else "list of at least {} entries"
+        )
+        return "a " + text.format(size)
+    bounds = {op: v for op in _SIGNS if (v := metadata(tp, op)) is not None}
+    suffix = f" {metadata(tp, 'unit')}" if metadata(tp, "unit") else ""
+    if len(bounds) == 2:  # an interval
+        (low, a), (high, b) = bounds.items()
+        return f"in {'(['[low == 'ge']}{a:g}, {b:g}{')]'[high == 'le']}{suffix}"
+    return "".join(f"{_SIGNS[op]} {v:g}{suffix}" for op, v in bounds.items())
+
+
+def _converts(value: Any, tp: Any) -> bool:
+    try:
+        msgspec.convert(plain(value), tp)
+    except (msgspec.ValidationError, TypeError):
+        return False
+    return True
+
+
+def _kind(x: Any) -> str:
+    """The JSON kind of a type or of a value: a number, a string, a list, a table."""
+    x = str if typing.get_origin(x) is Literal else typing.get_origin(x) or x
+    for cls, name in (
+        (bool, "true or false"),
+        (int | float, "a number"),
+        (str | enum.Enum, "a string"),
+        (list | tuple, "a list"),
+        (Mapping | Struct, "a table"),
+    ):
+        if isinstance(x, cls) or (isinstance(x, type) and issubclass(x, cls)):
+            return name
+    return "absent"
+
+
+# -- single values (option records outside the problem file) ----------------------------
+
+
+def _number(name: str, value: Any) -> float:
+    """``value`` as a finite float, or refused naming ``name``."""
+    if not math.isfinite(out := checked(value, float, name, "")):
+        raise InputError(f"{name} must be a finite number, got {value!r}")
+    return float(out)
+
+
+def _integer(name: str, value: Any, minimum: int) -> int:
+    """``value`` as an integer >= ``minimum``, or refused naming ``name``."""
+    return int(checked(value, Annotated[int, Meta(ge=minimum)], name, ""))
+
+
+def _boolean(name: str, value: Any) -> bool:
+    """``value`` as true or false, or refused naming ``name``."""
+    return bool(checked(value, bool, name, ""))
+
+
+def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
+    """``value`` as one of ``choices``, or refused naming ``name``."""
+    return str(checked(value, Literal[choices], name, ""))

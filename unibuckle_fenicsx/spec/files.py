@@ -1,0 +1,419 @@
+"""A problem file: read into a :class:`ProblemSpec`, written back, and its JSON Schema.
+
+Reading is ``msgspec.convert(to_si(raw), ProblemSpec)``: the Structs' annotations check
+every key (:mod:`~unibuckle_fenicsx.spec.base`). A file writes a few things in its own
+form, turned into the Structs' form here (:func:`_to_api`) and back (:func:`_to_file`):
+
+- the ``[edges.NAME]`` tables are the plate's ``edges``; edges not named take the
+  paper's (simply supported, the short edges compressed), but once any edge table or
+  ``[load]`` gives a load, the edges that give none carry none;
+- an obstacle's zone is one of the keys ``zone`` ("all" or a box), ``polygon`` (its
+  vertices) or ``circle`` (``{center, radius}``); a hole is ``{center, radius}`` or
+  ``{outline}``;
+- a laminate leaves out E and nu (its plies' in-plane constants) and the plate's
+  thickness (their total); a rectangle's ``[mesh]`` gives nx and ny, or a cell size.
+
+Numbers are converted to SI by their field's unit (``Meta(extra={"unit": ...})``).
+"""
+
+from __future__ import annotations
+
+import json
+import tomllib
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any
+
+import msgspec
+
+from unibuckle_fenicsx.errors import FieldError, InputError
+from unibuckle_fenicsx.laminate import laminate
+from unibuckle_fenicsx.spec.base import (
+    CONVERTING,
+    DIMENSIONS,
+    UNITS,
+    Stress,
+    element,
+    form,
+    hints,
+    join,
+    location,
+    members,
+    metadata,
+    plain,
+    reason,
+    table_of,
+    walk,
+)
+from unibuckle_fenicsx.spec.material import Ply
+from unibuckle_fenicsx.spec.obstacles import ObstacleSpec
+from unibuckle_fenicsx.spec.plate import EdgeSpec, PlateSpec, paper_edges
+from unibuckle_fenicsx.spec.problem import ProblemSpec
+
+#: Keys of an ``[obstacle]`` or ``[[obstacles]]`` table.
+OBSTACLE_KEYS = ("zone", "polygon", "circle", *ObstacleSpec.__struct_fields__[1:])
+#: Keys of a ``[[material.plies]]`` table.
+PLY_KEYS: tuple[str, ...] = Ply.__struct_fields__
+_LOADS = ("normal_stress", "shear_stress", "fixed_normal_stress", "fixed_shear_stress")
+
+
+def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSpec:
+    """A :class:`ProblemSpec` from a TOML-shaped mapping (:doc:`/guide/plate`).
+
+    Args:
+        data: The file's tables; ``name`` and ``units`` at the top.
+        name: The label when the file gives none.
+
+    Raises:
+        InputError: An unknown key, a value of the wrong type or out of its range, a
+            rule between keys broken; the message names the key.
+    """
+    if not isinstance(data, Mapping):
+        raise InputError(f"a problem file is a table of tables, got {data!r}")
+    api = _to_api({"name": name, **plain(data)})
+    if isinstance(api.get("units"), str) and api["units"] in UNITS:
+        api = scaled(api, ProblemSpec, api["units"], 1)
+    token = CONVERTING.set(True)
+    try:
+        return msgspec.convert(_laminate(api), ProblemSpec)
+    except msgspec.ValidationError as err:
+        raise InputError(_message(err, api)) from None
+    finally:
+        CONVERTING.reset(token)
+
+
+def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
+    """The TOML-shaped mapping of ``spec``, every key with the value used.
+
+    ``problem_from_dict(problem_to_dict(spec)) == spec`` for a spec without a predicate
+    zone (it cannot be written: it raises).
+
+    Args:
+        spec: The problem.
+        units: Unit system of the numbers written (one of :data:`UNITS`); the mapping's
+            ``units`` key says which.
+    """
+    if units not in UNITS:
+        raise InputError(f"units must be one of {tuple(UNITS)}, got {units!r}")
+    try:
+        data = msgspec.json.decode(msgspec.json.encode(spec))  # lists, not tuples; exact
+    except TypeError:
+        raise InputError("problem_to_dict: a predicate obstacle zone cannot be written") from None
+    return _to_file({**scaled(data, ProblemSpec, units, -1), "units": units}, spec)
+
+
+def stress_value(value: Stress) -> float | list[float]:
+    """An edge stress as written in a file: a number or ``[start, end]``."""
+    return list(value) if isinstance(value, tuple) else value
+
+
+def scaled(value: Any, tp: Any, units: str, sign: int) -> Any:
+    """``value`` (the Structs' form) with each number in a unit converted.
+
+    From the unit system ``units`` to SI (``sign`` 1) or back (-1). A value that is not
+    a number is left as it is, for the Structs to refuse.
+    """
+    if units == "SI":
+        return value
+    table = table_of(tp, value)
+    if isinstance(value, Mapping) and table is not None:
+        fields = hints(table)
+        return {
+            k: scaled(v, fields[k], units, sign) if k in fields else v for k, v in value.items()
+        }
+    entries = next((element(m) for m in members(tp) if element(m) is not None), None)
+    if isinstance(value, list) and entries is not None and table_of(entries, None) is not None:
+        return [scaled(v, entries, units, sign) for v in value]
+    dims = DIMENSIONS.get(metadata(tp, "unit"))
+    if dims is None:
+        return value
+    if isinstance(dims, list):  # one unit per entry, or the first for a number
+        if isinstance(value, list):  # of another length: left for the Structs to refuse
+            if len(value) != len(dims):
+                return value
+            return [_times(v, _factor(d, units, sign)) for v, d in zip(value, dims, strict=True)]
+        dims = dims[0]
+    return _times(value, _factor(dims, units, sign))
+
+
+def _factor(dims: tuple[int, int], units: str, sign: int) -> float:
+    """SI units per unit of dimensions (length, stress) in ``units`` (``sign`` -1: inverse).
+
+    A quotient for negative powers (N/m^3 = Pa/m): ``S / L``, not ``L**-1 * S``.
+    """
+    length, stress, _ = UNITS[units]
+    p, q = dims
+    up = (length ** max(p, 0) * stress ** max(q, 0)) ** sign
+    return up / (length ** max(-p, 0) * stress ** max(-q, 0)) ** sign
+
+
+def _times(value: Any, factor: float) -> Any:
+    """``value`` (a number, or lists of numbers) times ``factor``; anything else as is."""
+    if isinstance(value, list):
+        return [_times(v, factor) for v in value]
+    if isinstance(value, int | float) and not isinstance(value, bool):
+        return value * factor
+    return value
+
+
+# -- the file's form -------------------------------------------------------------------
+
+
+def _to_api(raw: dict[str, Any]) -> dict[str, Any]:
+    """The Structs' form of the file ``raw`` (see the module docstring)."""
+    out = dict(raw)
+    plate = out.get("plate", {})
+    if isinstance(plate, Mapping):
+        plate = out["plate"] = _plate(dict(plate), out.pop("edges", {}), out.get("load"))
+        mesh = out.get("mesh")
+        if isinstance(mesh, Mapping) and ({"nx", "ny"} & set(mesh)):
+            if any(plate.get(k) for k in ("outline", "file", "holes")):
+                raise InputError(
+                    "[mesh]: a plate meshed by gmsh (outline, holes or file) takes size = h "
+                    "(the characteristic cell size), not nx and ny"
+                )
+            if "size" in mesh:
+                raise InputError("[mesh]: give size (a cell size) or nx and ny, not both")
+    if isinstance(out.get("obstacle"), Mapping):
+        out["obstacle"] = _zone(out["obstacle"], "obstacle")
+    if isinstance(out.get("obstacles"), list):
+        out["obstacles"] = [
+            _zone(t, f"obstacles[{k}]") if isinstance(t, Mapping) else t
+            for k, t in enumerate(out["obstacles"])
+        ]
+    return out
+
+
+def _plate(plate: dict[str, Any], edges: Any, load: Any) -> dict[str, Any]:
+    """``[plate]`` with the holes in the Structs' form and the ``[edges.*]`` tables."""
+    _unknown(plate, PlateSpec.file_keys(), "plate")
+    gmsh = "outline" in plate or "file" in plate
+    if gmsh and "corners" in plate:
+        raise InputError(
+            "[plate]: give corners (a rectangle), or outline (a polygon) or file (a gmsh "
+            "file), not both"
+        )
+    if isinstance(plate.get("holes"), list):
+        plate["holes"] = [_hole(h, f"plate.holes[{k}]") for k, h in enumerate(plate["holes"])]
+    if not isinstance(edges, Mapping):
+        raise InputError(f"edges must be a table of [edges.NAME] tables, got {edges!r}")
+    loaded = any(isinstance(t, Mapping) and set(_LOADS) & set(t) for t in edges.values())
+    loaded |= isinstance(load, Mapping) and bool(load)
+    paper = () if gmsh else paper_edges()  # their loads only for a file that gives none
+    tables = {e.name: {} if loaded else {"normal_stress": e.normal_stress} for e in paper}
+    for name, table in edges.items():
+        if not isinstance(table, Mapping):
+            raise InputError(reason(f"edges.{name}", table, EdgeSpec))
+        _unknown(table, EdgeSpec.file_keys(), f"edges.{name}")
+        tables[name] = {**tables.get(name, {}), **table}
+    plate["edges"] = [{"name": name, **table} for name, table in tables.items()]
+    return plate
+
+
+def _unknown(table: Mapping[str, Any], allowed: Any, where: str) -> None:
+    """Refuse the keys of ``table`` not in ``allowed``."""
+    if found := [key for key in table if key not in allowed]:
+        raise InputError(f"unknown key(s) {found} in [{where}]; allowed: {list(allowed)}")
+
+
+def _hole(table: Any, where: str) -> Any:
+    """A hole's table in the Structs' form: a tagged circle or polygon."""
+    if not isinstance(table, Mapping):
+        return table
+    _unknown(table, ("center", "radius", "outline"), where)
+    if set(table) == {"outline"}:
+        return {"shape": "polygon", "vertices": table["outline"]}
+    if set(table) == {"center", "radius"}:
+        return {"shape": "circle", **table}
+    raise InputError(
+        f"[{where}] needs center = [x, y] and radius = r (a circle), or outline = [[x, y], "
+        f"...] (a polygon); got {sorted(table)}"
+    )
+
+
+def _zone(table: Mapping[str, Any], where: str) -> dict[str, Any]:
+    """An obstacle's table with its zone, polygon or circle as the Structs' ``zone``."""
+    _unknown(table, OBSTACLE_KEYS, where)
+    if isinstance(table.get("zone"), Mapping):  # a file's zone is "all" or a box
+        zone = hints(ObstacleSpec)["zone"]
+        raise InputError(f"{where}.zone must be {form(zone)}, got {table['zone']!r} (a table)")
+    given = [key for key in ("zone", "polygon", "circle") if key in table]
+    if len(given) != 1:
+        raise InputError(
+            f'[{where}] needs zone = "all" (the whole plate) or [[xmin, xmax], [ymin, ymax]], '
+            "or polygon = [[x, y], ...], or circle = {center = [x, y], radius = r}: exactly "
+            f"one of them; got {given or 'none'}"
+        )
+    out = {key: value for key, value in table.items() if key not in ("polygon", "circle")}
+    if "polygon" in table:
+        out = {"zone": {"shape": "polygon", "vertices": table["polygon"]}, **out}
+    elif "circle" in table:
+        circle = table["circle"]
+        if not isinstance(circle, Mapping) or "shape" in circle:
+            raise InputError(
+                f"{where}.circle must be a table {{center = [x, y], radius = r}}, got {circle!r}"
+            )
+        out = {"zone": {"shape": "circle", **circle}, **out}
+    return out
+
+
+def _laminate(api: dict[str, Any]) -> dict[str, Any]:
+    """A laminate's E and nu, and its plate's thickness, from its plies if not given."""
+    material = api.get("material")
+    if not (isinstance(material, Mapping) and isinstance(material.get("plies"), list)):
+        return api
+    try:
+        plies = msgspec.convert(material["plies"], tuple[Ply, ...])
+    except msgspec.ValidationError as err:
+        raise InputError(_message(err, api, ["material", "plies"])) from None
+    if not plies:
+        raise InputError(
+            "material.plies must be a list of tables ([[material.plies]] in TOML), at least "
+            "one, got []"
+        )
+    E, nu = laminate(plies).engineering_constants()
+    api["material"] = {"E": E, "nu": nu, **material}
+    plate = api.get("plate")
+    if isinstance(plate, dict) and "thickness" not in plate:
+        plate["thickness"] = sum(ply.thickness for ply in plies)
+    return api
+
+
+def _message(err: msgspec.ValidationError, api: Any, prefix: list[str | int] | None = None) -> str:
+    """The message of msgspec's ``err`` converting ``api``, naming the file's key."""
+    steps = [*(prefix or []), *location(err)]
+    cause = err.__cause__
+    if isinstance(cause, FieldError):
+        where = _file_key([*steps, *([cause.field] if cause.field else [])], api)
+        return (where if cause.field else f"[{where}]") + cause.text
+    if isinstance(cause, InputError):
+        return str(cause)
+    if cause is not None:
+        raise cause
+    tp, value = walk(ProblemSpec, api, steps)
+    return reason(_file_key(steps, api), value, tp)
+
+
+def _file_key(steps: list[str | int], api: Any) -> str:
+    """The file's key at ``steps`` of its Structs' form ``api`` (``edges.left``, ...)."""
+    key, node = "", api
+    for s in steps:
+        try:
+            node = node[s]
+        except (KeyError, IndexError, TypeError):
+            node = None
+        shape = node.get("shape") if isinstance(node, Mapping) else None
+        if key == "edges" and isinstance(s, int):
+            key = f"edges.{node['name']}" if isinstance(node, Mapping) else f"edges[{s}]"
+        elif s == "zone" and shape is not None:
+            key = join(key, shape)
+        elif s == "vertices":
+            key = key if key.endswith(".polygon") else join(key, "outline")
+        else:
+            key = "edges" if (key, s) == ("plate", "edges") else join(key, s)
+    return key
+
+
+def _to_file(data: dict[str, Any], spec: ProblemSpec) -> dict[str, Any]:
+    """The file's form of ``data``, the Structs' (:func:`msgspec.to_builtins` of ``spec``)."""
+    plate = data["plate"]
+    edges = {}
+    for edge in plate.pop("edges"):
+        del edge["tag"]
+        edges[edge.pop("name")] = edge
+    plate["holes"] = [_shape(h, "outline") for h in plate["holes"]]
+    if plate["outline"] is not None or plate["file"] is not None:
+        del plate["corners"]
+    if spec.material.plies:
+        del data["material"]["E"], data["material"]["nu"]
+    mesh = data["mesh"]
+    if mesh["size"] is not None or spec.plate.meshed_by_gmsh:
+        del mesh["nx"], mesh["ny"]
+    for point in data["points"]:  # a square grid's spacing: one number
+        if point["spacing"] is not None and len(set(point["spacing"])) == 1:
+            point["spacing"] = point["spacing"][0]
+    data["obstacle"] = _zone_key(data["obstacle"])
+    data["obstacles"] = [_zone_key(o) for o in data["obstacles"]]
+    out = {}
+    for key, value in data.items():
+        out[key] = value
+        if key == "material":
+            out["edges"] = edges
+    return _pruned(out)
+
+
+def _zone_key(obstacle: dict[str, Any] | None) -> dict[str, Any] | None:
+    """An obstacle's zone under its file key: zone, polygon or circle."""
+    if obstacle is None or not isinstance(obstacle["zone"], dict):
+        return obstacle
+    zone = obstacle.pop("zone")
+    return {zone["shape"]: _shape(zone, None), **obstacle}
+
+
+def _shape(table: dict[str, Any], vertices: str | None) -> Any:
+    """A circle's or polygon's file form: without its tag; a polygon's vertices."""
+    shape = table.pop("shape")
+    if shape == "polygon":
+        return {vertices: table["vertices"]} if vertices else table["vertices"]
+    return table
+
+
+def _pruned(value: Any) -> Any:
+    """``value`` without absent keys (None, empty lists): a file has no null."""
+    if isinstance(value, dict):
+        return {k: _pruned(v) for k, v in value.items() if v is not None and v != []}
+    return [_pruned(v) for v in value] if isinstance(value, list) else value
+
+
+# -- files -----------------------------------------------------------------------------
+
+
+def load_toml(path: str | Path) -> ProblemSpec:
+    """Read a :class:`ProblemSpec` from a TOML file (its keys: :func:`problem_from_dict`).
+
+    Raises:
+        InputError: The file is not UTF-8 TOML, or describes an invalid problem; the
+            message names the file.
+        OSError: The file cannot be read.
+    """
+    path = Path(path)
+    try:
+        data = tomllib.loads(path.read_bytes().decode("utf-8"))
+    except UnicodeDecodeError as err:
+        raise InputError(
+            f"{path}: not a UTF-8 text file ({err.reason} at byte {err.start})"
+        ) from None
+    except tomllib.TOMLDecodeError as err:
+        raise InputError(f"{path}: invalid TOML: {err}") from None
+    plate = data.get("plate")
+    if isinstance(plate, dict) and isinstance(plate.get("file"), str):
+        # A gmsh file is found next to the problem file.
+        plate["file"] = str((path.parent / plate["file"]).resolve())
+    try:
+        return problem_from_dict(data, name=path.stem)
+    except ValueError as err:
+        raise InputError(f"{path}: {err}") from None
+
+
+def load_problem(path: str | Path) -> ProblemSpec:
+    """A problem file: TOML, or the JSON of a result (its ``input``, which re-runs it).
+
+    Raises:
+        InputError: An invalid file or problem; the message names the file.
+        OSError: The file cannot be read.
+    """
+    path = Path(path)
+    if path.suffix.lower() != ".json":
+        return load_toml(path)
+    try:
+        data = json.loads(path.read_bytes().decode("utf-8"))
+    except (UnicodeDecodeError, json.JSONDecodeError) as err:
+        raise InputError(f"{path}: not a JSON result or problem file: {err}") from None
+    if isinstance(data, dict) and "input" in data:
+        data = data["input"]
+        if data is None:
+            raise InputError(f"{path}: this result's problem has no file form (a predicate zone)")
+    try:
+        return problem_from_dict(data, name=path.stem)
+    except ValueError as err:
+        raise InputError(f"{path}: {err}") from None
