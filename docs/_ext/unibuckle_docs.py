@@ -330,6 +330,10 @@ COMMANDS = {
     "orderings": lambda rows: _orderings_commands(rows),
     "plates": lambda rows: _plates_commands(rows),
     "routes": lambda rows: _routes_commands(rows),
+    "stages": lambda rows: (
+        f"python bench/bench_stages.py --meshes {_listed(rows, 'mesh')} "
+        "--json bench/results/stages.jsonl"
+    ),
 }
 
 
@@ -388,6 +392,23 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("factorisations", "factorisations"),
         ("solves", "solves"),
         ("ratio", "certificate time (free solves)"),
+        ("load_Pa", "λ_c (Pa)"),
+    ],
+    "stages": [
+        ("case", "plate"),
+        ("mesh", "mesh"),
+        ("dofs", "DOFs"),
+        ("setup", "setup (s)"),
+        ("free solve", "free solve (s)"),
+        ("coarse levels", "coarse levels (s)"),
+        ("fine IP", "fine interior point (s)"),
+        ("fine LDL calls", "fine factorisations"),
+        ("fine LDL", "their time (s)"),
+        ("fine eigen", "fine eigen solves (s)"),
+        ("certificate", "certificate (s)"),
+        ("total", "total (s)"),
+        ("free run", "free run (s)"),
+        ("ratio", "total / free run"),
         ("load_Pa", "λ_c (Pa)"),
     ],
     "routes": [

@@ -1,0 +1,215 @@
+"""Benchmark: CPU time of each stage of ``solve`` on a thin plate as the mesh grows.
+
+Finds the stage whose time grows faster than the mesh. For each mesh, a fresh process
+solves the benchmark plate of ``bench_plates.py`` (0.3 x 0.1 m, t = 0.1 mm, obstacle
+over the whole face) and, in another fresh process, the same plate without obstacle
+(the free run). Stage timers wrap the route's functions and add up their process time
+(``time.process_time``: on a machine shared with other jobs it moves far less than the
+wall time, which waits for a core); a stage called inside another is counted in both.
+The table gives, per mesh, the seconds of
+
+- ``setup``: every mesh's problem (mesh, prestress, assembly, contact data);
+- ``free solve``: the fine mesh's free eigen solve inside the run;
+- ``coarse levels``: the interior point on every mesh below the fine one;
+- ``fine IP``: the interior point on the fine mesh;
+- ``fine LDL``: the numeric factorisations of the fine mesh's shared LDL^T (count and
+  seconds each): the interior point's (most of ``fine IP``) and the certificate's;
+- ``fine eigen``: the reduced eigen solves on the fine mesh (the free one excluded);
+- ``certificate``: the global-optimality certificate;
+- ``total`` and ``free run`` (the whole free run), and ``ratio`` = total / free run;
+
+and, for each stage, the growth exponent p of t ~ DOFs^p between consecutive meshes:
+1 is linear; a sparse LDL^T of a 2D mesh (nested dissection) costs DOFs^1.5.
+
+Usage: python bench/bench_stages.py [--meshes 90x30,180x60,360x120] [--case ssss]
+[--repeat N] [--json FILE]
+
+With ``--repeat N`` each process is run N times and every stage keeps its minimum.
+"""
+
+from __future__ import annotations
+
+import argparse
+import functools
+import json
+import math
+import subprocess
+import sys
+import time
+from collections import defaultdict
+from collections.abc import Callable
+from typing import Any
+
+from _results import append_rows, print_header
+from msgspec.structs import replace
+
+STAGES = (
+    "setup", "free solve", "coarse levels", "fine IP", "fine LDL", "fine eigen",
+    "certificate", "total", "free run",
+)  # fmt: skip
+
+
+def _install_timers(acc: dict[tuple[str, int], list[float]]) -> None:
+    """Wrap the route's functions: ``acc[(stage, DOFs)] = [process seconds, calls]``."""
+    from unibuckle_fenicsx import analysis, eigen
+    from unibuckle_fenicsx.algorithms import chain, interior_point
+    from unibuckle_fenicsx.certificate import certify
+    from unibuckle_fenicsx.model import problem
+
+    def wrap(owner: Any, name: str, stage: str, dofs: Callable[..., int]) -> None:
+        inner = getattr(owner, name)
+
+        @functools.wraps(inner)
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            c0 = time.process_time()
+            try:
+                return inner(*args, **kwargs)
+            finally:
+                entry = acc[(stage, dofs(*args))]
+                entry[0] += time.process_time() - c0
+                entry[1] += 1
+
+        setattr(owner, name, timed)
+
+    def size(mat: Any) -> int:
+        return int(mat.getSize()[0])
+
+    wrap(problem.BucklingProblem, "__init__", "setup", lambda *a: 0)
+    wrap(problem.BucklingProblem, "solve_free", "free solve", lambda p: size(p.model.A))
+    wrap(problem.BucklingProblem, "evaluate", "eigen", lambda p, *a: size(p.model.A))
+    wrap(interior_point.InteriorPointNewton, "solve", "IP", lambda n, *a: size(n.A))
+    wrap(eigen.SharedFactorization, "factor", "LDL", lambda f, *a: size(f.matrix))
+    wrap(chain, "_explore", "coarsest", lambda p, *a: size(p.model.A))
+    wrap(certify, "certify", "certificate", lambda *a: 0)
+    analysis.certify = certify.certify  # the name analysis imported
+
+
+def worker(case: str, nx: int, ny: int, free: bool) -> None:
+    """One solve in this process; print a JSON line of its stage times."""
+    from mpi4py import MPI
+
+    from bench_plates import _spec
+
+    from unibuckle_fenicsx.analysis import solve
+
+    acc: dict[tuple[str, int], list[float]] = defaultdict(lambda: [0.0, 0])
+    _install_timers(acc)
+    spec = _spec(case, nx, ny)
+    if free:
+        spec = replace(spec, obstacle=None)
+    c0 = time.process_time()
+    with solve(spec, MPI.COMM_WORLD) as run:
+        result, solution = run.result, run.solution
+        levels = [] if solution is None else solution.details.get("levels", [])
+        row = {
+            "dofs": result.dofs,
+            "load_Pa": result.critical_load_Pa,
+            "levels": [
+                [lv["mesh"], lv.get("newton_steps"), lv.get("factorizations")] for lv in levels
+            ],
+        }
+    row["total"] = time.process_time() - c0
+    row["stages"] = [[stage, n, t, calls] for (stage, n), (t, calls) in acc.items()]
+    print(json.dumps(row))
+
+
+def _run(case: str, nx: int, ny: int, free: bool) -> dict[str, Any]:
+    cmd = [sys.executable, __file__, "--worker", case, str(nx), str(ny)]
+    out = subprocess.run(cmd + (["--free"] if free else []), check=True, capture_output=True)
+    return dict(json.loads(out.stdout.decode().strip().splitlines()[-1]))
+
+
+def _stages(run: dict[str, Any], free_run: dict[str, Any]) -> dict[str, Any]:
+    """The table's stages of one mesh from a run and its free run."""
+    n = run["dofs"]
+    got: dict[tuple[str, int], tuple[float, int]] = {(s, k): (t, c) for s, k, t, c in run["stages"]}
+
+    def seconds(stage: str, fine: bool | None = None) -> float:
+        return sum(
+            t for (s, k), (t, _) in got.items() if s == stage and (fine is None or (k == n) == fine)
+        )
+
+    factorisations = got.get(("LDL", n), (0.0, 0))[1]
+    coarsest = {k for s, k in got if s == "coarsest"}  # its IP runs inside _explore
+    intermediate = sum(
+        t for (s, k), (t, _) in got.items() if s == "IP" and k != n and k not in coarsest
+    )
+    return {
+        "setup": seconds("setup"),
+        "free solve": seconds("free solve", True),
+        "coarse levels": seconds("coarsest") + intermediate,
+        "fine IP": seconds("IP", True),
+        "fine LDL": seconds("LDL", True),
+        "fine LDL calls": factorisations,
+        "fine eigen": seconds("eigen", True),
+        "certificate": seconds("certificate"),
+        "total": run["total"],
+        "free run": free_run["total"],
+    }
+
+
+def main() -> None:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--meshes", default="90x30,180x60,360x120")
+    parser.add_argument("--case", default="ssss", help="a case of bench_plates.py")
+    parser.add_argument("--repeat", type=int, default=1, help="runs per process; minimum kept")
+    parser.add_argument("--json", help="append one JSON line per mesh to this file")
+    parser.add_argument("--worker", nargs=3, metavar=("CASE", "NX", "NY"), help=argparse.SUPPRESS)
+    parser.add_argument("--free", action="store_true", help=argparse.SUPPRESS)
+    args = parser.parse_args()
+    if args.worker:
+        worker(args.worker[0], int(args.worker[1]), int(args.worker[2]), args.free)
+        return
+    if args.repeat < 1:
+        parser.error(f"--repeat must be at least 1, got {args.repeat}")
+    meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
+    rows: list[dict[str, Any]] = []
+    for nx, ny in meshes:
+        best: dict[str, Any] | None = None
+        for _ in range(args.repeat):
+            run, free_run = _run(args.case, nx, ny, False), _run(args.case, nx, ny, True)
+            stages = _stages(run, free_run)
+            if best is None:
+                best = {"run": run, "stages": stages}
+            else:
+                best["stages"] = {k: min(v, stages[k]) for k, v in best["stages"].items()}
+        assert best is not None
+        rows.append(
+            {
+                "case": args.case,
+                "mesh": f"{nx}x{ny}",
+                "dofs": best["run"]["dofs"],
+                "load_Pa": best["run"]["load_Pa"],
+                "levels": best["run"]["levels"],
+                **best["stages"],
+                "ratio": best["stages"]["total"] / best["stages"]["free run"],
+            }
+        )
+    print_header(
+        f"{args.case}: process seconds per stage (growth exponent p, t ~ DOFs^p, "
+        "from the mesh before)",
+        ["stage"] + [f"{r['mesh']} ({r['dofs']} DOFs)" for r in rows],
+    )
+    for stage in STAGES:
+        cells = []
+        for k, r in enumerate(rows):
+            cell = f"{r[stage]:.2f}"
+            if stage == "fine LDL":
+                calls = r["fine LDL calls"]
+                cell = f"{r[stage]:.2f} ({calls} x {r[stage] / max(calls, 1):.3f})"
+            before = rows[k - 1] if k else None
+            if before is not None and before[stage] > 0 and r[stage] > 0:
+                p = math.log(r[stage] / before[stage]) / math.log(r["dofs"] / before["dofs"])
+                cell += f" (p {p:.2f})"
+            cells.append(cell)
+        print(f"| {stage} | " + " | ".join(cells) + " |")
+    ratios = " | ".join(f"{r['total'] / r['free run']:.2f}" for r in rows)
+    print(f"| ratio total / free run | {ratios} |")
+    for r in rows:
+        print(f"{r['mesh']}: load {r['load_Pa']!r} Pa; levels [mesh, steps, factorisations]")
+        print(f"  {r['levels']}")
+    append_rows(args.json, rows)
+
+
+if __name__ == "__main__":
+    main()
