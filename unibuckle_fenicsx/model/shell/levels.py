@@ -119,31 +119,11 @@ def solve_levels(
         problem = section.problem
         if not isinstance(problem, CoredSectionProblem) or section.constraints is None:
             raise RuntimeError("solve_levels: a core section without constraints")
-        polished = None
+        polished, polish_iterations = None, None
         if prev is not None and best is not None and prev.constraints is not None:
             z = prolong_directions(best.active, prev.constraints, section.constraints)
-            estimate = best.load
-            # Looser tolerances first: on thin walls the mode's tails flip sign from one
-            # contact set to the next (as on thin plates, :data:`THRESHOLDS`).
-            run = iterate(
-                problem, "prolonged", z, None, POLISH_ITERATIONS, thresholds=THRESHOLDS,
-                near=estimate,
-            )  # fmt: skip
-            if run.status is RunStatus.KKT and run.final is not None:
-                free = problem.solve_free().load
-                polished = UnilateralSolution(
-                    candidate=run.final,
-                    method="active-set (section levels)",
-                    eigensolves=problem.eigensolver.solves,
-                    lower_bound=free,
-                    global_optimum_proven=False,
-                    upper_bound=run.final.load,
-                    kkt_points=[run.final],
-                    lower_bound_by="interlacing",
-                )
-                polish_iterations = run.iterations
+            polished, polish_iterations = _polish(problem, z, best.load)
         if polished is None:
-            polish_iterations = None
             polished = solve_active_set(
                 problem, multilevel=False, max_iterations=max_iterations, bound_budget=0
             )
@@ -175,3 +155,31 @@ def solve_levels(
     elif isinstance(best.details, ActiveSetDetails):
         details.active_set = best.details
     return section, replace(best, details=details)
+
+
+def _polish(
+    problem: CoredSectionProblem, z: npt.NDArray[np.int64], estimate: float
+) -> tuple[UnilateralSolution | None, int | None]:
+    """The active set from the contact set ``z`` carried from the coarser section.
+
+    Returns the solution and its iterations when they reach a KKT point, else (None,
+    None). ``estimate``: the coarser section's load (the eigen solves shift near it).
+    """
+    # Looser tolerances first: on thin walls the mode's tails flip sign from one
+    # contact set to the next (as on thin plates, :data:`THRESHOLDS`).
+    run = iterate(
+        problem, "prolonged", z, None, POLISH_ITERATIONS, thresholds=THRESHOLDS, near=estimate
+    )
+    if run.status is not RunStatus.KKT or run.final is None:
+        return None, None
+    solution = UnilateralSolution(
+        candidate=run.final,
+        method="active-set (section levels)",
+        eigensolves=problem.eigensolver.solves,
+        lower_bound=problem.solve_free().load,
+        global_optimum_proven=False,
+        upper_bound=run.final.load,
+        kkt_points=[run.final],
+        lower_bound_by="interlacing",
+    )
+    return solution, run.iterations
