@@ -168,7 +168,11 @@ def _cli(python: str, spec) -> tuple[float, float]:
         cmd = [python, "-m", "unibuckle_fenicsx.cli", "solve", "--config", str(path)]
         env = {**os.environ, "OMP_NUM_THREADS": "1"}
         t0 = time.perf_counter()
-        subprocess.run([*cmd, "--json", str(out)], check=True, capture_output=True, env=env)
+        # cwd: python -m puts it first on sys.path, so the checkout's package would shadow
+        # the installation of ``python`` (the baseline would time this package).
+        subprocess.run(
+            [*cmd, "--json", str(out)], check=True, capture_output=True, env=env, cwd=tmp
+        )
         wall = time.perf_counter() - t0
         return wall, float(json.loads(out.read_text())["timings"]["total_s"])
 

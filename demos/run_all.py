@@ -51,6 +51,7 @@ DEMOS = (
     "demo_realistic.py",  # figures/realistic/; no row in the table
     "demo_column.py",  # figures/column/; no row in the table
     "study_ties.py",  # figures/ties/: k against the tie spacing; no row in the table
+    "demo_sections.py",  # figures/sections/: box and tube, hollow and filled; no row
 )
 #: The quickstart's runs (docs/guide/quickstart.md shows their output): the README's first
 #: problem file, as a user runs it, without and with --bracket.

@@ -52,6 +52,8 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
     pngs["column/contact_map.png"] = line
     pngs["column/tie_spacing.png"] = (750, 1125)  # charts.plot_sweep
     pngs["ties/tie_spacing_study.png"] = (750, 1125)  # study_ties: charts.plot_sweep
+    for name in ("box_filled", "box_hollow", "tube_filled", "tube_hollow"):  # demo_sections
+        pngs[f"sections/{name}.png"] = (h3, w3)
     return pngs
 
 
@@ -76,6 +78,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     for demo in (
         "demo_free_plate", "demo_obstacle_c1", "demo_obstacle_c2", "demo_obstacle_c3",
         "demo_garland", "demo_nonlinear", "demo_realistic", "demo_column", "study_ties",
+        "demo_sections",
     ):  # fmt: skip
         assert f"{demo}.py: ok" in proc.stdout
     assert "lambda/lambda_free" in proc.stdout and "certificate" in proc.stdout
@@ -153,6 +156,7 @@ PUBLIC_MODULES = (
     "unibuckle_fenicsx.viz.charts",
     "unibuckle_fenicsx.viz.fields",
     "unibuckle_fenicsx.viz.study",
+    "unibuckle_fenicsx.viz.section",
 )
 #: Scripts that study an algorithm itself and call it directly (not a user's workflow).
 ALGORITHM_STUDIES = ("study_penalty.py",)

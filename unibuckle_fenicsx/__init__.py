@@ -2,7 +2,9 @@
 
 Importing the package does not import PETSc, SLEPc, DOLFINx or pyvista:
 ``unibuckle_fenicsx.solve`` (:func:`unibuckle_fenicsx.analysis.solve`) imports them on
-first use.
+first use, as do the sections' ``SectionParameters``
+(:class:`unibuckle_fenicsx.model.shell.section.SectionParameters`) and ``solve_section``
+(:func:`unibuckle_fenicsx.section_analysis.solve_section`).
 """
 
 from typing import Any
@@ -31,6 +33,7 @@ __all__ = [
     "ObstacleSpec",
     "PlateSpec",
     "ProblemSpec",
+    "SectionParameters",
     "SolverSpec",
     "__version__",
     "load_toml",
@@ -38,13 +41,22 @@ __all__ = [
     "problem_from_dict",
     "problem_to_dict",
     "solve",
+    "solve_section",
 ]
 
 
 def __getattr__(name: str) -> Any:
-    """Lazy ``solve``: the computations import DOLFINx, PETSc and SLEPc."""
+    """Lazy ``solve`` and sections: the computations import DOLFINx, PETSc and SLEPc."""
     if name == "solve":
         from unibuckle_fenicsx.analysis import solve
 
         return solve
+    if name == "solve_section":
+        from unibuckle_fenicsx.section_analysis import solve_section
+
+        return solve_section
+    if name == "SectionParameters":
+        from unibuckle_fenicsx.model.shell.section import SectionParameters
+
+        return SectionParameters
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")

@@ -594,6 +594,15 @@ DEMOS = {
         ["column/mode.png", "column/contact_map.png", "column/tie_spacing.png"],
     ),
     "ties": ("study_ties.py", ["ties/tie_spacing_study.png"]),
+    "sections": (
+        "demo_sections.py",
+        [
+            "sections/box_filled.png",
+            "sections/box_hollow.png",
+            "sections/tube_filled.png",
+            "sections/tube_hollow.png",
+        ],
+    ),
 }
 
 

@@ -26,6 +26,8 @@ __all__ = [
     "MethodDetails",
     "PenaltyDetails",
     "RunSummary",
+    "SectionLevel",
+    "SectionLevelsDetails",
 ]
 
 
@@ -345,6 +347,50 @@ class FoundationDetails(Struct, kw_only=True):
     foundation_status: str
 
 
+class SectionLevel(Struct, kw_only=True):
+    """One section of the coarse-to-fine sections' solve.
+
+    Attributes:
+        mesh_size: Its cell size (m).
+        dofs: Its DOFs (six per node).
+        constrained: The core's constrained directions.
+        load: The critical stress found there (Pa).
+        kkt: Its state satisfies the KKT conditions.
+        eigensolves: Eigen solves on it.
+        wall_time_s: Seconds.
+    """
+
+    mesh_size: float
+    dofs: int
+    constrained: int
+    load: float
+    kkt: bool
+    eigensolves: int
+    wall_time_s: float
+
+
+class SectionLevelsDetails(Struct, kw_only=True):
+    """The sections' coarse-to-fine active set (a section with a core).
+
+    Attributes:
+        free_load: The finest hollow section's lambda_free.
+        polish_iterations: The active-set iterations from the contact set carried from
+            the coarser section, when they reached a KKT point.
+        active_set: The active set's record, when it ran from its seeds on the finest
+            section (the coarsest, or a carried contact set that did not polish).
+        levels: The sections, coarsest first.
+        coarse_eigensolves: Eigen solves on the coarser sections.
+        wall_time_s: Seconds.
+    """
+
+    free_load: float
+    polish_iterations: int | UnsetType = UNSET
+    active_set: ActiveSetDetails | UnsetType = UNSET
+    levels: list[SectionLevel]
+    coarse_eigensolves: int
+    wall_time_s: float
+
+
 #: The record of whichever algorithm ran.
 MethodDetails = (
     EnumerationDetails
@@ -352,4 +398,5 @@ MethodDetails = (
     | InteriorPointDetails
     | PenaltyDetails
     | FoundationDetails
+    | SectionLevelsDetails
 )

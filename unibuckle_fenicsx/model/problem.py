@@ -196,8 +196,12 @@ class Problem(Owner):
         self._abs_A: PETSc.Mat | None = None  # abs_pencil(), made when needed
         self._abs_B: PETSc.Mat | None = None
         self.tau = parts.spec.solver.tau
-        n_owned_w = parts.model.Vw.dofmap.index_map.size_local
-        self._w_owned = parts.model.w_dofs[:n_owned_w]
+        self._w_owned = self._owned_deflections()
+
+    def _owned_deflections(self) -> npt.NDArray[np.int32]:
+        """Local DOFs of the deflection owned by this rank (what :meth:`max_abs_w` reads)."""
+        n_owned_w = self.model.Vw.dofmap.index_map.size_local
+        return self.model.w_dofs[:n_owned_w]
 
     # -- primitives ----------------------------------------------------------------
     @property

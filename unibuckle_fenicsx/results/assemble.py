@@ -33,7 +33,7 @@ if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.certificate.certify import Certificate
     from unibuckle_fenicsx.model.problem import Mode, Problem
 
-__all__ = ["assemble_result", "certificate_record", "versions"]
+__all__ = ["assemble_result", "certificate_record", "record_contact", "versions"]
 
 
 def assemble_result(
@@ -96,6 +96,24 @@ def assemble_result(
     if solution is None or certificate is None:
         result.lower_bound_Pa = result.upper_bound_Pa = free.load
         return result
+    record_contact(result, problem, solution, certificate)
+    return result
+
+
+def record_contact(
+    result: BucklingResult,
+    problem: Problem,
+    solution: UnilateralSolution,
+    certificate: Certificate,
+) -> None:
+    """Fill in ``result``'s contact set, bracket, certificate and contact forces.
+
+    The part of :func:`assemble_result` that reads the unilateral ``solution``; a
+    section's result (:mod:`~unibuckle_fenicsx.section_analysis`) is filled in by it too.
+
+    Note:
+        Collective on the problem's communicator (gathers the contact DOFs).
+    """
     unilateral = _contact(result, problem, solution)
     result.lower_bound_Pa = certificate.lower_bound
     result.upper_bound_Pa = (
@@ -110,7 +128,6 @@ def assemble_result(
         result.details.continued = solution.continued
     if not problem.tensionless:
         result.contact_force = _contact_force(unilateral, solution, result.load_resolution)
-    return result
 
 
 def _details(problem: Problem, free: Mode) -> ResultDetails:

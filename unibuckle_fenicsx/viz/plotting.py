@@ -40,7 +40,9 @@ if TYPE_CHECKING:  # pragma: no cover
 
 __all__ = [
     "THEME",
+    "annotate",
     "colour_scale",
+    "coloured_surface",
     "plot_contact_force",
     "plot_contact_map",
     "plot_contact_set",
@@ -170,6 +172,82 @@ def colour_scale(wn: npt.NDArray[np.float64]) -> tuple[str, tuple[float, float]]
 
 
 # -- 3-D mode ----------------------------------------------------------------------------
+def annotate(plotter: Any, legend: Sequence[tuple[str, str]], title: str, font: str | None) -> None:
+    """The legend (label, colour) at the lower left and the title at the upper left."""
+    if legend:
+        plotter.add_legend(
+            labels=[[label, color] for label, color in legend],
+            bcolor="white",
+            border=True,
+            size=(0.3, 0.1),
+            loc="lower left",
+            face="rectangle",
+        )
+    if title:
+        plotter.add_text(
+            title,
+            position="upper_left",
+            font_size=THEME["font_size"] - 2,
+            color="black",
+            font_file=font,
+        )
+
+
+def coloured_surface(
+    pv: Any,
+    surface: Any,
+    scalars: str,
+    title: str,
+    *,
+    edges: bool,
+    line_width: float = 0.5,
+    ambient: float = 0.0,
+    cmap: str | None = None,
+    clim: tuple[float, float] = (-1.0, 1.0),
+) -> tuple[Any, str | None]:
+    """An off-screen plotter with ``surface`` coloured by ``scalars`` in [-1, 1] and its bar.
+
+    ``ambient``: VTK's ambient light coefficient (0 to 1), so that walls seen at a grazing
+    angle keep their colour; ``cmap`` and ``clim`` as :func:`colour_scale` gives them
+    (default: the theme's diverging map on [-1, 1]).
+
+    Returns:
+        The plotter (the caller closes it) and the font file of its text (or None).
+    """
+    font = _font_file()
+    plotter = pv.Plotter(off_screen=True, window_size=THEME["window_size"])
+    plotter.set_background("white")
+    plotter.add_mesh(
+        surface,
+        scalars=scalars,
+        cmap=THEME["cmap"] if cmap is None else cmap,
+        clim=clim,
+        show_edges=edges,
+        edge_color="gray",
+        line_width=line_width,
+        show_scalar_bar=False,
+        ambient=ambient,
+    )
+    bar = plotter.add_scalar_bar(
+        title=title,
+        vertical=True,
+        position_x=0.87,
+        position_y=0.2,
+        height=0.6,
+        width=0.06,
+        title_font_size=THEME["font_size"],
+        label_font_size=THEME["font_size"] - 2,
+        color="black",
+        fmt="%.1f",
+        n_labels=5,
+    )
+    if font is not None:
+        for prop in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
+            prop.SetFontFamily(_VTK_FONT_FILE)
+            prop.SetFontFile(font)
+    return plotter, font
+
+
 def plot_mode_3d(
     problem: Problem,
     mode: dolfinx.fem.Function,
@@ -220,32 +298,21 @@ def plot_mode_3d(
     warp = THEME["warp"] * scale
     warped = grid.warp_by_scalar("w / max|w|", factor=warp)
 
-    font = _font_file()
-    plotter = pv.Plotter(off_screen=True, window_size=THEME["window_size"])
-    plotter.set_background("white")
-    _add_surface(plotter, grid, warped, font, cmap, clim)
+    plotter, font = coloured_surface(
+        pv,
+        warped,
+        "w / max|w|",
+        "w (normalised)",
+        edges=grid.n_cells <= 2500,
+        cmap=cmap,
+        clim=clim,
+    )
     # Flat reference outline of the plate at w = 0.
     (px0, py0), (px1, py1) = problem.spec.plate.corners
     plate_outline = pv.Rectangle([[px0, py0, 0.0], [px1, py0, 0.0], [px1, py1, 0.0]])
     plotter.add_mesh(plate_outline.extract_feature_edges(), color="gray", line_width=1.5)
     legend = _add_obstacle(plotter, problem, show_zone, warp, contact_coordinates, contact_pressing)
-    if legend:
-        plotter.add_legend(
-            labels=[[label, color] for label, color in legend],
-            bcolor="white",
-            border=True,
-            size=(0.3, 0.1),
-            loc="lower left",
-            face="rectangle",
-        )
-    if title:
-        plotter.add_text(
-            title,
-            position="upper_left",
-            font_size=THEME["font_size"] - 2,
-            color="black",
-            font_file=font,
-        )
+    annotate(plotter, legend, title, font)
     plotter.add_axes(
         xlabel="x", ylabel="y", zlabel="w", color="black", viewport=(0.72, 0.0, 0.86, 0.18)
     )
@@ -258,44 +325,6 @@ def plot_mode_3d(
     plotter.screenshot(str(path))
     plotter.close()
     return path
-
-
-def _add_surface(
-    plotter: Any,
-    grid: Any,
-    warped: Any,
-    font: str | None,
-    cmap: str,
-    clim: tuple[float, float],
-) -> None:
-    """The warped mode coloured by w / max|w| on ``cmap`` over ``clim``, and its colour bar."""
-    plotter.add_mesh(
-        warped,
-        scalars="w / max|w|",
-        cmap=cmap,
-        clim=clim,
-        show_edges=grid.n_cells <= 2500,
-        edge_color="gray",
-        line_width=0.5,
-        show_scalar_bar=False,
-    )
-    bar = plotter.add_scalar_bar(
-        title="w (normalised)",
-        vertical=True,
-        position_x=0.87,
-        position_y=0.2,
-        height=0.6,
-        width=0.06,
-        title_font_size=THEME["font_size"],
-        label_font_size=THEME["font_size"] - 2,
-        color="black",
-        fmt="%.1f",
-        n_labels=5,
-    )
-    if font is not None:
-        for prop in (bar.GetTitleTextProperty(), bar.GetLabelTextProperty()):
-            prop.SetFontFamily(_VTK_FONT_FILE)
-            prop.SetFontFile(font)
 
 
 def _add_obstacle(

@@ -1,0 +1,123 @@
+r"""Sections with a core: the free solve and the unilateral solve, their times and ratio.
+
+Usage::
+
+    OMP_NUM_THREADS=1 flock /tmp/unibuckle-bigmem.lock \\
+        .venv/bin/python bench/bench_sections.py --shape box --size 0.00526 --levels 2
+
+A square box (b = d = 0.2 m, t = 2 mm: b/t = 100, L = 3b) or a circular tube (R = 0.1 m,
+t = 1 mm: R/t = 100, L = R), steel, simply supported ends, a rigid core over the whole
+length. One process: the set-up (mesh, prestress, assembly, change of basis), the free
+eigen solve (min of ``--repeat`` solves of the same pencil), and the unilateral solve
+(:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`: the active-set seeds on a
+section ``--levels`` times coarser, the contact set polished level by level), then the
+certificate. Prints one Markdown row; ``--json FILE`` appends it.
+
+Note:
+    Timings are only meaningful on a quiet machine; the ratio (unilateral over free) is
+    measured within one process.
+"""
+
+from __future__ import annotations
+
+import argparse
+import time
+
+from _results import append_rows, print_header
+
+COLUMNS = (
+    "shape", "dofs", "constrained", "cells_around", "free_load/ref", "core_load/ref",
+    "kkt", "certificate", "setup_s", "rotation_s", "free_s", "unilateral_s", "ratio",
+    "certify_s", "eigensolves_fine", "eigensolves_coarse",
+)  # fmt: skip
+
+
+def run(shape: str, size: float, levels: int, repeat: int, corner_cell: float | None) -> dict:
+    """One section: set-up, free solve, unilateral solve, certificate."""
+    from mpi4py import MPI
+
+    import msgspec
+
+    from unibuckle_fenicsx.algorithms.records import SectionLevelsDetails
+    from unibuckle_fenicsx.certificate.certify import certify
+    from unibuckle_fenicsx.la.eigen import GEPSolver
+    from unibuckle_fenicsx.model.shell.levels import solve_levels
+    from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
+
+    geometry = (
+        {"width": 0.2, "depth": 0.2, "thickness": 0.002, "length": 0.6}
+        if shape == "box"
+        else {"diameter": 0.2, "thickness": 0.001, "length": 0.1}
+    )
+    params = SectionParameters(
+        shape, E=2.1e11, nu=0.3, mesh_size=size, ends="simply_supported", core=True,
+        corner_cell=corner_cell if shape == "box" else None, **geometry,
+    )  # fmt: skip
+    t0 = time.perf_counter()
+    with build_section(params, MPI.COMM_WORLD) as section:
+        setup = time.perf_counter() - t0
+        rotation = section.problem.timings["rotation_s"]
+        ref = section.classical_stress()
+        times = []
+        for _ in range(repeat):
+            solver = GEPSolver(section.problem.pencil.A, section.problem.pencil.B, prefix="bench_")
+            t1 = time.perf_counter()
+            free = solver.solve().value
+            times.append(time.perf_counter() - t1)
+            solver.destroy()
+        dofs, cells = section.model.num_dofs, section.mesh.cells_around
+    t1 = time.perf_counter()
+    fine, solution = solve_levels(params, levels=levels)
+    unilateral = time.perf_counter() - t1
+    with fine:
+        t2 = time.perf_counter()
+        cert = certify(fine.problem, solution)
+        certify_s = time.perf_counter() - t2
+        details = solution.details
+        assert isinstance(details, SectionLevelsDetails)
+        levels_log = [msgspec.to_builtins(level) for level in details.levels]
+        return {
+            "shape": shape,
+            "dofs": dofs,
+            "constrained": fine.constraints.size if fine.constraints is not None else 0,
+            "cells_around": cells,
+            "free_load/ref": free / ref,
+            "core_load/ref": solution.load / ref,
+            "kkt": bool(solution.candidate.kkt),
+            "certificate": f"kkt={cert.kkt}, smallest={cert.smallest_of_reduced}, "
+            f"gap={cert.relative_gap:.3g} ({cert.proven_by})",
+            "setup_s": setup,
+            "rotation_s": rotation,
+            "free_s": min(times),
+            "unilateral_s": unilateral,
+            "ratio": unilateral / min(times),
+            "certify_s": certify_s,
+            "eigensolves_fine": levels_log[-1]["eigensolves"],
+            "eigensolves_coarse": details.coarse_eigensolves,
+            "levels": levels_log,
+            "corner_cell": corner_cell,
+        }
+
+
+def main() -> None:
+    """Parse the options, run, print the row."""
+    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    parser.add_argument("--shape", choices=("box", "tube"), default="box")
+    parser.add_argument("--size", type=float, default=0.00526, help="mesh size (m)")
+    parser.add_argument("--levels", type=int, default=2)
+    parser.add_argument("--repeat", type=int, default=3)
+    parser.add_argument("--corner-cell", type=float, default=None)
+    parser.add_argument("--json", default=None)
+    args = parser.parse_args()
+    row = run(args.shape, args.size, args.levels, args.repeat, args.corner_cell)
+    print_header("Sections with a core (one rank)", COLUMNS)
+    cells = []
+    for c in COLUMNS:
+        v = row[c]
+        cells.append(f"{v:.4g}" if isinstance(v, float) else str(v))
+    print("| " + " | ".join(cells) + " |", flush=True)
+    append_rows(args.json, [row])
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,150 @@
+r"""The core as an obstacle: the change of basis, and the unilateral critical state of a section.
+
+- The change of basis T (:mod:`unibuckle_fenicsx.model.shell.core`) is orthogonal on a box,
+  leaves the pencil's eigenvalues unchanged (congruence), and its constrained DOFs are the
+  normal displacements :math:`n_{in}\cdot u` (computed here from the coordinates).
+- Dense reference: on sections small enough to enumerate every contact set (2^12 and 2^8),
+  scipy solves each reduced pencil in the *global* basis (the constraints
+  :math:`n_{in}\cdot u = 0` by a null-space basis, independent of T) and keeps the smallest
+  load whose mode stays on the admissible side (the discrete critical state, paper,
+  Lemma 5.1); the package's active-set method on the rotated pencil must find it.
+"""
+
+from __future__ import annotations
+
+import itertools
+import math
+
+from mpi4py import MPI
+
+import numpy as np
+import pytest
+import scipy.linalg
+
+from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
+
+pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense references are serial")
+
+
+def _parameters(shape, **changes):
+    base = {
+        "box": {"width": 0.2, "depth": 0.1, "thickness": 0.002, "length": 0.2, "mesh_size": 0.1},
+        "tube": {"diameter": 0.2, "thickness": 0.002, "length": 0.2, "mesh_size": 0.1},
+    }[shape]
+    return SectionParameters(
+        shape, E=2.1e11, nu=0.3, ends="simply_supported", core=True, **{**base, **changes}
+    )
+
+
+def _normal_rows(section):
+    """(i, n) rows of the constraints n_in . u <= 0 from the node coordinates alone."""
+    V = section.model.W
+    X = V.tabulate_dof_coordinates()
+    p = section.parameters
+    rows, where = [], []
+    for k, (x, y, z) in enumerate(X):
+        if x < 1e-9 or x > p.length - 1e-9:
+            continue  # the ends: held by the supports
+        normals = []
+        if p.shape == "tube":
+            normals.append(np.array([0.0, -y, -z]) / math.hypot(y, z))
+        else:
+            if abs(abs(y) - 0.5 * p.width) < 1e-9:
+                normals.append(np.array([0.0, -np.sign(y), 0.0]))
+            if abs(abs(z) - 0.5 * p.depth) < 1e-9:
+                normals.append(np.array([0.0, 0.0, -np.sign(z)]))
+        for n in normals:
+            row = np.zeros(X.shape[0] * 6)
+            row[6 * k : 6 * k + 3] = n
+            rows.append(row)
+            where.append((x, y, z, *n))
+    return np.array(rows), np.array(where)
+
+
+def _dense_critical(A, B, C, tau=1e-8):
+    """Smallest load over all contact sets whose reduced first mode is admissible."""
+    best, best_set = math.inf, None
+    i = C.shape[0]
+    for size in range(i + 1):
+        for Z in itertools.combinations(range(i), size):
+            N = scipy.linalg.null_space(C[list(Z)]) if Z else np.eye(A.shape[0])
+            mu, Y = scipy.linalg.eigh(N.T @ B @ N, N.T @ A @ N)  # A SPD: swapped pencil
+            if mu[-1] <= 0.0:
+                continue
+            load = 1.0 / mu[-1]
+            u = N @ Y[:, -1]
+            values = C @ u
+            scale = np.abs(values).max() or 1.0
+            free = np.setdiff1d(np.arange(i), Z)
+            for sign in (1.0, -1.0):
+                if np.all(sign * values[free] <= tau * scale) and load < best:
+                    best, best_set = load, Z
+    return best, best_set
+
+
+@pytest.mark.parametrize("shape", ["box", "tube"])
+def test_change_of_basis_is_a_congruence(shape):
+    params = _parameters(shape, mesh_size=0.05, length=0.2)
+    with build_section(params, MPI.COMM_SELF) as sec:
+        T = sec.problem.pencil.T
+        Td = T.convert("dense").getDenseArray()
+        if shape == "box":
+            assert np.abs(Td.T @ Td - np.eye(Td.shape[0])).max() < 1e-15
+        C, _ = _normal_rows(sec)
+        u = np.random.default_rng(1).standard_normal(Td.shape[0])
+        constrained = np.linalg.solve(Td, u)[sec.rows]  # u' = T^-1 u at the rows
+        np.testing.assert_allclose(np.sort(constrained), np.sort(C @ u), atol=1e-12)
+        A, B = (m.convert("dense").getDenseArray() for m in (sec.model.A, sec.model.B))
+        Ar, Br = (
+            m.convert("dense").getDenseArray() for m in (sec.problem.pencil.A, sec.problem.pencil.B)
+        )
+        lam = 1.0 / scipy.linalg.eigh(B, A, eigvals_only=True)[-1]
+        lam_rotated = 1.0 / scipy.linalg.eigh(Br, Ar, eigvals_only=True)[-1]
+        assert lam_rotated == pytest.approx(lam, rel=1e-10)
+
+
+@pytest.mark.parametrize(
+    ("shape", "changes"), [("box", {}), ("tube", {"mesh_size": 0.08, "length": 0.16})]
+)
+def test_core_matches_dense_enumeration(shape, changes):
+    params = _parameters(shape, **changes)
+    with build_section(params, MPI.COMM_SELF) as sec:
+        C, _ = _normal_rows(sec)
+        assert C.shape[0] == sec.constraints.size <= 12
+        A, B = (m.convert("dense").getDenseArray() for m in (sec.model.A, sec.model.B))
+        expected, _ = _dense_critical(A, B, C)
+        solution = solve_active_set(sec.problem, multilevel=False)
+        assert solution.candidate.kkt
+        free = sec.problem.solve_free().load
+        assert free < expected  # the core is active on these sections
+        assert solution.load == pytest.approx(expected, rel=1e-8)
+
+
+def test_section_figure_is_written(tmp_path):
+    pytest.importorskip("pyvista")
+    from unibuckle_fenicsx.model.shell.section import figure_data
+    from unibuckle_fenicsx.viz.section import plot_section_mode_3d
+
+    with build_section(_parameters("box"), MPI.COMM_SELF) as sec:
+        solution = solve_active_set(sec.problem, multilevel=False)
+        data = figure_data(sec, solution.candidate)
+        assert len(data.pressing) + len(data.touching) == len(solution.active)
+        assert np.abs(data.displacement).max() == pytest.approx(1.0)
+        path = plot_section_mode_3d(data, tmp_path / "box.png", title="box")
+    assert path.stat().st_size > 10_000
+
+
+def test_core_over_part_of_the_length():
+    """Fewer constrained directions, a wider cone: free <= part of the length <= whole length."""
+    loads = []
+    for span in (None, (0.0, 0.1)):
+        params = _parameters("box", mesh_size=0.05, length=0.2, core_span=span)
+        with build_section(params, MPI.COMM_SELF) as sec:
+            x = sec.constraints.coordinates[:, 0]
+            assert (x.max() <= 0.1 + 1e-12) if span else (x.max() > 0.1)
+            loads.append(solve_active_set(sec.problem, multilevel=False).load)
+            free = sec.problem.solve_free().load
+    whole, part = loads
+    assert free <= part * (1 + 1e-9) and part <= whole * (1 + 1e-9), (free, part, whole)
+    assert part < whole  # the buckle moves to the uncovered half

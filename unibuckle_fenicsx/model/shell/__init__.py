@@ -1,0 +1,1 @@
+"""Shell model of thin-walled sections: meshes, forms, prestress, pencil, core constraints."""

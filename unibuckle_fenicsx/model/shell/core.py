@@ -1,0 +1,251 @@
+r"""The core as an obstacle: constrained normal directions, each made one DOF by a change of basis.
+
+At every node of the walls the core covers, the wall may only move away from it:
+:math:`n_{in}\cdot u \le 0` with :math:`n_{in}` the unit normal toward the core
+(:meth:`~unibuckle_fenicsx.model.shell.geometry.SectionMesh.inward_normals`): one per
+node of a face or of a tube, two at a box's corner (the two faces' normals). The
+package's contact manager and algorithms remove *single* DOFs with a sign
+(:class:`~unibuckle_fenicsx.model.contact.ContactSetManager`). A change of basis at the
+constrained nodes turns each constrained direction into one DOF: with the node's
+:math:`3\times3` block :math:`Q_k = R_k^{-1}`, :math:`R_k` the rows
+:math:`(n_1, [n_2,] m\ldots)` (the normals, completed to a basis by Gram-Schmidt on
+e_x, e_y, e_z), the global displacement is :math:`u = T u'` with T block-diagonal
+(:math:`Q_k` on the node's displacement DOFs, the identity elsewhere), and the first
+(and second) of the node's displacement DOFs in the new basis is :math:`n_j\cdot u`.
+The pencil becomes :math:`(A', B') = (T^TAT, T^TBT)` (PETSc ``PtAP``): congruent, so A'
+stays SPD and the eigenvalues do not change; a candidate set is again a set of rows to
+zero. When the normals are orthonormal (a box's corner, any single normal) T is
+orthogonal.
+
+Nodes whose normal displacement a support holds already (the loaded ends) are left out,
+as the plate's edge-held zone nodes are.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from mpi4py import MPI
+from petsc4py import PETSc
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.model.shell.geometry import SectionMesh
+from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE, ShellModel
+from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
+
+__all__ = ["CoreConstraints", "change_of_basis", "core_constraints", "perimeter_coordinate"]
+
+
+@dataclass(frozen=True)
+class CoreConstraints:
+    r"""The constrained directions, numbered 0..i-1 the same way on every rank.
+
+    Attributes:
+        coordinates: (i, 3) the node of each constraint (a box's corner node appears
+            twice), same on all ranks.
+        normals: (i, 3) its unit normal toward the core, same on all ranks.
+        unrolled: (i, 2) (x, s), s the arc length around the section's mid-line (m).
+        owned_positions: Constraint numbers of the constraints whose node this rank owns.
+        owned_local_dofs: Local W DOF (new basis) of each: ``6 k + j``, j the normal's
+            place at node k.
+        owned_global_dofs: Its global DOF.
+        owned_nodes: Local node (block) k of each.
+        num_held: Constrained nodes left out because a support holds their normal motion.
+    """
+
+    coordinates: npt.NDArray[np.float64]
+    normals: npt.NDArray[np.float64]
+    unrolled: npt.NDArray[np.float64]
+    owned_positions: npt.NDArray[np.int64]
+    owned_local_dofs: npt.NDArray[np.int32]
+    owned_global_dofs: npt.NDArray[np.int64]
+    owned_nodes: npt.NDArray[np.int32]
+    num_held: int
+
+    @property
+    def size(self) -> int:
+        """Number i of constrained directions."""
+        return int(self.coordinates.shape[0])
+
+
+def perimeter_coordinate(
+    section: SectionMesh, x: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]:
+    r"""Arc length s (m) along the section's mid-line of the points ``x`` (3, n).
+
+    Box: counter-clockwise from the corner (+b/2, -d/2); tube: :math:`R\varphi`,
+    :math:`\varphi` from +y toward +z in [0, 2 pi); flat face: y.
+    """
+    y, z = x[1], x[2]
+    if section.shape == "flat":
+        return np.asarray(y, dtype=float)
+    if section.shape == "tube":
+        return section.radius * np.mod(np.arctan2(z, y), 2.0 * math.pi)
+    b, d = section.width, section.depth
+    hb, hd = 0.5 * b, 0.5 * d
+    tol = section.tolerance
+    s = np.empty(y.shape)
+    right = np.abs(y - hb) < tol
+    top = (np.abs(z - hd) < tol) & ~right
+    left = (np.abs(y + hb) < tol) & ~top
+    bottom = ~(right | top | left)
+    s[right] = z[right] + hd
+    s[top] = d + (hb - y[top])
+    s[left] = d + b + (hd - z[left])
+    s[bottom] = 2 * d + b + (y[bottom] + hb)
+    return s
+
+
+def core_constraints(model: ShellModel, span: tuple[float, float] | None = None) -> CoreConstraints:
+    """The core's constrained directions at the nodes of the walls it covers.
+
+    Args:
+        model: The section's shell model (its supports decide which nodes are held).
+        span: The core's extent (x0, x1) along the member (m); None: the whole length.
+            Nodes within the closed span count (tolerance of the section's geometry).
+
+    Raises:
+        InputError: The span holds no free node, or a support holds part of a
+            constrained node's displacement (the change of basis would mix held and
+            free components).
+
+    Note:
+        Collective.
+    """
+    section = model.section
+    comm = model.mesh.comm
+    tol = section.tolerance
+    x0, x1 = (0.0, section.length) if span is None else span
+    if not (0.0 <= x0 < x1 <= section.length + tol):
+        raise InputError(
+            f"core span must satisfy 0 <= x0 < x1 <= length = {section.length:g} m, got {span}"
+        )
+    V = model.W
+    im = V.dofmap.index_map
+    n_owned = im.size_local
+    X = V.tabulate_dof_coordinates()[:n_owned]
+    inside = (X[:, 0] >= x0 - tol) & (X[:, 0] <= x1 + tol)
+    held = np.zeros((n_owned, DOFS_PER_NODE), dtype=bool)
+    bc = model.bc_dofs[model.bc_dofs < n_owned * DOFS_PER_NODE]
+    held.reshape(-1)[bc] = True
+    nodes = np.flatnonzero(inside).astype(np.int32)
+    normals_per_node = section.inward_normals(X[nodes].T) if nodes.size else []
+    rec_nodes, rec_j, rec_n = [], [], []
+    num_held = 0
+    for k, normals in zip(nodes.tolist(), normals_per_node, strict=True):
+        fixed = held[k, :3]
+        if not fixed.any():
+            for j, n in enumerate(normals):
+                rec_nodes.append(k)
+                rec_j.append(j)
+                rec_n.append(n)
+            continue
+        free_part = np.abs(normals[:, ~fixed]).max() if (~fixed).any() else 0.0
+        if free_part < 1e-12:
+            num_held += 1
+            continue
+        raise InputError(
+            f"a support holds part of the displacement of the core's node at {X[k].tolist()}: "
+            "the core may cover only nodes whose displacement is free or whose normal "
+            "motion is held"
+        )
+    owned_nodes = np.asarray(rec_nodes, dtype=np.int32)
+    js = np.asarray(rec_j, dtype=np.int32)
+    normals = np.asarray(rec_n, dtype=float).reshape(-1, 3)
+    coords = X[owned_nodes] if owned_nodes.size else np.zeros((0, 3))
+    s = perimeter_coordinate(section, coords.T) if owned_nodes.size else np.zeros(0)
+    unrolled = np.stack([coords[:, 0], s], axis=1) if owned_nodes.size else np.zeros((0, 2))
+    # One numbering on every rank: by quantised (x, s), then the normal's place.
+    gathered = comm.allgather((coords, normals, unrolled, js))
+    all_c = np.vstack([g[0] for g in gathered])
+    all_n = np.vstack([g[1] for g in gathered])
+    all_u = np.vstack([g[2] for g in gathered])
+    all_j = np.concatenate([g[3] for g in gathered])
+    size = max(section.length, section.perimeter)
+    keys = np.round(all_u / (GEOMETRY_RTOL * size)).astype(np.int64)
+    order = np.lexsort((all_j, keys[:, 1], keys[:, 0])) if all_j.size else np.zeros(0, np.int64)
+    total = int(all_j.size)
+    if total == 0:
+        raise InputError(
+            f"the core covers no free node: its span {(x0, x1)} m holds only nodes held by "
+            "the end supports; lengthen the span or refine the mesh"
+        )
+    rank_pos = np.empty(total, dtype=np.int64)
+    rank_pos[order] = np.arange(total, dtype=np.int64)
+    offset = int(sum(g[3].size for g in gathered[: comm.rank]))
+    positions = rank_pos[offset : offset + js.size]
+    local_dofs = (owned_nodes.astype(np.int64) * DOFS_PER_NODE + js).astype(np.int32)
+    return CoreConstraints(
+        coordinates=all_c[order],
+        normals=all_n[order],
+        unrolled=all_u[order],
+        owned_positions=positions,
+        owned_local_dofs=local_dofs,
+        owned_global_dofs=model.global_dofs(local_dofs),
+        owned_nodes=owned_nodes,
+        num_held=int(comm.allreduce(num_held, op=MPI.SUM)),
+    )
+
+
+def _node_block(normals: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
+    r""":math:`Q = R^{-1}`, R the rows (normals, completion): :math:`(Q^{-1}u)_j = n_j\cdot u`."""
+    rows = [np.asarray(n, dtype=float) for n in normals]
+    basis: list[npt.NDArray[np.float64]] = []
+    for n in rows:  # orthonormalised normals span the normals' plane
+        v = n - sum((n @ q) * q for q in basis)
+        basis.append(v / np.linalg.norm(v))
+    while len(rows) < 3:
+        cands = [e - sum((e @ q) * q for q in basis) for e in np.eye(3)]
+        best = max(cands, key=lambda v: float(np.linalg.norm(v)))
+        best = best / np.linalg.norm(best)
+        basis.append(best)
+        rows.append(best)
+    R = np.vstack(rows)
+    if abs(np.linalg.det(R)) < 1e-6:
+        raise InputError("the core's normals at a node are (nearly) parallel")
+    return np.linalg.inv(R)
+
+
+def change_of_basis(model: ShellModel, constraints: CoreConstraints) -> PETSc.Mat:
+    r"""The matrix T with :math:`u = T u'`: :math:`Q_k` on each constrained node's displacement.
+
+    Returns:
+        T, square, with W's layout; the caller must destroy it.
+
+    Note:
+        Collective.
+    """
+    V = model.W
+    bs = V.dofmap.index_map_bs
+    n_local = model.num_owned_dofs
+    start = int(model.global_dofs(np.zeros(1, np.int32))[0]) if n_local else 0
+    by_node: dict[int, list[npt.NDArray[np.float64]]] = {}
+    normals = constraints.normals[constraints.owned_positions]
+    for k, n in zip(constraints.owned_nodes.tolist(), normals, strict=True):
+        by_node.setdefault(k, []).append(n)
+    # CSR: identity rows, then the 3x3 blocks.
+    cols: list[list[int]] = [[start + r] for r in range(n_local)]
+    vals: list[list[float]] = [[1.0] for _ in range(n_local)]
+    for k, ns in by_node.items():
+        Q = _node_block(np.array(ns))
+        for c in range(3):
+            r = k * bs + c
+            cols[r] = [start + k * bs + j for j in range(3)]
+            vals[r] = Q[c].tolist()
+    indptr = np.zeros(n_local + 1, dtype=PETSc.IntType)
+    indptr[1:] = np.cumsum([len(c) for c in cols])
+    T = PETSc.Mat().createAIJ(
+        ((n_local, None), (n_local, None)),  # type: ignore[arg-type]
+        csr=(  # type: ignore[arg-type]
+            indptr,
+            np.asarray([c for row in cols for c in row], dtype=PETSc.IntType),
+            np.asarray([v for row in vals for v in row], dtype=PETSc.ScalarType),
+        ),
+        comm=model.mesh.comm,
+    )
+    T.assemble()
+    return T

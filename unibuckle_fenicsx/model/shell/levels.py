@@ -1,0 +1,185 @@
+r"""The unilateral critical state of a section over a hierarchy of meshes.
+
+The package's active-set method (:func:`~unibuckle_fenicsx.algorithms.active_set.solve_active_set`)
+runs its seeds on the coarsest section (the mesh size doubled ``levels`` times); each
+finer section starts from the coarser level's contact set, carried over by
+:func:`prolong_directions`, and the primal-dual iteration
+(:func:`~unibuckle_fenicsx.algorithms.pdas.iterate`) polishes it, its eigen solves
+shifted just below the expected load. This is the plate's multilevel route
+(:mod:`~unibuckle_fenicsx.algorithms.multilevel`) for meshes that are no structured
+rectangle; the answer is always a KKT point of the finest section. If a prolonged set
+reaches none, the seeds run again on that level.
+"""
+
+from __future__ import annotations
+
+import logging
+import time
+from dataclasses import replace
+
+from mpi4py import MPI
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms.active_set import POLISH_ITERATIONS, THRESHOLDS, solve_active_set
+from unibuckle_fenicsx.algorithms.pdas import iterate
+from unibuckle_fenicsx.algorithms.records import (
+    ActiveSetDetails,
+    SectionLevel,
+    SectionLevelsDetails,
+)
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.model.shell.core import CoreConstraints
+from unibuckle_fenicsx.model.shell.problem import CoredSectionProblem
+from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
+from unibuckle_fenicsx.spec import SolverSpec
+
+__all__ = ["prolong_directions", "solve_levels"]
+
+logger = logging.getLogger(__name__)
+
+
+def prolong_directions(
+    active: npt.NDArray[np.int64], coarse: CoreConstraints, fine: CoreConstraints
+) -> npt.NDArray[np.int64]:
+    """The contact set ``active`` of a coarse section on a finer section's directions.
+
+    Each fine direction takes the status of the nearest coarse direction with the same
+    normal (unrolled coordinates x, s): in contact when that one is. Written by hand
+    (a nearest-neighbour search per normal): the meshes need not be nested.
+    """
+    from scipy.spatial import cKDTree
+
+    mask = np.zeros(coarse.size, dtype=bool)
+    mask[active] = True
+    out = np.zeros(fine.size, dtype=bool)
+    # Group directions by their normal (faces of a box; a tube's normals all differ,
+    # so there the group is by the normal's angle: nearest in (x, s) alone).
+    key_c = np.round(coarse.normals, 6)
+    key_f = np.round(fine.normals, 6)
+    if np.unique(key_f, axis=0).shape[0] > 8:  # a curved wall: one group
+        key_c = np.zeros_like(key_c)
+        key_f = np.zeros_like(key_f)
+    for key in np.unique(key_f, axis=0):
+        cf = np.flatnonzero(np.all(key_f == key, axis=1))
+        cc = np.flatnonzero(np.all(key_c == key, axis=1))
+        if not cc.size:
+            continue
+        tree = cKDTree(coarse.unrolled[cc])
+        _, nearest = tree.query(fine.unrolled[cf])
+        out[cf] = mask[cc[nearest]]
+    return np.flatnonzero(out).astype(np.int64)
+
+
+def solve_levels(
+    parameters: SectionParameters,
+    *,
+    levels: int = 2,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    solver: SolverSpec | None = None,
+    max_iterations: int = 100,
+) -> tuple[Section, UnilateralSolution]:
+    """Unilateral critical state of a section with a core, coarse to fine.
+
+    Args:
+        parameters: The section, with ``core = True``.
+        levels: Coarser sections (each with twice the mesh size) to seed on, >= 0; 0
+            runs the seeds on the section itself.
+        comm: Communicator.
+        solver: Solver options.
+        max_iterations: Iterates per seed on the coarsest level, >= 1.
+
+    Returns:
+        The finest section (the caller destroys it) and the solution on it.
+
+    Note:
+        Collective on ``comm``.
+    """
+    if not parameters.core:
+        raise InputError("solve_levels needs a section with core = true")
+    if int(levels) != levels or levels < 0:
+        raise InputError(f"levels must be an integer >= 0, got {levels!r}")
+    t0 = time.perf_counter()
+    sizes = [parameters.mesh_size * 2.0**k for k in range(levels, -1, -1)]
+    corner = parameters.corner_cell
+    log: list[SectionLevel] = []
+    prev: Section | None = None
+    best: UnilateralSolution | None = None
+    polish_iterations: int | None = None
+    coarse_solves = 0
+    section: Section | None = None
+    for size in sizes:
+        tl = time.perf_counter()
+        graded = None if corner is None else corner * size / parameters.mesh_size
+        section = build_section(
+            replace(parameters, mesh_size=size, corner_cell=graded), comm, solver
+        )
+        problem = section.problem
+        if not isinstance(problem, CoredSectionProblem) or section.constraints is None:
+            raise RuntimeError("solve_levels: a core section without constraints")
+        polished, polish_iterations = None, None
+        if prev is not None and best is not None and prev.constraints is not None:
+            z = prolong_directions(best.active, prev.constraints, section.constraints)
+            polished, polish_iterations = _polish(problem, z, best.load)
+        if polished is None:
+            polished = solve_active_set(
+                problem, multilevel=False, max_iterations=max_iterations, bound_budget=0
+            )
+        log.append(
+            SectionLevel(
+                mesh_size=size,
+                dofs=section.model.num_dofs,
+                constrained=section.constraints.size,
+                load=polished.load,
+                kkt=polished.candidate.kkt,
+                eigensolves=problem.eigensolver.solves,
+                wall_time_s=time.perf_counter() - tl,
+            )
+        )
+        if prev is not None:
+            coarse_solves += prev.problem.eigensolver.solves
+            prev.destroy()
+        prev, best = section, polished
+    if section is None or best is None:
+        raise RuntimeError("solve_levels: no level ran")
+    details = SectionLevelsDetails(
+        free_load=section.problem.solve_free().load,
+        levels=log,
+        coarse_eigensolves=coarse_solves,
+        wall_time_s=time.perf_counter() - t0,
+    )
+    if polish_iterations is not None:
+        details.polish_iterations = polish_iterations
+    elif isinstance(best.details, ActiveSetDetails):
+        details.active_set = best.details
+    return section, replace(best, details=details)
+
+
+def _polish(
+    problem: CoredSectionProblem, z: npt.NDArray[np.int64], estimate: float
+) -> tuple[UnilateralSolution | None, int | None]:
+    """The active set from the contact set ``z`` carried from the coarser section.
+
+    Returns the solution and its iterations when they reach a KKT point, else (None,
+    None). ``estimate``: the coarser section's load (the eigen solves shift near it).
+    """
+    # Looser tolerances first: on thin walls the mode's tails flip sign from one
+    # contact set to the next (as on thin plates, :data:`THRESHOLDS`).
+    run = iterate(
+        problem, "prolonged", z, None, POLISH_ITERATIONS, thresholds=THRESHOLDS, near=estimate
+    )
+    if run.status is not RunStatus.KKT or run.final is None:
+        return None, None
+    solution = UnilateralSolution(
+        candidate=run.final,
+        method="active-set (section levels)",
+        eigensolves=problem.eigensolver.solves,
+        lower_bound=problem.solve_free().load,
+        global_optimum_proven=False,
+        upper_bound=run.final.load,
+        kkt_points=[run.final],
+        lower_bound_by="interlacing",
+    )
+    return solution, run.iterations

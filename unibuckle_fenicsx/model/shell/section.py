@@ -1,0 +1,327 @@
+r"""A section's buckling problem from plain parameters: the public surface of the shell model.
+
+:func:`build_section` takes what a ``[section]`` table will hold (shape, width, depth or
+diameter, thickness, length, ends, E, nu, the axial stress per unit load and its part
+varying over the depth, whether a core fills the section, the mesh size) and returns a
+:class:`Section`: the mesh, the shell model (A, B in global components), the prestress,
+and with a core the rotated pencil (A', B') with the constrained rows (one per
+constrained direction, sign +1: :math:`n_{in}\cdot u \le 0`) and each constrained node's
+frame, set up as a :class:`~unibuckle_fenicsx.model.shell.problem.SectionProblem` for
+the package's unilateral algorithms and certificate. :func:`figure_data` gathers what the
+3-D figure of a mode needs (:func:`~unibuckle_fenicsx.viz.section.plot_section_mode_3d`).
+
+The critical load :math:`\lambda` is the compressive stress in Pa when
+``axial_stress = -1`` (the prestress is :math:`\lambda` times the unit one). A box's
+buckling coefficient uses its widest face, :math:`k = \sigma t b^2/(\pi^2 D)`.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+from mpi4py import MPI
+
+import dolfinx
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.la.ownership import Owner
+from unibuckle_fenicsx.model.problem import Candidate
+from unibuckle_fenicsx.model.shell.core import CoreConstraints, change_of_basis, core_constraints
+from unibuckle_fenicsx.model.shell.forms import DRILLING_FACTOR
+from unibuckle_fenicsx.model.shell.geometry import SectionMesh, section_mesh
+from unibuckle_fenicsx.model.shell.model import ENDS, ShellModel, end_supports
+from unibuckle_fenicsx.model.shell.prestress import SectionPrestress, solve_section_prestress
+from unibuckle_fenicsx.model.shell.problem import (
+    CoredSectionProblem,
+    SectionProblem,
+    section_problem,
+)
+from unibuckle_fenicsx.spec import Material, SolverSpec
+from unibuckle_fenicsx.viz.section import SectionFigureData
+
+__all__ = ["GEOMETRIC", "Section", "SectionParameters", "build_section", "figure_data"]
+
+#: Displacement components in the geometric stiffness b: "donnell" (the normal
+#: deflection, as the plate model's b and the classical tube value) or "full" (all three).
+GEOMETRIC = ("donnell", "full")
+
+
+@dataclass(frozen=True)
+class SectionParameters:
+    r"""A section's description, checked before any mesh is made.
+
+    Args:
+        shape: "box" (rectangular hollow section) or "tube" (circular hollow section).
+        thickness: Wall thickness t (m), > 0 and < half the smallest dimension across.
+        length: Length L between the loaded ends (m), > 0.
+        E: Young's modulus (Pa), > 0.
+        nu: Poisson's ratio, in (-1, 0.5).
+        mesh_size: Target cell size (m), > 0 (a box's faces get an even number of cells).
+        width: Box: mid-line width b along y (m).
+        depth: Box: mid-line depth d along z (m).
+        diameter: Tube: mid-surface diameter 2R (m).
+        ends: The loaded ends: "clamped" or "simply_supported"
+            (:func:`~unibuckle_fenicsx.model.shell.model.end_supports`).
+        axial_stress: Uniform axial stress per unit load (Pa/Pa; compression < 0); -1
+            makes the critical load the compressive stress in Pa.
+        bending_stress: Part of the axial stress varying linearly over the depth, its
+            value at z = +d/2 (box) or +R (tube) per unit load (an axial force with
+            bending), 0 by default.
+        core: A rigid core fills the section: the walls may only move outward.
+        core_span: The core's extent (x0, x1) along the member (m); None: the whole length.
+        geometric: Components in b (:data:`GEOMETRIC`); "donnell" by default: the plate
+            model's b on a flat face and the classical value on a tube.
+        drilling: Drilling stiffness relative to Gt
+            (:data:`~unibuckle_fenicsx.model.shell.forms.DRILLING_FACTOR`).
+        corner_cell: A box's faces graded to cells this wide (m) at the corners
+            (:func:`~unibuckle_fenicsx.model.shell.geometry.box_mesh`); None: uniform.
+    """
+
+    shape: str
+    thickness: float
+    length: float
+    E: float
+    nu: float
+    mesh_size: float
+    width: float | None = None
+    depth: float | None = None
+    diameter: float | None = None
+    ends: str = "clamped"
+    axial_stress: float = -1.0
+    bending_stress: float = 0.0
+    core: bool = False
+    core_span: tuple[float, float] | None = None
+    geometric: str = "donnell"
+    drilling: float = DRILLING_FACTOR
+    corner_cell: float | None = None
+
+    def __post_init__(self) -> None:
+        across = self._check_shape()
+        t = _positive("thickness", self.thickness)
+        if t >= 0.5 * across:
+            raise InputError(
+                f"section.thickness = {t:g} m must be < half the smallest dimension across "
+                f"({0.5 * across:g} m): the walls would meet"
+            )
+        _positive("length", self.length)
+        _positive("mesh_size", self.mesh_size)
+        if self.corner_cell is not None:
+            _positive("corner_cell", self.corner_cell)
+        if not (isinstance(self.E, int | float) and math.isfinite(self.E) and self.E > 0):
+            raise InputError(f"material.E must be a finite number > 0 (Pa), got {self.E!r}")
+        if not (isinstance(self.nu, int | float) and -1.0 < self.nu < 0.5):
+            raise InputError(f"material.nu must lie in (-1, 0.5), got {self.nu!r}")
+        if self.ends not in ENDS:
+            raise InputError(f"section.ends must be one of {ENDS}, got {self.ends!r}")
+        if self.geometric not in GEOMETRIC:
+            raise InputError(f"geometric must be one of {GEOMETRIC}, got {self.geometric!r}")
+        if not (math.isfinite(self.drilling) and self.drilling > 0.0):
+            raise InputError(f"drilling must be a finite number > 0, got {self.drilling!r}")
+        self._check_load()
+
+    def _check_shape(self) -> float:
+        """The shape's keys; returns the smallest dimension across (m)."""
+        if self.shape not in ("box", "tube"):
+            raise InputError(f"section.shape must be one of ('box', 'tube'), got {self.shape!r}")
+        if self.shape == "box":
+            if self.diameter is not None:
+                raise InputError("section.diameter is for a tube; a box has width and depth")
+            return min(_positive("width", self.width), _positive("depth", self.depth))
+        for key in ("width", "depth"):
+            if getattr(self, key) is not None:
+                raise InputError(f"section.{key} is for a box; a tube has diameter")
+        return _positive("diameter", self.diameter)
+
+    def _check_load(self) -> None:
+        """The stresses and the core's span."""
+        for key in ("axial_stress", "bending_stress"):
+            if not math.isfinite(getattr(self, key)):
+                raise InputError(
+                    f"load.{key} must be a finite number (Pa), got {getattr(self, key)!r}"
+                )
+        if self.axial_stress == 0.0 and self.bending_stress == 0.0:
+            raise InputError("load.axial_stress and load.bending_stress are both 0: no load")
+        if self.core_span is not None:
+            if not self.core:
+                raise InputError("obstacle.core_span needs core = true")
+            x0, x1 = self.core_span
+            if not (0.0 <= x0 < x1 <= self.length):
+                raise InputError(
+                    f"obstacle.core_span must satisfy 0 <= x0 < x1 <= length = {self.length:g} m, "
+                    f"got {self.core_span}"
+                )
+
+    @property
+    def widest(self) -> float:
+        """The widest face b of a box (m), the buckling coefficient's width; a tube's 2R."""
+        if self.shape == "box":
+            return max(float(self.width or 0.0), float(self.depth or 0.0))
+        return float(self.diameter or 0.0)
+
+
+def _positive(key: str, value: float | None) -> float:
+    """``value`` as a float, or an :class:`InputError` naming ``section.key``."""
+    if value is None or not (isinstance(value, int | float) and math.isfinite(value)):
+        raise InputError(f"section.{key} must be a finite number > 0 (m), got {value!r}")
+    if value <= 0.0:
+        raise InputError(f"section.{key} must be > 0 (m), got {value!r}")
+    return float(value)
+
+
+class Section(Owner):
+    """A section's buckling problem, built by :func:`build_section`.
+
+    Attributes:
+        parameters: The description.
+        mesh: The section's mesh and tags.
+        prestress: The prestress per unit load.
+        model: The shell model: A, B in global components, with the end supports.
+        constraints: The core's constrained directions (None without a core).
+        problem: The pencil as a :class:`~unibuckle_fenicsx.model.shell.problem.SectionProblem`
+            (with a core: a :class:`~unibuckle_fenicsx.model.shell.problem.CoredSectionProblem`,
+            rotated, with the contact manager; without: A, B as they are).
+
+    Note:
+        :meth:`destroy` is collective; the section is a context manager.
+    """
+
+    def __init__(
+        self,
+        parameters: SectionParameters,
+        mesh: SectionMesh,
+        prestress: SectionPrestress,
+        model: ShellModel,
+        constraints: CoreConstraints | None,
+        problem: SectionProblem,
+    ) -> None:
+        self.parameters = parameters
+        self.mesh = mesh
+        self.prestress = prestress
+        self.model = model
+        self.constraints = constraints
+        self.problem = problem
+
+    @property
+    def rows(self) -> npt.NDArray[np.int64]:
+        """Global rows of (A', B') of the constrained directions, numbered 0..i-1 (collective)."""
+        if not isinstance(self.problem, CoredSectionProblem):
+            return np.empty(0, np.int64)
+        return self.problem.contact.global_rows()
+
+    @property
+    def signs(self) -> npt.NDArray[np.float64]:
+        r"""Sign of each constrained row: +1 (:math:`n_{in}\cdot u = u'_k \le 0`)."""
+        return np.ones(0 if self.constraints is None else self.constraints.size)
+
+    def buckling_coefficient(self, load: float) -> float:
+        r""":math:`k = \sigma t b^2/(\pi^2 D)`, b the widest face; NaN for a tube."""
+        return self.problem.buckling_coefficient(load)
+
+    def classical_stress(self) -> float:
+        r"""Reference stress (Pa): a box's k = 4 load, a tube's classical one.
+
+        Box: :math:`4\pi^2 D/(t b^2)`; tube: :math:`E t / (R\sqrt{3(1-\nu^2)})`.
+        """
+        p = self.parameters
+        t = p.thickness
+        if p.shape == "tube":
+            return p.E * t / (0.5 * p.widest * math.sqrt(3.0 * (1.0 - p.nu**2)))
+        D = p.E * t**3 / (12.0 * (1.0 - p.nu**2))
+        return 4.0 * math.pi**2 * D / (t * p.widest**2)
+
+    def destroy(self) -> None:
+        """Destroy the problem and the model (collective)."""
+        for name in ("problem", "model"):
+            owner = self.__dict__.get(name)
+            if owner is not None:
+                owner.destroy()
+
+    def __del__(self) -> None:
+        self.destroy()
+
+
+def build_section(
+    parameters: SectionParameters,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    solver: SolverSpec | None = None,
+) -> Section:
+    """Mesh, prestress, pencil and (with a core) the rotated pencil of a section.
+
+    Args:
+        parameters: The section (checked already: :class:`SectionParameters`).
+        comm: Communicator of the mesh.
+        solver: Solver options of the problem (tolerances, certificate).
+
+    Returns:
+        The :class:`Section`; the caller destroys it.
+
+    Note:
+        Collective on ``comm``.
+    """
+    p = parameters
+    msh = section_mesh(
+        p.shape, width=p.width, depth=p.depth, diameter=p.diameter, length=p.length,
+        size=p.mesh_size, comm=comm, corner_cell=p.corner_cell,
+    )  # fmt: skip
+    material = Material(E=p.E, nu=p.nu)
+    prestress = solve_section_prestress(
+        msh, material, p.thickness, p.axial_stress, p.bending_stress
+    )
+    model = ShellModel(
+        msh, material, p.thickness, prestress.N0, end_supports(msh, p.ends),
+        drilling=p.drilling, donnell=p.geometric == "donnell",
+    )  # fmt: skip
+    constraints = core_constraints(model, p.core_span) if p.core else None
+    T = change_of_basis(model, constraints) if constraints is not None else None
+    problem = section_problem(model, prestress, constraints, T, material, solver)
+    return Section(p, msh, prestress, model, constraints, problem)
+
+
+def figure_data(
+    section: Section, candidate: Candidate | None = None, mode: dolfinx.fem.Function | None = None
+) -> SectionFigureData:
+    """The arrays of the 3-D figure of a mode (serial sections only).
+
+    Args:
+        section: The section.
+        candidate: A unilateral critical state (its mode, contact set and forces), or
+        mode: A mode in the problem's basis (e.g. the free mode).
+
+    Note:
+        Serial (``comm.size == 1``), as :func:`~unibuckle_fenicsx.viz.plotting.plot_mode_3d`.
+    """
+    import dolfinx.plot
+
+    problem = section.problem
+    if problem.comm.size != 1:
+        raise RuntimeError("figure_data gathers serial sections only (comm.size == 1)")
+    if candidate is not None:
+        mode = candidate.mode
+    if mode is None:
+        raise ValueError("figure_data needs a candidate or a mode")
+    u = problem.global_mode(mode)
+    V = section.model.W
+    topology, _, x = dolfinx.plot.vtk_mesh(V)  # type: ignore[arg-type]
+    quads = np.asarray(topology, dtype=np.int64).reshape(-1, 5)[:, 1:]
+    disp = u.x.array.reshape(-1, 6)[:, :3]
+    scale = float(np.abs(disp).max()) or 1.0
+    disp = disp / scale
+    normals = section.mesh.inward_normals(np.asarray(x).T)
+    outward = np.array(
+        [max((-(n @ d) for n in ns), key=abs) for ns, d in zip(normals, disp, strict=True)]
+    )
+    pressing = touching = np.zeros((0, 3))
+    if candidate is not None and section.constraints is not None and candidate.active.size:
+        active = candidate.active
+        pts = section.constraints.coordinates[active]
+        push = candidate.forces[active] < -candidate.tau
+        pressing, touching = pts[push], pts[~push]
+    m = section.mesh
+    return SectionFigureData(
+        np.asarray(x, dtype=float), quads, disp, outward, pressing, touching, m.shape,
+        (m.length, m.width, m.depth),
+    )  # fmt: skip

@@ -1,0 +1,271 @@
+r"""Python entry point for sections: :func:`solve_section` a box or a tube, with or without a core.
+
+The section counterpart of :func:`~unibuckle_fenicsx.analysis.solve`: a
+:class:`~unibuckle_fenicsx.model.shell.section.SectionParameters` (shape, walls, ends,
+load, whether a rigid core fills the section) in, a :class:`SectionAnalysis` out, whose
+:class:`SectionResult` is the plate's :class:`~unibuckle_fenicsx.results.records.BucklingResult`
+with the section's reference stress. The obstacle is the core: at every node of the walls
+it covers, the wall may only move away from it (:mod:`~unibuckle_fenicsx.model.shell.core`).
+
+- Without a core the critical load is the pencil's smallest eigenvalue, verified the
+  smallest by the inertia of :math:`A - \sigma B` (as a plate without obstacle).
+- With a core the free load is the hollow section's; the unilateral critical state is
+  found coarse to fine (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`: the
+  active-set seeds on a coarser section, the contact set carried to the finer one) and
+  certified (:func:`~unibuckle_fenicsx.certificate.certify.certify`) on the finest.
+
+The critical load is the compressive stress in Pa when ``axial_stress = -1``. A box's
+``buckling_coefficient_k`` uses its widest face, :math:`k = \sigma t b^2/(\pi^2 D)`; a
+tube has none (its reference is :math:`\sigma_{cl} = E t/(R\sqrt{3(1-\nu^2)})`,
+``classical_stress_Pa``).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import logging
+import math
+import time
+from dataclasses import dataclass
+
+from mpi4py import MPI
+
+import dolfinx
+
+from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.certificate.certify import Certificate, certify
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.la.ownership import Owner
+from unibuckle_fenicsx.model.problem import Mode, Problem, UnilateralProblem
+from unibuckle_fenicsx.model.shell.levels import solve_levels
+from unibuckle_fenicsx.model.shell.section import (
+    Section,
+    SectionParameters,
+    build_section,
+    figure_data,
+)
+from unibuckle_fenicsx.results.assemble import record_contact, versions
+from unibuckle_fenicsx.results.records import BucklingResult, ResultDetails
+from unibuckle_fenicsx.spec import SolverSpec
+from unibuckle_fenicsx.viz.section import SectionFigureData
+
+__all__ = ["SectionAnalysis", "SectionResult", "solve_section"]
+
+logger = logging.getLogger(__name__)
+
+
+class SectionResult(BucklingResult, kw_only=True):
+    r"""Critical state of a section: a :class:`~unibuckle_fenicsx.results.records.BucklingResult`.
+
+    The fields keep the plate's meaning, with the section's words:
+    ``critical_load_Pa`` is the critical axial stress (the filled section's with a core),
+    ``free_load_Pa`` the hollow section's; ``buckling_coefficient_k`` uses a box's widest
+    face (None for a tube); ``mesh`` is [cells along, cells around]; ``dofs`` counts the
+    six components of every node; ``constrained_nodes`` counts the core's constrained
+    *directions* (a box's corner node has two), ``contact_coordinates`` their unrolled
+    (x, s) (m along the member, m around the mid-line); ``input`` is
+    ``{"section": the parameters}``.
+
+    Attributes:
+        classical_stress_Pa: The section's reference stress (Pa): a box's k = 4 load
+            :math:`4\pi^2 D/(t b^2)`, a tube's :math:`E t/(R\sqrt{3(1-\nu^2)})`.
+    """
+
+    classical_stress_Pa: float = math.nan
+
+    def summary(self) -> str:
+        """Lines for the terminal: the critical stress, the hollow one, the reference."""
+        k_value = self.buckling_coefficient_k
+        k = "" if k_value is None else f", k = {k_value:.4f}"
+        head = (
+            f"{self.case}: sigma_cr = {self.critical_load_Pa:.6e} Pa "
+            f"({self.ratio_to_free:.4f} x hollow {self.free_load_Pa:.6e} Pa){k}, "
+            f"{self.critical_load_Pa / self.classical_stress_Pa:.4f} x classical "
+            f"{self.classical_stress_Pa:.6e} Pa"
+        )
+        lines = [
+            f"{head}, method {self.method}, {self.eigensolves} eigensolves, "
+            f"{self.wall_time_s:.2f} s"
+        ]
+        cert = self.certificate
+        if cert is not None:
+            lines.append(
+                f"core: {self.constrained_nodes} constrained directions, |Z| = "
+                f"{self.contact_nodes}, KKT = {'yes' if cert.kkt else 'NO'}, "
+                f"certificate {cert.status} (lower bound {self.lower_bound_Pa:.6e} Pa "
+                f"by {cert.proven_by})"
+            )
+        return "\n  ".join(lines)
+
+
+@dataclass
+class SectionAnalysis(Owner):
+    """What :func:`solve_section` returns: the result, the section, the mode.
+
+    Attributes:
+        result: JSON-ready numbers (:class:`SectionResult`).
+        section: The finest section (mesh, shell model, the core's constraints, problem).
+        solution: The unilateral solution (None without a core).
+        certificate: Its certificate (None without a core).
+
+    Note:
+        :meth:`destroy` (or leaving a ``with`` block) is collective.
+    """
+
+    result: SectionResult
+    section: Section
+    solution: UnilateralSolution | None = None
+    certificate: Certificate | None = None
+
+    @property
+    def mode(self) -> dolfinx.fem.Function:
+        """The critical mode in global components (u, omega), max |u| = 1 (collective)."""
+        if self.solution is not None:
+            return self.section.problem.global_mode(self.solution.candidate.mode)
+        return self.free_mode
+
+    @property
+    def free_mode(self) -> dolfinx.fem.Function:
+        """The hollow section's mode in global components (collective)."""
+        free = self.section.problem.free
+        if free is None:
+            raise RuntimeError("free_mode: the section's free mode was not solved")
+        return self.section.problem.global_mode(free.function, name="free mode")
+
+    def figure_data(self, free: bool = False) -> SectionFigureData:
+        """The arrays of the 3-D figure of the critical mode (``free``: the hollow one).
+
+        Serial only (:func:`~unibuckle_fenicsx.model.shell.section.figure_data`); draw them
+        with :func:`~unibuckle_fenicsx.viz.section.plot_section_mode_3d`.
+        """
+        problem = self.section.problem
+        if free or self.solution is None:
+            if problem.free is None:
+                raise RuntimeError("figure_data: the section's free mode was not solved")
+            return figure_data(self.section, mode=problem.free.function)
+        return figure_data(self.section, self.solution.candidate)
+
+    def destroy(self) -> None:
+        """Destroy the section's PETSc/SLEPc objects (collective)."""
+        self.section.destroy()
+
+
+def solve_section(
+    parameters: SectionParameters,
+    comm: MPI.Comm = MPI.COMM_WORLD,
+    *,
+    levels: int = 1,
+    solver: SolverSpec | None = None,
+) -> SectionAnalysis:
+    """Critical axial stress and mode of a box or tube section; with a core, certified.
+
+    Args:
+        parameters: The section (:class:`~unibuckle_fenicsx.model.shell.section.SectionParameters`,
+            checked when built: bad keys raise :class:`~unibuckle_fenicsx.errors.InputError`).
+        comm: Communicator; the mesh is distributed over it.
+        levels: With a core, coarser sections (each with twice the mesh size) the
+            active-set seeds run on, >= 0. 1 by default: the seeds' many eigen solves on a
+            section of a quarter of the DOFs, a few polishing solves on the given one.
+        solver: Solver options (tolerances, the feasibility tolerance tau); the
+            package's defaults when None.
+
+    Returns:
+        The analysis; the caller destroys it (or uses ``with``).
+
+    Raises:
+        TypeError: ``parameters`` is not a SectionParameters.
+        InputError: ``levels`` out of range.
+        NumericalError: An eigen solve did not converge.
+
+    Note:
+        Collective on ``comm``. On an error every PETSc/SLEPc object built here is
+        destroyed before the error propagates.
+    """
+    t0 = time.perf_counter()
+    if not isinstance(parameters, SectionParameters):
+        raise TypeError(
+            f"solve_section: parameters must be a SectionParameters, got "
+            f"{type(parameters).__name__}"
+        )
+    if isinstance(levels, bool) or int(levels) != levels or levels < 0:
+        raise InputError(f"levels must be an integer >= 0, got {levels!r}")
+    solution: UnilateralSolution | None = None
+    certificate: Certificate | None = None
+    if parameters.core:
+        section, solution = solve_levels(parameters, levels=int(levels), comm=comm, solver=solver)
+    else:
+        section = build_section(parameters, comm, solver)
+    try:
+        problem = section.problem
+        t1 = time.perf_counter()
+        free = problem.solve_free()
+        problem.timings["free_solve_s"] = time.perf_counter() - t1
+        if solution is None:
+            t1 = time.perf_counter()
+            problem.verify_free()
+            problem.timings["free_check_s"] = time.perf_counter() - t1
+        else:
+            t1 = time.perf_counter()
+            certificate = certify(_cored(problem), solution)
+            problem.timings["certify_s"] = time.perf_counter() - t1
+            if not certificate.kkt:
+                logger.warning(
+                    "the section's result fails its certificate: %s",
+                    "; ".join(certificate.notes) or certificate.status,
+                )
+        result = _result(section, free, solution, certificate, time.perf_counter() - t0)
+    except BaseException:
+        section.destroy()
+        raise
+    return SectionAnalysis(result, section, solution, certificate)
+
+
+def _cored(problem: Problem) -> UnilateralProblem:
+    """``problem``, which has a core (an internal invariant: solve_levels made it)."""
+    if not isinstance(problem, UnilateralProblem):
+        raise TypeError("solve_section: a core section without its contact manager")
+    return problem
+
+
+def _result(
+    section: Section,
+    free: Mode,
+    solution: UnilateralSolution | None,
+    certificate: Certificate | None,
+    wall_time_s: float,
+) -> SectionResult:
+    """The :class:`SectionResult` of a solved section (collective: gathers the contact rows)."""
+    p = section.parameters
+    problem = section.problem
+    load = free.load if solution is None else solution.load
+    k = section.buckling_coefficient(load)
+    mode = free.function if solution is None else solution.candidate.mode
+    result = SectionResult(
+        case=f"section-{p.shape}",
+        method="free" if solution is None else solution.method,
+        route=["free"] if solution is None else list(solution.route),
+        critical_load_Pa=load,
+        free_load_Pa=free.load,
+        ratio_to_free=load / free.load,
+        critical_force_N_per_m=p.thickness * load,
+        buckling_coefficient_k=None if math.isnan(k) else k,
+        dofs=section.model.num_dofs,
+        mesh=[section.mesh.cells_along, section.mesh.cells_around],
+        eigensolves=1 + (0 if solution is None else solution.eigensolves),
+        wall_time_s=wall_time_s,
+        load_resolution=problem.load_resolution(mode.x.petsc_vec, load),
+        timings={**problem.timings, "total_s": wall_time_s},
+        mpi_size=problem.comm.size,
+        method_chosen_by="no core" if solution is None else "core: section levels",
+        details=ResultDetails(
+            free_eigen_error=free.eigen.error, free_eigen_iterations=free.eigen.iterations
+        ),
+        input={"section": dataclasses.asdict(p)},
+        versions=versions(),
+        classical_stress_Pa=section.classical_stress(),
+    )
+    if solution is None or certificate is None:
+        result.lower_bound_Pa = result.upper_bound_Pa = free.load
+        return result
+    record_contact(result, problem, solution, certificate)
+    return result

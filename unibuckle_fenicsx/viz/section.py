@@ -1,0 +1,124 @@
+"""3-D figure of a section's buckling mode and where the wall presses on the core (PNG).
+
+Draws from arrays (:class:`SectionFigureData`, made by
+:func:`~unibuckle_fenicsx.model.shell.section.figure_data`), never from a live problem;
+pyvista is imported inside the function (the ``demo`` extra), in the theme and off-screen
+set-up of :mod:`unibuckle_fenicsx.viz.plotting`.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+import numpy.typing as npt
+
+from unibuckle_fenicsx.viz.plotting import THEME, _prepare, _pyvista, annotate, coloured_surface
+
+__all__ = ["SectionFigureData", "plot_section_mode_3d"]
+
+
+@dataclass(frozen=True)
+class SectionFigureData:
+    """What the section's figure needs, on one rank.
+
+    Attributes:
+        points: (n, 3) mesh nodes (m).
+        quads: (c, 4) cells as node indices, in VTK's counter-clockwise order.
+        displacement: (n, 3) the mode's displacement, global components, max |u| = 1.
+        outward: (n,) its component along the outward normal (a corner node: the larger
+            in magnitude of its two), max |u| = 1.
+        pressing: (p, 3) nodes where the wall presses on the core (contact force > 0).
+        touching: (q, 3) other nodes of the contact set (on the core, no force).
+        shape: "box", "tube" or "flat".
+        size: (length, width, depth) of the section (m).
+    """
+
+    points: npt.NDArray[np.float64]
+    quads: npt.NDArray[np.int64]
+    displacement: npt.NDArray[np.float64]
+    outward: npt.NDArray[np.float64]
+    pressing: npt.NDArray[np.float64]
+    touching: npt.NDArray[np.float64]
+    shape: str
+    size: tuple[float, float, float]
+
+
+def plot_section_mode_3d(
+    data: SectionFigureData,
+    path: str | Path,
+    *,
+    title: str = "",
+    warp: float = 0.08,
+    show_core: bool = True,
+) -> Path:
+    """Warped section coloured by the outward displacement, the core, the pressing nodes.
+
+    Args:
+        data: The arrays to draw (:class:`SectionFigureData`).
+        path: PNG to write.
+        title: Text at the top left.
+        warp: Drawn displacement of max |u| = 1, relative to the section's largest
+            dimension across (0.08: visible, without faces crossing).
+        show_core: Outline the core.
+
+    Returns:
+        The written path.
+    """
+    pv = _pyvista()
+    path = _prepare(path)
+    length, width, depth = data.size
+    across = max(width, depth)
+    n = data.quads.shape[0]
+    cells = np.hstack([np.full((n, 1), 4, dtype=np.int64), data.quads]).ravel()
+    celltypes = np.full(n, pv.CellType.QUAD, dtype=np.uint8)
+    grid = pv.UnstructuredGrid(cells, celltypes, data.points + warp * across * data.displacement)
+    grid.point_data["outward"] = data.outward
+    # The cells' normals point into the section (toward the core): flip them, so that the
+    # walls seen from outside are lit; split at the box's corners for crisp edges.
+    surface = grid.extract_surface(algorithm="dataset_surface").compute_normals(
+        flip_normals=True, consistent_normals=False, split_vertices=True, feature_angle=30.0
+    )
+    plotter, font = coloured_surface(
+        pv,
+        surface,
+        "outward",
+        "outward u (normalised)",
+        edges=n <= 4000,
+        line_width=0.3,
+        ambient=0.4,
+    )
+    legend: list[tuple[str, str]] = []
+    if show_core and data.shape != "flat":
+        if data.shape == "box":
+            core = pv.Box(
+                bounds=(0.0, length, -0.5 * width, 0.5 * width, -0.5 * depth, 0.5 * depth)
+            )
+        else:
+            core = pv.Cylinder(
+                center=(0.5 * length, 0.0, 0.0),
+                direction=(1.0, 0.0, 0.0),
+                radius=0.5 * width,
+                height=length,
+                resolution=96,
+            )
+        plotter.add_mesh(core.extract_feature_edges(), color="black", line_width=2)
+        legend.append(("core (outline)", "black"))
+    for pts, color, label in (
+        (data.pressing, THEME["contact_color"], "presses on the core"),
+        (data.touching, "gold", "on the core, no force"),
+    ):
+        if len(pts):
+            plotter.add_points(pts, color=color, point_size=7, render_points_as_spheres=True)
+            legend.append((f"{label}: {len(pts)}", color))
+    annotate(plotter, legend, title, font)
+    plotter.add_axes(color="black", viewport=(0.72, 0.0, 0.86, 0.18))
+    centre = np.array([0.5 * length, 0.0, 0.0])
+    eye = centre + np.array([-0.6, -1.4, 1.0])
+    plotter.camera_position = [tuple(eye), tuple(centre), (0.0, 0.0, 1.0)]
+    plotter.reset_camera()
+    plotter.camera.zoom(1.1)
+    plotter.screenshot(str(path))
+    plotter.close()
+    return path
