@@ -712,6 +712,9 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
             "Path": ("class", "library/pathlib.html#pathlib.Path"),
             "argparse.ArgumentParser": ("class", "library/argparse.html#$"),
             "argparse.Namespace": ("class", "library/argparse.html#$"),
+            "argparse.RawDescriptionHelpFormatter": ("class", "library/argparse.html#$"),
+            "argparse.ArgumentDefaultsHelpFormatter": ("class", "library/argparse.html#$"),
+            "contextvars.ContextVar": ("class", "library/contextvars.html#$"),
             "enum.Enum": ("class", "library/enum.html#$"),
             "enum.StrEnum": ("class", "library/enum.html#$"),
             "logging.Logger": ("class", "library/logging.html#$"),
@@ -813,6 +816,7 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
             "msgspec.Meta": ("class", "api.html#$"),
             "msgspec.UnsetType": ("class", "api.html#$"),
             "msgspec.convert": ("function", "api.html#$"),
+            "msgspec.ValidationError": ("exception", "api.html#$"),
         },
     ),
 }
@@ -1060,8 +1064,49 @@ def _build_finished(app: Any, exception: Exception | None) -> None:
         copy_mathjax(Path(app.outdir))
 
 
+def _annotations_without_metadata() -> None:
+    """Render ``Annotated[T, Meta(...)]`` as ``T`` in the API pages.
+
+    msgspec's constraints and units on the problem's fields (``Meta(gt=0, extra={"unit":
+    "m"})``) are checked by the schema and documented on the key reference page; Sphinx would
+    print them inside the type and read their words as class names. Sphinx has no option
+    for this, so its ``stringify_annotation`` is wrapped where autodoc and napoleon import it.
+    """
+    import importlib
+    import typing
+
+    import sphinx.util.typing as sphinx_typing
+
+    original = sphinx_typing.stringify_annotation
+    if getattr(original, "_unibuckle", False):
+        return
+
+    def stringify(annotation: Any, *args: Any, **kwargs: Any) -> str:
+        if typing.get_origin(annotation) is typing.Annotated:
+            annotation = typing.get_args(annotation)[0]
+        return original(annotation, *args, **kwargs)
+
+    stringify._unibuckle = True  # type: ignore[attr-defined]
+    sphinx_typing.stringify_annotation = stringify
+    for name in (
+        "sphinx.util.inspect",
+        "sphinx.ext.napoleon.docstring",
+        "sphinx.ext.autodoc._dynamic._loader",
+        "sphinx.ext.autodoc._dynamic._type_annotations",
+        "sphinx.ext.autodoc._legacy_class_based._documenters",
+        "sphinx.ext.autodoc._generate",
+    ):
+        try:
+            module = importlib.import_module(name)
+        except ImportError:
+            continue
+        if hasattr(module, "stringify_annotation"):
+            module.stringify_annotation = stringify  # type: ignore[attr-defined]
+
+
 def setup(app: Any) -> dict[str, Any]:
     """Sphinx extension entry point."""
+    _annotations_without_metadata()
     if str(ROOT) not in sys.path:
         sys.path.insert(0, str(ROOT))
     app.connect("builder-inited", _builder_inited)

@@ -106,7 +106,7 @@ class Certificate:
             by the low-rank route (the returned KKT point is then not the global
             minimum): a :class:`~unibuckle_fenicsx.model.problem.Candidate` (its ``eigen`` is
             None: a Rayleigh quotient, not an eigenpair) from which a solver can
-            continue. Not in :meth:`as_dict` (its load is: ``refuting_load_Pa``).
+            continue. Not in ``as_dict`` (its load is: ``refuting_load_Pa``).
     """
 
     feasible: bool

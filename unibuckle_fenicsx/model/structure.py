@@ -8,8 +8,8 @@ mesh (a box or a circular tube) constrains the displacement normal to its wall, 
 combination of three components that changes from face to face; a change of basis at
 the constrained nodes (a local frame whose first axis is the wall's normal) makes it one
 DOF of W there, and the model then offers it exactly as the plate offers w: a scalar
-space of the mesh nodes (:attr:`NodalDofs.Vw`), the W DOF of each of its DOFs
-(:attr:`NodalDofs.w_dofs`) and the sub-space of W that holds it
+space of the mesh nodes (``NodalDofs.Vw``), the W DOF of each of its DOFs
+(``NodalDofs.w_dofs``) and the sub-space of W that holds it
 (:attr:`NodalDofs.w_subspace`). The contact manager, the algorithms and the certificates
 see constrained rows and their signs only, so a second model enters beside the plate
 without a copy of them.
@@ -42,7 +42,7 @@ class NodalDofs(Protocol):
         W: The function space of the mode.
         Vw: Scalar space of the constrained component at the mesh nodes (the plate's
             deflection w; a shell's wall-normal displacement in its local frames).
-        w_dofs: The local W DOF of each local DOF of :attr:`Vw`.
+        w_dofs: The local W DOF of each local DOF of ``Vw``.
         bc_dofs: Local W DOFs held by supports (edges, bilateral points).
     """
 

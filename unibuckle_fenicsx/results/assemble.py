@@ -1,7 +1,7 @@
 """The result of a solve, read off the live problem: the one place that turns objects into records.
 
 :func:`assemble_result` reads the set-up problem, its free mode, the algorithm's solution
-and its certificate, and returns a :class:`~.record.BucklingResult` that holds none of
+and its certificate, and returns a :class:`~.records.BucklingResult` that holds none of
 them. It is collective (the contact DOFs are gathered); the records it builds are the
 same on every rank.
 """

@@ -2,7 +2,7 @@
 
 The result holds numbers, names and records (the certificate's, each edge's load, the
 obstacle zones', the design output, the algorithm's record of its run), never a live
-object: :mod:`.assemble` reads them off a live problem, :mod:`.files` writes them. Its
+object: :mod:`.assemble` reads them off a live problem, ``results.files`` writes them. Its
 JSON form (:meth:`BucklingResult.as_dict`) is ``msgspec.to_builtins`` of the records, with
 non-finite numbers written as ``null`` and the algorithm's record flattened into
 ``details``.

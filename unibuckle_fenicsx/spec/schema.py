@@ -1,6 +1,6 @@
 """The JSON Schema of a problem file, from the Structs, and every key it accepts.
 
-:func:`msgspec.json.schema` writes the Structs' form; :func:`json_schema` turns it into
+``msgspec.json.schema`` writes the Structs' form; :func:`json_schema` turns it into
 the file's (the edge tables under ``edges``, an obstacle's ``polygon`` and ``circle``
 keys, a hole's ``outline``: :mod:`~unibuckle_fenicsx.spec.files`) and gives each key the
 description its Struct's docstring gives it (its ``Args:`` entry: msgspec reads a field's

@@ -1,4 +1,4 @@
-"""The interior-point Newton method on one mesh (the nested route is :mod:`..chain`).
+"""The interior-point Newton method on one mesh (the nested route is ``algorithms.chain``).
 
 - :mod:`.newton`: :class:`~.newton.InteriorPointNewton`, the runs down the central path
   and the contact set read off them;

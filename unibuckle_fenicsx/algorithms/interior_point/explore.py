@@ -2,7 +2,7 @@ r"""The interior point's coarsest mesh: its starts, and the arrangements carried
 
 On the coarsest mesh the method runs from a few starts (the parts of the free plate's
 first two modes on either side of the obstacle, the deflection under a pressure on the
-whole zone, on either end and in the middle: :attr:`~.options.ChainOptions.seeds`): the
+whole zone, on either end and in the middle: ``ChainOptions.seeds``): the
 buckle may sit almost anywhere at nearly the same load, and each start finds one
 arrangement (a start that joins the central path of one met before stops there,
 :class:`Paths`). The lowest critical states are carried to the next finer mesh as points
@@ -57,7 +57,7 @@ __all__ = [
 def canonical_sign(problem: UnilateralProblem, vec: Any) -> float:
     """+1 or -1: the sign that gives ``vec`` a negative oriented value at its largest node.
 
-    The largest |oriented value| (to 1e-6 of it; ties to the lowest node number) decides,
+    The largest absolute oriented value (to 1e-6 of it; ties to the lowest node number) decides,
     so that the eigen solver's arbitrary sign of the free mode does not, and a plate with
     the obstacle below starts as the mirror image of the one above (the starts are taken
     in the same order: :doc:`/verification/tuning`). Unlike

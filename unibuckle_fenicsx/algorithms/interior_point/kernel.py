@@ -17,7 +17,7 @@ Inertia control (Nocedal & Wright, *Numerical Optimization*, 2nd ed., ch. 19; WÃ
 Biegler, Math. Program. 106, 2006): the bordered matrix :math:`[[K, -Bu], [-Bu^T, 0]]`
 must have exactly one negative eigenvalue, i.e. :math:`\mathrm{neg}(K) + [(Bu)^Ty_2 > 0]
 = 1`, read off MUMPS's inertia; otherwise :math:`\delta M` is added (M:
-:attr:`NewtonOptions.metric <.options.NewtonOptions.metric>`) and K refactorised. After
+``NewtonOptions.metric``) and K refactorised. After
 a full step (or one that needed no correction) the unmodified matrix is tried first
 (IPOPT's rule): a correction carried from step to step damps the steps and the
 convergence turns linear. The line search backtracks on the barrier objective while the
@@ -65,10 +65,12 @@ class NewtonKernel(Owner):
         options: Settings (default :class:`~.options.NewtonOptions`).
 
     Attributes:
-        dofs, signs: Local W DOF and side :math:`s_k` of each owned constrained node.
-        Au, Bu, Fu: :math:`Au`, :math:`Bu`, :math:`F_u` at the last point evaluated.
+        dofs: Local W DOF of each owned constrained node.
+        signs: Side :math:`s_k` of each owned constrained node.
+        Au: :math:`Au` at the last point evaluated (``Bu``, ``Fu``: :math:`Bu`, :math:`F_u`).
         du: The last Newton direction's :math:`\delta u`.
-        y1, y2, rhs, trial: Work vectors (:math:`y_2 = K^{-1}Bu` after a direction).
+        trial: A work vector, as are ``y1``, ``y2`` and ``rhs`` (:math:`y_2 = K^{-1}Bu`
+            after a direction).
         last_correction: The inertia correction of the last step (0: none).
         delta_last: The last nonzero inertia correction.
         factorizations: Numeric factorisations so far.

@@ -22,7 +22,7 @@ thousands of constrained nodes have both a gap and a push close to zero. An acti
 step must decide for each of them whether it touches; the decisions flip from one step
 to the next and their number grows with the mesh. The barrier treats those nodes
 smoothly, and Newton's method on the barrier problem needs about the same number of
-steps on every mesh (the nested route, :mod:`..chain`, starts each mesh from the
+steps on every mesh (the nested route, ``algorithms.chain``, starts each mesh from the
 previous one's solution).
 
 Safeguards (Nocedal & Wright, *Numerical Optimization*, 2nd ed., ch. 19; Wächter &
