@@ -96,6 +96,8 @@ napoleon_type_aliases = _ALIASES
 nitpick_ignore_regex = [
     ("py:class", r"(gt|ge|lt|le|min_length|max_length)=.*"),
     ("py:(class|func|meth|attr|data)", r"(.*\.)?_\w+"),
+    # A function's own type parameter (PEP 695: factor_at[A: LowRankAttempt]) names no object.
+    ("py:class", r"A"),
 ]
 
 html_theme = "furo"

@@ -950,7 +950,7 @@ QUICKSTART = ROOT / "figures" / "quickstart"
 _SUMMARY = re.compile(
     r"lambda_c = (?P<load>\S+) Pa \((?P<ratio>\S+) x free (?P<free>\S+) Pa\), "
     r"k = (?P<k>\S+), method (?P<method>\S+)\s+i=(?P<i>\d+) \|Z\|=(?P<z>\d+)\s+"
-    r"KKT=(?P<kkt>\w+)\s+proven=(?P<proven>\w+) \(KKT only, m=(?P<m>\d+)\), "
+    r"KKT=(?P<kkt>\w+)\s+proven=(?P<proven>\w+) \(KKT only, m=(?P<m>\d+)(?:; [^)]*)?\), "
     r"(?P<solves>\d+) eigensolves, (?P<seconds>\S+) s"
 )
 _BOUND = re.compile(r"lies between (?P<lower>\S+) Pa .* and (?P<upper>\S+) Pa")
