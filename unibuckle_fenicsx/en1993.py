@@ -22,7 +22,7 @@ loaded edge, :math:`\sigma_1` the larger compression. The tables' buckling facto
 no maintained library implements them for a given :math:`\sigma_{cr}`, hence this module.
 :func:`design_element` classifies a plate by its edges, or refuses what the clause does
 not describe; the module imports no other of the package (it reads a problem through
-:class:`Problem`), so that the problem checks (:mod:`unibuckle_fenicsx.spec`) can refuse
+:class:`DesignProblem`), so that the problem checks (:mod:`unibuckle_fenicsx.spec`) can refuse
 such a plate, or a stress ratio outside the tables, before any solve.
 """
 
@@ -39,11 +39,11 @@ __all__ = [
     "ELEMENTS",
     "INTERNAL",
     "OUTSTAND",
+    "DesignEdge",
     "DesignElement",
-    "Edge",
-    "Load",
-    "Plate",
-    "Problem",
+    "DesignLoad",
+    "DesignPlate",
+    "DesignProblem",
     "buckling_factor",
     "design_element",
     "psi_range",
@@ -185,7 +185,7 @@ class DesignElement:
         return self.unloaded.index(self.free_edge)
 
 
-class Edge(Protocol):
+class DesignEdge(Protocol):
     """What :func:`design_element` reads of an edge (:class:`~unibuckle_fenicsx.spec.EdgeSpec`)."""
 
     @property
@@ -213,7 +213,7 @@ class Edge(Protocol):
         """Its fixed normal stress (Pa): a number or (start, end)."""
 
 
-class Plate(Protocol):
+class DesignPlate(Protocol):
     """What :func:`design_element` reads of a plate (:class:`~unibuckle_fenicsx.spec.PlateSpec`)."""
 
     @property
@@ -225,11 +225,11 @@ class Plate(Protocol):
         """The plate's gmsh file, or None."""
 
     @property
-    def edges(self) -> Sequence[Edge]:
+    def edges(self) -> Sequence[DesignEdge]:
         """The edges the plate names (the others are free)."""
 
 
-class Load(Protocol):
+class DesignLoad(Protocol):
     """What :func:`design_element` reads of a load (:class:`~unibuckle_fenicsx.spec.LoadSpec`)."""
 
     @property
@@ -245,15 +245,15 @@ class Load(Protocol):
         """The factor on the fixed load (0: none)."""
 
 
-class Problem(Protocol):
+class DesignProblem(Protocol):
     """What :func:`design_element` reads of a :class:`~unibuckle_fenicsx.spec.ProblemSpec`."""
 
     @property
-    def plate(self) -> Plate:
+    def plate(self) -> DesignPlate:
         """The plate."""
 
     @property
-    def load(self) -> Load:
+    def load(self) -> DesignLoad:
         """The load besides the edge stresses."""
 
 
@@ -274,7 +274,7 @@ def _ends(value: float | tuple[float, float]) -> tuple[float, float]:
     return (value, value) if isinstance(value, float | int) else value
 
 
-def design_element(spec: Problem) -> DesignElement:
+def design_element(spec: DesignProblem) -> DesignElement:
     """Classify the plate for the design output (EN 1993-1-5 4.4(2)), or refuse it.
 
     The direct stress acts across the edges given a normal stress (scaled or fixed); the
@@ -294,7 +294,7 @@ def design_element(spec: Problem) -> DesignElement:
     _check_plate(spec.plate, spec.load)
     fixed = spec.load.fixed_factor != 0.0
     named = {e.name: e for e in spec.plate.edges}
-    sides: dict[str, Edge] = {name: named.get(name, _FreeEdge(name)) for name in _NAMES}
+    sides: dict[str, DesignEdge] = {name: named.get(name, _FreeEdge(name)) for name in _NAMES}
     loaded = _loaded_pair(sides, fixed)
     unloaded = _PAIRS[loaded]
     for name in unloaded:
@@ -315,7 +315,7 @@ def design_element(spec: Problem) -> DesignElement:
     return element
 
 
-def _check_plate(plate: Plate, load: Load) -> None:
+def _check_plate(plate: DesignPlate, load: DesignLoad) -> None:
     """Refuse a plate that is not a rectangle, and a temperature rise."""
     why = (
         "is given by its outline"
@@ -339,7 +339,7 @@ def _check_plate(plate: Plate, load: Load) -> None:
         )
 
 
-def _loaded_pair(sides: dict[str, Edge], fixed: bool) -> tuple[str, str]:
+def _loaded_pair(sides: dict[str, DesignEdge], fixed: bool) -> tuple[str, str]:
     """The pair of opposite edges given a normal stress, or refuse a biaxial one."""
     stressed = [
         f"edges.{name}.normal_stress" for name, e in sides.items() if any(_ends(e.normal_stress))
@@ -360,7 +360,7 @@ def _loaded_pair(sides: dict[str, Edge], fixed: bool) -> tuple[str, str]:
     return pairs[0]
 
 
-def _check_unloaded(e: Edge) -> None:
+def _check_unloaded(e: DesignEdge) -> None:
     """Refuse an unloaded edge held in its plane, or free on springs."""
     if e.inplane != "free":
         raise InputError(
@@ -377,7 +377,7 @@ def _check_unloaded(e: Edge) -> None:
         )
 
 
-def _check_stress_ratio(loaded: list[Edge], element: DesignElement) -> None:
+def _check_stress_ratio(loaded: list[DesignEdge], element: DesignElement) -> None:
     """Refuse a stress ratio psi (of the scaled stresses alone) outside the element's table."""
     best: tuple[float, float, int, str] = (0.0, 0.0, 0, "")
     for e in loaded:
