@@ -13,22 +13,33 @@ mode and a new certificate); the table gives
   right-hand sides solved (batched), and its estimated cost in free solves (from counts:
   the rule that turns it on by default, at most 3);
 - ``certificate / free``: the certificate's time (continuations included) over the cold
-  free solve's, in one process, the median of ``--repeat`` runs (their values in the
-  JSON row's ``ratios``); ``route / free``: the global bound's routes alone (the split
-  route and the rank-2 attempts before it), the same run's;
+  free solve's, in one process, the least of ``--repeat`` runs (their values in the
+  JSON row's ``ratios``: the least is the one least disturbed by other work on the
+  machine); ``route / free``: the global bound's routes alone (the split route and the
+  rank-2 attempts before it), the least of the runs;
 - ``continued``: the loads of the refuting modes the solve continued from.
 
 With ``--bracket`` the certificate runs as asked for (``solver.bracket``: distances down
-to 1e-6, larger budgets, no cost limit); without, as by default.
+to 1e-6, larger budgets, no cost limit); without, as by default. With ``--uncapped`` the
+default solve is certified once more in the same process with the default's distances
+and budgets but no cost limit (``SplitOptions(max_cost=None)``): the run the estimate
+predicts, so that ``route / free`` is the measured cost the estimate is compared with.
+The rows also give the counts the cost model (``COST_MODEL``) is fitted to: DOFs,
+factorisations (attempts) and pieces examined; ``--fit`` fits its unit costs to the
+``--uncapped`` rows of a results file (non-negative least squares on the route's time
+in free solves) and prints them with the estimate against the measured cost per plate.
 
 Usage: python bench/bench_bracket.py [--meshes 90x30,180x60] [--cases ssss,cs,sc,cccc,shear]
-[--bracket] [--repeat N] [--json FILE]
+[--bracket | --uncapped] [--repeat N] [--json FILE] [--fit FILE]
 """
 
 from __future__ import annotations
 
 import argparse
-import statistics
+import json
+import math
+from pathlib import Path
+from typing import Any
 
 from mpi4py import MPI
 
@@ -36,6 +47,8 @@ from _results import append_rows, parse_plates, print_header
 from bench_plates import CASES, _spec
 
 from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
+from unibuckle_fenicsx.certificate.copositivity_split import SplitOptions
 from unibuckle_fenicsx.certificate.records import SplitRecord
 
 
@@ -47,66 +60,200 @@ def _attempts(split: SplitRecord | None) -> str:
     return "; ".join(out)
 
 
+def _number(value: float | None, spec: str) -> str:
+    return "-" if value is None else format(value, spec)
+
+
+def _predicted(analysis: Any, m: int) -> dict[str, Any]:
+    """The counts the default's estimate prices (no solve), and the DOFs."""
+    from unibuckle_fenicsx.certificate.copositivity_split import column_sources, estimate_counts
+
+    opts, sol = SplitOptions(), analysis.solution
+    sources = column_sources(analysis.problem, sol.candidate, sol.kkt_points, opts)
+    counts = estimate_counts(analysis.problem, sources, m, opts)
+    predicted = {"attempts": counts.attempts, "rhs": counts.rhs, "pieces": counts.pieces,
+                 "size": counts.size}  # fmt: skip
+    return {"dofs": int(analysis.problem.model.A.getSize()[0]), "predicted": predicted}
+
+
+def _run(spec: Any, comm: Any, uncapped: bool) -> dict[str, Any]:
+    """One solve in this process: result, certificate, solution, counts, the ratios.
+
+    With ``uncapped``, the default solve's point is bounded once more with the default's
+    budgets and no cost limit (:func:`copositivity_bound`, as the certificate calls it):
+    its time split into factorisations, solves and the rest (the pieces' dense work).
+    """
+    with solve(spec, comm) as analysis:
+        r, cert, sol = analysis.result, analysis.certificate, analysis.solution
+        assert cert is not None and sol is not None
+        free_s = analysis.problem.timings["free_solve_s"]
+        out = {"result": r, "cert": cert, "solution": sol, "free_solve_s": free_s,
+               "ratio": analysis.problem.timings["certify_s"] / free_s,
+               "route": 0.0 if cert.copositivity is None
+               else cert.copositivity.time_s / free_s}  # fmt: skip
+        out.update(_predicted(analysis, cert.negative_eigenvalues))
+        if uncapped:
+            options = BoundOptions(lowrank=None, split=SplitOptions(max_cost=None))
+            bound = copositivity_bound(analysis.problem, sol.candidate, sol.kkt_points, options)
+            t = bound.timings
+            out.update(bound=bound, route=t["total_s"] / free_s, ratio=t["total_s"] / free_s,
+                       factor=t["factor_s"] / free_s, solve=t["solve_s"] / free_s)  # fmt: skip
+        return out
+
+
+def _row(name: str, mesh: str, args: Any, runs: list[dict[str, Any]]) -> dict[str, Any]:
+    run = runs[-1]
+    r, cert, sol = run["result"], run["cert"], run["solution"]
+    bound = run.get("bound")
+    split = bound.split if bound is not None else (
+        None if cert.copositivity is None else cert.copositivity.split)  # fmt: skip
+    attempts = [] if split is None else split.attempts
+    row = {
+        "case": name,
+        "edges": CASES[name][2],
+        "mesh": mesh,
+        "bracket": args.bracket,
+        "uncapped": args.uncapped,
+        "repeat": args.repeat,
+        "dofs": run["dofs"],
+        "m": cert.negative_eigenvalues,
+        "load_Pa": r.critical_load_Pa,
+        "lower_bound_Pa": cert.lower_bound,
+        "relative_gap": cert.relative_gap,
+        "status": cert.status,
+        "proven_by": cert.proven_by,
+        "distances": _attempts(split) or "; ".join(cert.notes)[:80],
+        "r": None if split is None else split.r,
+        "pieces": None if split is None else split.pieces,
+        "rhs": None if split is None else split.solves,
+        "factorisations": len(attempts),
+        "examined": sum(a.examined or 0 for a in attempts),
+        "estimated_cost": None if split is None else split.estimated_cost,
+        "predicted": run["predicted"],
+        "free_solve_s": min(x["free_solve_s"] for x in runs),
+        "certify_ratio": min(x["ratio"] for x in runs),
+        "ratios": [x["ratio"] for x in runs],
+        "route_ratio": min(x["route"] for x in runs),
+        "routes": [x["route"] for x in runs],
+        "continued": [c.from_load for c in sol.continued],
+    }
+    if bound is not None:
+        # The bound found without the cost limit (not the certificate's status: the
+        # default solve's certificate ran with it).
+        value = bound.value
+        row.update(
+            lower_bound_Pa=value,
+            relative_gap=None if value is None else 1.0 - value / sol.candidate.load,
+            status="bound" if value is not None else "none",
+            proven_by=bound.method,
+            factor_ratio=min(x["factor"] for x in runs),
+            solve_ratio=min(x["solve"] for x in runs),
+        )  # fmt: skip
+    return row
+
+
+def _units(row: dict[str, Any]) -> tuple[float, float, float]:
+    """(factorisation, right-hand sides per free solve, piece) of one ``--uncapped`` row."""
+    rest = row["route_ratio"] - row["factor_ratio"] - row["solve_ratio"]
+    return (row["factor_ratio"] / max(row["factorisations"], 1),
+            row["rhs"] / row["solve_ratio"],
+            max(rest, 0.0) / max(row["examined"], 1))  # fmt: skip
+
+
+def fit(path: str) -> dict[str, float]:
+    """:data:`COST_MODEL`'s unit costs from the ``--uncapped`` rows of ``path``; print them.
+
+    Per row, in free solves (the least of the repeats, each in one process): one
+    factorisation (``factor_ratio`` over the factorisations), the right-hand sides per
+    free solve (their count over ``solve_ratio``) and one piece's work (the rest of the
+    route's time over the pieces examined). Plates with m <= 3 only: with m = 4 a piece
+    costs about three times more (the SPN programs of the deeper pieces), and their
+    estimate exceeds the limit many times over by the pieces alone (their rows are
+    printed, not fitted). Per mesh the largest factorisation and piece
+    and the fewest right-hand sides (the estimate serves a rule that says "at most");
+    between the smallest and the largest mesh, each unit's growth with the DOFs (a
+    two-point fit; with one mesh the model's growth is kept). Then, per plate, the
+    estimate by the model at run time, by the fitted one, and the measured cost.
+    """
+    from unibuckle_fenicsx.certificate.copositivity_split import COST_MODEL, CostCounts, price
+
+    every = [row for row in map(json.loads, Path(path).read_text().splitlines())
+             if row.get("uncapped") and row.get("factor_ratio") is not None]  # fmt: skip
+    rows = [row for row in every if row["m"] <= 3]
+    units = []
+    for row in rows:
+        units.append(_units(row))
+    sizes = sorted({row["dofs"] for row in rows})
+    pick = (max, min, max)
+    at = {n: [pick[k](u[k] for u, row in zip(units, rows, strict=True) if row["dofs"] == n)
+              for k in range(3)] for n in sizes}  # fmt: skip
+    model = dict(COST_MODEL)
+    ref = model["reference_dofs"]
+    keys = (("factorisation", "factor_growth", 1), ("rhs_per_solve", "rhs_growth", -1),
+            ("piece", "piece_growth", 1))  # fmt: skip
+    for k, (name, growth, sign) in enumerate(keys):
+        lo, hi = at[sizes[0]][k], at[sizes[-1]][k]
+        if len(sizes) > 1:
+            model[growth] = sign * math.log(hi / lo) / math.log(sizes[-1] / sizes[0])
+        model[name] = lo / (sizes[0] / ref) ** (sign * model[growth])
+    print("fitted:", {k: round(v, 4) for k, v in model.items()})
+    print_header(
+        f"{len(rows)} rows of {path}",
+        ("case", "mesh", "m", "factorisation / free", "rhs per free solve", "piece / free",
+         "factorisations", "rhs", "examined", "pieces expected", "estimate (run time)",
+         "estimate (fitted)", "measured"),
+    )  # fmt: skip
+    for row in every:
+        u = units[rows.index(row)] if row in rows else _units(row)
+        p = row["predicted"]
+        counts = CostCounts(p["attempts"], p["rhs"], p["pieces"], p["size"])
+        print(f"| {row['case']} | {row['mesh']} | {row['m']} | {u[0]:.3f} | {u[1]:.0f} | "
+              f"{u[2]:.4f} | {row['factorisations']} | {row['rhs']} | {row['examined']} | "
+              f"{p['attempts'] * p['pieces']:g} | {row['estimated_cost']:.2f} | "
+              f"{price(counts, model):.2f} | {row['route_ratio']:.2f} |")  # fmt: skip
+    return model
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--meshes", default="90x30,180x60")
     parser.add_argument("--cases", default=",".join(CASES))
-    parser.add_argument("--bracket", action="store_true", help="solver.bracket (as asked for)")
-    parser.add_argument("--repeat", type=int, default=1, help="runs per plate (median ratio)")
+    mode = parser.add_mutually_exclusive_group()
+    mode.add_argument("--bracket", action="store_true", help="solver.bracket (as asked for)")
+    mode.add_argument("--uncapped", action="store_true", help="default budgets, no cost limit")
+    parser.add_argument("--repeat", type=int, default=1, help="runs per plate (least ratio)")
     parser.add_argument("--json", help="append one JSON line per row to this file")
+    parser.add_argument("--fit", help="fit COST_MODEL's unit costs to this file's rows; no run")
     args, meshes = parse_plates(parser)
     comm = MPI.COMM_WORLD
+    if args.fit:
+        if comm.rank == 0:
+            fit(args.fit)
+        return
     if comm.rank == 0:
         print_header(
-            f"MPI ranks: {comm.size}; bracket asked for: {args.bracket}",
+            f"MPI ranks: {comm.size}; bracket asked for: {args.bracket}; "
+            f"uncapped: {args.uncapped}",
             ("case", "mesh", "m", "lambda_c (Pa)", "lower bound (Pa)", "gap", "status",
-             "distances", "r", "pieces", "rhs", "estimated cost", "certificate / free",
-             "route / free", "continued"),
+             "distances", "r", "pieces", "rhs", "examined", "estimated cost",
+             "certificate / free", "route / free", "continued"),
         )  # fmt: skip
     for nx, ny in meshes:
         for name in args.cases.split(","):
             spec = _spec(name, nx, ny, "above")
             if args.bracket:
                 spec = spec.with_solver(bracket=True)
-            ratios, routes = [], []
-            for _ in range(args.repeat):
-                with solve(spec, comm) as analysis:
-                    r, cert, sol = analysis.result, analysis.certificate, analysis.solution
-                    assert cert is not None and sol is not None
-                    t = analysis.problem.timings
-                    ratios.append(t["certify_s"] / t["free_solve_s"])
-                    record = cert.copositivity
-                    route_s = 0.0 if record is None else record.time_s
-                    routes.append(route_s / t["free_solve_s"])
-            split = None if cert.copositivity is None else cert.copositivity.split
-            row = {
-                "case": name,
-                "edges": CASES[name][2],
-                "mesh": f"{nx}x{ny}",
-                "bracket": args.bracket,
-                "m": cert.negative_eigenvalues,
-                "load_Pa": r.critical_load_Pa,
-                "lower_bound_Pa": cert.lower_bound,
-                "relative_gap": cert.relative_gap,
-                "status": cert.status,
-                "proven_by": cert.proven_by,
-                "distances": _attempts(split) or "; ".join(cert.notes)[:80],
-                "r": None if split is None else split.r,
-                "pieces": None if split is None else split.pieces,
-                "rhs": None if split is None else split.solves,
-                "estimated_cost": None if split is None else split.estimated_cost,
-                "free_solve_s": t["free_solve_s"],
-                "certify_ratio": statistics.median(ratios),
-                "ratios": ratios,
-                "route_ratio": statistics.median(routes),
-                "continued": [c.from_load for c in sol.continued],
-            }
+            runs = [_run(spec, comm, args.uncapped) for _ in range(args.repeat)]
+            row = _row(name, f"{nx}x{ny}", args, runs)
             if comm.rank == 0:
                 print(
-                    "| {case} | {mesh} | {m} | {load_Pa:.6f} | {lower_bound_Pa:.6f} | "
-                    "{relative_gap:.1e} | {status} | {distances} | {r} | {pieces} | {rhs} | "
-                    "{est} | **{certify_ratio:.2f}** | {route_ratio:.2f} | {continued} |".format(
+                    "| {case} | {mesh} | {m} | {load_Pa:.6f} | {lower} | "
+                    "{gap} | {status} | {distances} | {r} | {pieces} | {rhs} | "
+                    "{examined} | {est} | **{certify_ratio:.2f}** | {route_ratio:.2f} | "
+                    "{continued} |".format(
                         **row,
+                        lower=_number(row["lower_bound_Pa"], ".6f"),
+                        gap=_number(row["relative_gap"], ".1e"),
                         est="-" if row["estimated_cost"] is None
                         else f"{row['estimated_cost']:.2f}",
                     ),

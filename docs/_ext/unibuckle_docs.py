@@ -292,14 +292,19 @@ def _routes_commands(rows: list[dict[str, Any]]) -> str:
 
 
 def _bracket_commands(rows: list[dict[str, Any]]) -> str:
-    """The ``bench_bracket.py`` runs that wrote the rows: by default, then as asked for."""
+    """The ``bench_bracket.py`` runs that wrote the rows: as asked for, uncapped, by default."""
     commands = []
-    for asked in dict.fromkeys(bool(r.get("bracket")) for r in rows):
-        group = [r for r in rows if bool(r.get("bracket")) == asked]
+    modes = dict.fromkeys(
+        (bool(r.get("bracket")), bool(r.get("uncapped")), int(r.get("repeat") or 1)) for r in rows
+    )
+    for asked, uncapped, repeat in modes:
+        group = [r for r in rows if (bool(r.get("bracket")), bool(r.get("uncapped")),
+                                     int(r.get("repeat") or 1)) == (asked, uncapped, repeat)]  # fmt: skip
+        flags = (" --bracket" if asked else "") + (" --uncapped" if uncapped else "")
+        flags += f" --repeat {repeat}" if repeat > 1 else ""
         commands.append(
             f"python bench/bench_bracket.py --meshes {_listed(group, 'mesh')} "
-            f"--cases {_listed(group, 'case')}{' --bracket' if asked else ''} "
-            "--json bench/results/bracket.jsonl"
+            f"--cases {_listed(group, 'case')}{flags} --json bench/results/bracket.jsonl"
         )
     return "`, then `".join(commands)
 
@@ -395,6 +400,25 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("certificate", "certificate"),
         ("k", "k"),
         ("load_Pa", "λ_c (Pa)"),
+    ],
+    "bracket": [
+        ("case", "case"),
+        ("mesh", "mesh"),
+        ("bracket", "--bracket"),
+        ("uncapped", "--uncapped"),
+        ("m", "m"),
+        ("load_Pa", "λ_c (Pa)"),
+        ("lower_bound_Pa", "lower bound (Pa)"),
+        ("relative_gap", "gap"),
+        ("status", "status"),
+        ("distances", "distances (δ: verified, or why not)"),
+        ("r", "r"),
+        ("pieces", "pieces"),
+        ("examined", "pieces examined"),
+        ("rhs", "right-hand sides"),
+        ("estimated_cost", "estimated cost (free solves)"),
+        ("route_ratio", "route time (free solves)"),
+        ("certify_ratio", "certificate time (free solves)"),
     ],
     "certify": [
         ("case", "case"),

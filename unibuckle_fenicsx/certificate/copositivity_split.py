@@ -832,16 +832,22 @@ def _centre(V: Array, metric: Array) -> Array:
 
 
 # -- the route --------------------------------------------------------------------------------
-#: Calibration of :func:`estimate_cost` against ``bench/bench_bracket.py`` (the thin
-#: plates at 90x30 and 180x60, the certificate's time over a cold free solve in one
-#: process): one factorisation of K(lambda) over one free solve; right-hand sides of a
-#: batched solve (with the residual products and the second solve of the rounding
-#: bound) per free solve at 8463 DOFs; pieces expected for m = 2 and their growth with
-#: each further negative eigenvalue; one piece's dense work over a free solve at 8463
-#: DOFs. The free solve grows as about n^1.3, a right-hand side as n, the dense work not
-#: at all (``exponent``).
-COST_MODEL = {"factorisation": 0.3, "rhs_per_solve": 150.0, "pieces": 40.0, "growth": 4.0,
-              "piece": 0.02, "reference_dofs": 8463.0, "exponent": 1.3}  # fmt: skip
+#: Calibration of :func:`estimate_cost` against ``bench/bench_bracket.py --uncapped`` (the
+#: thin plates at 90x30 and 180x60 run with the default's budgets and no cost limit,
+#: each unit timed in free solves in one process; ``--fit`` derives them): one
+#: factorisation of K(lambda) over one free solve; right-hand sides of a batched solve
+#: (with the residual products and the second solve of the rounding bound) per free
+#: solve; one piece's work over a free solve (its dense programs, and the Gram products
+#: and column updates that go with them); each at ``reference_dofs`` DOFs. Above it each
+#: unit grows as (DOFs / ``reference_dofs``)^``*_growth`` (a two-point fit between the
+#: meshes, of the largest unit, or the fewest right-hand sides, over the plates of
+#: each); below it as ^``*_small`` (the free solve's fixed work dominates: a piece's
+#: dense work costs more free solves on a coarse mesh, checked at 30x10); the pieces
+#: expected for m = 2 and their growth with each further negative eigenvalue.
+COST_MODEL = {"factorisation": 0.35, "factor_growth": 0.66, "factor_small": 0.0,
+              "rhs_per_solve": 380.0, "rhs_growth": 0.47, "rhs_small": -0.3,
+              "piece": 0.029, "piece_growth": 0.91, "piece_small": -1.3,
+              "pieces": 40.0, "growth": 4.0, "reference_dofs": 8463.0}  # fmt: skip
 
 
 @dataclass
@@ -862,6 +868,55 @@ def column_sources(
     return Sources(patterns, first, movable)
 
 
+@dataclass(frozen=True)
+class CostCounts:
+    """What :func:`estimate_cost` counts: attempts, right-hand sides and pieces per attempt.
+
+    Attributes:
+        attempts: Factorisations (one per distance; two when ``opts.deltas`` holds two).
+        rhs: Right-hand sides per attempt (the negative space's block iterations, then two
+            per column).
+        pieces: Pieces expected per attempt (:data:`COST_MODEL`'s ``pieces`` for m = 2,
+            ``growth`` times as many per further negative eigenvalue, at most
+            ``opts.max_pieces``).
+        size: DOFs over :data:`COST_MODEL`'s ``reference_dofs``.
+    """
+
+    attempts: int
+    rhs: int
+    pieces: float
+    size: float
+
+
+def estimate_counts(
+    problem: UnilateralProblem, sources: Sources, m: int, opts: SplitOptions
+) -> CostCounts:
+    """The counts :func:`estimate_cost` prices (no solve)."""
+    columns = min(len(sources.first), opts.max_columns)
+    model = COST_MODEL
+    return CostCounts(
+        attempts=min(len(opts.deltas), 2),
+        rhs=(m + 3) * (opts.mode_iterations + 1) + 2 * (m + columns),
+        pieces=min(float(opts.max_pieces), model["pieces"] * model["growth"] ** max(m - 2, 0)),
+        size=float(problem.model.A.getSize()[0]) / model["reference_dofs"],
+    )
+
+
+def price(counts: CostCounts, model: dict[str, float] | None = None) -> float:
+    """The time of ``counts`` in free solves by ``model`` (default :data:`COST_MODEL`)."""
+    model = model or COST_MODEL
+    size = counts.size
+    regime = "growth" if size >= 1.0 else "small"
+
+    def scale(unit: str) -> float:
+        return float(size ** model[f"{unit}_{regime}"])
+
+    factorisation = model["factorisation"] * scale("factor")
+    per_rhs = scale("rhs") / model["rhs_per_solve"]
+    piece = model["piece"] * scale("piece")
+    return counts.attempts * (factorisation + counts.rhs * per_rhs + counts.pieces * piece)
+
+
 def estimate_cost(
     problem: UnilateralProblem, sources: Sources, m: int, opts: SplitOptions
 ) -> float:
@@ -872,15 +927,7 @@ def estimate_cost(
     when ``opts.deltas`` holds a second distance (tried when the first one's margins
     allow: the estimate is meant as an upper one, the rule it serves says "at most").
     """
-    columns = min(len(sources.first), opts.max_columns)
-    rhs = (m + 3) * (opts.mode_iterations + 1) + 2 * (m + columns)
-    model = COST_MODEL
-    size = float(problem.model.A.getSize()[0]) / model["reference_dofs"]
-    pieces = min(float(opts.max_pieces), model["pieces"] * model["growth"] ** max(m - 2, 0))
-    piece = model["piece"] * size ** -model["exponent"]
-    per_rhs = size ** (1.0 - model["exponent"]) / model["rhs_per_solve"]
-    attempts = min(len(opts.deltas), 2)
-    return attempts * (model["factorisation"] + rhs * per_rhs + pieces * piece)
+    return price(estimate_counts(problem, sources, m, opts))
 
 
 def split_certificate(
