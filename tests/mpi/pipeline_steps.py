@@ -23,12 +23,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from test_prestress import (
+from support.plates import (
     clamped_left_plate,
     n0_at_quadrature_points,
     strip_average,
 )
-
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import create_plate_mesh
