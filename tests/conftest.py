@@ -1,4 +1,8 @@
-"""Shared fixtures: teardown, the random active problems, nothing built before a refusal."""
+"""Shared fixtures: teardown, random active problems, nothing built early, the thin plate.
+
+What the tests share that is not a fixture (references, families, subprocesses) is the
+package ``tests/support/``.
+"""
 
 from __future__ import annotations
 
@@ -19,7 +23,7 @@ def _collective_teardown():
 
 @pytest.fixture(scope="session")
 def active_specs():
-    """The seeded random problems whose obstacle is active (families.active_family)."""
+    """The seeded random problems whose obstacle is active (support.families.active_family)."""
     from support.families import active_family
 
     return active_family()[0]
@@ -46,3 +50,15 @@ def nothing_built(monkeypatch):
     monkeypatch.setattr(unibuckle_fenicsx.viz.study, "solve", refuse)
     monkeypatch.setattr(unibuckle_fenicsx.model.build, "build_plate_mesh", refuse)
     monkeypatch.setattr(unibuckle_fenicsx.nonlinear, "solve_nonlinear", refuse)
+
+
+@pytest.fixture
+def thin_plate():
+    """The thin 3:1 plate against a whole-plate obstacle (:func:`support.plates.thin_plate`).
+
+    Called as ``thin_plate(name, nx, ny, **kw)``: the interior-point route's, the split
+    and low-rank certificates' and the sweep's and MPI tests' thin plate.
+    """
+    from support.plates import thin_plate
+
+    return thin_plate

@@ -4,13 +4,13 @@ Rectangles (cells or a size) and gmsh outlines with inclined edges and holes, th
 supports, uniform stress states and stress gradients, isotropic and anisotropic
 stiffness, one to three obstacles (box, polygon, circle, whole plate) on either side,
 tensionless and bilateral foundations, methods auto, active-set and enumerate
-(``tests/families.py``, :func:`families.schema_family`). Each is solved as a user would
-(``unibuckle_fenicsx.solve``, certificate on), and:
+(``tests/support/families.py``, :func:`support.families.schema_family`). Each is solved
+as a user would (``unibuckle_fenicsx.solve``, certificate on), and:
 
 - *everywhere*, its certificate is checked independently: the returned mode satisfies
   the KKT conditions (rigid obstacles) or is stationary for the spring quotient
   (tensionless foundations), recomputed with dense numpy from a separately assembled
-  problem (``tests/exhaustive.py``), and the bracket holds;
+  problem (``tests/support/exhaustive.py``), and the bracket holds;
 - *where 2^i is small* (i <= :data:`I_MAX`), the load equals the dense exhaustive
   minimum over all 2^i contact sets (rigid) or spring sets (tensionless foundations),
   to :data:`RTOL`, whenever the result claims to be proven or comes from an exact

@@ -3,7 +3,7 @@
 ``mpiexec -n P python tests/mpi/pipeline_steps.py NX NY [quick]`` prints, on rank 0, one JSON
 line with partition-independent quantities: mesh counts, prestress checks, norms of the
 assembled pencil, the contact nodes (coordinates), free and candidate loads, oriented
-mode values at the contact nodes and certificates. ``tests/test_mpi.py`` compares them
+mode values at the contact nodes and certificates. ``tests/mpi/test_mpi.py`` compares them
 with the same function run serially (:func:`collect`). The script itself asserts what
 must hold on every rank (identical collective decisions, ghost layer present).
 """

@@ -309,7 +309,7 @@ def test_cli_gmsh_plate_distributed(tmp_path):
     assert ser["certificate"]["kkt"] and len(ser["mesh"]) == 1
 
 
-def test_lowrank_certificate_distributed_equals_serial():
+def test_lowrank_certificate_distributed_equals_serial(thin_plate):
     """The low-rank route on 2 ranks: same bound (to the loads' 1e-8), columns and pieces.
 
     A thin SSSS plate (t/b = 1e-3, 30 x 10 cells, two pencil eigenvalues below its
@@ -323,11 +323,8 @@ def test_lowrank_certificate_distributed_equals_serial():
     spec.loader.exec_module(module)
     from unibuckle_fenicsx.algorithms.active_set import solve_active_set
     from unibuckle_fenicsx.model.build import build_problem
-    from unibuckle_fenicsx.spec import ObstacleSpec
-    from unibuckle_fenicsx.spec.cases import plate_case
 
-    plate = plate_case("thin", length=0.3, width=0.1, thickness=1e-4, nx=30, ny=10,
-                       zone=ObstacleSpec(zone="all"))  # fmt: skip
+    plate = thin_plate("thin", 30, 10)
     with build_problem(plate, MPI.COMM_SELF) as problem:
         active = solve_active_set(problem).active
     serial = module.certificate(MPI.COMM_SELF, 30, 10, active)

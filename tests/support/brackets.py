@@ -3,7 +3,7 @@
 The route is run on the KKT points of a small problem (the active set's answer, every
 other KKT point it met) and on the exhaustive minimiser claimed at raised loads (a wrong
 claim that no sound route may verify); every verified lower bound must lie below the
-exhaustive minimum (:func:`exhaustive.exhaustive_minimum`), every refuting mode be
+exhaustive minimum (:func:`support.exhaustive.exhaustive_minimum`), every refuting mode be
 admissible with a load between the minimum and the claimed load.
 """
 

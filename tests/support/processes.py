@@ -51,7 +51,7 @@ from pathlib import Path
 import unibuckle_fenicsx.sweep as sweep
 from unibuckle_fenicsx import cli
 
-original = sweep._solve_point
+original = sweep.solve_point
 calls = []
 
 
@@ -64,7 +64,7 @@ def solve_point(spec, comm):
     return original(spec, comm)
 
 
-sweep._solve_point = solve_point
+sweep.solve_point = solve_point
 sys.exit(cli.main(sys.argv[2:]))
 """
 

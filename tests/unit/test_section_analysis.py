@@ -1,9 +1,9 @@
 """The Python entry point for sections: ``unibuckle_fenicsx.solve_section``.
 
-The loads themselves are checked elsewhere (``tests/test_shell_core.py``: the active set
-against a dense enumeration of every contact set on this same small box;
-``tests/test_shell_convergence.py``: the classical anchors). Here the record: each field
-against its definition worked out by hand (k = sigma t b^2/(pi^2 D) with the widest face,
+The loads themselves are checked elsewhere (``tests/unit/model/test_shell_core.py``: the
+active set against a dense enumeration of every contact set on this same small box;
+``tests/verification/test_shell_convergence.py``: the classical anchors). Here the record:
+each field against its definition worked out by hand (k = sigma t b^2/(pi^2 D) with the widest face,
 the classical stresses 4 pi^2 D/(t b^2) and E t/(R sqrt(3(1 - nu^2)))), interlacing
 (the core never lowers the load), the certificate's bracket, the sign of the core's push
 (a rigid core pushes, never pulls: KKT), and bad input refused before any mesh.

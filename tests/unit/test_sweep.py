@@ -26,12 +26,10 @@ from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK
 from unibuckle_fenicsx.spec import (
     MeshSpec,
-    ObstacleSpec,
     load_toml,
     problem_from_dict,
     problem_to_dict,
 )
-from unibuckle_fenicsx.spec.cases import plate_case
 from unibuckle_fenicsx.sweep import (
     Variation,
     parse_variation,
@@ -344,16 +342,14 @@ def test_plot(tmp_path):
     }
 
 
-def test_a_thin_plate_line_is_the_same_on_every_run():
+def test_a_thin_plate_line_is_the_same_on_every_run(thin_plate):
     """A sweep line leaves out every wall time, the interior point's level records' too.
 
     The route on thin plates records seconds per mesh level and link; a line
     (``as_dict(timings=False)``, README "Sweeps and charts") must not carry them, or two
     runs (and a run on two ranks) would write different lines.
     """
-    spec = plate_case(
-        "thin", length=0.3, width=0.1, thickness=1e-4, nx=12, ny=4, zone=ObstacleSpec("all")
-    )
+    spec = thin_plate("thin", 12, 4)
     lines = []
     for _ in range(2):
         with solve(spec) as analysis:

@@ -4,7 +4,7 @@ The expected values are not the demos' own: an analytic formula worked out in th
 an exact property of the discretisation, another algorithm of the package solving the
 same problem, or the paper's statement. The stored files are ``figures/*/results.json``,
 ``figures/garland/*.jsonl`` and ``figures/quickstart/output.txt`` (pinned in
-``tests/test_quickstart.py``). The stored numbers are records (eight significant
+``tests/verification/test_quickstart.py``). The stored numbers are records (eight significant
 digits, ``unibuckle_fenicsx.results.record``): a comparison with them is good to
 :data:`RECORD` (the rounding of one number, at most half of it) and no closer.
 """

@@ -6,7 +6,7 @@ in-plane bending (stress-gradient ratio :math:`\psi = -1`), whose classical thin
 coefficient is k = 23.9 at a/b = 2/3 (Timoshenko and Gere, *Theory of Elastic
 Stability*, 1961, section 9.6, table of k for pure bending; Bleich, *Buckling Strength of
 Metal Structures*, 1952; EN 1993-1-5, Table 4.1). The references here are computed
-independently of the package in ``tests/kirchhoff.py``: the Ritz sine series (Timoshenko
+independently of the package in ``tests/support/kirchhoff.py``: the Ritz sine series (Timoshenko
 and Gere's own method; it reproduces their table) and, with the obstacle, finite
 differences with their own active-set loop.
 """
@@ -193,7 +193,7 @@ def test_whole_plate_obstacle_raises_the_bending_load_fd_brackets_it():
     Two half-waves without obstacle (k = 23.88); the obstacle forces a one-signed mode,
     k about 26.17.
     The MITC4 plate (32x24) converges from above and the finite-difference Kirchhoff plate
-    (same spacing, its own active set, ``tests/kirchhoff.py``) from below: they bracket the
+    (same spacing, its own active set, ``tests/support/kirchhoff.py``) from below: they bracket the
     limit, 1.6 % apart, both 8 % or more above the free value.
     """
     with solve(bending_plate(4 / 3, 24, zone="all", method="active-set")) as analysis:

@@ -37,8 +37,8 @@ from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.active_set import (
     POLISH_ITERATIONS,
     THRESHOLDS,
-    _distinct_kkt,
-    _multi_seed,
+    distinct_kkt,
+    multi_seed,
     solve_active_set,
 )
 from unibuckle_fenicsx.algorithms.multilevel import prolong, prolong_contact_set
@@ -191,7 +191,7 @@ def _sparse_kkt(problem: UnilateralProblem, active) -> tuple[bool, float]:
 
     The largest eigenvalue theta of B x = theta A x on the DOFs left after removing the
     edge DOFs and the w-DOFs of Z (ARPACK Lanczos, ``scipy.sparse.linalg.eigsh``), load
-    1/theta, checked by :func:`exhaustive.satisfies_kkt`.
+    1/theta, checked by :func:`support.exhaustive.satisfies_kkt`.
     """
 
     def csr(mat):
@@ -251,7 +251,7 @@ def test_thresholds_polish_a_thin_plate_within_budget():
         build_problem(spec, MPI.COMM_SELF) as fine,
         build_problem(spec.with_mesh(30, 10), MPI.COMM_SELF) as coarse,
     ):
-        best = _distinct_kkt(_multi_seed(coarse, 100))[0]
+        best = distinct_kkt(multi_seed(coarse, 100))[0]
         start = prolong(coarse, fine, best.active)
         plain = iterate(fine, "plain", start, None, POLISH_ITERATIONS)
         run = iterate(fine, "thresholds", start, None, POLISH_ITERATIONS, thresholds=THRESHOLDS)

@@ -1,10 +1,10 @@
 r"""Feasible descent (algorithms/descent.py): monotone, and it ends at KKT points.
 
-- On random small problems (:func:`families.active_family`; all 200 of the stress family
+- On random small problems (:func:`support.families.active_family`; all 200 of the stress family
   with ``-m stress``), started from an admissible mode, the loads it meets never increase
   and it stops at a point that satisfies the KKT conditions (README, "The problem")
   checked here with dense numpy on the assembled matrices, whose load LAPACK reproduces
-  for its contact set (:func:`exhaustive.dense_reduced_load`), and which is never below
+  for its contact set (:func:`support.exhaustive.dense_reduced_load`), and which is never below
   the exhaustive minimum.
 - On a thin long plate with the loaded edges clamped against a whole-plate obstacle,
   where the primal-dual iteration and the penalty continuation both stall, the solver's
@@ -31,7 +31,7 @@ from support.paths import MPI_SCRIPTS
 from support.processes import run_mpi
 from support.stress import FAMILY, reference
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
-from unibuckle_fenicsx.algorithms.descent import _Gradient, admissible_start, descend
+from unibuckle_fenicsx.algorithms.descent import Gradient, admissible_start, descend
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import UnilateralProblem
@@ -46,7 +46,7 @@ def dense_kkt(problem: UnilateralProblem, active) -> bool:
 
     The smallest positive eigenpair of the dense pencil with the edge DOFs and the w-DOFs
     of Z removed (``scipy.linalg.eigh``, no condensation), checked by
-    :func:`exhaustive.satisfies_kkt`.
+    :func:`support.exhaustive.satisfies_kkt`.
     """
     A, B = dense(problem.model.A), dense(problem.model.B)
     rows = problem.contact.global_rows()
@@ -229,7 +229,7 @@ def test_gradient_direction_leaves_the_obstacle_and_descends(active_specs):
         k = pulling[np.argmax(cand.forces[pulling])]
         rest = np.setdiff1d(cand.active, [k])
         u = cand.mode.x.petsc_vec
-        grad = _Gradient(problem)
+        grad = Gradient(problem)
         g = grad.direction(u, rest)
         values = problem.contact.values(g)
         assert values[k] < 0.0

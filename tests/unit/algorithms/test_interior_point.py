@@ -7,7 +7,7 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
   obstacle on either side.
 - Interpolation between nested meshes is exact for Q1 functions (a linear field).
 - The route on problems of the random stress family agrees with the exhaustive minimum
-  over all 2^i contact sets (dense linear algebra, ``tests/exhaustive.py``) wherever the
+  over all 2^i contact sets (dense linear algebra, ``tests/support/exhaustive.py``) wherever the
   active-set method does (sample here, the whole family with ``-m stress``).
 - A thin plate (t/b = 1e-3) against a whole-plate obstacle: the route answers with a
   certified KKT point that is the smallest eigenvalue of its reduced pencil, and the mode
@@ -80,21 +80,6 @@ SAMPLE = 12
 KNOWN_LOCAL_MINIMA: set[str] = set()
 
 
-def _thin(name: str = "ssss", nx: int = 6, ny: int = 3, **kw) -> object:
-    supports = {"cs": {"left": "clamped", "right": "clamped"}}.get(name, "simply_supported")
-    return plate_case(
-        name,
-        length=0.3,
-        width=0.1,
-        thickness=1e-4,
-        supports=supports,
-        nx=nx,
-        ny=ny,
-        zone=ObstacleSpec(zone="all"),
-        **kw,
-    )
-
-
 def _load_rounding(problem: UnilateralProblem, cand) -> float:
     r"""Relative resolution of a critical load in double precision.
 
@@ -137,13 +122,13 @@ def _dense_newton_step(A, B, E, x, lam, nu, mu_abs):
 
 @serial
 @pytest.mark.parametrize("side", ["above", "below"])
-def test_newton_direction_solves_the_linearised_conditions(side):
+def test_newton_direction_solves_the_linearised_conditions(side, thin_plate):
     r"""The obstacle on either side.
 
     The barrier's Hessian :math:`E\,diag(\nu/g)E^T` has the entries
     :math:`s_k^2\nu_k/g_k = \nu_k/g_k` whatever the sign :math:`s_k` of the side.
     """
-    spec = _thin(nx=6, ny=3)
+    spec = thin_plate(nx=6, ny=3)
     spec = structs.replace(spec, obstacle=structs.replace(spec.obstacle, side=side))
     problem = build_problem(spec, MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
@@ -181,7 +166,7 @@ def test_newton_direction_solves_the_linearised_conditions(side):
 
 
 @serial
-def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
+def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space(thin_plate):
     r"""At a load above the second free one, K has a negative direction on the tangent space.
 
     Reference: the smallest eigenvalue of the dense pencil
@@ -193,7 +178,7 @@ def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
     Rayleigh–Ritz value is that eigenvalue (to the rounding of the thin plate's solves,
     measured 1e-11 of it); the step along the direction lowers the barrier objective.
     """
-    problem = build_problem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    problem = build_problem(thin_plate(nx=6, ny=3), MPI.COMM_SELF)
     A, B = dense(problem.model.A), dense(problem.model.B)
     D = np.abs(B).sum(axis=1)
     P, R = np.flatnonzero(D > 0.0), np.flatnonzero(D == 0.0)
@@ -233,13 +218,13 @@ def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space():
 
 
 @serial
-def test_negative_curvature_is_the_same_on_two_ranks(tmp_path):
+def test_negative_curvature_is_the_same_on_two_ranks(tmp_path, thin_plate):
     """Three Krylov vectors: a Ritz value that depends on the start.
 
     The start is a function of the DOFs' coordinates, not of their numbers, so two ranks
     find the serial value (to the rounding of the solves, 1e-9 relative on this thin plate).
     """
-    spec = _thin(nx=12, ny=4)
+    spec = thin_plate(nx=12, ny=4)
     problem = build_problem(spec, MPI.COMM_SELF)
     A, B = dense(problem.model.A), dense(problem.model.B)
     lam = 1.3 / np.sort(np.linalg.eigvals(np.linalg.solve(A, B)).real)[-2]
@@ -258,9 +243,9 @@ def test_negative_curvature_is_the_same_on_two_ranks(tmp_path):
 
 
 @serial
-def test_prolongation_is_exact_for_q1():
-    coarse = build_problem(_thin(nx=4, ny=2), MPI.COMM_SELF)
-    fine = build_problem(_thin(nx=8, ny=4), MPI.COMM_SELF)
+def test_prolongation_is_exact_for_q1(thin_plate):
+    coarse = build_problem(thin_plate(nx=4, ny=2), MPI.COMM_SELF)
+    fine = build_problem(thin_plate(nx=8, ny=4), MPI.COMM_SELF)
     carry = Prolongation(coarse, fine)
     u = coarse.new_mode()
     u.sub(0).interpolate(lambda x: 1.0 + 2.0 * x[0] - 3.0 * x[1])
@@ -274,7 +259,7 @@ def test_prolongation_is_exact_for_q1():
 
 
 @serial
-def test_lift_is_the_least_energy_correction():
+def test_lift_is_the_least_energy_correction(thin_plate):
     """``lift`` moves every node off the obstacle by the correction of least energy.
 
     A coarse clamped plate's free mode, carried to a finer mesh and relaxed, crosses
@@ -283,8 +268,8 @@ def test_lift_is_the_least_energy_correction():
     (the nodal clip's is one) it has the least energy a(c, c) (the minimum-energy
     extension of prescribed values): checked against the clip's correction.
     """
-    coarse = build_problem(_thin("cs", nx=12, ny=4), MPI.COMM_SELF)
-    fine = build_problem(_thin("cs", nx=24, ny=8), MPI.COMM_SELF)
+    coarse = build_problem(thin_plate("cs", nx=12, ny=4), MPI.COMM_SELF)
+    fine = build_problem(thin_plate("cs", nx=24, ny=8), MPI.COMM_SELF)
     margin = 1e-3
     with InteriorPointNewton(fine) as newton:
         start = Prolongation(coarse, fine).mode(coarse.solve_free().function)
@@ -356,10 +341,10 @@ def _route(spec) -> dict:
 
 
 @serial
-def test_thin_plate_route_is_certified():
+def test_thin_plate_route_is_certified(thin_plate):
     """SSSS, loaded edges clamped: 45x15 cells, t/b = 1e-3, whole-plate obstacle."""
     for name in ("ssss", "cs"):
-        report = _route(_thin(name, nx=45, ny=15))
+        report = _route(thin_plate(name, nx=45, ny=15))
         assert report["method"].startswith("interior-point"), report["method"]
         assert report["kkt"] and report["smallest"], report
         assert report["on_contact"] == 0.0  # removed DOFs of the reduced pencil
@@ -369,7 +354,7 @@ def test_thin_plate_route_is_certified():
 
 
 @serial
-def test_obstacle_below_is_the_mirror_image():
+def test_obstacle_below_is_the_mirror_image(thin_plate):
     """The plate against an obstacle below is the mirror image (w -> -w) of the one above.
 
     A thin SSSS plate under shear (nearly equal arrangements of the buckle): the same
@@ -378,7 +363,7 @@ def test_obstacle_below_is_the_mirror_image():
     answered; before the starts were oriented by the obstacle, the mirrored plate ended
     at another contact set of equal load.
     """
-    spec = _thin("shear", nx=24, ny=8, load="shear")
+    spec = thin_plate("shear", nx=24, ny=8, load="shear")
     below = structs.replace(spec, obstacle=structs.replace(spec.obstacle, side="below"))
     above, under = _route(spec), _route(below)
     for report in (above, under):
@@ -456,8 +441,8 @@ def test_obstacles_on_opposite_sides_with_a_free_edge():
 
 @pytest.mark.mpi
 @serial
-def test_two_ranks_give_the_serial_answer(tmp_path):
-    spec = _thin("cs", nx=45, ny=15)
+def test_two_ranks_give_the_serial_answer(tmp_path, thin_plate):
+    spec = thin_plate("cs", nx=45, ny=15)
     serial_report = _route(spec)
     path = tmp_path / "plate.json"
     path.write_text(json.dumps({"input": problem_to_dict(spec)}))
@@ -468,13 +453,13 @@ def test_two_ranks_give_the_serial_answer(tmp_path):
 
 
 @serial
-def test_option_under_the_prefix_reaches_the_factorisation():
+def test_option_under_the_prefix_reaches_the_factorisation(thin_plate):
     """A command-line MUMPS control under the prefix, and the inertia controls, are in effect.
 
     The Newton matrix is factorised by the mesh's shared LDL^T (prefix ``unibuckle_ldl_``).
     Construction does not factorise; the controls are read at the first factorisation.
     """
-    problem = build_problem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    problem = build_problem(thin_plate(nx=6, ny=3), MPI.COMM_SELF)
     prefix = f"{problem.eigensolver.prefix}ldl_"
     assert prefix == "unibuckle_ldl_"
     opts = PETSc.Options()
@@ -504,7 +489,7 @@ def test_stall_watch_counts_steps_without_halving():
 
 
 @serial
-def test_starts_on_one_central_path_are_not_taken_further():
+def test_starts_on_one_central_path_are_not_taken_further(thin_plate):
     """A start on the central path of an arrangement met before stops there.
 
     Thin SSSS plate, 45x15 (coarsest mesh 22x7): several starts reach one arrangement;
@@ -512,7 +497,7 @@ def test_starts_on_one_central_path_are_not_taken_further():
     (``twin_rtol = path_rtol = 0``: only bit-identical loads compare equal, whatever the
     deflections), in fewer Newton steps on the coarsest mesh.
     """
-    problem = build_problem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
+    problem = build_problem(thin_plate("ssss", nx=45, ny=15), MPI.COMM_SELF)
     short = solve_interior_point(problem, ChainOptions())
     full = solve_interior_point(problem, ChainOptions(twin_rtol=0.0, path_rtol=0.0))
     coarse = [jsonable(sol.details.levels[0]) for sol in (short, full)]
@@ -530,15 +515,15 @@ def test_starts_on_one_central_path_are_not_taken_further():
 
 
 @serial
-def test_second_free_mode_is_the_pencils_second_eigenpair():
+def test_second_free_mode_is_the_pencils_second_eigenpair(thin_plate):
     """The starts "free2-" and "free2+" are the parts of the free plate's second mode.
 
     Reference: a dense solve of B x = theta A x (scipy.linalg.eigh) on the assembled
     matrices of a thin SSSS plate (6x3); the mode's Rayleigh quotient a(u, u)/b(u, u) is
     the second smallest positive load 1/theta. Tolerance: dense and SLEPc solves of these
-    plates agree to a few 1e-8 (cond(A) ~ 1e11, ``tests/test_stress_family.py``).
+    plates agree to a few 1e-8 (cond(A) ~ 1e11, ``tests/support/stress.py``).
     """
-    problem = build_problem(_thin("ssss", nx=6, ny=3), MPI.COMM_SELF)
+    problem = build_problem(thin_plate("ssss", nx=6, ny=3), MPI.COMM_SELF)
     A, B = dense(problem.model.A), dense(problem.model.B)
     theta = scipy.linalg.eigh(B, A, eigvals_only=True)
     loads = np.sort(1.0 / theta[theta > 0.0])
@@ -583,7 +568,7 @@ def test_clamped_plate_reaches_its_two_buckle_state(thickness):
 
 
 @serial
-def test_predicted_contact_set_is_the_affine_step_indicator():
+def test_predicted_contact_set_is_the_affine_step_indicator(thin_plate):
     r"""Z = {k : \delta z_k > g_k/2} for the dense Newton step at :math:`\mu = 0`.
 
     The affine-scaling step moves a gap g to :math:`g - \delta z` and a push
@@ -593,7 +578,7 @@ def test_predicted_contact_set_is_the_affine_step_indicator():
     :func:`test_newton_direction_solves_the_linearised_conditions`, with pushes that
     make some gaps close and others open.
     """
-    problem = build_problem(_thin(nx=6, ny=3), MPI.COMM_SELF)
+    problem = build_problem(thin_plate(nx=6, ny=3), MPI.COMM_SELF)
     with InteriorPointNewton(problem) as newton:
         u = newton.starts.pressure_mode()
         newton.kernel.normalize(u.x.petsc_vec)
@@ -618,14 +603,14 @@ def test_predicted_contact_set_is_the_affine_step_indicator():
 
 
 @serial
-def test_predicted_contact_set_read_inside_a_run_leaves_it_unchanged():
+def test_predicted_contact_set_read_inside_a_run_leaves_it_unchanged(thin_plate):
     """Read from the ``on_solved`` hook, the set costs no factorisation and no change.
 
     Thin SSSS plate, 22x7, from the pressure deflection: the run with the hook takes the
     same steps, factorisations and loads (bit for bit) as the run without it, and the
     set read inside equals the one computed afresh from a copy of the same point.
     """
-    problem = build_problem(_thin(nx=22, ny=7), MPI.COMM_SELF)
+    problem = build_problem(thin_plate(nx=22, ny=7), MPI.COMM_SELF)
     runs, inside, copies = [], [], []
 
     def hook(point):
@@ -651,7 +636,7 @@ def test_predicted_contact_set_read_inside_a_run_leaves_it_unchanged():
     assert all(np.array_equal(a, b) for a, b in zip(inside, fresh, strict=True))
 
 
-def test_result_reports_the_load_resolution():
+def test_result_reports_the_load_resolution(thin_plate):
     """The result's ``load_resolution`` is the first-order rounding bound of the load.
 
     Reference: ``_load_rounding`` above (numpy on A's CSR rows), from the returned mode.
@@ -659,7 +644,7 @@ def test_result_reports_the_load_resolution():
     eigenvalue (the shear stiffness: |A||u| >> |Au|; measured 2.8e-10 at 12x4, 3e-9 for
     SSSS at 45x15), on the paper's plate (t/b = 0.06) three orders below (8.5e-14).
     """
-    with solve(_thin("ssss", nx=12, ny=4), MPI.COMM_SELF) as analysis:
+    with solve(thin_plate("ssss", nx=12, ny=4), MPI.COMM_SELF) as analysis:
         assert analysis.solution is not None
         reference = _load_rounding(analysis.problem, analysis.solution.candidate)
         reported = analysis.result.load_resolution
@@ -671,7 +656,7 @@ def test_result_reports_the_load_resolution():
 
 
 @serial
-def test_a_set_predicted_twice_in_a_row_is_read_before_the_barrier_problem_is_solved():
+def test_a_set_predicted_twice_in_a_row_is_read_before_the_barrier_problem_is_solved(thin_plate):
     """The same critical state as the read where the barrier problem at 1e-9 is solved.
 
     Thin SSSS plate, 60x20, whole-plate obstacle: by default (``read_stable``) the
@@ -679,7 +664,7 @@ def test_a_set_predicted_twice_in_a_row_is_read_before_the_barrier_problem_is_so
     where the barrier problem at 1e-9 is solved. The same contact set, its load to the
     rounding of two solves at different shifts, in fewer fine-mesh steps.
     """
-    problem = build_problem(_thin("ssss", nx=60, ny=20), MPI.COMM_SELF)
+    problem = build_problem(thin_plate("ssss", nx=60, ny=20), MPI.COMM_SELF)
     stable = solve_interior_point(problem, ChainOptions())
     solved = solve_interior_point(problem, ChainOptions(read_stable=False))
     fine = [jsonable(sol.details.levels[-1]) for sol in (stable, solved)]
@@ -694,14 +679,14 @@ def test_a_set_predicted_twice_in_a_row_is_read_before_the_barrier_problem_is_so
 
 
 @serial
-def test_fine_mesh_read_early_gives_the_load_read_at_the_end():
+def test_fine_mesh_read_early_gives_the_load_read_at_the_end(thin_plate):
     """The fine mesh's contact set read at 1e-9: the same critical state, fewer steps.
 
     Thin SSSS plate, 45x15, whole-plate obstacle: with ``read_mu = 0`` the contact set is
     read off the gaps at the end (``fine_mu_min``); by default the predicted set read
     where the barrier problem at 1e-9 is solved is a KKT point, and the run stops there.
     """
-    problem = build_problem(_thin("ssss", nx=45, ny=15), MPI.COMM_SELF)
+    problem = build_problem(thin_plate("ssss", nx=45, ny=15), MPI.COMM_SELF)
     early = solve_interior_point(problem, ChainOptions())
     late = solve_interior_point(problem, ChainOptions(read_mu=0.0))
     fine = [jsonable(sol.details.levels[-1]) for sol in (early, late)]

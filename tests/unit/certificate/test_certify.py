@@ -1,7 +1,7 @@
 r"""The global-optimality certificate (copositivity of A - lambda B on the cone).
 
 Soundness is checked against independent exhaustive minima (dense numpy over all 2^i
-contact sets, ``tests/exhaustive.py``): a verified lower bound may never
+contact sets, ``tests/support/exhaustive.py``): a verified lower bound may never
 exceed the true critical load, and a KKT point that is not the global minimum may never
 be proven. Completeness where the theory says so: below the second pencil eigenvalue the
 rank-2 certificate exists (README, "Proving the global minimum"), so the paper's cases are

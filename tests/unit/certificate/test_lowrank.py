@@ -4,8 +4,8 @@ r"""The low-rank copositivity certificate (several pencil eigenvalues below the 
   and the double-double residual's bound against the exact residual of a thin plate's
   K(lambda) (Python's :class:`fractions.Fraction`).
 - Soundness against independent exhaustive minima (dense numpy over all 2^i contact sets,
-  ``tests/exhaustive.py``) on long plates on coarse meshes whose KKT points have two or
-  more pencil eigenvalues below them (``tests/families.py``): the verified lower bound
+  ``tests/support/exhaustive.py``) on long plates on coarse meshes whose KKT points have two or
+  more pencil eigenvalues below them (``tests/support/families.py``): the verified lower bound
   never exceeds the exhaustive minimum, for the returned KKT point, for every other KKT
   point met (wrong ones included), and for the true minimiser claimed at a load raised by
   1e-4 and 1e-3; a refuting mode is admissible with a load between the minimum and the
@@ -35,8 +35,6 @@ from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.certificate.copositivity_lowrank import LowRankOptions, lowrank_certificate
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.model.build import build_problem
-from unibuckle_fenicsx.spec import ObstacleSpec
-from unibuckle_fenicsx.spec.cases import plate_case
 from unibuckle_fenicsx.tolerances import BRACKET_GAP, ROUNDING_RTOL
 
 pytest.importorskip("clarabel")
@@ -67,14 +65,13 @@ def test_error_free_transformations_are_exact():
 
 
 @serial
-def test_double_double_residual_bound_holds_on_a_thin_plate():
+def test_double_double_residual_bound_holds_on_a_thin_plate(thin_plate):
     """|rho - rho_hat| <= e componentwise, with rho = w - K x exact (Fraction), t/b = 1e-3.
 
     Also: the bound is far below what a double-precision residual can promise (the
     rounding of |K||x|, which on this plate exceeds |Kx| by orders of magnitude).
     """
-    spec = plate_case("thin", length=0.3, width=0.1, thickness=1e-4, nx=9, ny=3,
-                      zone=ObstacleSpec(zone="all"))  # fmt: skip
+    spec = thin_plate("thin", 9, 3)
     with build_problem(spec, MPI.COMM_SELF) as problem:
         lam = 1.1 * problem.solve_free().load
         matrix = ShiftedMatrix(problem.model.A, problem.model.B)
@@ -138,7 +135,7 @@ def test_lowrank_bound_is_sound_on_the_family():
 
 
 @serial
-def test_thin_ssss_plate_is_bracketed():
+def test_thin_ssss_plate_is_bracketed(thin_plate):
     """SSSS 0.3 x 0.1 x 1e-4 m at 45 x 15: two pencil eigenvalues below, bracketed <= 1e-3.
 
     The bound and the load bracket the critical load: lower <= load (the load is that
@@ -146,8 +143,7 @@ def test_thin_ssss_plate_is_bracketed():
     and the route's record (split, or low-rank when the split route fails); the summary
     says "bracketed to".
     """
-    spec = plate_case("ssss", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
-                      zone=ObstacleSpec(zone="all")).with_solver(bracket=True)  # fmt: skip
+    spec = thin_plate("ssss", 45, 15).with_solver(bracket=True)
     with solve(spec, MPI.COMM_SELF) as analysis:
         cert = analysis.certificate
         load = analysis.result.critical_load_Pa
@@ -166,7 +162,7 @@ def test_thin_ssss_plate_is_bracketed():
 
 
 @serial
-def test_interior_bump_on_the_thin_ssss_plate_is_not_bracketed():
+def test_interior_bump_on_the_thin_ssss_plate_is_not_bracketed(thin_plate):
     """A wrong KKT point of the thin SSSS plate (0.3 x 0.1 x 1e-4 m, 45 x 15) stays unproven.
 
     The interior buckle between two touch-downs (thin-plate k = 16/3; README, "Every
@@ -177,11 +173,8 @@ def test_interior_bump_on_the_thin_ssss_plate_is_not_bracketed():
     bound on the critical load), and a refuting mode, if one is found, must be admissible
     and below the interior buckle's load.
     """
-    ssss = plate_case("ssss", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
-                      zone=ObstacleSpec(zone="all")).with_solver(bracket=True)  # fmt: skip
-    clamped = plate_case("cs", length=0.3, width=0.1, thickness=1e-4, nx=45, ny=15,
-                         supports={"left": "clamped", "right": "clamped"},
-                         zone=ObstacleSpec(zone="all")).with_solver(certify=False)  # fmt: skip
+    ssss = thin_plate("ssss", 45, 15).with_solver(bracket=True)
+    clamped = thin_plate("cs", 45, 15).with_solver(certify=False)
     with solve(clamped, MPI.COMM_SELF) as analysis:
         start = analysis.solution.active.copy()
     with build_problem(ssss, MPI.COMM_SELF) as problem:

@@ -5,8 +5,8 @@ r"""The split copositivity certificate (two or more pencil eigenvalues below the
   :class:`fractions.Fraction`): on a thin plate, :math:`|G - [W, M]^TK^{-1}[W, M]| \le E`
   entrywise, K the stored matrix solved exactly.
 - Soundness against independent exhaustive minima (dense numpy over all 2^i contact
-  sets, ``tests/exhaustive.py``) on long plates on coarse meshes
-  (``tests/families.py``: :func:`long_plate_family`, and :func:`translated_family`,
+  sets, ``tests/support/exhaustive.py``) on long plates on coarse meshes
+  (``tests/support/families.py``: :func:`long_plate_family`, and :func:`translated_family`,
   whose buckles slide along a row of nodes): the verified lower bound never exceeds the
   exhaustive minimum, for the returned KKT point, every other KKT point met (wrong ones
   included) and the true minimiser claimed at loads raised by 1e-4, 1e-3 and 1e-2; a
@@ -38,17 +38,15 @@ from support.exhaustive import RTOL, exhaustive_minimum
 from support.families import long_plate_family, translated_family
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.certificate.copositivity_split import (
+    Basis,
+    Patterns,
     SplitOptions,
-    _Basis,
-    _negative_space,
-    _Patterns,
-    _scatter_columns,
+    negative_space,
+    scatter_columns,
     split_certificate,
 )
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix
 from unibuckle_fenicsx.model.build import build_problem
-from unibuckle_fenicsx.spec import ObstacleSpec
-from unibuckle_fenicsx.spec.cases import plate_case
 from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 pytest.importorskip("clarabel")
@@ -61,16 +59,11 @@ SAMPLE = 3
 OPTIONS = SplitOptions(deltas=(1e-4, 1e-5, 1e-6), fallback=(1e-3, 1e-2), max_cost=None)
 
 
-def _thin(name: str, nx: int, ny: int, **kwargs):
-    return plate_case(name, length=0.3, width=0.1, thickness=1e-4, nx=nx, ny=ny,
-                      zone=ObstacleSpec(zone="all"), **kwargs)  # fmt: skip
-
-
 @serial
-def test_translations_follow_the_coordinates():
+def test_translations_follow_the_coordinates(thin_plate):
     """A pattern moved by k node spacings lands k spacings further, and back again."""
-    with build_problem(_thin("t", 9, 3), MPI.COMM_SELF) as problem:
-        patterns = _Patterns(problem)
+    with build_problem(thin_plate("t", 9, 3), MPI.COMM_SELF) as problem:
+        patterns = Patterns(problem)
         xy = problem.contact.coordinates
         h = 0.3 / 9
         rng = np.random.default_rng(3)
@@ -105,27 +98,26 @@ def _exact_solve(K, rhs):
 
 
 @serial
-def test_gram_error_bound_holds_exactly_on_a_thin_plate():
+def test_gram_error_bound_holds_exactly_on_a_thin_plate(thin_plate):
     """|G - C'K^-1C| <= E for the stored K solved exactly (Fraction), t/b = 1e-3.
 
     C = the negative space's vectors and columns on the zone; the entries of G come from
     double-precision solves and residuals, their bounds from rounding analysis.
     """
-    spec = plate_case("thin", length=0.3, width=0.1, thickness=1e-4, nx=6, ny=2,
-                      zone=ObstacleSpec(zone="all"))  # fmt: skip
+    spec = thin_plate("thin", 6, 2)
     with build_problem(spec, MPI.COMM_SELF) as problem:
         lam = 1.2 * problem.solve_free().load
         matrix = ShiftedMatrix(problem.model.A, problem.model.B)
         m, _, _ = matrix.factor(lam)
-        space = _negative_space(problem, matrix, lam, m, None, 4)
+        space = negative_space(problem, matrix, lam, m, None, 4)
         assert m >= 1 and space is not None
         psi, _, _ = space
         W = np.column_stack([problem.model.B * _vec(problem, p) for p in psi.T])
-        basis = _Basis(problem, matrix, m, m + 3)
+        basis = Basis(problem, matrix, m, m + 3)
         basis.add(W, [f"W{j}" for j in range(m)])
         i = problem.num_constrained
         items = [("a", np.eye(1, i, 0)[0]), ("b", np.ones(i)), ("c", np.arange(i) % 2)]
-        basis.add(_scatter_columns(problem, items), ["a", "b", "c"])
+        basis.add(scatter_columns(problem, items), ["a", "b", "c"])
         ai, aj, av = matrix.K.getValuesCSR()
         n = len(ai) - 1
         K = [[Fraction(0)] * n for _ in range(n)]
@@ -222,7 +214,7 @@ def test_answer_never_ends_above_a_refuting_mode():
 
 
 @serial
-def test_thin_ssss_plate_refuted_then_continued_and_bracketed():
+def test_thin_ssss_plate_refuted_then_continued_and_bracketed(thin_plate):
     """0.3 x 0.1 x 1e-4 m at 45 x 15 (two pencil eigenvalues below the load), --bracket.
 
     The interior point stops at a KKT point that the certificate refutes (an admissible
@@ -233,7 +225,7 @@ def test_thin_ssss_plate_refuted_then_continued_and_bracketed():
     free solve is quick and the bracket's estimated cost exceeds 3 free solves: it runs
     on request.)
     """
-    with solve(_thin("ssss", 45, 15).with_solver(bracket=True), MPI.COMM_SELF) as analysis:
+    with solve(thin_plate("ssss", 45, 15).with_solver(bracket=True), MPI.COMM_SELF) as analysis:
         cert = analysis.certificate
         load = analysis.result.critical_load_Pa
         continued = analysis.solution.continued
@@ -247,14 +239,14 @@ def test_thin_ssss_plate_refuted_then_continued_and_bracketed():
 
 
 @serial
-def test_route_skipped_by_default_where_it_costs_more():
+def test_route_skipped_by_default_where_it_costs_more(thin_plate):
     """The thin SSSS plate at 45 x 15 without ``--bracket``: the rule, and the summary.
 
     The route runs by default only when its estimated cost (counts only) is at most
     ``SplitOptions.max_cost``; here it is not run, its record says so with the estimate,
     the answer stays a KKT point and the summary names ``--bracket``.
     """
-    with solve(_thin("ssss", 45, 15), MPI.COMM_SELF) as analysis:
+    with solve(thin_plate("ssss", 45, 15), MPI.COMM_SELF) as analysis:
         cert = analysis.certificate
         text = analysis.result.summary()
     assert cert is not None and cert.kkt and cert.negative_eigenvalues >= 2
@@ -269,13 +261,13 @@ def test_route_skipped_by_default_where_it_costs_more():
 @serial
 @pytest.mark.slow
 @pytest.mark.parametrize("mesh", [(90, 30), (180, 60)])
-def test_thin_ssss_plate_is_bracketed_on_request(mesh):
+def test_thin_ssss_plate_is_bracketed_on_request(mesh, thin_plate):
     """SSSS 0.3 x 0.1 x 1e-4 m at the benchmark's meshes, ``--bracket``: bracketed to 1e-4.
 
     Never above the load the active set reaches at 90 x 30 (4075.186054 Pa, below the
     interior point's): the bound must hold for every admissible mode.
     """
-    with solve(_thin("ssss", *mesh).with_solver(bracket=True), MPI.COMM_SELF) as analysis:
+    with solve(thin_plate("ssss", *mesh).with_solver(bracket=True), MPI.COMM_SELF) as analysis:
         cert = analysis.certificate
         load = analysis.result.critical_load_Pa
     assert cert is not None and cert.status in ("bracketed", "proven"), cert.notes

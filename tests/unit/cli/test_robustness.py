@@ -83,7 +83,7 @@ def test_unwritable_outputs_are_refused_at_once(
     def no_run(*args, **kwargs):
         raise AssertionError("PETSc was started before the output was refused")
 
-    monkeypatch.setattr(cli, "_run", no_run)
+    monkeypatch.setattr(cli, "run_command", no_run)
     config = tmp_path / "plate.toml"
     config.write_text(SMALL)
     before = sorted(tmp_path.rglob("*"))
@@ -176,7 +176,7 @@ def test_bad_petsc_option_exit_2(tmp_path, option, reason):
 def test_ctrl_c_during_a_sweep(tmp_path):
     """SIGINT: a one-line message, exit 130, the finished lines intact and resumable.
 
-    The sweep is paused after its first point (``conftest.paused_sweep``), so the
+    The sweep is paused after its first point (``support.processes.paused_sweep``), so the
     interrupt lands mid-sweep whatever the machine's load (a loaded machine could finish
     the whole sweep before the test saw its first line).
     """
@@ -222,7 +222,7 @@ def run(*args):
     HalfBuilt()
 
 
-cli._run = run
+cli.run_command = run
 sys.exit(cli.main(sys.argv[1:]))
 """
 
@@ -260,7 +260,7 @@ def test_an_interrupt_inside_a_petsc_callback_is_an_interrupt(monkeypatch, capsy
     def interrupted(self, snes, x, b):
         raise KeyboardInterrupt
 
-    monkeypatch.setattr(VonKarmanPlate, "_residual", interrupted)
+    monkeypatch.setattr(VonKarmanPlate, "residual", interrupted)
     monkeypatch.setattr(sys, "unraisablehook", sys.unraisablehook)  # main() replaces it
     args = ["nonlinear", "--case", "c1", "--nx", "6", "--ny", "4", "-q"]
     assert main(args) == EXIT_INTERRUPTED

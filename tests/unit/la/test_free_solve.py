@@ -4,7 +4,7 @@ r"""The free plate's smallest eigenpair, shifted near an estimate and proven by 
 at a shift just above an estimate of the lowest load, solves at that target, and reads
 from the inertia that the pair is the smallest; a shift that lies above two eigenvalues,
 or below the first, is lowered or checked. The reference values are LAPACK's
-(``scipy.linalg.eigh`` on the dense pencil, ``tests/exhaustive.py``), never the solver's.
+(``scipy.linalg.eigh`` on the dense pencil, ``tests/support/exhaustive.py``), never the solver's.
 """
 
 from __future__ import annotations
@@ -40,7 +40,7 @@ from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import Problem
 
 #: SLEPc converges to a relative residual of eps_tol = 1e-10 and LAPACK to about 1e-13 on
-#: these pencils, so 1e-8 leaves a margin of 100 (tests/exhaustive.py).
+#: these pencils, so 1e-8 leaves a margin of 100 (tests/support/exhaustive.py).
 RTOL = 1e-8
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference: serial")
@@ -319,9 +319,9 @@ def test_loose_options_on_the_shifted_solve_never_overestimate(monkeypatch):
     """Loose options on the shifted solve: the free load never lies above lambda_1.
 
     A tolerance of 0.1 with three basis vectors (which at target 0 stopped on a pair
-    18 % high, tests/test_problem.py): shifted above the load, a converged Ritz value below
-    the shift lies at or below lambda_1 (Rayleigh-Ritz), so the free load stays a lower
-    bound of the critical load.
+    18 % high, tests/unit/model/test_problem.py): shifted above the load, a converged Ritz
+    value below the shift lies at or below lambda_1 (Rayleigh-Ritz), so the free load
+    stays a lower bound of the critical load.
     """
     monkeypatch.setattr(build_module, "FREE_ESTIMATE_DOFS", 0)
     loose = {"eps_tol": 0.1, "eps_ncv": 3}

@@ -2,7 +2,7 @@ r"""Plates meshed by gmsh: outlines, holes, named boundary parts, files; MPI dis
 
 Expected values: the structured rectangle's (the same plate meshed by gmsh's quad
 algorithm), the Navier load, and for the square plate with a central circular hole an
-independent computation with another mesh family and element (``tests/rm_triangles.py``:
+independent computation with another mesh family and element (``tests/support/rm_triangles.py``:
 cubic triangles, plain shear, scipy's Lanczos); for the interior point nested over gmsh
 meshes of sizes 2h and h, the same route on h alone.
 """

@@ -3,7 +3,7 @@
 ``side = "above"`` (the default) imposes w <= 0 in the zone, ``"below"`` w >= 0; several
 ``[[obstacles]]`` unite their zones' nodes, each with its side. Expected values: the
 mirror symmetry w -> -w (an obstacle below gives the load of the same obstacle above),
-and the dense exhaustive minimum over all 2^i contact sets (``tests/exhaustive.py``,
+and the dense exhaustive minimum over all 2^i contact sets (``tests/support/exhaustive.py``,
 LAPACK, nothing of the package's algorithms).
 """
 

@@ -11,7 +11,7 @@ Expected values:
 - springs: :math:`k_p \to 0` is the plate without points, :math:`k_p \to \infty` the
   bilateral point (error of first order in :math:`1/k_p`);
 - one-sided points, and ties with a whole-plate obstacle: the Kirchhoff plate on bicubic
-  Hermite elements with its own active-set loop (``tests/hermite_plate.py``).
+  Hermite elements with its own active-set loop (``tests/support/hermite_plate.py``).
 """
 
 from __future__ import annotations

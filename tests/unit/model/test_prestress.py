@@ -153,10 +153,10 @@ def test_equilibrium_of_a_plate_is_checked_once(monkeypatch):
     from unibuckle_fenicsx.model import prestress
 
     calls = []
-    check = prestress._check_self_equilibrated
-    monkeypatch.setattr(prestress, "_EQUILIBRATED", set())
+    check = prestress.check_self_equilibrated
+    monkeypatch.setattr(prestress, "EQUILIBRATED", set())
     monkeypatch.setattr(
-        prestress, "_check_self_equilibrated", lambda *a: calls.append(1) or check(*a)
+        prestress, "check_self_equilibrated", lambda *a: calls.append(1) or check(*a)
     )
     edges = (EdgeSpec("left", normal_stress=-1.0), EdgeSpec("right", normal_stress=-1.0))
     plate = PlateSpec(edges=(*edges, EdgeSpec("bottom"), EdgeSpec("top")))

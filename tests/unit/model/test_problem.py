@@ -319,5 +319,5 @@ def test_a_free_load_that_is_not_the_smallest_is_caught():
     with solve(paper_case("free", 40, 20)) as analysis:  # the default options: verified
         assert analysis.problem._free_verified
         # Navier's value for the paper's plate, 12.7559 MPa (README); the mesh error at
-        # 40x20 is 3.4e-3 (it falls as h^2: tests/test_plate.py).
+        # 40x20 is 3.4e-3 (it falls as h^2: tests/verification/test_plate.py).
         assert abs(analysis.result.critical_load_Pa / 12.7559e6 - 1.0) < 4e-3

@@ -16,7 +16,7 @@ Expected values:
   Bleich, *Buckling Strength of Metal Structures*, 1952, chapter IX); its clamped limit
   for the long plate is the published k = 6.97 (Timoshenko and Gere, section 9.2);
 - unilateral, a whole-plate obstacle: the Kirchhoff plate on bicubic Hermite elements
-  with its own active-set loop (``tests/hermite_plate.py``, nothing shared with the
+  with its own active-set loop (``tests/support/hermite_plate.py``, nothing shared with the
   package).
 """
 

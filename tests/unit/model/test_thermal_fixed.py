@@ -17,7 +17,7 @@ Expected values:
   :math:`N_{yy} = N_{xy} = 0` (compatible strains): the plate of the edge stress pair
   :math:`[-E\alpha T_0, -E\alpha(T_0 + g b)]`;
 - a fixed shear with a scaled compression: the bicubic Hermite Kirchhoff plate
-  (``tests/hermite_plate.py``), whose pure shear load of the square plate is the
+  (``tests/support/hermite_plate.py``), whose pure shear load of the square plate is the
   published k = 9.325 (Stein and Neff, NACA TN 1222, 1947; Timoshenko and Gere, 1961,
   section 9.7, give 9.34 by a shorter series).
 """
