@@ -755,7 +755,7 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
         "https://petsc.org/release/petsc4py/",
         {
             f"{prefix}PETSc.{name}": ("class", f"reference/petsc4py.PETSc.{name}.html")
-            for name in ("Vec", "Mat", "KSP", "PC", "Options", "Viewer")
+            for name in ("Vec", "Mat", "KSP", "PC", "SNES", "Options", "Viewer")
             for prefix in ("petsc4py.", "")  # as the hints write it: from petsc4py import PETSc
         },
     ),
