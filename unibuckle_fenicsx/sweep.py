@@ -440,6 +440,19 @@ def _resume(
     return done, stale
 
 
+def _say_resumed(path: Path, done: int, stale: int, points: int) -> None:
+    """The progress lines of a resumed sweep: the points kept and those solved again."""
+    if done:
+        PROGRESS.info("sweep: %d of %d points already in %s", done, points, path)
+    if stale:
+        PROGRESS.info(
+            "sweep: %d line(s) of %s hold another input (the base file changed): "
+            "solving their points again",
+            stale,
+            path,
+        )
+
+
 def run_sweep(
     base: Mapping[str, Any],
     variations: Sequence[Variation],
@@ -482,15 +495,8 @@ def run_sweep(
     try:
         mine = todo[color::groups]
         show = progress and comm.rank == 0
-        if show and done:
-            PROGRESS.info("sweep: %d of %d points already in %s", len(done), len(points), path)
-        if show and stale:
-            PROGRESS.info(
-                "sweep: %d line(s) of %s hold another input (the base file changed): "
-                "solving their points again",
-                stale,
-                path,
-            )
+        if show:
+            _say_resumed(path, len(done), stale, len(points))
         lines = Progress(
             "sweep",
             len(todo),

@@ -262,38 +262,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
 
 def solve_flags(s: argparse.ArgumentParser) -> None:
     """The ``solve`` subcommand's own flags (the solver's, and --output)."""
-    s.add_argument(
-        "--method",
-        choices=list(METHODS),
-        help="unilateral algorithm (auto: exact enumeration when 2^i <= --max-candidates "
-        "and its estimated time fits --enumeration-budget, else interior-point on thin "
-        "plates (t/b < 0.02) and active-set on thicker ones; enumerate alone = the "
-        "paper's stopping rule) " + _solver_default("method"),
-    )
-    s.add_argument(
-        "--complete",
-        action="store_true",
-        help="enumerate: visit every subset (checks the paper's monotonicity)",
-    )
-    s.add_argument(
-        "--until-proven",
-        action="store_true",
-        help="enumerate: go past the paper's stopping size p* until the interlacing bound "
-        "proves the best set optimal (exact; implied by --method auto)",
-    )
-    s.add_argument(
-        "--max-candidates",
-        type=int,
-        metavar="N",
-        help="enumerate: refuse above N candidate sets " + _solver_default("max_candidates"),
-    )
-    s.add_argument(
-        "--enumeration-budget",
-        type=float,
-        metavar="SECONDS",
-        help="auto: enumerate only if the estimated time is below this "
-        + _solver_default("enumeration_budget_s"),
-    )
+    _method_flags(s)
     s.add_argument(
         "--max-iterations",
         type=int,
@@ -344,6 +313,42 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
         "as VTK (.pvd/.vtu, readable by pyvista.read) into DIR (created if missing; its "
         "parent must exist): NAME_w.bp, NAME_theta.bp, NAME.pvd, with NAME the problem's "
         "name, characters other than letters, digits, '.', '-' and '_' replaced by '_'",
+    )
+
+
+def _method_flags(s: argparse.ArgumentParser) -> None:
+    """The ``solve`` flags that choose the method and bound the enumeration."""
+    s.add_argument(
+        "--method",
+        choices=list(METHODS),
+        help="unilateral algorithm (auto: exact enumeration when 2^i <= --max-candidates "
+        "and its estimated time fits --enumeration-budget, else interior-point on thin "
+        "plates (t/b < 0.02) and active-set on thicker ones; enumerate alone = the "
+        "paper's stopping rule) " + _solver_default("method"),
+    )
+    s.add_argument(
+        "--complete",
+        action="store_true",
+        help="enumerate: visit every subset (checks the paper's monotonicity)",
+    )
+    s.add_argument(
+        "--until-proven",
+        action="store_true",
+        help="enumerate: go past the paper's stopping size p* until the interlacing bound "
+        "proves the best set optimal (exact; implied by --method auto)",
+    )
+    s.add_argument(
+        "--max-candidates",
+        type=int,
+        metavar="N",
+        help="enumerate: refuse above N candidate sets " + _solver_default("max_candidates"),
+    )
+    s.add_argument(
+        "--enumeration-budget",
+        type=float,
+        metavar="SECONDS",
+        help="auto: enumerate only if the estimated time is below this "
+        + _solver_default("enumeration_budget_s"),
     )
 
 

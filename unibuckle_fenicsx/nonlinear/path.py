@@ -511,14 +511,7 @@ def solve_nonlinear(
         linear = solve_linear(spec if obstacle else spec.without_obstacles(), comm)
     timings = {"linear_s": time.perf_counter() - t0}
     result = linear.result
-    reference = result.critical_load_Pa if obstacle else result.free_load_Pa
-    how = "free" if not obstacle else result.method
-    if obstacle:
-        how += (
-            ", KKT"
-            if result.certificate is not None and result.certificate.kkt
-            else ", NOT certified"
-        )
+    reference, how = _reference(result, obstacle)
     label = f"{spec.name} delta/t={options.imperfection:g}"
     gapped = obstacle and bool(spec.gapped_obstacles)
     plate = None
@@ -564,6 +557,18 @@ def solve_nonlinear(
     )  # fmt: skip
     nl.verdict = judge(nl).summary(nl)
     return NonlinearAnalysis(nl, plate, linear, owns_linear)
+
+
+def _reference(result: BucklingResult, obstacle: bool) -> tuple[float, str]:
+    """The linear load the path is compared with, and how it was found.
+
+    With the obstacle: the unilateral critical load, its method and whether it is a KKT
+    point; without: the free plate's load.
+    """
+    if not obstacle:
+        return result.free_load_Pa, "free"
+    kkt = result.certificate is not None and result.certificate.kkt
+    return result.critical_load_Pa, result.method + (", KKT" if kkt else ", NOT certified")
 
 
 def _checked(
