@@ -33,6 +33,7 @@ from unibuckle_fenicsx.analysis import solve as solve_linear
 from unibuckle_fenicsx.errors import InputError, NonlinearError, NumericalError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.la.ownership import Owner
+from unibuckle_fenicsx.model.contact import ContactSetManager
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
 from unibuckle_fenicsx.nonlinear.estimators import (
@@ -437,7 +438,7 @@ def contact_check(plate: VonKarmanPlate, rtol: float = 1e-8) -> dict[str, Any]:
         skip[dofs[dofs < n_owned]] = True
     out: dict[str, Any] = {"force_scale": scale, "rtol": rtol}
     ok = True
-    if plate.contact is not None:
+    if isinstance(plate.contact, ContactSetManager):
         w = plate.zone_clearance()  # s w - g: <= 0 admissible
         on = np.zeros(plate.contact.size, dtype=bool)
         on[plate.contact_nodes()] = True
@@ -672,7 +673,7 @@ def _result(
         completed=completed,
         stop_reason=why,
         rejected_steps=rejected,
-        constrained_nodes=0 if plate.contact is None else plate.contact.size,
+        constrained_nodes=plate.contact.size,
         contact_load_Pa=next((q.load_Pa for q in path if q.contact_nodes), None),
         gapped=gapped,
         unilateral_load_Pa=closed,
