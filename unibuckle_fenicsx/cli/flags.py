@@ -355,7 +355,9 @@ def _method_flags(s: argparse.ArgumentParser) -> None:
 def nonlinear_parser(sub: Any, parents: list[Parser]) -> None:
     """The ``nonlinear`` subcommand's arguments (defaults: :class:`NonlinearOptions`)."""
     from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
+    from unibuckle_fenicsx.nonlinear.options import NonlinearOptions
 
+    defaults = NonlinearOptions()
     n = sub.add_parser(
         "nonlinear",
         parents=parents,
@@ -370,21 +372,21 @@ def nonlinear_parser(sub: Any, parents: list[Parser]) -> None:
     n.add_argument(
         "--imperfection",
         type=float,
-        default=NONLINEAR_DEFAULTS["imperfection"],
+        default=defaults.imperfection,
         metavar="DELTA",
         help="imperfection amplitude max|w0| / thickness, in (0, 1]",
     )
     n.add_argument(
         "--shape",
         choices=list(SHAPES),
-        default=NONLINEAR_DEFAULTS["shape"],
+        default=defaults.shape,
         help="imperfection shape: the linear free or unilateral mode (auto: unilateral "
         "with the obstacle, free without)",
     )
     n.add_argument(
         "--control",
         choices=list(CONTROLS),
-        default=NONLINEAR_DEFAULTS["control"],
+        default=defaults.control,
         help="load control (edge traction, adaptive steps) or displacement control (end "
         "shortening of the loaded edges; uniaxial compression only)",
     )
@@ -392,28 +394,18 @@ def nonlinear_parser(sub: Any, parents: list[Parser]) -> None:
     n.add_argument(
         "--max-load",
         type=float,
-        default=NONLINEAR_DEFAULTS["max_load"],
+        default=defaults.max_load,
         metavar="RATIO",
         help="stop at RATIO times the linear critical load, in (0, 5]",
     )
     n.add_argument(
         "--max-step",
         type=float,
-        default=NONLINEAR_DEFAULTS["max_step"],
+        default=defaults.max_step,
         metavar="FRACTION",
         help="largest load step, relative to the linear critical load",
     )
 
-
-#: The nonlinear flags' defaults: those of NonlinearOptions (its dataclass fields),
-#: repeated here so that building the parser imports no DOLFINx; a test holds them equal.
-NONLINEAR_DEFAULTS: dict[str, Any] = {
-    "imperfection": 1e-3,
-    "shape": "auto",
-    "control": "load",
-    "max_load": 1.2,
-    "max_step": 0.05,
-}
 
 #: Flags that matter only for some methods: flag -> (the methods whose options Struct
 #: reads its SolverSpec field, the field).
@@ -434,7 +426,7 @@ METHOD_FLAGS = {
 }
 
 
-def solver_changes(args: argparse.Namespace) -> tuple[dict[str, Any], list[str]]:
+def solver_changes(args: argparse.Namespace) -> tuple[dict[str, str | float | bool], list[str]]:
     """SolverSpec changes from the flags, and the method-specific flags given."""
     values = {
         "--complete": args.complete or None,
@@ -445,7 +437,7 @@ def solver_changes(args: argparse.Namespace) -> tuple[dict[str, Any], list[str]]
         "--bound-budget": args.bound_budget,
         "--penalty": args.penalty,
     }
-    changes: dict[str, Any] = {
+    changes: dict[str, str | float | bool] = {
         k: v for k, v in {"method": args.method, "tau": args.tau}.items() if v is not None
     }
     if args.no_certify:
