@@ -27,8 +27,7 @@ class NonlinearOptions(Table, frozen=True):
 
     Args:
         imperfection: :math:`\delta`, the imperfection's amplitude max :math:`|w_0|`
-            relative to the thickness, in (0, 1]; the default 1e-3 is small enough for a
-            sharp knee and large enough for a smooth path.
+            relative to the thickness, in (0, 1].
         shape: Imperfection shape, one of :data:`~unibuckle_fenicsx.nonlinear.choices.SHAPES`.
         control: "load" (edge traction :math:`\lambda`, adaptive steps) or
             "displacement" (end shortening of the loaded edges; :math:`\lambda` from the
