@@ -270,7 +270,10 @@ def _edge_forms(
 
 
 class NoZone:
-    """The zone of a plate without obstacle: no node (a :class:`ContactSetManager` of none).
+    """The zone of a plate without obstacle: no node.
+
+    A :class:`~unibuckle_fenicsx.model.contact.ContactSetManager` of no node, so that a
+    plate's ``contact`` is never None.
 
     Attributes:
         size: 0.
@@ -287,16 +290,16 @@ class NoZone:
         self.gaps: npt.NDArray[np.float64] = np.empty(0)
 
     def values(self, u: PETSc.Vec) -> npt.NDArray[np.float64]:
-        """No entry (as :meth:`ContactSetManager.values`)."""
+        """No entry (as ``ContactSetManager.values``)."""
         return np.empty(0)
 
     def scatter(self, values: npt.NDArray[np.float64], u: PETSc.Vec) -> PETSc.Vec:
-        """``u`` set to zero (as :meth:`ContactSetManager.scatter`)."""
+        """``u`` set to zero (as ``ContactSetManager.scatter``)."""
         u.zeroEntries()
         return u
 
     def global_rows(self) -> npt.NDArray[np.int64]:
-        """No row (as :meth:`ContactSetManager.global_rows`)."""
+        """No row (as ``ContactSetManager.global_rows``)."""
         return np.empty(0, dtype=np.int64)
 
 
