@@ -294,12 +294,12 @@ def _routes_commands(rows: list[dict[str, Any]]) -> str:
 def _bracket_commands(rows: list[dict[str, Any]]) -> str:
     """The ``bench_bracket.py`` runs that wrote the rows: as asked for, uncapped, by default."""
     commands = []
-    modes = dict.fromkeys(
-        (bool(r.get("bracket")), bool(r.get("uncapped")), int(r.get("repeat") or 1)) for r in rows
-    )
-    for asked, uncapped, repeat in modes:
-        group = [r for r in rows if (bool(r.get("bracket")), bool(r.get("uncapped")),
-                                     int(r.get("repeat") or 1)) == (asked, uncapped, repeat)]  # fmt: skip
+
+    def mode(r: dict[str, Any]) -> tuple[bool, bool, int]:
+        return bool(r.get("bracket")), bool(r.get("uncapped")), int(r.get("repeat") or 1)
+
+    for asked, uncapped, repeat in dict.fromkeys(mode(r) for r in rows):
+        group = [r for r in rows if mode(r) == (asked, uncapped, repeat)]
         flags = (" --bracket" if asked else "") + (" --uncapped" if uncapped else "")
         flags += f" --repeat {repeat}" if repeat > 1 else ""
         commands.append(
