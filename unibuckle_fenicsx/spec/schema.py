@@ -4,7 +4,8 @@
 the file's (the edge tables under ``edges``, an obstacle's ``polygon`` and ``circle``
 keys, a hole's ``outline``: :mod:`~unibuckle_fenicsx.spec.files`) and gives each key the
 description its Struct's docstring gives it (its ``Args:`` entry: msgspec reads a field's
-description only from its ``Meta``, and the docstring is where the API documents it).
+description only from its ``Meta``, and the docstring is where the API documents it). A
+section's file (:mod:`~unibuckle_fenicsx.spec.section`) is the schema's other branch.
 """
 
 from __future__ import annotations
@@ -18,15 +19,20 @@ import msgspec
 from unibuckle_fenicsx.spec.base import bare, element, hints, is_table, members
 from unibuckle_fenicsx.spec.plate import PlateSpec
 from unibuckle_fenicsx.spec.problem import ProblemSpec
+from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
 __all__ = ["accepted_keys", "json_schema"]
 
 
 def json_schema() -> dict[str, Any]:
-    """The JSON Schema (draft 2020-12) of a problem file, as a mapping."""
-    schema: dict[str, Any] = msgspec.json.schema(ProblemSpec)
-    defs = schema["$defs"]
-    for name, cls in _tables(ProblemSpec).items():
+    """The JSON Schema (draft 2020-12) of a problem file, as a mapping.
+
+    A plate's file or a section's (one with a ``[section]`` table): ``anyOf`` the two.
+    """
+    tops, defs = msgspec.json.schema_components([ProblemSpec, SectionProblemSpec])
+    schema: dict[str, Any] = {"anyOf": list(tops), "$defs": defs}
+    tables = {**_tables(ProblemSpec), **_tables(SectionProblemSpec)}
+    for name, cls in tables.items():
         node = defs[name]
         node["description"] = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0]
         for key, text in field_docs(cls).items():
@@ -135,5 +141,6 @@ def accepted_keys() -> list[str]:
         if isinstance(node.get("additionalProperties"), dict):
             visit(resolve(node["additionalProperties"]), f"{prefix}<name>.")
 
-    visit(resolve(schema), "")
+    for top, _ in tables(schema):  # a plate's file, a section's
+        visit(top, "")
     return keys

@@ -29,6 +29,9 @@ from dataclasses import dataclass
 from mpi4py import MPI
 from petsc4py import PETSc
 
+import dolfinx
+import ufl
+
 import numpy as np
 import numpy.typing as npt
 
@@ -37,7 +40,13 @@ from unibuckle_fenicsx.model.shell.geometry import SectionMesh
 from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE, ShellModel
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
-__all__ = ["CoreConstraints", "change_of_basis", "core_constraints", "perimeter_coordinate"]
+__all__ = [
+    "CoreConstraints",
+    "change_of_basis",
+    "core_constraints",
+    "core_springs",
+    "perimeter_coordinate",
+]
 
 
 @dataclass(frozen=True)
@@ -189,6 +198,39 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
         owned_nodes=owned_nodes,
         num_held=int(comm.allreduce(num_held, op=MPI.SUM)),
     )
+
+
+def core_springs(
+    model: ShellModel, constraints: CoreConstraints, stiffness: float
+) -> npt.NDArray[np.float64]:
+    r"""The core's lumped foundation spring (N/m) of each constrained direction, on every rank.
+
+    The spring of node k is :math:`k_f \int \varphi_k\,dx` (the row sum of the Q1 mass
+    matrix, as the plate's foundation), split equally between a box corner's two
+    directions (the halves of its cells on either face; exact for the corner's
+    symmetric cells).
+
+    Args:
+        model: The section's shell model.
+        constraints: Its constrained directions.
+        stiffness: The Winkler modulus :math:`k_f` (N/m^3), > 0.
+
+    Note:
+        Collective.
+    """
+    v = ufl.TestFunction(model.W)
+    areas = dolfinx.fem.assemble_vector(dolfinx.fem.form(v[0] * ufl.dx))
+    areas.scatter_reverse(dolfinx.la.InsertMode.add)
+    nodes = constraints.owned_nodes
+    share = np.unique(nodes, return_counts=True)
+    count = dict(zip(share[0].tolist(), share[1].tolist(), strict=True))
+    local = np.array(
+        [stiffness * areas.array[DOFS_PER_NODE * k] / count[k] for k in nodes.tolist()]
+    )
+    springs = np.zeros(constraints.size)
+    for positions, values in model.mesh.comm.allgather((constraints.owned_positions, local)):
+        springs[positions] = values
+    return springs
 
 
 def _node_block(normals: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
