@@ -27,7 +27,6 @@ import logging
 import math
 import time
 from dataclasses import dataclass
-from typing import Any
 
 from mpi4py import MPI
 
@@ -85,7 +84,7 @@ class SectionResult(BucklingResult, kw_only=True):
     """
 
     classical_stress_Pa: float = math.nan
-    faces: list[dict[str, Any]] = msgspec.field(default_factory=list)
+    faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
 
     def summary(self) -> str:
         """Lines for the terminal: the critical stress, the hollow one, the reference."""
@@ -200,7 +199,7 @@ def solve_section(
         destroyed before the error propagates.
     """
     t0 = time.perf_counter()
-    echo: dict[str, Any] | None = None
+    echo: dict[str, object] | None = None
     if isinstance(parameters, SectionProblemSpec):
         echo = problem_to_dict(parameters)
         levels, solver = parameters.mesh.levels, parameters.solver
@@ -265,7 +264,7 @@ _FACES = (("right", 1, -1.0), ("top", 2, -1.0), ("left", 1, 1.0), ("bottom", 2, 
 
 def _faces(
     section: Section, load: float, active: npt.NDArray[np.int64] | None
-) -> list[dict[str, Any]]:
+) -> list[dict[str, str | float]]:
     """Each face of a box at the load ``load``, with the contact set ``active``."""
     p = section.parameters
     if p.shape != "box" or p.width is None or p.depth is None:
@@ -275,7 +274,7 @@ def _faces(
     touching = np.zeros(len(normals), dtype=bool)
     if active is not None:
         touching[active] = True
-    out = []
+    out: list[dict[str, str | float]] = []
     for name, axis, sign in _FACES:
         width = p.depth if axis == 1 else p.width  # a face normal to y spans the depth
         on = normals[:, axis] * sign > 0.5
