@@ -853,6 +853,21 @@ class Sources:
     movable: list[tuple[str, Array]]
 
 
+@dataclass
+class _State:
+    """What one distance's attempt leaves to the next (:func:`split_certificate`).
+
+    Attributes:
+        columns: The columns met so far (name, oriented values on I).
+        movable: The patterns translated on demand (name, oriented values on I).
+        start: The negative space's block to restart the inverse iteration from.
+    """
+
+    columns: list[tuple[str, Array]]
+    movable: list[tuple[str, Array]]
+    start: Array | None = None
+
+
 def column_sources(
     problem: UnilateralProblem, candidate: Candidate, others: list[Candidate], opts: SplitOptions
 ) -> Sources:
@@ -915,7 +930,7 @@ def split_certificate(
     if sources is None:
         sources = column_sources(problem, candidate, others, opts)
     patterns = sources.patterns
-    state: dict[str, Any] = {"columns": sources.first, "movable": sources.movable, "start": None}
+    state = _State(sources.first, sources.movable)
 
     def attempt(delta: float) -> SplitAttempt:
         return _attempt(problem, matrix, candidate, delta, patterns, state, opts, out)
@@ -967,7 +982,7 @@ def _attempt(
     candidate: Candidate,
     delta: float,
     patterns: _Patterns,
-    state: dict[str, Any],
+    state: _State,
     opts: SplitOptions,
     out: SplitOutcome,
 ) -> SplitAttempt:
@@ -1022,7 +1037,7 @@ def _attempt(
         pieces.append((V, level, []))
     proven = not pieces and not why
     if proven:
-        state["columns"] = _carried(basis, relax, patterns)
+        state.columns = _carried(basis, relax, patterns)
     attempt.proven, attempt.r, attempt.pieces, attempt.examined = (
         proven,
         basis.r,
@@ -1037,7 +1052,7 @@ def _widen(
     problem: UnilateralProblem,
     basis: _Basis,
     relax: _Relaxation,
-    state: dict[str, Any],
+    state: _State,
     load: float,
     found: tuple[list[tuple[str, Array]], Refuting | None],
     out: SplitOutcome,
@@ -1055,7 +1070,7 @@ def _widen(
     if not items:
         return None, "a direction of the negative space is not covered and no new column helps"
     basis.add(_scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
-    state["columns"] = list(state["columns"]) + items
+    state.columns = list(state.columns) + items
     widened = _Relaxation.of(basis)
     widened.used |= relax.used
     return widened, ""
@@ -1071,18 +1086,18 @@ def _first_basis(
     matrix: ShiftedMatrix,
     lam: float,
     neg: int,
-    state: dict[str, Any],
+    state: _State,
     opts: SplitOptions,
 ) -> tuple[_Basis | None, str]:
     """The negative space's block W and the columns met so far, or None and why not."""
-    space = _negative_space(problem, matrix, lam, neg, state["start"], opts.mode_iterations)
+    space = _negative_space(problem, matrix, lam, neg, state.start, opts.mode_iterations)
     if space is None:
         return None, f"the {neg} pencil modes below the shift were not found"
-    psi, theta, state["start"] = space
+    psi, theta, state.start = space
     # A-normalised Ritz pairs: psi'B K^-1 B psi = 1/(theta (theta - lam)), so this scaling
     # makes G_W nearly -I (the z-space's angles then nearly Euclidean).
     W = _block_product(problem.model.B, psi) * np.sqrt(theta * (lam - theta))[None, :]
-    items = _normalised(state["columns"], [])[: opts.max_columns]
+    items = _normalised(state.columns, [])[: opts.max_columns]
     capacity = neg + min(opts.max_columns, len(items) + opts.max_rounds * opts.per_round)
     basis = _Basis(problem, matrix, neg, capacity)
     basis.add(W, [f"W{j}" for j in range(neg)])
@@ -1199,7 +1214,7 @@ def _new_columns(
     basis: _Basis,
     relax: _Relaxation,
     patterns: _Patterns,
-    state: dict[str, Any],
+    state: _State,
     candidate: Candidate,
     uncovered: tuple[Array, Array, float],
     opts: SplitOptions,
@@ -1229,7 +1244,7 @@ def _new_columns(
         plus = np.maximum(values, 0.0)
         items: list[tuple[str, Array]] = [(f"cut{len(basis.names)}", plus)]
         scored = []
-        for name, part in state["movable"]:
+        for name, part in state.movable:
             best = None
             for k in patterns.shifts():
                 moved = patterns.translate(part, k)
