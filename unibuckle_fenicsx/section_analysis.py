@@ -211,21 +211,8 @@ def solve_section(
         )
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    solution: UnilateralSolution | None = None
     certificate: Certificate | None = None
-    iterations = 100 if solver is None else solver.max_iterations
-    if parameters.core and parameters.foundation_stiffness is None:
-        section, solution = solve_levels(
-            parameters, levels=int(levels), comm=comm, solver=solver, max_iterations=iterations
-        )
-    else:
-        section = build_section(parameters, comm, solver)
-        if parameters.core:  # an elastic core: the plate's spring-set iteration
-            try:
-                solution = solve_foundation(_cored(section.problem), max_iterations=iterations)
-            except BaseException:
-                section.destroy()
-                raise
+    section, solution = _solve(parameters, int(levels), comm, solver)
     try:
         problem = section.problem
         t1 = time.perf_counter()
@@ -288,6 +275,25 @@ def _faces(
             }
         )
     return out
+
+
+def _solve(
+    parameters: SectionParameters, levels: int, comm: MPI.Comm, solver: SolverSpec | None
+) -> tuple[Section, UnilateralSolution | None]:
+    """The section and, with a core, its unilateral solution (rigid: by levels; elastic)."""
+    iterations = 100 if solver is None else solver.max_iterations
+    if parameters.core and parameters.foundation_stiffness is None:
+        return solve_levels(
+            parameters, levels=levels, comm=comm, solver=solver, max_iterations=iterations
+        )
+    section = build_section(parameters, comm, solver)
+    if not parameters.core:
+        return section, None
+    try:  # an elastic core: the plate's spring-set iteration
+        return section, solve_foundation(_cored(section.problem), max_iterations=iterations)
+    except BaseException:
+        section.destroy()
+        raise
 
 
 def _cored(problem: Problem) -> UnilateralProblem:
