@@ -407,7 +407,7 @@ def _done_points(
     return done, stale
 
 
-def _solve_point(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, object]:
+def solve_point(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, object]:
     """Solve one point; the JSON-ready line body (results, or the error; and the input)."""
     body = _solve(spec, comm)
     return {**body, "input": point_input(spec)}
@@ -534,7 +534,7 @@ def run_sweep(
         )
         t0 = time.perf_counter()
         for count, k in enumerate(mine, start=1):
-            body = _solve_point(specs[k], sub)
+            body = solve_point(specs[k], sub)
             if sub.rank == 0:
                 _append(path, {"index": k, "point": points[k], **body})
             if comm.rank == 0:

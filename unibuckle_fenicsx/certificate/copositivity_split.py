@@ -205,7 +205,7 @@ class SplitOutcome(LowRankOutcome):
 
 
 # -- the columns and their Gram matrix ----------------------------------------------------
-class _Basis:
+class Basis:
     """Columns [W | M] (owned rows), their solves, and G = [W, M]^T K^-1 [W, M] with a bound.
 
     The first m columns are the negative-space vectors W; the others are nonnegative on
@@ -345,7 +345,7 @@ def _dense_like(mat: Any, values: Array) -> Any:
     return dense
 
 
-def _negative_space(
+def negative_space(
     problem: UnilateralProblem,
     matrix: ShiftedMatrix,
     lam: float,
@@ -410,7 +410,7 @@ def _negative_space(
 
 
 # -- translations of patterns on the zone --------------------------------------------------
-class _Patterns:
+class Patterns:
     """Constrained nodes, the plate's long axis and translations of node patterns along it.
 
     Nodes are keyed by their coordinates in quarter node spacings (a translation by k
@@ -506,7 +506,7 @@ def _reaction(candidate: Candidate) -> Array:
 
 
 def _sources(
-    patterns: _Patterns, candidate: Candidate, others: list[Candidate], opts: SplitOptions
+    patterns: Patterns, candidate: Candidate, others: list[Candidate], opts: SplitOptions
 ) -> tuple[list[tuple[str, Array]], list[tuple[str, Array]]]:
     """(first columns, patterns to translate on demand), as oriented values on I.
 
@@ -534,7 +534,7 @@ def _sources(
     return first, movable
 
 
-def _translates(patterns: _Patterns, w: Array, opts: SplitOptions) -> list[tuple[str, Array]]:
+def _translates(patterns: Patterns, w: Array, opts: SplitOptions) -> list[tuple[str, Array]]:
     """The reaction's line across the plate at every line, and its long clusters moved."""
     out: list[tuple[str, Array]] = []
     clusters = patterns.clusters(w)
@@ -623,7 +623,7 @@ class _Relaxation:
     used: set[int] = field(default_factory=set)  # columns in some mu met
 
     @classmethod
-    def of(cls, basis: _Basis) -> _Relaxation:
+    def of(cls, basis: Basis) -> _Relaxation:
         m = basis.m
         G = basis.G
         S_W = np.linalg.inv(G[:m, :m])
@@ -664,7 +664,7 @@ class _Relaxation:
 
 
 # -- one piece ------------------------------------------------------------------------------
-def _combined(basis: _Basis, mus: list[Array], factor: float) -> tuple[Array, Array, Array] | None:
+def _combined(basis: Basis, mus: list[Array], factor: float) -> tuple[Array, Array, Array] | None:
     r"""(G1s, E1s, scaling) of C = [W, M mu_1 ... M mu_k], or None unless In(G1) = (m, 0, k).
 
     :math:`G_1 = C^TGC` and its bound: C is nonnegative, so
@@ -715,7 +715,7 @@ def _cone_form(G1s: Array, dg: Array, V: Array, k: int) -> tuple[Array, Array, A
     return Tn, 0.5 * (Qn + Qn.T), d
 
 
-def _in_cap(basis: _Basis, V: Array, mu: Array, factor: float) -> tuple[bool, float, int | None]:
+def _in_cap(basis: Basis, V: Array, mu: Array, factor: float) -> tuple[bool, float, int | None]:
     r"""Whether every generator of cone(V) lies in the cap of the one column M mu (verified).
 
     With one column the directions z where :math:`\min_{y \le 0}` of the form is
@@ -750,7 +750,7 @@ def _in_cap(basis: _Basis, V: Array, mu: Array, factor: float) -> tuple[bool, fl
 
 
 def _piece_check(
-    basis: _Basis, V: Array, mus: list[Array], factor: float, sdp: bool
+    basis: Basis, V: Array, mus: list[Array], factor: float, sdp: bool
 ) -> tuple[bool, float, Array | None]:
     """(proven, margin, a point of cone(V) where the form is lowest when not proven).
 
@@ -848,7 +848,7 @@ COST_MODEL = {"factorisation": 0.3, "rhs_per_solve": 150.0, "pieces": 40.0, "gro
 class Sources:
     """The zone's patterns and the columns they give for one KKT point (see :func:`_sources`)."""
 
-    patterns: _Patterns
+    patterns: Patterns
     first: list[tuple[str, Array]]
     movable: list[tuple[str, Array]]
 
@@ -872,7 +872,7 @@ def column_sources(
     problem: UnilateralProblem, candidate: Candidate, others: list[Candidate], opts: SplitOptions
 ) -> Sources:
     """The first columns and the patterns translated on demand (no solve)."""
-    patterns = _Patterns(problem)
+    patterns = Patterns(problem)
     first, movable = _sources(patterns, candidate, others, opts)
     return Sources(patterns, first, movable)
 
@@ -943,7 +943,7 @@ def split_certificate(
     return out
 
 
-def _scatter_columns(problem: UnilateralProblem, items: list[tuple[str, Array]]) -> Array:
+def scatter_columns(problem: UnilateralProblem, items: list[tuple[str, Array]]) -> Array:
     """The W-vectors (owned rows) of columns given as oriented values on I."""
     vec = problem.model.A.createVecRight()
     cols = []
@@ -981,7 +981,7 @@ def _attempt(
     matrix: ShiftedMatrix,
     candidate: Candidate,
     delta: float,
-    patterns: _Patterns,
+    patterns: Patterns,
     state: _State,
     opts: SplitOptions,
     out: SplitOutcome,
@@ -1050,7 +1050,7 @@ def _attempt(
 
 def _widen(
     problem: UnilateralProblem,
-    basis: _Basis,
+    basis: Basis,
     relax: _Relaxation,
     state: _State,
     load: float,
@@ -1069,7 +1069,7 @@ def _widen(
     items = columns[: basis.room]
     if not items:
         return None, "a direction of the negative space is not covered and no new column helps"
-    basis.add(_scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
+    basis.add(scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
     state.columns = list(state.columns) + items
     widened = _Relaxation.of(basis)
     widened.used |= relax.used
@@ -1088,9 +1088,9 @@ def _first_basis(
     neg: int,
     state: _State,
     opts: SplitOptions,
-) -> tuple[_Basis | None, str]:
+) -> tuple[Basis | None, str]:
     """The negative space's block W and the columns met so far, or None and why not."""
-    space = _negative_space(problem, matrix, lam, neg, state.start, opts.mode_iterations)
+    space = negative_space(problem, matrix, lam, neg, state.start, opts.mode_iterations)
     if space is None:
         return None, f"the {neg} pencil modes below the shift were not found"
     psi, theta, state.start = space
@@ -1099,16 +1099,16 @@ def _first_basis(
     W = _block_product(problem.model.B, psi) * np.sqrt(theta * (lam - theta))[None, :]
     items = _normalised(state.columns, [])[: opts.max_columns]
     capacity = neg + min(opts.max_columns, len(items) + opts.max_rounds * opts.per_round)
-    basis = _Basis(problem, matrix, neg, capacity)
+    basis = Basis(problem, matrix, neg, capacity)
     basis.add(W, [f"W{j}" for j in range(neg)])
     gneg, _, gmargin = _inertia(basis.G, basis.E, opts.margin_factor)
     if gneg != neg or gmargin <= 1.0:
         return None, "W'K^-1W is not verified negative definite"
-    basis.add(_scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
+    basis.add(scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
     return basis, ""
 
 
-def _carried(basis: _Basis, relax: _Relaxation, patterns: _Patterns) -> list[tuple[str, Array]]:
+def _carried(basis: Basis, relax: _Relaxation, patterns: Patterns) -> list[tuple[str, Array]]:
     """The columns the next (smaller) distance starts from, after a proof here.
 
     Those the duals used here and their neighbours along the plate: the others answered
@@ -1135,7 +1135,7 @@ class _Proof:
 
 
 def _prove_piece(
-    basis: _Basis,
+    basis: Basis,
     relax: _Relaxation,
     V: Array,
     level: int,
@@ -1183,7 +1183,7 @@ def _prove_piece(
 
 
 def _together(
-    basis: _Basis, V: Array, mus: list[Array], level: int, opts: SplitOptions
+    basis: Basis, V: Array, mus: list[Array], level: int, opts: SplitOptions
 ) -> float | None:
     """The piece's margin with the combinations ``mus`` together, or None if unproven.
 
@@ -1211,9 +1211,9 @@ def _together(
 
 def _new_columns(
     problem: UnilateralProblem,
-    basis: _Basis,
+    basis: Basis,
     relax: _Relaxation,
-    patterns: _Patterns,
+    patterns: Patterns,
     state: _State,
     candidate: Candidate,
     uncovered: tuple[Array, Array, float],

@@ -536,7 +536,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         if xs is None:
             raise RuntimeError("_snes: the work vectors come first (an internal invariant)")
         snes = PETSc.SNES().create(self.comm)
-        snes.setFunction(self._residual, self.b)
+        snes.setFunction(self.residual, self.b)
         snes.setJacobian(self._jacobian, self.J)
         options = dict(SNES_OPTIONS if snes_options is None else snes_options)
         self._lower: PETSc.Vec | None = None
@@ -584,7 +584,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         x.array[:] = self.x.x.array[: self.num_owned_dofs]
         _update_ghosts(x)
 
-    def _residual(self, _snes: PETSc.SNES | None, x: PETSc.Vec, b: PETSc.Vec) -> None:
+    def residual(self, _snes: PETSc.SNES | None, x: PETSc.Vec, b: PETSc.Vec) -> None:
         """SNES function: the scaled residual F(x) with the edge conditions lifted."""
         self._assign(x)
         with b.localForm() as local:
@@ -595,7 +595,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         if self.Ks is not None:
             if self._d is None or self._Kd is None:
                 raise RuntimeError(
-                    "_residual: expected self._d is not None and self._Kd is not None (an "
+                    "residual: expected self._d is not None and self._Kd is not None (an "
                     "internal invariant)"
                 )
             x.copy(self._d)
@@ -700,7 +700,7 @@ class VonKarmanPlate(MixedDofs, Owner):
                 "internal invariant)"
             )
         self._to_vector(self._xs)
-        self._residual(None, self._xs, self.b)
+        self.residual(None, self._xs, self.b)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs, alpha=0.0)
         return self.b
 
