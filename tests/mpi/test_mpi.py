@@ -348,12 +348,12 @@ def test_a_section_on_two_ranks_equals_one():
     The contact set is compared by its size (its coordinates: the serial tests').
     """
     spec = importlib.util.spec_from_file_location(
-        "section_parallel", HERE / "mpi" / "section_parallel.py"
+        "section_parallel", MPI_SCRIPTS / "section_parallel.py"
     )
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
     serial = module.collect(MPI.COMM_SELF)
-    parallel = json.loads(run_mpi(HERE / "mpi" / "section_parallel.py", 2).strip().splitlines()[-1])
+    parallel = json.loads(run_mpi(MPI_SCRIPTS / "section_parallel.py", 2).strip().splitlines()[-1])
     for name, (load, free, contact, kkt) in serial.items():
         p_load, p_free, p_contact, p_kkt = parallel[name]
         assert _same_load(load, p_load) and _same_load(free, p_free), (name, serial, parallel)
