@@ -90,6 +90,36 @@ def test_help(tmp_path):
         assert action.help, action.option_strings
 
 
+def test_importing_the_module_entry_point_runs_nothing(monkeypatch):
+    """``python -m unibuckle_fenicsx.cli`` runs the CLI; importing the module does not.
+
+    Sphinx's autosummary imports every module: with the call unguarded, the docs build ran
+    ``main()`` on Sphinx's own arguments and printed an argparse error.
+    """
+    import importlib
+    import sys
+
+    monkeypatch.setattr(sys, "argv", ["sphinx-build", "html"])
+    monkeypatch.delitem(sys.modules, "unibuckle_fenicsx.cli.__main__", raising=False)
+    module = importlib.import_module("unibuckle_fenicsx.cli.__main__")  # no SystemExit
+    assert callable(module.main)
+
+
+def test_an_in_process_run_sets_the_callers_logging_back(tmp_path):
+    """``main()`` called in-process leaves the root logger as it found it.
+
+    Its handler holds this run's ``sys.stderr``; left installed, a later log record was
+    written to a stream closed in between ("I/O operation on closed file").
+    """
+    import logging
+
+    root = logging.getLogger()
+    before = root.handlers[:], root.level
+    out = tmp_path / "free.json"
+    assert main(["solve", "--case", "free", "--nx", "4", "--ny", "2", "--json", str(out)]) == 0
+    assert (root.handlers, root.level) == before
+
+
 def test_solve_free_case_writes_json(tmp_path, capsys):
     out = tmp_path / "free.json"
     assert main(["solve", "--case", "free", "--nx", "20", "--ny", "10", "--json", str(out)]) == 0

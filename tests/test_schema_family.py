@@ -140,7 +140,7 @@ def _design_by_hand(data: dict) -> tuple[str, str | None] | str:
 
 def test_the_design_element_of_every_family_file():
     """[design] on each file: the element, or the refusal, as worked out by hand."""
-    from unibuckle_fenicsx.spec.checks import design_element
+    from unibuckle_fenicsx.en1993 import design_element
 
     seen = set()
     for data, _ in FAMILY:

@@ -6,7 +6,7 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
 
 - 4.4(2): the relative plate slenderness :math:`\bar\lambda_p = \sqrt{f_y/\sigma_{cr}}`;
 - the element, from the plate's edges parallel to the direct stress (its *unloaded*
-  edges, :func:`~unibuckle_fenicsx.spec.checks.design_element`): both supported, an
+  edges, :func:`~unibuckle_fenicsx.en1993.design_element`): both supported, an
   **internal** compression element, :math:`\rho = (\bar\lambda_p - 0.055(3 + \psi))/
   \bar\lambda_p^2 \le 1` above :math:`\bar\lambda_p = 0.5 + \sqrt{0.085 - 0.055\psi}`
   (eq. (4.2)) and Table 4.1 (:math:`1 \ge \psi \ge -3`); one free, an **outstand**,
@@ -39,13 +39,14 @@ from msgspec import UNSET, Struct, UnsetType
 
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
+    DesignElement,
     buckling_factor,
+    design_element,
     psi_range,
     reduction_factor,
     table_row,
 )
 from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
-from unibuckle_fenicsx.spec.checks import DesignElement, design_element
 
 __all__ = ["CLAUSES", "DesignRecord", "clauses", "design_output", "reduction_factor"]
 
@@ -68,7 +69,7 @@ class DesignRecord(Struct, kw_only=True):
     Attributes:
         yield_stress_Pa: :math:`f_y`.
         partial_factor: :math:`\gamma_{M1}`.
-        element: "internal" or "outstand" (:func:`~unibuckle_fenicsx.spec.checks.design_element`).
+        element: "internal" or "outstand" (:func:`~unibuckle_fenicsx.en1993.design_element`).
         free_edge: An outstand's free unloaded edge (None for an internal element).
         table: The table row of :math:`\psi` and :math:`k_\sigma` (Table 4.1 or 4.2).
         edge: The loaded edge of the largest compression.

@@ -19,14 +19,19 @@ loaded edge, :math:`\sigma_1` the larger compression. The tables' buckling facto
 :math:`k_\sigma` (long plates, hinged edges) are given for comparison with the computed
 :math:`\sigma_{cr}`; the slenderness here is :math:`\bar\lambda_p = \sqrt{f_y/\sigma_{cr}}`
 (4.4(2)) with this package's :math:`\sigma_{cr}`. The formulas are a few lines each and
-no maintained library implements them for a given :math:`\sigma_{cr}`, hence this module;
-it has no dependency, so that the problem checks (:mod:`unibuckle_fenicsx.spec`) can
-refuse, before any solve, a stress ratio outside the tables.
+no maintained library implements them for a given :math:`\sigma_{cr}`, hence this module.
+:func:`design_element` classifies a plate by its edges, or refuses what the clause does
+not describe; the module imports no other of the package (it reads a problem through
+:class:`DesignProblem`), so that the problem checks (:mod:`unibuckle_fenicsx.spec`) can refuse
+such a plate, or a stress ratio outside the tables, before any solve.
 """
 
 from __future__ import annotations
 
 import math
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import Protocol
 
 from unibuckle_fenicsx.errors import InputError
 
@@ -34,7 +39,13 @@ __all__ = [
     "ELEMENTS",
     "INTERNAL",
     "OUTSTAND",
+    "DesignEdge",
+    "DesignElement",
+    "DesignLoad",
+    "DesignPlate",
+    "DesignProblem",
     "buckling_factor",
+    "design_element",
     "psi_range",
     "reduction_factor",
     "table_row",
@@ -135,3 +146,254 @@ def buckling_factor(element: str, psi: float, free_edge_most_compressed: bool = 
     if psi > -1.0:
         return 1.70 - 5.0 * psi + 17.1 * psi**2
     return 23.8
+
+
+# -- the element of a plate ----------------------------------------------------------------
+
+#: The rectangle's edges in pairs of opposite edges, and the pair each pair's edges run
+#: along (a [start, end] stress runs from the smaller coordinate to the larger).
+_PAIRS = {("left", "right"): ("bottom", "top"), ("bottom", "top"): ("left", "right")}
+_NAMES = tuple(name for pair in _PAIRS for name in pair)
+
+
+@dataclass(frozen=True)
+class DesignElement:
+    """The plate as a compression element of EN 1993-1-5 4.4 (:func:`design_element`).
+
+    Attributes:
+        kind: :data:`INTERNAL` (both unloaded edges supported) or :data:`OUTSTAND` (one
+            free).
+        loaded: The two opposite edges across which the direct stress acts.
+        unloaded: The two edges parallel to it.
+        free_edge: The free unloaded edge of an outstand, else None.
+    """
+
+    kind: str
+    loaded: tuple[str, str]
+    unloaded: tuple[str, str]
+    free_edge: str | None = None
+
+    @property
+    def free_end(self) -> int | None:
+        """Which end (0 start, 1 end) of a loaded edge lies on the free edge, or None.
+
+        A loaded edge runs from its end with the smaller coordinate to the larger, so its
+        start lies on the first edge of ``unloaded`` (bottom, or left).
+        """
+        if self.free_edge is None:
+            return None
+        return self.unloaded.index(self.free_edge)
+
+
+class DesignEdge(Protocol):
+    """What :func:`design_element` reads of an edge (:class:`~unibuckle_fenicsx.spec.EdgeSpec`)."""
+
+    @property
+    def name(self) -> str:
+        """The edge's name: "left", "right", "bottom" or "top"."""
+
+    @property
+    def support(self) -> str:
+        """Its transverse condition ("free", "simply_supported", ...)."""
+
+    @property
+    def inplane(self) -> str:
+        """Its in-plane condition ("free", "clamped", "roller")."""
+
+    @property
+    def translational_stiffness(self) -> float:
+        """Its springs on the deflection (N/m^2), >= 0."""
+
+    @property
+    def normal_stress(self) -> float | tuple[float, float]:
+        """Its normal stress per unit load (Pa/Pa): a number or (start, end)."""
+
+    @property
+    def fixed_normal_stress(self) -> float | tuple[float, float]:
+        """Its fixed normal stress (Pa): a number or (start, end)."""
+
+
+class DesignPlate(Protocol):
+    """What :func:`design_element` reads of a plate (:class:`~unibuckle_fenicsx.spec.PlateSpec`)."""
+
+    @property
+    def outline(self) -> object:
+        """The plate's outline, or None for a rectangle."""
+
+    @property
+    def file(self) -> str | None:
+        """The plate's gmsh file, or None."""
+
+    @property
+    def edges(self) -> Sequence[DesignEdge]:
+        """The edges the plate names (the others are free)."""
+
+
+class DesignLoad(Protocol):
+    """What :func:`design_element` reads of a load (:class:`~unibuckle_fenicsx.spec.LoadSpec`)."""
+
+    @property
+    def thermal(self) -> bool:
+        """Whether the scaled load has a temperature rise."""
+
+    @property
+    def fixed_thermal(self) -> bool:
+        """Whether the fixed load has a temperature rise."""
+
+    @property
+    def fixed_factor(self) -> float:
+        """The factor on the fixed load (0: none)."""
+
+
+class DesignProblem(Protocol):
+    """What :func:`design_element` reads of a :class:`~unibuckle_fenicsx.spec.ProblemSpec`."""
+
+    @property
+    def plate(self) -> DesignPlate:
+        """The plate."""
+
+    @property
+    def load(self) -> DesignLoad:
+        """The load besides the edge stresses."""
+
+
+@dataclass(frozen=True)
+class _FreeEdge:
+    """An edge of the rectangle that the plate does not name: free, without stress."""
+
+    name: str
+    support: str = "free"
+    inplane: str = "free"
+    translational_stiffness: float = 0.0
+    normal_stress: float = 0.0
+    fixed_normal_stress: float = 0.0
+
+
+def _ends(value: float | tuple[float, float]) -> tuple[float, float]:
+    """(start, end) of an edge stress: the pair itself, or the number twice."""
+    return (value, value) if isinstance(value, float | int) else value
+
+
+def design_element(spec: DesignProblem) -> DesignElement:
+    """Classify the plate for the design output (EN 1993-1-5 4.4(2)), or refuse it.
+
+    The direct stress acts across the edges given a normal stress (scaled or fixed); the
+    other two edges are the unloaded ones: both supported, an internal element (Table
+    4.1); one free (``support = "free"``, no translational spring), an outstand (Table
+    4.2). A stress ratio outside the element's table is refused here when the scaled
+    stresses alone fix it (no fixed normal stress); with a fixed part it depends on the
+    load and the output says so.
+
+    Raises:
+        InputError: What clause 4.4 does not describe, naming the keys: a plate that is
+            not a rectangle (outline, file), a temperature rise, normal stress in
+            both directions (biaxial), both unloaded edges free, a free edge on springs,
+            an unloaded edge held in its plane (a transverse stress), a stress ratio
+            outside the table.
+    """
+    _check_plate(spec.plate, spec.load)
+    fixed = spec.load.fixed_factor != 0.0
+    named = {e.name: e for e in spec.plate.edges}
+    sides: dict[str, DesignEdge] = {name: named.get(name, _FreeEdge(name)) for name in _NAMES}
+    loaded = _loaded_pair(sides, fixed)
+    unloaded = _PAIRS[loaded]
+    for name in unloaded:
+        _check_unloaded(sides[name])
+    free = [name for name in unloaded if sides[name].support == "free"]
+    if len(free) == 2:
+        raise InputError(
+            f'design: edges.{unloaded[0]}.support and edges.{unloaded[1]}.support are both "free": '
+            "with both unloaded edges free the plate is a strut (column-like buckling), "
+            "neither an internal nor an outstand element of EN 1993-1-5 4.4; leave [design] "
+            "out or support an unloaded edge"
+        )
+    element = DesignElement(
+        OUTSTAND if free else INTERNAL, loaded, unloaded, free[0] if free else None
+    )
+    if not (fixed and any(any(_ends(sides[name].fixed_normal_stress)) for name in loaded)):
+        _check_stress_ratio([sides[name] for name in loaded], element)
+    return element
+
+
+def _check_plate(plate: DesignPlate, load: DesignLoad) -> None:
+    """Refuse a plate that is not a rectangle, and a temperature rise."""
+    why = (
+        "is given by its outline"
+        if plate.outline is not None
+        else "is a gmsh file"
+        if plate.file is not None
+        else ""
+    )
+    if why:
+        raise InputError(
+            f"design: EN 1993-1-5 4.4 describes a rectangular plate element by its two "
+            f"unloaded edges; this plate {why} (plate.outline, plate.file): leave [design] "
+            "out, or give the rectangle's plate.corners"
+        )
+    if load.thermal or (load.fixed_thermal and load.fixed_factor != 0.0):
+        key = "load.temperature" if load.thermal else "load.fixed_temperature"
+        raise InputError(
+            f"design: {key}: a temperature rise adds a membrane stress (set by the in-plane "
+            "supports) that the edge stresses, from which the design output takes sigma_cr "
+            "and psi, do not show: leave [design] or the temperature out"
+        )
+
+
+def _loaded_pair(sides: dict[str, DesignEdge], fixed: bool) -> tuple[str, str]:
+    """The pair of opposite edges given a normal stress, or refuse a biaxial one."""
+    stressed = [
+        f"edges.{name}.normal_stress" for name, e in sides.items() if any(_ends(e.normal_stress))
+    ]
+    stressed += [
+        f"edges.{name}.fixed_normal_stress"
+        for name, e in sides.items()
+        if fixed and any(_ends(e.fixed_normal_stress))
+    ]
+    pairs = [pair for pair in _PAIRS if any(key.split(".")[1] in pair for key in stressed)]
+    if len(pairs) != 1:
+        given = ", ".join(stressed)
+        raise InputError(
+            f"design: {given} give normal stress in both directions (biaxial): EN 1993-1-5 "
+            "4.4 describes direct stress in one direction (section 10 combines biaxial "
+            "stresses, which is not done here); leave [design] out"
+        )
+    return pairs[0]
+
+
+def _check_unloaded(e: DesignEdge) -> None:
+    """Refuse an unloaded edge held in its plane, or free on springs."""
+    if e.inplane != "free":
+        raise InputError(
+            f'design: edges.{e.name}.inplane = "{e.inplane}" holds an unloaded edge in '
+            "its plane, which adds a transverse stress (Poisson's ratio times the direct "
+            "stress) that EN 1993-1-5 4.4 does not describe: leave the unloaded edges "
+            'free in their plane (inplane = "free") or [design] out'
+        )
+    if e.support == "free" and e.translational_stiffness > 0.0:
+        raise InputError(
+            f"design: edges.{e.name}.translational_stiffness: an unloaded edge on springs "
+            "is neither supported (an internal element, EN 1993-1-5 Table 4.1) nor free "
+            '(an outstand, Table 4.2): give it support = "simply_supported" or no springs'
+        )
+
+
+def _check_stress_ratio(loaded: list[DesignEdge], element: DesignElement) -> None:
+    """Refuse a stress ratio psi (of the scaled stresses alone) outside the element's table."""
+    best: tuple[float, float, int, str] = (0.0, 0.0, 0, "")
+    for e in loaded:
+        ends = [-v for v in _ends(e.normal_stress)]  # compression positive
+        for k in (0, 1):
+            if ends[k] > best[0]:
+                best = (ends[k], ends[1 - k], k, e.name)
+    sigma1, sigma2, k, name = best
+    if sigma1 <= 0.0:
+        return  # no scaled compression: the compression check says so
+    psi = sigma2 / sigma1
+    at_free = element.free_end is None or k == element.free_end or psi == 1.0
+    low, _ = psi_range(element.kind, at_free)
+    if psi < low:
+        raise InputError(
+            f"design: edges.{name}.normal_stress gives the stress ratio psi = sigma_2/sigma_1 "
+            f"= {psi:.4g}, outside EN 1993-1-5 {table_row(element.kind, at_free)}, which "
+            f"covers 1 >= psi >= {low:g}: leave [design] out or change the stress gradient"
+        )

@@ -18,11 +18,12 @@ and one exit status (:mod:`.status`, :class:`~unibuckle_fenicsx.outcome.Outcome`
 from __future__ import annotations
 
 import argparse
+import contextlib
 import logging
 import os
 import sys
 import traceback
-from collections.abc import Sequence
+from collections.abc import Iterator, Sequence
 from typing import Any, NoReturn
 
 from unibuckle_fenicsx.cli.flags import build_parser
@@ -56,15 +57,28 @@ __all__ = [
 ]
 
 
-def _logging(verbose: int, quiet: bool, rank: int) -> None:
+@contextlib.contextmanager
+def _logging(verbose: int, quiet: bool, rank: int) -> Iterator[None]:
+    """The run's log on standard error; the caller's logging set back afterwards.
+
+    ``main()`` may be called in-process (a notebook, a test): the handler it installs
+    holds the ``sys.stderr`` of this run, which may be closed after it.
+    """
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
     root = logging.getLogger()
+    progress = logging.getLogger("unibuckle_fenicsx.progress")
+    saved = root.handlers[:], root.level, progress.level
     root.handlers[:] = [handler]
     root.setLevel([logging.WARNING, logging.INFO, logging.DEBUG][min(verbose, 2)])
-    progress = logging.getLogger("unibuckle_fenicsx.progress")
     quiet = quiet or rank != 0
     progress.setLevel(logging.WARNING if quiet else min(root.level, logging.INFO))
+    try:
+        yield
+    finally:
+        root.handlers[:], levels = saved[0], saved[1:]
+        root.setLevel(levels[0])
+        progress.setLevel(levels[1])
 
 
 def main(argv: Sequence[str] | None = None) -> int:
@@ -90,10 +104,10 @@ def main(argv: Sequence[str] | None = None) -> int:
         if comm.rank == 0:
             print(f"unibuckle: error: {problem}", file=sys.stderr)
         return EXIT_BAD_INPUT
-    _logging(args.verbose, args.quiet, comm.rank)
-    ending = _Ending(comm)
-    status, raised = _guarded_run(args, rest, comm)
-    return ending.finish(status, raised or bool(PENDING))
+    with _logging(args.verbose, args.quiet, comm.rank):
+        ending = _Ending(comm)
+        status, raised = _guarded_run(args, rest, comm)
+        return ending.finish(status, raised or bool(PENDING))
 
 
 def _abort(comm: Any, status: int, message: str | None) -> NoReturn:

@@ -4,4 +4,5 @@ import sys
 
 from unibuckle_fenicsx.cli import main
 
-sys.exit(main())
+if __name__ == "__main__":  # importing the module (autodoc does) runs nothing
+    sys.exit(main())

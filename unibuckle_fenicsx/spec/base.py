@@ -41,7 +41,7 @@ Units = Literal["SI", "mm-N-MPa"]
 #: The units of fields (``Meta(extra={"unit": ...})``) that a unit system converts, as
 #: powers (p, q) of its length L and stress S: a value is ``(L**p * S**q)`` SI units.
 #: A list: one per entry of a list value (the first for a number).
-DIMENSIONS: dict[str, Any] = {
+DIMENSIONS: dict[str, tuple[int, int] | list[tuple[int, int]]] = {
     "m": (1, 0),
     "Pa": (0, 1),
     "N/m": (1, 1),  # = Pa m
@@ -127,8 +127,8 @@ class Table(Struct, frozen=True, forbid_unknown_fields=True):
 
 
 @functools.cache
-def hints(cls: type) -> dict[str, Any]:
-    """A Struct's field types, with their Meta."""
+def hints(cls: type) -> dict[str, object]:
+    """A Struct's field types (annotations), with their Meta."""
     found = typing.get_type_hints(cls, include_extras=True)
     return {name: found[name] for name in cls.__struct_fields__}  # type: ignore[attr-defined]
 
@@ -226,10 +226,7 @@ def table_of(tp: Any, value: Any, field: str | None = None) -> Any:
 def walk(tp: Any, value: Any, steps: list[str | int]) -> tuple[Any, Any]:
     """The type and value at ``steps`` (field names and indices) below ``tp``, ``value``."""
     for key in steps:
-        try:
-            child = value[key]
-        except (KeyError, IndexError, TypeError):
-            child = None
+        entry = child(value, key)
         if isinstance(key, str):
             table = table_of(tp, value, key)
             tp = hints(table).get(key, Any) if table is not None else Any
@@ -240,8 +237,29 @@ def walk(tp: Any, value: Any, steps: list[str | int]) -> tuple[Any, Any]:
                 tp = element(lists[0])
             else:
                 tp = args[key] if key < len(args) else Any
-        value = child
+        value = entry
     return tp, value
+
+
+def as_table(value: object) -> dict[str, object]:
+    """``value``, a table of a builtins form (JSON, TOML)."""
+    assert isinstance(value, dict)
+    return value
+
+
+def as_tables(value: object) -> list[dict[str, object]]:
+    """``value``, a list of tables of a builtins form."""
+    assert isinstance(value, list)
+    return [as_table(v) for v in value]
+
+
+def child(value: object, step: str | int) -> object:
+    """The entry ``step`` (a key or an index) of a table or list ``value``, or None."""
+    if isinstance(value, Mapping) and isinstance(step, str):
+        return value.get(step)
+    if isinstance(value, list | tuple) and isinstance(step, int) and step < len(value):
+        return value[step]
+    return None
 
 
 def location(err: msgspec.ValidationError) -> list[str | int]:

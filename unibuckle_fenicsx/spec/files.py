@@ -20,9 +20,8 @@ from __future__ import annotations
 
 import json
 import tomllib
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
-from typing import Any
 
 import msgspec
 
@@ -33,6 +32,9 @@ from unibuckle_fenicsx.spec.base import (
     DIMENSIONS,
     UNITS,
     Stress,
+    as_table,
+    as_tables,
+    child,
     element,
     form,
     hints,
@@ -57,7 +59,7 @@ PLY_KEYS: tuple[str, ...] = Ply.__struct_fields__
 _LOADS = ("normal_stress", "shear_stress", "fixed_normal_stress", "fixed_shear_stress")
 
 
-def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSpec:
+def problem_from_dict(data: Mapping[str, object], name: str = "plate") -> ProblemSpec:
     """A :class:`ProblemSpec` from a TOML-shaped mapping (:doc:`/guide/plate`).
 
     Args:
@@ -71,8 +73,8 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
     if not isinstance(data, Mapping):
         raise InputError(f"a problem file is a table of tables, got {data!r}")
     api = _to_api({"name": name, **plain(data)})
-    if isinstance(api.get("units"), str) and api["units"] in UNITS:
-        api = scaled(api, ProblemSpec, api["units"], 1)
+    if isinstance(units := api.get("units"), str) and units in UNITS:
+        api = as_table(scaled(api, ProblemSpec, units, 1))
     token = CONVERTING.set(True)
     try:
         return msgspec.convert(_laminate(api), ProblemSpec)
@@ -82,7 +84,7 @@ def problem_from_dict(data: Mapping[str, Any], name: str = "plate") -> ProblemSp
         CONVERTING.reset(token)
 
 
-def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
+def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, object]:
     """The TOML-shaped mapping of ``spec``, every key with the value used.
 
     ``problem_from_dict(problem_to_dict(spec)) == spec`` for a spec without a predicate
@@ -97,9 +99,10 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, Any]:
         raise InputError(f"units must be one of {tuple(UNITS)}, got {units!r}")
     try:
         data = msgspec.json.decode(msgspec.json.encode(spec))  # lists, not tuples; exact
+        data = as_table(scaled(data, ProblemSpec, units, -1))
     except TypeError:
         raise InputError("problem_to_dict: a predicate obstacle zone cannot be written") from None
-    return _to_file({**scaled(data, ProblemSpec, units, -1), "units": units}, spec)
+    return _to_file(data | {"units": units}, spec)
 
 
 def stress_value(value: Stress) -> float | list[float]:
@@ -107,7 +110,7 @@ def stress_value(value: Stress) -> float | list[float]:
     return list(value) if isinstance(value, tuple) else value
 
 
-def scaled(value: Any, tp: Any, units: str, sign: int) -> Any:
+def scaled(value: object, tp: object, units: str, sign: int) -> object:
     """``value`` (the Structs' form) with each number in a unit converted.
 
     From the unit system ``units`` to SI (``sign`` 1) or back (-1). A value that is not
@@ -147,7 +150,7 @@ def _factor(dims: tuple[int, int], units: str, sign: int) -> float:
     return up / (length ** max(-p, 0) * stress ** max(-q, 0)) ** sign
 
 
-def _times(value: Any, factor: float) -> Any:
+def _times(value: object, factor: float) -> object:
     """``value`` (a number, or lists of numbers) times ``factor``; anything else as is."""
     if isinstance(value, list):
         return [_times(v, factor) for v in value]
@@ -159,7 +162,7 @@ def _times(value: Any, factor: float) -> Any:
 # -- the file's form -------------------------------------------------------------------
 
 
-def _to_api(raw: dict[str, Any]) -> dict[str, Any]:
+def _to_api(raw: dict[str, object]) -> dict[str, object]:
     """The Structs' form of the file ``raw`` (see the module docstring)."""
     out = dict(raw)
     plate = out.get("plate", {})
@@ -174,17 +177,17 @@ def _to_api(raw: dict[str, Any]) -> dict[str, Any]:
                 )
             if "size" in mesh:
                 raise InputError("[mesh]: give size (a cell size) or nx and ny, not both")
-    if isinstance(out.get("obstacle"), Mapping):
-        out["obstacle"] = _zone(out["obstacle"], "obstacle")
-    if isinstance(out.get("obstacles"), list):
+    if isinstance(obstacle := out.get("obstacle"), Mapping):
+        out["obstacle"] = _zone(obstacle, "obstacle")
+    if isinstance(obstacles := out.get("obstacles"), list):
         out["obstacles"] = [
             _zone(t, f"obstacles[{k}]") if isinstance(t, Mapping) else t
-            for k, t in enumerate(out["obstacles"])
+            for k, t in enumerate(obstacles)
         ]
     return out
 
 
-def _plate(plate: dict[str, Any], edges: Any, load: Any) -> dict[str, Any]:
+def _plate(plate: dict[str, object], edges: object, load: object) -> dict[str, object]:
     """``[plate]`` with the holes in the Structs' form and the ``[edges.*]`` tables."""
     _unknown(plate, PlateSpec.file_keys(), "plate")
     gmsh = "outline" in plate or "file" in plate
@@ -193,8 +196,8 @@ def _plate(plate: dict[str, Any], edges: Any, load: Any) -> dict[str, Any]:
             "[plate]: give corners (a rectangle), or outline (a polygon) or file (a gmsh "
             "file), not both"
         )
-    if isinstance(plate.get("holes"), list):
-        plate["holes"] = [_hole(h, f"plate.holes[{k}]") for k, h in enumerate(plate["holes"])]
+    if isinstance(holes := plate.get("holes"), list):
+        plate["holes"] = [_hole(h, f"plate.holes[{k}]") for k, h in enumerate(holes)]
     if not isinstance(edges, Mapping):
         raise InputError(f"edges must be a table of [edges.NAME] tables, got {edges!r}")
     loaded = any(isinstance(t, Mapping) and set(_LOADS) & set(t) for t in edges.values())
@@ -210,13 +213,13 @@ def _plate(plate: dict[str, Any], edges: Any, load: Any) -> dict[str, Any]:
     return plate
 
 
-def _unknown(table: Mapping[str, Any], allowed: Any, where: str) -> None:
+def _unknown(table: Mapping[str, object], allowed: Sequence[str], where: str) -> None:
     """Refuse the keys of ``table`` not in ``allowed``."""
     if found := [key for key in table if key not in allowed]:
         raise InputError(f"unknown key(s) {found} in [{where}]; allowed: {list(allowed)}")
 
 
-def _hole(table: Any, where: str) -> Any:
+def _hole(table: object, where: str) -> object:
     """A hole's table in the Structs' form: a tagged circle or polygon."""
     if not isinstance(table, Mapping):
         return table
@@ -231,7 +234,7 @@ def _hole(table: Any, where: str) -> Any:
     )
 
 
-def _zone(table: Mapping[str, Any], where: str) -> dict[str, Any]:
+def _zone(table: Mapping[str, object], where: str) -> dict[str, object]:
     """An obstacle's table with its zone, polygon or circle as the Structs' ``zone``."""
     _unknown(table, OBSTACLE_KEYS, where)
     if isinstance(table.get("zone"), Mapping):  # a file's zone is "all" or a box
@@ -257,7 +260,7 @@ def _zone(table: Mapping[str, Any], where: str) -> dict[str, Any]:
     return out
 
 
-def _laminate(api: dict[str, Any]) -> dict[str, Any]:
+def _laminate(api: dict[str, object]) -> dict[str, object]:
     """A laminate's E and nu, and its plate's thickness, from its plies if not given."""
     material = api.get("material")
     if not (isinstance(material, Mapping) and isinstance(material.get("plies"), list)):
@@ -279,7 +282,9 @@ def _laminate(api: dict[str, Any]) -> dict[str, Any]:
     return api
 
 
-def _message(err: msgspec.ValidationError, api: Any, prefix: list[str | int] | None = None) -> str:
+def _message(
+    err: msgspec.ValidationError, api: object, prefix: list[str | int] | None = None
+) -> str:
     """The message of msgspec's ``err`` converting ``api``, naming the file's key."""
     steps = [*(prefix or []), *location(err)]
     cause = err.__cause__
@@ -294,14 +299,11 @@ def _message(err: msgspec.ValidationError, api: Any, prefix: list[str | int] | N
     return reason(_file_key(steps, api), value, tp)
 
 
-def _file_key(steps: list[str | int], api: Any) -> str:
+def _file_key(steps: list[str | int], api: object) -> str:
     """The file's key at ``steps`` of its Structs' form ``api`` (``edges.left``, ...)."""
     key, node = "", api
     for s in steps:
-        try:
-            node = node[s]
-        except (KeyError, IndexError, TypeError):
-            node = None
+        node = child(node, s)
         shape = node.get("shape") if isinstance(node, Mapping) else None
         if key == "edges" and isinstance(s, int):
             key = f"edges.{node['name']}" if isinstance(node, Mapping) else f"edges[{s}]"
@@ -314,51 +316,50 @@ def _file_key(steps: list[str | int], api: Any) -> str:
     return key
 
 
-def _to_file(data: dict[str, Any], spec: ProblemSpec) -> dict[str, Any]:
-    """The file's form of ``data``, the Structs' (:func:`msgspec.to_builtins` of ``spec``)."""
-    plate = data["plate"]
+def _to_file(data: dict[str, object], spec: ProblemSpec) -> dict[str, object]:
+    """The file's form of ``data``, the Structs' (``spec`` as JSON)."""
+    plate, mesh = as_table(data["plate"]), as_table(data["mesh"])
     edges = {}
-    for edge in plate.pop("edges"):
+    for edge in as_tables(plate.pop("edges")):
         del edge["tag"]
-        edges[edge.pop("name")] = edge
-    plate["holes"] = [_shape(h, "outline") for h in plate["holes"]]
-    if plate["outline"] is not None or plate["file"] is not None:
+        edges[str(edge.pop("name"))] = edge
+    plate["holes"] = [_shape(h, "outline") for h in as_tables(plate["holes"])]
+    if spec.plate.outline is not None or spec.plate.file is not None:
         del plate["corners"]
     if spec.material.plies:
-        del data["material"]["E"], data["material"]["nu"]
-    mesh = data["mesh"]
-    if mesh["size"] is not None or spec.plate.meshed_by_gmsh:
+        material = as_table(data["material"])
+        del material["E"], material["nu"]
+    if spec.mesh.size is not None or spec.plate.meshed_by_gmsh:
         del mesh["nx"], mesh["ny"]
-    for point in data["points"]:  # a square grid's spacing: one number
-        if point["spacing"] is not None and len(set(point["spacing"])) == 1:
-            point["spacing"] = point["spacing"][0]
+    for point in as_tables(data["points"]):  # a square grid's spacing: one number
+        if isinstance(spacing := point["spacing"], list) and len(set(spacing)) == 1:
+            point["spacing"] = spacing[0]
     data["obstacle"] = _zone_key(data["obstacle"])
-    data["obstacles"] = [_zone_key(o) for o in data["obstacles"]]
-    out = {}
+    data["obstacles"] = [_zone_key(o) for o in as_tables(data["obstacles"])]
+    out: dict[str, object] = {}
     for key, value in data.items():
         out[key] = value
         if key == "material":
             out["edges"] = edges
-    return _pruned(out)
+    return as_table(_pruned(out))
 
 
-def _zone_key(obstacle: dict[str, Any] | None) -> dict[str, Any] | None:
+def _zone_key(obstacle: object) -> object:
     """An obstacle's zone under its file key: zone, polygon or circle."""
-    if obstacle is None or not isinstance(obstacle["zone"], dict):
+    if obstacle is None or not isinstance(zone := as_table(obstacle)["zone"], dict):
         return obstacle
-    zone = obstacle.pop("zone")
-    return {zone["shape"]: _shape(zone, None), **obstacle}
+    rest = {k: v for k, v in as_table(obstacle).items() if k != "zone"}
+    return {zone["shape"]: _shape(zone, None), **rest}
 
 
-def _shape(table: dict[str, Any], vertices: str | None) -> Any:
+def _shape(table: dict[str, object], vertices: str | None) -> object:
     """A circle's or polygon's file form: without its tag; a polygon's vertices."""
-    shape = table.pop("shape")
-    if shape == "polygon":
+    if table["shape"] == "polygon":
         return {vertices: table["vertices"]} if vertices else table["vertices"]
-    return table
+    return {k: v for k, v in table.items() if k != "shape"}
 
 
-def _pruned(value: Any) -> Any:
+def _pruned(value: object) -> object:
     """``value`` without absent keys (None, empty lists): a file has no null."""
     if isinstance(value, dict):
         return {k: _pruned(v) for k, v in value.items() if v is not None and v != []}

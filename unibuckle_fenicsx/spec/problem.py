@@ -8,9 +8,10 @@ from typing import Any, ClassVar, Literal
 import msgspec
 from msgspec.structs import force_setattr, replace
 
+from unibuckle_fenicsx.en1993 import design_element
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.spec.base import UNITS, Table, stress_ends
-from unibuckle_fenicsx.spec.checks import check_features, check_supports, design_element
+from unibuckle_fenicsx.spec.checks import check_features, check_supports
 from unibuckle_fenicsx.spec.material import Material
 from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
 from unibuckle_fenicsx.spec.plate import MeshSpec, PlateSpec
@@ -153,7 +154,7 @@ class ProblemSpec(Table, frozen=True):
         """The design output needs a compressive normal edge stress (its sigma_cr).
 
         And a plate that EN 1993-1-5 4.4 describes: an internal or an outstand element
-        (:func:`~unibuckle_fenicsx.spec.checks.design_element` says which, or refuses).
+        (:func:`~unibuckle_fenicsx.en1993.design_element` says which, or refuses).
         """
         if self.design is None:
             return

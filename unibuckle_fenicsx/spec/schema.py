@@ -11,20 +11,28 @@ from __future__ import annotations
 
 import inspect
 import re
-from typing import Any
 
 import msgspec
 
-from unibuckle_fenicsx.spec.base import bare, element, hints, is_table, members
+from unibuckle_fenicsx.spec.base import (
+    Table,
+    as_table,
+    as_tables,
+    bare,
+    element,
+    hints,
+    is_table,
+    members,
+)
 from unibuckle_fenicsx.spec.plate import PlateSpec
 from unibuckle_fenicsx.spec.problem import ProblemSpec
 
 __all__ = ["accepted_keys", "json_schema"]
 
 
-def json_schema() -> dict[str, Any]:
+def json_schema() -> dict[str, object]:
     """The JSON Schema (draft 2020-12) of a problem file, as a mapping."""
-    schema: dict[str, Any] = msgspec.json.schema(ProblemSpec)
+    schema = msgspec.json.schema(ProblemSpec)
     defs = schema["$defs"]
     for name, cls in _tables(ProblemSpec).items():
         node = defs[name]
@@ -63,7 +71,7 @@ def json_schema() -> dict[str, Any]:
     defs["Material"]["required"] = []  # a laminate's E and nu are its plies'
     head = {"$schema": "https://json-schema.org/draft/2020-12/schema"}
     head["title"] = "unibuckle_fenicsx problem file"
-    return msgspec.json.decode(msgspec.json.encode(head | schema))  # JSON's lists
+    return as_table(msgspec.json.decode(msgspec.json.encode(head | schema)))  # lists
 
 
 def field_docs(cls: type) -> dict[str, str]:
@@ -81,7 +89,9 @@ def field_docs(cls: type) -> dict[str, str]:
     return found
 
 
-def _tables(cls: Any, found: dict[str, Any] | None = None) -> dict[str, Any]:
+def _tables(
+    cls: type[Table], found: dict[str, type[Table]] | None = None
+) -> dict[str, type[Table]]:
     """The tables (Structs) below ``cls``, by name."""
     found = {} if found is None else found
     found[cls.__name__] = cls
@@ -92,7 +102,7 @@ def _tables(cls: Any, found: dict[str, Any] | None = None) -> dict[str, Any]:
     return found
 
 
-def _inner(tp: Any) -> list[Any]:
+def _inner(tp: object) -> list[object]:
     """The types inside ``tp``: its union's members, its list's entries."""
     out = []
     for m in members(tp):
@@ -109,31 +119,32 @@ def accepted_keys() -> list[str]:
     ``[edges.NAME]`` table ``<name>`` (``edges.<name>.support``).
     """
     schema = json_schema()
+    defs = as_table(schema["$defs"])
     keys: list[str] = []
 
-    def resolve(node: dict[str, Any]) -> dict[str, Any]:
-        ref = node.get("$ref", "")
-        return schema["$defs"][ref.rpartition("/")[2]] if ref else node
+    def resolve(node: object) -> dict[str, object]:
+        ref = as_table(node).get("$ref")
+        return as_table(defs[ref.rpartition("/")[2]]) if isinstance(ref, str) else as_table(node)
 
-    def tables(node: dict[str, Any]) -> list[tuple[dict[str, Any], str]]:
+    def tables(node: object) -> list[tuple[dict[str, object], str]]:
         """The tables a value may be (with the suffix ``[]`` for a list of them)."""
         node = resolve(node)
-        found = [t for a in node.get("anyOf", []) for t in tables(a)]
+        found = [t for a in as_tables(node.get("anyOf", [])) for t in tables(a)]
         if "properties" in node or isinstance(node.get("additionalProperties"), dict):
             found.append((node, ""))
-        if node.get("type") == "array" and isinstance(node.get("items"), dict):
-            found += [(t, "[]" + s) for t, s in tables(node["items"])]
+        if node.get("type") == "array" and isinstance(items := node.get("items"), dict):
+            found += [(t, "[]" + s) for t, s in tables(items)]
         return found
 
-    def visit(node: dict[str, Any], prefix: str) -> None:
-        for key, sub in node.get("properties", {}).items():
+    def visit(node: dict[str, object], prefix: str) -> None:
+        for key, sub in as_table(node.get("properties", {})).items():
             found = tables(sub)
             if not found and prefix + key not in keys:
                 keys.append(prefix + key)
             for table, suffix in found:
                 visit(table, f"{prefix}{key}{suffix}.")
-        if isinstance(node.get("additionalProperties"), dict):
-            visit(resolve(node["additionalProperties"]), f"{prefix}<name>.")
+        if isinstance(extra := node.get("additionalProperties"), dict):
+            visit(resolve(extra), f"{prefix}<name>.")
 
     visit(resolve(schema), "")
     return keys
