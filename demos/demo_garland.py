@@ -53,7 +53,7 @@ warnings.filterwarnings("error")  # demos run warning-free
 # E = 1 GPa, ν = 0.3, compressed by a unit stress on the edges x = 0 and x = a, the
 # obstacle over the whole plate. Cells of b/12 (`--coarse`: b/6): MITC4 then lies
 # 0.9–1.8 % above the thin-plate k when a half-wave spans 8 cells or more (measured on
-# the SSSS garland, falling as h²; `tests/test_sweep.py`), and 3.4 % at a/b = 0.5, where
+# the SSSS garland, falling as h²; `tests/unit/test_sweep.py`), and 3.4 % at a/b = 0.5, where
 # the half-wave along x spans 6 cells. The curves are compared within
 # :data:`MESH_RTOL`, that error with a margin (`--coarse`, a smoke run: 15 % at
 # a/b = 0.5). φ = a/b runs from 0.5 to 4 in steps of 0.25.

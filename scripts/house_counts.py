@@ -16,7 +16,11 @@ that each count is made of. What is counted:
   ``errors.py``;
 - the lines of the problem-file package (``spec/``, or ``config/`` before it);
 - import circles among the package's modules (every import, inside functions and
-  ``TYPE_CHECKING`` blocks too: a circle of types is a circle a reader walks).
+  ``TYPE_CHECKING`` blocks too: a circle of types is a circle a reader walks);
+- in ``tests/``: the files that import a test module (``test_*`` or ``conftest``; what
+  tests share belongs in ``tests/support/`` or a fixture), and the package's private
+  names (a leading underscore) that tests import, read from an imported module
+  (``module._name``) or replace (``monkeypatch.setattr(module, "_name", ...)``).
 """
 
 from __future__ import annotations
@@ -29,6 +33,7 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parent.parent
 PACKAGE = ROOT / "unibuckle_fenicsx"
+TESTS = ROOT / "tests"
 
 
 def _sources() -> list[Path]:
@@ -134,6 +139,65 @@ def _waivers() -> tuple[list[str], object]:
     return files, lint.get("mccabe", {}).get("max-complexity")
 
 
+def _private(name: str) -> bool:
+    return name.startswith("_") and not name.startswith("__")
+
+
+def _bindings(tree: ast.Module, where: str) -> tuple[set[str], dict[str, str], list[str]]:
+    """(modules imported, local names bound to the package's modules, private imports)."""
+    package = PACKAGE.name
+    imported: set[str] = set()
+    modules: dict[str, str] = {}
+    private = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            for alias in node.names:
+                imported.add(alias.name)
+                if alias.name.split(".")[0] == package:
+                    modules[alias.asname or package] = alias.name if alias.asname else package
+        elif isinstance(node, ast.ImportFrom) and not node.level:
+            base = node.module or ""
+            imported.add(base)
+            for alias in node.names if base.split(".")[0] == package else []:
+                if _private(alias.name):
+                    private.append(f"{where}:{node.lineno} {base}.{alias.name}")
+                else:
+                    modules.setdefault(alias.asname or alias.name, f"{base}.{alias.name}")
+    return imported, modules, private
+
+
+def _private_uses(tree: ast.Module, modules: dict[str, str], where: str) -> list[str]:
+    """``module._name`` and ``setattr``-like ``(module, "_name", ...)`` on the package's modules."""
+    found = []
+    for node in ast.walk(tree):
+        owner, name = None, ""
+        if isinstance(node, ast.Attribute) and _private(node.attr):
+            owner, name = node.value, node.attr
+        elif isinstance(node, ast.Call) and len(node.args) >= 2:
+            key = node.args[1]
+            if isinstance(key, ast.Constant) and isinstance(key.value, str) and _private(key.value):
+                owner, name = node.args[0], key.value
+        chain = []
+        while isinstance(owner, ast.Attribute):
+            chain.insert(0, owner.attr)
+            owner = owner.value
+        if isinstance(owner, ast.Name) and owner.id in modules:
+            found.append(f"{where}:{node.lineno} {'.'.join([modules[owner.id], *chain, name])}")
+    return found
+
+
+def _test_imports(trees: dict[Path, ast.Module]) -> tuple[list[str], list[str]]:
+    """(files importing a test module, private package names used), in ``tests/``."""
+    importing, private = [], []
+    for path, tree in trees.items():
+        where = str(path.relative_to(ROOT))
+        imported, modules, names = _bindings(tree, where)
+        if any(m.split(".")[-1].startswith("test_") or m == "conftest" for m in imported):
+            importing.append(where)
+        private += names + _private_uses(tree, modules, where)
+    return importing, sorted(set(private))
+
+
 def counts() -> list[tuple[str, int | object, str, list[str]]]:
     """(what, value, target, the items counted) for each count."""
     sources = _sources()
@@ -166,6 +230,8 @@ def counts() -> list[tuple[str, int | object, str, list[str]]]:
     modules = {_module(p) for p in sources}
     graph = {_module(p): _imports(p, trees[p], modules) for p in sources}
     circles = _circles(graph)
+    test_trees = {p: ast.parse(p.read_text()) for p in sorted(TESTS.rglob("*.py"))}
+    importing, private = _test_imports(test_trees)
     return [
         ("functions over 100 lines", len(over100), "0", over100),
         ("functions over 80 lines", len(over80), "<= 3", over80),
@@ -183,13 +249,15 @@ def counts() -> list[tuple[str, int | object, str, list[str]]]:
         ("error classes outside errors.py", len(errors), "0", errors),
         (f"lines of {spec_dir.name}/", spec_lines, "<= 1600", []),
         ("import circles", len(circles), "0", [" <-> ".join(c) for c in circles]),
+        ("test modules importing a test module", len(importing), "0", importing),
+        ("tests importing a private package name", len(private), "0", private),
     ]  # fmt: skip
 
 
 def main(argv: list[str]) -> int:
     """Print the counts (``--list``: with what each is made of)."""
     for what, value, target, items in counts():
-        print(f"{what:36s} {value!s:>6}   target {target}")
+        print(f"{what:40s} {value!s:>6}   target {target}")
         if "--list" in argv:
             for item in items:
                 print(f"    {item}")

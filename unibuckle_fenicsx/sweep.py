@@ -77,6 +77,7 @@ __all__ = [
     "STATUSES",
     "Variation",
     "base_mapping",
+    "index_of",
     "parse_variation",
     "point_input",
     "point_problem",
@@ -167,7 +168,7 @@ def sweep_points(variations: Sequence[Variation]) -> list[dict[str, float]]:
     )]  # fmt: skip
 
 
-def base_mapping(path: str | Path) -> dict[str, Any]:
+def base_mapping(path: str | Path) -> dict[str, object]:
     """The problem file ``path`` as a mapping with every key and the value used.
 
     In the file's own ``units``, and with ``[mesh] size`` kept if the file gives it.
@@ -180,11 +181,11 @@ def base_mapping(path: str | Path) -> dict[str, Any]:
     return problem_to_dict(spec, units=spec.units)
 
 
-def _is_number(value: Any) -> bool:
+def _is_number(value: object) -> bool:
     return isinstance(value, int | float) and not isinstance(value, bool)
 
 
-def _locate(data: dict[str, Any], path: str, flag: str) -> tuple[Any, Any]:
+def _locate(data: dict[str, object], path: str, flag: str) -> tuple[Any, Any]:
     """The container and key of the value at the dotted ``path`` of ``data``.
 
     Raises:
@@ -216,7 +217,7 @@ def _locate(data: dict[str, Any], path: str, flag: str) -> tuple[Any, Any]:
     return node, (leaf if isinstance(node, Mapping) else int(leaf))
 
 
-def set_value(data: dict[str, Any], path: str, value: float, flag: str = "--vary") -> None:
+def set_value(data: dict[str, object], path: str, value: float, flag: str = "--vary") -> None:
     """Set the number at the dotted ``path`` of the problem mapping ``data``, in place.
 
     Raises:
@@ -225,7 +226,8 @@ def set_value(data: dict[str, Any], path: str, value: float, flag: str = "--vary
     """
     if path in SHORTCUTS:
         axis = SHORTCUTS[path]
-        corners = data.get("plate", {}).get("corners")
+        plate = data.get("plate")
+        corners = plate.get("corners") if isinstance(plate, dict) else None
         if not isinstance(corners, list):
             raise InputError(f"{flag} {path}: the problem has no plate.corners")
         corners[1][axis] = corners[0][axis] + value
@@ -241,7 +243,7 @@ def set_value(data: dict[str, Any], path: str, value: float, flag: str = "--vary
     node[index] = value
 
 
-def set_text(data: dict[str, Any], path: str, text: str, flag: str = "--set") -> None:
+def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set") -> None:
     """Set the value at the dotted ``path`` of ``data`` from ``text``, read as the value there.
 
     A number, a boolean (true/false) or a string replaces one of its kind; the shortcuts
@@ -271,7 +273,7 @@ def set_text(data: dict[str, Any], path: str, text: str, flag: str = "--set") ->
         )
 
 
-def point_problem(base: Mapping[str, Any], point: Mapping[str, float]) -> ProblemSpec:
+def point_problem(base: Mapping[str, object], point: Mapping[str, float]) -> ProblemSpec:
     """The problem of one sweep point: ``base`` with the point's values set.
 
     Raises:
@@ -286,7 +288,7 @@ def point_problem(base: Mapping[str, Any], point: Mapping[str, float]) -> Proble
         raise InputError(f"sweep point {dict(point)}: {err}") from None
 
 
-def read_lines(path: str | Path, *, strict: bool = False) -> list[dict[str, Any]]:
+def read_lines(path: str | Path, *, strict: bool = False) -> list[dict[str, object]]:
     """The JSON lines of a sweep file.
 
     Args:
@@ -314,7 +316,7 @@ def read_lines(path: str | Path, *, strict: bool = False) -> list[dict[str, Any]
     return out
 
 
-def _parse_line(raw: bytes) -> tuple[dict[str, Any] | None, str]:
+def _parse_line(raw: bytes) -> tuple[dict[str, object] | None, str]:
     """A sweep line from its bytes, or None and why not."""
     try:
         line = json.loads(raw.decode("utf-8"))
@@ -327,18 +329,30 @@ def _parse_line(raw: bytes) -> tuple[dict[str, Any] | None, str]:
     return None, "no index and point"
 
 
-def point_input(spec: ProblemSpec) -> dict[str, Any]:
+def index_of(line: Mapping[str, object]) -> int:
+    """The point number of a sweep line (:func:`read_lines` keeps only lines with one).
+
+    Raises:
+        InputError: ``line`` has no integer ``index`` (it is not a sweep's line).
+    """
+    index = line.get("index")
+    if not isinstance(index, int):
+        raise InputError(f"not a line of a sweep (no integer index): {dict(line)!r:.80}")
+    return index
+
+
+def point_input(spec: ProblemSpec) -> dict[str, object]:
     """The ``input`` a point's line stores: its problem, every key, as read back from JSON."""
     return json.loads(json.dumps(problem_to_dict(spec)))
 
 
-def _write_atomically(path: Path, lines: list[dict[str, Any]]) -> None:
+def _write_atomically(path: Path, lines: list[dict[str, object]]) -> None:
     tmp = path.with_name(path.name + ".tmp")
     tmp.write_text("".join(json.dumps(line) + "\n" for line in lines))
     os.replace(tmp, path)
 
 
-def _append(path: Path, line: dict[str, Any]) -> None:
+def _append(path: Path, line: dict[str, object]) -> None:
     """Append one line with a single write, and flush it to disk."""
     data = (json.dumps(line) + "\n").encode()
     fd = os.open(path, os.O_WRONLY | os.O_APPEND | os.O_CREAT, 0o644)
@@ -352,8 +366,8 @@ def _append(path: Path, line: dict[str, Any]) -> None:
 
 
 def _done_points(
-    path: Path, points: list[dict[str, float]], inputs: list[dict[str, Any]]
-) -> tuple[dict[int, dict[str, Any]], int]:
+    path: Path, points: list[dict[str, float]], inputs: list[dict[str, object]]
+) -> tuple[dict[int, dict[str, object]], int]:
     """The lines of ``path`` that can be kept, and how many are stale; the file cleaned up.
 
     A line is kept if its point is this sweep's and its stored ``input`` equals the
@@ -365,10 +379,10 @@ def _done_points(
     """
     if not path.exists():
         return {}, 0
-    done: dict[int, dict[str, Any]] = {}
+    done: dict[int, dict[str, object]] = {}
     stale = 0
     for line in read_lines(path, strict=True):
-        k = line["index"]
+        k = index_of(line)
         if not 0 <= k < len(points) or line["point"] != points[k]:
             raise InputError(
                 f"--json {path}: holds a point of another sweep (line index {k}, point "
@@ -382,13 +396,13 @@ def _done_points(
     return done, stale
 
 
-def _solve_point(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
+def solve_point(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, object]:
     """Solve one point; the JSON-ready line body (results, or the error; and the input)."""
     body = _solve(spec, comm)
     return {**body, "input": point_input(spec)}
 
 
-def _solve(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, Any]:
+def _solve(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, object]:
     from unibuckle_fenicsx.analysis import solve
 
     try:
@@ -414,7 +428,7 @@ def _check_ranks(ranks_per_point: int, comm: MPI.Comm) -> None:
 
 def _resume(
     path: Path, points: list[dict[str, float]], specs: list[ProblemSpec], comm: MPI.Comm
-) -> tuple[dict[int, dict[str, Any]], int]:
+) -> tuple[dict[int, dict[str, object]], int]:
     """The lines of ``path`` kept and the stale ones' count, on every rank.
 
     See :func:`_done_points`.
@@ -426,7 +440,7 @@ def _resume(
         Collective.
     """
     error = None
-    done: dict[int, dict[str, Any]] = {}
+    done: dict[int, dict[str, object]] = {}
     stale = 0
     if comm.rank == 0:
         try:
@@ -440,15 +454,28 @@ def _resume(
     return done, stale
 
 
+def _say_resumed(path: Path, done: int, stale: int, points: int) -> None:
+    """The progress lines of a resumed sweep: the points kept and those solved again."""
+    if done:
+        PROGRESS.info("sweep: %d of %d points already in %s", done, points, path)
+    if stale:
+        PROGRESS.info(
+            "sweep: %d line(s) of %s hold another input (the base file changed): "
+            "solving their points again",
+            stale,
+            path,
+        )
+
+
 def run_sweep(
-    base: Mapping[str, Any],
+    base: Mapping[str, object],
     variations: Sequence[Variation],
     out: str | Path,
     comm: MPI.Comm = MPI.COMM_WORLD,
     *,
     ranks_per_point: int = 1,
     progress: bool = True,
-) -> list[dict[str, Any]]:
+) -> list[dict[str, object]]:
     """Solve every point of the grid of ``variations`` and write ``out`` (JSON lines).
 
     Args:
@@ -482,15 +509,8 @@ def run_sweep(
     try:
         mine = todo[color::groups]
         show = progress and comm.rank == 0
-        if show and done:
-            PROGRESS.info("sweep: %d of %d points already in %s", len(done), len(points), path)
-        if show and stale:
-            PROGRESS.info(
-                "sweep: %d line(s) of %s hold another input (the base file changed): "
-                "solving their points again",
-                stale,
-                path,
-            )
+        if show:
+            _say_resumed(path, len(done), stale, len(points))
         lines = Progress(
             "sweep",
             len(todo),
@@ -503,7 +523,7 @@ def run_sweep(
         )
         t0 = time.perf_counter()
         for count, k in enumerate(mine, start=1):
-            body = _solve_point(specs[k], sub)
+            body = solve_point(specs[k], sub)
             if sub.rank == 0:
                 _append(path, {"index": k, "point": points[k], **body})
             if comm.rank == 0:
@@ -520,7 +540,7 @@ def run_sweep(
         sub.Free()
     final = None
     if comm.rank == 0:
-        everything = {line["index"]: line for line in read_lines(path)}
+        everything = {index_of(line): line for line in read_lines(path)}
         final = [everything[k] for k in sorted(everything)]
         _write_atomically(path, final)
     return comm.bcast(final, root=0)

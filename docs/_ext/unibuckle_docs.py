@@ -17,7 +17,7 @@ The site loads no script from the network: MathJax comes from the ``django-stati
 wheel of the ``docs`` extra (MathJax 3.2.2, the same files as the npm package), copied into
 ``_static/mathjax`` when the site is written (:func:`copy_mathjax`).
 
-The functions are importable without Sphinx (``tests/test_docs.py`` uses them).
+The functions are importable without Sphinx (``tests/docs/test_docs.py`` uses them).
 """
 
 from __future__ import annotations
@@ -763,7 +763,7 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
         "https://petsc.org/release/petsc4py/",
         {
             f"{prefix}PETSc.{name}": ("class", f"reference/petsc4py.PETSc.{name}.html")
-            for name in ("Vec", "Mat", "KSP", "PC", "Options", "Viewer")
+            for name in ("Vec", "Mat", "KSP", "PC", "SNES", "Options", "Viewer")
             for prefix in ("petsc4py.", "")  # as the hints write it: from petsc4py import PETSc
         },
     ),

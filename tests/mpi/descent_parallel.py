@@ -3,7 +3,7 @@
 Usage: mpiexec -n 2 python descent_parallel.py PROBLEM.json
 
 From the left half of the (4 m long) plate in contact, made admissible, as
-tests/test_descent.py does serially, then the descent; prints the load, the contact
+tests/unit/algorithms/test_descent.py does serially, then the descent; prints the load, the contact
 set's coordinates and the number of steps.
 """
 

@@ -2,7 +2,7 @@
 
 ``mpiexec -n P python tests/mpi/free_estimate.py`` prints, on rank 0, the paper's free
 load at 48x24 (its estimate made at 12x6: the threshold is lowered to this small mesh)
-and the number of shifts its proof took; ``tests/test_free_solve.py`` compares 1 and 2
+and the number of shifts its proof took; ``tests/unit/la/test_free_solve.py`` compares 1 and 2
 ranks.
 """
 

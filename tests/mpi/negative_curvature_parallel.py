@@ -20,7 +20,7 @@ from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.spec import load_problem
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
-from test_interior_point import at_saddle
+from support.newton import at_saddle
 
 spec = load_problem(sys.argv[1])
 lam, vectors = float(sys.argv[2]), int(sys.argv[3])

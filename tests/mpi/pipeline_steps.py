@@ -3,7 +3,7 @@
 ``mpiexec -n P python tests/mpi/pipeline_steps.py NX NY [quick]`` prints, on rank 0, one JSON
 line with partition-independent quantities: mesh counts, prestress checks, norms of the
 assembled pencil, the contact nodes (coordinates), free and candidate loads, oriented
-mode values at the contact nodes and certificates. ``tests/test_mpi.py`` compares them
+mode values at the contact nodes and certificates. ``tests/mpi/test_mpi.py`` compares them
 with the same function run serially (:func:`collect`). The script itself asserts what
 must hold on every rank (identical collective decisions, ghost layer present).
 """
@@ -23,12 +23,11 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from test_prestress import (
+from support.plates import (
     clamped_left_plate,
     n0_at_quadrature_points,
     strip_average,
 )
-
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.mesh import create_plate_mesh

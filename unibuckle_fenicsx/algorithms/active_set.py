@@ -155,7 +155,7 @@ def _seeds(
     return out
 
 
-def _multi_seed(problem: UnilateralProblem, max_iterations: int) -> list[Run]:
+def multi_seed(problem: UnilateralProblem, max_iterations: int) -> list[Run]:
     """Run the iteration from every seed, starting from the free mode."""
     free = problem.solve_free().function.x.petsc_vec
     values = problem.contact.values(free)
@@ -232,7 +232,7 @@ def _twin_groups(points: list[Candidate]) -> list[list[Candidate]]:
     return [sorted(g, key=lambda s: (len(s.active), tuple(s.active))) for g in groups]
 
 
-def _distinct_kkt(runs: list[Run]) -> list[Candidate]:
+def distinct_kkt(runs: list[Run]) -> list[Candidate]:
     """Distinct KKT end points of ``runs``, sorted by load then lexicographically."""
     found: dict[bytes, Candidate] = {}
     for run in runs:
@@ -313,14 +313,14 @@ def _coarse_levels(
             continue
         tl = time.perf_counter()
         if coarse.candidates is None:
-            coarse.runs = _multi_seed(cp, max_iterations)
+            coarse.runs = multi_seed(cp, max_iterations)
             runs = coarse.runs
         else:
             if coarse.last is None:
                 raise RuntimeError("_coarse_levels: a polish without a coarser level")
             budget = min(max_iterations, POLISH_ITERATIONS)
             runs = _polish(cp, coarse.last, coarse.candidates, budget, coarse.bests)
-        kkt = _distinct_kkt(runs)
+        kkt = distinct_kkt(runs)
         groups = _twin_groups(kkt)
         if groups:
             best = groups[0][0].load
@@ -373,7 +373,7 @@ def _fall_back(
     Their runs are appended to ``runs``, what they did to ``warnings``. Collective.
     """
     out = _Fallbacks()
-    if _distinct_kkt(runs):
+    if distinct_kkt(runs):
         return out
     # The iteration stalled on this mesh: penalty continuation, started from the free
     # plate (on thin plates a stalled contact set is a poorer start).
@@ -389,7 +389,7 @@ def _fall_back(
         f"the active-set iteration stalled; penalty continuation ({out.penalty_solves} "
         f"eigen solves) ended {'at a KKT point' if run.status == 'kkt' else run.status}"
     )
-    if _distinct_kkt(runs):
+    if distinct_kkt(runs):
         return out
     # Both stalled: the feasible descent cannot cycle (docs: methods/active_set).
     last, steps = _descent(problem, runs, DESCENT_BUDGET * max_iterations)
@@ -458,7 +458,7 @@ def _fine_level(
         runs = _polish(problem, coarse.last, coarse.candidates, budget, coarse.bests)
         seeded_on = [coarse.last.spec.mesh.nx, coarse.last.spec.mesh.ny]
     else:
-        runs = _multi_seed(problem, max_iterations)
+        runs = multi_seed(problem, max_iterations)
         seeded_on = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
     if coarse.last is not None:
         coarse.last.destroy()
@@ -552,7 +552,7 @@ def solve_active_set(
     runs, seeded_on = _fine_level(problem, coarse, max_iterations)
     warnings: list[str] = []
     fallbacks = _fall_back(problem, runs, max_iterations, warnings)
-    kkt = _distinct_kkt(runs)
+    kkt = distinct_kkt(runs)
     cycles = [r.seed for r in runs + coarse.runs if r.status is RunStatus.CYCLE]
     if cycles:
         warnings.append(f"active-set iteration cycled from seed(s) {cycles}")

@@ -104,7 +104,7 @@ class _Arc(ArcPlane):
             self.phi_max = 0.5 * math.atan2(2.0 * self.b12, self.b11 - self.b22)
 
 
-class _Gradient:
+class Gradient:
     r"""Descent direction :math:`g = -A_{W'}^{-1} r` with :math:`r = Au - R(u)Bu`.
 
     On a node k released from W (:math:`u_k = 0`, :math:`r_k > 0`) alone,
@@ -214,7 +214,7 @@ def descend(
         run.status = RunStatus.KKT
         return run, dict.fromkeys(STEP_KINDS, 0)
     u = start.mode.x.petsc_vec.copy()
-    gradient: _Gradient | None = None
+    gradient: Gradient | None = None
     sets = _Sets(start.active, _pulling(start, n, tau))
     steps = dict.fromkeys(STEP_KINDS, 0)
     try:
@@ -224,7 +224,7 @@ def descend(
             cand: Candidate | None = None
             if sets.by_gradient:
                 steps["gradient"] += 1
-                gradient = gradient or _Gradient(problem)  # rarely needed: made on first use
+                gradient = gradient or Gradient(problem)  # rarely needed: made on first use
                 arc = gradient.arc(u, trial)
             else:
                 cand = problem.evaluate(trial, initial=u)

@@ -265,6 +265,38 @@ def _stop(levels: list[LevelSummary], complete: bool, until_proven: bool) -> boo
     return level.best_set is not None
 
 
+def _details(
+    levels: list[LevelSummary],
+    nodes: int,
+    p_optimum: int,
+    complete: bool,
+    until_proven: bool,
+    ranks: int,
+    t_start: float,
+) -> EnumerationDetails:
+    """The enumeration's record: per size visited its best and least loads, counts and times."""
+    monotone, violations = _monotonicity(levels) if complete else (None, [])
+    first = next(lv for lv in levels if lv.best_set is not None)
+    return EnumerationDetails(
+        constrained_nodes=nodes,
+        candidate_count=candidate_count(nodes),
+        candidates_evaluated=sum(lv.candidates for lv in levels),
+        candidate_ranks=ranks,
+        complete=complete,
+        until_proven=until_proven,
+        p_optimum=p_optimum,
+        lambda_by_p=[_finite_or_none(lv.best_load) for lv in levels],
+        feasible_by_p=[lv.feasible for lv in levels],
+        candidates_by_p=[lv.candidates for lv in levels],
+        lambda_min_by_p=[_finite_or_none(lv.load_min) for lv in levels],
+        wall_by_p_s=[lv.wall_s for lv in levels],
+        monotone=monotone,
+        monotone_violations=violations,
+        lower_bound_interlacing=first.load_min,
+        enumeration_wall_s=time.perf_counter() - t_start,
+    )
+
+
 def _solution(
     problem: UnilateralProblem,
     levels: list[LevelSummary],
@@ -284,7 +316,6 @@ def _solution(
         Collective on ``problem.comm`` and ``ccomm``.
     """
     i = problem.contact.size
-    count = candidate_count(i)
     rank, size = ccomm.rank, ccomm.size
     with_feasible = [lv for lv in levels if lv.best_set is not None]
     if not with_feasible:
@@ -307,25 +338,7 @@ def _solution(
     candidate = _share(problem, kept[level_of], ccomm)
     eigensolves = int(ccomm.allreduce(problem.eigensolver.solves - solves0, op=MPI.SUM))
 
-    monotone, violations = _monotonicity(levels) if complete else (None, [])
-    details = EnumerationDetails(
-        constrained_nodes=i,
-        candidate_count=count,
-        candidates_evaluated=sum(lv.candidates for lv in levels),
-        candidate_ranks=size,
-        complete=complete,
-        until_proven=until_proven,
-        p_optimum=len(chosen),
-        lambda_by_p=[_finite_or_none(lv.best_load) for lv in levels],
-        feasible_by_p=[lv.feasible for lv in levels],
-        candidates_by_p=[lv.candidates for lv in levels],
-        lambda_min_by_p=[_finite_or_none(lv.load_min) for lv in levels],
-        wall_by_p_s=[lv.wall_s for lv in levels],
-        monotone=monotone,
-        monotone_violations=violations,
-        lower_bound_interlacing=with_feasible[0].load_min,
-        enumeration_wall_s=time.perf_counter() - t_start,
-    )
+    details = _details(levels, i, len(chosen), complete, until_proven, size, t_start)
     if problem.comm.rank == 0 and rank == 0:
         logger.info(
             "enumeration: lambda = %.9e, |Z| = %d, p* = %d, lower bound %.9e (%s), %d eigen solves",

@@ -56,6 +56,12 @@ class Run:
     best_feasible: Candidate | None = None
     history: list[tuple[int, float, bool]] = field(default_factory=list)
 
+    def record(self, size: int, cand: Candidate) -> None:
+        """Count one more iterate: ``cand``, on a contact set of ``size`` nodes."""
+        self.iterations += 1
+        self.final = cand
+        self.history.append((size, cand.load, cand.feasible))
+
     def summary(self) -> RunSummary:
         """The run's record."""
         final = self.final
@@ -90,6 +96,24 @@ def _changes(
         if add.any() or release.any() or stage == len(stages) - 1:
             return add, release, stage
         stage += 1
+
+
+def _restrict(
+    cand: Candidate,
+    add: npt.NDArray[np.bool_],
+    release: npt.NDArray[np.bool_],
+    most_violated: bool,
+    damped: bool,
+) -> None:
+    """Narrow the changes in place (the greedy and the damped rules).
+
+    With ``most_violated`` add only the most violated node(s); while ``damped`` and adding,
+    release none.
+    """
+    if most_violated and add.any():
+        add &= cand.values >= cand.values[add].max() * (1.0 - ROUNDING_RTOL)
+    if damped and add.any():
+        release[:] = False
 
 
 def iterate(
@@ -141,9 +165,7 @@ def iterate(
         vec = cand.mode.x.petsc_vec
         if near is not None and math.isfinite(cand.load):
             near = cand.load
-        run.iterations = it + 1
-        run.final = cand
-        run.history.append((len(active), cand.load, cand.feasible))
+        run.record(len(active), cand)
         if not math.isfinite(cand.load):
             run.status = RunStatus.NO_FINITE_LOAD
             break
@@ -158,10 +180,7 @@ def iterate(
             # KKT at the looser thresholds: tightened (same contact set and mode).
             stage, damped = tighter, False
             seen.clear()
-        if (greedy or damped) and add.any():
-            add &= cand.values >= cand.values[add].max() * (1.0 - ROUNDING_RTOL)
-        if damped and add.any():
-            release[:] = False
+        _restrict(cand, add, release, greedy or damped, damped)
         new = (inz & ~release) | add
         nxt = np.flatnonzero(new).astype(np.int64)
         if nxt in seen:

@@ -47,7 +47,7 @@ Note:
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from typing import TYPE_CHECKING, Any
 
 from mpi4py import MPI
@@ -370,15 +370,9 @@ def copositivity_bound(
             result, stop = _at_shift(problem, matrix, nappes, lam, attempt, opts, notes)
             if stop:
                 break
-        if result is None and several and opts.split is not None:
-            found = _split(problem, matrix, candidate, others or [], opts.split, notes)
-            split, refuting = found.record(), found.refuting
-            result = _route_bound(found, "split-spn")
-        if result is None and refuting is None and several and opts.lowrank is not None:
-            outcome = _lowrank(problem, matrix, candidate, others or [], opts.lowrank, notes)
-            if outcome is not None:
-                lowrank, refuting = outcome.record(), outcome.refuting
-                result = _route_bound(outcome, "lowrank-spn")
+        if result is None and several:
+            routes = _split_routes(problem, matrix, candidate, others or [], opts, notes)
+            result, split, lowrank, refuting = routes
     finally:
         timings = _timings(problem, matrix, t0, start)
         if own:
@@ -390,19 +384,52 @@ def copositivity_bound(
             "algorithm's"
         )
         result = LowerBound(None, "none", None)
-    return LowerBound(
-        result.value,
-        result.method,
-        result.delta,
-        result.margins,
-        tuple(attempts),
-        tuple(notes),
-        timings,
-        m,
-        lowrank,
-        refuting,
-        split,
+    return replace(
+        result,
+        attempts=tuple(attempts),
+        notes=tuple(notes),
+        timings=timings,
+        negative_eigenvalues=m,
+        lowrank=lowrank,
+        refuting=refuting,
+        split=split,
     )
+
+
+def _split_routes(
+    problem: UnilateralProblem,
+    matrix: ShiftedMatrix,
+    candidate: Candidate,
+    others: list[Candidate],
+    opts: BoundOptions,
+    notes: list[str],
+) -> tuple[LowerBound | None, SplitRecord | None, LowRankRecord | None, Refuting | None]:
+    """The routes for two or more pencil eigenvalues below the shift.
+
+    The split route, then the low-rank one unless the split found a bound or an admissible
+    mode below the load.
+
+    Returns:
+        The bound (or None), the split's and the low-rank route's records (None where a
+        route did not run) and the refuting mode (or None).
+
+    Note:
+        Collective.
+    """
+    result: LowerBound | None = None
+    split: SplitRecord | None = None
+    lowrank: LowRankRecord | None = None
+    refuting: Refuting | None = None
+    if opts.split is not None:
+        found = _split(problem, matrix, candidate, others, opts.split, notes)
+        split, refuting = found.record(), found.refuting
+        result = _route_bound(found, "split-spn")
+    if result is None and refuting is None and opts.lowrank is not None:
+        outcome = _lowrank(problem, matrix, candidate, others, opts.lowrank, notes)
+        if outcome is not None:
+            lowrank, refuting = outcome.record(), outcome.refuting
+            result = _route_bound(outcome, "lowrank-spn")
+    return result, split, lowrank, refuting
 
 
 def _route_bound(outcome: LowRankOutcome, method: str) -> LowerBound | None:

@@ -206,7 +206,7 @@ class SplitOutcome(LowRankOutcome):
 
 
 # -- the columns and their Gram matrix ----------------------------------------------------
-class _Basis:
+class Basis:
     """Columns [W | M] (owned rows), their solves, and G = [W, M]^T K^-1 [W, M] with a bound.
 
     The first m columns are the negative-space vectors W; the others are nonnegative on
@@ -346,7 +346,7 @@ def _dense_like(mat: Any, values: Array) -> Any:
     return dense
 
 
-def _negative_space(
+def negative_space(
     problem: UnilateralProblem,
     matrix: ShiftedMatrix,
     lam: float,
@@ -411,7 +411,7 @@ def _negative_space(
 
 
 # -- translations of patterns on the zone --------------------------------------------------
-class _Patterns:
+class Patterns:
     """Constrained nodes, the plate's long axis and translations of node patterns along it.
 
     Nodes are keyed by their coordinates in quarter node spacings (a translation by k
@@ -506,7 +506,7 @@ def _reaction(candidate: Candidate) -> Array:
 
 
 def _sources(
-    patterns: _Patterns, candidate: Candidate, others: list[Candidate], opts: SplitOptions
+    patterns: Patterns, candidate: Candidate, others: list[Candidate], opts: SplitOptions
 ) -> tuple[list[tuple[str, Array]], list[tuple[str, Array]]]:
     """(first columns, patterns to translate on demand), as oriented values on I.
 
@@ -534,7 +534,7 @@ def _sources(
     return first.items, movable
 
 
-def _translates(patterns: _Patterns, w: Array, opts: SplitOptions, first: _First) -> None:
+def _translates(patterns: Patterns, w: Array, opts: SplitOptions, first: _First) -> None:
     """Into ``first``: the reaction's line across the plate at every line, long clusters moved."""
     clusters = patterns.clusters(w)
     line = patterns.line_profile(w)
@@ -625,7 +625,7 @@ class _Relaxation:
     used: set[int] = field(default_factory=set)  # columns in some mu met
 
     @classmethod
-    def of(cls, basis: _Basis) -> _Relaxation:
+    def of(cls, basis: Basis) -> _Relaxation:
         m = basis.m
         G = basis.G
         S_W = np.linalg.inv(G[:m, :m])
@@ -666,7 +666,7 @@ class _Relaxation:
 
 
 # -- one piece ------------------------------------------------------------------------------
-def _combined(basis: _Basis, mus: list[Array], factor: float) -> tuple[Array, Array, Array] | None:
+def _combined(basis: Basis, mus: list[Array], factor: float) -> tuple[Array, Array, Array] | None:
     r"""(G1s, E1s, scaling) of C = [W, M mu_1 ... M mu_k], or None unless In(G1) = (m, 0, k).
 
     :math:`G_1 = C^TGC` and its bound: C is nonnegative, so
@@ -717,7 +717,7 @@ def _cone_form(G1s: Array, dg: Array, V: Array, k: int) -> tuple[Array, Array, A
     return Tn, 0.5 * (Qn + Qn.T), d
 
 
-def _in_cap(basis: _Basis, V: Array, mu: Array, factor: float) -> tuple[bool, float, int | None]:
+def _in_cap(basis: Basis, V: Array, mu: Array, factor: float) -> tuple[bool, float, int | None]:
     r"""Whether every generator of cone(V) lies in the cap of the one column M mu (verified).
 
     With one column the directions z where :math:`\min_{y \le 0}` of the form is
@@ -752,7 +752,7 @@ def _in_cap(basis: _Basis, V: Array, mu: Array, factor: float) -> tuple[bool, fl
 
 
 def _piece_check(
-    basis: _Basis, V: Array, mus: list[Array], factor: float, sdp: bool
+    basis: Basis, V: Array, mus: list[Array], factor: float, sdp: bool
 ) -> tuple[bool, float, Array | None]:
     """(proven, margin, a point of cone(V) where the form is lowest when not proven).
 
@@ -850,16 +850,31 @@ COST_MODEL = {"factorisation": 0.3, "rhs_per_solve": 150.0, "pieces": 40.0, "gro
 class Sources:
     """The zone's patterns and the columns they give for one KKT point (see :func:`_sources`)."""
 
-    patterns: _Patterns
+    patterns: Patterns
     first: list[tuple[str, Array]]
     movable: list[tuple[str, Array]]
+
+
+@dataclass
+class _State:
+    """What one distance's attempt leaves to the next (:func:`split_certificate`).
+
+    Attributes:
+        columns: The columns met so far (name, oriented values on I).
+        movable: The patterns translated on demand (name, oriented values on I).
+        start: The negative space's block to restart the inverse iteration from.
+    """
+
+    columns: list[tuple[str, Array]]
+    movable: list[tuple[str, Array]]
+    start: Array | None = None
 
 
 def column_sources(
     problem: UnilateralProblem, candidate: Candidate, others: list[Candidate], opts: SplitOptions
 ) -> Sources:
     """The first columns and the patterns translated on demand (no solve)."""
-    patterns = _Patterns(problem)
+    patterns = Patterns(problem)
     first, movable = _sources(patterns, candidate, others, opts)
     return Sources(patterns, first, movable)
 
@@ -917,7 +932,7 @@ def split_certificate(
     if sources is None:
         sources = column_sources(problem, candidate, others, opts)
     patterns = sources.patterns
-    state: dict[str, Any] = {"columns": sources.first, "movable": sources.movable, "start": None}
+    state = _State(sources.first, sources.movable)
 
     def attempt(delta: float) -> SplitAttempt:
         return _attempt(problem, matrix, candidate, delta, patterns, state, opts, out)
@@ -930,7 +945,7 @@ def split_certificate(
     return out
 
 
-def _scatter_columns(problem: UnilateralProblem, items: list[tuple[str, Array]]) -> Array:
+def scatter_columns(problem: UnilateralProblem, items: list[tuple[str, Array]]) -> Array:
     """The W-vectors (owned rows) of columns given as oriented values on I."""
     vec = problem.model.A.createVecRight()
     cols = []
@@ -1005,8 +1020,8 @@ def _attempt(
     matrix: ShiftedMatrix,
     candidate: Candidate,
     delta: float,
-    patterns: _Patterns,
-    state: dict[str, Any],
+    patterns: Patterns,
+    state: _State,
     opts: SplitOptions,
     out: SplitOutcome,
 ) -> SplitAttempt:
@@ -1061,7 +1076,7 @@ def _attempt(
         pieces.append((V, level, []))
     proven = not pieces and not why
     if proven:
-        state["columns"] = _carried(basis, relax, patterns)
+        state.columns = _carried(basis, relax, patterns)
     attempt.proven, attempt.r, attempt.pieces, attempt.examined = (
         proven,
         basis.r,
@@ -1074,9 +1089,9 @@ def _attempt(
 
 def _widen(
     problem: UnilateralProblem,
-    basis: _Basis,
+    basis: Basis,
     relax: _Relaxation,
-    state: dict[str, Any],
+    state: _State,
     load: float,
     found: tuple[list[tuple[str, Array]], Refuting | None],
     out: SplitOutcome,
@@ -1093,8 +1108,8 @@ def _widen(
     items = columns[: basis.room]
     if not items:
         return None, "a direction of the negative space is not covered and no new column helps"
-    basis.add(_scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
-    state["columns"] = list(state["columns"]) + items
+    basis.add(scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
+    state.columns = list(state.columns) + items
     widened = _Relaxation.of(basis)
     widened.used |= relax.used
     return widened, ""
@@ -1110,29 +1125,29 @@ def _first_basis(
     matrix: ShiftedMatrix,
     lam: float,
     neg: int,
-    state: dict[str, Any],
+    state: _State,
     opts: SplitOptions,
-) -> tuple[_Basis | None, str]:
+) -> tuple[Basis | None, str]:
     """The negative space's block W and the columns met so far, or None and why not."""
-    space = _negative_space(problem, matrix, lam, neg, state["start"], opts.mode_iterations)
+    space = negative_space(problem, matrix, lam, neg, state.start, opts.mode_iterations)
     if space is None:
         return None, f"the {neg} pencil modes below the shift were not found"
-    psi, theta, state["start"] = space
+    psi, theta, state.start = space
     # A-normalised Ritz pairs: psi'B K^-1 B psi = 1/(theta (theta - lam)), so this scaling
     # makes G_W nearly -I (the z-space's angles then nearly Euclidean).
     W = _block_product(problem.model.B, psi) * np.sqrt(theta * (lam - theta))[None, :]
-    items = _normalised(state["columns"], [], opts.max_columns)
+    items = _normalised(state.columns, [], opts.max_columns)
     capacity = neg + min(opts.max_columns, len(items) + opts.max_rounds * opts.per_round)
-    basis = _Basis(problem, matrix, neg, capacity)
+    basis = Basis(problem, matrix, neg, capacity)
     basis.add(W, [f"W{j}" for j in range(neg)])
     gneg, _, gmargin = _inertia(basis.G, basis.E, opts.margin_factor)
     if gneg != neg or gmargin <= 1.0:
         return None, "W'K^-1W is not verified negative definite"
-    basis.add(_scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
+    basis.add(scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
     return basis, ""
 
 
-def _carried(basis: _Basis, relax: _Relaxation, patterns: _Patterns) -> list[tuple[str, Array]]:
+def _carried(basis: Basis, relax: _Relaxation, patterns: Patterns) -> list[tuple[str, Array]]:
     """The columns the next (smaller) distance starts from, after a proof here.
 
     Those the duals used here and their neighbours along the plate: the others answered
@@ -1159,7 +1174,7 @@ class _Proof:
 
 
 def _prove_piece(
-    basis: _Basis,
+    basis: Basis,
     relax: _Relaxation,
     V: Array,
     level: int,
@@ -1207,7 +1222,7 @@ def _prove_piece(
 
 
 def _together(
-    basis: _Basis, V: Array, mus: list[Array], level: int, opts: SplitOptions
+    basis: Basis, V: Array, mus: list[Array], level: int, opts: SplitOptions
 ) -> float | None:
     """The piece's margin with the combinations ``mus`` together, or None if unproven.
 
@@ -1235,10 +1250,10 @@ def _together(
 
 def _new_columns(
     problem: UnilateralProblem,
-    basis: _Basis,
+    basis: Basis,
     relax: _Relaxation,
-    patterns: _Patterns,
-    state: dict[str, Any],
+    patterns: Patterns,
+    state: _State,
     candidate: Candidate,
     uncovered: tuple[Array, Array, float],
     opts: SplitOptions,
@@ -1268,7 +1283,7 @@ def _new_columns(
         plus = np.maximum(values, 0.0)
         items: list[tuple[str, Array]] = [(f"cut{len(basis.names)}", plus)]
         scored = []
-        for name, part in state["movable"]:
+        for name, part in state.movable:
             best = None
             for k in patterns.shifts():
                 moved = patterns.translate(part, k)

@@ -119,9 +119,9 @@ def _abort(comm: Any, status: int, message: str | None) -> NoReturn:
 
 
 def _guarded_run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> tuple[int, bool]:
-    """The exit status of :func:`_run`, and whether this rank raised (it may be alone)."""
+    """The exit status of :func:`run_command`, and whether this rank raised (it may be alone)."""
     try:
-        return _run(args, rest, comm), False
+        return run_command(args, rest, comm), False
     except (KeyboardInterrupt, Exception) as err:
         outcome = Outcome.of(err)
         if outcome is Outcome.INTERRUPTED:
@@ -219,7 +219,7 @@ def _message(err: BaseException, options: Sequence[str]) -> str:
     return str(err)
 
 
-def _run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> int:
+def run_command(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> int:
     """The subcommand of ``args``, with PETSc given the single-dash options ``rest``."""
     import petsc4py
 

@@ -262,38 +262,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
 
 def solve_flags(s: argparse.ArgumentParser) -> None:
     """The ``solve`` subcommand's own flags (the solver's, and --output)."""
-    s.add_argument(
-        "--method",
-        choices=list(METHODS),
-        help="unilateral algorithm (auto: exact enumeration when 2^i <= --max-candidates "
-        "and its estimated time fits --enumeration-budget, else interior-point on thin "
-        "plates (t/b < 0.02) and active-set on thicker ones; enumerate alone = the "
-        "paper's stopping rule) " + _solver_default("method"),
-    )
-    s.add_argument(
-        "--complete",
-        action="store_true",
-        help="enumerate: visit every subset (checks the paper's monotonicity)",
-    )
-    s.add_argument(
-        "--until-proven",
-        action="store_true",
-        help="enumerate: go past the paper's stopping size p* until the interlacing bound "
-        "proves the best set optimal (exact; implied by --method auto)",
-    )
-    s.add_argument(
-        "--max-candidates",
-        type=int,
-        metavar="N",
-        help="enumerate: refuse above N candidate sets " + _solver_default("max_candidates"),
-    )
-    s.add_argument(
-        "--enumeration-budget",
-        type=float,
-        metavar="SECONDS",
-        help="auto: enumerate only if the estimated time is below this "
-        + _solver_default("enumeration_budget_s"),
-    )
+    _method_flags(s)
     s.add_argument(
         "--max-iterations",
         type=int,
@@ -347,10 +316,48 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
     )
 
 
+def _method_flags(s: argparse.ArgumentParser) -> None:
+    """The ``solve`` flags that choose the method and bound the enumeration."""
+    s.add_argument(
+        "--method",
+        choices=list(METHODS),
+        help="unilateral algorithm (auto: exact enumeration when 2^i <= --max-candidates "
+        "and its estimated time fits --enumeration-budget, else interior-point on thin "
+        "plates (t/b < 0.02) and active-set on thicker ones; enumerate alone = the "
+        "paper's stopping rule) " + _solver_default("method"),
+    )
+    s.add_argument(
+        "--complete",
+        action="store_true",
+        help="enumerate: visit every subset (checks the paper's monotonicity)",
+    )
+    s.add_argument(
+        "--until-proven",
+        action="store_true",
+        help="enumerate: go past the paper's stopping size p* until the interlacing bound "
+        "proves the best set optimal (exact; implied by --method auto)",
+    )
+    s.add_argument(
+        "--max-candidates",
+        type=int,
+        metavar="N",
+        help="enumerate: refuse above N candidate sets " + _solver_default("max_candidates"),
+    )
+    s.add_argument(
+        "--enumeration-budget",
+        type=float,
+        metavar="SECONDS",
+        help="auto: enumerate only if the estimated time is below this "
+        + _solver_default("enumeration_budget_s"),
+    )
+
+
 def nonlinear_parser(sub: Any, parents: list[Parser]) -> None:
     """The ``nonlinear`` subcommand's arguments (defaults: :class:`NonlinearOptions`)."""
     from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
+    from unibuckle_fenicsx.nonlinear.options import NonlinearOptions
 
+    defaults = NonlinearOptions()
     n = sub.add_parser(
         "nonlinear",
         parents=parents,
@@ -365,21 +372,21 @@ def nonlinear_parser(sub: Any, parents: list[Parser]) -> None:
     n.add_argument(
         "--imperfection",
         type=float,
-        default=NONLINEAR_DEFAULTS["imperfection"],
+        default=defaults.imperfection,
         metavar="DELTA",
         help="imperfection amplitude max|w0| / thickness, in (0, 1]",
     )
     n.add_argument(
         "--shape",
         choices=list(SHAPES),
-        default=NONLINEAR_DEFAULTS["shape"],
+        default=defaults.shape,
         help="imperfection shape: the linear free or unilateral mode (auto: unilateral "
         "with the obstacle, free without)",
     )
     n.add_argument(
         "--control",
         choices=list(CONTROLS),
-        default=NONLINEAR_DEFAULTS["control"],
+        default=defaults.control,
         help="load control (edge traction, adaptive steps) or displacement control (end "
         "shortening of the loaded edges; uniaxial compression only)",
     )
@@ -387,28 +394,18 @@ def nonlinear_parser(sub: Any, parents: list[Parser]) -> None:
     n.add_argument(
         "--max-load",
         type=float,
-        default=NONLINEAR_DEFAULTS["max_load"],
+        default=defaults.max_load,
         metavar="RATIO",
         help="stop at RATIO times the linear critical load, in (0, 5]",
     )
     n.add_argument(
         "--max-step",
         type=float,
-        default=NONLINEAR_DEFAULTS["max_step"],
+        default=defaults.max_step,
         metavar="FRACTION",
         help="largest load step, relative to the linear critical load",
     )
 
-
-#: The nonlinear flags' defaults: those of NonlinearOptions (its dataclass fields),
-#: repeated here so that building the parser imports no DOLFINx; a test holds them equal.
-NONLINEAR_DEFAULTS: dict[str, Any] = {
-    "imperfection": 1e-3,
-    "shape": "auto",
-    "control": "load",
-    "max_load": 1.2,
-    "max_step": 0.05,
-}
 
 #: Flags that matter only for some methods: flag -> (the methods whose options Struct
 #: reads its SolverSpec field, the field).
@@ -429,7 +426,7 @@ METHOD_FLAGS = {
 }
 
 
-def solver_changes(args: argparse.Namespace) -> tuple[dict[str, Any], list[str]]:
+def solver_changes(args: argparse.Namespace) -> tuple[dict[str, str | float | bool], list[str]]:
     """SolverSpec changes from the flags, and the method-specific flags given."""
     values = {
         "--complete": args.complete or None,
@@ -440,7 +437,7 @@ def solver_changes(args: argparse.Namespace) -> tuple[dict[str, Any], list[str]]
         "--bound-budget": args.bound_budget,
         "--penalty": args.penalty,
     }
-    changes: dict[str, Any] = {
+    changes: dict[str, str | float | bool] = {
         k: v for k, v in {"method": args.method, "tau": args.tau}.items() if v is not None
     }
     if args.no_certify:

@@ -54,6 +54,7 @@ __all__ = [
     "EigenPair",
     "GEPSolver",
     "SmallestProof",
+    "SmallestSearch",
     "extreme_eigenvalues",
     "lowest_eigenvalues",
     "swapped_eigenpairs",
@@ -156,6 +157,13 @@ class SmallestProof:
 def _is_zero(B: PETSc.Mat) -> bool:
     """Whether B has no non-zero entry (collective)."""
     return bool(B.norm(PETSc.NormType.INFINITY) == 0.0)  # type: ignore[arg-type]
+
+
+def _no_load(out: PETSc.Vec | None, iterations: int, converged: int) -> EigenPair:
+    """The pair of a pencil with no finite load: ``inf``, its vector (into ``out``) zero."""
+    if out is not None:
+        out.zeroEntries()
+    return EigenPair(float("inf"), 0.0, iterations, converged)
 
 
 #: The spectral transformation's solves must be exact: a KSP "preonly" with one of these.
@@ -322,9 +330,7 @@ class GEPSolver(Owner):
         A, B = self.reduced(np.empty(0, np.int64) if removed is None else removed)
         if _is_zero(B):
             # Every DOF carrying geometric stiffness is removed: no finite load.
-            if out is not None:
-                out.zeroEntries()
-            return EigenPair(float("inf"), 0.0, 0, 0)
+            return _no_load(out, 0, 0)
         start = initial if initial is not None and self._useful_start(initial, B) else None
         eps = self._run(A, B, start, near)
         self.solves += 1
@@ -358,9 +364,7 @@ class GEPSolver(Owner):
         nconv = eps.getConverged()
         its = eps.getIterationNumber()
         if nconv < 1 and self.indefinite and self._negligible_spectrum():
-            if out is not None:
-                out.zeroEntries()
-            return EigenPair(float("inf"), 0.0, int(its), 0)
+            return _no_load(out, int(its), 0)
         if nconv < 1:
             reason = eps.getConvergedReason()
             raise EigenSolveError(
@@ -372,9 +376,7 @@ class GEPSolver(Owner):
         if self.indefinite and self._is_roundoff(theta):
             # No eigenvalue of B x = theta A x is distinguishable from zero above it: the
             # geometric stiffness is nowhere positive on this space, no finite load.
-            if out is not None:
-                out.zeroEntries()
-            return EigenPair(float("inf"), 0.0, int(its), int(nconv))
+            return _no_load(out, int(its), int(nconv))
         value = 1.0 / theta if self.indefinite else theta
         if not np.isfinite(value) or value <= 0.0:
             raise EigenSolveError(
@@ -488,33 +490,11 @@ class GEPSolver(Owner):
     def smallest(
         self, out: PETSc.Vec | None = None, estimate: tuple[float, ...] = ()
     ) -> tuple[EigenPair, SmallestProof | None]:
-        r"""The smallest eigenpair of the whole pencil (nothing removed), with its proof.
+        """The smallest eigenpair of the whole pencil (nothing removed), with its proof.
 
-        Given ``estimate``, the lowest eigenvalues of a coarser mesh's pencil (ascending,
-        the same on every rank), the pencil is factorised once at a shift :math:`\sigma`
-        just above the lowest (:data:`FREE_ABOVE`, below the second) by the shared
-        :math:`LDL^T`, and Krylov-Schur solves at that target with it. The inertia counts
-        the eigenvalues below :math:`\sigma` (Sylvester's law) and proves the pair the
-        smallest (:class:`SmallestProof`):
-
-        - k of them (1 to :data:`FREE_MAX_BELOW`): Krylov-Schur asks for the k pairs
-          nearest :math:`\sigma` (then 2k + 1, if some lay above it); once k lie below
-          it they are every eigenvalue there (B-orthogonal vectors), and the lowest is
-          the pencil's smallest (a Ritz value below the shift lies at or below its
-          eigenvalue, Rayleigh-Ritz, so the load found is never above it);
-        - none: the pair found is the nearest above :math:`\sigma`, and one more
-          factorisation just below its eigenvalue (:data:`SMALLEST_RTOL_FACTOR` times the
-          tolerance) must show none there either.
-
-        More than :data:`FREE_MAX_BELOW` below :math:`\sigma`, or fewer pairs found below
-        it than lie there: the next shift lies below the estimate (``FREE_BELOW``)
-        and the pencil is factorised again. If no shift proves it (or nothing converges,
-        or there is no estimate) the pair comes from :meth:`solve` at target 0 (a MUMPS
+        Proven by the inertia of shifts near ``estimate`` (:class:`SmallestSearch`);
+        without an estimate, or if no shift proves it, the pair at target 0 (a MUMPS
         LU), unproven: the caller checks it (:meth:`count_below`).
-
-        The EPS takes the options under ``prefix`` (``-unibuckle_eps_tol``,
-        ``-unibuckle_eps_ncv``, ...; the Krylov subspace defaults to :data:`FREE_NCV`),
-        the factorisation those of :attr:`factorization` (``<prefix>ldl_``).
 
         Args:
             out: Vector receiving the eigenvector.
@@ -526,77 +506,14 @@ class GEPSolver(Owner):
         Note:
             Collective.
         """
-        shifts: list[float] = []
-        solves = self.solves
-        if estimate and estimate[0] > 0.0 and not _is_zero(self.B):
-            lowest = estimate[0]
-            above = FREE_ABOVE
-            if len(estimate) > 1 and estimate[1] > lowest:
-                above = min(above, FREE_GAP_SHARE * (estimate[1] / lowest - 1.0))
-            rtol = SMALLEST_RTOL_FACTOR * self.tol
-            for shift in (lowest * (1.0 + above), *(lowest * f for f in FREE_BELOW)):
-                shifts.append(shift)
-                found = self._smallest_at(shift, out, rtol, shifts)
-                if found is None:
-                    break  # nothing converged, or a lower eigenvalue was passed over
-                pair, below = found
-                if pair is not None:
-                    proof = SmallestProof(shifts[-1], below, tuple(shifts), self.solves - solves)
-                    return pair, proof
-            logger.debug("%s: no shift %s proved the smallest pair", self.prefix, shifts)
-        return self.solve(out=out), None
+        return SmallestSearch(self, estimate).run(out)
 
-    def _smallest_at(
-        self, shift: float, out: PETSc.Vec | None, rtol: float, shifts: list[float]
-    ) -> tuple[EigenPair | None, int] | None:
-        """One try of :meth:`smallest` at ``shift``: (the proven pair or None, count below).
-
-        None when the tries should stop: nothing converged, or the pencil has an
-        eigenvalue below the one found and above the shift (Krylov-Schur passed over
-        it). Collective.
-        """
+    def _free_eps(self) -> SLEPc.EPS:
+        """The smallest pair's EPS (prefix ``<prefix>``, :data:`FREE_NCV`), made on first use."""
         if self._free is None:
             self._free = self._shifted_eps(self.prefix, FREE_NCV)
             self._free_ncv = int(self._free.getDimensions()[1])
-        eps = self._free
-        below = self._shift_to(eps, self.A, self.B, shift, None)
-        if below > FREE_MAX_BELOW:
-            return None, below
-        # As many pairs as lie below the shift; then, if pairs above it lay nearer, more.
-        for wanted in (below, 2 * below + 1) if below else (1,):
-            ncv = max(self._free_ncv, 2 * wanted)
-            # mpd with ncv: left unset it keeps its first value, below ncv - nev.
-            eps.setDimensions(wanted, ncv, ncv)
-            eps.solve()
-            self.solves += 1
-            loads = [self._load(eps.getEigenvalue(k).real) for k in range(eps.getConverged())]
-            if not loads:
-                return None
-            under = [k for k, load in enumerate(loads) if load <= shift * (1.0 - rtol)]
-            if below and len(under) >= below:
-                return self._indexed_pair(eps, min(under, key=loads.__getitem__), out), below
-        if below:
-            return None, below  # pairs nearer the shift lay above it: lower the shift
-        pair = self._indexed_pair(eps, 0, out)
-        check = pair.value * (1.0 - rtol)
-        if check <= shift:
-            return pair, below  # the first inertia covers it
-        shifts.append(check)
-        if self.count_below(check) != 0:
-            return None
-        return pair, 0
-
-    def _load(self, theta: float) -> float:
-        """The load of an eigenvalue of the EPS's pencil (1/theta for the swapped one)."""
-        return 1.0 / theta if self.indefinite else theta
-
-    def _indexed_pair(self, eps: SLEPc.EPS, index: int, out: PETSc.Vec | None) -> EigenPair:
-        """Converged pair ``index`` of ``eps`` as a load (its vector into ``out``)."""
-        value = self._load(eps.getEigenvalue(index).real)
-        if out is not None:
-            eps.getEigenvector(index, out)
-        error = eps.computeError(index)
-        return EigenPair(float(value), float(error), eps.getIterationNumber(), eps.getConverged())
+        return self._free
 
     def operators_changed(self) -> None:
         """Forget the scales cached from A and B (call after changing them in place)."""
@@ -672,6 +589,123 @@ class GEPSolver(Owner):
 
     def __del__(self) -> None:
         self.destroy()
+
+
+class SmallestSearch:
+    r"""The smallest eigenpair of a :class:`GEPSolver`'s whole pencil, with its proof.
+
+    Given ``estimate``, the lowest eigenvalues of a coarser mesh's pencil (ascending,
+    the same on every rank), the pencil is factorised once at a shift :math:`\sigma`
+    just above the lowest (:data:`FREE_ABOVE`, below the second) by the shared
+    :math:`LDL^T`, and Krylov-Schur solves at that target with it. The inertia counts
+    the eigenvalues below :math:`\sigma` (Sylvester's law) and proves the pair the
+    smallest (:class:`SmallestProof`):
+
+    - k of them (1 to :data:`FREE_MAX_BELOW`): Krylov-Schur asks for the k pairs
+      nearest :math:`\sigma` (then 2k + 1, if some lay above it); once k lie below
+      it they are every eigenvalue there (B-orthogonal vectors), and the lowest is
+      the pencil's smallest (a Ritz value below the shift lies at or below its
+      eigenvalue, Rayleigh-Ritz, so the load found is never above it);
+    - none: the pair found is the nearest above :math:`\sigma`, and one more
+      factorisation just below its eigenvalue (:data:`SMALLEST_RTOL_FACTOR` times the
+      tolerance) must show none there either.
+
+    More than :data:`FREE_MAX_BELOW` below :math:`\sigma`, or fewer pairs found below
+    it than lie there: the next shift lies below the estimate (``FREE_BELOW``)
+    and the pencil is factorised again. If no shift proves it (or nothing converges,
+    or there is no estimate) the pair comes from :meth:`GEPSolver.solve` at target 0 (a
+    MUMPS LU), unproven: the caller checks it (:meth:`GEPSolver.count_below`).
+
+    The EPS (the solver's, made on first use and kept) takes the options under the
+    solver's prefix (``-unibuckle_eps_tol``, ``-unibuckle_eps_ncv``, ...; the Krylov
+    subspace defaults to :data:`FREE_NCV`), the factorisation those of
+    :attr:`GEPSolver.factorization` (``<prefix>ldl_``).
+
+    Args:
+        solver: The solver whose pencil (A, B), nothing removed, is searched.
+        estimate: Estimates of the lowest eigenvalues, ascending (empty: none).
+
+    Attributes:
+        shifts: Every shift factorised so far, in order.
+
+    Note:
+        Collective on the solver's communicator.
+    """
+
+    def __init__(self, solver: GEPSolver, estimate: tuple[float, ...]) -> None:
+        self.solver = solver
+        self.estimate = estimate
+        self.shifts: list[float] = []
+        self.rtol = SMALLEST_RTOL_FACTOR * solver.tol
+
+    def run(self, out: PETSc.Vec | None) -> tuple[EigenPair, SmallestProof | None]:
+        """The pair (its vector into ``out``) and its proof, or None for the pair at 0."""
+        solver, estimate = self.solver, self.estimate
+        solves = solver.solves
+        if estimate and estimate[0] > 0.0 and not _is_zero(solver.B):
+            lowest = estimate[0]
+            above = FREE_ABOVE
+            if len(estimate) > 1 and estimate[1] > lowest:
+                above = min(above, FREE_GAP_SHARE * (estimate[1] / lowest - 1.0))
+            for shift in (lowest * (1.0 + above), *(lowest * f for f in FREE_BELOW)):
+                self.shifts.append(shift)
+                found = self._at(shift, out)
+                if found is None:
+                    break  # nothing converged, or a lower eigenvalue was passed over
+                pair, below = found
+                if pair is not None:
+                    shifts = tuple(self.shifts)
+                    return pair, SmallestProof(shifts[-1], below, shifts, solver.solves - solves)
+            logger.debug("%s: no shift %s proved the smallest pair", solver.prefix, self.shifts)
+        return solver.solve(out=out), None
+
+    def _at(self, shift: float, out: PETSc.Vec | None) -> tuple[EigenPair | None, int] | None:
+        """One try at ``shift``: (the proven pair or None, count below).
+
+        None when the tries should stop: nothing converged, or the pencil has an
+        eigenvalue below the one found and above the shift (Krylov-Schur passed over
+        it). Collective.
+        """
+        solver, rtol = self.solver, self.rtol
+        eps = solver._free_eps()
+        below = solver._shift_to(eps, solver.A, solver.B, shift, None)
+        if below > FREE_MAX_BELOW:
+            return None, below
+        # As many pairs as lie below the shift; then, if pairs above it lay nearer, more.
+        for wanted in (below, 2 * below + 1) if below else (1,):
+            ncv = max(solver._free_ncv, 2 * wanted)
+            # mpd with ncv: left unset it keeps its first value, below ncv - nev.
+            eps.setDimensions(wanted, ncv, ncv)
+            eps.solve()
+            solver.solves += 1
+            loads = [self._load(eps.getEigenvalue(k).real) for k in range(eps.getConverged())]
+            if not loads:
+                return None
+            under = [k for k, load in enumerate(loads) if load <= shift * (1.0 - rtol)]
+            if below and len(under) >= below:
+                return self._indexed_pair(eps, min(under, key=loads.__getitem__), out), below
+        if below:
+            return None, below  # pairs nearer the shift lay above it: lower the shift
+        pair = self._indexed_pair(eps, 0, out)
+        check = pair.value * (1.0 - rtol)
+        if check <= shift:
+            return pair, below  # the first inertia covers it
+        self.shifts.append(check)
+        if solver.count_below(check) != 0:
+            return None
+        return pair, 0
+
+    def _load(self, theta: float) -> float:
+        """The load of an eigenvalue of the EPS's pencil (1/theta for the swapped one)."""
+        return 1.0 / theta if self.solver.indefinite else theta
+
+    def _indexed_pair(self, eps: SLEPc.EPS, index: int, out: PETSc.Vec | None) -> EigenPair:
+        """Converged pair ``index`` of ``eps`` as a load (its vector into ``out``)."""
+        value = self._load(eps.getEigenvalue(index).real)
+        if out is not None:
+            eps.getEigenvector(index, out)
+        error = eps.computeError(index)
+        return EigenPair(float(value), float(error), eps.getIterationNumber(), eps.getConverged())
 
 
 def swapped_eigenpairs(

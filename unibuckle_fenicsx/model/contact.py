@@ -307,16 +307,7 @@ class ContactSetManager:
             np.concatenate(comm.allgather(springs))[order] if tensionless else None
         )
         if self.coordinates.shape[0] == 0:
-            nx = model.mesh.topology.index_map(0).size_global
-            zones = "; ".join(o.describe() for o in self.obstacles)
-            named = "/".join(dict.fromkeys(o.zone_key for o in self.obstacles))
-            raise EmptyZoneError(
-                f"obstacle.{named} {zones} holds no free mesh node ({self.num_edge_fixed} "
-                f"zone nodes are held by supports: edges or bilateral points; the mesh has "
-                f"{nx} vertices, cells "
-                f"up to {self._spacing():.3g} m across their diagonal): enlarge the zone or "
-                "refine the mesh"
-            )
+            raise self._empty_zone()
         offset = int(sum(len(g) for g in gathered[: comm.rank]))
         rank_pos = np.empty(len(order), dtype=np.int64)
         rank_pos[order] = np.arange(len(order), dtype=np.int64)
@@ -327,6 +318,19 @@ class ContactSetManager:
     def obstacle(self) -> ObstacleSpec:
         """The first obstacle (the only one for a problem with one ``[obstacle]``)."""
         return self.obstacles[0]
+
+    def _empty_zone(self) -> EmptyZoneError:
+        """The error for zones that hold no free mesh node (collective: the cell size)."""
+        nx = self.model.mesh.topology.index_map(0).size_global
+        zones = "; ".join(o.describe() for o in self.obstacles)
+        named = "/".join(dict.fromkeys(o.zone_key for o in self.obstacles))
+        return EmptyZoneError(
+            f"obstacle.{named} {zones} holds no free mesh node ({self.num_edge_fixed} "
+            f"zone nodes are held by supports: edges or bilateral points; the mesh has "
+            f"{nx} vertices, cells "
+            f"up to {self._spacing():.3g} m across their diagonal): enlarge the zone or "
+            "refine the mesh"
+        )
 
     def _spacing(self) -> float:
         msh = self.model.mesh

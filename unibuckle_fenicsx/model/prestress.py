@@ -345,11 +345,11 @@ def _solve_membrane(
         # sweep's repeated points). A user's mesh is checked every time: its tags decide
         # where the loads act. Decided on every rank alike (the check is collective).
         key = repr((plate, loaded))
-        known = plate_mesh and msh.comm.allreduce(key in _EQUILIBRATED, op=MPI.LAND)
+        known = plate_mesh and msh.comm.allreduce(key in EQUILIBRATED, op=MPI.LAND)
         if loaded and not known:
-            _check_self_equilibrated(msh, facet_tags, ds, plate, loaded)
+            check_self_equilibrated(msh, facet_tags, ds, plate, loaded)
             if plate_mesh:
-                _EQUILIBRATED.add(key)
+                EQUILIBRATED.add(key)
         bcs = pin_rigid_motions(V, msh)
 
     problem = dolfinx.fem.petsc.LinearProblem(
@@ -448,10 +448,10 @@ def _discretisation_noise(
 
 
 #: The plates (and loaded edges) whose loads were found self-equilibrated in this process.
-_EQUILIBRATED: set[str] = set()
+EQUILIBRATED: set[str] = set()
 
 
-def _check_self_equilibrated(
+def check_self_equilibrated(
     msh: dolfinx.mesh.Mesh,
     facet_tags: dolfinx.mesh.MeshTags,
     ds: ufl.Measure,

@@ -5,7 +5,8 @@
 :mod:`~unibuckle_fenicsx.nonlinear.imperfection`: the imperfection;
 :mod:`~unibuckle_fenicsx.nonlinear.path`: load stepping;
 :mod:`~unibuckle_fenicsx.nonlinear.estimators`: Southwell and inflection loads;
-:mod:`~unibuckle_fenicsx.nonlinear.choices`: the named choices). Importing this package
+:mod:`~unibuckle_fenicsx.nonlinear.choices`: the named choices;
+:mod:`~unibuckle_fenicsx.nonlinear.options`: the options). Importing this package
 is cheap: the names below load their module (and DOLFINx, PETSc) on first use.
 """
 
@@ -21,7 +22,7 @@ _HOMES = {
     "southwell_window": "estimators",
     "VonKarmanPlate": "model",
     "NonlinearAnalysis": "path",
-    "NonlinearOptions": "path",
+    "NonlinearOptions": "options",
     "NonlinearResult": "path",
     "PathPoint": "path",
     "solve_nonlinear": "path",

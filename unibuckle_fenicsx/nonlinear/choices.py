@@ -2,10 +2,17 @@
 
 from __future__ import annotations
 
-__all__ = ["CONTROLS", "SHAPES"]
+import typing
+from typing import Literal
+
+__all__ = ["CONTROLS", "SHAPES", "Control", "Shape"]
 
 #: Path controls: the edge load, or the end shortening of the loaded edges.
-CONTROLS = ("load", "displacement")
+Control = Literal["load", "displacement"]
 #: Imperfection shapes: the linear free mode, the unilateral mode, or "auto" (the
 #: unilateral mode with the obstacle, the free mode without).
-SHAPES = ("auto", "free", "unilateral")
+Shape = Literal["auto", "free", "unilateral"]
+#: The names of :data:`Control`'s choices.
+CONTROLS: tuple[str, ...] = typing.get_args(Control)
+#: The names of :data:`Shape`'s choices.
+SHAPES: tuple[str, ...] = typing.get_args(Shape)

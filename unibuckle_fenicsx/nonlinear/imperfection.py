@@ -18,6 +18,7 @@ import ufl
 from unibuckle_fenicsx.analysis import Analysis
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.options import Prefix, set_options
+from unibuckle_fenicsx.model.contact import ContactSetManager
 from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
 from unibuckle_fenicsx.nonlinear.model import THETA_SUB, VonKarmanPlate
 
@@ -119,54 +120,81 @@ def imperfection_shape(
         Collective.
     """
     problem = linear.problem
-    contact = problem.contact if obstacle and isinstance(problem, UnilateralProblem) else None
-    name = shape if shape != "auto" else ("unilateral" if contact is not None else "free")
-    if name == "unilateral" and (contact is None or linear.solution is None):
+    if not (obstacle and isinstance(problem, UnilateralProblem)):
+        if shape == "unilateral":
+            raise InputError('shape = "unilateral" needs a problem with its obstacle')
+        out = dolfinx.fem.Function(problem.model.W, name="imperfection_shape")
+        out.x.array[:] = linear.free_mode.x.array
+        out.x.array[:] *= _orientation(problem, out)
+        return out, "free"
+    name = "unilateral" if shape == "auto" else shape
+    if name == "unilateral" and linear.solution is None:
         raise InputError('shape = "unilateral" needs a problem with its obstacle')
     out = dolfinx.fem.Function(problem.model.W, name="imperfection_shape")
     if name == "unilateral":
         out.x.array[:] = linear.mode.x.array  # oriented: w <= 0 in the zone
     else:
         out.x.array[:] = linear.free_mode.x.array
-        if contact is not None:
-            values = contact.values(out.x.petsc_vec)
-            if -values.min() < values.max():  # the sign with the lower max over the zone
-                out.x.array[:] *= -1.0
-                values = -values
-            if values.max() > 0.0:
-                raise InputError(
-                    'shape = "free": the free mode crosses the obstacle whichever its sign '
-                    f"(w > 0 at {int((values > 0).sum())} of the {contact.size} zone nodes); "
-                    'use shape = "unilateral"'
-                )
-        else:
-            out.x.array[:] *= _orientation(problem, out)
-    if contact is not None:
-        sides = {float(v) for v in contact.signs}
-        if len(sides) != 1:
-            raise InputError(
-                "the nonlinear analysis pushes the imperfection off the obstacles by a uniform "
-                "pressure: it needs every obstacle on one side of the plate (all above or all "
-                "below)"
-            )
-        p = _pressure_shape(problem, sides.pop())
-        out.x.petsc_vec.axpy(PUSH_OFF, p.x.petsc_vec)
-        out.x.scatter_forward()
-        out.x.petsc_vec.scale(1.0 / problem.max_abs_w(out.x.petsc_vec))
-        out.x.scatter_forward()
-        worst = float(contact.values(out.x.petsc_vec).max())
-        if worst >= 0.0:
-            raise InputError(
-                f'the imperfection shape "{name}" touches the obstacle (w = {worst:.3g} '
-                "max|w| at a zone node after the push-off)"
-            )
+        _orient_off(problem.contact, out)
+    _push_off(problem, out, name)
     return out, name
+
+
+def _orient_off(contact: ContactSetManager, out: dolfinx.fem.Function) -> None:
+    """Give the free mode ``out`` the sign with the lower max over the zone, in place.
+
+    Raises:
+        InputError: It crosses the obstacle whichever its sign.
+
+    Note:
+        Collective.
+    """
+    values = contact.values(out.x.petsc_vec)
+    if -values.min() < values.max():  # the sign with the lower max over the zone
+        out.x.array[:] *= -1.0
+        values = -values
+    if values.max() > 0.0:
+        raise InputError(
+            'shape = "free": the free mode crosses the obstacle whichever its sign '
+            f"(w > 0 at {int((values > 0).sum())} of the {contact.size} zone nodes); "
+            'use shape = "unilateral"'
+        )
+
+
+def _push_off(problem: UnilateralProblem, out: dolfinx.fem.Function, name: str) -> None:
+    """Push the shape ``out`` off the obstacles (:data:`PUSH_OFF`), max |w| = 1, in place.
+
+    Raises:
+        InputError: Obstacles on both sides, or the shape still touches one.
+
+    Note:
+        Collective.
+    """
+    contact = problem.contact
+    sides = {float(v) for v in contact.signs}
+    if len(sides) != 1:
+        raise InputError(
+            "the nonlinear analysis pushes the imperfection off the obstacles by a uniform "
+            "pressure: it needs every obstacle on one side of the plate (all above or all "
+            "below)"
+        )
+    p = _pressure_shape(problem, sides.pop())
+    out.x.petsc_vec.axpy(PUSH_OFF, p.x.petsc_vec)
+    out.x.scatter_forward()
+    out.x.petsc_vec.scale(1.0 / problem.max_abs_w(out.x.petsc_vec))
+    out.x.scatter_forward()
+    worst = float(contact.values(out.x.petsc_vec).max())
+    if worst >= 0.0:
+        raise InputError(
+            f'the imperfection shape "{name}" touches the obstacle (w = {worst:.3g} '
+            "max|w| at a zone node after the push-off)"
+        )
 
 
 def check_gaps(plate: VonKarmanPlate, imperfection: float) -> None:
     """Refuse an imperfection that reaches an obstacle across its gap (collective)."""
-    if plate.contact is None or not plate.contact.gaps.any():
-        return
+    if not plate.contact.gaps.any():
+        return  # no gap, or no obstacle
     clearance = plate.zone_clearance(plate.x0)
     gapped = plate.contact.gaps > 0
     if clearance[gapped].max() >= 0.0:

@@ -82,9 +82,11 @@ from unibuckle_fenicsx.spec import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
 __all__ = [
     "CONTROLS",
     "SNES_OPTIONS",
+    "NoZone",
     "StepReport",
     "VonKarmanPlate",
     "displacement_axis",
+    "membrane_strain",
 ]
 
 #: Default SNES options (prefix ``unibuckle_nl_``): Newton with MUMPS LU; the VI type is
@@ -164,6 +166,192 @@ def _scalar(form: dolfinx.fem.Form, comm: MPI.Comm) -> float:
     return float(comm.allreduce(dolfinx.fem.assemble_scalar(form), op=MPI.SUM))
 
 
+def _inplane_bcs(
+    W: dolfinx.fem.FunctionSpace,
+    facet_tags: dolfinx.mesh.MeshTags,
+    plate: PlateSpec,
+    axis: int | None,
+) -> tuple[list[dolfinx.fem.DirichletBC], list[tuple[dolfinx.fem.Constant, float]]]:
+    """In-plane edge conditions, prescribed shortening, and rigid-motion pins.
+
+    Args:
+        W: The mixed space (u, w, theta).
+        facet_tags: Edge markers of its mesh.
+        plate: The plate (its edges' in-plane conditions and loads).
+        axis: Axis of the end shortening (:func:`displacement_axis`; None under load
+            control).
+
+    Returns:
+        The conditions, and per loaded edge under end shortening the constant of its
+        prescribed normal displacement and its factor (shortening per unit value).
+    """
+    msh = W.mesh
+    fdim = msh.topology.dim - 1
+    U = W.sub(U_SUB)
+    bcs: list[dolfinx.fem.DirichletBC] = []
+    edge_values: list[tuple[dolfinx.fem.Constant, float]] = []
+    held = {0: False, 1: False}  # a component held along an edge (no translation)
+
+    def fix(
+        edge: EdgeSpec, c: int, value: float | dolfinx.fem.Constant, tag: int | None = None
+    ) -> None:
+        Vc, _ = U.sub(c).collapse()
+        tags = edge_tags(plate, edge) if tag is None else (tag,)
+        facets = edge_facets(facet_tags, tags)
+        dofs = dolfinx.fem.locate_dofs_topological((U.sub(c), Vc), fdim, facets)
+        bcs.append(dolfinx.fem.dirichletbc(value, dofs[0], U.sub(c)))
+
+    loaded = [e for e in plate.edges if e.loaded]
+    for e in plate.edges:
+        if axis is not None and e.loaded:
+            # u . n = -shortening per loaded edge (outward normal +-axis).
+            sign = 1.0 if e.name in ("right", "top") else -1.0
+            value = dolfinx.fem.Constant(msh, 0.0)
+            edge_values.append((value, -sign / len(loaded)))
+            fix(e, axis, value)
+            held[axis] = True
+            continue
+        if e.inplane == "free":
+            continue
+        for tag in edge_tags(plate, e):
+            components: tuple[int, ...] = (0, 1)
+            if e.inplane == "roller":
+                components = (edge_normal_axis(msh, facet_tags, tag, e.name),)
+            for c in components:
+                fix(e, c, 0.0, tag)
+                held[c] = True
+    if axis is None and not bcs:
+        bcs += pin_rigid_motions(U, msh)
+    elif axis is not None and not held[1 - axis]:
+        bcs += pin_rigid_motions(U, msh, only=1 - axis)
+    return bcs, edge_values
+
+
+def membrane_strain(
+    u: ufl.core.expr.Expr, w: ufl.core.expr.Expr, w0: ufl.core.expr.Expr
+) -> ufl.core.expr.Expr:
+    r"""Von Kármán's membrane strain from the stress-free imperfect shape ``w0`` (m).
+
+    :math:`e = \mathrm{sym}\nabla u + \tfrac12(\nabla w\otimes\nabla w
+    - \nabla w_0\otimes\nabla w_0)` (the module docstring).
+    """
+    return ufl.sym(ufl.grad(u)) + 0.5 * (
+        ufl.outer(ufl.grad(w), ufl.grad(w)) - ufl.outer(ufl.grad(w0), ufl.grad(w0))
+    )
+
+
+def _norms(form: dolfinx.fem.Form) -> tuple[float, float]:
+    """The 2-norm and the largest entry of the assembled vector of ``form`` (collective)."""
+    f = dolfinx.fem.petsc.assemble_vector(form)
+    _add_ghosts(f)
+    norms = float(f.norm()), float(f.norm(PETSc.NormType.INFINITY))  # type: ignore[arg-type]
+    f.destroy()
+    return norms
+
+
+def _edge_forms(
+    x: dolfinx.fem.Function, plate: PlateSpec, loaded: list[EdgeSpec], ds: ufl.Measure, t: float
+) -> list[tuple[dolfinx.fem.Form, float, EdgeSpec]]:
+    """Per loaded edge: the form of its normal displacement's integral (m²), its length, itself.
+
+    The end shortening is minus the mean normal displacement, summed over the loaded
+    edges. Collective (the lengths).
+    """
+    msh = x.function_space.mesh
+    n = ufl.FacetNormal(msh)
+    return [
+        (
+            dolfinx.fem.form(t * ufl.inner(ufl.split(x)[U_SUB], n) * ds(edge_tags(plate, e))),
+            _scalar(dolfinx.fem.form(1.0 * ds(edge_tags(plate, e))), msh.comm),
+            e,
+        )
+        for e in loaded
+    ]
+
+
+class NoZone:
+    """The zone of a plate without obstacle: no node.
+
+    A :class:`~unibuckle_fenicsx.model.contact.ContactSetManager` of no node, so that a
+    plate's ``contact`` is never None.
+
+    Attributes:
+        size: 0.
+        coordinates: (0, 2).
+        signs: (0,).
+        gaps: (0,).
+    """
+
+    size = 0
+
+    def __init__(self) -> None:
+        self.coordinates: npt.NDArray[np.float64] = np.empty((0, 2))
+        self.signs: npt.NDArray[np.float64] = np.empty(0)
+        self.gaps: npt.NDArray[np.float64] = np.empty(0)
+
+    def values(self, u: PETSc.Vec) -> npt.NDArray[np.float64]:
+        """No entry (as ``ContactSetManager.values``)."""
+        return np.empty(0)
+
+    def scatter(self, values: npt.NDArray[np.float64], u: PETSc.Vec) -> PETSc.Vec:
+        """``u`` set to zero (as ``ContactSetManager.scatter``)."""
+        u.zeroEntries()
+        return u
+
+    def global_rows(self) -> npt.NDArray[np.int64]:
+        """No row (as ``ContactSetManager.global_rows``)."""
+        return np.empty(0, dtype=np.int64)
+
+
+def _bounds(
+    contact: ContactSetManager, template: PETSc.Vec, t: float
+) -> tuple[PETSc.Vec, PETSc.Vec]:
+    """The SNES VI's lower and upper bounds of the scaled state: the obstacles' only.
+
+    Obstacle above: w <= g (upper bound); below: w >= -g (lower bound); w/t here; every
+    other bound infinite. The caller destroys both vectors. Collective.
+    """
+    lower, upper = template.duplicate(), template.duplicate()
+    lower.set(PETSc.NINFINITY)
+    upper.set(PETSc.INFINITY)
+    rows = contact.global_rows()
+    lo, hi = upper.getOwnershipRange()
+    mine = (rows >= lo) & (rows < hi)
+    above = mine & (contact.signs > 0)
+    below = mine & (contact.signs < 0)
+    upper.array[rows[above] - lo] = contact.gaps[above] / t
+    lower.array[rows[below] - lo] = -contact.gaps[below] / t
+    return lower, upper
+
+
+def _add_to_diagonal(
+    K: PETSc.Mat | None,
+    rows: npt.NDArray[np.int64],
+    values: npt.NDArray[np.float64],
+    n_owned: int,
+    comm: MPI.Comm,
+) -> PETSc.Mat:
+    """``K`` plus ``values`` on the diagonal at the global ``rows`` (assembled).
+
+    ``K`` None: a new diagonal matrix of ``n_owned`` rows per rank, which the caller
+    destroys. Collective.
+    """
+    if K is None:
+        K = PETSc.Mat().createAIJ(
+            ((n_owned, None), (n_owned, None)),  # type: ignore[arg-type]
+            nnz=1,
+            comm=comm,  # type: ignore[arg-type]
+        )
+        lo, hi = K.getOwnershipRange()
+        for r in range(lo, hi):
+            K.setValue(r, r, 0.0)
+    K.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)  # type: ignore[arg-type]
+    for r, k in zip(rows.tolist(), values.tolist(), strict=True):
+        K.setValue(r, r, k, addv=True)
+    K.assemble()
+    return K
+
+
 class VonKarmanPlate(MixedDofs, Owner):
     r"""Geometrically nonlinear (von Kármán) plate with the linear model's edges and loads.
 
@@ -183,7 +371,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         x: The current state :math:`(u/t, w/t, \theta)` (scaled, see the module note).
         x0: The imperfect, stress-free shape :math:`(0, w_0/t, \theta_0)`.
         load: :math:`\lambda` (Pa) under load control.
-        contact: The zone's nodes (None without obstacle).
+        contact: The zone's nodes (a :class:`NoZone` without obstacle).
 
     Note:
         Construction, :meth:`solve` and :meth:`destroy` are collective.
@@ -221,15 +409,19 @@ class VonKarmanPlate(MixedDofs, Owner):
         self.mesh, self.facet_tags = mesh, facet_tags
         self.comm = mesh.comm
         self._spaces(degree)
-        self._edge_values: list[tuple[dolfinx.fem.Constant, float]] = []
-        self.bcs = self.bending_bcs + self._inplane_bcs()
+        inplane, self._edge_values = _inplane_bcs(
+            self.W, self.facet_tags, self.plate, self._displacement_axis
+        )
+        self.bcs = self.bending_bcs + inplane
         self.x = dolfinx.fem.Function(self.W, name="state")
         self.x0 = dolfinx.fem.Function(self.W, name="imperfection")
         self.load = dolfinx.fem.Constant(mesh, 0.0)
         ks = self._forms(loaded)
         self._matrices(ks)
-        self.contact = (
-            ContactSetManager(self, spec.all_obstacles) if obstacle and spec.all_obstacles else None
+        self.contact: ContactSetManager | NoZone = (
+            ContactSetManager(self, spec.all_obstacles)
+            if obstacle and spec.all_obstacles
+            else NoZone()
         )
         self.snes: PETSc.SNES | None = self._snes(snes_options)
 
@@ -276,9 +468,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         u_h, w_h, theta_h = ufl.split(self.x)
         _, w0_h, theta0_h = ufl.split(self.x0)
         u, w, w0 = t * u_h, t * w_h, t * w0_h
-        e = ufl.sym(ufl.grad(u)) + 0.5 * (
-            ufl.outer(ufl.grad(w), ufl.grad(w)) - ufl.outer(ufl.grad(w0), ufl.grad(w0))
-        )
+        e = membrane_strain(u, w, w0)
         kappa = ufl.sym(ufl.grad(theta_h - theta0_h))
         energy = 0.5 * ufl.inner(voigt_to_ufl(Cm, e), e) + 0.5 * ufl.inner(
             voigt_to_ufl(D, kappa), kappa
@@ -293,7 +483,6 @@ class VonKarmanPlate(MixedDofs, Owner):
         if springs is not None:
             Pi = Pi + (0.5 / self.energy_scale) * springs
         ds = ufl.Measure("ds", domain=msh, subdomain_data=self.facet_tags)
-        n = ufl.FacetNormal(msh)
         tractions = [
             (edge_traction(msh, self.facet_tags, self.plate, e, tag), tag)
             for e in loaded
@@ -308,28 +497,13 @@ class VonKarmanPlate(MixedDofs, Owner):
             (t / self.energy_scale) * ufl.inner(traction, ufl.split(v)[U_SUB]) * ds(tag)
             for traction, tag in tractions
         )
-        f = dolfinx.fem.petsc.assemble_vector(dolfinx.fem.form(unit_load))
-        _add_ghosts(f)
-        #: 2-norm of the scaled load vector per unit lambda (Pa).
-        self.unit_load_norm = float(f.norm())  # type: ignore[arg-type]
-        #: Its largest entry.
-        self.unit_load_inf = float(f.norm(PETSc.NormType.INFINITY))  # type: ignore[arg-type]
-        f.destroy()
+        #: The 2-norm and the largest entry of the scaled load vector per unit lambda (Pa).
+        self.unit_load_norm, self.unit_load_inf = _norms(dolfinx.fem.form(unit_load))
         F = ufl.derivative(Pi, self.x, v)
         J = ufl.derivative(F, self.x, dx_)
         self.F_form = dolfinx.fem.form(F)
         self.J_form = dolfinx.fem.form(J)
-        # End shortening: -(mean normal displacement) summed over the loaded edges.
-        self._edge_forms = [
-            (
-                dolfinx.fem.form(
-                    t * ufl.inner(ufl.split(self.x)[U_SUB], n) * ds(edge_tags(self.plate, e))
-                ),
-                _scalar(dolfinx.fem.form(1.0 * ds(edge_tags(self.plate, e))), self.comm),
-                e,
-            )
-            for e in loaded
-        ]
+        self._edge_forms = _edge_forms(self.x, self.plate, loaded, ds, t)
         return ks
 
     def _matrices(self, ks: float | npt.NDArray[np.float64]) -> None:
@@ -361,27 +535,15 @@ class VonKarmanPlate(MixedDofs, Owner):
         xs = self._xs
         if xs is None:
             raise RuntimeError("_snes: the work vectors come first (an internal invariant)")
-        t = self.thickness
         snes = PETSc.SNES().create(self.comm)
-        snes.setFunction(self._residual, self.b)
+        snes.setFunction(self.residual, self.b)
         snes.setJacobian(self._jacobian, self.J)
         options = dict(SNES_OPTIONS if snes_options is None else snes_options)
         self._lower: PETSc.Vec | None = None
         self._upper: PETSc.Vec | None = None
-        if self.contact is not None:
+        if isinstance(self.contact, ContactSetManager):
             options.setdefault("snes_type", "vinewtonrsls")
-            self._lower = xs.duplicate()
-            self._upper = xs.duplicate()
-            self._lower.set(PETSc.NINFINITY)
-            self._upper.set(PETSc.INFINITY)
-            # Obstacle above: w <= g (upper bound); below: w >= -g (lower bound); w/t here.
-            rows = self.contact.global_rows()
-            lo, hi = self._upper.getOwnershipRange()
-            mine = (rows >= lo) & (rows < hi)
-            above = mine & (self.contact.signs > 0)
-            below = mine & (self.contact.signs < 0)
-            self._upper.array[rows[above] - lo] = self.contact.gaps[above] / t
-            self._lower.array[rows[below] - lo] = -self.contact.gaps[below] / t
+            self._lower, self._upper = _bounds(self.contact, xs, self.thickness)
             snes.setVariableBounds(self._lower, self._upper)
         else:
             options.setdefault("snes_type", "newtonls")
@@ -389,49 +551,6 @@ class VonKarmanPlate(MixedDofs, Owner):
         return snes
 
     # -- set-up helpers ------------------------------------------------------------
-    def _inplane_bcs(self) -> list[dolfinx.fem.DirichletBC]:
-        """In-plane edge conditions, prescribed shortening, and rigid-motion pins."""
-        msh, W, plate = self.mesh, self.W, self.plate
-        fdim = msh.topology.dim - 1
-        U = W.sub(U_SUB)
-        bcs: list[dolfinx.fem.DirichletBC] = []
-        held = {0: False, 1: False}  # a component held along an edge (no translation)
-
-        def fix(
-            edge: EdgeSpec, c: int, value: float | dolfinx.fem.Constant, tag: int | None = None
-        ) -> None:
-            Vc, _ = U.sub(c).collapse()
-            tags = edge_tags(plate, edge) if tag is None else (tag,)
-            facets = edge_facets(self.facet_tags, tags)
-            dofs = dolfinx.fem.locate_dofs_topological((U.sub(c), Vc), fdim, facets)
-            bcs.append(dolfinx.fem.dirichletbc(value, dofs[0], U.sub(c)))
-
-        axis = self._displacement_axis
-        loaded = [e for e in plate.edges if e.loaded]
-        for e in plate.edges:
-            if axis is not None and e.loaded:
-                # u . n = -shortening per loaded edge (outward normal +-axis).
-                sign = 1.0 if e.name in ("right", "top") else -1.0
-                value = dolfinx.fem.Constant(msh, 0.0)
-                self._edge_values.append((value, -sign / len(loaded)))
-                fix(e, axis, value)
-                held[axis] = True
-                continue
-            if e.inplane == "free":
-                continue
-            for tag in edge_tags(plate, e):
-                components: tuple[int, ...] = (0, 1)
-                if e.inplane == "roller":
-                    components = (edge_normal_axis(msh, self.facet_tags, tag, e.name),)
-                for c in components:
-                    fix(e, c, 0.0, tag)
-                    held[c] = True
-        if axis is None and not bcs:
-            bcs += pin_rigid_motions(U, msh)
-        elif axis is not None and not held[1 - axis]:
-            bcs += pin_rigid_motions(U, msh, only=1 - axis)
-        return bcs
-
     def _add_point_springs(self, t: float) -> None:
         """Spring points: k_p t^2 / D11 on the diagonal of K_s (the quadratic part, about x0)."""
         if not any(g.spec.kind == "spring" for g in self.points):
@@ -440,20 +559,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         keep = ~np.isin(local, self.bc_dofs)
         rows = self.global_dofs(local[keep])
         stiffness = stiffness[keep] * t**2 / self.energy_scale
-        if self.Ks is None:
-            n = self.num_owned_dofs
-            self.Ks = PETSc.Mat().createAIJ(
-                ((n, None), (n, None)),  # type: ignore[arg-type]
-                nnz=1,
-                comm=self.comm,
-            )
-            lo, hi = self.Ks.getOwnershipRange()
-            for r in range(lo, hi):
-                self.Ks.setValue(r, r, 0.0)
-        self.Ks.setOption(PETSc.Mat.Option.NEW_NONZERO_ALLOCATION_ERR, False)  # type: ignore[arg-type]
-        for r, k in zip(rows.tolist(), stiffness.tolist(), strict=True):
-            self.Ks.setValue(r, r, k, addv=True)
-        self.Ks.assemble()
+        self.Ks = _add_to_diagonal(self.Ks, rows, stiffness, self.num_owned_dofs, self.comm)
 
     # -- PlateDofs (for ContactSetManager) -------------------------------------------
     @property
@@ -478,7 +584,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         x.array[:] = self.x.x.array[: self.num_owned_dofs]
         _update_ghosts(x)
 
-    def _residual(self, _snes: PETSc.SNES | None, x: PETSc.Vec, b: PETSc.Vec) -> None:
+    def residual(self, _snes: PETSc.SNES | None, x: PETSc.Vec, b: PETSc.Vec) -> None:
         """SNES function: the scaled residual F(x) with the edge conditions lifted."""
         self._assign(x)
         with b.localForm() as local:
@@ -489,7 +595,7 @@ class VonKarmanPlate(MixedDofs, Owner):
         if self.Ks is not None:
             if self._d is None or self._Kd is None:
                 raise RuntimeError(
-                    "_residual: expected self._d is not None and self._Kd is not None (an "
+                    "residual: expected self._d is not None and self._Kd is not None (an "
                     "internal invariant)"
                 )
             x.copy(self._d)
@@ -526,13 +632,8 @@ class VonKarmanPlate(MixedDofs, Owner):
 
     def project(self) -> None:
         """Clip the state onto the obstacles (w <= 0 above, >= 0 below); not collective."""
-        if self.contact is None:
-            return
         if self._upper is None or self._lower is None:
-            raise RuntimeError(
-                "project: expected self._upper is not None and self._lower is not None (an "
-                "internal invariant)"
-            )
+            return  # no obstacle (or destroyed)
         arr = self.x.x.petsc_vec.array
         np.minimum(arr, self._upper.array, out=arr)
         np.maximum(arr, self._lower.array, out=arr)
@@ -570,14 +671,10 @@ class VonKarmanPlate(MixedDofs, Owner):
 
     def zone_deflection(self) -> npt.NDArray[np.float64]:
         """Deflection (m) towards the obstacles at the zone nodes, s_k w_k (empty without one)."""
-        if self.contact is None:
-            return np.empty(0)
         return self.thickness * self.contact.values(self.x.x.petsc_vec)
 
     def zone_clearance(self, x: dolfinx.fem.Function | None = None) -> npt.NDArray[np.float64]:
         """s_k w_k - g_k (m) at the zone nodes: <= 0 admissible, 0 on the obstacle."""
-        if self.contact is None:
-            return np.empty(0)
         x = self.x if x is None else x
         return self.thickness * self.contact.values(x.x.petsc_vec) - self.contact.gaps
 
@@ -603,7 +700,7 @@ class VonKarmanPlate(MixedDofs, Owner):
                 "internal invariant)"
             )
         self._to_vector(self._xs)
-        self._residual(None, self._xs, self.b)
+        self.residual(None, self._xs, self.b)
         dolfinx.fem.petsc.set_bc(self.b, self.bcs, alpha=0.0)
         return self.b
 

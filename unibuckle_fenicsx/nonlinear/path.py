@@ -16,7 +16,7 @@ from __future__ import annotations
 import logging
 import time
 from dataclasses import asdict, dataclass, field
-from typing import Any
+from typing import NotRequired, TypedDict
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -33,8 +33,9 @@ from unibuckle_fenicsx.analysis import solve as solve_linear
 from unibuckle_fenicsx.errors import InputError, NonlinearError, NumericalError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.la.ownership import Owner
+from unibuckle_fenicsx.model.contact import ContactSetManager
 from unibuckle_fenicsx.model.problem import UnilateralProblem
-from unibuckle_fenicsx.nonlinear.choices import CONTROLS, SHAPES
+from unibuckle_fenicsx.nonlinear.choices import SHAPES
 from unibuckle_fenicsx.nonlinear.estimators import (
     inflection_load,
     southwell_load,
@@ -49,11 +50,12 @@ from unibuckle_fenicsx.nonlinear.model import (
     VonKarmanPlate,
     displacement_axis,
 )
+from unibuckle_fenicsx.nonlinear.options import NonlinearOptions
 from unibuckle_fenicsx.nonlinear.verdict import judge
 from unibuckle_fenicsx.progress import LOGGER
 from unibuckle_fenicsx.results.assemble import versions
 from unibuckle_fenicsx.results.records import BucklingResult
-from unibuckle_fenicsx.spec import UNITS, ProblemSpec, _boolean, _choice, _integer, _number
+from unibuckle_fenicsx.spec import UNITS, ProblemSpec
 from unibuckle_fenicsx.tolerances import NONLINEAR_ATOL
 
 __all__ = [
@@ -68,70 +70,8 @@ __all__ = [
 logger = logging.getLogger(__name__)
 
 
-@dataclass(frozen=True)
-class NonlinearOptions:
-    r"""Options of the nonlinear analysis.
-
-    Args:
-        imperfection: :math:`\delta`, the imperfection's amplitude max :math:`|w_0|`
-            relative to the thickness, in (0, 1].
-        shape: Imperfection shape, one of :data:`~unibuckle_fenicsx.nonlinear.choices.SHAPES`.
-        control: "load" (edge traction :math:`\lambda`, adaptive steps) or
-            "displacement" (end shortening of the loaded edges; :math:`\lambda` from the
-            edge reactions; a uniaxial compression only).
-        obstacle: Keep the problem's obstacle (False: the same plate without it).
-        max_load: Stop the path at this multiple of the linear critical load, in (0, 5].
-        max_step: Largest step, relative to the linear critical load (or to the flat
-            plate's end shortening under it), in (0, 1].
-        min_step: Smallest step before giving up, relative as ``max_step``, in
-            (0, max_step].
-        deflection_step: Target relative change of max |w| per step, in (0, 1].
-        max_steps: Largest number of accepted steps, >= 1.
-        degree: Lagrange degree of the in-plane displacement (1 or 2); None: the
-            problem's ``solver.prestress_degree``.
-    """
-
-    imperfection: float = 1e-3
-    shape: str = "auto"
-    control: str = "load"
-    obstacle: bool = True
-    max_load: float = 1.2
-    max_step: float = 0.05
-    min_step: float = 1e-5
-    deflection_step: float = 0.1
-    max_steps: int = 400
-    degree: int | None = None
-
-    def __post_init__(self) -> None:
-        if not 0.0 < _number("imperfection", self.imperfection) <= 1.0:
-            raise InputError(
-                "imperfection (delta: max |w0| / thickness) must lie in (0, 1], got "
-                f"{self.imperfection!r}"
-            )
-        _choice("shape", self.shape, SHAPES)
-        _choice("control", self.control, CONTROLS)
-        _boolean("obstacle", self.obstacle)
-        if not 0.0 < _number("max_load", self.max_load) <= 5.0:
-            raise InputError(
-                "max_load (a multiple of the linear critical load) must lie in (0, 5], got "
-                f"{self.max_load!r}"
-            )
-        if not 0.0 < _number("max_step", self.max_step) <= 1.0:
-            raise InputError(f"max_step must lie in (0, 1], got {self.max_step!r}")
-        if not 0.0 < _number("min_step", self.min_step) <= self.max_step:
-            raise InputError(
-                f"min_step must lie in (0, max_step = {self.max_step}], got {self.min_step!r}"
-            )
-        if not 0.0 < _number("deflection_step", self.deflection_step) <= 1.0:
-            raise InputError(f"deflection_step must lie in (0, 1], got {self.deflection_step!r}")
-        _integer("max_steps", self.max_steps, 1)
-        if self.degree is not None and (isinstance(self.degree, bool) or self.degree not in (1, 2)):
-            raise InputError(f"degree (in-plane displacement) must be 1 or 2, got {self.degree!r}")
-
-
-@dataclass(frozen=True)
-class PathPoint:
-    r"""One converged state of the path.
+class PathPoint(TypedDict):
+    r"""One converged state of the path (a mapping, as the JSON's ``path`` holds it).
 
     Attributes:
         load_Pa: :math:`\lambda`.
@@ -146,6 +86,35 @@ class PathPoint:
     contact_nodes: int
     end_shortening_m: float
     newton_iterations: int
+
+
+class ContactCheck(TypedDict):
+    r"""The contact conditions of a state (:func:`contact_check`; the JSON's ``contact_check``).
+
+    Attributes:
+        force_scale: :math:`s = \lambda \|f\|_\infty`, the scale of the forces.
+        rtol: The tolerance relative to it.
+        max_zone_w_m: The largest :math:`s_k w_k - g_k` at the zone nodes (<= 0
+            admissible); with the obstacle only, as the next four.
+        contact_nodes: Zone nodes on the obstacle.
+        max_contact_force: The largest scaled residual at a contact node (None
+            without one).
+        min_contact_force: The smallest (None without one).
+        max_complementarity: The largest :math:`|(s w - g) F|` over the zone, per t.
+        max_free_residual: The largest scaled residual at a DOF free of edge conditions
+            and of contact.
+        satisfied: All of the conditions hold.
+    """
+
+    force_scale: float
+    rtol: float
+    max_zone_w_m: NotRequired[float]
+    contact_nodes: NotRequired[int]
+    max_contact_force: NotRequired[float | None]
+    min_contact_force: NotRequired[float | None]
+    max_complementarity: NotRequired[float]
+    max_free_residual: NotRequired[float]
+    satisfied: NotRequired[bool]
 
 
 @dataclass
@@ -209,13 +178,13 @@ class NonlinearResult:
     inflection_load_Pa: float | None
     southwell_ratio: float | None
     inflection_ratio: float | None
-    path: list[dict[str, Any]]
+    path: list[PathPoint]
     completed: bool
     stop_reason: str
     rejected_steps: int
     constrained_nodes: int
-    contact_check: dict[str, Any]
-    options: dict[str, Any]
+    contact_check: ContactCheck
+    options: dict[str, object]
     wall_time_s: float
     contact_load_Pa: float | None = None
     gapped: bool = False
@@ -260,7 +229,7 @@ class NonlinearResult:
             f"{linear:.6e} Pa. Validated: {validated or 'nothing'}. Not validated: {missing}"
         )
 
-    def as_dict(self) -> dict[str, Any]:
+    def as_dict(self) -> dict[str, object]:
         """JSON-ready mapping."""
         return asdict(self)
 
@@ -333,6 +302,18 @@ class NonlinearAnalysis(Owner):
             self.linear.destroy()
 
 
+def _measure(plate: VonKarmanPlate, iterations: int) -> PathPoint:
+    """The current state of ``plate``, reached in ``iterations`` Newton iterations (collective)."""
+    lam = plate.load.value.item() if plate.control == "load" else plate.edge_reaction_load()
+    return PathPoint(
+        load_Pa=float(lam),
+        max_w_m=plate.max_abs_w(),
+        contact_nodes=int(plate.contact_nodes().size),
+        end_shortening_m=plate.end_shortening(),
+        newton_iterations=iterations,
+    )
+
+
 def _trace(
     plate: VonKarmanPlate,
     options: NonlinearOptions,
@@ -347,25 +328,15 @@ def _trace(
     # Under end shortening the post-buckled plate is softer; its load is checked instead.
     p_max = stop_load if load_control else 4.0 * options.max_load * unit
 
-    def measure(iterations: int) -> PathPoint:
-        lam = plate.load.value.item() if load_control else plate.edge_reaction_load()
-        return PathPoint(
-            float(lam),
-            plate.max_abs_w(),
-            int(plate.contact_nodes().size),
-            plate.end_shortening(),
-            iterations,
-        )
-
     plate.set_control(0.0)
     plate.x.x.array[:] = plate.x0.x.array
-    path = [measure(0)]
+    path = [_measure(plate, 0)]
     p, p_prev = 0.0, None
     x_prev: npt.NDArray[np.floating] | None = None
     step = options.max_step * unit
     rejected = 0
     while True:
-        if path[-1].load_Pa >= stop_load * (1 - 1e-12) or p >= p_max * (1 - 1e-12):
+        if path[-1]["load_Pa"] >= stop_load * (1 - 1e-12) or p >= p_max * (1 - 1e-12):
             return path, True, f"reached {options.max_load:g} x the linear critical load", rejected
         if len(path) > options.max_steps:
             return path, False, f"stopped after max_steps = {options.max_steps} steps", rejected
@@ -376,9 +347,11 @@ def _trace(
             plate.project()
         plate.set_control(p_try)
         report = plate.solve()
-        point = measure(report.iterations) if report.converged else None
+        point = _measure(plate, report.iterations) if report.converged else None
         jump = (
-            abs(point.max_w_m - path[-1].max_w_m) / path[-1].max_w_m if point is not None else 0.0
+            abs(point["max_w_m"] - path[-1]["max_w_m"]) / path[-1]["max_w_m"]
+            if point is not None
+            else 0.0
         )
         if point is None or (
             jump > 2.0 * options.deflection_step and step > options.min_step * unit
@@ -391,7 +364,7 @@ def _trace(
                 why = (
                     f"SNES did not converge at the smallest step (converged reason "
                     f"{report.reason}, {report.iterations} iterations) from lambda = "
-                    f"{path[-1].load_Pa:.6e} Pa"
+                    f"{path[-1]['load_Pa']:.6e} Pa"
                 )
                 return path, False, why, rejected
             continue
@@ -407,15 +380,15 @@ def _trace(
                 "%d contact nodes, %d Newton iterations",
                 label,
                 len(path) - 1,
-                point.load_Pa,
-                point.load_Pa / reference,
-                point.max_w_m / t,
-                point.contact_nodes,
+                point["load_Pa"],
+                point["load_Pa"] / reference,
+                point["max_w_m"] / t,
+                point["contact_nodes"],
                 report.iterations,
             )
 
 
-def contact_check(plate: VonKarmanPlate, rtol: float = 1e-8) -> dict[str, Any]:
+def contact_check(plate: VonKarmanPlate, rtol: float = 1e-8) -> ContactCheck:
     r"""The contact conditions of the current state.
 
     With :math:`F` the residual (the gradient of the energy, scaled) and
@@ -435,9 +408,9 @@ def contact_check(plate: VonKarmanPlate, rtol: float = 1e-8) -> dict[str, Any]:
     for bc in plate.bcs:
         dofs = bc.dof_indices()[0]
         skip[dofs[dofs < n_owned]] = True
-    out: dict[str, Any] = {"force_scale": scale, "rtol": rtol}
+    out = ContactCheck(force_scale=scale, rtol=rtol)
     ok = True
-    if plate.contact is not None:
+    if isinstance(plate.contact, ContactSetManager):
         w = plate.zone_clearance()  # s w - g: <= 0 admissible
         on = np.zeros(plate.contact.size, dtype=bool)
         on[plate.contact_nodes()] = True
@@ -448,16 +421,14 @@ def contact_check(plate: VonKarmanPlate, rtol: float = 1e-8) -> dict[str, Any]:
             skip |= np.abs(indicator.array) > 0.5
         finally:
             indicator.destroy()
-        out.update(
-            max_zone_w_m=float(w.max()),
-            contact_nodes=int(on.sum()),
-            max_contact_force=float(forces[on].max()) if on.any() else None,
-            min_contact_force=float(forces[on].min()) if on.any() else None,
-            max_complementarity=float(np.abs(w * forces).max() / plate.thickness),
-        )
+        out["max_zone_w_m"] = float(w.max())
+        out["contact_nodes"] = int(on.sum())
+        top = out["max_contact_force"] = float(forces[on].max()) if on.any() else None
+        out["min_contact_force"] = float(forces[on].min()) if on.any() else None
+        out["max_complementarity"] = float(np.abs(w * forces).max() / plate.thickness)
         ok = out["max_zone_w_m"] <= 0.0
-        if out["max_contact_force"] is not None:
-            ok = ok and out["max_contact_force"] <= rtol
+        if top is not None:
+            ok = ok and top <= rtol
     free = float(np.abs(F.array[~skip]).max(initial=0.0)) / scale
     out["max_free_residual"] = float(plate.comm.allreduce(free, op=MPI.MAX))
     out["satisfied"] = bool(ok and out["max_free_residual"] <= rtol)
@@ -511,14 +482,7 @@ def solve_nonlinear(
         linear = solve_linear(spec if obstacle else spec.without_obstacles(), comm)
     timings = {"linear_s": time.perf_counter() - t0}
     result = linear.result
-    reference = result.critical_load_Pa if obstacle else result.free_load_Pa
-    how = "free" if not obstacle else result.method
-    if obstacle:
-        how += (
-            ", KKT"
-            if result.certificate is not None and result.certificate.kkt
-            else ", NOT certified"
-        )
+    reference, how = _reference(result, obstacle)
     label = f"{spec.name} delta/t={options.imperfection:g}"
     gapped = obstacle and bool(spec.gapped_obstacles)
     plate = None
@@ -564,6 +528,18 @@ def solve_nonlinear(
     )  # fmt: skip
     nl.verdict = judge(nl).summary(nl)
     return NonlinearAnalysis(nl, plate, linear, owns_linear)
+
+
+def _reference(result: BucklingResult, obstacle: bool) -> tuple[float, str]:
+    """The linear load the path is compared with, and how it was found.
+
+    With the obstacle: the unilateral critical load, its method and whether it is a KKT
+    point; without: the free plate's load.
+    """
+    if not obstacle:
+        return result.free_load_Pa, "free"
+    kkt = result.certificate is not None and result.certificate.kkt
+    return result.critical_load_Pa, result.method + (", KKT" if kkt else ", NOT certified")
 
 
 def _checked(
@@ -637,8 +613,8 @@ def _result(
     """
     path, completed, why, rejected = traced
     result, reference, how = linear
-    loads = np.array([q.load_Pa for q in path])
-    max_w = np.array([q.max_w_m for q in path])
+    loads = np.array([q["load_Pa"] for q in path])
+    max_w = np.array([q["max_w_m"] for q in path])
     knee = inflection_load(loads, max_w)
     southwell, count = (
         southwell_load(loads, max_w, max_w[0], knee, spec.plate.thickness)
@@ -663,16 +639,16 @@ def _result(
         inflection_load_Pa=knee,
         southwell_ratio=None if southwell is None else southwell / reference,
         inflection_ratio=None if knee is None else knee / reference,
-        path=[asdict(q) for q in path],
+        path=path,
         completed=completed,
         stop_reason=why,
         rejected_steps=rejected,
-        constrained_nodes=0 if plate.contact is None else plate.contact.size,
-        contact_load_Pa=next((q.load_Pa for q in path if q.contact_nodes), None),
+        constrained_nodes=plate.contact.size,
+        contact_load_Pa=next((q["load_Pa"] for q in path if q["contact_nodes"]), None),
         gapped=gapped,
         unilateral_load_Pa=closed,
         contact_check=check,
-        options={**asdict(options), "degree": degree},
+        options={**structs.asdict(options), "degree": degree},
         wall_time_s=time.perf_counter() - t0,
         timings=timings,
         mpi_size=comm.size,

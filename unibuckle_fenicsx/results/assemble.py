@@ -257,7 +257,7 @@ def _total_temperature(spec: ProblemSpec, load: float) -> float | None:
     )
 
 
-def _input(spec: ProblemSpec) -> dict[str, Any] | None:
+def _input(spec: ProblemSpec) -> dict[str, object] | None:
     try:
         return problem_to_dict(spec)
     except ValueError:  # a predicate zone

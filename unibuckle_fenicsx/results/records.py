@@ -231,7 +231,7 @@ class BucklingResult(Struct, kw_only=True):
     critical_total_temperature_K: float | None = None
     design: DesignRecord | None = None
     units: str = "SI"
-    input: dict[str, Any] | None = None
+    input: dict[str, object] | None = None
     versions: dict[str, str] = {}
     obstacle_zones: list[ZoneReport] = []
     contact_force: ContactForce | None = None
@@ -241,7 +241,7 @@ class BucklingResult(Struct, kw_only=True):
         """No certificate (no obstacle: the free load, verified the smallest), or a KKT one."""
         return self.certificate is None or self.certificate.kkt
 
-    def as_dict(self, timings: bool = True) -> dict[str, Any]:
+    def as_dict(self, timings: bool = True) -> dict[str, object]:
         """JSON-ready mapping (non-finite floats become ``null``: JSON has no infinity).
 
         The fields in their order, ``details`` holding the algorithm's record's fields
@@ -319,12 +319,17 @@ class BucklingResult(Struct, kw_only=True):
         m = cert.negative_eigenvalues
         hint = ""
         if by == "interlacing" and m is not None and m >= 2:
-            tried = (self.input or {}).get("solver", {}).get("bracket")
+            tried = self._input_table("solver").get("bracket")
             hint = "; --bracket verified no higher bound" if tried else "; --bracket may raise it"
         return (
             f"not proven: the critical load lies between {lower / scale:.6e} {unit} "
             f"(verified lower bound, {how}) and {high}{hint}"
         )
+
+    def _input_table(self, key: str) -> dict[str, object]:
+        """The table ``key`` of the problem solved, as its file writes it (empty if absent)."""
+        table = (self.input or {}).get(key)
+        return table if isinstance(table, dict) else {}
 
     def _model_lines(self) -> list[str]:
         """Summary lines of what the model holds beyond plate, edges and obstacle."""
@@ -332,7 +337,7 @@ class BucklingResult(Struct, kw_only=True):
         lines = []
         if isinstance(self.details.gapped_obstacles, str):
             lines.append(self.details.gapped_obstacles)
-        load = (self.input or {}).get("load", {})
+        load = self._input_table("load")
         if self.critical_temperature_K is not None:
             lines.append(
                 f"temperature rise per unit lambda {load.get('temperature')}: critical rise "
@@ -369,8 +374,8 @@ class BucklingResult(Struct, kw_only=True):
 
     def _point_restraints(self, reports: list[PointReport]) -> list[str]:
         """Each point restraint described in the summary's units (the JSON's are SI)."""
-        tables = (self.input or {}).get("points", [])
-        if self.units == "SI" or len(tables) != len(reports):
+        tables = (self.input or {}).get("points")
+        if self.units == "SI" or not isinstance(tables, list) or len(tables) != len(reports):
             return [p.restraint for p in reports]
         return [PointSpec(**table).describe(self.units) for table in tables]
 
@@ -472,7 +477,7 @@ def jsonable(record: Any) -> Any:
     return _finite(to_builtins(record, enc_hook=_numpy))
 
 
-def _flat(key: str, value: Any) -> dict[str, Any]:
+def _flat(key: str, value: Any) -> dict[str, object]:
     """A ``details`` entry as the JSON's keys: the algorithm's record spread out."""
     return value if key == "run" else {key: value}
 

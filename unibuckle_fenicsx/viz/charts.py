@@ -200,6 +200,30 @@ def _exact_curves(
             ax.plot(xs[o], ys[o], style, color="0.35", lw=1.2, label=label)
 
 
+def _marker_legend(ax: Any) -> None:
+    """Legend entries for the certificate markers."""
+    markers = (
+        ("o", "0.2", "proven optimal"),
+        ("D", "0.2", "bracketed (verified gap)"),
+        ("o", "white", "KKT only"),
+        ("x", "0.2", "not certified"),
+    )
+    for style, mfc, text in markers:
+        ax.plot([], [], style, color="0.2", mfc=mfc, label=text)
+
+
+def _k_range(ax: Any, lines: Sequence[Mapping[str, Any]], aspect: bool) -> None:
+    """Keep the interesting range readable: very short plates have large k (aspect sweeps)."""
+    solved_lines = [m for m in lines if m.get("buckling_coefficient_k") is not None]
+    shown = [float(m["buckling_coefficient_k"]) for m in solved_lines] + [
+        float(m["buckling_coefficient_k"]) * m["free_load_Pa"] / m["critical_load_Pa"]
+        for m in solved_lines
+    ]
+    if shown:
+        low, high = min(shown), max(shown)
+        ax.set_ylim(0.9 * low, min(1.05 * high, 2.5 * low) if aspect else 1.05 * high)
+
+
 def plot_sweep(
     lines: Sequence[Mapping[str, Any]],
     variations: Sequence[Variation],
@@ -250,24 +274,8 @@ def plot_sweep(
         # Exact curves on a fine grid of the swept number.
         point = dict(zip(others, key, strict=True))
         _exact_curves(ax, base, first, point, abscissa, suffix)
-    # Legend entries for the certificate markers.
-    markers = (
-        ("o", "0.2", "proven optimal"),
-        ("D", "0.2", "bracketed (verified gap)"),
-        ("o", "white", "KKT only"),
-        ("x", "0.2", "not certified"),
-    )
-    for style, mfc, text in markers:
-        ax.plot([], [], style, color="0.2", mfc=mfc, label=text)
-    # Keep the interesting range readable: very short plates have large k (aspect sweeps).
-    solved_lines = [m for m in lines if m.get("buckling_coefficient_k") is not None]
-    shown = [float(m["buckling_coefficient_k"]) for m in solved_lines] + [
-        float(m["buckling_coefficient_k"]) * m["free_load_Pa"] / m["critical_load_Pa"]
-        for m in solved_lines
-    ]
-    if shown:
-        low, high = min(shown), max(shown)
-        ax.set_ylim(0.9 * low, min(1.05 * high, 2.5 * low) if aspect else 1.05 * high)
+    _marker_legend(ax)
+    _k_range(ax, lines, aspect)
     ax.set_xlabel("aspect ratio a/b" if aspect else axis_label(first.path, base))
     ax.set_ylabel(r"buckling coefficient $k = N b^2 / (\pi^2 D)$")
     ax.set_title(

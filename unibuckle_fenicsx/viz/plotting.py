@@ -751,6 +751,30 @@ def _reference_errors(
             )
 
 
+def _mesh_axes(ax0: Any, ax1: Any, studies: Mapping[str, Sequence[tuple[int, int, float]]]) -> None:
+    """The meshes (nx × ny) on both x axes, the h² slope on the right, labels and legends."""
+    all_nx = sorted({r[0] for rows in studies.values() for r in rows})
+    ny_of = {r[0]: r[1] for rows in studies.values() for r in rows}
+    ticks = [f"{n}×{ny_of[n]}" for n in all_nx]
+    if len(all_nx) >= 2:
+        n0 = float(all_nx[0])
+        guide = np.array([n0, float(all_nx[-1])])
+        ymax = max((line.get_ydata().max() for line in ax1.get_lines()), default=1e-2)
+        ax1.loglog(guide, ymax * (guide / n0) ** -2, "k-", lw=0.8, alpha=0.6, label="slope h²")
+    ax0.set_xscale("log", base=2)
+    ax0.set_xticks(all_nx, ticks)
+    ax0.set_xlabel("mesh (quadrilaterals nx × ny)")
+    ax0.set_ylabel("critical load λ (MPa)")
+    ax0.grid(True, alpha=0.3)
+    ax0.legend(fontsize=THEME["mpl_font_size"] - 2)
+    ax1.set_xscale("log", base=2)
+    ax1.set_xticks(all_nx, ticks)
+    ax1.set_xlabel("mesh (quadrilaterals nx × ny)")
+    ax1.set_ylabel("relative difference")
+    ax1.grid(True, which="both", alpha=0.3)
+    ax1.legend(fontsize=THEME["mpl_font_size"] - 3)
+
+
 def plot_convergence(
     path: str | Path,
     studies: Mapping[str, Sequence[tuple[int, int, float]]],
@@ -809,26 +833,7 @@ def plot_convergence(
     if reference is not None:
         ax0.axhline(reference / 1e6, color="k", ls="--", lw=1.0, label=reference_label)
         _reference_errors(ax1, studies, reference, reference_label, markers)
-    all_nx = sorted({r[0] for rows in studies.values() for r in rows})
-    ny_of = {r[0]: r[1] for rows in studies.values() for r in rows}
-    ticks = [f"{n}×{ny_of[n]}" for n in all_nx]
-    if len(all_nx) >= 2:
-        n0 = float(all_nx[0])
-        guide = np.array([n0, float(all_nx[-1])])
-        ymax = max((line.get_ydata().max() for line in ax1.get_lines()), default=1e-2)
-        ax1.loglog(guide, ymax * (guide / n0) ** -2, "k-", lw=0.8, alpha=0.6, label="slope h²")
-    ax0.set_xscale("log", base=2)
-    ax0.set_xticks(all_nx, ticks)
-    ax0.set_xlabel("mesh (quadrilaterals nx × ny)")
-    ax0.set_ylabel("critical load λ (MPa)")
-    ax0.grid(True, alpha=0.3)
-    ax0.legend(fontsize=THEME["mpl_font_size"] - 2)
-    ax1.set_xscale("log", base=2)
-    ax1.set_xticks(all_nx, ticks)
-    ax1.set_xlabel("mesh (quadrilaterals nx × ny)")
-    ax1.set_ylabel("relative difference")
-    ax1.grid(True, which="both", alpha=0.3)
-    ax1.legend(fontsize=THEME["mpl_font_size"] - 3)
+    _mesh_axes(ax0, ax1, studies)
     if title:
         fig.suptitle(title)
     return _save(plt, fig, path)

@@ -275,39 +275,56 @@ def mesh_study(
                         tau=problem.tau,
                     )
             if zone is not None and mesh == contact_mesh:
-                xy, w = fields.nodal_deflection(problem, analysis.mode)
-                if not isinstance(problem, UnilateralProblem):
-                    raise TypeError("a zone without a contact manager (an internal invariant)")
-                if comm.rank == 0:
-                    plotting.plot_contact_set(
-                        figures / "contact_set.png",
-                        xy,
-                        w,
-                        corners=spec.plate.corners,
-                        zone=zone,
-                        constrained=problem.contact.coordinates,
-                        contact_coordinates=result.contact_coordinates,
-                        contact_pressing=fields.pressing(result),
-                        title=f"{_title(name)}: contact set on the {point.label} mesh",
-                        tau=problem.tau,
-                    )
-                    force = result.contact_force
-                    if force is not None and force.resolution is not None:
-                        plotting.plot_contact_force(
-                            figures / "contact_force.png",
-                            result.contact_coordinates,
-                            force.push,
-                            force.resolution,
-                            corners=spec.plate.corners,
-                            zone=zone,
-                            title=f"{_title(name)}: the obstacle's push, {point.label} mesh",
-                        )
+                _contact_figures(figures, name, point.label, spec, analysis, zone)
             if output is not None:
                 write_fields(analysis, output / name / point.label)
             if at_each is not None:
                 point.extra = at_each(analysis)
         points.append(point)
     return MeshStudy(name, points, zone)
+
+
+def _contact_figures(
+    figures: Path,
+    name: str,
+    label: str,
+    spec: ProblemSpec,
+    analysis: Analysis,
+    zone: tuple[tuple[float, float], tuple[float, float]],
+) -> None:
+    """The contact set and the obstacle's push on the mesh ``label`` (drawn on rank 0).
+
+    Note:
+        Collective (the nodal deflection is gathered).
+    """
+    problem, result = analysis.problem, analysis.result
+    xy, w = fields.nodal_deflection(problem, analysis.mode)
+    if not isinstance(problem, UnilateralProblem):
+        raise TypeError("a zone without a contact manager (an internal invariant)")
+    if problem.comm.rank == 0:
+        plotting.plot_contact_set(
+            figures / "contact_set.png",
+            xy,
+            w,
+            corners=spec.plate.corners,
+            zone=zone,
+            constrained=problem.contact.coordinates,
+            contact_coordinates=result.contact_coordinates,
+            contact_pressing=fields.pressing(result),
+            title=f"{_title(name)}: contact set on the {label} mesh",
+            tau=problem.tau,
+        )
+        force = result.contact_force
+        if force is not None and force.resolution is not None:
+            plotting.plot_contact_force(
+                figures / "contact_force.png",
+                result.contact_coordinates,
+                force.push,
+                force.resolution,
+                corners=spec.plate.corners,
+                zone=zone,
+                title=f"{_title(name)}: the obstacle's push, {label} mesh",
+            )
 
 
 def _title(name: str) -> str:

@@ -1,0 +1,584 @@
+"""Command line: help, JSON output, and bad input (exit status 2, message on stderr).
+
+Most calls run :func:`unibuckle_fenicsx.cli.main` in-process (cheap); one subprocess per
+kind of exit checks the installed console script itself.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED, EXIT_OK, build_parser, main
+from unibuckle_fenicsx.model.materials import navier_load_mindlin
+
+SCRIPT = Path(sys.executable).parent / "unibuckle"
+
+#: Fields the README ("Command line") promises in the JSON result.
+REQUIRED = (
+    "critical_load_Pa",
+    "free_load_Pa",
+    "ratio_to_free",
+    "buckling_coefficient_k",
+    "dofs",
+    "mesh",
+    "method",
+    "eigensolves",
+    "wall_time_s",
+)
+
+FREE_TOML = """\
+[plate]
+corners = [[-0.1, -0.05], [0.1, 0.05]]
+thickness = 0.006
+[material]
+E = 1.0e9
+nu = 0.3
+[mesh]
+nx = 8
+ny = 4
+"""
+
+
+def run_script(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    return subprocess.run([str(SCRIPT), *args], capture_output=True, text=True, env=env, cwd=cwd)
+
+
+def test_help(tmp_path):
+    top = run_script("--help", cwd=tmp_path)
+    assert top.returncode == 0, top.stderr
+    assert "solve" in top.stdout and "PETSc" in top.stdout
+    sub = run_script("solve", "--help", cwd=tmp_path)
+    assert sub.returncode == 0, sub.stderr
+    flags = (
+        "--case",
+        "--config",
+        "--nx",
+        "--ny",
+        "--method",
+        "--complete",
+        "--max-candidates",
+        "--penalty",
+        "--tau",
+        "--candidate-parallel",
+        "--json",
+        "--output",
+        "--verbose",
+        "--quiet",
+        "--no-certify",
+        "--max-iterations",
+        "--bound-budget",
+        "--enumeration-budget",
+    )
+    for flag in flags:
+        assert flag in sub.stdout, flag
+    # The exit statuses are documented.
+    for status in (EXIT_OK, EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED):
+        assert f"\n  {status}  " in sub.stdout
+    # Every flag is explained: each option of the sub-command carries a help text.
+    solve_parser = build_parser()[1]["solve"]
+    for action in solve_parser._actions:
+        assert action.help, action.option_strings
+
+
+def test_importing_the_module_entry_point_runs_nothing(monkeypatch):
+    """``python -m unibuckle_fenicsx.cli`` runs the CLI; importing the module does not.
+
+    Sphinx's autosummary imports every module: with the call unguarded, the docs build ran
+    ``main()`` on Sphinx's own arguments and printed an argparse error.
+    """
+    import importlib
+    import sys
+
+    monkeypatch.setattr(sys, "argv", ["sphinx-build", "html"])
+    monkeypatch.delitem(sys.modules, "unibuckle_fenicsx.cli.__main__", raising=False)
+    module = importlib.import_module("unibuckle_fenicsx.cli.__main__")  # no SystemExit
+    assert callable(module.main)
+
+
+def test_an_in_process_run_sets_the_callers_logging_back(tmp_path):
+    """``main()`` called in-process leaves the root logger as it found it.
+
+    Its handler holds this run's ``sys.stderr``; left installed, a later log record was
+    written to a stream closed in between ("I/O operation on closed file").
+    """
+    import logging
+
+    root = logging.getLogger()
+    before = root.handlers[:], root.level
+    out = tmp_path / "free.json"
+    assert main(["solve", "--case", "free", "--nx", "4", "--ny", "2", "--json", str(out)]) == 0
+    assert (root.handlers, root.level) == before
+
+
+def test_solve_free_case_writes_json(tmp_path, capsys):
+    out = tmp_path / "free.json"
+    assert main(["solve", "--case", "free", "--nx", "20", "--ny", "10", "--json", str(out)]) == 0
+    stdout = capsys.readouterr().out.strip().splitlines()
+    assert len(stdout) == 2 and stdout[0].startswith("free: lambda_c = ")
+    assert (
+        stdout[1] == "  edge stress per unit lambda (tension > 0): left normal -1; right normal -1"
+    )
+    data = json.loads(out.read_text())
+    for key in REQUIRED:
+        assert key in data, key
+    assert data["method"] == "free"
+    assert data["mesh"] == [20, 10]
+    assert data["dofs"] == 3 * 21 * 11  # (w, theta_x, theta_y) at the Q1 nodes
+    assert data["eigensolves"] == 1
+    # Navier (hard support, m = 2): the MITC4 load is 1.4 % above it on 20x10 (README,
+    # "Verification"), and so is k against the Navier coefficient
+    # k_RM = 4 / (1 + pi^2 D (m^2/a^2 + 1/b^2) / (kappa G t)) = 3.9204 (a = 0.2, b = 0.1).
+    exact, m = navier_load_mindlin(1.0e9, 0.3, 0.006, 0.2, 0.1)
+    assert m == 2
+    D = 1.0e9 * 0.006**3 / (12 * (1 - 0.3**2))
+    G = 1.0e9 / (2 * 1.3)
+    k_rm = 4 / (1 + math.pi**2 * D * (4 / 0.2**2 + 1 / 0.1**2) / (5 / 6 * G * 0.006))
+    assert data["critical_load_Pa"] == pytest.approx(exact, rel=2e-2)
+    assert data["buckling_coefficient_k"] == pytest.approx(k_rm, rel=2e-2)
+    assert data["critical_load_Pa"] / exact == pytest.approx(
+        data["buckling_coefficient_k"] / k_rm, rel=1e-12
+    )
+
+
+def test_solve_config_file(tmp_path, capsys):
+    path = tmp_path / "myplate.toml"
+    path.write_text(FREE_TOML)
+    out = tmp_path / "o.json"
+    assert main(["solve", "--config", str(path), "--json", str(out)]) == 0
+    assert capsys.readouterr().out.startswith("myplate: ")
+    data = json.loads(out.read_text())
+    assert data["case"] == "myplate" and data["mesh"] == [8, 4]
+    # --nx/--ny override the file; the file describes the paper's free plate, so the
+    # answer is that of --case free on the same mesh.
+    out2, out3 = tmp_path / "o2.json", tmp_path / "o3.json"
+    mesh = ["--nx", "20", "--ny", "10"]
+    assert main(["solve", "--config", str(path), *mesh, "--json", str(out2)]) == 0
+    assert main(["solve", "--case", "free", *mesh, "--json", str(out3)]) == 0
+    from_file, from_case = (json.loads(o.read_text()) for o in (out2, out3))
+    assert from_file["mesh"] == [20, 10]
+    assert from_file["critical_load_Pa"] == pytest.approx(from_case["critical_load_Pa"], rel=1e-12)
+
+
+BAD_TOML = {
+    "thickness": ("[plate]\nthickness = 0.0\n", r"plate\.thickness"),
+    "nu": ("[material]\nE = 1.0e9\nnu = 0.5\n", r"material\.nu"),
+    "rectangle": ("[plate]\ncorners = [[0.1, 0.0], [0.1, 0.05]]\n", r"plate\.corners"),
+    "unknown key": ("[mesh]\nnx = 4\nnz = 4\n", r"unknown key\(s\) \['nz'\] in \[mesh\]"),
+    "tension": (
+        "[edges.left]\nnormal_stress = 1.0\n[edges.right]\nnormal_stress = 1.0\n"
+        "[mesh]\nnx = 4\nny = 2\n",
+        r"tension everywhere.*normal_stress",
+    ),
+    "empty zone": (
+        "[mesh]\nnx = 20\nny = 10\n[obstacle]\nzone = [[0.001, 0.002], [0.001, 0.002]]\n",
+        r"obstacle\.zone .* holds no free mesh node",
+    ),
+}
+
+
+@pytest.mark.parametrize("case", list(BAD_TOML))
+def test_bad_config_exits_2(case, tmp_path, capsys):
+    text, match = BAD_TOML[case]
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    out = tmp_path / "bad.json"
+    assert main(["solve", "--config", str(path), "--json", str(out)]) == 2
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith("unibuckle: error: ")
+    assert re.search(match, captured.err), captured.err
+    assert not out.exists()
+
+
+@pytest.mark.parametrize(
+    ("args", "match"),
+    [
+        (["--nx", "0"], r"mesh\.nx"),
+        (["--tau", "0.5"], r"solver\.tau"),
+        (["--max-candidates", "0"], r"solver\.max_candidates"),
+    ],
+)
+def test_bad_flag_value_exits_2(args, match, capsys):
+    assert main(["solve", "--case", "free", *args]) == 2
+    err = capsys.readouterr().err
+    assert re.search(match, err), err
+
+
+@pytest.mark.parametrize("value", ["-1e-3", "-1E-3", "-0.001", "-1.5e+2", "-.5e-1"])
+def test_negative_numbers_in_exponent_form_are_values(value, capsys):
+    """``--imperfection -1e-3`` is the value -0.001, refused by its range (exit 2).
+
+    argparse took ``-1e-3`` for an option ("expected one argument"); ``-0.001`` worked.
+    """
+    parser, _ = build_parser()
+    args, rest = parser.parse_known_args(["nonlinear", "--case", "c1", "--imperfection", value])
+    assert args.imperfection == float(value) and rest == []
+    assert main(["nonlinear", "--case", "c1", "--imperfection", value]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"--imperfection must lie in (0, 1], got {float(value)!r}" in err, err
+    # A PETSc option's negative value still goes to PETSc, in its place.
+    _, rest = parser.parse_known_args(["solve", "--case", "c1", "-unibuckle_eps_target", value])
+    assert rest == ["-unibuckle_eps_target", value]
+
+
+def test_set_changes_the_value_at_its_dotted_path():
+    """--set PATH=VALUE changes that value of the problem, read as the kind found there."""
+    from unibuckle_fenicsx.cli.problem import spec_from_args
+    from unibuckle_fenicsx.spec.cases import paper_case
+
+    parser, _ = build_parser()
+    args = parser.parse_args(
+        ["solve", "--case", "c1", "--set", "solver.tau=1e-9", "--set", "solver.method=penalty"]
+    )
+    spec = spec_from_args(args)
+    assert spec.solver.tau == 1e-9 and spec.solver.method == "penalty"
+    assert paper_case("c1").solver.tau != 1e-9  # the value was changed, not already there
+    assert spec.plate == paper_case("c1").plate  # and nothing else
+
+
+@pytest.mark.parametrize(
+    ("setting", "match"),
+    [
+        ("solver.nope=1", r"--set solver\.nope: solver has no key 'nope'"),
+        ("solver.tau=abc", r"--set solver\.tau: 'abc' is not a number"),
+        ("solver.tau", r"--set 'solver\.tau': give PATH=VALUE"),
+        ("solver.tau=0.5", r"solver\.tau"),  # the schema's range
+    ],
+)
+def test_bad_set_exits_2_naming_it(setting, match, capsys, no_solve):
+    assert main(["solve", "--case", "free", "--set", setting]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert re.search(match, err), err
+
+
+def test_nonlinear_flag_defaults_are_the_options_defaults():
+    """The nonlinear flags' defaults are NonlinearOptions' and its choices the package's.
+
+    The parser reads them from the Struct's module, which imports no DOLFINx.
+    """
+    import msgspec
+
+    from unibuckle_fenicsx.cli.flags import NONLINEAR_FLAGS
+    from unibuckle_fenicsx.nonlinear import CONTROLS, SHAPES, NonlinearOptions
+
+    fields = {f.name: f.default for f in msgspec.structs.fields(NonlinearOptions)}
+    parser, _ = build_parser()
+    args = parser.parse_args(["nonlinear", "--case", "c1"])
+    assert {k: getattr(args, k) for k in NONLINEAR_FLAGS} == {k: fields[k] for k in NONLINEAR_FLAGS}
+    choices = {
+        a.dest: tuple(a.choices)
+        for sub in parser._subparsers._group_actions[0].choices.values()
+        for a in sub._actions
+        if a.choices
+    }
+    assert choices["shape"] == SHAPES and choices["control"] == CONTROLS
+
+
+def test_missing_config_file_exits_2(tmp_path, capsys):
+    assert main(["solve", "--config", str(tmp_path / "nowhere.toml")]) == 2
+    assert "nowhere.toml" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize(
+    "args",
+    [
+        ["solve"],  # neither --case nor --config
+        ["solve", "--case", "c4"],
+        ["solve", "--case", "free", "--config", "x.toml"],
+        ["solve", "--case", "free", "--no-such-flag"],
+    ],
+)
+def test_usage_errors_exit_2(args, capsys):
+    with pytest.raises(SystemExit) as exc:
+        main(args)
+    assert exc.value.code == 2
+    assert "usage: unibuckle" in capsys.readouterr().err
+
+
+def test_unknown_flag_after_solve_shows_the_solve_usage(capsys):
+    with pytest.raises(SystemExit):
+        main(["solve", "--case", "free", "--no-such-flag"])
+    err = capsys.readouterr().err
+    assert "usage: unibuckle solve" in err and "--no-such-flag" in err
+
+
+def test_console_script_exit_status(tmp_path):
+    """The installed script: 2 with the message on stderr for bad input, 0 otherwise."""
+    path = tmp_path / "bad.toml"
+    path.write_text("[material]\nE = 1.0e9\nnu = -1.0\n")
+    bad = run_script("solve", "--config", str(path), cwd=tmp_path)
+    assert bad.returncode == 2
+    assert "material.nu" in bad.stderr and bad.stdout == ""
+    good = run_script("solve", "--case", "free", "--nx", "8", "--ny", "4", cwd=tmp_path)
+    assert good.returncode == 0, good.stderr
+    assert good.stdout.startswith("free: lambda_c = ")
+    assert "Traceback" not in bad.stderr + good.stderr
+    assert list(tmp_path.iterdir()) == [path]  # no stray files in the working directory
+
+
+# -- input a user can trust: refused early, with the parameter or file named --------------
+@pytest.fixture
+def no_solve(monkeypatch):
+    """Fail the test if a solve starts: bad input must be refused before any work."""
+    import unibuckle_fenicsx.analysis
+
+    def refuse(*args, **kwargs):
+        raise AssertionError("the solve started")
+
+    monkeypatch.setattr(unibuckle_fenicsx.analysis, "solve", refuse)
+
+
+@pytest.mark.parametrize(
+    ("text", "match"),
+    [
+        ('[solver]\ncomplete = "false"\n', r"solver\.complete must be true or false"),
+        ('[material]\nE = "abc"\nnu = 0.3\n', r"material\.E must be a number, got 'abc'"),
+        ('[plate]\nthickness = "thin"\n', r"plate\.thickness must be a number"),
+        ('[solver]\nmax_candidates = "many"\n', r"solver\.max_candidates must be an integer"),
+        ("[plate\n", r"invalid TOML"),
+        ("[obstacle]\n", r"\[obstacle\] needs zone"),
+    ],
+)
+def test_bad_file_exits_2_naming_key_and_file(tmp_path, capsys, no_solve, text, match):
+    path = tmp_path / "bad.toml"
+    path.write_text(text)
+    assert main(["solve", "--config", str(path)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert re.search(match, err) and str(path) in err, err
+    assert "Traceback" not in err
+
+
+@pytest.mark.parametrize("flag", ["--json", "--output"])
+def test_unwritable_output_is_refused_before_solving(tmp_path, capsys, no_solve, flag):
+    blocker = tmp_path / "a_file"
+    blocker.write_text("")
+    target = blocker / "sub" / ("out.json" if flag == "--json" else "vtx")
+    assert main(["solve", "--case", "c1", flag, str(target)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"{flag}: {blocker} is not a directory" in err, err
+
+
+def test_one_cell_and_huge_meshes_are_refused(capsys, monkeypatch):
+    """--nx 1 names mesh.nx; a 100000 x 100000 mesh is refused with its memory estimate."""
+    import unibuckle_fenicsx.model.build as build_module
+
+    assert main(["solve", "--case", "free", "--nx", "1"]) == EXIT_BAD_INPUT
+    assert "mesh.nx must be an integer >= 2" in capsys.readouterr().err
+
+    def no_mesh(*args, **kwargs):
+        raise AssertionError("the mesh was built")
+
+    monkeypatch.setattr(build_module, "build_plate_mesh", no_mesh)
+    assert main(["solve", "--case", "free", "--nx", "100000", "--ny", "100000"]) == 2
+    err = capsys.readouterr().err
+    assert "30,000,600,003 DOFs" in err and "GB" in err and "available" in err, err
+
+
+def test_plate_far_from_the_origin(tmp_path, capsys):
+    """Translation invariance: the plate at (1000, 2000) m has the load of the one at 0."""
+    loads = []
+    for corners in ("[[1000.0, 2000.0], [1000.2, 2000.1]]", "[[0.0, 0.0], [0.2, 0.1]]"):
+        path = tmp_path / "plate.toml"
+        path.write_text(f"[plate]\ncorners = {corners}\n[mesh]\nnx = 20\nny = 10\n")
+        out = tmp_path / "out.json"
+        assert main(["solve", "--config", str(path), "--json", str(out)]) == EXIT_OK
+        loads.append(json.loads(out.read_text())["critical_load_Pa"])
+    assert loads[0] == pytest.approx(loads[1], rel=1e-9)
+
+
+def test_mm_file_prints_mpa_and_solves_the_same_problem(tmp_path, capsys):
+    path = tmp_path / "mm.toml"
+    path.write_text(
+        'units = "mm-N-MPa"\n[plate]\ncorners = [[-100.0, -50.0], [100.0, 50.0]]\n'
+        "thickness = 6.0\n[material]\nE = 1000.0\nnu = 0.3\n[mesh]\nnx = 8\nny = 4\n"
+    )
+    out_mm, out_si = tmp_path / "mm.json", tmp_path / "si.json"
+    assert main(["solve", "--config", str(path), "--json", str(out_mm)]) == EXIT_OK
+    line = capsys.readouterr().out.splitlines()[0]
+    assert re.search(r"lambda_c = 1\.\d+e\+01 MPa", line), line
+    assert main(["solve", "--case", "free", "--nx", "8", "--ny", "4", "--json", str(out_si)]) == 0
+    mm, si = (json.loads(p.read_text()) for p in (out_mm, out_si))
+    assert mm["units"] == "mm-N-MPa" and mm["input"]["units"] == "SI"
+    assert mm["critical_load_Pa"] == pytest.approx(si["critical_load_Pa"], rel=1e-12)
+
+
+def test_options_that_do_not_apply_are_named(capsys):
+    args = ["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--method", "active-set"]
+    assert main([*args, "--complete", "--until-proven", "--penalty", "5"]) == EXIT_OK
+    err = capsys.readouterr().err
+    for flag in ("--complete", "--until-proven", "--penalty"):
+        assert re.search(rf"warning: {flag} \(applies to --method \w+\) is ignored", err), err
+
+
+def test_options_that_auto_does_not_use_are_named(capsys):
+    """Under auto an enumeration flag waits for auto's choice; the file's method counts.
+
+    c2 at 8x4 has i = 3 (8 candidate sets): max_candidates = 4 makes auto choose the
+    active set, which leaves --complete unused; a method set in the problem (here by
+    --set) makes --complete inapplicable before the solve, as --method would.
+    """
+    args = ["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--complete", "-q"]
+    assert main([*args, "--set", "solver.max_candidates=4"]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert re.search(
+        r"warning: --complete \(applies to --method enumerate\) was not used: "
+        r"auto chose active-set \(2\^3 = 8 candidate sets",
+        err,
+    ), err
+    assert main([*args, "--set", "solver.method=active-set"]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert (
+        "warning: --complete (applies to --method enumerate) is ignored with --method active-set"
+        in err
+    ), err
+    assert main(args) == EXIT_OK  # auto enumerates: --complete applies, no warning
+    assert "warning" not in capsys.readouterr().err
+
+
+def test_nonlinear_help_names_only_its_own_flags(capsys):
+    """The nonlinear help names no --output (it writes no fields).
+
+    An unknown flag is reported with the nonlinear usage line, not the top-level one.
+    """
+    nonlinear = build_parser()[1]["nonlinear"]
+    assert "--output" not in nonlinear.format_help()
+    with pytest.raises(SystemExit) as exit_:
+        main(["nonlinear", "--case", "c1", "--output", "x"])
+    assert exit_.value.code == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert (
+        err.startswith("usage: unibuckle nonlinear") and "unrecognized arguments: --output" in err
+    )
+
+
+def test_candidate_parallel_under_auto_enumerates(capsys):
+    """--candidate-parallel with no method: auto runs the enumeration (i = 3 here)."""
+    assert main(["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--candidate-parallel"]) == 0
+    assert "method enumerate" in capsys.readouterr().out
+    assert main(["solve", "--case", "c1", "--candidate-parallel"]) == EXIT_BAD_INPUT
+    assert "--candidate-parallel runs the enumeration" in capsys.readouterr().err
+
+
+def test_progress_lines_and_quiet(capsys):
+    """Enumeration reports each size p on stderr; -q keeps stderr empty."""
+    args = ["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--method", "enumerate"]
+    assert main([*args, "--until-proven"]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert "enumeration p = 0 done: 1 sets" in err and "enumeration p = 1 done: 3 sets" in err
+    assert main([*args, "--until-proven", "-q"]) == EXIT_OK
+    assert capsys.readouterr().err == ""
+
+
+def test_json_says_what_it_solved_and_reruns(tmp_path, capsys):
+    """The JSON holds input, versions and why auto chose; --config on it gives the same load."""
+    out, again = tmp_path / "c2.json", tmp_path / "again.json"
+    assert main(["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--json", str(out)]) == 0
+    data = json.loads(out.read_text())
+    assert data["input"]["mesh"] == {"nx": 8, "ny": 4}
+    assert data["input"]["obstacle"] == {
+        "zone": [[-0.04, 0.04], [-0.02, 0.02]],
+        "side": "above",
+        "gap": 0.0,
+    }
+    assert data["input"]["solver"]["tau"] == 1e-8  # defaults included
+    for key in ("unibuckle_fenicsx", "dolfinx", "PETSc", "SLEPc", "python"):
+        assert key in data["versions"], key
+    assert data["method"] == "enumerate"
+    assert data["method_chosen_by"].startswith("auto: 2^3 = 8 candidate sets")
+    assert main(["solve", "--config", str(out), "--json", str(again)]) == EXIT_OK
+    rerun = json.loads(again.read_text())
+    assert rerun["critical_load_Pa"] == data["critical_load_Pa"]
+    assert rerun["contact_indices"] == data["contact_indices"]
+
+
+def test_output_is_readable_by_pyvista(tmp_path, capsys):
+    """--output writes VTK (.pvd) next to the VTX (.bp) files; pyvista reads the fields."""
+    pv = pytest.importorskip("pyvista")
+    args = ["solve", "--case", "c2", "--nx", "8", "--ny", "4", "--output", str(tmp_path / "o")]
+    assert main(args) == EXIT_OK
+    mesh = pv.read(tmp_path / "o" / "c2.pvd")
+    block = mesh[0] if isinstance(mesh, pv.MultiBlock) else mesh
+    for name in ("w", "w_free", "obstacle_zone", "contact", "theta"):
+        assert name in block.point_data, name
+    assert np.abs(block.point_data["w"]).max() == pytest.approx(1.0)
+
+
+#: Pure shear on a mesh with one row of free nodes (clamped bottom and top, ny = 2): the
+#: contributions of b(w, w) above and below the row cancel, B vanishes identically.
+NO_BUCKLING_TOML = """\
+name = "shear_one_row"
+[plate]
+corners = [[0.0, 0.0], [0.3, 0.1]]
+thickness = 1e-3
+[edges.left]
+shear_stress = 1.0
+[edges.right]
+shear_stress = 1.0
+[edges.bottom]
+support = "clamped"
+shear_stress = -1.0
+[edges.top]
+support = "clamped"
+shear_stress = -1.0
+[mesh]
+nx = 6
+ny = 2
+"""
+
+#: Compression along x, tension along y, whole-plate obstacle on a 6x3 mesh: every
+#: contact set's mode crosses the obstacle (checked by enumerating all 2^10 sets).
+BLOCKED_TOML = """\
+name = "blocked"
+[plate]
+corners = [[0.0, 0.0], [0.5, 0.1]]
+thickness = 7.4e-5
+[material]
+E = 1.0e9
+nu = 0.44
+[edges.left]
+normal_stress = -0.5
+[edges.right]
+normal_stress = -0.5
+[edges.bottom]
+support = "clamped"
+normal_stress = 0.3
+[edges.top]
+support = "simply_supported_soft"
+normal_stress = 0.3
+[mesh]
+nx = 6
+ny = 3
+[obstacle]
+zone = "all"
+"""
+
+
+def test_no_buckling_load_exits_2(tmp_path, capsys):
+    """A load that buckles nothing on this mesh: refused, not 1/round-off as a load."""
+    path = tmp_path / "p.toml"
+    path.write_text(NO_BUCKLING_TOML)
+    assert main(["solve", "--config", str(path)]) == EXIT_BAD_INPUT
+    assert "no positive buckling load" in capsys.readouterr().err
+
+
+@pytest.mark.parametrize("method", ["enumerate", "active-set"])
+def test_no_admissible_mode_exits_3(method, tmp_path, capsys):
+    """No contact set has an admissible mode: exit 3 with the lower bound, no traceback."""
+    path = tmp_path / "p.toml"
+    path.write_text(BLOCKED_TOML)
+    out = tmp_path / "r.json"
+    args = ["solve", "--config", str(path), "--method", method, "--json", str(out)]
+    assert main(args) == EXIT_NOT_CERTIFIED
+    err = capsys.readouterr().err
+    assert "no admissible mode with a finite load" in err and "lambda_free" in err
+    assert not out.exists()

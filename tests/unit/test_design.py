@@ -1,0 +1,354 @@
+r"""Design output: EN 1993-1-5 slenderness and reduction factor from this package's σ_cr.
+
+Expected values are the formulas of EN 1993-1-5:2006+AC:2009, 4.4(2), written out here
+by hand: :math:`\bar\lambda_p = \sqrt{f_y/\sigma_{cr}}`; for internal compression
+elements (both unloaded edges supported), :math:`\rho = (\bar\lambda_p -
+0.055(3+\psi))/\bar\lambda_p^2` above :math:`\bar\lambda_p = 0.5 + \sqrt{0.085 -
+0.055\psi}`, 1 below (4.2); for outstand elements (one unloaded edge free),
+:math:`\rho = (\bar\lambda_p - 0.188)/\bar\lambda_p^2` above 0.748, 1 below (4.3).
+The internal threshold is the root of :math:`\lambda^2 - \lambda + 0.055(3 + \psi) =
+0`, so ρ is continuous there (1 on both sides); for ψ = 1 it is the familiar 0.673. The
+buckling factors k_σ are the values of Tables 4.1 and 4.2 at ψ = 1, 0, -1 and their
+formulas between, typed in from the tables.
+"""
+
+from __future__ import annotations
+
+import math
+
+from mpi4py import MPI
+
+import pytest
+
+from support.paths import ROOT
+from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.design import reduction_factor
+from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
+
+
+def plate(edges, *, obstacle=None, design=None, **extra):
+    data = {
+        "units": "mm-N-MPa",
+        "plate": {"corners": [[0, 0], [600, 200]], "thickness": 4.0},
+        "material": {"E": 210000.0, "nu": 0.3},
+        "edges": edges,
+        "mesh": {"nx": 12, "ny": 4},
+        "design": design or {"yield_stress": 355.0, "partial_factor": 1.1},
+        **extra,
+    }
+    if obstacle:
+        data["obstacle"] = obstacle
+    return problem_from_dict(data)
+
+
+def result(spec):
+    with solve(spec, MPI.COMM_WORLD) as analysis:
+        return analysis.result
+
+
+@pytest.mark.parametrize(
+    "slenderness, psi, rho",
+    [
+        (0.5, 1.0, 1.0),
+        (1.0, 1.0, 0.78),  # (1 - 0.22) / 1
+        (2.0, 1.0, 0.445),  # (2 - 0.22) / 4
+        (1.0, -1.0, 0.89),  # (1 - 0.11) / 1
+        (1.5, 0.0, (1.5 - 0.165) / 2.25),
+        (0.79, 0.0, 1.0),  # below 0.5 + sqrt(0.085) = 0.7915
+        (1.2, -3.0, 1.0 / 1.2),  # (1.2 - 0) / 1.44
+    ],
+)
+def test_reduction_factor_is_en_1993_1_5_eq_4_2(slenderness, psi, rho):
+    assert reduction_factor(slenderness, psi) == pytest.approx(rho, rel=1e-12)
+
+
+@pytest.mark.parametrize("psi", [1.0, 0.5, 0.0, -1.0, -2.0, -3.0])
+def test_reduction_factor_is_continuous_at_its_threshold(psi):
+    threshold = 0.5 + math.sqrt(0.085 - 0.055 * psi)
+    assert reduction_factor(threshold, psi) == 1.0
+    assert reduction_factor(threshold * (1 + 1e-9), psi) == pytest.approx(1.0, abs=1e-8)
+    with pytest.raises(ValueError, match=r"psi must lie in \[-3, 1\]"):
+        reduction_factor(1.0, -3.5)
+
+
+def test_design_keys_are_read_converted_and_written_back():
+    spec = plate({"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}})
+    assert spec.design.yield_stress == pytest.approx(355e6) and spec.design.partial_factor == 1.1
+    assert problem_from_dict(problem_to_dict(spec, units="mm-N-MPa")) == spec
+    assert problem_to_dict(spec, units="mm-N-MPa")["design"]["yield_stress"] == pytest.approx(355)
+
+
+@pytest.mark.parametrize(
+    "design, extra, match",
+    [
+        ({"yield_stress": 0.0}, {}, r"design\.yield_stress must be > 0 Pa"),
+        ({"yield_stress": 355.0, "partial_factor": -1}, {}, r"design\.partial_factor must be > 0"),
+        ({"partial_factor": 1.0}, {}, r"\[design\] needs 'yield_stress'"),
+        ({"yield_stress": 355.0, "gamma": 1.0}, {}, r"unknown key\(s\) \['gamma'\] in \[design\]"),
+    ],
+)
+def test_bad_design_tables_are_refused(design, extra, match):
+    with pytest.raises(ValueError, match=match):
+        plate({"left": {"normal_stress": -1.0}}, design=design, **extra)
+
+
+def test_design_needs_a_compressive_edge_stress():
+    edges = {name: {"inplane": "clamped"} for name in ("left", "right", "bottom", "top")}
+    with pytest.raises(ValueError, match=r"design: the EN 1993-1-5 output takes sigma_cr"):
+        plate(
+            edges,
+            load={"temperature": 1.0},
+            material={"E": 210000.0, "nu": 0.3, "thermal_expansion": 1.2e-5},
+        )
+
+
+def test_uniform_compression():
+    """Uniform: psi = 1, sigma_cr = lambda_c; slenderness, rho, rho f_y / gamma_M1 by hand."""
+    out = result(plate({"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}))
+    d = out.design
+    assert d.sigma_cr_Pa == out.critical_load_Pa and d.psi == 1.0
+    slenderness = math.sqrt(355e6 / out.critical_load_Pa)
+    assert d.relative_slenderness == pytest.approx(slenderness, rel=1e-14)
+    rho = min(1.0, (slenderness - 0.22) / slenderness**2) if slenderness > 0.5 + 0.03**0.5 else 1
+    assert d.reduction_factor == pytest.approx(rho, rel=1e-14)
+    assert d.reduced_design_stress_Pa == pytest.approx(rho * 355e6 / 1.1, rel=1e-14)
+    assert "calibrated on plates buckling freely to both sides" in d.notes[0]
+    assert "4.4(2), eq. (4.2)" in d.clauses
+    assert "EN 1993-1-5: sigma_cr" in out.summary()
+
+
+def test_stress_gradient_obstacle_shear_and_fixed_part():
+    """The critical state's edge stresses give psi; notes for the obstacle and the shear."""
+    edges = {
+        "left": {"normal_stress": [-1.0, 0.0], "fixed_normal_stress": [-20.0, 20.0]},
+        "right": {"normal_stress": [-1.0, 0.0], "fixed_normal_stress": [-20.0, 20.0]},
+        "bottom": {"fixed_shear_stress": 5.0},
+        "top": {"fixed_shear_stress": 5.0},
+    }
+    edges["left"]["fixed_shear_stress"] = edges["right"]["fixed_shear_stress"] = -5.0
+    out = result(plate(edges, obstacle={"zone": "all"}))
+    lam = out.critical_load_Pa
+    sigma1, sigma2 = 20e6 + lam, -20e6  # compression positive, at y = 0 and y = b
+    d = out.design
+    assert d.sigma_cr_Pa == pytest.approx(sigma1, rel=1e-14)
+    assert d.psi == pytest.approx(sigma2 / sigma1, rel=1e-14)
+    assert any("unilateral" in n for n in d.notes) and any("section 10" in n for n in d.notes)
+
+
+# -- outstand elements (one unloaded edge free) ------------------------------------------
+@pytest.mark.parametrize(
+    "slenderness, psi, rho",
+    [
+        (0.748, 1.0, 1.0),
+        (0.7, -1.0, 1.0),
+        (1.0, 1.0, 0.812),  # (1 - 0.188) / 1
+        (1.5, 0.0, (1.5 - 0.188) / 2.25),
+        (1.5, -1.0, (1.5 - 0.188) / 2.25),  # psi does not enter (4.3)
+        (5.0, -3.0, (5.0 - 0.188) / 25.0),
+    ],
+)
+def test_outstand_reduction_factor_is_en_1993_1_5_eq_4_3(slenderness, psi, rho):
+    assert reduction_factor(slenderness, psi, "outstand") == pytest.approx(rho, rel=1e-12)
+
+
+def test_the_internal_formula_is_unconservative_for_an_outstand_below_psi_0_42():
+    """The issue's numbers: at slenderness 1.5 and psi = -1, 0.618 (internal) > 0.583."""
+    internal, outstand = reduction_factor(1.5, -1.0), reduction_factor(1.5, -1.0, "outstand")
+    assert internal == pytest.approx((1.5 - 0.11) / 2.25, rel=1e-12)  # 0.6178
+    assert outstand == pytest.approx(1.312 / 2.25, rel=1e-12)  # 0.5831
+    assert internal > outstand
+    # Equal where 0.055 (3 + psi) = 0.188, psi = 0.418; above, the outstand's is larger.
+    assert reduction_factor(1.5, 0.5) < reduction_factor(1.5, 0.5, "outstand")
+
+
+@pytest.mark.parametrize(
+    "element, at_free, psi, k",
+    [
+        ("internal", True, 1.0, 4.0),
+        ("internal", True, 0.5, 8.2 / 1.55),
+        ("internal", True, 0.0, 7.81),
+        ("internal", True, -0.5, 7.81 + 3.145 + 2.445),
+        ("internal", True, -1.0, 23.9),
+        ("internal", True, -2.0, 5.98 * 9.0),
+        ("outstand", True, 1.0, 0.43),
+        ("outstand", True, 0.0, 0.57),
+        ("outstand", True, -1.0, 0.85),
+        ("outstand", True, -3.0, 0.57 + 0.63 + 0.63),
+        ("outstand", False, 1.0, 0.43),
+        ("outstand", False, 0.5, 0.578 / 0.84),
+        ("outstand", False, 0.0, 1.70),
+        ("outstand", False, -0.5, 1.70 + 2.5 + 4.275),
+        ("outstand", False, -1.0, 23.8),
+    ],
+)
+def test_buckling_factors_of_tables_4_1_and_4_2(element, at_free, psi, k):
+    from unibuckle_fenicsx.en1993 import buckling_factor
+
+    assert buckling_factor(element, psi, at_free) == pytest.approx(k, rel=1e-12)
+
+
+def test_table_4_2_ranges():
+    """Larger compression at the supported edge: Table 4.2 stops at psi = -1."""
+    from unibuckle_fenicsx.en1993 import buckling_factor
+
+    with pytest.raises(ValueError, match=r"psi must lie in \[-1, 1\] \(EN 1993-1-5, Table 4.2"):
+        buckling_factor("outstand", -1.5, False)
+    assert buckling_factor("outstand", -1.5, True) > 0.0
+
+
+OUTSTAND_EDGES = {
+    "left": {"normal_stress": -1.0},
+    "right": {"normal_stress": -1.0},
+    "top": {"support": "free"},
+}
+
+
+def _outstand(edges=None, **extra):
+    """The issue's plate: 3 x 1 m, t = 10 mm, steel, top edge free, f_y = 355 MPa."""
+    data = {
+        "plate": {"corners": [[0, 0], [3.0, 1.0]], "thickness": 0.01},
+        "material": {"E": 2.1e11, "nu": 0.3},
+        "edges": edges or OUTSTAND_EDGES,
+        "mesh": {"nx": 12, "ny": 4},
+        "design": {"yield_stress": 3.55e8},
+        **extra,
+    }
+    return problem_from_dict(data)
+
+
+def test_an_outstand_gets_the_outstand_reduction_factor():
+    """A free unloaded edge: rho = (lambda_p - 0.188) / lambda_p^2, and the JSON says so.
+
+    Before, the internal element's (lambda_p - 0.22) / lambda_p^2 was returned.
+    """
+    out = result(_outstand())
+    d = out.design
+    slenderness = math.sqrt(3.55e8 / out.critical_load_Pa)
+    assert d.relative_slenderness == pytest.approx(slenderness, rel=1e-14)
+    assert d.element == "outstand" and d.free_edge == "top"
+    assert d.reduction_factor == pytest.approx((slenderness - 0.188) / slenderness**2, 1e-14)
+    assert d.k_sigma_table == 0.43 and d.psi == 1.0
+    assert "outstand compression element (edges.top free)" in d.clauses
+    assert "eq. (4.3)" in d.clauses and "Table 4.2" in d.clauses
+    assert "outstand element (free edge top)" in out.summary()
+
+
+def test_an_internal_element_says_so():
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    d = result(_outstand(edges)).design
+    assert d.element == "internal" and d.free_edge is None and d.k_sigma_table == 4.0
+    assert "internal compression element" in d.clauses and "Table 4.1" in d.clauses
+
+
+@pytest.mark.parametrize(
+    ("free", "at_free", "k"),
+    [("top", False, 1.70), ("bottom", True, 0.57)],
+)
+def test_the_outstand_row_follows_the_larger_compression(free, at_free, k):
+    """sigma_x = -lambda (1 - y/b): largest at the bottom edge, zero at the top (psi = 0).
+
+    With the top free the larger compression acts at the supported edge (Table 4.2,
+    lower row: k = 1.70), with the bottom free at the free edge (upper row: 0.57).
+    """
+    gradient = {"normal_stress": [-1.0, 0.0]}
+    edges = {"left": gradient, "right": gradient, free: {"support": "free"}}
+    d = result(_outstand(edges)).design
+    assert d.psi == 0.0 and d.k_sigma_table == k and d.free_edge == free
+    where = "free" if at_free else "supported"
+    assert f"larger compression at the {where} edge" in d.table
+
+
+REFUSED = [
+    (
+        {"top": {"support": "free"}, "bottom": {"support": "free"}},
+        {},
+        r"edges\.bottom\.support and edges\.top\.support are both \"free\".*strut",
+    ),
+    (
+        {"bottom": {"normal_stress": -0.5}},
+        {},
+        r"edges\.left\.normal_stress, edges\.right\.normal_stress, edges\.bottom\.normal_stress "
+        r"give normal stress in both directions",
+    ),
+    (
+        {"top": {"support": "free", "translational_stiffness": 1e6}},
+        {},
+        r"edges\.top\.translational_stiffness: an unloaded edge on springs",
+    ),
+    ({"top": {"inplane": "roller"}}, {}, r"edges\.top\.inplane = \"roller\" holds an unloaded"),
+    (
+        {"left": {"normal_stress": [-1.0, 2.0]}, "right": {"normal_stress": [-1.0, 2.0]},
+         "top": {"support": "free"}},
+        {},
+        r"edges\.left\.normal_stress gives the stress ratio psi = sigma_2/sigma_1 = -2, "
+        r"outside EN 1993-1-5 Table 4\.2 \(outstand .* at the supported edge\)",
+    ),
+    (
+        {"left": {"normal_stress": [-1.0, 4.0]}, "right": {"normal_stress": [-1.0, 4.0]}},
+        {},
+        r"psi = sigma_2/sigma_1 = -4, outside EN 1993-1-5 Table 4\.1",
+    ),
+    (
+        {"left": {"normal_stress": -1.0, "inplane": "clamped"}},
+        {"load": {"temperature": 1.0},
+         "material": {"E": 2.1e11, "nu": 0.3, "thermal_expansion": 1.2e-5}},
+        r"design: load\.temperature: a temperature rise adds a membrane stress",
+    ),
+]  # fmt: skip
+
+
+@pytest.mark.parametrize(("edges", "extra", "match"), REFUSED)
+def test_what_clause_4_4_does_not_describe_is_refused(edges, extra, match):
+    base = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    merged = {name: {**base.get(name, {}), **edges.get(name, {})} for name in (*base, *edges)}
+    with pytest.raises(ValueError, match=match):
+        _outstand(merged, **extra)
+
+
+def test_an_outline_plate_is_refused():
+    data = {
+        "plate": {"outline": [[0, 0], [3, 0], [3, 1], [0, 1]], "thickness": 0.01},
+        "edges": {"ends": {"segments": [1, 3], "normal_stress": -1.0}},
+        "mesh": {"size": 0.25},
+        "design": {"yield_stress": 3.55e8},
+    }
+    with pytest.raises(ValueError, match=r"design: .* this plate is given by its outline"):
+        problem_from_dict(data)
+
+
+def test_a_rectangle_with_a_hole_is_classified_by_its_edges():
+    """The README's plate (clamped all round, a 40 mm hole): an internal element, a note.
+
+    Its unloaded edges (bottom, top) are clamped: internal, Table 4.1. At sigma_cr = 1.753e9
+    Pa (the README's load), psi = 1: lambda_p = sqrt(3.55e8/1.753e9) = 0.45 <= 0.673, rho = 1
+    by eq. (4.2); the output says that 4.4 describes plates without openings.
+    """
+    from unibuckle_fenicsx import load_toml
+    from unibuckle_fenicsx.design import design_output
+
+    spec = load_toml(ROOT / "demos" / "plate.toml")
+    assert spec.plate.holes
+    out = design_output(spec, spec.design, 1.753e9)
+    assert (out.element, out.free_edge, out.psi) == ("internal", None, 1.0)
+    assert out.relative_slenderness == pytest.approx(math.sqrt(3.55e8 / 1.753e9), rel=1e-14)
+    assert out.reduction_factor == 1.0
+    assert any("without openings" in note for note in out.notes), out.notes
+
+
+def test_psi_outside_the_table_with_a_fixed_part_gives_no_rho():
+    """With a fixed normal stress psi depends on the load: no refusal, no rho, a note.
+
+    In-plane bending (bottom compressed) plus a fixed tension at the free top edge:
+    sigma_1 = lambda at the supported bottom, sigma_2 = -(lambda + 1 MPa) at the top,
+    psi = -1 - 1e6/lambda < -1, below Table 4.2's lower row.
+    """
+    gradient = {"normal_stress": [-1.0, 1.0], "fixed_normal_stress": [0.0, 1e6]}
+    edges = {"left": gradient, "right": gradient, "top": {"support": "free"}}
+    out = result(_outstand(edges))
+    d = out.design
+    lam = out.critical_load_Pa
+    assert d.sigma_cr_Pa == pytest.approx(lam, rel=1e-14)
+    assert d.psi == pytest.approx(-1.0 - 1e6 / lam, rel=1e-12)
+    assert d.reduction_factor is None and d.k_sigma_table is None
+    assert "outside Table 4.2" in d.notes[-1]
+    assert "rho = none (psi outside Table 4.2" in out.summary()

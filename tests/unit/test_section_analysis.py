@@ -1,0 +1,106 @@
+"""The Python entry point for sections: ``unibuckle_fenicsx.solve_section``.
+
+The loads themselves are checked elsewhere (``tests/unit/model/test_shell_core.py``: the
+active set against a dense enumeration of every contact set on this same small box;
+``tests/verification/test_shell_convergence.py``: the classical anchors). Here the record:
+each field against its definition worked out by hand (k = sigma t b^2/(pi^2 D) with the widest face,
+the classical stresses 4 pi^2 D/(t b^2) and E t/(R sqrt(3(1 - nu^2)))), interlacing
+(the core never lowers the load), the certificate's bracket, the sign of the core's push
+(a rigid core pushes, never pulls: KKT), and bad input refused before any mesh.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+from mpi4py import MPI
+
+import pytest
+
+import unibuckle_fenicsx
+from unibuckle_fenicsx import SectionParameters, solve_section
+from unibuckle_fenicsx.errors import InputError
+
+pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial sections")
+
+E, NU, T = 2.1e11, 0.3, 0.002
+D = E * T**3 / (12.0 * (1.0 - NU**2))
+
+
+def _box(**changes):
+    base = {
+        "width": 0.2, "depth": 0.1, "thickness": T, "length": 0.2, "E": E, "nu": NU,
+        "mesh_size": 0.1, "ends": "simply_supported", "core": True,
+    }  # fmt: skip
+    return SectionParameters("box", **{**base, **changes})
+
+
+def test_box_with_a_core_gives_the_plate_record():
+    with solve_section(_box(), MPI.COMM_SELF, levels=0) as analysis:
+        r = analysis.result
+        assert isinstance(r, unibuckle_fenicsx.results.records.BucklingResult)
+        load = r.critical_load_Pa
+        # The widest face is the width, 0.2 m (the depth is 0.1 m).
+        assert r.buckling_coefficient_k == pytest.approx(T * load * 0.2**2 / (math.pi**2 * D))
+        assert r.classical_stress_Pa == pytest.approx(4.0 * math.pi**2 * D / (T * 0.2**2))
+        assert r.critical_force_N_per_m == pytest.approx(T * load)
+        assert r.free_load_Pa <= load and r.ratio_to_free == pytest.approx(load / r.free_load_Pa)
+        cert = r.certificate
+        assert cert is not None and cert.kkt
+        assert r.lower_bound_Pa <= load * (1 + 1e-9)
+        assert r.upper_bound_Pa is None or load <= r.upper_bound_Pa * (1 + 1e-9)
+        assert r.constrained_nodes == 12 and 0 < r.contact_nodes == len(r.contact_coordinates)
+        assert r.contact_force is not None
+        push = r.contact_force.push
+        assert len(push) == r.contact_nodes
+        assert r.contact_force.resolution is not None
+        assert min(push) >= -r.contact_force.resolution
+        data = json.loads(json.dumps(r.as_dict()))
+        assert data["input"]["section"]["shape"] == "box" and data["input"]["section"]["core"]
+        assert "x hollow" in r.summary() and "KKT = yes" in r.summary()
+        # The 3-D figure's arrays come with it: the contact set drawn on the walls.
+        fig = analysis.figure_data()
+        assert len(fig.pressing) + len(fig.touching) == r.contact_nodes
+        assert analysis.mode.x.array.size == r.dofs
+
+
+def test_tube_without_a_core_is_its_free_load():
+    params = SectionParameters(
+        "tube", diameter=0.2, thickness=T, length=0.1, E=E, nu=NU, mesh_size=0.05,
+        ends="simply_supported",
+    )  # fmt: skip
+    with solve_section(params, MPI.COMM_SELF) as analysis:
+        r = analysis.result
+        assert r.method == "free" and r.certificate is None and analysis.solution is None
+        assert r.critical_load_Pa == r.free_load_Pa == r.lower_bound_Pa == r.upper_bound_Pa
+        assert r.buckling_coefficient_k is None
+        assert r.classical_stress_Pa == pytest.approx(E * T / (0.1 * math.sqrt(3 * (1 - NU**2))))
+        assert r.constrained_nodes == 0 and r.contact_force is None
+
+
+@pytest.mark.parametrize(
+    ("call", "error", "words"),
+    [
+        (lambda: solve_section({"shape": "box"}), TypeError, "SectionParameters"),
+        (lambda: solve_section(_box(), levels=-1), InputError, "levels"),
+        (lambda: solve_section(_box(), levels=1.5), InputError, "levels"),
+        (lambda: _box(diameter=0.2), InputError, "section.diameter"),
+        (lambda: _box(core=False, core_span=(0.0, 0.1)), InputError, "core_span"),
+        (lambda: _box(thickness=0.05), InputError, "section.thickness"),
+    ],
+)
+def test_bad_section_input_is_refused_before_any_mesh(call, error, words):
+    with pytest.raises(error, match=words):
+        call()
+
+
+def test_sections_are_public_and_lazy():
+    """Exported in ``__all__``; importing the package imports no DOLFINx (the plate rule)."""
+    import subprocess
+    import sys
+
+    assert {"SectionParameters", "solve_section"} <= set(unibuckle_fenicsx.__all__)
+    code = "import sys, unibuckle_fenicsx; print('dolfinx' in sys.modules)"
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
+    assert out.stdout.strip() == "False"

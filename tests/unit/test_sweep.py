@@ -1,0 +1,384 @@
+"""Sweeps: the --vary grammar, the paths, resuming a killed sweep, MPI, and the garland.
+
+The garland test compares the bilateral SSSS curve with the exact thin-plate value
+k = min_m (m/phi + phi/m)^2 (Timoshenko and Gere, Theory of Elastic Stability, 1961,
+section 9.2); the other tests compare a sweep with itself run differently (killed and
+resumed, or under mpiexec), which is what they are about.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+from pathlib import Path
+
+from mpi4py import MPI
+
+import numpy as np
+import pytest
+
+from support.paths import ROOT
+from support.processes import paused_sweep, run_mpi
+from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK
+from unibuckle_fenicsx.spec import (
+    MeshSpec,
+    load_toml,
+    problem_from_dict,
+    problem_to_dict,
+)
+from unibuckle_fenicsx.sweep import (
+    Variation,
+    parse_variation,
+    point_problem,
+    read_lines,
+    set_value,
+    sweep_points,
+)
+from unibuckle_fenicsx.viz.charts import reference_k
+
+SCRIPT = Path(sys.executable).parent / "unibuckle"
+
+#: A small plate with a box obstacle: each point is an enumeration of a few sets (~1 s).
+SMALL = """\
+name = "small"
+[plate]
+corners = [[-0.1, -0.05], [0.1, 0.05]]
+thickness = 0.006
+[material]
+E = 1.0e9
+nu = 0.3
+[mesh]
+nx = 6
+ny = 4
+[obstacle]
+zone = [[-0.04, 0.04], [-0.05, 0.05]]
+"""
+VARY = ("--vary", "plate.thickness=0.004,0.005,0.006,0.007")
+
+SSSS = """\
+name = "ssss"
+[plate]
+corners = [[0.0, 0.0], [1.0, 1.0]]
+thickness = 0.001
+[material]
+E = 1.0e9
+nu = 0.3
+[edges.left]
+normal_stress = -1.0
+[edges.right]
+normal_stress = -1.0
+[mesh]
+size = {size}
+"""
+
+
+def run_sweep_cli(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
+    env = {**os.environ, "OMP_NUM_THREADS": "1"}
+    return subprocess.run(
+        [str(SCRIPT), "sweep", *args], capture_output=True, text=True, env=env, cwd=cwd
+    )
+
+
+# -- the grammar --------------------------------------------------------------------
+
+
+def test_range_and_list():
+    v = parse_variation("plate.corners.1.0=0.1:0.4:7")
+    assert v.path == "plate.corners.1.0"
+    np.testing.assert_allclose(v.values, np.linspace(0.1, 0.4, 7), rtol=0, atol=1e-15)
+    assert v.values[0] == 0.1 and v.values[-1] == 0.4  # ends exactly included
+    assert parse_variation("material.nu=0.2, 0.3,0.35").values == (0.2, 0.3, 0.35)
+    assert parse_variation("mesh.nx=8:8:1").values == (8.0,)
+
+
+@pytest.mark.parametrize(
+    ("text", "message"),
+    [
+        ("plate.thickness", "expected PATH=START:STOP:N"),
+        ("plate.thickness=", "expected PATH=START:STOP:N"),
+        ("plate.thickness=0.1:0.2:0", "N must be an integer >= 1"),
+        ("plate.thickness=0.1:0.2:2.5", "N must be an integer >= 1"),
+        ("plate.thickness=0.1:abc:3", "'abc' is not a number"),
+        ("plate.thickness=0.1,nan", "not a finite number"),
+    ],
+)
+def test_bad_variation(text, message):
+    with pytest.raises(ValueError, match=message):
+        parse_variation(text)
+
+
+def test_grid_order_first_slowest():
+    points = sweep_points([Variation("a", (1.0, 2.0)), Variation("b", (10.0, 20.0, 30.0))])
+    assert points == [
+        {"a": a, "b": b} for a in (1.0, 2.0) for b in (10.0, 20.0, 30.0)
+    ]  # fmt: skip
+    with pytest.raises(ValueError, match="given twice"):
+        sweep_points([Variation("a", (1.0,)), Variation("a", (2.0,))])
+
+
+def test_paths(tmp_path):
+    path = tmp_path / "small.toml"
+    path.write_text(SMALL)
+    base = problem_to_dict(load_toml(path))
+    spec = point_problem(base, {"plate.corners.1.0": 0.3, "material.nu": 0.25})
+    assert spec.plate.corners == ((-0.1, -0.05), (0.3, 0.05))
+    assert spec.material.nu == 0.25
+    spec = point_problem(base, {"plate.length": 0.5, "plate.width": 0.2})
+    assert spec.plate.corners == ((-0.1, -0.05), (-0.1 + 0.5, -0.05 + 0.2))
+    spec = point_problem(base, {"mesh.nx": 10.0, "edges.top.shear_stress": 0.5})
+    assert spec.mesh.nx == 10 and isinstance(spec.mesh.nx, int)
+    # The base's own loads stay: left/right compressed, top sheared.
+    assert spec.plate.edge("left").normal_stress == -1.0
+    assert spec.plate.edge("top").shear_stress == 0.5
+    for path_, message in (
+        ("plate.depth", "plate has no key 'depth'"),
+        ("plate.corners.2.0", "is a list of 2"),
+        ("edges.left.support", "is not a number"),
+        ("mesh.nx", "must be an integer"),
+    ):
+        with pytest.raises(ValueError, match=message):
+            set_value(problem_to_dict(load_toml(path)), path_, 2.5)
+    with pytest.raises(ValueError, match=r"plate\.thickness must be > 0"):
+        point_problem(base, {"plate.thickness": -1.0})
+
+
+def test_mesh_size_and_units():
+    # ceil(0.3/0.01) = 30, ceil(0.1/0.01) = 10: an exact division gives no extra cell.
+    assert MeshSpec.cells_for(0.3, 0.1, 0.01) == (30, 10)
+    assert MeshSpec.cells_for(0.3, 0.1, 0.07) == (5, 2)
+    data = {"plate": {"corners": [[0, 0], [0.3, 0.1]]}, "mesh": {"size": 0.02}}
+    spec = problem_from_dict(data)
+    assert (spec.mesh.nx, spec.mesh.ny, spec.mesh.size) == (15, 5, 0.02)
+    assert problem_from_dict(problem_to_dict(spec)) == spec
+    with pytest.raises(ValueError, match=r"size \(a cell size\) or nx and ny, not both"):
+        problem_from_dict({"mesh": {"size": 0.02, "nx": 4}})
+    # A file in mm-N-MPa written back in its own units reads as the same problem.
+    mm = problem_from_dict(
+        {"units": "mm-N-MPa", "plate": {"corners": [[0, 0], [300, 100]], "thickness": 1.0},
+         "material": {"E": 2.1e5, "nu": 0.3}, "mesh": {"size": 20.0}}
+    )  # fmt: skip
+    back = problem_to_dict(mm, units="mm-N-MPa")
+    assert back["plate"]["corners"] == [[0.0, 0.0], [300.0, 100.0]]
+    assert back["material"]["E"] == pytest.approx(2.1e5, rel=1e-15)
+    assert problem_from_dict(back) == mm
+
+
+# -- the command: resume, errors, chart ---------------------------------------------
+
+
+def test_killed_sweep_resumes_to_the_same_file(tmp_path):
+    base = tmp_path / "small.toml"
+    base.write_text(SMALL)
+    whole = run_sweep_cli("--config", str(base), *VARY, "--json", "whole.jsonl", cwd=tmp_path)
+    assert whole.returncode == EXIT_OK, whole.stderr
+    expected = (tmp_path / "whole.jsonl").read_text()
+    assert [line["status"] for line in read_lines(tmp_path / "whole.jsonl")] == ["ok"] * 4
+
+    # Kill the same sweep once its first line is on disk (paused there: no race with the
+    # sweep's speed, which depends on the machine's load).
+    out = tmp_path / "killed.jsonl"
+    proc = paused_sweep(["--config", str(base), *VARY, "--json", str(out), "-q"], tmp_path)
+    proc.send_signal(signal.SIGKILL)
+    proc.wait()
+    done = read_lines(out)
+    assert len(done) == 1, "killed after its first point"
+    # A line cut by the kill is dropped on resume.
+    with out.open("a") as f:
+        f.write('{"index": 3, "point": {"plate.thick')
+    again = run_sweep_cli("--config", str(base), *VARY, "--json", str(out), cwd=tmp_path)
+    assert again.returncode == EXIT_OK, again.stderr
+    assert f"{len(done)} of 4 points already in" in again.stderr
+    assert out.read_text() == expected
+
+    # Another sweep into the same file is refused before solving.
+    other = run_sweep_cli(
+        "--config", str(base), "--vary", "plate.thickness=0.001,0.002", "--json", str(out),
+        cwd=tmp_path,
+    )  # fmt: skip
+    assert other.returncode == EXIT_BAD_INPUT
+    assert "holds a point of another sweep" in other.stderr
+
+
+def test_a_line_is_reused_only_for_the_same_input(tmp_path, capsys):
+    """Edit the base file (E halved) and re-run: every point is solved again.
+
+    With the edge stress given, N0 does not depend on E and a, the bending and shear
+    energy, is proportional to it: the loads halve exactly (to the eigen solver's
+    tolerance). A line of the same input is kept; the file ends as a fresh sweep's.
+    """
+    from unibuckle_fenicsx.cli import main
+
+    base = tmp_path / "small.toml"
+    base.write_text(SMALL)
+    out = tmp_path / "k.jsonl"
+    args = ["sweep", "--config", str(base), "--vary", "plate.thickness=0.005,0.006"]
+    assert main([*args, "--json", str(out)]) == EXIT_OK
+    before = read_lines(out)
+    capsys.readouterr()
+
+    base.write_text(SMALL.replace("E = 1.0e9", "E = 0.5e9"))
+    assert main([*args, "--json", str(out)]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert f"2 line(s) of {out} hold another input" in err, err
+    after = read_lines(out)
+    for old, new in zip(before, after, strict=True):
+        assert new["input"]["material"]["E"] == 0.5e9
+        assert new["critical_load_Pa"] == pytest.approx(old["critical_load_Pa"] / 2, rel=1e-8)
+    fresh = tmp_path / "fresh.jsonl"
+    assert main([*args, "--json", str(fresh)]) == EXIT_OK
+    assert out.read_text() == fresh.read_text()
+
+    # One point of the same input is kept, the other (a line of another input) solved.
+    lines = out.read_text().splitlines()
+    stale = json.loads(lines[1])
+    stale["input"]["material"]["E"] = 1.0e9
+    stale["critical_load_Pa"] = 1.0
+    out.write_text(lines[0] + "\n" + json.dumps(stale) + "\n")
+    capsys.readouterr()
+    assert main([*args, "--json", str(out)]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert "1 of 2 points already in" in err and "1 line(s)" in err, err
+    assert out.read_text() == fresh.read_text()
+
+
+def test_bad_sweep_input(tmp_path):
+    base = tmp_path / "small.toml"
+    base.write_text(SMALL)
+    for vary, message in (
+        ("plate.thickness=-0.001,0.006", "plate.thickness must be > 0"),
+        ("plate.nothing=1,2", "plate has no key 'nothing'"),
+        ("plate.thickness=1:2", "a range is START:STOP:N"),
+    ):
+        proc = run_sweep_cli(
+            "--config", str(base), "--vary", vary, "--json", "x.jsonl", cwd=tmp_path
+        )
+        assert proc.returncode == EXIT_BAD_INPUT, proc.stderr
+        assert message in proc.stderr
+        assert not (tmp_path / "x.jsonl").exists() or not read_lines(tmp_path / "x.jsonl")
+
+
+# -- the garland ----------------------------------------------------------------------
+
+
+@pytest.mark.parametrize("phi", [0.6, 1.0, 1.5, 2.2])
+def test_bilateral_garland(tmp_path, phi):
+    """SSSS, uniaxial: k within the MITC4 mesh error of min_m (m/phi + phi/m)^2.
+
+    At h = b/12 (t/b = 1e-3) the measured error is 0.9-1.8 %, positive, and it falls as
+    h^2: at b/16 it is smaller by (16/12)^2 = 1.78 within 25 %.
+    """
+    path = tmp_path / "ssss.toml"
+    errors = []
+    for size in (1 / 12, 1 / 16):
+        path.write_text(SSSS.format(size=size))
+        spec = point_problem(problem_to_dict(load_toml(path)), {"plate.length": phi})
+        exact = reference_k(spec)[0]
+        assert exact is not None
+        with solve(spec, MPI.COMM_SELF) as analysis:
+            errors.append(analysis.result.buckling_coefficient_k / exact - 1.0)
+    assert 0.0 < errors[0] < 0.02
+    assert errors[0] / errors[1] == pytest.approx((16 / 12) ** 2, rel=0.25)
+
+
+def test_reference_values():
+    """The curves drawn on the charts, at points where they are known by hand."""
+    data = {"plate": {"corners": [[0, 0], [1.0, 1.0]], "thickness": 1e-3}}
+    square = problem_from_dict(data)
+    assert reference_k(square) == (4.0, None, "exact")  # m = 1: (1 + 1)^2
+    data["plate"]["corners"] = [[0, 0], [np.sqrt(2), 1.0]]
+    data["obstacle"] = {"zone": "all"}
+    bil, uni, _ = reference_k(problem_from_dict(data))
+    assert bil == pytest.approx(4.5) and uni == pytest.approx(4.5)  # the m = 1, 2 crossing
+    data["plate"]["corners"] = [[0, 0], [3.0, 1.0]]
+    bil, uni, _ = reference_k(problem_from_dict(data))
+    assert bil == pytest.approx(4.0) and uni == 4.5
+
+
+# -- MPI ----------------------------------------------------------------------------
+
+
+@pytest.mark.slow
+@pytest.mark.mpi
+@pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="launches mpiexec itself")
+def test_two_ranks_give_the_serial_lines(tmp_path):
+    base = tmp_path / "small.toml"
+    base.write_text(SMALL)
+    serial = run_sweep_cli("--config", str(base), *VARY, "--json", "serial.jsonl", cwd=tmp_path)
+    assert serial.returncode == EXIT_OK, serial.stderr
+    cli = ROOT / "unibuckle_fenicsx" / "cli.py"
+    run_mpi(cli, 2, "sweep", "--config", str(base), *VARY, "--json", str(tmp_path / "p.jsonl"))
+    assert (tmp_path / "p.jsonl").read_text() == (tmp_path / "serial.jsonl").read_text()
+    # Each point's mesh over both ranks: the same loads within the eigen tolerance.
+    run_mpi(
+        cli, 2, "sweep", "--config", str(base), *VARY, "--json", str(tmp_path / "r2.jsonl"),
+        "--ranks-per-point", "2",
+    )  # fmt: skip
+    for a, b in zip(
+        read_lines(tmp_path / "serial.jsonl"), read_lines(tmp_path / "r2.jsonl"), strict=True
+    ):
+        assert a["point"] == b["point"] and a["status"] == b["status"] == "ok"
+        assert b["mpi_size"] == 2
+        assert b["critical_load_Pa"] == pytest.approx(a["critical_load_Pa"], rel=1e-8)
+        np.testing.assert_allclose(b["contact_coordinates"], a["contact_coordinates"], atol=1e-15)
+
+
+def test_plot(tmp_path):
+    base = tmp_path / "small.toml"
+    base.write_text(SMALL)
+    proc = run_sweep_cli(
+        "--config", str(base), "--vary", "plate.length=0.2,0.3", "--json", "l.jsonl",
+        "--plot", "chart.png", "-q", cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == EXIT_OK, proc.stderr
+    assert "chart.png" in proc.stdout
+    png = (tmp_path / "chart.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n" and len(png) > 10_000
+    assert json.loads((tmp_path / "l.jsonl").read_text().splitlines()[1])["point"] == {
+        "plate.length": 0.3
+    }
+
+
+def test_a_thin_plate_line_is_the_same_on_every_run(thin_plate):
+    """A sweep line leaves out every wall time, the interior point's level records' too.
+
+    The route on thin plates records seconds per mesh level and link; a line
+    (``as_dict(timings=False)``, README "Sweeps and charts") must not carry them, or two
+    runs (and a run on two ranks) would write different lines.
+    """
+    spec = thin_plate("thin", 12, 4)
+    lines = []
+    for _ in range(2):
+        with solve(spec) as analysis:
+            assert analysis.result.method.startswith("interior-point")
+            assert analysis.result.details.run.levels[0].seconds > 0.0
+            lines.append(json.dumps(analysis.result.as_dict(timings=False), sort_keys=True))
+    assert lines[0] == lines[1]
+    assert '"seconds"' not in lines[0]
+
+
+def test_ranks_per_point_errors_name_the_flag(tmp_path):
+    """A bad ranks_per_point names the command line's flag as well (--ranks-per-point)."""
+    from unibuckle_fenicsx.sweep import run_sweep
+
+    v = [parse_variation("material.nu=0.2,0.3")]
+    for bad, why in ((0, r"must be an integer >= 1"), (MPI.COMM_WORLD.size + 1, "must divide")):
+        with pytest.raises(ValueError, match=rf"ranks_per_point \(--ranks-per-point\).*{why}"):
+            run_sweep({}, v, tmp_path / "s.jsonl", MPI.COMM_WORLD, ranks_per_point=bad)
+
+
+def test_chart_axes_name_the_swept_number_in_words():
+    """An axis reads "tie spacing (m)", not the dotted key ``points.0.spacing``."""
+    from unibuckle_fenicsx.viz.charts import axis_label
+
+    base = {"units": "SI", "points": [{"kind": "bilateral", "spacing": 0.5}]}
+    assert axis_label("points.0.spacing", base) == "tie spacing (m)"
+    assert axis_label("points.0.spacing", {**base, "units": "mm-N-MPa"}) == "tie spacing (mm)"
+    assert axis_label("plate.thickness", base) == "plate thickness (m)"
+    assert axis_label("edges.top.rotational_stiffness", base) == (
+        "rotational stiffness of the top edge (N·m/(m·rad))"
+    )
+    assert axis_label("obstacle.foundation_stiffness", base) == "foundation modulus (Pa/m)"
