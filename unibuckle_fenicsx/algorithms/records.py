@@ -135,9 +135,6 @@ class LinkRecord(Struct):
         load: The load it ended with (None if none).
         contact_nodes: |Z| (None if no contact set was read).
         kkt: It ended at a KKT point.
-        tolerance: The tolerance of that KKT point where it is not ``solver.tau`` (a
-            state within the load's resolution:
-            :func:`~.interior_point.links.resolved`), else None.
     """
 
     link: str
@@ -150,7 +147,6 @@ class LinkRecord(Struct):
     load: float | None = None
     contact_nodes: int | None = None
     kkt: bool = False
-    tolerance: float | None = None
 
 
 class LevelRecord(Struct, kw_only=True):

@@ -85,10 +85,8 @@ class Certificate:
         max_contact_value: :math:`\max_Z |u_k| / \max|w|` (0 for an eigenvector of the
             reduced pencil; checked, not assumed).
         relative_residual: :math:`\|r\ \text{off}\ Z\|_2 / \|Au\|_2`.
-        tolerance: The :math:`\tau` of the values and forces: ``solver.tau``, or the larger
-            tolerance of a KKT point within the load's resolution (interior point).
-        kkt: Feasible, forces at most :math:`\tau`, residual at most :math:`\sqrt\tau`
-            (of ``solver.tau``).
+        tolerance: :math:`\tau`.
+        kkt: Feasible, forces at most :math:`\tau`, residual at most :math:`\sqrt\tau`.
         smallest_of_reduced: :math:`\lambda` is the smallest eigenvalue of the reduced
             pencil (inertia check, on every route); ``None`` when not checked
             (certification off, or a mode not computed by an eigen solve).
@@ -286,7 +284,7 @@ def certify(
         max_contact_force=cand.max_force,
         max_contact_value=on_contact,
         relative_residual=residual,
-        tolerance=cand.tau,
+        tolerance=problem.tau,
         kkt=bool(kkt),
         smallest_of_reduced=smallest,
         lower_bound=br.lower,
@@ -330,26 +328,14 @@ class _Bracket:
 def _local(
     problem: UnilateralProblem, cand: Candidate, notes: list[str]
 ) -> tuple[bool, float, float]:
-    r"""The KKT conditions of ``cand``: (kkt, residual off Z, largest value on Z).
-
-    At the candidate's tolerance (``solver.tau``, or the larger one of a state within
-    the load's resolution, noted); the residual at :math:`\sqrt{\tau}` of ``solver.tau``.
-    """
-    tau = cand.tau
-    if tau > problem.tau:
-        notes.append(
-            f"KKT within the load's resolution: values and forces at tolerance {tau:.3g} "
-            f"(solver.tau {problem.tau:.3g})"
-        )
+    """The KKT conditions of ``cand``: (kkt, residual off Z, largest value on Z)."""
+    tau = problem.tau
     residual = _residual_off_contact(problem, cand)
     # The mode must vanish on Z (checked, not assumed: a mode from elsewhere than an
     # eigen solve of the reduced pencil need not).
     on_contact = float(np.abs(cand.values[cand.active]).max(initial=0.0))
     kkt = (
-        cand.feasible
-        and cand.max_force <= tau
-        and residual <= math.sqrt(problem.tau)
-        and on_contact <= tau
+        cand.feasible and cand.max_force <= tau and residual <= math.sqrt(tau) and on_contact <= tau
     )
     if on_contact > tau:
         notes.append(f"the mode does not vanish on the contact set (max |u_Z| = {on_contact:.3g})")

@@ -78,8 +78,7 @@ class CertificateRecord(Struct, kw_only=True):
         max_contact_force: Largest force on Z, relative to :math:`\|Au\|_\infty`.
         max_contact_value: Largest |u| on Z, relative to max|w|.
         relative_residual: :math:`\|r\ \text{off}\ Z\|_2 / \|Au\|_2`.
-        tolerance: :math:`\tau` of the KKT check's values and forces: ``solver.tau``, or
-            the larger tolerance of a KKT point within the load's resolution.
+        tolerance: :math:`\tau`.
         kkt: The KKT conditions hold.
         smallest_of_reduced: The load is the reduced pencil's smallest eigenvalue (None
             if not checked).

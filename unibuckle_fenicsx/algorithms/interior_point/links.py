@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import math
 import time
-from dataclasses import dataclass, field, replace
+from dataclasses import dataclass, field
 
 import numpy as np
 import numpy.typing as npt
@@ -43,7 +43,6 @@ __all__ = [
     "newton_link",
     "polish",
     "read_contact",
-    "resolved",
     "run_from",
 ]
 
@@ -151,13 +150,10 @@ def read_contact(
     level: MeshLevel,
     label: str,
     active: npt.NDArray[np.int64] | None = None,
-    fine: bool = False,
 ) -> Candidate:
     """The exact critical state of the contact set ``active`` read off ``point``.
 
     Default: the nodes at the tolerance (:meth:`~.newton.InteriorPointNewton.contact_set`).
-    ``fine``: on the fine mesh, a state that is no KKT point at ``tau`` is tried as one
-    within the load's resolution (:func:`resolved`).
     """
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
@@ -176,86 +172,7 @@ def read_contact(
             kkt=cand.kkt,
         )
     )
-    if fine and not cand.kkt:
-        return resolved(problem, cand, level, label) or cand
     return cand
-
-
-def penetration(cand: Candidate) -> float:
-    """The largest value of ``cand``'s mode on I, relative to max|w| (feasible: at most tau)."""
-    return float(cand.values.max(initial=-math.inf))
-
-
-def violation(cand: Candidate) -> float:
-    """The largest value of ``cand``'s mode on I and force on Z (relative; KKT: at most tau)."""
-    return max(penetration(cand), cand.max_force)
-
-
-def resolved(
-    problem: UnilateralProblem, cand: Candidate, level: MeshLevel, label: str
-) -> Candidate | None:
-    r"""``cand`` as a KKT point within the load's resolution, or None.
-
-    The resolution :math:`\eta` is the relative accuracy of any load of this mesh: the
-    larger of the eigen solver's tolerance and
-    :meth:`~unibuckle_fenicsx.model.problem.Problem.load_resolution` (double precision
-    on the mode; 1e-9 to 1e-8 on thin plates). The state (Z, lambda, u) breaks the KKT
-    conditions at ``tau``: some node off Z lies above the obstacle (:math:`u_k > \tau`,
-    relative to max|w|) or some node of Z pulls it (:math:`r_k > \tau`, relative to
-    :math:`\|Au\|_\infty`). Flipping those nodes,
-    :math:`Z' = Z \cup \{k \notin Z: u_k > \tau\} \setminus \{k \in Z: r_k > \tau\}`,
-    changes the load by a quantity of second order in the violations (the load is
-    stationary in the mode). Where one eigen solve finds
-    :math:`|\lambda(Z') - \lambda(Z)| \le \eta\lambda`, the two states are one critical
-    state as far as double precision can tell, and the lower of the two is returned as a
-    KKT point at the tolerance of its own largest violation (its ``tau``; a Z' that is a
-    KKT point at ``tau`` is returned as it is). A penetration :math:`\epsilon` costs a
-    load of order :math:`\epsilon^2` (a node's stiffness is of the order of the load
-    when the mode is scaled to max|w| = 1), so states that penetrate by more than
-    :math:`\sqrt\eta` are not tried (no solve is spent); a pull is measured against
-    :math:`\|Au\|_\infty`, which the shear stiffness dominates on a thin plate, so its
-    size bounds nothing and every pulling state is tried (one eigen solve a read).
-
-    Note:
-        Collective.
-    """
-    if not math.isfinite(cand.load) or violation(cand) <= cand.tau:
-        return None
-    rounding = problem.load_resolution(cand.mode.x.petsc_vec, cand.load)
-    eta = max(problem.spec.solver.eps_tol, rounding)
-    if not penetration(cand) <= math.sqrt(eta):
-        return None
-    t0 = time.perf_counter()
-    solves0 = problem.eigensolver.solves
-    active = np.zeros(problem.num_constrained, dtype=bool)
-    active[cand.active] = True
-    flipped = (~active & (cand.values > cand.tau)) | (active & (cand.forces > cand.tau))
-    other = problem.evaluate(
-        np.flatnonzero(active ^ flipped), initial=cand.mode.x.petsc_vec, near=cand.load
-    )
-    level.offer(other)
-    found: Candidate | None = None
-    if other.kkt:
-        found = other
-    elif math.isfinite(other.load) and abs(other.load - cand.load) <= eta * cand.load:
-        tried = [c for c in (cand, other) if penetration(c) <= math.sqrt(eta)]
-        best = min(tried, key=lambda c: c.load)
-        tol = max(best.tau, violation(best))
-        found = replace(best, tau=tol, feasible=True)
-    level.links.append(
-        LinkRecord(
-            "evaluate",
-            label + " (flipped)",
-            "kkt" if found is not None else "not-kkt",
-            eigensolves=problem.eigensolver.solves - solves0,
-            seconds=time.perf_counter() - t0,
-            load=other.load if math.isfinite(other.load) else None,
-            contact_nodes=len(other.active),
-            kkt=found is not None,
-            tolerance=None if found is None else found.tau,
-        )
-    )
-    return found
 
 
 @dataclass
@@ -311,7 +228,7 @@ class Reader:
             return None
         self.tried.append(active)
         label = f"{self.label} ({how} at {point.mu:.0e})"
-        cand = read_contact(self.problem, self.newton, point, self.level, label, active, True)
+        cand = read_contact(self.problem, self.newton, point, self.level, label, active)
         if not cand.kkt:
             return None
         self.armed, self.found = False, cand
@@ -387,8 +304,7 @@ def critical_state(
     short polish and no descent (a second try follows). Saddles are escaped on every
     try: an escape costs less than a second try from the coarsest mesh.
     """
-    fine = reader is not None
-    cand = read_contact(problem, newton, point, level, label, fine=fine)
+    cand = read_contact(problem, newton, point, level, label)
     if cand.kkt:
         return cand, point
     for attempt in range(options.escapes):
@@ -400,7 +316,7 @@ def critical_state(
             newton, point, level, tag, options, keep_push=False,
             mu=max(point.mu, options.escape_mu), mu_min=max(point.mu, options.fine_mu_min),
         )  # fmt: skip
-        cand = read_contact(problem, newton, point, level, tag, fine=fine)
+        cand = read_contact(problem, newton, point, level, tag)
         if cand.kkt:
             return cand, point
     if point.mu > options.last_mu_min:
@@ -412,7 +328,7 @@ def critical_state(
         )  # fmt: skip
         if reader is not None and reader.found is not None:
             return reader.found, point
-        cand = read_contact(problem, newton, point, level, tag, fine=fine)
+        cand = read_contact(problem, newton, point, level, tag)
         if cand.kkt:
             return cand, point
     if math.isfinite(cand.load):
