@@ -18,6 +18,17 @@ With ``--cli`` it also times what a user waits: ``unibuckle solve`` on the plate
 ``unibuckle solve`` on the same plate without obstacle (whole processes, start-up and
 JIT cache included).
 
+With ``--cli`` the row also keeps the processes' CPU seconds (user + system, of the
+process and the ones it waited for): ``cli_cpu_ratios`` (each pair's ratio;
+``cli_cpu_ratio`` their median), ``cli_cpu_s`` and ``free_cli_cpu_s`` (the minima). On
+a machine shared with other jobs the wall time waits for a core; the CPU time moves far
+less.
+
+With ``--cli --baseline PYTHON`` the same two commands of the package installed for
+another interpreter (an older version) are timed after them, and their ratios kept
+(``baseline_cli_ratios``, ``baseline_cli_cpu_ratios``): the change of a ratio measured
+on the same machine at the same time.
+
 With ``--repeat N`` each plate is solved N times (and each CLI pair run N times) and the
 ratios are the medians (all of them in the JSON row's ``ratios`` and ``cli_ratios``): on
 a shared machine one free solve of a 90×30 plate took 0.17 to 0.35 s within an hour,
@@ -31,8 +42,12 @@ at most 3 free solves; ``bench_bracket.py`` measures it).
 With ``--side below`` the face lies below the plate (w >= 0): the mirror image, the same
 loads (w -> -w), by the same route.
 
-Usage: python bench/bench_plates.py [--meshes 90x30,180x60] [--cases ssss,cs,sc,cccc,shear]
-[--side above|below] [--cli] [--bracket] [--repeat N] [--json FILE]
+The cases ``c1``, ``c2``, ``c3`` are the paper's plate (0.2 x 0.1 m, t = 6 mm) with its
+obstacle zones (:func:`~unibuckle_fenicsx.spec.cases.paper_case`), solved and timed the
+same way (``--side`` does not apply to them).
+
+Usage: python bench/bench_plates.py [--meshes 90x30,180x60] [--cases ssss,cs,sc,cccc,shear,c1,c3]
+[--side above|below] [--cli] [--baseline PYTHON] [--bracket] [--repeat N] [--json FILE]
 """
 
 from __future__ import annotations
@@ -40,6 +55,7 @@ from __future__ import annotations
 import argparse
 import json
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -57,7 +73,8 @@ from unibuckle_fenicsx.certificate.certify import Certificate
 from unibuckle_fenicsx.certificate.records import LowRankRecord
 from unibuckle_fenicsx.results.records import jsonable
 from unibuckle_fenicsx.spec import ObstacleSpec, problem_to_dict
-from unibuckle_fenicsx.spec.cases import plate_case
+from unibuckle_fenicsx.spec.cases import CASES as PAPER_CASES
+from unibuckle_fenicsx.spec.cases import paper_case, plate_case
 
 #: name -> (edge supports, load, description of the edges)
 CASES = {
@@ -78,6 +95,8 @@ def _spec(
     thickness: float = THICKNESS,
     length: float = LENGTH,
 ):
+    if name in PAPER_CASES:
+        return paper_case(name, nx, ny)
     supports, load, _ = CASES[name]
     return plate_case(
         name,
@@ -124,15 +143,24 @@ def _times(timings: dict[str, float]) -> tuple[float, float, float]:
     return free, (timings["unilateral_s"] + certify) / free, certify / free
 
 
-def _cli_seconds(spec) -> float:
-    """Wall time of ``unibuckle solve`` on ``spec`` (a whole process)."""
+def _cli_seconds(spec, python: str = sys.executable) -> tuple[float, float]:
+    """Wall time and CPU time (user + system) of ``unibuckle solve`` on ``spec``.
+
+    ``python``: the interpreter whose installation of the package runs it.
+    """
     with tempfile.TemporaryDirectory() as tmp:
         path = Path(tmp) / "plate.json"
         path.write_text(json.dumps({"input": problem_to_dict(spec)}))
-        cmd = [sys.executable, "-m", "unibuckle_fenicsx.cli", "solve", "--config", str(path)]
+        cmd = [python, "-m", "unibuckle_fenicsx.cli", "solve", "--config", str(path)]
+        before = resource.getrusage(resource.RUSAGE_CHILDREN)
         t0 = time.perf_counter()
-        subprocess.run(cmd, check=True, capture_output=True, env={**os.environ})
-        return time.perf_counter() - t0
+        # cwd: python -m puts it first on sys.path (a checkout there would shadow the
+        # installation of ``python``).
+        subprocess.run(cmd, check=True, capture_output=True, env={**os.environ}, cwd=tmp)
+        wall = time.perf_counter() - t0
+        after = resource.getrusage(resource.RUSAGE_CHILDREN)
+        cpu = (after.ru_utime + after.ru_stime) - (before.ru_utime + before.ru_stime)
+        return wall, cpu
 
 
 def main() -> None:
@@ -150,12 +178,15 @@ def main() -> None:
     parser.add_argument(
         "--repeat", type=int, default=1, help="solves per plate; the ratios are the medians"
     )
+    parser.add_argument(
+        "--baseline", metavar="PYTHON", help="with --cli: also time another installation"
+    )
     args, meshes = parse_plates(parser)
     comm = MPI.COMM_WORLD
     if comm.rank == 0:
         print_header(
             f"MPI ranks: {comm.size}; plate {LENGTH} x {WIDTH} m, t = {THICKNESS} m, "
-            f"zone all, face {args.side}",
+            f"zone all, face {args.side} (c1, c2, c3: the paper's plate and zones)",
             (
                 "case", "mesh", "i", "\\|Z\\|", "levels: steps / factorisations / eigen solves",
                 "route", "free solve (s)", "ratio", "CLI ratio", "KKT", "smallest",
@@ -190,7 +221,7 @@ def main() -> None:
                     "case": name,
                     "side": args.side,
                     "bracket": args.bracket,
-                    "edges": CASES[name][2],
+                    "edges": CASES[name][2] if name in CASES else "paper",
                     "mesh": f"{nx}x{ny}",
                     "i": r.constrained_nodes,
                     "contact_nodes": r.contact_nodes,
@@ -213,9 +244,21 @@ def main() -> None:
             cli_ratio = None
             if args.cli and comm.size == 1:
                 free = replace(spec, obstacle=None)
-                cli = [_cli_seconds(spec) / _cli_seconds(free) for _ in range(args.repeat)]
+                pairs = [(_cli_seconds(spec), _cli_seconds(free)) for _ in range(args.repeat)]
+                cli = [full[0] / bare[0] for full, bare in pairs]
                 cli_ratio = statistics.median(cli)
                 row["cli_ratios"] = cli
+                row["cli_cpu_ratios"] = [full[1] / bare[1] for full, bare in pairs]
+                row["cli_cpu_ratio"] = statistics.median(row["cli_cpu_ratios"])
+                row["cli_cpu_s"] = min(full[1] for full, _ in pairs)
+                row["free_cli_cpu_s"] = min(bare[1] for _, bare in pairs)
+                if args.baseline:
+                    pairs = [
+                        (_cli_seconds(spec, args.baseline), _cli_seconds(free, args.baseline))
+                        for _ in range(args.repeat)
+                    ]
+                    row["baseline_cli_ratios"] = [full[0] / bare[0] for full, bare in pairs]
+                    row["baseline_cli_cpu_ratios"] = [full[1] / bare[1] for full, bare in pairs]
             row["cli_ratio"] = cli_ratio
             if comm.rank == 0:  # one row at a time: a long run shows its progress
                 print(

@@ -268,6 +268,8 @@ def _plates_commands(rows: list[dict[str, Any]]) -> str:
     for mesh in dict.fromkeys(str(r["mesh"]) for r in rows):
         group = [r for r in rows if str(r["mesh"]) == mesh]
         flags = " --cli" if any(r.get("cli_ratio") is not None for r in group) else ""
+        if any(r.get("baseline_cli_ratios") for r in group):
+            flags += " --baseline PYTHON_OF_19a5414"
         flags += " --bracket" if any(r.get("bracket") for r in group) else ""
         repeat = max(len(r.get("ratios", [0])) for r in group)
         flags += f" --repeat {repeat}" if repeat > 1 else ""
@@ -317,10 +319,19 @@ def _free_commands(rows: list[dict[str, Any]]) -> str:
 
 
 def _orderings_commands(rows: list[dict[str, Any]]) -> str:
-    """The ``bench_orderings.py`` runs that wrote the rows: one per plate and repeat count."""
+    """The ``bench_orderings.py`` runs that wrote the rows.
+
+    One per plate, repeat count, orderings and matrices: the meshes that share them.
+    """
+
+    def run(row: dict[str, Any]) -> tuple[str, int, str, str]:
+        mesh = [r for r in rows if (r["plate"], r["mesh"]) == (row["plate"], row["mesh"])]
+        return row["plate"], row["repeat"], _listed(mesh, "ordering"), _listed(mesh, "kind")
+
     commands = []
-    for plate, repeat in dict.fromkeys((r["plate"], r["repeat"]) for r in rows):
-        group = [r for r in rows if (r["plate"], r["repeat"]) == (plate, repeat)]
+    for key in dict.fromkeys(run(r) for r in rows):
+        group = [r for r in rows if run(r) == key]
+        plate, repeat = key[:2]
         commands.append(
             f"python bench/bench_orderings.py --plates {plate} --meshes {_listed(group, 'mesh')} "
             f"--orderings {_listed(group, 'ordering')} --kinds {_listed(group, 'kind')} "
@@ -393,6 +404,7 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("levels", "per level: steps / factorisations / eigen solves"),
         ("ratio", "time (free solves)"),
         ("cli_ratio", "`unibuckle solve` (free solves)"),
+        ("cli_cpu_ratio", "its CPU time (free runs)"),
         ("m", "m"),
         ("certificate", "certificate"),
         ("k", "k"),

@@ -90,11 +90,19 @@ ORDERINGS = {"amd": 0, "amf": 2, "scotch": 3, "pord": 4, "metis": 5, "qamd": 6}
 #: fastest factorisation there (measured on :doc:`/verification/floor`).
 ORDERING_BELOW = {"plate": "amf", "membrane": "amd"}
 #: Rows from which a factorisation is ordered by nested dissection (METIS) instead, by
-#: whether its analysis serves one numeric factorisation or many (the eigen solves of a
-#: route's contact sets, the interior point's Newton steps): METIS's analysis costs more
-#: than one numeric factorisation on the package's matrices, and saves a fraction of
-#: each (measured on :doc:`/verification/floor`).
-NESTED_DISSECTION_ROWS = {False: 400_000, True: 100_000}
+#: kind and by whether its analysis serves one numeric factorisation or many (the eigen
+#: solves of a route's contact sets, the interior point's Newton steps). METIS's
+#: analysis costs more than the minimum-degree orderings' and saves part of every
+#: numeric factorisation: on a plate's matrices it pays for one factorisation only on
+#: the largest meshes, for a route's many on much smaller ones. On the membrane
+#: stiffness of a large mesh a minimum-degree ordering needs several times METIS's
+#: operations on some plates (AMD on one, AMF on another), METIS never much more than
+#: the least (measured up to 10^6 rows on :doc:`/verification/floor`). The package
+#: factorises a membrane stiffness once.
+NESTED_DISSECTION_ROWS = {
+    "plate": {False: 600_000, True: 100_000},
+    "membrane": {False: 200_000, True: 100_000},
+}
 
 
 def mumps_ordering(rows: int, kind: str = "plate", reused: bool = False) -> int:
@@ -105,7 +113,7 @@ def mumps_ordering(rows: int, kind: str = "plate", reused: bool = False) -> int:
     ``-<prefix>mat_mumps_icntl_7`` (e.g. ``-unibuckle_ldl_mat_mumps_icntl_7 5``)
     overrides it for one factorisation.
     """
-    if rows >= NESTED_DISSECTION_ROWS[reused]:
+    if rows >= NESTED_DISSECTION_ROWS[kind][reused]:
         return ORDERINGS["metis"]
     return ORDERINGS[ORDERING_BELOW[kind]]
 
