@@ -10,8 +10,10 @@ t = 1 mm: R/t = 100, L = R), steel, simply supported ends, a rigid core over the
 length. One process: the set-up (mesh, prestress, assembly, change of basis), the free
 eigen solve (min of ``--repeat`` solves of the same pencil), and the unilateral solve
 (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`: the active-set seeds on a
-section ``--levels`` times coarser, the contact set polished level by level), then the
-certificate. Prints one Markdown row; ``--json FILE`` appends it.
+section ``--levels`` times coarser, the contact set polished level by level; or, with
+``--route interior-point``, the thin plates' interior-point chain on the section itself),
+then the certificate. The factorisations are PETSc's count of numeric ones (MUMPS) in the
+unilateral solve. Prints one Markdown row; ``--json FILE`` appends it.
 
 Note:
     Timings are only meaningful on a quiet machine; the ratio (unilateral over free) is
@@ -26,18 +28,36 @@ import time
 from _results import append_rows, print_header
 
 COLUMNS = (
-    "shape", "dofs", "constrained", "cells_around", "free_load/ref", "core_load/ref",
+    "shape", "route", "dofs", "constrained", "cells_around", "free_load/ref", "core_load/ref",
     "kkt", "certificate", "setup_s", "rotation_s", "free_s", "unilateral_s", "ratio",
-    "certify_s", "eigensolves_fine", "eigensolves_coarse",
+    "certify_s", "eigensolves_fine", "eigensolves_coarse", "factorisations",
 )  # fmt: skip
 
 
-def run(shape: str, size: float, levels: int, repeat: int, corner_cell: float | None) -> dict:
-    """One section: set-up, free solve, unilateral solve, certificate."""
+def _factorisations() -> int:
+    """Numeric factorisations so far (PETSc's log: MUMPS's Cholesky and LU events)."""
+    from petsc4py import PETSc
+
+    return sum(
+        int(PETSc.Log.Event(name).getPerfInfo()["count"])
+        for name in ("MatCholFctrNum", "MatLUFactorNum")
+    )
+
+
+def run(
+    shape: str, size: float, levels: int, repeat: int, corner_cell: float | None, route: str
+) -> dict:
+    """One section: set-up, free solve, unilateral solve, certificate.
+
+    ``route``: "levels" (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`) or
+    "interior-point" (the thin plates' chain, on the section itself).
+    """
     from mpi4py import MPI
+    from petsc4py import PETSc
 
     import msgspec
 
+    from unibuckle_fenicsx.algorithms.chain import solve_interior_point
     from unibuckle_fenicsx.algorithms.records import SectionLevelsDetails
     from unibuckle_fenicsx.certificate.certify import certify
     from unibuckle_fenicsx.la.eigen import GEPSolver
@@ -53,6 +73,7 @@ def run(shape: str, size: float, levels: int, repeat: int, corner_cell: float | 
         shape, E=2.1e11, nu=0.3, mesh_size=size, ends="simply_supported", core=True,
         corner_cell=corner_cell if shape == "box" else None, **geometry,
     )  # fmt: skip
+    PETSc.Log.begin()  # the factorisations' counts
     t0 = time.perf_counter()
     with build_section(params, MPI.COMM_WORLD) as section:
         setup = time.perf_counter() - t0
@@ -67,17 +88,29 @@ def run(shape: str, size: float, levels: int, repeat: int, corner_cell: float | 
             solver.destroy()
         dofs, cells = section.model.num_dofs, section.mesh.cells_around
     t1 = time.perf_counter()
-    fine, solution = solve_levels(params, levels=levels)
+    before = _factorisations()
+    if route == "levels":
+        fine, solution = solve_levels(params, levels=levels)
+    else:
+        fine = build_section(params, MPI.COMM_WORLD)
+        t1 = time.perf_counter()  # the set-up is not the unilateral solve's
+        solution = solve_interior_point(fine.problem)
     unilateral = time.perf_counter() - t1
+    factorisations = _factorisations() - before
     with fine:
         t2 = time.perf_counter()
         cert = certify(fine.problem, solution)
         certify_s = time.perf_counter() - t2
         details = solution.details
-        assert isinstance(details, SectionLevelsDetails)
-        levels_log = [msgspec.to_builtins(level) for level in details.levels]
+        if isinstance(details, SectionLevelsDetails):
+            levels_log = [msgspec.to_builtins(level) for level in details.levels]
+            coarse = details.coarse_eigensolves
+        else:
+            levels_log = [{"eigensolves": solution.eigensolves}]
+            coarse = 0
         return {
             "shape": shape,
+            "route": route,
             "dofs": dofs,
             "constrained": fine.constraints.size if fine.constraints is not None else 0,
             "cells_around": cells,
@@ -93,7 +126,8 @@ def run(shape: str, size: float, levels: int, repeat: int, corner_cell: float | 
             "ratio": unilateral / min(times),
             "certify_s": certify_s,
             "eigensolves_fine": levels_log[-1]["eigensolves"],
-            "eigensolves_coarse": details.coarse_eigensolves,
+            "eigensolves_coarse": coarse,
+            "factorisations": factorisations,
             "levels": levels_log,
             "corner_cell": corner_cell,
         }
@@ -107,9 +141,10 @@ def main() -> None:
     parser.add_argument("--levels", type=int, default=2)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--corner-cell", type=float, default=None)
+    parser.add_argument("--route", choices=("levels", "interior-point"), default="levels")
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
-    row = run(args.shape, args.size, args.levels, args.repeat, args.corner_cell)
+    row = run(args.shape, args.size, args.levels, args.repeat, args.corner_cell, args.route)
     print_header("Sections with a core (one rank)", COLUMNS)
     cells = []
     for c in COLUMNS:

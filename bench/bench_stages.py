@@ -21,6 +21,12 @@ The table gives, per mesh, the seconds of
 and, for each stage, the growth exponent p of t ~ DOFs^p between consecutive meshes:
 1 is linear; a sparse LDL^T of a 2D mesh (nested dissection) costs DOFs^1.5.
 
+It also counts, independent of the machine's load, per mesh level of the route: Newton
+steps / numeric factorisations / solves with a factorisation / eigen solves (the
+factorisations and solves are PETSc's ``MatCholFctrNum`` and ``MatSolve`` events inside
+the level's runs, eigen solves' included), and the whole run's factorisations and
+solves against the free run's.
+
 Usage: python bench/bench_stages.py [--meshes 90x30,180x60,360x120] [--case ssss]
 [--repeat N] [--json FILE]
 
@@ -47,10 +53,24 @@ STAGES = (
     "setup", "free solve", "coarse levels", "fine IP", "fine LDL", "fine eigen",
     "certificate", "total", "free run",
 )  # fmt: skip
+STAGE_EVENTS = ("coarsest", "level")  # the stages whose counts make the levels' table
+
+
+#: PETSc's log events counted: numeric factorisations (MUMPS LDL^T) and solves with one.
+EVENTS = ("MatCholFctrNum", "MatSolve")
+
+
+def _counts() -> tuple[int, ...]:
+    from petsc4py import PETSc
+
+    return tuple(int(PETSc.Log.Event(e).getPerfInfo()["count"]) for e in EVENTS)
 
 
 def _install_timers(acc: dict[tuple[str, int], list[float]]) -> None:
-    """Wrap the route's functions: ``acc[(stage, DOFs)] = [process seconds, calls]``."""
+    """Wrap the route's functions: ``acc[(stage, DOFs)] = [process seconds, calls, *counts]``.
+
+    ``counts``: the :data:`EVENTS` inside the calls.
+    """
     from unibuckle_fenicsx import analysis
     from unibuckle_fenicsx.algorithms import chain
     from unibuckle_fenicsx.algorithms.interior_point import explore, newton
@@ -63,13 +83,15 @@ def _install_timers(acc: dict[tuple[str, int], list[float]]) -> None:
 
         @functools.wraps(inner)
         def timed(*args: Any, **kwargs: Any) -> Any:
-            c0 = time.process_time()
+            c0, n0 = time.process_time(), _counts()
             try:
                 return inner(*args, **kwargs)
             finally:
                 entry = acc[(stage, dofs(*args))]
                 entry[0] += time.process_time() - c0
                 entry[1] += 1
+                for j, (a, b) in enumerate(zip(n0, _counts(), strict=True)):
+                    entry[2 + j] += b - a
 
         setattr(owner, name, timed)
 
@@ -82,6 +104,7 @@ def _install_timers(acc: dict[tuple[str, int], list[float]]) -> None:
     wrap(newton.InteriorPointNewton, "solve", "IP", lambda n, *a, **k: size(n.kernel.A))
     wrap(factor.SharedFactorization, "factor", "LDL", lambda f, *a: size(f.matrix))
     wrap(explore, "explore", "coarsest", lambda p, *a, **k: size(p.model.A))
+    wrap(chain, "_carry", "level", lambda ps, k, *a, **kw: size(ps[k].model.A))
     wrap(certify, "certify", "certificate", lambda *a, **k: 0)
     # The names imported elsewhere, bound before the wrapping.
     analysis.certify, analysis.build_problem = certify.certify, build.build_problem
@@ -91,27 +114,35 @@ def _install_timers(acc: dict[tuple[str, int], list[float]]) -> None:
 def worker(case: str, nx: int, ny: int, free: bool) -> None:
     """One solve in this process; print a JSON line of its stage times."""
     from mpi4py import MPI
+    from petsc4py import PETSc
 
     from bench_plates import _spec
 
     from unibuckle_fenicsx.analysis import solve
 
-    acc: dict[tuple[str, int], list[float]] = defaultdict(lambda: [0.0, 0])
+    PETSc.Log.begin()
+    acc: dict[tuple[str, int], list[float]] = defaultdict(lambda: [0.0, 0, 0, 0])
     _install_timers(acc)
     spec = _spec(case, nx, ny)
     if free:
         spec = replace(spec, obstacle=None)
-    c0 = time.process_time()
+    c0, n0 = time.process_time(), _counts()
     with solve(spec, MPI.COMM_WORLD) as run:
         result, solution = run.result, run.solution
         levels = [] if solution is None else getattr(solution.details, "levels", [])
-        row = {
+        cert = run.certificate
+        row: dict[str, Any] = {
             "dofs": result.dofs,
             "load_Pa": result.critical_load_Pa,
-            "levels": [[lv.mesh, lv.newton_steps, lv.factorizations] for lv in levels],
+            "kkt": None if cert is None else cert.kkt,
+            "tolerance": None if cert is None else cert.tolerance,
+            "levels": [
+                [lv.mesh, lv.newton_steps, lv.factorizations, lv.eigensolves] for lv in levels
+            ],
         }
     row["total"] = time.process_time() - c0
-    row["stages"] = [[stage, n, t, calls] for (stage, n), (t, calls) in acc.items()]
+    row["factorisations"], row["solves"] = (b - a for a, b in zip(n0, _counts(), strict=True))
+    row["stages"] = [[stage, n, *values] for (stage, n), values in acc.items()]
     print(json.dumps(row))
 
 
@@ -124,7 +155,9 @@ def _run(case: str, nx: int, ny: int, free: bool) -> dict[str, Any]:
 def _stages(run: dict[str, Any], free_run: dict[str, Any]) -> dict[str, Any]:
     """The table's stages of one mesh from a run and its free run."""
     n = run["dofs"]
-    got: dict[tuple[str, int], tuple[float, int]] = {(s, k): (t, c) for s, k, t, c in run["stages"]}
+    got: dict[tuple[str, int], tuple[float, int]] = {
+        (s, k): (t, c) for s, k, t, c, *_ in run["stages"]
+    }
 
     def seconds(stage: str, fine: bool | None = None) -> float:
         return sum(
@@ -150,6 +183,22 @@ def _stages(run: dict[str, Any], free_run: dict[str, Any]) -> dict[str, Any]:
     }
 
 
+def _per_level(run: dict[str, Any]) -> str:
+    """Per level: mesh: Newton steps / factorisations / solves / eigen solves.
+
+    The factorisations and solves are the PETSc events counted inside the level's runs
+    (its eigen solves' included); the levels' runs, keyed by their DOFs, in the order of
+    the route's level records (coarsest first).
+    """
+    counted = sorted((row[1], row[4], row[5]) for row in run["stages"] if row[0] in STAGE_EVENTS)
+    cells = []
+    for lv, (_, factorisations, solves) in zip(run["levels"], counted, strict=False):
+        mesh, steps, _, eigensolves = lv
+        name = "x".join(str(m) for m in mesh)
+        cells.append(f"{name}: {steps}/{factorisations}/{solves}/{eigensolves}")
+    return " · ".join(cells)
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--meshes", default="90x30,180x60,360x120")
@@ -172,17 +221,25 @@ def main() -> None:
             run, free_run = _run(args.case, nx, ny, False), _run(args.case, nx, ny, True)
             stages = _stages(run, free_run)
             if best is None:
-                best = {"run": run, "stages": stages}
+                best = {"run": run, "free": free_run, "stages": stages}
             else:
                 best["stages"] = {k: min(v, stages[k]) for k, v in best["stages"].items()}
         assert best is not None
+        run = best["run"]
         rows.append(
             {
                 "case": args.case,
                 "mesh": f"{nx}x{ny}",
-                "dofs": best["run"]["dofs"],
-                "load_Pa": best["run"]["load_Pa"],
-                "levels": best["run"]["levels"],
+                "dofs": run["dofs"],
+                "load_Pa": run["load_Pa"],
+                "kkt": run.get("kkt"),
+                "tolerance": run.get("tolerance"),
+                "levels": run["levels"],
+                "per_level": _per_level(run),
+                "factorisations": run["factorisations"],
+                "solves": run["solves"],
+                "free_factorisations": best["free"]["factorisations"],
+                "free_solves": best["free"]["solves"],
                 **best["stages"],
                 "ratio": best["stages"]["total"] / best["stages"]["free run"],
             }
@@ -208,8 +265,12 @@ def main() -> None:
     ratios = " | ".join(f"{r['total'] / r['free run']:.2f}" for r in rows)
     print(f"| ratio total / free run | {ratios} |")
     for r in rows:
-        print(f"{r['mesh']}: load {r['load_Pa']!r} Pa; levels [mesh, steps, factorisations]")
-        print(f"  {r['levels']}")
+        print(
+            f"{r['mesh']}: load {r['load_Pa']!r} Pa, KKT {r['kkt']} at tolerance "
+            f"{r['tolerance']}; whole run {r['factorisations']} factorisations, "
+            f"{r['solves']} solves (free run {r['free_factorisations']}, {r['free_solves']})"
+        )
+        print(f"  per level, steps / factorisations / solves / eigen solves: {r['per_level']}")
     append_rows(args.json, rows)
 
 

@@ -168,6 +168,7 @@ if comm.rank == 0:
 # %%
 scale = 1e6  # Pa per MPa
 design = result.design
+assert design is not None, "the plate has a design output ([design] in the problem)"
 summary = {
     "mesh_size_mm": SIZE,
     "cells": result.mesh,
@@ -180,8 +181,8 @@ summary = {
     "buckling_coefficient_k": result.buckling_coefficient_k,
     "method": result.method,
     "certificate": {k: getattr(result.certificate, k) for k in ("kkt", "global_optimum_proven")},
-    "design": {k: design[k] for k in ("relative_slenderness", "psi", "reduction_factor")},
-    "design_stress_MPa": design["reduced_design_stress_Pa"] / scale,
+    "design": {k: getattr(design, k) for k in ("relative_slenderness", "psi", "reduction_factor")},
+    "design_stress_MPa": design.reduced_design_stress_Pa / scale,
     "tie_spacing_study": [
         {
             "spacing_mm": line["point"]["points.0.spacing"],
@@ -224,12 +225,12 @@ assert oriented.max() <= problem.tau, oriented.max()
 assert np.abs(w_ties).max() <= 1e-12, w_ties
 assert result.critical_load_Pa < without_shear.critical_load_Pa
 slenderness = np.sqrt(FY * scale / result.critical_load_Pa)
-assert design["psi"] == 1.0
-assert np.isclose(design["relative_slenderness"], slenderness, rtol=1e-12)
+assert design.psi == 1.0
+assert np.isclose(design.relative_slenderness, slenderness, rtol=1e-12)
 # EN 1993-1-5 (4.2), internal compression element, psi = 1: rho = 1 up to 0.673, else
 # (slenderness - 0.055 (3 + psi)) / slenderness^2 (worked out here, not by the package).
 rho = 1.0 if slenderness <= 0.673 else (slenderness - 0.22) / slenderness**2
-assert np.isclose(design["reduction_factor"], min(rho, 1.0), rtol=1e-12)
+assert np.isclose(design.reduction_factor, min(rho, 1.0), rtol=1e-12)
 assert all(line["status"] == "ok" for line in lines), [line["status"] for line in lines]
 by_spacing = {line["point"]["points.0.spacing"]: line for line in lines}
 for line in lines:

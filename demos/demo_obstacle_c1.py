@@ -91,11 +91,12 @@ series = study.mesh_study(
 paper = series.at(PAPER_MESH).result
 upper_bound = series.at(REFINED_MESH).extra["upper_bound_all_constrained_Pa"]
 if comm.rank == 0:
-    cert = paper.certificate or {}
+    cert = paper.certificate
+    assert cert is not None and cert.upper_bound_Pa is not None, "the solve certifies"
     print(
-        f"paper mesh: lambda in [{cert['lower_bound_Pa']:.6e}, {cert['upper_bound_Pa']:.6e}] "
-        f"Pa (gap {cert['relative_gap']:.1e}), KKT {cert['kkt']}, smallest of the reduced "
-        f"pencil {cert['smallest_of_reduced']}; lambda(Z = I) on the refined mesh "
+        f"paper mesh: lambda in [{cert.lower_bound_Pa:.6e}, {cert.upper_bound_Pa:.6e}] "
+        f"Pa (gap {cert.relative_gap:.1e}), KKT {cert.kkt}, smallest of the reduced "
+        f"pencil {cert.smallest_of_reduced}; lambda(Z = I) on the refined mesh "
         f"{upper_bound:.6e} Pa"
     )
 

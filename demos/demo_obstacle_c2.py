@@ -93,11 +93,11 @@ for name, solver in variants.items():
         r = analysis.result
     stop_rule[name] = r
     if comm.rank == 0:
-        cert = r.certificate or {}
+        cert = r.certificate
         print(
             f"  {name:27s} lambda = {r.critical_load_Pa:.6e} Pa  |Z| = {r.contact_nodes}  "
-            f"p* = {r.p_star}  KKT = {cert.get('kkt')}  proven = "
-            f"{cert.get('global_optimum_proven')}  {r.eigensolves} eigen solves"
+            f"p* = {r.p_star}  KKT = {cert and cert.kkt}  proven = "
+            f"{cert and cert.global_optimum_proven}  {r.eigensolves} eigen solves"
         )
 
 # %% [markdown]

@@ -16,10 +16,12 @@ from unibuckle_fenicsx.spec import (
     ObstacleSpec,
     PlateSpec,
     ProblemSpec,
+    SectionProblemSpec,
     SolverSpec,
     load_toml,
     problem_from_dict,
     problem_to_dict,
+    section_from_dict,
 )
 from unibuckle_fenicsx.spec.cases import CASES, paper_case
 
@@ -34,12 +36,14 @@ __all__ = [
     "PlateSpec",
     "ProblemSpec",
     "SectionParameters",
+    "SectionProblemSpec",
     "SolverSpec",
     "__version__",
     "load_toml",
     "paper_case",
     "problem_from_dict",
     "problem_to_dict",
+    "section_from_dict",
     "solve",
     "solve_section",
 ]

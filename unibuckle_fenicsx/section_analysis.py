@@ -32,8 +32,13 @@ from mpi4py import MPI
 
 import dolfinx
 
+import msgspec
+import numpy as np
+import numpy.typing as npt
+
 from unibuckle_fenicsx.algorithms import UnilateralSolution
-from unibuckle_fenicsx.certificate.certify import Certificate, certify
+from unibuckle_fenicsx.algorithms.foundation import solve_foundation
+from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode, Problem, UnilateralProblem
@@ -43,10 +48,11 @@ from unibuckle_fenicsx.model.shell.section import (
     SectionParameters,
     build_section,
     figure_data,
+    section_parameters,
 )
 from unibuckle_fenicsx.results.assemble import record_contact, versions
 from unibuckle_fenicsx.results.records import BucklingResult, ResultDetails
-from unibuckle_fenicsx.spec import SolverSpec
+from unibuckle_fenicsx.spec import SectionProblemSpec, SolverSpec, problem_to_dict
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = ["SectionAnalysis", "SectionResult", "solve_section"]
@@ -63,15 +69,22 @@ class SectionResult(BucklingResult, kw_only=True):
     face (None for a tube); ``mesh`` is [cells along, cells around]; ``dofs`` counts the
     six components of every node; ``constrained_nodes`` counts the core's constrained
     *directions* (a box's corner node has two), ``contact_coordinates`` their unrolled
-    (x, s) (m along the member, m around the mid-line); ``input`` is
-    ``{"section": the parameters}``.
+    (x, s) (m along the member, m around the mid-line); ``input`` is the section's
+    problem file (:func:`~unibuckle_fenicsx.spec.problem_to_dict`) when one was solved,
+    else ``{"section": the parameters}``.
 
     Attributes:
         classical_stress_Pa: The section's reference stress (Pa): a box's k = 4 load
             :math:`4\pi^2 D/(t b^2)`, a tube's :math:`E t/(R\sqrt{3(1-\nu^2)})`.
+        faces: A box's faces at the critical load (empty for a tube): each face's name
+            (``right``, ``top``, ``left``, ``bottom``: y = +b/2, z = +d/2, y = -b/2,
+            z = -d/2), its width (m), its own buckling coefficient
+            :math:`\sigma t w^2/(\pi^2 D)`, its constrained directions and those in
+            contact with the core (pressing a foundation).
     """
 
     classical_stress_Pa: float = math.nan
+    faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
 
     def summary(self) -> str:
         """Lines for the terminal: the critical stress, the hollow one, the reference."""
@@ -151,7 +164,7 @@ class SectionAnalysis(Owner):
 
 
 def solve_section(
-    parameters: SectionParameters,
+    parameters: SectionParameters | SectionProblemSpec,
     comm: MPI.Comm = MPI.COMM_WORLD,
     *,
     levels: int = 1,
@@ -161,7 +174,11 @@ def solve_section(
 
     Args:
         parameters: The section (:class:`~unibuckle_fenicsx.model.shell.section.SectionParameters`,
-            checked when built: bad keys raise :class:`~unibuckle_fenicsx.errors.InputError`).
+            checked when built: bad keys raise :class:`~unibuckle_fenicsx.errors.InputError`),
+            or a section's problem file
+            (:class:`~unibuckle_fenicsx.spec.section.SectionProblemSpec`: its
+            ``mesh.levels`` and ``[solver]`` replace ``levels`` and ``solver``, and the
+            result's ``input`` is the file, which re-runs it).
         comm: Communicator; the mesh is distributed over it.
         levels: With a core, coarser sections (each with twice the mesh size) the
             active-set seeds run on, >= 0. 1 by default: the seeds' many eigen solves on a
@@ -182,19 +199,20 @@ def solve_section(
         destroyed before the error propagates.
     """
     t0 = time.perf_counter()
+    echo: dict[str, object] | None = None
+    if isinstance(parameters, SectionProblemSpec):
+        echo = problem_to_dict(parameters)
+        levels, solver = parameters.mesh.levels, parameters.solver
+        parameters = section_parameters(parameters)
     if not isinstance(parameters, SectionParameters):
         raise TypeError(
-            f"solve_section: parameters must be a SectionParameters, got "
-            f"{type(parameters).__name__}"
+            f"solve_section: parameters must be a SectionParameters or a SectionProblemSpec, "
+            f"got {type(parameters).__name__}"
         )
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    solution: UnilateralSolution | None = None
     certificate: Certificate | None = None
-    if parameters.core:
-        section, solution = solve_levels(parameters, levels=int(levels), comm=comm, solver=solver)
-    else:
-        section = build_section(parameters, comm, solver)
+    section, solution = _solve(parameters, int(levels), comm, solver)
     try:
         problem = section.problem
         t1 = time.perf_counter()
@@ -206,7 +224,12 @@ def solve_section(
             problem.timings["free_check_s"] = time.perf_counter() - t1
         else:
             t1 = time.perf_counter()
-            certificate = certify(_cored(problem), solution)
+            cored = _cored(problem)
+            certificate = (
+                certify_foundation(cored, solution)
+                if cored.tensionless
+                else certify(cored, solution)
+            )
             problem.timings["certify_s"] = time.perf_counter() - t1
             if not certificate.kkt:
                 logger.warning(
@@ -214,10 +237,63 @@ def solve_section(
                     "; ".join(certificate.notes) or certificate.status,
                 )
         result = _result(section, free, solution, certificate, time.perf_counter() - t0)
+        if echo is not None:
+            result.input = echo
     except BaseException:
         section.destroy()
         raise
     return SectionAnalysis(result, section, solution, certificate)
+
+
+#: A box's faces: name, the axis of their normal (1: y, 2: z) and its inward sign.
+_FACES = (("right", 1, -1.0), ("top", 2, -1.0), ("left", 1, 1.0), ("bottom", 2, 1.0))
+
+
+def _faces(
+    section: Section, load: float, active: npt.NDArray[np.int64] | None
+) -> list[dict[str, str | float]]:
+    """Each face of a box at the load ``load``, with the contact set ``active``."""
+    p = section.parameters
+    if p.shape != "box" or p.width is None or p.depth is None:
+        return []
+    D = p.E * p.thickness**3 / (12.0 * (1.0 - p.nu**2))
+    normals = np.zeros((0, 3)) if section.constraints is None else section.constraints.normals
+    touching = np.zeros(len(normals), dtype=bool)
+    if active is not None:
+        touching[active] = True
+    out: list[dict[str, str | float]] = []
+    for name, axis, sign in _FACES:
+        width = p.depth if axis == 1 else p.width  # a face normal to y spans the depth
+        on = normals[:, axis] * sign > 0.5
+        out.append(
+            {
+                "face": name,
+                "width_m": width,
+                "buckling_coefficient_k": load * p.thickness * width**2 / (math.pi**2 * D),
+                "constrained": int(on.sum()),
+                "in_contact": int((on & touching).sum()),
+            }
+        )
+    return out
+
+
+def _solve(
+    parameters: SectionParameters, levels: int, comm: MPI.Comm, solver: SolverSpec | None
+) -> tuple[Section, UnilateralSolution | None]:
+    """The section and, with a core, its unilateral solution (rigid: by levels; elastic)."""
+    iterations = 100 if solver is None else solver.max_iterations
+    if parameters.core and parameters.foundation_stiffness is None:
+        return solve_levels(
+            parameters, levels=levels, comm=comm, solver=solver, max_iterations=iterations
+        )
+    section = build_section(parameters, comm, solver)
+    if not parameters.core:
+        return section, None
+    try:  # an elastic core: the plate's spring-set iteration
+        return section, solve_foundation(_cored(section.problem), max_iterations=iterations)
+    except BaseException:
+        section.destroy()
+        raise
 
 
 def _cored(problem: Problem) -> UnilateralProblem:
@@ -256,13 +332,18 @@ def _result(
         load_resolution=problem.load_resolution(mode.x.petsc_vec, load),
         timings={**problem.timings, "total_s": wall_time_s},
         mpi_size=problem.comm.size,
-        method_chosen_by="no core" if solution is None else "core: section levels",
+        method_chosen_by="no core"
+        if solution is None
+        else "core: foundation"
+        if problem.tensionless
+        else "core: section levels",
         details=ResultDetails(
             free_eigen_error=free.eigen.error, free_eigen_iterations=free.eigen.iterations
         ),
         input={"section": dataclasses.asdict(p)},
         versions=versions(),
         classical_stress_Pa=section.classical_stress(),
+        faces=_faces(section, load, None if solution is None else solution.active),
     )
     if solution is None or certificate is None:
         result.lower_bound_Pa = result.upper_bound_Pa = free.load

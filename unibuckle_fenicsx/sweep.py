@@ -71,7 +71,13 @@ from mpi4py import MPI
 from unibuckle_fenicsx.errors import InputError, NumericalError
 from unibuckle_fenicsx.outcome import Outcome
 from unibuckle_fenicsx.progress import Progress
-from unibuckle_fenicsx.spec import ProblemSpec, load_problem, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.spec import (
+    ProblemSpec,
+    SectionProblemSpec,
+    load_problem,
+    problem_from_dict,
+    problem_to_dict,
+)
 
 __all__ = [
     "STATUSES",
@@ -178,6 +184,11 @@ def base_mapping(path: str | Path) -> dict[str, object]:
         OSError: It cannot be read.
     """
     spec = load_problem(path)
+    if isinstance(spec, SectionProblemSpec):
+        raise InputError(
+            f"{path}: a section's file is not swept (plates only); solve each point with "
+            "unibuckle solve --set section.KEY=VALUE"
+        )
     return problem_to_dict(spec, units=spec.units)
 
 

@@ -360,9 +360,11 @@ COMMANDS = {
     "orderings": lambda rows: _orderings_commands(rows),
     "plates": lambda rows: _plates_commands(rows),
     "routes": lambda rows: _routes_commands(rows),
-    "stages": lambda rows: (
-        f"python bench/bench_stages.py --meshes {_listed(rows, 'mesh')} "
+    "stages": lambda rows: "`, then `".join(
+        f"python bench/bench_stages.py --case {case} "
+        f"--meshes {_listed([r for r in rows if r['case'] == case], 'mesh')} "
         "--json bench/results/stages.jsonl"
+        for case in dict.fromkeys(str(r["case"]) for r in rows)
     ),
 }
 
@@ -459,6 +461,12 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("total", "total (s)"),
         ("free run", "free run (s)"),
         ("ratio", "total / free run"),
+        ("per_level", "per level: steps / factorisations / solves / eigen solves"),
+        ("factorisations", "factorisations (run)"),
+        ("free_factorisations", "factorisations (free run)"),
+        ("solves", "solves (run)"),
+        ("free_solves", "solves (free run)"),
+        ("tolerance", "KKT tolerance"),
         ("load_Pa", "λ_c (Pa)"),
     ],
     "routes": [

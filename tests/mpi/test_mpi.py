@@ -340,3 +340,21 @@ def test_lowrank_certificate_distributed_equals_serial(thin_plate):
         serial["pieces"],
     )
     assert abs(par["value"] - serial["value"]) <= LOAD_RTOL * serial["value"]
+
+
+def test_a_section_on_two_ranks_equals_one():
+    """A small box, hollow, with a rigid core and an elastic one: the serial loads on 2 ranks.
+
+    The contact set is compared by its size (its coordinates: the serial tests').
+    """
+    spec = importlib.util.spec_from_file_location(
+        "section_parallel", MPI_SCRIPTS / "section_parallel.py"
+    )
+    module = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(module)
+    serial = module.collect(MPI.COMM_SELF)
+    parallel = json.loads(run_mpi(MPI_SCRIPTS / "section_parallel.py", 2).strip().splitlines()[-1])
+    for name, (load, free, contact, kkt) in serial.items():
+        p_load, p_free, p_contact, p_kkt = parallel[name]
+        assert _same_load(load, p_load) and _same_load(free, p_free), (name, serial, parallel)
+        assert (contact, kkt) == (p_contact, p_kkt), name

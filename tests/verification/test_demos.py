@@ -58,10 +58,12 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
 
 
 @serial_only
-@pytest.mark.demo
 @pytest.mark.serial
 def test_run_all_coarse_writes_every_figure(tmp_path):
     """run_all --coarse exits 0, prints the table and writes non-blank PNGs of the right size.
+
+    In the default selection (about two minutes of one worker): ``make demo`` is one of the
+    README's two commands, and a change of the package's API has broken its scripts before.
 
     Sizes come from plotting.THEME (pyvista window, matplotlib figsize x dpi); "not blank"
     means a pixel standard deviation above 0.03 (on [0, 1]) and at least 2 % of the pixels

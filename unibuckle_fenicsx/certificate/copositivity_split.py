@@ -72,6 +72,7 @@ Note:
 
 from __future__ import annotations
 
+import hashlib
 import itertools
 import math
 from dataclasses import dataclass, field
@@ -434,27 +435,26 @@ class Patterns:
         self.lines = np.round((self.xy[:, self.axis] - (along[0] if along.size else 0.0))
                               / (self.h if self.h > 0 else 1.0)).astype(np.int64)  # fmt: skip
         self.mirrors = mirror_maps(problem)
-        self._maps: dict[int, tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]] = {}
 
     def _code(self, keys: npt.NDArray[np.int64]) -> npt.NDArray[np.int64]:
         return np.asarray(keys[:, 0] * self._stride + keys[:, 1], dtype=np.int64)
 
-    def _map(self, k: int) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.int64]]:
-        """(source nodes, target nodes) of the translation by k node spacings."""
-        if k not in self._maps:
-            keys = self.keys.copy()
-            keys[:, self.axis] += 4 * k
-            code = self._code(keys)
-            pos = np.clip(np.searchsorted(self._sorted, code), 0, max(len(code) - 1, 0))
-            ok = self._sorted[pos] == code if len(code) else np.zeros(0, dtype=bool)
-            self._maps[k] = (np.flatnonzero(ok), self._order[pos[ok]])
-        return self._maps[k]
-
     def translate(self, values: Array, k: int) -> Array:
-        """``values`` moved by k node spacings along the long axis (nodes off the zone dropped)."""
-        src, dst = self._map(k)
+        """``values`` moved by k node spacings along the long axis (nodes off the zone dropped).
+
+        Only the nonzero entries are looked up (a line across the plate, a buckle's
+        touch-down): a translation costs their number, and no map of a shift is kept
+        (one for every shift would grow as the nodes times the lines along the plate).
+        """
+        src = np.flatnonzero(values)
+        keys = self.keys[src]
+        keys[:, self.axis] += 4 * k
+        code = self._code(keys)
+        size = len(self._sorted)
+        pos = np.clip(np.searchsorted(self._sorted, code), 0, max(size - 1, 0))
+        ok = self._sorted[pos] == code if size else np.zeros(len(code), dtype=bool)
         out = np.zeros_like(values)
-        out[dst] = values[src]
+        out[self._order[pos[ok]]] = values[src[ok]]
         return out
 
     def shifts(self) -> range:
@@ -516,41 +516,43 @@ def _sources(
     reactions.
     """
     w = _reaction(candidate)
-    first: list[tuple[str, Array]] = []
+    first = _First(opts.max_columns)
     movable: list[tuple[str, Array]] = []
     if w.max(initial=0.0) > 0:
-        first.append(("reaction", w))
-        first += _translates(patterns, w, opts)
+        first.add("reaction", w)
+        _translates(patterns, w, opts, first)
         images = [("", w)] + [(f"mirror-{n}-", w[p]) for n, p in patterns.mirrors.items()]
         for name, image in images:
             if name:
-                first.append((f"{name}reaction", image))
+                first.add(f"{name}reaction", image)
             for j, part in enumerate(patterns.clusters(image)):
                 label = f"{name}cluster{j}"
-                first.append((label, part))
+                first.add(label, part)
                 movable.append((label, part))
     for k, other in enumerate(others):
-        first.append((f"kkt{k}", _reaction(other)))
-    return first, movable
+        first.add(f"kkt{k}", _reaction(other))
+    return first.items, movable
 
 
-def _translates(patterns: Patterns, w: Array, opts: SplitOptions) -> list[tuple[str, Array]]:
-    """The reaction's line across the plate at every line, and its long clusters moved."""
-    out: list[tuple[str, Array]] = []
+def _translates(patterns: Patterns, w: Array, opts: SplitOptions, first: _First) -> None:
+    """Into ``first``: the reaction's line across the plate at every line, long clusters moved."""
     clusters = patterns.clusters(w)
     line = patterns.line_profile(w)
     if line.sum() >= opts.line_share * max(float(c.sum()) for c in clusters):
         for k in patterns.shifts():
+            if first.full:
+                return
             moved = patterns.translate(line, k)
             if moved.sum() >= opts.line_fraction * line.sum():
-                out.append((f"line@{k}", moved))
+                first.add(f"line@{k}", moved)
     for j, part in enumerate(clusters):
         if patterns.extent(part) > opts.line_extent:
             for k in patterns.shifts():
+                if first.full:
+                    return
                 moved = patterns.translate(part, k)
                 if k and moved.sum() >= opts.clip_fraction * part.sum():
-                    out.append((f"cluster{j}@{k}", moved))
-    return out
+                    first.add(f"cluster{j}@{k}", moved)
 
 
 # -- the dual of the relaxation at a direction ---------------------------------------------
@@ -1002,25 +1004,62 @@ def scatter_columns(problem: UnilateralProblem, items: list[tuple[str, Array]]) 
     return np.column_stack(cols) if cols else np.zeros((nloc, 0))
 
 
-def _normalised(items: list[tuple[str, Array]], have: list[Array]) -> list[tuple[str, Array]]:
-    """Nonnegative, scaled to max 1, without zeros and repeats (of ``have`` or each other)."""
+def _key(v: Array) -> bytes:
+    """A normalised column's identity: a digest of its values rounded to 1e-9."""
+    return hashlib.blake2b(np.round(v, 9).tobytes(), digest_size=16).digest()
 
-    def key(v: Array) -> bytes:
-        return np.round(v, 9).tobytes()
 
-    seen = {key(v) for v in have}
+def _normal(values: Array) -> Array | None:
+    """``values`` made nonnegative and scaled to max 1 (None if nothing is left)."""
+    v = np.maximum(values, 0.0)
+    top = float(v.max(initial=0.0))
+    return v / top if top > 0 else None
+
+
+def _normalised(
+    items: list[tuple[str, Array]], have: list[Array], limit: int | None = None
+) -> list[tuple[str, Array]]:
+    """Nonnegative, scaled to max 1, without zeros and repeats (of ``have`` or each other).
+
+    At most ``limit`` of them (the first ones), if given.
+    """
+    seen = {_key(v) for v in have}
     out: list[tuple[str, Array]] = []
     for name, values in items:
-        v = np.maximum(values, 0.0)
-        top = float(v.max(initial=0.0))
-        if not top > 0:
+        if limit is not None and len(out) >= limit:
+            break
+        v = _normal(values)
+        if v is None or _key(v) in seen:
             continue
-        v = v / top
-        if key(v) in seen:
-            continue
-        seen.add(key(v))
+        seen.add(_key(v))
         out.append((name, v))
     return out
+
+
+class _First:
+    """The first columns, kept while fewer than ``limit`` of them are distinct.
+
+    The first basis takes the first ``limit`` distinct columns (:func:`_normalised`);
+    the columns after them are never used, and are not kept (a line's translates alone
+    would be one column per line along the plate, each as long as the zone).
+    """
+
+    def __init__(self, limit: int) -> None:
+        self.items: list[tuple[str, Array]] = []
+        self.limit = limit
+        self._seen: set[bytes] = set()
+
+    @property
+    def full(self) -> bool:
+        return len(self._seen) >= self.limit
+
+    def add(self, name: str, values: Array) -> None:
+        if self.full:
+            return
+        self.items.append((name, values))
+        v = _normal(values)
+        if v is not None:
+            self._seen.add(_key(v))
 
 
 def _attempt(
@@ -1144,7 +1183,7 @@ def _first_basis(
     # A-normalised Ritz pairs: psi'B K^-1 B psi = 1/(theta (theta - lam)), so this scaling
     # makes G_W nearly -I (the z-space's angles then nearly Euclidean).
     W = _block_product(problem.model.B, psi) * np.sqrt(theta * (lam - theta))[None, :]
-    items = _normalised(state.columns, [])[: opts.max_columns]
+    items = _normalised(state.columns, [], opts.max_columns)
     capacity = neg + min(opts.max_columns, len(items) + opts.max_rounds * opts.per_round)
     basis = Basis(problem, matrix, neg, capacity)
     basis.add(W, [f"W{j}" for j in range(neg)])

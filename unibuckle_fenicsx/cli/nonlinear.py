@@ -12,6 +12,7 @@ from unibuckle_fenicsx.cli.problem import spec_from_args, warn_plate_model
 from unibuckle_fenicsx.cli.status import report_failure
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
+from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
 
 def nonlinear_command(args: argparse.Namespace, comm: Any) -> int:
@@ -37,6 +38,8 @@ def nonlinear_command(args: argparse.Namespace, comm: Any) -> int:
                 message = "--" + name.replace("_", "-") + message[len(name) :]
         raise InputError(message) from None
     spec = spec_from_args(args)
+    if isinstance(spec, SectionProblemSpec):
+        raise InputError("unibuckle nonlinear: a section's load path is not modelled (plates only)")
     if args.shape == "unilateral" and (args.no_obstacle or not spec.all_obstacles):
         why = "--no-obstacle removes it" if args.no_obstacle else "the problem has none"
         raise InputError(

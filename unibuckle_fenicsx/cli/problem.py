@@ -11,6 +11,7 @@ from unibuckle_fenicsx.errors import InputError
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.spec import ProblemSpec
+from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
 
 def warn_plate_model(spec: ProblemSpec, comm: Any) -> None:
@@ -22,14 +23,18 @@ def warn_plate_model(spec: ProblemSpec, comm: Any) -> None:
         print(f"unibuckle: warning: {note}", file=sys.stderr)
 
 
-def spec_from_args(args: argparse.Namespace) -> ProblemSpec:
-    """The problem of --case or --config, with --nx/--ny applied."""
+def spec_from_args(args: argparse.Namespace) -> ProblemSpec | SectionProblemSpec:
+    """The problem of --case or --config, with --set and --nx/--ny applied."""
     from unibuckle_fenicsx.spec import load_problem
     from unibuckle_fenicsx.spec.cases import paper_case
 
     spec = paper_case(args.case) if args.case else load_config(args.config, load_problem)
     if args.settings:
         spec = _with_settings(spec, args.settings)
+    if isinstance(spec, SectionProblemSpec):
+        if args.nx is not None or args.ny is not None:
+            raise InputError("--nx, --ny set a plate's cells; a section takes [mesh] size = h")
+        return spec
     if args.nx is not None or args.ny is not None:
         spec = spec.with_mesh(
             spec.mesh.nx if args.nx is None else args.nx,
@@ -38,14 +43,16 @@ def spec_from_args(args: argparse.Namespace) -> ProblemSpec:
     return spec
 
 
-def _with_settings(spec: ProblemSpec, settings: Sequence[str]) -> ProblemSpec:
+def _with_settings(
+    spec: ProblemSpec | SectionProblemSpec, settings: Sequence[str]
+) -> ProblemSpec | SectionProblemSpec:
     """``spec`` with the ``--set PATH=VALUE`` changes (dotted paths of the problem file).
 
     Raises:
         ValueError: A setting without '=', a path the problem file does not have, or a
             value the schema refuses (the message names the path).
     """
-    from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
+    from unibuckle_fenicsx.spec import problem_to_dict, spec_from_dict
     from unibuckle_fenicsx.sweep import set_text
 
     data = problem_to_dict(spec, units=spec.units)
@@ -55,7 +62,7 @@ def _with_settings(spec: ProblemSpec, settings: Sequence[str]) -> ProblemSpec:
             raise InputError(f"--set {setting!r}: give PATH=VALUE, e.g. solver.tau=1e-9")
         set_text(data, path.strip(), text.strip())
     try:
-        return problem_from_dict(data, name=spec.name)
+        return spec_from_dict(data, name=spec.name)
     except ValueError as err:
         raise InputError(f"--set {' '.join(settings)}: {err}") from None
 

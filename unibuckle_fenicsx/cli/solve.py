@@ -6,20 +6,26 @@ import argparse
 import sys
 from typing import Any
 
+from msgspec.structs import replace
+
 from unibuckle_fenicsx.cli.flags import solver_changes, unused_flags
 from unibuckle_fenicsx.cli.problem import spec_from_args, warn_plate_model
 from unibuckle_fenicsx.cli.status import report_failure
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
+from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
 
 def solve_command(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle solve``: one problem, its summary, JSON and fields."""
     from unibuckle_fenicsx.analysis import solve
-    from unibuckle_fenicsx.results.files import write_fields, write_json
+    from unibuckle_fenicsx.results.files import write_fields
 
     # A refused input or a failed solve raises: main() tells the outcome.
     spec = spec_from_args(args)
     changes, flags = solver_changes(args)
+    if isinstance(spec, SectionProblemSpec):
+        return _section(args, replace(spec, solver=replace(spec.solver, **changes)), comm)
     spec = spec.with_solver(**changes)
     method = spec.solver.method  # the flag's, or the problem file's
     _warn_unused(flags, method, comm)
@@ -34,6 +40,13 @@ def solve_command(args: argparse.Namespace, comm: Any) -> int:
                 unwritten = f"--output {args.output}: {err}"
     result = analysis.result
     _warn_unused(flags, method, comm, result)
+    return _report(args, result, comm, unwritten)
+
+
+def _report(args: argparse.Namespace, result: Any, comm: Any, unwritten: str | None) -> int:
+    """The summary, the JSON (rank 0) and the exit status of a solved ``result``."""
+    from unibuckle_fenicsx.results.files import write_json
+
     outcome = Outcome.of(result)
     certificate = result.certificate
     if comm.rank == 0:
@@ -56,6 +69,19 @@ def solve_command(args: argparse.Namespace, comm: Any) -> int:
     if unwritten is not None:
         return report_failure(comm, f"could not write {unwritten}; the result is the summary above")
     return outcome.exit_status
+
+
+def _section(args: argparse.Namespace, spec: SectionProblemSpec, comm: Any) -> int:
+    """A section's file: solved by :func:`~unibuckle_fenicsx.section_analysis.solve_section`."""
+    from unibuckle_fenicsx.section_analysis import solve_section
+
+    if args.output:
+        raise InputError(
+            f"--output {args.output}: a section's fields are not written (its mode: the "
+            "Python API's SectionAnalysis.figure_data); give --json for the result"
+        )
+    with solve_section(spec, comm) as analysis:
+        return _report(args, analysis.result, comm, None)
 
 
 def _warn_unused(flags: list[str], method: str, comm: Any, result: Any = None) -> None:

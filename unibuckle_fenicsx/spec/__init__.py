@@ -19,7 +19,8 @@ Struct base, units, messages), :mod:`~unibuckle_fenicsx.spec.plate`,
 :mod:`~unibuckle_fenicsx.spec.material`, :mod:`~unibuckle_fenicsx.spec.obstacles`,
 :mod:`~unibuckle_fenicsx.spec.solver` (the methods and their options),
 :mod:`~unibuckle_fenicsx.spec.checks` (rules across tables),
-:mod:`~unibuckle_fenicsx.spec.problem`, :mod:`~unibuckle_fenicsx.spec.files` (a file read
+:mod:`~unibuckle_fenicsx.spec.problem`, :mod:`~unibuckle_fenicsx.spec.section` (a
+section's file), :mod:`~unibuckle_fenicsx.spec.files` (a file read
 and written), :mod:`~unibuckle_fenicsx.spec.schema` (its JSON Schema) and
 :mod:`~unibuckle_fenicsx.spec.cases` (the paper's cases).
 """
@@ -44,6 +45,8 @@ from unibuckle_fenicsx.spec.files import (
     load_toml,
     problem_from_dict,
     problem_to_dict,
+    section_from_dict,
+    spec_from_dict,
     stress_value,
 )
 from unibuckle_fenicsx.spec.material import Material, Ply
@@ -59,6 +62,7 @@ from unibuckle_fenicsx.spec.plate import (
 )
 from unibuckle_fenicsx.spec.problem import ProblemSpec
 from unibuckle_fenicsx.spec.schema import accepted_keys, json_schema
+from unibuckle_fenicsx.spec.section import SectionProblemSpec
 from unibuckle_fenicsx.spec.solver import (
     METHODS,
     OPTIONS,
@@ -90,6 +94,7 @@ __all__ = [
     "PointSpec",
     "Polygon",
     "ProblemSpec",
+    "SectionProblemSpec",
     "SolverSpec",
     "Temperature",
     "_boolean",
@@ -104,6 +109,8 @@ __all__ = [
     "plate_case",
     "problem_from_dict",
     "problem_to_dict",
+    "section_from_dict",
+    "spec_from_dict",
     "stress_ends",
     "stress_value",
     "temperature_field",

@@ -51,6 +51,7 @@ from unibuckle_fenicsx.spec.material import Ply
 from unibuckle_fenicsx.spec.obstacles import ObstacleSpec
 from unibuckle_fenicsx.spec.plate import EdgeSpec, PlateSpec, paper_edges
 from unibuckle_fenicsx.spec.problem import ProblemSpec
+from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
 #: Keys of an ``[obstacle]`` or ``[[obstacles]]`` table.
 OBSTACLE_KEYS = ("zone", "polygon", "circle", *ObstacleSpec.__struct_fields__[1:])
@@ -72,6 +73,7 @@ def problem_from_dict(data: Mapping[str, object], name: str = "plate") -> Proble
     """
     if not isinstance(data, Mapping):
         raise InputError(f"a problem file is a table of tables, got {data!r}")
+    _not_a_section(data)
     api = _to_api({"name": name, **plain(data)})
     if isinstance(units := api.get("units"), str) and units in UNITS:
         api = as_table(scaled(api, ProblemSpec, units, 1))
@@ -84,14 +86,58 @@ def problem_from_dict(data: Mapping[str, object], name: str = "plate") -> Proble
         CONVERTING.reset(token)
 
 
-def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, object]:
+def section_from_dict(data: Mapping[str, object], name: str = "section") -> SectionProblemSpec:
+    """A :class:`~unibuckle_fenicsx.spec.section.SectionProblemSpec` from a TOML-shaped mapping.
+
+    Raises:
+        InputError: An unknown key, a value of the wrong type or out of its range, a
+            rule between keys broken; the message names the key.
+    """
+    if not isinstance(data, Mapping):
+        raise InputError(f"a problem file is a table of tables, got {data!r}")
+    api = as_table({"name": name, **as_table(plain(data))})
+    if isinstance(units := api.get("units"), str) and units in UNITS:
+        api = as_table(scaled(api, SectionProblemSpec, units, 1))
+    token = CONVERTING.set(True)
+    try:
+        return msgspec.convert(api, SectionProblemSpec)
+    except msgspec.ValidationError as err:
+        raise InputError(_message(err, api, root=SectionProblemSpec)) from None
+    finally:
+        CONVERTING.reset(token)
+
+
+def spec_from_dict(data: Mapping[str, object], name: str) -> ProblemSpec | SectionProblemSpec:
+    """A section's problem if ``data`` has a ``[section]`` table, else a plate's."""
+    if isinstance(data, Mapping) and "section" in data:
+        return section_from_dict(data, name)
+    return problem_from_dict(data, name)
+
+
+def _not_a_section(data: Mapping[str, object]) -> None:
+    """Refuse a section's keys in a plate's file: [section], load.axial_stress, obstacle.core."""
+    if "section" in data:
+        raise InputError(
+            "[section]: a section's file is read by section_from_dict (or load_problem)"
+        )
+    for table, key in (("obstacle", "core"), ("load", "axial_stress"), ("load", "bending_stress")):
+        if isinstance(found := data.get(table), Mapping) and key in found:
+            raise InputError(
+                f"{table}.{key} is a section's key, and this file has no [section] table "
+                "(shape, thickness, length, width and depth or diameter): a plate has no core "
+                "and takes its load on its edges ([edges.NAME] normal_stress)"
+            )
+
+
+def problem_to_dict(spec: ProblemSpec | SectionProblemSpec, units: str = "SI") -> dict[str, object]:
     """The TOML-shaped mapping of ``spec``, every key with the value used.
 
     ``problem_from_dict(problem_to_dict(spec)) == spec`` for a spec without a predicate
-    zone (it cannot be written: it raises).
+    zone (it cannot be written: it raises); for a section's,
+    ``section_from_dict(problem_to_dict(spec)) == spec``.
 
     Args:
-        spec: The problem.
+        spec: The problem (a plate's or a section's).
         units: Unit system of the numbers written (one of :data:`UNITS`); the mapping's
             ``units`` key says which.
     """
@@ -99,9 +145,12 @@ def problem_to_dict(spec: ProblemSpec, units: str = "SI") -> dict[str, object]:
         raise InputError(f"units must be one of {tuple(UNITS)}, got {units!r}")
     try:
         data = msgspec.json.decode(msgspec.json.encode(spec))  # lists, not tuples; exact
-        data = as_table(scaled(data, ProblemSpec, units, -1))
+        data = as_table(scaled(data, type(spec), units, -1))
     except TypeError:
         raise InputError("problem_to_dict: a predicate obstacle zone cannot be written") from None
+    if isinstance(spec, SectionProblemSpec):
+        data.pop("units")
+        return as_table(_pruned({"name": data.pop("name"), "units": units, **data}))
     return _to_file(data | {"units": units}, spec)
 
 
@@ -283,7 +332,10 @@ def _laminate(api: dict[str, object]) -> dict[str, object]:
 
 
 def _message(
-    err: msgspec.ValidationError, api: object, prefix: list[str | int] | None = None
+    err: msgspec.ValidationError,
+    api: object,
+    prefix: list[str | int] | None = None,
+    root: type[ProblemSpec | SectionProblemSpec] = ProblemSpec,
 ) -> str:
     """The message of msgspec's ``err`` converting ``api``, naming the file's key."""
     steps = [*(prefix or []), *location(err)]
@@ -295,7 +347,7 @@ def _message(
         return str(cause)
     if cause is not None:
         raise cause
-    tp, value = walk(ProblemSpec, api, steps)
+    tp, value = walk(root, api, steps)
     return reason(_file_key(steps, api), value, tp)
 
 
@@ -369,8 +421,10 @@ def _pruned(value: object) -> object:
 # -- files -----------------------------------------------------------------------------
 
 
-def load_toml(path: str | Path) -> ProblemSpec:
-    """Read a :class:`ProblemSpec` from a TOML file (its keys: :func:`problem_from_dict`).
+def load_toml(path: str | Path) -> ProblemSpec | SectionProblemSpec:
+    """Read a problem from a TOML file: a section's if it has a ``[section]`` table.
+
+    Its keys: :func:`problem_from_dict` (a plate) or :func:`section_from_dict`.
 
     Raises:
         InputError: The file is not UTF-8 TOML, or describes an invalid problem; the
@@ -391,12 +445,12 @@ def load_toml(path: str | Path) -> ProblemSpec:
         # A gmsh file is found next to the problem file.
         plate["file"] = str((path.parent / plate["file"]).resolve())
     try:
-        return problem_from_dict(data, name=path.stem)
+        return spec_from_dict(data, name=path.stem)
     except ValueError as err:
         raise InputError(f"{path}: {err}") from None
 
 
-def load_problem(path: str | Path) -> ProblemSpec:
+def load_problem(path: str | Path) -> ProblemSpec | SectionProblemSpec:
     """A problem file: TOML, or the JSON of a result (its ``input``, which re-runs it).
 
     Raises:
@@ -415,6 +469,6 @@ def load_problem(path: str | Path) -> ProblemSpec:
         if data is None:
             raise InputError(f"{path}: this result's problem has no file form (a predicate zone)")
     try:
-        return problem_from_dict(data, name=path.stem)
+        return spec_from_dict(data, name=path.stem)
     except ValueError as err:
         raise InputError(f"{path}: {err}") from None

@@ -4,7 +4,8 @@
 the file's (the edge tables under ``edges``, an obstacle's ``polygon`` and ``circle``
 keys, a hole's ``outline``: :mod:`~unibuckle_fenicsx.spec.files`) and gives each key the
 description its Struct's docstring gives it (its ``Args:`` entry: msgspec reads a field's
-description only from its ``Meta``, and the docstring is where the API documents it).
+description only from its ``Meta``, and the docstring is where the API documents it). A
+section's file (:mod:`~unibuckle_fenicsx.spec.section`) is the schema's other branch.
 """
 
 from __future__ import annotations
@@ -26,15 +27,19 @@ from unibuckle_fenicsx.spec.base import (
 )
 from unibuckle_fenicsx.spec.plate import PlateSpec
 from unibuckle_fenicsx.spec.problem import ProblemSpec
+from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
 __all__ = ["accepted_keys", "json_schema"]
 
 
 def json_schema() -> dict[str, object]:
-    """The JSON Schema (draft 2020-12) of a problem file, as a mapping."""
-    schema = msgspec.json.schema(ProblemSpec)
-    defs = schema["$defs"]
-    for name, cls in _tables(ProblemSpec).items():
+    """The JSON Schema (draft 2020-12) of a problem file, as a mapping.
+
+    A plate's file or a section's (one with a ``[section]`` table): ``anyOf`` the two.
+    """
+    tops, defs = msgspec.json.schema_components([ProblemSpec, SectionProblemSpec])
+    schema = {"anyOf": list(tops), "$defs": defs}
+    for name, cls in {**_tables(ProblemSpec), **_tables(SectionProblemSpec)}.items():
         node = defs[name]
         node["description"] = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0]
         for key, text in field_docs(cls).items():
@@ -146,5 +151,6 @@ def accepted_keys() -> list[str]:
         if isinstance(extra := node.get("additionalProperties"), dict):
             visit(resolve(extra), f"{prefix}<name>.")
 
-    visit(resolve(schema), "")
+    for top, _ in tables(schema):  # a plate's file, a section's
+        visit(top, "")
     return keys

@@ -41,6 +41,8 @@ from unibuckle_fenicsx.certificate.copositivity_split import (
     Basis,
     Patterns,
     SplitOptions,
+    _normalised,
+    column_sources,
     negative_space,
     scatter_columns,
     split_certificate,
@@ -78,6 +80,32 @@ def test_translations_follow_the_coordinates(thin_plate):
             kept = patterns.translate(np.ones(len(xy)), k) > 0
             home = patterns.translate(kept.astype(float), -k) > 0
             assert np.array_equal(back[home], values[home])
+
+
+@serial
+def test_first_columns_stop_where_the_first_basis_stops(thin_plate):
+    """The first columns are kept only up to the first ``max_columns`` distinct ones.
+
+    Thin SSSS plate, 45 x 15 (45 lines along, so the reaction's line has some 90
+    translates): with ``max_columns = 7`` the columns kept are a prefix of those kept
+    with no effective limit (10 000: every translate, every cluster, as before the
+    limit), and the first basis (:func:`_normalised`, the first 7 distinct ones) is the
+    same from either, name by name and value by value. A line's translates are one
+    column per line, each as long as the zone: kept whole they grew as the nodes times
+    the lines (some 5 GB at 10^6 DOFs).
+    """
+    with solve(thin_plate("ssss", 45, 15), MPI.COMM_SELF) as analysis:
+        problem, sol = analysis.problem, analysis.solution
+        assert sol is not None
+        few = column_sources(problem, sol.candidate, [], SplitOptions(max_columns=7))
+        every = column_sources(problem, sol.candidate, [], SplitOptions(max_columns=10_000))
+    assert 7 <= len(few.first) < len(every.first)
+    assert [n for n, _ in few.first] == [n for n, _ in every.first[: len(few.first)]]
+    assert all(np.array_equal(a, b) for (_, a), (_, b) in zip(few.first, every.first, strict=False))
+    basis = [_normalised(src.first, [], 7) for src in (few, every)]
+    assert [n for n, _ in basis[0]] == [n for n, _ in basis[1]] and len(basis[0]) == 7
+    assert all(np.array_equal(a, b) for (_, a), (_, b) in zip(*basis, strict=True))
+    assert [n for n, _ in few.movable] == [n for n, _ in every.movable]
 
 
 def _exact_solve(K, rhs):

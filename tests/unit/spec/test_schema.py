@@ -26,6 +26,7 @@ from unibuckle_fenicsx.spec import (
     json_schema,
     problem_from_dict,
     problem_to_dict,
+    spec_from_dict,
 )
 
 SCHEMA_FILE = ROOT / "schema" / "unibuckle-problem.schema.json"
@@ -72,6 +73,21 @@ TWO_OBSTACLES = {
         {"zone": [[-0.02, 0.02], [-0.02, 0.02]], "side": "above", "gap": 0.001},
     ],
 }
+
+#: A section's file (a box with an elastic core over part of its length).
+SECTION = {
+    "section": {
+        "shape": "box", "width": 0.2, "depth": 0.1, "diameter": None, "thickness": 0.002,
+        "length": 0.4, "ends": "clamped",
+    },
+    "material": {"E": 2.1e11, "nu": 0.3},
+    "load": {"axial_stress": -1.0, "bending_stress": -0.2},
+    "obstacle": {"core": True, "span": [0.1, 0.3], "foundation_stiffness": 1e9},
+    "mesh": {"size": 0.02, "levels": 2},
+}  # fmt: skip
+SECTION["section"].pop("diameter")
+#: A tube's: its diameter.
+TUBE = {**SECTION, "section": {"shape": "tube", "diameter": 0.2, "thickness": 0.001, "length": 0.4}}
 
 
 def _keys(data: dict[str, Any], prefix: str = "") -> set[str]:
@@ -139,22 +155,23 @@ def test_unibuckle_schema_into_a_pipe_closed_early(tmp_path):
 
 def test_every_accepted_key_loads(tmp_path):
     """The documents hold every accepted key, and nothing else; each loads."""
-    documents = [*BASES.values(), LAMINATE, THERMAL, TWO_OBSTACLES, _gmsh_file(tmp_path)]
+    documents = [*BASES.values(), LAMINATE, THERMAL, TWO_OBSTACLES, SECTION, TUBE]
+    documents.append(_gmsh_file(tmp_path))
     for data in documents:
-        problem_from_dict(data)
+        spec_from_dict(data, "plate")
     covered = set().union(*(_keys(data) for data in documents))
     assert covered == set(accepted_keys())
 
 
 def test_the_input_echo_passes_the_schema_and_round_trips(tmp_path):
-    for data in [*BASES.values(), LAMINATE, THERMAL, TWO_OBSTACLES]:
-        spec = problem_from_dict(data)
+    for data in [*BASES.values(), LAMINATE, THERMAL, TWO_OBSTACLES, SECTION, TUBE]:
+        spec = spec_from_dict(data, "plate")
         for units in ("SI", "mm-N-MPa"):
             echo = json.loads(json.dumps(problem_to_dict(spec, units=units)))
-            problem_from_dict(echo)  # the echo is a problem file
+            spec_from_dict(echo, "plate")  # the echo is a problem file
             assert _keys(echo) <= set(accepted_keys())
         # Written in SI, the echo is the problem (in other units, up to rounding).
-        assert problem_from_dict(problem_to_dict(spec), name=spec.name) == spec
+        assert spec_from_dict(problem_to_dict(spec), name=spec.name) == spec
 
 
 @pytest.mark.parametrize(
@@ -232,10 +249,11 @@ def test_every_accepted_key_round_trips_through_load_and_dump(tmp_path):
     relative 4e-15: two conversions by the mm-N-MPa factors 1e-3 and 1e6, each within
     half an ulp per product).
     """
-    documents = [*BASES.values(), LAMINATE, THERMAL, TWO_OBSTACLES, _gmsh_file(tmp_path)]
+    documents = [*BASES.values(), LAMINATE, THERMAL, TWO_OBSTACLES, SECTION, TUBE]
+    documents.append(_gmsh_file(tmp_path))
     checked = set()
     for data in documents:
-        spec = problem_from_dict(data)
+        spec = spec_from_dict(data, "plate")
         dump = problem_to_dict(spec)
         for key, path, value in _concrete(data):
             written: Any = dump
@@ -243,8 +261,8 @@ def test_every_accepted_key_round_trips_through_load_and_dump(tmp_path):
                 written = written[part]
             assert _numbers_equal(written, value), (key, value, written)
             checked.add(key)
-        assert problem_from_dict(dump, name=spec.name) == spec
-        mm = problem_from_dict(problem_to_dict(spec, units="mm-N-MPa"), name=spec.name)
+        assert spec_from_dict(dump, name=spec.name) == spec
+        mm = spec_from_dict(problem_to_dict(spec, units="mm-N-MPa"), name=spec.name)
         si, back = (json.loads(json.dumps(problem_to_dict(s))) for s in (spec, mm))
         for (key, _, a), (_, _, b) in zip(_concrete(si), _concrete(back), strict=True):
             assert _close(a, b), (key, a, b)

@@ -29,6 +29,9 @@ from dataclasses import dataclass
 from mpi4py import MPI
 from petsc4py import PETSc
 
+import dolfinx
+import ufl
+
 import numpy as np
 import numpy.typing as npt
 
@@ -37,7 +40,13 @@ from unibuckle_fenicsx.model.shell.geometry import SectionMesh
 from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE, ShellModel
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
-__all__ = ["CoreConstraints", "change_of_basis", "core_constraints", "perimeter_coordinate"]
+__all__ = [
+    "CoreConstraints",
+    "change_of_basis",
+    "core_constraints",
+    "core_springs",
+    "perimeter_coordinate",
+]
 
 
 @dataclass(frozen=True)
@@ -117,23 +126,58 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
         Collective.
     """
     section = model.section
-    comm = model.mesh.comm
     tol = section.tolerance
     x0, x1 = (0.0, section.length) if span is None else span
     if not (0.0 <= x0 < x1 <= section.length + tol):
         raise InputError(
             f"core span must satisfy 0 <= x0 < x1 <= length = {section.length:g} m, got {span}"
         )
-    V = model.W
-    im = V.dofmap.index_map
-    n_owned = im.size_local
-    X = V.tabulate_dof_coordinates()[:n_owned]
+    X = model.W.tabulate_dof_coordinates()[: model.W.dofmap.index_map.size_local]
     inside = (X[:, 0] >= x0 - tol) & (X[:, 0] <= x1 + tol)
-    held = np.zeros((n_owned, DOFS_PER_NODE), dtype=bool)
-    bc = model.bc_dofs[model.bc_dofs < n_owned * DOFS_PER_NODE]
+    owned_nodes, js, normals, num_held = _directions(model, X, np.flatnonzero(inside))
+    coords = X[owned_nodes] if owned_nodes.size else np.zeros((0, 3))
+    s = perimeter_coordinate(section, coords.T) if owned_nodes.size else np.zeros(0)
+    unrolled = np.stack([coords[:, 0], s], axis=1) if owned_nodes.size else np.zeros((0, 2))
+    # One numbering on every rank: by quantised (x, s), then the normal's place.
+    gathered = model.mesh.comm.allgather((coords, normals, unrolled, js))
+    all_j = np.concatenate([g[3] for g in gathered])
+    if all_j.size == 0:
+        raise InputError(
+            f"the core covers no free node: its span {(x0, x1)} m holds only nodes held by "
+            "the end supports; lengthen the span or refine the mesh"
+        )
+    all_u = np.vstack([g[2] for g in gathered])
+    size = max(section.length, section.perimeter)
+    keys = np.round(all_u / (GEOMETRY_RTOL * size)).astype(np.int64)
+    order = np.lexsort((all_j, keys[:, 1], keys[:, 0]))
+    rank_pos = np.empty(all_j.size, dtype=np.int64)
+    rank_pos[order] = np.arange(all_j.size, dtype=np.int64)
+    offset = int(sum(g[3].size for g in gathered[: model.mesh.comm.rank]))
+    local_dofs = (owned_nodes.astype(np.int64) * DOFS_PER_NODE + js).astype(np.int32)
+    return CoreConstraints(
+        coordinates=np.vstack([g[0] for g in gathered])[order],
+        normals=np.vstack([g[1] for g in gathered])[order],
+        unrolled=all_u[order],
+        owned_positions=rank_pos[offset : offset + js.size],
+        owned_local_dofs=local_dofs,
+        owned_global_dofs=model.global_dofs(local_dofs),
+        owned_nodes=owned_nodes,
+        num_held=int(model.mesh.comm.allreduce(num_held, op=MPI.SUM)),
+    )
+
+
+def _directions(
+    model: ShellModel, X: npt.NDArray[np.float64], nodes: npt.NDArray[np.int64]
+) -> tuple[npt.NDArray[np.int32], npt.NDArray[np.int32], npt.NDArray[np.float64], int]:
+    """(node, normal's place j, normal) of each direction at the owned ``nodes``, and the held.
+
+    A node whose normal motion a support holds is left out (counted); one whose support
+    holds only part of it is refused (:func:`core_constraints`).
+    """
+    held = np.zeros((X.shape[0], DOFS_PER_NODE), dtype=bool)
+    bc = model.bc_dofs[model.bc_dofs < X.shape[0] * DOFS_PER_NODE]
     held.reshape(-1)[bc] = True
-    nodes = np.flatnonzero(inside).astype(np.int32)
-    normals_per_node = section.inward_normals(X[nodes].T) if nodes.size else []
+    normals_per_node = model.section.inward_normals(X[nodes].T) if nodes.size else []
     rec_nodes, rec_j, rec_n = [], [], []
     num_held = 0
     for k, normals in zip(nodes.tolist(), normals_per_node, strict=True):
@@ -153,42 +197,45 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
             "the core may cover only nodes whose displacement is free or whose normal "
             "motion is held"
         )
-    owned_nodes = np.asarray(rec_nodes, dtype=np.int32)
-    js = np.asarray(rec_j, dtype=np.int32)
-    normals = np.asarray(rec_n, dtype=float).reshape(-1, 3)
-    coords = X[owned_nodes] if owned_nodes.size else np.zeros((0, 3))
-    s = perimeter_coordinate(section, coords.T) if owned_nodes.size else np.zeros(0)
-    unrolled = np.stack([coords[:, 0], s], axis=1) if owned_nodes.size else np.zeros((0, 2))
-    # One numbering on every rank: by quantised (x, s), then the normal's place.
-    gathered = comm.allgather((coords, normals, unrolled, js))
-    all_c = np.vstack([g[0] for g in gathered])
-    all_n = np.vstack([g[1] for g in gathered])
-    all_u = np.vstack([g[2] for g in gathered])
-    all_j = np.concatenate([g[3] for g in gathered])
-    size = max(section.length, section.perimeter)
-    keys = np.round(all_u / (GEOMETRY_RTOL * size)).astype(np.int64)
-    order = np.lexsort((all_j, keys[:, 1], keys[:, 0])) if all_j.size else np.zeros(0, np.int64)
-    total = int(all_j.size)
-    if total == 0:
-        raise InputError(
-            f"the core covers no free node: its span {(x0, x1)} m holds only nodes held by "
-            "the end supports; lengthen the span or refine the mesh"
-        )
-    rank_pos = np.empty(total, dtype=np.int64)
-    rank_pos[order] = np.arange(total, dtype=np.int64)
-    offset = int(sum(g[3].size for g in gathered[: comm.rank]))
-    positions = rank_pos[offset : offset + js.size]
-    local_dofs = (owned_nodes.astype(np.int64) * DOFS_PER_NODE + js).astype(np.int32)
-    return CoreConstraints(
-        coordinates=all_c[order],
-        normals=all_n[order],
-        unrolled=all_u[order],
-        owned_positions=positions,
-        owned_local_dofs=local_dofs,
-        owned_global_dofs=model.global_dofs(local_dofs),
-        owned_nodes=owned_nodes,
-        num_held=int(comm.allreduce(num_held, op=MPI.SUM)),
+    return (
+        np.asarray(rec_nodes, dtype=np.int32),
+        np.asarray(rec_j, dtype=np.int32),
+        np.asarray(rec_n, dtype=float).reshape(-1, 3),
+        num_held,
     )
+
+
+def core_springs(
+    model: ShellModel, constraints: CoreConstraints, stiffness: float
+) -> npt.NDArray[np.float64]:
+    r"""The core's lumped foundation spring (N/m) of each constrained direction, on every rank.
+
+    The spring of node k is :math:`k_f \int \varphi_k\,dx` (the row sum of the Q1 mass
+    matrix, as the plate's foundation), split equally between a box corner's two
+    directions (the halves of its cells on either face; exact for the corner's
+    symmetric cells).
+
+    Args:
+        model: The section's shell model.
+        constraints: Its constrained directions.
+        stiffness: The Winkler modulus :math:`k_f` (N/m^3), > 0.
+
+    Note:
+        Collective.
+    """
+    v = ufl.TestFunction(model.W)
+    areas = dolfinx.fem.assemble_vector(dolfinx.fem.form(v[0] * ufl.dx))
+    areas.scatter_reverse(dolfinx.la.InsertMode.add)
+    nodes = constraints.owned_nodes
+    share = np.unique(nodes, return_counts=True)
+    count = dict(zip(share[0].tolist(), share[1].tolist(), strict=True))
+    local = np.array(
+        [stiffness * areas.array[DOFS_PER_NODE * k] / count[k] for k in nodes.tolist()]
+    )
+    springs = np.zeros(constraints.size)
+    for positions, values in model.mesh.comm.allgather((constraints.owned_positions, local)):
+        springs[positions] = values
+    return springs
 
 
 def _node_block(normals: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:

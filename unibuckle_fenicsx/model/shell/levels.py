@@ -103,49 +103,29 @@ def solve_levels(
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
     t0 = time.perf_counter()
     sizes = [parameters.mesh_size * 2.0**k for k in range(levels, -1, -1)]
-    corner = parameters.corner_cell
     log: list[SectionLevel] = []
     prev: Section | None = None
     best: UnilateralSolution | None = None
     polish_iterations: int | None = None
     coarse_solves = 0
-    section: Section | None = None
     for size in sizes:
-        tl = time.perf_counter()
-        graded = None if corner is None else corner * size / parameters.mesh_size
-        section = build_section(
-            replace(parameters, mesh_size=size, corner_cell=graded), comm, solver
-        )
-        problem = section.problem
-        if not isinstance(problem, CoredSectionProblem) or section.constraints is None:
-            raise RuntimeError("solve_levels: a core section without constraints")
-        polished, polish_iterations = None, None
-        if prev is not None and best is not None and prev.constraints is not None:
-            z = prolong_directions(best.active, prev.constraints, section.constraints)
-            polished, polish_iterations = _polish(problem, z, best.load)
-        if polished is None:
-            polished = solve_active_set(
-                problem, multilevel=False, max_iterations=max_iterations, bound_budget=0
+        try:
+            section, polished, polish_iterations, level = _level(
+                parameters, size, prev, best, comm, solver, max_iterations
             )
-        log.append(
-            SectionLevel(
-                mesh_size=size,
-                dofs=section.model.num_dofs,
-                constrained=section.constraints.size,
-                load=polished.load,
-                kkt=polished.candidate.kkt,
-                eigensolves=problem.eigensolver.solves,
-                wall_time_s=time.perf_counter() - tl,
-            )
-        )
+        except BaseException:
+            if prev is not None:
+                prev.destroy()
+            raise
+        log.append(level)
         if prev is not None:
             coarse_solves += prev.problem.eigensolver.solves
             prev.destroy()
         prev, best = section, polished
-    if section is None or best is None:
+    if prev is None or best is None:
         raise RuntimeError("solve_levels: no level ran")
     details = SectionLevelsDetails(
-        free_load=section.problem.solve_free().load,
+        free_load=prev.problem.solve_free().load,
         levels=log,
         coarse_eigensolves=coarse_solves,
         wall_time_s=time.perf_counter() - t0,
@@ -154,7 +134,53 @@ def solve_levels(
         details.polish_iterations = polish_iterations
     elif isinstance(best.details, ActiveSetDetails):
         details.active_set = best.details
-    return section, replace(best, details=details)
+    return prev, replace(best, details=details)
+
+
+def _level(
+    parameters: SectionParameters,
+    size: float,
+    prev: Section | None,
+    best: UnilateralSolution | None,
+    comm: MPI.Comm,
+    solver: SolverSpec | None,
+    max_iterations: int,
+) -> tuple[Section, UnilateralSolution, int | None, SectionLevel]:
+    """One level: the section on cells of ``size``, solved from the coarser one's ``best``.
+
+    Returns the section (the caller destroys it), its solution, the polish's iterations
+    (None: the seeds ran) and the level's record.
+    """
+    tl = time.perf_counter()
+    corner = parameters.corner_cell
+    graded = None if corner is None else corner * size / parameters.mesh_size
+    section = build_section(replace(parameters, mesh_size=size, corner_cell=graded), comm, solver)
+    problem = section.problem
+    if not isinstance(problem, CoredSectionProblem) or section.constraints is None:
+        section.destroy()
+        raise RuntimeError("solve_levels: a core section without constraints")
+    polished, polish_iterations = None, None
+    try:
+        if prev is not None and best is not None and prev.constraints is not None:
+            z = prolong_directions(best.active, prev.constraints, section.constraints)
+            polished, polish_iterations = _polish(problem, z, best.load)
+        if polished is None:
+            polished = solve_active_set(
+                problem, multilevel=False, max_iterations=max_iterations, bound_budget=0
+            )
+    except BaseException:
+        section.destroy()
+        raise
+    level = SectionLevel(
+        mesh_size=size,
+        dofs=section.model.num_dofs,
+        constrained=section.constraints.size,
+        load=polished.load,
+        kkt=polished.candidate.kkt,
+        eigensolves=problem.eigensolver.solves,
+        wall_time_s=time.perf_counter() - tl,
+    )
+    return section, polished, polish_iterations, level
 
 
 def _polish(

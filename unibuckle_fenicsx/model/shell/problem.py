@@ -110,14 +110,19 @@ class SectionContact(ContactSetManager):
     remove rows then work unchanged on the rotated pencil's DOFs.
     """
 
-    def __init__(self, pencil: RotatedPencil, constraints: CoreConstraints) -> None:
+    def __init__(
+        self,
+        pencil: RotatedPencil,
+        constraints: CoreConstraints,
+        springs: npt.NDArray[np.float64] | None = None,
+    ) -> None:
         self.model = cast(Any, pencil)
         self.obstacles = (ObstacleSpec(zone="all"),)
         self.constraints = constraints
         self.coordinates = constraints.unrolled
         self.signs = np.ones(constraints.size)
         self.gaps = np.zeros(constraints.size)
-        self.stiffness = None
+        self.stiffness = springs
         self.num_edge_fixed = constraints.num_held
         self._owned = _Owned(
             constraints.owned_positions,
@@ -134,6 +139,7 @@ def section_problem(
     material: Material,
     solver: SolverSpec | None = None,
     eps_options: dict[str, str | float | int] | None = None,
+    springs: npt.NDArray[np.float64] | None = None,
 ) -> SectionProblem:
     """A section set up for its free solve, and with a core for the unilateral algorithms.
 
@@ -148,6 +154,8 @@ def section_problem(
         material: The elastic constants.
         solver: Solver options (tolerances, certificate).
         eps_options: EPS options of the pencil's solver.
+        springs: (i,) the core's foundation spring of each constrained direction (N/m;
+            :func:`~unibuckle_fenicsx.model.shell.core.core_springs`); None: a rigid core.
 
     Returns:
         A :class:`CoredSectionProblem` with a core, else a :class:`SectionProblem`; the
@@ -159,6 +167,7 @@ def section_problem(
     t0 = time.perf_counter()
     section = model.section
     solver = solver if solver is not None else SolverSpec()
+    k_f = None if springs is None else 1.0  # marks a foundation; the springs are given
     plate = PlateSpec(
         corners=((0.0, 0.0), (section.length, section.perimeter)),
         thickness=model.thickness,
@@ -169,7 +178,7 @@ def section_problem(
         plate=plate,
         material=material,
         mesh=MeshSpec(section.cells_along, section.cells_around),
-        obstacle=ObstacleSpec(zone="all") if constraints is not None else None,
+        obstacle=None if constraints is None else ObstacleSpec("all", foundation_stiffness=k_f),
         solver=solver,
     )
     pencil = RotatedPencil(model, T)
@@ -198,7 +207,7 @@ def section_problem(
     problem = (
         SectionProblem(parts)
         if constraints is None
-        else CoredSectionProblem(parts, SectionContact(pencil, constraints))
+        else CoredSectionProblem(parts, SectionContact(pencil, constraints, springs))
     )
     problem.timings["setup_s"] = time.perf_counter() - t0
     return problem

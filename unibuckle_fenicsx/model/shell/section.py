@@ -30,7 +30,12 @@ import numpy.typing as npt
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Candidate
-from unibuckle_fenicsx.model.shell.core import CoreConstraints, change_of_basis, core_constraints
+from unibuckle_fenicsx.model.shell.core import (
+    CoreConstraints,
+    change_of_basis,
+    core_constraints,
+    core_springs,
+)
 from unibuckle_fenicsx.model.shell.forms import DRILLING_FACTOR
 from unibuckle_fenicsx.model.shell.geometry import SectionMesh, section_mesh
 from unibuckle_fenicsx.model.shell.model import ENDS, ShellModel, end_supports
@@ -40,10 +45,17 @@ from unibuckle_fenicsx.model.shell.problem import (
     SectionProblem,
     section_problem,
 )
-from unibuckle_fenicsx.spec import Material, SolverSpec
+from unibuckle_fenicsx.spec import Material, SectionProblemSpec, SolverSpec
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
-__all__ = ["GEOMETRIC", "Section", "SectionParameters", "build_section", "figure_data"]
+__all__ = [
+    "GEOMETRIC",
+    "Section",
+    "SectionParameters",
+    "build_section",
+    "figure_data",
+    "section_parameters",
+]
 
 #: Displacement components in the geometric stiffness b: "donnell" (the normal
 #: deflection, as the plate model's b and the classical tube value) or "full" (all three).
@@ -73,6 +85,9 @@ class SectionParameters:
             bending), 0 by default.
         core: A rigid core fills the section: the walls may only move outward.
         core_span: The core's extent (x0, x1) along the member (m); None: the whole length.
+        foundation_stiffness: The core as a tensionless Winkler foundation of this
+            modulus (N/m^3), > 0 (:func:`~unibuckle_fenicsx.model.shell.core.core_springs`);
+            None: a rigid core.
         geometric: Components in b (:data:`GEOMETRIC`); "donnell" by default: the plate
             model's b on a flat face and the classical value on a tube.
         drilling: Drilling stiffness relative to Gt
@@ -95,6 +110,7 @@ class SectionParameters:
     bending_stress: float = 0.0
     core: bool = False
     core_span: tuple[float, float] | None = None
+    foundation_stiffness: float | None = None
     geometric: str = "donnell"
     drilling: float = DRILLING_FACTOR
     corner_cell: float | None = None
@@ -145,6 +161,10 @@ class SectionParameters:
                 )
         if self.axial_stress == 0.0 and self.bending_stress == 0.0:
             raise InputError("load.axial_stress and load.bending_stress are both 0: no load")
+        if self.foundation_stiffness is not None:
+            if not self.core:
+                raise InputError("obstacle.foundation_stiffness needs core = true")
+            _positive("foundation_stiffness", self.foundation_stiffness, "obstacle", "N/m^3")
         if self.core_span is not None:
             if not self.core:
                 raise InputError("obstacle.core_span needs core = true")
@@ -163,12 +183,24 @@ class SectionParameters:
         return float(self.diameter or 0.0)
 
 
-def _positive(key: str, value: float | None) -> float:
-    """``value`` as a float, or an :class:`InputError` naming ``section.key``."""
+def section_parameters(spec: SectionProblemSpec) -> SectionParameters:
+    """The :class:`SectionParameters` of a section's problem file (checked already)."""
+    s, core = spec.section, spec.obstacle
+    return SectionParameters(
+        s.shape, thickness=s.thickness, length=s.length, E=spec.material.E,
+        nu=spec.material.nu, mesh_size=spec.mesh.size, width=s.width, depth=s.depth,
+        diameter=s.diameter, ends=s.ends, axial_stress=spec.load.axial_stress,
+        bending_stress=spec.load.bending_stress, core=core.core, core_span=core.span,
+        foundation_stiffness=core.foundation_stiffness,
+    )  # fmt: skip
+
+
+def _positive(key: str, value: float | None, table: str = "section", unit: str = "m") -> float:
+    """``value`` as a float, or an :class:`InputError` naming ``table.key``."""
     if value is None or not (isinstance(value, int | float) and math.isfinite(value)):
-        raise InputError(f"section.{key} must be a finite number > 0 (m), got {value!r}")
+        raise InputError(f"{table}.{key} must be a finite number > 0 ({unit}), got {value!r}")
     if value <= 0.0:
-        raise InputError(f"section.{key} must be > 0 (m), got {value!r}")
+        raise InputError(f"{table}.{key} must be > 0 ({unit}), got {value!r}")
     return float(value)
 
 
@@ -277,7 +309,10 @@ def build_section(
     )  # fmt: skip
     constraints = core_constraints(model, p.core_span) if p.core else None
     T = change_of_basis(model, constraints) if constraints is not None else None
-    problem = section_problem(model, prestress, constraints, T, material, solver)
+    springs = None
+    if constraints is not None and p.foundation_stiffness is not None:
+        springs = core_springs(model, constraints, p.foundation_stiffness)
+    problem = section_problem(model, prestress, constraints, T, material, solver, springs=springs)
     return Section(p, msh, prestress, model, constraints, problem)
 
 

@@ -1,0 +1,184 @@
+r"""A section's problem file: ``[section]``, ``[material]``, ``[load]``, ``[obstacle]``, ``[mesh]``.
+
+A file with a ``[section]`` table describes a box or a tube whose walls are the shell
+model's (:mod:`~unibuckle_fenicsx.model.shell`), not a plate: its tables are these, each
+checked as the plate's are (:mod:`~unibuckle_fenicsx.spec.base`). The critical load is
+the compressive axial stress in Pa when ``axial_stress = -1``.
+"""
+
+from __future__ import annotations
+
+from typing import Annotated, ClassVar, Literal
+
+import msgspec
+from msgspec import Meta
+
+from unibuckle_fenicsx.errors import FieldError
+from unibuckle_fenicsx.spec.base import Table, Units, unit
+from unibuckle_fenicsx.spec.solver import SolverSpec
+
+Length = Annotated[float, unit("m", gt=0)]
+#: The ``[solver]`` options a section uses (the others are the plate's methods').
+SOLVER_KEYS = ("tau", "eps_tol", "max_iterations")
+
+
+class SectionSpec(Table, frozen=True):
+    """A box or tube section (the file's ``[section]``).
+
+    Args:
+        shape: "box" (rectangular hollow section) or "tube" (circular hollow section).
+        width: Box: mid-line width b of the faces along y (m), > 0; not for a tube.
+        depth: Box: mid-line depth d along z (m), > 0; not for a tube.
+        diameter: Tube: mid-surface diameter 2R (m), > 0; not for a box.
+        thickness: Wall thickness t (m), > 0 and below half the smallest dimension
+            across (the walls would meet).
+        length: Length L between the loaded ends (m), > 0.
+        ends: The loaded ends: "clamped" or "simply_supported" (the section's ends held
+            against moving off the member's axis; clamped ends also against turning).
+    """
+
+    KEY: ClassVar[str] = "section"
+    shape: Literal["box", "tube"]
+    thickness: Length
+    length: Length
+    width: Length | None = None
+    depth: Length | None = None
+    diameter: Length | None = None
+    ends: Literal["clamped", "simply_supported"] = "clamped"
+
+    def check(self) -> None:
+        """A box has width and depth, a tube a diameter; the walls do not meet."""
+        keys = ("width", "depth") if self.shape == "box" else ("diameter",)
+        for other in ("width", "depth", "diameter"):
+            given = getattr(self, other) is not None
+            if other in keys and not given:
+                raise FieldError(self.KEY, other, f" is needed by a {self.shape} (m, > 0)")
+            if other not in keys and given:
+                raise FieldError(
+                    self.KEY, other, f" is not a key of a {self.shape}: it has {' and '.join(keys)}"
+                )
+        across = min(getattr(self, k) for k in keys)
+        if self.thickness >= 0.5 * across:
+            raise FieldError(
+                self.KEY,
+                "thickness",
+                f" must be < half of {' and '.join(keys)} ({0.5 * across:g} m): the walls "
+                f"would meet, got {self.thickness!r}",
+            )
+
+
+class WallMaterial(Table, frozen=True):
+    """The walls' isotropic material (a section file's ``[material]``).
+
+    Args:
+        E: Young's modulus (Pa), > 0.
+        nu: Poisson's ratio, in (-1, 0.5).
+    """
+
+    KEY: ClassVar[str] = "material"
+    E: Annotated[float, unit("Pa", gt=0)]
+    nu: Annotated[float, Meta(gt=-1.0, lt=0.5)]
+
+
+class AxialLoad(Table, frozen=True):
+    """The end load per unit load factor (a section file's ``[load]``).
+
+    Args:
+        axial_stress: Uniform axial stress per unit load (Pa per Pa; compression < 0);
+            -1 makes the critical load the compressive stress in Pa.
+        bending_stress: The part varying linearly over the depth, its value at
+            z = +d/2 (box) or +R (tube) per unit load (an axial force with bending); 0.
+    """
+
+    KEY: ClassVar[str] = "load"
+    axial_stress: float = -1.0
+    bending_stress: float = 0.0
+
+    def check(self) -> None:
+        """Some load."""
+        if self.axial_stress == 0.0 and self.bending_stress == 0.0:
+            raise FieldError(self.KEY, "axial_stress", " and load.bending_stress are 0: no load")
+
+
+class CoreSpec(Table, frozen=True):
+    r"""The core filling the section (a section file's ``[obstacle]``).
+
+    Args:
+        core: A core fills the section: the walls may only move outward (rigid), or
+            press it only as far as its foundation lets them (``foundation_stiffness``).
+        span: The core's extent [x0, x1] along the member (m), 0 <= x0 < x1 <= length;
+            absent: the whole length.
+        foundation_stiffness: The core as a tensionless Winkler foundation of this
+            modulus (N/m^3, Pa/m), > 0: the walls press it with :math:`k_f\,u_n` and leave
+            it freely; absent: a rigid core. For concrete, about :math:`E_c` over the
+            depth the wall's bulge strains (a few wall half-waves).
+    """
+
+    KEY: ClassVar[str] = "obstacle"
+    core: bool = False
+    span: Annotated[tuple[float, float], unit("m")] | None = None
+    foundation_stiffness: Annotated[float, unit("N/m^3", gt=0)] | None = None
+
+    def check(self) -> None:
+        """A span or a stiffness belongs to a core."""
+        for key in ("span", "foundation_stiffness"):
+            if getattr(self, key) is not None and not self.core:
+                raise FieldError(self.KEY, key, " is the core's: it needs core = true")
+
+
+class SectionMeshSpec(Table, frozen=True):
+    """The section's cells (a section file's ``[mesh]``).
+
+    Args:
+        size: Target cell size (m), > 0; a box's faces get an even number of cells.
+        levels: With a rigid core, coarser sections (each with twice the cell size) the
+            contact search seeds on, >= 0; 1: its many eigen solves on a quarter of the
+            DOFs, a few polishing solves on the given cells.
+    """
+
+    KEY: ClassVar[str] = "mesh"
+    size: Length
+    levels: Annotated[int, Meta(ge=0)] = 1
+
+
+class SectionProblemSpec(Table, frozen=True):
+    """A section problem (a file with a ``[section]`` table), in SI units.
+
+    Args:
+        name: Label used in output (a file's stem when it gives none).
+        units: The unit system the file is written in and results are printed in.
+        section: The section's shape, walls and ends.
+        material: The walls' material.
+        load: The end load per unit load factor.
+        obstacle: The core, if any.
+        mesh: The cells.
+        solver: Solver options: of :data:`SOLVER_KEYS` (the feasibility tolerance tau,
+            the eigen solves' tolerance, the active-set iterations per seed); the plate's
+            methods' options are refused.
+    """
+
+    KEY: ClassVar[str] = ""
+    section: SectionSpec
+    material: WallMaterial
+    mesh: SectionMeshSpec
+    name: str = "section"
+    units: Units = "SI"
+    load: AxialLoad = msgspec.field(default_factory=AxialLoad)
+    obstacle: CoreSpec = msgspec.field(default_factory=CoreSpec)
+    solver: SolverSpec = msgspec.field(default_factory=SolverSpec)
+
+    def check(self) -> None:
+        """The core's span lies on the member; the solver's options are a section's."""
+        span, length = self.obstacle.span, self.section.length
+        if span is not None and not 0.0 <= span[0] < span[1] <= length:
+            raise FieldError(
+                "",
+                "obstacle.span",
+                f" must satisfy 0 <= x0 < x1 <= section.length = {length:g} m, got {list(span)}",
+            )
+        default = SolverSpec()
+        for key in SolverSpec.__struct_fields__:
+            if key not in SOLVER_KEYS and getattr(self.solver, key) != getattr(default, key):
+                raise FieldError(
+                    "", f"solver.{key}", f" is a plate's option; a section takes {SOLVER_KEYS}"
+                )
