@@ -331,8 +331,9 @@ def continue_from(
     A certificate that meets such a mode (a *refuting* mode: the returned KKT point is
     not the global minimum) hands it back; the feasible descent from it never raises the
     load, so the answer becomes a KKT point (or admissible mode) at or below ``start``'s
-    load. The returned point joins the other KKT points met; the continuation is
-    recorded in ``solution.continued``.
+    load (within rounding, :data:`~unibuckle_fenicsx.tolerances.ROUNDING_RTOL`). The
+    returned point joins the other KKT points met; the continuation is recorded in
+    ``solution.continued``.
 
     Args:
         problem: The problem.
@@ -345,8 +346,12 @@ def continue_from(
     """
     run, steps = descend(problem, start, max_steps)
     final = run.final if run.status is RunStatus.KKT else run.best_feasible
-    if final is None or not final.feasible or final.load > start.load:
-        final = start  # R never rises along the descent; rounding aside, keep the start
+    # R never rises along the descent, but the start's load is a Rayleigh quotient and an
+    # eigen solve's load is accurate to its tolerance: a KKT point of the start's own
+    # contact set can come out a rounding above it and is still the answer (the start,
+    # not an eigenvector, would fail the certificate's KKT test).
+    if final is None or not final.feasible or final.load > start.load * (1.0 + ROUNDING_RTOL):
+        final = start
     record = ContinuedRecord(
         from_load=start.load,
         to_load=final.load,

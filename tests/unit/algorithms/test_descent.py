@@ -32,11 +32,14 @@ from support.processes import run_mpi
 from support.stress import FAMILY, reference
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.descent import Gradient, admissible_start, descend
+from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.certificate.certify import certify
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.spec import ObstacleSpec, problem_to_dict
 from unibuckle_fenicsx.spec.cases import plate_case
+from unibuckle_fenicsx.spec.solver import SolverSpec
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 
@@ -244,3 +247,41 @@ def test_gradient_direction_leaves_the_obstacle_and_descends(active_specs):
         assert rayleigh(x + eps * d) < rayleigh(x)
         g.destroy()
         grad.destroy()
+
+
+def test_continuation_from_a_refuting_mode_ends_at_a_kkt_point():
+    """The design chart's plate "loaded edges clamped" at a/b = 2.5 (cells b/12), bracketed.
+
+    The route answers a KKT point that the split copositivity certificate refutes with an
+    admissible mode a little lower (a Rayleigh quotient, not an eigenvector); the feasible
+    descent from that mode reaches the eigen mode of its contact set, whose computed load
+    can lie a rounding (the eigen tolerance) above the mode's quotient. The answer must be
+    that KKT point, not the refuting mode: the result satisfies the KKT test of the paper's
+    Theorem 1 (checked by the certificate and, serially, by a dense solve) at a load no
+    higher than the refuting mode's within :data:`~unibuckle_fenicsx.tolerances.ROUNDING_RTOL`,
+    and strictly below the refuted answer.
+    """
+    spec = plate_case(
+        "loaded-edges-clamped",
+        length=2.5,
+        width=1.0,
+        thickness=1e-3,
+        supports={"left": "clamped", "right": "clamped"},
+        nx=30,
+        ny=12,
+        zone=ObstacleSpec(zone="all"),
+        solver=SolverSpec(bracket=True),
+    )
+    with solve(spec) as analysis:
+        sol, cert = analysis.solution, analysis.certificate
+        assert sol is not None and cert is not None
+        assert len(sol.continued) >= 1  # the certificate refuted the route's answer
+        first, last = sol.continued[0], sol.continued[-1]
+        assert first.from_load < first.refuted_load
+        assert cert.kkt, cert.notes
+        assert cert.status != "not-kkt"
+        assert sol.load == last.to_load
+        assert sol.load <= last.from_load * (1.0 + ROUNDING_RTOL)
+        assert sol.load < first.refuted_load
+        if analysis.problem.comm.size == 1:
+            assert dense_kkt(analysis.problem, sol.active)
