@@ -68,7 +68,7 @@ def _logging(verbose: int, quiet: bool, rank: int) -> Iterator[None]:
     handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
     root = logging.getLogger()
     progress = logging.getLogger("unibuckle_fenicsx.progress")
-    saved = root.handlers[:], root.level, progress.level
+    handlers, root_level, progress_level = root.handlers[:], root.level, progress.level
     root.handlers[:] = [handler]
     root.setLevel([logging.WARNING, logging.INFO, logging.DEBUG][min(verbose, 2)])
     quiet = quiet or rank != 0
@@ -76,9 +76,9 @@ def _logging(verbose: int, quiet: bool, rank: int) -> Iterator[None]:
     try:
         yield
     finally:
-        root.handlers[:], levels = saved[0], saved[1:]
-        root.setLevel(levels[0])
-        progress.setLevel(levels[1])
+        root.handlers[:] = handlers
+        root.setLevel(root_level)
+        progress.setLevel(progress_level)
 
 
 def main(argv: Sequence[str] | None = None) -> int:
