@@ -22,6 +22,7 @@ import pytest
 import scipy.linalg
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+from unibuckle_fenicsx.model.shell.levels import solve_levels
 from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
 
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense references are serial")
@@ -119,6 +120,11 @@ def test_core_matches_dense_enumeration(shape, changes):
         free = sec.problem.solve_free().load
         assert free < expected  # the core is active on these sections
         assert solution.load == pytest.approx(expected, rel=1e-8)
+    # The sections' route: the seeds of levels.SEEDS on the section itself.
+    finest, seeded = solve_levels(params, levels=0, comm=MPI.COMM_SELF)
+    with finest:
+        assert seeded.candidate.kkt
+        assert seeded.load == pytest.approx(expected, rel=1e-8)
 
 
 def test_section_figure_is_written(tmp_path):
