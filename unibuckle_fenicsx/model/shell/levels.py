@@ -47,10 +47,11 @@ logger = logging.getLogger(__name__)
 
 #: The active set's seeds on a section (of
 #: :data:`~unibuckle_fenicsx.algorithms.active_set.SEED_NAMES`): the free mode's two
-#: sign patterns, and every direction in contact (one solve). The
-#: plate's windows along the long side and its greedy seeds are left out: on the sections
-#: of :doc:`/verification/sections` they ran 100 and 25 steps without reaching a KKT
-#: point (a tube) or reached the free seeds' point (a box).
+#: sign patterns, and every direction in contact (one solve). The plate's windows along
+#: the long side and its greedy seeds (small contact sets first) are left out: with a
+#: core the contact set is most of the walls, where they lift off the free mode's signs
+#: seed, and those seeds cost most of the solves and found no lower KKT point on the
+#: sections of :doc:`/verification/sections` ("Cost").
 SEEDS = ("free+", "free-", "all")
 #: Steps of the plain rule when the polish at looser tolerances reached no KKT point
 #: (:func:`_polish`): a carried set that predicts the finer section's ends in fewer; one
