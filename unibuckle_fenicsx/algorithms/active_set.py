@@ -159,13 +159,22 @@ def _seeds(
 
 
 def multi_seed(
-    problem: UnilateralProblem, max_iterations: int, seeds: tuple[str, ...] = SEED_NAMES
+    problem: UnilateralProblem,
+    max_iterations: int,
+    seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
 ) -> list[Run]:
-    """Run the iteration from every seed of ``seeds``, starting from the free mode."""
+    """Run the iteration from every seed of ``seeds``, starting from the free mode.
+
+    The seeds of ``more_seeds`` run after them only if none of theirs reached a KKT point.
+    """
     free = problem.solve_free().function.x.petsc_vec
     values = problem.contact.values(free)
     runs: list[Run] = []
-    for name, z in _seeds(problem, values, problem.tau, seeds):  # the greedy seeds come last
+    # The greedy seeds come last.
+    for name, z in _seeds(problem, values, problem.tau, seeds + more_seeds):
+        if name in more_seeds and any(r.status is RunStatus.KKT for r in runs if r.seed in seeds):
+            break
         greedy = name.startswith("greedy")
         capped = greedy and any(r.status is RunStatus.KKT for r in runs)
         budget = min(max_iterations, GREEDY_ITERATIONS) if capped else max_iterations
@@ -305,6 +314,7 @@ def _coarse_levels(
     max_iterations: int,
     refine_margin: float,
     seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
 ) -> _Coarse:
     """Seeds on the coarsest level, then the best contact sets polished level by level.
 
@@ -319,7 +329,7 @@ def _coarse_levels(
             continue
         tl = time.perf_counter()
         if coarse.candidates is None:
-            coarse.runs = multi_seed(cp, max_iterations, seeds)
+            coarse.runs = multi_seed(cp, max_iterations, seeds, more_seeds)
             runs = coarse.runs
         else:
             if coarse.last is None:
@@ -455,6 +465,7 @@ def _fine_level(
     coarse: _Coarse,
     max_iterations: int,
     seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
 ) -> tuple[list[Run], list[int] | str]:
     """The fine mesh's runs: the coarse sets polished, or the seeds; and what seeded them.
 
@@ -467,7 +478,7 @@ def _fine_level(
         runs = _polish(problem, coarse.last, coarse.candidates, budget, coarse.bests)
         seeded_on = [coarse.last.spec.mesh.nx, coarse.last.spec.mesh.ny]
     else:
-        runs = multi_seed(problem, max_iterations, seeds)
+        runs = multi_seed(problem, max_iterations, seeds, more_seeds)
         seeded_on = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
     if coarse.last is not None:
         coarse.last.destroy()
@@ -510,11 +521,15 @@ def _check_options(
     refine_margin: float,
     bound_budget: int,
     seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
 ) -> None:
     """Refuse settings out of range, naming them."""
-    unknown = [name for name in seeds if name not in SEED_NAMES]
-    if unknown or not seeds:
-        raise InputError(f"seeds must be some of {SEED_NAMES}, got {seeds!r}")
+    unknown = [name for name in seeds + more_seeds if name not in SEED_NAMES]
+    if unknown or not seeds or set(seeds) & set(more_seeds):
+        raise InputError(
+            f"seeds and more_seeds must be some of {SEED_NAMES}, seeds not empty and none "
+            f"in both, got {seeds!r} and {more_seeds!r}"
+        )
     # The [solver] keys' ranges, from their one description:
     ActiveSetOptions(max_iterations=max_iterations, bound_budget=bound_budget)
     if int(coarse_min_cells) != coarse_min_cells or coarse_min_cells < 2:
@@ -532,6 +547,7 @@ def solve_active_set(
     refine_margin: float = 0.02,
     bound_budget: int = 64,
     seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
 ) -> UnilateralSolution:
     """Unilateral critical load by a multi-seed primal-dual active-set method.
 
@@ -549,6 +565,8 @@ def solve_active_set(
         seeds: The seeds run on the coarsest level, some of :data:`SEED_NAMES` in their
             order; all of them by default (a plate's buckle may sit at either end or in
             the middle, and small contact sets come first on plates).
+        more_seeds: Seeds run after ``seeds`` (on the same level) only if none of those
+            reached a KKT point; none by default.
 
     Returns:
         The best KKT point found (or, flagged in the record's ``warning``, the best
@@ -561,15 +579,15 @@ def solve_active_set(
         Collective on ``problem.comm``.
     """
     require_obstacle(problem, "solve_active_set")
-    _check_options(max_iterations, coarse_min_cells, refine_margin, bound_budget, seeds)
+    _check_options(max_iterations, coarse_min_cells, refine_margin, bound_budget, seeds, more_seeds)
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     free_load = problem.solve_free().load
     spec = problem.spec
     structured = multilevel and problem.structured  # coarse copies need spec.mesh
     levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
-    coarse = _coarse_levels(problem, levels, max_iterations, refine_margin, seeds)
-    runs, seeded_on = _fine_level(problem, coarse, max_iterations, seeds)
+    coarse = _coarse_levels(problem, levels, max_iterations, refine_margin, seeds, more_seeds)
+    runs, seeded_on = _fine_level(problem, coarse, max_iterations, seeds, more_seeds)
     warnings: list[str] = []
     fallbacks = _fall_back(problem, runs, max_iterations, warnings)
     kkt = distinct_kkt(runs)

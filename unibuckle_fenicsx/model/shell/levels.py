@@ -11,9 +11,10 @@ rectangle; the answer is always a KKT point of the finest section. The polish ru
 first with the plate's looser tolerances, then, if they reach no KKT point, with the
 plain rule (:func:`_polish`); if neither does, the seeds run again on that level.
 
-The seeds are those of :data:`SEEDS`, not all of the plate's: a core makes every wall
-move outward, and the contact set is the walls' nodes save where they lift off, which the
-free mode's signs seed (:doc:`/verification/sections`, "Cost").
+The seeds are those of :data:`SEEDS`, the plate's others (:data:`MORE_SEEDS`) only if
+these reach no KKT point: a core makes every wall move outward, and the contact set is
+the walls' nodes save where they lift off, which the free mode's signs seed
+(:doc:`/verification/sections`, "Cost").
 """
 
 from __future__ import annotations
@@ -28,7 +29,12 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
-from unibuckle_fenicsx.algorithms.active_set import POLISH_ITERATIONS, THRESHOLDS, solve_active_set
+from unibuckle_fenicsx.algorithms.active_set import (
+    POLISH_ITERATIONS,
+    SEED_NAMES,
+    THRESHOLDS,
+    solve_active_set,
+)
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.algorithms.records import (
     ActiveSetDetails,
@@ -41,18 +47,20 @@ from unibuckle_fenicsx.model.shell.problem import CoredSectionProblem
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import SolverSpec
 
-__all__ = ["SEEDS", "prolong_directions", "solve_levels"]
+__all__ = ["MORE_SEEDS", "SEEDS", "prolong_directions", "solve_levels"]
 
 logger = logging.getLogger(__name__)
 
 #: The active set's seeds on a section (of
 #: :data:`~unibuckle_fenicsx.algorithms.active_set.SEED_NAMES`): the free mode's two
-#: sign patterns, and every direction in contact (one solve). The plate's windows along
-#: the long side and its greedy seeds (small contact sets first) are left out: with a
-#: core the contact set is most of the walls, where they lift off the free mode's signs
-#: seed, and those seeds cost most of the solves and found no lower KKT point on the
-#: sections of :doc:`/verification/sections` ("Cost").
-SEEDS = ("free+", "free-", "all")
+#: sign patterns. With a core the contact set is most of the walls, and where they lift
+#: off the free mode's signs seed; the plate's other seeds (every direction in contact,
+#: windows along the long side, the greedy ones) run only when neither of these reaches
+#: a KKT point (:data:`MORE_SEEDS`): they cost most of the solves and found no lower KKT
+#: point on the sections of :doc:`/verification/sections` ("Cost").
+SEEDS = ("free+", "free-")
+#: The plate's other seeds, in their order: run when :data:`SEEDS` reach no KKT point.
+MORE_SEEDS = tuple(name for name in SEED_NAMES if name not in SEEDS)
 #: Steps of the plain rule when the polish at looser tolerances reached no KKT point
 #: (:func:`_polish`): a carried set that predicts the finer section's ends in fewer; one
 #: that does not costs these, then the seeds on the finer section.
@@ -189,6 +197,7 @@ def _level(
                 max_iterations=max_iterations,
                 bound_budget=0,
                 seeds=SEEDS,
+                more_seeds=MORE_SEEDS,
             )
     except BaseException:
         section.destroy()
