@@ -14,8 +14,10 @@ it covers, the wall may only move away from it (:mod:`~unibuckle_fenicsx.model.s
   active-set seeds on a coarser section, the contact set carried to the finer one) and
   certified (:func:`~unibuckle_fenicsx.certificate.certify.certify`) on the finest.
 
-The critical load is the compressive stress in Pa when ``axial_stress = -1``. A box's
-``buckling_coefficient_k`` uses its widest face, :math:`k = \sigma t b^2/(\pi^2 D)`; a
+The critical load is the factor on the stresses per unit load: the compressive stress in
+Pa when ``axial_stress = -1`` without bending. A box's ``buckling_coefficient_k`` uses its
+widest face, :math:`k = \sigma t b^2/(\pi^2 D)` with :math:`\sigma` the face's largest
+compressive stress at that load (with bending, the extreme fibre's); a
 tube has none (its reference is :math:`\sigma_{cl} = E t/(R\sqrt{3(1-\nu^2)})`,
 ``classical_stress_Pa``).
 """
@@ -65,8 +67,11 @@ class SectionResult(BucklingResult, kw_only=True):
 
     The fields keep the plate's meaning, with the section's words:
     ``critical_load_Pa`` is the critical axial stress (the filled section's with a core),
-    ``free_load_Pa`` the hollow section's; ``buckling_coefficient_k`` uses a box's widest
-    face (None for a tube); ``mesh`` is [cells along, cells around]; ``dofs`` counts the
+    ``free_load_Pa`` the hollow section's (load factors on the stresses per unit load:
+    with ``axial_stress = -1`` and no bending, the compressive stress in Pa);
+    ``buckling_coefficient_k`` uses a box's widest face and its largest compressive
+    stress at the critical load, so it is the classical k whatever the stress gradient
+    (None for a tube); ``mesh`` is [cells along, cells around]; ``dofs`` counts the
     six components of every node; ``constrained_nodes`` counts the core's constrained
     *directions* (a box's corner node has two), ``contact_coordinates`` their unrolled
     (x, s) (m along the member, m around the mid-line); ``input`` is the section's
@@ -78,9 +83,10 @@ class SectionResult(BucklingResult, kw_only=True):
             :math:`4\pi^2 D/(t b^2)`, a tube's :math:`E t/(R\sqrt{3(1-\nu^2)})`.
         faces: A box's faces at the critical load (empty for a tube): each face's name
             (``right``, ``top``, ``left``, ``bottom``: y = +b/2, z = +d/2, y = -b/2,
-            z = -d/2), its width (m), its own buckling coefficient
-            :math:`\sigma t w^2/(\pi^2 D)`, its constrained directions and those in
-            contact with the core (pressing a foundation).
+            z = -d/2), its width (m), its largest compressive stress ``compression_Pa``
+            (Pa, <= 0: none), its own buckling coefficient :math:`\sigma t w^2/(\pi^2 D)`
+            with that stress (NaN, null in JSON, without compression), its constrained
+            directions and those in contact with the core (pressing a foundation).
     """
 
     classical_stress_Pa: float = math.nan
@@ -245,8 +251,14 @@ def solve_section(
     return SectionAnalysis(result, section, solution, certificate)
 
 
-#: A box's faces: name, the axis of their normal (1: y, 2: z) and its inward sign.
-_FACES = (("right", 1, -1.0), ("top", 2, -1.0), ("left", 1, 1.0), ("bottom", 2, 1.0))
+#: A box's faces: name, the axis of their normal (1: y, 2: z), its inward sign, and the
+#: depth coordinate zeta (-1 to 1 over the depth) the face spans.
+_FACES = (
+    ("right", 1, -1.0, (-1.0, 1.0)),
+    ("top", 2, -1.0, (1.0, 1.0)),
+    ("left", 1, 1.0, (-1.0, 1.0)),
+    ("bottom", 2, 1.0, (-1.0, -1.0)),
+)
 
 
 def _faces(
@@ -262,14 +274,18 @@ def _faces(
     if active is not None:
         touching[active] = True
     out: list[dict[str, str | float]] = []
-    for name, axis, sign in _FACES:
+    for name, axis, sign, zeta in _FACES:
         width = p.depth if axis == 1 else p.width  # a face normal to y spans the depth
         on = normals[:, axis] * sign > 0.5
+        sigma = load * p.compression(zeta) + 0.0  # the face's largest compression (no -0.0)
         out.append(
             {
                 "face": name,
                 "width_m": width,
-                "buckling_coefficient_k": load * p.thickness * width**2 / (math.pi**2 * D),
+                "compression_Pa": sigma,
+                "buckling_coefficient_k": sigma * p.thickness * width**2 / (math.pi**2 * D)
+                if sigma > 0.0
+                else math.nan,
                 "constrained": int(on.sum()),
                 "in_contact": int((on & touching).sum()),
             }

@@ -11,8 +11,9 @@ the package's unilateral algorithms and certificate. :func:`figure_data` gathers
 3-D figure of a mode needs (:func:`~unibuckle_fenicsx.viz.section.plot_section_mode_3d`).
 
 The critical load :math:`\lambda` is the compressive stress in Pa when
-``axial_stress = -1`` (the prestress is :math:`\lambda` times the unit one). A box's
-buckling coefficient uses its widest face, :math:`k = \sigma t b^2/(\pi^2 D)`.
+``axial_stress = -1`` without bending (the prestress is :math:`\lambda` times the unit
+one). A box's buckling coefficient uses its widest face, :math:`k = \sigma t b^2/(\pi^2 D)`
+with :math:`\sigma` that face's largest compressive stress at the load.
 """
 
 from __future__ import annotations
@@ -175,6 +176,17 @@ class SectionParameters:
                     f"got {self.core_span}"
                 )
 
+    def compression(self, zeta: tuple[float, float] = (-1.0, 1.0)) -> float:
+        r"""The largest compressive stress per unit load (Pa/Pa) over depths ``zeta``.
+
+        The axial stress is :math:`\sigma_a + \sigma_b\zeta` (``axial_stress``,
+        ``bending_stress``), :math:`\zeta` from -1 to 1 over the depth (a box's bottom and
+        top faces at -1 and 1, its side faces across it; a tube's wall across it); the
+        result is :math:`\max_\zeta -(\sigma_a + \sigma_b\zeta)`, <= 0 where none is in
+        compression.
+        """
+        return max(-(self.axial_stress + self.bending_stress * z) for z in zeta)
+
     @property
     def widest(self) -> float:
         """The widest face b of a box (m), the buckling coefficient's width; a tube's 2R."""
@@ -250,8 +262,20 @@ class Section(Owner):
         return np.ones(0 if self.constraints is None else self.constraints.size)
 
     def buckling_coefficient(self, load: float) -> float:
-        r""":math:`k = \sigma t b^2/(\pi^2 D)`, b the widest face; NaN for a tube."""
-        return self.problem.buckling_coefficient(load)
+        r""":math:`k = \sigma t b^2/(\pi^2 D)` of a box's widest face b; NaN for a tube.
+
+        :math:`\sigma` is that face's largest compressive stress at the load ``load``,
+        ``load`` times :meth:`SectionParameters.compression` over the depth (the widest
+        faces, a flange pair or a web pair, reach the section's largest compression), so
+        that k is the classical coefficient whatever the stress per unit load and its
+        gradient (:math:`\psi = -1`: a web's 23.9 when hinged). NaN without compression.
+        """
+        p = self.parameters
+        sigma = load * p.compression()
+        if p.shape == "tube" or sigma <= 0.0:
+            return math.nan
+        D = p.E * p.thickness**3 / (12.0 * (1.0 - p.nu**2))
+        return sigma * p.thickness * p.widest**2 / (math.pi**2 * D)
 
     def classical_stress(self) -> float:
         r"""Reference stress (Pa): a box's k = 4 load, a tube's classical one.
