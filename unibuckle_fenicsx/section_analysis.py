@@ -81,6 +81,10 @@ class SectionResult(BucklingResult, kw_only=True):
     Attributes:
         classical_stress_Pa: The section's reference stress (Pa): a box's k = 4 load
             :math:`4\pi^2 D/(t b^2)`, a tube's :math:`E t/(R\sqrt{3(1-\nu^2)})`.
+        compression_Pa: The largest compressive stress at the critical load (Pa), the
+            extreme fibre's: ``critical_load_Pa`` times the largest compression per unit
+            load (:meth:`~unibuckle_fenicsx.model.shell.section.SectionParameters.compression`),
+            equal to it with ``axial_stress = -1`` and no bending.
         faces: A box's faces at the critical load (empty for a tube): each face's name
             (``right``, ``top``, ``left``, ``bottom``: y = +b/2, z = +d/2, y = -b/2,
             z = -d/2), its width (m), its largest compressive stress ``compression_Pa``
@@ -90,16 +94,25 @@ class SectionResult(BucklingResult, kw_only=True):
     """
 
     classical_stress_Pa: float = math.nan
+    compression_Pa: float = math.nan
     faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
 
     def summary(self) -> str:
         """Lines for the terminal: the critical stress, the hollow one, the reference."""
         k_value = self.buckling_coefficient_k
         k = "" if k_value is None else f", k = {k_value:.4f}"
+        sigma = self.compression_Pa
+        if math.isnan(sigma):  # a result written before the field: the load factor
+            sigma = self.critical_load_Pa
+        factor = (
+            ""
+            if sigma == self.critical_load_Pa
+            else f" at the extreme fibre, load factor {self.critical_load_Pa:.6e}"
+        )
         head = (
-            f"{self.case}: sigma_cr = {self.critical_load_Pa:.6e} Pa "
-            f"({self.ratio_to_free:.4f} x hollow {self.free_load_Pa:.6e} Pa){k}, "
-            f"{self.critical_load_Pa / self.classical_stress_Pa:.4f} x classical "
+            f"{self.case}: sigma_cr = {sigma:.6e} Pa{factor} "
+            f"({self.ratio_to_free:.4f} x hollow {sigma / self.ratio_to_free:.6e} Pa){k}, "
+            f"{sigma / self.classical_stress_Pa:.4f} x classical "
             f"{self.classical_stress_Pa:.6e} Pa"
         )
         lines = [
@@ -359,6 +372,7 @@ def _result(
         input={"section": dataclasses.asdict(p)},
         versions=versions(),
         classical_stress_Pa=section.classical_stress(),
+        compression_Pa=load * p.compression(),
         faces=_faces(section, load, None if solution is None else solution.active),
     )
     if solution is None or certificate is None:

@@ -92,7 +92,13 @@ def _deep_web(axial: float, bending: float) -> dict:
     )  # fmt: skip
     with solve_section(web, MPI.COMM_SELF) as analysis:
         r = analysis.result
-        return {"load": r.critical_load_Pa, "k": r.buckling_coefficient_k, "faces": r.faces}
+        return {
+            "load": r.critical_load_Pa,
+            "k": r.buckling_coefficient_k,
+            "faces": r.faces,
+            "compression": r.compression_Pa,
+            "summary": r.summary(),
+        }
 
 
 def test_a_deep_web_in_bending_has_the_classical_coefficient():
@@ -113,6 +119,10 @@ def test_a_deep_web_in_bending_has_the_classical_coefficient():
     )
     assert faces["bottom"]["compression_Pa"] == pytest.approx(-sigma, rel=1e-12)
     assert math.isnan(faces["bottom"]["buckling_coefficient_k"])
+    # The summary's sigma_cr and its ratio to the classical k = 4 load: the extreme fibre's.
+    assert double["compression"] == pytest.approx(sigma, rel=1e-12)
+    assert f"sigma_cr = {sigma:.6e} Pa at the extreme fibre" in double["summary"]
+    assert f"{double['k'] / 4:.4f} x classical" in double["summary"]
     # Compression with bending, psi = 0 on the webs: 7.81 (Table 4.1) < k < 13.6 (clamped).
     mixed = _deep_web(-1.0, -1.0)
     assert 7.81 < mixed["k"] < 13.6, mixed["k"]
