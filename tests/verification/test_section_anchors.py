@@ -24,6 +24,8 @@ r"""Sections other than the square box of the docs, against independent values.
   :math:`1/(1 + D\alpha^2/(\kappa G t))` (as the plate's Navier solution): 2.6970e9 Pa
   for R = 0.05 m, t = 1 mm, L = 10 mm (Kirchhoff's 2.7491e9). The package gives 2.7235e9
   and 2.7036e9 Pa on cells of 1 and 0.5 mm, Richardson-extrapolated 2.6970e9 (1e-5).
+- Walls in tension everywhere have no positive critical load: refused before any mesh
+  (exit status 2), as a plate's tension everywhere is.
 """
 
 from __future__ import annotations
@@ -37,6 +39,7 @@ import pytest
 from scipy.optimize import brentq
 
 from unibuckle_fenicsx import SectionParameters, solve_section
+from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
 
 E, NU, T = 2.1e11, 0.3, 0.002
 
@@ -156,3 +159,25 @@ def test_a_short_tube_converges_to_the_axisymmetric_load():
     coarse, expected = _short_tube(0.001)
     fine, _ = _short_tube(0.0005)
     assert fine - (coarse - fine) / 3 == pytest.approx(expected, rel=1e-4)
+
+
+@pytest.mark.parametrize(("axial", "bending"), [(1.0, 0.0), (1.0, -1.0), (2.0, 1.5)])
+def test_walls_in_tension_everywhere_are_refused_before_any_mesh(
+    tmp_path, monkeypatch, capsys, axial, bending
+):
+    import unibuckle_fenicsx.model.shell.section as section
+
+    def no_mesh(*args, **kwargs):
+        raise AssertionError("a mesh was built")
+
+    monkeypatch.setattr(section, "section_mesh", no_mesh)
+    path = tmp_path / "tension.toml"
+    path.write_text(
+        '[section]\nshape = "box"\nwidth = 0.1\ndepth = 0.1\nthickness = 0.002\n'
+        f"length = 0.2\n[material]\nE = {E}\nnu = {NU}\n[mesh]\nsize = 0.025\n"
+        f"[load]\naxial_stress = {axial}\nbending_stress = {bending}\n"
+    )
+    assert main(["solve", "--config", str(path)]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert f"load.axial_stress = {axial} with load.bending_stress = {bending}" in err
+    assert "tension everywhere" in err
