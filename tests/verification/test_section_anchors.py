@@ -40,6 +40,7 @@ from scipy.optimize import brentq
 
 from unibuckle_fenicsx import SectionParameters, solve_section
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
+from unibuckle_fenicsx.section_analysis import SectionResult
 
 E, NU, T = 2.1e11, 0.3, 0.002
 
@@ -88,48 +89,45 @@ def test_a_rectangular_box_has_timoshenko_s_corner_restraint():
         assert k == pytest.approx(expected, rel=6e-3), (width, depth, k)
 
 
-def _deep_web(axial: float, bending: float) -> dict:
+def _deep_web(axial: float, bending: float) -> SectionResult:
     web = SectionParameters(
         "box", width=0.1, depth=0.3, thickness=T, length=0.9, E=E, nu=NU, mesh_size=0.025,
         ends="simply_supported", axial_stress=axial, bending_stress=bending,
     )  # fmt: skip
     with solve_section(web, MPI.COMM_SELF) as analysis:
-        r = analysis.result
-        return {
-            "load": r.critical_load_Pa,
-            "k": r.buckling_coefficient_k,
-            "faces": r.faces,
-            "compression": r.compression_Pa,
-            "summary": r.summary(),
-        }
+        return analysis.result
 
 
 def test_a_deep_web_in_bending_has_the_classical_coefficient():
     """Webs 0.3 m deep at psi = -1: 23.9 < k < 39.6; the tension flange has no k."""
     unit, double = _deep_web(0.0, -1.0), _deep_web(0.0, -2.0)
     # Twice the stress per unit load: half the load factor, the same stresses and k.
-    assert double["load"] == pytest.approx(unit["load"] / 2, rel=1e-8)
-    assert double["k"] == pytest.approx(unit["k"], rel=1e-8)
-    assert 23.9 < unit["k"] < 39.6, unit["k"]
+    assert double.critical_load_Pa == pytest.approx(unit.critical_load_Pa / 2, rel=1e-8)
+    assert double.buckling_coefficient_k == pytest.approx(unit.buckling_coefficient_k, rel=1e-8)
+    assert 23.9 < unit.buckling_coefficient_k < 39.6, unit.buckling_coefficient_k
     D = E * T**3 / (12 * (1 - NU**2))
-    faces = {f["face"]: f for f in double["faces"]}
+    faces = {f["face"]: f for f in double.faces}
     # The top flange and the webs' top fibres: 2 x the load factor of the doubled load.
     for name in ("top", "right", "left"):
-        assert faces[name]["compression_Pa"] == pytest.approx(2 * double["load"], rel=1e-12)
-    sigma = 2 * double["load"]
+        assert faces[name]["compression_Pa"] == pytest.approx(
+            2 * double.critical_load_Pa, rel=1e-12
+        )
+    sigma = 2 * double.critical_load_Pa
     assert faces["right"]["buckling_coefficient_k"] == pytest.approx(
         sigma * T * 0.3**2 / (math.pi**2 * D), rel=1e-12
     )
     assert faces["bottom"]["compression_Pa"] == pytest.approx(-sigma, rel=1e-12)
     assert math.isnan(faces["bottom"]["buckling_coefficient_k"])
     # The summary's sigma_cr and its ratio to the classical k = 4 load: the extreme fibre's.
-    assert double["compression"] == pytest.approx(sigma, rel=1e-12)
-    assert f"sigma_cr = {sigma:.6e} Pa at the extreme fibre" in double["summary"]
-    assert f"{double['k'] / 4:.4f} x classical" in double["summary"]
+    assert double.compression_Pa == pytest.approx(sigma, rel=1e-12)
+    assert f"sigma_cr = {sigma:.6e} Pa at the extreme fibre" in double.summary()
+    assert f"{double.buckling_coefficient_k / 4:.4f} x classical" in double.summary()
     # Compression with bending, psi = 0 on the webs: 7.81 (Table 4.1) < k < 13.6 (clamped).
     mixed = _deep_web(-1.0, -1.0)
-    assert 7.81 < mixed["k"] < 13.6, mixed["k"]
-    assert mixed["k"] == pytest.approx(2 * mixed["load"] * T * 0.3**2 / (math.pi**2 * D), rel=1e-12)
+    assert 7.81 < mixed.buckling_coefficient_k < 13.6, mixed.buckling_coefficient_k
+    assert mixed.buckling_coefficient_k == pytest.approx(
+        2 * mixed.critical_load_Pa * T * 0.3**2 / (math.pi**2 * D), rel=1e-12
+    )
 
 
 def _short_tube(size: float) -> tuple[float, float]:
