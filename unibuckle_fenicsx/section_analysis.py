@@ -66,9 +66,9 @@ class SectionResult(BucklingResult, kw_only=True):
     r"""Critical state of a section: a :class:`~unibuckle_fenicsx.results.records.BucklingResult`.
 
     The fields keep the plate's meaning, with the section's words:
-    ``critical_load_Pa`` is the critical axial stress (the filled section's with a core),
-    ``free_load_Pa`` the hollow section's (load factors on the stresses per unit load:
-    with ``axial_stress = -1`` and no bending, the compressive stress in Pa);
+    ``critical_load_Pa`` is the critical load factor on the stresses per unit load (the
+    filled section's with a core), ``free_load_Pa`` the hollow section's: with
+    ``axial_stress = -1`` and no bending, the compressive stress in Pa;
     ``buckling_coefficient_k`` uses a box's widest face and its largest compressive
     stress at the critical load, so it is the classical k whatever the stress gradient
     (None for a tube); ``mesh`` is [cells along, cells around]; ``dofs`` counts the
@@ -76,7 +76,8 @@ class SectionResult(BucklingResult, kw_only=True):
     *directions* (a box's corner node has two), ``contact_coordinates`` their unrolled
     (x, s) (m along the member, m around the mid-line); ``input`` is the section's
     problem file (:func:`~unibuckle_fenicsx.spec.problem_to_dict`) when one was solved,
-    else ``{"section": the parameters}``.
+    else ``{"section": the parameters}``; ``critical_force_N_per_m`` is the extreme
+    fibre's :math:`t\sigma` (``compression_Pa``).
 
     Attributes:
         classical_stress_Pa: The section's reference stress (Pa): a box's k = 4 load
@@ -352,7 +353,7 @@ def _result(
         critical_load_Pa=load,
         free_load_Pa=free.load,
         ratio_to_free=load / free.load,
-        critical_force_N_per_m=p.thickness * load,
+        critical_force_N_per_m=p.thickness * load * p.compression(),
         buckling_coefficient_k=None if math.isnan(k) else k,
         dofs=section.model.num_dofs,
         mesh=[section.mesh.cells_along, section.mesh.cells_around],

@@ -120,6 +120,7 @@ def test_a_deep_web_in_bending_has_the_classical_coefficient():
     assert math.isnan(faces["bottom"]["buckling_coefficient_k"])
     # The summary's sigma_cr and its ratio to the classical k = 4 load: the extreme fibre's.
     assert double.compression_Pa == pytest.approx(sigma, rel=1e-12)
+    assert double.critical_force_N_per_m == pytest.approx(T * sigma, rel=1e-12)
     assert f"sigma_cr = {sigma:.6e} Pa at the extreme fibre" in double.summary()
     assert f"{double.buckling_coefficient_k / 4:.4f} x classical" in double.summary()
     # Compression with bending, psi = 0 on the webs: 7.81 (Table 4.1) < k < 13.6 (clamped).
