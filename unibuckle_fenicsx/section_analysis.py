@@ -102,7 +102,7 @@ class SectionResult(BucklingResult, kw_only=True):
         """Lines for the terminal: the critical stress, the hollow one, the reference."""
         k_value = self.buckling_coefficient_k
         k = "" if k_value is None else f", k = {k_value:.4f}"
-        sigma = self.compression_Pa
+        sigma = self.compression_Pa  # the stresses printed are the extreme fibre's
         if math.isnan(sigma):  # a result written before the field: the load factor
             sigma = self.critical_load_Pa
         factor = (
@@ -125,8 +125,9 @@ class SectionResult(BucklingResult, kw_only=True):
             lines.append(
                 f"core: {self.constrained_nodes} constrained directions, |Z| = "
                 f"{self.contact_nodes}, KKT = {'yes' if cert.kkt else 'NO'}, "
-                f"certificate {cert.status} (lower bound {self.lower_bound_Pa:.6e} Pa "
-                f"by {cert.proven_by})"
+                f"certificate {cert.status} (lower bound "
+                f"{self.lower_bound_Pa * sigma / self.critical_load_Pa:.6e} Pa by "
+                f"{cert.proven_by})"
             )
         return "\n  ".join(lines)
 

@@ -179,3 +179,18 @@ def test_walls_in_tension_everywhere_are_refused_before_any_mesh(
     err = capsys.readouterr().err
     assert f"load.axial_stress = {axial} with load.bending_stress = {bending}" in err
     assert "tension everywhere" in err
+
+
+def test_a_filled_box_in_bending_quotes_one_stress_throughout():
+    """The summary's sigma_cr, hollow load and lower bound: all the extreme fibre's."""
+    box = SectionParameters(
+        "box", width=0.1, depth=0.1, thickness=T, length=0.2, E=E, nu=NU, mesh_size=0.025,
+        ends="simply_supported", axial_stress=-1.0, bending_stress=-1.0, core=True,
+    )  # fmt: skip
+    with solve_section(box, MPI.COMM_SELF, levels=0) as analysis:
+        r = analysis.result
+    # The interlacing bound is the hollow section's load; its fibre carries twice it.
+    assert r.lower_bound_Pa == r.free_load_Pa
+    hollow = f"{2 * r.free_load_Pa:.6e} Pa"
+    assert f"x hollow {hollow})" in r.summary()
+    assert f"(lower bound {hollow} by interlacing)" in r.summary()
