@@ -40,6 +40,7 @@ from scipy.optimize import brentq
 
 from unibuckle_fenicsx import SectionParameters, solve_section
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.section_analysis import SectionResult
 
 E, NU, T = 2.1e11, 0.3, 0.002
@@ -194,3 +195,17 @@ def test_a_filled_box_in_bending_quotes_one_stress_throughout():
     hollow = f"{2 * r.free_load_Pa:.6e} Pa"
     assert f"x hollow {hollow})" in r.summary()
     assert f"(lower bound {hollow} by interlacing)" in r.summary()
+
+
+@pytest.mark.parametrize(
+    ("span", "what"),
+    [((0.01, 0.02), "no node of the mesh"), ((0.0, 0.0125), "only nodes held by the end")],
+)
+def test_a_core_span_without_a_free_node_is_refused_saying_why(span, what):
+    """Cells of 25 mm: a span between two nodes, or holding only the end's held nodes."""
+    box = SectionParameters(
+        "box", width=0.1, depth=0.1, thickness=T, length=0.2, E=E, nu=NU, mesh_size=0.025,
+        ends="simply_supported", core=True, core_span=span,
+    )  # fmt: skip
+    with pytest.raises(InputError, match=f"the core covers no free node: .* holds {what}"):
+        solve_section(box, MPI.COMM_SELF, levels=0)
