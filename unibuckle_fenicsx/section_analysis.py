@@ -84,8 +84,8 @@ class SectionResult(BucklingResult, kw_only=True):
             :math:`4\pi^2 D/(t b^2)`, a tube's :math:`E t/(R\sqrt{3(1-\nu^2)})`.
         compression_Pa: The largest compressive stress at the critical load (Pa), the
             extreme fibre's: ``critical_load_Pa`` times the largest compression per unit
-            load (:meth:`~unibuckle_fenicsx.model.shell.section.SectionParameters.compression`),
-            equal to it with ``axial_stress = -1`` and no bending.
+            load (``SectionParameters.compression()``), equal to it with
+            ``axial_stress = -1`` and no bending.
         faces: A box's faces at the critical load (empty for a tube): each face's name
             (``right``, ``top``, ``left``, ``bottom``: y = +b/2, z = +d/2, y = -b/2,
             z = -d/2), its width (m), its largest compressive stress ``compression_Pa``

@@ -24,6 +24,13 @@ r"""Sections other than the square box of the docs, against independent values.
   :math:`1/(1 + D\alpha^2/(\kappa G t))` (as the plate's Navier solution): 2.6970e9 Pa
   for R = 0.05 m, t = 1 mm, L = 10 mm (Kirchhoff's 2.7491e9). The package gives 2.7235e9
   and 2.7036e9 Pa on cells of 1 and 0.5 mm, Richardson-extrapolated 2.6970e9 (1e-5).
+- The same tube with clamped ends (all six components held, so the ends cannot move
+  axially either): no closed form, so a one-dimensional reference computed differently, a
+  Timoshenko beam on the hoop's foundation :math:`Et/R^2` (linear elements, one-point
+  shear, 800 of them, scipy's dense eigensolver), with the axial force that the held ends
+  add, :math:`N_x = \nu C \bar w/R`, as the energy :math:`\nu^2 C (\int w)^2/(L R^2)`,
+  C = Et/(1 - ν²): 7.4967e9 Pa (7.4557e9 with the ends free to move axially). The
+  package: 7.934e9 and 7.602e9 Pa on cells of 1 and 0.5 mm, Richardson 7.491e9 (7e-4).
 - Walls in tension everywhere have no positive critical load: refused before any mesh
   (exit status 2), as a plate's tension everywhere is.
 """
@@ -36,6 +43,7 @@ from mpi4py import MPI
 
 import numpy as np
 import pytest
+from scipy.linalg import eigh
 from scipy.optimize import brentq
 
 from unibuckle_fenicsx import SectionParameters, solve_section
@@ -132,12 +140,11 @@ def test_a_deep_web_in_bending_has_the_classical_coefficient():
     )
 
 
-def _short_tube(size: float) -> tuple[float, float]:
+def _short_tube(size: float, ends: str = "simply_supported") -> tuple[float, float]:
     """(package, reference) of the short tube's axisymmetric buckling stress (Pa)."""
     R, t, L = 0.05, 0.001, 0.01
     tube = SectionParameters(
-        "tube", diameter=2 * R, thickness=t, length=L, E=E, nu=NU, mesh_size=size,
-        ends="simply_supported",
+        "tube", diameter=2 * R, thickness=t, length=L, E=E, nu=NU, mesh_size=size, ends=ends,
     )  # fmt: skip
     with solve_section(tube, MPI.COMM_SELF) as analysis:
         load = analysis.result.critical_load_Pa
@@ -151,6 +158,36 @@ def test_a_short_tube_buckles_axisymmetrically():
     load, expected = _short_tube(0.001)
     assert expected == pytest.approx(2.6970e9, rel=1e-4)
     assert load == pytest.approx(expected, rel=0.015)
+
+
+def _clamped_axisymmetric_beam(R: float, t: float, L: float, n: int = 800) -> float:
+    """Timoshenko beam on the hoop foundation, ends clamped and axially held (Pa)."""
+    D, G, C = E * t**3 / (12 * (1 - NU**2)), E / (2 * (1 + NU)), E * t / (1 - NU**2)
+    h = L / n
+    b_w, b_th = np.array([-1, 0, 1, 0]) / h, np.array([0, -1, 0, 1]) / h
+    shear = b_w - np.array([0, 0.5, 0, 0.5])  # one-point shear strain of the element
+    hoop = E * t / R**2 * h / 6 * np.array([[2, 0, 1, 0], [0] * 4, [1, 0, 2, 0], [0] * 4])
+    k_e = D * h * np.outer(b_th, b_th) + 5 / 6 * G * t * h * np.outer(shear, shear) + hoop
+    K, B, mean = np.zeros((2 * n + 2,) * 2), np.zeros((2 * n + 2,) * 2), np.zeros(2 * n + 2)
+    for e in range(n):
+        dofs = np.ix_(range(2 * e, 2 * e + 4), range(2 * e, 2 * e + 4))
+        K[dofs] += k_e
+        B[dofs] += t * h * np.outer(b_w, b_w)
+        mean[2 * e : 2 * e + 4] += np.array([h / 2, 0, h / 2, 0])
+    K += NU**2 * C / (L * R**2) * np.outer(mean, mean)  # N_x of the axially held ends
+    free = np.arange(2, 2 * n)  # w and its rotation held at both ends
+    mu = eigh(B[np.ix_(free, free)], K[np.ix_(free, free)], eigvals_only=True)
+    return float(1.0 / mu.max())
+
+
+@pytest.mark.convergence
+def test_a_clamped_short_tube_converges_to_the_beam_on_the_hoop():
+    """Richardson over cells of 1 and 0.5 mm: the 1-D reference within 2e-3."""
+    expected = _clamped_axisymmetric_beam(0.05, 0.001, 0.01)
+    assert expected == pytest.approx(7.4967e9, rel=1e-4)
+    coarse, _ = _short_tube(0.001, "clamped")
+    fine, _ = _short_tube(0.0005, "clamped")
+    assert fine - (coarse - fine) / 3 == pytest.approx(expected, rel=2e-3)
 
 
 @pytest.mark.convergence

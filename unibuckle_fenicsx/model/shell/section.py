@@ -272,7 +272,7 @@ class Section(Owner):
         r""":math:`k = \sigma t b^2/(\pi^2 D)` of a box's widest face b; NaN for a tube.
 
         :math:`\sigma` is that face's largest compressive stress at the load ``load``,
-        ``load`` times :meth:`SectionParameters.compression` over the depth (the widest
+        ``load`` times ``SectionParameters.compression()`` over the depth (the widest
         faces, a flange pair or a web pair, reach the section's largest compression), so
         that k is the classical coefficient whatever the stress per unit load and its
         gradient (:math:`\psi = -1`: a web's 23.9 when hinged). NaN without compression.
