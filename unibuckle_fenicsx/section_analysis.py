@@ -121,12 +121,12 @@ class SectionResult(BucklingResult, kw_only=True):
             f"{self.wall_time_s:.2f} s"
         ]
         cert = self.certificate
-        if cert is not None:
+        if cert is not None and self.lower_bound_Pa is not None:
+            lower = self.lower_bound_Pa * sigma / self.critical_load_Pa
             lines.append(
                 f"core: {self.constrained_nodes} constrained directions, |Z| = "
                 f"{self.contact_nodes}, KKT = {'yes' if cert.kkt else 'NO'}, "
-                f"certificate {cert.status} (lower bound "
-                f"{self.lower_bound_Pa * sigma / self.critical_load_Pa:.6e} Pa by "
+                f"certificate {cert.status} (lower bound {lower:.6e} Pa by "
                 f"{cert.proven_by})"
             )
         return "\n  ".join(lines)

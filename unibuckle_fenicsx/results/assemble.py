@@ -97,6 +97,14 @@ def assemble_result(
         result.lower_bound_Pa = result.upper_bound_Pa = free.load
         return result
     record_contact(result, problem, solution, certificate)
+    if (
+        spec.design is not None
+        and result.design is not None
+        and not (certificate.global_optimum_proven)
+    ):
+        from unibuckle_fenicsx.design import at_lower_bound
+
+        at_lower_bound(result.design, spec, spec.design, certificate.lower_bound)
     return result
 
 
