@@ -97,14 +97,17 @@ def assemble_result(
         result.lower_bound_Pa = result.upper_bound_Pa = free.load
         return result
     record_contact(result, problem, solution, certificate)
+    lower = certificate.lower_bound  # a safe value to design with when not proven
     if (
         spec.design is not None
         and result.design is not None
-        and not (certificate.global_optimum_proven)
+        and not certificate.global_optimum_proven
+        and math.isfinite(lower)
+        and lower > 0.0
     ):
         from unibuckle_fenicsx.design import at_lower_bound
 
-        at_lower_bound(result.design, spec, spec.design, certificate.lower_bound)
+        at_lower_bound(result.design, spec, spec.design, lower)
     return result
 
 
