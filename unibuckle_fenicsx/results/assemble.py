@@ -97,18 +97,18 @@ def assemble_result(
         result.lower_bound_Pa = result.upper_bound_Pa = free.load
         return result
     record_contact(result, problem, solution, certificate)
-    lower = certificate.lower_bound  # a safe value to design with when not proven
-    if (
-        spec.design is not None
-        and result.design is not None
-        and not certificate.global_optimum_proven
-        and math.isfinite(lower)
-        and lower > 0.0
-    ):
-        from unibuckle_fenicsx.design import at_lower_bound
-
-        at_lower_bound(result.design, spec, spec.design, lower)
+    if not certificate.global_optimum_proven:
+        _design_at_lower_bound(result, spec, certificate.lower_bound)
     return result
+
+
+def _design_at_lower_bound(result: BucklingResult, spec: ProblemSpec, lower: float) -> None:
+    """The design output at the verified lower bound ``lower``: the safe values."""
+    from unibuckle_fenicsx.design import DesignRecord, at_lower_bound
+
+    design = result.design
+    if spec.design is not None and isinstance(design, DesignRecord) and 0.0 < lower < math.inf:
+        at_lower_bound(design, spec, spec.design, lower)
 
 
 def record_contact(
