@@ -54,7 +54,13 @@ from unibuckle_fenicsx.model.shell.section import (
 )
 from unibuckle_fenicsx.results.assemble import record_contact, versions
 from unibuckle_fenicsx.results.records import BucklingResult, ResultDetails
-from unibuckle_fenicsx.section_design import SectionDesignRecord, design_line, section_design
+from unibuckle_fenicsx.section_design import (
+    SectionDesignRecord,
+    at_lower_bound,
+    design_line,
+    face_compressions,
+    section_design,
+)
 from unibuckle_fenicsx.spec import DesignSpec, SectionProblemSpec, SolverSpec, problem_to_dict
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
@@ -270,20 +276,17 @@ def solve_section(
             result.input = echo
         if design is not None:
             result.design = section_design(parameters, design, result.critical_load_Pa)
+            lower = result.lower_bound_Pa
+            if certificate is not None and not certificate.global_optimum_proven and lower:
+                at_lower_bound(result.design, parameters, design, lower)
     except BaseException:
         section.destroy()
         raise
     return SectionAnalysis(result, section, solution, certificate)
 
 
-#: A box's faces: name, the axis of their normal (1: y, 2: z), its inward sign, and the
-#: depth coordinate zeta (-1 to 1 over the depth) the face spans.
-_FACES = (
-    ("right", 1, -1.0, (-1.0, 1.0)),
-    ("top", 2, -1.0, (1.0, 1.0)),
-    ("left", 1, 1.0, (-1.0, 1.0)),
-    ("bottom", 2, 1.0, (-1.0, -1.0)),
-)
+#: A box's faces: name, the axis of their normal (1: y, 2: z) and its inward sign.
+_FACES = (("right", 1, -1.0), ("top", 2, -1.0), ("left", 1, 1.0), ("bottom", 2, 1.0))
 
 
 def _faces(
@@ -299,10 +302,11 @@ def _faces(
     if active is not None:
         touching[active] = True
     out: list[dict[str, str | float]] = []
-    for name, axis, sign, zeta in _FACES:
+    compressions = face_compressions(p)
+    for name, axis, sign in _FACES:
         width = p.depth if axis == 1 else p.width  # a face normal to y spans the depth
         on = normals[:, axis] * sign > 0.5
-        sigma = load * p.compression(zeta) + 0.0  # the face's largest compression (no -0.0)
+        sigma = load * max(compressions[name]) + 0.0  # its largest compression (no -0.0)
         out.append(
             {
                 "face": name,

@@ -246,3 +246,31 @@ def test_a_core_span_without_a_free_node_is_refused_saying_why(span, what):
     )  # fmt: skip
     with pytest.raises(InputError, match=f"the core covers no free node: .* holds {what}"):
         solve_section(box, MPI.COMM_SELF, levels=0)
+
+
+def test_a_filled_box_s_design_is_also_given_at_the_hollow_load():
+    """KKT only (the sections' usual certificate): rho at the lower bound too, by hand.
+
+    The filled box 100 x 100 x 2 mm, f_y = 355 MPa, gamma_M1 = 1: at the lower bound (the
+    hollow load by interlacing) each face has psi = 1, lambda_p = sqrt(f_y/sigma) and
+    rho = (lambda_p - 0.22)/lambda_p^2 by EN 1993-1-5 eq. (4.2), or 1 up to 0.673.
+    """
+    from unibuckle_fenicsx.spec import DesignSpec
+
+    box = SectionParameters(
+        "box", width=0.1, depth=0.1, thickness=T, length=0.2, E=E, nu=NU, mesh_size=0.025,
+        ends="simply_supported", core=True,
+    )  # fmt: skip
+    design = DesignSpec(yield_stress=3.55e8)
+    with solve_section(box, MPI.COMM_SELF, levels=0, design=design) as analysis:
+        r = analysis.result
+    assert r.certificate is not None and not r.certificate.global_optimum_proven
+    assert r.lower_bound_Pa == pytest.approx(r.free_load_Pa, rel=1e-12)
+    low = r.design.lower_bound
+    assert low.sigma_cr_Pa == r.lower_bound_Pa
+    slenderness = math.sqrt(3.55e8 / r.lower_bound_Pa)
+    rho = 1.0 if slenderness <= 0.673 else (slenderness - 0.22) / slenderness**2
+    assert low.relative_slenderness == pytest.approx(slenderness, rel=1e-14)
+    assert [f.reduction_factor for f in low.faces] == pytest.approx([rho] * 4, rel=1e-14)
+    assert any("not proven the lowest" in note for note in r.design.notes)
+    assert f"sigma_cr = {r.lower_bound_Pa:.4g} Pa, slenderness {slenderness:.4g}" in r.summary()

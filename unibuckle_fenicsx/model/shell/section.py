@@ -183,16 +183,14 @@ class SectionParameters:
                     f"got {self.core_span}"
                 )
 
-    def compression(self, zeta: tuple[float, float] = (-1.0, 1.0)) -> float:
-        r"""The largest compressive stress per unit load (Pa/Pa) over depths ``zeta``.
+    def compression(self) -> float:
+        r"""The largest compressive stress per unit load (Pa/Pa), the extreme fibre's.
 
         The axial stress is :math:`\sigma_a + \sigma_b\zeta` (``axial_stress``,
-        ``bending_stress``), :math:`\zeta` from -1 to 1 over the depth (a box's bottom and
-        top faces at -1 and 1, its side faces across it; a tube's wall across it); the
-        result is :math:`\max_\zeta -(\sigma_a + \sigma_b\zeta)`, <= 0 where none is in
-        compression.
+        ``bending_stress``), :math:`\zeta` from -1 to 1 over the depth; the result is
+        :math:`|\sigma_b| - \sigma_a`, <= 0 when no fibre is in compression.
         """
-        return max(-(self.axial_stress + self.bending_stress * z) for z in zeta)
+        return abs(self.bending_stress) - self.axial_stress
 
     @property
     def widest(self) -> float:
