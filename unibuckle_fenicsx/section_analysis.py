@@ -53,7 +53,13 @@ from unibuckle_fenicsx.model.shell.section import (
 from unibuckle_fenicsx.results.assemble import record_contact, versions
 from unibuckle_fenicsx.results.records import BucklingResult, ResultDetails
 from unibuckle_fenicsx.section_design import SectionDesignRecord, design_line, section_design
-from unibuckle_fenicsx.spec import DesignSpec, SectionProblemSpec, SolverSpec, problem_to_dict
+from unibuckle_fenicsx.spec import (
+    UNITS,
+    DesignSpec,
+    SectionProblemSpec,
+    SolverSpec,
+    problem_to_dict,
+)
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = ["SectionAnalysis", "SectionResult", "solve_section"]
@@ -90,29 +96,33 @@ class SectionResult(BucklingResult, kw_only=True):
     faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
 
     def summary(self) -> str:
-        """Lines for the terminal: the critical stress, the hollow one, the reference."""
+        """Lines for the terminal: the critical stress, the hollow one, the reference.
+
+        Stresses in the file's unit system (``units``: Pa, or MPa for mm-N-MPa).
+        """
+        scale, unit = UNITS[self.units][1:]
         k_value = self.buckling_coefficient_k
         k = "" if k_value is None else f", k = {k_value:.4f}"
         head = (
-            f"{self.case}: sigma_cr = {self.critical_load_Pa:.6e} Pa "
-            f"({self.ratio_to_free:.4f} x hollow {self.free_load_Pa:.6e} Pa){k}, "
+            f"{self.case}: sigma_cr = {self.critical_load_Pa / scale:.6e} {unit} "
+            f"({self.ratio_to_free:.4f} x hollow {self.free_load_Pa / scale:.6e} {unit}){k}, "
             f"{self.critical_load_Pa / self.classical_stress_Pa:.4f} x classical "
-            f"{self.classical_stress_Pa:.6e} Pa"
+            f"{self.classical_stress_Pa / scale:.6e} {unit}"
         )
         lines = [
             f"{head}, method {self.method}, {self.eigensolves} eigensolves, "
             f"{self.wall_time_s:.2f} s"
         ]
-        cert = self.certificate
+        cert, lower = self.certificate, self.lower_bound_Pa
         if cert is not None:
+            bound = "none" if lower is None else f"{lower / scale:.6e} {unit}"
             lines.append(
                 f"core: {self.constrained_nodes} constrained directions, |Z| = "
                 f"{self.contact_nodes}, KKT = {'yes' if cert.kkt else 'NO'}, "
-                f"certificate {cert.status} (lower bound {self.lower_bound_Pa:.6e} Pa "
-                f"by {cert.proven_by})"
+                f"certificate {cert.status} (lower bound {bound} by {cert.proven_by})"
             )
         if isinstance(self.design, SectionDesignRecord):
-            lines.append(design_line(self.design))
+            lines.append(design_line(self.design, scale, unit))
         return "\n  ".join(lines)
 
 
@@ -208,9 +218,11 @@ def solve_section(
     """
     t0 = time.perf_counter()
     echo: dict[str, object] | None = None
+    units = "SI"
     if isinstance(parameters, SectionProblemSpec):
         echo = problem_to_dict(parameters)
         levels, solver, design = parameters.mesh.levels, parameters.solver, parameters.design
+        units = parameters.units
         parameters = section_parameters(parameters)
     if not isinstance(parameters, SectionParameters):
         raise TypeError(
@@ -246,7 +258,7 @@ def solve_section(
                 )
         result = _result(section, free, solution, certificate, time.perf_counter() - t0)
         if echo is not None:
-            result.input = echo
+            result.input, result.units = echo, units
         if design is not None:
             result.design = section_design(parameters, design, result.critical_load_Pa)
     except BaseException:
