@@ -364,28 +364,3 @@ def _kind(x: Any) -> str:
         if isinstance(x, cls) or (isinstance(x, type) and issubclass(x, cls)):
             return name
     return "absent"
-
-
-# -- single values (option records outside the problem file) ----------------------------
-
-
-def _number(name: str, value: Any) -> float:
-    """``value`` as a finite float, or refused naming ``name``."""
-    if not math.isfinite(out := checked(value, float, name, "")):
-        raise InputError(f"{name} must be a finite number, got {value!r}")
-    return float(out)
-
-
-def _integer(name: str, value: Any, minimum: int) -> int:
-    """``value`` as an integer >= ``minimum``, or refused naming ``name``."""
-    return int(checked(value, Annotated[int, Meta(ge=minimum)], name, ""))
-
-
-def _boolean(name: str, value: Any) -> bool:
-    """``value`` as true or false, or refused naming ``name``."""
-    return bool(checked(value, bool, name, ""))
-
-
-def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
-    """``value`` as one of ``choices``, or refused naming ``name``."""
-    return str(checked(value, Literal[choices], name, ""))
