@@ -109,7 +109,7 @@ class Table(Struct, frozen=True, forbid_unknown_fields=True):
         for name in self.__struct_fields__:
             bad = next((v for v in _floats(getattr(self, name)) if not math.isfinite(v)), None)
             if bad is not None:
-                raise FieldError(self.key(), name, f" must be a finite number, got {bad!r}")
+                raise self.error(name, f" must be a finite number, got {bad!r}")
         self.check()
 
     def check(self) -> None:
@@ -118,6 +118,10 @@ class Table(Struct, frozen=True, forbid_unknown_fields=True):
     def key(self) -> str:
         """This table's key in messages when it is built in code."""
         return self.KEY
+
+    def error(self, field: str, text: str) -> FieldError:
+        """The refusal of this table's ``field`` ("": the table): its key, then ``text``."""
+        return FieldError(self.key(), field, text)
 
     @classmethod
     def file_keys(cls) -> list[str]:
