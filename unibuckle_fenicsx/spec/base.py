@@ -113,7 +113,7 @@ class Table(Struct, frozen=True, forbid_unknown_fields=True):
         self.check()
 
     def check(self) -> None:
-        """The rules between this table's fields (each raises a ``FieldError``)."""
+        """The rules between this table's fields (each raises :meth:`error`)."""
 
     def key(self) -> str:
         """This table's key in messages when it is built in code."""
