@@ -91,6 +91,18 @@ def test_section_command(tmp_path: Path) -> None:
     assert [face["face"] for face in result["faces"]] == ["right", "top", "left", "bottom"]
 
 
+def test_section_numbers_are_the_stored_run_s() -> None:
+    """The README quotes the run of its section command that ``make demo`` stores."""
+    stored = (ROOT / "figures" / "quickstart" / "box.txt").read_text()
+    found = re.search(r"sigma_cr = (\S+) Pa \((\S+) x hollow (\S+) Pa\), k = (\S+),", stored)
+    assert found is not None, stored
+    critical, gain, hollow, k = (float(x) for x in found.groups())
+    text = " ".join(README.split())
+    assert f"critical axial stress ({critical / 1e6:.1f} MPa" in text
+    assert f"{gain:.2f} × the hollow box's {hollow / 1e6:.1f} MPa" in text
+    assert f"widest face ({k:.2f};" in text
+
+
 def test_results_table_is_the_demo_s() -> None:
     """The README's table of the paper's plate is figures/results.md's, as it says.
 

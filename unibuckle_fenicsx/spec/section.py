@@ -14,6 +14,7 @@ import msgspec
 from msgspec import Meta
 
 from unibuckle_fenicsx.spec.base import Table, Units, unit
+from unibuckle_fenicsx.spec.obstacles import DesignSpec
 from unibuckle_fenicsx.spec.solver import SolverSpec
 
 Length = Annotated[float, unit("m", gt=0)]
@@ -150,6 +151,8 @@ class SectionProblemSpec(Table, frozen=True):
         load: The end load per unit load factor.
         obstacle: The core, if any.
         mesh: The cells.
+        design: With ``[design]``: EN 1993-1-5 per face and EN 1994-1-1's wall limits from
+            the critical state (:mod:`~unibuckle_fenicsx.section_design`).
         solver: Solver options: of :data:`SOLVER_KEYS` (the feasibility tolerance tau,
             the eigen solves' tolerance, the active-set iterations per seed); the plate's
             methods' options are refused.
@@ -164,6 +167,7 @@ class SectionProblemSpec(Table, frozen=True):
     load: AxialLoad = msgspec.field(default_factory=AxialLoad)
     obstacle: CoreSpec = msgspec.field(default_factory=CoreSpec)
     solver: SolverSpec = msgspec.field(default_factory=SolverSpec)
+    design: DesignSpec | None = None
 
     def check(self) -> None:
         """The core's span lies on the member; the solver's options are a section's."""
