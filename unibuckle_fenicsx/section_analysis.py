@@ -61,7 +61,13 @@ from unibuckle_fenicsx.section_design import (
     face_compressions,
     section_design,
 )
-from unibuckle_fenicsx.spec import DesignSpec, SectionProblemSpec, SolverSpec, problem_to_dict
+from unibuckle_fenicsx.spec import (
+    UNITS,
+    DesignSpec,
+    SectionProblemSpec,
+    SolverSpec,
+    problem_to_dict,
+)
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = ["SectionAnalysis", "SectionResult", "solve_section"]
@@ -108,7 +114,11 @@ class SectionResult(BucklingResult, kw_only=True):
     faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
 
     def summary(self) -> str:
-        """Lines for the terminal: the critical stress, the hollow one, the reference."""
+        """Lines for the terminal: the critical stress, the hollow one, the reference.
+
+        Stresses in the file's unit system (``units``: Pa, or MPa for mm-N-MPa).
+        """
+        scale, unit = UNITS[self.units][1:]
         k_value = self.buckling_coefficient_k
         k = "" if k_value is None else f", k = {k_value:.4f}"
         sigma = self.compression_Pa  # the stresses printed are the extreme fibre's
@@ -117,29 +127,34 @@ class SectionResult(BucklingResult, kw_only=True):
         factor = (
             ""
             if sigma == self.critical_load_Pa
-            else f" at the extreme fibre, load factor {self.critical_load_Pa:.6e}"
+            else f" at the extreme fibre, load factor {self.critical_load_Pa / scale:.6e} {unit}"
         )
+        hollow = self.free_load_Pa * (sigma / self.critical_load_Pa)  # its extreme fibre's
         head = (
-            f"{self.case}: sigma_cr = {sigma:.6e} Pa{factor} "
-            f"({self.ratio_to_free:.4f} x hollow {sigma / self.ratio_to_free:.6e} Pa){k}, "
+            f"{self.case}: sigma_cr = {sigma / scale:.6e} {unit}{factor} "
+            f"({self.ratio_to_free:.4f} x hollow {hollow / scale:.6e} {unit}){k}, "
             f"{sigma / self.classical_stress_Pa:.4f} x classical "
-            f"{self.classical_stress_Pa:.6e} Pa"
+            f"{self.classical_stress_Pa / scale:.6e} {unit}"
         )
         lines = [
             f"{head}, method {self.method}, {self.eigensolves} eigensolves, "
             f"{self.wall_time_s:.2f} s"
         ]
-        cert = self.certificate
-        if cert is not None and self.lower_bound_Pa is not None:
-            lower = self.lower_bound_Pa * sigma / self.critical_load_Pa
+        cert, lower = self.certificate, self.lower_bound_Pa
+        if cert is not None:
+            # The bound in the same stress as sigma_cr (the extreme fibre's).
+            bound = (
+                "none"
+                if lower is None
+                else f"{lower * (sigma / self.critical_load_Pa) / scale:.6e} {unit}"
+            )
             lines.append(
                 f"core: {self.constrained_nodes} constrained directions, |Z| = "
                 f"{self.contact_nodes}, KKT = {'yes' if cert.kkt else 'NO'}, "
-                f"certificate {cert.status} (lower bound {lower:.6e} Pa by "
-                f"{cert.proven_by})"
+                f"certificate {cert.status} (lower bound {bound} by {cert.proven_by})"
             )
         if isinstance(self.design, SectionDesignRecord):
-            lines.append(design_line(self.design))
+            lines.append(design_line(self.design, scale, unit))
         return "\n  ".join(lines)
 
 
@@ -235,9 +250,11 @@ def solve_section(
     """
     t0 = time.perf_counter()
     echo: dict[str, object] | None = None
+    units = "SI"
     if isinstance(parameters, SectionProblemSpec):
         echo = problem_to_dict(parameters)
         levels, solver, design = parameters.mesh.levels, parameters.solver, parameters.design
+        units = parameters.units
         parameters = section_parameters(parameters)
     if not isinstance(parameters, SectionParameters):
         raise TypeError(
@@ -273,7 +290,7 @@ def solve_section(
                 )
         result = _result(section, free, solution, certificate, time.perf_counter() - t0)
         if echo is not None:
-            result.input = echo
+            result.input, result.units = echo, units
         if design is not None:
             result.design = section_design(parameters, design, result.critical_load_Pa)
             lower = result.lower_bound_Pa

@@ -236,18 +236,18 @@ def at_lower_bound(
     return record
 
 
-def design_line(d: SectionDesignRecord) -> str:
-    """The summary line of a section's design output."""
+def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") -> str:
+    """The summary line of a section's design output (stresses in ``unit``, Pa / ``scale``)."""
     text = (
-        f"design: largest compression sigma_cr = {d.sigma_cr_Pa:.4g} Pa, "
+        f"design: largest compression sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit}, "
         f"slenderness {d.relative_slenderness:.4g}"
     )
     face = next((f for f in d.faces if f.face == d.governing_face), None)
     if face is not None and face.reduction_factor is not None:
+        reduced = face.reduced_design_stress_Pa or 0.0
         text += (
             f"; EN 1993-1-5 face {face.face}: psi = {face.psi:.3g}, rho = "
-            f"{face.reduction_factor:.4g}, rho f_y/gamma_M1 = "
-            f"{face.reduced_design_stress_Pa:.4g} Pa"
+            f"{face.reduction_factor:.4g}, rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
         )
     if d.width_to_thickness is not None and d.width_to_thickness_limit is not None:
         verdict = (
@@ -263,7 +263,7 @@ def design_line(d: SectionDesignRecord) -> str:
     if isinstance(low, SectionDesignRecord):
         text += (
             f"\n  design at the verified lower bound (the safe value, sigma_cr not proven "
-            f"the lowest): sigma_cr = {low.sigma_cr_Pa:.4g} Pa, slenderness "
+            f"the lowest): sigma_cr = {low.sigma_cr_Pa / scale:.4g} {unit}, slenderness "
             f"{low.relative_slenderness:.4g}"
         )
         face = next((f for f in low.faces if f.face == low.governing_face), None)
