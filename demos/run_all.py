@@ -54,10 +54,11 @@ DEMOS = (
     "demo_sections.py",  # figures/sections/: box and tube, hollow and filled; no row
 )
 #: The quickstart's runs (docs/guide/quickstart.md shows their output): the README's first
-#: problem file, as a user runs it, without and with --bracket.
+#: problem file, as a user runs it, without and with --bracket; and the README's section.
 QUICKSTART = {
     "output.txt": ["solve", "--config", "demos/plate.toml", "--json", "plate.json"],
     "output_bracket.txt": ["solve", "--config", "demos/plate.toml", "--bracket"],
+    "box.txt": ["solve", "--config", "demos/box.toml", "--json", "box.json"],
 }
 CASES = ("free", "c1", "c2", "c3")
 COLUMNS = (

@@ -52,7 +52,8 @@ from unibuckle_fenicsx.model.shell.section import (
 )
 from unibuckle_fenicsx.results.assemble import record_contact, versions
 from unibuckle_fenicsx.results.records import BucklingResult, ResultDetails
-from unibuckle_fenicsx.spec import SectionProblemSpec, SolverSpec, problem_to_dict
+from unibuckle_fenicsx.section_design import SectionDesignRecord, design_line, section_design
+from unibuckle_fenicsx.spec import DesignSpec, SectionProblemSpec, SolverSpec, problem_to_dict
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = ["SectionAnalysis", "SectionResult", "solve_section"]
@@ -71,7 +72,9 @@ class SectionResult(BucklingResult, kw_only=True):
     *directions* (a box's corner node has two), ``contact_coordinates`` their unrolled
     (x, s) (m along the member, m around the mid-line); ``input`` is the section's
     problem file (:func:`~unibuckle_fenicsx.spec.problem_to_dict`) when one was solved,
-    else ``{"section": the parameters}``.
+    else ``{"section": the parameters}``; ``design``, with a ``[design]`` table, is a
+    :class:`~unibuckle_fenicsx.section_design.SectionDesignRecord` (EN 1993-1-5 per face of
+    a box, EN 1994-1-1's wall limits with a core).
 
     Attributes:
         classical_stress_Pa: The section's reference stress (Pa): a box's k = 4 load
@@ -108,6 +111,8 @@ class SectionResult(BucklingResult, kw_only=True):
                 f"certificate {cert.status} (lower bound {self.lower_bound_Pa:.6e} Pa "
                 f"by {cert.proven_by})"
             )
+        if isinstance(self.design, SectionDesignRecord):
+            lines.append(design_line(self.design))
         return "\n  ".join(lines)
 
 
@@ -169,6 +174,7 @@ def solve_section(
     *,
     levels: int = 1,
     solver: SolverSpec | None = None,
+    design: DesignSpec | None = None,
 ) -> SectionAnalysis:
     """Critical axial stress and mode of a box or tube section; with a core, certified.
 
@@ -177,14 +183,16 @@ def solve_section(
             checked when built: bad keys raise :class:`~unibuckle_fenicsx.errors.InputError`),
             or a section's problem file
             (:class:`~unibuckle_fenicsx.spec.section.SectionProblemSpec`: its
-            ``mesh.levels`` and ``[solver]`` replace ``levels`` and ``solver``, and the
-            result's ``input`` is the file, which re-runs it).
+            ``mesh.levels``, ``[solver]`` and ``[design]`` replace ``levels``, ``solver``
+            and ``design``, and the result's ``input`` is the file, which re-runs it).
         comm: Communicator; the mesh is distributed over it.
         levels: With a core, coarser sections (each with twice the mesh size) the
             active-set seeds run on, >= 0. 1 by default: the seeds' many eigen solves on a
             section of a quarter of the DOFs, a few polishing solves on the given one.
         solver: Solver options (tolerances, the feasibility tolerance tau); the
             package's defaults when None.
+        design: The yield stress and partial factor of the design output
+            (:mod:`~unibuckle_fenicsx.section_design`); None: none.
 
     Returns:
         The analysis; the caller destroys it (or uses ``with``).
@@ -202,7 +210,7 @@ def solve_section(
     echo: dict[str, object] | None = None
     if isinstance(parameters, SectionProblemSpec):
         echo = problem_to_dict(parameters)
-        levels, solver = parameters.mesh.levels, parameters.solver
+        levels, solver, design = parameters.mesh.levels, parameters.solver, parameters.design
         parameters = section_parameters(parameters)
     if not isinstance(parameters, SectionParameters):
         raise TypeError(
@@ -239,6 +247,8 @@ def solve_section(
         result = _result(section, free, solution, certificate, time.perf_counter() - t0)
         if echo is not None:
             result.input = echo
+        if design is not None:
+            result.design = section_design(parameters, design, result.critical_load_Pa)
     except BaseException:
         section.destroy()
         raise

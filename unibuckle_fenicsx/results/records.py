@@ -21,6 +21,7 @@ from unibuckle_fenicsx.certificate.records import CopositivityRecord
 from unibuckle_fenicsx.design import DesignRecord
 from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
+from unibuckle_fenicsx.section_design import SectionDesignRecord
 from unibuckle_fenicsx.spec import UNITS, PointSpec
 
 __all__ = [
@@ -228,7 +229,7 @@ class BucklingResult(Struct, kw_only=True):
     critical_load_factor: float | None = None
     critical_temperature_K: float | None = None
     critical_total_temperature_K: float | None = None
-    design: DesignRecord | None = None
+    design: DesignRecord | SectionDesignRecord | None = None
     units: str = "SI"
     input: dict[str, object] | None = None
     versions: dict[str, str] = {}
@@ -354,7 +355,7 @@ class BucklingResult(Struct, kw_only=True):
                 "total temperature rise at the critical state (the fixed rise and lambda "
                 f"times the scaled one): {self.critical_total_temperature_K:.6g} K"
             )
-        if self.design is not None:
+        if isinstance(self.design, DesignRecord):
             lines.append(_design_line(self.design, scale, unit))
         factor = load.get("fixed_factor", 1.0)
         if fixed and factor:

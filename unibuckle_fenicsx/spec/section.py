@@ -15,6 +15,7 @@ from msgspec import Meta
 
 from unibuckle_fenicsx.errors import FieldError
 from unibuckle_fenicsx.spec.base import Table, Units, unit
+from unibuckle_fenicsx.spec.obstacles import DesignSpec
 from unibuckle_fenicsx.spec.solver import SolverSpec
 
 Length = Annotated[float, unit("m", gt=0)]
@@ -152,6 +153,8 @@ class SectionProblemSpec(Table, frozen=True):
         load: The end load per unit load factor.
         obstacle: The core, if any.
         mesh: The cells.
+        design: With ``[design]``: EN 1993-1-5 per face and EN 1994-1-1's wall limits from
+            the critical state (:mod:`~unibuckle_fenicsx.section_design`).
         solver: Solver options: of :data:`SOLVER_KEYS` (the feasibility tolerance tau,
             the eigen solves' tolerance, the active-set iterations per seed); the plate's
             methods' options are refused.
@@ -166,6 +169,7 @@ class SectionProblemSpec(Table, frozen=True):
     load: AxialLoad = msgspec.field(default_factory=AxialLoad)
     obstacle: CoreSpec = msgspec.field(default_factory=CoreSpec)
     solver: SolverSpec = msgspec.field(default_factory=SolverSpec)
+    design: DesignSpec | None = None
 
     def check(self) -> None:
         """The core's span lies on the member; the solver's options are a section's."""

@@ -1,0 +1,136 @@
+"""A section's design output: EN 1993-1-5 per face of a box, EN 1994-1-1's wall limits.
+
+Every expected value is worked out here from the codes' formulas, not read from the
+package: the relative slenderness sqrt(f_y/sigma_cr) (EN 1993-1-5, 4.4(2)); the reduction
+factor of an internal compression element rho = (lambda_p - 0.055 (3 + psi))/lambda_p^2
+(eq. (4.2)); Table 4.1's k_sigma = 7.81 - 6.29 psi + 9.78 psi^2 for 0 > psi > -1; the
+limits of EN 1994-1-1 Table 6.3, 52 sqrt(235/f_y) for a filled rectangular section and
+90 (235/f_y) for a filled circular one (f_y in N/mm^2). The stresses at the critical state
+follow from the load's definition (axial stress plus the bending part times z/(d/2)).
+"""
+
+from __future__ import annotations
+
+import json
+import math
+from types import SimpleNamespace
+
+from mpi4py import MPI
+
+import pytest
+
+from unibuckle_fenicsx import SectionParameters, solve_section
+from unibuckle_fenicsx.section_design import section_design
+from unibuckle_fenicsx.spec import DesignSpec, load_problem
+
+pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial sections")
+
+
+def _section(shape: str = "box", **changes: object) -> SimpleNamespace:
+    base = {
+        "shape": shape, "thickness": 0.002, "width": 0.2, "depth": 0.1, "diameter": None,
+        "axial_stress": -1.0, "bending_stress": 0.0, "core": False,
+    }  # fmt: skip
+    return SimpleNamespace(**{**base, **changes})
+
+
+def test_uniform_compression_gives_every_face_the_internal_element_s_rho():
+    load, fy = 2.0e8, 3.55e8
+    out = section_design(_section(), DesignSpec(yield_stress=fy, partial_factor=1.1), load)
+    slenderness = math.sqrt(fy / load)  # 1.3323
+    rho = (slenderness - 0.055 * 4.0) / slenderness**2
+    assert out.sigma_cr_Pa == pytest.approx(load)
+    assert out.relative_slenderness == pytest.approx(slenderness)
+    assert [f.face for f in out.faces] == ["right", "top", "left", "bottom"]
+    for face in out.faces:
+        assert face.psi == 1.0 and face.k_sigma_table == 4.0
+        assert face.reduction_factor == pytest.approx(rho)
+        assert face.reduced_design_stress_Pa == pytest.approx(rho * fy / 1.1)
+    assert out.width_to_thickness is None  # no core: no EN 1994-1-1 limit
+
+
+def test_bending_puts_a_face_in_tension_and_the_webs_in_a_gradient():
+    # axial -1, bending +2 at z = +d/2: top +1 (tension), bottom -3, webs from +1 to -3.
+    load, fy = 4.0e7, 3.55e8
+    out = section_design(_section(bending_stress=2.0), DesignSpec(yield_stress=fy), load)
+    faces = {f.face: f for f in out.faces}
+    assert out.sigma_cr_Pa == pytest.approx(3.0 * load)
+    assert faces["top"].sigma_cr_Pa == pytest.approx(-load)
+    assert faces["top"].reduction_factor is None and faces["top"].psi is None
+    web = faces["right"]
+    psi = -1.0 / 3.0
+    slenderness = math.sqrt(fy / (3.0 * load))
+    assert web.psi == pytest.approx(psi)
+    assert web.k_sigma_table == pytest.approx(7.81 - 6.29 * psi + 9.78 * psi**2)
+    assert web.reduction_factor == pytest.approx(
+        (slenderness - 0.055 * (3.0 + psi)) / slenderness**2
+    )
+    bottom = faces["bottom"]
+    assert bottom.psi == 1.0
+    assert bottom.reduction_factor == pytest.approx((slenderness - 0.22) / slenderness**2)
+    assert out.governing_face == "bottom"  # rho falls with psi at one slenderness
+
+
+def test_a_stocky_face_is_fully_effective():
+    # lambda_p = 0.5 below the limit 0.5 + sqrt(0.085 - 0.055) = 0.673 of psi = 1.
+    out = section_design(_section(), DesignSpec(yield_stress=2.35e8), 4 * 2.35e8)
+    assert out.faces[0].relative_slenderness == pytest.approx(0.5)
+    assert out.faces[0].reduction_factor == 1.0
+
+
+@pytest.mark.parametrize(
+    ("shape", "changes", "ratio", "limit"),
+    [
+        # h = 0.2 + 0.002 (overall) over t = 0.002; 52 sqrt(235/355).
+        ("box", {}, 101.0, 52.0 * math.sqrt(235.0 / 355.0)),
+        # d = 0.3 + 0.002 over t; 90 * 235/355.
+        ("tube", {"width": None, "depth": None, "diameter": 0.3}, 151.0, 90.0 * 235.0 / 355.0),
+    ],
+)
+def test_filled_sections_are_checked_against_en_1994_table_6_3(shape, changes, ratio, limit):
+    section = _section(shape, core=True, **changes)
+    out = section_design(section, DesignSpec(yield_stress=3.55e8), 3.0e8)
+    assert out.width_to_thickness == pytest.approx(ratio)
+    assert out.width_to_thickness_limit == pytest.approx(limit)
+    assert out.local_buckling_negligible is False
+    assert any("unilateral" in note for note in out.notes)
+    stocky = section_design(
+        _section(shape, core=True, **{**changes, "thickness": 0.01}), DesignSpec(2.35e8), 3e8
+    )
+    assert stocky.local_buckling_negligible is True  # 21 < 52, 31 < 90
+
+
+def test_a_tube_gets_its_slenderness_only():
+    section = _section("tube", width=None, depth=None, diameter=0.2, bending_stress=-0.5)
+    out = section_design(section, DesignSpec(yield_stress=2.35e8), 1.0e9)
+    assert out.sigma_cr_Pa == pytest.approx(1.5e9)  # axial 1 plus the bending part 0.5
+    assert out.relative_slenderness == pytest.approx(math.sqrt(2.35e8 / 1.5e9))
+    assert out.faces == [] and out.governing_face is None
+    assert "EN 1993-1-6" in out.clauses[0]
+
+
+def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):
+    path = tmp_path / "box.toml"
+    path.write_text(
+        "[section]\nshape = 'box'\nwidth = 0.2\ndepth = 0.1\nthickness = 0.002\n"
+        "length = 0.2\nends = 'simply_supported'\n[material]\nE = 2.1e11\nnu = 0.3\n"
+        "[obstacle]\ncore = true\n[mesh]\nsize = 0.1\nlevels = 0\n"
+        "[design]\nyield_stress = 3.55e8\n"
+    )
+    spec = load_problem(path)
+    with solve_section(spec, MPI.COMM_SELF) as analysis:
+        result = analysis.result
+        data = json.loads(json.dumps(result.as_dict()))
+        assert "design: largest compression" in result.summary()
+    design = data["design"]
+    load = data["critical_load_Pa"]
+    assert design["sigma_cr_Pa"] == pytest.approx(load)
+    assert design["relative_slenderness"] == pytest.approx(math.sqrt(3.55e8 / load))
+    assert design["width_to_thickness"] == pytest.approx(0.202 / 0.002)
+    assert data["input"]["design"]["yield_stress"] == 3.55e8  # the file re-runs it
+    without = SectionParameters(
+        "box", width=0.2, depth=0.1, thickness=0.002, length=0.2, E=2.1e11, nu=0.3,
+        mesh_size=0.1, ends="simply_supported",
+    )  # fmt: skip
+    with solve_section(without, MPI.COMM_SELF) as analysis:
+        assert analysis.result.design is None

@@ -1,0 +1,237 @@
+r"""Design output of a section: EN 1993-1-5 per face of a box, and EN 1994-1-1's wall limits.
+
+A section's ``[design]`` table (the plate's, :class:`~unibuckle_fenicsx.spec.DesignSpec`)
+asks for the design quantities of its critical state :math:`\lambda_c`:
+
+- :math:`\sigma_{cr}`, the largest compressive axial stress in the walls at
+  :math:`\lambda_c` (the axial part plus the bending part at the extreme fibre), and the
+  section's relative slenderness :math:`\bar\lambda = \sqrt{f_y/\sigma_{cr}}`;
+- for a **box**, each face as an *internal* compression element of EN 1993-1-5:2006+AC:2009,
+  4.4(2) (both its edges held by the neighbouring faces): the face's
+  :math:`\sigma_{cr}` is its largest compression at the section's critical state (the walls
+  buckle together, one load factor for all), :math:`\psi = \sigma_2/\sigma_1` the ratio of
+  the axial stresses at its two edges (1 on a face at constant z, the gradient of the
+  bending part across a face spanning the depth), :math:`\bar\lambda_p =
+  \sqrt{f_y/\sigma_{cr}}`, the buckling factor of Table 4.1 at that :math:`\psi`, and
+  :math:`\rho` by eq. (4.2) (:mod:`unibuckle_fenicsx.en1993`); a face in tension has none;
+- for a **tube**, :math:`\bar\lambda` only: a circular wall is a shell, whose buckling
+  reduction (EN 1993-1-6, section 8.5: the fabrication quality class, :math:`\alpha_x`,
+  :math:`\chi_x`) this output does not apply;
+- with a **core**, the limits of EN 1994-1-1:2004, 6.7.1(9) and Table 6.3, below which the
+  local buckling of a concrete-filled section may be neglected in a composite column:
+  :math:`\max(h/t) \le 52\varepsilon` for a rectangular section (h its greater overall
+  dimension), :math:`d/t \le 90\varepsilon^2` for a circular one (d its outer diameter),
+  :math:`\varepsilon = \sqrt{235/f_y}` with :math:`f_y` in N/mm². The overall dimensions
+  are the mid-line ones plus t.
+
+The clauses were calibrated on walls that buckle to both sides; with a core the computed
+:math:`\sigma_{cr}` is the unilateral one, and the output says that applying 4.4(2) to it
+is outside that calibration. The formulas are the codes' few lines; no maintained library
+evaluates them for a computed :math:`\sigma_{cr}`, hence this module.
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Protocol
+
+from msgspec import Struct
+
+from unibuckle_fenicsx.design import CALIBRATION
+from unibuckle_fenicsx.en1993 import INTERNAL, buckling_factor, psi_range, reduction_factor
+from unibuckle_fenicsx.spec import DesignSpec
+
+__all__ = ["FaceDesign", "SectionDesignRecord", "section_design"]
+
+#: The clauses of a box's face.
+FACE_CLAUSES = (
+    "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of each face as an "
+    "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma"
+)
+#: The clause of a tube's slenderness.
+TUBE_CLAUSES = (
+    "relative slenderness sqrt(f_y/sigma_cr) only: a circular wall is a shell (EN 1993-1-6, "
+    "8.5: its buckling reduction needs the fabrication quality class, not applied here)"
+)
+#: The clause of the filled sections' wall limits.
+FILLED_CLAUSES = "EN 1994-1-1:2004, 6.7.1(9), Table 6.3: max(h/t) or max(d/t) of a filled section"
+
+
+class DesignSection(Protocol):
+    """What the design output reads of a section (its :class:`SectionParameters`)."""
+
+    @property
+    def shape(self) -> str: ...
+    @property
+    def thickness(self) -> float: ...
+    @property
+    def width(self) -> float | None: ...
+    @property
+    def depth(self) -> float | None: ...
+    @property
+    def diameter(self) -> float | None: ...
+    @property
+    def axial_stress(self) -> float: ...
+    @property
+    def bending_stress(self) -> float: ...
+    @property
+    def core(self) -> bool: ...
+
+
+class FaceDesign(Struct, kw_only=True):
+    r"""One face of a box as an internal compression element (EN 1993-1-5, 4.4(2)).
+
+    Attributes:
+        face: ``right``, ``top``, ``left`` or ``bottom`` (the result's ``faces``).
+        sigma_cr_Pa: :math:`\sigma_1`, its largest compression at the critical state (Pa);
+            <= 0: the face is in tension, and the fields below are None.
+        psi: :math:`\psi = \sigma_2/\sigma_1` across the face.
+        relative_slenderness: :math:`\bar\lambda_p = \sqrt{f_y/\sigma_1}`.
+        k_sigma_table: Table 4.1's :math:`k_\sigma` at :math:`\psi`.
+        reduction_factor: :math:`\rho`, eq. (4.2); None for :math:`\psi < -3`.
+        reduced_design_stress_Pa: :math:`\rho f_y/\gamma_{M1}` (Pa).
+    """
+
+    face: str
+    sigma_cr_Pa: float
+    psi: float | None = None
+    relative_slenderness: float | None = None
+    k_sigma_table: float | None = None
+    reduction_factor: float | None = None
+    reduced_design_stress_Pa: float | None = None
+
+
+class SectionDesignRecord(Struct, kw_only=True):
+    r"""The design quantities of a section's critical state (its JSON's ``design``).
+
+    Attributes:
+        yield_stress_Pa: :math:`f_y`.
+        partial_factor: :math:`\gamma_{M1}`.
+        sigma_cr_Pa: The largest compressive axial stress in the walls at the critical
+            state (Pa).
+        relative_slenderness: :math:`\sqrt{f_y/\sigma_{cr}}`.
+        clauses: The clauses applied.
+        notes: What the output rests on, and what it leaves out.
+        faces: A box's faces (:class:`FaceDesign`); empty for a tube.
+        governing_face: The face of the smallest :math:`\rho` (None for a tube).
+        width_to_thickness: With a core: :math:`h/t` (box, h the greater overall
+            dimension) or :math:`d/t` (tube, d the outer diameter); else None.
+        width_to_thickness_limit: EN 1994-1-1 Table 6.3's limit of that ratio.
+        local_buckling_negligible: Whether the ratio is within the limit (6.7.1(9)).
+    """
+
+    yield_stress_Pa: float
+    partial_factor: float
+    sigma_cr_Pa: float
+    relative_slenderness: float
+    clauses: list[str]
+    notes: list[str]
+    faces: list[FaceDesign]
+    governing_face: str | None = None
+    width_to_thickness: float | None = None
+    width_to_thickness_limit: float | None = None
+    local_buckling_negligible: bool | None = None
+
+
+def face_compressions(section: DesignSection) -> dict[str, tuple[float, float]]:
+    """A box's faces: the compressions (Pa per unit load, > 0) at their two edges.
+
+    The axial stress is ``axial_stress`` plus ``bending_stress`` times z/(d/2): the top
+    (z = +d/2) and bottom (z = -d/2) faces carry one value, the right and left faces
+    (spanning the depth) the two.
+    """
+    top = -(section.axial_stress + section.bending_stress)
+    bottom = -(section.axial_stress - section.bending_stress)
+    return {
+        "right": (top, bottom),
+        "top": (top, top),
+        "left": (top, bottom),
+        "bottom": (bottom, bottom),
+    }
+
+
+def _face(name: str, ends: tuple[float, float], design: DesignSpec) -> FaceDesign:
+    """The face ``name`` whose edges carry the compressions ``ends`` (Pa)."""
+    sigma1, sigma2 = max(ends), min(ends)
+    if sigma1 <= 0.0:
+        return FaceDesign(face=name, sigma_cr_Pa=sigma1)
+    psi = sigma2 / sigma1 + 0.0  # no -0.0
+    slenderness = math.sqrt(design.yield_stress / sigma1)
+    out = FaceDesign(face=name, sigma_cr_Pa=sigma1, psi=psi, relative_slenderness=slenderness)
+    if psi >= psi_range(INTERNAL)[0]:
+        out.k_sigma_table = buckling_factor(INTERNAL, psi)
+        out.reduction_factor = reduction_factor(slenderness, psi, INTERNAL)
+        out.reduced_design_stress_Pa = (
+            out.reduction_factor * design.yield_stress / design.partial_factor
+        )
+    return out
+
+
+def section_design(section: DesignSection, design: DesignSpec, load: float) -> SectionDesignRecord:
+    """The design quantities of the section's critical load ``load`` (the module docstring)."""
+    t = section.thickness
+    compression = load * (-section.axial_stress + abs(section.bending_stress))
+    out = SectionDesignRecord(
+        yield_stress_Pa=design.yield_stress,
+        partial_factor=design.partial_factor,
+        sigma_cr_Pa=compression,
+        relative_slenderness=math.sqrt(design.yield_stress / compression),
+        clauses=[],
+        notes=[CALIBRATION],
+        faces=[],
+    )
+    if section.shape == "box":
+        out.clauses.append(FACE_CLAUSES)
+        out.notes.append(
+            "every face at the section's critical load factor: conservative for a face "
+            "that buckles because its neighbours do"
+        )
+        for name, (a, b) in face_compressions(section).items():
+            out.faces.append(_face(name, (load * a, load * b), design))
+        rated = [f for f in out.faces if f.reduction_factor is not None]
+        if rated:
+            out.governing_face = min(rated, key=lambda f: f.reduction_factor or 1.0).face
+    else:
+        out.clauses.append(TUBE_CLAUSES)
+    if section.core:
+        out.notes.append(
+            "with the core sigma_cr is the unilateral critical stress: outside the "
+            "calibration of EN 1993-1-5 4.4(2)"
+        )
+        out.clauses.append(FILLED_CLAUSES)
+        epsilon = math.sqrt(235.0e6 / design.yield_stress)
+        if section.shape == "box":
+            across = max(section.width or 0.0, section.depth or 0.0) + t
+            out.width_to_thickness_limit = 52.0 * epsilon
+        else:
+            across = (section.diameter or 0.0) + t
+            out.width_to_thickness_limit = 90.0 * epsilon**2
+        out.width_to_thickness = across / t
+        out.local_buckling_negligible = out.width_to_thickness <= out.width_to_thickness_limit
+    return out
+
+
+def design_line(d: SectionDesignRecord) -> str:
+    """The summary line of a section's design output."""
+    text = (
+        f"design: largest compression sigma_cr = {d.sigma_cr_Pa:.4g} Pa, "
+        f"slenderness {d.relative_slenderness:.4g}"
+    )
+    face = next((f for f in d.faces if f.face == d.governing_face), None)
+    if face is not None and face.reduction_factor is not None:
+        text += (
+            f"; EN 1993-1-5 face {face.face}: psi = {face.psi:.3g}, rho = "
+            f"{face.reduction_factor:.4g}, rho f_y/gamma_M1 = "
+            f"{face.reduced_design_stress_Pa:.4g} Pa"
+        )
+    if d.width_to_thickness is not None and d.width_to_thickness_limit is not None:
+        verdict = (
+            "local buckling may be neglected"
+            if d.local_buckling_negligible
+            else "above it: local buckling to be considered"
+        )
+        text += (
+            f"; EN 1994-1-1 Table 6.3: {d.width_to_thickness:.4g} against "
+            f"{d.width_to_thickness_limit:.4g} ({verdict})"
+        )
+    return text
