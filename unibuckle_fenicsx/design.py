@@ -26,9 +26,13 @@ compressive normal stress on a loaded edge at the critical load (the fixed part 
 edge. The clause's reduction factors were calibrated on plates that buckle freely to
 both sides (bilateral buckling); with an obstacle this :math:`\sigma_{cr}` is the
 unilateral one, and applying them to it is outside that calibration: the output says
-so. With shear in the load, EN 1993-1-5 combines the stresses by the reduced stress
-method (section 10, :math:`\bar\lambda_p = \sqrt{\alpha_{ult,k}/\alpha_{cr}}`), which is
-not done here: the output then notes that ρ is the direct stress's.
+so. A critical load not proven the lowest (a KKT point, or bracketed) is that of an
+admissible mode, so the critical stress may lie lower, down to the certificate's verified
+lower bound: the output then gives the same quantities at that bound too
+(:func:`at_lower_bound`), the safe values. With shear in the load, EN 1993-1-5
+combines the stresses by the reduced stress method (section 10,
+:math:`\bar\lambda_p = \sqrt{\alpha_{ult,k}/\alpha_{cr}}`), which is not done here: the
+output then notes that ρ is the direct stress's.
 """
 
 from __future__ import annotations
@@ -48,7 +52,14 @@ from unibuckle_fenicsx.en1993 import (
 )
 from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
 
-__all__ = ["CLAUSES", "DesignRecord", "clauses", "design_output", "reduction_factor"]
+__all__ = [
+    "CLAUSES",
+    "DesignRecord",
+    "at_lower_bound",
+    "clauses",
+    "design_output",
+    "reduction_factor",
+]
 
 #: The clauses the design output of an internal element rests on (:func:`clauses`).
 CLAUSES = (
@@ -84,6 +95,9 @@ class DesignRecord(Struct, kw_only=True):
             range of :math:`\psi`.
         reduced_design_stress_Pa: :math:`\rho f_y/\gamma_{M1}` (absent without
             :math:`\rho`).
+        lower_bound: When the critical load is not proven the lowest (a KKT point, or
+            bracketed), the same quantities at the verified lower bound of the critical
+            load, the safe value (:func:`at_lower_bound`); absent when proven.
     """
 
     yield_stress_Pa: float
@@ -100,6 +114,7 @@ class DesignRecord(Struct, kw_only=True):
     k_sigma_table: float | None = None
     reduction_factor: float | None = None
     reduced_design_stress_Pa: float | UnsetType = UNSET
+    lower_bound: DesignRecord | UnsetType = UNSET
 
 
 def clauses(element: DesignElement, free_edge_most_compressed: bool = True) -> str:
@@ -184,3 +199,26 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.reduction_factor = rho
     out.reduced_design_stress_Pa = rho * design.yield_stress / design.partial_factor
     return out
+
+
+#: Said when the critical load is not proven the lowest.
+UNPROVEN = (
+    "sigma_cr is that of a critical state not proven the lowest: the critical stress may "
+    "lie lower, down to the verified lower bound; lower_bound holds the design quantities "
+    "there (the safe values)"
+)
+
+
+def at_lower_bound(
+    record: DesignRecord, spec: ProblemSpec, design: DesignSpec, lower: float
+) -> DesignRecord:
+    """``record`` with the design quantities at the verified lower bound ``lower`` added.
+
+    A critical load not proven the lowest is that of an admissible mode: the critical
+    load may lie lower, down to the certificate's lower bound, so sigma_cr, and with it
+    the slenderness and rho, may be on the unsafe side; the output gives both.
+    """
+    record.lower_bound = design_output(spec, design, lower)
+    record.lower_bound.notes = []  # the same as the record's
+    record.notes.append(UNPROVEN)
+    return record

@@ -14,8 +14,10 @@ it covers, the wall may only move away from it (:mod:`~unibuckle_fenicsx.model.s
   active-set seeds on a coarser section, the contact set carried to the finer one) and
   certified (:func:`~unibuckle_fenicsx.certificate.certify.certify`) on the finest.
 
-The critical load is the compressive stress in Pa when ``axial_stress = -1``. A box's
-``buckling_coefficient_k`` uses its widest face, :math:`k = \sigma t b^2/(\pi^2 D)`; a
+The critical load is the factor on the stresses per unit load: the compressive stress in
+Pa when ``axial_stress = -1`` without bending. A box's ``buckling_coefficient_k`` uses its
+widest face, :math:`k = \sigma t b^2/(\pi^2 D)` with :math:`\sigma` the face's largest
+compressive stress at that load (with bending, the extreme fibre's); a
 tube has none (its reference is :math:`\sigma_{cl} = E t/(R\sqrt{3(1-\nu^2)})`,
 ``classical_stress_Pa``).
 """
@@ -52,8 +54,20 @@ from unibuckle_fenicsx.model.shell.section import (
 )
 from unibuckle_fenicsx.results.assemble import record_contact, versions
 from unibuckle_fenicsx.results.records import BucklingResult, ResultDetails
-from unibuckle_fenicsx.section_design import SectionDesignRecord, design_line, section_design
-from unibuckle_fenicsx.spec import DesignSpec, SectionProblemSpec, SolverSpec, problem_to_dict
+from unibuckle_fenicsx.section_design import (
+    SectionDesignRecord,
+    at_lower_bound,
+    design_line,
+    face_compressions,
+    section_design,
+)
+from unibuckle_fenicsx.spec import (
+    UNITS,
+    DesignSpec,
+    SectionProblemSpec,
+    SolverSpec,
+    problem_to_dict,
+)
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = ["SectionAnalysis", "SectionResult", "solve_section"]
@@ -65,54 +79,82 @@ class SectionResult(BucklingResult, kw_only=True):
     r"""Critical state of a section: a :class:`~unibuckle_fenicsx.results.records.BucklingResult`.
 
     The fields keep the plate's meaning, with the section's words:
-    ``critical_load_Pa`` is the critical axial stress (the filled section's with a core),
-    ``free_load_Pa`` the hollow section's; ``buckling_coefficient_k`` uses a box's widest
-    face (None for a tube); ``mesh`` is [cells along, cells around]; ``dofs`` counts the
+    ``critical_load_Pa`` is the critical load factor on the stresses per unit load (the
+    filled section's with a core), ``free_load_Pa`` the hollow section's: with
+    ``axial_stress = -1`` and no bending, the compressive stress in Pa;
+    ``buckling_coefficient_k`` uses a box's widest face and its largest compressive
+    stress at the critical load, so it is the classical k whatever the stress gradient
+    (None for a tube); ``mesh`` is [cells along, cells around]; ``dofs`` counts the
     six components of every node; ``constrained_nodes`` counts the core's constrained
     *directions* (a box's corner node has two), ``contact_coordinates`` their unrolled
     (x, s) (m along the member, m around the mid-line); ``input`` is the section's
     problem file (:func:`~unibuckle_fenicsx.spec.problem_to_dict`) when one was solved,
-    else ``{"section": the parameters}``; ``design``, with a ``[design]`` table, is a
+    else ``{"section": the parameters}``; ``critical_force_N_per_m`` is the extreme
+    fibre's :math:`t\sigma` (``compression_Pa``); ``design``, with a ``[design]`` table, is a
     :class:`~unibuckle_fenicsx.section_design.SectionDesignRecord` (EN 1993-1-5 per face of
     a box, EN 1994-1-1's wall limits with a core).
 
     Attributes:
         classical_stress_Pa: The section's reference stress (Pa): a box's k = 4 load
             :math:`4\pi^2 D/(t b^2)`, a tube's :math:`E t/(R\sqrt{3(1-\nu^2)})`.
+        compression_Pa: The largest compressive stress at the critical load (Pa), the
+            extreme fibre's: ``critical_load_Pa`` times the largest compression per unit
+            load (``SectionParameters.compression()``), equal to it with
+            ``axial_stress = -1`` and no bending.
         faces: A box's faces at the critical load (empty for a tube): each face's name
             (``right``, ``top``, ``left``, ``bottom``: y = +b/2, z = +d/2, y = -b/2,
-            z = -d/2), its width (m), its own buckling coefficient
-            :math:`\sigma t w^2/(\pi^2 D)`, its constrained directions and those in
-            contact with the core (pressing a foundation).
+            z = -d/2), its width (m), its largest compressive stress ``compression_Pa``
+            (Pa, <= 0: none), its own buckling coefficient :math:`\sigma t w^2/(\pi^2 D)`
+            with that stress (NaN, null in JSON, without compression), its constrained
+            directions and those in contact with the core (pressing a foundation).
     """
 
     classical_stress_Pa: float = math.nan
+    compression_Pa: float = math.nan
     faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
 
     def summary(self) -> str:
-        """Lines for the terminal: the critical stress, the hollow one, the reference."""
+        """Lines for the terminal: the critical stress, the hollow one, the reference.
+
+        Stresses in the file's unit system (``units``: Pa, or MPa for mm-N-MPa).
+        """
+        scale, unit = UNITS[self.units][1:]
         k_value = self.buckling_coefficient_k
         k = "" if k_value is None else f", k = {k_value:.4f}"
+        sigma = self.compression_Pa  # the stresses printed are the extreme fibre's
+        if math.isnan(sigma):  # a result written before the field: the load factor
+            sigma = self.critical_load_Pa
+        factor = (
+            ""
+            if sigma == self.critical_load_Pa
+            else f" at the extreme fibre, load factor {self.critical_load_Pa / scale:.6e} {unit}"
+        )
+        hollow = self.free_load_Pa * (sigma / self.critical_load_Pa)  # its extreme fibre's
         head = (
-            f"{self.case}: sigma_cr = {self.critical_load_Pa:.6e} Pa "
-            f"({self.ratio_to_free:.4f} x hollow {self.free_load_Pa:.6e} Pa){k}, "
-            f"{self.critical_load_Pa / self.classical_stress_Pa:.4f} x classical "
-            f"{self.classical_stress_Pa:.6e} Pa"
+            f"{self.case}: sigma_cr = {sigma / scale:.6e} {unit}{factor} "
+            f"({self.ratio_to_free:.4f} x hollow {hollow / scale:.6e} {unit}){k}, "
+            f"{sigma / self.classical_stress_Pa:.4f} x classical "
+            f"{self.classical_stress_Pa / scale:.6e} {unit}"
         )
         lines = [
             f"{head}, method {self.method}, {self.eigensolves} eigensolves, "
             f"{self.wall_time_s:.2f} s"
         ]
-        cert = self.certificate
+        cert, lower = self.certificate, self.lower_bound_Pa
         if cert is not None:
+            # The bound in the same stress as sigma_cr (the extreme fibre's).
+            bound = (
+                "none"
+                if lower is None
+                else f"{lower * (sigma / self.critical_load_Pa) / scale:.6e} {unit}"
+            )
             lines.append(
                 f"core: {self.constrained_nodes} constrained directions, |Z| = "
                 f"{self.contact_nodes}, KKT = {'yes' if cert.kkt else 'NO'}, "
-                f"certificate {cert.status} (lower bound {self.lower_bound_Pa:.6e} Pa "
-                f"by {cert.proven_by})"
+                f"certificate {cert.status} (lower bound {bound} by {cert.proven_by})"
             )
         if isinstance(self.design, SectionDesignRecord):
-            lines.append(design_line(self.design))
+            lines.append(design_line(self.design, scale, unit))
         return "\n  ".join(lines)
 
 
@@ -208,9 +250,11 @@ def solve_section(
     """
     t0 = time.perf_counter()
     echo: dict[str, object] | None = None
+    units = "SI"
     if isinstance(parameters, SectionProblemSpec):
         echo = problem_to_dict(parameters)
         levels, solver, design = parameters.mesh.levels, parameters.solver, parameters.design
+        units = parameters.units
         parameters = section_parameters(parameters)
     if not isinstance(parameters, SectionParameters):
         raise TypeError(
@@ -246,9 +290,12 @@ def solve_section(
                 )
         result = _result(section, free, solution, certificate, time.perf_counter() - t0)
         if echo is not None:
-            result.input = echo
+            result.input, result.units = echo, units
         if design is not None:
             result.design = section_design(parameters, design, result.critical_load_Pa)
+            lower = result.lower_bound_Pa
+            if certificate is not None and not certificate.global_optimum_proven and lower:
+                at_lower_bound(result.design, parameters, design, lower)
     except BaseException:
         section.destroy()
         raise
@@ -272,14 +319,19 @@ def _faces(
     if active is not None:
         touching[active] = True
     out: list[dict[str, str | float]] = []
+    compressions = face_compressions(p)
     for name, axis, sign in _FACES:
         width = p.depth if axis == 1 else p.width  # a face normal to y spans the depth
         on = normals[:, axis] * sign > 0.5
+        sigma = load * max(compressions[name]) + 0.0  # its largest compression (no -0.0)
         out.append(
             {
                 "face": name,
                 "width_m": width,
-                "buckling_coefficient_k": load * p.thickness * width**2 / (math.pi**2 * D),
+                "compression_Pa": sigma,
+                "buckling_coefficient_k": sigma * p.thickness * width**2 / (math.pi**2 * D)
+                if sigma > 0.0
+                else math.nan,
                 "constrained": int(on.sum()),
                 "in_contact": int((on & touching).sum()),
             }
@@ -333,7 +385,7 @@ def _result(
         critical_load_Pa=load,
         free_load_Pa=free.load,
         ratio_to_free=load / free.load,
-        critical_force_N_per_m=p.thickness * load,
+        critical_force_N_per_m=p.thickness * load * p.compression(),
         buckling_coefficient_k=None if math.isnan(k) else k,
         dofs=section.model.num_dofs,
         mesh=[section.mesh.cells_along, section.mesh.cells_around],
@@ -353,6 +405,7 @@ def _result(
         input={"section": dataclasses.asdict(p)},
         versions=versions(),
         classical_stress_Pa=section.classical_stress(),
+        compression_Pa=load * p.compression(),
         faces=_faces(section, load, None if solution is None else solution.active),
     )
     if solution is None or certificate is None:

@@ -35,13 +35,19 @@ from __future__ import annotations
 import math
 from typing import Protocol
 
-from msgspec import Struct
+from msgspec import UNSET, Struct, UnsetType
 
-from unibuckle_fenicsx.design import CALIBRATION
+from unibuckle_fenicsx.design import CALIBRATION, UNPROVEN
 from unibuckle_fenicsx.en1993 import INTERNAL, buckling_factor, psi_range, reduction_factor
 from unibuckle_fenicsx.spec import DesignSpec
 
-__all__ = ["FaceDesign", "SectionDesignRecord", "section_design"]
+__all__ = [
+    "FaceDesign",
+    "SectionDesignRecord",
+    "at_lower_bound",
+    "face_compressions",
+    "section_design",
+]
 
 #: The clauses of a box's face.
 FACE_CLAUSES = (
@@ -118,6 +124,10 @@ class SectionDesignRecord(Struct, kw_only=True):
             dimension) or :math:`d/t` (tube, d the outer diameter); else None.
         width_to_thickness_limit: EN 1994-1-1 Table 6.3's limit of that ratio.
         local_buckling_negligible: Whether the ratio is within the limit (6.7.1(9)).
+        lower_bound: With a core whose critical load is not proven the lowest (a KKT
+            point: the sections' usual certificate), the same quantities at the verified
+            lower bound (the hollow section's load by interlacing, unless a closer one was
+            verified), the safe values; absent otherwise.
     """
 
     yield_stress_Pa: float
@@ -131,6 +141,7 @@ class SectionDesignRecord(Struct, kw_only=True):
     width_to_thickness: float | None = None
     width_to_thickness_limit: float | None = None
     local_buckling_negligible: bool | None = None
+    lower_bound: SectionDesignRecord | UnsetType = UNSET
 
 
 def face_compressions(section: DesignSection) -> dict[str, tuple[float, float]]:
@@ -211,18 +222,32 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
     return out
 
 
-def design_line(d: SectionDesignRecord) -> str:
-    """The summary line of a section's design output."""
+def at_lower_bound(
+    record: SectionDesignRecord, section: DesignSection, design: DesignSpec, lower: float
+) -> SectionDesignRecord:
+    """``record`` with the design quantities at the verified lower bound ``lower`` added.
+
+    The section's counterpart of :func:`unibuckle_fenicsx.design.at_lower_bound`: an
+    unproven critical load may be on the unsafe side, down to ``lower``.
+    """
+    record.lower_bound = section_design(section, design, lower)
+    record.lower_bound.notes = []  # the same as the record's
+    record.notes.append(UNPROVEN)
+    return record
+
+
+def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") -> str:
+    """The summary line of a section's design output (stresses in ``unit``, Pa / ``scale``)."""
     text = (
-        f"design: largest compression sigma_cr = {d.sigma_cr_Pa:.4g} Pa, "
+        f"design: largest compression sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit}, "
         f"slenderness {d.relative_slenderness:.4g}"
     )
     face = next((f for f in d.faces if f.face == d.governing_face), None)
     if face is not None and face.reduction_factor is not None:
+        reduced = face.reduced_design_stress_Pa or 0.0
         text += (
             f"; EN 1993-1-5 face {face.face}: psi = {face.psi:.3g}, rho = "
-            f"{face.reduction_factor:.4g}, rho f_y/gamma_M1 = "
-            f"{face.reduced_design_stress_Pa:.4g} Pa"
+            f"{face.reduction_factor:.4g}, rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
         )
     if d.width_to_thickness is not None and d.width_to_thickness_limit is not None:
         verdict = (
@@ -234,4 +259,14 @@ def design_line(d: SectionDesignRecord) -> str:
             f"; EN 1994-1-1 Table 6.3: {d.width_to_thickness:.4g} against "
             f"{d.width_to_thickness_limit:.4g} ({verdict})"
         )
+    low = d.lower_bound
+    if isinstance(low, SectionDesignRecord):
+        text += (
+            f"\n  design at the verified lower bound (the safe value, sigma_cr not proven "
+            f"the lowest): sigma_cr = {low.sigma_cr_Pa / scale:.4g} {unit}, slenderness "
+            f"{low.relative_slenderness:.4g}"
+        )
+        face = next((f for f in low.faces if f.face == low.governing_face), None)
+        if face is not None and face.reduction_factor is not None:
+            text += f", face {face.face} rho = {face.reduction_factor:.4g}"
     return text

@@ -352,3 +352,30 @@ def test_psi_outside_the_table_with_a_fixed_part_gives_no_rho():
     assert d.reduction_factor is None and d.k_sigma_table is None
     assert "outside Table 4.2" in d.notes[-1]
     assert "rho = none (psi outside Table 4.2" in out.summary()
+
+
+def test_an_unproven_critical_load_adds_the_design_at_its_lower_bound():
+    """KKT only (certify = false): rho at lambda_c may be unsafe; the lower bound's is given.
+
+    The 600 x 200 x 4 mm plate on a whole face: lambda_c = 381 MPa, not proven the lowest,
+    the verified lower bound the free plate's 331 MPa (interlacing, less its rounding). At
+    it, by hand, lambda_p = sqrt(355/331.1) = 1.035 and rho = (1.035 - 0.22)/1.035^2 = 0.761, where
+    lambda_c's 0.965 gives 0.800: 5 % on the unsafe side.
+    """
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    spec = plate(edges, obstacle={"zone": "all", "side": "below"}, solver={"certify": False})
+    with solve(spec, MPI.COMM_SELF) as analysis:
+        r = analysis.result
+    assert r.certificate is not None and r.certificate.status == "kkt-only"
+    assert r.lower_bound_Pa == pytest.approx(r.free_load_Pa, rel=1e-12)
+    low = r.design.lower_bound
+    slenderness = math.sqrt(355e6 / r.lower_bound_Pa)
+    rho = (slenderness - 0.055 * 4) / slenderness**2
+    assert low.sigma_cr_Pa == r.lower_bound_Pa
+    assert low.relative_slenderness == pytest.approx(slenderness, rel=1e-14)
+    assert low.reduction_factor == pytest.approx(rho, rel=1e-14)
+    assert low.reduced_design_stress_Pa == pytest.approx(rho * 355e6 / 1.1, rel=1e-14)
+    assert low.reduction_factor < r.design.reduction_factor
+    assert any("not proven the lowest" in note for note in r.design.notes)
+    assert f"slenderness {slenderness:.4g}, rho = {rho:.4g}" in r.summary()
+    assert r.as_dict()["design"]["lower_bound"]["reduction_factor"] == low.reduction_factor

@@ -128,6 +128,19 @@ def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):
     assert design["relative_slenderness"] == pytest.approx(math.sqrt(3.55e8 / load))
     assert design["width_to_thickness"] == pytest.approx(0.202 / 0.002)
     assert data["input"]["design"]["yield_stress"] == 3.55e8  # the file re-runs it
+    # The same file in mm-N-MPa: the summary speaks MPa, the JSON stays SI.
+    path.write_text(
+        "units = 'mm-N-MPa'\n[section]\nshape = 'box'\nwidth = 200\ndepth = 100\n"
+        "thickness = 2\nlength = 200\nends = 'simply_supported'\n[material]\nE = 2.1e5\n"
+        "nu = 0.3\n[obstacle]\ncore = true\n[mesh]\nsize = 100\nlevels = 0\n"
+        "[design]\nyield_stress = 355\n"
+    )
+    with solve_section(load_problem(path), MPI.COMM_SELF) as analysis:
+        summary = analysis.result.summary()
+        assert analysis.result.critical_load_Pa == pytest.approx(load, rel=1e-9)
+    assert f"sigma_cr = {load / 1e6:.6e} MPa" in summary
+    assert f"largest compression sigma_cr = {load / 1e6:.4g} MPa" in summary
+    assert " Pa" not in summary.replace("MPa", "")
     without = SectionParameters(
         "box", width=0.2, depth=0.1, thickness=0.002, length=0.2, E=2.1e11, nu=0.3,
         mesh_size=0.1, ends="simply_supported",

@@ -1016,7 +1016,7 @@ def _normal(values: Array) -> Array | None:
     return v / top if top > 0 else None
 
 
-def _normalised(
+def distinct_columns(
     items: list[tuple[str, Array]], have: list[Array], limit: int | None = None
 ) -> list[tuple[str, Array]]:
     """Nonnegative, scaled to max 1, without zeros and repeats (of ``have`` or each other).
@@ -1039,7 +1039,7 @@ def _normalised(
 class _First:
     """The first columns, kept while fewer than ``limit`` of them are distinct.
 
-    The first basis takes the first ``limit`` distinct columns (:func:`_normalised`);
+    The first basis takes the first ``limit`` distinct columns (:func:`distinct_columns`);
     the columns after them are never used, and are not kept (a line's translates alone
     would be one column per line along the plate, each as long as the zone).
     """
@@ -1183,7 +1183,7 @@ def _first_basis(
     # A-normalised Ritz pairs: psi'B K^-1 B psi = 1/(theta (theta - lam)), so this scaling
     # makes G_W nearly -I (the z-space's angles then nearly Euclidean).
     W = _block_product(problem.model.B, psi) * np.sqrt(theta * (lam - theta))[None, :]
-    items = _normalised(state.columns, [], opts.max_columns)
+    items = distinct_columns(state.columns, [], opts.max_columns)
     capacity = neg + min(opts.max_columns, len(items) + opts.max_rounds * opts.per_round)
     basis = Basis(problem, matrix, neg, capacity)
     basis.add(W, [f"W{j}" for j in range(neg)])
@@ -1343,7 +1343,7 @@ def _new_columns(
                 scored.append((best[0], f"{name}@{best[1]}", best[2]))
         scored.sort(key=lambda item: -item[0])
         items += [(name, moved) for _, name, moved in scored]
-        return _normalised(items, basis.values)[: opts.per_round], None
+        return distinct_columns(items, basis.values)[: opts.per_round], None
     finally:
         u.destroy()
         clip.destroy()

@@ -13,7 +13,6 @@ from typing import Annotated, ClassVar, Literal
 
 from msgspec import Meta
 
-from unibuckle_fenicsx.errors import FieldError
 from unibuckle_fenicsx.nonlinear.choices import Control, Shape
 from unibuckle_fenicsx.spec.base import Table
 
@@ -61,14 +60,13 @@ class NonlinearOptions(Table, frozen=True):
         for name in self.__struct_fields__:
             value = getattr(self, name)
             if isinstance(value, float) and not math.isfinite(value):
-                raise FieldError("", name, f" must be a finite number, got {value!r}")
+                raise self.error(name, f" must be a finite number, got {value!r}")
         super().__post_init__()
 
     def check(self) -> None:
         """The smallest step is at most the largest."""
         if self.min_step > self.max_step:
-            raise FieldError(
-                "",
+            raise self.error(
                 "min_step",
                 f" must lie in (0, max_step = {self.max_step}], got {self.min_step!r}",
             )

@@ -97,7 +97,18 @@ def assemble_result(
         result.lower_bound_Pa = result.upper_bound_Pa = free.load
         return result
     record_contact(result, problem, solution, certificate)
+    if not certificate.global_optimum_proven:
+        _design_at_lower_bound(result, spec, certificate.lower_bound)
     return result
+
+
+def _design_at_lower_bound(result: BucklingResult, spec: ProblemSpec, lower: float) -> None:
+    """The design output at the verified lower bound ``lower``: the safe values."""
+    from unibuckle_fenicsx.design import DesignRecord, at_lower_bound
+
+    design = result.design
+    if spec.design is not None and isinstance(design, DesignRecord) and 0.0 < lower < math.inf:
+        at_lower_bound(design, spec, spec.design, lower)
 
 
 def record_contact(

@@ -406,6 +406,20 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
         + f"; {d.element} element"
         + (f" (free edge {d.free_edge})" if d.free_edge else "")
         + ", 4.4(2) calibrated on bilateral plates"
+        + _design_lower(d, scale, unit)
+    )
+
+
+def _design_lower(d: DesignRecord, scale: float, unit: str) -> str:
+    """The design line's part at the verified lower bound, when not proven."""
+    low = d.lower_bound
+    if not isinstance(low, DesignRecord):
+        return ""
+    rho = "none" if low.reduction_factor is None else f"{low.reduction_factor:.4g}"
+    return (
+        f"\n  EN 1993-1-5 at the verified lower bound (the safe value, sigma_cr not proven "
+        f"the lowest): sigma_cr = {low.sigma_cr_Pa / scale:.4g} {unit}, slenderness "
+        f"{low.relative_slenderness:.4g}, rho = {rho}"
     )
 
 

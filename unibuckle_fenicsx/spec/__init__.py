@@ -30,10 +30,6 @@ from __future__ import annotations
 from unibuckle_fenicsx.spec.base import (
     UNITS,
     Temperature,
-    _boolean,
-    _choice,
-    _integer,
-    _number,
     stress_ends,
     temperature_field,
 )
@@ -97,10 +93,6 @@ __all__ = [
     "SectionProblemSpec",
     "SolverSpec",
     "Temperature",
-    "_boolean",
-    "_choice",
-    "_integer",
-    "_number",
     "accepted_keys",
     "json_schema",
     "load_problem",

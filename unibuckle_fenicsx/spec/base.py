@@ -109,15 +109,19 @@ class Table(Struct, frozen=True, forbid_unknown_fields=True):
         for name in self.__struct_fields__:
             bad = next((v for v in _floats(getattr(self, name)) if not math.isfinite(v)), None)
             if bad is not None:
-                raise FieldError(self.key(), name, f" must be a finite number, got {bad!r}")
+                raise self.error(name, f" must be a finite number, got {bad!r}")
         self.check()
 
     def check(self) -> None:
-        """The rules between this table's fields (each raises a ``FieldError``)."""
+        """The rules between this table's fields (each raises :meth:`error`)."""
 
     def key(self) -> str:
         """This table's key in messages when it is built in code."""
         return self.KEY
+
+    def error(self, field: str, text: str) -> FieldError:
+        """The refusal of this table's ``field`` ("": the table): its key, then ``text``."""
+        return FieldError(self.key(), field, text)
 
     @classmethod
     def file_keys(cls) -> list[str]:
@@ -364,28 +368,3 @@ def _kind(x: Any) -> str:
         if isinstance(x, cls) or (isinstance(x, type) and issubclass(x, cls)):
             return name
     return "absent"
-
-
-# -- single values (option records outside the problem file) ----------------------------
-
-
-def _number(name: str, value: Any) -> float:
-    """``value`` as a finite float, or refused naming ``name``."""
-    if not math.isfinite(out := checked(value, float, name, "")):
-        raise InputError(f"{name} must be a finite number, got {value!r}")
-    return float(out)
-
-
-def _integer(name: str, value: Any, minimum: int) -> int:
-    """``value`` as an integer >= ``minimum``, or refused naming ``name``."""
-    return int(checked(value, Annotated[int, Meta(ge=minimum)], name, ""))
-
-
-def _boolean(name: str, value: Any) -> bool:
-    """``value`` as true or false, or refused naming ``name``."""
-    return bool(checked(value, bool, name, ""))
-
-
-def _choice(name: str, value: Any, choices: tuple[str, ...]) -> str:
-    """``value`` as one of ``choices``, or refused naming ``name``."""
-    return str(checked(value, Literal[choices], name, ""))

@@ -14,23 +14,11 @@ from unibuckle_fenicsx.geometry import Shape, collinear, narrowest_neck, segment
 from unibuckle_fenicsx.spec.plate import (
     EDGE_NAMES,
     HOLES,
-    MAX_THICKNESS_RATIO,
     THICK_PLATE_RATIO,
     Circle,
     PlateSpec,
     Polygon,
 )
-
-__all__ = [
-    "FEATURE_RATIO",
-    "MAX_THICKNESS_RATIO",
-    "THICK_PLATE_RATIO",
-    "TOUCH_TOLERANCE",
-    "check_features",
-    "check_supports",
-    "plate_features",
-    "plate_model_note",
-]
 
 #: Gmsh plates: a hole, a ligament or an outline segment shorter than mesh.size over
 #: this is refused (gmsh's quadrilaterals cannot be graded down to it reliably: a hole of

@@ -74,16 +74,7 @@ def problem_from_dict(data: Mapping[str, object], name: str = "plate") -> Proble
     if not isinstance(data, Mapping):
         raise InputError(f"a problem file is a table of tables, got {data!r}")
     _not_a_section(data)
-    api = _to_api({"name": name, **plain(data)})
-    if isinstance(units := api.get("units"), str) and units in UNITS:
-        api = as_table(scaled(api, ProblemSpec, units, 1))
-    token = CONVERTING.set(True)
-    try:
-        return msgspec.convert(_laminate(api), ProblemSpec)
-    except msgspec.ValidationError as err:
-        raise InputError(_message(err, api)) from None
-    finally:
-        CONVERTING.reset(token)
+    return _convert(_to_api({"name": name, **plain(data)}), ProblemSpec)
 
 
 def section_from_dict(data: Mapping[str, object], name: str = "section") -> SectionProblemSpec:
@@ -95,14 +86,18 @@ def section_from_dict(data: Mapping[str, object], name: str = "section") -> Sect
     """
     if not isinstance(data, Mapping):
         raise InputError(f"a problem file is a table of tables, got {data!r}")
-    api = as_table({"name": name, **as_table(plain(data))})
+    return _convert({"name": name, **as_table(plain(data))}, SectionProblemSpec)
+
+
+def _convert[S: (ProblemSpec, SectionProblemSpec)](api: dict[str, object], root: type[S]) -> S:
+    """The Structs' form ``api`` of a file as ``root``: in SI, a laminate's E and nu set."""
     if isinstance(units := api.get("units"), str) and units in UNITS:
-        api = as_table(scaled(api, SectionProblemSpec, units, 1))
+        api = as_table(scaled(api, root, units, 1))
     token = CONVERTING.set(True)
     try:
-        return msgspec.convert(api, SectionProblemSpec)
+        return msgspec.convert(_laminate(api) if root is ProblemSpec else api, root)
     except msgspec.ValidationError as err:
-        raise InputError(_message(err, api, root=SectionProblemSpec)) from None
+        raise InputError(_message(err, api, root=root)) from None
     finally:
         CONVERTING.reset(token)
 

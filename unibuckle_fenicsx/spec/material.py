@@ -9,7 +9,7 @@ from typing import Annotated, ClassVar
 import numpy as np
 from msgspec import Meta
 
-from unibuckle_fenicsx.errors import FieldError, InputError
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.laminate import laminate
 from unibuckle_fenicsx.spec.base import Matrix3, Table, unit
 
@@ -50,8 +50,7 @@ class Ply(Table, frozen=True):
         """The rules between this table's fields."""
         bound = math.sqrt(self.E1 / self.E2)
         if not abs(self.nu12) < bound:
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "nu12",
                 f" must satisfy |nu12| < sqrt(E1/E2) = {bound:.4g} (a positive definite ply), "
                 f"got {self.nu12!r}",
@@ -105,8 +104,7 @@ class Material(Table, frozen=True):
     def check(self) -> None:
         """The rules between this table's fields."""
         if self.thermal_expansion and self.plies:
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "thermal_expansion",
                 ": a laminate's plies expand differently (their own coefficients along and "
                 "across the fibres), which is not modelled; a thermal load needs an isotropic "
@@ -117,23 +115,21 @@ class Material(Table, frozen=True):
         for name in ("membrane_voigt", "bending_voigt"):
             mat = np.array(getattr(self, name) or np.eye(3), dtype=float)
             if not np.allclose(mat, mat.T, rtol=1e-12, atol=0.0):
-                raise FieldError(self.key(), name, " must be symmetric")
+                raise self.error(name, " must be symmetric")
             if np.linalg.eigvalsh(mat).min() <= 0.0:
-                raise FieldError(self.key(), name, " must be positive definite")
+                raise self.error(name, " must be positive definite")
 
     def _check_laminate(self) -> None:
         """A symmetric stack of plies; E and nu its in-plane constants; no Voigt matrices."""
         if self.membrane_voigt is not None or self.bending_voigt is not None:
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "plies",
                 ": a laminate's stiffness comes from its plies; give plies, or membrane_voigt "
                 "and bending_voigt, not both",
             )
         stack = laminate(self.plies, self.shear_correction)
         if stack.coupling > 1e-10:
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "plies",
                 ": the stack is not symmetric about its mid-plane (bending-membrane coupling: "
                 f"largest |B_ij| = {np.abs(stack.B).max():.4g} N, {stack.coupling:.2g} of "
@@ -143,8 +139,7 @@ class Material(Table, frozen=True):
             )
         E, nu = stack.engineering_constants()
         if not (math.isclose(self.E, E, rel_tol=1e-9) and math.isclose(self.nu, nu, rel_tol=1e-9)):
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "E",
                 f" and material.nu of a laminate are its in-plane constants E_x = {E:.6g} Pa "
                 f"and nu_xy = {nu:.6g} from the plies (got {self.E!r}, {self.nu!r}): leave "

@@ -12,7 +12,7 @@ import numpy.typing as npt
 from msgspec import Meta
 from msgspec.structs import force_setattr
 
-from unibuckle_fenicsx.errors import FieldError, InputError
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import points_in_circle, points_in_polygon
 from unibuckle_fenicsx.spec.base import (
     UNITS,
@@ -84,12 +84,9 @@ class ObstacleSpec(Table, frozen=True):
     def check(self) -> None:
         """The rules between this table's fields."""
         if isinstance(self.zone, tuple) and any(lo > hi for lo, hi in self.zone):
-            raise FieldError(
-                self.key(), "zone", f" needs xmin <= xmax and ymin <= ymax, got {self.zone!r}"
-            )
+            raise self.error("zone", f" needs xmin <= xmax and ymin <= ymax, got {self.zone!r}")
         if self.side == "both" and self.foundation_stiffness is None:
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "side",
                 ' = "both": a rigid obstacle on both sides of the plate is a bilateral support '
                 "(w = 0 in the zone), not an obstacle; give an edge its [edges.NAME] support "
@@ -97,8 +94,7 @@ class ObstacleSpec(Table, frozen=True):
                 "is for a foundation (foundation_stiffness)",
             )
         if self.gap and self.foundation_stiffness is not None:
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "gap",
                 ": a gap is modelled for rigid obstacles only, not for a foundation "
                 "(foundation_stiffness)",
@@ -246,38 +242,33 @@ class PointSpec(Table, frozen=True):
     def check(self) -> None:
         """The rules between this table's fields."""
         if (self.at is None) == (self.spacing is None):
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "",
                 " needs at = [x, y] (one point) or spacing = s or [sx, sy] (a grid, with "
                 "optional offset and region): exactly one of them",
             )
         if self.at is not None and (self.offset, self.region) != (None, None):
             name = "offset" if self.offset is not None else "region"
-            raise FieldError(self.key(), name, " belongs to a grid (spacing), not to at")
+            raise self.error(name, " belongs to a grid (spacing), not to at")
         if isinstance(self.spacing, float | int):  # the same in x and y
             force_setattr(self, "spacing", (self.spacing, self.spacing))
         if self.spacing is not None and min(self.spacing) <= 0.0:
-            raise FieldError(self.key(), "spacing", f" must be > 0 m, got {plain(self.spacing)!r}")
+            raise self.error("spacing", f" must be > 0 m, got {plain(self.spacing)!r}")
         if (self.kind == "spring") != (self.stiffness is not None):
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "stiffness",
                 f': kind = "spring" needs a stiffness > 0 N/m, got {self.stiffness!r}'
                 if self.kind == "spring"
                 else f' belongs to kind = "spring", not "{self.kind}"',
             )
         if self.kind == "one-sided" and self.side is None:
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "side",
                 ': kind = "one-sided" needs side = "above" (the point holds the plate from '
                 'above: w <= 0) or "below" (from below: w >= 0)',
             )
         if self.side is not None and self.kind != "one-sided":
-            raise FieldError(
-                self.key(), "side", f' belongs to kind = "one-sided", not "{self.kind}"'
-            )
+            raise self.error("side", f' belongs to kind = "one-sided", not "{self.kind}"')
 
     @property
     def sign(self) -> float:

@@ -13,7 +13,7 @@ import numpy.typing as npt
 from msgspec import Meta
 from msgspec.structs import force_setattr, replace
 
-from unibuckle_fenicsx.errors import FieldError, InputError
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import (
     circle_points,
     distance_to_polygon,
@@ -76,7 +76,7 @@ class Polygon(Table, frozen=True, tag_field="shape", tag="polygon"):
     def check(self) -> None:
         """The rules between this table's fields."""
         if (why := polygon_fault(self.vertices)) is not None:
-            raise FieldError(self.key(), "vertices", why)
+            raise self.error("vertices", why)
 
 
 def polygon_fault(vertices: tuple[Point, ...]) -> str | None:
@@ -145,18 +145,16 @@ class EdgeSpec(Table, frozen=True):
     def check(self) -> None:
         """The rules between this table's fields."""
         if self.segments is not None and len(set(self.segments)) != len(self.segments):
-            raise FieldError(self.key(), "segments", f" repeats a segment: {list(self.segments)}")
+            raise self.error("segments", f" repeats a segment: {list(self.segments)}")
         if self.rotational_stiffness > 0.0 and self.support == "clamped":
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "rotational_stiffness",
                 ': support = "clamped" fixes the rotation already; a rotational spring '
                 'needs a support that leaves it free ("simply_supported", '
                 '"simply_supported_soft" or "free")',
             )
         if self.translational_stiffness > 0.0 and self.support != "free":
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "translational_stiffness",
                 f': support = "{self.support}" fixes the deflection already; an elastically '
                 'supported edge has support = "free"',
@@ -258,28 +256,26 @@ class PlateSpec(Table, frozen=True):
         """The rules between this table's fields."""
         if self.outline is not None:
             if (why := polygon_fault(self.outline)) is not None:
-                raise FieldError(self.key(), "outline", why)
+                raise self.error("outline", why)
             v = np.asarray(self.outline)
             lo, hi = v.min(axis=0).tolist(), v.max(axis=0).tolist()
             force_setattr(self, "corners", ((lo[0], lo[1]), (hi[0], hi[1])))
         (x0, y0), (x1, y1) = self.corners
         if not (x1 > x0 and y1 > y0):
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "corners",
                 " must satisfy x1 > x0 and y1 > y0 (a non-degenerate rectangle), got "
                 f"{self.corners!r}",
             )
         names = [e.name for e in self.edges]
         if len(set(names)) != len(names):
-            raise FieldError(self.key(), "edges", f": duplicate edge names {names}")
+            raise self.error("edges", f": duplicate edge names {names}")
         self._check_file()
         self._check_holes()
         self._check_edges()
         b = min(self.length, self.width)
         if self.file is None and self.thickness > MAX_THICKNESS_RATIO * b:
-            raise FieldError(
-                self.key(),
+            raise self.error(
                 "thickness",
                 f" = {self.thickness:g} m is {self.thickness / b:.3g} times the plate's smaller "
                 f"side {b:g} m: not a plate; plate.thickness must be at most "
@@ -291,13 +287,11 @@ class PlateSpec(Table, frozen=True):
         if self.file is None:
             return
         if Path(self.file).suffix.lower() not in (".geo", ".msh"):
-            raise FieldError(
-                self.key(), "file", f" must be a gmsh .geo or .msh file, got {self.file!r}"
-            )
+            raise self.error("file", f" must be a gmsh .geo or .msh file, got {self.file!r}")
         if self.outline is not None or self.holes:
-            raise FieldError(self.key(), "file", ": give a file, or an outline and holes, not both")
+            raise self.error("file", ": give a file, or an outline and holes, not both")
         if not Path(self.file).is_file():
-            raise FieldError(self.key(), "file", f": no such file {self.file!r}")
+            raise self.error("file", f": no such file {self.file!r}")
 
     def _check_holes(self) -> None:
         outer = self.boundary
@@ -310,16 +304,13 @@ class PlateSpec(Table, frozen=True):
             else:
                 inside = polygon_inside(hole.vertices, outer)
             if not inside:
-                raise FieldError(
-                    self.key(),
+                raise self.error(
                     f"holes[{k}]",
                     " must lie inside the plate, without touching its edge",
                 )
             for j in range(k):
                 if not _disjoint(self.holes[j], hole):
-                    raise FieldError(
-                        self.key(), f"holes[{j}]", f" and plate.holes[{k}] overlap or touch"
-                    )
+                    raise self.error(f"holes[{j}]", f" and plate.holes[{k}] overlap or touch")
 
     def _check_edges(self) -> None:
         """Each edge part's name or segments belong to this plate."""

@@ -15,16 +15,7 @@ import re
 
 import msgspec
 
-from unibuckle_fenicsx.spec.base import (
-    Table,
-    as_table,
-    as_tables,
-    bare,
-    element,
-    hints,
-    is_table,
-    members,
-)
+from unibuckle_fenicsx.spec.base import Table, as_table, as_tables
 from unibuckle_fenicsx.spec.plate import PlateSpec
 from unibuckle_fenicsx.spec.problem import ProblemSpec
 from unibuckle_fenicsx.spec.section import SectionProblemSpec
@@ -39,8 +30,9 @@ def json_schema() -> dict[str, object]:
     """
     tops, defs = msgspec.json.schema_components([ProblemSpec, SectionProblemSpec])
     schema = {"anyOf": list(tops), "$defs": defs}
-    for name, cls in {**_tables(ProblemSpec), **_tables(SectionProblemSpec)}.items():
-        node = defs[name]
+    for name, cls in _tables(Table).items():
+        if (node := defs.get(name)) is None:
+            continue
         node["description"] = inspect.cleandoc(cls.__doc__ or "").split("\n\n")[0]
         for key, text in field_docs(cls).items():
             if key in node["properties"]:
@@ -94,27 +86,12 @@ def field_docs(cls: type) -> dict[str, str]:
     return found
 
 
-def _tables(
-    cls: type[Table], found: dict[str, type[Table]] | None = None
-) -> dict[str, type[Table]]:
-    """The tables (Structs) below ``cls``, by name."""
-    found = {} if found is None else found
-    found[cls.__name__] = cls
-    for tp in hints(cls).values():
-        for m in _inner(tp):
-            if is_table(m) and bare(m).__name__ not in found:
-                _tables(bare(m), found)
+def _tables(cls: type[Table]) -> dict[str, type[Table]]:
+    """The tables (Structs) derived from ``cls``, by name."""
+    found: dict[str, type[Table]] = {}
+    for sub in cls.__subclasses__():
+        found |= {sub.__name__: sub, **_tables(sub)}
     return found
-
-
-def _inner(tp: object) -> list[object]:
-    """The types inside ``tp``: its union's members, its list's entries."""
-    out = []
-    for m in members(tp):
-        out.append(m)
-        if element(m) is not None:
-            out += _inner(element(m))
-    return out
 
 
 def accepted_keys() -> list[str]:

@@ -13,7 +13,6 @@ from typing import Annotated, ClassVar, Literal
 import msgspec
 from msgspec import Meta
 
-from unibuckle_fenicsx.errors import FieldError
 from unibuckle_fenicsx.spec.base import Table, Units, unit
 from unibuckle_fenicsx.spec.obstacles import DesignSpec
 from unibuckle_fenicsx.spec.solver import SolverSpec
@@ -53,15 +52,14 @@ class SectionSpec(Table, frozen=True):
         for other in ("width", "depth", "diameter"):
             given = getattr(self, other) is not None
             if other in keys and not given:
-                raise FieldError(self.KEY, other, f" is needed by a {self.shape} (m, > 0)")
+                raise self.error(other, f" is needed by a {self.shape} (m, > 0)")
             if other not in keys and given:
-                raise FieldError(
-                    self.KEY, other, f" is not a key of a {self.shape}: it has {' and '.join(keys)}"
+                raise self.error(
+                    other, f" is not a key of a {self.shape}: it has {' and '.join(keys)}"
                 )
         across = min(getattr(self, k) for k in keys)
         if self.thickness >= 0.5 * across:
-            raise FieldError(
-                self.KEY,
+            raise self.error(
                 "thickness",
                 f" must be < half of {' and '.join(keys)} ({0.5 * across:g} m): the walls "
                 f"would meet, got {self.thickness!r}",
@@ -98,7 +96,7 @@ class AxialLoad(Table, frozen=True):
     def check(self) -> None:
         """Some load."""
         if self.axial_stress == 0.0 and self.bending_stress == 0.0:
-            raise FieldError(self.KEY, "axial_stress", " and load.bending_stress are 0: no load")
+            raise self.error("axial_stress", " and load.bending_stress are 0: no load")
 
 
 class CoreSpec(Table, frozen=True):
@@ -124,7 +122,7 @@ class CoreSpec(Table, frozen=True):
         """A span or a stiffness belongs to a core."""
         for key in ("span", "foundation_stiffness"):
             if getattr(self, key) is not None and not self.core:
-                raise FieldError(self.KEY, key, " is the core's: it needs core = true")
+                raise self.error(key, " is the core's: it needs core = true")
 
 
 class SectionMeshSpec(Table, frozen=True):
@@ -175,14 +173,13 @@ class SectionProblemSpec(Table, frozen=True):
         """The core's span lies on the member; the solver's options are a section's."""
         span, length = self.obstacle.span, self.section.length
         if span is not None and not 0.0 <= span[0] < span[1] <= length:
-            raise FieldError(
-                "",
+            raise self.error(
                 "obstacle.span",
                 f" must satisfy 0 <= x0 < x1 <= section.length = {length:g} m, got {list(span)}",
             )
         default = SolverSpec()
         for key in SolverSpec.__struct_fields__:
             if key not in SOLVER_KEYS and getattr(self.solver, key) != getattr(default, key):
-                raise FieldError(
-                    "", f"solver.{key}", f" is a plate's option; a section takes {SOLVER_KEYS}"
+                raise self.error(
+                    f"solver.{key}", f" is a plate's option; a section takes {SOLVER_KEYS}"
                 )

@@ -41,8 +41,8 @@ from unibuckle_fenicsx.certificate.copositivity_split import (
     Basis,
     Patterns,
     SplitOptions,
-    _normalised,
     column_sources,
+    distinct_columns,
     negative_space,
     scatter_columns,
     split_certificate,
@@ -89,7 +89,7 @@ def test_first_columns_stop_where_the_first_basis_stops(thin_plate):
     Thin SSSS plate, 45 x 15 (45 lines along, so the reaction's line has some 90
     translates): with ``max_columns = 7`` the columns kept are a prefix of those kept
     with no effective limit (10 000: every translate, every cluster, as before the
-    limit), and the first basis (:func:`_normalised`, the first 7 distinct ones) is the
+    limit), and the first basis (:func:`distinct_columns`, the first 7 distinct ones) is the
     same from either, name by name and value by value. A line's translates are one
     column per line, each as long as the zone: kept whole they grew as the nodes times
     the lines (some 5 GB at 10^6 DOFs).
@@ -102,7 +102,7 @@ def test_first_columns_stop_where_the_first_basis_stops(thin_plate):
     assert 7 <= len(few.first) < len(every.first)
     assert [n for n, _ in few.first] == [n for n, _ in every.first[: len(few.first)]]
     assert all(np.array_equal(a, b) for (_, a), (_, b) in zip(few.first, every.first, strict=False))
-    basis = [_normalised(src.first, [], 7) for src in (few, every)]
+    basis = [distinct_columns(src.first, [], 7) for src in (few, every)]
     assert [n for n, _ in basis[0]] == [n for n, _ in basis[1]] and len(basis[0]) == 7
     assert all(np.array_equal(a, b) for (_, a), (_, b) in zip(*basis, strict=True))
     assert [n for n, _ in few.movable] == [n for n, _ in every.movable]

@@ -34,7 +34,7 @@ from unibuckle_fenicsx.cli import (
 from unibuckle_fenicsx.results.assemble import versions
 from unibuckle_fenicsx.results.files import file_stem
 from unibuckle_fenicsx.spec import problem_from_dict
-from unibuckle_fenicsx.spec.checks import MAX_THICKNESS_RATIO, THICK_PLATE_RATIO
+from unibuckle_fenicsx.spec.plate import MAX_THICKNESS_RATIO, THICK_PLATE_RATIO
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="runs its own processes")

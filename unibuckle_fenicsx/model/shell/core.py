@@ -142,9 +142,11 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
     gathered = model.mesh.comm.allgather((coords, normals, unrolled, js))
     all_j = np.concatenate([g[3] for g in gathered])
     if all_j.size == 0:
+        held = model.mesh.comm.allreduce(int(inside.sum()), op=MPI.SUM) > 0
+        what = "only nodes held by the end supports" if held else "no node of the mesh"
         raise InputError(
-            f"the core covers no free node: its span {(x0, x1)} m holds only nodes held by "
-            "the end supports; lengthen the span or refine the mesh"
+            f"the core covers no free node: its span {(x0, x1)} m holds {what}; "
+            "lengthen the span or refine the mesh"
         )
     all_u = np.vstack([g[2] for g in gathered])
     size = max(section.length, section.perimeter)

@@ -11,8 +11,9 @@ the package's unilateral algorithms and certificate. :func:`figure_data` gathers
 3-D figure of a mode needs (:func:`~unibuckle_fenicsx.viz.section.plot_section_mode_3d`).
 
 The critical load :math:`\lambda` is the compressive stress in Pa when
-``axial_stress = -1`` (the prestress is :math:`\lambda` times the unit one). A box's
-buckling coefficient uses its widest face, :math:`k = \sigma t b^2/(\pi^2 D)`.
+``axial_stress = -1`` without bending (the prestress is :math:`\lambda` times the unit
+one). A box's buckling coefficient uses its widest face, :math:`k = \sigma t b^2/(\pi^2 D)`
+with :math:`\sigma` that face's largest compressive stress at the load.
 """
 
 from __future__ import annotations
@@ -161,6 +162,13 @@ class SectionParameters:
                 )
         if self.axial_stress == 0.0 and self.bending_stress == 0.0:
             raise InputError("load.axial_stress and load.bending_stress are both 0: no load")
+        if self.compression() <= 0.0:
+            raise InputError(
+                f"load.axial_stress = {self.axial_stress!r} with load.bending_stress = "
+                f"{self.bending_stress!r} puts the walls in tension everywhere (the extreme "
+                "fibre's compression per unit load, |bending_stress| - axial_stress, must "
+                "be > 0): no buckling under a positive load; compression is axial_stress < 0"
+            )
         if self.foundation_stiffness is not None:
             if not self.core:
                 raise InputError("obstacle.foundation_stiffness needs core = true")
@@ -174,6 +182,15 @@ class SectionParameters:
                     f"obstacle.core_span must satisfy 0 <= x0 < x1 <= length = {self.length:g} m, "
                     f"got {self.core_span}"
                 )
+
+    def compression(self) -> float:
+        r"""The largest compressive stress per unit load (Pa/Pa), the extreme fibre's.
+
+        The axial stress is :math:`\sigma_a + \sigma_b\zeta` (``axial_stress``,
+        ``bending_stress``), :math:`\zeta` from -1 to 1 over the depth; the result is
+        :math:`|\sigma_b| - \sigma_a`, <= 0 when no fibre is in compression.
+        """
+        return abs(self.bending_stress) - self.axial_stress
 
     @property
     def widest(self) -> float:
@@ -250,8 +267,20 @@ class Section(Owner):
         return np.ones(0 if self.constraints is None else self.constraints.size)
 
     def buckling_coefficient(self, load: float) -> float:
-        r""":math:`k = \sigma t b^2/(\pi^2 D)`, b the widest face; NaN for a tube."""
-        return self.problem.buckling_coefficient(load)
+        r""":math:`k = \sigma t b^2/(\pi^2 D)` of a box's widest face b; NaN for a tube.
+
+        :math:`\sigma` is that face's largest compressive stress at the load ``load``,
+        ``load`` times ``SectionParameters.compression()`` over the depth (the widest
+        faces, a flange pair or a web pair, reach the section's largest compression), so
+        that k is the classical coefficient whatever the stress per unit load and its
+        gradient (:math:`\psi = -1`: a web's 23.9 when hinged). NaN without compression.
+        """
+        p = self.parameters
+        sigma = load * p.compression()
+        if p.shape == "tube" or sigma <= 0.0:
+            return math.nan
+        D = p.E * p.thickness**3 / (12.0 * (1.0 - p.nu**2))
+        return sigma * p.thickness * p.widest**2 / (math.pi**2 * D)
 
     def classical_stress(self) -> float:
         r"""Reference stress (Pa): a box's k = 4 load, a tube's classical one.
