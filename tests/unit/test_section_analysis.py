@@ -19,6 +19,7 @@ from mpi4py import MPI
 import pytest
 
 import unibuckle_fenicsx
+from support.paths import ROOT
 from unibuckle_fenicsx import SectionParameters, solve_section
 from unibuckle_fenicsx.errors import InputError
 
@@ -104,3 +105,25 @@ def test_sections_are_public_and_lazy():
     code = "import sys, unibuckle_fenicsx; print('dolfinx' in sys.modules)"
     out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True)
     assert out.stdout.strip() == "False"
+
+
+def test_levels_end_no_higher_than_the_seeds_on_the_given_section():
+    """The coarse-to-fine route keeps the critical state the seeds find on the given cells.
+
+    ``demos/box.toml`` (the README's filled box, clamped ends, b/8 cells): a carried
+    contact set polished by the plain rule once ended at a KKT point 6e-4 above the one
+    the seeds reach on these cells (``levels = 0``); the route must not end higher than
+    that (to the eigen solves' tolerance).
+    """
+    from msgspec.structs import replace
+
+    from unibuckle_fenicsx.spec import load_problem
+
+    spec = load_problem(ROOT / "demos" / "box.toml")
+    loads = {}
+    for levels in (1, 0):
+        file = replace(spec, mesh=replace(spec.mesh, levels=levels))
+        with solve_section(file, MPI.COMM_SELF) as analysis:
+            assert analysis.result.certificate is not None and analysis.result.certificate.kkt
+            loads[levels] = analysis.result.critical_load_Pa
+    assert loads[1] <= loads[0] * (1 + 1e-7), loads

@@ -8,8 +8,9 @@ finer section starts from the coarser level's contact set, carried over by
 shifted just below the expected load. This is the plate's multilevel route
 (:mod:`~unibuckle_fenicsx.algorithms.multilevel`) for meshes that are no structured
 rectangle; the answer is always a KKT point of the finest section. The polish runs
-first with the plate's looser tolerances, then, if they reach no KKT point, with the
-plain rule (:func:`_polish`); if neither does, the seeds run again on that level.
+first with the plate's looser tolerances (:func:`_polish`); if they reach no KKT point,
+the plain rule polishes the carried set and the seeds run again on that level, and the
+lower of their KKT points is kept (either may end higher than the other).
 
 The seeds are those of :data:`SEEDS`, the plate's others (:data:`MORE_SEEDS`) only if
 these reach no KKT point: a core makes every wall move outward, and the contact set is
@@ -62,8 +63,7 @@ SEEDS = ("free+", "free-")
 #: The plate's other seeds, in their order: run when :data:`SEEDS` reach no KKT point.
 MORE_SEEDS = tuple(name for name in SEED_NAMES if name not in SEEDS)
 #: Steps of the plain rule when the polish at looser tolerances reached no KKT point
-#: (:func:`_polish`): a carried set that predicts the finer section's ends in fewer; one
-#: that does not costs these, then the seeds on the finer section.
+#: (:func:`_polish`); the seeds run on the finer section too, and the lower KKT point wins.
 PLAIN_POLISH_ITERATIONS = 50
 
 
@@ -187,9 +187,13 @@ def _level(
         raise RuntimeError("solve_levels: a core section without constraints")
     polished, polish_iterations = None, None
     try:
+        plain: tuple[UnilateralSolution | None, int | None] = (None, None)
         if prev is not None and best is not None and prev.constraints is not None:
             z = prolong_directions(best.active, prev.constraints, section.constraints)
-            polished, polish_iterations = _polish(problem, z, best.load, max_iterations)
+            polished, polish_iterations = _polish(problem, z, best.load, THRESHOLDS, 0)
+            if polished is None:
+                budget = min(max_iterations, PLAIN_POLISH_ITERATIONS)
+                plain = _polish(problem, z, best.load, (), POLISH_ITERATIONS, budget)
         if polished is None:
             polished = solve_active_set(
                 problem,
@@ -199,6 +203,10 @@ def _level(
                 seeds=SEEDS,
                 more_seeds=MORE_SEEDS,
             )
+            kept, plain_iterations = plain
+            if kept is not None and kept.load < polished.load:
+                solves = problem.eigensolver.solves
+                polished, polish_iterations = replace(kept, eigensolves=solves), plain_iterations
     except BaseException:
         section.destroy()
         raise
@@ -221,29 +229,26 @@ def _level(
 
 
 def _polish(
-    problem: CoredSectionProblem, z: npt.NDArray[np.int64], estimate: float, max_iterations: int
+    problem: CoredSectionProblem,
+    z: npt.NDArray[np.int64],
+    estimate: float,
+    thresholds: tuple[float, ...],
+    before: int,
+    budget: int = POLISH_ITERATIONS,
 ) -> tuple[UnilateralSolution | None, int | None]:
     """The active set from the contact set ``z`` carried from the coarser section.
 
-    Returns the solution and its iterations when they reach a KKT point, else (None,
-    None). ``estimate``: the coarser section's load (the eigen solves shift near it).
-    First with looser tolerances (:data:`THRESHOLDS`, :data:`POLISH_ITERATIONS` steps:
-    on thin walls the mode's tails flip sign from one contact set to the next, as on
-    thin plates); if that reaches no KKT point, the plain rule at ``tau`` from the
-    carried set again (:data:`PLAIN_POLISH_ITERATIONS` steps at most, fewer if
-    ``max_iterations`` says so), which reaches one where the looser tolerances first
-    lead to another contact set (:doc:`/verification/sections`, "Cost").
+    Returns the solution and its iterations (``before`` of an earlier polish included)
+    when they reach a KKT point, else (None, None). ``estimate``: the coarser section's
+    load (the eigen solves shift near it). ``thresholds``: the looser tolerances
+    (:data:`THRESHOLDS`: on thin walls the mode's tails flip sign from one contact set
+    to the next, as on thin plates), or none (the plain rule at ``tau``); ``budget``:
+    the steps allowed.
     """
-    iterations = 0
-    run = None
-    plain = min(max_iterations, PLAIN_POLISH_ITERATIONS)
-    for thresholds, budget in ((THRESHOLDS, POLISH_ITERATIONS), ((), plain)):
-        run = iterate(problem, "prolonged", z, None, budget, thresholds=thresholds, near=estimate)
-        iterations += run.iterations
-        if run.status is RunStatus.KKT and run.final is not None:
-            break
-    if run is None or run.status is not RunStatus.KKT or run.final is None:
+    run = iterate(problem, "prolonged", z, None, budget, thresholds=thresholds, near=estimate)
+    if run.status is not RunStatus.KKT or run.final is None:
         return None, None
+    iterations = before + run.iterations
     solution = UnilateralSolution(
         candidate=run.final,
         method="active-set (section levels)",
