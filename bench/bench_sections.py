@@ -13,7 +13,10 @@ eigen solve (min of ``--repeat`` solves of the same pencil), and the unilateral 
 section ``--levels`` times coarser, the contact set polished level by level; or, with
 ``--route interior-point``, the thin plates' interior-point chain on the section itself),
 then the certificate. The factorisations are PETSc's count of numeric ones (MUMPS) in the
-unilateral solve. Prints one Markdown row; ``--json FILE`` appends it.
+unilateral solve, per section level and in all. Prints one Markdown row, then one row per
+level (its steps of the active set, eigen solves, factorisations and seconds); ``--json
+FILE`` appends the row, with the levels, and the unilateral load (``core_load_Pa``) to
+compare routes by.
 
 Note:
     Timings are only meaningful on a quiet machine; the ratio (unilateral over free) is
@@ -31,6 +34,11 @@ COLUMNS = (
     "shape", "route", "dofs", "constrained", "cells_around", "free_load/ref", "core_load/ref",
     "kkt", "certificate", "setup_s", "rotation_s", "free_s", "unilateral_s", "ratio",
     "certify_s", "eigensolves_fine", "eigensolves_coarse", "factorisations",
+)  # fmt: skip
+#: The columns of a level's row (coarsest first).
+LEVEL_COLUMNS = (
+    "mesh_size", "dofs", "constrained", "seeded", "steps", "eigensolves", "factorisations",
+    "wall_time_s", "load",
 )  # fmt: skip
 
 
@@ -61,8 +69,20 @@ def run(
     from unibuckle_fenicsx.algorithms.records import SectionLevelsDetails
     from unibuckle_fenicsx.certificate.certify import certify
     from unibuckle_fenicsx.la.eigen import GEPSolver
-    from unibuckle_fenicsx.model.shell.levels import solve_levels
+    from unibuckle_fenicsx.model.shell import levels as section_levels
     from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
+
+    # Each level's factorisations: the count before and after it (in order, coarsest first).
+    per_level: list[int] = []
+    level = section_levels._level
+
+    def counted(*args, **kwargs):  # type: ignore[no-untyped-def]
+        n0 = _factorisations()
+        out = level(*args, **kwargs)
+        per_level.append(_factorisations() - n0)
+        return out
+
+    section_levels._level = counted
 
     geometry = (
         {"width": 0.2, "depth": 0.2, "thickness": 0.002, "length": 0.6}
@@ -90,7 +110,7 @@ def run(
     t1 = time.perf_counter()
     before = _factorisations()
     if route == "levels":
-        fine, solution = solve_levels(params, levels=levels)
+        fine, solution = section_levels.solve_levels(params, levels=levels)
     else:
         fine = build_section(params, MPI.COMM_WORLD)
         t1 = time.perf_counter()  # the set-up is not the unilateral solve's
@@ -104,18 +124,31 @@ def run(
         details = solution.details
         if isinstance(details, SectionLevelsDetails):
             levels_log = [msgspec.to_builtins(level) for level in details.levels]
+            for entry, count in zip(levels_log, per_level, strict=True):
+                entry["factorisations"] = count
             coarse = details.coarse_eigensolves
         else:
-            levels_log = [{"eigensolves": solution.eigensolves}]
+            levels_log = [{"eigensolves": solution.eigensolves, "factorisations": factorisations}]
             coarse = 0
+        per_level_text = "; ".join(
+            f"{1e3 * entry['mesh_size']:g} mm{' seeds' if entry.get('seeded') else ''}: "
+            f"{entry.get('steps', '-')} / {entry['factorisations']} / {entry['eigensolves']}"
+            if "mesh_size" in entry
+            else f"{entry['factorisations']} / {entry['eigensolves']}"
+            for entry in levels_log
+        )
         return {
             "shape": shape,
             "route": route,
+            "size_m": size,
+            "levels_requested": levels,
+            "per_level": per_level_text,
             "dofs": dofs,
             "constrained": fine.constraints.size if fine.constraints is not None else 0,
             "cells_around": cells,
             "free_load/ref": free / ref,
             "core_load/ref": solution.load / ref,
+            "core_load_Pa": solution.load,
             "kkt": bool(solution.candidate.kkt),
             "certificate": f"kkt={cert.kkt}, smallest={cert.smallest_of_reduced}, "
             f"gap={cert.relative_gap:.3g} ({cert.proven_by})",
@@ -151,6 +184,15 @@ def main() -> None:
         v = row[c]
         cells.append(f"{v:.4g}" if isinstance(v, float) else str(v))
     print("| " + " | ".join(cells) + " |", flush=True)
+    print()
+    print_header("Its levels, coarsest first", LEVEL_COLUMNS)
+    for level in row["levels"]:
+        cells = [level.get(c, "") for c in LEVEL_COLUMNS]
+        print(
+            "| " + " | ".join(f"{v:.6g}" if isinstance(v, float) else str(v) for v in cells) + " |"
+        )
+    print(f"per level (steps / factorisations / eigen solves): {row['per_level']}")
+    print(f"core load {row['core_load_Pa']!r} Pa", flush=True)
     append_rows(args.json, [row])
 
 

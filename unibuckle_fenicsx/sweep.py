@@ -209,9 +209,10 @@ def _locate(data: dict[str, object], path: str, flag: str) -> tuple[Any, Any]:
         where = ".".join(keys[:depth]) or "the problem file"
         if isinstance(node, Mapping):
             if key not in node:
+                # The shortcuts set a plate's corners: a section's file has none.
+                shortcuts = f"; shortcuts: {sorted(SHORTCUTS)}" if "plate" in data else ""
                 raise InputError(
-                    f"{flag} {path}: {where} has no key {key!r} (keys: {sorted(node)}; "
-                    f"shortcuts: {sorted(SHORTCUTS)})"
+                    f"{flag} {path}: {where} has no key {key!r} (keys: {sorted(node)}{shortcuts})"
                 )
         elif isinstance(node, list):
             if not (key.isdigit() and int(key) < len(node)):

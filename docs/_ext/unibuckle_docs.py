@@ -212,6 +212,10 @@ def schema_page() -> str:
     keys, source = accepted_keys()
     schema = json_schema()
     described = dict(schema_rows(schema))
+    # A key a section's file shares with a plate's (mesh.size, material.E, ...) is
+    # described by the plate's branch first: its row adds the section's own words.
+    branch = schema.get("$defs", {}).get("SectionProblemSpec")
+    section = {} if branch is None else dict(schema_rows(branch, schema))
     lines = [
         f"Generated from `unibuckle_fenicsx.spec.json_schema()` and {source} when "
         "these pages were built.",
@@ -222,13 +226,17 @@ def schema_page() -> str:
     for key in keys:
         node = described.get(key, {})
         default = node.get("default", "")
+        text = _myst(node.get("description", ""))
+        own = section.get(key, {}).get("description", "")
+        if own and section[key] is not node and _myst(own) != text:
+            text += f" A section's file: {_myst(own)}"
         lines.append(
             "| `{}` | {} | {} | {} | {} |".format(
                 key,
                 _cell(_type(node, schema)) if node else "",
                 _cell(_range(node)),
                 f"`{json.dumps(default)}`" if "default" in node else _cell(default),
-                _cell(_myst(node.get("description", ""))),
+                _cell(text),
             )
         )
     lines += [
@@ -345,8 +353,19 @@ def _orderings_commands(rows: list[dict[str, Any]]) -> str:
     return "`, then `".join(commands)
 
 
+def _sections_commands(rows: list[dict[str, Any]]) -> str:
+    """The ``bench_sections.py`` runs that wrote the rows: one per section, size and levels."""
+    return "`, then `".join(
+        f"python bench/bench_sections.py --shape {r['shape']} --size {r['size_m']:g} "
+        f"--levels {r['levels_requested']} --route {r['route']} "
+        "--json bench/results/sections.jsonl"
+        for r in rows
+    )
+
+
 COMMANDS = {
     "bracket": lambda rows: _bracket_commands(rows),
+    "sections": lambda rows: _sections_commands(rows),
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"
@@ -414,6 +433,18 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("certificate", "certificate"),
         ("k", "k"),
         ("load_Pa", "λ_c (Pa)"),
+    ],
+    "sections": [
+        ("shape", "section"),
+        ("route", "route"),
+        ("dofs", "DOFs"),
+        ("constrained", "constrained directions"),
+        ("per_level", "per level: steps / factorisations / eigen solves"),
+        ("factorisations", "factorisations"),
+        ("ratio", "time (free solves)"),
+        ("core_load/ref", "σ/σ_ref"),
+        ("kkt", "KKT"),
+        ("core_load_Pa", "σ_c (Pa)"),
     ],
     "bracket": [
         ("case", "case"),

@@ -262,6 +262,15 @@ def test_schema_page_from_a_json_schema(monkeypatch: pytest.MonkeyPatch) -> None
     assert "1 keys." in page
 
 
+def test_schema_page_gives_a_sections_own_words_for_the_keys_it_shares() -> None:
+    # mesh.size means a rectangle's cell size on a plate, a target cell size on a
+    # section (spec.section.SectionMeshSpec): the row names both.
+    page = unibuckle_docs.schema_page()
+    row = next(line for line in page.splitlines() if line.startswith("| `mesh.size` |"))
+    assert "A rectangle's nx and ny" in row
+    assert "A section's file: Target cell size (m), > 0; a box's faces get an even" in row
+
+
 def _words(page: Path) -> int:
     return len(page.read_text().split())
 

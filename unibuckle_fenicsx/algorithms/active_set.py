@@ -112,9 +112,12 @@ SEED_NAMES = ("free+", "free-", "all", "end-low", "middle", "end-high", "greedy+
 
 
 def _seeds(
-    problem: UnilateralProblem, free_values: npt.NDArray[np.float64], tau: float
+    problem: UnilateralProblem,
+    free_values: npt.NDArray[np.float64],
+    tau: float,
+    names: tuple[str, ...] = SEED_NAMES,
 ) -> list[tuple[str, npt.NDArray[np.int64]]]:
-    """Seed contact sets (deduplicated, in :data:`SEED_NAMES` order)."""
+    """Seed contact sets (deduplicated, in the order of ``names``, a part of :data:`SEED_NAMES`)."""
     xy = problem.contact.coordinates
     plate = problem.spec.plate
     (x0, y0), (x1, y1) = plate.corners
@@ -130,7 +133,7 @@ def _seeds(
     scale = np.abs(free_values).max() if free_values.size else 1.0
     out: list[tuple[str, npt.NDArray[np.int64]]] = []
     seen: set[bytes] = set()
-    for name in SEED_NAMES:
+    for name in names:
         if name == "free+":
             z = np.flatnonzero(free_values > tau * scale)
         elif name == "free-":
@@ -155,12 +158,23 @@ def _seeds(
     return out
 
 
-def multi_seed(problem: UnilateralProblem, max_iterations: int) -> list[Run]:
-    """Run the iteration from every seed, starting from the free mode."""
+def multi_seed(
+    problem: UnilateralProblem,
+    max_iterations: int,
+    seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
+) -> list[Run]:
+    """Run the iteration from every seed of ``seeds``, starting from the free mode.
+
+    The seeds of ``more_seeds`` run after them only if none of theirs reached a KKT point.
+    """
     free = problem.solve_free().function.x.petsc_vec
     values = problem.contact.values(free)
     runs: list[Run] = []
-    for name, z in _seeds(problem, values, problem.tau):  # the greedy seeds come last
+    # The greedy seeds come last.
+    for name, z in _seeds(problem, values, problem.tau, seeds + more_seeds):
+        if name in more_seeds and any(r.status is RunStatus.KKT for r in runs if r.seed in seeds):
+            break
         greedy = name.startswith("greedy")
         capped = greedy and any(r.status is RunStatus.KKT for r in runs)
         budget = min(max_iterations, GREEDY_ITERATIONS) if capped else max_iterations
@@ -299,6 +313,8 @@ def _coarse_levels(
     levels: list[tuple[int, int]],
     max_iterations: int,
     refine_margin: float,
+    seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
 ) -> _Coarse:
     """Seeds on the coarsest level, then the best contact sets polished level by level.
 
@@ -313,7 +329,7 @@ def _coarse_levels(
             continue
         tl = time.perf_counter()
         if coarse.candidates is None:
-            coarse.runs = multi_seed(cp, max_iterations)
+            coarse.runs = multi_seed(cp, max_iterations, seeds, more_seeds)
             runs = coarse.runs
         else:
             if coarse.last is None:
@@ -445,7 +461,11 @@ def _choose(
 
 
 def _fine_level(
-    problem: UnilateralProblem, coarse: _Coarse, max_iterations: int
+    problem: UnilateralProblem,
+    coarse: _Coarse,
+    max_iterations: int,
+    seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
 ) -> tuple[list[Run], list[int] | str]:
     """The fine mesh's runs: the coarse sets polished, or the seeds; and what seeded them.
 
@@ -458,7 +478,7 @@ def _fine_level(
         runs = _polish(problem, coarse.last, coarse.candidates, budget, coarse.bests)
         seeded_on = [coarse.last.spec.mesh.nx, coarse.last.spec.mesh.ny]
     else:
-        runs = multi_seed(problem, max_iterations)
+        runs = multi_seed(problem, max_iterations, seeds, more_seeds)
         seeded_on = [spec.mesh.nx, spec.mesh.ny] if problem.structured else "fine"
     if coarse.last is not None:
         coarse.last.destroy()
@@ -496,9 +516,20 @@ def _details(
 
 
 def _check_options(
-    max_iterations: int, coarse_min_cells: int, refine_margin: float, bound_budget: int
+    max_iterations: int,
+    coarse_min_cells: int,
+    refine_margin: float,
+    bound_budget: int,
+    seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
 ) -> None:
     """Refuse settings out of range, naming them."""
+    unknown = [name for name in seeds + more_seeds if name not in SEED_NAMES]
+    if unknown or not seeds or set(seeds) & set(more_seeds):
+        raise InputError(
+            f"seeds and more_seeds must be some of {SEED_NAMES}, seeds not empty and none "
+            f"in both, got {seeds!r} and {more_seeds!r}"
+        )
     # The [solver] keys' ranges, from their one description:
     ActiveSetOptions(max_iterations=max_iterations, bound_budget=bound_budget)
     if int(coarse_min_cells) != coarse_min_cells or coarse_min_cells < 2:
@@ -515,6 +546,8 @@ def solve_active_set(
     coarse_min_cells: int = 8,
     refine_margin: float = 0.02,
     bound_budget: int = 64,
+    seeds: tuple[str, ...] = SEED_NAMES,
+    more_seeds: tuple[str, ...] = (),
 ) -> UnilateralSolution:
     """Unilateral critical load by a multi-seed primal-dual active-set method.
 
@@ -529,6 +562,11 @@ def solve_active_set(
             refined, >= 0.
         bound_budget: Evaluations allowed for the lattice lower bound, >= 0 (the search
             runs only if the budget covers at least the i singletons).
+        seeds: The seeds run on the coarsest level, some of :data:`SEED_NAMES` in their
+            order; all of them by default (a plate's buckle may sit at either end or in
+            the middle, and small contact sets come first on plates).
+        more_seeds: Seeds run after ``seeds`` (on the same level) only if none of those
+            reached a KKT point; none by default.
 
     Returns:
         The best KKT point found (or, flagged in the record's ``warning``, the best
@@ -541,15 +579,15 @@ def solve_active_set(
         Collective on ``problem.comm``.
     """
     require_obstacle(problem, "solve_active_set")
-    _check_options(max_iterations, coarse_min_cells, refine_margin, bound_budget)
+    _check_options(max_iterations, coarse_min_cells, refine_margin, bound_budget, seeds, more_seeds)
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     free_load = problem.solve_free().load
     spec = problem.spec
     structured = multilevel and problem.structured  # coarse copies need spec.mesh
     levels = mesh_levels(spec.mesh.nx, spec.mesh.ny, coarse_min_cells) if structured else []
-    coarse = _coarse_levels(problem, levels, max_iterations, refine_margin)
-    runs, seeded_on = _fine_level(problem, coarse, max_iterations)
+    coarse = _coarse_levels(problem, levels, max_iterations, refine_margin, seeds, more_seeds)
+    runs, seeded_on = _fine_level(problem, coarse, max_iterations, seeds, more_seeds)
     warnings: list[str] = []
     fallbacks = _fall_back(problem, runs, max_iterations, warnings)
     kkt = distinct_kkt(runs)

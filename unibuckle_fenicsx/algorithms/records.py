@@ -356,7 +356,11 @@ class SectionLevel(Struct, kw_only=True):
         constrained: The core's constrained directions.
         load: The critical stress found there (Pa).
         kkt: Its state satisfies the KKT conditions.
-        eigensolves: Eigen solves on it.
+        eigensolves: Eigen solves on it (its free solve included).
+        steps: Active-set steps on it: the polish's from the carried contact set, or,
+            where the seeds ran (``seeded``), all of theirs and any fallback's.
+        seeded: The seeds ran on it (the coarsest section, or a carried set that did
+            not reach a KKT point).
         wall_time_s: Seconds.
     """
 
@@ -366,6 +370,8 @@ class SectionLevel(Struct, kw_only=True):
     load: float
     kkt: bool
     eigensolves: int
+    steps: int = 0
+    seeded: bool = False
     wall_time_s: float
 
 

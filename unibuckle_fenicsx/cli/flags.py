@@ -205,7 +205,10 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "solve",
         parents=[problem, common],
         help="solve one problem (a paper case or a TOML file)",
-        description="Compute the critical load of one problem and print a one-line summary.",
+        description="Compute the critical load of one problem and print a one-line summary.\n"
+        "The problem is a plate (a paper case or a TOML file) or a section: a file with a\n"
+        "[section] table (a box or a tube, with a core or hollow), solved on its [mesh]\n"
+        "size and levels (--nx, --ny and --output apply to plates only).",
         epilog=EPILOG,
         formatter_class=Formatter,
     )

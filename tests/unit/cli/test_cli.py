@@ -81,6 +81,8 @@ def test_help(tmp_path):
     )
     for flag in flags:
         assert flag in sub.stdout, flag
+    # A section's file is a problem the command solves: the help says so.
+    assert "[section] table" in " ".join(sub.stdout.split())
     # The exit statuses are documented.
     for status in (EXIT_OK, EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED):
         assert f"\n  {status}  " in sub.stdout

@@ -22,6 +22,7 @@ import pytest
 import scipy.linalg
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+from unibuckle_fenicsx.model.shell.levels import solve_levels
 from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
 
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense references are serial")
@@ -119,6 +120,40 @@ def test_core_matches_dense_enumeration(shape, changes):
         free = sec.problem.solve_free().load
         assert free < expected  # the core is active on these sections
         assert solution.load == pytest.approx(expected, rel=1e-8)
+    # The sections' route: the seeds of levels.SEEDS on the section itself.
+    finest, seeded = solve_levels(params, levels=0, comm=MPI.COMM_SELF)
+    with finest:
+        assert seeded.candidate.kkt
+        assert seeded.load == pytest.approx(expected, rel=1e-8)
+
+
+def test_the_plates_other_seeds_run_only_when_the_sections_reach_no_kkt_point():
+    # The rule of solve_active_set's more_seeds, on the small box of the dense reference.
+    from unibuckle_fenicsx.errors import InputError
+    from unibuckle_fenicsx.model.shell.levels import MORE_SEEDS, SEEDS
+
+    with build_section(_parameters("box"), MPI.COMM_SELF) as sec:
+        problem = sec.problem
+        found = solve_active_set(
+            problem, multilevel=False, bound_budget=0, seeds=SEEDS, more_seeds=MORE_SEEDS
+        )
+        runs = found.details.runs
+        assert [r.seed for r in runs] == list(SEEDS)
+        assert any(r.status == "kkt" for r in runs)
+        # One greedy step adds one direction: no KKT point, so "all" runs after it.
+        again = solve_active_set(
+            problem,
+            multilevel=False,
+            bound_budget=0,
+            max_iterations=1,
+            seeds=("greedy+",),
+            more_seeds=("all",),
+        )
+        assert again.details.runs[0].status == "max_iterations"
+        assert [r.seed for r in again.details.runs][:2] == ["greedy+", "all"]
+        for bad in ({"seeds": ()}, {"seeds": ("nope",)}, {"more_seeds": ("free+",)}):
+            with pytest.raises(InputError, match="seeds"):
+                solve_active_set(problem, multilevel=False, **bad)
 
 
 def test_section_figure_is_written(tmp_path):

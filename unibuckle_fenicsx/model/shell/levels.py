@@ -7,8 +7,14 @@ finer section starts from the coarser level's contact set, carried over by
 (:func:`~unibuckle_fenicsx.algorithms.pdas.iterate`) polishes it, its eigen solves
 shifted just below the expected load. This is the plate's multilevel route
 (:mod:`~unibuckle_fenicsx.algorithms.multilevel`) for meshes that are no structured
-rectangle; the answer is always a KKT point of the finest section. If a prolonged set
-reaches none, the seeds run again on that level.
+rectangle; the answer is always a KKT point of the finest section. The polish runs
+first with the plate's looser tolerances, then, if they reach no KKT point, with the
+plain rule (:func:`_polish`); if neither does, the seeds run again on that level.
+
+The seeds are those of :data:`SEEDS`, the plate's others (:data:`MORE_SEEDS`) only if
+these reach no KKT point: a core makes every wall move outward, and the contact set is
+the walls' nodes save where they lift off, which the free mode's signs seed
+(:doc:`/verification/sections`, "Cost").
 """
 
 from __future__ import annotations
@@ -23,7 +29,12 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
-from unibuckle_fenicsx.algorithms.active_set import POLISH_ITERATIONS, THRESHOLDS, solve_active_set
+from unibuckle_fenicsx.algorithms.active_set import (
+    POLISH_ITERATIONS,
+    SEED_NAMES,
+    THRESHOLDS,
+    solve_active_set,
+)
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.algorithms.records import (
     ActiveSetDetails,
@@ -36,9 +47,24 @@ from unibuckle_fenicsx.model.shell.problem import CoredSectionProblem
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import SolverSpec
 
-__all__ = ["prolong_directions", "solve_levels"]
+__all__ = ["MORE_SEEDS", "SEEDS", "prolong_directions", "solve_levels"]
 
 logger = logging.getLogger(__name__)
+
+#: The active set's seeds on a section (of
+#: :data:`~unibuckle_fenicsx.algorithms.active_set.SEED_NAMES`): the free mode's two
+#: sign patterns. With a core the contact set is most of the walls, and where they lift
+#: off the free mode's signs seed; the plate's other seeds (every direction in contact,
+#: windows along the long side, the greedy ones) run only when neither of these reaches
+#: a KKT point (:data:`MORE_SEEDS`): they cost most of the solves and found no lower KKT
+#: point on the sections of :doc:`/verification/sections` ("Cost").
+SEEDS = ("free+", "free-")
+#: The plate's other seeds, in their order: run when :data:`SEEDS` reach no KKT point.
+MORE_SEEDS = tuple(name for name in SEED_NAMES if name not in SEEDS)
+#: Steps of the plain rule when the polish at looser tolerances reached no KKT point
+#: (:func:`_polish`): a carried set that predicts the finer section's ends in fewer; one
+#: that does not costs these, then the seeds on the finer section.
+PLAIN_POLISH_ITERATIONS = 50
 
 
 def prolong_directions(
@@ -163,14 +189,23 @@ def _level(
     try:
         if prev is not None and best is not None and prev.constraints is not None:
             z = prolong_directions(best.active, prev.constraints, section.constraints)
-            polished, polish_iterations = _polish(problem, z, best.load)
+            polished, polish_iterations = _polish(problem, z, best.load, max_iterations)
         if polished is None:
             polished = solve_active_set(
-                problem, multilevel=False, max_iterations=max_iterations, bound_budget=0
+                problem,
+                multilevel=False,
+                max_iterations=max_iterations,
+                bound_budget=0,
+                seeds=SEEDS,
+                more_seeds=MORE_SEEDS,
             )
     except BaseException:
         section.destroy()
         raise
+    details = polished.details
+    seeded_steps = (
+        sum(r.iterations for r in details.runs) if isinstance(details, ActiveSetDetails) else 0
+    )
     level = SectionLevel(
         mesh_size=size,
         dofs=section.model.num_dofs,
@@ -178,25 +213,36 @@ def _level(
         load=polished.load,
         kkt=polished.candidate.kkt,
         eigensolves=problem.eigensolver.solves,
+        steps=seeded_steps if polish_iterations is None else polish_iterations,
+        seeded=polish_iterations is None,
         wall_time_s=time.perf_counter() - tl,
     )
     return section, polished, polish_iterations, level
 
 
 def _polish(
-    problem: CoredSectionProblem, z: npt.NDArray[np.int64], estimate: float
+    problem: CoredSectionProblem, z: npt.NDArray[np.int64], estimate: float, max_iterations: int
 ) -> tuple[UnilateralSolution | None, int | None]:
     """The active set from the contact set ``z`` carried from the coarser section.
 
     Returns the solution and its iterations when they reach a KKT point, else (None,
     None). ``estimate``: the coarser section's load (the eigen solves shift near it).
+    First with looser tolerances (:data:`THRESHOLDS`, :data:`POLISH_ITERATIONS` steps:
+    on thin walls the mode's tails flip sign from one contact set to the next, as on
+    thin plates); if that reaches no KKT point, the plain rule at ``tau`` from the
+    carried set again (:data:`PLAIN_POLISH_ITERATIONS` steps at most, fewer if
+    ``max_iterations`` says so), which reaches one where the looser tolerances first
+    lead to another contact set (:doc:`/verification/sections`, "Cost").
     """
-    # Looser tolerances first: on thin walls the mode's tails flip sign from one
-    # contact set to the next (as on thin plates, :data:`THRESHOLDS`).
-    run = iterate(
-        problem, "prolonged", z, None, POLISH_ITERATIONS, thresholds=THRESHOLDS, near=estimate
-    )
-    if run.status is not RunStatus.KKT or run.final is None:
+    iterations = 0
+    run = None
+    plain = min(max_iterations, PLAIN_POLISH_ITERATIONS)
+    for thresholds, budget in ((THRESHOLDS, POLISH_ITERATIONS), ((), plain)):
+        run = iterate(problem, "prolonged", z, None, budget, thresholds=thresholds, near=estimate)
+        iterations += run.iterations
+        if run.status is RunStatus.KKT and run.final is not None:
+            break
+    if run is None or run.status is not RunStatus.KKT or run.final is None:
         return None, None
     solution = UnilateralSolution(
         candidate=run.final,
@@ -208,4 +254,4 @@ def _polish(
         kkt_points=[run.final],
         lower_bound_by="interlacing",
     )
-    return solution, run.iterations
+    return solution, iterations
