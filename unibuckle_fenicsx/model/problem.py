@@ -359,13 +359,18 @@ class Problem(Owner):
 
     # -- reporting ------------------------------------------------------------------
     def buckling_coefficient(self, load: float) -> float:
-        r""":math:`k = N b^2/(\pi^2 D)` with N = t lambda and b the plate width (y extent).
+        r""":math:`k = \sigma t b^2/(\pi^2 D)` at the load factor ``load`` (:math:`\lambda`).
 
-        D is :math:`\sqrt{D_{11}D_{22}}` of the bending stiffness (an isotropic plate's D).
+        :math:`\sigma = \lambda\sigma_1`, :math:`\sigma_1` the largest compressive normal
+        edge stress per unit load (or, without one, the largest shear stress) and b the
+        width it acts across (``PlateSpec.reference_load``);
+        the fixed stresses are not in it. D is :math:`\sqrt{D_{11}D_{22}}` of the bending
+        stiffness (an isotropic plate's D).
         """
         plate, mat = self.spec.plate, self.spec.material
         D = reference_bending_stiffness(mat, plate.thickness)
-        return plate.thickness * load * plate.width**2 / (np.pi**2 * D)
+        stress, b = plate.reference_load()
+        return plate.thickness * (stress * load) * b**2 / (np.pi**2 * D)
 
     def destroy(self) -> None:
         """Destroy the PETSc/SLEPc objects (collective) and take back the run's options."""

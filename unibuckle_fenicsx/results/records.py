@@ -153,8 +153,11 @@ class BucklingResult(Struct, kw_only=True):
         free_load_Pa: lambda without obstacle (Pa).
         ratio_to_free: critical / free.
         critical_force_N_per_m: N = t lambda.
-        buckling_coefficient_k: k = N b^2 / (pi^2 D), b = plate width; None when the
-            scaled load is a temperature rise alone (lambda is then a factor on it).
+        buckling_coefficient_k: k = sigma t b^2 / (pi^2 D), sigma = lambda times the
+            largest compressive edge stress per unit load (pure shear: the largest shear
+            stress) and b the width it acts across
+            (``PlateSpec.reference_load``); None when
+            the scaled load is a temperature rise alone (lambda is then a factor on it).
         dofs: Global DOF count of (w, theta).
         mesh: [nx, ny] (a user-supplied or gmsh mesh: [number of cells]).
         eigensolves: Linear eigen solves, including the free one.

@@ -388,6 +388,49 @@ class PlateSpec(Table, frozen=True):
         """Whether an edge carries a fixed stress."""
         return any(e.fixed_loaded for e in self.edges)
 
+    def reference_load(self) -> tuple[float, float]:
+        r"""(sigma, b): the reference edge stress per unit load and the width it acts across.
+
+        The largest compressive normal edge stress per unit load (Pa/Pa, positive), and b
+        (m) the length of the loaded edge: for the rectangle the y extent (left, right) or
+        the x extent (bottom, top); for an outline, the plate's extent across the
+        direction of that edge's traction (its longest segment's normal). Without a
+        compressive normal stress, the largest absolute shear stress per unit load, and b
+        the plate's smaller extent along and across the sheared edge (for the rectangle
+        its shorter side, the b of :math:`k_\tau = 5.34 + 4(b/a)^2`). An edge whose
+        direction the plate does not give (a file's or a mesh's part, the holes): b the y
+        extent, or for shear the smaller of the x and y extents. Ties: the first edge
+        listed. Edges in tension alone: the least tensile stress, negative. The fixed
+        stresses are not in it: (0, y extent) when no edge is loaded.
+        """
+        edges = [e for e in self.edges if e.loaded]
+        compression = [max(-v for v in e.normal_ends) for e in edges]
+        shear = [max(abs(v) for v in e.shear_ends) for e in edges]
+        if not edges:
+            return 0.0, self.width
+        normal = max(compression) > 0.0 or max(shear) == 0.0
+        values = compression if normal else shear
+        k = int(np.argmax(values))  # the first of equal values
+        along, across = self._edge_extents(edges[k])
+        if normal:
+            return values[k], along
+        return values[k], min(along, across)
+
+    def _edge_extents(self, edge: EdgeSpec) -> tuple[float, float]:
+        """The plate's extents (m) along and across ``edge`` (see :meth:`reference_load`)."""
+        if self.outline is not None and edge.segments is not None:
+            v = np.asarray(self.outline, dtype=float)
+            ends = [(v[k], v[(k + 1) % len(v)]) for k in edge.segments]
+            start, end = max(ends, key=lambda pair: float(np.hypot(*(pair[1] - pair[0]))))
+            d = end - start
+            t = d / np.hypot(d[0], d[1])
+            along = v[:, 0] * t[0] + v[:, 1] * t[1]
+            across = v[:, 1] * t[0] - v[:, 0] * t[1]
+            return float(along.max() - along.min()), float(across.max() - across.min())
+        if edge.tag is None and self.file is None and edge.name in ("bottom", "top"):
+            return self.length, self.width
+        return self.width, self.length  # left, right, or an edge of unknown direction
+
     def fixed_part(self) -> PlateSpec:
         """The plate with its edges' fixed stresses as the stresses (for the fixed prestress)."""
         return replace(self, edges=tuple(e.fixed_part() for e in self.edges))
