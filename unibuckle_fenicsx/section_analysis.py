@@ -313,7 +313,7 @@ def _faces(
     p = section.parameters
     if p.shape != "box" or p.width is None or p.depth is None:
         return []
-    D = p.E * p.thickness**3 / (12.0 * (1.0 - p.nu**2))
+    D = p.bending_stiffness
     normals = np.zeros((0, 3)) if section.constraints is None else section.constraints.normals
     touching = np.zeros(len(normals), dtype=bool)
     if active is not None:

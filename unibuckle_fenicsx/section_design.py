@@ -82,6 +82,7 @@ class DesignSection(Protocol):
     def bending_stress(self) -> float: ...
     @property
     def core(self) -> bool: ...
+    def compression(self) -> float: ...
 
 
 class FaceDesign(Struct, kw_only=True):
@@ -181,7 +182,7 @@ def _face(name: str, ends: tuple[float, float], design: DesignSpec) -> FaceDesig
 def section_design(section: DesignSection, design: DesignSpec, load: float) -> SectionDesignRecord:
     """The design quantities of the section's critical load ``load`` (the module docstring)."""
     t = section.thickness
-    compression = load * (-section.axial_stress + abs(section.bending_stress))
+    compression = load * section.compression()
     out = SectionDesignRecord(
         yield_stress_Pa=design.yield_stress,
         partial_factor=design.partial_factor,

@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import json
 import math
-from types import SimpleNamespace
 
 from mpi4py import MPI
 
@@ -26,12 +25,13 @@ from unibuckle_fenicsx.spec import DesignSpec, load_problem
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial sections")
 
 
-def _section(shape: str = "box", **changes: object) -> SimpleNamespace:
+def _section(shape: str = "box", **changes: object) -> SectionParameters:
     base = {
-        "shape": shape, "thickness": 0.002, "width": 0.2, "depth": 0.1, "diameter": None,
+        "thickness": 0.002, "width": 0.2, "depth": 0.1, "diameter": None, "length": 0.6,
+        "E": 2.1e11, "nu": 0.3, "mesh_size": 0.02,
         "axial_stress": -1.0, "bending_stress": 0.0, "core": False,
     }  # fmt: skip
-    return SimpleNamespace(**{**base, **changes})
+    return SectionParameters(shape, **{**base, **changes})
 
 
 def test_uniform_compression_gives_every_face_the_internal_element_s_rho():

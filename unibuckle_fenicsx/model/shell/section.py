@@ -30,6 +30,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
+from unibuckle_fenicsx.model.materials import bending_stiffness
 from unibuckle_fenicsx.model.problem import Candidate
 from unibuckle_fenicsx.model.shell.core import (
     CoreConstraints,
@@ -193,6 +194,11 @@ class SectionParameters:
         return abs(self.bending_stress) - self.axial_stress
 
     @property
+    def bending_stiffness(self) -> float:
+        """The walls' flexural rigidity D (N m)."""
+        return bending_stiffness(self.E, self.nu, self.thickness)
+
+    @property
     def widest(self) -> float:
         """The widest face b of a box (m), the buckling coefficient's width; a tube's 2R."""
         if self.shape == "box":
@@ -279,8 +285,7 @@ class Section(Owner):
         sigma = load * p.compression()
         if p.shape == "tube" or sigma <= 0.0:
             return math.nan
-        D = p.E * p.thickness**3 / (12.0 * (1.0 - p.nu**2))
-        return sigma * p.thickness * p.widest**2 / (math.pi**2 * D)
+        return sigma * p.thickness * p.widest**2 / (math.pi**2 * p.bending_stiffness)
 
     def classical_stress(self) -> float:
         r"""Reference stress (Pa): a box's k = 4 load, a tube's classical one.
@@ -291,8 +296,7 @@ class Section(Owner):
         t = p.thickness
         if p.shape == "tube":
             return p.E * t / (0.5 * p.widest * math.sqrt(3.0 * (1.0 - p.nu**2)))
-        D = p.E * t**3 / (12.0 * (1.0 - p.nu**2))
-        return 4.0 * math.pi**2 * D / (t * p.widest**2)
+        return 4.0 * math.pi**2 * p.bending_stiffness / (t * p.widest**2)
 
     def destroy(self) -> None:
         """Destroy the problem and the model (collective)."""
