@@ -9,9 +9,10 @@ mode and a new certificate); the table gives
 
 - the load returned, the verified lower bound and the relative gap, the status (proven,
   bracketed, KKT only) and m, the pencil eigenvalues below the load;
-- the split route's distances tried (verified or why not), its columns r, pieces and
-  right-hand sides solved (batched), and its estimated cost in free solves (from counts:
-  the rule that turns it on by default, at most 3);
+- the split route's distances tried (verified or why not), its columns r, pieces
+  proven, right-hand sides solved (batched), pieces examined, factorisations (one per
+  distance), and its estimated cost in free solves (from counts: the rule that turns it
+  on by default, at most 3);
 - ``certificate / free``: the certificate's time (continuations included) over the cold
   free solve's, in one process, the least of ``--repeat`` runs (their values in the
   JSON row's ``ratios``: the least is the one least disturbed by other work on the
@@ -235,7 +236,7 @@ def main() -> None:
             f"MPI ranks: {comm.size}; bracket asked for: {args.bracket}; "
             f"uncapped: {args.uncapped}",
             ("case", "mesh", "m", "lambda_c (Pa)", "lower bound (Pa)", "gap", "status",
-             "distances", "r", "pieces", "rhs", "examined", "estimated cost",
+             "distances", "r", "pieces", "rhs", "examined", "factorisations", "estimated cost",
              "certificate / free", "route / free", "continued"),
         )  # fmt: skip
     for nx, ny in meshes:
@@ -249,7 +250,8 @@ def main() -> None:
                 print(
                     "| {case} | {mesh} | {m} | {load_Pa:.6f} | {lower} | "
                     "{gap} | {status} | {distances} | {r} | {pieces} | {rhs} | "
-                    "{examined} | {est} | **{certify_ratio:.2f}** | {route_ratio:.2f} | "
+                    "{examined} | {factorisations} | {est} | **{certify_ratio:.2f}** | "
+                    "{route_ratio:.2f} | "
                     "{continued} |".format(
                         **row,
                         lower=_number(row["lower_bound_Pa"], ".6f"),

@@ -37,7 +37,9 @@ a load below :math:`\lambda`.
 :math:`c = G_{MW}S_Wz` and :math:`H = G_{MM} - G_{MW}S_WG_{WM}` (Lawson-Hanson on the
 Gram form): its :math:`\mu` is the contact reaction, made of columns, of the least-energy
 mode there. A piece is tried with the :math:`\mu` of its centre, then with those of the
-points where the check fails, else bisected. Where even the dual is negative, the
+points where the check fails, then with its generators' :math:`\mu` and a multiplier
+interpolated linearly between them (exact within one active set of the relaxation, so
+the piece need not lie in one cap), else bisected. Where even the dual is negative, the
 relaxed minimiser :math:`u = K^{-1}C(\ldots)` crosses the obstacle: its part that does
 becomes a new column (a cut), with the translates of the reaction's pieces that best
 cover it; and if u, or u with its crossing part clipped, is admissible with a load below
@@ -154,6 +156,10 @@ class SplitOptions:
             cut by the plate's end is still one).
         line_extent: Clusters spanning more lines than this along the plate are placed at
             every translation from the start (the lines do not describe them).
+        interpolate: A piece no single cap holds is tried with its generators' multipliers
+            interpolated linearly over it before it is split (:func:`_interpolated`): exact
+            within one active set of the relaxation, so larger pieces are proven (on by
+            default: fewer pieces on the plates with m >= 3).
     """
 
     deltas: tuple[float, ...] = (1e-3, 1e-4)
@@ -174,6 +180,7 @@ class SplitOptions:
     line_share: float = 0.25
     clip_fraction: float = 0.1
     line_extent: int = 4
+    interpolate: bool = True
 
     @classmethod
     def thorough(cls) -> SplitOptions:
@@ -1265,7 +1272,72 @@ def _prove_piece(
             muw = muw / muw.max()
             if not any(float(np.abs(muw - q).max()) <= 1e-6 for q in mus):
                 mus.append(muw)
+    if opts.interpolate:
+        margin = _interpolated(basis, relax, V, iterations, opts.margin_factor)
+        if margin is not None:
+            return _Proof(margin=margin, tried=mus)
     return _Proof(margin=_together(basis, V, mus, level, opts), tried=mus, rounding=rounding)
+
+
+def _interpolated(
+    basis: Basis, relax: _Relaxation, V: Array, iterations: int, factor: float
+) -> float | None:
+    r"""The piece's margin with each generator's own multiplier interpolated over the piece.
+
+    The combinations are the generators' :math:`\mu` (the contact reactions of their
+    least-energy modes). For :math:`z = V\alpha` the multiplier
+    :math:`\nu(\alpha) = \Lambda^T\alpha \ge 0` on them gives the weak-duality bound
+    :math:`\min_{w \ge 0} Q(\alpha, w) \ge \alpha^TR\alpha`, with
+    :math:`R = Q_{\alpha\alpha} - (Q_{\alpha w} - \Lambda)Q_{ww}^{-1}(Q_{\alpha w} - \Lambda)^T`;
+    within one active set of the relaxation its optimal multiplier is linear in z, so the
+    interpolation is exact there and the piece need not be small. Row i of
+    :math:`\Lambda` is generator i's best (its dual on the combinations), and
+    :math:`N = [[N_{\alpha\alpha}, \Lambda], [\Lambda^T, 0]]` with
+    :math:`N_{\alpha\alpha}` the positive off-diagonal part of R is an SPN decomposition
+    of Q when :math:`R - N_{\alpha\alpha} \succ 0`; else the SPN program on the same
+    combinations (Clarabel) looks for any N. Either N is checked as every piece's is
+    (bordered inertia, rigorous bound on G's error). None when unproven (a generator whose
+    dual bound is not positive is left to the caps: a new column there).
+    """
+    mus: list[Array] = []
+    for j in range(V.shape[1]):
+        b, mu, t = relax.bound(V[:, j], iterations)
+        top = float(mu.max(initial=0.0))
+        if b <= 0 or not top > 0:  # left to the caps (a new column there) or a split
+            return None
+        mu = mu / top
+        if not any(float(np.abs(mu - q).max()) <= 1e-6 for q in mus):
+            mus.append(mu)
+    combined = _combined(basis, mus, factor)
+    if combined is None:
+        return None
+    G1s, E1s, dg = combined
+    form = _cone_form(G1s, dg, V, len(mus))
+    if form is None:
+        return None
+    Tn, Qn, _ = form
+    n = V.shape[1]
+    Qaa, Qaw, Qww = Qn[:n, :n], Qn[:n, n:], Qn[n:, n:]
+    try:
+        P = np.linalg.inv(Qww)
+    except np.linalg.LinAlgError:
+        return None
+    P = 0.5 * (P + P.T)
+    # Row i: the nonnegative row closest to Q_aw's in P's norm (its dual, Lawson-Hanson).
+    Lam = np.vstack([_dual(P, P @ Qaw[i], 4 * len(mus) + 8) for i in range(n)])
+    D = Qaw - Lam
+    R = Qaa - D @ P @ D.T
+    R = 0.5 * (R + R.T)
+    Naa = np.maximum(R, 0.0)
+    np.fill_diagonal(Naa, 0.0)
+    if float(np.linalg.eigvalsh(R - Naa).min()) > 0:
+        N = np.block([[Naa, Lam], [Lam.T, np.zeros((len(mus), len(mus)))]])
+    else:  # the SPN program on the same combinations (any N, not only these rows)
+        t, N, _ = _spn(Qn)
+        if not (math.isfinite(t) and t > 0):
+            return None
+    margin = _check_piece(G1s, E1s, Tn, N, basis.m, factor)
+    return margin if margin > 1.0 else None
 
 
 def _together(

@@ -267,6 +267,30 @@ def test_thin_ssss_plate_refuted_then_continued_and_bracketed(thin_plate):
 
 
 @serial
+def test_interpolated_multipliers_prove_larger_pieces(thin_plate):
+    """The thin SSSS plate at 45 x 15, the default's distances, with and without.
+
+    A piece that no single combination's cap holds is tried with its generators'
+    multipliers interpolated over it before it is split; the same distances are verified
+    (the bound is lambda_c (1 - delta) either way), with fewer pieces examined (measured:
+    80 without, 36 with).
+    """
+    with solve(thin_plate("ssss", 45, 15), MPI.COMM_SELF) as analysis:
+        problem, sol = analysis.problem, analysis.solution
+        matrix = ShiftedMatrix(problem.model.A, problem.model.B)
+        try:
+            runs = [split_certificate(problem, matrix, sol.candidate, sol.kkt_points,
+                                      SplitOptions(max_cost=None, interpolate=flag))
+                    for flag in (False, True)]  # fmt: skip
+        finally:
+            matrix.destroy()
+    without, with_ = ([a.examined for a in out.attempts] for out in runs)
+    assert [a.proven for a in runs[0].attempts] == [a.proven for a in runs[1].attempts]
+    assert runs[0].value is not None and runs[1].value == runs[0].value
+    assert sum(with_) < sum(without), (with_, without)
+
+
+@serial
 def test_route_skipped_by_default_where_it_costs_more(thin_plate):
     """The thin SSSS plate at 45 x 15 without ``--bracket``: the rule, and the summary.
 
