@@ -25,18 +25,24 @@ to 1e-6, larger budgets, no cost limit); without, as by default. With ``--uncapp
 default solve is certified once more in the same process with the default's distances
 and budgets but no cost limit (``SplitOptions(max_cost=None)``): the run the estimate
 predicts, so that ``route / free`` is the measured cost the estimate is compared with.
+With ``--compare`` each plate's default solve is bounded twice in one process, without
+and with the interpolated multipliers (``SplitOptions(interpolate=False)``, the pieces as
+before them, then the default), with the default's budgets, or with ``--bracket``'s
+(``SplitOptions.thorough()``), no cost limit; the table gives both, "without -> with"
+(rows in ``bench/results/bracket_compare.jsonl``, docs/verification/bracket_cost.md).
 The rows also give the counts the cost model (``COST_MODEL``) is fitted to: DOFs,
 factorisations (attempts) and pieces examined; ``--fit`` fits its unit costs to the
 ``--uncapped`` rows of a results file (non-negative least squares on the route's time
 in free solves) and prints them with the estimate against the measured cost per plate.
 
 Usage: python bench/bench_bracket.py [--meshes 90x30,180x60] [--cases ssss,cs,sc,cccc,shear]
-[--bracket | --uncapped] [--repeat N] [--json FILE] [--fit FILE]
+[--bracket | --uncapped] [--compare] [--repeat N] [--json FILE] [--fit FILE]
 """
 
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import json
 import math
 from pathlib import Path
@@ -215,6 +221,69 @@ def fit(path: str) -> dict[str, float]:
     return model
 
 
+def _compare(spec: Any, comm: Any, thorough: bool, repeat: int) -> dict[str, Any]:
+    """Without and with the interpolated multipliers, from one solve, in one process.
+
+    Per variant (keys ending ``_without`` and ``_with``): the bound of the last run and
+    the least of ``repeat`` times over the free solve's (all of them in ``routes_*``).
+    """
+    with solve(spec, comm) as analysis:
+        sol, free_s = analysis.solution, analysis.problem.timings["free_solve_s"]
+        assert sol is not None
+        load = sol.candidate.load
+        row: dict[str, Any] = {"load_Pa": load, "free_solve_s": free_s}
+        for interpolate, tag in ((False, "without"), (True, "with")):
+            base = SplitOptions.thorough() if thorough else SplitOptions(max_cost=None)
+            split = dataclasses.replace(base, interpolate=interpolate)
+            options = BoundOptions(lowrank=None, split=split)
+            times = []
+            for _ in range(repeat):
+                bound = copositivity_bound(analysis.problem, sol.candidate, sol.kkt_points, options)
+                times.append(bound.timings["total_s"] / free_s)
+            record = bound.split
+            attempts = [] if record is None else record.attempts
+            row["m"] = None if record is None else record.m
+            row.update({
+                f"gap_{tag}": None if bound.value is None else 1.0 - bound.value / load,
+                f"lower_bound_Pa_{tag}": bound.value,
+                f"factorisations_{tag}": len(attempts),
+                f"rhs_{tag}": None if record is None else record.solves,
+                f"examined_{tag}": sum(a.examined or 0 for a in attempts),
+                f"pieces_{tag}": None if record is None else record.pieces,
+                f"route_ratio_{tag}": min(times),
+                f"routes_{tag}": times,
+            })  # fmt: skip
+        return row
+
+
+def _print_compare(name: str, mesh: str, budgets: str, row: dict[str, Any]) -> None:
+    def pair(key: str, spec: str = "") -> str:
+        values = (row[f"{key}_{tag}"] for tag in ("without", "with"))
+        return " -> ".join("-" if x is None else format(x, spec) for x in values)
+
+    print(f"| {name} | {mesh} | {row['m']} | {budgets} | {pair('gap', '.0e')} | "
+          f"{pair('factorisations')} | {pair('rhs')} | {pair('examined')} | "
+          f"{pair('pieces')} | {pair('route_ratio', '.2f')} |", flush=True)  # fmt: skip
+
+
+def _compare_all(args: Any, meshes: list[tuple[int, int]], comm: Any) -> None:
+    """``--compare``: the table "without -> with" per plate and mesh, and its JSON rows."""
+    budgets = "--bracket" if args.bracket else "default"
+    if comm.rank == 0:
+        print_header(
+            f"MPI ranks: {comm.size}; without -> with the interpolated multipliers",
+            ("case", "mesh", "m", "budgets", "gap", "factorisations", "rhs", "examined",
+             "pieces proven", "route / free"),
+        )  # fmt: skip
+    for nx, ny in meshes:
+        for name in args.cases.split(","):
+            row = _compare(_spec(name, nx, ny, "above"), comm, args.bracket, args.repeat)
+            if comm.rank == 0:
+                _print_compare(name, f"{nx}x{ny}", budgets, row)
+                row.update(case=name, mesh=f"{nx}x{ny}", bracket=args.bracket, repeat=args.repeat)
+                append_rows(args.json, [row])
+
+
 def main() -> None:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--meshes", default="90x30,180x60")
@@ -222,6 +291,9 @@ def main() -> None:
     mode = parser.add_mutually_exclusive_group()
     mode.add_argument("--bracket", action="store_true", help="solver.bracket (as asked for)")
     mode.add_argument("--uncapped", action="store_true", help="default budgets, no cost limit")
+    parser.add_argument(
+        "--compare", action="store_true", help="without and with the interpolated multipliers"
+    )
     parser.add_argument("--repeat", type=int, default=1, help="runs per plate (least ratio)")
     parser.add_argument("--json", help="append one JSON line per row to this file")
     parser.add_argument("--fit", help="fit COST_MODEL's unit costs to this file's rows; no run")
@@ -230,6 +302,9 @@ def main() -> None:
     if args.fit:
         if comm.rank == 0:
             fit(args.fit)
+        return
+    if args.compare:
+        _compare_all(args, meshes, comm)
         return
     if comm.rank == 0:
         print_header(

@@ -363,8 +363,26 @@ def _sections_commands(rows: list[dict[str, Any]]) -> str:
     )
 
 
+def _compare_commands(rows: list[dict[str, Any]]) -> str:
+    """The ``bench_bracket.py --compare`` runs that wrote the rows (budgets, repeats)."""
+    commands = []
+
+    def mode(r: dict[str, Any]) -> tuple[bool, int]:
+        return bool(r.get("bracket")), int(r.get("repeat") or 1)
+
+    for asked, repeat in dict.fromkeys(mode(r) for r in rows):
+        group = [r for r in rows if mode(r) == (asked, repeat)]
+        flags = (" --bracket" if asked else "") + (f" --repeat {repeat}" if repeat > 1 else "")
+        commands.append(
+            f"python bench/bench_bracket.py --compare --meshes {_listed(group, 'mesh')} "
+            f"--cases {_listed(group, 'case')}{flags} --json bench/results/bracket_compare.jsonl"
+        )
+    return "`, then `".join(commands)
+
+
 COMMANDS = {
     "bracket": lambda rows: _bracket_commands(rows),
+    "bracket_compare": lambda rows: _compare_commands(rows),
     "sections": lambda rows: _sections_commands(rows),
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
@@ -464,6 +482,25 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("estimated_cost", "estimated cost (free solves)"),
         ("route_ratio", "route time (free solves)"),
         ("certify_ratio", "certificate time (free solves)"),
+    ],
+    "bracket_compare": [
+        ("case", "case"),
+        ("mesh", "mesh"),
+        ("bracket", "--bracket"),
+        ("m", "m"),
+        ("load_Pa", "λ_c (Pa)"),
+        *[
+            (f"{key}_{tag}", f"{header} ({tag})")
+            for key, header in (
+                ("gap", "gap"),
+                ("factorisations", "factorisations"),
+                ("rhs", "right-hand sides"),
+                ("examined", "pieces examined"),
+                ("pieces", "pieces proven"),
+                ("route_ratio", "route time (free solves)"),
+            )
+            for tag in ("without", "with")
+        ],
     ],
     "certify": [
         ("case", "case"),
