@@ -91,6 +91,11 @@ def test_a_section_file_round_trips_through_load_and_dump(tmp_path):
     assert load_problem(tmp_path / "box.json") == loaded.__class__(
         **{f: getattr(loaded, f) for f in loaded.__struct_fields__ if f != "name"}, name="box"
     )
+    # A result of a file in mm-N-MPa: its input in SI, re-run in mm-N-MPa (the same SI values).
+    result = {"units": "mm-N-MPa", "input": problem_to_dict(loaded)}
+    (tmp_path / "mm.json").write_text(json.dumps(result))
+    rerun = load_problem(tmp_path / "mm.json")
+    assert rerun.units == "mm-N-MPa" and rerun.section == loaded.section
 
 
 def _mapping(**changes):
