@@ -129,6 +129,7 @@ def solve_levels(
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
     t0 = time.perf_counter()
     sizes = [parameters.mesh_size * 2.0**k for k in range(levels, -1, -1)]
+    _check_levels(parameters, levels)
     log: list[SectionLevel] = []
     prev: Section | None = None
     best: UnilateralSolution | None = None
@@ -139,9 +140,15 @@ def solve_levels(
             section, polished, polish_iterations, level = _level(
                 parameters, size, prev, best, comm, solver, max_iterations
             )
-        except BaseException:
+        except BaseException as err:
             if prev is not None:
                 prev.destroy()
+            if isinstance(err, InputError) and size != sizes[-1]:  # a coarser section's
+                raise InputError(
+                    f"mesh.levels = {levels}: the coarser section of cells {size:g} m "
+                    f"(mesh.size doubled): {err}; lower mesh.levels (0: the seeds run on "
+                    "the given cells)"
+                ) from None
             raise
         log.append(level)
         if prev is not None:
@@ -161,6 +168,19 @@ def solve_levels(
     elif isinstance(best.details, ActiveSetDetails):
         details.active_set = best.details
     return prev, replace(best, details=details)
+
+
+def _check_levels(parameters: SectionParameters, levels: int) -> None:
+    """Refuse ``levels`` whose coarsest section has fewer than 2 cells along the member."""
+    most = 0  # the coarsest level SectionParameters accepts
+    while parameters.mesh_size * 2.0 ** (most + 1) * (1.0 + 1e-9) < parameters.length:
+        most += 1
+    if levels > most:
+        raise InputError(
+            f"mesh.levels = {levels}: the coarsest section's cells, mesh.size x 2^{levels} = "
+            f"{parameters.mesh_size * 2.0**levels:g} m, are not below section.length = "
+            f"{parameters.length:g} m (at least 2 cells along): mesh.levels <= {most} here"
+        )
 
 
 def _level(
