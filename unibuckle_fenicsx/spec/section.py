@@ -131,8 +131,8 @@ class SectionMeshSpec(Table, frozen=True):
     Args:
         size: Target cell size (m), > 0; a box's faces get an even number of cells.
         levels: With a rigid core, coarser sections (each with twice the cell size) the
-            contact search seeds on, >= 0; 1: its many eigen solves on a quarter of the
-            DOFs, a few polishing solves on the given cells.
+            search starts on, >= 0 (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`);
+            1: its many steps on a quarter of the DOFs, a few on the given cells.
     """
 
     KEY: ClassVar[str] = "mesh"

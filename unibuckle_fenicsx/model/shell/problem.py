@@ -90,6 +90,18 @@ class RotatedPencil(Owner):
             self.T.mult(u, out)
         return out
 
+    def to_rotated(self, u: PETSc.Vec, out: PETSc.Vec) -> PETSc.Vec:
+        r"""Components :math:`u' = T^T u` of the new basis of a vector ``u`` of global ones.
+
+        The inverse of :meth:`to_global`: T is orthogonal, its blocks are made from
+        orthonormal normals (a box's faces meet at right angles; a tube's node has one).
+        """
+        if self.T is None:
+            u.copy(out)
+        else:
+            self.T.multTranspose(u, out)
+        return out
+
     def destroy(self) -> None:
         """Destroy A', B' and T (collective); the model's own A, B stay with the model."""
         if getattr(self, "T", None) is None:
