@@ -68,11 +68,13 @@ from unibuckle_fenicsx.spec import SolverSpec
 
 __all__ = [
     "CHAIN_OPTIONS",
+    "COARSEST_DOFS",
     "INTERIOR_POINT_DOFS",
     "MORE_SEEDS",
     "ROUTES",
     "SEEDS",
     "estimated_dofs",
+    "interior_levels",
     "prolong_directions",
     "solve_levels",
 ]
@@ -105,6 +107,12 @@ INTERIOR_POINT_DOFS = 10_000
 #: gave the lowest KKT point on the finest, and each further arrangement costs a whole
 #: run of Newton steps on the finest section (:doc:`/verification/sections`, "Cost").
 CHAIN_OPTIONS = ChainOptions(arrangements=1)
+#: The interior point starts on a section at least this coarse: the cell size doubled
+#: while the coarser section keeps this many DOFs (more if ``levels`` asks). The
+#: starts take a few hundred Newton steps there; on the sections of
+#: :doc:`/verification/sections` ("Cost") a coarsest section of 1 000 to 2 500 DOFs
+#: ranked their arrangements as the finest did.
+COARSEST_DOFS = 1_000
 
 
 class _NoKKTPoint(Exception):
@@ -157,7 +165,8 @@ def solve_levels(
     Args:
         parameters: The section, with ``core = True``.
         levels: Coarser sections (each with twice the mesh size) to start on, >= 0; 0
-            runs on the section itself.
+            runs on the section itself. The interior point takes more while the
+            coarsest keeps :data:`COARSEST_DOFS`.
         comm: Communicator.
         solver: Solver options.
         max_iterations: Iterates per seed on the coarsest level, >= 1.
@@ -180,7 +189,7 @@ def solve_levels(
         route == "auto" and estimated_dofs(parameters) >= INTERIOR_POINT_DOFS
     ):
         try:
-            return _interior_point(parameters, levels, comm, solver)
+            return _interior_point(parameters, interior_levels(parameters, levels), comm, solver)
         except _NoKKTPoint:
             if route == "interior-point":
                 raise RuntimeError("the interior-point route reached no KKT point") from None
@@ -195,6 +204,19 @@ def estimated_dofs(parameters: SectionParameters) -> int:
     widths = (float(across[0] or 0.0), float(across[1] or 0.0))
     around, along = grid_nodes(p.shape, widths, p.length, p.mesh_size, p.corner_cell)
     return DOFS_PER_NODE * around * along
+
+
+def interior_levels(parameters: SectionParameters, levels: int) -> int:
+    """The interior point's coarser sections: ``levels``, or more.
+
+    More while the coarsest keeps :data:`COARSEST_DOFS` (estimated: :func:`estimated_dofs`).
+    """
+    k = 0
+    while True:
+        coarser = replace(parameters, mesh_size=parameters.mesh_size * 2.0 ** (k + 1))
+        if estimated_dofs(coarser) < COARSEST_DOFS:
+            return max(levels, k)
+        k += 1
 
 
 def _sizes(parameters: SectionParameters, levels: int) -> list[float]:
