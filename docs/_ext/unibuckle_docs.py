@@ -873,6 +873,7 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
             "dolfinx.mesh.MeshTags": ("class", "generated/dolfinx.mesh.html#$"),
             "dolfinx.la.Vector": ("class", "generated/dolfinx.la.html#$"),
             "dolfinx.io.gmsh.model_to_mesh": ("function", "generated/dolfinx.io.gmsh.html#$"),
+            "dolfinx.fem.petsc.LinearProblem": ("class", "generated/dolfinx.fem.petsc.html#$"),
         },
     ),
     "ufl": (

@@ -268,7 +268,7 @@ def test_schema_page_gives_a_sections_own_words_for_the_keys_it_shares() -> None
     page = unibuckle_docs.schema_page()
     row = next(line for line in page.splitlines() if line.startswith("| `mesh.size` |"))
     assert "A rectangle's nx and ny" in row
-    assert "A section's file: Target cell size (m), > 0; a box's faces get an even" in row
+    assert "A section's file: Target cell size (m), > 0 and below the section's length" in row
 
 
 def _words(page: Path) -> int:

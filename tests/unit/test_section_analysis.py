@@ -127,3 +127,48 @@ def test_levels_end_no_higher_than_the_seeds_on_the_given_section():
             assert analysis.result.certificate is not None and analysis.result.certificate.kkt
             loads[levels] = analysis.result.critical_load_Pa
     assert loads[1] <= loads[0] * (1 + 1e-7), loads
+
+
+def test_a_filled_box_does_not_depend_on_what_the_process_solved_before(tmp_path):
+    """The same file gives the same bits first in a fresh process and after other solves.
+
+    Nothing of one run reaches the next: no PETSc option left in the database, no cache,
+    no random state, no warm start. A small filled box (b = 0.1 m, b/t = 50, L = 2b,
+    cells b/4) is solved by ``unibuckle solve`` in a fresh process, then here after a
+    plate with an obstacle, the hollow box and itself: its load, eigen solves and contact
+    set equal the fresh run's to the bit, and the options database is as it was.
+    Rounding is another matter: a 1-ulp change of the input (a length of 3 * 0.2 against
+    0.6) may take the active set to another KKT point of a flat landscape.
+    """
+    import subprocess
+    import sys
+
+    from petsc4py import PETSc
+
+    from unibuckle_fenicsx.cli import EXIT_OK, main
+
+    box = tmp_path / "box.toml"
+    box.write_text(
+        '[section]\nshape = "box"\nwidth = 0.1\ndepth = 0.1\nthickness = 0.002\n'
+        'length = 0.2\nends = "simply_supported"\n[material]\nE = 2.1e11\nnu = 0.3\n'
+        "[obstacle]\ncore = true\n[mesh]\nsize = 0.025\n"
+    )
+    fresh = tmp_path / "fresh.json"
+    code = "import sys; from unibuckle_fenicsx.cli import main; sys.exit(main(sys.argv[1:]))"
+    args = ["solve", "--config", str(box), "-q", "--json"]
+    subprocess.run([sys.executable, "-c", code, *args, str(fresh)], check=True, cwd=ROOT)
+    before = PETSc.Options().getAll()
+    runs = [
+        ["solve", "--case", "c1", "--nx", "8", "--ny", "4", "-q"],
+        [*args[:-2], "-q", "--set", "obstacle.core=false"],
+        [*args, str(tmp_path / "1.json")],
+        [*args, str(tmp_path / "2.json")],
+    ]
+    for run in runs:
+        assert main(run) == EXIT_OK
+    assert PETSc.Options().getAll() == before
+    expected = json.loads(fresh.read_text())
+    for name in ("1.json", "2.json"):
+        got = json.loads((tmp_path / name).read_text())
+        for key in ("critical_load_Pa", "free_load_Pa", "eigensolves", "contact_indices"):
+            assert got[key] == expected[key], (name, key)

@@ -32,7 +32,13 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.la.options import Prefix, option_defaults, ordering_options
+from unibuckle_fenicsx.la.options import (
+    Options,
+    Prefix,
+    option_defaults,
+    ordering_options,
+    set_options,
+)
 from unibuckle_fenicsx.model.materials import membrane_voigt
 from unibuckle_fenicsx.model.mesh import edge_line, edge_normal_axis, edge_tags
 from unibuckle_fenicsx.spec import (
@@ -47,6 +53,7 @@ __all__ = [
     "DIRECT_SOLVE",
     "NEAR_TENSION",
     "Prestress",
+    "direct_problem",
     "edge_traction",
     "membrane_force",
     "pin_rigid_motions",
@@ -72,6 +79,22 @@ DIRECT_SOLVE: dict[str, str | bool] = {
     "pc_factor_mat_solver_type": "mumps",
     "ksp_error_if_not_converged": True,
 }
+
+
+def direct_problem(
+    a: ufl.Form, L: ufl.Form, bcs: list[Any], prefix: str, options: Options = DIRECT_SOLVE
+) -> dolfinx.fem.petsc.LinearProblem:
+    """DOLFINx's linear problem of ``a = L``, its KSP under ``prefix`` with ``options`` as defaults.
+
+    The options go through :func:`~unibuckle_fenicsx.la.options.set_options` (an option
+    the database holds already, e.g. from the command line, wins; nothing stays behind),
+    not through the problem's ``petsc_options``: DOLFINx 0.11 sets those over the
+    database's values and, popping them, removes the unprefixed options of the same
+    names while its own prefixed ones stay in the database.
+    """
+    problem = dolfinx.fem.petsc.LinearProblem(a, L, bcs=bcs, petsc_options_prefix=prefix)
+    set_options(problem.solver, prefix, options)
+    return problem
 
 
 def material_constant(value: Any, expr: ufl.core.expr.Expr) -> dolfinx.fem.Constant:
@@ -352,12 +375,8 @@ def _solve_membrane(
                 EQUILIBRATED.add(key)
         bcs = pin_rigid_motions(V, msh)
 
-    problem = dolfinx.fem.petsc.LinearProblem(
-        a,
-        L,
-        bcs=bcs,
-        petsc_options=DIRECT_SOLVE if petsc_options is None else petsc_options,
-        petsc_options_prefix=Prefix.PRESTRESS,
+    problem = direct_problem(
+        a, L, bcs, Prefix.PRESTRESS, DIRECT_SOLVE if petsc_options is None else petsc_options
     )
     problem.A.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
     # The ordering is read at the symbolic factorisation, inside solve().

@@ -448,6 +448,9 @@ def load_toml(path: str | Path) -> ProblemSpec | SectionProblemSpec:
 def load_problem(path: str | Path) -> ProblemSpec | SectionProblemSpec:
     """A problem file: TOML, or the JSON of a result (its ``input``, which re-runs it).
 
+    A result's ``input`` is in SI; its ``units`` (the unit system of the file it solved)
+    become the problem's, so that the re-run prints, and ``--set`` reads, in that system.
+
     Raises:
         InputError: An invalid file or problem; the message names the file.
         OSError: The file cannot be read.
@@ -459,11 +462,16 @@ def load_problem(path: str | Path) -> ProblemSpec | SectionProblemSpec:
         data = json.loads(path.read_bytes().decode("utf-8"))
     except (UnicodeDecodeError, json.JSONDecodeError) as err:
         raise InputError(f"{path}: not a JSON result or problem file: {err}") from None
+    units = None
     if isinstance(data, dict) and "input" in data:
+        units = data.get("units", "SI")
+        if units not in UNITS:
+            raise InputError(f"{path}: units must be one of {tuple(UNITS)}, got {units!r}")
         data = data["input"]
         if data is None:
             raise InputError(f"{path}: this result's problem has no file form (a predicate zone)")
     try:
-        return spec_from_dict(data, name=path.stem)
+        spec = spec_from_dict(data, name=path.stem)
     except ValueError as err:
         raise InputError(f"{path}: {err}") from None
+    return spec if units is None else msgspec.structs.replace(spec, units=units)

@@ -412,6 +412,14 @@ def test_mm_file_prints_mpa_and_solves_the_same_problem(tmp_path, capsys):
     mm, si = (json.loads(p.read_text()) for p in (out_mm, out_si))
     assert mm["units"] == "mm-N-MPa" and mm["input"]["units"] == "SI"
     assert mm["critical_load_Pa"] == pytest.approx(si["critical_load_Pa"], rel=1e-12)
+    # Re-run from the JSON: the file's units again (the same load in MPa, 1e-6 x Pa).
+    rerun = tmp_path / "rerun.json"
+    capsys.readouterr()
+    assert main(["solve", "--config", str(out_mm), "--json", str(rerun)]) == EXIT_OK
+    again = capsys.readouterr().out.splitlines()[0]
+    assert re.search(r"lambda_c = 1\.\d+e\+01 MPa", again), again
+    assert json.loads(rerun.read_text())["units"] == "mm-N-MPa"
+    assert json.loads(rerun.read_text())["critical_load_Pa"] == mm["critical_load_Pa"]
 
 
 def test_options_that_do_not_apply_are_named(capsys):

@@ -173,3 +173,45 @@ def test_equilibrium_of_a_plate_is_checked_once(monkeypatch):
         with pytest.raises(ValueError, match=r"not self-equilibrated"):
             solve_prestress(msh, tags, unbalanced, MATERIAL, plate_mesh=True)
     assert len(calls) == 4
+
+
+def test_prestress_solves_leave_the_options_database_as_they_found_it():
+    """The prestress solves' KSP options are defaults: a database value wins, none stays.
+
+    README, "Command line": ``-unibuckle_prestress_pc_type lu`` reaches the plate's
+    prestress solve; the defaults (:data:`~unibuckle_fenicsx.model.prestress.DIRECT_SOLVE`)
+    are removed after it; options of other prefixes (a user's unprefixed ``-ksp_type``)
+    are left alone. Before, DOLFINx's ``petsc_options`` overwrote the user's value,
+    deleted the unprefixed ``ksp_type`` and ``pc_type`` and left its own four entries in
+    the database for every later solve of the process. The loads are LU's and Cholesky's
+    of the same matrix: equal to rounding.
+    """
+    from petsc4py import PETSc
+
+    from unibuckle_fenicsx.model.shell.geometry import box_mesh
+    from unibuckle_fenicsx.model.shell.prestress import solve_section_prestress
+
+    opts = PETSc.Options()
+    mine = {
+        "ksp_type": "gmres",
+        "pc_type": "jacobi",
+        "unibuckle_prestress_pc_type": "lu",
+        "unibuckle_section_prestress_pc_type": "lu",
+    }
+    before = opts.getAll()
+    for key, value in mine.items():
+        opts.setValue(key, value)
+    try:
+        spec = paper_case("free", 10, 6)
+        msh, tags = create_plate_mesh(spec.plate, spec.mesh, MPI.COMM_WORLD)
+        lu = solve_prestress(msh, tags, spec.plate, spec.material)
+        section = box_mesh(0.1, 0.1, 0.2, 0.05, MPI.COMM_WORLD)
+        solve_section_prestress(section, spec.material, 0.002, -1.0)
+        assert opts.getAll() == {**before, **mine}
+    finally:
+        for key in mine:
+            opts.delValue(key)
+    assert opts.getAll() == before
+    cholesky = solve_prestress(msh, tags, spec.plate, spec.material)
+    assert opts.getAll() == before
+    assert lu.max_compression == pytest.approx(cholesky.max_compression, rel=1e-12)

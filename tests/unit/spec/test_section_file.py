@@ -91,6 +91,11 @@ def test_a_section_file_round_trips_through_load_and_dump(tmp_path):
     assert load_problem(tmp_path / "box.json") == loaded.__class__(
         **{f: getattr(loaded, f) for f in loaded.__struct_fields__ if f != "name"}, name="box"
     )
+    # A result of a file in mm-N-MPa: its input in SI, re-run in mm-N-MPa (the same SI values).
+    result = {"units": "mm-N-MPa", "input": problem_to_dict(loaded)}
+    (tmp_path / "mm.json").write_text(json.dumps(result))
+    rerun = load_problem(tmp_path / "mm.json")
+    assert rerun.units == "mm-N-MPa" and rerun.section == loaded.section
 
 
 def _mapping(**changes):
@@ -241,3 +246,36 @@ def test_an_elastic_core_between_its_limits():
     assert loads["stiff"] == pytest.approx(loads["rigid"], rel=1e-5)
     assert loads["hollow"] < loads["medium"] < loads["stiff"] <= loads["rigid"] * (1 + 1e-9)
     assert loads["rigid over [0, L]"] == pytest.approx(loads["rigid"], rel=1e-12)
+
+
+def test_cells_too_coarse_are_refused_naming_size_or_levels(tmp_path, capsys):
+    """mesh.size not below the length, or levels whose coarser section cannot seed: exit 2.
+
+    A section needs 2 cells along (ceil(L/h) >= 2, its end nodes are supported); the
+    coarser sections of ``mesh.levels`` double the cells, so on L = 0.2 m, h = 0.0125 m
+    (16 cells) at most 3 levels leave 2 cells; a core's span [0.06, 0.09] m holds a node
+    of cells 0.0125 m (x = 0.0625) but none of cells 0.05 m (levels = 2). Each message
+    names the key to change, not a plate's mesh.nx or only the span.
+    """
+    core = BOX.replace("[mesh]", "[obstacle]\ncore = true\n[mesh]")
+    short = core.replace("core = true", "core = true\nspan = [0.06, 0.09]")
+    cases = [
+        (
+            BOX.replace("size = 0.0125", "size = 0.2"),
+            "mesh.size = 0.2 m must be below section.length = 0.2 m",
+        ),
+        (
+            core.replace("size = 0.0125", "size = 0.0125\nlevels = 4"),
+            "mesh.levels = 4: the coarsest section's cells, mesh.size x 2^4 = 0.2 m, are not "
+            "below section.length = 0.2 m (at least 2 cells along): mesh.levels <= 3 here",
+        ),
+        (
+            short.replace("size = 0.0125", "size = 0.0125\nlevels = 2"),
+            "mesh.levels = 2: the coarser section of cells 0.05 m (mesh.size doubled): the "
+            "core covers no free node",
+        ),
+    ]
+    for text, message in cases:
+        assert main(["solve", "--config", str(_write(tmp_path, text)), "-q"]) == EXIT_BAD_INPUT
+        err = capsys.readouterr().err
+        assert message in err, err

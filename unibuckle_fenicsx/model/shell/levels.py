@@ -185,11 +185,13 @@ def solve_levels(
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
     if route not in ROUTES:
         raise InputError(f"route must be one of {ROUTES}, got {route!r}")
+    _check_levels(parameters, levels)
     if route == "interior-point" or (
         route == "auto" and estimated_dofs(parameters) >= INTERIOR_POINT_DOFS
     ):
         try:
-            return _interior_point(parameters, interior_levels(parameters, levels), comm, solver)
+            more = interior_levels(parameters, levels)
+            return _interior_point(parameters, more, comm, solver, levels)
         except _NoKKTPoint:
             if route == "interior-point":
                 raise RuntimeError("the interior-point route reached no KKT point") from None
@@ -211,12 +213,10 @@ def interior_levels(parameters: SectionParameters, levels: int) -> int:
 
     More while the coarsest keeps :data:`COARSEST_DOFS` (estimated: :func:`estimated_dofs`).
     """
-    k = 0
-    while True:
-        coarser = replace(parameters, mesh_size=parameters.mesh_size * 2.0 ** (k + 1))
-        if estimated_dofs(coarser) < COARSEST_DOFS:
-            return max(levels, k)
+    k, most = 0, _most_levels(parameters)
+    while k < most and estimated_dofs(_at(parameters, 2.0 ** (k + 1))) >= COARSEST_DOFS:
         k += 1
+    return max(levels, k)
 
 
 def _sizes(parameters: SectionParameters, levels: int) -> list[float]:
@@ -228,15 +228,31 @@ def _build(
     parameters: SectionParameters, size: float, comm: MPI.Comm, solver: SolverSpec | None
 ) -> Section:
     """The section on cells of ``size`` (a box's corner cells graded in proportion)."""
+    return build_section(_at(parameters, size / parameters.mesh_size), comm, solver)
+
+
+def _at(parameters: SectionParameters, factor: float) -> SectionParameters:
+    """``parameters`` with cells ``factor`` times as large (corner cells too)."""
     corner = parameters.corner_cell
-    graded = None if corner is None else corner * size / parameters.mesh_size
-    return build_section(replace(parameters, mesh_size=size, corner_cell=graded), comm, solver)
+    return replace(
+        parameters,
+        mesh_size=parameters.mesh_size * factor,
+        corner_cell=None if corner is None else corner * factor,
+    )
 
 
 def _interior_point(
-    parameters: SectionParameters, levels: int, comm: MPI.Comm, solver: SolverSpec | None
+    parameters: SectionParameters,
+    levels: int,
+    comm: MPI.Comm,
+    solver: SolverSpec | None,
+    asked: int,
 ) -> tuple[Section, UnilateralSolution]:
     """The nested interior-point chain over the sections (module docstring).
+
+    ``levels``: the coarser sections (:func:`interior_levels`), ``asked`` of them the
+    caller's: a coarser section that cannot be built (its core covers no free node) ends
+    the added ones, and is refused among the asked ones.
 
     Raises:
         _NoKKTPoint: It reached no KKT point on the finest section (all destroyed).
@@ -247,8 +263,19 @@ def _interior_point(
 
     sections: list[Section] = []
     try:
-        for size in _sizes(parameters, levels):
-            sections.append(_build(parameters, size, comm, solver))
+        for k, size in enumerate(_sizes(parameters, levels)[::-1]):  # finest first
+            try:
+                sections.insert(0, _build(parameters, size, comm, solver))
+            except InputError as err:
+                if k == 0:  # the given cells' own error
+                    raise
+                if k > asked:  # a level added by interior_levels: fewer of them
+                    break
+                raise InputError(
+                    f"mesh.levels = {asked}: the coarser section of cells {size:g} m "
+                    f"(mesh.size doubled): {err}; lower mesh.levels (0: the search starts "
+                    "on the given cells)"
+                ) from None
         problems = [_cored(section) for section in sections]
         solution = solve_interior_point(
             problems[-1],
@@ -294,9 +321,15 @@ def _active_set(
             section, polished, polish_iterations, level = _level(
                 parameters, size, prev, best, comm, solver, max_iterations
             )
-        except BaseException:
+        except BaseException as err:
             if prev is not None:
                 prev.destroy()
+            if isinstance(err, InputError) and size != sizes[-1]:  # a coarser section's
+                raise InputError(
+                    f"mesh.levels = {levels}: the coarser section of cells {size:g} m "
+                    f"(mesh.size doubled): {err}; lower mesh.levels (0: the seeds run on "
+                    "the given cells)"
+                ) from None
             raise
         log.append(level)
         if prev is not None:
@@ -316,6 +349,25 @@ def _active_set(
     elif isinstance(best.details, ActiveSetDetails):
         details.active_set = best.details
     return prev, replace(best, details=details)
+
+
+def _most_levels(parameters: SectionParameters) -> int:
+    """The most coarser sections with 2 cells along the member (SectionParameters accepts)."""
+    most = 0
+    while parameters.mesh_size * 2.0 ** (most + 1) * (1.0 + 1e-9) < parameters.length:
+        most += 1
+    return most
+
+
+def _check_levels(parameters: SectionParameters, levels: int) -> None:
+    """Refuse ``levels`` whose coarsest section has fewer than 2 cells along the member."""
+    most = _most_levels(parameters)
+    if levels > most:
+        raise InputError(
+            f"mesh.levels = {levels}: the coarsest section's cells, mesh.size x 2^{levels} = "
+            f"{parameters.mesh_size * 2.0**levels:g} m, are not below section.length = "
+            f"{parameters.length:g} m (at least 2 cells along): mesh.levels <= {most} here"
+        )
 
 
 def _level(

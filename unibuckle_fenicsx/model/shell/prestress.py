@@ -29,7 +29,7 @@ import numpy as np
 
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.materials import membrane_voigt
-from unibuckle_fenicsx.model.prestress import DIRECT_SOLVE, material_constant
+from unibuckle_fenicsx.model.prestress import direct_problem, material_constant
 from unibuckle_fenicsx.model.shell.forms import ShellFields, membrane_force
 from unibuckle_fenicsx.model.shell.geometry import END_FINISH, END_START, SectionMesh
 from unibuckle_fenicsx.model.shell.model import (
@@ -113,9 +113,7 @@ def solve_section_prestress(
     t = material_constant(thickness, x)
     L = t * sigma * W[0] * ds(END_FINISH) - t * sigma * W[0] * ds(END_START)
     bcs = support_bcs(V, section, node_pins(section))
-    problem = dolfinx.fem.petsc.LinearProblem(
-        a, L, bcs=bcs, petsc_options=dict(DIRECT_SOLVE), petsc_options_prefix=PRESTRESS_PREFIX
-    )
+    problem = direct_problem(a, L, bcs, PRESTRESS_PREFIX)
     u0 = problem.solve()
     if not isinstance(u0, dolfinx.fem.Function):
         raise TypeError("solve_section_prestress: expected one Function (an internal invariant)")

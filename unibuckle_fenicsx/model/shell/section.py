@@ -74,7 +74,8 @@ class SectionParameters:
         length: Length L between the loaded ends (m), > 0.
         E: Young's modulus (Pa), > 0.
         nu: Poisson's ratio, in (-1, 0.5).
-        mesh_size: Target cell size (m), > 0 (a box's faces get an even number of cells).
+        mesh_size: Target cell size (m), > 0 and below ``length`` (at least 2 cells along;
+            a box's faces get an even number of cells).
         width: Box: mid-line width b along y (m).
         depth: Box: mid-line depth d along z (m).
         diameter: Tube: mid-surface diameter 2R (m).
@@ -127,6 +128,12 @@ class SectionParameters:
             )
         _positive("length", self.length)
         _positive("mesh_size", self.mesh_size)
+        if self.mesh_size * (1.0 + 1e-9) >= self.length:  # geometry's cells along: ceil(L/h)
+            raise InputError(
+                f"mesh.size = {self.mesh_size:g} m must be below section.length = "
+                f"{self.length:g} m: the section needs at least 2 cells along its length "
+                "(the nodes of its loaded ends are supported)"
+            )
         if self.corner_cell is not None:
             _positive("corner_cell", self.corner_cell)
         if not (isinstance(self.E, int | float) and math.isfinite(self.E) and self.E > 0):
