@@ -229,3 +229,22 @@ def test_a_route_is_one_of_the_routes():
 
     with pytest.raises(InputError, match="route must be one of"):
         solve_levels(_parameters("box"), levels=0, comm=MPI.COMM_SELF, route="simplex")
+
+
+def test_a_coarser_section_without_core_nodes_ends_the_added_levels():
+    # The core over 0.31..0.34 m holds the 25 mm cells' nodes at 0.325 m, none of the
+    # 50 mm cells' (0.30, 0.35): the interior point's added level is dropped, a level
+    # the caller asked for is refused naming mesh.levels.
+    from unibuckle_fenicsx.errors import InputError
+    from unibuckle_fenicsx.model.shell.levels import interior_levels
+
+    params = _parameters(
+        "box", width=0.2, depth=0.2, length=0.6, mesh_size=0.025, core_span=(0.31, 0.34)
+    )
+    assert interior_levels(params, 0) >= 1
+    finest, solution = solve_levels(params, levels=0, comm=MPI.COMM_SELF, route="interior-point")
+    with finest:
+        assert len(solution.details.levels) == 1
+        assert solution.candidate.kkt
+    with pytest.raises(InputError, match=r"mesh\.levels"):
+        solve_levels(params, levels=1, comm=MPI.COMM_SELF, route="interior-point")
