@@ -31,6 +31,17 @@ Usage: python bench/bench_stages.py [--meshes 90x30,180x60,360x120] [--case ssss
 [--repeat N] [--json FILE]
 
 With ``--repeat N`` each process is run N times and every stage keeps its minimum.
+
+With ``--phases`` it also prints, per mesh and per level of the route, the *exclusive*
+process seconds of each phase (a phase called inside another is charged to the inner
+one only, so a level's phases add up to its time): ``setup`` (mesh, prestress,
+assembly), ``kernel`` (a Newton kernel's matrices, once per mesh), ``prolong`` (the
+carried mode's interpolation), ``relax`` (its block solves into the mesh's Kirchhoff
+kernel), ``lift`` (the least-energy correction: one factorisation), ``LDL`` (numeric
+factorisations of the shared LDL^T), ``Newton`` (the steps' vector work and bookkeeping),
+``sets`` (reading contact sets off barrier points), ``eigen`` (reduced eigen solves, their
+factorisations included), ``other`` (the rest of the level's code); the fine level, the
+free solve and the certificate in rows of their own.
 """
 
 from __future__ import annotations
@@ -111,7 +122,81 @@ def _install_timers(acc: dict[tuple[str, int], list[float]]) -> None:
     chain.explore = explore.explore
 
 
-def worker(case: str, nx: int, ny: int, free: bool) -> None:
+#: Exclusive phases (``--phases``): (module, owner, attribute, phase, DOFs of the call).
+PHASES = (
+    "setup", "kernel", "prolong", "relax", "lift", "LDL", "Newton", "sets", "eigen", "other",
+)  # fmt: skip
+
+
+def _install_phases(acc: dict[tuple[str, int], list[float]]) -> None:
+    """Wrap the route's functions: ``acc[(phase, DOFs)] = [exclusive seconds, calls, *counts]``.
+
+    Exclusive: the process time and :data:`EVENTS` of the wrapped calls made inside a
+    call are charged to theirs only.
+    """
+    from unibuckle_fenicsx import analysis
+    from unibuckle_fenicsx.algorithms import chain, multilevel
+    from unibuckle_fenicsx.algorithms.interior_point import explore, kernel, newton, starts
+    from unibuckle_fenicsx.certificate import certify
+    from unibuckle_fenicsx.la import factor
+    from unibuckle_fenicsx.model import build, problem
+
+    inner: list[list[float]] = []  # per open call: [seconds, *counts] of its wrapped callees
+
+    def wrap(owner: Any, name: str, phase: str, dofs: Callable[..., int]) -> None:
+        wrapped = getattr(owner, name)
+
+        @functools.wraps(wrapped)
+        def timed(*args: Any, **kwargs: Any) -> Any:
+            c0, n0 = time.process_time(), _counts()
+            inner.append([0.0] * (1 + len(EVENTS)))
+            result = None
+            try:
+                result = wrapped(*args, **kwargs)
+                return result
+            finally:
+                counts = (b - a for a, b in zip(n0, _counts(), strict=True))
+                spent = [time.process_time() - c0, *counts]
+                callees = inner.pop()
+                if inner:
+                    inner[-1] = [x + y for x, y in zip(inner[-1], spent, strict=True)]
+                entry = acc[(phase, dofs(result, *args))]
+                entry[0] += spent[0] - callees[0]
+                entry[1] += 1
+                for j in range(len(EVENTS)):
+                    entry[2 + j] += spent[1 + j] - callees[1 + j]
+
+        setattr(owner, name, timed)
+
+    def size(mat: Any) -> int:
+        return int(mat.getSize()[0])
+
+    def of_problem(r: Any, p: Any, *a: Any, **k: Any) -> int:
+        return size(p.model.A)
+
+    wrap(build, "build_problem", "setup", lambda r, *a, **k: size(r.model.A))
+    wrap(build, "build_unilateral_problem", "setup", lambda r, *a, **k: size(r.model.A))
+    wrap(problem.Problem, "solve_free", "free solve", of_problem)
+    wrap(problem.UnilateralProblem, "evaluate", "eigen", of_problem)
+    wrap(kernel.NewtonKernel, "__init__", "kernel", lambda r, k, p, *a, **kw: size(p.model.A))
+    wrap(newton.InteriorPointNewton, "solve", "Newton", lambda r, n, *a, **k: size(n.kernel.A))
+    for name in ("predicted_contact_set", "contact_set"):
+        wrap(newton.InteriorPointNewton, name, "sets", lambda r, n, *a, **k: size(n.kernel.A))
+    wrap(factor.SharedFactorization, "factor", "LDL", lambda r, f, *a: size(f.matrix))
+    wrap(multilevel.Prolongation, "__init__", "prolong", lambda r, c, co, f: size(f.model.A))
+    wrap(multilevel.Prolongation, "mode", "prolong", lambda r, c, *a: size(c.fine.model.A))
+    for name in ("relax", "lift"):
+        wrap(starts.Starts, name, name, lambda r, s, *a, **k: size(s.kernel.A))
+    wrap(explore, "explore", "other", of_problem)
+    wrap(chain, "_carry", "other", lambda r, ps, k, *a, **kw: size(ps[k].model.A))
+    wrap(certify, "certify", "certificate", lambda *a, **k: 0)
+    # The names imported elsewhere, bound before the wrapping.
+    analysis.certify, analysis.build_problem = certify.certify, build.build_problem
+    chain.explore, chain.build_unilateral_problem = explore.explore, build.build_unilateral_problem
+    chain.Prolongation = multilevel.Prolongation
+
+
+def worker(case: str, nx: int, ny: int, free: bool, phases: bool = False) -> None:
     """One solve in this process; print a JSON line of its stage times."""
     from mpi4py import MPI
     from petsc4py import PETSc
@@ -122,7 +207,7 @@ def worker(case: str, nx: int, ny: int, free: bool) -> None:
 
     PETSc.Log.begin()
     acc: dict[tuple[str, int], list[float]] = defaultdict(lambda: [0.0, 0, 0, 0])
-    _install_timers(acc)
+    (_install_phases if phases else _install_timers)(acc)
     spec = _spec(case, nx, ny)
     if free:
         spec = replace(spec, obstacle=None)
@@ -142,14 +227,49 @@ def worker(case: str, nx: int, ny: int, free: bool) -> None:
         }
     row["total"] = time.process_time() - c0
     row["factorisations"], row["solves"] = (b - a for a, b in zip(n0, _counts(), strict=True))
-    row["stages"] = [[stage, n, *values] for (stage, n), values in acc.items()]
+    key = "phases" if phases else "stages"
+    row[key] = [[stage, n, *values] for (stage, n), values in acc.items()]
     print(json.dumps(row))
 
 
-def _run(case: str, nx: int, ny: int, free: bool) -> dict[str, Any]:
+def _run(case: str, nx: int, ny: int, free: bool, phases: bool = False) -> dict[str, Any]:
     cmd = [sys.executable, __file__, "--worker", case, str(nx), str(ny)]
-    out = subprocess.run(cmd + (["--free"] if free else []), check=True, capture_output=True)
+    cmd += (["--free"] if free else []) + (["--phases"] if phases else [])
+    out = subprocess.run(cmd, check=True, capture_output=True)
     return dict(json.loads(out.stdout.decode().strip().splitlines()[-1]))
+
+
+def _phase_rows(
+    case: str, mesh: str, run: dict[str, Any], free_run: dict[str, Any]
+) -> list[dict[str, Any]]:
+    """One row per level of ``run`` (coarsest first): its exclusive phase seconds.
+
+    The fine level's row also holds the free solve, the certificate, the whole run's
+    and the free run's process seconds and their ratio.
+    """
+    got: dict[tuple[str, int], list[float]] = {(s, k): v for s, k, *v in run["phases"]}
+    sizes = sorted({k for ph, k in got if ph in PHASES})
+    rows = []
+    for n, (level, steps, _, eigensolves) in zip(sizes, run["levels"], strict=True):
+        here = {ph: v for (ph, k), v in got.items() if k == n and ph in PHASES}
+        rows.append(
+            {
+                "case": case, "mesh": mesh, "level": "x".join(map(str, level)), "dofs": n,
+                "steps": steps, "eigensolves": eigensolves,
+                "factorisations": int(sum(v[2] for v in here.values())),
+                "solves": int(sum(v[3] for v in here.values())),
+                "LDL calls": int(here.get("LDL", [0.0, 0])[1]),
+                **{ph: here.get(ph, [0.0])[0] for ph in PHASES},
+                "level total": sum(v[0] for v in here.values()),
+            }
+        )  # fmt: skip
+    fine = rows[-1]
+    fine["free solve"] = got.get(("free solve", fine["dofs"]), [0.0])[0]
+    fine["certificate"] = got.get(("certificate", 0), [0.0])[0]
+    fine["total"], fine["free run"] = run["total"], free_run["total"]
+    fine["ratio"] = run["total"] / free_run["total"]
+    fine["load_Pa"], fine["kkt"] = run["load_Pa"], run.get("kkt")
+    return rows
 
 
 def _stages(run: dict[str, Any], free_run: dict[str, Any]) -> dict[str, Any]:
@@ -207,13 +327,19 @@ def main() -> None:
     parser.add_argument("--json", help="append one JSON line per mesh to this file")
     parser.add_argument("--worker", nargs=3, metavar=("CASE", "NX", "NY"), help=argparse.SUPPRESS)
     parser.add_argument("--free", action="store_true", help=argparse.SUPPRESS)
+    parser.add_argument(
+        "--phases", action="store_true", help="exclusive seconds per level and phase instead"
+    )
     args = parser.parse_args()
     if args.worker:
-        worker(args.worker[0], int(args.worker[1]), int(args.worker[2]), args.free)
+        worker(args.worker[0], int(args.worker[1]), int(args.worker[2]), args.free, args.phases)
         return
     if args.repeat < 1:
         parser.error(f"--repeat must be at least 1, got {args.repeat}")
     meshes = [tuple(int(v) for v in m.split("x")) for m in args.meshes.split(",")]
+    if args.phases:
+        _phases_main(args.case, meshes, args.json)
+        return
     rows: list[dict[str, Any]] = []
     for nx, ny in meshes:
         best: dict[str, Any] | None = None
@@ -272,6 +398,27 @@ def main() -> None:
         )
         print(f"  per level, steps / factorisations / solves / eigen solves: {r['per_level']}")
     append_rows(args.json, rows)
+
+
+def _phases_main(case: str, meshes: list[tuple[int, ...]], path: str | None) -> None:
+    """``--phases``: one run and one free run per mesh; a row per level and phase."""
+    tail = ("free solve", "certificate", "total", "free run", "ratio")
+    print_header(
+        f"{case}: exclusive process seconds per level and phase (LDL: count x seconds each)",
+        ["mesh", "level", "DOFs", "steps / factorisations / solves / eigen solves", *PHASES,
+         "level", *tail],
+    )  # fmt: skip
+    for nx, ny in meshes:
+        mesh = f"{nx}x{ny}"
+        rows = _phase_rows(case, mesh, _run(case, nx, ny, False, True), _run(case, nx, ny, True))
+        for r in rows:
+            cells = [f"{r[ph]:.2f}" for ph in PHASES]
+            calls = r["LDL calls"]
+            cells[PHASES.index("LDL")] = f"{calls} x {r['LDL'] / max(calls, 1):.3f}"
+            cells += [f"{r['level total']:.2f}"] + [f"{r[k]:.2f}" if k in r else "" for k in tail]
+            counts = f"{r['steps']}/{r['factorisations']}/{r['solves']}/{r['eigensolves']}"
+            print(f"| {mesh} | {r['level']} | {r['dofs']} | {counts} | " + " | ".join(cells) + " |")
+        append_rows(path, rows)
 
 
 if __name__ == "__main__":

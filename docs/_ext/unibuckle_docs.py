@@ -379,6 +379,12 @@ COMMANDS = {
     "orderings": lambda rows: _orderings_commands(rows),
     "plates": lambda rows: _plates_commands(rows),
     "routes": lambda rows: _routes_commands(rows),
+    "phases": lambda rows: "`, then `".join(
+        f"python bench/bench_stages.py --phases --case {case} "
+        f"--meshes {_listed([r for r in rows if r['case'] == case], 'mesh')} "
+        "--json bench/results/phases.jsonl"
+        for case in dict.fromkeys(str(r["case"]) for r in rows)
+    ),
     "stages": lambda rows: "`, then `".join(
         f"python bench/bench_stages.py --case {case} "
         f"--meshes {_listed([r for r in rows if r['case'] == case], 'mesh')} "
@@ -476,6 +482,34 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("factorisations", "factorisations"),
         ("solves", "solves"),
         ("ratio", "certificate time (free solves)"),
+        ("load_Pa", "λ_c (Pa)"),
+    ],
+    "phases": [
+        ("case", "plate"),
+        ("mesh", "mesh"),
+        ("level", "level"),
+        ("dofs", "DOFs"),
+        ("steps", "Newton steps"),
+        ("factorisations", "factorisations"),
+        ("solves", "solves"),
+        ("eigensolves", "eigen solves"),
+        ("setup", "setup (s)"),
+        ("kernel", "kernel (s)"),
+        ("prolong", "prolong (s)"),
+        ("relax", "relax (s)"),
+        ("lift", "lift (s)"),
+        ("LDL calls", "LDL count"),
+        ("LDL", "LDL (s)"),
+        ("Newton", "Newton (s)"),
+        ("sets", "sets (s)"),
+        ("eigen", "eigen (s)"),
+        ("other", "other (s)"),
+        ("level total", "level (s)"),
+        ("free solve", "free solve (s)"),
+        ("certificate", "certificate (s)"),
+        ("total", "total (s)"),
+        ("free run", "free run (s)"),
+        ("ratio", "total / free run"),
         ("load_Pa", "λ_c (Pa)"),
     ],
     "stages": [
