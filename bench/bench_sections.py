@@ -9,14 +9,24 @@ A square box (b = d = 0.2 m, t = 2 mm: b/t = 100, L = 3b) or a circular tube (R 
 t = 1 mm: R/t = 100, L = R), steel, simply supported ends, a rigid core over the whole
 length. One process: the set-up (mesh, prestress, assembly, change of basis), the free
 eigen solve (min of ``--repeat`` solves of the same pencil), and the unilateral solve
-(:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`: the active-set seeds on a
-section ``--levels`` times coarser, the contact set polished level by level; or, with
-``--route interior-point``, the thin plates' interior-point chain on the section itself),
-then the certificate. The factorisations are PETSc's count of numeric ones (MUMPS) in the
-unilateral solve, per section level and in all. Prints one Markdown row, then one row per
-level (its steps of the active set, eigen solves, factorisations and seconds); ``--json
+(:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels` over the section and its
+``--levels`` coarser copies, its sections' set-up included) by ``--route``:
+``active-set`` (the active-set seeds on the coarsest section, the contact set polished
+level by level; ``levels`` is its old name), ``interior-point`` (the nested
+interior-point chain, the mode carried from section to section), ``auto`` (the
+interior point, the active set if it reaches no KKT point) or ``single`` (the
+interior-point chain on the section itself, no coarser one); then the certificate.
+The factorisations are PETSc's count of numeric ones (MUMPS) in the unilateral solve, in
+all and, for the active set, per section level; the interior point's per level are its
+Newton kernel's count. Prints one Markdown row, then one row per level (its steps: the
+active set's or the Newton steps; eigen solves, factorisations and seconds); ``--json
 FILE`` appends the row, with the levels, and the unilateral load (``core_load_Pa``) to
 compare routes by.
+
+Ratios, both within the one process: ``ratio`` is the unilateral solve (its sections'
+set-up included) over the free eigen solve; ``process_ratio`` the whole cored run
+(unilateral solve and certificate) over the whole hollow run (the section's set-up and
+its free solve): what a user waits for with a core over what without.
 
 Note:
     Timings are only meaningful on a quiet machine; the ratio (unilateral over free) is
@@ -26,6 +36,7 @@ Note:
 from __future__ import annotations
 
 import argparse
+import math
 import time
 
 from _results import append_rows, print_header
@@ -33,7 +44,7 @@ from _results import append_rows, print_header
 COLUMNS = (
     "shape", "route", "dofs", "constrained", "cells_around", "free_load/ref", "core_load/ref",
     "kkt", "certificate", "setup_s", "rotation_s", "free_s", "unilateral_s", "ratio",
-    "certify_s", "eigensolves_fine", "eigensolves_coarse", "factorisations",
+    "certify_s", "process_ratio", "eigensolves_fine", "eigensolves_coarse", "factorisations",
 )  # fmt: skip
 #: The columns of a level's row (coarsest first).
 LEVEL_COLUMNS = (
@@ -57,8 +68,9 @@ def run(
 ) -> dict:
     """One section: set-up, free solve, unilateral solve, certificate.
 
-    ``route``: "levels" (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`) or
-    "interior-point" (the thin plates' chain, on the section itself).
+    ``route``: "active-set", "interior-point", "auto" (the routes of
+    :func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`) or "single" (the
+    interior-point chain on the section itself).
     """
     from mpi4py import MPI
     from petsc4py import PETSc
@@ -66,7 +78,7 @@ def run(
     import msgspec
 
     from unibuckle_fenicsx.algorithms.chain import solve_interior_point
-    from unibuckle_fenicsx.algorithms.records import SectionLevelsDetails
+    from unibuckle_fenicsx.algorithms.records import InteriorPointDetails, SectionLevelsDetails
     from unibuckle_fenicsx.certificate.certify import certify
     from unibuckle_fenicsx.la.eigen import GEPSolver
     from unibuckle_fenicsx.model.shell import levels as section_levels
@@ -109,8 +121,8 @@ def run(
         dofs, cells = section.model.num_dofs, section.mesh.cells_around
     t1 = time.perf_counter()
     before = _factorisations()
-    if route == "levels":
-        fine, solution = section_levels.solve_levels(params, levels=levels)
+    if route != "single":
+        fine, solution = section_levels.solve_levels(params, levels=levels, route=route)
     else:
         fine = build_section(params, MPI.COMM_WORLD)
         t1 = time.perf_counter()  # the set-up is not the unilateral solve's
@@ -126,6 +138,23 @@ def run(
             levels_log = [msgspec.to_builtins(level) for level in details.levels]
             for entry, count in zip(levels_log, per_level, strict=True):
                 entry["factorisations"] = count
+            coarse = details.coarse_eigensolves
+        elif isinstance(details, InteriorPointDetails):
+            sizes = [size * 2.0**k for k in range(len(details.levels) - 1, -1, -1)]
+            levels_log = [
+                {
+                    "mesh_size": h,
+                    "cells": level.mesh,
+                    "constrained": level.constrained_nodes,
+                    "steps": level.newton_steps,
+                    "factorisations": level.factorizations,
+                    "eigensolves": level.eigensolves,
+                    "wall_time_s": level.seconds,
+                    "load": min((r.load for r in level.links if r.kkt), default=math.nan),
+                }
+                for h, level in zip(sizes, details.levels, strict=True)
+            ]
+            levels_log[-1]["eigensolves"] = details.fine_eigensolves
             coarse = details.coarse_eigensolves
         else:
             levels_log = [{"eigensolves": solution.eigensolves, "factorisations": factorisations}]
@@ -158,6 +187,7 @@ def run(
             "unilateral_s": unilateral,
             "ratio": unilateral / min(times),
             "certify_s": certify_s,
+            "process_ratio": (unilateral + certify_s) / (setup + min(times)),
             "eigensolves_fine": levels_log[-1]["eigensolves"],
             "eigensolves_coarse": coarse,
             "factorisations": factorisations,
@@ -174,10 +204,15 @@ def main() -> None:
     parser.add_argument("--levels", type=int, default=2)
     parser.add_argument("--repeat", type=int, default=3)
     parser.add_argument("--corner-cell", type=float, default=None)
-    parser.add_argument("--route", choices=("levels", "interior-point"), default="levels")
+    parser.add_argument(
+        "--route",
+        choices=("auto", "active-set", "levels", "interior-point", "single"),
+        default="auto",
+    )
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
-    row = run(args.shape, args.size, args.levels, args.repeat, args.corner_cell, args.route)
+    route = "active-set" if args.route == "levels" else args.route
+    row = run(args.shape, args.size, args.levels, args.repeat, args.corner_cell, route)
     print_header("Sections with a core (one rank)", COLUMNS)
     cells = []
     for c in COLUMNS:

@@ -11,8 +11,9 @@ it covers, the wall may only move away from it (:mod:`~unibuckle_fenicsx.model.s
   smallest by the inertia of :math:`A - \sigma B` (as a plate without obstacle).
 - With a core the free load is the hollow section's; the unilateral critical state is
   found coarse to fine (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`: the
-  active-set seeds on a coarser section, the contact set carried to the finer one) and
-  certified (:func:`~unibuckle_fenicsx.certificate.certify.certify`) on the finest.
+  interior point's starts on a coarser section, the mode carried to the finer one; the
+  active set's seeds and carried contact set if it reaches no KKT point) and certified
+  (:func:`~unibuckle_fenicsx.certificate.certify.certify`) on the finest.
 
 The critical load is the factor on the stresses per unit load: the compressive stress in
 Pa when ``axial_stress = -1`` without bending. A box's ``buckling_coefficient_k`` uses its
@@ -228,9 +229,10 @@ def solve_section(
             ``mesh.levels``, ``[solver]`` and ``[design]`` replace ``levels``, ``solver``
             and ``design``, and the result's ``input`` is the file, which re-runs it).
         comm: Communicator; the mesh is distributed over it.
-        levels: With a core, coarser sections (each with twice the mesh size) the
-            active-set seeds run on, >= 0. 1 by default: the seeds' many eigen solves on a
-            section of a quarter of the DOFs, a few polishing solves on the given one.
+        levels: With a core, coarser sections (each with twice the mesh size) the search
+            starts on, >= 0 (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`:
+            the interior point's starts, or the active set's seeds). 1 by default: the
+            starts' many steps on a section of a quarter of the DOFs, a few on the given one.
         solver: Solver options (tolerances, the feasibility tolerance tau); the
             package's defaults when None.
         design: The yield stress and partial factor of the design output
@@ -398,7 +400,7 @@ def _result(
         if solution is None
         else "core: foundation"
         if problem.tensionless
-        else "core: section levels",
+        else f"core: section levels, {solution.method}",
         details=ResultDetails(
             free_eigen_error=free.eigen.error, free_eigen_iterations=free.eigen.iterations
         ),

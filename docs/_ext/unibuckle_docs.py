@@ -466,6 +466,7 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("per_level", "per level: steps / factorisations / eigen solves"),
         ("factorisations", "factorisations"),
         ("ratio", "time (free solves)"),
+        ("process_ratio", "whole run (hollow runs)"),
         ("core_load/ref", "σ/σ_ref"),
         ("kkt", "KKT"),
         ("core_load_Pa", "σ_c (Pa)"),

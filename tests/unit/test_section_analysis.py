@@ -172,3 +172,24 @@ def test_a_filled_box_does_not_depend_on_what_the_process_solved_before(tmp_path
         got = json.loads((tmp_path / name).read_text())
         for key in ("critical_load_Pa", "free_load_Pa", "eigensolves", "contact_indices"):
             assert got[key] == expected[key], (name, key)
+
+
+def test_the_section_problem_s_k_is_the_result_s_with_any_stress_per_unit_load():
+    """The problem's k is the result's, sigma t b^2/(pi^2 D) at the extreme fibre.
+
+    A hollow 0.1 x 0.06 m box (b/t = 50) under axial_stress = -2 with bending_stress = 0.5
+    per unit load: the extreme fibre carries 2.5 times the load factor. The result's k and
+    the section problem's ``buckling_coefficient`` (a Python user's, as on a plate's
+    problem) are that formula worked here by hand; before, the problem's took the load
+    factor itself as the stress (2.5 times too small).
+    """
+    box = SectionParameters(
+        "box", width=0.1, depth=0.06, thickness=0.002, length=0.2, E=2.1e11, nu=0.3,
+        mesh_size=0.02, ends="simply_supported", axial_stress=-2.0, bending_stress=0.5,
+    )  # fmt: skip
+    D = 2.1e11 * 0.002**3 / (12.0 * (1.0 - 0.3**2))
+    with solve_section(box, MPI.COMM_SELF) as analysis:
+        load = analysis.result.critical_load_Pa
+        k = 2.5 * load * 0.002 * 0.1**2 / (math.pi**2 * D)
+        assert analysis.result.buckling_coefficient_k == pytest.approx(k, rel=1e-13)
+        assert analysis.section.problem.buckling_coefficient(load) == pytest.approx(k, rel=1e-13)

@@ -46,6 +46,10 @@ from __future__ import annotations
 import logging
 import math
 import time
+from collections.abc import Callable, Sequence
+from typing import Protocol
+
+import dolfinx
 
 from msgspec import UNSET
 from msgspec.structs import replace
@@ -86,8 +90,22 @@ logger = logging.getLogger(__name__)
 THIN_PLATE = 0.02
 
 
+class Carry(Protocol):
+    """What carries a mode from a coarse problem to a finer one (``fine``, ``mode``)."""
+
+    fine: UnilateralProblem
+
+    def mode(self, u: dolfinx.fem.Function) -> dolfinx.fem.Function:
+        """The coarse mode ``u`` on the fine problem's space."""
+        ...
+
+
+#: Makes the :class:`Carry` from ``problems[k - 1]`` to ``problems[k]``.
+CarryFactory = Callable[[UnilateralProblem, UnilateralProblem], Carry]
+
+
 def _refine(
-    carry: Prolongation,
+    carry: Carry,
     point: BarrierPoint,
     level: MeshLevel,
     options: ChainOptions,
@@ -139,9 +157,11 @@ def _refine(
     return cand, new
 
 
-def _level_record(problem: UnilateralProblem) -> MeshLevel:
+def _level_record(problem: UnilateralProblem, cells: bool = False) -> MeshLevel:
+    """The record of one mesh; ``cells``: name it by its cells even if unstructured."""
     spec = problem.spec
-    mesh: list[int | str] = [spec.mesh.nx, spec.mesh.ny] if problem.structured else ["fine"]
+    named = problem.structured or cells
+    mesh: list[int | str] = [spec.mesh.nx, spec.mesh.ny] if named else ["fine"]
     if _gmsh_levels(problem):
         mesh = [f"h={spec.mesh.size:.3g}"]
     return MeshLevel(mesh, problem.num_constrained)
@@ -206,13 +226,15 @@ def _carry(
     label: str,
     quick: bool,
     newtons: dict[int, InteriorPointNewton],
+    carrier: CarryFactory,
 ) -> tuple[list[Candidate], list[BarrierPoint]]:
     """Carry every point from ``problems[k - 1]`` to ``problems[k]``.
 
     On an intermediate mesh the points whose loads lie more than ``carry_margin`` above
     the lowest are dropped (the meshes rank the arrangements better as they get finer);
     on the finest, the KKT points met are returned. ``newtons``: the method on each mesh
-    (created here when missing), shared by the arrangements and tries.
+    (created here when missing), shared by the arrangements and tries. ``carrier``
+    makes the carry between the two meshes.
     """
     tl = time.perf_counter()
     last = k == len(problems) - 1
@@ -220,7 +242,7 @@ def _carry(
     carried: list[BarrierPoint] = []
     if k not in newtons:
         newtons[k] = InteriorPointNewton(problems[k])
-    carry = Prolongation(problems[k - 1], problems[k])
+    carry = carrier(problems[k - 1], problems[k])
     for j, point in enumerate(points):
         tag = label if len(points) == 1 else f"{label} {j + 1}"
         cand, new = _refine(carry, point, level, options, last, mu, tag, quick, newtons[k])
@@ -245,10 +267,13 @@ def _ascend(
     label: str,
     quick: bool,
     newtons: dict[int, InteriorPointNewton],
+    carrier: CarryFactory,
 ) -> Candidate | None:
     """Carry ``points`` from ``problems[0]`` to the fine mesh; the lowest KKT point there."""
     for k in range(1, len(problems)):
-        found, points = _carry(problems, k, points, levels[k], options, mu, label, quick, newtons)
+        found, points = _carry(
+            problems, k, points, levels[k], options, mu, label, quick, newtons, carrier
+        )
         if k == len(problems) - 1:
             return min(found, key=lambda c: c.load) if found else None
         if not points:
@@ -257,7 +282,10 @@ def _ascend(
 
 
 def _levels(
-    problems: list[UnilateralProblem], options: ChainOptions
+    problems: list[UnilateralProblem],
+    options: ChainOptions,
+    carrier: CarryFactory = Prolongation,
+    cells: bool = False,
 ) -> tuple[list[MeshLevel], list[Candidate], Candidate | None]:
     """Explore the coarsest mesh and carry its best critical states up to the finest.
 
@@ -265,8 +293,9 @@ def _levels(
     still move freely. If the fine mesh then ends at no KKT point (typically at a saddle
     where buckles that the barrier keeps apart have almost equal loads), the lowest is
     carried once more at ``flat_mu``, which keeps the parts lying on the obstacle flat.
+    ``carrier`` makes the carry between two meshes; ``cells``: name the meshes by cells.
     """
-    levels = [_level_record(p) for p in problems]
+    levels = [_level_record(p, cells) for p in problems]
     tl = time.perf_counter()
     explored, carried = explore(problems[0], levels[0], options, carry=len(problems) > 1)
     levels[0].seconds = time.perf_counter() - tl
@@ -277,13 +306,15 @@ def _levels(
     newtons: dict[int, InteriorPointNewton] = {}  # one per mesh: one symbolic analysis
     try:
         chosen = _ascend(
-            problems, points, levels, options, options.level_mu, "prolonged", True, newtons
-        )
+            problems, points, levels, options, options.level_mu, "prolonged", True, newtons,
+            carrier,
+        )  # fmt: skip
         if chosen is None:
             flat = [carried[0].flat]
             chosen = _ascend(
-                problems, flat, levels, options, options.flat_mu, "prolonged flat", False, newtons
-            )
+                problems, flat, levels, options, options.flat_mu, "prolonged flat", False,
+                newtons, carrier,
+            )  # fmt: skip
     finally:
         for newton in newtons.values():
             newton.destroy()
@@ -291,27 +322,36 @@ def _levels(
 
 
 def _nested(
-    problem: UnilateralProblem, options: ChainOptions
+    problem: UnilateralProblem,
+    options: ChainOptions,
+    coarser: Sequence[UnilateralProblem] | None = None,
+    carrier: CarryFactory = Prolongation,
 ) -> tuple[list[MeshLevel], list[Candidate], Candidate | None, int]:
     """The route over ``problem``'s coarser copies and itself (:func:`_levels`).
 
     Returns the levels, the coarsest mesh's KKT points, the fine mesh's critical state
-    (or None), and the coarser meshes' eigen solves; the copies are destroyed.
-    Collective.
+    (or None), and the coarser meshes' eigen solves. The copies are made here and
+    destroyed (a plate's) unless the caller gives them (``coarser``, coarsest first,
+    carried by ``carrier``; they stay the caller's). Collective.
     """
     problems: list[UnilateralProblem] = []
-    for coarse in _coarser(problem, options):
-        try:
-            problems.append(build_unilateral_problem(coarse, problem.comm))
-        except EmptyZoneError:
-            continue
+    made = coarser is None
+    if coarser is None:
+        for coarse in _coarser(problem, options):
+            try:
+                problems.append(build_unilateral_problem(coarse, problem.comm))
+            except EmptyZoneError:
+                continue
+    else:
+        problems.extend(coarser)
     problems.append(problem)
     try:
-        levels, explored, chosen = _levels(problems, options)
+        levels, explored, chosen = _levels(problems, options, carrier, cells=not made)
     finally:
         other_solves = sum(p.eigensolver.solves for p in problems[:-1])
-        for p in problems[:-1]:
-            p.destroy()
+        if made:
+            for p in problems[:-1]:
+                p.destroy()
     return levels, explored, chosen, other_solves
 
 
@@ -324,13 +364,25 @@ def _fallback(problem: UnilateralProblem, options: ChainOptions) -> UnilateralSo
 
 
 def solve_interior_point(
-    problem: UnilateralProblem, options: ChainOptions | None = None
+    problem: UnilateralProblem,
+    options: ChainOptions | None = None,
+    *,
+    coarser: Sequence[UnilateralProblem] | None = None,
+    carrier: CarryFactory = Prolongation,
+    fallback: Callable[[UnilateralProblem], UnilateralSolution] | None = None,
 ) -> UnilateralSolution:
     """Critical state of ``problem`` (rigid obstacles) by the chain of the module docstring.
 
     Args:
         problem: A set-up problem with a rigid obstacle.
         options: Settings (default :class:`ChainOptions`).
+        coarser: The same problem on coarser meshes, coarsest first (the caller's: not
+            destroyed here); None: a plate's copies, made here (:func:`_coarser`).
+        carrier: Makes what carries a mode from one mesh to the next finer
+            (:class:`Carry`); the plate's
+            :class:`~unibuckle_fenicsx.algorithms.multilevel.Prolongation` by default.
+        fallback: Solves ``problem`` when the route reaches no KKT point; None: the
+            multilevel active set from scratch.
 
     Returns:
         The critical state with its bracket and the per-mesh records in
@@ -349,7 +401,7 @@ def solve_interior_point(
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     free_load = problem.solve_free().load
-    levels, explored, chosen, other_solves = _nested(problem, options)
+    levels, explored, chosen, other_solves = _nested(problem, options, coarser, carrier)
     if (chosen is None or not chosen.kkt) and levels and levels[-1].best_admissible is not None:
         # The lowest admissible mode met, taken to a critical state by the feasible
         # descent (monotone: it cannot cycle), before anything starts afresh.
@@ -359,7 +411,7 @@ def solve_interior_point(
             chosen = final
     if chosen is None or not chosen.kkt:
         logger.warning("interior point: no KKT point on the fine mesh; the active-set chain runs")
-        solution = _fallback(problem, options)
+        solution = _fallback(problem, options) if fallback is None else fallback(problem)
         if isinstance(solution.details, ActiveSetDetails):
             solution.details.interior_point_levels = [lv.record() for lv in levels]
         solution.method = "interior-point"

@@ -132,9 +132,8 @@ class SectionMeshSpec(Table, frozen=True):
         size: Target cell size (m), > 0 and below the section's length (2 cells along at
             least); a box's faces get an even number of cells.
         levels: With a rigid core, coarser sections (each with twice the cell size) the
-            contact search seeds on, >= 0, as long as the coarsest keeps 2 cells along; 1:
-            its many eigen solves on a quarter of the DOFs, a few polishing solves on the
-            given cells.
+            search starts on, >= 0, as long as the coarsest keeps 2 cells along; 1: its
+            many steps on a quarter of the DOFs, a few on the given cells.
     """
 
     KEY: ClassVar[str] = "mesh"

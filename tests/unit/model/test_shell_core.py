@@ -120,11 +120,32 @@ def test_core_matches_dense_enumeration(shape, changes):
         free = sec.problem.solve_free().load
         assert free < expected  # the core is active on these sections
         assert solution.load == pytest.approx(expected, rel=1e-8)
-    # The sections' route: the seeds of levels.SEEDS on the section itself.
-    finest, seeded = solve_levels(params, levels=0, comm=MPI.COMM_SELF)
+    # The sections' routes on the section itself: the seeds of levels.SEEDS, and the
+    # interior-point chain (its contact set read off the barrier problem, the answer the
+    # reduced pencil's exact eigenpair).
+    for route in ("active-set", "interior-point"):
+        finest, seeded = solve_levels(params, levels=0, comm=MPI.COMM_SELF, route=route)
+        with finest:
+            assert seeded.candidate.kkt
+            assert seeded.load == pytest.approx(expected, rel=1e-8)
+
+
+def test_interior_point_over_two_sections_matches_the_active_set():
+    # The nested chain: barrier Newton on the box at twice the cell size, its mode carried
+    # to the finer section (SectionProlongation), polished there. Reference: the plate's
+    # active set with all its seeds on the finer section (an independent algorithm).
+    params = _parameters("box", mesh_size=0.05)
+    with build_section(params, MPI.COMM_SELF) as sec:
+        reference = solve_active_set(sec.problem, multilevel=False)
+        assert reference.candidate.kkt
+        assert sec.problem.solve_free().load < reference.load  # the core is active
+    finest, solution = solve_levels(params, levels=1, comm=MPI.COMM_SELF, route="interior-point")
     with finest:
-        assert seeded.candidate.kkt
-        assert seeded.load == pytest.approx(expected, rel=1e-8)
+        assert solution.method == "interior-point (section levels)"
+        assert len(solution.details.levels) == 2
+        assert solution.details.levels[-1].constrained_nodes == finest.constraints.size
+        assert solution.candidate.kkt
+        assert solution.load == pytest.approx(reference.load, rel=1e-8)
 
 
 def test_the_plates_other_seeds_run_only_when_the_sections_reach_no_kkt_point():
@@ -183,3 +204,47 @@ def test_core_over_part_of_the_length():
     whole, part = loads
     assert free <= part * (1 + 1e-9) and part <= whole * (1 + 1e-9), (free, part, whole)
     assert part < whole  # the buckle moves to the uncovered half
+
+
+@pytest.mark.parametrize(
+    ("shape", "changes"),
+    [
+        ("box", {"mesh_size": 0.05}),
+        ("tube", {"mesh_size": 0.03}),
+        ("box", {"width": 0.3}),
+        ("box", {"mesh_size": 0.04, "corner_cell": 0.01}),
+    ],
+)
+def test_the_dofs_auto_routes_by_are_the_sections(shape, changes):
+    # "auto" decides before any mesh is made: its estimate must be the built section's DOFs.
+    from unibuckle_fenicsx.model.shell.levels import estimated_dofs
+
+    params = _parameters(shape, **changes)
+    with build_section(params, MPI.COMM_SELF) as sec:
+        assert estimated_dofs(params) == sec.model.num_dofs
+
+
+def test_a_route_is_one_of_the_routes():
+    from unibuckle_fenicsx.errors import InputError
+
+    with pytest.raises(InputError, match="route must be one of"):
+        solve_levels(_parameters("box"), levels=0, comm=MPI.COMM_SELF, route="simplex")
+
+
+def test_a_coarser_section_without_core_nodes_ends_the_added_levels():
+    # The core over 0.31..0.34 m holds the 25 mm cells' nodes at 0.325 m, none of the
+    # 50 mm cells' (0.30, 0.35): the interior point's added level is dropped, a level
+    # the caller asked for is refused naming mesh.levels.
+    from unibuckle_fenicsx.errors import InputError
+    from unibuckle_fenicsx.model.shell.levels import interior_levels
+
+    params = _parameters(
+        "box", width=0.2, depth=0.2, length=0.6, mesh_size=0.025, core_span=(0.31, 0.34)
+    )
+    assert interior_levels(params, 0) >= 1
+    finest, solution = solve_levels(params, levels=0, comm=MPI.COMM_SELF, route="interior-point")
+    with finest:
+        assert len(solution.details.levels) == 1
+        assert solution.candidate.kkt
+    with pytest.raises(InputError, match=r"mesh\.levels"):
+        solve_levels(params, levels=1, comm=MPI.COMM_SELF, route="interior-point")

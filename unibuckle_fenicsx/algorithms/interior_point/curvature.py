@@ -70,8 +70,12 @@ class NegativeCurvature(Owner):
             return np.modf(np.sin(a * x[0] / length + b * x[1] / length + shift) * c)[0]
 
         f = self.kernel.problem.new_mode("probe")
-        f.sub(0).interpolate(lambda x: noise(x, 0.0))
-        f.sub(1).interpolate(lambda x: np.vstack([noise(x, 1.0), noise(x, 2.0)]))
+        bs = f.function_space.dofmap.index_map_bs
+        if bs > 1:  # a blocked space (a section's six components per node)
+            f.interpolate(lambda x: np.vstack([noise(x, float(k)) for k in range(bs)]))
+        else:  # the plate's (w, theta)
+            f.sub(0).interpolate(lambda x: noise(x, 0.0))
+            f.sub(1).interpolate(lambda x: np.vstack([noise(x, 1.0), noise(x, 2.0)]))
         f.x.scatter_forward()
         return f.x.petsc_vec.copy()
 

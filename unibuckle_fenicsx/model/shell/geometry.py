@@ -45,6 +45,7 @@ __all__ = [
     "SectionMesh",
     "box_mesh",
     "flat_face_mesh",
+    "grid_nodes",
     "section_mesh",
     "tube_mesh",
 ]
@@ -355,6 +356,23 @@ def flat_face_mesh(
     markers[FLAT_TOP] = lambda x: np.isclose(x[1], width, rtol=0.0, atol=tol)
     facet_tags, cell_tags = _tags(msh, tags, markers)
     return SectionMesh(msh, facet_tags, cell_tags, "flat", length, width, 0.0, ny, nx)
+
+
+def grid_nodes(
+    shape: str, across: tuple[float, float], length: float, size: float, corner: float | None
+) -> tuple[int, int]:
+    """(nodes around, nodes along) of the mesh :func:`section_mesh` would make, without it.
+
+    ``across``: a box's (width, depth), a tube's (diameter, diameter), a flat face's
+    (width, 0); ``corner``: a box's ``corner_cell``. No input is checked here.
+    """
+    along = _cells_for(length, size, even=False, least=1) + 1
+    if shape == "tube":
+        return _cells_for(math.pi * across[0], size, least=8), along
+    if shape == "flat":
+        return _cells_for(across[0], size, even=False, least=1) + 1, along
+    b, d = across
+    return sum(_face_fractions(e, size, corner).size - 1 for e in (d, b, d, b)), along
 
 
 def section_mesh(

@@ -12,6 +12,19 @@ first with the plate's looser tolerances (:func:`_polish`); if they reach no KKT
 the plain rule polishes the carried set and the seeds run again on that level, and the
 lower of their KKT points is kept (either may end higher than the other).
 
+That is the ``"active-set"`` route. The ``"interior-point"`` route (:func:`_interior_point`)
+runs the thin plates' nested interior-point chain
+(:func:`~unibuckle_fenicsx.algorithms.chain.solve_interior_point`) over the same
+sections: barrier Newton from its starts on the coarsest section, the barrier point's
+mode carried to each finer section
+(:class:`~unibuckle_fenicsx.model.shell.prolong.SectionProlongation`) and restored
+there by a few Newton steps, the contact set read on the finest and its exact
+eigenpair checked against the KKT conditions. Near where a wall lifts off the core the
+mode's tails make the active set's steps flip directions a few at a time, more the finer
+the mesh; the barrier moves them all at once. ``"auto"`` (the default) runs it on
+sections of at least :data:`INTERIOR_POINT_DOFS` degrees of freedom and, if it reaches
+no KKT point, the active-set route; smaller sections take the active-set route.
+
 The seeds are those of :data:`SEEDS`, the plate's others (:data:`MORE_SEEDS`) only if
 these reach no KKT point: a core makes every wall move outward, and the contact set is
 the walls' nodes save where they lift off, which the free mode's signs seed
@@ -36,6 +49,7 @@ from unibuckle_fenicsx.algorithms.active_set import (
     THRESHOLDS,
     solve_active_set,
 )
+from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_interior_point
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.algorithms.records import (
     ActiveSetDetails,
@@ -43,12 +57,27 @@ from unibuckle_fenicsx.algorithms.records import (
     SectionLevelsDetails,
 )
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.model.shell.core import CoreConstraints
+from unibuckle_fenicsx.model.shell.geometry import grid_nodes
+from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE
 from unibuckle_fenicsx.model.shell.problem import CoredSectionProblem
+from unibuckle_fenicsx.model.shell.prolong import SectionProlongation
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import SolverSpec
 
-__all__ = ["MORE_SEEDS", "SEEDS", "prolong_directions", "solve_levels"]
+__all__ = [
+    "CHAIN_OPTIONS",
+    "COARSEST_DOFS",
+    "INTERIOR_POINT_DOFS",
+    "MORE_SEEDS",
+    "ROUTES",
+    "SEEDS",
+    "estimated_dofs",
+    "interior_levels",
+    "prolong_directions",
+    "solve_levels",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -65,6 +94,29 @@ MORE_SEEDS = tuple(name for name in SEED_NAMES if name not in SEEDS)
 #: Steps of the plain rule when the polish at looser tolerances reached no KKT point
 #: (:func:`_polish`); the seeds run on the finer section too, and the lower KKT point wins.
 PLAIN_POLISH_ITERATIONS = 50
+#: The routes of :func:`solve_levels` (module docstring).
+ROUTES = ("auto", "interior-point", "active-set")
+#: "auto" takes the interior point on sections of at least this many DOFs (estimated
+#: from the cell size: six per node): below it the active set's few hundred eigen solves
+#: on small pencils cost no more than the interior point's starts on the coarsest
+#: section, and on a small box it ended at a lower KKT point (:doc:`/verification/sections`,
+#: "Cost").
+INTERIOR_POINT_DOFS = 10_000
+#: The interior point's settings on sections: only the lowest arrangement of the
+#: coarsest section is carried up (``arrangements = 1``). On every section measured it
+#: gave the lowest KKT point on the finest, and each further arrangement costs a whole
+#: run of Newton steps on the finest section (:doc:`/verification/sections`, "Cost").
+CHAIN_OPTIONS = ChainOptions(arrangements=1)
+#: The interior point starts on a section at least this coarse: the cell size doubled
+#: while the coarser section keeps this many DOFs (more if ``levels`` asks). The
+#: starts take a few hundred Newton steps there; on the sections of
+#: :doc:`/verification/sections` ("Cost") a coarsest section of 1 000 to 2 500 DOFs
+#: ranked their arrangements as the finest did.
+COARSEST_DOFS = 1_000
+
+
+class _NoKKTPoint(Exception):
+    """The interior-point route reached no KKT point (``"auto"`` falls back)."""
 
 
 def prolong_directions(
@@ -106,16 +158,20 @@ def solve_levels(
     comm: MPI.Comm = MPI.COMM_WORLD,
     solver: SolverSpec | None = None,
     max_iterations: int = 100,
+    route: str = "auto",
 ) -> tuple[Section, UnilateralSolution]:
     """Unilateral critical state of a section with a core, coarse to fine.
 
     Args:
         parameters: The section, with ``core = True``.
-        levels: Coarser sections (each with twice the mesh size) to seed on, >= 0; 0
-            runs the seeds on the section itself.
+        levels: Coarser sections (each with twice the mesh size) to start on, >= 0; 0
+            runs on the section itself. The interior point takes more while the
+            coarsest keeps :data:`COARSEST_DOFS`.
         comm: Communicator.
         solver: Solver options.
         max_iterations: Iterates per seed on the coarsest level, >= 1.
+        route: One of :data:`ROUTES` (module docstring); "auto" by default: the
+            interior point, the active set only if it reaches no KKT point.
 
     Returns:
         The finest section (the caller destroys it) and the solution on it.
@@ -127,9 +183,134 @@ def solve_levels(
         raise InputError("solve_levels needs a section with core = true")
     if int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    t0 = time.perf_counter()
-    sizes = [parameters.mesh_size * 2.0**k for k in range(levels, -1, -1)]
+    if route not in ROUTES:
+        raise InputError(f"route must be one of {ROUTES}, got {route!r}")
     _check_levels(parameters, levels)
+    if route == "interior-point" or (
+        route == "auto" and estimated_dofs(parameters) >= INTERIOR_POINT_DOFS
+    ):
+        try:
+            more = interior_levels(parameters, levels)
+            return _interior_point(parameters, more, comm, solver, levels)
+        except _NoKKTPoint:
+            if route == "interior-point":
+                raise RuntimeError("the interior-point route reached no KKT point") from None
+            logger.warning("sections: the interior point reached no KKT point; the active set runs")
+    return _active_set(parameters, levels, comm, solver, max_iterations)
+
+
+def estimated_dofs(parameters: SectionParameters) -> int:
+    """The section's DOFs before it is meshed: six per node of its (x, s) grid."""
+    p = parameters
+    across = (p.diameter, p.diameter) if p.shape == "tube" else (p.width, p.depth)
+    widths = (float(across[0] or 0.0), float(across[1] or 0.0))
+    around, along = grid_nodes(p.shape, widths, p.length, p.mesh_size, p.corner_cell)
+    return DOFS_PER_NODE * around * along
+
+
+def interior_levels(parameters: SectionParameters, levels: int) -> int:
+    """The interior point's coarser sections: ``levels``, or more.
+
+    More while the coarsest keeps :data:`COARSEST_DOFS` (estimated: :func:`estimated_dofs`).
+    """
+    k, most = 0, _most_levels(parameters)
+    while k < most and estimated_dofs(_at(parameters, 2.0 ** (k + 1))) >= COARSEST_DOFS:
+        k += 1
+    return max(levels, k)
+
+
+def _sizes(parameters: SectionParameters, levels: int) -> list[float]:
+    """The sections' cell sizes, coarsest first."""
+    return [parameters.mesh_size * 2.0**k for k in range(levels, -1, -1)]
+
+
+def _build(
+    parameters: SectionParameters, size: float, comm: MPI.Comm, solver: SolverSpec | None
+) -> Section:
+    """The section on cells of ``size`` (a box's corner cells graded in proportion)."""
+    return build_section(_at(parameters, size / parameters.mesh_size), comm, solver)
+
+
+def _at(parameters: SectionParameters, factor: float) -> SectionParameters:
+    """``parameters`` with cells ``factor`` times as large (corner cells too)."""
+    corner = parameters.corner_cell
+    return replace(
+        parameters,
+        mesh_size=parameters.mesh_size * factor,
+        corner_cell=None if corner is None else corner * factor,
+    )
+
+
+def _interior_point(
+    parameters: SectionParameters,
+    levels: int,
+    comm: MPI.Comm,
+    solver: SolverSpec | None,
+    asked: int,
+) -> tuple[Section, UnilateralSolution]:
+    """The nested interior-point chain over the sections (module docstring).
+
+    ``levels``: the coarser sections (:func:`interior_levels`), ``asked`` of them the
+    caller's: a coarser section that cannot be built (its core covers no free node) ends
+    the added ones, and is refused among the asked ones.
+
+    Raises:
+        _NoKKTPoint: It reached no KKT point on the finest section (all destroyed).
+    """
+
+    def no_kkt(problem: UnilateralProblem) -> UnilateralSolution:
+        raise _NoKKTPoint
+
+    sections: list[Section] = []
+    try:
+        for k, size in enumerate(_sizes(parameters, levels)[::-1]):  # finest first
+            try:
+                sections.insert(0, _build(parameters, size, comm, solver))
+            except InputError as err:
+                if k == 0:  # the given cells' own error
+                    raise
+                if k > asked:  # a level added by interior_levels: fewer of them
+                    break
+                raise InputError(
+                    f"mesh.levels = {asked}: the coarser section of cells {size:g} m "
+                    f"(mesh.size doubled): {err}; lower mesh.levels (0: the search starts "
+                    "on the given cells)"
+                ) from None
+        problems = [_cored(section) for section in sections]
+        solution = solve_interior_point(
+            problems[-1],
+            CHAIN_OPTIONS,
+            coarser=problems[:-1],
+            carrier=SectionProlongation,
+            fallback=no_kkt,
+        )
+    except BaseException:
+        for section in sections:
+            section.destroy()
+        raise
+    for section in sections[:-1]:
+        section.destroy()
+    solution.method = "interior-point (section levels)"
+    return sections[-1], solution
+
+
+def _cored(section: Section) -> CoredSectionProblem:
+    """``section``'s problem, which has a core (an internal invariant of :func:`_build`)."""
+    if not isinstance(section.problem, CoredSectionProblem) or section.constraints is None:
+        raise RuntimeError("solve_levels: a core section without constraints")
+    return section.problem
+
+
+def _active_set(
+    parameters: SectionParameters,
+    levels: int,
+    comm: MPI.Comm,
+    solver: SolverSpec | None,
+    max_iterations: int,
+) -> tuple[Section, UnilateralSolution]:
+    """The active-set route (module docstring)."""
+    t0 = time.perf_counter()
+    sizes = _sizes(parameters, levels)
     log: list[SectionLevel] = []
     prev: Section | None = None
     best: UnilateralSolution | None = None
@@ -170,11 +351,17 @@ def solve_levels(
     return prev, replace(best, details=details)
 
 
-def _check_levels(parameters: SectionParameters, levels: int) -> None:
-    """Refuse ``levels`` whose coarsest section has fewer than 2 cells along the member."""
-    most = 0  # the coarsest level SectionParameters accepts
+def _most_levels(parameters: SectionParameters) -> int:
+    """The most coarser sections with 2 cells along the member (SectionParameters accepts)."""
+    most = 0
     while parameters.mesh_size * 2.0 ** (most + 1) * (1.0 + 1e-9) < parameters.length:
         most += 1
+    return most
+
+
+def _check_levels(parameters: SectionParameters, levels: int) -> None:
+    """Refuse ``levels`` whose coarsest section has fewer than 2 cells along the member."""
+    most = _most_levels(parameters)
     if levels > most:
         raise InputError(
             f"mesh.levels = {levels}: the coarsest section's cells, mesh.size x 2^{levels} = "
@@ -198,9 +385,7 @@ def _level(
     (None: the seeds ran) and the level's record.
     """
     tl = time.perf_counter()
-    corner = parameters.corner_cell
-    graded = None if corner is None else corner * size / parameters.mesh_size
-    section = build_section(replace(parameters, mesh_size=size, corner_cell=graded), comm, solver)
+    section = _build(parameters, size, comm, solver)
     problem = section.problem
     if not isinstance(problem, CoredSectionProblem) or section.constraints is None:
         section.destroy()

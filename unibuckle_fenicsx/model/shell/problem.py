@@ -29,6 +29,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver
 from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.contact import ContactSetManager, _Owned
+from unibuckle_fenicsx.model.materials import bending_stiffness
 from unibuckle_fenicsx.model.problem import Problem, SetUp, UnilateralProblem
 from unibuckle_fenicsx.model.shell.core import CoreConstraints
 from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE, ShellModel, chop_roundoff
@@ -90,6 +91,18 @@ class RotatedPencil(Owner):
             self.T.mult(u, out)
         return out
 
+    def to_rotated(self, u: PETSc.Vec, out: PETSc.Vec) -> PETSc.Vec:
+        r"""Components :math:`u' = T^T u` of the new basis of a vector ``u`` of global ones.
+
+        The inverse of :meth:`to_global`: T is orthogonal, its blocks are made from
+        orthonormal normals (a box's faces meet at right angles; a tube's node has one).
+        """
+        if self.T is None:
+            u.copy(out)
+        else:
+            self.T.multTranspose(u, out)
+        return out
+
     def destroy(self) -> None:
         """Destroy A', B' and T (collective); the model's own A, B stay with the model."""
         if getattr(self, "T", None) is None:
@@ -140,6 +153,7 @@ def section_problem(
     solver: SolverSpec | None = None,
     eps_options: dict[str, str | float | int] | None = None,
     springs: npt.NDArray[np.float64] | None = None,
+    compression: float = 1.0,
 ) -> SectionProblem:
     """A section set up for its free solve, and with a core for the unilateral algorithms.
 
@@ -156,6 +170,9 @@ def section_problem(
         eps_options: EPS options of the pencil's solver.
         springs: (i,) the core's foundation spring of each constrained direction (N/m;
             :func:`~unibuckle_fenicsx.model.shell.core.core_springs`); None: a rigid core.
+        compression: The largest compressive stress per unit load (Pa/Pa,
+            ``SectionParameters.compression()``): the buckling coefficient's stress is the
+            load times it; 1 for a uniform unit compression.
 
     Returns:
         A :class:`CoredSectionProblem` with a core, else a :class:`SectionProblem`; the
@@ -209,6 +226,7 @@ def section_problem(
         if constraints is None
         else CoredSectionProblem(parts, SectionContact(pencil, constraints, springs))
     )
+    problem.compression = compression
     problem.timings["setup_s"] = time.perf_counter() - t0
     return problem
 
@@ -240,16 +258,26 @@ class SectionProblem(Problem):
         out.x.scatter_forward()
         return out
 
+    #: The largest compressive stress per unit load (Pa/Pa), set by :func:`section_problem`.
+    compression: float = 1.0
+
     def buckling_coefficient(self, load: float) -> float:
-        r""":math:`k = \sigma t b^2/(\pi^2 D)` with b the widest face (a box) or 0 (a tube)."""
+        r""":math:`k = \sigma t b^2/(\pi^2 D)` of a box's widest face b; NaN for a tube.
+
+        :math:`\sigma` is that face's largest compressive stress at the load factor
+        ``load``: ``load`` times :attr:`compression` (the extreme fibre's; the widest
+        faces, a flange pair or a web pair, reach it), so that k is the classical
+        coefficient whatever the stress per unit load and its gradient. NaN without
+        compression.
+        """
         section = self.pencil.shell.section
         t = self.pencil.shell.thickness
-        mat = self.spec.material
-        D = mat.E * t**3 / (12.0 * (1.0 - mat.nu**2))
-        if section.shape == "tube":
+        sigma = load * self.compression
+        if section.shape == "tube" or sigma <= 0.0:
             return float("nan")
+        D = bending_stiffness(self.spec.material.E, self.spec.material.nu, t)
         b = max(section.width, section.depth)
-        return float(t * load * b**2 / (np.pi**2 * D))
+        return float(t * sigma * b**2 / (np.pi**2 * D))
 
 
 class CoredSectionProblem(SectionProblem, UnilateralProblem):

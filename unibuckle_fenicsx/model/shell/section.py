@@ -282,17 +282,13 @@ class Section(Owner):
     def buckling_coefficient(self, load: float) -> float:
         r""":math:`k = \sigma t b^2/(\pi^2 D)` of a box's widest face b; NaN for a tube.
 
-        :math:`\sigma` is that face's largest compressive stress at the load ``load``,
-        ``load`` times ``SectionParameters.compression()`` over the depth (the widest
-        faces, a flange pair or a web pair, reach the section's largest compression), so
-        that k is the classical coefficient whatever the stress per unit load and its
-        gradient (:math:`\psi = -1`: a web's 23.9 when hinged). NaN without compression.
+        :math:`\sigma` is the load ``load`` times ``SectionParameters.compression()``, the
+        largest compression, which the widest faces reach: the classical coefficient
+        whatever the stress per unit load and its gradient (:math:`\psi = -1`: a web's
+        23.9 when hinged); NaN without compression
+        (:meth:`.SectionProblem.buckling_coefficient`).
         """
-        p = self.parameters
-        sigma = load * p.compression()
-        if p.shape == "tube" or sigma <= 0.0:
-            return math.nan
-        return sigma * p.thickness * p.widest**2 / (math.pi**2 * p.bending_stiffness)
+        return self.problem.buckling_coefficient(load)
 
     def classical_stress(self) -> float:
         r"""Reference stress (Pa): a box's k = 4 load, a tube's classical one.
@@ -352,7 +348,10 @@ def build_section(
     springs = None
     if constraints is not None and p.foundation_stiffness is not None:
         springs = core_springs(model, constraints, p.foundation_stiffness)
-    problem = section_problem(model, prestress, constraints, T, material, solver, springs=springs)
+    problem = section_problem(
+        model, prestress, constraints, T, material, solver, springs=springs,
+        compression=p.compression(),
+    )  # fmt: skip
     return Section(p, msh, prestress, model, constraints, problem)
 
 
