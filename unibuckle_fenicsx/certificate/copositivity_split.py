@@ -1268,15 +1268,21 @@ def _prove_piece(
         bw, muw, tw = relax.bound(V[:, outside], iterations, mu)
         if bw <= 0:
             return _Proof(uncovered=(V[:, outside], muw, tw, bw))
-        if muw.max(initial=0.0) > 0:
-            muw = muw / muw.max()
-            if not any(float(np.abs(muw - q).max()) <= 1e-6 for q in mus):
-                mus.append(muw)
+        _add_combination(mus, muw)
     if opts.interpolate:
         margin = _interpolated(basis, relax, V, iterations, opts.margin_factor)
         if margin is not None:
             return _Proof(margin=margin, tried=mus)
     return _Proof(margin=_together(basis, V, mus, level, opts), tried=mus, rounding=rounding)
+
+
+def _add_combination(mus: list[Array], mu: Array) -> None:
+    """Append ``mu`` scaled to a largest entry of 1 unless zero or already in ``mus`` (to 1e-6)."""
+    top = float(mu.max(initial=0.0))
+    if top > 0:
+        mu = mu / top
+        if not any(float(np.abs(mu - q).max()) <= 1e-6 for q in mus):
+            mus.append(mu)
 
 
 def _interpolated(
@@ -1305,9 +1311,7 @@ def _interpolated(
         top = float(mu.max(initial=0.0))
         if b <= 0 or not top > 0:  # left to the caps (a new column there) or a split
             return None
-        mu = mu / top
-        if not any(float(np.abs(mu - q).max()) <= 1e-6 for q in mus):
-            mus.append(mu)
+        _add_combination(mus, mu)
     combined = _combined(basis, mus, factor)
     if combined is None:
         return None
