@@ -918,10 +918,16 @@ def estimate_counts(
     """The counts :func:`estimate_cost` prices (no solve)."""
     columns = min(len(sources.first), opts.max_columns)
     model = COST_MODEL
+    # growth**(m - 2) overflows a float past m of about 500 (a filled tube's pencil can
+    # hold that many eigenvalues below the load); the cap binds long before: compare logs.
+    extra = max(m - 2, 0)
+    capped = math.log(model["pieces"]) + extra * math.log(model["growth"]) >= math.log(
+        opts.max_pieces
+    )
     return CostCounts(
         attempts=min(len(opts.deltas), 2),
         rhs=(m + 3) * (opts.mode_iterations + 1) + 2 * (m + columns),
-        pieces=min(float(opts.max_pieces), model["pieces"] * model["growth"] ** max(m - 2, 0)),
+        pieces=float(opts.max_pieces) if capped else model["pieces"] * model["growth"] ** extra,
         size=float(problem.model.A.getSize()[0]) / model["reference_dofs"],
     )
 

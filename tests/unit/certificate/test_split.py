@@ -328,3 +328,24 @@ def test_thin_ssss_plate_is_bracketed_on_request(mesh, thin_plate):
     assert cert.lower_bound <= load
     if mesh == (90, 30):
         assert cert.lower_bound <= 4075.186054
+
+
+def test_cost_estimate_of_hundreds_of_negative_eigenvalues_is_the_cap():
+    """The estimate's pieces: 40 at m = 2, 4 times as many per further one, at most the cap.
+
+    COST_MODEL's rule, capped at ``max_pieces``. A filled tube (R/t = 50, L = R, 10 mm
+    cells) has m = 576 pencil eigenvalues below its load: 4**574 overflows a float, and
+    the certificate ended in an OverflowError (an internal error, no result).
+    """
+    from types import SimpleNamespace
+
+    from unibuckle_fenicsx.certificate.copositivity_split import estimate_counts
+
+    opts = SplitOptions()
+    matrix = SimpleNamespace(getSize=lambda: (8463, 8463))
+    problem = SimpleNamespace(model=SimpleNamespace(A=matrix))
+    sources = SimpleNamespace(first=[("column", None)] * 3)
+    assert estimate_counts(problem, sources, 2, opts).pieces == 40.0
+    assert estimate_counts(problem, sources, 3, opts).pieces == 160.0
+    for m in (5, 576, 10**6):
+        assert estimate_counts(problem, sources, m, opts).pieces == float(opts.max_pieces)
