@@ -35,7 +35,8 @@ with looser tolerances first (:data:`THRESHOLDS`, then ``solver.tau``), so that 
 places the contact lines before it chases the sign of the mode's tails. The answer is
 always a KKT point of the *fine* problem.
 
-**Fallbacks.** When the finest level reaches no KKT point: penalty continuation
+**Fallbacks.** When the finest level reaches no KKT point (or only the one with every
+constrained node in contact while other seeds stalled): penalty continuation
 (:mod:`.continuation`), then, if that stalls too, the feasible descent
 (:mod:`.descent`), which cannot cycle, from the best admissible mode met.
 
@@ -381,15 +382,44 @@ class _Fallbacks:
     route: list[str] = field(default_factory=list)
 
 
+#: How a run ends when it gave up before a KKT point (:func:`_reached`).
+_STALLS = (RunStatus.CYCLE, RunStatus.MAX_ITERATIONS, RunStatus.STALLED)
+
+
+def _pinned(problem: UnilateralProblem, run: Run) -> bool:
+    """Whether ``run`` ended at a KKT point with every constrained node in contact."""
+    final = run.final
+    return (
+        run.status is RunStatus.KKT
+        and final is not None
+        and final.active.size == problem.num_constrained
+    )
+
+
+def _reached(problem: UnilateralProblem, runs: list[Run]) -> bool:
+    """Whether ``runs`` reached a KKT point the fallbacks need not look below.
+
+    (:func:`_fall_back`: not the all-contact one alone while another run stalled.)
+    """
+    kkt = [r for r in runs if r.status is RunStatus.KKT and r.final is not None]
+    stalled = any(r.status in _STALLS for r in runs)
+    return any(not _pinned(problem, r) for r in kkt) or (bool(kkt) and not stalled)
+
+
 def _fall_back(
     problem: UnilateralProblem, runs: list[Run], max_iterations: int, warnings: list[str]
 ) -> _Fallbacks:
     """The penalty continuation, then the feasible descent, while no run is at a KKT point.
 
+    A KKT point with every constrained node in contact (the "all" seed's at once) counts
+    as none while another run stalled: its mode stays off the obstacle everywhere, which
+    on a filled section leaves only the walls' stretching (a filled tube's load of
+    thousands of times the hollow one's), while the stalled runs met lower modes.
+
     Their runs are appended to ``runs``, what they did to ``warnings``. Collective.
     """
     out = _Fallbacks()
-    if distinct_kkt(runs):
+    if _reached(problem, runs):
         return out
     # The iteration stalled on this mesh: penalty continuation, started from the free
     # plate (on thin plates a stalled contact set is a poorer start).
@@ -405,10 +435,12 @@ def _fall_back(
         f"the active-set iteration stalled; penalty continuation ({out.penalty_solves} "
         f"eigen solves) ended {'at a KKT point' if run.status == 'kkt' else run.status}"
     )
-    if distinct_kkt(runs):
+    if _reached(problem, runs):
         return out
-    # Both stalled: the feasible descent cannot cycle (docs: methods/active_set).
-    last, steps = _descent(problem, runs, DESCENT_BUDGET * max_iterations)
+    # Both stalled: the feasible descent cannot cycle (docs: methods/active_set); not
+    # from the all-contact point, a KKT point it cannot leave.
+    starts = [r for r in runs if not _pinned(problem, r)]
+    last, steps = _descent(problem, starts, DESCENT_BUDGET * max_iterations)
     if last is not None:
         runs.append(last)
         out.route.append("feasible-descent")

@@ -248,3 +248,46 @@ def test_a_coarser_section_without_core_nodes_ends_the_added_levels():
         assert solution.candidate.kkt
     with pytest.raises(InputError, match=r"mesh\.levels"):
         solve_levels(params, levels=1, comm=MPI.COMM_SELF, route="interior-point")
+
+
+def test_a_filled_tube_whose_seeds_stall_is_not_left_at_every_direction_in_contact():
+    # A short filled tube (R/t = 50, L = R, 21 facets, 4 cells along): the seeds free+/-
+    # and the windows stall (20 steps), and the plate's "all" seed is a KKT point at
+    # once: every direction pinned, the walls only stretching, 5.7e12 Pa = 1384 x the
+    # hollow tube. The fallbacks must run from the stalled seeds instead.
+    # Reference, independent of the solvers: the critical load is the least Rayleigh
+    # quotient over the admissible cone (paper, section 2), so the quotient of any
+    # admissible vector bounds it from above. The vector: the outward axisymmetric bulge
+    # u_n = -sin(pi x/L) at every constrained direction (n_in . u <= 0 is admissible),
+    # on the rotated pencil, the rotations left 0. Its analytic value on the smooth
+    # tube: bending, hoop stretching and the transverse shear strain w' (the rotations
+    # are 0) over the work of the axial stress, D pi^2/(t L^2) + E L^2/((1 - nu^2) pi^2
+    # R^2) + (5/6) G = 9.08e10 Pa (7.6e7 + 2.34e10 + 6.73e10).
+    from unibuckle_fenicsx.model.shell.levels import MORE_SEEDS, SEEDS
+
+    params = _parameters("tube", length=0.1, mesh_size=0.03)
+    with build_section(params, MPI.COMM_SELF) as sec:
+        con, pencil = sec.constraints, sec.problem.pencil
+        u = pencil.A.createVecRight()
+        x = con.coordinates[con.owned_positions, 0]
+        u.array[con.owned_local_dofs] = -np.sin(math.pi * x / params.length)
+        bulge = pencil.A(u).dot(u) / pencil.B(u).dot(u)
+        u.destroy()
+        E, nu, t, L, R = params.E, params.nu, params.thickness, params.length, 0.1
+        D = E * t**3 / (12 * (1 - nu**2))
+        G = E / (2 * (1 + nu))
+        smooth = (
+            D * math.pi**2 / (t * L**2) + E * L**2 / ((1 - nu**2) * math.pi**2 * R**2) + 5 / 6 * G
+        )
+        assert bulge == pytest.approx(smooth, rel=0.02)  # 21 facets, 4 cells along
+        solution = solve_active_set(
+            sec.problem,
+            multilevel=False,
+            max_iterations=20,
+            bound_budget=0,
+            seeds=SEEDS,
+            more_seeds=MORE_SEEDS,
+        )
+        assert sec.problem.solve_free().load < solution.load <= bulge
+        assert solution.candidate.kkt
+        assert len(solution.active) < con.size
