@@ -120,7 +120,9 @@ class SectionDesignRecord(Struct, kw_only=True):
         clauses: The clauses applied.
         notes: What the output rests on, and what it leaves out.
         faces: A box's faces (:class:`FaceDesign`); empty for a tube.
-        governing_face: The face of the smallest :math:`\rho` (None for a tube).
+        governing_face: The face that reaches :math:`\rho f_y/\gamma_{M1}` at the
+            smallest multiple of the critical load, the smallest :math:`\rho f_y/\sigma_1`
+            (None for a tube).
         width_to_thickness: With a core: :math:`h/t` (box, h the greater overall
             dimension) or :math:`d/t` (tube, d the outer diameter); else None.
         width_to_thickness_limit: EN 1994-1-1 Table 6.3's limit of that ratio.
@@ -179,6 +181,17 @@ def _face(name: str, ends: tuple[float, float], design: DesignSpec) -> FaceDesig
     return out
 
 
+def _reaches_reduced_stress(face: FaceDesign) -> float:
+    r"""The multiple of the critical load at which ``face`` carries :math:`\rho f_y/\gamma_{M1}`.
+
+    Every face's stress grows with the one load factor: the face that reaches its reduced
+    stress first governs (with one compression on every face, the one of the smallest
+    :math:`\rho`; with bending, a lightly compressed face's smaller :math:`\rho` does
+    not make it govern).
+    """
+    return (face.reduced_design_stress_Pa or 0.0) / face.sigma_cr_Pa
+
+
 def section_design(section: DesignSection, design: DesignSpec, load: float) -> SectionDesignRecord:
     """The design quantities of the section's critical load ``load`` (the module docstring)."""
     t = section.thickness
@@ -200,9 +213,9 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         )
         for name, (a, b) in face_compressions(section).items():
             out.faces.append(_face(name, (load * a, load * b), design))
-        rated = [f for f in out.faces if f.reduction_factor is not None]
+        rated = [f for f in out.faces if f.reduced_design_stress_Pa is not None]
         if rated:
-            out.governing_face = min(rated, key=lambda f: f.reduction_factor or 1.0).face
+            out.governing_face = min(rated, key=_reaches_reduced_stress).face
     else:
         out.clauses.append(TUBE_CLAUSES)
     if section.core:

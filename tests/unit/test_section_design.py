@@ -71,6 +71,29 @@ def test_bending_puts_a_face_in_tension_and_the_webs_in_a_gradient():
     assert out.governing_face == "bottom"  # rho falls with psi at one slenderness
 
 
+def test_the_governing_face_is_the_one_reaching_its_reduced_stress_first():
+    # axial -1, bending -0.5 at z = +d/2: top 1.5, bottom 0.5, webs 1.5 to 0.5 (psi = 1/3),
+    # at the load 1.8327e8 Pa of a filled box 150 x 100 x 2 mm (its run, S355). By eq.
+    # (4.2): top lambda_p = sqrt(355/274.9) = 1.136, rho = 0.7096; bottom (91.6 MPa)
+    # lambda_p = 1.968, rho = 0.4513, the smallest rho. The load factor that brings a face
+    # to rho f_y: top 0.7096 x 355/274.9 = 0.916, webs 0.738 x 355/274.9 = 0.953, bottom
+    # 0.4513 x 355/91.6 = 1.748: the top face governs, the bottom one least.
+    load, fy = 1.8327e8, 3.55e8
+    section = _section(width=0.15, depth=0.1, bending_stress=-0.5)
+    out = section_design(section, DesignSpec(yield_stress=fy), load)
+    first = {}
+    for name, sigma, psi in (("top", 1.5, 1.0), ("right", 1.5, 1 / 3), ("bottom", 0.5, 1.0)):
+        slenderness = math.sqrt(fy / (sigma * load))
+        rho = (slenderness - 0.055 * (3.0 + psi)) / slenderness**2
+        first[name] = rho * fy / (sigma * load)
+    assert first["top"] == pytest.approx(0.916, abs=1e-3)
+    assert first["right"] == pytest.approx(0.953, abs=1e-3)
+    assert first["bottom"] == pytest.approx(1.748, abs=1e-3)
+    faces = {f.face: f for f in out.faces}
+    assert faces["bottom"].reduction_factor == pytest.approx(0.4513, abs=1e-4)
+    assert out.governing_face == "top"
+
+
 def test_a_stocky_face_is_fully_effective():
     # lambda_p = 0.5 below the limit 0.5 + sqrt(0.085 - 0.055) = 0.673 of psi = 1.
     out = section_design(_section(), DesignSpec(yield_stress=2.35e8), 4 * 2.35e8)
