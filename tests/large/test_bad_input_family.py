@@ -275,6 +275,7 @@ RULES: list[tuple[str, str, dict[tuple, Any], str]] = [
         "load.temperature",
     ),
     ("design: an outline", "outline", {("design",): {"yield_stress": 3.55e8}}, "plate.outline"),
+    ("design: a laminate", "laminate", {("design",): {"yield_stress": 3.55e8}}, "material.plies"),
     (
         "a one-sided point without its side",
         "features",

@@ -102,6 +102,17 @@ def test_design_needs_a_compressive_edge_stress():
         )
 
 
+def test_design_of_a_laminate_is_refused():
+    # EN 1993-1-5 (Eurocode 3) is a steel code: eq. (4.2)'s rho is calibrated on steel
+    # plates (their imperfections and residual stresses). A carbon-epoxy [0/90/0]
+    # stack (E1 = 140 GPa, E2 = 10 GPa) with f_y = 355 MPa got rho = 0.3575, exit 0.
+    ply = {"E1": 1.4e5, "E2": 1.0e4, "G12": 5.0e3, "nu12": 0.3, "G13": 5.0e3, "G23": 3.0e3}
+    plies = [{"thickness": t, "angle": a, **ply} for t, a in ((1.0, 0.0), (2.0, 90.0), (1.0, 0.0))]
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    with pytest.raises(ValueError, match=r"design: material\.plies"):
+        plate(edges, material={"plies": plies})
+
+
 def test_uniform_compression():
     """Uniform: psi = 1, sigma_cr = lambda_c; slenderness, rho, rho f_y / gamma_M1 by hand."""
     out = result(plate({"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}))

@@ -153,11 +153,18 @@ class ProblemSpec(Table, frozen=True):
     def _check_design(self) -> None:
         """The design output needs a compressive normal edge stress (its sigma_cr).
 
-        And a plate that EN 1993-1-5 4.4 describes: an internal or an outstand element
-        (:func:`~unibuckle_fenicsx.en1993.design_element` says which, or refuses).
+        And a plate that EN 1993-1-5 4.4 describes: of steel (not a laminate), an internal
+        or an outstand element (:func:`~unibuckle_fenicsx.en1993.design_element` says
+        which, or refuses).
         """
         if self.design is None:
             return
+        if self.material.plies:
+            raise InputError(
+                "design: material.plies gives a laminate, and EN 1993-1-5 (Eurocode 3) "
+                "describes steel plates: its reduction factor rho (4.4(2)) is calibrated on "
+                "steel plates' imperfections and residual stresses; leave [design] out"
+            )
         compressed = any(
             min(*stress_ends(e.normal_stress), *stress_ends(e.fixed_normal_stress)) < 0.0
             for e in self.plate.edges
