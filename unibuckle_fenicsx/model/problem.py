@@ -286,11 +286,24 @@ class Problem(Owner):
         # inertia alike).
         below = self.eigensolver.count_below(sigma)
         if below:
-            raise EigenSolveError(
-                f"the free eigen solve returned lambda = {free.load!r}, but {below} "
-                "eigenvalue(s) of the pencil lie below it (inertia of A - sigma B): "
+            # A count within rounding of the load says nothing: a plate so thin against
+            # its width that double precision fixes its load more loosely than sigma's
+            # margin (b/t of about 1e6) is not the eigen solver's fault.
+            resolution = self.load_resolution(free.function.x.petsc_vec, free.load)
+            why = (
                 "the eigen solver stopped on a higher pair; its options "
                 "(-unibuckle_eps_tol, -unibuckle_eps_ncv, ...) are too loose"
+            )
+            if resolution > 1.0 - sigma / free.load:
+                why = (
+                    f"double precision fixes that load only to {resolution:.2g} of it "
+                    f"(load_resolution), beyond the count's margin {1.0 - sigma / free.load:.2g}: "
+                    "the plate (plate.thickness; a section's wall, section.thickness) is "
+                    "too thin against its width for its stiffness to keep the digits"
+                )
+            raise EigenSolveError(
+                f"the free eigen solve returned lambda = {free.load!r}, but {below} "
+                f"eigenvalue(s) of the pencil lie below it (inertia of A - sigma B): {why}"
             )
         self._free_verified = True
 

@@ -543,3 +543,56 @@ def test_incomplete_path_says_what_it_validated(tmp_path, capsys, monkeypatch):
     assert "the path from 1.05 to --max-load 1.2 x the linear load" in missing
     assert "DIVERGED_LINE_SEARCH" in missing
     assert json.loads(out.read_text())["completed"] is False
+
+
+def test_a_plate_too_thin_for_double_precision_is_said_so(tmp_path, capsys):
+    """b/t = 1e6 and 1e7: the stiffness keeps fewer digits than the answer shows.
+
+    The rounding bound (``load_resolution``, eps |u|^T|A||u| / (lambda u^T B u)) grows as
+    (b/t)^2. SSSS 0.2 x 0.1 m (the paper's plate, 40 x 20 cells) at t = 2e-7 m: the
+    inertia check of the free pair fails within rounding; its message said the eigen
+    solver's options were too loose. An outstand 0.5 x 0.1 m (bottom edge simply
+    supported, top free, compression 1 to 0.5 across, E = 210 GPa, 50 x 10 cells) at
+    t = 1e-8 m: exit 0 with k = 0.503 and no word, where the same plate at t = 1e-5 m
+    (bound 2.5e-5) has k = 0.742 (k of a thin plate does not depend on t).
+    """
+    ssss = tmp_path / "ssss.toml"
+    ssss.write_text(
+        SMALL.replace("thickness = 0.006", "thickness = 1e-7").replace("nx = 8", "nx = 40")
+        .replace("ny = 4", "ny = 20")
+    )  # fmt: skip
+    assert main(["solve", "--config", str(ssss), "-q"]) == EXIT_NOT_CERTIFIED
+    err = capsys.readouterr().err
+    assert "load_resolution" in err and "section.thickness" in err, err
+    assert "too loose" not in err, err
+    outstand = """\
+[plate]
+corners = [[0.0, 0.0], [0.5, 0.1]]
+thickness = THICKNESS
+[material]
+E = 2.1e11
+nu = 0.3
+[edges.left]
+normal_stress = [-1.0, -0.5]
+[edges.right]
+normal_stress = [-1.0, -0.5]
+[edges.top]
+support = "free"
+[mesh]
+nx = 50
+ny = 10
+"""
+    k = {}
+    for t in ("1e-5", "1e-8"):
+        path = tmp_path / f"outstand_{t}.toml"
+        path.write_text(outstand.replace("THICKNESS", t))
+        out = tmp_path / f"outstand_{t}.json"
+        assert main(["solve", "--config", str(path), "-q", "--json", str(out)]) == EXIT_OK
+        err = capsys.readouterr().err
+        result = json.loads(out.read_text())
+        k[t] = result["buckling_coefficient_k"]
+        assert ("warning: double precision fixes the critical load" in err) == (t == "1e-8")
+    assert k["1e-5"] == pytest.approx(0.7422, abs=1e-4)
+    off = abs(k["1e-8"] / k["1e-5"] - 1.0)
+    assert off > 0.01  # the warning is due ...
+    assert off < json.loads((tmp_path / "outstand_1e-8.json").read_text())["load_resolution"]
