@@ -70,7 +70,7 @@ OUT_OF_RANGE: dict[str, list[Any]] = {
     "rotational_stiffness": [-1.0],
     "translational_stiffness": [-1.0],
     "yield_stress": [0.0, -1.0],
-    "partial_factor": [0.0],
+    "partial_factor": [0.0, 0.9],
     "stiffness": [0.0, -1.0],
     "spacing": [[0.0, 0.05], [-0.1, 0.05]],
     "gap": [-1e-4],

@@ -82,7 +82,10 @@ def test_design_keys_are_read_converted_and_written_back():
     "design, extra, match",
     [
         ({"yield_stress": 0.0}, {}, r"design\.yield_stress must be > 0 Pa"),
-        ({"yield_stress": 355.0, "partial_factor": -1}, {}, r"design\.partial_factor must be > 0"),
+        ({"yield_stress": 355.0, "partial_factor": -1}, {}, r"design\.partial_factor must be >= 1"),
+        # gamma_M1 = 0.9 put rho f_y/gamma_M1 11 % above rho f_y, accepted (EN 1993-1-1,
+        # 6.1: recommended 1.0; a resistance factor is not below 1).
+        ({"yield_stress": 355.0, "partial_factor": 0.9}, {}, r"partial_factor must be >= 1"),
         ({"partial_factor": 1.0}, {}, r"\[design\] needs 'yield_stress'"),
         ({"yield_stress": 355.0, "gamma": 1.0}, {}, r"unknown key\(s\) \['gamma'\] in \[design\]"),
     ],

@@ -197,13 +197,14 @@ class DesignSpec(Table, frozen=True):
 
     Args:
         yield_stress: :math:`f_y` (Pa), > 0.
-        partial_factor: :math:`\gamma_{M1}`, > 0; 1.0, the recommended value of EN 1993-1-1,
-            6.1.
+        partial_factor: :math:`\gamma_{M1}`, >= 1; 1.0, the recommended value of EN
+            1993-1-1, 6.1 (a resistance factor below 1 would put the design stress
+            above the reduced characteristic one, rho f_y).
     """
 
     KEY: ClassVar[str] = "design"
     yield_stress: Annotated[float, unit("Pa", gt=0)]
-    partial_factor: Annotated[float, Meta(gt=0)] = 1.0
+    partial_factor: Annotated[float, Meta(ge=1.0)] = 1.0
 
 
 class PointSpec(Table, frozen=True):
