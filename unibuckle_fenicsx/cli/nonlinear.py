@@ -9,7 +9,7 @@ from typing import Any
 
 from unibuckle_fenicsx.cli.flags import NONLINEAR_FLAGS
 from unibuckle_fenicsx.cli.problem import spec_from_args, warn_plate_model
-from unibuckle_fenicsx.cli.status import report_failure
+from unibuckle_fenicsx.cli.status import print_out, report_failure
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
 from unibuckle_fenicsx.spec.section import SectionProblemSpec
@@ -58,7 +58,7 @@ def nonlinear_command(args: argparse.Namespace, comm: Any) -> int:
                 Path(args.json).write_text(json.dumps(result.as_dict(), indent=2) + "\n")
             except OSError as err:
                 unwritten = f"could not write --json {args.json}: {err}"
-        print(result.summary(), flush=True)
+        print_out(result.summary())
         if not result.certified:
             print(
                 f"unibuckle: error: {result.shortfall()}"

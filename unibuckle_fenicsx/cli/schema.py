@@ -3,11 +3,10 @@
 from __future__ import annotations
 
 import argparse
-import os
 import sys
 from pathlib import Path
 
-from unibuckle_fenicsx.cli.status import EXIT_BAD_INPUT, EXIT_OK
+from unibuckle_fenicsx.cli.status import EXIT_BAD_INPUT, EXIT_OK, print_out
 
 
 def schema_command(args: argparse.Namespace) -> int:
@@ -18,13 +17,7 @@ def schema_command(args: argparse.Namespace) -> int:
 
     text = "\n".join(accepted_keys()) if args.keys else json.dumps(json_schema(), indent=2)
     if not args.output:
-        try:
-            print(text, flush=True)
-        except BrokenPipeError:
-            # The reader stopped early (``| head``): not an error. Python's recipe (the
-            # signal module's "Note on SIGPIPE"): stdout to devnull, so that the
-            # interpreter's last flush at exit does not fail again.
-            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        print_out(text)
         return EXIT_OK
     try:
         Path(args.output).write_text(text + "\n")

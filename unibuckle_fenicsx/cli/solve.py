@@ -10,7 +10,7 @@ from msgspec.structs import replace
 
 from unibuckle_fenicsx.cli.flags import solver_changes, unused_flags
 from unibuckle_fenicsx.cli.problem import spec_from_args, warn_plate_model
-from unibuckle_fenicsx.cli.status import report_failure
+from unibuckle_fenicsx.cli.status import print_out, report_failure
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
 from unibuckle_fenicsx.spec.section import SectionProblemSpec
@@ -55,7 +55,7 @@ def _report(args: argparse.Namespace, result: Any, comm: Any, unwritten: str | N
                 write_json(result, args.json)
             except OSError as err:
                 unwritten = f"--json {args.json}: {err}"
-        print(result.summary(), flush=True)
+        print_out(result.summary())
         coarse = resolution_note(result.load_resolution)
         if coarse is not None:
             print(f"unibuckle: warning: {coarse}", file=sys.stderr)

@@ -2,6 +2,9 @@
 
 from __future__ import annotations
 
+import os
+import signal
+import sys
 from typing import Any
 
 from unibuckle_fenicsx.outcome import Outcome
@@ -39,3 +42,20 @@ def report_failure(comm: Any, message: str, status: int = EXIT_BAD_INPUT) -> int
     """
     PENDING.append((status, message))
     return status
+
+
+def print_out(text: str) -> None:
+    """Print ``text`` on stdout; a reader that stopped early (``| head``) is not an error.
+
+    PETSc, once loaded, takes SIGPIPE for a crash and aborts the run ("Caught signal
+    number 13 Broken Pipe", MPI_Abort): Python's own disposition (ignored, so that the
+    write raises BrokenPipeError) is restored first. Then Python's recipe (the signal
+    module's "Note on SIGPIPE"): stdout to devnull, so that the interpreter's last flush
+    at exit does not fail again.
+    """
+    if hasattr(signal, "SIGPIPE"):
+        signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+    try:
+        print(text, flush=True)
+    except BrokenPipeError:
+        os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())

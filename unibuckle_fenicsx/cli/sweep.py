@@ -7,7 +7,7 @@ import logging
 from typing import Any
 
 from unibuckle_fenicsx.cli.problem import load_config
-from unibuckle_fenicsx.cli.status import report_failure
+from unibuckle_fenicsx.cli.status import print_out, report_failure
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
 
@@ -66,14 +66,13 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
         from collections import Counter
 
         counts = Counter(line["status"] for line in lines)
-        print(
+        print_out(
             f"sweep: {len(lines)} points in {args.json}: "
-            + ", ".join(f"{n} {status}" for status, n in sorted(counts.items())),
-            flush=True,
+            + ", ".join(f"{n} {status}" for status, n in sorted(counts.items()))
         )
         if args.plot:
             from unibuckle_fenicsx.viz.charts import plot_sweep
 
-            print(f"sweep: chart {plot_sweep(lines, variations, base, args.plot)}")
+            print_out(f"sweep: chart {plot_sweep(lines, variations, base, args.plot)}")
     ok = all(line["status"] == Outcome.OK for line in lines)
     return (Outcome.OK if ok else Outcome.NOT_CERTIFIED).exit_status

@@ -596,3 +596,28 @@ ny = 10
     off = abs(k["1e-8"] / k["1e-5"] - 1.0)
     assert off > 0.01  # the warning is due ...
     assert off < json.loads((tmp_path / "outstand_1e-8.json").read_text())["load_resolution"]
+
+
+@serial
+def test_a_summary_into_a_pipe_closed_early_is_not_an_error(tmp_path):
+    """``unibuckle solve ... | head -1``: the reader stops early, the run ends with exit 0.
+
+    PETSc takes SIGPIPE for a crash: the run ended with "Caught signal number 13 Broken
+    Pipe", MPI_Abort and exit 59 (or 141, killed by the signal). The pipe is closed
+    before the summary is written (the solve takes tenths of a second), so the write
+    meets a closed pipe for certain.
+    """
+    box = ["--config", str(ROOT / "demos/box.toml"), "--set", "obstacle.core=false"]
+    for args in (["--case", "free"], [*box, "--set", "mesh.size=0.025"]):
+        proc = subprocess.Popen(
+            [str(SCRIPT), "solve", *args, "-q"],
+            stdout=subprocess.PIPE,
+            stderr=subprocess.PIPE,
+            cwd=tmp_path,
+            env={**os.environ, "OMP_NUM_THREADS": "1"},
+        )
+        assert proc.stdout is not None and proc.stderr is not None
+        proc.stdout.close()  # what head does after its lines
+        err = proc.stderr.read().decode()
+        assert proc.wait() == EXIT_OK, err
+        assert "PETSC ERROR" not in err and "Traceback" not in err, err
