@@ -253,7 +253,7 @@ class ChainOptions:
             the plates' runs end where the gaps' set is the predicted one or a saddle's;
             on sections with a core, where a wall lies almost flat on the core, the
             gaps there stay above ``tau`` at every parameter reached, and only the
-            predicted set holds them (:doc:`/verification/sections`, "Cost").
+            predicted set holds them (:doc:`/verification/sections_finest`).
         clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
             (the least-energy correction lifts those closer to the obstacle to it).
         max_steps: Newton steps per run.
