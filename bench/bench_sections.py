@@ -68,8 +68,9 @@ def run(
 ) -> dict:
     """One section: set-up, free solve, unilateral solve, certificate.
 
-    ``route``: "active-set", "interior-point", "auto" (the routes of
-    :func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`) or "single" (the
+    ``route``: "active-set", "interior-point" (the routes of
+    :func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`), "auto" (the one
+    :func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses) or "single" (the
     interior-point chain on the section itself).
     """
     from mpi4py import MPI
@@ -79,10 +80,12 @@ def run(
 
     from unibuckle_fenicsx.algorithms.chain import solve_interior_point
     from unibuckle_fenicsx.algorithms.records import InteriorPointDetails, SectionLevelsDetails
+    from unibuckle_fenicsx.analysis import choose_section_method
     from unibuckle_fenicsx.certificate.certify import certify
     from unibuckle_fenicsx.la.eigen import GEPSolver
     from unibuckle_fenicsx.model.shell import levels as section_levels
     from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
+    from unibuckle_fenicsx.spec import SolverSpec
 
     # Each level's factorisations: the count before and after it (in order, coarsest first).
     per_level: list[int] = []
@@ -122,7 +125,10 @@ def run(
     t1 = time.perf_counter()
     before = _factorisations()
     if route != "single":
-        fine, solution = section_levels.solve_levels(params, levels=levels, route=route)
+        chosen = route
+        if route == "auto":
+            chosen, _ = choose_section_method(params, SolverSpec())
+        fine, solution = section_levels.solve_levels(params, levels=levels, route=chosen)
     else:
         fine = build_section(params, MPI.COMM_WORLD)
         t1 = time.perf_counter()  # the set-up is not the unilateral solve's

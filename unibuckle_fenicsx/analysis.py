@@ -1,4 +1,11 @@
-"""High-level entry point: :func:`solve` a :class:`~unibuckle_fenicsx.spec.ProblemSpec`."""
+"""High-level entry point: :func:`solve` a :class:`~unibuckle_fenicsx.spec.ProblemSpec`.
+
+The method of every unilateral problem is decided here: a plate's by :func:`choose_method`
+(once its mesh is built and its free eigen solve timed), a section's by
+:func:`choose_section_method` (before any mesh). Each returns a key of
+:data:`~unibuckle_fenicsx.algorithms.registry.REGISTRY`, through which the method runs,
+and the reason a result records as ``method_chosen_by``.
+"""
 
 from __future__ import annotations
 
@@ -19,11 +26,17 @@ from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
+from unibuckle_fenicsx.model.shell.levels import INTERIOR_POINT_DOFS, estimated_dofs
+from unibuckle_fenicsx.model.shell.section import SectionParameters
 from unibuckle_fenicsx.results.assemble import assemble_result
 from unibuckle_fenicsx.results.records import BucklingResult
-from unibuckle_fenicsx.spec import Method, ProblemSpec
+from unibuckle_fenicsx.spec import Method, ProblemSpec, SolverSpec
+from unibuckle_fenicsx.spec.section import check_section_method
 
-__all__ = ["Analysis", "choose_method", "solve"]
+__all__ = ["FREE", "Analysis", "choose_method", "choose_section_method", "solve"]
+
+#: The "method" of a problem without obstacle (a section without core): its free load.
+FREE = "free"
 
 logger = logging.getLogger(__name__)
 
@@ -94,6 +107,38 @@ def choose_method(
         f"auto: 2^{i} = {shown} candidate sets, about {estimate:.3g} s "
         f"({solve_time_s:.3g} s per eigen solve), within enumeration_budget_s = "
         f"{options.enumeration_budget_s:g}"
+    )
+
+
+def choose_section_method(parameters: SectionParameters, solver: SolverSpec) -> tuple[str, str]:
+    """The method to run on a section, and why ("auto" decides by the section's size).
+
+    Without a core, :data:`FREE` (the hollow section's smallest eigenvalue); an elastic
+    core runs the spring-set iteration (:data:`~.algorithms.registry.FOUNDATION`), as a
+    plate's tensionless foundation does. A rigid core runs the ``[solver] method`` given,
+    one of :data:`~unibuckle_fenicsx.spec.section.SECTION_METHODS`; "auto" runs the
+    interior point on sections of at least
+    :data:`~unibuckle_fenicsx.model.shell.levels.INTERIOR_POINT_DOFS` degrees of
+    freedom, estimated before meshing
+    (:func:`~unibuckle_fenicsx.model.shell.levels.estimated_dofs`), and the active set
+    on smaller ones. The interior point falls back on the active set when it reaches no
+    KKT point (its route then takes the link "active-set").
+
+    Raises:
+        InputError: A method no section runs (``solver.method``, the allowed named).
+    """
+    check_section_method(solver.method)
+    if not parameters.core:
+        return FREE, "no core"
+    if parameters.foundation_stiffness is not None:
+        return FOUNDATION, "elastic core: spring-set iteration"
+    if solver.method != Method.AUTO:
+        return solver.method, "given"
+    dofs = estimated_dofs(parameters)
+    large = dofs >= INTERIOR_POINT_DOFS
+    return Method.INTERIOR_POINT if large else Method.ACTIVE_SET, (
+        f"auto: about {dofs} DOFs (estimated before meshing) "
+        f"{'>=' if large else '<'} INTERIOR_POINT_DOFS = {INTERIOR_POINT_DOFS}"
     )
 
 
@@ -243,7 +288,7 @@ def _analyse(
     problem.timings["free_solve_s"] = t_free
     solution: UnilateralSolution | None = None
     certificate: Certificate | None = None
-    method, reason = "free", "no obstacle"
+    method, reason = FREE, "no obstacle"
     if not isinstance(problem, UnilateralProblem):
         # The free load is the answer: verified the smallest (one LDL^T's inertia).
         t1 = time.perf_counter()

@@ -10,9 +10,12 @@ it covers, the wall may only move away from it (:mod:`~unibuckle_fenicsx.model.s
 - Without a core the critical load is the pencil's smallest eigenvalue, verified the
   smallest by the inertia of :math:`A - \sigma B` (as a plate without obstacle).
 - With a core the free load is the hollow section's; the unilateral critical state is
-  found coarse to fine (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`: the
-  interior point's starts on a coarser section, the mode carried to the finer one; the
-  active set's seeds and carried contact set if it reaches no KKT point) and certified
+  found by the method :func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses,
+  run through the registry (:data:`~unibuckle_fenicsx.algorithms.registry.REGISTRY`):
+  with a rigid core coarse to fine (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`:
+  the interior point's starts on a coarser section, the mode carried to the finer one;
+  or the active set's seeds and carried contact set), with an elastic core by the
+  spring-set iteration; it is certified
   (:func:`~unibuckle_fenicsx.certificate.certify.certify`) on the finest.
 
 The critical load is the factor on the stresses per unit load: the compressive stress in
@@ -40,12 +43,12 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
-from unibuckle_fenicsx.algorithms.foundation import solve_foundation
+from unibuckle_fenicsx.algorithms.registry import entry
+from unibuckle_fenicsx.analysis import FREE, choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode, Problem, UnilateralProblem
-from unibuckle_fenicsx.model.shell.levels import solve_levels
 from unibuckle_fenicsx.model.shell.section import (
     Section,
     SectionParameters,
@@ -233,8 +236,10 @@ def solve_section(
             starts on, >= 0 (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`:
             the interior point's starts, or the active set's seeds). 1 by default: the
             starts' many steps on a section of a quarter of the DOFs, a few on the given one.
-        solver: Solver options (tolerances, the feasibility tolerance tau); the
-            package's defaults when None.
+        solver: Solver options (the method, one of
+            :data:`~unibuckle_fenicsx.spec.section.SECTION_METHODS`, chosen by
+            :func:`~unibuckle_fenicsx.analysis.choose_section_method`; tolerances, the
+            feasibility tolerance tau); the package's defaults when None.
         design: The yield stress and partial factor of the design output
             (:mod:`~unibuckle_fenicsx.section_design`); None: none.
 
@@ -243,7 +248,8 @@ def solve_section(
 
     Raises:
         TypeError: ``parameters`` is not a SectionParameters.
-        InputError: ``levels`` out of range.
+        InputError: ``levels`` out of range, or a method no section runs
+            (``solver.method``).
         NumericalError: An eigen solve did not converge.
 
     Note:
@@ -266,7 +272,10 @@ def solve_section(
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
     certificate: Certificate | None = None
-    section, solution = _solve(parameters, int(levels), comm, solver)
+    solver = solver or SolverSpec()
+    method, reason = choose_section_method(parameters, solver)
+    logger.info("section: method %s (%s)", method, reason)
+    section, solution = _solve(parameters, int(levels), comm, method, solver)
     try:
         problem = section.problem
         t1 = time.perf_counter()
@@ -290,7 +299,7 @@ def solve_section(
                     "the section's result fails its certificate: %s",
                     "; ".join(certificate.notes) or certificate.status,
                 )
-        result = _result(section, free, solution, certificate, time.perf_counter() - t0)
+        result = _result(section, free, solution, certificate, time.perf_counter() - t0, reason)
         if echo is not None:
             result.input, result.units = echo, units
         if design is not None:
@@ -342,22 +351,15 @@ def _faces(
 
 
 def _solve(
-    parameters: SectionParameters, levels: int, comm: MPI.Comm, solver: SolverSpec | None
+    parameters: SectionParameters, levels: int, comm: MPI.Comm, method: str, solver: SolverSpec
 ) -> tuple[Section, UnilateralSolution | None]:
-    """The section and, with a core, its unilateral solution (rigid: by levels; elastic)."""
-    iterations = 100 if solver is None else solver.max_iterations
-    if parameters.core and parameters.foundation_stiffness is None:
-        return solve_levels(
-            parameters, levels=levels, comm=comm, solver=solver, max_iterations=iterations
-        )
-    section = build_section(parameters, comm, solver)
-    if not parameters.core:
-        return section, None
-    try:  # an elastic core: the plate's spring-set iteration
-        return section, solve_foundation(_cored(section.problem), max_iterations=iterations)
-    except BaseException:
-        section.destroy()
-        raise
+    """The section and, with a core, its solution by ``method`` (a registry key, or free)."""
+    if method == FREE:
+        return build_section(parameters, comm, solver), None
+    run = entry(method).section
+    if run is None:
+        raise RuntimeError(f"solve_section: the method {method!r} has no section runner")
+    return run(parameters, levels, comm, solver)
 
 
 def _cored(problem: Problem) -> UnilateralProblem:
@@ -373,8 +375,13 @@ def _result(
     solution: UnilateralSolution | None,
     certificate: Certificate | None,
     wall_time_s: float,
+    method_chosen_by: str,
 ) -> SectionResult:
-    """The :class:`SectionResult` of a solved section (collective: gathers the contact rows)."""
+    """The :class:`SectionResult` of a solved section (collective: gathers the contact rows).
+
+    ``method_chosen_by``: why its method ran
+    (:func:`~unibuckle_fenicsx.analysis.choose_section_method`).
+    """
     p = section.parameters
     problem = section.problem
     load = free.load if solution is None else solution.load
@@ -396,11 +403,7 @@ def _result(
         load_resolution=problem.load_resolution(mode.x.petsc_vec, load),
         timings={**problem.timings, "total_s": wall_time_s},
         mpi_size=problem.comm.size,
-        method_chosen_by="no core"
-        if solution is None
-        else "core: foundation"
-        if problem.tensionless
-        else f"core: section levels, {solution.method}",
+        method_chosen_by=method_chosen_by,
         details=ResultDetails(
             free_eigen_error=free.eigen.error, free_eigen_iterations=free.eigen.iterations
         ),

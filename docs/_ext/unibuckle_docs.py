@@ -397,6 +397,11 @@ COMMANDS = {
     "orderings": lambda rows: _orderings_commands(rows),
     "plates": lambda rows: _plates_commands(rows),
     "routes": lambda rows: _routes_commands(rows),
+    "fixed_factor": lambda rows: (
+        f"python bench/bench_fixed_factor.py --meshes {_listed(rows, 'mesh')} "
+        f"--cases {_listed(rows, 'case')} --repeat {rows[0]['runs']} "
+        "--json bench/results/fixed_factor.jsonl"
+    ),
     "phases": lambda rows: "`, then `".join(
         f"python bench/bench_stages.py --phases --case {case} "
         f"--meshes {_listed([r for r in rows if r['case'] == case], 'mesh')} "
@@ -520,6 +525,26 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("solves", "solves"),
         ("ratio", "certificate time (free solves)"),
         ("load_Pa", "λ_c (Pa)"),
+    ],
+    "fixed_factor": [
+        ("case", "plate"),
+        ("mesh", "mesh"),
+        ("today_fine", "today's fine level: steps / factorisations / eigen solves"),
+        ("start", "start"),
+        ("start_nodes", "its nodes"),
+        ("start_after", "today's fine factorisations before it"),
+        ("factorisations", "factorisations"),
+        ("solves", "solves"),
+        ("columns", "G columns"),
+        ("eigensolves", "eigen solves"),
+        ("end", "end"),
+        ("contact", "\\|Z\\|"),
+        ("rel_diff", "load − today's (relative)"),
+        ("t_factor", "LDL (s)"),
+        ("t_capacitance", "G (s)"),
+        ("t_eigen", "eigen (s)"),
+        ("t_total", "polish (s)"),
+        ("factor_equivalents", "polish (fine factorisations)"),
     ],
     "phases": [
         ("case", "plate"),

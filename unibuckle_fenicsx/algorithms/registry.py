@@ -9,10 +9,14 @@ command line reads them there, so that building its parser imports no PETSc).
 algorithms: the function that runs each method on a
 :class:`~unibuckle_fenicsx.model.problem.UnilateralProblem`, and the links its route may
 take (a result's ``route`` starts with the method and takes only those).
-:func:`unibuckle_fenicsx.analysis.solve` runs the method through it.
+:func:`unibuckle_fenicsx.analysis.solve` runs the method through it. An entry that also
+runs on a box or tube with a core has a ``section`` runner: it builds the section
+(with its coarser sections) from its parameters and solves it;
+:func:`unibuckle_fenicsx.section_analysis.solve_section` runs it.
 
-"auto" chooses among the others (:func:`unibuckle_fenicsx.analysis.choose_method`) and
-runs nothing of its own. A tensionless foundation's spring-set iteration is chosen by the
+"auto" chooses among the others (:func:`unibuckle_fenicsx.analysis.choose_method` for a
+plate, :func:`unibuckle_fenicsx.analysis.choose_section_method` for a section) and runs
+nothing of its own. A tensionless foundation's spring-set iteration is chosen by the
 problem, never named in a file: it is registered under :data:`FOUNDATION` and is no
 :class:`~unibuckle_fenicsx.spec.Method`.
 """
@@ -36,6 +40,8 @@ from unibuckle_fenicsx.algorithms.interior_point.options import ChainOptions
 from unibuckle_fenicsx.algorithms.penalty import solve_penalty
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import UnilateralProblem
+from unibuckle_fenicsx.model.shell.levels import solve_levels
+from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import OPTIONS, FoundationOptions, Method, SolverSpec
 from unibuckle_fenicsx.spec.base import Table
 from unibuckle_fenicsx.spec.solver import (
@@ -45,10 +51,17 @@ from unibuckle_fenicsx.spec.solver import (
     PenaltyOptions,
 )
 
-__all__ = ["FOUNDATION", "REGISTRY", "MethodEntry", "entry"]
+__all__ = ["FOUNDATION", "REGISTRY", "MethodEntry", "SectionRun", "entry"]
 
 #: The name of a tensionless foundation's spring-set iteration (a result's ``method``).
 FOUNDATION = "foundation"
+
+#: Runs a method on a section with a core: its parameters, its coarser sections (``mesh.levels``,
+#: >= 0), the communicator and the ``[solver]`` table in; the finest section (the caller
+#: destroys it) and the solution on it out. Collective.
+SectionRun = Callable[
+    [SectionParameters, int, MPI.Comm, SolverSpec], tuple[Section, UnilateralSolution]
+]
 
 
 @dataclass(frozen=True)
@@ -64,12 +77,15 @@ class MethodEntry:
             each rank holds a part of the mesh; the other methods take None only).
         links: The links its route may take (the first is the method itself, with which
             every route starts).
+        section: Runs it on a box or tube with a core (:data:`SectionRun`); None: it runs
+            on plates only.
     """
 
     name: str
     options: type[Table]
     run: Callable[[UnilateralProblem, Any, MPI.Comm | None], UnilateralSolution]
     links: tuple[str, ...]
+    section: SectionRun | None = None
 
     def options_of(self, solver: SolverSpec) -> Any:
         """This method's options as ``solver`` (the problem's ``[solver]``) sets them."""
@@ -125,6 +141,40 @@ def _foundation(
     return solve_foundation(problem, max_iterations=options.max_iterations)
 
 
+def _section_levels(route: str) -> SectionRun:
+    """The section runner of ``route``: that route over the section's coarser sections."""
+
+    def run(
+        parameters: SectionParameters, levels: int, comm: MPI.Comm, solver: SolverSpec
+    ) -> tuple[Section, UnilateralSolution]:
+        return solve_levels(
+            parameters,
+            levels=levels,
+            comm=comm,
+            solver=solver,
+            max_iterations=solver.max_iterations,
+            route=route,
+        )
+
+    return run
+
+
+def _section_foundation(
+    parameters: SectionParameters, levels: int, comm: MPI.Comm, solver: SolverSpec
+) -> tuple[Section, UnilateralSolution]:
+    """An elastic core: the spring-set iteration on the section itself (no coarser ones)."""
+    section = build_section(parameters, comm, solver)
+    problem = section.problem
+    if not isinstance(problem, UnilateralProblem):
+        section.destroy()
+        raise TypeError("a core section without its contact manager")
+    try:
+        return section, solve_foundation(problem, max_iterations=solver.max_iterations)
+    except BaseException:
+        section.destroy()
+        raise
+
+
 #: Every method that runs, by name (``auto`` is a choice among them, not one of them).
 REGISTRY: dict[str, MethodEntry] = {
     e.name: e
@@ -142,6 +192,7 @@ REGISTRY: dict[str, MethodEntry] = {
                 "active-set",
                 "penalty-continuation",
             ),
+            _section_levels(Method.INTERIOR_POINT),
         ),
         MethodEntry(
             Method.ACTIVE_SET,
@@ -149,9 +200,16 @@ REGISTRY: dict[str, MethodEntry] = {
             _active_set,
             # Its fallbacks (:func:`.active_set.solve_active_set`) after it.
             ("active-set", "penalty-continuation", "feasible-descent"),
+            _section_levels(Method.ACTIVE_SET),
         ),
         MethodEntry(Method.PENALTY, OPTIONS[Method.PENALTY], _penalty, ("penalty",)),
-        MethodEntry(FOUNDATION, FoundationOptions, _foundation, ("foundation", "arc-descent")),
+        MethodEntry(
+            FOUNDATION,
+            FoundationOptions,
+            _foundation,
+            ("foundation", "arc-descent"),
+            _section_foundation,
+        ),
     )
 }
 

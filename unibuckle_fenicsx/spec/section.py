@@ -13,13 +13,34 @@ from typing import Annotated, ClassVar, Literal
 import msgspec
 from msgspec import Meta
 
+from unibuckle_fenicsx.errors import FieldError
 from unibuckle_fenicsx.spec.base import Table, Units, unit
 from unibuckle_fenicsx.spec.obstacles import DesignSpec
-from unibuckle_fenicsx.spec.solver import SolverSpec
+from unibuckle_fenicsx.spec.solver import Method, SolverSpec
 
 Length = Annotated[float, unit("m", gt=0)]
 #: The ``[solver]`` options a section uses (the others are the plate's methods').
-SOLVER_KEYS = ("tau", "eps_tol", "max_iterations")
+SOLVER_KEYS = ("method", "tau", "eps_tol", "max_iterations")
+#: The methods a section with a rigid core may name (``[solver] method``, ``--method``):
+#: "auto" chooses between the other two by the section's size
+#: (:func:`~unibuckle_fenicsx.analysis.choose_section_method`). The enumeration's 2^i
+#: candidate sets are out of reach with a core's hundreds of directions, and the penalty
+#: was never verified on a shell.
+SECTION_METHODS: tuple[Method, ...] = (Method.AUTO, Method.INTERIOR_POINT, Method.ACTIVE_SET)
+
+
+def check_section_method(method: str) -> None:
+    """Refuse a ``[solver] method`` no section runs (one of :data:`SECTION_METHODS` runs).
+
+    Raises:
+        FieldError: ``method`` is not one of :data:`SECTION_METHODS` (an
+            :class:`~unibuckle_fenicsx.errors.InputError` naming ``solver.method``).
+    """
+    if method not in SECTION_METHODS:
+        allowed = ", ".join(f'"{m}"' for m in SECTION_METHODS)
+        raise FieldError(
+            "", "solver.method", f" must be one of {allowed} for a section, got {str(method)!r}"
+        )
 
 
 class SectionSpec(Table, frozen=True):
@@ -154,9 +175,10 @@ class SectionProblemSpec(Table, frozen=True):
         mesh: The cells.
         design: With ``[design]``: EN 1993-1-5 per face and EN 1994-1-1's wall limits from
             the critical state (:mod:`~unibuckle_fenicsx.section_design`).
-        solver: Solver options: of :data:`SOLVER_KEYS` (the feasibility tolerance tau,
-            the eigen solves' tolerance, the active-set iterations per seed); the plate's
-            methods' options are refused.
+        solver: Solver options: of :data:`SOLVER_KEYS` (the method, one of
+            :data:`SECTION_METHODS`; the feasibility tolerance tau, the eigen solves'
+            tolerance, the active-set iterations per seed); the plate's methods' options
+            are refused.
     """
 
     KEY: ClassVar[str] = ""
@@ -178,6 +200,7 @@ class SectionProblemSpec(Table, frozen=True):
                 "obstacle.span",
                 f" must satisfy 0 <= x0 < x1 <= section.length = {length:g} m, got {list(span)}",
             )
+        check_section_method(self.solver.method)
         default = SolverSpec()
         for key in SolverSpec.__struct_fields__:
             if key not in SOLVER_KEYS and getattr(self.solver, key) != getattr(default, key):

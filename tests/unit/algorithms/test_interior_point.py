@@ -21,7 +21,9 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
   step (the direction for a zero barrier parameter) closes by more than half their gap;
   read inside a run it leaves the run unchanged; the fine mesh read early gives the
   load of the mesh read at the end, in fewer Newton steps, and a set predicted at two
-  steps in a row the load of the set read where the barrier problem is solved.
+  steps in a row the load of the set read where the barrier problem is solved; where
+  the gaps' set at a barrier point is no KKT point, ``read_predicted`` reads the
+  predicted set there, the KKT point the gaps give at a smaller parameter.
 - Near a saddle of the barrier problem, the direction of most negative curvature read
   off the regularised factorisation is that of a dense reference (the Schur complement
   onto the DOFs with geometric stiffness, on the tangent space), and the step along it
@@ -57,6 +59,11 @@ from unibuckle_fenicsx.algorithms.interior_point import (
     NewtonStatus,
 )
 from unibuckle_fenicsx.algorithms.interior_point.explore import second_free_mode
+from unibuckle_fenicsx.algorithms.interior_point.links import (
+    MeshLevel,
+    critical_state,
+    read_contact,
+)
 from unibuckle_fenicsx.algorithms.interior_point.newton import StallWatch
 from unibuckle_fenicsx.algorithms.interior_point.options import PUSH_MARGIN
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
@@ -634,6 +641,44 @@ def test_predicted_contact_set_read_inside_a_run_leaves_it_unchanged(thin_plate)
     assert plain.history == hooked.history
     assert len(inside) >= 2
     assert all(np.array_equal(a, b) for a, b in zip(inside, fresh, strict=True))
+
+
+@serial
+def test_a_state_read_off_the_gaps_short_of_kkt_reads_the_predicted_set_too(thin_plate):
+    """With ``read_predicted`` the predicted set is read where the gaps' set fails.
+
+    Thin SSSS plate, 45x15, a run from the pressure deflection to the barrier problem at
+    1e-9: there the gaps at the tolerance hold part of the contact set only (no KKT
+    point), while the predicted set is the one the gaps give where the barrier problem
+    at 1e-10 is solved, a KKT point (reference: that read, by the gaps alone). By
+    default :func:`~.links.critical_state` goes on from the gaps' set (a further run);
+    with ``read_predicted`` it returns the predicted set's KKT point at once.
+    """
+    problem = build_problem(thin_plate("ssss", nx=45, ny=15), MPI.COMM_SELF)
+    options = ChainOptions(read_predicted=True)
+    with InteriorPointNewton(problem) as newton:
+        newton.kernel.forget_corrections()
+        reference, _ = newton.solve(newton.starts.pressure_mode(), mu=1e-2, mu_min=1e-10)
+        at_reference = newton.contact_set(reference)
+        expected = read_contact(problem, newton, reference, MeshLevel([45, 15], 0), "ref")
+        states = {}
+        for read_predicted in (False, True):
+            newton.kernel.forget_corrections()
+            point, _ = newton.solve(newton.starts.pressure_mode(), mu=1e-2, mu_min=1e-9)
+            gaps = newton.contact_set(point)
+            level = MeshLevel([45, 15], problem.num_constrained)
+            chosen = replace(options, read_predicted=read_predicted)
+            cand, _ = critical_state(problem, newton, point, level, "test", chosen, carry=False)
+            states[read_predicted] = (cand, level.links)
+    problem.destroy()
+    assert expected.kkt and not np.array_equal(gaps, at_reference)
+    cand, links = states[True]
+    assert cand is not None and cand.kkt
+    assert np.array_equal(cand.active, at_reference)
+    assert [(link.link, link.kkt) for link in links] == [("evaluate", False), ("evaluate", True)]
+    assert links[1].seed == "test (predicted)"
+    _, default_links = states[False]
+    assert "interior-point" in [link.link for link in default_links]  # ran on
 
 
 def test_result_reports_the_load_resolution(thin_plate):

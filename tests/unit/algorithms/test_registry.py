@@ -36,6 +36,15 @@ def test_every_method_but_auto_has_one_entry_with_the_specs_options():
         entry("auto")
 
 
+def test_the_entries_that_run_on_sections_are_the_methods_a_section_names():
+    # A section file may name SECTION_METHODS (spec, no PETSc); each but "auto" must run
+    # through an entry with a section runner, and an elastic core through the foundation's.
+    from unibuckle_fenicsx.spec.section import SECTION_METHODS
+
+    on_sections = {name for name, e in REGISTRY.items() if e.section is not None}
+    assert on_sections == {m.value for m in SECTION_METHODS if m is not Method.AUTO} | {FOUNDATION}
+
+
 def test_an_entrys_options_are_those_of_the_solver_table():
     spec = paper_case("c1")
     solver = structs.replace(spec.solver, method=Method.PENALTY, penalty=5.0, max_iterations=7)

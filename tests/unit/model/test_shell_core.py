@@ -250,6 +250,47 @@ def test_a_coarser_section_without_core_nodes_ends_the_added_levels():
         solve_levels(params, levels=1, comm=MPI.COMM_SELF, route="interior-point")
 
 
+def test_the_interior_points_fallback_takes_over_its_sections(monkeypatch):
+    # When the chain reaches no KKT point (here starved: one Newton step per run, no
+    # polish, no descent), the active-set route runs on the two sections the interior
+    # point built: each built and its free mode solved once (before, the fallback built
+    # both again: 4 and 4). Reference: the plate's active set with all its seeds on the
+    # finer section (an independent algorithm), as above.
+    import unibuckle_fenicsx.model.shell.levels as levels
+    from unibuckle_fenicsx.algorithms.chain import ChainOptions
+    from unibuckle_fenicsx.la.eigen import GEPSolver
+
+    params = _parameters("box", mesh_size=0.05)
+    with build_section(params, MPI.COMM_SELF) as sec:
+        reference = solve_active_set(sec.problem, multilevel=False)
+        assert reference.candidate.kkt
+    counts = {"built": 0, "free": 0}
+    build, smallest = levels.build_section, GEPSolver.smallest
+
+    def counted_build(*args, **kwargs):
+        counts["built"] += 1
+        return build(*args, **kwargs)
+
+    def counted_smallest(self, *args, **kwargs):
+        counts["free"] += 1
+        return smallest(self, *args, **kwargs)
+
+    starved = ChainOptions(
+        arrangements=1, max_steps=1, polish_iterations=0, quick_polish_iterations=0,
+        descent_budget=0,
+    )  # fmt: skip
+    monkeypatch.setattr(levels, "CHAIN_OPTIONS", starved)
+    monkeypatch.setattr(levels, "build_section", counted_build)
+    monkeypatch.setattr(GEPSolver, "smallest", counted_smallest)
+    finest, solution = solve_levels(params, levels=1, comm=MPI.COMM_SELF, route="interior-point")
+    with finest:
+        assert counts == {"built": 2, "free": 2}
+        assert solution.route[:2] == ["interior-point", "active-set (section levels)"]
+        assert len(solution.details.levels) == 2
+        assert solution.candidate.kkt
+        assert solution.load == pytest.approx(reference.load, rel=1e-8)
+
+
 def test_a_filled_tube_whose_seeds_stall_is_not_left_at_every_direction_in_contact():
     # A short filled tube (R/t = 50, L = R, 21 facets, 4 cells along): the seeds free+/-
     # and the windows stall (20 steps), and the plate's "all" seed is a KKT point at

@@ -137,7 +137,10 @@ def _mapping(**changes):
          r"obstacle.foundation_stiffness must be > 0 N/m\^3"),
         ({"obstacle__core": True, "obstacle__span": [0.0, 0.5]},
          r"obstacle.span must satisfy 0 <= x0 < x1 <= section.length = 0.4 m"),
-        ({"solver__method": "enumerate"}, "solver.method is a plate's option"),
+        ({"solver__method": "enumerate"},
+         r'solver.method must be one of "auto", "interior-point", "active-set" for a '
+         r"section, got 'enumerate'"),
+        ({"solver__penalty": 5.0}, "solver.penalty is a plate's option"),
         ({"section__radius": 0.1}, r"unknown key\(s\) \['radius'\] in \[section\]"),
     ],
 )  # fmt: skip

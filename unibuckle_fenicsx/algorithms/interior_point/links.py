@@ -286,6 +286,33 @@ def descend_from(
     return final
 
 
+def _read_state(
+    newton: InteriorPointNewton, point: BarrierPoint, level: MeshLevel, label: str, predicted: bool
+) -> Candidate:
+    """The critical state read off ``point`` by :func:`critical_state`.
+
+    The gaps' set (:func:`read_contact`); with ``predicted``
+    (``ChainOptions.read_predicted``), where that is no KKT point, the predicted set too
+    (:meth:`~.newton.InteriorPointNewton.predicted_contact_set`: one more factorisation
+    and eigen solve), and the one nearer to a KKT point (:func:`_violation`) is kept.
+    """
+    problem = newton.problem
+    cand = read_contact(problem, newton, point, level, label)
+    if cand.kkt or not predicted:
+        return cand
+    active = newton.predicted_contact_set(point)
+    if np.array_equal(active, cand.active):
+        return cand
+    other = read_contact(problem, newton, point, level, f"{label} (predicted)", active)
+    return other if other.kkt or _violation(other) < _violation(cand) else cand
+
+
+def _violation(cand: Candidate) -> float:
+    """How far ``cand`` is from a KKT point: its largest value, or largest force on Z."""
+    largest = float(cand.values.max()) if cand.values.size else -math.inf
+    return max(largest, cand.max_force)
+
+
 def critical_state(
     problem: UnilateralProblem,
     newton: InteriorPointNewton,
@@ -304,7 +331,7 @@ def critical_state(
     short polish and no descent (a second try follows). Saddles are escaped on every
     try: an escape costs less than a second try from the coarsest mesh.
     """
-    cand = read_contact(problem, newton, point, level, label)
+    cand = _read_state(newton, point, level, label, options.read_predicted)
     if cand.kkt:
         return cand, point
     for attempt in range(options.escapes):
@@ -316,7 +343,7 @@ def critical_state(
             newton, point, level, tag, options, keep_push=False,
             mu=max(point.mu, options.escape_mu), mu_min=max(point.mu, options.fine_mu_min),
         )  # fmt: skip
-        cand = read_contact(problem, newton, point, level, tag)
+        cand = _read_state(newton, point, level, tag, options.read_predicted)
         if cand.kkt:
             return cand, point
     if point.mu > options.last_mu_min:
@@ -328,7 +355,7 @@ def critical_state(
         )  # fmt: skip
         if reader is not None and reader.found is not None:
             return reader.found, point
-        cand = read_contact(problem, newton, point, level, tag)
+        cand = _read_state(newton, point, level, tag, options.read_predicted)
         if cand.kkt:
             return cand, point
     if math.isfinite(cand.load):

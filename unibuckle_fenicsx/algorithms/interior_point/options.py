@@ -247,6 +247,13 @@ class ChainOptions:
             predict the same set (each prediction one more solve with the next step's
             factorisation).
         last_mu_min: ... once more when that contact set is not a KKT point.
+        read_predicted: Where the contact set read off the gaps at the end of a run
+            (:func:`~.links.critical_state`) is no KKT point, read the predicted set
+            there too and go on from the one nearer to a KKT point. Off by default:
+            the plates' runs end where the gaps' set is the predicted one or a saddle's;
+            on sections with a core, where a wall lies almost flat on the core, the
+            gaps there stay above ``tau`` at every parameter reached, and only the
+            predicted set holds them (:doc:`/verification/sections_finest`).
         clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
             (the least-energy correction lifts those closer to the obstacle to it).
         max_steps: Newton steps per run.
@@ -289,6 +296,7 @@ class ChainOptions:
     read_mu: float = 1e-9
     read_stable: bool = True
     last_mu_min: float = 1e-14
+    read_predicted: bool = False
     clip_margin: float = 1e-6
     max_steps: int = 100
     escapes: int = 3

@@ -21,9 +21,14 @@ mode carried to each finer section
 there by a few Newton steps, the contact set read on the finest and its exact
 eigenpair checked against the KKT conditions. Near where a wall lifts off the core the
 mode's tails make the active set's steps flip directions a few at a time, more the finer
-the mesh; the barrier moves them all at once. ``"auto"`` (the default) runs it on
-sections of at least :data:`INTERIOR_POINT_DOFS` degrees of freedom and, if it reaches
-no KKT point, the active-set route; smaller sections take the active-set route.
+the mesh; the barrier moves them all at once. If it reaches no KKT point, the active-set
+route runs on the sections it built (the finest and the coarser ones the active set
+starts on: assembled, prestressed and their free modes solved once).
+
+Which route runs is decided with the plate's method, in one place
+(:func:`~unibuckle_fenicsx.analysis.choose_section_method`, ``"auto"``: the interior
+point on sections of at least :data:`INTERIOR_POINT_DOFS` degrees of freedom, the
+active set on smaller ones); :func:`solve_levels` runs the route it is given.
 
 The seeds are those of :data:`SEEDS`, the plate's others (:data:`MORE_SEEDS`) only if
 these reach no KKT point: a core makes every wall move outward, and the contact set is
@@ -35,6 +40,7 @@ from __future__ import annotations
 
 import logging
 import time
+from collections.abc import Sequence
 from dataclasses import replace
 
 from mpi4py import MPI
@@ -95,7 +101,7 @@ MORE_SEEDS = tuple(name for name in SEED_NAMES if name not in SEEDS)
 #: (:func:`_polish`); the seeds run on the finer section too, and the lower KKT point wins.
 PLAIN_POLISH_ITERATIONS = 50
 #: The routes of :func:`solve_levels` (module docstring).
-ROUTES = ("auto", "interior-point", "active-set")
+ROUTES = ("interior-point", "active-set")
 #: "auto" takes the interior point on sections of at least this many DOFs (estimated
 #: from the cell size: six per node): below it the active set's few hundred eigen solves
 #: on small pencils cost no more than the interior point's starts on the coarsest
@@ -105,18 +111,17 @@ INTERIOR_POINT_DOFS = 10_000
 #: The interior point's settings on sections: only the lowest arrangement of the
 #: coarsest section is carried up (``arrangements = 1``). On every section measured it
 #: gave the lowest KKT point on the finest, and each further arrangement costs a whole
-#: run of Newton steps on the finest section (:doc:`/verification/sections`, "Cost").
-CHAIN_OPTIONS = ChainOptions(arrangements=1)
+#: run of Newton steps on the finest section. Where a read of the gaps is no KKT point,
+#: the predicted contact set is read too (``read_predicted``): where a wall lies almost
+#: flat on the core its gaps stay above the tolerance, and only the predicted set holds
+#: them (:doc:`/verification/sections_finest`).
+CHAIN_OPTIONS = ChainOptions(arrangements=1, read_predicted=True)
 #: The interior point starts on a section at least this coarse: the cell size doubled
 #: while the coarser section keeps this many DOFs (more if ``levels`` asks). The
 #: starts take a few hundred Newton steps there; on the sections of
 #: :doc:`/verification/sections` ("Cost") a coarsest section of 1 000 to 2 500 DOFs
 #: ranked their arrangements as the finest did.
 COARSEST_DOFS = 1_000
-
-
-class _NoKKTPoint(Exception):
-    """The interior-point route reached no KKT point (``"auto"`` falls back)."""
 
 
 def prolong_directions(
@@ -154,11 +159,11 @@ def prolong_directions(
 def solve_levels(
     parameters: SectionParameters,
     *,
+    route: str,
     levels: int = 2,
     comm: MPI.Comm = MPI.COMM_WORLD,
     solver: SolverSpec | None = None,
     max_iterations: int = 100,
-    route: str = "auto",
 ) -> tuple[Section, UnilateralSolution]:
     """Unilateral critical state of a section with a core, coarse to fine.
 
@@ -169,9 +174,11 @@ def solve_levels(
             coarsest keeps :data:`COARSEST_DOFS`.
         comm: Communicator.
         solver: Solver options.
+        route: One of :data:`ROUTES` (module docstring): "interior-point" (the active
+            set on its sections if it reaches no KKT point) or "active-set";
+            :func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses it for
+            :func:`~unibuckle_fenicsx.section_analysis.solve_section`.
         max_iterations: Iterates per seed on the coarsest level, >= 1.
-        route: One of :data:`ROUTES` (module docstring); "auto" by default: the
-            interior point, the active set only if it reaches no KKT point.
 
     Returns:
         The finest section (the caller destroys it) and the solution on it.
@@ -186,16 +193,9 @@ def solve_levels(
     if route not in ROUTES:
         raise InputError(f"route must be one of {ROUTES}, got {route!r}")
     _check_levels(parameters, levels)
-    if route == "interior-point" or (
-        route == "auto" and estimated_dofs(parameters) >= INTERIOR_POINT_DOFS
-    ):
-        try:
-            more = interior_levels(parameters, levels)
-            return _interior_point(parameters, more, comm, solver, levels)
-        except _NoKKTPoint:
-            if route == "interior-point":
-                raise RuntimeError("the interior-point route reached no KKT point") from None
-            logger.warning("sections: the interior point reached no KKT point; the active set runs")
+    if route == "interior-point":
+        more = interior_levels(parameters, levels)
+        return _interior_point(parameters, more, comm, solver, levels, max_iterations)
     return _active_set(parameters, levels, comm, solver, max_iterations)
 
 
@@ -247,19 +247,23 @@ def _interior_point(
     comm: MPI.Comm,
     solver: SolverSpec | None,
     asked: int,
+    max_iterations: int,
 ) -> tuple[Section, UnilateralSolution]:
     """The nested interior-point chain over the sections (module docstring).
 
     ``levels``: the coarser sections (:func:`interior_levels`), ``asked`` of them the
     caller's: a coarser section that cannot be built (its core covers no free node) ends
-    the added ones, and is refused among the asked ones.
-
-    Raises:
-        _NoKKTPoint: It reached no KKT point on the finest section (all destroyed).
+    the added ones, and is refused among the asked ones. If the chain reaches no KKT
+    point, the active-set route (``max_iterations`` per seed) runs on the finest section
+    and the ``asked`` coarser ones, as built here.
     """
 
-    def no_kkt(problem: UnilateralProblem) -> UnilateralSolution:
-        raise _NoKKTPoint
+    def active_set(problem: UnilateralProblem) -> UnilateralSolution:
+        _, solution = _active_set(
+            parameters, asked, comm, solver, max_iterations, built=sections[-(asked + 1) :]
+        )
+        # Every eigen solve on the finest section (the chain adds the coarser ones').
+        return replace(solution, eigensolves=problem.eigensolver.solves)
 
     sections: list[Section] = []
     try:
@@ -282,7 +286,7 @@ def _interior_point(
             CHAIN_OPTIONS,
             coarser=problems[:-1],
             carrier=SectionProlongation,
-            fallback=no_kkt,
+            fallback=active_set,
         )
     except BaseException:
         for section in sections:
@@ -307,22 +311,28 @@ def _active_set(
     comm: MPI.Comm,
     solver: SolverSpec | None,
     max_iterations: int,
+    built: Sequence[Section] = (),
 ) -> tuple[Section, UnilateralSolution]:
-    """The active-set route (module docstring)."""
+    """The active-set route (module docstring).
+
+    ``built``: the ``levels + 1`` sections, coarsest first, built already (the interior
+    point's, which stay the caller's); empty: each built here, and destroyed once the
+    next finer one is solved.
+    """
     t0 = time.perf_counter()
     sizes = _sizes(parameters, levels)
     log: list[SectionLevel] = []
     prev: Section | None = None
     best: UnilateralSolution | None = None
     polish_iterations: int | None = None
-    coarse_solves = 0
-    for size in sizes:
+    for k, size in enumerate(sizes):
         try:
             section, polished, polish_iterations, level = _level(
-                parameters, size, prev, best, comm, solver, max_iterations
-            )
+                parameters, size, prev, best, comm, solver, max_iterations,
+                built[k] if built else None,
+            )  # fmt: skip
         except BaseException as err:
-            if prev is not None:
+            if prev is not None and not built:
                 prev.destroy()
             if isinstance(err, InputError) and size != sizes[-1]:  # a coarser section's
                 raise InputError(
@@ -332,8 +342,7 @@ def _active_set(
                 ) from None
             raise
         log.append(level)
-        if prev is not None:
-            coarse_solves += prev.problem.eigensolver.solves
+        if prev is not None and not built:
             prev.destroy()
         prev, best = section, polished
     if prev is None or best is None:
@@ -341,7 +350,7 @@ def _active_set(
     details = SectionLevelsDetails(
         free_load=prev.problem.solve_free().load,
         levels=log,
-        coarse_eigensolves=coarse_solves,
+        coarse_eigensolves=sum(level.eigensolves for level in log[:-1]),
         wall_time_s=time.perf_counter() - t0,
     )
     if polish_iterations is not None:
@@ -378,18 +387,22 @@ def _level(
     comm: MPI.Comm,
     solver: SolverSpec | None,
     max_iterations: int,
+    built: Section | None = None,
 ) -> tuple[Section, UnilateralSolution, int | None, SectionLevel]:
     """One level: the section on cells of ``size``, solved from the coarser one's ``best``.
 
-    Returns the section (the caller destroys it), its solution, the polish's iterations
-    (None: the seeds ran) and the level's record.
+    ``built``: that section, built already (the caller's); None: built here. Returns the
+    section (the caller destroys it), its solution, the polish's iterations (None: the
+    seeds ran) and the level's record (its eigen solves: this level's own).
     """
     tl = time.perf_counter()
-    section = _build(parameters, size, comm, solver)
+    section = _build(parameters, size, comm, solver) if built is None else built
     problem = section.problem
     if not isinstance(problem, CoredSectionProblem) or section.constraints is None:
-        section.destroy()
+        if built is None:
+            section.destroy()
         raise RuntimeError("solve_levels: a core section without constraints")
+    solves0 = problem.eigensolver.solves
     polished, polish_iterations = None, None
     try:
         plain: tuple[UnilateralSolution | None, int | None] = (None, None)
@@ -413,7 +426,8 @@ def _level(
                 solves = problem.eigensolver.solves
                 polished, polish_iterations = replace(kept, eigensolves=solves), plain_iterations
     except BaseException:
-        section.destroy()
+        if built is None:
+            section.destroy()
         raise
     details = polished.details
     seeded_steps = (
@@ -425,7 +439,7 @@ def _level(
         constrained=section.constraints.size,
         load=polished.load,
         kkt=polished.candidate.kkt,
-        eigensolves=problem.eigensolver.solves,
+        eigensolves=problem.eigensolver.solves - solves0,
         steps=seeded_steps if polish_iterations is None else polish_iterations,
         seeded=polish_iterations is None,
         wall_time_s=time.perf_counter() - tl,
