@@ -38,7 +38,6 @@ the walls' nodes save where they lift off, which the free mode's signs seed
 
 from __future__ import annotations
 
-import logging
 import time
 from collections.abc import Sequence
 from dataclasses import replace
@@ -84,8 +83,6 @@ __all__ = [
     "prolong_directions",
     "solve_levels",
 ]
-
-logger = logging.getLogger(__name__)
 
 #: The active set's seeds on a section (of
 #: :data:`~unibuckle_fenicsx.algorithms.active_set.SEED_NAMES`): the free mode's two
