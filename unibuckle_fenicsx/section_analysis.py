@@ -74,7 +74,14 @@ from unibuckle_fenicsx.spec import (
 )
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
-__all__ = ["SectionAnalysis", "SectionResult", "solve_section"]
+__all__ = [
+    "MIN_FACE_CELLS",
+    "MIN_HALF_WAVE_CELLS",
+    "SectionAnalysis",
+    "SectionResult",
+    "coarse_mesh_note",
+    "solve_section",
+]
 
 logger = logging.getLogger(__name__)
 
@@ -271,6 +278,9 @@ def solve_section(
         )
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
+    coarse = coarse_mesh_note(parameters)
+    if coarse is not None:
+        logger.warning("%s", coarse)
     certificate: Certificate | None = None
     solver = solver or SolverSpec()
     method, reason = choose_section_method(parameters, solver)
@@ -311,6 +321,44 @@ def solve_section(
         section.destroy()
         raise
     return SectionAnalysis(result, section, solution, certificate)
+
+
+#: Fewer cells than this across a box's narrowest face draw a warning: there the hollow
+#: box's load is already more than about 5 % above its converged value, and a core's
+#: shorter buckles make it worse (:doc:`/guide/sections`, "Cell size").
+MIN_FACE_CELLS = 5
+#: Fewer cells than this along a tube's axisymmetric half-wave
+#: :math:`\pi\sqrt{Rt}/(12(1-\nu^2))^{1/4}` draw a warning, by the same measure
+#: (:doc:`/guide/sections`, "Cell size").
+MIN_HALF_WAVE_CELLS = 1.5
+
+
+def coarse_mesh_note(parameters: SectionParameters) -> str | None:
+    """A warning when the cells are too coarse for the walls' buckles, else None.
+
+    The rule (:data:`MIN_FACE_CELLS`, :data:`MIN_HALF_WAVE_CELLS`) is a priori, from the
+    section's dimensions and cell size: on cells too coarse for the buckles the shell's
+    critical stress is too high (it falls as the cells are refined), and so are k and
+    the design values.
+    """
+    p = parameters
+    need: float
+    if p.shape == "box":
+        across = min(float(p.width or 0.0), float(p.depth or 0.0))
+        cells, need, what = across / p.mesh_size, MIN_FACE_CELLS, "across the narrowest face"
+    else:
+        radius = 0.5 * float(p.diameter or 0.0)
+        wave = math.pi * math.sqrt(radius * p.thickness) / (12.0 * (1.0 - p.nu**2)) ** 0.25
+        cells, need = wave / p.mesh_size, MIN_HALF_WAVE_CELLS
+        what = f"along the wall's axisymmetric half-wave ({wave:.3g} m)"
+    if cells >= need:
+        return None
+    return (
+        f"mesh.size = {p.mesh_size:.3g} m gives {cells:.2g} cells {what}, fewer than {need}: "
+        "on cells this coarse the critical stress, k and the design values come out too "
+        f"high (refine mesh.size to {p.mesh_size * cells / need:.3g} m or less; "
+        'docs/guide/sections.md, "Cell size")'
+    )
 
 
 #: A box's faces: name, the axis of their normal (1: y, 2: z) and its inward sign.

@@ -11,7 +11,9 @@ the classical stresses 4 pi^2 D/(t b^2) and E t/(R sqrt(3(1 - nu^2)))), interlac
 
 from __future__ import annotations
 
+import dataclasses
 import json
+import logging
 import math
 
 from mpi4py import MPI
@@ -193,3 +195,28 @@ def test_the_section_problem_s_k_is_the_result_s_with_any_stress_per_unit_load()
         k = 2.5 * load * 0.002 * 0.1**2 / (math.pi**2 * D)
         assert analysis.result.buckling_coefficient_k == pytest.approx(k, rel=1e-13)
         assert analysis.section.problem.buckling_coefficient(load) == pytest.approx(k, rel=1e-13)
+
+
+def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
+    # Box: cells across the narrowest face, min(width, depth)/mesh.size, here 0.1/0.05 = 2
+    # (below MIN_FACE_CELLS = 5); 0.1/0.02 = 5 is not. Tube (R = 0.1 m, t = 2 mm,
+    # nu = 0.3): the axisymmetric half-wave pi sqrt(R t)/(12 (1 - nu^2))^(1/4)
+    # = pi * 0.0141421 / 1.81762 = 0.024444 m, so 0.02 m cells give 1.22 of them (below
+    # MIN_HALF_WAVE_CELLS = 1.5) and 0.016 m cells 1.53.
+    from unibuckle_fenicsx.section_analysis import coarse_mesh_note
+
+    assert coarse_mesh_note(_box(mesh_size=0.02)) is None
+    note = coarse_mesh_note(_box(mesh_size=0.05))
+    assert note is not None and "2 cells across the narrowest face" in note
+    assert "mesh.size to 0.02 m" in note
+    tube = SectionParameters(
+        "tube", diameter=0.2, thickness=T, length=0.2, E=E, nu=NU, mesh_size=0.02
+    )
+    note = coarse_mesh_note(tube)
+    assert note is not None and "1.2 cells" in note and "(0.0244 m)" in note
+    assert coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.016)) is None
+    # The warning is logged by the solve (a hollow box on two cells a face: a free solve).
+    with caplog.at_level(logging.WARNING, logger="unibuckle_fenicsx.section_analysis"):
+        with solve_section(_box(mesh_size=0.05, core=False), MPI.COMM_SELF, levels=0):
+            pass
+    assert any("cells across the narrowest face" in r.getMessage() for r in caplog.records)
