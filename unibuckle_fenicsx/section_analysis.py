@@ -72,6 +72,7 @@ from unibuckle_fenicsx.spec import (
     SolverSpec,
     problem_to_dict,
 )
+from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = [
@@ -80,7 +81,9 @@ __all__ = [
     "SectionAnalysis",
     "SectionResult",
     "coarse_mesh_note",
+    "half_wave",
     "solve_section",
+    "thick_wall_note",
 ]
 
 logger = logging.getLogger(__name__)
@@ -278,9 +281,9 @@ def solve_section(
         )
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    coarse = coarse_mesh_note(parameters)
-    if coarse is not None:
-        logger.warning("%s", coarse)
+    for note in (thick_wall_note(parameters), coarse_mesh_note(parameters)):
+        if note is not None:
+            logger.warning("%s", note)
     certificate: Certificate | None = None
     solver = solver or SolverSpec()
     method, reason = choose_section_method(parameters, solver)
@@ -347,8 +350,7 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
         across = min(float(p.width or 0.0), float(p.depth or 0.0))
         cells, need, what = across / p.mesh_size, MIN_FACE_CELLS, "across the narrowest face"
     else:
-        radius = 0.5 * float(p.diameter or 0.0)
-        wave = math.pi * math.sqrt(radius * p.thickness) / (12.0 * (1.0 - p.nu**2)) ** 0.25
+        wave = half_wave(p)
         cells, need = wave / p.mesh_size, MIN_HALF_WAVE_CELLS
         what = f"along the wall's axisymmetric half-wave ({wave:.3g} m)"
     if cells >= need:
@@ -358,6 +360,38 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
         "on cells this coarse the critical stress, k and the design values come out too "
         f"high (refine mesh.size to {p.mesh_size * cells / need:.3g} m or less; "
         'docs/guide/sections.md, "Cell size")'
+    )
+
+
+def half_wave(parameters: SectionParameters) -> float:
+    r"""A tube's axisymmetric buckling half-wave :math:`\pi\sqrt{Rt}/(12(1-\nu^2))^{1/4}` (m)."""
+    p = parameters
+    radius = 0.5 * float(p.diameter or 0.0)
+    return math.pi * math.sqrt(radius * p.thickness) / (12.0 * (1.0 - p.nu**2)) ** 0.25
+
+
+def thick_wall_note(parameters: SectionParameters) -> str | None:
+    """A warning when the wall is thick for the shell model, else None.
+
+    The plate's rule (:func:`~unibuckle_fenicsx.spec.checks.plate_model_note`): the
+    shell's Reissner-Mindlin kinematics model walls up to about
+    :data:`~unibuckle_fenicsx.spec.plate.THICK_PLATE_RATIO` times the width of their
+    buckles: a box's narrowest face, a tube's axisymmetric half-wave (:func:`half_wave`).
+    """
+    p = parameters
+    if p.shape == "box":
+        span = min(float(p.width or 0.0), float(p.depth or 0.0))
+        what = "the narrowest face"
+    else:
+        span, what = half_wave(p), "the tube's axisymmetric half-wave"
+    ratio = p.thickness / span
+    if ratio <= THICK_PLATE_RATIO:
+        return None
+    return (
+        f"section.thickness = {p.thickness:g} m is {ratio:.3g} times {what} ({span:.3g} m): "
+        "the shell (transverse shear, no thickness stretch) is a model of walls up to about "
+        f"{THICK_PLATE_RATIO:g} times the width of their buckles; beyond, compare with a "
+        "3-D solid model"
     )
 
 

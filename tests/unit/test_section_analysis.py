@@ -220,3 +220,24 @@ def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
         with solve_section(_box(mesh_size=0.05, core=False), MPI.COMM_SELF, levels=0):
             pass
     assert any("cells across the narrowest face" in r.getMessage() for r in caplog.records)
+
+
+def test_walls_thick_for_the_shell_model_draw_a_warning():
+    # The plate's rule, t over the width of the buckles at most THICK_PLATE_RATIO = 0.2.
+    # Box: 0.03/0.1 = 0.3 warns, 0.002/0.1 does not. Tube (R = 0.1 m, nu = 0.3): the
+    # half-wave pi sqrt(R t)/(12 (1 - nu^2))^(1/4) is 0.05466 m at t = 0.01 m (ratio
+    # 0.183: no warning) and 0.07730 m at t = 0.02 m (ratio 0.259: a warning).
+    from unibuckle_fenicsx.section_analysis import half_wave, thick_wall_note
+
+    assert thick_wall_note(_box()) is None
+    note = thick_wall_note(_box(thickness=0.03))
+    assert note is not None and "section.thickness = 0.03 m is 0.3 times" in note
+    tube = SectionParameters(
+        "tube", diameter=0.2, thickness=0.01, length=0.2, E=E, nu=NU, mesh_size=0.01
+    )
+    assert half_wave(tube) == pytest.approx(0.05466, rel=1e-3)
+    assert thick_wall_note(tube) is None
+    thick = dataclasses.replace(tube, thickness=0.02)
+    assert half_wave(thick) == pytest.approx(0.07730, rel=1e-3)
+    note = thick_wall_note(thick)
+    assert note is not None and "0.259 times the tube's axisymmetric half-wave" in note
