@@ -48,7 +48,7 @@ from unibuckle_fenicsx.analysis import FREE, choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
-from unibuckle_fenicsx.model.problem import Mode, Problem, UnilateralProblem
+from unibuckle_fenicsx.model.problem import Mode
 from unibuckle_fenicsx.model.shell.section import (
     Section,
     SectionParameters,
@@ -300,7 +300,7 @@ def solve_section(
             problem.timings["free_check_s"] = time.perf_counter() - t1
         else:
             t1 = time.perf_counter()
-            cored = _cored(problem)
+            cored = section.cored
             certificate = (
                 certify_foundation(cored, solution)
                 if cored.tensionless
@@ -345,21 +345,16 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     the design values.
     """
     p = parameters
-    need: float
-    if p.shape == "box":
-        across = min(float(p.width or 0.0), float(p.depth or 0.0))
-        cells, need, what = across / p.mesh_size, MIN_FACE_CELLS, "across the narrowest face"
-    else:
-        wave = half_wave(p)
-        cells, need = wave / p.mesh_size, MIN_HALF_WAVE_CELLS
-        what = f"along the wall's axisymmetric half-wave ({wave:.3g} m)"
+    span, what = _buckle_width(p)
+    cells = span / p.mesh_size
+    need = MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS
     if cells >= need:
         return None
     return (
-        f"mesh.size = {p.mesh_size:.3g} m gives {cells:.2g} cells {what}, fewer than {need}: "
-        "on cells this coarse the critical stress, k and the design values come out too "
-        f"high (refine mesh.size to {p.mesh_size * cells / need:.3g} m or less; "
-        'docs/guide/sections.md, "Cell size")'
+        f"mesh.size = {p.mesh_size:.3g} m gives {cells:.2g} cells across {what} "
+        f"({span:.3g} m), fewer than {need}: on cells this coarse the critical stress, k "
+        f"and the design values come out too high (refine mesh.size to {span / need:.3g} m "
+        'or less; docs/guide/sections.md, "Cell size")'
     )
 
 
@@ -370,20 +365,27 @@ def half_wave(parameters: SectionParameters) -> float:
     return math.pi * math.sqrt(radius * p.thickness) / (12.0 * (1.0 - p.nu**2)) ** 0.25
 
 
+def _buckle_width(parameters: SectionParameters) -> tuple[float, str]:
+    """The width of the walls' buckles (m) and its name.
+
+    A box's narrowest face; a tube's axisymmetric half-wave (:func:`half_wave`).
+    """
+    p = parameters
+    if p.shape == "box":
+        return min(float(p.width or 0.0), float(p.depth or 0.0)), "the narrowest face"
+    return half_wave(p), "the tube's axisymmetric half-wave"
+
+
 def thick_wall_note(parameters: SectionParameters) -> str | None:
     """A warning when the wall is thick for the shell model, else None.
 
     The plate's rule (:func:`~unibuckle_fenicsx.spec.checks.plate_model_note`): the
     shell's Reissner-Mindlin kinematics model walls up to about
     :data:`~unibuckle_fenicsx.spec.plate.THICK_PLATE_RATIO` times the width of their
-    buckles: a box's narrowest face, a tube's axisymmetric half-wave (:func:`half_wave`).
+    buckles (:func:`_buckle_width`).
     """
     p = parameters
-    if p.shape == "box":
-        span = min(float(p.width or 0.0), float(p.depth or 0.0))
-        what = "the narrowest face"
-    else:
-        span, what = half_wave(p), "the tube's axisymmetric half-wave"
+    span, what = _buckle_width(p)
     ratio = p.thickness / span
     if ratio <= THICK_PLATE_RATIO:
         return None
@@ -442,13 +444,6 @@ def _solve(
     if run is None:
         raise RuntimeError(f"solve_section: the method {method!r} has no section runner")
     return run(parameters, levels, comm, solver)
-
-
-def _cored(problem: Problem) -> UnilateralProblem:
-    """``problem``, which has a core (an internal invariant: solve_levels made it)."""
-    if not isinstance(problem, UnilateralProblem):
-        raise TypeError("solve_section: a core section without its contact manager")
-    return problem
 
 
 def _result(

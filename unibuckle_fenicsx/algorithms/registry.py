@@ -164,12 +164,8 @@ def _section_foundation(
 ) -> tuple[Section, UnilateralSolution]:
     """An elastic core: the spring-set iteration on the section itself (no coarser ones)."""
     section = build_section(parameters, comm, solver)
-    problem = section.problem
-    if not isinstance(problem, UnilateralProblem):
-        section.destroy()
-        raise TypeError("a core section without its contact manager")
     try:
-        return section, solve_foundation(problem, max_iterations=solver.max_iterations)
+        return section, solve_foundation(section.cored, max_iterations=solver.max_iterations)
     except BaseException:
         section.destroy()
         raise

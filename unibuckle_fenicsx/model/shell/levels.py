@@ -277,7 +277,7 @@ def _interior_point(
                     f"(mesh.size doubled): {err}; lower mesh.levels (0: the search starts "
                     "on the given cells)"
                 ) from None
-        problems = [_cored(section) for section in sections]
+        problems = [section.cored for section in sections]
         solution = solve_interior_point(
             problems[-1],
             CHAIN_OPTIONS,
@@ -293,13 +293,6 @@ def _interior_point(
         section.destroy()
     solution.method = "interior-point (section levels)"
     return sections[-1], solution
-
-
-def _cored(section: Section) -> CoredSectionProblem:
-    """``section``'s problem, which has a core (an internal invariant of :func:`_build`)."""
-    if not isinstance(section.problem, CoredSectionProblem) or section.constraints is None:
-        raise RuntimeError("solve_levels: a core section without constraints")
-    return section.problem
 
 
 def _active_set(

@@ -268,6 +268,17 @@ class Section(Owner):
         self.problem = problem
 
     @property
+    def cored(self) -> CoredSectionProblem:
+        """The problem with the core's contact manager.
+
+        Raises:
+            RuntimeError: The section has no core (an internal invariant of its caller).
+        """
+        if not isinstance(self.problem, CoredSectionProblem) or self.constraints is None:
+            raise RuntimeError("a section without a core has no contact manager")
+        return self.problem
+
+    @property
     def rows(self) -> npt.NDArray[np.int64]:
         """Global rows of (A', B') of the constrained directions, numbered 0..i-1 (collective)."""
         if not isinstance(self.problem, CoredSectionProblem):
