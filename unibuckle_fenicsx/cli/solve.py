@@ -74,9 +74,9 @@ def _report(args: argparse.Namespace, result: Any, comm: Any, unwritten: str | N
     return outcome.exit_status
 
 
-#: The relative load resolution above which a warning says so (1 %). On the plates of
-#: the verification pages it is 1e-9 to 1e-7; it grows as (b/t)^2: 2.5e-3 at b/t = 1e5,
-#: 0.24 at 1e6, where the computed k is already 1.3 % off the well-conditioned one.
+#: The relative load resolution above which a warning says so (1 %): a load fixed only
+#: that closely is no design value; well-conditioned plates are many orders below it
+#: (docs/guide/results.md, ``load_resolution``; it grows as (b/t)^2).
 RESOLUTION_WARNING = 1e-2
 
 
