@@ -162,6 +162,33 @@ def test_a_short_tube_buckles_axisymmetrically():
     assert load == pytest.approx(expected, rel=0.015)
 
 
+def test_a_filled_short_tube_at_its_hollow_load_is_proven():
+    """The core adds nothing where the hollow mode moves outward only: proven, both routes.
+
+    The short tube's mode is one axial half-wave, axisymmetric (above): one-signed, so
+    turned outward it is admissible for the core, and the filled load is the hollow one;
+    interlacing (the core never lowers it) closes the bracket. On 2 mm cells (5 along,
+    5 688 DOFs, the active set's route over a coarser section) the filled tube was
+    certified kkt-only with the same bounds, 2.808205e9 Pa at both ends, and its design
+    repeated at the "verified lower bound, sigma_cr not proven the lowest"; the interior
+    point's route (1 mm cells) said proven.
+    """
+    from unibuckle_fenicsx.spec import DesignSpec
+
+    tube = SectionParameters(
+        "tube", diameter=0.1, thickness=0.001, length=0.01, E=E, nu=NU, mesh_size=0.002,
+        ends="simply_supported", core=True,
+    )  # fmt: skip
+    design = DesignSpec(yield_stress=3.55e8)
+    with solve_section(tube, MPI.COMM_SELF, design=design) as analysis:
+        r = analysis.result
+    assert r.method == "active-set (section levels)" and r.contact_nodes == 0
+    assert r.critical_load_Pa == pytest.approx(r.free_load_Pa, rel=1e-10)
+    assert r.certificate is not None and r.certificate.status == "proven"
+    assert not isinstance(r.design.lower_bound, type(r.design))
+    assert "certificate proven" in r.summary() and "not proven" not in r.summary()
+
+
 def test_a_short_tube_on_few_cells_along_draws_the_coarse_mesh_warning(caplog):
     """Cells too few along a short member are warned of, as cells across a face are.
 
