@@ -336,7 +336,7 @@ def test_two_ranks_give_the_serial_lines(tmp_path):
     base.write_text(SMALL)
     serial = run_sweep_cli("--config", str(base), *VARY, "--json", "serial.jsonl", cwd=tmp_path)
     assert serial.returncode == EXIT_OK, serial.stderr
-    cli = ROOT / "unibuckle_fenicsx" / "cli.py"
+    cli = ROOT / "unibuckle_fenicsx" / "cli" / "__main__.py"
     run_mpi(cli, 2, "sweep", "--config", str(base), *VARY, "--json", str(tmp_path / "p.jsonl"))
     assert (tmp_path / "p.jsonl").read_text() == (tmp_path / "serial.jsonl").read_text()
     # Each point's mesh over both ranks: the same loads within the eigen tolerance.
