@@ -172,10 +172,15 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
             "the element is the rectangle's, and sigma_cr (computed with the holes) "
             "includes their effect"
         )
-    if spec.all_obstacles or spec.one_sided_points:
+    if spec.one_sided_points or any(o.side != "both" for o in spec.all_obstacles):
         out.notes.append(
             "with an obstacle sigma_cr is the unilateral critical stress: outside the "
             "calibration of 4.4(2)"
+        )
+    elif spec.all_obstacles:
+        out.notes.append(
+            'with a bilateral foundation (obstacle.side = "both") sigma_cr includes the '
+            "foundation's stiffness: outside the calibration of 4.4(2)"
         )
     shear = any(
         any(stress_ends(e.shear_stress)) or any(stress_ends(e.fixed_shear_stress))

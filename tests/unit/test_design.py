@@ -149,6 +149,23 @@ def test_stress_gradient_obstacle_shear_and_fixed_part():
     assert any("unilateral" in n for n in d.notes) and any("section 10" in n for n in d.notes)
 
 
+def test_a_bilateral_foundation_is_not_called_unilateral():
+    """A foundation on both sides (springs in tension too) makes a linear eigenproblem.
+
+    Its design note says what sigma_cr includes, not that it is a unilateral one; a
+    foundation on one side keeps the unilateral note.
+    """
+    from unibuckle_fenicsx.design import design_output
+
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    for side, word in (("both", "bilateral foundation"), ("below", "unilateral")):
+        spec = plate(edges, obstacle={"zone": "all", "side": side, "foundation_stiffness": 1e-3})
+        assert spec.design is not None
+        notes = design_output(spec, spec.design, 100.0).notes
+        assert any(word in n for n in notes), notes
+        assert side != "both" or not any("unilateral" in n for n in notes), notes
+
+
 # -- outstand elements (one unloaded edge free) ------------------------------------------
 @pytest.mark.parametrize(
     "slenderness, psi, rho",

@@ -300,12 +300,16 @@ def test_a_filled_box_in_bending_quotes_one_stress_throughout():
     [((0.01, 0.02), "no node of the mesh"), ((0.0, 0.0125), "only nodes held by the end")],
 )
 def test_a_core_span_without_a_free_node_is_refused_saying_why(span, what):
-    """Cells of 25 mm: a span between two nodes, or holding only the end's held nodes."""
+    """Cells of 25 mm: a span between two nodes, or holding only the end's held nodes.
+
+    The message names the key (obstacle.span) as every bad input's does.
+    """
     box = SectionParameters(
         "box", width=0.1, depth=0.1, thickness=T, length=0.2, E=E, nu=NU, mesh_size=0.025,
         ends="simply_supported", core=True, core_span=span,
     )  # fmt: skip
-    with pytest.raises(InputError, match=f"the core covers no free node: .* holds {what}"):
+    match = rf"the core covers no free node: .* \(obstacle.span\) holds {what}"
+    with pytest.raises(InputError, match=match):
         solve_section(box, MPI.COMM_SELF, levels=0)
 
 

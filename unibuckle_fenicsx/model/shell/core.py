@@ -145,8 +145,8 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
         held = model.mesh.comm.allreduce(int(inside.sum()), op=MPI.SUM) > 0
         what = "only nodes held by the end supports" if held else "no node of the mesh"
         raise InputError(
-            f"the core covers no free node: its span {(x0, x1)} m holds {what}; "
-            "lengthen the span or refine the mesh"
+            f"the core covers no free node: its span {(x0, x1)} m (obstacle.span) holds "
+            f"{what}; lengthen obstacle.span or refine mesh.size"
         )
     all_u = np.vstack([g[2] for g in gathered])
     size = max(section.length, section.perimeter)
