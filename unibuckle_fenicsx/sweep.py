@@ -30,7 +30,10 @@ spacing), ``material.plies.0.angle``, ``load.fixed_factor`` (the fixed part's fa
 an interaction curve), ``design.yield_stress``. Two shortcuts move a corner:
 ``plate.length`` sets x1 = x0 + value and ``plate.width`` sets y1 = y0 + value. Values
 are in the base file's ``units``. Write ``[mesh] size = h`` in the base file so that the
-cell count follows the plate's size.
+cell count follows the plate's size. A section's file (:doc:`/guide/sections`) is swept
+the same way, each point solved as ``unibuckle solve`` solves it: ``section.thickness``
+(a wall's b/t or D/t), ``section.length``, ``section.width``, ``section.diameter``,
+``load.bending_stress``, ``obstacle.foundation_stiffness``, ``mesh.size``.
 
 **Resume.** Each line is appended with one ``write`` of the whole line and flushed to
 disk, so a killed sweep leaves complete lines (and at most one truncated last line,
@@ -75,8 +78,8 @@ from unibuckle_fenicsx.spec import (
     ProblemSpec,
     SectionProblemSpec,
     load_problem,
-    problem_from_dict,
     problem_to_dict,
+    spec_from_dict,
 )
 
 __all__ = [
@@ -184,11 +187,6 @@ def base_mapping(path: str | Path) -> dict[str, object]:
         OSError: It cannot be read.
     """
     spec = load_problem(path)
-    if isinstance(spec, SectionProblemSpec):
-        raise InputError(
-            f"{path}: a section's file is not swept (plates only); solve each point with "
-            "unibuckle solve --set section.KEY=VALUE"
-        )
     return problem_to_dict(spec, units=spec.units)
 
 
@@ -285,8 +283,12 @@ def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set")
         )
 
 
-def point_problem(base: Mapping[str, object], point: Mapping[str, float]) -> ProblemSpec:
+def point_problem(
+    base: Mapping[str, object], point: Mapping[str, float]
+) -> ProblemSpec | SectionProblemSpec:
     """The problem of one sweep point: ``base`` with the point's values set.
+
+    A plate's, or a section's if ``base`` has a ``[section]`` table.
 
     Raises:
         ValueError: A bad path, or a value the schema refuses (the message names both).
@@ -295,7 +297,7 @@ def point_problem(base: Mapping[str, object], point: Mapping[str, float]) -> Pro
     for path, value in point.items():
         set_value(data, path, value)
     try:
-        return problem_from_dict(data, name=str(base.get("name", "plate")))
+        return spec_from_dict(data, name=str(base.get("name", "plate")))
     except ValueError as err:
         raise InputError(f"sweep point {dict(point)}: {err}") from None
 
@@ -353,7 +355,7 @@ def index_of(line: Mapping[str, object]) -> int:
     return index
 
 
-def point_input(spec: ProblemSpec) -> dict[str, object]:
+def point_input(spec: ProblemSpec | SectionProblemSpec) -> dict[str, object]:
     """The ``input`` a point's line stores: its problem, every key, as read back from JSON."""
     return json.loads(json.dumps(problem_to_dict(spec)))
 
@@ -408,18 +410,23 @@ def _done_points(
     return done, stale
 
 
-def solve_point(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, object]:
+def solve_point(spec: ProblemSpec | SectionProblemSpec, comm: MPI.Comm) -> dict[str, object]:
     """Solve one point; the JSON-ready line body (results, or the error; and the input)."""
     body = _solve(spec, comm)
     return {**body, "input": point_input(spec)}
 
 
-def _solve(spec: ProblemSpec, comm: MPI.Comm) -> dict[str, object]:
+def _solve(spec: ProblemSpec | SectionProblemSpec, comm: MPI.Comm) -> dict[str, object]:
     from unibuckle_fenicsx.analysis import solve
+    from unibuckle_fenicsx.section_analysis import solve_section
 
     try:
-        with solve(spec, comm) as analysis:
-            result = analysis.result
+        if isinstance(spec, SectionProblemSpec):
+            with solve_section(spec, comm) as section:
+                result = section.result
+        else:
+            with solve(spec, comm) as analysis:
+                result = analysis.result
     except (InputError, NumericalError) as err:  # anything else is a bug: it stops the sweep
         return {"status": str(Outcome.of(err)), "error": str(err)}
     return {"status": str(Outcome.of(result)), **result.as_dict(timings=False)}
@@ -439,7 +446,10 @@ def _check_ranks(ranks_per_point: int, comm: MPI.Comm) -> None:
 
 
 def _resume(
-    path: Path, points: list[dict[str, float]], specs: list[ProblemSpec], comm: MPI.Comm
+    path: Path,
+    points: list[dict[str, float]],
+    specs: list[ProblemSpec | SectionProblemSpec],
+    comm: MPI.Comm,
 ) -> tuple[dict[int, dict[str, object]], int]:
     """The lines of ``path`` kept and the stale ones' count, on every rank.
 

@@ -58,7 +58,9 @@ edges.top.rotational_stiffness, points.0.spacing, material.plies.0.angle,
 load.fixed_factor (the fixed part's factor: an interaction curve);
 plate.length and plate.width set x1 = x0 + value and y1 = y0 + value. Several
 --vary make a grid (the first varies slowest). Values are in the file's units. Give
-[mesh] size = h in the file for a cell count that follows the plate's size.
+[mesh] size = h in the file for a cell count that follows the plate's size. A
+section's file: section.thickness (b/t, D/t), section.length, section.width,
+section.diameter, load.bending_stress, mesh.size.
 
 Each finished point appends one JSON line to --json: index, point, status and the keys
 of 'unibuckle solve --json' (without wall times). Re-running the same command resumes:
@@ -193,8 +195,9 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
     parser = Parser(
         prog="unibuckle",
         description=(
-            "Unilateral buckling of thin plates (Reissner-Mindlin, MITC4): the critical "
-            "load and the buckling mode that respects a rigid obstacle on one side. "
+            "Unilateral buckling of thin plates (Reissner-Mindlin, MITC4) and of box and "
+            "tube sections (a shell of the same element): the critical load and the "
+            "buckling mode that respects a rigid obstacle on one side (a face, a core). "
             "Arguments starting with a single dash that argparse does not know "
             "(-unibuckle_eps_view, ...) go to PETSc/SLEPc."
         ),
@@ -217,8 +220,9 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "sweep",
         parents=[common],
         help="solve a problem file over a grid of values of some of its numbers",
-        description="Solve the problem of --config at every point of the --vary grid, "
-        "writing one JSON line per point (resumable), and optionally a chart of k.",
+        description="Solve the problem of --config (a plate's or a section's file) at every "
+        "point of the --vary grid, writing one JSON line per point (resumable), and "
+        "optionally a chart of k (a section's: its critical stress over the classical one).",
         epilog=SWEEP_EPILOG,
         formatter_class=Formatter,
     )
@@ -241,7 +245,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "--plot",
         metavar="PNG",
         help="draw k against the first --vary (bilateral and unilateral, with the "
-        "exact curves where they exist)",
+        "exact curves where they exist; a section: sigma_cr over the classical stress, "
+        "hollow and with its core)",
     )
     w.add_argument(
         "--ranks-per-point",

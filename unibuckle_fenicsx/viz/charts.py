@@ -6,7 +6,8 @@ curve per combination of the other swept numbers. Unilateral points are marked b
 certificate: filled circle = proven globally optimal, filled diamond = bracketed (a
 verified relative gap of at most 1e-3, written beside it), open circle = KKT point only,
 cross = not certified. When the sweep varies ``plate.length`` or ``plate.width`` the abscissa is the
-aspect ratio a/b.
+aspect ratio a/b. A section's sweep draws its critical stress over its classical stress
+instead (:func:`plot_sweep`).
 
 Exact thin-plate curves are drawn where they exist (:func:`reference_k`):
 
@@ -89,6 +90,8 @@ def _unit(path: str, units: str) -> str:
     last = path.rsplit(".", 1)[-1]
     if path in ("plate.length", "plate.width", "mesh.size", "plate.thickness"):
         return length
+    if path.startswith("section.") and last != "ends":
+        return length
     if path.startswith(("plate.corners", "obstacle.zone", "obstacle.tolerance", "obstacle.gap")):
         return length
     if path.startswith("points.") and path.split(".")[2] in ("at", "spacing", "offset", "region"):
@@ -128,6 +131,19 @@ _WORDS = {
 }
 
 
+#: A section file's numbers in words, by their dotted path (before :data:`_WORDS`).
+_SECTION_WORDS = {
+    "section.thickness": "wall thickness",
+    "section.length": "section length",
+    "section.width": "box width",
+    "section.depth": "box depth",
+    "section.diameter": "tube diameter",
+    "load.bending_stress": "bending stress at the extreme fibre",
+    "load.axial_stress": "axial stress",
+    "obstacle.foundation_stiffness": "core's foundation modulus",
+}
+
+
 def axis_label(path: str, base: Mapping[str, Any]) -> str:
     """The swept number in words with its unit, e.g. "tie spacing (m)", for a chart's axis.
 
@@ -135,7 +151,8 @@ def axis_label(path: str, base: Mapping[str, Any]) -> str:
     not know is shown as its dotted path.
     """
     parts = path.split(".")
-    words = _WORDS.get(parts[-1], path)
+    section = _SECTION_WORDS.get(path) if "section" in base else None
+    words = section or _WORDS.get(parts[-1], path)
     edge = parts[1] if parts[0] == "edges" and len(parts) > 2 else ""
     kind = "point"
     if parts[0] == "points" and len(parts) > 2 and parts[1].isdigit():
@@ -148,6 +165,42 @@ def axis_label(path: str, base: Mapping[str, Any]) -> str:
     text = words.format(edge=edge, kind=kind)
     unit = _unit(path, str(base.get("units", "SI")))
     return f"{text} ({unit})" if unit else text
+
+
+def _plate_point(base: Mapping[str, Any], point: Mapping[str, float]) -> ProblemSpec:
+    """The plate's problem at a sweep point (:func:`plot_sweep` draws plates' charts)."""
+    spec = point_problem(base, point)
+    if not isinstance(spec, ProblemSpec):
+        raise TypeError("a section's sweep is drawn by plot_sweep")
+    return spec
+
+
+def _groups(
+    lines: Sequence[Mapping[str, Any]], others: Sequence[str]
+) -> list[tuple[tuple[float, ...], str, list[Mapping[str, Any]]]]:
+    """The lines by the values of the other swept numbers: (values, legend suffix, lines)."""
+    groups: dict[tuple[float, ...], list[Mapping[str, Any]]] = {}
+    for line in lines:
+        groups.setdefault(_group_key(line, others), []).append(line)
+    out = []
+    for key, members in sorted(groups.items()):
+        label = ", ".join(f"{p} = {v:g}" for p, v in zip(others, key, strict=True))
+        out.append((key, f" ({label})" if label else "", members))
+    return out
+
+
+def _save(fig: Any, ax: Any, path: str | Path) -> Path:
+    """Grid, legend, and the figure written to ``path`` (its folder made); returns it."""
+    import matplotlib.pyplot as plt
+
+    ax.grid(True, alpha=0.3)
+    ax.legend(fontsize=8, loc="best")
+    fig.tight_layout()
+    path = Path(path)
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(path, dpi=150)
+    plt.close(fig)
+    return path
 
 
 def _group_key(line: Mapping[str, Any], others: Sequence[str]) -> tuple[float, ...]:
@@ -184,7 +237,7 @@ def _exact_curves(
     for value in dense:
         point = {first.path: float(value), **others}
         try:
-            spec = point_problem(base, point)
+            spec = _plate_point(base, point)
         except ValueError:
             continue
         bil, uni, what = reference_k(spec)
@@ -232,7 +285,17 @@ def plot_sweep(
     *,
     title: str | None = None,
 ) -> Path:
-    """Draw k against the first variation (see the module docstring); returns ``path``."""
+    r"""Draw k against the first variation (see the module docstring); returns ``path``.
+
+    A section's sweep (``base`` with a ``[section]`` table) draws
+    its critical stress over its classical stress instead: the reference being each line's
+    ``classical_stress_Pa`` (a box: its widest face as a long simply supported plate,
+    k = 4; a tube: :math:`E t/(R\sqrt{3(1-\nu^2)})`), so that 1 is what the design codes'
+    elastic values assume; the hollow section (``free_load_Pa``) solid, with its core
+    (``critical_load_Pa``) dashed and marked by its certificate.
+    """
+    if "section" in base:
+        return _plot_section_sweep(lines, variations, base, path, title)
     import matplotlib as mpl
 
     mpl.use("Agg")
@@ -247,15 +310,10 @@ def plot_sweep(
 
     fig, ax = plt.subplots(figsize=(7.5, 5.0))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
-    groups: dict[tuple[float, ...], list[Mapping[str, Any]]] = {}
-    for line in lines:
-        groups.setdefault(_group_key(line, others), []).append(line)
-    for g, (key, members) in enumerate(sorted(groups.items())):
+    for g, (key, suffix, members) in enumerate(_groups(lines, others)):
         colour = colours[g % len(colours)]
-        label = ", ".join(f"{p} = {v:g}" for p, v in zip(others, key, strict=True))
-        suffix = f" ({label})" if label else ""
         solved = [m for m in members if m.get("buckling_coefficient_k") is not None]
-        specs = [point_problem(base, m["point"]) for m in solved]
+        specs = [_plate_point(base, m["point"]) for m in solved]
         x = np.array(
             [abscissa(s, m["point"][first.path]) for s, m in zip(specs, solved, strict=True)]
         )
@@ -281,11 +339,47 @@ def plot_sweep(
     ax.set_title(
         title or f"{base.get('name', 'plate')}: k against the {axis_label(first.path, base)}"
     )
-    ax.grid(True, alpha=0.3)
-    ax.legend(fontsize=8, loc="best")
-    fig.tight_layout()
-    path = Path(path)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fig.savefig(path, dpi=150)
-    plt.close(fig)
-    return path
+    return _save(fig, ax, path)
+
+
+def _plot_section_sweep(
+    lines: Sequence[Mapping[str, Any]],
+    variations: Sequence[Variation],
+    base: Mapping[str, Any],
+    path: str | Path,
+    title: str | None,
+) -> Path:
+    """A section's chart (:func:`plot_sweep`); returns ``path``."""
+    import matplotlib as mpl
+
+    mpl.use("Agg")
+    import matplotlib.pyplot as plt
+
+    first = variations[0]
+    others = [v.path for v in variations[1:]]
+    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    for g, (_, suffix, members) in enumerate(_groups(lines, others)):
+        colour = colours[g % len(colours)]
+        solved = [m for m in members if m.get("classical_stress_Pa") is not None]
+        solved.sort(key=lambda m: m["point"][first.path])
+        x = np.array([m["point"][first.path] for m in solved])
+        reference = np.array([float(m["classical_stress_Pa"]) for m in solved])
+        hollow = rounded(np.array([float(m["free_load_Pa"]) for m in solved]) / reference)
+        ax.plot(x, hollow, "-", color=colour, lw=1.0, marker=".", label=f"hollow{suffix}")
+        cored = [i for i, m in enumerate(solved) if m.get("certificate") is not None]
+        if cored:
+            ratio = rounded(np.array([float(m["critical_load_Pa"]) for m in solved]) / reference)
+            ax.plot(x[cored], ratio[cored], "--", color=colour, lw=1.0, label=f"core{suffix}")
+            for i in cored:
+                _certificate_mark(ax, x[i], ratio[i], solved[i]["certificate"], colour)
+    ax.axhline(1.0, ls=":", color="0.35", lw=1.2, label="classical stress")
+    _marker_legend(ax)
+    ax.set_xlabel(axis_label(first.path, base))
+    ax.set_ylabel(r"$\sigma_{cr}$ / classical stress")
+    ax.set_title(
+        title
+        or f"{base.get('name', 'section')}: critical stress against the "
+        f"{axis_label(first.path, base)}"
+    )
+    return _save(fig, ax, path)
