@@ -65,11 +65,7 @@ from unibuckle_fenicsx.algorithms.interior_point.links import (
     newton_link,
 )
 from unibuckle_fenicsx.algorithms.interior_point.newton import InteriorPointNewton
-from unibuckle_fenicsx.algorithms.interior_point.options import (
-    BarrierPoint,
-    ChainOptions,
-    NewtonOptions,
-)
+from unibuckle_fenicsx.algorithms.interior_point.options import BarrierPoint, ChainOptions
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation, mesh_levels
 from unibuckle_fenicsx.algorithms.records import (
     ActiveSetDetails,
@@ -245,8 +241,7 @@ def _carry(
     found: list[Candidate] = []
     carried: list[BarrierPoint] = []
     if k not in newtons:
-        newton_options = NewtonOptions(stall_restart=options.stall_restart)
-        newtons[k] = InteriorPointNewton(problems[k], newton_options)
+        newtons[k] = InteriorPointNewton(problems[k])
     carry = carrier(problems[k - 1], problems[k])
     for j, point in enumerate(points):
         tag = label if len(points) == 1 else f"{label} {j + 1}"

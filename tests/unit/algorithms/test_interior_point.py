@@ -495,17 +495,6 @@ def test_stall_watch_counts_steps_without_halving():
     assert not any(StallWatch(0).stalled(1.0) for _ in range(50))
 
 
-def test_stall_watch_restart_forgets_the_best_residual():
-    """After a restart the count runs from the next residual, however large it is."""
-    watch = StallWatch(3)
-    # 1e-5 is the best (a barrier problem solved); the next parameter starts at 2.5.
-    assert not watch.stalled(1e-5)
-    watch.restart()
-    # 2.5 sets the new best, 1.2 halves it: no stall although all lie above 1e-5.
-    assert [watch.stalled(r) for r in (2.5, 1.2, 1.0, 0.9)] == [False, False, False, False]
-    assert watch.stalled(0.8)  # the third step since 1.2 without halving it
-
-
 @serial
 def test_starts_on_one_central_path_are_not_taken_further(thin_plate):
     """A start on the central path of an arrangement met before stops there.

@@ -102,10 +102,6 @@ class StallWatch:
             self.since += 1
         return self.since >= self.steps
 
-    def restart(self) -> None:
-        """Forget the best residual: the count starts again at the next one."""
-        self.best, self.since = math.inf, 0
-
 
 @dataclass
 class _Run:
@@ -301,13 +297,10 @@ class InteriorPointNewton(Owner):
         mu, e_c, solved = self._lower(
             run.mu, run.mu_min, m.e_u, m.e_c, m.floor, run.nu * m.gap, m.scale
         )
-        lowered = mu < run.mu
         run.mu = mu
         run.mu_abs = mu * m.scale
         # (Watched first: a run that stops here does not compute a next step.)
         stalled = run.mu_min < run.mu_start and run.watch.stalled(m.e_u)
-        if lowered and opts.stall_restart:  # the next residual, the new parameter's, counts
-            run.watch.restart()
         converged = (
             mu <= run.mu_min
             and m.e_u <= max(opts.kappa_eps * mu, m.floor)

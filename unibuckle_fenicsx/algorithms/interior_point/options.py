@@ -115,12 +115,6 @@ class NewtonOptions:
             :math:`F_u` has not halved in this many steps (0: never), whatever
             parameter it has reached; the caller reads the contact set there as at
             convergence and goes on from it (saddle escape, lower barrier, polish).
-        stall_restart: Count the ``stall_steps`` from where the barrier parameter was
-            last lowered too (the best residual forgotten there), so that the first
-            barrier problem below the start one may take more than ``stall_steps``
-            steps while its residual keeps halving. Off by default: on a benchmark
-            plate a run it lets go on ended at no KKT point where the stopped run's
-            reads reached one (:doc:`/verification/fine_level`).
         push_floor: At the first step, a given push is raised to this fraction of
             :math:`\mu/g` node by node (in (0, 1)): a push of zero is off the path.
         max_load_step: A step changes the load by at most this fraction of it.
@@ -157,7 +151,6 @@ class NewtonOptions:
     curvature_vectors: int = 8
     saddle_curvature: float = 1e-4
     stall_steps: int = 10
-    stall_restart: bool = False
     push_floor: float = 1e-3
     max_load_step: float = 0.5
     armijo: float = 1e-4
@@ -261,9 +254,6 @@ class ChainOptions:
             on sections with a core, where a wall lies almost flat on the core, the
             gaps there stay above ``tau`` at every parameter reached, and only the
             predicted set holds them (:doc:`/verification/sections_finest`).
-        stall_restart: The runs on the finer meshes count their stalled steps from the
-            last decrease of the barrier parameter (``stall_restart`` of
-            :class:`NewtonOptions`). Off by default, as there.
         clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
             (the least-energy correction lifts those closer to the obstacle to it).
         max_steps: Newton steps per run.
@@ -307,7 +297,6 @@ class ChainOptions:
     read_stable: bool = True
     last_mu_min: float = 1e-14
     read_predicted: bool = False
-    stall_restart: bool = False
     clip_margin: float = 1e-6
     max_steps: int = 100
     escapes: int = 3

@@ -111,12 +111,8 @@ INTERIOR_POINT_DOFS = 10_000
 #: run of Newton steps on the finest section. Where a read of the gaps is no KKT point,
 #: the predicted contact set is read too (``read_predicted``): where a wall lies almost
 #: flat on the core its gaps stay above the tolerance, and only the predicted set holds
-#: them (:doc:`/verification/sections_finest`). The fine section's runs count their
-#: stalled steps from the last decrease of the barrier parameter (``stall_restart``):
-#: there the first barrier problem below the carried one takes more steps than the
-#: watch allows while its residual keeps halving, and a run stopped in it costs a
-#: saddle escape that solves it again (:doc:`/verification/sections_finest`).
-CHAIN_OPTIONS = ChainOptions(arrangements=1, read_predicted=True, stall_restart=True)
+#: them (:doc:`/verification/sections_finest`).
+CHAIN_OPTIONS = ChainOptions(arrangements=1, read_predicted=True)
 #: The interior point starts on a section at least this coarse: the cell size doubled
 #: while the coarser section keeps this many DOFs (more if ``levels`` asks). The
 #: starts take a few hundred Newton steps there; on the sections of
