@@ -76,10 +76,12 @@ from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = [
+    "MIN_ALONG_CELLS",
     "MIN_FACE_CELLS",
     "MIN_HALF_WAVE_CELLS",
     "SectionAnalysis",
     "SectionResult",
+    "buckle_length",
     "coarse_mesh_note",
     "half_wave",
     "solve_section",
@@ -334,28 +336,52 @@ MIN_FACE_CELLS = 5
 #: :math:`\pi\sqrt{Rt}/(12(1-\nu^2))^{1/4}` draw a warning, by the same measure
 #: (:doc:`/guide/sections`, "Cell size").
 MIN_HALF_WAVE_CELLS = 1.5
+#: Fewer cells than this along the longest buckle the ends allow (:func:`buckle_length`)
+#: draw a warning, by the same measure: a short section buckles in one wave as long as
+#: the member, whatever its walls' own buckles (:doc:`/guide/sections`, "Cell size").
+MIN_ALONG_CELLS = 5
 
 
 def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     """A warning when the cells are too coarse for the walls' buckles, else None.
 
-    The rule (:data:`MIN_FACE_CELLS`, :data:`MIN_HALF_WAVE_CELLS`) is a priori, from the
-    section's dimensions and cell size: on cells too coarse for the buckles the shell's
-    critical stress is too high (it falls as the cells are refined), and so are k and
-    the design values.
+    The rule (:data:`MIN_FACE_CELLS`, :data:`MIN_HALF_WAVE_CELLS` across, then
+    :data:`MIN_ALONG_CELLS` along :func:`buckle_length`) is a priori, from the section's
+    dimensions and cell size: on cells too coarse for the buckles the shell's critical
+    stress is too high (it falls as the cells are refined), and so are k and the design
+    values.
     """
     p = parameters
     span, what = _buckle_width(p)
+    need: float = MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS
+    where = f"across {what}"
     cells = span / p.mesh_size
-    need = MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS
     if cells >= need:
-        return None
+        span, what = buckle_length(p)
+        need, where = MIN_ALONG_CELLS, f"along {what}"
+        cells = span / p.mesh_size
+        if cells >= need:
+            return None
     return (
-        f"mesh.size = {p.mesh_size:.3g} m gives {cells:.2g} cells across {what} "
+        f"mesh.size = {p.mesh_size:.3g} m gives {cells:.2g} cells {where} "
         f"({span:.3g} m), fewer than {need}: on cells this coarse the critical stress, k "
         f"and the design values come out too high (refine mesh.size to {span / need:.3g} m "
         'or less; docs/guide/sections.md, "Cell size")'
     )
+
+
+def buckle_length(parameters: SectionParameters) -> tuple[float, str]:
+    r"""The longest buckle the loaded ends allow along the member (m), and its name.
+
+    The length L between simply supported ends (one half-wave :math:`\sin(\pi x/L)`),
+    L/2 between clamped ones (the one-wave mode :math:`1 - \cos(2\pi x/L)` bends in
+    half-waves of L/2). On a long member the walls' own buckles are shorter and
+    :func:`coarse_mesh_note` checks those; on a short one this length is the buckle's.
+    """
+    p = parameters
+    if p.ends == "clamped":
+        return 0.5 * p.length, "half the length between the clamped ends"
+    return p.length, "the length between the simply supported ends"
 
 
 def half_wave(parameters: SectionParameters) -> float:

@@ -37,6 +37,8 @@ r"""Sections other than the square box of the docs, against independent values.
 
 from __future__ import annotations
 
+import dataclasses
+import logging
 import math
 
 from mpi4py import MPI
@@ -158,6 +160,65 @@ def test_a_short_tube_buckles_axisymmetrically():
     load, expected = _short_tube(0.001)
     assert expected == pytest.approx(2.6970e9, rel=1e-4)
     assert load == pytest.approx(expected, rel=0.015)
+
+
+def test_a_filled_short_tube_at_its_hollow_load_is_proven():
+    """The core adds nothing where the hollow mode moves outward only: proven, both routes.
+
+    The short tube's mode is one axial half-wave, axisymmetric (above): one-signed, so
+    turned outward it is admissible for the core, and the filled load is the hollow one;
+    interlacing (the core never lowers it) closes the bracket. On 2 mm cells (5 along,
+    5 688 DOFs, the active set's route over a coarser section) the filled tube was
+    certified kkt-only with the same bounds, 2.808205e9 Pa at both ends, and its design
+    repeated at the "verified lower bound, sigma_cr not proven the lowest"; the interior
+    point's route (1 mm cells) said proven.
+    """
+    from unibuckle_fenicsx.spec import DesignSpec
+
+    tube = SectionParameters(
+        "tube", diameter=0.1, thickness=0.001, length=0.01, E=E, nu=NU, mesh_size=0.002,
+        ends="simply_supported", core=True,
+    )  # fmt: skip
+    design = DesignSpec(yield_stress=3.55e8)
+    with solve_section(tube, MPI.COMM_SELF, design=design) as analysis:
+        r = analysis.result
+    assert r.method == "active-set (section levels)" and r.contact_nodes == 0
+    assert r.critical_load_Pa == pytest.approx(r.free_load_Pa, rel=1e-10)
+    assert r.certificate is not None and r.certificate.status == "proven"
+    assert not isinstance(r.design.lower_bound, type(r.design))
+    assert "certificate proven" in r.summary() and "not proven" not in r.summary()
+
+
+def test_a_short_tube_on_few_cells_along_draws_the_coarse_mesh_warning(caplog):
+    """Cells too few along a short member are warned of, as cells across a face are.
+
+    The short tube (R = 50 mm, t = 1 mm, L = 10 mm) buckles in one half-wave of the
+    length, shorter than the walls' own half-wave (12.2 mm, 2.4 cells of 5 mm: no
+    warning by it). On 5 mm cells, 2 along L, its load is 3.7265e9 Pa, 38 % above the
+    axisymmetric reference 2.6970e9 Pa (above); between clamped ends, 1 cell along L/2,
+    6.812e10 Pa, 9.1 times the 1-D beam on the hoop's 7.4967e9 Pa (above). Both were
+    printed without a warning. On 5 cells along (2 mm cells; 1 mm clamped) the loads are
+    2.8082e9 and 7.934e9 Pa, 4.1 % and 5.8 % high, as the rule across a face allows.
+    """
+    from unibuckle_fenicsx.section_analysis import coarse_mesh_note
+
+    expected = 2.6970e9
+    R, t, L = 0.05, 0.001, 0.01
+    tube = SectionParameters(
+        "tube", diameter=2 * R, thickness=t, length=L, E=E, nu=NU, mesh_size=0.005,
+        ends="simply_supported",
+    )  # fmt: skip
+    with caplog.at_level(logging.WARNING, logger="unibuckle_fenicsx.section_analysis"):
+        with solve_section(tube, MPI.COMM_SELF) as analysis:
+            load = analysis.result.critical_load_Pa
+    assert load > 1.3 * expected
+    assert any("2 cells along the length" in r.getMessage() for r in caplog.records)
+    clamped = dataclasses.replace(tube, ends="clamped")
+    note = coarse_mesh_note(clamped)
+    assert note is not None and "1 cells along half the length" in note
+    # 5 cells along L (simply supported) and along L/2 (clamped): no warning.
+    assert coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.002)) is None
+    assert coarse_mesh_note(dataclasses.replace(clamped, mesh_size=0.001)) is None
 
 
 def _clamped_axisymmetric_beam(R: float, t: float, L: float, n: int = 800) -> float:

@@ -54,6 +54,7 @@ from unibuckle_fenicsx.algorithms.active_set import (
     THRESHOLDS,
     solve_active_set,
 )
+from unibuckle_fenicsx.algorithms.bounds import bracket
 from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_interior_point
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.algorithms.records import (
@@ -458,12 +459,15 @@ def _polish(
     if run.status is not RunStatus.KKT or run.final is None:
         return None, None
     iterations = before + run.iterations
+    # Interlacing closes the bracket when the load is the free one (the free mode
+    # admissible: |Z| = 0), as the active set's own bracket says (no lattice search).
+    closed = bracket(problem, problem.solve_free().load, run.final, 0, "active-set")
     solution = UnilateralSolution(
         candidate=run.final,
         method="active-set (section levels)",
         eigensolves=problem.eigensolver.solves,
-        lower_bound=problem.solve_free().load,
-        global_optimum_proven=False,
+        lower_bound=closed.lower,
+        global_optimum_proven=closed.proven,
         upper_bound=run.final.load,
         kkt_points=[run.final],
         lower_bound_by="interlacing",
