@@ -355,11 +355,13 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     span, what = _buckle_width(p)
     need: float = MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS
     where = f"across {what}"
-    cells = span / p.mesh_size
+    # The mesh's rounding (geometry's cells across: ceil(extent/size - 1e-9)): 0.35/0.07
+    # is 4.999999999999999 cells, and the mesh makes 5 (6 on a box's face).
+    cells = span / p.mesh_size * (1.0 + 1e-9)
     if cells >= need:
         span, what = buckle_length(p)
         need, where = MIN_ALONG_CELLS, f"along {what}"
-        cells = span / p.mesh_size
+        cells = span / p.mesh_size * (1.0 + 1e-9)
         if cells >= need:
             return None
     return (

@@ -259,6 +259,27 @@ def test_cli_several_obstacles_distributed(tmp_path):
     assert ser["certificate"]["kkt"] and ser["constrained_nodes"] > 20
 
 
+def test_cli_interior_point_constraint_on_one_rank(tmp_path):
+    """The interior point with constrained nodes on one rank only: no hang, the free load.
+
+    One one-sided point (c1's plate, 16x8): its node is owned by one of the 2 ranks, the
+    other owns no constrained node. Its complementarity residual skipped the reduction
+    over the ranks there, and the first rank waited in it for ever. The free mode or its
+    mirror image meets a single one-sided point, so the critical load is the free load
+    (ratio 1), and the serial run's (every load within LOAD_RTOL).
+    """
+    path = tmp_path / "stud.toml"
+    path.write_text(
+        "[mesh]\nnx = 16\nny = 8\n"
+        '[[points]]\nat = [-0.05, 0.0]\nkind = "one-sided"\nside = "below"\n'
+        '[solver]\nmethod = "interior-point"\n'
+    )
+    ser, par = _config_on_two_ranks(tmp_path, path)
+    assert par["method"] == "interior-point" and par["certificate"]["kkt"]
+    assert par["constrained_nodes"] == 1
+    assert par["critical_load_Pa"] == pytest.approx(ser["free_load_Pa"], rel=LOAD_RTOL)
+
+
 @pytest.mark.parametrize(("side", "stiffness"), [("above", 2e7), ("above", 5e7), ("both", 1e7)])
 def test_cli_foundation_distributed(tmp_path, side, stiffness):
     """A tensionless (side above) and a bilateral (side both) Winkler foundation on 2 ranks.

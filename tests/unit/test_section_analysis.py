@@ -222,6 +222,25 @@ def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
     assert any("cells across the narrowest face" in r.getMessage() for r in caplog.records)
 
 
+def test_cells_exactly_enough_draw_no_warning():
+    """0.35/0.07 is 4.999999999999999 in floating point: 5 cells, not fewer than 5.
+
+    The mesh rounds the same way (geometry's ceil(extent/size - 1e-9): a face of 0.35 m
+    gets 5 cells, made 6); the note said "gives 5 cells ..., fewer than 5" and asked to
+    refine to the size given.
+    """
+    from unibuckle_fenicsx.section_analysis import coarse_mesh_note
+
+    assert 0.35 / 0.07 < 5
+    across = SectionParameters(
+        "box", width=0.35, depth=0.35, thickness=T, length=1.0, E=E, nu=NU, mesh_size=0.07,
+        ends="simply_supported",
+    )  # fmt: skip
+    assert coarse_mesh_note(across) is None
+    along = dataclasses.replace(across, width=0.5, depth=0.5, length=0.35)
+    assert coarse_mesh_note(along) is None
+
+
 def test_walls_thick_for_the_shell_model_draw_a_warning():
     # The plate's rule, t over the width of the buckles at most THICK_PLATE_RATIO = 0.2.
     # Box: 0.03/0.1 = 0.3 warns, 0.002/0.1 does not. Tube (R = 0.1 m, nu = 0.3): the

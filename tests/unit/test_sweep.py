@@ -313,6 +313,33 @@ def test_reference_values():
     assert bil == pytest.approx(4.0) and uni == 4.5
 
 
+def test_no_reference_curve_for_a_foundation_or_holes():
+    """The rigid obstacle's curve is not drawn for a foundation, nor the plate's for holes.
+
+    A whole-plate tensionless foundation of 0.3 N/m^3 under the 3 x 1 m plate (E = 1e9
+    Pa, t = 1 mm): its k is at most the bilateral foundation's, min over m of
+    (m/phi + phi/m)^2 + k_f a^2 b^2/(m^2 pi^4 D) = 4.03 (m = 3; Timoshenko & Gere, section
+    9.2, with the Winkler term), below the rigid obstacle's 4.5, which was drawn for it;
+    the free plate's curve stays (the bilateral k is the plate's without the foundation).
+    A plate with a hole is not the garland's plate.
+    """
+    data = {
+        "plate": {"corners": [[0, 0], [3.0, 1.0]], "thickness": 1e-3},
+        "obstacle": {"zone": "all", "foundation_stiffness": 0.3},
+    }
+    spec = problem_from_dict(data)
+    mat = spec.material
+    D = mat.E * 1e-3**3 / (12 * (1 - mat.nu**2))
+    winkler = min((m / 3 + 3 / m) ** 2 + 0.3 * 9 / (m**2 * np.pi**4 * D) for m in range(1, 6))
+    assert winkler == pytest.approx(4.03, abs=0.01)
+    bilateral, unilateral, _ = reference_k(spec)
+    assert bilateral == pytest.approx(4.0) and unilateral is None  # m = 3: (1 + 1)^2
+    del data["obstacle"]
+    data["plate"]["holes"] = [{"center": [1.5, 0.5], "radius": 0.2}]
+    data["mesh"] = {"size": 0.1}
+    assert reference_k(problem_from_dict(data)) == (None, None, "")
+
+
 # -- MPI ----------------------------------------------------------------------------
 
 
@@ -324,7 +351,7 @@ def test_two_ranks_give_the_serial_lines(tmp_path):
     base.write_text(SMALL)
     serial = run_sweep_cli("--config", str(base), *VARY, "--json", "serial.jsonl", cwd=tmp_path)
     assert serial.returncode == EXIT_OK, serial.stderr
-    cli = ROOT / "unibuckle_fenicsx" / "cli.py"
+    cli = ROOT / "unibuckle_fenicsx" / "cli" / "__main__.py"
     run_mpi(cli, 2, "sweep", "--config", str(base), *VARY, "--json", str(tmp_path / "p.jsonl"))
     assert (tmp_path / "p.jsonl").read_text() == (tmp_path / "serial.jsonl").read_text()
     # Each point's mesh over both ranks: the same loads within the eigen tolerance.

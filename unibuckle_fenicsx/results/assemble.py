@@ -60,7 +60,7 @@ def assemble_result(
         critical_load_Pa=load,
         free_load_Pa=free.load,
         ratio_to_free=load / free.load,
-        critical_force_N_per_m=spec.plate.thickness * load,
+        critical_force_N_per_m=_critical_force(spec, load),
         # k is a buckling coefficient of edge loads: none for a rise alone.
         buckling_coefficient_k=(problem.buckling_coefficient(load) if spec.plate.loaded else None),
         dofs=problem.model.num_dofs,
@@ -100,6 +100,14 @@ def assemble_result(
     if not certificate.global_optimum_proven:
         _design_at_lower_bound(result, spec, certificate.lower_bound)
     return result
+
+
+def _critical_force(spec: ProblemSpec, load: float) -> float | None:
+    """N = t sigma (N/m), sigma = load times the reference stress of k; None for a rise alone."""
+    if not spec.plate.loaded:
+        return None
+    stress, _ = spec.plate.reference_load()
+    return spec.plate.thickness * stress * load
 
 
 def _design_at_lower_bound(result: BucklingResult, spec: ProblemSpec, lower: float) -> None:

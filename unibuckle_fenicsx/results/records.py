@@ -152,7 +152,8 @@ class BucklingResult(Struct, kw_only=True):
         critical_load_Pa: lambda, the critical compressive stress (Pa).
         free_load_Pa: lambda without obstacle (Pa).
         ratio_to_free: critical / free.
-        critical_force_N_per_m: N = t lambda.
+        critical_force_N_per_m: N = t sigma (N/m), sigma of ``buckling_coefficient_k`` at
+            lambda (with a unit edge stress, t lambda); None for a temperature rise alone.
         buckling_coefficient_k: k = sigma t b^2 / (pi^2 D), sigma = lambda times the
             largest compressive edge stress per unit load (pure shear: the largest shear
             stress) and b the width it acts across
@@ -208,7 +209,7 @@ class BucklingResult(Struct, kw_only=True):
     critical_load_Pa: float
     free_load_Pa: float
     ratio_to_free: float
-    critical_force_N_per_m: float
+    critical_force_N_per_m: float | None
     buckling_coefficient_k: float | None
     dofs: int
     mesh: list[int]

@@ -14,7 +14,7 @@ Exact thin-plate curves are drawn where they exist (:func:`reference_k`):
 - SSSS plate, uniform compression of the short edges x = const, no obstacle:
   :math:`k = \min_m (m/\phi + \phi/m)^2`, :math:`\phi = a/b` (Timoshenko and Gere,
   *Theory of Elastic Stability*, 1961, section 9.2);
-- the same plate with the obstacle over the whole plate: the single buckle
+- the same plate with a rigid obstacle (no gap) over the whole plate: the single buckle
   :math:`(\phi + 1/\phi)^2` up to :math:`\phi = \sqrt 2`, where it reaches 4.5, and 4.5
   beyond (:doc:`/verification/thin_plates`: a buckle against the loaded edge
   that touches down, f = 2 sin t (1 + cos t), has k = 9/2);
@@ -66,13 +66,24 @@ def reference_k(spec: ProblemSpec) -> tuple[float | None, float | None, str]:
         or spec.has_fixed_load
         or spec.load.thermal
         or spec.material.plies
+        or spec.material.membrane_voigt is not None
+        or spec.material.bending_voigt is not None
+        or spec.plate.holes
+        or spec.bilateral_foundations
         or any(e.springs for e in spec.plate.edges)
     )
     if not plain or not _uniaxial_x(spec):  # the curves below know none of these
         return None, None, ""
     supports = {edge.name: edge.support for edge in spec.plate.edges}
     phi = spec.plate.length / spec.plate.width
-    whole = len(spec.all_obstacles) == 1 and spec.all_obstacles[0].zone == "all"
+    obstacles = spec.all_obstacles
+    # The rigid obstacle in contact: not a foundation, nor one with a gap (left out).
+    whole = (
+        len(obstacles) == 1
+        and obstacles[0].zone == "all"
+        and obstacles[0].foundation_stiffness is None
+        and obstacles[0].gap == 0.0
+    )
     if all(s in _SS for s in supports.values()):
         m_max = max(1, math.ceil(phi)) + 1
         bilateral = min((m / phi + phi / m) ** 2 for m in range(1, m_max + 1))

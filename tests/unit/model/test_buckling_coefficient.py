@@ -51,6 +51,24 @@ def test_k_does_not_depend_on_the_size_of_the_unit_edge_stress():
     assert unit == pytest.approx(4.0, rel=0.05)  # a/b = 3: k = 4 (module docstring)
 
 
+def test_the_critical_force_is_t_times_the_critical_stress():
+    """N = t sigma_cr whatever the size of the unit edge stress: near 4 pi^2 D / b^2.
+
+    An edge stress of -3 per unit load: sigma_cr = 3 lambda_c, so N = 3 t lambda_c (it was
+    t lambda_c, a third). The thin-plate value N = k pi^2 D / b^2 with k = 4 (module
+    docstring) within the 24 x 8 mesh's 5 %.
+    """
+    spec = loaded(long_plate(0.3, 0.1, 24, 8), -3.0, ("left", "right"))
+    with solve(spec, MPI.COMM_WORLD) as analysis:
+        result = analysis.result
+    mat = spec.material
+    D = mat.E * THICKNESS**3 / (12.0 * (1.0 - mat.nu**2))
+    assert result.critical_force_N_per_m == pytest.approx(
+        THICKNESS * 3.0 * result.critical_load_Pa, rel=1e-12
+    )
+    assert result.critical_force_N_per_m == pytest.approx(4.0 * math.pi**2 * D / 0.1**2, rel=0.05)
+
+
 def test_k_of_a_plate_compressed_on_top_and_bottom_uses_the_loaded_width():
     upright = loaded(long_plate(0.1, 0.3, 8, 24), -1.0, ("bottom", "top"))
     lying = long_plate(0.3, 0.1, 24, 8)  # the same plate transposed, loaded left/right

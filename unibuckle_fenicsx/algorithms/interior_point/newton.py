@@ -274,8 +274,8 @@ class InteriorPointNewton(Owner):
         e_u = float(kernel.Fu.norm(PETSc.NormType.INFINITY)) / f_scale
         floor = max(opts.residual_floor, kernel.rounding(u, run.lam) / f_scale)
         rel_u = float(kernel.Fu.norm()) / float(kernel.Au.norm())
-        e_c = kernel.max(np.abs(nu * gap - run.mu_abs)) / scale if gap.size else 0.0
-        e_c = max(e_c, 0.0)
+        # Collective on every rank, also one that owns no constrained node (-inf there).
+        e_c = max(kernel.max(np.abs(nu * gap - run.mu_abs)) / scale, 0.0)
         run.record.history.append((run.lam, run.mu, e_u, e_c))
         logger.debug(
             "ipm step %d: lambda %.12g mu %.1e e_u %.2e e_c %.2e rel_u %.2e",
