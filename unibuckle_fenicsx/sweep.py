@@ -257,7 +257,9 @@ def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set")
     """Set the value at the dotted ``path`` of ``data`` from ``text``, read as the value there.
 
     A number, a boolean (true/false) or a string replaces one of its kind; the shortcuts
-    of :data:`SHORTCUTS` take a number.
+    of :data:`SHORTCUTS` take a number. A key that ``data`` leaves out but a problem
+    file may hold (``obstacle.span``, ``design.yield_stress``) is added, its value read
+    by its text (see :func:`_add`), and checked by the schema afterwards.
 
     Raises:
         ValueError: ``path`` names nothing in ``data``, or ``text`` is not of the kind of
@@ -266,7 +268,12 @@ def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set")
     if path in SHORTCUTS:
         set_value(data, path, _float(text, path, flag), flag)
         return
-    node, index = _locate(data, path, flag)
+    try:
+        node, index = _locate(data, path, flag)
+    except InputError:
+        if _add(data, path, text, flag):
+            return
+        raise
     current = node[index]
     if isinstance(current, bool):
         if text.lower() not in ("true", "false"):
@@ -281,6 +288,67 @@ def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set")
             f"{flag} {path}: the value there, {current!r}, is a table or a list: name one "
             "of its entries"
         )
+
+
+def _schema_key(path: str) -> str:
+    """The schema's dotted key of ``path``: list indices as ``[]``, an edge's name ``<name>``."""
+    parts = path.split(".")
+    out: list[str] = []
+    for depth, part in enumerate(parts):
+        if part.isdigit() and out:
+            out[-1] += "[]"
+        elif depth == 1 and parts[0] == "edges":
+            out.append("<name>")
+        else:
+            out.append(part)
+    return ".".join(out)
+
+
+def _add(data: dict[str, object], path: str, text: str, flag: str) -> bool:
+    """Add the key ``path`` that ``data`` leaves out, if a problem file may hold it.
+
+    The tables on the way are made; the value is read from ``text`` as a boolean
+    (true/false), a list of numbers (``0.05,0.15``), a number, or else a string; the
+    schema then checks it. False (nothing added) if no problem file has that key, or
+    the path runs through a list entry that is not there.
+
+    Raises:
+        InputError: A list with an entry that is not a number (the message names ``flag``
+            and ``path``).
+    """
+    from unibuckle_fenicsx.spec.schema import accepted_keys
+
+    if _schema_key(path) not in accepted_keys():
+        return False
+    keys = path.split(".")
+    node: Any = data
+    for key in keys[:-1]:
+        if isinstance(node, list):
+            if not (key.isdigit() and int(key) < len(node)):
+                return False
+            node = node[int(key)]
+        elif isinstance(node, dict):
+            node = node.setdefault(key, {})
+        if not isinstance(node, dict | list):
+            return False
+    if not isinstance(node, dict):
+        return False
+    node[keys[-1]] = _new_value(text, path, flag)
+    return True
+
+
+def _new_value(text: str, path: str, flag: str) -> object:
+    """A value for a key the file left out, read from ``text`` (see :func:`_add`)."""
+    if text.lower() in ("true", "false"):
+        return text.lower() == "true"
+    if "," in text:
+        return [_float(part, path, flag) for part in text.split(",")]
+    if re.fullmatch(r"\s*[+-]?\d+\s*", text):
+        return int(text)
+    try:
+        return _float(text, path, flag)
+    except InputError:
+        return text
 
 
 def point_problem(

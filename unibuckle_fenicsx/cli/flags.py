@@ -182,7 +182,9 @@ def problem_flags() -> Parser:
         default=[],
         dest="settings",
         help="set a value of the problem file by its dotted path (as --vary of the sweep): "
-        "--set solver.tau=1e-9 --set plate.thickness=0.004 (repeatable; the file's units)",
+        "--set solver.tau=1e-9 --set plate.thickness=0.004, or add a key the file leaves "
+        "out: --set design.yield_stress=3.55e8, a list as obstacle.span=0.05,0.15 "
+        "(repeatable; the file's units)",
     )
     problem.add_argument(
         "--json", metavar="PATH", help="write the result as JSON (the folder must exist)"

@@ -17,7 +17,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
+from support.paths import ROOT
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_NOT_CERTIFIED, EXIT_OK, build_parser, main
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.materials import navier_load_mindlin
 
 SCRIPT = Path(sys.executable).parent / "unibuckle"
@@ -246,6 +248,33 @@ def test_set_changes_the_value_at_its_dotted_path():
     assert spec.solver.tau == 1e-9 and spec.solver.method == "penalty"
     assert paper_case("c1").solver.tau != 1e-9  # the value was changed, not already there
     assert spec.plate == paper_case("c1").plate  # and nothing else
+
+
+def test_set_adds_a_key_the_file_leaves_out():
+    """--set adds an optional key a problem file may hold: a table, a list, a number.
+
+    ``demos/box.toml`` has no ``[design]`` and no ``obstacle.span``; the values are the
+    file's units (SI).
+    """
+    from unibuckle_fenicsx.cli.problem import spec_from_args
+
+    parser, _ = build_parser()
+    box = str(ROOT / "demos" / "box.toml")
+    args = parser.parse_args(
+        ["solve", "--config", box, "--set", "design.yield_stress=3.55e8",
+         "--set", "obstacle.span=0.05,0.15", "--set", "mesh.levels=0"]
+    )  # fmt: skip
+    spec = spec_from_args(args)
+    assert spec.design is not None and spec.design.yield_stress == 3.55e8
+    assert spec.obstacle.span == (0.05, 0.15) and spec.mesh.levels == 0
+    # A key no problem file has is still refused naming the keys there.
+    bad = parser.parse_args(["solve", "--config", box, "--set", "obstacle.spam=1"])
+    with pytest.raises(InputError, match=r"--set obstacle\.spam: obstacle has no key 'spam'"):
+        spec_from_args(bad)
+    # A value the schema refuses names the key.
+    bad = parser.parse_args(["solve", "--config", box, "--set", "obstacle.span=0.2,0.1"])
+    with pytest.raises(InputError, match=r"obstacle\.span"):
+        spec_from_args(bad)
 
 
 @pytest.mark.parametrize(
