@@ -230,6 +230,9 @@ def _locate(data: dict[str, object], path: str, flag: str) -> tuple[Any, Any]:
 def set_value(data: dict[str, object], path: str, value: float, flag: str = "--vary") -> None:
     """Set the number at the dotted ``path`` of the problem mapping ``data``, in place.
 
+    A number that ``data`` leaves out but a problem file may hold
+    (``design.yield_stress`` of a file without ``[design]``) is added (:func:`_add`).
+
     Raises:
         ValueError: ``path`` does not name a number of ``data`` (the message lists what
             is there), or ``value`` is not an integer where one is needed.
@@ -242,7 +245,12 @@ def set_value(data: dict[str, object], path: str, value: float, flag: str = "--v
             raise InputError(f"{flag} {path}: the problem has no plate.corners")
         corners[1][axis] = corners[0][axis] + value
         return
-    node, index = _locate(data, path, flag)
+    try:
+        node, index = _locate(data, path, flag)
+    except InputError:
+        if _add(data, path, repr(float(value)), flag):
+            return
+        raise
     current = node[index]
     if not _is_number(current):
         raise InputError(f"{flag} {path}: the value there, {current!r}, is not a number")

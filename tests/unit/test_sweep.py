@@ -161,6 +161,25 @@ def test_paths(tmp_path):
         point_problem(base, {"plate.thickness": -1.0})
 
 
+def test_a_number_the_file_leaves_out_is_varied():
+    """--vary adds a number a problem file may hold (a design chart over f_y)."""
+    data = problem_to_dict(problem_from_dict(compressed_plate()))
+    assert "design" not in data
+    spec = point_problem(data, {"design.yield_stress": 2.35e8})
+    assert spec.design is not None and spec.design.yield_stress == 2.35e8
+    # A key no problem file has is refused naming where it is missing.
+    with pytest.raises(ValueError, match=r"--vary design\.spam: the problem file has no key"):
+        point_problem(data, {"design.spam": 1.0})
+
+
+def compressed_plate() -> dict[str, object]:
+    """A plate compressed on its short edges, with no [design] table."""
+    return {
+        "plate": {"corners": [[0.0, 0.0], [0.3, 0.1]], "thickness": 0.003},
+        "edges": {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}},
+    }
+
+
 def test_mesh_size_and_units():
     # ceil(0.3/0.01) = 30, ceil(0.1/0.01) = 10: an exact division gives no extra cell.
     assert MeshSpec.cells_for(0.3, 0.1, 0.01) == (30, 10)
