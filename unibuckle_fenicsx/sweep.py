@@ -57,6 +57,7 @@ Note:
 from __future__ import annotations
 
 import copy
+import functools
 import itertools
 import json
 import logging
@@ -298,6 +299,14 @@ def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set")
         )
 
 
+@functools.cache
+def _schema_keys() -> frozenset[str]:
+    """Every dotted key a problem file may hold (built once: a chart sets hundreds of points)."""
+    from unibuckle_fenicsx.spec.schema import accepted_keys
+
+    return frozenset(accepted_keys())
+
+
 def _schema_key(path: str) -> str:
     """The schema's dotted key of ``path``: list indices as ``[]``, an edge's name ``<name>``."""
     parts = path.split(".")
@@ -324,9 +333,7 @@ def _add(data: dict[str, object], path: str, text: str, flag: str) -> bool:
         InputError: A list with an entry that is not a number (the message names ``flag``
             and ``path``).
     """
-    from unibuckle_fenicsx.spec.schema import accepted_keys
-
-    if _schema_key(path) not in accepted_keys():
+    if _schema_key(path) not in _schema_keys():
         return False
     keys = path.split(".")
     node: Any = data

@@ -18,9 +18,9 @@ def _check_chart(base: Any) -> None:
     The chart draws k = t lambda b^2/(pi^2 D), a buckling coefficient of edge loads; for a
     temperature rise alone lambda is a factor on the rise and k means nothing.
     """
-    from unibuckle_fenicsx.spec import problem_from_dict
+    from unibuckle_fenicsx.spec import is_section, problem_from_dict
 
-    if "section" in base:  # loaded at its ends: the chart's ordinate is its stress
+    if is_section(base):  # loaded at its ends: the chart's ordinate is its stress
         return
     if not problem_from_dict(base).plate.loaded:
         raise InputError(

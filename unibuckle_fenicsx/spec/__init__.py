@@ -37,6 +37,7 @@ from unibuckle_fenicsx.spec.cases import CASES, paper_case, plate_case
 from unibuckle_fenicsx.spec.files import (
     OBSTACLE_KEYS,
     PLY_KEYS,
+    is_section,
     load_problem,
     load_toml,
     problem_from_dict,
@@ -94,6 +95,7 @@ __all__ = [
     "SolverSpec",
     "Temperature",
     "accepted_keys",
+    "is_section",
     "json_schema",
     "load_problem",
     "load_toml",

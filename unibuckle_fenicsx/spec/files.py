@@ -102,16 +102,21 @@ def _convert[S: (ProblemSpec, SectionProblemSpec)](api: dict[str, object], root:
         CONVERTING.reset(token)
 
 
+def is_section(data: Mapping[str, object]) -> bool:
+    """Whether the TOML-shaped mapping ``data`` is a section's file (its ``[section]``)."""
+    return isinstance(data, Mapping) and "section" in data
+
+
 def spec_from_dict(data: Mapping[str, object], name: str) -> ProblemSpec | SectionProblemSpec:
     """A section's problem if ``data`` has a ``[section]`` table, else a plate's."""
-    if isinstance(data, Mapping) and "section" in data:
+    if is_section(data):
         return section_from_dict(data, name)
     return problem_from_dict(data, name)
 
 
 def _not_a_section(data: Mapping[str, object]) -> None:
     """Refuse a section's keys in a plate's file: [section], load.axial_stress, obstacle.core."""
-    if "section" in data:
+    if is_section(data):
         raise InputError(
             "[section]: a section's file is read by section_from_dict (or load_problem)"
         )

@@ -32,7 +32,7 @@ from typing import Any
 import numpy as np
 
 from unibuckle_fenicsx.results import rounded
-from unibuckle_fenicsx.spec import EDGE_NAMES, UNITS, ProblemSpec
+from unibuckle_fenicsx.spec import EDGE_NAMES, UNITS, ProblemSpec, is_section
 from unibuckle_fenicsx.sweep import Variation, point_problem
 
 __all__ = ["axis_label", "plot_sweep", "reference_k"]
@@ -162,7 +162,7 @@ def axis_label(path: str, base: Mapping[str, Any]) -> str:
     not know is shown as its dotted path.
     """
     parts = path.split(".")
-    section = _SECTION_WORDS.get(path) if "section" in base else None
+    section = _SECTION_WORDS.get(path) if is_section(base) else None
     words = section or _WORDS.get(parts[-1], path)
     edge = parts[1] if parts[0] == "edges" and len(parts) > 2 else ""
     kind = "point"
@@ -305,7 +305,7 @@ def plot_sweep(
     elastic values assume; the hollow section (``free_load_Pa``) solid, with its core
     (``critical_load_Pa``) dashed and marked by its certificate.
     """
-    if "section" in base:
+    if is_section(base):
         return _plot_section_sweep(lines, variations, base, path, title)
     import matplotlib as mpl
 
