@@ -48,6 +48,7 @@ from unibuckle_fenicsx.en1993 import (
     design_element,
     psi_range,
     reduction_factor,
+    stress_ratio,
     table_row,
 )
 from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
@@ -155,7 +156,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     """The design quantities of the critical load ``load``, see the module docstring."""
     element = design_element(spec)
     sigma1, sigma2, end, edge = _critical_edge_stress(spec, load, element.loaded)
-    psi = sigma2 / sigma1 + 0.0 if sigma1 > 0.0 else None  # no -0.0
+    psi = stress_ratio(sigma1, sigma2) if sigma1 > 0.0 else None
     at_free = element.free_end is None or end == element.free_end or psi == 1.0
     out = DesignRecord(
         yield_stress_Pa=design.yield_stress,

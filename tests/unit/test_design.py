@@ -209,6 +209,22 @@ def test_loaded_edges_in_tension_at_the_critical_state_give_no_slenderness():
     assert "no compression on the loaded edges at the critical state" in out.summary()
 
 
+def test_a_ratio_a_rounding_below_the_table_end_is_the_end():
+    """[-0.7, 2.1] is psi = -3 (2.1/0.7 = 3.0000000000000004 in double precision).
+
+    It was refused as "psi = -3, outside Table 4.1, which covers 1 >= psi >= -3"; Table
+    4.1 gives k_sigma = 5.98 (1 - psi)^2 = 95.68 there.
+    """
+    from unibuckle_fenicsx.design import design_output
+
+    pair = {"normal_stress": [-0.7, 2.1]}
+    spec = plate({"left": pair, "right": pair})
+    assert spec.design is not None
+    d = design_output(spec, spec.design, 1e9)
+    assert d.psi == -3.0 and d.sigma_cr_Pa == pytest.approx(0.7e9, rel=1e-14)
+    assert d.k_sigma_table == pytest.approx(5.98 * 16, rel=1e-14)
+
+
 def test_a_fixed_compression_switched_off_by_its_factor_is_no_compression():
     """load.fixed_factor = 0 leaves the scaled tension alone: refused before the solve."""
     with pytest.raises(ValueError, match=r"design: the EN 1993-1-5 output takes sigma_cr"):
