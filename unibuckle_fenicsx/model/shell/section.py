@@ -406,7 +406,7 @@ def build_section(
     T = change_of_basis(model, constraints) if constraints is not None else None
     springs = None
     if constraints is not None and p.foundation_stiffness is not None:
-        springs = core_springs(model, constraints, p.foundation_stiffness)
+        springs = core_springs(model, constraints, p.foundation_stiffness, p.core_span)
     problem = section_problem(
         model, prestress, constraints, T, material, solver, springs=springs,
         compression=p.compression(),
