@@ -209,11 +209,12 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         sigma_cr_Pa=compression,
         relative_slenderness=math.sqrt(design.yield_stress / compression),
         clauses=[],
-        notes=[CALIBRATION],
+        notes=[],
         faces=[],
     )
-    if section.shape == "box":
+    if section.shape == "box":  # a tube's output applies no rho: no note of its calibration
         out.clauses.append(FACE_CLAUSES)
+        out.notes.append(CALIBRATION)
         out.notes.append(
             "every face at the section's critical load factor: conservative for a face "
             "that buckles because its neighbours do"
@@ -228,9 +229,10 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
     else:
         out.clauses.append(TUBE_CLAUSES)
     if section.core:
+        outside = ": outside the calibration of EN 1993-1-5 4.4(2)"
         out.notes.append(
-            "with the core sigma_cr is the unilateral critical stress: outside the "
-            "calibration of EN 1993-1-5 4.4(2)"
+            "with the core sigma_cr is the unilateral critical stress"
+            + (outside if section.shape == "box" else "")
         )
         out.clauses.append(FILLED_CLAUSES)
         epsilon = math.sqrt(235.0e6 / design.yield_stress)

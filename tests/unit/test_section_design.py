@@ -142,6 +142,10 @@ def test_a_tube_gets_its_slenderness_only():
     assert out.relative_slenderness == pytest.approx(math.sqrt(2.35e8 / 1.5e9))
     assert out.faces == [] and out.governing_face is None
     assert "EN 1993-1-6" in out.clauses[0]
+    # No rho of EN 1993-1-5 4.4(2) is applied to a tube, filled or not: no note says it is.
+    filled = section_design(_section("tube", width=None, depth=None, diameter=0.2, core=True),
+                            DesignSpec(yield_stress=2.35e8), 1.0e9)  # fmt: skip
+    assert not any("4.4(2)" in note for note in out.notes + filled.notes)
 
 
 def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):
