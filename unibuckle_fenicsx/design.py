@@ -185,6 +185,12 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
             'with a bilateral foundation (obstacle.side = "both") sigma_cr includes the '
             "foundation's stiffness: outside the calibration of 4.4(2)"
         )
+    if any(p.kind != "one-sided" for p in spec.points):
+        out.notes.append(
+            "with point restraints (points: bilateral ties or springs) sigma_cr includes "
+            "them: 4.4 describes a plate held by its edges alone, outside the calibration "
+            "of 4.4(2)"
+        )
     shear = any(
         any(stress_ends(e.shear_stress)) or any(stress_ends(e.fixed_shear_stress))
         for e in spec.plate.edges

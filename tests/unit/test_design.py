@@ -182,6 +182,29 @@ def test_an_obstacle_with_a_gap_is_not_called_unilateral():
         assert any("unilateral" in n for n in notes) == unilateral, notes
 
 
+@pytest.mark.parametrize(
+    "point", [{"kind": "bilateral"}, {"kind": "spring", "stiffness": 1e3}, {"kind": "one-sided"}]
+)
+def test_point_restraints_are_noted(point):
+    """Ties or springs inside the plate are noted: 4.4 describes a plate held by its edges.
+
+    They raise sigma_cr (a row of ties at mid-width of a 300 x 100 x 3 mm plate: 1106 MPa
+    against 689 MPa without) and the design said nothing of them; a one-sided point has
+    the unilateral note.
+    """
+    from unibuckle_fenicsx.design import design_output
+
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    point = {"at": [300.0, 100.0], **point} | (
+        {"side": "below"} if point["kind"] == "one-sided" else {}
+    )
+    spec = plate(edges, points=[point])
+    assert spec.design is not None
+    notes = design_output(spec, spec.design, 100.0).notes
+    ties = any("point restraints" in n for n in notes)
+    assert ties == (point["kind"] != "one-sided"), notes
+
+
 SHEARED_TENSION = {  # scaled: tension across left/right and shear; fixed: 10 MPa compression
     name: {"shear_stress": 1.0 if name in ("left", "right") else -1.0}
     | ({"normal_stress": 1.0, "fixed_normal_stress": -10.0} if name in ("left", "right") else {})
