@@ -51,6 +51,7 @@ from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode
 from unibuckle_fenicsx.model.shell.section import (
     Section,
+    SectionFigureData,
     SectionParameters,
     build_section,
     figure_data,
@@ -73,7 +74,6 @@ from unibuckle_fenicsx.spec import (
     problem_to_dict,
 )
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
-from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = [
     "MIN_ALONG_CELLS",
