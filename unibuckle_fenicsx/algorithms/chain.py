@@ -133,16 +133,9 @@ def _refine(
         newton.starts.relax(mode.x.petsc_vec, "deflection")
         newton.starts.relax(mode.x.petsc_vec, "rotations")
         newton.starts.lift(mode, options.clip_margin)
-        # The push and the load carried too, where the options ask and the carry can.
-        carried = getattr(carry, "push", None) if options.carry_push else None
-        push = None
-        if carried is not None:
-            push = newton.starts.carried_push(mode, carried(point.push), mu)
         reader = Reader(fine, newton, level, options) if last else None
         new, rec = newton.solve(
             mode,
-            load=None if push is None else point.load,
-            push=push,
             mu=mu,
             mu_min=options.fine_mu_min if last else mu,
             max_steps=options.max_steps,

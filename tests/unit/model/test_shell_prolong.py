@@ -17,7 +17,7 @@ import dolfinx
 import numpy as np
 import pytest
 
-from unibuckle_fenicsx.model.shell.core import perimeter_coordinate, tributary_areas
+from unibuckle_fenicsx.model.shell.core import perimeter_coordinate
 from unibuckle_fenicsx.model.shell.prolong import SectionProlongation
 from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
 
@@ -105,37 +105,3 @@ def test_the_two_meshes_must_be_of_one_section():
     ):
         with pytest.raises(ValueError, match="one section"):
             SectionProlongation(sc.problem, sf.problem)
-
-
-@pytest.mark.parametrize(
-    ("shape", "coarse", "fine", "changes"),
-    [
-        ("box", 0.06, 0.025, {}),  # not nested
-        ("box", 0.1, 0.05, {"corner_cell": 0.01}),  # graded rings
-        ("tube", 0.07, 0.03, {}),
-    ],
-)
-def test_a_pressure_is_carried_as_nodal_forces_of_the_fine_areas(shape, coarse, fine, changes):
-    """A uniform pressure's nodal pushes, carried, are the fine areas' nodal pushes.
-
-    Each fine push is p = 2.5 Pa times the fine direction's wall area (the fine mesh's
-    lumped areas, not the coarse ones), also next to the ends, whose held nodes have no
-    push: a uniform field is interpolated exactly.
-    """
-    comm = MPI.COMM_WORLD
-    with (
-        build_section(_params(shape, coarse, **changes), comm) as sc,
-        build_section(_params(shape, fine, **changes), comm) as sf,
-    ):
-        carry = SectionProlongation(sc.problem, sf.problem)
-        cc, cf = sc.constraints, sf.constraints
-        area_c = tributary_areas(sc.problem.pencil.shell, cc)[cc.owned_positions]
-        area_f = tributary_areas(sf.problem.pencil.shell, cf)[cf.owned_positions]
-        assert area_f.mean() < 0.5 * area_c.mean()  # finer cells: smaller areas
-
-        def pressure(c):
-            return np.full(c.owned_positions.size, 2.5)
-
-        out = carry.push(pressure(cc) * area_c)
-        want = pressure(cf) * area_f
-        assert np.abs(out - want).max() <= 1e-12 * np.abs(want).max()

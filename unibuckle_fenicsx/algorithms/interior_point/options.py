@@ -254,9 +254,6 @@ class ChainOptions:
             on sections with a core, where a wall lies almost flat on the core, the
             gaps there stay above ``tau`` at every parameter reached, and only the
             predicted set holds them (:doc:`/verification/sections_finest`).
-        carry_push: Carry the push with the mode from one mesh to the next, where the
-            carry can (its ``push`` method), instead of starting it at mu/g (node by node).
-            Off by default: the plates' carry has none.
         clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
             (the least-energy correction lifts those closer to the obstacle to it).
         max_steps: Newton steps per run.
@@ -300,7 +297,6 @@ class ChainOptions:
     read_stable: bool = True
     last_mu_min: float = 1e-14
     read_predicted: bool = False
-    carry_push: bool = False
     clip_margin: float = 1e-6
     max_steps: int = 100
     escapes: int = 3

@@ -16,7 +16,6 @@ Note:
 from __future__ import annotations
 
 import logging
-import math
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -26,7 +25,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.algorithms.interior_point.kernel import NewtonKernel, dot
+from unibuckle_fenicsx.algorithms.interior_point.kernel import NewtonKernel
 from unibuckle_fenicsx.algorithms.interior_point.options import (
     PUSH_MARGIN,
     RELAX_OPTIONS,
@@ -261,29 +260,6 @@ class Starts(Owner):
         gap = -kernel.oriented(vec)
         mu_abs = mu * f_scale * kernel.problem.max_abs_w(vec)
         return np.maximum(-kernel.oriented(kernel.Fu), mu_abs / gap)
-
-    def carried_push(
-        self, mode: dolfinx.fem.Function, push: npt.NDArray[np.float64], mu: float
-    ) -> npt.NDArray[np.float64]:
-        r"""The push ``push`` carried with ``mode`` from a coarser mesh, made a start.
-
-        ``push`` belongs to the mode as carried (its coarse mesh's :math:`u^TBu = 1`);
-        ``mode`` (strictly inside the cone) is normalised in place and the push scaled
-        with it. Each entry is at least :math:`\mu/g` (the central path's push at the
-        Rayleigh quotient), so a node that the coarse mesh held off the obstacle starts
-        as a reset push would, and one it held against it keeps its reaction.
-        """
-        kernel = self.kernel
-        vec = mode.x.petsc_vec
-        kernel.B.mult(vec, kernel.Bu)
-        scale = 1.0 / math.sqrt(dot(vec, kernel.Bu))
-        kernel.normalize(vec)
-        kernel.A.mult(vec, kernel.Au)
-        kernel.B.mult(vec, kernel.Bu)
-        f_scale = dot(vec, kernel.Au) * float(kernel.Bu.norm(PETSc.NormType.INFINITY))
-        gap = -kernel.oriented(vec)
-        mu_abs = mu * f_scale * kernel.problem.max_abs_w(vec)
-        return np.maximum(scale * np.asarray(push, dtype=float), mu_abs / gap)
 
     def from_candidate(self, cand: Candidate, mu: float) -> BarrierPoint:
         r"""A barrier point near an exact critical state ``cand`` (a :class:`Candidate`).

@@ -46,7 +46,6 @@ __all__ = [
     "core_constraints",
     "core_springs",
     "perimeter_coordinate",
-    "tributary_areas",
 ]
 
 
@@ -213,26 +212,15 @@ def core_springs(
 ) -> npt.NDArray[np.float64]:
     r"""The core's lumped foundation spring (N/m) of each constrained direction, on every rank.
 
-    :math:`k_f` times the direction's :func:`tributary_areas` (the plate's lumped
-    foundation).
+    The spring of node k is :math:`k_f \int \varphi_k\,dx` (the row sum of the Q1 mass
+    matrix, as the plate's foundation), split equally between a box corner's two
+    directions (the halves of its cells on either face; exact for the corner's
+    symmetric cells).
 
     Args:
         model: The section's shell model.
         constraints: Its constrained directions.
         stiffness: The Winkler modulus :math:`k_f` (N/m^3), > 0.
-
-    Note:
-        Collective.
-    """
-    return stiffness * tributary_areas(model, constraints)
-
-
-def tributary_areas(model: ShellModel, constraints: CoreConstraints) -> npt.NDArray[np.float64]:
-    r"""The wall area (m^2) of each constrained direction, on every rank.
-
-    The area of node k is :math:`\int \varphi_k\,dx` (the row sum of the Q1 mass
-    matrix), split equally between a box corner's two directions (the halves of its
-    cells on either face; exact for the corner's symmetric cells).
 
     Note:
         Collective.
@@ -243,11 +231,13 @@ def tributary_areas(model: ShellModel, constraints: CoreConstraints) -> npt.NDAr
     nodes = constraints.owned_nodes
     share = np.unique(nodes, return_counts=True)
     count = dict(zip(share[0].tolist(), share[1].tolist(), strict=True))
-    local = np.array([areas.array[DOFS_PER_NODE * k] / count[k] for k in nodes.tolist()])
-    out = np.zeros(constraints.size)
+    local = np.array(
+        [stiffness * areas.array[DOFS_PER_NODE * k] / count[k] for k in nodes.tolist()]
+    )
+    springs = np.zeros(constraints.size)
     for positions, values in model.mesh.comm.allgather((constraints.owned_positions, local)):
-        out[positions] = values
-    return out
+        springs[positions] = values
+    return springs
 
 
 def _node_block(normals: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:

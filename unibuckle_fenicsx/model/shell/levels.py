@@ -113,7 +113,7 @@ INTERIOR_POINT_DOFS = 10_000
 #: the predicted contact set is read too (``read_predicted``): where a wall lies almost
 #: flat on the core its gaps stay above the tolerance, and only the predicted set holds
 #: them (:doc:`/verification/sections_finest`).
-CHAIN_OPTIONS = ChainOptions(arrangements=1, read_predicted=True, carry_push=True)
+CHAIN_OPTIONS = ChainOptions(arrangements=1, read_predicted=True)
 #: The interior point starts on a section at least this coarse: the cell size doubled
 #: while the coarser section keeps this many DOFs (more if ``levels`` asks). The
 #: starts take a few hundred Newton steps there; on the sections of

@@ -33,16 +33,10 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.model.problem import UnilateralProblem
-from unibuckle_fenicsx.model.shell.core import perimeter_coordinate, tributary_areas
+from unibuckle_fenicsx.model.shell.core import perimeter_coordinate
 from unibuckle_fenicsx.model.shell.geometry import SectionMesh
 from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE
-from unibuckle_fenicsx.model.shell.problem import (
-    CoredSectionProblem,
-    RotatedPencil,
-    SectionContact,
-    SectionProblem,
-)
-from unibuckle_fenicsx.tolerances import DIVISION_FLOOR
+from unibuckle_fenicsx.model.shell.problem import RotatedPencil, SectionProblem
 
 __all__ = ["SectionProlongation"]
 
@@ -90,8 +84,6 @@ class SectionProlongation:
             raise RuntimeError("SectionProlongation: the coarse nodes are no (x, s) grid")
         xf, self._phi_f = _nodes(sf, pf.W)
         self._index, self._weight = self._weights(xg, sg, xf)
-        # push(): the coarse and fine directions' wall areas, made on first use.
-        self._areas: tuple[npt.NDArray[np.float64], npt.NDArray[np.float64]] | None = None
 
     def _grid(
         self, x: npt.NDArray[np.float64]
@@ -151,42 +143,6 @@ class SectionProlongation:
         pf.to_rotated(fine_global.x.petsc_vec, out.x.petsc_vec)
         out.x.scatter_forward()
         return out
-
-    def push(self, push: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
-        r"""The core's nodal pushes ``push`` (N per unit mode) on the fine section's directions.
-
-        ``push``: one per constrained direction the coarse rank owns (the order of its
-        contact manager's ``owned_positions``); the result likewise on the fine section.
-        A nodal push is a pressure times the direction's wall area
-        (:func:`~unibuckle_fenicsx.model.shell.core.tributary_areas`): the pressures are
-        interpolated as a mode's normal components are (:meth:`mode`), over the
-        constrained directions alone (the weights of the nodes a support holds, which
-        have no push, are left out: divided by the interpolated weights), and multiplied
-        by the fine directions' areas.
-
-        Raises:
-            TypeError: Either section has no core.
-        """
-        coarse, fine = self.coarse, self.fine
-        if not isinstance(coarse, CoredSectionProblem) or not isinstance(fine, CoredSectionProblem):
-            raise TypeError("SectionProlongation.push needs two sections with a core")
-        cc = cast(SectionContact, coarse.contact).constraints
-        cf = cast(SectionContact, fine.contact).constraints
-        if self._areas is None:
-            self._areas = (
-                tributary_areas(coarse.pencil.shell, cc)[cc.owned_positions],
-                tributary_areas(fine.pencil.shell, cf)[cf.owned_positions],
-            )
-        area_c, area_f = self._areas
-        carried = []
-        for values in (push / area_c, np.ones(area_c.size)):
-            field = coarse.new_mode("pressure")
-            field.x.petsc_vec.array[cc.owned_local_dofs] = values
-            field.x.scatter_forward()
-            out = self.mode(field)
-            carried.append(np.array(out.x.array[cf.owned_local_dofs], dtype=np.float64))
-        pressure, weight = carried
-        return np.asarray(pressure / np.maximum(weight, DIVISION_FLOOR) * area_f)
 
 
 def _nodes(
