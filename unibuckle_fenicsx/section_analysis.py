@@ -76,6 +76,7 @@ from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
 from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = [
+    "COLUMN_FRACTION",
     "MIN_ALONG_CELLS",
     "MIN_FACE_CELLS",
     "MIN_HALF_WAVE_CELLS",
@@ -83,6 +84,7 @@ __all__ = [
     "SectionResult",
     "buckle_length",
     "coarse_mesh_note",
+    "column_note",
     "half_wave",
     "solve_section",
     "thick_wall_note",
@@ -317,11 +319,11 @@ def solve_section(
         result = _result(section, free, solution, certificate, time.perf_counter() - t0, reason)
         if echo is not None:
             result.input, result.units = echo, units
+        column = column_note(parameters, result.critical_load_Pa, solution is not None)
+        if column is not None:
+            logger.warning("%s", column)
         if design is not None:
-            result.design = section_design(parameters, design, result.critical_load_Pa)
-            lower = result.lower_bound_Pa
-            if certificate is not None and not certificate.global_optimum_proven and lower:
-                at_lower_bound(result.design, parameters, design, lower)
+            result.design = _design(parameters, design, result, certificate, column)
     except BaseException:
         section.destroy()
         raise
@@ -340,6 +342,53 @@ MIN_HALF_WAVE_CELLS = 1.5
 #: draw a warning, by the same measure: a short section buckles in one wave as long as
 #: the member, whatever its walls' own buckles (:doc:`/guide/sections`, "Cell size").
 MIN_ALONG_CELLS = 5
+
+
+def _design(
+    parameters: SectionParameters,
+    design: DesignSpec,
+    result: SectionResult,
+    certificate: Certificate | None,
+    column: str | None,
+) -> SectionDesignRecord:
+    """The design output of ``result``, at the verified lower bound too if not proven.
+
+    ``column``: the warning of a column's mode (:func:`column_note`), a note of it.
+    """
+    record = section_design(parameters, design, result.critical_load_Pa)
+    if column is not None:
+        record.notes.append(column)
+    lower = result.lower_bound_Pa
+    if certificate is not None and not certificate.global_optimum_proven and lower:
+        at_lower_bound(record, parameters, design, lower)
+    return record
+
+
+#: A hollow member whose critical axial stress reaches this fraction of its Euler stress
+#: draws a warning: its mode is the column's, or coupled with it (the shell's column has
+#: shear deformation and comes out up to a few % below Euler's load).
+COLUMN_FRACTION = 0.8
+
+
+def column_note(parameters: SectionParameters, load: float, cored: bool) -> str | None:
+    """A warning when the hollow member's critical state is a column's, else None.
+
+    Its uniform axial stress at ``load`` at or above :data:`COLUMN_FRACTION` of the
+    Euler stress (:meth:`SectionParameters.euler_stress`): k and EN 1993-1-5's face
+    values are the walls' quantities, not a column's. A core (``cored``) holds the walls
+    off a column's mode (rigid) or resists it (elastic): no warning.
+    """
+    p = parameters
+    axial = -load * p.axial_stress
+    euler = p.euler_stress()
+    if cored or axial < COLUMN_FRACTION * euler:
+        return None
+    return (
+        f"the critical axial stress {axial:.4g} Pa is {axial / euler:.3g} times the member's "
+        f"Euler stress {euler:.4g} Pa: the mode is the column's (or coupled with it), and k "
+        "and the EN 1993-1-5 face values are the walls' quantities, not the column's "
+        "(EN 1993-1-1, 6.3.1)"
+    )
 
 
 def coarse_mesh_note(parameters: SectionParameters) -> str | None:

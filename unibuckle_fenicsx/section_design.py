@@ -122,7 +122,7 @@ class SectionDesignRecord(Struct, kw_only=True):
         faces: A box's faces (:class:`FaceDesign`); empty for a tube.
         governing_face: The face that reaches :math:`\rho f_y/\gamma_{M1}` at the
             smallest multiple of the critical load, the smallest :math:`\rho f_y/\sigma_1`
-            (None for a tube).
+            (of faces reaching it together, the widest; None for a tube).
         width_to_thickness: With a core: :math:`h/t` (box, h the greater overall
             dimension) or :math:`d/t` (tube, d the outer diameter); else None.
         width_to_thickness_limit: EN 1994-1-1 Table 6.3's limit of that ratio.
@@ -188,8 +188,15 @@ def _reaches_reduced_stress(face: FaceDesign) -> float:
     stress first governs (with one compression on every face, the one of the smallest
     :math:`\rho`; with bending, a lightly compressed face's smaller :math:`\rho` does
     not make it govern).
+    Faces that reach it together (one compression on every face: the same :math:`\rho`)
+    leave the widest to govern, the face whose own buckling the narrower ones restrain.
     """
     return (face.reduced_design_stress_Pa or 0.0) / face.sigma_cr_Pa
+
+
+def _face_width(section: DesignSection, name: str) -> float:
+    """The width (m) of the box's face ``name``: the right and left faces span the depth."""
+    return float((section.depth if name in ("right", "left") else section.width) or 0.0)
 
 
 def section_design(section: DesignSection, design: DesignSpec, load: float) -> SectionDesignRecord:
@@ -202,11 +209,12 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         sigma_cr_Pa=compression,
         relative_slenderness=math.sqrt(design.yield_stress / compression),
         clauses=[],
-        notes=[CALIBRATION],
+        notes=[],
         faces=[],
     )
-    if section.shape == "box":
+    if section.shape == "box":  # a tube's output applies no rho: no note of its calibration
         out.clauses.append(FACE_CLAUSES)
+        out.notes.append(CALIBRATION)
         out.notes.append(
             "every face at the section's critical load factor: conservative for a face "
             "that buckles because its neighbours do"
@@ -215,13 +223,16 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             out.faces.append(_face(name, (load * a, load * b), design))
         rated = [f for f in out.faces if f.reduced_design_stress_Pa is not None]
         if rated:
-            out.governing_face = min(rated, key=_reaches_reduced_stress).face
+            first = min(_reaches_reduced_stress(f) for f in rated)
+            tied = [f for f in rated if _reaches_reduced_stress(f) <= first * (1.0 + 1e-12)]
+            out.governing_face = max(tied, key=lambda f: _face_width(section, f.face)).face
     else:
         out.clauses.append(TUBE_CLAUSES)
     if section.core:
+        outside = ": outside the calibration of EN 1993-1-5 4.4(2)"
         out.notes.append(
-            "with the core sigma_cr is the unilateral critical stress: outside the "
-            "calibration of EN 1993-1-5 4.4(2)"
+            "with the core sigma_cr is the unilateral critical stress"
+            + (outside if section.shape == "box" else "")
         )
         out.clauses.append(FILLED_CLAUSES)
         epsilon = math.sqrt(235.0e6 / design.yield_stress)

@@ -49,6 +49,18 @@ def test_uniform_compression_gives_every_face_the_internal_element_s_rho():
     assert out.width_to_thickness is None  # no core: no EN 1994-1-1 limit
 
 
+def test_under_one_compression_the_widest_face_governs():
+    # Every face of the 200 x 100 box carries the critical stress: one slenderness, one
+    # rho (eq. (4.2)), one multiple of the load to rho f_y. The wide faces (top, bottom:
+    # 200 mm) buckle and the narrow ones (right, left: 100 mm, k 4 times smaller by
+    # sigma t w^2/(pi^2 D)) restrain them: the tie goes to the first wide face.
+    for width, depth, widest in ((0.2, 0.1, "top"), (0.1, 0.2, "right")):
+        section = _section(width=width, depth=depth)
+        out = section_design(section, DesignSpec(yield_stress=3.55e8), 2.0e8)
+        assert len({f.reduction_factor for f in out.faces}) == 1
+        assert out.governing_face == widest
+
+
 def test_bending_puts_a_face_in_tension_and_the_webs_in_a_gradient():
     # axial -1, bending +2 at z = +d/2: top +1 (tension), bottom -3, webs from +1 to -3.
     load, fy = 4.0e7, 3.55e8
@@ -130,6 +142,10 @@ def test_a_tube_gets_its_slenderness_only():
     assert out.relative_slenderness == pytest.approx(math.sqrt(2.35e8 / 1.5e9))
     assert out.faces == [] and out.governing_face is None
     assert "EN 1993-1-6" in out.clauses[0]
+    # No rho of EN 1993-1-5 4.4(2) is applied to a tube, filled or not: no note says it is.
+    filled = section_design(_section("tube", width=None, depth=None, diameter=0.2, core=True),
+                            DesignSpec(yield_stress=2.35e8), 1.0e9)  # fmt: skip
+    assert not any("4.4(2)" in note for note in out.notes + filled.notes)
 
 
 def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):

@@ -332,3 +332,25 @@ def test_a_filled_tube_whose_seeds_stall_is_not_left_at_every_direction_in_conta
         assert sec.problem.solve_free().load < solution.load <= bulge
         assert solution.candidate.kkt
         assert len(solution.active) < con.size
+
+
+@pytest.mark.parametrize("span", [None, (0.08, 0.32), (0.1, 0.3)])
+def test_an_elastic_core_s_springs_are_the_areas_it_covers(span):
+    # A box 0.3 x 0.1 m on cells of 0.0375 and 0.025 m around (8 and 4 a face) and 0.04 m
+    # along (10): each face's directions carry k_f times the face's area the core covers,
+    # its width times the covered length, which leaves out the simply supported ends'
+    # half cells (their nodes are held): 0.36 m of the whole 0.4 m, 0.24 m of a span
+    # from node to node (0.08 to 0.32 m), 0.2 m of one from cell centre to cell centre.
+    # A corner's area belongs to its faces' cells, a span's end node to the half inside.
+    from unibuckle_fenicsx.model.shell.core import core_springs
+
+    p = _parameters("box", width=0.3, depth=0.1, length=0.4, mesh_size=0.04, core_span=span)
+    section = build_section(p, MPI.COMM_WORLD)
+    try:
+        springs = core_springs(section.model, section.constraints, 2.0, span)
+        across_y = np.abs(section.constraints.normals[:, 1]) > 0.5
+    finally:
+        section.destroy()
+    length = {None: 0.36, (0.08, 0.32): 0.24, (0.1, 0.3): 0.2}[span]
+    assert springs[across_y].sum() == pytest.approx(2.0 * 2 * 0.1 * length, rel=1e-12)
+    assert springs[~across_y].sum() == pytest.approx(2.0 * 2 * 0.3 * length, rel=1e-12)

@@ -36,6 +36,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.model.shell.forms import cell_frame
 from unibuckle_fenicsx.model.shell.geometry import SectionMesh
 from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE, ShellModel
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
@@ -208,36 +209,69 @@ def _directions(
 
 
 def core_springs(
-    model: ShellModel, constraints: CoreConstraints, stiffness: float
+    model: ShellModel,
+    constraints: CoreConstraints,
+    stiffness: float,
+    span: tuple[float, float] | None = None,
 ) -> npt.NDArray[np.float64]:
     r"""The core's lumped foundation spring (N/m) of each constrained direction, on every rank.
 
     The spring of node k is :math:`k_f \int \varphi_k\,dx` (the row sum of the Q1 mass
-    matrix, as the plate's foundation), split equally between a box corner's two
-    directions (the halves of its cells on either face; exact for the corner's
-    symmetric cells).
+    matrix, as the plate's foundation), the area the node stands for: the half cells
+    around it. A box corner's two directions get their own faces' halves,
+    :math:`\int \varphi_k (n_c\cdot n_j)^2\,dx` with :math:`n_c` the cell's normal and
+    :math:`n_j` the direction's (1 on its face, 0 on the other: the faces' cells differ
+    in width when the width and depth do). With a ``span``, the part of that area the
+    core covers: the fraction of the node's stretch along the member
+    :math:`[x_k - h/2, x_k + h/2]` (h the cells' length along, uniform) inside the span,
+    so a node at the span's end stands for its inner half.
 
     Args:
         model: The section's shell model.
         constraints: Its constrained directions.
         stiffness: The Winkler modulus :math:`k_f` (N/m^3), > 0.
+        span: The core's extent (x0, x1) along the member (m); None: the whole length.
 
     Note:
         Collective.
     """
     v = ufl.TestFunction(model.W)
-    areas = dolfinx.fem.assemble_vector(dolfinx.fem.form(v[0] * ufl.dx))
+    n = cell_frame(model.mesh)[2]
+    # Components 0..2 of a node's row: its area on cells of normal e_c (weight n_c^2); 3: all.
+    form = sum(v[c] * n[c] ** 2 for c in range(3)) + v[3]
+    areas = dolfinx.fem.assemble_vector(dolfinx.fem.form(form * ufl.dx))
     areas.scatter_reverse(dolfinx.la.InsertMode.add)
+    rows = areas.array.reshape(-1, DOFS_PER_NODE)
     nodes = constraints.owned_nodes
     share = np.unique(nodes, return_counts=True)
     count = dict(zip(share[0].tolist(), share[1].tolist(), strict=True))
+    normals = constraints.normals[constraints.owned_positions]
+    covered = _covered_fraction(model, nodes, span)
     local = np.array(
-        [stiffness * areas.array[DOFS_PER_NODE * k] / count[k] for k in nodes.tolist()]
+        [
+            stiffness * f * (rows[k, 3] if count[k] == 1 else float(rows[k, :3] @ nj**2))
+            for k, nj, f in zip(nodes.tolist(), normals, covered, strict=True)
+        ]
     )
     springs = np.zeros(constraints.size)
     for positions, values in model.mesh.comm.allgather((constraints.owned_positions, local)):
         springs[positions] = values
     return springs
+
+
+def _covered_fraction(
+    model: ShellModel, nodes: npt.NDArray[np.int32], span: tuple[float, float] | None
+) -> npt.NDArray[np.float64]:
+    """The fraction of each node's stretch along the member that ``span`` covers."""
+    if span is None:
+        return np.ones(nodes.size)
+    section = model.section
+    h = section.length / section.cells_along
+    x = model.W.tabulate_dof_coordinates()[nodes, 0]
+    low = np.maximum(x - 0.5 * h, 0.0)
+    high = np.minimum(x + 0.5 * h, section.length)
+    inside = np.minimum(high, span[1]) - np.maximum(low, span[0])
+    return np.asarray(np.clip(inside / (high - low), 0.0, 1.0), dtype=float)
 
 
 def _node_block(normals: npt.NDArray[np.float64]) -> npt.NDArray[np.float64]:
