@@ -48,6 +48,7 @@ from unibuckle_fenicsx.en1993 import (
     design_element,
     psi_range,
     reduction_factor,
+    stress_ratio,
     table_row,
 )
 from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
@@ -84,7 +85,9 @@ class DesignRecord(Struct, kw_only=True):
         free_edge: An outstand's free unloaded edge (None for an internal element).
         table: The table row of :math:`\psi` and :math:`k_\sigma` (Table 4.1 or 4.2).
         edge: The loaded edge of the largest compression.
-        sigma_cr_Pa: :math:`\sigma_1`, that compression at the critical load.
+        sigma_cr_Pa: :math:`\sigma_1`, that compression at the critical load; <= 0 when
+            the loaded edges are in tension there (a fixed compression outgrown by a
+            scaled tension), and then ``psi`` and the fields below are None.
         clauses: The clauses applied.
         notes: What the output rests on, and what it leaves out.
         psi: :math:`\psi = \sigma_2/\sigma_1` along that edge.
@@ -109,8 +112,8 @@ class DesignRecord(Struct, kw_only=True):
     sigma_cr_Pa: float
     clauses: str
     notes: list[str]
-    psi: float = 0.0
-    relative_slenderness: float = 0.0
+    psi: float | None = None
+    relative_slenderness: float | None = None
     k_sigma_table: float | None = None
     reduction_factor: float | None = None
     reduced_design_stress_Pa: float | UnsetType = UNSET
@@ -134,9 +137,9 @@ def _critical_edge_stress(
     """(sigma_1, sigma_2, end of sigma_1, edge): the largest compression at the critical state.
 
     Pa, compression positive, over the loaded ``edges``; sigma_2 is the other end (0
-    start, 1 end) of the same edge.
+    start, 1 end) of the same edge. Edges in tension alone: the least tension, negative.
     """
-    best = (0.0, 0.0, 0, "")
+    best = (-math.inf, 0.0, 0, "")
     factor = spec.load.fixed_factor
     for e in spec.plate.edges:
         if e.name not in edges:
@@ -153,7 +156,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     """The design quantities of the critical load ``load``, see the module docstring."""
     element = design_element(spec)
     sigma1, sigma2, end, edge = _critical_edge_stress(spec, load, element.loaded)
-    psi = sigma2 / sigma1 + 0.0  # no -0.0
+    psi = stress_ratio(sigma1, sigma2) if sigma1 > 0.0 else None
     at_free = element.free_end is None or end == element.free_end or psi == 1.0
     out = DesignRecord(
         yield_stress_Pa=design.yield_stress,
@@ -172,12 +175,12 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
             "the element is the rectangle's, and sigma_cr (computed with the holes) "
             "includes their effect"
         )
-    if spec.one_sided_points or any(o.side != "both" for o in spec.all_obstacles):
+    if spec.one_sided_points or spec.unilateral_obstacles:
         out.notes.append(
             "with an obstacle sigma_cr is the unilateral critical stress: outside the "
             "calibration of 4.4(2)"
         )
-    elif spec.all_obstacles:
+    elif spec.bilateral_foundations:
         out.notes.append(
             'with a bilateral foundation (obstacle.side = "both") sigma_cr includes the '
             "foundation's stiffness: outside the calibration of 4.4(2)"
@@ -191,6 +194,13 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
             "the load has shear: EN 1993-1-5 section 10 (reduced stress method) would "
             "combine it; rho here is the direct stress's, with this sigma_cr"
         )
+    if psi is None:
+        out.notes.append(
+            f"the loaded edges are in tension at the critical state (least tension "
+            f"{-sigma1:.4g} Pa on edges.{edge}: the fixed compression is outgrown by the "
+            "scaled tension): no sigma_cr, slenderness or rho"
+        )
+        return out
     out.psi = psi
     slenderness = math.sqrt(design.yield_stress / sigma1)
     out.relative_slenderness = slenderness

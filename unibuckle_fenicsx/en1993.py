@@ -48,6 +48,7 @@ __all__ = [
     "design_element",
     "psi_range",
     "reduction_factor",
+    "stress_ratio",
     "table_row",
 ]
 
@@ -79,6 +80,18 @@ def psi_range(element: str, free_edge_most_compressed: bool = True) -> tuple[flo
     if element == OUTSTAND and not free_edge_most_compressed:
         return (-1.0, 1.0)
     return (-3.0, 1.0)
+
+
+def stress_ratio(sigma1: float, sigma2: float) -> float:
+    r""":math:`\psi = \sigma_2/\sigma_1` (:math:`\sigma_1 > 0`), an integer when within 1e-12.
+
+    The tables' ends and rows are at whole numbers (-3, -1, 0, 1): a ratio a rounding
+    off one (``[-0.7, 2.1]`` gives -3.0000000000000004) is that number, not outside the
+    table.
+    """
+    psi = sigma2 / sigma1 + 0.0  # no -0.0
+    whole = float(round(psi))
+    return whole + 0.0 if abs(psi - whole) <= 1e-12 * max(1.0, abs(psi)) else psi
 
 
 def _check(element: str, psi: float, free_edge_most_compressed: bool) -> None:
@@ -388,7 +401,7 @@ def _check_stress_ratio(loaded: list[DesignEdge], element: DesignElement) -> Non
     sigma1, sigma2, k, name = best
     if sigma1 <= 0.0:
         return  # no scaled compression: the compression check says so
-    psi = sigma2 / sigma1
+    psi = stress_ratio(sigma1, sigma2)
     at_free = element.free_end is None or k == element.free_end or psi == 1.0
     low, _ = psi_range(element.kind, at_free)
     if psi < low:

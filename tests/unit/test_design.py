@@ -166,6 +166,71 @@ def test_a_bilateral_foundation_is_not_called_unilateral():
         assert side != "both" or not any("unilateral" in n for n in notes), notes
 
 
+def test_an_obstacle_with_a_gap_is_not_called_unilateral():
+    """An obstacle with a gap leaves sigma_cr the free plate's: no unilateral note.
+
+    The linear critical state leaves it out (an infinitesimal buckle does not reach it,
+    ``ProblemSpec.unilateral_obstacles``); the design notes called sigma_cr unilateral.
+    """
+    from unibuckle_fenicsx.design import design_output
+
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    for gap, unilateral in ((0.5, False), (0.0, True)):
+        spec = plate(edges, obstacle={"zone": "all", "side": "below", "gap": gap})
+        assert spec.design is not None
+        notes = design_output(spec, spec.design, 100.0).notes
+        assert any("unilateral" in n for n in notes) == unilateral, notes
+
+
+SHEARED_TENSION = {  # scaled: tension across left/right and shear; fixed: 10 MPa compression
+    name: {"shear_stress": 1.0 if name in ("left", "right") else -1.0}
+    | ({"normal_stress": 1.0, "fixed_normal_stress": -10.0} if name in ("left", "right") else {})
+    for name in ("left", "right", "bottom", "top")
+}
+
+
+def test_loaded_edges_in_tension_at_the_critical_state_give_no_slenderness():
+    """A fixed compression outgrown by the scaled tension: no sigma_cr, no rho.
+
+    At the load factor 2e7, sigma = -10 MPa (fixed) + 2e7 x 1 = +10 MPa on left and right:
+    tension, so the largest compression is -10 MPa (by hand) and 4.4(2) has no
+    slenderness. Before, psi = sigma_2/sigma_1 divided by zero after the solve (exit 1).
+    """
+    from unibuckle_fenicsx.design import design_output
+
+    spec = plate(SHEARED_TENSION)
+    assert spec.design is not None
+    d = design_output(spec, spec.design, 2e7)
+    assert d.sigma_cr_Pa == pytest.approx(-10e6, rel=1e-14)
+    assert (d.psi, d.relative_slenderness, d.reduction_factor) == (None, None, None)
+    assert "in tension at the critical state" in d.notes[-1]
+    out = result(spec)  # shear buckles it near 1e9 Pa, far above 10 MPa: in tension
+    assert out.design.relative_slenderness is None
+    assert "no compression on the loaded edges at the critical state" in out.summary()
+
+
+def test_a_ratio_a_rounding_below_the_table_end_is_the_end():
+    """[-0.7, 2.1] is psi = -3 (2.1/0.7 = 3.0000000000000004 in double precision).
+
+    It was refused as "psi = -3, outside Table 4.1, which covers 1 >= psi >= -3"; Table
+    4.1 gives k_sigma = 5.98 (1 - psi)^2 = 95.68 there.
+    """
+    from unibuckle_fenicsx.design import design_output
+
+    pair = {"normal_stress": [-0.7, 2.1]}
+    spec = plate({"left": pair, "right": pair})
+    assert spec.design is not None
+    d = design_output(spec, spec.design, 1e9)
+    assert d.psi == -3.0 and d.sigma_cr_Pa == pytest.approx(0.7e9, rel=1e-14)
+    assert d.k_sigma_table == pytest.approx(5.98 * 16, rel=1e-14)
+
+
+def test_a_fixed_compression_switched_off_by_its_factor_is_no_compression():
+    """load.fixed_factor = 0 leaves the scaled tension alone: refused before the solve."""
+    with pytest.raises(ValueError, match=r"design: the EN 1993-1-5 output takes sigma_cr"):
+        plate(SHEARED_TENSION, load={"fixed_factor": 0.0})
+
+
 # -- outstand elements (one unloaded edge free) ------------------------------------------
 @pytest.mark.parametrize(
     "slenderness, psi, rho",
@@ -320,7 +385,7 @@ REFUSED = [
         r"psi = sigma_2/sigma_1 = -4, outside EN 1993-1-5 Table 4\.1",
     ),
     (
-        {"left": {"normal_stress": -1.0, "inplane": "clamped"}},
+        {"left": {"normal_stress": 0.0, "inplane": "clamped"}},
         {"load": {"temperature": 1.0},
          "material": {"E": 2.1e11, "nu": 0.3, "thermal_expansion": 1.2e-5}},
         r"design: load\.temperature: a temperature rise adds a membrane stress",

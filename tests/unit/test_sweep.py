@@ -359,6 +359,31 @@ def test_no_reference_curve_for_a_foundation_or_holes():
     assert reference_k(problem_from_dict(data)) == (None, None, "")
 
 
+@pytest.mark.parametrize("held", ["roller", "clamped"])
+def test_no_garland_for_unloaded_edges_held_in_their_plane(held):
+    """Unloaded edges held in their plane add sigma_y = nu sigma_x: not the garland's plate.
+
+    The SSSS square with rollers on y = 0, b: sigma_x (1 + nu) = 4 pi^2 D/(t b^2) (m = n
+    = 1 of the biaxial plate, Timoshenko & Gere, section 9.2), k = 4/(1 + nu) = 3.08,
+    where the chart drew the garland's 4 as "exact". Clamped, the edges also shear the
+    plate: no exact curve either.
+    """
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    edges |= {name: {"inplane": held} for name in ("bottom", "top")}
+    data = {
+        "plate": {"corners": [[0, 0], [0.1, 0.1]], "thickness": 1e-4},
+        "material": {"E": 2.1e11, "nu": 0.3},
+        "edges": edges,
+        "mesh": {"nx": 20, "ny": 20},
+    }
+    spec = problem_from_dict(data)
+    assert reference_k(spec) == (None, None, "")
+    if held == "roller":
+        with solve(spec, MPI.COMM_SELF) as analysis:
+            k = analysis.result.buckling_coefficient_k
+        assert k == pytest.approx(4.0 / 1.3, rel=0.01)  # MITC4 at b/20: +0.3 %
+
+
 # -- MPI ----------------------------------------------------------------------------
 
 

@@ -153,7 +153,16 @@ def _refine(
     if reader.found is not None:
         return reader.found, new
     cand, new = critical_state(
-        fine, newton, new, level, label, options, carry=False, quick=quick, reader=reader
+        fine,
+        newton,
+        new,
+        level,
+        label,
+        options,
+        carry=False,
+        quick=quick,
+        reader=reader,
+        double=True,
     )
     return cand, new
 

@@ -399,6 +399,12 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
     """The summary line of the design output."""
     rho = d.reduction_factor
     reduced = d.reduced_design_stress_Pa
+    if d.relative_slenderness is None:  # the loaded edges in tension at the critical state
+        return (
+            f"EN 1993-1-5: no compression on the loaded edges at the critical state (least "
+            f"tension {-d.sigma_cr_Pa / scale:.4g} {unit}, {d.edge}): no sigma_cr, slenderness "
+            "or rho" + _design_lower(d, scale, unit)
+        )
     return (
         f"EN 1993-1-5: sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit} ({d.edge}), "
         f"psi = {d.psi:.3g}, slenderness {d.relative_slenderness:.4g}, rho = "
@@ -420,6 +426,8 @@ def _design_lower(d: DesignRecord, scale: float, unit: str) -> str:
     if not isinstance(low, DesignRecord):
         return ""
     rho = "none" if low.reduction_factor is None else f"{low.reduction_factor:.4g}"
+    if low.relative_slenderness is None:
+        return "\n  EN 1993-1-5 at the verified lower bound: no compression on the loaded edges"
     return (
         f"\n  EN 1993-1-5 at the verified lower bound (the safe value, sigma_cr not proven "
         f"the lowest): sigma_cr = {low.sigma_cr_Pa / scale:.4g} {unit}, slenderness "

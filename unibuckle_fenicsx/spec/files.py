@@ -257,7 +257,8 @@ def _plate(plate: dict[str, object], edges: object, load: object) -> dict[str, o
         if not isinstance(table, Mapping):
             raise InputError(reason(f"edges.{name}", table, EdgeSpec))
         _unknown(table, EdgeSpec.file_keys(), f"edges.{name}")
-        tables[name] = {**tables.get(name, {}), **table}
+        held = table.get("inplane", "free") != "free"  # takes no paper's load: its reaction
+        tables[name] = {**({} if held else tables.get(name, {})), **table}
     plate["edges"] = [{"name": name, **table} for name, table in tables.items()]
     return plate
 

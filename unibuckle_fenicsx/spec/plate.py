@@ -24,7 +24,7 @@ from unibuckle_fenicsx.geometry import (
     polygon_inside,
     polygons_disjoint,
 )
-from unibuckle_fenicsx.spec.base import Point, Stress, Table, stress_ends, unit
+from unibuckle_fenicsx.spec.base import Point, Stress, Table, plain, stress_ends, unit
 
 #: Edge names of a rectangular plate, in facet-tag order 1..4.
 EDGE_NAMES = ("left", "right", "bottom", "top")
@@ -95,13 +95,24 @@ Segments = Annotated[
 ]
 
 
+#: The edge stresses that an edge held in its plane does not take (the prestress solve's
+#: Dirichlet condition replaces the traction): "roller" holds the normal displacement,
+#: "clamped" both.
+HELD_STRESSES = {
+    "roller": ("normal_stress", "fixed_normal_stress"),
+    "clamped": ("normal_stress", "fixed_normal_stress", "shear_stress", "fixed_shear_stress"),
+}
+
+
 class EdgeSpec(Table, frozen=True):
     r"""Conditions on one edge part (the file's ``[edges.NAME]``).
 
     Args:
         name: Edge name; for the rectangle one of :data:`EDGE_NAMES`.
         support: Transverse condition, one of :data:`BENDING_SUPPORTS`.
-        inplane: In-plane condition for the prestress, one of :data:`INPLANE_SUPPORTS`.
+        inplane: In-plane condition for the prestress, one of :data:`INPLANE_SUPPORTS`;
+            the stress on a held edge is its support's reaction, so a stress given in a
+            held direction (:data:`HELD_STRESSES`) is refused.
         normal_stress: Normal edge stress per unit load (Pa/Pa), tension positive; the
             paper's compressed edges have -1. A pair ``(start, end)`` varies linearly along
             the edge (:func:`~unibuckle_fenicsx.model.mesh.edge_line` gives the direction):
@@ -159,6 +170,15 @@ class EdgeSpec(Table, frozen=True):
                 f': support = "{self.support}" fixes the deflection already; an elastically '
                 'supported edge has support = "free"',
             )
+        for name in HELD_STRESSES.get(self.inplane, ()):
+            if any(stress_ends(getattr(self, name))):
+                raise self.error(
+                    name,
+                    f" = {plain(getattr(self, name))!r} is not applied: inplane = "
+                    f'"{self.inplane}" holds the edge in its plane, and the support\'s reaction '
+                    "is the stress there (the other edges' loads reach it); leave "
+                    f'{name} out on this edge, or give it inplane = "free"',
+                )
 
     @property
     def springs(self) -> bool:

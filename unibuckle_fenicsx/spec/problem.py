@@ -165,8 +165,13 @@ class ProblemSpec(Table, frozen=True):
                 "describes steel plates: its reduction factor rho (4.4(2)) is calibrated on "
                 "steel plates' imperfections and residual stresses; leave [design] out"
             )
+        factor = self.load.fixed_factor  # the fixed part as applied
         compressed = any(
-            min(*stress_ends(e.normal_stress), *stress_ends(e.fixed_normal_stress)) < 0.0
+            min(
+                *stress_ends(e.normal_stress),
+                *(factor * f for f in stress_ends(e.fixed_normal_stress)),
+            )
+            < 0.0
             for e in self.plate.edges
         )
         if not compressed:

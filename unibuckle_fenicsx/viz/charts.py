@@ -41,9 +41,17 @@ _SS = ("simply_supported", "simply_supported_soft")
 
 
 def _uniaxial_x(spec: ProblemSpec) -> bool:
-    """Uniform compression of the edges x = const only."""
+    """Uniform compression of the edges x = const only.
+
+    The edges y = const free in their plane (held, they add the transverse stress
+    nu sigma_x: k = 4/(1 + nu) for the square), the loaded ones not clamped in it.
+    """
     e = {edge.name: edge for edge in spec.plate.edges}
     if set(e) != set(EDGE_NAMES) or not all(edge.uniform for edge in e.values()):
+        return False
+    if e["bottom"].inplane != "free" or e["top"].inplane != "free":
+        return False
+    if "clamped" in (e["left"].inplane, e["right"].inplane):
         return False
     left, right = e["left"].normal_ends[0], e["right"].normal_ends[0]
     return (

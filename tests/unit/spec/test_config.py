@@ -194,6 +194,40 @@ def test_toml_all_zone_edges_and_solver(tmp_path):
     assert (spec.solver.method, spec.solver.tau, spec.solver.shear) == ("active-set", 1e-6, "full")
 
 
+@pytest.mark.parametrize(
+    ("inplane", "key", "value"),
+    [
+        ("roller", "normal_stress", -2.0),
+        ("roller", "fixed_normal_stress", [-5.0, 5.0]),
+        ("clamped", "normal_stress", -1.0),
+        ("clamped", "shear_stress", 0.5),
+        ("clamped", "fixed_shear_stress", 1.0),
+    ],
+)
+def test_a_stress_on_an_edge_held_in_its_plane_is_refused(inplane, key, value):
+    """The prestress solve's Dirichlet condition replaces the traction there: not applied.
+
+    Left "roller" with normal_stress -2 and right -1 was solved as the plate under -1
+    (the roller's reaction) while k and the design read the -2: k = 8.09 and sigma_cr
+    twice the plate's, for the simply supported 2:1 plate whose k is 4 (Timoshenko and
+    Gere, section 9.2; computed 4.05 from the right edge's -1).
+    """
+    edges = {"left": {"inplane": inplane, key: value}, "right": {"normal_stress": -1.0}}
+    pattern = rf'edges\.left\.{key} = .* is not applied: inplane = "{inplane}" holds the edge'
+    with pytest.raises(ValueError, match=pattern):
+        problem_from_dict({"edges": edges})
+    if inplane == "roller" and key == "normal_stress":  # a roller slides: shear applies
+        edges["left"] = {"inplane": "roller", "shear_stress": 0.0}
+        assert problem_from_dict({"edges": edges}).plate.edge("left").inplane == "roller"
+
+
+def test_the_papers_load_leaves_an_edge_held_in_its_plane_out():
+    """A file that sets no load gets the paper's -1 on left and right, but not on a held edge."""
+    spec = problem_from_dict({"edges": {"left": {"inplane": "roller"}}})
+    assert spec.plate.edge("left").normal_stress == 0.0
+    assert spec.plate.edge("right").normal_stress == -1.0
+
+
 def test_toml_without_obstacle_is_free_plate(tmp_path):
     path = tmp_path / "free.toml"
     path.write_text("[material]\nE = 1.0e9\nnu = 0.3\n")
