@@ -73,7 +73,8 @@ GEOMETRIC = ("auto", "donnell", "full")
 #: wall by :math:`\sin^2`): it puts the column's load about twice too high. Above 4 times
 #: the reference, twice the Euler stress is above a hollow box's local modes (k up to
 #: about 7 on the widest face, 1.75 times the reference) and a tube's, whose load
-#: Donnell's gives (Flügge's is up to 2 % lower on them).
+#: Donnell's gives as the classical theory does (the full stiffness is lower on a tube's
+#: modes of few circumferential waves: :doc:`/guide/sections`, "Limits").
 COLUMN_RATIO = 4.0
 
 
