@@ -51,6 +51,7 @@ from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode
 from unibuckle_fenicsx.model.shell.section import (
     Section,
+    SectionFigureData,
     SectionParameters,
     build_section,
     figure_data,
@@ -73,7 +74,6 @@ from unibuckle_fenicsx.spec import (
     problem_to_dict,
 )
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
-from unibuckle_fenicsx.viz.section import SectionFigureData
 
 __all__ = [
     "COLUMN_FRACTION",
@@ -335,9 +335,10 @@ def solve_section(
 #: shorter buckles make it worse (:doc:`/guide/sections`, "Cell size").
 MIN_FACE_CELLS = 5
 #: Fewer cells than this along a tube's axisymmetric half-wave
-#: :math:`\pi\sqrt{Rt}/(12(1-\nu^2))^{1/4}` draw a warning, by the same measure
+#: :math:`\pi\sqrt{Rt}/(12(1-\nu^2))^{1/4}` draw a warning, by the same measure: the
+#: hollow tube is then about 5 % or less above its converged load at R/t = 50 and 100
 #: (:doc:`/guide/sections`, "Cell size").
-MIN_HALF_WAVE_CELLS = 1.5
+MIN_HALF_WAVE_CELLS = 2.5
 #: Fewer cells than this along the longest buckle the ends allow (:func:`buckle_length`)
 #: draw a warning, by the same measure: a short section buckles in one wave as long as
 #: the member, whatever its walls' own buckles (:doc:`/guide/sections`, "Cell size").
@@ -394,28 +395,31 @@ def column_note(parameters: SectionParameters, load: float, cored: bool) -> str 
 def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     """A warning when the cells are too coarse for the walls' buckles, else None.
 
-    The rule (:data:`MIN_FACE_CELLS`, :data:`MIN_HALF_WAVE_CELLS` across, then
-    :data:`MIN_ALONG_CELLS` along :func:`buckle_length`) is a priori, from the section's
+    The rule (:data:`MIN_FACE_CELLS`, :data:`MIN_HALF_WAVE_CELLS` across,
+    :data:`MIN_ALONG_CELLS` along :func:`buckle_length`; the note names the one that asks
+    for the finest cells) is a priori, from the section's
     dimensions and cell size: on cells too coarse for the buckles the shell's critical
     stress is too high (it falls as the cells are refined), and so are k and the design
     values.
     """
     p = parameters
-    span, what = _buckle_width(p)
-    need: float = MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS
-    where = f"across {what}"
+    width, across = _buckle_width(p)
+    length, along = buckle_length(p)
+    checks = [
+        (width, float(MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS),
+         f"across {across}"),
+        (length, float(MIN_ALONG_CELLS), f"along {along}"),
+    ]  # fmt: skip
     # The mesh's rounding (geometry's cells across: ceil(extent/size - 1e-9)): 0.35/0.07
     # is 4.999999999999999 cells, and the mesh makes 5 (6 on a box's face).
+    short = [c for c in checks if c[0] / p.mesh_size * (1.0 + 1e-9) < c[1]]
+    if not short:
+        return None
+    span, need, where = min(short, key=lambda c: c[0] / c[1])  # the finest cells asked for
     cells = span / p.mesh_size * (1.0 + 1e-9)
-    if cells >= need:
-        span, what = buckle_length(p)
-        need, where = MIN_ALONG_CELLS, f"along {what}"
-        cells = span / p.mesh_size * (1.0 + 1e-9)
-        if cells >= need:
-            return None
     return (
         f"mesh.size = {p.mesh_size:.3g} m gives {cells:.2g} cells {where} "
-        f"({span:.3g} m), fewer than {need}: on cells this coarse the critical stress, k "
+        f"({span:.3g} m), fewer than {need:g}: on cells this coarse the critical stress, k "
         f"and the design values come out too high (refine mesh.size to {span / need:.3g} m "
         'or less; docs/guide/sections.md, "Cell size")'
     )

@@ -38,7 +38,13 @@ from typing import Protocol
 from msgspec import UNSET, Struct, UnsetType
 
 from unibuckle_fenicsx.design import CALIBRATION, UNPROVEN
-from unibuckle_fenicsx.en1993 import INTERNAL, buckling_factor, psi_range, reduction_factor
+from unibuckle_fenicsx.en1993 import (
+    INTERNAL,
+    buckling_factor,
+    psi_range,
+    reduction_factor,
+    stress_ratio,
+)
 from unibuckle_fenicsx.spec import DesignSpec
 
 __all__ = [
@@ -169,7 +175,7 @@ def _face(name: str, ends: tuple[float, float], design: DesignSpec) -> FaceDesig
     sigma1, sigma2 = max(ends), min(ends)
     if sigma1 <= 0.0:
         return FaceDesign(face=name, sigma_cr_Pa=sigma1)
-    psi = sigma2 / sigma1 + 0.0  # no -0.0
+    psi = stress_ratio(sigma1, sigma2)  # a whole number within rounding: the table's row
     slenderness = math.sqrt(design.yield_stress / sigma1)
     out = FaceDesign(face=name, sigma_cr_Pa=sigma1, psi=psi, relative_slenderness=slenderness)
     if psi >= psi_range(INTERNAL)[0]:

@@ -201,8 +201,9 @@ def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
     # Box: cells across the narrowest face, min(width, depth)/mesh.size, here 0.1/0.05 = 2
     # (below MIN_FACE_CELLS = 5); 0.1/0.02 = 5 is not. Tube (R = 0.1 m, t = 2 mm,
     # nu = 0.3): the axisymmetric half-wave pi sqrt(R t)/(12 (1 - nu^2))^(1/4)
-    # = pi * 0.0141421 / 1.81762 = 0.024444 m, so 0.02 m cells give 1.22 of them (below
-    # MIN_HALF_WAVE_CELLS = 1.5) and 0.016 m cells 1.53.
+    # = pi * 0.0141421 / 1.81762 = 0.024444 m, so 0.02 m cells give 1.22 of them and
+    # 0.016 m cells 1.53 (below MIN_HALF_WAVE_CELLS = 2.5: this tube, L = 2R, is 9 % high
+    # on 1.5 cells, docs/guide/sections.md "Cell size"), 0.0097 m cells 2.52.
     from unibuckle_fenicsx.section_analysis import coarse_mesh_note
 
     assert coarse_mesh_note(_box(mesh_size=0.02)) is None
@@ -214,7 +215,9 @@ def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
     )
     note = coarse_mesh_note(tube)
     assert note is not None and "1.2 cells" in note and "(0.0244 m)" in note
-    assert coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.016)) is None
+    note = coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.016))
+    assert note is not None and "1.5 cells" in note and "fewer than 2.5" in note
+    assert coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.0097)) is None
     # The warning is logged by the solve (a hollow box on two cells a face: a free solve).
     with caplog.at_level(logging.WARNING, logger="unibuckle_fenicsx.section_analysis"):
         with solve_section(_box(mesh_size=0.05, core=False), MPI.COMM_SELF, levels=0):

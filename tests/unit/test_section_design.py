@@ -106,6 +106,23 @@ def test_the_governing_face_is_the_one_reaching_its_reduced_stress_first():
     assert out.governing_face == "top"
 
 
+def test_a_web_at_psi_minus_three_keeps_table_4_1_s_row():
+    # Axial +0.5 (tension) and bending 1.0 at z = +d/2: the bottom face carries 0.5 per
+    # unit load, the top one -1.5, the webs psi = -1.5/0.5 = -3, Table 4.1's last row:
+    # k_sigma = 5.98 (1 - psi)^2 = 95.68, rho = (lambda_p - 0.055 (3 + psi))/lambda_p^2
+    # = 1/lambda_p. At this load the quotient rounds to -3.0000000000000004, outside the
+    # table, and the webs had no rho.
+    load, fy = 433334300.8371483, 3.55e8
+    assert (load * -1.5) / (load * 0.5) < -3.0
+    section = _section(axial_stress=0.5, bending_stress=1.0)
+    out = section_design(section, DesignSpec(yield_stress=fy), load)
+    web = {f.face: f for f in out.faces}["right"]
+    slenderness = math.sqrt(fy / (0.5 * load))
+    assert web.psi == -3.0
+    assert web.k_sigma_table == pytest.approx(95.68)
+    assert web.reduction_factor == pytest.approx(1.0 / slenderness)
+
+
 def test_a_stocky_face_is_fully_effective():
     # lambda_p = 0.5 below the limit 0.5 + sqrt(0.085 - 0.055) = 0.673 of psi = 1.
     out = section_design(_section(), DesignSpec(yield_stress=2.35e8), 4 * 2.35e8)

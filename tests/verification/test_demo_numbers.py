@@ -190,3 +190,32 @@ def test_tie_spacing_table_is_the_study_s():
     none = rows[-1]
     assert none["k_bilateral"] == pytest.approx(4.0, rel=0.01)
     assert none["k"] == pytest.approx(4.5, rel=0.01)
+
+
+@serial
+def test_garland_clamped_point_ends_at_the_active_sets_arrangement():
+    """demo_garland, loaded edges clamped, a/b = 2 (24 x 12 cells), with the bracket asked for.
+
+    Without it the interior point ends at four lines of contact across the plate; the
+    certificate refutes that point with an admissible mode of lower load, and the solve,
+    continued from it, ends at two lines. The expected load is the multilevel active
+    set's on the same plate (another algorithm, which reaches two lines by itself): the
+    stored point equals it to the record's resolution, and is proven or bracketed.
+    """
+    from unibuckle_fenicsx.spec import problem_from_dict
+
+    stored = next(
+        json.loads(line)
+        for line in (FIGURES / "garland" / "loaded_edges_clamped.jsonl").open()
+        if line.strip() and json.loads(line)["point"]["plate.length"] == 2.0
+    )
+    assert stored["certificate"]["status"] in ("proven", "bracketed"), stored["certificate"]
+    data = stored["input"]  # its cell size b/12 rounded to eight digits (a record) gives 25 x 13
+    data["mesh"]["size"] = 1.0 / stored["mesh"][1]
+    spec = problem_from_dict(data).with_solver(method="active-set", bracket=False)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        with solve(spec, MPI.COMM_SELF) as analysis:
+            load = analysis.result.critical_load_Pa
+            assert analysis.result.mesh == stored["mesh"]
+    assert stored["critical_load_Pa"] == pytest.approx(load, rel=RECORD)

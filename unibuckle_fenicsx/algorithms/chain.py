@@ -71,6 +71,7 @@ from unibuckle_fenicsx.algorithms.records import (
     ActiveSetDetails,
     InteriorPointDetails,
     LinkRecord,
+    SectionLevelsDetails,
 )
 from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.model.build import build_unilateral_problem
@@ -152,7 +153,16 @@ def _refine(
     if reader.found is not None:
         return reader.found, new
     cand, new = critical_state(
-        fine, newton, new, level, label, options, carry=False, quick=quick, reader=reader
+        fine,
+        newton,
+        new,
+        level,
+        label,
+        options,
+        carry=False,
+        quick=quick,
+        reader=reader,
+        double=True,
     )
     return cand, new
 
@@ -412,7 +422,7 @@ def solve_interior_point(
     if chosen is None or not chosen.kkt:
         logger.warning("interior point: no KKT point on the fine mesh; the active-set chain runs")
         solution = _fallback(problem, options) if fallback is None else fallback(problem)
-        if isinstance(solution.details, ActiveSetDetails):
+        if isinstance(solution.details, ActiveSetDetails | SectionLevelsDetails):
             solution.details.interior_point_levels = [lv.record() for lv in levels]
         solution.method = "interior-point"
         solution.route = ["interior-point", *solution.route]

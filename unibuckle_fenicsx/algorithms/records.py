@@ -387,6 +387,9 @@ class SectionLevelsDetails(Struct, kw_only=True):
         levels: The sections, coarsest first.
         coarse_eigensolves: Eigen solves on the coarser sections.
         wall_time_s: Seconds.
+        interior_point_levels: When the interior point's route fell back to this one,
+            its per-section records (:class:`LevelRecord`, coarsest first), as
+            :class:`ActiveSetDetails` keeps a plate's.
     """
 
     free_load: float
@@ -395,6 +398,7 @@ class SectionLevelsDetails(Struct, kw_only=True):
     levels: list[SectionLevel]
     coarse_eigensolves: int
     wall_time_s: float
+    interior_point_levels: list[LevelRecord] | UnsetType = UNSET
 
 
 #: The record of whichever algorithm ran.

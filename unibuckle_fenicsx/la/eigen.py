@@ -471,6 +471,59 @@ class GEPSolver(Owner):
         eps.solve()
         return eps.getConverged() >= 1
 
+    def lowest_pairs(
+        self,
+        removed: npt.NDArray[np.int64],
+        near: float,
+        count: int,
+        initial: PETSc.Vec | None = None,
+    ) -> list[tuple[EigenPair, PETSc.Vec]]:
+        """The ``count`` smallest eigenpairs with the DOFs ``removed`` set to zero.
+
+        Solved as :meth:`solve` with ``near`` (the shared factorisation at the shift
+        :data:`NEAR_MARGIN` below ``near``, one eigen solve), for ``count`` pairs, in
+        ascending order of load; the vectors are the caller's to destroy. Empty when the
+        inertia shows an eigenvalue below the shift or fewer pairs converge: the pairs
+        returned are then proven the smallest.
+
+        Args:
+            removed: Global row indices owned by this rank to remove.
+            near: An estimate of the smallest eigenvalue (> 0, the same on every rank).
+            count: Pairs wanted, >= 1.
+            initial: Optional start vector.
+
+        Note:
+            Collective.
+        """
+        A, B = self.reduced(removed)
+        if _is_zero(B):
+            return []
+        start = initial if initial is not None and self._useful_start(initial, B) else None
+        eps = self._near_eps()
+        nev, ncv, mpd = eps.getDimensions()
+        eps.setDimensions(count, max(ncv, 2 * count + 2))
+        try:
+            below = self._shift_to(eps, A, B, near * (1.0 - NEAR_MARGIN), start)
+            if below != 0:
+                return []
+            eps.solve()
+            self.solves += 1
+            self.shifted_solves += 1
+            if eps.getConverged() < count:
+                return []
+            its = int(eps.getIterationNumber())
+            pairs: list[tuple[EigenPair, PETSc.Vec]] = []
+            for k in range(count):
+                vec = A.createVecRight()
+                eps.getEigenvector(k, vec)
+                theta = eps.getEigenvalue(k).real
+                value = 1.0 / theta if self.indefinite else theta
+                pair = EigenPair(float(value), float(eps.computeError(k)), its, count)
+                pairs.append((pair, vec))
+        finally:
+            eps.setDimensions(nev, ncv, mpd)
+        return sorted(pairs, key=lambda p: p[0].value)
+
     def count_below(self, shift: float) -> int:
         r"""Eigenvalues of the whole pencil in :math:`(0, \sigma)`, by an inertia.
 

@@ -1,48 +1,24 @@
 """3-D figure of a section's buckling mode and where the wall presses on the core (PNG).
 
-Draws from arrays (:class:`SectionFigureData`, made by
-:func:`~unibuckle_fenicsx.model.shell.section.figure_data`), never from a live problem;
+Draws from arrays (:class:`~unibuckle_fenicsx.model.shell.section.SectionFigureData`, made
+by :func:`~unibuckle_fenicsx.model.shell.section.figure_data`), never from a live problem;
 pyvista is imported inside the function (the ``demo`` extra), in the theme and off-screen
 set-up of :mod:`unibuckle_fenicsx.viz.plotting`.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
-import numpy.typing as npt
 
 from unibuckle_fenicsx.viz.plotting import THEME, _prepare, _pyvista, annotate, coloured_surface
 
-__all__ = ["SectionFigureData", "plot_section_mode_3d"]
+if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.model.shell.section import SectionFigureData
 
-
-@dataclass(frozen=True)
-class SectionFigureData:
-    """What the section's figure needs, on one rank.
-
-    Attributes:
-        points: (n, 3) mesh nodes (m).
-        quads: (c, 4) cells as node indices, in VTK's counter-clockwise order.
-        displacement: (n, 3) the mode's displacement, global components, max |u| = 1.
-        outward: (n,) its component along the outward normal (a corner node: the larger
-            in magnitude of its two), max |u| = 1.
-        pressing: (p, 3) nodes where the wall presses on the core (contact force > 0).
-        touching: (q, 3) other nodes of the contact set (on the core, no force).
-        shape: "box", "tube" or "flat".
-        size: (length, width, depth) of the section (m).
-    """
-
-    points: npt.NDArray[np.float64]
-    quads: npt.NDArray[np.int64]
-    displacement: npt.NDArray[np.float64]
-    outward: npt.NDArray[np.float64]
-    pressing: npt.NDArray[np.float64]
-    touching: npt.NDArray[np.float64]
-    shape: str
-    size: tuple[float, float, float]
+__all__ = ["plot_section_mode_3d"]
 
 
 def plot_section_mode_3d(
@@ -56,7 +32,8 @@ def plot_section_mode_3d(
     """Warped section coloured by the outward displacement, the core, the pressing nodes.
 
     Args:
-        data: The arrays to draw (:class:`SectionFigureData`).
+        data: The arrays to draw
+            (:class:`~unibuckle_fenicsx.model.shell.section.SectionFigureData`).
         path: PNG to write.
         title: Text at the top left.
         warp: Drawn displacement of max |u| = 1, relative to the section's largest

@@ -374,3 +374,71 @@ def test_two_ranks_give_the_shifted_free_load(tmp_path):
     load2, shifts2 = parallel_line.split()
     assert shifts1 == shifts2 == "1"
     assert float(load2) == pytest.approx(float(load1), rel=RTOL)
+
+
+def pair_solver(problem: Problem) -> GEPSolver:
+    """A new solver of ``problem``'s pencil (prefix test_pairs_; the caller destroys it)."""
+    return GEPSolver(
+        problem.model.A,
+        problem.model.B,
+        indefinite=problem.prestress.indefinite,
+        prefix="test_pairs_",
+        options=EIGEN_OPTIONS,
+    )
+
+
+@serial
+def test_the_two_lowest_pairs_in_one_shifted_solve(paper):
+    """``lowest_pairs`` below an estimate: LAPACK's two lowest loads, ascending.
+
+    One eigen solve at the shift 0.1 % below the estimate; a shift above the lowest
+    load (its inertia counts one eigenvalue below) returns nothing: the pairs returned
+    are proven the lowest. The plate in tension somewhere (indefinite B) takes the
+    swapped pencil.
+    """
+    none = np.empty(0, np.int64)
+    problem, (first, second) = paper
+    with build_problem(tension_somewhere(20, 10), MPI.COMM_SELF) as swapped:
+        for plate, loads in ((problem, (first, second)), (swapped, lowest_loads(swapped))):
+            gep = pair_solver(plate)
+            try:
+                pairs = gep.lowest_pairs(none, loads[0], 2)
+                assert [pair.value for pair, _ in pairs] == pytest.approx(loads, rel=RTOL)
+                assert gep.solves == 1
+                for _, vec in pairs:
+                    vec.destroy()
+                assert gep.lowest_pairs(none, 1.01 * loads[0], 2) == []
+            finally:
+                gep.destroy()
+
+
+@serial
+def test_a_mode_projected_on_two_pairs_takes_their_mixed_load(paper):
+    """``project_on_pairs``: u = 0.6 v1 + 0.8 v2 comes back, its load 0.36 l1 + 0.64 l2.
+
+    v1, v2 are B-orthonormal eigenvectors (SLEPc normalises them so), so the quotient
+    of the combination is the weighted mean of their loads (LAPACK's) with the squared
+    weights; the A-orthogonal projection of a vector already in the span is itself.
+    """
+    from unibuckle_fenicsx.algorithms.interior_point.links import project_on_pairs
+
+    problem, (first, second) = paper
+    gep = pair_solver(problem)
+    pairs = gep.lowest_pairs(np.empty(0, np.int64), first, 2)
+    try:
+        v1, v2 = (vec for _, vec in pairs)
+        u = v1.duplicate()
+        u.set(0.0)
+        u.axpy(0.6, v1)
+        u.axpy(0.8, v2)
+        projected = project_on_pairs(problem, u, [v1, v2])
+        assert projected is not None
+        mode, load = projected
+        assert load == pytest.approx(0.36 * first + 0.64 * second, rel=RTOL)
+        diff = mode.x.petsc_vec.copy()
+        diff.axpy(-1.0, u)
+        assert diff.norm() <= 1e-8 * u.norm()
+    finally:
+        for _, vec in pairs:
+            vec.destroy()
+        gep.destroy()

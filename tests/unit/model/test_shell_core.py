@@ -287,6 +287,8 @@ def test_the_interior_points_fallback_takes_over_its_sections(monkeypatch):
         assert counts == {"built": 2, "free": 2}
         assert solution.route[:2] == ["interior-point", "active-set (section levels)"]
         assert len(solution.details.levels) == 2
+        # The interior point's own records of its two sections are kept, as a plate's.
+        assert len(solution.details.interior_point_levels) == 2
         assert solution.candidate.kkt
         assert solution.load == pytest.approx(reference.load, rel=1e-8)
 

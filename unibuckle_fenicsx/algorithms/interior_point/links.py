@@ -18,6 +18,10 @@ import math
 import time
 from dataclasses import dataclass, field
 
+from petsc4py import PETSc
+
+import dolfinx
+
 import numpy as np
 import numpy.typing as npt
 
@@ -32,16 +36,19 @@ from unibuckle_fenicsx.algorithms.interior_point.options import (
 )
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.algorithms.records import LevelRecord, LinkRecord
-from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
-from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
+from unibuckle_fenicsx.la.eigen import EigenPair
+from unibuckle_fenicsx.model.problem import Candidate, Problem, UnilateralProblem
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
 
 __all__ = [
     "MeshLevel",
     "Reader",
     "critical_state",
     "descend_from",
+    "double_read",
     "newton_link",
     "polish",
+    "project_on_pairs",
     "read_contact",
     "run_from",
 ]
@@ -150,15 +157,20 @@ def read_contact(
     level: MeshLevel,
     label: str,
     active: npt.NDArray[np.int64] | None = None,
+    double: float | None = None,
 ) -> Candidate:
     """The exact critical state of the contact set ``active`` read off ``point``.
 
     Default: the nodes at the tolerance (:meth:`~.newton.InteriorPointNewton.contact_set`).
+    ``double``: where the reduced mode crosses the obstacle by more than this at the
+    barrier point's load, look for a double eigenvalue (:func:`double_read`).
     """
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     active = newton.contact_set(point) if active is None else active
     cand = problem.evaluate(active, initial=point.mode.x.petsc_vec, near=point.load)
+    if double is not None and not cand.kkt:
+        cand = double_read(problem, point, cand, double) or cand
     level.offer(cand)
     level.links.append(
         LinkRecord(
@@ -173,6 +185,78 @@ def read_contact(
         )
     )
     return cand
+
+
+def double_read(
+    problem: UnilateralProblem, point: BarrierPoint, cand: Candidate, push: float
+) -> Candidate | None:
+    r"""The critical state of ``cand``'s contact set on a double eigenvalue, or None.
+
+    Where two buckles of the same load are weakly coupled, the pencil reduced on the
+    contact set Z read off the barrier point can have two eigenvalues closer than the
+    smallest-eigenvalue check resolves (:data:`~unibuckle_fenicsx.tolerances.SMALLEST_RTOL_FACTOR`
+    eigen tolerances), and the eigen solver then returns an arbitrary mode of their
+    plane: typically one that lifts one buckle and pushes the other into the obstacle.
+    Every mode of that plane is an eigenvector to that resolution; the one taken is the
+    barrier point's mode projected on the plane (:func:`project_on_pairs`), its load
+    its Rayleigh quotient, which lies between the two eigenvalues, so that the inertia
+    check of the smallest eigenvalue holds. Tried only where ``cand`` crosses the
+    obstacle by more than ``push`` of its largest deflection and its load is the
+    barrier point's to that resolution (one eigen solve for the two lowest pairs);
+    returned only if it is a KKT point.
+    """
+    resolution = SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol
+    if not cand.active.size or not math.isfinite(cand.load) or cand.values.max() <= push:
+        return None
+    if abs(cand.load - point.load) > resolution * point.load:
+        return None
+    rows = problem.contact.removed_rows(cand.active)
+    u = point.mode.x.petsc_vec
+    pairs = problem.eigensolver.lowest_pairs(rows, cand.load, 2, initial=u)
+    try:
+        if len(pairs) < 2 or pairs[1][0].value > pairs[0][0].value * (1.0 + resolution):
+            return None
+        projected = project_on_pairs(problem, u, [vec for _, vec in pairs])
+    finally:
+        for _, vec in pairs:
+            vec.destroy()
+    if projected is None:
+        return None
+    mode, load = projected
+    first = pairs[0][0]
+    eigen = EigenPair(load, first.error, first.iterations, first.converged)
+    double = problem.candidate(mode, load, cand.active, eigen=eigen)
+    return double if double.kkt else None
+
+
+def project_on_pairs(
+    problem: Problem, u: PETSc.Vec, vecs: list[PETSc.Vec]
+) -> tuple[dolfinx.fem.Function, float] | None:
+    r"""``u`` projected on the span of ``vecs``, and its Rayleigh quotient :math:`a/b`.
+
+    The projection is :math:`A`-orthogonal (A is positive definite, B need not be);
+    None when :math:`b \le 0` there. Collective.
+    """
+    A, B = problem.model.A, problem.model.B
+    Av = [A.createVecLeft() for _ in vecs]
+    try:
+        for vec, out in zip(vecs, Av, strict=True):
+            A.mult(vec, out)
+        gram = np.array([[out.dot(vec) for vec in vecs] for out in Av])
+        coef = np.linalg.solve(gram, np.array([out.dot(u) for out in Av]))
+        mode = problem.new_mode("projected")
+        x = mode.x.petsc_vec
+        x.set(0.0)
+        for c, vec in zip(coef, vecs, strict=True):
+            x.axpy(float(c), vec)
+        mode.x.scatter_forward()
+        A.mult(x, Av[0])
+        B.mult(x, Av[1])
+        a, b = float(x.dot(Av[0])), float(x.dot(Av[1]))
+    finally:
+        for out in Av:
+            out.destroy()
+    return (mode, a / b) if b > 0.0 else None
 
 
 @dataclass
@@ -228,7 +312,15 @@ class Reader:
             return None
         self.tried.append(active)
         label = f"{self.label} ({how} at {point.mu:.0e})"
-        cand = read_contact(self.problem, self.newton, point, self.level, label, active)
+        cand = read_contact(
+            self.problem,
+            self.newton,
+            point,
+            self.level,
+            label,
+            active,
+            double=self.options.double_push,
+        )
         if not cand.kkt:
             return None
         self.armed, self.found = False, cand
@@ -287,7 +379,12 @@ def descend_from(
 
 
 def _read_state(
-    newton: InteriorPointNewton, point: BarrierPoint, level: MeshLevel, label: str, predicted: bool
+    newton: InteriorPointNewton,
+    point: BarrierPoint,
+    level: MeshLevel,
+    label: str,
+    predicted: bool,
+    double: float | None = None,
 ) -> Candidate:
     """The critical state read off ``point`` by :func:`critical_state`.
 
@@ -295,15 +392,18 @@ def _read_state(
     (``ChainOptions.read_predicted``), where that is no KKT point, the predicted set too
     (:meth:`~.newton.InteriorPointNewton.predicted_contact_set`: one more factorisation
     and eigen solve), and the one nearer to a KKT point (:func:`_violation`) is kept.
+    ``double``: as :func:`read_contact`'s.
     """
     problem = newton.problem
-    cand = read_contact(problem, newton, point, level, label)
+    cand = read_contact(problem, newton, point, level, label, double=double)
     if cand.kkt or not predicted:
         return cand
     active = newton.predicted_contact_set(point)
     if np.array_equal(active, cand.active):
         return cand
-    other = read_contact(problem, newton, point, level, f"{label} (predicted)", active)
+    other = read_contact(
+        problem, newton, point, level, f"{label} (predicted)", active, double=double
+    )
     return other if other.kkt or _violation(other) < _violation(cand) else cand
 
 
@@ -323,15 +423,18 @@ def critical_state(
     carry: bool = True,
     quick: bool = False,
     reader: Reader | None = None,
+    double: bool = False,
 ) -> tuple[Candidate | None, BarrierPoint]:
     """Read the contact set off ``point``; escape a saddle, drive the barrier lower, polish.
 
     Returns the KKT point (or None) and the barrier point it belongs to (recomputed
     after a polish only when ``carry``: it goes on to a finer mesh). ``quick``: a
     short polish and no descent (a second try follows). Saddles are escaped on every
-    try: an escape costs less than a second try from the coarsest mesh.
+    try: an escape costs less than a second try from the coarsest mesh. ``double``:
+    read double eigenvalues (:func:`double_read`; on the fine mesh).
     """
-    cand = _read_state(newton, point, level, label, options.read_predicted)
+    push = options.double_push if double else None
+    cand = _read_state(newton, point, level, label, options.read_predicted, push)
     if cand.kkt:
         return cand, point
     for attempt in range(options.escapes):
@@ -343,7 +446,7 @@ def critical_state(
             newton, point, level, tag, options, keep_push=False,
             mu=max(point.mu, options.escape_mu), mu_min=max(point.mu, options.fine_mu_min),
         )  # fmt: skip
-        cand = _read_state(newton, point, level, tag, options.read_predicted)
+        cand = _read_state(newton, point, level, tag, options.read_predicted, push)
         if cand.kkt:
             return cand, point
     if point.mu > options.last_mu_min:
@@ -355,7 +458,7 @@ def critical_state(
         )  # fmt: skip
         if reader is not None and reader.found is not None:
             return reader.found, point
-        cand = _read_state(newton, point, level, tag, options.read_predicted)
+        cand = _read_state(newton, point, level, tag, options.read_predicted, push)
         if cand.kkt:
             return cand, point
     if math.isfinite(cand.load):

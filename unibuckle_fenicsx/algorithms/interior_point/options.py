@@ -254,6 +254,12 @@ class ChainOptions:
             on sections with a core, where a wall lies almost flat on the core, the
             gaps there stay above ``tau`` at every parameter reached, and only the
             predicted set holds them (:doc:`/verification/sections_finest`).
+        double_push: On the fine mesh, a contact set read at the barrier point's load
+            whose mode crosses the obstacle by more than this (relative to its largest
+            deflection) is checked for a double eigenvalue
+            (:func:`~.links.double_read`: one more eigen solve). The sign changes of
+            the degenerate nodes stay below a thousandth of the buckle; a second
+            buckle of the same load crosses by a good part of its own.
         clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
             (the least-energy correction lifts those closer to the obstacle to it).
         max_steps: Newton steps per run.
@@ -297,6 +303,7 @@ class ChainOptions:
     read_stable: bool = True
     last_mu_min: float = 1e-14
     read_predicted: bool = False
+    double_push: float = 1e-2
     clip_margin: float = 1e-6
     max_steps: int = 100
     escapes: int = 3
