@@ -9,7 +9,7 @@ A square box (b = d = 0.2 m, t = 2 mm: b/t = 100, L = 3b) or a circular tube (R 
 t = 1 mm: R/t = 100, L = R), steel, simply supported ends, a rigid core over the whole
 length. One process: the set-up (mesh, prestress, assembly, change of basis), the free
 eigen solve (min of ``--repeat`` solves of the same pencil), and the unilateral solve
-(:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels` over the section and its
+(:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels` over the section and its
 ``--levels`` coarser copies, its sections' set-up included) by ``--route``:
 ``active-set`` (the active-set seeds on the coarsest section, the contact set polished
 level by level; ``levels`` is its old name), ``interior-point`` (the nested
@@ -69,7 +69,7 @@ def run(
     """One section: set-up, free solve, unilateral solve, certificate.
 
     ``route``: "active-set", "interior-point" (the routes of
-    :func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`), "auto" (the one
+    :func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`), "auto" (the one
     :func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses) or "single" (the
     interior-point chain on the section itself).
     """
@@ -78,12 +78,12 @@ def run(
 
     import msgspec
 
+    from unibuckle_fenicsx.algorithms import section_levels
     from unibuckle_fenicsx.algorithms.chain import solve_interior_point
     from unibuckle_fenicsx.algorithms.records import InteriorPointDetails, SectionLevelsDetails
     from unibuckle_fenicsx.analysis import choose_section_method
     from unibuckle_fenicsx.certificate.certify import certify
     from unibuckle_fenicsx.la.eigen import GEPSolver
-    from unibuckle_fenicsx.model.shell import levels as section_levels
     from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
     from unibuckle_fenicsx.spec import SolverSpec
 

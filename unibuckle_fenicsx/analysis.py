@@ -21,12 +21,12 @@ import dolfinx
 from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
 from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
 from unibuckle_fenicsx.algorithms.registry import FOUNDATION, entry
+from unibuckle_fenicsx.algorithms.section_levels import INTERIOR_POINT_DOFS, estimated_dofs
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
-from unibuckle_fenicsx.model.shell.levels import INTERIOR_POINT_DOFS, estimated_dofs
 from unibuckle_fenicsx.model.shell.section import SectionParameters
 from unibuckle_fenicsx.results.assemble import assemble_result
 from unibuckle_fenicsx.results.records import BucklingResult
@@ -118,9 +118,9 @@ def choose_section_method(parameters: SectionParameters, solver: SolverSpec) -> 
     plate's tensionless foundation does. A rigid core runs the ``[solver] method`` given,
     one of :data:`~unibuckle_fenicsx.spec.section.SECTION_METHODS`; "auto" runs the
     interior point on sections of at least
-    :data:`~unibuckle_fenicsx.model.shell.levels.INTERIOR_POINT_DOFS` degrees of
+    :data:`~unibuckle_fenicsx.algorithms.section_levels.INTERIOR_POINT_DOFS` degrees of
     freedom, estimated before meshing
-    (:func:`~unibuckle_fenicsx.model.shell.levels.estimated_dofs`), and the active set
+    (:func:`~unibuckle_fenicsx.algorithms.section_levels.estimated_dofs`), and the active set
     on smaller ones. The interior point falls back on the active set when it reaches no
     KKT point (its route then takes the link "active-set").
 

@@ -12,8 +12,9 @@ it covers, the wall may only move away from it (:mod:`~unibuckle_fenicsx.model.s
 - With a core the free load is the hollow section's; the unilateral critical state is
   found by the method :func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses,
   run through the registry (:data:`~unibuckle_fenicsx.algorithms.registry.REGISTRY`):
-  with a rigid core coarse to fine (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`:
-  the interior point's starts on a coarser section, the mode carried to the finer one;
+  with a rigid core coarse to fine
+  (:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`: the interior
+  point's starts on a coarser section, the mode carried to the finer one;
   or the active set's seeds and carried contact set), with an elastic core by the
   spring-set iteration; it is certified
   (:func:`~unibuckle_fenicsx.certificate.certify.certify`) on the finest.
@@ -247,7 +248,7 @@ def solve_section(
             and ``design``, and the result's ``input`` is the file, which re-runs it).
         comm: Communicator; the mesh is distributed over it.
         levels: With a core, coarser sections (each with twice the mesh size) the search
-            starts on, >= 0 (:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`:
+            starts on, >= 0 (:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`:
             the interior point's starts, or the active set's seeds). 1 by default: the
             starts' many steps on a section of a quarter of the DOFs, a few on the given one.
         solver: Solver options (the method, one of

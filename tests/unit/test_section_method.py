@@ -21,10 +21,10 @@ import pytest
 
 import unibuckle_fenicsx.analysis as analysis
 from unibuckle_fenicsx import SectionParameters, section_from_dict, solve_section
+from unibuckle_fenicsx.algorithms.section_levels import solve_levels
 from unibuckle_fenicsx.analysis import choose_section_method
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.model.shell.levels import solve_levels
 from unibuckle_fenicsx.model.shell.section import section_parameters
 from unibuckle_fenicsx.spec import SolverSpec
 

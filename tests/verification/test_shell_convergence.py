@@ -149,7 +149,7 @@ def test_core_restrains_the_box_corners():
     face as a plate against a rigid face with simply supported unloaded edges and with
     clamped ones (the package's plate solver, same cells across the face).
     """
-    from unibuckle_fenicsx.model.shell.levels import solve_levels
+    from unibuckle_fenicsx.algorithms.section_levels import solve_levels
     from unibuckle_fenicsx.model.shell.section import SectionParameters
 
     n = 16

@@ -38,9 +38,9 @@ from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.algorithms.foundation import solve_foundation
 from unibuckle_fenicsx.algorithms.interior_point.options import ChainOptions
 from unibuckle_fenicsx.algorithms.penalty import solve_penalty
+from unibuckle_fenicsx.algorithms.section_levels import solve_levels
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.problem import UnilateralProblem
-from unibuckle_fenicsx.model.shell.levels import solve_levels
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import OPTIONS, FoundationOptions, Method, SolverSpec
 from unibuckle_fenicsx.spec.base import Table

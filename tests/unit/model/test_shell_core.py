@@ -22,7 +22,7 @@ import pytest
 import scipy.linalg
 
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
-from unibuckle_fenicsx.model.shell.levels import solve_levels
+from unibuckle_fenicsx.algorithms.section_levels import solve_levels
 from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
 
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense references are serial")
@@ -150,8 +150,8 @@ def test_interior_point_over_two_sections_matches_the_active_set():
 
 def test_the_plates_other_seeds_run_only_when_the_sections_reach_no_kkt_point():
     # The rule of solve_active_set's more_seeds, on the small box of the dense reference.
+    from unibuckle_fenicsx.algorithms.section_levels import MORE_SEEDS, SEEDS
     from unibuckle_fenicsx.errors import InputError
-    from unibuckle_fenicsx.model.shell.levels import MORE_SEEDS, SEEDS
 
     with build_section(_parameters("box"), MPI.COMM_SELF) as sec:
         problem = sec.problem
@@ -217,7 +217,7 @@ def test_core_over_part_of_the_length():
 )
 def test_the_dofs_auto_routes_by_are_the_sections(shape, changes):
     # "auto" decides before any mesh is made: its estimate must be the built section's DOFs.
-    from unibuckle_fenicsx.model.shell.levels import estimated_dofs
+    from unibuckle_fenicsx.algorithms.section_levels import estimated_dofs
 
     params = _parameters(shape, **changes)
     with build_section(params, MPI.COMM_SELF) as sec:
@@ -235,8 +235,8 @@ def test_a_coarser_section_without_core_nodes_ends_the_added_levels():
     # The core over 0.31..0.34 m holds the 25 mm cells' nodes at 0.325 m, none of the
     # 50 mm cells' (0.30, 0.35): the interior point's added level is dropped, a level
     # the caller asked for is refused naming mesh.levels.
+    from unibuckle_fenicsx.algorithms.section_levels import interior_levels
     from unibuckle_fenicsx.errors import InputError
-    from unibuckle_fenicsx.model.shell.levels import interior_levels
 
     params = _parameters(
         "box", width=0.2, depth=0.2, length=0.6, mesh_size=0.025, core_span=(0.31, 0.34)
@@ -256,7 +256,7 @@ def test_the_interior_points_fallback_takes_over_its_sections(monkeypatch):
     # point built: each built and its free mode solved once (before, the fallback built
     # both again: 4 and 4). Reference: the plate's active set with all its seeds on the
     # finer section (an independent algorithm), as above.
-    import unibuckle_fenicsx.model.shell.levels as levels
+    import unibuckle_fenicsx.algorithms.section_levels as levels
     from unibuckle_fenicsx.algorithms.chain import ChainOptions
     from unibuckle_fenicsx.la.eigen import GEPSolver
 
@@ -306,7 +306,7 @@ def test_a_filled_tube_whose_seeds_stall_is_not_left_at_every_direction_in_conta
     # tube: bending, hoop stretching and the transverse shear strain w' (the rotations
     # are 0) over the work of the axial stress, D pi^2/(t L^2) + E L^2/((1 - nu^2) pi^2
     # R^2) + (5/6) G = 9.08e10 Pa (7.6e7 + 2.34e10 + 6.73e10).
-    from unibuckle_fenicsx.model.shell.levels import MORE_SEEDS, SEEDS
+    from unibuckle_fenicsx.algorithms.section_levels import MORE_SEEDS, SEEDS
 
     params = _parameters("tube", length=0.1, mesh_size=0.03)
     with build_section(params, MPI.COMM_SELF) as sec:

@@ -2,7 +2,7 @@ r"""A section's mode carried from one section mesh to another of the same sectio
 
 The interior-point chain (:func:`~unibuckle_fenicsx.algorithms.chain.solve_interior_point`)
 carries a barrier point's mode from a coarse section to the next finer one
-(:func:`~unibuckle_fenicsx.model.shell.levels.solve_levels`). Every section mesh is a
+(:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`). Every section mesh is a
 tensor product (:mod:`~unibuckle_fenicsx.model.shell.geometry`): a ring of nodes around
 the section swept along x. In the unrolled coordinates (x, s), s the arc length around
 the mid-line (:func:`~unibuckle_fenicsx.model.shell.core.perimeter_coordinate`), each
