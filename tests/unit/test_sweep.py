@@ -462,6 +462,33 @@ def test_chart_axes_name_the_swept_number_in_words():
     assert axis_label("obstacle.foundation_stiffness", base) == "foundation modulus (Pa/m)"
 
 
+def test_an_aspect_chart_s_title_names_its_axis(tmp_path, monkeypatch):
+    """A sweep of plate.length is drawn against a/b: its title says so, as its axis does.
+
+    The title read "k against the plate length (m)" over an axis of a/b.
+    """
+    import tomllib
+
+    from unibuckle_fenicsx.viz import charts
+
+    seen, save = {}, charts._save
+
+    def keep(fig, ax, path):
+        seen.update(title=ax.get_title(), xlabel=ax.get_xlabel())
+        return save(fig, ax, path)
+
+    monkeypatch.setattr(charts, "_save", keep)
+    base = tomllib.loads(SMALL)
+    lines = [
+        {"point": {"plate.length": a}, "status": "ok", "buckling_coefficient_k": 4.4,
+         "free_load_Pa": 1.0, "critical_load_Pa": 1.1, "certificate": None}
+        for a in (0.2, 0.3)
+    ]  # fmt: skip
+    charts.plot_sweep(lines, [parse_variation("plate.length=0.2,0.3")], base, tmp_path / "c.png")
+    assert seen["xlabel"] == "aspect ratio a/b"
+    assert seen["title"] == "small: k against the aspect ratio a/b"
+
+
 # -- sections -----------------------------------------------------------------------
 
 #: A filled square box 100 x 100 mm, L = 200 mm, on 25 mm cells: each point about 1 s.

@@ -353,11 +353,10 @@ def plot_sweep(
         _exact_curves(ax, base, first, point, abscissa, suffix)
     _marker_legend(ax)
     _k_range(ax, lines, aspect)
-    ax.set_xlabel("aspect ratio a/b" if aspect else axis_label(first.path, base))
+    xlabel = "aspect ratio a/b" if aspect else axis_label(first.path, base)
+    ax.set_xlabel(xlabel)
     ax.set_ylabel(r"buckling coefficient $k = N b^2 / (\pi^2 D)$")
-    ax.set_title(
-        title or f"{base.get('name', 'plate')}: k against the {axis_label(first.path, base)}"
-    )
+    ax.set_title(title or f"{base.get('name', 'plate')}: k against the {xlabel}")
     return _save(fig, ax, path)
 
 
