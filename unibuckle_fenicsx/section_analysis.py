@@ -65,6 +65,7 @@ from unibuckle_fenicsx.section_design import (
     at_lower_bound,
     design_line,
     face_compressions,
+    face_width,
     section_design,
 )
 from unibuckle_fenicsx.spec import (
@@ -406,18 +407,17 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     p = parameters
     width, across = _buckle_width(p)
     length, along = buckle_length(p)
-    checks = [
-        (width, float(MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS),
-         f"across {across}"),
-        (length, float(MIN_ALONG_CELLS), f"along {along}"),
-    ]  # fmt: skip
+    need_across = MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS
+    checks = [(width, need_across, f"across {across}"), (length, MIN_ALONG_CELLS, f"along {along}")]
     # The mesh's rounding (geometry's cells across: ceil(extent/size - 1e-9)): 0.35/0.07
     # is 4.999999999999999 cells, and the mesh makes 5 (6 on a box's face).
-    short = [c for c in checks if c[0] / p.mesh_size * (1.0 + 1e-9) < c[1]]
+    counted = [
+        (span / p.mesh_size * (1.0 + 1e-9), need, span, where) for span, need, where in checks
+    ]
+    short = [c for c in counted if c[0] < c[1]]
     if not short:
         return None
-    span, need, where = min(short, key=lambda c: c[0] / c[1])  # the finest cells asked for
-    cells = span / p.mesh_size * (1.0 + 1e-9)
+    cells, need, span, where = min(short, key=lambda c: c[0] / c[1])  # the finest cells asked
     return (
         f"mesh.size = {p.mesh_size:.3g} m gives {cells:.2g} cells {where} "
         f"({span:.3g} m), fewer than {need:g}: on cells this coarse the critical stress, k "
@@ -498,7 +498,7 @@ def _faces(
     out: list[dict[str, str | float]] = []
     compressions = face_compressions(p)
     for name, axis, sign in _FACES:
-        width = p.depth if axis == 1 else p.width  # a face normal to y spans the depth
+        width = face_width(p, name)
         on = normals[:, axis] * sign > 0.5
         sigma = load * max(compressions[name]) + 0.0  # its largest compression (no -0.0)
         out.append(

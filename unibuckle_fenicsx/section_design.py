@@ -52,6 +52,7 @@ __all__ = [
     "SectionDesignRecord",
     "at_lower_bound",
     "face_compressions",
+    "face_width",
     "section_design",
 ]
 
@@ -200,7 +201,7 @@ def _reaches_reduced_stress(face: FaceDesign) -> float:
     return (face.reduced_design_stress_Pa or 0.0) / face.sigma_cr_Pa
 
 
-def _face_width(section: DesignSection, name: str) -> float:
+def face_width(section: DesignSection, name: str) -> float:
     """The width (m) of the box's face ``name``: the right and left faces span the depth."""
     return float((section.depth if name in ("right", "left") else section.width) or 0.0)
 
@@ -231,7 +232,7 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         if rated:
             first = min(_reaches_reduced_stress(f) for f in rated)
             tied = [f for f in rated if _reaches_reduced_stress(f) <= first * (1.0 + 1e-12)]
-            out.governing_face = max(tied, key=lambda f: _face_width(section, f.face)).face
+            out.governing_face = max(tied, key=lambda f: face_width(section, f.face)).face
     else:
         out.clauses.append(TUBE_CLAUSES)
     if section.core:
