@@ -13,6 +13,7 @@ from typing import Any
 
 from unibuckle_fenicsx.cli.status import (
     EXIT_BAD_INPUT,
+    EXIT_BROKEN_PIPE,
     EXIT_BUG,
     EXIT_INTERRUPTED,
     EXIT_NOT_CERTIFIED,
@@ -44,6 +45,8 @@ exit status:
      exists (or none was found), the message gives the lower bound and no JSON is written
   {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
+  {EXIT_BROKEN_PIPE}  standard output closed by its reader (| head -1): ended quietly (mpiexec
+     gives the same status); the files written before stay
 
 Single-dash options that argparse does not know go to PETSc/SLEPc under the package's
 prefixes, e.g. -unibuckle_eps_view, -unibuckle_eps_tol 1e-12, -unibuckle_ldl_ksp_view.
@@ -78,6 +81,8 @@ exit status:
   {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C): the finished points are in --json; the same
      command resumes
+  {EXIT_BROKEN_PIPE}  standard output closed by its reader (| head -1): ended quietly (mpiexec
+     gives the same status); the files written before stay
 """
 
 NONLINEAR_EPILOG = f"""\
@@ -101,6 +106,8 @@ exit status:
      why and no JSON is written
   {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
+  {EXIT_BROKEN_PIPE}  standard output closed by its reader (| head -1): ended quietly (mpiexec
+     gives the same status); the files written before stay
 
 {JSON_HELP}
 
