@@ -246,7 +246,8 @@ def solve_section(
             or a section's problem file
             (:class:`~unibuckle_fenicsx.spec.section.SectionProblemSpec`: its
             ``mesh.levels``, ``[solver]`` and ``[design]`` replace ``levels``, ``solver``
-            and ``design``, and the result's ``input`` is the file, which re-runs it).
+            and ``design``, the result's ``case`` is the file's ``name`` and its ``input``
+            the file, which re-runs it).
         comm: Communicator; the mesh is distributed over it.
         levels: With a core, coarser sections (each with twice the mesh size) the search
             starts on, >= 0 (:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`:
@@ -274,9 +275,9 @@ def solve_section(
     """
     t0 = time.perf_counter()
     echo: dict[str, object] | None = None
-    units = "SI"
+    units, name = "SI", None
     if isinstance(parameters, SectionProblemSpec):
-        echo = problem_to_dict(parameters)
+        echo, name = problem_to_dict(parameters), parameters.name
         levels, solver, design = parameters.mesh.levels, parameters.solver, parameters.design
         units = parameters.units
         parameters = section_parameters(parameters)
@@ -319,8 +320,8 @@ def solve_section(
                     "; ".join(certificate.notes) or certificate.status,
                 )
         result = _result(section, free, solution, certificate, time.perf_counter() - t0, reason)
-        if echo is not None:
-            result.input, result.units = echo, units
+        if echo is not None:  # a file's run: its name, its input
+            result.case, result.input, result.units = str(name), echo, units
         column = column_note(parameters, result.critical_load_Pa, solution is not None)
         if column is not None:
             logger.warning("%s", column)
