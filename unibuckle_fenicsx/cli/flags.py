@@ -217,10 +217,10 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "solve",
         parents=[problem, common],
         help="solve one problem (a paper case or a TOML file)",
-        description="Compute the critical load of one problem and print a one-line summary.\n"
+        description="Compute the critical load of one problem and print its summary.\n"
         "The problem is a plate (a paper case or a TOML file) or a section: a file with a\n"
         "[section] table (a box or a tube, with a core or hollow), solved on its [mesh]\n"
-        "size and levels (--nx, --ny and --output apply to plates only).",
+        "size and levels (--nx, --ny, --output and --candidate-parallel: plates only).",
         epilog=EPILOG,
         formatter_class=Formatter,
     )
@@ -229,8 +229,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "sweep",
         parents=[common],
         help="solve a problem file over a grid of values of some of its numbers",
-        description="Solve the problem of --config (a plate's or a section's file) at every "
-        "point of the --vary grid, writing one JSON line per point (resumable), and "
+        description="Solve the problem of --config (a plate's or a section's file) at every\n"
+        "point of the --vary grid, writing one JSON line per point (resumable), and\n"
         "optionally a chart of k (a section's: its critical stress over the classical one).",
         epilog=SWEEP_EPILOG,
         formatter_class=Formatter,
