@@ -173,6 +173,15 @@ class SectionResult(BucklingResult, kw_only=True):
                 f"{self.contact_nodes}, KKT = {'yes' if cert.kkt else 'NO'}, "
                 f"certificate {cert.status} (lower bound {bound} by {cert.proven_by})"
             )
+            bracket = self._bound_line(
+                scale,
+                unit,
+                what="critical stress",
+                free="the hollow section's",
+                ratio=sigma / self.critical_load_Pa,
+            )
+            if bracket:
+                lines.append(bracket)
         if isinstance(self.design, SectionDesignRecord):
             lines.append(design_line(self.design, scale, unit))
         return "\n  ".join(lines)
