@@ -9,13 +9,17 @@ A problem file describes a plate (:class:`~unibuckle_fenicsx.spec.ProblemSpec`, 
 
 from __future__ import annotations
 
+from typing import TYPE_CHECKING
+
 from mpi4py import MPI
 
-from unibuckle_fenicsx.analysis import Analysis, solve
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.section_analysis import SectionAnalysis, solve_section
-from unibuckle_fenicsx.spec import ProblemSpec
 from unibuckle_fenicsx.spec.section import SectionProblemSpec
+
+if TYPE_CHECKING:  # pragma: no cover
+    from unibuckle_fenicsx.analysis import Analysis
+    from unibuckle_fenicsx.section_analysis import SectionAnalysis
+    from unibuckle_fenicsx.spec import ProblemSpec
 
 __all__ = ["analyse"]
 
@@ -45,11 +49,15 @@ def analyse(
     Note:
         Collective on ``comm``.
     """
+    # Looked up at the call, as the command line's imports: DOLFINx loads on the first
+    # solve, and the module's own solve is called (a test may replace it).
+    from unibuckle_fenicsx import analysis, section_analysis
+
     if isinstance(spec, SectionProblemSpec):
         if candidate_parallel:
             raise InputError(
                 "--candidate-parallel shares a plate's enumeration among the ranks; a "
                 "section is not enumerated (its mesh is distributed): leave it out"
             )
-        return solve_section(spec, comm)
-    return solve(spec, comm, candidate_parallel=candidate_parallel)
+        return section_analysis.solve_section(spec, comm)
+    return analysis.solve(spec, comm, candidate_parallel=candidate_parallel)
