@@ -39,6 +39,7 @@ __all__ = [
     "ELEMENTS",
     "INTERNAL",
     "OUTSTAND",
+    "STEEL_MODULUS",
     "DesignEdge",
     "DesignElement",
     "DesignLoad",
@@ -58,6 +59,11 @@ INTERNAL = "internal"
 OUTSTAND = "outstand"
 #: The elements of EN 1993-1-5 4.4(2).
 ELEMENTS = (INTERNAL, OUTSTAND)
+#: Young's moduli (Pa) taken as a steel's by the design output: structural steel's 210
+#: GPa (EN 1993-1-1 3.2.6) and stainless steel's 200 GPa (EN 1993-1-4 Table 2.1), with
+#: the 200-205 GPa some codes and texts give carbon steel; aluminium (70 GPa) and other
+#: metals lie far outside.
+STEEL_MODULUS = (1.9e11, 2.2e11)
 
 
 def table_row(element: str, free_edge_most_compressed: bool) -> str:
