@@ -287,7 +287,7 @@ def solve_section(
         )
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    for note in (thick_wall_note(parameters), coarse_mesh_note(parameters)):
+    for note in (thick_wall_note(parameters, units), coarse_mesh_note(parameters, units)):
         if note is not None:
             logger.warning("%s", note)
     certificate: Certificate | None = None
@@ -321,7 +321,7 @@ def solve_section(
         result = _result(section, free, solution, certificate, time.perf_counter() - t0, reason)
         if echo is not None:
             result.input, result.units = echo, units
-        column = column_note(parameters, result.critical_load_Pa, solution is not None)
+        column = column_note(parameters, result.critical_load_Pa, solution is not None, units)
         if column is not None:
             logger.warning("%s", column)
         if design is not None:
@@ -373,28 +373,32 @@ def _design(
 COLUMN_FRACTION = 0.8
 
 
-def column_note(parameters: SectionParameters, load: float, cored: bool) -> str | None:
+def column_note(
+    parameters: SectionParameters, load: float, cored: bool, units: str = "SI"
+) -> str | None:
     """A warning when the hollow member's critical state is a column's, else None.
 
     Its uniform axial stress at ``load`` at or above :data:`COLUMN_FRACTION` of the
     Euler stress (:meth:`SectionParameters.euler_stress`): k and EN 1993-1-5's face
     values are the walls' quantities, not a column's. A core (``cored``) holds the walls
-    off a column's mode (rigid) or resists it (elastic): no warning.
+    off a column's mode (rigid) or resists it (elastic): no warning. Stresses in the
+    unit system ``units`` (:data:`~unibuckle_fenicsx.spec.base.UNITS`), the file's.
     """
     p = parameters
     axial = -load * p.axial_stress
     euler = p.euler_stress()
     if cored or axial < COLUMN_FRACTION * euler:
         return None
+    _, scale, unit = UNITS[units]
     return (
-        f"the critical axial stress {axial:.4g} Pa is {axial / euler:.3g} times the member's "
-        f"Euler stress {euler:.4g} Pa: the mode is the column's (or coupled with it), and k "
-        "and the EN 1993-1-5 face values are the walls' quantities, not the column's "
-        "(EN 1993-1-1, 6.3.1)"
+        f"the critical axial stress {axial / scale:.4g} {unit} is {axial / euler:.3g} times "
+        f"the member's Euler stress {euler / scale:.4g} {unit}: the mode is the column's "
+        "(or coupled with it), and k and the EN 1993-1-5 face values are the walls' "
+        "quantities, not the column's (EN 1993-1-1, 6.3.1)"
     )
 
 
-def coarse_mesh_note(parameters: SectionParameters) -> str | None:
+def coarse_mesh_note(parameters: SectionParameters, units: str = "SI") -> str | None:
     """A warning when the cells are too coarse for the walls' buckles, else None.
 
     The rule (:data:`MIN_FACE_CELLS`, :data:`MIN_HALF_WAVE_CELLS` across,
@@ -402,7 +406,7 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     for the finest cells) is a priori, from the section's
     dimensions and cell size: on cells too coarse for the buckles the shell's critical
     stress is too high (it falls as the cells are refined), and so are k and the design
-    values.
+    values. Lengths in the unit system ``units``, the file's.
     """
     p = parameters
     width, across = _buckle_width(p)
@@ -418,12 +422,19 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     if not short:
         return None
     cells, need, span, where = min(short, key=lambda c: c[0] / c[1])  # the finest cells asked
+    metres, unit = _length_unit(units)
     return (
-        f"mesh.size = {p.mesh_size:.3g} m gives {cells:.2g} cells {where} "
-        f"({span:.3g} m), fewer than {need:g}: on cells this coarse the critical stress, k "
-        f"and the design values come out too high (refine mesh.size to {span / need:.3g} m "
-        'or less; docs/guide/sections.md, "Cell size")'
+        f"mesh.size = {p.mesh_size / metres:.3g} {unit} gives {cells:.2g} cells {where} "
+        f"({span / metres:.3g} {unit}), fewer than {need:g}: on cells this coarse the "
+        "critical stress, k and the design values come out too high (refine mesh.size to "
+        f'{span / need / metres:.3g} {unit} or less; docs/guide/sections.md, "Cell size")'
     )
+
+
+def _length_unit(units: str) -> tuple[float, str]:
+    """Metres per length unit of the unit system ``units``, and the unit's name."""
+    metres = UNITS[units][0]
+    return metres, "m" if metres == 1.0 else "mm"
 
 
 def buckle_length(parameters: SectionParameters) -> tuple[float, str]:
@@ -458,21 +469,23 @@ def _buckle_width(parameters: SectionParameters) -> tuple[float, str]:
     return half_wave(p), "the tube's axisymmetric half-wave"
 
 
-def thick_wall_note(parameters: SectionParameters) -> str | None:
+def thick_wall_note(parameters: SectionParameters, units: str = "SI") -> str | None:
     """A warning when the wall is thick for the shell model, else None.
 
     The plate's rule (:func:`~unibuckle_fenicsx.spec.checks.plate_model_note`): the
     shell's Reissner-Mindlin kinematics model walls up to about
     :data:`~unibuckle_fenicsx.spec.plate.THICK_PLATE_RATIO` times the width of their
-    buckles (:func:`_buckle_width`).
+    buckles (:func:`_buckle_width`). Lengths in the unit system ``units``, the file's.
     """
     p = parameters
     span, what = _buckle_width(p)
     ratio = p.thickness / span
     if ratio <= THICK_PLATE_RATIO:
         return None
+    metres, unit = _length_unit(units)
     return (
-        f"section.thickness = {p.thickness:g} m is {ratio:.3g} times {what} ({span:.3g} m): "
+        f"section.thickness = {p.thickness / metres:g} {unit} is {ratio:.3g} times {what} "
+        f"({span / metres:.3g} {unit}): "
         "the shell (transverse shear, no thickness stretch) is a model of walls up to about "
         f"{THICK_PLATE_RATIO:g} times the width of their buckles; beyond, compare with a "
         "3-D solid model"

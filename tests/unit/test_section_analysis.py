@@ -263,3 +263,39 @@ def test_walls_thick_for_the_shell_model_draw_a_warning():
     assert half_wave(thick) == pytest.approx(0.07730, rel=1e-3)
     note = thick_wall_note(thick)
     assert note is not None and "0.259 times the tube's axisymmetric half-wave" in note
+
+
+def test_the_warnings_of_a_file_in_mm_n_mpa_are_in_its_units(caplog):
+    """A file in mm-N-MPa: its warnings in mm and MPa, not in the SI of the solve.
+
+    The column's warning said "Euler stress 5.527e+08 Pa" and the cells' "mesh.size =
+    0.05 m" to a file that writes 50 mm and 210000 MPa. The box 100 x 100 x 4 mm, 2.5 m
+    between simply supported ends: Euler's pi^2 E (b^2/6)/L^2 = 552.7 MPa.
+    """
+    from unibuckle_fenicsx import section_from_dict
+    from unibuckle_fenicsx.section_analysis import column_note
+
+    column = SectionParameters(
+        "box", width=0.1, depth=0.1, thickness=0.004, length=2.5, E=E, nu=NU, mesh_size=0.02,
+        ends="simply_supported",
+    )  # fmt: skip
+    euler = math.pi**2 * E * (0.1**2 / 6.0) / 2.5**2
+    note = column_note(column, 5.457e8, False, "mm-N-MPa")
+    assert note is not None
+    assert (
+        "critical axial stress 545.7 MPa" in note and f"Euler stress {euler / 1e6:.4g} MPa" in note
+    )
+    assert "Pa is" not in note.replace("MPa", "")
+    mm = section_from_dict({
+        "units": "mm-N-MPa",
+        "section": {"shape": "box", "width": 200.0, "depth": 100.0, "thickness": 2.0,
+                    "length": 200.0, "ends": "simply_supported"},
+        "material": {"E": 2.1e5, "nu": NU},
+        "mesh": {"size": 50.0, "levels": 0},
+    })  # fmt: skip
+    with caplog.at_level(logging.WARNING, logger="unibuckle_fenicsx.section_analysis"):
+        with solve_section(mm, MPI.COMM_SELF):
+            pass
+    messages = " ".join(r.getMessage() for r in caplog.records)
+    assert "mesh.size = 50 mm gives 2 cells across the narrowest face (100 mm)" in messages
+    assert "refine mesh.size to 20 mm or less" in messages

@@ -14,7 +14,7 @@ import msgspec
 from msgspec import Meta
 
 from unibuckle_fenicsx.errors import FieldError
-from unibuckle_fenicsx.spec.base import Table, Units, unit
+from unibuckle_fenicsx.spec.base import UNITS, Table, Units, unit
 from unibuckle_fenicsx.spec.obstacles import DesignSpec
 from unibuckle_fenicsx.spec.solver import Method, SolverSpec
 
@@ -136,7 +136,13 @@ class CoreSpec(Table, frozen=True):
 
     KEY: ClassVar[str] = "obstacle"
     core: bool = False
-    span: Annotated[tuple[float, float], unit("m")] | None = None
+    span: (
+        Annotated[
+            tuple[float, float],
+            Meta(extra={"unit": "m", "form": "a pair [x0, x1] (from x0 to x1 along the member)"}),
+        ]
+        | None
+    ) = None
     foundation_stiffness: Annotated[float, unit("N/m^3", gt=0)] | None = None
 
     def check(self) -> None:
@@ -196,9 +202,12 @@ class SectionProblemSpec(Table, frozen=True):
         """The core's span lies on the member; the solver's options are a section's."""
         span, length = self.obstacle.span, self.section.length
         if span is not None and not 0.0 <= span[0] < span[1] <= length:
+            metres = UNITS[self.units][0]  # in the file's units
+            name = "m" if metres == 1.0 else "mm"
             raise self.error(
                 "obstacle.span",
-                f" must satisfy 0 <= x0 < x1 <= section.length = {length:g} m, got {list(span)}",
+                f" must satisfy 0 <= x0 < x1 <= section.length = {length / metres:g} {name}, "
+                f"got [{span[0] / metres:g}, {span[1] / metres:g}]",
             )
         check_section_method(self.solver.method)
         default = SolverSpec()

@@ -137,6 +137,9 @@ def _mapping(**changes):
          r"obstacle.foundation_stiffness must be > 0 N/m\^3"),
         ({"obstacle__core": True, "obstacle__span": [0.0, 0.5]},
          r"obstacle.span must satisfy 0 <= x0 < x1 <= section.length = 0.4 m"),
+        # A span is a pair along the member, not a plate's point [x, y].
+        ({"obstacle__core": True, "obstacle__span": [0.0, 0.1, 0.2]},
+         r"obstacle.span must be a pair \[x0, x1\] \(from x0 to x1 along the member\)"),
         ({"solver__method": "enumerate"},
          r'solver.method must be one of "auto", "interior-point", "active-set" for a '
          r"section, got 'enumerate'"),
@@ -147,6 +150,18 @@ def _mapping(**changes):
 def test_bad_section_input_is_refused_naming_the_key(changes, message):
     with pytest.raises(ValueError, match=message):
         section_from_dict(_mapping(**changes))
+
+
+def test_a_span_off_the_member_is_refused_in_the_file_s_units():
+    """A file in mm-N-MPa: the span and the length as the file writes them, not in m."""
+    data = _mapping(obstacle__core=True, obstacle__span=[0.0, 500.0])
+    data["units"] = "mm-N-MPa"
+    data["section"] = {k: v * 1e3 for k, v in data["section"].items() if k != "shape"} | {
+        "shape": "box"
+    }
+    data["material"], data["mesh"] = {"E": 2.1e5, "nu": NU}, {"size": 50.0}
+    with pytest.raises(ValueError, match=r"section.length = 400 mm, got \[0, 500\]$"):
+        section_from_dict(data)
 
 
 def test_a_core_on_a_plate_is_refused():

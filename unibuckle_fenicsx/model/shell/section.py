@@ -50,7 +50,6 @@ from unibuckle_fenicsx.model.shell.problem import (
 from unibuckle_fenicsx.spec import Material, SectionProblemSpec, SolverSpec
 
 __all__ = [
-    "COLUMN_RATIO",
     "GEOMETRIC",
     "Section",
     "SectionFigureData",
@@ -60,22 +59,15 @@ __all__ = [
     "section_parameters",
 ]
 
-#: Displacement components in the geometric stiffness b: "donnell" (the normal
-#: deflection, as the plate model's b and the classical tube value), "full" (all three),
-#: or "auto" (:meth:`SectionParameters.donnell`: Donnell's unless the member is long
-#: enough to buckle as a column).
-GEOMETRIC = ("auto", "donnell", "full")
-#: With ``geometric = "auto"``, a member whose Euler stress
-#: (:meth:`SectionParameters.euler_stress`) is below this multiple of its walls'
-#: reference stress (:meth:`SectionParameters.classical_stress`) gets the full geometric
-#: stiffness. Donnell's leaves out the in-plane motion of the walls, which in a column's
-#: mode carries half of the section (a box's faces parallel to the deflection, a tube's
-#: wall by :math:`\sin^2`): it puts the column's load about twice too high. Above 4 times
-#: the reference, twice the Euler stress is above a hollow box's local modes (k up to
-#: about 7 on the widest face, 1.75 times the reference) and a tube's, whose load
-#: Donnell's gives as the classical theory does (the full stiffness is lower on a tube's
-#: modes of few circumferential waves: :doc:`/guide/sections`, "Limits").
-COLUMN_RATIO = 4.0
+#: Displacement components in the geometric stiffness b: "full" (all three: the axial
+#: stress's work on the wall's rotation in its own plane as well as out of it, the
+#: consistent term of the shell's stiffness, as in Flügge's and Sanders' stability
+#: equations) or "donnell" (the normal deflection only, the plate model's b). Donnell's
+#: leaves out the in-plane part, which a column's mode and a tube's modes of few
+#: circumferential waves carry: with this stiffness it puts a tube's n-wave mode about
+#: 1 + 1/n² too high and a column's load at twice Euler's; a box's walls' modes carry
+#: none of it (:doc:`/verification/sections_geometric`).
+GEOMETRIC = ("full", "donnell")
 
 
 @dataclass(frozen=True)
@@ -105,9 +97,9 @@ class SectionParameters:
         foundation_stiffness: The core as a tensionless Winkler foundation of this
             modulus (N/m^3), > 0 (:func:`~unibuckle_fenicsx.model.shell.core.core_springs`);
             None: a rigid core.
-        geometric: Components in b (:data:`GEOMETRIC`); "auto" by default: Donnell's
-            (the plate model's b on a flat face, the classical value on a tube) unless
-            the member can buckle as a column (:meth:`donnell`), whose load it doubles.
+        geometric: Components in b (:data:`GEOMETRIC`); "full" by default, the term
+            consistent with the shell's stiffness (Sanders' and Flügge's equations);
+            "donnell" only to compare with Donnell's shallow-shell theory.
         drilling: Drilling stiffness relative to Gt
             (:data:`~unibuckle_fenicsx.model.shell.forms.DRILLING_FACTOR`).
         corner_cell: A box's faces graded to cells this wide (m) at the corners
@@ -129,7 +121,7 @@ class SectionParameters:
     core: bool = False
     core_span: tuple[float, float] | None = None
     foundation_stiffness: float | None = None
-    geometric: str = "auto"
+    geometric: str = "full"
     drilling: float = DRILLING_FACTOR
     corner_cell: float | None = None
 
@@ -248,14 +240,7 @@ class SectionParameters:
         return math.pi**2 * self.E * r2 / effective**2
 
     def donnell(self) -> bool:
-        """Whether the geometric stiffness is Donnell's (the normal deflection only).
-
-        ``geometric = "auto"``: unless the member's Euler stress is below
-        :data:`COLUMN_RATIO` times its walls' reference stress, where a column's mode
-        needs the walls' in-plane motion in b.
-        """
-        if self.geometric == "auto":
-            return self.euler_stress() >= COLUMN_RATIO * self.classical_stress()
+        """Whether the geometric stiffness is Donnell's (the normal deflection only)."""
         return self.geometric == "donnell"
 
     @property
