@@ -8,7 +8,7 @@ from typing import Any, ClassVar, Literal
 import msgspec
 from msgspec.structs import force_setattr, replace
 
-from unibuckle_fenicsx.en1993 import STEEL_MODULUS, design_element
+from unibuckle_fenicsx.en1993 import check_steel_modulus, design_element
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.spec.base import UNITS, Table, stress_ends
 from unibuckle_fenicsx.spec.checks import check_features, check_supports
@@ -183,14 +183,11 @@ class ProblemSpec(Table, frozen=True):
         self._check_steel()
 
     def _check_steel(self) -> None:
-        """Refuse a Young's modulus (or a general stiffness) that is not a steel's.
+        """Refuse a general stiffness or a Young's modulus that is not a steel's.
 
-        EN 1993-1-5 4.4's rho (and epsilon = sqrt(235/f_y)) rest on steel, E = 210 GPa
-        (EN 1993-1-1 3.2.6); :data:`STEEL_MODULUS` keeps the moduli given for steels
-        (stainless 200 GPa, EN 1993-1-4 Table 2.1). Aluminium (70 GPa) has its own
-        curves (EN 1999-1-1 6.1.4), which this output does not give.
+        EN 1993-1-5 describes isotropic steel plates
+        (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
         """
-        low, high = STEEL_MODULUS
         _, stress, name = UNITS[self.units]
         general = [
             key
@@ -205,14 +202,7 @@ class ProblemSpec(Table, frozen=True):
                 f"design: material.{general[0]} gives a general stiffness, and EN 1993-1-5 "
                 "(Eurocode 3) describes isotropic steel plates; leave [design] out"
             )
-        if not low <= self.material.E <= high:
-            raise InputError(
-                f"design: material.E = {self.material.E / stress:.6g} {name} is not a steel's "
-                f"(EN 1993-1-5's rho rests on steel, E in [{low / stress:.6g}, "
-                f"{high / stress:.6g}] {name}: 210 GPa, stainless 200 GPa); for aluminium "
-                "use EN 1999-1-1 6.1.4, whose curves this output does not give; leave "
-                "[design] out"
-            )
+        check_steel_modulus(self.material.E, stress, name)
 
     def check_scaled_load(self) -> None:
         """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""
