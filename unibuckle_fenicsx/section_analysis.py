@@ -47,6 +47,7 @@ from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.registry import entry
 from unibuckle_fenicsx.analysis import FREE, choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
+from unibuckle_fenicsx.en1993 import check_steel_modulus
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode
@@ -295,11 +296,7 @@ def solve_section(
             f"solve_section: parameters must be a SectionParameters or a SectionProblemSpec, "
             f"got {type(parameters).__name__}"
         )
-    if isinstance(levels, bool) or int(levels) != levels or levels < 0:
-        raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    for note in (thick_wall_note(parameters, units), coarse_mesh_note(parameters, units)):
-        if note is not None:
-            logger.warning("%s", note)
+    _check(parameters, levels, design, units)
     certificate: Certificate | None = None
     solver = solver or SolverSpec()
     method, reason = choose_section_method(parameters, solver)
@@ -355,6 +352,24 @@ MIN_HALF_WAVE_CELLS = 2.5
 #: draw a warning, by the same measure: a short section buckles in one wave as long as
 #: the member, whatever its walls' own buckles (:doc:`/guide/sections`, "Cell size").
 MIN_ALONG_CELLS = 5
+
+
+def _check(
+    parameters: SectionParameters, levels: int, design: DesignSpec | None, units: str
+) -> None:
+    """Refuse what no solve should start with, and warn of walls or cells out of range.
+
+    Raises:
+        InputError: ``levels`` not an integer >= 0; a design output asked of a wall whose
+            E is not a steel's (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
+    """
+    if isinstance(levels, bool) or int(levels) != levels or levels < 0:
+        raise InputError(f"levels must be an integer >= 0, got {levels!r}")
+    if design is not None:
+        check_steel_modulus(parameters.E, *UNITS[units][1:])
+    for note in (thick_wall_note(parameters, units), coarse_mesh_note(parameters, units)):
+        if note is not None:
+            logger.warning("%s", note)
 
 
 def _design(
