@@ -108,23 +108,35 @@ SANDERS = 0.9601  # Sanders' equations over SIGMA_CL, L = R (tests/support/cylin
 
 
 # %%
+#: What a figure's sigma_cr is divided by: a face of the box as a long simply supported
+#: plate (k = 4), the tube's classical axisymmetric stress.
+REFERENCES = {"box": "the k = 4 plate's", "tube": "classical sigma_cl"}
+
+
+def title(name: str, state: str, sigma: float, reference: float) -> str:
+    """A 3-D figure's title: the section, its state, sigma_cr in MPa and over its reference."""
+    ratio = sigma / reference
+    return f"{name}, {state}: sigma_cr = {sigma / 1e6:.1f} MPa = {ratio:.3f} x {REFERENCES[name]}"
+
+
 def solve_and_draw(
     params: SectionParameters, name: str, reference: float, levels: int, hollow: bool
 ) -> dict:
-    """Solve a filled section; draw its filled (and ``hollow``: hollow) mode; the numbers."""
+    """Solve a filled section; draw its filled (and ``hollow``: hollow) mode; the numbers.
+
+    The figures' titles give sigma_cr in MPa and over ``reference`` (:data:`REFERENCES`).
+    """
     with solve_section(params, comm, levels=0 if args.coarse else levels) as analysis:
         result = analysis.result
         if comm.size == 1:
             from unibuckle_fenicsx.viz.section import plot_section_mode_3d
 
-            filled = result.critical_load_Pa / reference
-            hollow_ratio = result.free_load_Pa / reference
+            filled = title(name, "filled", result.critical_load_Pa, reference)
             paths = [
                 plot_section_mode_3d(
                     analysis.figure_data(),
                     figures / f"{name}_filled.png",
-                    title=f"{name}, filled: sigma_cr = {filled:.3f} x reference "
-                    f"({result.ratio_to_free:.2f} x hollow)",
+                    title=f"{filled} ({result.ratio_to_free:.2f} x hollow)",
                 )
             ]
             if hollow:
@@ -132,7 +144,7 @@ def solve_and_draw(
                     plot_section_mode_3d(
                         analysis.figure_data(free=True),
                         figures / f"{name}_hollow.png",
-                        title=f"{name}, hollow: sigma_cr = {hollow_ratio:.4f} x reference",
+                        title=title(name, "hollow", result.free_load_Pa, reference),
                         show_core=False,
                     )
                 )
@@ -180,7 +192,7 @@ with solve_section(hollow_tube, comm) as analysis:
         path = plot_section_mode_3d(
             analysis.figure_data(),
             figures / "tube_hollow.png",
-            title=f"tube, hollow: sigma_cr = {tube['fine_hollow/reference']:.4f} x reference",
+            title=title("tube", "hollow", result.critical_load_Pa, SIGMA_CL),
             show_core=False,
         )
         print(f"wrote {path}")

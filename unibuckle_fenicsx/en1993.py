@@ -39,12 +39,14 @@ __all__ = [
     "ELEMENTS",
     "INTERNAL",
     "OUTSTAND",
+    "STEEL_MODULUS",
     "DesignEdge",
     "DesignElement",
     "DesignLoad",
     "DesignPlate",
     "DesignProblem",
     "buckling_factor",
+    "check_steel_modulus",
     "design_element",
     "psi_range",
     "reduction_factor",
@@ -58,6 +60,33 @@ INTERNAL = "internal"
 OUTSTAND = "outstand"
 #: The elements of EN 1993-1-5 4.4(2).
 ELEMENTS = (INTERNAL, OUTSTAND)
+#: Young's moduli (Pa) taken as a steel's by the design output: structural steel's 210
+#: GPa (EN 1993-1-1 3.2.6) and stainless steel's 200 GPa (EN 1993-1-4 Table 2.1), with
+#: the 200-205 GPa some codes and texts give carbon steel; aluminium (70 GPa) and other
+#: metals lie far outside.
+STEEL_MODULUS = (1.9e11, 2.2e11)
+
+
+def check_steel_modulus(E: float, stress: float, name: str) -> None:
+    """Refuse a Young's modulus ``E`` (Pa) that is not a steel's (:data:`STEEL_MODULUS`).
+
+    EN 1993-1-5 4.4's rho (and epsilon = sqrt(235/f_y)) rest on steel, E = 210 GPa
+    (EN 1993-1-1 3.2.6); aluminium (70 GPa) has its own curves (EN 1999-1-1 6.1.4),
+    which the design output does not give. ``stress`` and ``name`` are the file's
+    stress unit in Pa and its name, for the message.
+
+    Raises:
+        InputError: ``E`` outside :data:`STEEL_MODULUS`, naming ``material.E``.
+    """
+    low, high = STEEL_MODULUS
+    if not low <= E <= high:
+        raise InputError(
+            f"design: material.E = {E / stress:.6g} {name} is not a steel's "
+            f"(EN 1993-1-5's rho rests on steel, E in [{low / stress:.6g}, "
+            f"{high / stress:.6g}] {name}: 210 GPa, stainless 200 GPa); for aluminium "
+            "use EN 1999-1-1 6.1.4, whose curves this output does not give; leave "
+            "[design] out"
+        )
 
 
 def table_row(element: str, free_edge_most_compressed: bool) -> str:

@@ -47,6 +47,7 @@ from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.registry import entry
 from unibuckle_fenicsx.analysis import FREE, choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
+from unibuckle_fenicsx.en1993 import check_steel_modulus
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode
@@ -173,6 +174,15 @@ class SectionResult(BucklingResult, kw_only=True):
                 f"{self.contact_nodes}, KKT = {'yes' if cert.kkt else 'NO'}, "
                 f"certificate {cert.status} (lower bound {bound} by {cert.proven_by})"
             )
+            bracket = self._bound_line(
+                scale,
+                unit,
+                what="critical stress",
+                free="the hollow section's",
+                ratio=sigma / self.critical_load_Pa,
+            )
+            if bracket:
+                lines.append(bracket)
         if isinstance(self.design, SectionDesignRecord):
             lines.append(design_line(self.design, scale, unit))
         return "\n  ".join(lines)
@@ -246,7 +256,8 @@ def solve_section(
             or a section's problem file
             (:class:`~unibuckle_fenicsx.spec.section.SectionProblemSpec`: its
             ``mesh.levels``, ``[solver]`` and ``[design]`` replace ``levels``, ``solver``
-            and ``design``, and the result's ``input`` is the file, which re-runs it).
+            and ``design``, the result's ``case`` is the file's ``name`` and its ``input``
+            the file, which re-runs it).
         comm: Communicator; the mesh is distributed over it.
         levels: With a core, coarser sections (each with twice the mesh size) the search
             starts on, >= 0 (:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`:
@@ -274,9 +285,9 @@ def solve_section(
     """
     t0 = time.perf_counter()
     echo: dict[str, object] | None = None
-    units = "SI"
+    units, name = "SI", None
     if isinstance(parameters, SectionProblemSpec):
-        echo = problem_to_dict(parameters)
+        echo, name = problem_to_dict(parameters), parameters.name
         levels, solver, design = parameters.mesh.levels, parameters.solver, parameters.design
         units = parameters.units
         parameters = section_parameters(parameters)
@@ -285,11 +296,7 @@ def solve_section(
             f"solve_section: parameters must be a SectionParameters or a SectionProblemSpec, "
             f"got {type(parameters).__name__}"
         )
-    if isinstance(levels, bool) or int(levels) != levels or levels < 0:
-        raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    for note in (thick_wall_note(parameters, units), coarse_mesh_note(parameters, units)):
-        if note is not None:
-            logger.warning("%s", note)
+    _check(parameters, levels, design, units)
     certificate: Certificate | None = None
     solver = solver or SolverSpec()
     method, reason = choose_section_method(parameters, solver)
@@ -319,8 +326,8 @@ def solve_section(
                     "; ".join(certificate.notes) or certificate.status,
                 )
         result = _result(section, free, solution, certificate, time.perf_counter() - t0, reason)
-        if echo is not None:
-            result.input, result.units = echo, units
+        if echo is not None:  # a file's run: its name, its input
+            result.case, result.input, result.units = str(name), echo, units
         column = column_note(parameters, result.critical_load_Pa, solution is not None, units)
         if column is not None:
             logger.warning("%s", column)
@@ -345,6 +352,24 @@ MIN_HALF_WAVE_CELLS = 2.5
 #: draw a warning, by the same measure: a short section buckles in one wave as long as
 #: the member, whatever its walls' own buckles (:doc:`/guide/sections`, "Cell size").
 MIN_ALONG_CELLS = 5
+
+
+def _check(
+    parameters: SectionParameters, levels: int, design: DesignSpec | None, units: str
+) -> None:
+    """Refuse what no solve should start with, and warn of walls or cells out of range.
+
+    Raises:
+        InputError: ``levels`` not an integer >= 0; a design output asked of a wall whose
+            E is not a steel's (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
+    """
+    if isinstance(levels, bool) or int(levels) != levels or levels < 0:
+        raise InputError(f"levels must be an integer >= 0, got {levels!r}")
+    if design is not None:
+        check_steel_modulus(parameters.E, *UNITS[units][1:])
+    for note in (thick_wall_note(parameters, units), coarse_mesh_note(parameters, units)):
+        if note is not None:
+            logger.warning("%s", note)
 
 
 def _design(

@@ -500,16 +500,11 @@ def solve_point(spec: ProblemSpec | SectionProblemSpec, comm: MPI.Comm) -> dict[
 
 
 def _solve(spec: ProblemSpec | SectionProblemSpec, comm: MPI.Comm) -> dict[str, object]:
-    from unibuckle_fenicsx.analysis import solve
-    from unibuckle_fenicsx.section_analysis import solve_section
+    from unibuckle_fenicsx.run import analyse
 
     try:
-        if isinstance(spec, SectionProblemSpec):
-            with solve_section(spec, comm) as section:
-                result = section.result
-        else:
-            with solve(spec, comm) as analysis:
-                result = analysis.result
+        with analyse(spec, comm) as analysis:
+            result = analysis.result
     except (InputError, NumericalError) as err:  # anything else is a bug: it stops the sweep
         return {"status": str(Outcome.of(err)), "error": str(err)}
     return {"status": str(Outcome.of(result)), **result.as_dict(timings=False)}

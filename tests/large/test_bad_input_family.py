@@ -1,8 +1,8 @@
 r"""The bad-input family: every key of the problem file given a bad value, and bad files.
 
-Five base problem files hold every key of the schema (README, "Problem files"): a
-rectangle with an anisotropic material, every edge key, three obstacles (box, polygon,
-circle), every solver key and design output; a bilateral foundation; an outline with
+Five base problem files hold every key of the schema (README, "Problem files"): a steel
+rectangle with every edge key, three obstacles (box, polygon, circle), every solver key
+and design output; a bilateral foundation on an anisotropic material; an outline with
 holes, segments and a cell size; restrained edges, fixed and thermal loads, point
 restraints and a gapped obstacle; a laminate. Each of their values, and each number
 inside a list value, is replaced in turn by a value of the wrong type (a string, a
@@ -276,6 +276,13 @@ RULES: list[tuple[str, str, dict[tuple, Any], str]] = [
     ),
     ("design: an outline", "outline", {("design",): {"yield_stress": 3.55e8}}, "plate.outline"),
     ("design: a laminate", "laminate", {("design",): {"yield_stress": 3.55e8}}, "material.plies"),
+    ("design: aluminium", "rectangle", {("material", "E"): 7.0e10}, "material.E"),
+    (
+        "design: a general stiffness",
+        "foundation",
+        {("design",): {"yield_stress": 3.55e8}},
+        "material.membrane_voigt",
+    ),
     (
         "a one-sided point without its side",
         "features",

@@ -135,6 +135,11 @@ def _design_by_hand(data: dict) -> tuple[str, str | None] | str:
     at_supported = bool(free) and psi != 1.0 and unloaded[k] != free[0]
     if psi < (-1.0 if at_supported else -3.0):
         return "stress ratio psi"
+    # EN 1993-1-5 is a steel code: E = 210 GPa (EN 1993-1-1 3.2.6), isotropic.
+    if "membrane_voigt" in data["material"]:
+        return "material.membrane_voigt gives a general stiffness"
+    if data["material"]["E"] != 2.1e11:
+        return "is not a steel's"
     return ("outstand", free[0]) if free else ("internal", None)
 
 

@@ -15,13 +15,7 @@ RECTANGLE = {
     "name": "base",
     "units": "SI",
     "plate": {"corners": [[0.0, 0.0], [0.2, 0.1]], "thickness": 0.006},
-    "material": {
-        "E": 1.0e9,
-        "nu": 0.3,
-        "shear_correction": 0.8,
-        "membrane_voigt": [[6.6e6 * q for q in row] for row in _Q],
-        "bending_voigt": [[_D * q for q in row] for row in _Q],
-    },
+    "material": {"E": 2.1e11, "nu": 0.3},  # a steel's: the design output refuses others
     "edges": {
         "left": {
             "support": "simply_supported",
@@ -58,7 +52,13 @@ RECTANGLE = {
 }
 FOUNDATION = {
     "plate": {"corners": [[0.0, 0.0], [0.2, 0.1]], "thickness": 0.006},
-    "material": {"E": 1.0e9, "nu": 0.3},
+    "material": {
+        "E": 1.0e9,
+        "nu": 0.3,
+        "shear_correction": 0.8,
+        "membrane_voigt": [[6.6e6 * q for q in row] for row in _Q],
+        "bending_voigt": [[_D * q for q in row] for row in _Q],
+    },
     "obstacle": {"zone": "all", "side": "both", "foundation_stiffness": 1.0e7},
 }
 OUTLINE = {

@@ -116,6 +116,32 @@ def test_design_of_a_laminate_is_refused():
         plate(edges, material={"plies": plies})
 
 
+@pytest.mark.parametrize(
+    "material, match",
+    [
+        # Aluminium, E = 70 GPa: EN 1999-1-1 6.1.4 has its own curves. Before, the 300 x
+        # 100 x 3 mm SSSS plate (f_y = 250 MPa) got EN 1993-1-5's rho = 0.7691, exit 0.
+        ({"E": 70000.0, "nu": 0.33}, r"material\.E = 70000 MPa is not a steel's .*190000, 220000"),
+        ({"E": 250000.0, "nu": 0.3}, r"material\.E = 250000 MPa is not a steel's"),
+        (
+            {"E": 210000.0, "nu": 0.3, "bending_voigt": [[1e6, 0, 0], [0, 1e6, 0], [0, 0, 1e5]]},
+            r"material\.bending_voigt gives a general stiffness",
+        ),
+    ],
+)
+def test_design_of_a_plate_not_of_steel_is_refused(material, match):
+    # EN 1993-1-5 4.4(2)'s rho rests on steel, E = 210 GPa (EN 1993-1-1 3.2.6).
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    with pytest.raises(ValueError, match=match):
+        plate(edges, material=material)
+
+
+def test_stainless_steel_keeps_the_design():
+    """E = 200 GPa (stainless steel, EN 1993-1-4 Table 2.1) is a steel's: not refused."""
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    assert plate(edges, material={"E": 200000.0, "nu": 0.3}).design is not None
+
+
 def test_uniform_compression():
     """Uniform: psi = 1, sigma_cr = lambda_c; slenderness, rho, rho f_y / gamma_M1 by hand."""
     out = result(plate({"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}))

@@ -19,6 +19,7 @@ from mpi4py import MPI
 import pytest
 
 from unibuckle_fenicsx import SectionParameters, solve_section
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.section_design import section_design
 from unibuckle_fenicsx.spec import DesignSpec, load_problem
 
@@ -203,3 +204,22 @@ def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):
     )  # fmt: skip
     with solve_section(without, MPI.COMM_SELF) as analysis:
         assert analysis.result.design is None
+
+
+def test_the_design_of_a_section_not_of_steel_is_refused(tmp_path):
+    # EN 1993-1-5 4.4(2)'s rho rests on steel, E = 210 GPa (EN 1993-1-1 3.2.6); an
+    # aluminium box (70 GPa) belongs to EN 1999-1-1 6.1.4: refused before any mesh.
+    path = tmp_path / "box.toml"
+    path.write_text(
+        "units = 'mm-N-MPa'\n[section]\nshape = 'box'\nwidth = 200\ndepth = 100\n"
+        "thickness = 2\nlength = 200\n[material]\nE = 70000\nnu = 0.33\n"
+        "[mesh]\nsize = 100\n[design]\nyield_stress = 250\n"
+    )
+    with pytest.raises(InputError, match=r"material\.E = 70000 MPa is not a steel's"):
+        load_problem(path)
+    aluminium = _section(E=7.0e10, nu=0.33)
+    with pytest.raises(InputError, match=r"material\.E = 7e\+10 Pa is not a steel's"):
+        solve_section(aluminium, MPI.COMM_SELF, design=DesignSpec(yield_stress=2.5e8))
+    # Without [design] the aluminium box is a fine problem (only the design is refused).
+    path.write_text(path.read_text().replace("[design]\nyield_stress = 250\n", ""))
+    assert load_problem(path).material.E == pytest.approx(7.0e10)

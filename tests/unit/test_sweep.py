@@ -173,9 +173,10 @@ def test_a_number_the_file_leaves_out_is_varied():
 
 
 def compressed_plate() -> dict[str, object]:
-    """A plate compressed on its short edges, with no [design] table."""
+    """A steel plate compressed on its short edges, with no [design] table."""
     return {
         "plate": {"corners": [[0.0, 0.0], [0.3, 0.1]], "thickness": 0.003},
+        "material": {"E": 2.1e11, "nu": 0.3},
         "edges": {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}},
     }
 

@@ -32,6 +32,7 @@ from unibuckle_fenicsx.cli.outputs import check_outputs
 from unibuckle_fenicsx.cli.schema import schema_command
 from unibuckle_fenicsx.cli.solve import solve_command
 from unibuckle_fenicsx.cli.status import (
+    BROKEN_PIPE,
     BUG_REPORT,
     EXIT_BAD_INPUT,
     EXIT_BUG,
@@ -39,11 +40,14 @@ from unibuckle_fenicsx.cli.status import (
     EXIT_NOT_CERTIFIED,
     EXIT_OK,
     PENDING,
+    ignore_broken_pipe,
     report_failure,
+    stdout_closed,
+    with_broken_pipe,
 )
 from unibuckle_fenicsx.cli.sweep import sweep_command
 from unibuckle_fenicsx.errors import NumericalError
-from unibuckle_fenicsx.outcome import Outcome, petsc_failure
+from unibuckle_fenicsx.outcome import Outcome, in_chain, petsc_failure
 
 __all__ = [
     "BUG_REPORT",
@@ -90,8 +94,9 @@ def main(argv: Sequence[str] | None = None) -> int:
     if unknown:  # the subcommand's usage line, not the top-level one
         commands[args.command].error(f"unrecognized arguments: {' '.join(unknown)}")
 
+    BROKEN_PIPE.clear()
     if args.command == "schema":
-        return schema_command(args)
+        return with_broken_pipe(schema_command(args))
 
     from mpi4py import MPI  # before petsc4py: loads libmpi
 
@@ -107,7 +112,7 @@ def main(argv: Sequence[str] | None = None) -> int:
     with _logging(args.verbose, args.quiet, comm.rank):
         ending = _Ending(comm)
         status, raised = _guarded_run(args, rest, comm)
-        return ending.finish(status, raised or bool(PENDING))
+        return with_broken_pipe(ending.finish(status, raised or bool(PENDING)))
 
 
 def _abort(comm: Any, status: int, message: str | None) -> NoReturn:
@@ -123,6 +128,8 @@ def _guarded_run(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> tu
     try:
         return run_command(args, rest, comm), False
     except (KeyboardInterrupt, Exception) as err:
+        if _broken_pipe(err):  # the reader of stdout stopped (| head): end quietly
+            return stdout_closed(), True
         outcome = Outcome.of(err)
         if outcome is Outcome.INTERRUPTED:
             return _interrupted(args, comm), True
@@ -206,6 +213,16 @@ def _interrupted(args: argparse.Namespace, comm: Any) -> int:
     return EXIT_INTERRUPTED
 
 
+def _broken_pipe(err: BaseException) -> bool:
+    """Whether ``err`` is a write to a closed standard output, by Python or by a PETSc viewer."""
+    import errno
+
+    if in_chain(err, BrokenPipeError) is not None:
+        return True
+    failure = petsc_failure(err)
+    return failure is not None and os.strerror(errno.EPIPE) in failure.reason
+
+
 def _message(err: BaseException, options: Sequence[str]) -> str:
     """The error line of a run that raised ``err`` (``options``: those given to PETSc)."""
     failure = petsc_failure(err)
@@ -224,6 +241,7 @@ def run_command(args: argparse.Namespace, rest: Sequence[str], comm: Any) -> int
     import petsc4py
 
     petsc4py.init([sys.argv[0], *rest])
+    ignore_broken_pipe()  # after PETSc's signal handler, which takes SIGPIPE for a crash
 
     if args.command == "sweep":
         return sweep_command(args, comm)

@@ -13,6 +13,7 @@ from typing import Any
 
 from unibuckle_fenicsx.cli.status import (
     EXIT_BAD_INPUT,
+    EXIT_BROKEN_PIPE,
     EXIT_BUG,
     EXIT_INTERRUPTED,
     EXIT_NOT_CERTIFIED,
@@ -44,6 +45,8 @@ exit status:
      exists (or none was found), the message gives the lower bound and no JSON is written
   {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
+  {EXIT_BROKEN_PIPE}  standard output closed by its reader (| head -1): ended quietly (mpiexec
+     gives the same status); the files written before stay
 
 Single-dash options that argparse does not know go to PETSc/SLEPc under the package's
 prefixes, e.g. -unibuckle_eps_view, -unibuckle_eps_tol 1e-12, -unibuckle_ldl_ksp_view.
@@ -78,6 +81,8 @@ exit status:
   {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C): the finished points are in --json; the same
      command resumes
+  {EXIT_BROKEN_PIPE}  standard output closed by its reader (| head -1): ended quietly (mpiexec
+     gives the same status); the files written before stay
 """
 
 NONLINEAR_EPILOG = f"""\
@@ -101,6 +106,8 @@ exit status:
      why and no JSON is written
   {EXIT_BUG}  an internal error (a bug): the traceback and a request for a report
   {EXIT_INTERRUPTED}  interrupted (Ctrl-C); nothing written
+  {EXIT_BROKEN_PIPE}  standard output closed by its reader (| head -1): ended quietly (mpiexec
+     gives the same status); the files written before stay
 
 {JSON_HELP}
 
@@ -210,10 +217,10 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "solve",
         parents=[problem, common],
         help="solve one problem (a paper case or a TOML file)",
-        description="Compute the critical load of one problem and print a one-line summary.\n"
+        description="Compute the critical load of one problem and print its summary.\n"
         "The problem is a plate (a paper case or a TOML file) or a section: a file with a\n"
         "[section] table (a box or a tube, with a core or hollow), solved on its [mesh]\n"
-        "size and levels (--nx, --ny and --output apply to plates only).",
+        "size and levels (--nx, --ny, --output and --candidate-parallel: plates only).",
         epilog=EPILOG,
         formatter_class=Formatter,
     )
@@ -222,8 +229,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "sweep",
         parents=[common],
         help="solve a problem file over a grid of values of some of its numbers",
-        description="Solve the problem of --config (a plate's or a section's file) at every "
-        "point of the --vary grid, writing one JSON line per point (resumable), and "
+        description="Solve the problem of --config (a plate's or a section's file) at every\n"
+        "point of the --vary grid, writing one JSON line per point (resumable), and\n"
         "optionally a chart of k (a section's: its critical stress over the classical one).",
         epilog=SWEEP_EPILOG,
         formatter_class=Formatter,

@@ -14,10 +14,15 @@ if TYPE_CHECKING:  # pragma: no cover
 from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
 
-def warn_plate_model(spec: ProblemSpec, comm: Any) -> None:
-    """A warning on stderr when the plate lies outside the plate model's usual range."""
+def warn_plate_model(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
+    """A warning on stderr when a plate lies outside the plate model's usual range.
+
+    A section's walls are checked by the section's solve (its log's warnings).
+    """
     from unibuckle_fenicsx.spec.checks import plate_model_note
 
+    if isinstance(spec, SectionProblemSpec):
+        return
     note = plate_model_note(spec.plate)
     if note is not None and comm.rank == 0:
         print(f"unibuckle: warning: {note}", file=sys.stderr)
@@ -34,6 +39,11 @@ def spec_from_args(args: argparse.Namespace) -> ProblemSpec | SectionProblemSpec
     if isinstance(spec, SectionProblemSpec):
         if args.nx is not None or args.ny is not None:
             raise InputError("--nx, --ny set a plate's cells; a section takes [mesh] size = h")
+        if getattr(args, "output", None):
+            raise InputError(
+                f"--output {args.output}: a section's fields are not written (its mode: the "
+                "Python API's SectionAnalysis.figure_data); give --json for the result"
+            )
         return spec
     if args.nx is not None or args.ny is not None:
         spec = spec.with_mesh(

@@ -11,31 +11,27 @@ from msgspec.structs import replace
 from unibuckle_fenicsx.cli.flags import solver_changes, unused_flags
 from unibuckle_fenicsx.cli.problem import spec_from_args, warn_plate_model
 from unibuckle_fenicsx.cli.status import print_out, report_failure
-from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
-from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
 
 def solve_command(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle solve``: one problem, its summary, JSON and fields."""
-    from unibuckle_fenicsx.analysis import solve
     from unibuckle_fenicsx.results.files import write_fields
+    from unibuckle_fenicsx.run import analyse
 
     # A refused input or a failed solve raises: main() tells the outcome.
     spec = spec_from_args(args)
     changes, flags = solver_changes(args)
-    if isinstance(spec, SectionProblemSpec):
-        return _section(args, replace(spec, solver=replace(spec.solver, **changes)), comm)
-    spec = spec.with_solver(**changes)
+    spec = replace(spec, solver=replace(spec.solver, **changes))
     method = spec.solver.method  # the flag's, or the problem file's
     _warn_unused(flags, method, comm)
     warn_plate_model(spec, comm)
-    analysis = solve(spec, comm, candidate_parallel=args.candidate_parallel)
+    analysis = analyse(spec, comm, candidate_parallel=args.candidate_parallel)
     unwritten = None
     with analysis:
-        if args.output:
+        if args.output:  # a plate's (spec_from_args refuses it for a section)
             try:
-                write_fields(analysis, args.output)
+                write_fields(analysis, args.output)  # type: ignore[arg-type]
             except OSError as err:  # the folder went away during the solve
                 unwritten = f"--output {args.output}: {err}"
     result = analysis.result
@@ -93,19 +89,6 @@ def resolution_note(resolution: float | None) -> str | None:
         "against its width that its stiffness loses that many digits; the load, k and "
         "the design values may be off by as much"
     )
-
-
-def _section(args: argparse.Namespace, spec: SectionProblemSpec, comm: Any) -> int:
-    """A section's file: solved by :func:`~unibuckle_fenicsx.section_analysis.solve_section`."""
-    from unibuckle_fenicsx.section_analysis import solve_section
-
-    if args.output:
-        raise InputError(
-            f"--output {args.output}: a section's fields are not written (its mode: the "
-            "Python API's SectionAnalysis.figure_data); give --json for the result"
-        )
-    with solve_section(spec, comm) as analysis:
-        return _report(args, analysis.result, comm, None)
 
 
 def _warn_unused(flags: list[str], method: str, comm: Any, result: Any = None) -> None:

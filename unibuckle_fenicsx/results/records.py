@@ -303,12 +303,22 @@ class BucklingResult(Struct, kw_only=True):
             f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{bound}{second}{extra}"
         )
 
-    def _bound_line(self, scale: float, unit: str) -> str:
+    def _bound_line(
+        self,
+        scale: float,
+        unit: str,
+        *,
+        what: str = "critical load",
+        free: str = "the free plate's",
+        ratio: float = 1.0,
+    ) -> str:
         """Where the critical load lies when it is not proven: the verified bracket.
 
         The printed load is that of an admissible mode, so the critical load is at most
         it; the verified lower bound is the safe value (the free plate's load when nothing
-        closer was verified; ``--bracket`` may raise it). Empty when proven.
+        closer was verified; ``--bracket`` may raise it). Empty when proven. ``what``,
+        ``free`` and ``ratio`` (the printed stress per unit load): a section's words and
+        its extreme fibre's stress.
         """
         cert = self.certificate
         if not self.constrained_nodes or cert is None or cert.global_optimum_proven:
@@ -317,8 +327,8 @@ class BucklingResult(Struct, kw_only=True):
         if lower is None:
             return ""
         by = cert.proven_by
-        how = "the free plate's, by interlacing" if by == "interlacing" else f"by {by}"
-        high = "no admissible mode" if upper is None else f"{upper / scale:.6e} {unit}"
+        how = f"{free}, by interlacing" if by == "interlacing" else f"by {by}"
+        high = "no admissible mode" if upper is None else f"{upper * ratio / scale:.6e} {unit}"
         # Two or more pencil eigenvalues below: only the low-rank bracket may do better.
         m = cert.negative_eigenvalues
         hint = ""
@@ -326,7 +336,7 @@ class BucklingResult(Struct, kw_only=True):
             tried = self._input_table("solver").get("bracket")
             hint = "; --bracket verified no higher bound" if tried else "; --bracket may raise it"
         return (
-            f"not proven: the critical load lies between {lower / scale:.6e} {unit} "
+            f"not proven: the {what} lies between {lower * ratio / scale:.6e} {unit} "
             f"(verified lower bound, {how}) and {high}{hint}"
         )
 

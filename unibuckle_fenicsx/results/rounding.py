@@ -2,8 +2,9 @@
 
 A result's JSON form (:meth:`~.records.BucklingResult.as_dict`) holds what the run did
 on this machine (its eigen solves, times, round-off); :func:`record` keeps what the
-problem decides, rounded to :data:`RECORD_DIGITS` significant digits, and
-:func:`rounded` is what a figure draws. The demos write their records with them.
+problem decides, its results rounded to :data:`RECORD_DIGITS` significant digits and
+its input exact (:data:`EXACT`), and :func:`rounded` is what a figure draws. The demos
+write their records with them.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from typing import Any
 import numpy as np
 import numpy.typing as npt
 
-__all__ = ["RECORD_DIGITS", "record", "rounded"]
+__all__ = ["EXACT", "RECORD_DIGITS", "record", "rounded"]
 
 #: Significant digits of the numbers a record keeps (:func:`record`): the loads carry
 #: about ten (the eigen solver's tolerance, 1e-10) and double precision fixes them to
@@ -40,6 +41,10 @@ CERTIFICATE_VERDICT = (
     "feasible", "kkt", "smallest_of_reduced", "global_optimum_proven", "proven_by", "status",
     "negative_eigenvalues", "tolerance",
 )  # fmt: skip
+#: What a record keeps exact: the problem it solved (a result's ``input``, a sweep line's
+#: ``point``). It is the same on every machine, and re-running a record's input must give
+#: the same problem: ``mesh.size`` = b/12 rounded to 0.083333333 meshes 13 cells across.
+EXACT = frozenset({"input", "point"})
 #: The contact set's keys, left out of a record with ``contact=False`` (the contact
 #: force lists its pushes in the order of the set).
 CONTACT_KEYS = ("contact_nodes", "contact_coordinates", "contact_indices", "contact_force")
@@ -50,7 +55,8 @@ def record(data: Any, *, contact: bool = True) -> Any:
 
     The same on every machine up to its last digit: the keys of :data:`RUN_DEPENDENT`
     left out at any depth, a certificate reduced to its verdict
-    (:data:`CERTIFICATE_VERDICT`), every number rounded to :data:`RECORD_DIGITS`
+    (:data:`CERTIFICATE_VERDICT`), the problem (:data:`EXACT`) kept as it is, every
+    other number rounded to :data:`RECORD_DIGITS`
     significant digits, those of a list of numbers to the digits of its largest (a
     coordinate's rounding, 3e-19 beside 0.1, is then 0). A number that lies within its
     noise of a rounding boundary may still change its last digit between machines.
@@ -65,6 +71,9 @@ def record(data: Any, *, contact: bool = True) -> Any:
         out = {}
         for key, value in data.items():
             if key in RUN_DEPENDENT or (not contact and key in CONTACT_KEYS):
+                continue
+            if key in EXACT:
+                out[key] = value
                 continue
             if key == "certificate" and isinstance(value, dict):
                 value = {k: value[k] for k in CERTIFICATE_VERDICT if k in value}

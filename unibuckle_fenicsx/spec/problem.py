@@ -8,7 +8,7 @@ from typing import Any, ClassVar, Literal
 import msgspec
 from msgspec.structs import force_setattr, replace
 
-from unibuckle_fenicsx.en1993 import design_element
+from unibuckle_fenicsx.en1993 import check_steel_modulus, design_element
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.spec.base import UNITS, Table, stress_ends
 from unibuckle_fenicsx.spec.checks import check_features, check_supports
@@ -153,9 +153,9 @@ class ProblemSpec(Table, frozen=True):
     def _check_design(self) -> None:
         """The design output needs a compressive normal edge stress (its sigma_cr).
 
-        And a plate that EN 1993-1-5 4.4 describes: of steel (not a laminate), an internal
-        or an outstand element (:func:`~unibuckle_fenicsx.en1993.design_element` says
-        which, or refuses).
+        And a plate that EN 1993-1-5 4.4 describes: an internal or an outstand element
+        (:func:`~unibuckle_fenicsx.en1993.design_element` says which, or refuses), of steel
+        (not a laminate, nor another metal: :meth:`_check_steel`).
         """
         if self.design is None:
             return
@@ -180,6 +180,29 @@ class ProblemSpec(Table, frozen=True):
                 "stress, and this load has none (give a loaded edge normal_stress < 0)"
             )
         design_element(self)
+        self._check_steel()
+
+    def _check_steel(self) -> None:
+        """Refuse a general stiffness or a Young's modulus that is not a steel's.
+
+        EN 1993-1-5 describes isotropic steel plates
+        (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
+        """
+        _, stress, name = UNITS[self.units]
+        general = [
+            key
+            for key, value in (
+                ("membrane_voigt", self.material.membrane_voigt),
+                ("bending_voigt", self.material.bending_voigt),
+            )
+            if value is not None
+        ]
+        if general:
+            raise InputError(
+                f"design: material.{general[0]} gives a general stiffness, and EN 1993-1-5 "
+                "(Eurocode 3) describes isotropic steel plates; leave [design] out"
+            )
+        check_steel_modulus(self.material.E, stress, name)
 
     def check_scaled_load(self) -> None:
         """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""

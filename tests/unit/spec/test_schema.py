@@ -11,6 +11,7 @@ family's three bases come from its module.
 from __future__ import annotations
 
 import json
+import signal
 import subprocess
 import sys
 from pathlib import Path
@@ -137,10 +138,11 @@ def test_unibuckle_schema_writes_it(tmp_path, capsys):
 
 
 def test_unibuckle_schema_into_a_pipe_closed_early(tmp_path):
-    """``unibuckle schema | head``: a reader that stops early is not an error.
+    """``unibuckle schema | head``: a reader that stops early ends it quietly, status 141.
 
     The pipe is closed before the command writes (it takes a few tenths of a second to
-    start), so its write meets a closed pipe for certain: no traceback, status 0.
+    start), so its write meets a closed pipe for certain: no traceback, 128 + SIGPIPE, the
+    status of any command a closed pipe ends (``seq 100 | head -1`` under pipefail).
     """
     script = Path(sys.executable).parent / "unibuckle"
     proc = subprocess.Popen(
@@ -149,7 +151,7 @@ def test_unibuckle_schema_into_a_pipe_closed_early(tmp_path):
     assert proc.stdout is not None and proc.stderr is not None
     proc.stdout.close()  # what head does after its lines
     err = proc.stderr.read().decode()
-    assert proc.wait() == EXIT_OK, err
+    assert proc.wait() == 128 + signal.SIGPIPE, err
     assert "Traceback" not in err and "BrokenPipe" not in err, err
 
 

@@ -188,6 +188,12 @@ def test_bad_section_file_exits_2_before_any_mesh(tmp_path, monkeypatch, capsys)
     assert main(bad) == EXIT_BAD_INPUT
     assert "section.thickness must be < half of width and depth (0.05 m)" in capsys.readouterr().err
     assert main(["solve", "--config", str(path), "--nx", "4"]) == EXIT_BAD_INPUT
+    # A plate's flags: --output (fields), --candidate-parallel (an enumeration; it was
+    # ignored, the section solved on its distributed mesh).
+    assert main(["solve", "--config", str(path), "--output", str(tmp_path)]) == EXIT_BAD_INPUT
+    assert "a section's fields are not written" in capsys.readouterr().err
+    assert main(["solve", "--config", str(path), "--candidate-parallel"]) == EXIT_BAD_INPUT
+    assert "--candidate-parallel shares a plate's enumeration" in capsys.readouterr().err
     # A key of the other shape (--set adds it, the schema refuses it): the box's own keys
     # are named, not a plate's shortcuts.
     bad = ["solve", "--config", str(path), "--set", "section.diameter=0.2"]
@@ -212,8 +218,11 @@ def _plate_face_load() -> float:
 def test_unibuckle_solve_runs_a_section_file(tmp_path, capsys):
     out = tmp_path / "box.json"
     assert main(["solve", "--config", str(_write(tmp_path)), "--json", str(out)]) == EXIT_OK
-    assert "section-box: sigma_cr" in capsys.readouterr().out
+    # The file's name (its stem, box.toml giving none) heads the summary and the JSON, as
+    # a plate's does: it was "section-box" whatever the file.
+    assert capsys.readouterr().out.startswith("box: sigma_cr")
     r = json.loads(out.read_text())
+    assert r["case"] == "box"
     load = r["critical_load_Pa"]
     # The plate solver's face (0.27 % apart on these cells: the box's faces also stretch
     # in their plane at the corners), and the long box's k = 4 (4.07 on b/8; 4.007 on
