@@ -173,6 +173,42 @@ def test_newton_direction_solves_the_linearised_conditions(side, thin_plate):
 
 
 @serial
+def test_a_line_search_that_backtracks_to_its_end_returns_the_step_it_applied(thin_plate):
+    """The load moves by the returned step times dlambda, the mode by the step applied.
+
+    A direction pointing out of the cone (every trial's barrier objective infinite) with
+    a descending slope backtracks ``max_backtracks`` times: the mode then is the
+    normalised u0 + alpha du of the last trial, and the returned alpha must be that one
+    (it was one backtrack factor smaller).
+    """
+    spec = thin_plate(nx=6, ny=3)
+    problem = build_problem(spec, MPI.COMM_SELF)
+    options = NewtonOptions(max_backtracks=3, backtrack=0.5)
+    with InteriorPointNewton(problem, options) as newton:
+        kernel = newton.kernel
+        u = newton.starts.pressure_mode()  # strictly inside the cone
+        vec = u.x.petsc_vec
+        kernel.normalize(vec)
+        u0 = vec.array.copy()
+        gap = -kernel.oriented(vec)
+        assert gap.min() > 0
+        kernel.du.set(0.0)
+        kernel.add_zone(kernel.du, -1e3 * np.abs(u0).max() * np.ones(gap.size))  # outward
+        du = kernel.du.array.copy()
+        kernel.A.mult(vec, kernel.Au)
+        energy_slope = abs(kernel.Au.dot(kernel.du))
+        mu_abs = 1e-3
+        # A descending slope Au.du + mu sum(dz/g) < 0: the search does not stop at once.
+        dz = -gap * (1.0 + 10.0 * energy_slope / (mu_abs * gap.size))
+        alpha = kernel.line_search(vec, mu_abs, 1.0, dz, gap, e_u=1.0)
+        applied = vec.array.copy()
+    problem.destroy()
+    assert alpha == pytest.approx(0.25, rel=1e-15)  # 1, 0.5, 0.25: three trials
+    trial = u0 + alpha * du
+    assert np.allclose(applied / np.abs(applied).max(), trial / np.abs(trial).max(), atol=1e-12)
+
+
+@serial
 def test_negative_curvature_is_the_lowest_curvature_on_the_tangent_space(thin_plate):
     r"""At a load above the second free one, K has a negative direction on the tangent space.
 

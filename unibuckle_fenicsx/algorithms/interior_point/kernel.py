@@ -307,17 +307,21 @@ class NewtonKernel(Owner):
         gap: npt.NDArray[np.float64],
         e_u: float,
     ) -> float:
-        """Backtrack from ``alpha`` on the barrier objective; apply the step to ``u``."""
+        """Backtrack from ``alpha`` on the barrier objective; apply the step to ``u``.
+
+        Returns the step length applied: the accepted one, or the last tried when every
+        backtrack fails.
+        """
         local = e_u <= self.options.local_residual
         phi0 = self.merit(u, mu_abs)
         self.A.mult(u, self.Au)
         slope = dot(self.Au, self.du) + mu_abs * self.sum((dz / gap).sum())
         opts = self.options
-        for _ in range(opts.max_backtracks):
+        for tried in range(1, opts.max_backtracks + 1):
             u.copy(self.trial)
             self.trial.axpy(alpha, self.du)
             self.normalize(self.trial)
-            if local or slope >= 0.0:
+            if local or slope >= 0.0 or tried == opts.max_backtracks:
                 break
             phi = self.merit(self.trial, mu_abs)
             if phi <= phi0 + opts.armijo * alpha * slope + MERIT_RTOL * abs(phi0):

@@ -121,7 +121,7 @@ class NewtonOptions:
         armijo: Sufficient decrease of the backtracking line searches, relative to
             the model's (Nocedal & Wright's :math:`c_1`, 1e-4).
         backtrack: Factor of a step length per backtrack (in (0, 1): halving).
-        max_backtracks: Backtracks of a line search before it gives up.
+        max_backtracks: Trials of a line search before it gives up (>= 1; the last is applied).
         held_stiffness: A DOF held fixed by a diagonal entry gets this times the largest
             diagonal entry of A: it moves by its inverse (1e-8) of the correction.
         interior_margin: The gap, relative to max|w|, of a barrier point made from an
