@@ -45,6 +45,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.registry import entry
+from unibuckle_fenicsx.algorithms.section_levels import check_levels
 from unibuckle_fenicsx.analysis import FREE, choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.en1993 import check_steel_modulus
@@ -360,11 +361,14 @@ def _check(
     """Refuse what no solve should start with, and warn of walls or cells out of range.
 
     Raises:
-        InputError: ``levels`` not an integer >= 0; a design output asked of a wall whose
+        InputError: ``levels`` not an integer >= 0, or (a rigid core) its coarsest
+            section without 2 cells along; a design output asked of a wall whose
             E is not a steel's (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
     """
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
+    if parameters.core and parameters.foundation_stiffness is None:  # a rigid core's levels
+        check_levels(parameters, int(levels), units)
     if design is not None:
         check_steel_modulus(parameters.E, *UNITS[units][1:])
     for note in (thick_wall_note(parameters, units), coarse_mesh_note(parameters, units)):

@@ -71,6 +71,7 @@ from unibuckle_fenicsx.model.shell.problem import CoredSectionProblem
 from unibuckle_fenicsx.model.shell.prolong import SectionProlongation
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import SolverSpec
+from unibuckle_fenicsx.spec.base import in_file
 
 __all__ = [
     "CHAIN_OPTIONS",
@@ -190,7 +191,7 @@ def solve_levels(
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
     if route not in ROUTES:
         raise InputError(f"route must be one of {ROUTES}, got {route!r}")
-    _check_levels(parameters, levels)
+    check_levels(parameters, levels)
     if route == "interior-point":
         more = interior_levels(parameters, levels)
         return _interior_point(parameters, more, comm, solver, levels, max_iterations)
@@ -359,14 +360,20 @@ def _most_levels(parameters: SectionParameters) -> int:
     return most
 
 
-def _check_levels(parameters: SectionParameters, levels: int) -> None:
-    """Refuse ``levels`` whose coarsest section has fewer than 2 cells along the member."""
+def check_levels(parameters: SectionParameters, levels: int, units: str = "SI") -> None:
+    """Refuse ``levels`` whose coarsest section has fewer than 2 cells along the member.
+
+    The message in the unit system ``units`` (:data:`~unibuckle_fenicsx.spec.base.UNITS`),
+    the file's.
+    """
     most = _most_levels(parameters)
     if levels > most:
+        coarsest, name = in_file(parameters.mesh_size * 2.0**levels, "m", units)
+        length, _ = in_file(parameters.length, "m", units)
         raise InputError(
             f"mesh.levels = {levels}: the coarsest section's cells, mesh.size x 2^{levels} = "
-            f"{parameters.mesh_size * 2.0**levels:g} m, are not below section.length = "
-            f"{parameters.length:g} m (at least 2 cells along): mesh.levels <= {most} here"
+            f"{coarsest:g} {name}, are not below section.length = "
+            f"{length:g} {name} (at least 2 cells along): mesh.levels <= {most} here"
         )
 
 

@@ -20,6 +20,7 @@ import contextvars
 import enum
 import functools
 import math
+import re
 import types
 import typing
 from collections.abc import Iterator, Mapping
@@ -50,6 +51,54 @@ DIMENSIONS: dict[str, tuple[int, int] | list[tuple[int, int]]] = {
     "N m": (3, 1),  # = Pa m^3
     "K, K/m": [(0, 0), (-1, 0), (-1, 0)],  # a rise, or [T0, dT/dx, dT/dy]
 }
+
+
+#: The unit system of the file being read (:data:`UNITS`): its messages speak it.
+FILE_UNITS: contextvars.ContextVar[str] = contextvars.ContextVar("file_units", default="SI")
+
+
+def factor(dims: tuple[int, int], units: str, sign: int = 1) -> float:
+    """SI units per unit of dimensions (length, stress) in ``units`` (``sign`` -1: inverse).
+
+    A quotient for negative powers (N/m^3 = Pa/m): ``S / L``, not ``L**-1 * S``.
+    """
+    length, stress, _ = UNITS[units]
+    p, q = dims
+    up = (length ** max(p, 0) * stress ** max(q, 0)) ** sign
+    return up / (length ** max(-p, 0) * stress ** max(-q, 0)) ** sign
+
+
+def unit_name(name: str, units: str | None = None) -> str:
+    """The SI unit ``name`` (of :data:`DIMENSIONS`) as ``units`` writes it (None: the file's).
+
+    "m" -> "mm", "Pa" -> "MPa", "N/m^3" -> "N/mm^3" in mm-N-MPa; other names as they are.
+    """
+    units = FILE_UNITS.get() if units is None else units
+    if units == "SI" or name not in DIMENSIONS:
+        return name
+    length = "m" if UNITS[units][0] == 1.0 else "mm"
+    return re.sub(r"\bPa\b", UNITS[units][2], re.sub(r"\bm\b", length, name))
+
+
+def in_file[V](value: V, name: str, units: str | None = None) -> tuple[V, str]:
+    """The SI ``value`` in the unit ``name`` as ``units`` writes it, and the unit's name.
+
+    ``value``: a number, or lists or tuples of numbers; ``units``: None for the file's
+    being read (:data:`FILE_UNITS`). In SI the value itself (its messages unchanged);
+    else rounded to 12 digits, the conversion's last-bit noise dropped (2 mm -> 0.002 m
+    -> 2.0000000000000004 mm).
+    """
+    units, dims = FILE_UNITS.get() if units is None else units, DIMENSIONS.get(name)
+    if units == "SI" or not isinstance(dims, tuple):
+        return value, name
+    per = factor(dims, units)
+
+    def convert(x: Any) -> Any:
+        if isinstance(x, list | tuple):
+            return type(x)(convert(v) for v in x)
+        return float(f"{x / per:.12g}") if isinstance(x, int | float) else x
+
+    return convert(value), unit_name(name, units)
 
 
 def unit(name: str, **bounds: Any) -> Meta:
@@ -340,7 +389,7 @@ def _range(tp: Any) -> str:
         )
         return "a " + text.format(size)
     bounds = {op: v for op in _SIGNS if (v := metadata(tp, op)) is not None}
-    suffix = f" {metadata(tp, 'unit')}" if metadata(tp, "unit") else ""
+    suffix = f" {unit_name(metadata(tp, 'unit'))}" if metadata(tp, "unit") else ""
     if len(bounds) == 2:  # an interval
         (low, a), (high, b) = bounds.items()
         return f"in {'(['[low == 'ge']}{a:g}, {b:g}{')]'[high == 'le']}{suffix}"

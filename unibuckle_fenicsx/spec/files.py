@@ -30,12 +30,14 @@ from unibuckle_fenicsx.laminate import laminate
 from unibuckle_fenicsx.spec.base import (
     CONVERTING,
     DIMENSIONS,
+    FILE_UNITS,
     UNITS,
     Stress,
     as_table,
     as_tables,
     child,
     element,
+    factor,
     form,
     hints,
     join,
@@ -91,15 +93,18 @@ def section_from_dict(data: Mapping[str, object], name: str = "section") -> Sect
 
 def _convert[S: (ProblemSpec, SectionProblemSpec)](api: dict[str, object], root: type[S]) -> S:
     """The Structs' form ``api`` of a file as ``root``: in SI, a laminate's E and nu set."""
-    if isinstance(units := api.get("units"), str) and units in UNITS:
-        api = as_table(scaled(api, root, units, 1))
-    token = CONVERTING.set(True)
+    written = api  # the file's numbers, for messages (in its units, as it writes them)
+    units = api.get("units")
+    units = units if isinstance(units, str) and units in UNITS else "SI"
+    api = as_table(scaled(api, root, units, 1))
+    token, in_units = CONVERTING.set(True), FILE_UNITS.set(units)
     try:
-        return msgspec.convert(_laminate(api) if root is ProblemSpec else api, root)
+        return msgspec.convert(_laminate(api, written) if root is ProblemSpec else api, root)
     except msgspec.ValidationError as err:
-        raise InputError(_message(err, api, root=root)) from None
+        raise InputError(_message(err, api, root=root, written=written)) from None
     finally:
         CONVERTING.reset(token)
+        FILE_UNITS.reset(in_units)
 
 
 def is_section(data: Mapping[str, object]) -> bool:
@@ -183,20 +188,9 @@ def scaled(value: object, tp: object, units: str, sign: int) -> object:
         if isinstance(value, list):  # of another length: left for the Structs to refuse
             if len(value) != len(dims):
                 return value
-            return [_times(v, _factor(d, units, sign)) for v, d in zip(value, dims, strict=True)]
+            return [_times(v, factor(d, units, sign)) for v, d in zip(value, dims, strict=True)]
         dims = dims[0]
-    return _times(value, _factor(dims, units, sign))
-
-
-def _factor(dims: tuple[int, int], units: str, sign: int) -> float:
-    """SI units per unit of dimensions (length, stress) in ``units`` (``sign`` -1: inverse).
-
-    A quotient for negative powers (N/m^3 = Pa/m): ``S / L``, not ``L**-1 * S``.
-    """
-    length, stress, _ = UNITS[units]
-    p, q = dims
-    up = (length ** max(p, 0) * stress ** max(q, 0)) ** sign
-    return up / (length ** max(-p, 0) * stress ** max(-q, 0)) ** sign
+    return _times(value, factor(dims, units, sign))
 
 
 def _times(value: object, factor: float) -> object:
@@ -310,15 +304,18 @@ def _zone(table: Mapping[str, object], where: str) -> dict[str, object]:
     return out
 
 
-def _laminate(api: dict[str, object]) -> dict[str, object]:
-    """A laminate's E and nu, and its plate's thickness, from its plies if not given."""
+def _laminate(api: dict[str, object], written: object = None) -> dict[str, object]:
+    """A laminate's E and nu, and its plate's thickness, from its plies if not given.
+
+    ``written``: the file's numbers (before their conversion to SI), for messages.
+    """
     material = api.get("material")
     if not (isinstance(material, Mapping) and isinstance(material.get("plies"), list)):
         return api
     try:
         plies = msgspec.convert(material["plies"], tuple[Ply, ...])
     except msgspec.ValidationError as err:
-        raise InputError(_message(err, api, ["material", "plies"])) from None
+        raise InputError(_message(err, api, ["material", "plies"], written=written)) from None
     if not plies:
         raise InputError(
             "material.plies must be a list of tables ([[material.plies]] in TOML), at least "
@@ -337,8 +334,13 @@ def _message(
     api: object,
     prefix: list[str | int] | None = None,
     root: type[ProblemSpec | SectionProblemSpec] = ProblemSpec,
+    written: object = None,
 ) -> str:
-    """The message of msgspec's ``err`` converting ``api``, naming the file's key."""
+    """The message of msgspec's ``err`` converting ``api``, naming the file's key.
+
+    A value refused by its type or range is quoted from ``written`` (the file's numbers,
+    before their conversion to SI; None: ``api``'s).
+    """
     steps = [*(prefix or []), *location(err)]
     cause = err.__cause__
     if isinstance(cause, FieldError):
@@ -348,7 +350,7 @@ def _message(
         return str(cause)
     if cause is not None:
         raise cause
-    tp, value = walk(root, api, steps)
+    tp, value = walk(root, api if written is None else written, steps)
     return reason(_file_key(steps, api), value, tp)
 
 

@@ -11,7 +11,7 @@ from msgspec import Meta
 
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.laminate import laminate
-from unibuckle_fenicsx.spec.base import Matrix3, Table, unit
+from unibuckle_fenicsx.spec.base import Matrix3, Table, in_file, unit
 
 Modulus = Annotated[float, unit("Pa", gt=0)]
 
@@ -139,9 +139,10 @@ class Material(Table, frozen=True):
             )
         E, nu = stack.engineering_constants()
         if not (math.isclose(self.E, E, rel_tol=1e-9) and math.isclose(self.nu, nu, rel_tol=1e-9)):
+            (E, name), (given, _) = in_file(E, "Pa"), in_file(self.E, "Pa")
             raise self.error(
                 "E",
-                f" and material.nu of a laminate are its in-plane constants E_x = {E:.6g} Pa "
-                f"and nu_xy = {nu:.6g} from the plies (got {self.E!r}, {self.nu!r}): leave "
+                f" and material.nu of a laminate are its in-plane constants E_x = {E:.6g} "
+                f"{name} and nu_xy = {nu:.6g} from the plies (got {given!r}, {self.nu!r}): leave "
                 "them out (Material.from_plies)",
             )

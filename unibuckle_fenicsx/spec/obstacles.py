@@ -20,9 +20,11 @@ from unibuckle_fenicsx.spec.base import (
     Point,
     Table,
     Temperature,
+    in_file,
     plain,
     temperature_field,
     unit,
+    unit_name,
 )
 from unibuckle_fenicsx.spec.plate import Circle, PlateSpec, Polygon
 
@@ -84,7 +86,8 @@ class ObstacleSpec(Table, frozen=True):
     def check(self) -> None:
         """The rules between this table's fields."""
         if isinstance(self.zone, tuple) and any(lo > hi for lo, hi in self.zone):
-            raise self.error("zone", f" needs xmin <= xmax and ymin <= ymax, got {self.zone!r}")
+            zone = in_file(self.zone, "m")[0]
+            raise self.error("zone", f" needs xmin <= xmax and ymin <= ymax, got {zone!r}")
         if self.side == "both" and self.foundation_stiffness is None:
             raise self.error(
                 "side",
@@ -254,11 +257,13 @@ class PointSpec(Table, frozen=True):
         if isinstance(self.spacing, float | int):  # the same in x and y
             force_setattr(self, "spacing", (self.spacing, self.spacing))
         if self.spacing is not None and min(self.spacing) <= 0.0:
-            raise self.error("spacing", f" must be > 0 m, got {plain(self.spacing)!r}")
+            spacing, name = in_file(plain(self.spacing), "m")
+            raise self.error("spacing", f" must be > 0 {name}, got {spacing!r}")
         if (self.kind == "spring") != (self.stiffness is not None):
             raise self.error(
                 "stiffness",
-                f': kind = "spring" needs a stiffness > 0 N/m, got {self.stiffness!r}'
+                f': kind = "spring" needs a stiffness > 0 {unit_name("N/m")}, got '
+                f"{self.stiffness!r}"
                 if self.kind == "spring"
                 else f' belongs to kind = "spring", not "{self.kind}"',
             )

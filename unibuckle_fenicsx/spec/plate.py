@@ -24,7 +24,7 @@ from unibuckle_fenicsx.geometry import (
     polygon_inside,
     polygons_disjoint,
 )
-from unibuckle_fenicsx.spec.base import Point, Stress, Table, plain, stress_ends, unit
+from unibuckle_fenicsx.spec.base import Point, Stress, Table, in_file, plain, stress_ends, unit
 
 #: Edge names of a rectangular plate, in facet-tag order 1..4.
 EDGE_NAMES = ("left", "right", "bottom", "top")
@@ -285,7 +285,7 @@ class PlateSpec(Table, frozen=True):
             raise self.error(
                 "corners",
                 " must satisfy x1 > x0 and y1 > y0 (a non-degenerate rectangle), got "
-                f"{self.corners!r}",
+                f"{in_file(self.corners, 'm')[0]!r}",
             )
         names = [e.name for e in self.edges]
         if len(set(names)) != len(names):
@@ -295,10 +295,11 @@ class PlateSpec(Table, frozen=True):
         self._check_edges()
         b = min(self.length, self.width)
         if self.file is None and self.thickness > MAX_THICKNESS_RATIO * b:
+            (t, name), (side, _) = in_file(self.thickness, "m"), in_file(b, "m")
             raise self.error(
                 "thickness",
-                f" = {self.thickness:g} m is {self.thickness / b:.3g} times the plate's smaller "
-                f"side {b:g} m: not a plate; plate.thickness must be at most "
+                f" = {t:g} {name} is {self.thickness / b:.3g} times the plate's smaller "
+                f"side {side:g} {name}: not a plate; plate.thickness must be at most "
                 f"{MAX_THICKNESS_RATIO:g} times it (Reissner-Mindlin theory is a model of "
                 f"plates up to t/b of about {THICK_PLATE_RATIO:g})",
             )

@@ -10,7 +10,7 @@ from msgspec.structs import force_setattr, replace
 
 from unibuckle_fenicsx.en1993 import check_steel_modulus, design_element
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.spec.base import UNITS, Table, stress_ends
+from unibuckle_fenicsx.spec.base import UNITS, Table, in_file, stress_ends
 from unibuckle_fenicsx.spec.checks import check_features, check_supports
 from unibuckle_fenicsx.spec.material import Material
 from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec, PointSpec
@@ -63,9 +63,10 @@ class ProblemSpec(Table, frozen=True):
         if self.material.plies:
             total = sum(ply.thickness for ply in self.material.plies)
             if not math.isclose(self.plate.thickness, total, rel_tol=1e-9):
+                (t, name), (sum_t, _) = in_file(self.plate.thickness, "m"), in_file(total, "m")
                 raise InputError(
-                    f"plate.thickness = {self.plate.thickness!r} m differs from the plies' "
-                    f"total {total!r} m: leave plate.thickness out for a laminate (it is the "
+                    f"plate.thickness = {t!r} {name} differs from the plies' "
+                    f"total {sum_t!r} {name}: leave plate.thickness out for a laminate (it is the "
                     "plies')"
                 )
         self._check_load()

@@ -15,7 +15,7 @@ from msgspec import Meta
 
 from unibuckle_fenicsx.en1993 import check_steel_modulus
 from unibuckle_fenicsx.errors import FieldError
-from unibuckle_fenicsx.spec.base import UNITS, Table, Units, unit
+from unibuckle_fenicsx.spec.base import UNITS, Table, Units, in_file, unit
 from unibuckle_fenicsx.spec.obstacles import DesignSpec
 from unibuckle_fenicsx.spec.solver import Method, SolverSpec
 
@@ -81,10 +81,11 @@ class SectionSpec(Table, frozen=True):
                 )
         across = min(getattr(self, k) for k in keys)
         if self.thickness >= 0.5 * across:
+            (half, name), (t, _) = in_file(0.5 * across, "m"), in_file(self.thickness, "m")
             raise self.error(
                 "thickness",
-                f" must be < half of {' and '.join(keys)} ({0.5 * across:g} m): the walls "
-                f"would meet, got {self.thickness!r}",
+                f" must be < half of {' and '.join(keys)} ({half:g} {name}): the walls "
+                f"would meet, got {t!r}",
             )
 
 

@@ -48,6 +48,7 @@ from unibuckle_fenicsx.model.shell.problem import (
     section_problem,
 )
 from unibuckle_fenicsx.spec import Material, SectionProblemSpec, SolverSpec
+from unibuckle_fenicsx.spec.base import in_file
 
 __all__ = [
     "GEOMETRIC",
@@ -135,12 +136,7 @@ class SectionParameters:
             )
         _positive("length", self.length)
         _positive("mesh_size", self.mesh_size)
-        if self.mesh_size * (1.0 + 1e-9) >= self.length:  # geometry's cells along: ceil(L/h)
-            raise InputError(
-                f"mesh.size = {self.mesh_size:g} m must be below section.length = "
-                f"{self.length:g} m: the section needs at least 2 cells along its length "
-                "(the nodes of its loaded ends are supported)"
-            )
+        check_cells_along(self.mesh_size, self.length)
         if self.corner_cell is not None:
             _positive("corner_cell", self.corner_cell)
         if not (isinstance(self.E, int | float) and math.isfinite(self.E) and self.E > 0):
@@ -251,9 +247,29 @@ class SectionParameters:
         return float(self.diameter or 0.0)
 
 
+def check_cells_along(size: float, length: float, units: str = "SI") -> None:
+    """Refuse a cell size ``size`` not below ``length`` (m): 2 cells along at least.
+
+    The message in the unit system ``units`` (:data:`~unibuckle_fenicsx.spec.base.UNITS`),
+    the file's.
+    """
+    if size * (1.0 + 1e-9) >= length:  # geometry's cells along: ceil(L/h)
+        (h, name), (L, _) = in_file(size, "m", units), in_file(length, "m", units)
+        raise InputError(
+            f"mesh.size = {h:g} {name} must be below section.length = {L:g} {name}: the "
+            "section needs at least 2 cells along its length (the nodes of its loaded ends "
+            "are supported)"
+        )
+
+
 def section_parameters(spec: SectionProblemSpec) -> SectionParameters:
-    """The :class:`SectionParameters` of a section's problem file (checked already)."""
+    """The :class:`SectionParameters` of a section's problem file (checked already).
+
+    Raises:
+        InputError: A cell size not below the length (in the file's units).
+    """
     s, core = spec.section, spec.obstacle
+    check_cells_along(spec.mesh.size, s.length, spec.units)
     return SectionParameters(
         s.shape, thickness=s.thickness, length=s.length, E=spec.material.E,
         nu=spec.material.nu, mesh_size=spec.mesh.size, width=s.width, depth=s.depth,
