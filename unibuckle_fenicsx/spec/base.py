@@ -80,7 +80,7 @@ def unit_name(name: str, units: str | None = None) -> str:
     return re.sub(r"\bPa\b", UNITS[units][2], re.sub(r"\bm\b", length, name))
 
 
-def in_file[V](value: V, name: str, units: str | None = None) -> tuple[V, str]:
+def in_file(value: Any, name: str, units: str | None = None) -> tuple[Any, str]:
     """The SI ``value`` in the unit ``name`` as ``units`` writes it, and the unit's name.
 
     ``value``: a number, or lists or tuples of numbers; ``units``: None for the file's
