@@ -81,7 +81,8 @@ def test_design_keys_are_read_converted_and_written_back():
 @pytest.mark.parametrize(
     "design, extra, match",
     [
-        ({"yield_stress": 0.0}, {}, r"design\.yield_stress must be > 0 Pa"),
+        # The file is in mm-N-MPa: its unit (MPa) and its number in the message.
+        ({"yield_stress": 0.0}, {}, r"design\.yield_stress must be > 0 MPa, got 0\.0$"),
         ({"yield_stress": 355.0, "partial_factor": -1}, {}, r"design\.partial_factor must be >= 1"),
         # gamma_M1 = 0.9 put rho f_y/gamma_M1 11 % above rho f_y, accepted (EN 1993-1-1,
         # 6.1: recommended 1.0; a resistance factor is not below 1).
