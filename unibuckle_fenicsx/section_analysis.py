@@ -77,6 +77,7 @@ from unibuckle_fenicsx.spec import (
     SolverSpec,
     problem_to_dict,
 )
+from unibuckle_fenicsx.spec.base import in_file
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
 
 __all__ = [
@@ -451,19 +452,13 @@ def coarse_mesh_note(parameters: SectionParameters, units: str = "SI") -> str | 
     if not short:
         return None
     cells, need, span, where = min(short, key=lambda c: c[0] / c[1])  # the finest cells asked
-    metres, unit = _length_unit(units)
+    (size, finer, width), unit = in_file((p.mesh_size, span / need, span), "m", units)
     return (
-        f"mesh.size = {p.mesh_size / metres:.3g} {unit} gives {cells:.2g} cells {where} "
-        f"({span / metres:.3g} {unit}), fewer than {need:g}: on cells this coarse the "
+        f"mesh.size = {size:.3g} {unit} gives {cells:.2g} cells {where} "
+        f"({width:.3g} {unit}), fewer than {need:g}: on cells this coarse the "
         "critical stress, k and the design values come out too high (refine mesh.size to "
-        f'{span / need / metres:.3g} {unit} or less; docs/guide/sections.md, "Cell size")'
+        f'{finer:.3g} {unit} or less; docs/guide/sections.md, "Cell size")'
     )
-
-
-def _length_unit(units: str) -> tuple[float, str]:
-    """Metres per length unit of the unit system ``units``, and the unit's name."""
-    metres = UNITS[units][0]
-    return metres, "m" if metres == 1.0 else "mm"
 
 
 def buckle_length(parameters: SectionParameters) -> tuple[float, str]:
@@ -511,10 +506,10 @@ def thick_wall_note(parameters: SectionParameters, units: str = "SI") -> str | N
     ratio = p.thickness / span
     if ratio <= THICK_PLATE_RATIO:
         return None
-    metres, unit = _length_unit(units)
+    (t, width), unit = in_file((p.thickness, span), "m", units)
     return (
-        f"section.thickness = {p.thickness / metres:g} {unit} is {ratio:.3g} times {what} "
-        f"({span / metres:.3g} {unit}): "
+        f"section.thickness = {t:g} {unit} is {ratio:.3g} times {what} "
+        f"({width:.3g} {unit}): "
         "the shell (transverse shear, no thickness stretch) is a model of walls up to about "
         f"{THICK_PLATE_RATIO:g} times the width of their buckles; beyond, compare with a "
         "3-D solid model"

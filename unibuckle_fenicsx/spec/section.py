@@ -204,12 +204,11 @@ class SectionProblemSpec(Table, frozen=True):
         """The core's span lies on the member; the solver's options are a section's."""
         span, length = self.obstacle.span, self.section.length
         if span is not None and not 0.0 <= span[0] < span[1] <= length:
-            metres = UNITS[self.units][0]  # in the file's units
-            name = "m" if metres == 1.0 else "mm"
+            (L, x0, x1), name = in_file((length, *span), "m", self.units)  # the file's units
             raise self.error(
                 "obstacle.span",
-                f" must satisfy 0 <= x0 < x1 <= section.length = {length / metres:g} {name}, "
-                f"got [{span[0] / metres:g}, {span[1] / metres:g}]",
+                f" must satisfy 0 <= x0 < x1 <= section.length = {L:g} {name}, "
+                f"got [{x0:g}, {x1:g}]",
             )
         check_section_method(self.solver.method)
         if self.design is not None:
