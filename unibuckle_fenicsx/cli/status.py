@@ -60,6 +60,11 @@ def ignore_broken_pipe() -> None:
     """
     from petsc4py import PETSc  # noqa: F401  (initialises PETSc: its handlers are set)
 
+    _ignore_sigpipe()
+
+
+def _ignore_sigpipe() -> None:
+    """SIGPIPE ignored (Python's disposition at start-up), where the platform has it."""
     if hasattr(signal, "SIGPIPE"):
         signal.signal(signal.SIGPIPE, signal.SIG_IGN)
 
@@ -72,8 +77,7 @@ def print_out(text: str) -> None:
     run goes on (what it writes to files is written) and ends with
     :data:`EXIT_BROKEN_PIPE`, as a command that the signal ends would.
     """
-    if hasattr(signal, "SIGPIPE"):
-        signal.signal(signal.SIGPIPE, signal.SIG_IGN)
+    _ignore_sigpipe()
     try:
         print(text, flush=True)
     except BrokenPipeError:
