@@ -77,7 +77,7 @@ from unibuckle_fenicsx.spec import (
     SolverSpec,
     problem_to_dict,
 )
-from unibuckle_fenicsx.spec.base import in_file
+from unibuckle_fenicsx.spec.base import FILE_UNITS, in_file
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
 
 __all__ = [
@@ -303,7 +303,11 @@ def solve_section(
     solver = solver or SolverSpec()
     method, reason = choose_section_method(parameters, solver)
     logger.info("section: method %s (%s)", method, reason)
-    section, solution = _solve(parameters, int(levels), comm, method, solver)
+    in_units = FILE_UNITS.set(units)  # the messages of the mesh's checks (the core's span)
+    try:
+        section, solution = _solve(parameters, int(levels), comm, method, solver)
+    finally:
+        FILE_UNITS.reset(in_units)
     try:
         problem = section.problem
         t1 = time.perf_counter()

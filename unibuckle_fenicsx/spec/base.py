@@ -53,7 +53,8 @@ DIMENSIONS: dict[str, tuple[int, int] | list[tuple[int, int]]] = {
 }
 
 
-#: The unit system of the file being read (:data:`UNITS`): its messages speak it.
+#: The unit system of the file being read or solved (:data:`UNITS`): its messages speak
+#: it (:func:`~unibuckle_fenicsx.section_analysis.solve_section` sets it for its solve).
 FILE_UNITS: contextvars.ContextVar[str] = contextvars.ContextVar("file_units", default="SI")
 
 
