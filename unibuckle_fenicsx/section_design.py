@@ -272,8 +272,8 @@ def member_note(section: DesignSection, design: DesignSpec) -> str:
     text = (
         "the member's flexural buckling (EN 1993-1-1, 6.3.1) is not part of this output: "
         "its walls' section as a column has relative slenderness sqrt(f_y/sigma_E) = "
-        f"{slenderness:.3g} (sigma_E its Euler stress; buckling may be ignored at 0.2 "
-        "or less, 6.3.1.2(4))"
+        f"{slenderness:.3g} (sigma_E its Euler stress, L_e = L, or L/2 between clamped "
+        "ends; buckling may be ignored at 0.2 or less, 6.3.1.2(4))"
     )
     if section.core:
         text += (
