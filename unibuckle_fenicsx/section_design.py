@@ -264,7 +264,7 @@ def member_note(section: DesignSection, design: DesignSpec) -> str:
     mode shows only if it comes first (a warning says so), and a core keeps the walls
     off it. EN 1993-1-1, 6.3.1.2: the relative slenderness :math:`\sqrt{A f_y/N_{cr}} =
     \sqrt{f_y/\sigma_E}`, :math:`\sigma_E` the Euler stress of the walls' section
-    (:meth:`~unibuckle_fenicsx.model.shell.section.SectionParameters.euler_stress`);
+    (:meth:`~unibuckle_fenicsx.SectionParameters.euler_stress`);
     at 0.2 or less buckling may be ignored (6.3.1.2(4)). A filled member's needs the
     infill's stiffness (EN 1994-1-1, 6.7.3.3), which the output does not have.
     """
