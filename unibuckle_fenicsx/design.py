@@ -59,6 +59,7 @@ __all__ = [
     "at_lower_bound",
     "clauses",
     "design_output",
+    "euler_stress",
     "reduction_factor",
 ]
 
@@ -92,8 +93,14 @@ class DesignRecord(Struct, kw_only=True):
         notes: What the output rests on, and what it leaves out.
         psi: :math:`\psi = \sigma_2/\sigma_1` along that edge.
         relative_slenderness: :math:`\bar\lambda_p`, 4.4(2).
-        k_sigma_table: The table's buckling factor :math:`k_\sigma` at :math:`\psi` (None
-            outside the table's range of :math:`\psi`).
+        k_sigma: This plate's buckling factor :math:`k_\sigma = \sigma_{cr}/\sigma_E`,
+            :math:`\sigma_E = \pi^2 E t^2/(12(1 - \nu^2) b^2)` with b the loaded edge's
+            length (EN 1993-1-5 Annex A.1, eq. (A.2)): what the plate's edges, aspect,
+            obstacle and points give.
+        k_sigma_table: The table's :math:`k_\sigma` at :math:`\psi`, for comparison: a
+            long plate with hinged edges (Table 4.1 or 4.2), not this plate's (a clamped
+            square's ``k_sigma`` is 10.1, its ``k_sigma_table`` 4.0); None outside the
+            table's range of :math:`\psi`.
         reduction_factor: :math:`\rho`, eq. (4.2) or (4.3); None outside the table's
             range of :math:`\psi`.
         reduced_design_stress_Pa: :math:`\rho f_y/\gamma_{M1}` (absent without
@@ -114,6 +121,7 @@ class DesignRecord(Struct, kw_only=True):
     notes: list[str]
     psi: float | None = None
     relative_slenderness: float | None = None
+    k_sigma: float | None = None
     k_sigma_table: float | None = None
     reduction_factor: float | None = None
     reduced_design_stress_Pa: float | UnsetType = UNSET
@@ -210,6 +218,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.psi = psi
     slenderness = math.sqrt(design.yield_stress / sigma1)
     out.relative_slenderness = slenderness
+    out.k_sigma = sigma1 / euler_stress(spec, element.loaded)
     low, _ = psi_range(element.kind, at_free)
     if psi < low:  # only with a fixed part: a scaled one alone is refused beforehand
         out.notes.append(f"psi = {psi:.3g} < {low:g}: outside {out.table}, no rho")
@@ -220,6 +229,19 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.reduction_factor = rho
     out.reduced_design_stress_Pa = rho * design.yield_stress / design.partial_factor
     return out
+
+
+def euler_stress(spec: ProblemSpec, loaded: tuple[str, str]) -> float:
+    r""":math:`\sigma_E = \pi^2 E t^2/(12(1 - \nu^2) b^2)` (Pa), EN 1993-1-5 eq. (A.2).
+
+    b is the length of the ``loaded`` edges: the y extent for left and right, the x
+    extent for bottom and top. The material is isotropic (the design output refuses a
+    laminate and a Voigt matrix).
+    """
+    plate, material = spec.plate, spec.material
+    b = plate.width if loaded == ("left", "right") else plate.length
+    ratio = plate.thickness / b
+    return math.pi**2 * material.E * ratio**2 / (12.0 * (1.0 - material.nu**2))
 
 
 #: Said when the critical load is not proven the lowest.

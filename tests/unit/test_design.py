@@ -22,7 +22,7 @@ import pytest
 
 from support.paths import ROOT
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.design import reduction_factor
+from unibuckle_fenicsx.design import euler_stress, reduction_factor
 from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
 
 
@@ -156,6 +156,37 @@ def test_uniform_compression():
     assert "calibrated on plates buckling freely to both sides" in d.notes[0]
     assert "4.4(2), eq. (4.2)" in d.clauses
     assert "EN 1993-1-5: sigma_cr" in out.summary()
+
+
+def test_k_sigma_is_the_plate_s_and_k_sigma_table_the_long_hinged_plate_s():
+    """A clamped square (300 x 300 x 2 mm, loaded on bottom and top, 24 x 24 cells).
+
+    ``k_sigma`` = sigma_cr / sigma_E, sigma_E = pi^2 E t^2 / (12 (1 - nu^2) b^2) by
+    hand (EN 1993-1-5 eq. (A.2), b the loaded edge's length 300 mm): near Timoshenko
+    and Gere's 10.07 (*Theory of elastic stability*, 2nd ed., section 9.5: a clamped
+    square; 10.18 on these cells, the mesh's error); ``k_sigma_table`` is Table
+    4.1's 4.0 at psi = 1, the long hinged plate's. Before, only the table's 4.0 was
+    given, easy to read as this plate's k.
+    """
+    clamped = {"support": "clamped"}
+    edges = {
+        "left": clamped,
+        "right": clamped,
+        "bottom": {**clamped, "normal_stress": -1.0},
+        "top": {**clamped, "normal_stress": -1.0},
+    }
+    square = {"corners": [[0, 0], [300, 300]], "thickness": 2.0}
+    spec = plate(edges, mesh={"nx": 24, "ny": 24})
+    d = result(problem_from_dict({**problem_to_dict(spec), "plate": square})).design
+    euler = math.pi**2 * 210000e6 * (2.0 / 300.0) ** 2 / (12 * (1 - 0.3**2))
+    assert d.k_sigma == pytest.approx(d.sigma_cr_Pa / euler, rel=1e-12)
+    assert d.k_sigma == pytest.approx(10.07, rel=0.015)
+    assert d.k_sigma_table == 4.0
+    # b is the loaded edges' length: the x extent for bottom and top (300 of 300 x 450 mm)
+    tall = problem_from_dict(
+        {**problem_to_dict(spec), "plate": {**square, "corners": [[0, 0], [300, 450]]}}
+    )
+    assert euler_stress(tall, ("bottom", "top")) == pytest.approx(euler, rel=1e-12)
 
 
 def test_stress_gradient_obstacle_shear_and_fixed_part():
