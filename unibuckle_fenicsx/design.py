@@ -19,7 +19,7 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
   interpolates :math:`\rho_c = (\rho - \chi_c)\xi(2 - \xi) + \chi_c` between the
   plate's :math:`\rho` and the column's :math:`\chi_c` (4.5.3: :math:`\sigma_{cr,c} =
   \pi^2 E t^2/(12(1 - \nu^2) a^2)`, curve a), :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1`
-  in [0, 1]; at :math:`\xi \ge 1` (most plates with :math:`a/b \ge 1`) it is :math:`\rho`;
+  in [0, 1]; at :math:`\xi \ge 1`, and for :math:`a/b \ge 1`, it is :math:`\rho`;
 
 What the clause does not describe is refused when the problem is built (both unloaded
 edges free, biaxial stress, a temperature rise, a plate that is not a rectangle, ...);
@@ -109,19 +109,19 @@ class DesignRecord(Struct, kw_only=True):
             long plate with hinged edges (Table 4.1 or 4.2), not this plate's (a clamped
             square's ``k_sigma`` is 10.1, its ``k_sigma_table`` 4.0); None outside the
             table's range of :math:`\psi`.
-        reduction_factor: The reduction factor to apply, :math:`\rho_c` of 4.5.4(1):
-            the plate-type ``plate_reduction_factor`` where :math:`\xi \ge 1`, else
-            interpolated towards the column-type ``column_reduction_factor``; None
-            outside the table's range of :math:`\psi`.
+        reduction_factor: The reduction factor to apply: for a short plate (a/b < 1,
+            the note of 4.4(2)) :math:`\rho_c` of 4.5.4(1), the plate-type
+            ``plate_reduction_factor`` interpolated towards the column-type
+            ``column_reduction_factor`` where :math:`\xi < 1`; else
+            ``plate_reduction_factor``. None outside the table's range of :math:`\psi`.
         plate_reduction_factor: :math:`\rho`, eq. (4.2) or (4.3).
         column_critical_stress_Pa: :math:`\sigma_{cr,c} = \pi^2 E t^2/(12(1 - \nu^2)
             a^2)`, a the plate's length along the stress (4.5.3(2), eq. (4.8)): the
             plate as a column, its unloaded edges' supports removed.
         column_reduction_factor: :math:`\chi_c` at :math:`\bar\lambda_c = \sqrt{f_y/
             \sigma_{cr,c}}`, curve a (:math:`\alpha` = 0.21, 4.5.3(4), (5)).
-        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)); below 1 (short
-            plates: the note of 4.4(2) for :math:`a/b < 1`) column-type buckling lowers
-            the reduction factor.
+        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)); below 1 on a short
+            plate column-type buckling lowers the reduction factor.
         reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M1}` (absent without
             :math:`\rho`).
         lower_bound: When the critical load is not proven the lowest (a KKT point, or
@@ -251,15 +251,16 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.k_sigma_table = buckling_factor(element.kind, psi, at_free)
     rho = reduction_factor(slenderness, psi, element.kind, at_free)
     out.plate_reduction_factor = rho
-    # The plate as a column (4.5.3, 4.5.4): a short plate (a/b < 1) buckles like one.
+    # The plate as a column (4.5.3, 4.5.4): a short plate (a/b < 1) may buckle like one.
     column = euler_stress(spec, element.loaded, along=True)
     chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
     out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
     out.xi = sigma1 / column - 1.0
-    rho_c = interpolated_reduction_factor(rho, chi, out.xi)
+    short = column > euler_stress(spec, element.loaded)  # sigma_cr,c / sigma_E = (b/a)^2
+    rho_c = interpolated_reduction_factor(rho, chi, out.xi) if short else rho
     out.reduction_factor = rho_c
     out.reduced_design_stress_Pa = rho_c * design.yield_stress / design.partial_factor
-    if out.xi < 1.0:
+    if short and out.xi < 1.0:
         out.notes.append(
             f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "
             f"{out.xi:.3g} < 1, rho_c = {rho_c:.4g} between the plate's rho = {rho:.4g} and "

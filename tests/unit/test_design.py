@@ -229,6 +229,32 @@ def test_a_long_plate_keeps_the_plate_type_reduction_factor():
     assert d.xi > 1 and d.reduction_factor == d.plate_reduction_factor
 
 
+@pytest.mark.parametrize("length", [0.8, 1.2])
+def test_an_outstand_s_column_type_reduction_is_for_a_b_below_1(length):
+    """The issue's outstand cut to a = 0.8 and 1.2 m (b = 1 m, 8 x 10 cells).
+
+    Both have xi < 1 (an outstand's sigma_cr is near (0.425 + (b/a)^2) sigma_E, its
+    column's (b/a)^2 sigma_E); EN 1993-1-5 sends a plate to 4.5.4 for a/b < 1 (the
+    note of 4.4(2)): rho_c by hand (as in the test above, eq. (4.3)'s rho) at 0.8,
+    eq. (4.3)'s rho itself at 1.2.
+    """
+    spec = _outstand(mesh={"nx": 8, "ny": 10})
+    data = problem_to_dict(spec)
+    data["plate"] = {"corners": [[0, 0], [length, 1.0]], "thickness": 0.01}
+    d = result(problem_from_dict(data)).design
+    slenderness = math.sqrt(355e6 / d.sigma_cr_Pa)
+    rho = (slenderness - 0.188) / slenderness**2
+    column = math.pi**2 * 2.1e11 * (0.01 / length) ** 2 / (12 * (1 - 0.3**2))
+    lam_c = math.sqrt(355e6 / column)
+    phi = 0.5 * (1 + 0.21 * (lam_c - 0.2) + lam_c**2)
+    chi = 1 / (phi + math.sqrt(phi**2 - lam_c**2))
+    xi = d.sigma_cr_Pa / column - 1
+    assert d.element == "outstand" and 0 < xi < 1
+    assert d.xi == pytest.approx(xi, rel=1e-12)
+    expected = (rho - chi) * xi * (2 - xi) + chi if length < 1.0 else rho
+    assert d.reduction_factor == pytest.approx(expected, rel=1e-12)
+
+
 def test_stress_gradient_obstacle_shear_and_fixed_part():
     """The critical state's edge stresses give psi; notes for the obstacle and the shear."""
     edges = {

@@ -415,7 +415,7 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
             f"tension {-d.sigma_cr_Pa / scale:.4g} {unit}, {d.edge}): no sigma_cr, slenderness "
             "or rho" + _design_lower(d, scale, unit)
         )
-    column = d.xi is not None and d.xi < 1.0 and d.plate_reduction_factor is not None
+    column = d.plate_reduction_factor is not None and d.reduction_factor != d.plate_reduction_factor
     return (
         f"EN 1993-1-5: sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit} ({d.edge}), "
         f"psi = {d.psi:.3g}, slenderness {d.relative_slenderness:.4g}, rho = "
