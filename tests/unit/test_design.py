@@ -231,7 +231,7 @@ def test_a_long_plate_keeps_the_plate_type_reduction_factor():
 
 @pytest.mark.parametrize("length", [0.8, 1.2])
 def test_an_outstand_s_column_type_reduction_is_for_a_b_below_1(length):
-    """The issue's outstand cut to a = 0.8 and 1.2 m (b = 1 m, 8 x 10 cells).
+    """The outstand of ``_outstand`` cut to a = 0.8 and 1.2 m (b = 1 m, 8 x 10 cells).
 
     Both have xi < 1 (an outstand's sigma_cr is near (0.425 + (b/a)^2) sigma_E, its
     column's (b/a)^2 sigma_E); EN 1993-1-5 sends a plate to 4.5.4 for a/b < 1 (the
@@ -395,7 +395,7 @@ def test_outstand_reduction_factor_is_en_1993_1_5_eq_4_3(slenderness, psi, rho):
 
 
 def test_the_internal_formula_is_unconservative_for_an_outstand_below_psi_0_42():
-    """The issue's numbers: at slenderness 1.5 and psi = -1, 0.618 (internal) > 0.583."""
+    """Eq. (4.2) and (4.3) at slenderness 1.5 and psi = -1: 0.618 (internal) > 0.583."""
     internal, outstand = reduction_factor(1.5, -1.0), reduction_factor(1.5, -1.0, "outstand")
     assert internal == pytest.approx((1.5 - 0.11) / 2.25, rel=1e-12)  # 0.6178
     assert outstand == pytest.approx(1.312 / 2.25, rel=1e-12)  # 0.5831
@@ -447,7 +447,7 @@ OUTSTAND_EDGES = {
 
 
 def _outstand(edges=None, **extra):
-    """The issue's plate: 3 x 1 m, t = 10 mm, steel, top edge free, f_y = 355 MPa."""
+    """An outstand: 3 x 1 m, t = 10 mm, steel, top edge free, f_y = 355 MPa."""
     data = {
         "plate": {"corners": [[0, 0], [3.0, 1.0]], "thickness": 0.01},
         "material": {"E": 2.1e11, "nu": 0.3},
