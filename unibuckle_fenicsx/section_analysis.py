@@ -77,7 +77,7 @@ from unibuckle_fenicsx.spec import (
     SolverSpec,
     problem_to_dict,
 )
-from unibuckle_fenicsx.spec.base import FILE_UNITS, in_file
+from unibuckle_fenicsx.spec.base import file_units, in_file
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
 
 __all__ = [
@@ -303,11 +303,8 @@ def solve_section(
     solver = solver or SolverSpec()
     method, reason = choose_section_method(parameters, solver)
     logger.info("section: method %s (%s)", method, reason)
-    in_units = FILE_UNITS.set(units)  # the messages of the mesh's checks (the core's span)
-    try:
+    with file_units(units):  # the messages of the mesh's checks (the core's span)
         section, solution = _solve(parameters, int(levels), comm, method, solver)
-    finally:
-        FILE_UNITS.reset(in_units)
     try:
         problem = section.problem
         t1 = time.perf_counter()
@@ -613,7 +610,7 @@ def _result(
         buckling_coefficient_k=None if math.isnan(k) else k,
         dofs=section.model.num_dofs,
         mesh=[section.mesh.cells_along, section.mesh.cells_around],
-        eigensolves=1 + (0 if solution is None else solution.eigensolves),
+        eigensolves=problem.free_solves + (0 if solution is None else solution.eigensolves),
         wall_time_s=wall_time_s,
         load_resolution=problem.load_resolution(mode.x.petsc_vec, load),
         timings={**problem.timings, "total_s": wall_time_s},

@@ -119,7 +119,7 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
         span: The core's extent (x0, x1) along the member (m); None: the whole length.
             Nodes within the closed span count (tolerance of the section's geometry).
             Its messages are in the units of the file solved
-            (:data:`~unibuckle_fenicsx.spec.base.FILE_UNITS`).
+            (:func:`~unibuckle_fenicsx.spec.base.file_units`).
 
     Raises:
         InputError: The span holds no free node, or a support holds part of a
