@@ -379,3 +379,36 @@ def test_a_section_on_two_ranks_equals_one():
         p_load, p_free, p_contact, p_kkt = parallel[name]
         assert _same_load(load, p_load) and _same_load(free, p_free), (name, serial, parallel)
         assert (contact, kkt) == (p_contact, p_kkt), name
+
+
+def test_a_warning_is_printed_once_on_two_ranks(tmp_path):
+    """Every rank computes the run's warnings; rank 0 alone prints them.
+
+    A hollow box 50 x 50 x 5 mm, 0.6 m long, on cells of 12.5 mm: two warnings, the
+    coarse cells (4 across a face, fewer than 5) and the column (its critical stress
+    0.94 times the Euler stress pi^2 E (b^2/6)/L^2 = 2.40e9 Pa of a thin-walled square
+    box). On 2 ranks each was printed twice.
+    """
+    import os
+    import subprocess
+    import sys
+
+    from support.processes import mpiexec
+
+    path = tmp_path / "column.toml"
+    path.write_text(
+        'name = "column"\n'
+        '[section]\nshape = "box"\nwidth = 0.05\ndepth = 0.05\nthickness = 0.005\n'
+        'length = 0.6\nends = "simply_supported"\n'
+        "[material]\nE = 2.1e11\nnu = 0.3\n[load]\naxial_stress = -1.0\n"
+        "[obstacle]\ncore = false\n[mesh]\nsize = 0.0125\n"
+    )
+    script = [sys.executable, "-m", "unibuckle_fenicsx.cli", "solve", "--config", str(path)]
+    proc = subprocess.run(
+        [mpiexec(), "-n", "2", *script],
+        capture_output=True, text=True, env={**os.environ, "OMP_NUM_THREADS": "1"},
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stderr.count("fewer than 5: on cells this coarse") == 1, proc.stderr
+    assert proc.stderr.count("times the member's Euler stress") == 1, proc.stderr
+    assert proc.stdout.count("column: sigma_cr = ") == 1, proc.stdout

@@ -66,10 +66,13 @@ def _logging(verbose: int, quiet: bool, rank: int) -> Iterator[None]:
     """The run's log on standard error; the caller's logging set back afterwards.
 
     ``main()`` may be called in-process (a notebook, a test): the handler it installs
-    holds the ``sys.stderr`` of this run, which may be closed after it.
+    holds the ``sys.stderr`` of this run, which may be closed after it. Every rank
+    computes the same warnings (from values reduced over the ranks): rank 0 prints the
+    log, the others only their errors.
     """
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
+    handler.setLevel(logging.NOTSET if rank == 0 else logging.ERROR)
     root = logging.getLogger()
     progress = logging.getLogger("unibuckle_fenicsx.progress")
     handlers, root_level, progress_level = root.handlers[:], root.level, progress.level
