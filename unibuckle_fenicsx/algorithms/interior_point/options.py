@@ -264,8 +264,8 @@ class ChainOptions:
             ``read_mu`` gives an admissible mode that the obstacle pulls at nodes of
             the set, those nodes are released and the smaller set read (one eigen
             solve each, :func:`~.links.released`), at most this many times in a row
-            (0: never); a KKT point met so ends the run. The flooded sets read on the
-            clamped plate at 360x120 took five (:doc:`/verification/fine_level_release`).
+            (0: never); a KKT point met so ends the run
+            (:doc:`/verification/fine_level_release`).
         clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
             (the least-energy correction lifts those closer to the obstacle to it).
         max_steps: Newton steps per run.
