@@ -16,37 +16,13 @@ import pytest
 import scipy.linalg
 
 from support.exhaustive import dense
+from support.plates import STEEP_TOML
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
 from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.spec.files import load_toml
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference: serial")
-
-#: A 300 x 100 x 3 mm SSSS steel plate under in-plane bending with psi = -9 (edge
-#: stresses -1 at y = 0 to 9 at y = b): the compressed strip is b/10, one cell of 30 x 10.
-STEEP_TOML = """
-name = "steep_gradient"
-[plate]
-corners = [[0.0, 0.0], [0.3, 0.1]]
-thickness = 0.003
-[material]
-E = 2.1e11
-nu = 0.3
-[edges.left]
-support = "simply_supported"
-normal_stress = [-1.0, 9.0]
-[edges.right]
-support = "simply_supported"
-normal_stress = [-1.0, 9.0]
-[edges.bottom]
-support = "simply_supported"
-[edges.top]
-support = "simply_supported"
-[mesh]
-nx = 30
-ny = 10
-"""
 
 
 def psi1_file(tmp_path):
