@@ -77,7 +77,7 @@ from unibuckle_fenicsx.spec import (
     SolverSpec,
     problem_to_dict,
 )
-from unibuckle_fenicsx.spec.base import in_file
+from unibuckle_fenicsx.spec.base import file_units, in_file
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
 
 __all__ = [
@@ -303,7 +303,8 @@ def solve_section(
     solver = solver or SolverSpec()
     method, reason = choose_section_method(parameters, solver)
     logger.info("section: method %s (%s)", method, reason)
-    section, solution = _solve(parameters, int(levels), comm, method, solver)
+    with file_units(units):  # the messages of the mesh's checks (the core's span)
+        section, solution = _solve(parameters, int(levels), comm, method, solver)
     try:
         problem = section.problem
         t1 = time.perf_counter()
@@ -397,32 +398,47 @@ def _design(
     return record
 
 
-#: A hollow member whose critical axial stress reaches this fraction of its Euler stress
-#: draws a warning: its mode is the column's, or coupled with it (the shell's column has
-#: shear deformation and comes out up to a few % below Euler's load).
+#: A member whose critical axial stress reaches this fraction of its Euler stress draws
+#: a warning. Hollow: its mode is the column's, or coupled with it (the shell's column
+#: has shear deformation and comes out up to a few % below Euler's load). With a core:
+#: the core keeps the walls off the column's mode, so the result says nothing of it.
 COLUMN_FRACTION = 0.8
 
 
 def column_note(
     parameters: SectionParameters, load: float, cored: bool, units: str = "SI"
 ) -> str | None:
-    """A warning when the hollow member's critical state is a column's, else None.
+    """A warning when the member's Euler stress is near or below its critical one, else None.
 
     Its uniform axial stress at ``load`` at or above :data:`COLUMN_FRACTION` of the
-    Euler stress (:meth:`SectionParameters.euler_stress`): k and EN 1993-1-5's face
-    values are the walls' quantities, not a column's. A core (``cored``) holds the walls
-    off a column's mode (rigid) or resists it (elastic): no warning. Stresses in the
-    unit system ``units`` (:data:`~unibuckle_fenicsx.spec.base.UNITS`), the file's.
+    Euler stress (:meth:`SectionParameters.euler_stress`, the walls' section alone).
+    Hollow: k and EN 1993-1-5's face values are the walls' quantities, not a column's.
+    With a core (``cored``): the model holds the walls off the column's mode (a rigid
+    core lets them move only outward, an elastic one resists with springs fixed in
+    space), while a real core moves with the member; the critical stress is the walls'
+    local one, and the member's flexural buckling is not checked (EN 1994-1-1, 6.7.3).
+    Stresses in the unit system ``units`` (:data:`~unibuckle_fenicsx.spec.base.UNITS`),
+    the file's.
     """
     p = parameters
     axial = -load * p.axial_stress
     euler = p.euler_stress()
-    if cored or axial < COLUMN_FRACTION * euler:
+    if axial < COLUMN_FRACTION * euler:
         return None
     _, scale, unit = UNITS[units]
-    return (
+    stresses = (
         f"the critical axial stress {axial / scale:.4g} {unit} is {axial / euler:.3g} times "
-        f"the member's Euler stress {euler / scale:.4g} {unit}: the mode is the column's "
+        f"the member's Euler stress {euler / scale:.4g} {unit}"
+    )
+    if cored:
+        return (
+            f"{stresses} (its walls' section alone): the core holds the walls off the "
+            "member's column mode here, so sigma_cr is the walls' local critical stress "
+            "and says nothing of the member's flexural buckling, to be checked on its own "
+            "(EN 1994-1-1, 6.7.3, with the infill's stiffness; EN 1993-1-1, 6.3.1 without)"
+        )
+    return (
+        f"{stresses}: the mode is the column's "
         "(or coupled with it), and k and the EN 1993-1-5 face values are the walls' "
         "quantities, not the column's (EN 1993-1-1, 6.3.1)"
     )

@@ -53,6 +53,7 @@ __all__ = [
     "at_lower_bound",
     "face_compressions",
     "face_width",
+    "member_note",
     "section_design",
 ]
 
@@ -90,6 +91,7 @@ class DesignSection(Protocol):
     @property
     def core(self) -> bool: ...
     def compression(self) -> float: ...
+    def euler_stress(self) -> float: ...
 
 
 class FaceDesign(Struct, kw_only=True):
@@ -235,6 +237,7 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             out.governing_face = max(tied, key=lambda f: face_width(section, f.face)).face
     else:
         out.clauses.append(TUBE_CLAUSES)
+    out.notes.append(member_note(section, design))
     if section.core:
         outside = ": outside the calibration of EN 1993-1-5 4.4(2)"
         out.notes.append(
@@ -252,6 +255,32 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         out.width_to_thickness = across / t
         out.local_buckling_negligible = out.width_to_thickness <= out.width_to_thickness_limit
     return out
+
+
+def member_note(section: DesignSection, design: DesignSpec) -> str:
+    r"""The note that the member's flexural buckling is not in the output, with its slenderness.
+
+    The section's critical state is its walls' lowest mode: a hollow member's column
+    mode shows only if it comes first (a warning says so), and a core keeps the walls
+    off it. EN 1993-1-1, 6.3.1.2: the relative slenderness :math:`\sqrt{A f_y/N_{cr}} =
+    \sqrt{f_y/\sigma_E}`, :math:`\sigma_E` the Euler stress of the walls' section
+    (:meth:`~unibuckle_fenicsx.SectionParameters.euler_stress`);
+    at 0.2 or less buckling may be ignored (6.3.1.2(4)). A filled member's needs the
+    infill's stiffness (EN 1994-1-1, 6.7.3.3), which the output does not have.
+    """
+    slenderness = math.sqrt(design.yield_stress / section.euler_stress())
+    text = (
+        "the member's flexural buckling (EN 1993-1-1, 6.3.1) is not part of this output: "
+        "its walls' section as a column has relative slenderness sqrt(f_y/sigma_E) = "
+        f"{slenderness:.3g} (sigma_E its Euler stress, L_e = L, or L/2 between clamped "
+        "ends; buckling may be ignored at 0.2 or less, 6.3.1.2(4))"
+    )
+    if section.core:
+        text += (
+            "; a filled member's needs the infill's stiffness (EN 1994-1-1, 6.7.3.3), "
+            "and the core keeps its walls off the column's mode here"
+        )
+    return text
 
 
 def at_lower_bound(

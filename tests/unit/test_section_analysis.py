@@ -299,3 +299,33 @@ def test_the_warnings_of_a_file_in_mm_n_mpa_are_in_its_units(caplog):
     messages = " ".join(r.getMessage() for r in caplog.records)
     assert "mesh.size = 50 mm gives 2 cells across the narrowest face (100 mm)" in messages
     assert "refine mesh.size to 20 mm or less" in messages
+
+
+@pytest.mark.parametrize("foundation", [None, 1e10])
+def test_a_filled_member_near_its_euler_stress_is_warned_of_its_column(foundation):
+    """The core keeps the walls off the column's mode: the result says nothing of it.
+
+    The box 100 x 100 x 4 mm, 1.5 m between simply supported ends, filled: its walls'
+    reference stress 4 pi^2 D/(t b^2) = 1.215e9 Pa, about 1.9 times that with the core
+    (2.3e9 Pa), while the walls' section alone has Euler's pi^2 E (b^2/6)/L^2 = 1.535e9
+    Pa (thin-walled square box: I/A = b^2/6). The rigid core lets the walls move only
+    outward, and an elastic one resists them with springs fixed in space: no column mode
+    either way. The result said nothing; it now names the member's flexural buckling
+    (EN 1994-1-1, 6.7.3). Below 0.8 of Euler's stress (a short member) no warning.
+    """
+    from unibuckle_fenicsx.section_analysis import column_note
+
+    member = SectionParameters(
+        "box", width=0.1, depth=0.1, thickness=0.004, length=1.5, E=E, nu=NU,
+        mesh_size=0.02, ends="simply_supported", core=True, foundation_stiffness=foundation,
+    )  # fmt: skip
+    euler = math.pi**2 * E * (0.1**2 / 6.0) / 1.5**2
+    assert euler == pytest.approx(1.535e9, rel=1e-3)
+    note = column_note(member, 2.3e9, True)
+    assert note is not None
+    assert f"{2.3e9 / euler:.3g} times the member's Euler stress {euler:.4g} Pa" in note
+    assert "flexural buckling" in note and "EN 1994-1-1, 6.7.3" in note
+    assert column_note(member, 0.79 * euler, True) is None
+    # The hollow member's warning is the column's mode itself (unchanged).
+    hollow = dataclasses.replace(member, core=False, foundation_stiffness=None)
+    assert "the mode is the column's" in (column_note(hollow, 0.9 * euler, False) or "")

@@ -223,3 +223,32 @@ def test_the_design_of_a_section_not_of_steel_is_refused(tmp_path):
     # Without [design] the aluminium box is a fine problem (only the design is refused).
     path.write_text(path.read_text().replace("[design]\nyield_stress = 250\n", ""))
     assert load_problem(path).material.E == pytest.approx(7.0e10)
+
+
+@pytest.mark.parametrize("core", [False, True])
+def test_the_design_output_says_the_member_s_buckling_is_not_in_it(core):
+    """A long member's design output gave the walls' values only, silent on the column.
+
+    The box 200 x 200 x 2 mm, 6 m between simply supported ends: its walls buckle at
+    4 pi^2 D/(t b^2) = 75.9 MPa, a fifth of its Euler stress pi^2 E (b^2/6)/L^2 =
+    383.8 MPa (I/A = b^2/6 of the thin-walled square), so no column warning; but as a
+    column its relative slenderness sqrt(f_y/sigma_E) = sqrt(355/383.8) = 0.962 (EN
+    1993-1-1, 6.3.1.2) is far above the 0.2 below which buckling may be ignored
+    (6.3.1.2(4)). The output now says the member's buckling is not part of it, with
+    that slenderness; a filled member's needs the infill's stiffness (EN 1994-1-1,
+    6.7.3.3).
+    """
+    section = _section(width=0.2, depth=0.2, length=6.0, ends="simply_supported", core=core)
+    euler = math.pi**2 * 2.1e11 * (0.2**2 / 6.0) / 6.0**2
+    assert euler == pytest.approx(3.838e8, rel=1e-3)
+    out = section_design(section, DesignSpec(yield_stress=3.55e8), 7.59e7)
+    notes = [n for n in out.notes if "flexural buckling" in n]
+    assert len(notes) == 1
+    assert f"sqrt(f_y/sigma_E) = {math.sqrt(3.55e8 / euler):.3g}" in notes[0]
+    assert "0.962" in notes[0] and "EN 1993-1-1, 6.3.1" in notes[0]
+    assert ("EN 1994-1-1, 6.7.3.3" in notes[0]) == core
+    tube = _section("tube", width=None, depth=None, diameter=0.2, length=6.0, core=core)
+    tube_euler = math.pi**2 * 2.1e11 * (0.1**2 / 2.0) / 3.0**2  # clamped: L_e = L/2
+    note = next(n for n in section_design(tube, DesignSpec(yield_stress=3.55e8), 1e9).notes
+                if "flexural buckling" in n)  # fmt: skip
+    assert f"= {math.sqrt(3.55e8 / tube_euler):.3g} " in note

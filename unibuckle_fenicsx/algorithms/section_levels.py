@@ -276,8 +276,9 @@ def _interior_point(
                     raise
                 if k > asked:  # a level added by interior_levels: fewer of them
                     break
+                cells, unit = in_file(size, "m")
                 raise InputError(
-                    f"mesh.levels = {asked}: the coarser section of cells {size:g} m "
+                    f"mesh.levels = {asked}: the coarser section of cells {cells:g} {unit} "
                     f"(mesh.size doubled): {err}; lower mesh.levels (0: the search starts "
                     "on the given cells)"
                 ) from None
@@ -329,8 +330,9 @@ def _active_set(
             if prev is not None and not built:
                 prev.destroy()
             if isinstance(err, InputError) and size != sizes[-1]:  # a coarser section's
+                cells, unit = in_file(size, "m")
                 raise InputError(
-                    f"mesh.levels = {levels}: the coarser section of cells {size:g} m "
+                    f"mesh.levels = {levels}: the coarser section of cells {cells:g} {unit} "
                     f"(mesh.size doubled): {err}; lower mesh.levels (0: the seeds run on "
                     "the given cells)"
                 ) from None

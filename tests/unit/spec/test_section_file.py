@@ -164,6 +164,37 @@ def test_a_span_off_the_member_is_refused_in_the_file_s_units():
         section_from_dict(data)
 
 
+@pytest.mark.parametrize(
+    ("span", "levels", "message"),
+    [
+        ([15.0, 20.0], 0, "its span (15, 20) mm (obstacle.span) holds no node of the mesh"),
+        ([60.0, 90.0], 2, "mesh.levels = 2: the coarser section of cells 50 mm (mesh.size"),
+    ],
+)
+def test_a_core_span_found_empty_on_the_mesh_is_refused_in_the_file_s_units(span, levels, message):
+    """A file in mm-N-MPa: the span the mesh finds empty, and the coarser cells, in mm.
+
+    The box 100 x 100 x 2 mm, L = 200 mm on cells of 12.5 mm: [15, 20] mm holds no node
+    (nodes at 0, 12.5, 25 mm), [60, 90] mm the node at 62.5 mm but none of the cells of
+    50 mm (mesh.size doubled twice). Both were said in m: "its span (0.015, 0.02) m",
+    "cells 0.05 m".
+    """
+    from unibuckle_fenicsx.errors import InputError
+
+    spec = section_from_dict({
+        "units": "mm-N-MPa",
+        "section": {"shape": "box", "width": 100.0, "depth": 100.0, "thickness": 2.0,
+                    "length": 200.0, "ends": "simply_supported"},
+        "material": {"E": 2.1e5, "nu": NU},
+        "obstacle": {"core": True, "span": span},
+        "mesh": {"size": 12.5, "levels": levels},
+    })  # fmt: skip
+    with pytest.raises(InputError) as caught:
+        solve_section(spec, MPI.COMM_SELF)
+    assert message in str(caught.value)
+    assert " m " not in str(caught.value) and " m)" not in str(caught.value)
+
+
 def test_a_core_on_a_plate_is_refused():
     """A plate's file has no core: ``[obstacle] core`` without a ``[section]``."""
     with pytest.raises(ValueError, match=r"^obstacle.core is a section's key, and this file"):

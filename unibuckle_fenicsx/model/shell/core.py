@@ -39,6 +39,7 @@ from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.shell.forms import cell_frame
 from unibuckle_fenicsx.model.shell.geometry import SectionMesh
 from unibuckle_fenicsx.model.shell.model import DOFS_PER_NODE, ShellModel
+from unibuckle_fenicsx.spec.base import in_file
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
@@ -117,6 +118,8 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
         model: The section's shell model (its supports decide which nodes are held).
         span: The core's extent (x0, x1) along the member (m); None: the whole length.
             Nodes within the closed span count (tolerance of the section's geometry).
+            Its messages are in the units of the file solved
+            (:func:`~unibuckle_fenicsx.spec.base.file_units`).
 
     Raises:
         InputError: The span holds no free node, or a support holds part of a
@@ -129,9 +132,10 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
     section = model.section
     tol = section.tolerance
     x0, x1 = (0.0, section.length) if span is None else span
+    (a, b, length), unit = in_file((x0, x1, section.length), "m")
     if not (0.0 <= x0 < x1 <= section.length + tol):
         raise InputError(
-            f"core span must satisfy 0 <= x0 < x1 <= length = {section.length:g} m, got {span}"
+            f"core span must satisfy 0 <= x0 < x1 <= length = {length:g} {unit}, got ({a:g}, {b:g})"
         )
     X = model.W.tabulate_dof_coordinates()[: model.W.dofmap.index_map.size_local]
     inside = (X[:, 0] >= x0 - tol) & (X[:, 0] <= x1 + tol)
@@ -146,7 +150,7 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
         held = model.mesh.comm.allreduce(int(inside.sum()), op=MPI.SUM) > 0
         what = "only nodes held by the end supports" if held else "no node of the mesh"
         raise InputError(
-            f"the core covers no free node: its span {(x0, x1)} m (obstacle.span) holds "
+            f"the core covers no free node: its span ({a:g}, {b:g}) {unit} (obstacle.span) holds "
             f"{what}; lengthen obstacle.span or refine mesh.size"
         )
     all_u = np.vstack([g[2] for g in gathered])
