@@ -4,7 +4,8 @@
   command-line flag). The message names the key and the allowed range; it is raised before
   any solve. Its subclasses say which input: :class:`FieldError` (a rule between the
   fields of one table is broken), :class:`EmptyZoneError` (an obstacle zone holds no free
-  mesh node), :class:`BilateralZoneError` (zones on both sides of the plate share a node).
+  mesh node), :class:`BilateralZoneError` (zones on both sides of the plate share a node),
+  :class:`NoLoadError` (no positive buckling load on the mesh).
 - :class:`NumericalError`: a solve that did not converge or found nothing admissible:
   :class:`EigenSolveError` (an eigen solve did not converge),
   :class:`NoAdmissibleModeError` (no admissible mode with a finite load),
@@ -27,6 +28,7 @@ __all__ = [
     "FieldError",
     "InputError",
     "NoAdmissibleModeError",
+    "NoLoadError",
     "NonlinearError",
     "NumericalError",
     "UnibuckleError",
@@ -47,6 +49,10 @@ class EmptyZoneError(InputError):
 
 class BilateralZoneError(InputError):
     """Obstacles on opposite sides of the plate share a mesh node."""
+
+
+class NoLoadError(InputError):
+    """The plate has no positive buckling load on this mesh (b(w, w) nowhere positive)."""
 
 
 class FieldError(InputError):

@@ -6,7 +6,8 @@ r"""Plate set-ups used by several test modules and by the MPI scripts.
 - :func:`clamped_left_plate`: the paper's plate held in its plane on the left edge and
   pushed on the right one (a non-uniform prestress), with :func:`n0_at_quadrature_points`
   and :func:`strip_average` to read its membrane force (the prestress tests and
-  ``tests/mpi/pipeline_steps.py``).
+  ``tests/mpi/pipeline_steps.py``);
+- :data:`STEEP_TOML`: a plate under a steep stress gradient (psi = -9), as a problem file.
 """
 
 from __future__ import annotations
@@ -21,6 +22,31 @@ import numpy as np
 
 from unibuckle_fenicsx.spec import EdgeSpec, Material, ObstacleSpec, PlateSpec, ProblemSpec
 from unibuckle_fenicsx.spec.cases import plate_case
+
+#: A 300 x 100 x 3 mm SSSS steel plate under in-plane bending with psi = -9 (edge
+#: stresses -1 at y = 0 to 9 at y = b): the compressed strip is b/10, one cell of 30 x 10.
+STEEP_TOML = """
+name = "steep_gradient"
+[plate]
+corners = [[0.0, 0.0], [0.3, 0.1]]
+thickness = 0.003
+[material]
+E = 2.1e11
+nu = 0.3
+[edges.left]
+support = "simply_supported"
+normal_stress = [-1.0, 9.0]
+[edges.right]
+support = "simply_supported"
+normal_stress = [-1.0, 9.0]
+[edges.bottom]
+support = "simply_supported"
+[edges.top]
+support = "simply_supported"
+[mesh]
+nx = 30
+ny = 10
+"""
 
 
 def thin_plate(name: str = "ssss", nx: int = 6, ny: int = 3, **kw) -> ProblemSpec:

@@ -76,7 +76,12 @@ from unibuckle_fenicsx.algorithms.records import (
     Fallback,
     KktPoint,
 )
-from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleModeError
+from unibuckle_fenicsx.errors import (
+    EmptyZoneError,
+    InputError,
+    NoAdmissibleModeError,
+    NoLoadError,
+)
 from unibuckle_fenicsx.model.build import build_unilateral_problem
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
@@ -309,6 +314,19 @@ class _Coarse:
     solves: int = 0
 
 
+def _has_load(cp: UnilateralProblem) -> bool:
+    """Whether the coarse problem ``cp`` has a free load, which the seeds start from.
+
+    A level whose cells cannot resolve a steep stress gradient's compressed strip (a
+    cell across) has none, where the fine mesh has one. Collective.
+    """
+    try:
+        cp.solve_free()
+    except NoLoadError:
+        return False
+    return True
+
+
 def _coarse_levels(
     problem: UnilateralProblem,
     levels: list[tuple[int, int]],
@@ -319,16 +337,26 @@ def _coarse_levels(
 ) -> _Coarse:
     """Seeds on the coarsest level, then the best contact sets polished level by level.
 
+    A level the seeds would run on is skipped where it has no positive load
+    (:func:`_has_load`); they run on the next finer one (the fine mesh, if none).
     The finest coarse problem is left alive in the result (:attr:`_Coarse.last`, for
     the fine level's polish); the caller destroys it. Collective.
     """
     coarse = _Coarse()
     for nx, ny in levels:
+        tl = time.perf_counter()
         try:
             cp = build_unilateral_problem(problem.spec.with_mesh(nx, ny), problem.comm)
         except EmptyZoneError:
             continue
+        except NoLoadError:  # its geometric stiffness is round-off
+            _skip(coarse, problem, [nx, ny], None, tl)
+            continue
         tl = time.perf_counter()
+        if coarse.candidates is None and not _has_load(cp):
+            _skip(coarse, problem, [nx, ny], cp, tl)
+            cp.destroy()
+            continue
         if coarse.candidates is None:
             coarse.runs = multi_seed(cp, max_iterations, seeds, more_seeds)
             runs = coarse.runs
@@ -371,6 +399,32 @@ def _coarse_levels(
             coarse.candidates = None
             coarse.bests.clear()
     return coarse
+
+
+def _skip(
+    coarse: _Coarse,
+    problem: UnilateralProblem,
+    mesh: list[int],
+    cp: UnilateralProblem | None,
+    since: float,
+) -> None:
+    """Record the coarse level ``mesh`` (``cp``, None if refused) as skipped: no load."""
+    why = "no positive buckling load on this mesh"
+    solves = cp.eigensolver.solves if cp is not None else 0
+    coarse.solves += solves
+    coarse.log.append(
+        ActiveSetLevel(
+            mesh=mesh,
+            constrained_nodes=cp.num_constrained if cp is not None else 0,
+            eigensolves=solves,
+            wall_time_s=time.perf_counter() - since,
+            runs=[],
+            kkt_loads=[],
+            skipped=why,
+        )
+    )
+    if problem.comm.rank == 0:
+        PROGRESS.info("active set, level %dx%d skipped: %s", *mesh, why)
 
 
 @dataclass

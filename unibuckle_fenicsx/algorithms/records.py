@@ -80,6 +80,8 @@ class ActiveSetLevel(Struct, kw_only=True):
         wall_time_s: Seconds on it.
         runs: Its runs.
         kkt_loads: The loads of its distinct KKT points, lowest first.
+        skipped: Why no seed ran on it (no positive buckling load on this mesh),
+            where none did.
     """
 
     mesh: list[int]
@@ -88,6 +90,7 @@ class ActiveSetLevel(Struct, kw_only=True):
     wall_time_s: float
     runs: list[RunSummary]
     kkt_loads: list[float]
+    skipped: str | UnsetType = UNSET
 
 
 class KktPoint(Struct, kw_only=True):

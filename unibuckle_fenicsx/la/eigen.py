@@ -419,7 +419,12 @@ class GEPSolver(Owner):
         Its spectral transformation shifts the first operator in place and solves with
         the :attr:`factorization`'s KSP: the operator passed is that factorisation's
         matrix, filled by :meth:`_shift_to` before each solve. It takes the EPS options
-        (not the ``st_`` ones: its solver is the shared one) under ``prefix``.
+        (not the ``st_`` ones: its solver is the shared one) under ``prefix``: the
+        solver's ``options`` under its own prefix (the smallest pair's EPS), else
+        :data:`EIGEN_OPTIONS`'s. The shifted solves (``<prefix>near_``), which recover from
+        a failed solve at target 0 (:meth:`_by_inertia`), take an option given for the
+        solver's prefix (in Python or on the command line) by its tolerance only: an
+        iteration limit meant for the first solve leaves the recovery alone.
         """
         eps = SLEPc.EPS().create(self.A.comm)
         eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
@@ -428,7 +433,8 @@ class GEPSolver(Owner):
         eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
         st = eps.getST()
         st.setType(SLEPc.ST.Type.SINVERT)
-        eps_only = {k: v for k, v in self._options.items() if not k.startswith("st_")}
+        given = self._options if prefix == self.prefix else EIGEN_OPTIONS
+        eps_only = {k: v for k, v in given.items() if not k.startswith("st_")}
         set_options(eps, prefix, eps_only)
         st.setMatMode(SLEPc.ST.MatMode.INPLACE)
         st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)

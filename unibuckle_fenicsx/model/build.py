@@ -35,7 +35,13 @@ import dolfinx
 
 from msgspec.structs import replace
 
-from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError, NumericalError
+from unibuckle_fenicsx.errors import (
+    BilateralZoneError,
+    EmptyZoneError,
+    InputError,
+    NoLoadError,
+    NumericalError,
+)
 from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver, lowest_eigenvalues
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Options, Prefix, push_run_options
@@ -219,7 +225,8 @@ def check_pencil(
         with_obstacle: The problem has obstacles (the message says what they change).
 
     Raises:
-        InputError: B is round-off, or A - B_fixed is not positive definite.
+        NoLoadError: B is round-off.
+        InputError: A - B_fixed is not positive definite.
 
     Note:
         Collective.
@@ -227,7 +234,7 @@ def check_pencil(
     scale = max(prestress.max_compression, prestress.max_tension)
     b_norm = float(model.B.norm(PETSc.NormType.INFINITY))
     if b_norm <= NULL_GEOMETRIC_STIFFNESS * scale:
-        raise InputError(
+        raise NoLoadError(
             "the plate has no positive buckling load on this mesh: the geometric "
             f"stiffness b(w, w) vanishes on the free deflections (|B| = {b_norm:.3g} "
             f"against |N0| = {scale:.3g} N/m); refine the mesh or check the edge loads"

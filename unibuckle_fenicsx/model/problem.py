@@ -32,7 +32,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
-from unibuckle_fenicsx.errors import EigenSolveError, InputError
+from unibuckle_fenicsx.errors import EigenSolveError, InputError, NoLoadError
 from unibuckle_fenicsx.la.eigen import EigenPair, GEPSolver, SmallestProof
 from unibuckle_fenicsx.la.factor import abs_matrix
 from unibuckle_fenicsx.la.options import pop_run_options
@@ -242,6 +242,10 @@ class Problem(Owner):
         ``free_proof``). Otherwise (or if no shift proves it) the solve runs at
         target 0 and :meth:`verify_free` checks the pair when it matters.
 
+        Raises:
+            NoLoadError: The pencil has no positive eigenvalue (no load buckles the
+                plate on this mesh).
+
         Note:
             Collective.
         """
@@ -254,7 +258,7 @@ class Problem(Owner):
             self.free_solves = self.eigensolver.solves - solves
             self._free_verified = self.free_proof is not None
             if not np.isfinite(pair.value):
-                raise InputError(
+                raise NoLoadError(
                     "the plate has no positive buckling load on this mesh: the geometric "
                     "stiffness b(w, w) is nowhere positive on the free deflections (edge "
                     "loads in tension, or the supports fix every deflection DOF); check the "

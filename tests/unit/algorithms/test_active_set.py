@@ -32,6 +32,7 @@ import scipy.sparse.linalg
 
 from support.exhaustive import RTOL, exhaustive_minimum, satisfies_kkt
 from support.paths import MPI_SCRIPTS
+from support.plates import STEEP_TOML
 from support.processes import run_mpi
 from unibuckle_fenicsx.algorithms import RunStatus
 from unibuckle_fenicsx.algorithms.active_set import (
@@ -268,6 +269,43 @@ def test_prolongation_includes_midway_nodes():
     z = prolong_contact_set(np.array([0, 1]), coarse, fine, (0.0, 0.0), (0.5, 0.5), (4, 2))
     # 0.25 lies between the edge node x = 0 (abstains) and contact node 0.5: in contact.
     assert z.tolist() == [0, 1, 2, 3]
+
+
+#: The plate of STEEP_TOML shortened to 100 x 100 mm on 8 x 20 cells (the compressed
+#: strip of b/10 two cells across), the obstacle over part of that strip (6 nodes; one on
+#: 4 x 10 cells).
+STEEP_STRIP_TOML = (
+    STEEP_TOML.replace("[0.3, 0.1]", "[0.1, 0.1]").replace("nx = 30", "nx = 8")
+    + "[obstacle]\nzone = [[0.03, 0.07], [0.0, 0.01]]\n"
+).replace("ny = 10", "ny = 20")
+
+
+@serial
+def test_a_coarse_level_with_no_load_is_skipped(tmp_path):
+    """A level whose strip is one cell (no positive load there) seeds nothing; the fine does.
+
+    The 4 x 10 level (``coarse_min_cells = 4``) has no positive load; the seeds run on
+    the 8 x 20 mesh and end at the exhaustive minimum over the 2^6 contact sets by LAPACK
+    (:func:`support.exhaustive.exhaustive_minimum`), the answer of the active set without
+    levels. Before, the level's free solve refused the plate ("no positive buckling load
+    on this mesh", exit 2), whose fine mesh has one.
+    """
+    from unibuckle_fenicsx.spec.files import load_toml
+
+    path = tmp_path / "strip.toml"
+    path.write_text(STEEP_STRIP_TOML)
+    with build_problem(load_toml(path), MPI.COMM_SELF) as problem:
+        assert problem.num_constrained == 6
+        expected, minimisers, _ = exhaustive_minimum(problem)
+        solution = solve_active_set(problem, coarse_min_cells=4, bound_budget=0)
+        single = solve_active_set(problem, multilevel=False, bound_budget=0)
+    (level,) = solution.details.levels
+    assert level.mesh == [4, 10] and level.runs == []
+    assert level.skipped == "no positive buckling load on this mesh"
+    assert solution.details.seeded_on == [8, 20]
+    assert solution.load == pytest.approx(expected, rel=RTOL)
+    assert tuple(int(k) for k in solution.active) in minimisers
+    assert solution.load == pytest.approx(single.load, rel=1e-12)
 
 
 def test_bad_options_raise_before_work():

@@ -16,6 +16,7 @@ import pytest
 import scipy.linalg
 
 from support.exhaustive import dense
+from support.plates import STEEP_TOML
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
 from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver
 from unibuckle_fenicsx.model.build import build_problem
@@ -23,30 +24,25 @@ from unibuckle_fenicsx.spec.files import load_toml
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference: serial")
 
-#: A 300 x 100 x 3 mm SSSS steel plate under in-plane bending with psi = -9 (edge
-#: stresses -1 at y = 0 to 9 at y = b): the compressed strip is b/10, one cell of 30 x 10.
-STEEP_TOML = """
-name = "steep_gradient"
-[plate]
-corners = [[0.0, 0.0], [0.3, 0.1]]
-thickness = 0.003
-[material]
-E = 2.1e11
-nu = 0.3
-[edges.left]
-support = "simply_supported"
-normal_stress = [-1.0, 9.0]
-[edges.right]
-support = "simply_supported"
-normal_stress = [-1.0, 9.0]
-[edges.bottom]
-support = "simply_supported"
-[edges.top]
-support = "simply_supported"
-[mesh]
-nx = 30
-ny = 10
-"""
+
+def psi1_file(tmp_path):
+    """The plate of STEEP_TOML with psi = -1 on 12 x 4 cells, written to ``tmp_path``."""
+    path = tmp_path / "psi1.toml"
+    text = STEEP_TOML.replace("[-1.0, 9.0]", "[-1.0, 1.0]").replace("nx = 30", "nx = 12")
+    path.write_text(text.replace("ny = 10", "ny = 4"))
+    return path
+
+
+def lapack_load(path):
+    """LAPACK's smallest positive load of ``path``'s pencil (dense ``scipy.linalg.eigh``).
+
+    1/theta, theta the largest eigenvalue of B x = theta A x.
+    """
+    with build_problem(load_toml(path), MPI.COMM_SELF) as problem:
+        A, B = dense(problem.model.A), dense(problem.model.B)
+    theta = scipy.linalg.eigh(B, A, eigvals_only=True)
+    assert theta[-1] > 1e-6 * np.abs(theta).max()  # a real load
+    return 1.0 / theta[-1]
 
 
 @serial
@@ -74,14 +70,9 @@ def test_a_failed_solve_with_a_load_finds_it_by_inertia(tmp_path):
     lowest positive 1/theta to 1e-8. Before, the failed solve raised
     EigenSolveError.
     """
-    path = tmp_path / "psi1.toml"
-    text = STEEP_TOML.replace("[-1.0, 9.0]", "[-1.0, 1.0]").replace("nx = 30", "nx = 12")
-    path.write_text(text.replace("ny = 10", "ny = 4"))
+    path = psi1_file(tmp_path)
+    expected = lapack_load(path)
     with build_problem(load_toml(path), MPI.COMM_SELF) as problem:
-        A, B = dense(problem.model.A), dense(problem.model.B)
-        theta = scipy.linalg.eigh(B, A, eigvals_only=True)
-        expected = 1.0 / theta[-1]
-        assert theta[-1] > 1e-6 * np.abs(theta).max()  # a real load
         gep = GEPSolver(
             problem.model.A,
             problem.model.B,
@@ -110,9 +101,7 @@ def test_a_failed_free_solve_counts_every_eigen_solve(tmp_path):
 
     from unibuckle_fenicsx import solve
 
-    path = tmp_path / "psi1.toml"
-    text = STEEP_TOML.replace("[-1.0, 9.0]", "[-1.0, 1.0]").replace("nx = 30", "nx = 12")
-    path.write_text(text.replace("ny = 10", "ny = 4"))
+    path = psi1_file(tmp_path)
     PETSc.Log.begin()
     event, options = PETSc.Log.Event("EPSSolve"), PETSc.Options()
     options["unibuckle_eps_max_it"], options["unibuckle_eps_ncv"] = 1, 3
@@ -125,3 +114,40 @@ def test_a_failed_free_solve_counts_every_eigen_solve(tmp_path):
         options.delValue("unibuckle_eps_ncv")
     assert event.getPerfInfo()["count"] - before == 3
     assert eigensolves == 3
+
+
+@serial
+def test_an_option_for_the_first_solve_leaves_the_recovery_alike_both_ways(tmp_path):
+    """``eps_max_it = 1`` in Python and on the command line: the same load, LAPACK's.
+
+    The psi = -1 plate on 12 x 4 cells: the solve at target 0 (prefix ``unibuckle_``)
+    stops after one iteration, and the inertias and the shifted solve under their own
+    prefix (``unibuckle_near_``) find the smallest load, LAPACK's lowest positive
+    1/theta (``scipy.linalg.eigh`` on the dense pencil) to 1e-8, whichever way the
+    option came. Before, the option given in Python reached the shifted solve too, which
+    converged nothing ("converged no eigenpair"), where the command line's gave the load.
+    """
+    import json
+    import os
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    from unibuckle_fenicsx import solve
+
+    path = psi1_file(tmp_path)
+    expected = lapack_load(path)
+    with solve(load_toml(path), eps_options={"eps_max_it": 1}) as analysis:
+        python_load = analysis.result.critical_load_Pa
+    script = Path(sys.executable).parent / "unibuckle"
+    out = tmp_path / "result.json"
+    proc = subprocess.run(
+        [str(script), "solve", "--config", str(path), "-q", "--json", str(out),
+         "-unibuckle_eps_max_it", "1"],
+        capture_output=True, text=True, env={**os.environ, "OMP_NUM_THREADS": "1"},
+        cwd=tmp_path,
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    command_line_load = json.loads(out.read_text())["critical_load_Pa"]
+    assert python_load == pytest.approx(expected, rel=1e-8)
+    assert command_line_load == pytest.approx(expected, rel=1e-8)
