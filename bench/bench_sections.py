@@ -21,14 +21,10 @@ all and, for the active set, per section level; the interior point's per level a
 Newton kernel's count. Per level too: the seconds of its section's build (mesh,
 prestress, assembly, change of basis: ``build_s``) and of the numeric factorisations
 through the section's shared LDLᵀ (``factor_s``: the Newton steps', the inertia
-corrections', the certificate's on the finest). ``--shell-ordering plate`` orders a
-section's factorisations by the plates' rows of
-:data:`~unibuckle_fenicsx.la.options.NESTED_DISSECTION_ROWS` (the ordering before the
-sections had their own; :doc:`/verification/sections_cost`). Prints one Markdown row,
-then one row per level (its steps: the active set's or the Newton steps; eigen solves,
-factorisations and seconds); ``--json
-FILE`` appends the row, with the levels, and the unilateral load (``core_load_Pa``) to
-compare routes by.
+corrections', the certificate's on the finest). Prints one Markdown row, then one row
+per level (its steps: the active set's or the Newton steps; eigen solves, factorisations
+and seconds); ``--json FILE`` appends the row, with the levels, and the unilateral load
+(``core_load_Pa``) to compare routes by.
 
 Ratios, both within the one process: ``ratio`` is the unilateral solve (its sections'
 set-up included) over the free eigen solve; ``process_ratio`` the whole cored run
@@ -91,7 +87,6 @@ def run(
     repeat: int,
     corner_cell: float | None,
     route: str,
-    shell_ordering: str = "shell",
 ) -> dict:
     """One section: set-up, free solve, unilateral solve, certificate.
 
@@ -110,7 +105,7 @@ def run(
     from unibuckle_fenicsx.algorithms.records import InteriorPointDetails, SectionLevelsDetails
     from unibuckle_fenicsx.analysis import choose_section_method
     from unibuckle_fenicsx.certificate.certify import certify
-    from unibuckle_fenicsx.la import factor, options
+    from unibuckle_fenicsx.la import factor
     from unibuckle_fenicsx.la.eigen import GEPSolver
     from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
     from unibuckle_fenicsx.spec import SolverSpec
@@ -126,8 +121,6 @@ def run(
         return out
 
     section_levels._level = counted
-    if shell_ordering == "plate":
-        options.NESTED_DISSECTION_ROWS["shell"] = dict(options.NESTED_DISSECTION_ROWS["plate"])
     # Seconds per section (keyed by its rows): its builds, its shared LDL^T's factorisations.
     build_s: dict[int, float] = {}
     factor_s: dict[int, float] = {}
@@ -269,20 +262,10 @@ def main() -> None:
         choices=("auto", "active-set", "levels", "interior-point", "single"),
         default="auto",
     )
-    parser.add_argument(
-        "--shell-ordering",
-        choices=("shell", "plate"),
-        default="shell",
-        help="the sections' orderings by NESTED_DISSECTION_ROWS' shell rows or the plates'",
-    )
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
     route = "active-set" if args.route == "levels" else args.route
-    row = run(
-        args.shape, args.size, args.levels, args.repeat, args.corner_cell, route,
-        args.shell_ordering,
-    )  # fmt: skip
-    row["shell_ordering"] = args.shell_ordering
+    row = run(args.shape, args.size, args.levels, args.repeat, args.corner_cell, route)
     print_header("Sections with a core (one rank)", COLUMNS)
     cells = []
     for c in COLUMNS:

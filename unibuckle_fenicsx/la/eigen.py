@@ -216,7 +216,6 @@ class GEPSolver(Owner):
             its factorisations serve many numeric ones, which orders them by METIS from
             fewer rows (:func:`~unibuckle_fenicsx.la.options.mumps_ordering`). False for
             the free plate alone.
-        kind: The pencil's kind for the orderings ("plate", or "shell": a section's).
 
     Attributes:
         solves: Eigen solves performed so far.
@@ -235,12 +234,10 @@ class GEPSolver(Owner):
         tol: float = 1e-10,
         options: Options | None = None,
         reused: bool = True,
-        kind: str = "plate",
     ) -> None:
         if not prefix:
             raise ValueError("GEPSolver needs a non-empty options prefix")
         self.reused = reused
-        self.kind = kind
         self.A = A
         self.B = compact(B)  # owned: its products cost a fifth of B's
         self.indefinite = indefinite
@@ -364,7 +361,7 @@ class GEPSolver(Owner):
             eps.setInitialSpace([initial])
         # The ordering, read at the first (symbolic) factorisation of the LU.
         key = "st_mat_mumps_icntl_7"
-        with option_defaults(self.prefix, ordering_options(A, key, self.kind, self.reused)):
+        with option_defaults(self.prefix, ordering_options(A, key, reused=self.reused)):
             eps.solve()
         return eps
 
@@ -407,7 +404,7 @@ class GEPSolver(Owner):
         the certificate on the same problem: one symbolic analysis per mesh.
         """
         if self._ldl is None:
-            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_", self.reused, self.kind)
+            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_", self.reused)
         return self._ldl
 
     def _near_eps(self) -> SLEPc.EPS:

@@ -81,9 +81,7 @@ def compact(mat: PETSc.Mat) -> PETSc.Mat:
     return _without_zeros(mat, csr[2], csr)
 
 
-def set_ldl_options(
-    ksp: PETSc.KSP, prefix: str, reused: bool = False, kind: str = "plate"
-) -> None:
+def set_ldl_options(ksp: PETSc.KSP, prefix: str, reused: bool = False) -> None:
     """Make ``ksp`` a MUMPS :math:`LDL^T` with inertia (:data:`LDL_OPTIONS`), unfactorised.
 
     :func:`set_options` with ``setup=True`` would factorise the current operator (the
@@ -93,12 +91,11 @@ def set_ldl_options(
     factor matrix instead, which PETSc hands to MUMPS when it starts; the rest of
     :data:`LDL_OPTIONS` goes through the database (a command-line option under
     ``prefix`` still wins). The ordering is
-    :func:`~unibuckle_fenicsx.la.options.mumps_ordering`'s for the operator's size and
-    ``kind`` (``reused``: for an analysis that serves many numeric factorisations). The
-    operator must be set. Collective.
+    :func:`~unibuckle_fenicsx.la.options.mumps_ordering`'s for the operator's size
+    (``reused``: for an analysis that serves many numeric factorisations). The operator
+    must be set. Collective.
     """
-    operator = ksp.getOperators()[0]
-    options = {**ordering_options(operator, kind=kind, reused=reused), **LDL_OPTIONS}
+    options = {**ordering_options(ksp.getOperators()[0], reused=reused), **LDL_OPTIONS}
     mumps = {k: v for k, v in options.items() if k.startswith("mat_mumps_icntl_")}
     others = {k: v for k, v in options.items() if k not in mumps}
     set_options(ksp, prefix, others)
@@ -179,22 +176,19 @@ class SharedFactorization(Owner):
         prefix: Options prefix of the factorisation (:data:`LDL_OPTIONS`).
         reused: Its analysis will serve many numeric factorisations (a route's), for
             the ordering (:func:`~unibuckle_fenicsx.la.options.mumps_ordering`).
-        kind: The matrix's kind for the ordering ("plate" or "shell").
 
     Note:
         Collective. Owned by the problem's :class:`~unibuckle_fenicsx.la.eigen.GEPSolver`
         (:attr:`~unibuckle_fenicsx.la.eigen.GEPSolver.factorization`).
     """
 
-    def __init__(
-        self, A: PETSc.Mat, prefix: str, reused: bool = False, kind: str = "plate"
-    ) -> None:
+    def __init__(self, A: PETSc.Mat, prefix: str, reused: bool = False) -> None:
         self.matrix = A.duplicate(copy=True)
         self.matrix.setOption(PETSc.Mat.Option.SPD, False)  # type: ignore[arg-type]
         self.matrix.setOption(PETSc.Mat.Option.SYMMETRIC, True)  # type: ignore[arg-type]
         self.ksp = PETSc.KSP().create(A.comm)
         self.ksp.setOperators(self.matrix)
-        set_ldl_options(self.ksp, prefix, reused, kind)
+        set_ldl_options(self.ksp, prefix, reused)
         self.prefix = prefix
         self._holder: object | None = None
 

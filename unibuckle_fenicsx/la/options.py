@@ -88,7 +88,7 @@ ORDERINGS = {"amd": 0, "amf": 2, "scotch": 3, "pord": 4, "metis": 5, "qamd": 6}
 #: approximate minimum fill, the membrane stiffness of the prestress by approximate
 #: minimum degree; of the orderings whose analysis costs little, each gives the
 #: fastest factorisation there (measured on :doc:`/verification/floor`).
-ORDERING_BELOW = {"plate": "amf", "membrane": "amd", "shell": "amf"}
+ORDERING_BELOW = {"plate": "amf", "membrane": "amd"}
 #: Rows from which a factorisation is ordered by nested dissection (METIS) instead, by
 #: kind and by whether its analysis serves one numeric factorisation or many (the eigen
 #: solves of a route's contact sets, the interior point's Newton steps). METIS's
@@ -98,18 +98,15 @@ ORDERING_BELOW = {"plate": "amf", "membrane": "amd", "shell": "amf"}
 #: stiffness of a large mesh a minimum-degree ordering needs several times METIS's
 #: operations on some plates (AMD on one, AMF on another), METIS never much more than
 #: the least (measured up to 10^6 rows on :doc:`/verification/floor`). The package
-#: factorises a membrane stiffness once. A section's shell pencil (six DOFs a node on
-#: a closed surface) has METIS's factors cheaper from about 2·10^4 rows: for its
-#: route's many factorisations from there (:doc:`/verification/sections_cost`).
+#: factorises a membrane stiffness once.
 NESTED_DISSECTION_ROWS = {
     "plate": {False: 600_000, True: 100_000},
     "membrane": {False: 200_000, True: 100_000},
-    "shell": {False: 600_000, True: 18_000},
 }
 
 
 def mumps_ordering(rows: int, kind: str = "plate", reused: bool = False) -> int:
-    """MUMPS ICNTL(7) for a matrix of ``rows`` rows of ``kind`` ("plate", "membrane", "shell").
+    """MUMPS ICNTL(7) for a matrix of ``rows`` rows of ``kind`` ("plate" or "membrane").
 
     METIS from :data:`NESTED_DISSECTION_ROWS` rows (``reused``: for an analysis that
     serves many numeric factorisations), else :data:`ORDERING_BELOW`'s. The option

@@ -14,7 +14,6 @@ from __future__ import annotations
 
 import itertools
 import math
-from dataclasses import replace
 
 from mpi4py import MPI
 
@@ -389,27 +388,3 @@ def test_an_elastic_core_s_springs_are_the_areas_it_covers(span):
     length = {None: 0.36, (0.08, 0.32): 0.24, (0.1, 0.3): 0.2}[span]
     assert springs[across_y].sum() == pytest.approx(2.0 * 2 * 0.1 * length, rel=1e-12)
     assert springs[~across_y].sum() == pytest.approx(2.0 * 2 * 0.3 * length, rel=1e-12)
-
-
-def test_a_sections_factorisations_take_the_shell_ordering(monkeypatch):
-    # A section's pencil is ordered by the "shell" rows of NESTED_DISSECTION_ROWS, a
-    # plate's by the "plate" rows (unchanged): with the shell's threshold lowered below
-    # this small section, MUMPS reports METIS (INFOG(7) = 5) for the cored section's
-    # LU (its free solve) and shared LDL^T (the interior point's Newton matrix), the
-    # minimum-fill ordering (AMF, 2) for the hollow section's LU (one factorisation).
-    from unibuckle_fenicsx.la import options
-
-    monkeypatch.setitem(options.NESTED_DISSECTION_ROWS, "shell", {False: 10**9, True: 300})
-    params = _parameters("box", mesh_size=0.05, length=0.2)
-    with build_section(params, MPI.COMM_SELF) as sec:
-        assert sec.model.A.getSize()[0] > 300
-        sec.problem.solve_free()
-        lu = sec.problem.eigensolver.eps.getST().getKSP().getPC().getFactorMatrix()
-        assert lu.getMumpsInfog(7) == options.ORDERINGS["metis"]
-        shared = sec.problem.eigensolver.factorization
-        shared.factor(sec)
-        assert shared.ksp.getPC().getFactorMatrix().getMumpsInfog(7) == options.ORDERINGS["metis"]
-    with build_section(replace(params, core=False), MPI.COMM_SELF) as hollow:
-        hollow.problem.solve_free()
-        lu = hollow.problem.eigensolver.eps.getST().getKSP().getPC().getFactorMatrix()
-        assert lu.getMumpsInfog(7) == options.ORDERINGS["amf"]

@@ -206,7 +206,6 @@ def section_problem(
         tol=solver.eps_tol,
         options={**EIGEN_OPTIONS, **(eps_options or {})},
         reused=constraints is not None,  # the contact sets: many factorisations
-        kind="shell",
     )
     parts = SetUp(
         spec=spec,
