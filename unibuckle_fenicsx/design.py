@@ -15,6 +15,11 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
   edge :math:`1 \ge \psi \ge -3`, at the supported one :math:`1 \ge \psi \ge -1`);
 - :math:`\psi = \sigma_2/\sigma_1`, the ratio of the loaded edge's end stresses with
   :math:`\sigma_1` the larger compression.
+- a short plate (:math:`a/b < 1`, the note of 4.4(2)) may buckle like a column: 4.5.4(1)
+  interpolates :math:`\rho_c = (\rho - \chi_c)\xi(2 - \xi) + \chi_c` between the
+  plate's :math:`\rho` and the column's :math:`\chi_c` (4.5.3: :math:`\sigma_{cr,c} =
+  \pi^2 E t^2/(12(1 - \nu^2) a^2)`, curve a), :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1`
+  in [0, 1]; at :math:`\xi \ge 1`, and for :math:`a/b \ge 1`, it is :math:`\rho`;
 
 What the clause does not describe is refused when the problem is built (both unloaded
 edges free, biaxial stress, a temperature rise, a plate that is not a rectangle, ...);
@@ -45,7 +50,9 @@ from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     DesignElement,
     buckling_factor,
+    column_reduction_factor,
     design_element,
+    interpolated_reduction_factor,
     psi_range,
     reduction_factor,
     stress_ratio,
@@ -59,13 +66,15 @@ __all__ = [
     "at_lower_bound",
     "clauses",
     "design_output",
+    "euler_stress",
     "reduction_factor",
 ]
 
 #: The clauses the design output of an internal element rests on (:func:`clauses`).
 CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of an internal "
-    "compression element; 4.4(2): relative slenderness; Table 4.1: stress ratio psi"
+    "compression element; 4.4(2): relative slenderness; Table 4.1: stress ratio psi; "
+    "4.5.3(2), 4.5.4(1): column-type buckling, rho_c"
 )
 
 #: Said with every design output.
@@ -92,11 +101,28 @@ class DesignRecord(Struct, kw_only=True):
         notes: What the output rests on, and what it leaves out.
         psi: :math:`\psi = \sigma_2/\sigma_1` along that edge.
         relative_slenderness: :math:`\bar\lambda_p`, 4.4(2).
-        k_sigma_table: The table's buckling factor :math:`k_\sigma` at :math:`\psi` (None
-            outside the table's range of :math:`\psi`).
-        reduction_factor: :math:`\rho`, eq. (4.2) or (4.3); None outside the table's
-            range of :math:`\psi`.
-        reduced_design_stress_Pa: :math:`\rho f_y/\gamma_{M1}` (absent without
+        k_sigma: This plate's buckling factor :math:`k_\sigma = \sigma_{cr}/\sigma_E`,
+            :math:`\sigma_E = \pi^2 E t^2/(12(1 - \nu^2) b^2)` with b the loaded edge's
+            length (EN 1993-1-5 Annex A.1, eq. (A.2)): what the plate's edges, aspect,
+            obstacle and points give.
+        k_sigma_table: The table's :math:`k_\sigma` at :math:`\psi`, for comparison: a
+            long plate with hinged edges (Table 4.1 or 4.2), not this plate's (a clamped
+            square's ``k_sigma`` is 10.1, its ``k_sigma_table`` 4.0); None outside the
+            table's range of :math:`\psi`.
+        reduction_factor: The reduction factor to apply: for a short plate (a/b < 1,
+            the note of 4.4(2)) :math:`\rho_c` of 4.5.4(1), the plate-type
+            ``plate_reduction_factor`` interpolated towards the column-type
+            ``column_reduction_factor`` where :math:`\xi < 1`; else
+            ``plate_reduction_factor``. None outside the table's range of :math:`\psi`.
+        plate_reduction_factor: :math:`\rho`, eq. (4.2) or (4.3).
+        column_critical_stress_Pa: :math:`\sigma_{cr,c} = \pi^2 E t^2/(12(1 - \nu^2)
+            a^2)`, a the plate's length along the stress (4.5.3(2), eq. (4.8)): the
+            plate as a column, its unloaded edges' supports removed.
+        column_reduction_factor: :math:`\chi_c` at :math:`\bar\lambda_c = \sqrt{f_y/
+            \sigma_{cr,c}}`, curve a (:math:`\alpha` = 0.21, 4.5.3(4), (5)).
+        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)); below 1 on a short
+            plate column-type buckling lowers the reduction factor.
+        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M1}` (absent without
             :math:`\rho`).
         lower_bound: When the critical load is not proven the lowest (a KKT point, or
             bracketed), the same quantities at the verified lower bound of the critical
@@ -114,8 +140,13 @@ class DesignRecord(Struct, kw_only=True):
     notes: list[str]
     psi: float | None = None
     relative_slenderness: float | None = None
+    k_sigma: float | None = None
     k_sigma_table: float | None = None
     reduction_factor: float | None = None
+    plate_reduction_factor: float | None = None
+    column_critical_stress_Pa: float | None = None
+    column_reduction_factor: float | None = None
+    xi: float | None = None
     reduced_design_stress_Pa: float | UnsetType = UNSET
     lower_bound: DesignRecord | UnsetType = UNSET
 
@@ -127,7 +158,8 @@ def clauses(element: DesignElement, free_edge_most_compressed: bool = True) -> s
     return (
         "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.3): reduction factor rho of an outstand "
         f"compression element (edges.{element.free_edge} free); 4.4(2): relative "
-        f"slenderness; {table_row(element.kind, free_edge_most_compressed)}: stress ratio psi"
+        f"slenderness; {table_row(element.kind, free_edge_most_compressed)}: stress ratio psi; "
+        "4.5.3(2), 4.5.4(1): column-type buckling, rho_c"
     )
 
 
@@ -210,6 +242,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.psi = psi
     slenderness = math.sqrt(design.yield_stress / sigma1)
     out.relative_slenderness = slenderness
+    out.k_sigma = sigma1 / euler_stress(spec, element.loaded)
     low, _ = psi_range(element.kind, at_free)
     if psi < low:  # only with a fixed part: a scaled one alone is refused beforehand
         out.notes.append(f"psi = {psi:.3g} < {low:g}: outside {out.table}, no rho")
@@ -217,9 +250,38 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     psi = min(psi, 1.0)
     out.k_sigma_table = buckling_factor(element.kind, psi, at_free)
     rho = reduction_factor(slenderness, psi, element.kind, at_free)
-    out.reduction_factor = rho
-    out.reduced_design_stress_Pa = rho * design.yield_stress / design.partial_factor
+    out.plate_reduction_factor = rho
+    # The plate as a column (4.5.3, 4.5.4): a short plate (a/b < 1) may buckle like one.
+    column = euler_stress(spec, element.loaded, along=True)
+    chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
+    out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
+    out.xi = sigma1 / column - 1.0
+    short = column > euler_stress(spec, element.loaded)  # sigma_cr,c / sigma_E = (b/a)^2
+    rho_c = interpolated_reduction_factor(rho, chi, out.xi) if short else rho
+    out.reduction_factor = rho_c
+    out.reduced_design_stress_Pa = rho_c * design.yield_stress / design.partial_factor
+    if short and out.xi < 1.0:
+        out.notes.append(
+            f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "
+            f"{out.xi:.3g} < 1, rho_c = {rho_c:.4g} between the plate's rho = {rho:.4g} and "
+            f"the column's chi_c = {chi:.4g} (sigma_cr,c by eq. (4.8), the loaded edges "
+            "hinged)"
+        )
     return out
+
+
+def euler_stress(spec: ProblemSpec, loaded: tuple[str, str], *, along: bool = False) -> float:
+    r""":math:`\sigma_E = \pi^2 E t^2/(12(1 - \nu^2) b^2)` (Pa), EN 1993-1-5 eq. (A.2).
+
+    b is the length of the ``loaded`` edges: the y extent for left and right, the x
+    extent for bottom and top; with ``along``, the plate's length a along the stress
+    instead: :math:`\sigma_{cr,c}`, the plate as a column (4.5.3(2), eq. (4.8)). The
+    material is isotropic (the design output refuses a laminate and a Voigt matrix).
+    """
+    plate, material = spec.plate, spec.material
+    across = (loaded == ("left", "right")) != along
+    ratio = plate.thickness / (plate.width if across else plate.length)
+    return math.pi**2 * material.E * ratio**2 / (12.0 * (1.0 - material.nu**2))
 
 
 #: Said when the critical load is not proven the lowest.

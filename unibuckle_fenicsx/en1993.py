@@ -36,6 +36,7 @@ from typing import Protocol
 from unibuckle_fenicsx.errors import InputError
 
 __all__ = [
+    "COLUMN_IMPERFECTION",
     "ELEMENTS",
     "INTERNAL",
     "OUTSTAND",
@@ -47,7 +48,9 @@ __all__ = [
     "DesignProblem",
     "buckling_factor",
     "check_steel_modulus",
+    "column_reduction_factor",
     "design_element",
+    "interpolated_reduction_factor",
     "psi_range",
     "reduction_factor",
     "stress_ratio",
@@ -155,6 +158,34 @@ def reduction_factor(
     if slenderness <= 0.5 + math.sqrt(0.085 - 0.055 * psi):
         return 1.0
     return min(1.0, (slenderness - 0.055 * (3.0 + psi)) / slenderness**2)
+
+
+#: The imperfection factor of an unstiffened plate's column-type buckling (EN 1993-1-5
+#: 4.5.3(5): buckling curve a of EN 1993-1-1 Table 6.1).
+COLUMN_IMPERFECTION = 0.21
+
+
+def column_reduction_factor(slenderness: float, alpha: float = COLUMN_IMPERFECTION) -> float:
+    r""":math:`\chi_c` of EN 1993-1-1 6.3.1.2 (eq. (6.49)) at :math:`\bar\lambda_c`, <= 1.
+
+    :math:`\Phi = 0.5(1 + \alpha(\bar\lambda_c - 0.2) + \bar\lambda_c^2)`,
+    :math:`\chi_c = 1/(\Phi + \sqrt{\Phi^2 - \bar\lambda_c^2})`; for an unstiffened plate
+    :math:`\bar\lambda_c = \sqrt{f_y/\sigma_{cr,c}}` and :math:`\alpha` = 0.21 (EN 1993-1-5
+    4.5.3(4), (5)).
+    """
+    phi = 0.5 * (1.0 + alpha * (slenderness - 0.2) + slenderness**2)
+    return min(1.0, 1.0 / (phi + math.sqrt(phi**2 - slenderness**2)))
+
+
+def interpolated_reduction_factor(rho: float, chi: float, xi: float) -> float:
+    r""":math:`\rho_c = (\rho - \chi_c)\,\xi(2 - \xi) + \chi_c`, EN 1993-1-5 4.5.4(1).
+
+    The interaction of plate-type (:math:`\rho`) and column-type (:math:`\chi_c`)
+    buckling, :math:`\xi = \sigma_{cr,p}/\sigma_{cr,c} - 1` clipped to [0, 1]: at
+    :math:`\xi \ge 1` the plate-type :math:`\rho` itself.
+    """
+    xi = min(1.0, max(0.0, xi))
+    return (rho - chi) * xi * (2.0 - xi) + chi
 
 
 def buckling_factor(element: str, psi: float, free_edge_most_compressed: bool = True) -> float:

@@ -594,7 +594,7 @@ def _result(
         buckling_coefficient_k=None if math.isnan(k) else k,
         dofs=section.model.num_dofs,
         mesh=[section.mesh.cells_along, section.mesh.cells_around],
-        eigensolves=1 + (0 if solution is None else solution.eigensolves),
+        eigensolves=problem.free_solves + (0 if solution is None else solution.eigensolves),
         wall_time_s=wall_time_s,
         load_resolution=problem.load_resolution(mode.x.petsc_vec, load),
         timings={**problem.timings, "total_s": wall_time_s},

@@ -180,8 +180,20 @@ def _check_design(data: dict, load: float) -> None:
         rho = 1.0 if lam <= 0.5 + math.sqrt(0.085 - 0.055 * d.psi) else min(1.0, rho)
     else:
         rho = 1.0 if lam <= 0.748 else min(1.0, (lam - 0.188) / lam**2)
+    # 4.5.4(1) for a/b < 1: rho_c between rho and the column's chi_c (curve a).
+    plate, material = spec.plate, spec.material
+    a, b = plate.length, plate.width
+    if d.edge in ("bottom", "top"):
+        a, b = b, a
+    column = math.pi**2 * material.E * (plate.thickness / a) ** 2 / (12 * (1 - material.nu**2))
+    lam_c = math.sqrt(DESIGN["yield_stress"] / column)
+    phi = 0.5 * (1 + 0.21 * (lam_c - 0.2) + lam_c**2)
+    chi = min(1.0, 1 / (phi + math.sqrt(phi**2 - lam_c**2)))
+    xi = min(1.0, max(0.0, d.sigma_cr_Pa / column - 1))
     assert d.element == expected[0]
-    assert d.reduction_factor == pytest.approx(rho, rel=1e-14), data["name"]
+    assert d.plate_reduction_factor == pytest.approx(rho, rel=1e-14), data["name"]
+    rho_c = (rho - chi) * xi * (2 - xi) + chi if a < b else rho
+    assert d.reduction_factor == pytest.approx(rho_c, rel=1e-13, abs=1e-15), data["name"]
 
 
 def _check(data: dict, features: list[str]) -> None:

@@ -52,6 +52,7 @@ from unibuckle_fenicsx.model.problem import Problem, SetUp, UnilateralProblem
 from unibuckle_fenicsx.model.resources import check_memory
 from unibuckle_fenicsx.model.structure import StructuralModel
 from unibuckle_fenicsx.spec import ProblemSpec
+from unibuckle_fenicsx.spec.base import file_units
 from unibuckle_fenicsx.tolerances import NULL_GEOMETRIC_STIFFNESS
 
 logger = logging.getLogger(__name__)
@@ -419,6 +420,18 @@ def build_problem(
     Note:
         Collective on ``comm``.
     """
+    with file_units(spec.units):  # its refusals and warnings speak the file's units
+        return _build_problem(spec, comm, eps_options, mesh, facet_tags)
+
+
+def _build_problem(
+    spec: ProblemSpec,
+    comm: MPI.Comm,
+    eps_options: Options | None,
+    mesh: dolfinx.mesh.Mesh | None,
+    facet_tags: dolfinx.mesh.MeshTags | None,
+) -> Problem | UnilateralProblem:
+    """The stages of :func:`build_problem`."""
     t0 = time.perf_counter()
     if spec.has_fixed_load:
         spec.check_scaled_load()

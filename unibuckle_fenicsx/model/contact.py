@@ -24,6 +24,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError
 from unibuckle_fenicsx.model.structure import NodalDofs
 from unibuckle_fenicsx.spec import ObstacleSpec
+from unibuckle_fenicsx.spec.base import in_file
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
@@ -79,8 +80,8 @@ def check_zone_has_nodes(
     for k, (o, mask) in enumerate(zip(found, inside, strict=True)):
         if msh.comm.allreduce(int(np.count_nonzero(mask)), op=MPI.SUM) == 0:
             raise EmptyZoneError(
-                f"{_label(found, k, labels)}.{o.zone_key} {o.describe()} holds no free mesh node: "
-                f"none of the {msh.geometry.index_map().size_global} mesh nodes lies in it; "
+                f"{_label(found, k, labels)}.{o.zone_key} {o.describe(None)} holds no free mesh "
+                f"node: none of the {msh.geometry.index_map().size_global} mesh nodes lies in it; "
                 "enlarge the zone or refine the mesh"
             )
     above = np.zeros(n_owned, dtype=bool)
@@ -95,10 +96,11 @@ def check_zone_has_nodes(
     shared = [p for p in msh.comm.allgather(local) if p is not None]
     if shared:
         names = [_label(found, k, labels) for k in range(len(found))]
+        (px, py), metres = in_file(shared[0], "m")
         raise BilateralZoneError(
             f"obstacle zones on both sides of the plate share mesh nodes, e.g. "
-            f"({shared[0][0]:.6g}, {shared[0][1]:.6g}) ({', '.join(names)}: "
-            f"{', '.join(f'{o.describe()} ({o.side})' for o in found)}): "
+            f"({px:.6g}, {py:.6g}) {metres} ({', '.join(names)}: "
+            f"{', '.join(f'{o.describe(None)} ({o.side})' for o in found)}): "
             + (
                 'a foundation on both sides is one zone with side = "both" (a bilateral '
                 "foundation); make the zones disjoint"
@@ -322,13 +324,14 @@ class ContactSetManager:
     def _empty_zone(self) -> EmptyZoneError:
         """The error for zones that hold no free mesh node (collective: the cell size)."""
         nx = self.model.mesh.topology.index_map(0).size_global
-        zones = "; ".join(o.describe() for o in self.obstacles)
+        zones = "; ".join(o.describe(None) for o in self.obstacles)
+        spacing, metres = in_file(self._spacing(), "m")
         named = "/".join(dict.fromkeys(o.zone_key for o in self.obstacles))
         return EmptyZoneError(
             f"obstacle.{named} {zones} holds no free mesh node ({self.num_edge_fixed} "
             f"zone nodes are held by supports: edges or bilateral points; the mesh has "
             f"{nx} vertices, cells "
-            f"up to {self._spacing():.3g} m across their diagonal): enlarge the zone or "
+            f"up to {spacing:.3g} {metres} across their diagonal): enlarge the zone or "
             "refine the mesh"
         )
 

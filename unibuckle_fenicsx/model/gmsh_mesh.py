@@ -43,6 +43,7 @@ import numpy as np
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import distance_to_polygon
 from unibuckle_fenicsx.spec import EDGE_NAMES, Circle, MeshSpec, ObstacleSpec, PlateSpec, Polygon
+from unibuckle_fenicsx.spec.base import in_file, unit_name
 from unibuckle_fenicsx.spec.checks import FEATURE_RATIO, plate_features
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
@@ -342,7 +343,10 @@ def _structure_parallelograms(gmsh: Any, size: float) -> int:
 def _features_text(plate: PlateSpec) -> str:
     """The plate's two smallest features, for a message."""
     features = plate_features(plate)[:2]
-    return "; ".join(f"{what}: {length:.3g} m" for length, what in features) or "none"
+    return (
+        "; ".join("{}: {:.3g} {}".format(what, *in_file(length, "m")) for length, what in features)
+        or "none"
+    )
 
 
 def _quadrilaterals_only(gmsh: Any, hint: str = "") -> None:
@@ -517,7 +521,8 @@ def _mesh_built(gmsh: Any, plate: PlateSpec, size: float, curves: list[Curve]) -
             )
         return
     raise InputError(
-        f"gmsh could not mesh the plate with quadrilaterals only at mesh.size = {size:g} m "
+        f"gmsh could not mesh the plate with quadrilaterals only at mesh.size = "
+        f"{in_file(size, 'm')[0]:g} {unit_name('m')} "
         f"({failures[-1]}); the plate's smallest features: {_features_text(plate)}: give a "
         "smaller mesh.size, or enlarge them"
     )

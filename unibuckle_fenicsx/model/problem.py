@@ -190,6 +190,9 @@ class Problem(Owner):
         self.free: Mode | None = None
         #: Why the free pair is the smallest, if its solve proved it (:meth:`solve_free`).
         self.free_proof: SmallestProof | None = None
+        #: Eigen solves the free pair took (:meth:`solve_free`): more than one when shifts
+        #: were tried, or after a failed solve (the spectral radius, the shifted solve).
+        self.free_solves = 0
         self._free_verified = False  # the free pair was proven the smallest
         self._r: PETSc.Vec | None = None  # work vectors of residual()
         self._Bu: PETSc.Vec | None = None
@@ -244,9 +247,11 @@ class Problem(Owner):
         """
         if self.free is None:
             u = self.new_mode("free_mode")
+            solves = self.eigensolver.solves
             pair, self.free_proof = self.eigensolver.smallest(
                 out=u.x.petsc_vec, estimate=self._estimate()
             )
+            self.free_solves = self.eigensolver.solves - solves
             self._free_verified = self.free_proof is not None
             if not np.isfinite(pair.value):
                 raise InputError(

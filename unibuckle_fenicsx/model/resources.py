@@ -11,6 +11,7 @@ from mpi4py import MPI
 
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.spec import ProblemSpec
+from unibuckle_fenicsx.spec.base import in_file
 
 __all__ = ["BYTES_PER_DOF", "available_memory", "check_memory"]
 
@@ -48,7 +49,8 @@ def check_memory(spec: ProblemSpec, comm: MPI.Comm) -> None:
                 "check_memory: expected spec.mesh.size is not None (an internal invariant)"
             )
         dofs = int(3 * plate.area / spec.mesh.size**2)
-        what = f"mesh.size = {spec.mesh.size:g} m on {plate.area:.3g} m^2 gives about"
+        (size, metres), (area, square) = in_file(spec.mesh.size, "m"), in_file(plate.area, "m^2")
+        what = f"mesh.size = {size:g} {metres} on {area:.3g} {square} gives about"
     else:
         dofs = spec.mesh.num_dofs
         what = f"mesh.nx x mesh.ny = {spec.mesh.nx} x {spec.mesh.ny} gives"

@@ -78,6 +78,7 @@ from unibuckle_fenicsx.model.points import point_bcs, point_springs, snap_points
 from unibuckle_fenicsx.model.prestress import edge_traction, pin_rigid_motions, voigt_to_ufl
 from unibuckle_fenicsx.nonlinear.choices import CONTROLS
 from unibuckle_fenicsx.spec import EDGE_NAMES, EdgeSpec, PlateSpec, ProblemSpec
+from unibuckle_fenicsx.spec.base import file_units
 
 __all__ = [
     "CONTROLS",
@@ -441,7 +442,8 @@ class VonKarmanPlate(MixedDofs, Owner):
         self.bending_bcs = edge_support_bcs(
             self.W, self.facet_tags, self.plate, w_sub=W_SUB, theta_sub=THETA_SUB
         )
-        self.points = snap_points(self.Vw, self.plate, spec.points)
+        with file_units(spec.units):  # a point outside the plate: in the file's units
+            self.points = snap_points(self.Vw, self.plate, spec.points)
         if spec.one_sided_points:
             raise InputError(
                 "points: the nonlinear analysis does not model one-sided points (kind = "

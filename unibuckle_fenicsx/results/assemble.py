@@ -69,7 +69,7 @@ def assemble_result(
             if not problem.structured
             else [spec.mesh.nx, spec.mesh.ny]
         ),
-        eigensolves=1 + (0 if solution is None else solution.eigensolves),
+        eigensolves=problem.free_solves + (0 if solution is None else solution.eigensolves),
         wall_time_s=wall_time_s,
         timings={**problem.timings, "total_s": wall_time_s},
         mpi_size=mpi_size,

@@ -16,6 +16,7 @@ in a file (``obstacles[1]``) the loader says.
 
 from __future__ import annotations
 
+import contextlib
 import contextvars
 import enum
 import functools
@@ -49,12 +50,27 @@ DIMENSIONS: dict[str, tuple[int, int] | list[tuple[int, int]]] = {
     "N/m^2": (0, 1),
     "N/m^3": (-1, 1),
     "N m": (3, 1),  # = Pa m^3
+    "m^2": (2, 0),  # an area, in messages
     "K, K/m": [(0, 0), (-1, 0), (-1, 0)],  # a rise, or [T0, dT/dx, dT/dy]
 }
 
 
 #: The unit system of the file being read (:data:`UNITS`): its messages speak it.
 FILE_UNITS: contextvars.ContextVar[str] = contextvars.ContextVar("file_units", default="SI")
+
+
+@contextlib.contextmanager
+def file_units(units: str) -> Iterator[None]:
+    """Within the block, messages speak ``units`` (:data:`FILE_UNITS`): a run's set-up.
+
+    The file's reading sets them itself; a problem's solve (its mesh, points and
+    contact set-up) refuses and warns in them too.
+    """
+    token = FILE_UNITS.set(units)
+    try:
+        yield
+    finally:
+        FILE_UNITS.reset(token)
 
 
 def factor(dims: tuple[int, int], units: str, sign: int = 1) -> float:
@@ -114,12 +130,13 @@ Stress = float | tuple[float, float]
 Temperature = float | tuple[float, float, float]
 Matrix3 = tuple[tuple[float, float, float], tuple[float, float, float], tuple[float, float, float]]
 #: How messages write these types (a union's members hold no Meta: msgspec 0.22 crashes
-#: on a bounded number beside a list in a union).
+#: on a bounded number beside a list in a union); a unit in braces is written in the
+#: file's units (:func:`unit_name`).
 FORMS: dict[Any, str] = {
     Point: "a point [x, y]",
     Box: "a box [[xmin, xmax], [ymin, ymax]]",
     Stress: "a number or a pair [start, end] (linear along the edge)",
-    Temperature: "a number (K) or [T0, dT/dx, dT/dy] (K, K/m)",
+    Temperature: "a number (K) or [T0, dT/dx, dT/dy] ({K, K/m})",
     Matrix3: "a 3x3 matrix [[a, b, c], [d, e, f], [g, h, i]]",
 }
 
@@ -361,7 +378,7 @@ def form(tp: Any) -> str:
     b = bare(tp)
     given = metadata(tp, "form") or FORMS.get(b)
     if given:
-        return str(given)
+        return re.sub(r"\{([^}]*)\}", lambda unit: unit_name(unit.group(1)), str(given))
     if typing.get_origin(b) in (Union, types.UnionType):
         return " or ".join(form(m) for m in members(b) if bare(m) is not type(None))
     if b is int:

@@ -120,20 +120,26 @@ class ObstacleSpec(Table, frozen=True):
         """The problem file's key of the zone: "zone", "polygon" or "circle"."""
         return self.zone.KEY if isinstance(self.zone, Polygon | Circle) else "zone"
 
-    def describe(self) -> str:
-        """Short human-readable description of the zone."""
+    def describe(self, units: str | None = "SI") -> str:
+        """Short human-readable description of the zone.
+
+        ``units``: "SI" (the result's), or None for a message: the lengths in the units
+        of the file being read or solved (:data:`~unibuckle_fenicsx.spec.base.FILE_UNITS`),
+        with the unit's name.
+        """
         zone = self.zone
         if isinstance(zone, str):
             return "whole plate"
         if isinstance(zone, Polygon):
             return f"polygon of {len(zone.vertices)} vertices"
-        if isinstance(zone, Circle):
-            (cx, cy), r = zone.center, zone.radius
-            return f"circle about ({cx:g}, {cy:g}) of radius {r:g}"
         if callable(zone):
             return f"predicate {getattr(zone, '__name__', 'zone')}"
-        (x0, x1), (y0, y1) = zone
-        return f"[{x0:g}, {x1:g}] x [{y0:g}, {y1:g}]"
+        values = (*zone.center, zone.radius) if isinstance(zone, Circle) else (*zone[0], *zone[1])
+        (a, b, c, *d), name = in_file(values, "m", units)
+        named = "" if name == "m" else f" {name}"  # SI's messages as they were
+        if isinstance(zone, Circle):
+            return f"circle about ({a:g}, {b:g}) of radius {c:g}{named}"
+        return f"[{a:g}, {b:g}] x [{c:g}, {d[0]:g}]{named}"
 
     def contains(self, x: npt.NDArray[np.float64], size: float) -> npt.NDArray[np.bool_]:
         """Mask of the points ``x`` (shape (3, n)) in the closed zone.
@@ -299,18 +305,23 @@ class PointSpec(Table, frozen=True):
                 first = math.ceil((lo - start - tol) / step)
                 last = math.floor((hi - start + tol) / step)
                 if last - first > 100_000:
+                    spacing, name = in_file(list(self.spacing), "m")
                     raise InputError(
-                        f"points.spacing {self.spacing} gives more than 100000 points per row"
+                        f"points.spacing {spacing} {name} gives more than 100000 points per row"
                     )
                 axes.append(start + step * np.arange(first, last + 1))
             gx, gy = np.meshgrid(*axes, indexing="ij")
             points = np.column_stack([gx.ravel(), gy.ravel()])
         inside = plate.contains(points, tol) if plate.file is None else np.ones(len(points), bool)
         if self.at is not None and not inside.all():
-            raise InputError(f"points.at {list(self.at)} lies outside the plate (or in a hole)")
+            at, name = in_file(list(self.at), "m")
+            named = "" if name == "m" else f" {name}"  # SI's messages as they were
+            raise InputError(f"points.at {at}{named} lies outside the plate (or in a hole)")
         if not inside.any():
+            spacing, name = in_file(list(self.spacing or ()), "m")
+            named = "" if name == "m" else f" {name}"
             raise InputError(
-                f"points: the grid of spacing {list(self.spacing or ())} holds no point of the "
+                f"points: the grid of spacing {spacing}{named} holds no point of the "
                 "plate; check spacing, offset and region"
             )
         return points[inside]

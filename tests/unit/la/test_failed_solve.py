@@ -95,3 +95,33 @@ def test_a_failed_solve_with_a_load_finds_it_by_inertia(tmp_path):
         finally:
             gep.destroy()
     assert pair.value == pytest.approx(expected, rel=1e-8)
+
+
+@serial
+def test_a_failed_free_solve_counts_every_eigen_solve(tmp_path):
+    """A failed free solve, the spectral radius and the shifted solve: three eigen solves.
+
+    The psi = -1 plate on 12 x 4 cells, Krylov-Schur cut to one iteration (the command
+    line's ``-unibuckle_eps_max_it 1 -unibuckle_eps_ncv 3``): three SLEPc solves, counted
+    by PETSc's own log (its ``EPSSolve`` event), and the result says three. Before, it
+    said one (the free solve's count was fixed).
+    """
+    from petsc4py import PETSc
+
+    from unibuckle_fenicsx import solve
+
+    path = tmp_path / "psi1.toml"
+    text = STEEP_TOML.replace("[-1.0, 9.0]", "[-1.0, 1.0]").replace("nx = 30", "nx = 12")
+    path.write_text(text.replace("ny = 10", "ny = 4"))
+    PETSc.Log.begin()
+    event, options = PETSc.Log.Event("EPSSolve"), PETSc.Options()
+    options["unibuckle_eps_max_it"], options["unibuckle_eps_ncv"] = 1, 3
+    before = event.getPerfInfo()["count"]
+    try:
+        with solve(load_toml(path)) as analysis:
+            eigensolves = analysis.result.eigensolves
+    finally:
+        options.delValue("unibuckle_eps_max_it")
+        options.delValue("unibuckle_eps_ncv")
+    assert event.getPerfInfo()["count"] - before == 3
+    assert eigensolves == 3

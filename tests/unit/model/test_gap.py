@@ -15,7 +15,7 @@ Expected values:
   linear unilateral load with the gap closed, computed here by a separate linear solve
   of the same plate with ``gap = 0``: the obstacle stiffens the plate only once reached.
   With a gap no linear load is the answer, so the verdict validates none; a load 8 %
-  above the linear one (the issue's small-gap run) is never called validated.
+  above the linear one (a small gap's run) is never called validated.
 """
 
 from __future__ import annotations

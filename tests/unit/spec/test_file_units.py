@@ -262,3 +262,54 @@ def test_the_cells_along_the_member_speak_the_file_s_units(monkeypatch, changes,
         spec = section_from_dict(_section(units, **copy.deepcopy(changes)))
         with pytest.raises(ValueError, match=f"^{re.escape(expected)}"):
             solve_section(spec)
+
+
+@pytest.mark.parametrize(
+    ("changes", "mm", "si"),
+    [
+        (
+            {"points": lambda s, p: [{"at": [500.0 * s, 0.0], "kind": "bilateral"}]},
+            "points[0].at [500.0, 0.0] mm lies outside the plate",
+            "points[0].at [0.5, 0.0] lies outside the plate",
+        ),
+        (
+            {
+                "points": lambda s, p: [
+                    {"spacing": 10.0 * s, "region": [[200.0 * s, 300.0 * s], [0.0, 10.0 * s]]}
+                ]
+            },
+            "points[0]: the grid of spacing [10.0, 10.0] mm holds no point of the plate",
+            "points[0]: the grid of spacing [0.01, 0.01] holds no point of the plate",
+        ),
+        (
+            {"load": lambda s, p: {"temperature": "hot"}},
+            "load.temperature must be a number (K) or [T0, dT/dx, dT/dy] (K, K/mm)",
+            "load.temperature must be a number (K) or [T0, dT/dx, dT/dy] (K, K/m)",
+        ),
+    ],
+    ids=["at", "grid", "temperature_form"],
+)
+def test_points_and_a_temperature_s_form_speak_the_file_s_units(changes, mm, si):
+    """A point outside the plate, a grid missing it, a temperature's form (K/mm).
+
+    Before, the points were quoted in metres and the gradient named K/m in a mm-N-MPa file.
+    """
+    assert _refused(problem_from_dict, _plate("mm-N-MPa", **changes)).startswith(mm)
+    assert _refused(problem_from_dict, _plate("SI", **changes)).startswith(si)
+
+
+def test_an_empty_zone_found_on_the_mesh_speaks_the_file_s_units():
+    """A zone between the nodes of 4 x 4 cells (50 x 25 mm): refused once the mesh exists.
+
+    Before, its corners were quoted in metres ([0.001, 0.002] x ...) in a mm-N-MPa file.
+    """
+    from unibuckle_fenicsx import solve
+
+    for units, expected in (
+        ("mm-N-MPa", "obstacle.zone [1, 2] x [1, 2] mm holds no free mesh node"),
+        ("SI", "obstacle.zone [0.001, 0.002] x [0.001, 0.002] holds no free mesh node"),
+    ):
+        zone = lambda s, p: [[1.0 * s, 2.0 * s], [1.0 * s, 2.0 * s]]  # noqa: E731
+        spec = problem_from_dict(_plate(units, obstacle__zone=zone, mesh={"nx": 4, "ny": 4}))
+        with pytest.raises(ValueError, match=f"^{re.escape(expected)}"):
+            solve(spec)
