@@ -46,7 +46,7 @@ import pytest
 import scipy.linalg
 from msgspec import structs
 
-from support.exhaustive import dense
+from support.exhaustive import dense, dense_reduced_load, satisfies_kkt
 from support.newton import at_saddle
 from support.paths import MPI_SCRIPTS
 from support.processes import run_mpi
@@ -61,8 +61,10 @@ from unibuckle_fenicsx.algorithms.interior_point import (
 from unibuckle_fenicsx.algorithms.interior_point.explore import second_free_mode
 from unibuckle_fenicsx.algorithms.interior_point.links import (
     MeshLevel,
+    Reader,
     critical_state,
     read_contact,
+    released,
 )
 from unibuckle_fenicsx.algorithms.interior_point.newton import StallWatch
 from unibuckle_fenicsx.algorithms.interior_point.options import PUSH_MARGIN
@@ -779,4 +781,69 @@ def test_fine_mesh_read_early_gives_the_load_read_at_the_end(thin_plate):
     assert np.array_equal(early.candidate.active, late.candidate.active)
     # The same contact set, solved at shifts below two barrier loads (1e-9 and 1e-14).
     assert early.load == pytest.approx(late.load, rel=_load_rounding(problem, late.candidate))
+    problem.destroy()
+
+
+def _dense_forces(problem: UnilateralProblem, A, B, active) -> np.ndarray:
+    r"""Forces of the smallest reduced eigenpair at the constrained nodes, by LAPACK.
+
+    :math:`r = Au - \lambda Bu` relative to :math:`\|Au\|_\infty`, of the pencil reduced
+    on ``active`` (``scipy.linalg.eigh``), the mode oriented to stay off the obstacle.
+    """
+    removed = np.union1d(problem.model.bc_dofs, problem.contact.removed_rows(active))
+    keep = np.setdiff1d(np.arange(A.shape[0]), removed)
+    theta, vecs = scipy.linalg.eigh(B[np.ix_(keep, keep)], A[np.ix_(keep, keep)])
+    u = np.zeros(A.shape[0])
+    u[keep] = vecs[:, -1]
+    u /= np.abs(u[problem.model.w_dofs]).max()
+    rows, signs = problem.contact.global_rows(), problem.contact.signs
+    if (signs * u[rows]).max() > problem.tau:
+        u = -u  # the admissible side
+    assert (signs * u[rows]).max() <= problem.tau
+    r = A @ u - (B @ u) / theta[-1]
+    return signs * r[rows] / np.abs(A @ u).max()
+
+
+@serial
+def test_a_read_pulled_at_nodes_of_its_set_is_released_to_a_kkt_point(thin_plate):
+    """``release_steps``: the nodes where the obstacle pulls are dropped and the set read again.
+
+    Thin SSSS plate, 12x4: the route's KKT set with the two nodes nearest to the obstacle
+    off it added gives an admissible mode that the obstacle pulls at exactly those two
+    nodes (reference: the reduced pencil's smallest eigenpair by LAPACK, its forces
+    r = Au - lambda Bu). Read from a barrier point near the KKT state, that set is no
+    KKT point; with one release step the reader drops the pulled nodes, and the set it
+    reads is a KKT point (checked on the dense matrices) whose load is LAPACK's for that
+    set; with none (``release_steps = 0``) the read ends nothing.
+    """
+    problem = build_problem(thin_plate("ssss", nx=12, ny=4), MPI.COMM_SELF)
+    kkt = solve_interior_point(problem, ChainOptions()).candidate
+    off = np.setdiff1d(np.arange(problem.contact.size), kkt.active)
+    extra = np.sort(off[np.argsort(-kkt.values[off])][:2])
+    pulled_set = np.union1d(kkt.active, extra)
+    A, B = dense(problem.model.A), dense(problem.model.B)
+    forces = _dense_forces(problem, A, B, pulled_set)
+    expected = pulled_set[forces[pulled_set] <= problem.tau]
+    assert np.array_equal(np.setdiff1d(pulled_set, expected), extra)  # pulled at the two only
+    cand = problem.evaluate(pulled_set, initial=kkt.mode.x.petsc_vec, near=kkt.load)
+    assert cand.feasible and not cand.kkt
+    kept = released(cand)
+    assert kept is not None and np.array_equal(kept, expected)
+    results = {}
+    with InteriorPointNewton(problem) as newton:
+        for steps in (0, 1):
+            point = newton.starts.from_candidate(kkt, 1e-9)
+            level = MeshLevel([12, 4], problem.num_constrained)
+            reader = Reader(problem, newton, level, ChainOptions(release_steps=steps))
+            status = reader.arm("test")._read(point, pulled_set, "given")
+            results[steps] = (status, reader.found, [link.seed for link in level.links])
+    assert results[0] == (None, None, ["test (given at 1e-09)"])
+    status, found, seeds = results[1]
+    assert status is NewtonStatus.READ and found is not None
+    assert seeds == ["test (given at 1e-09)", "test (given at 1e-09) (release 1)"]
+    assert np.array_equal(found.active, expected)
+    x = found.mode.x.petsc_vec.array.copy()
+    assert satisfies_kkt(problem, A, B, x, found.load, found.active)
+    reference = dense_reduced_load(problem, tuple(expected))
+    assert found.load == pytest.approx(reference, rel=_load_rounding(problem, found))
     problem.destroy()

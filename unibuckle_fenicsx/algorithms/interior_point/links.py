@@ -50,6 +50,7 @@ __all__ = [
     "polish",
     "project_on_pairs",
     "read_contact",
+    "released",
     "run_from",
 ]
 
@@ -321,10 +322,43 @@ class Reader:
             active,
             double=self.options.double_push,
         )
+        for step in range(self.options.release_steps):
+            kept = released(cand)
+            if kept is None or any(np.array_equal(kept, other) for other in self.tried):
+                break
+            self.tried.append(kept)
+            cand = read_contact(
+                self.problem,
+                self.newton,
+                point,
+                self.level,
+                f"{label} (release {step + 1})",
+                kept,
+                double=self.options.double_push,
+            )
         if not cand.kkt:
             return None
         self.armed, self.found = False, cand
         return NewtonStatus.READ
+
+
+def released(cand: Candidate) -> npt.NDArray[np.int64] | None:
+    r"""``cand``'s contact set without the nodes that pull, or None.
+
+    For a critical state that fails the KKT conditions only by the obstacle's pull
+    (admissible: :math:`u_k \le \tau` on every node, with :math:`r_k > \tau` at some
+    nodes of Z, :math:`r = Au - \lambda Bu` relative to :math:`\|Au\|_\infty`), the
+    release step of the active-set iteration
+    (:mod:`~unibuckle_fenicsx.algorithms.pdas`): Z without those nodes.
+    None when ``cand`` is a KKT point, crosses the obstacle, has no finite load, or no
+    node of Z pulls.
+    """
+    if cand.kkt or not cand.feasible or not math.isfinite(cand.load):
+        return None
+    pulls = cand.forces[cand.active] > cand.tau
+    if not pulls.any():
+        return None
+    return cand.active[~pulls]
 
 
 def polish(

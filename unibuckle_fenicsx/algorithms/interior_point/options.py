@@ -260,6 +260,12 @@ class ChainOptions:
             (:func:`~.links.double_read`: one more eigen solve). The sign changes of
             the degenerate nodes stay below a thousandth of the buckle; a second
             buckle of the same load crosses by a good part of its own.
+        release_steps: On the fine mesh, where a contact set read at or below
+            ``read_mu`` gives an admissible mode that the obstacle pulls at nodes of
+            the set, those nodes are released and the smaller set read (one eigen
+            solve each, :func:`~.links.released`), at most this many times in a row
+            (0: never); a KKT point met so ends the run. The flooded sets read on the
+            clamped plate at 360x120 took five (:doc:`/verification/fine_level_release`).
         clip_margin: Smallest gap (relative to max|w|) of an interpolated mode's nodes
             (the least-energy correction lifts those closer to the obstacle to it).
         max_steps: Newton steps per run.
@@ -304,6 +310,7 @@ class ChainOptions:
     last_mu_min: float = 1e-14
     read_predicted: bool = False
     double_push: float = 1e-2
+    release_steps: int = 8
     clip_margin: float = 1e-6
     max_steps: int = 100
     escapes: int = 3
