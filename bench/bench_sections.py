@@ -18,10 +18,13 @@ interior point, the active set if it reaches no KKT point) or ``single`` (the
 interior-point chain on the section itself, no coarser one); then the certificate.
 The factorisations are PETSc's count of numeric ones (MUMPS) in the unilateral solve, in
 all and, for the active set, per section level; the interior point's per level are its
-Newton kernel's count. Prints one Markdown row, then one row per level (its steps: the
-active set's or the Newton steps; eigen solves, factorisations and seconds); ``--json
-FILE`` appends the row, with the levels, and the unilateral load (``core_load_Pa``) to
-compare routes by.
+Newton kernel's count. Per level too: the seconds of its section's build (mesh,
+prestress, assembly, change of basis: ``build_s``) and of the numeric factorisations
+through the section's shared LDLᵀ (``factor_s``: the Newton steps', the inertia
+corrections', the certificate's on the finest). Prints one Markdown row, then one row
+per level (its steps: the active set's or the Newton steps; eigen solves, factorisations
+and seconds); ``--json FILE`` appends the row, with the levels, and the unilateral load
+(``core_load_Pa``) to compare routes by.
 
 Ratios, both within the one process: ``ratio`` is the unilateral solve (its sections'
 set-up included) over the free eigen solve; ``process_ratio`` the whole cored run
@@ -49,7 +52,7 @@ COLUMNS = (
 #: The columns of a level's row (coarsest first).
 LEVEL_COLUMNS = (
     "mesh_size", "dofs", "constrained", "seeded", "steps", "eigensolves", "factorisations",
-    "wall_time_s", "load",
+    "build_s", "factor_s", "wall_time_s", "load",
 )  # fmt: skip
 
 
@@ -63,8 +66,27 @@ def _factorisations() -> int:
     )
 
 
+def _timed_by_rows(owner: object, name: str, seconds: dict[int, float], rows) -> None:  # type: ignore[no-untyped-def]
+    """Wrap ``owner.name`` to add its seconds to ``seconds[rows(args)]``."""
+    inner = getattr(owner, name)
+
+    def timed(*args, **kwargs):  # type: ignore[no-untyped-def]
+        t0 = time.perf_counter()
+        out = inner(*args, **kwargs)
+        key = rows(args, out)
+        seconds[key] = seconds.get(key, 0.0) + time.perf_counter() - t0
+        return out
+
+    setattr(owner, name, timed)
+
+
 def run(
-    shape: str, size: float, levels: int, repeat: int, corner_cell: float | None, route: str
+    shape: str,
+    size: float,
+    levels: int,
+    repeat: int,
+    corner_cell: float | None,
+    route: str,
 ) -> dict:
     """One section: set-up, free solve, unilateral solve, certificate.
 
@@ -83,6 +105,7 @@ def run(
     from unibuckle_fenicsx.algorithms.records import InteriorPointDetails, SectionLevelsDetails
     from unibuckle_fenicsx.analysis import choose_section_method
     from unibuckle_fenicsx.certificate.certify import certify
+    from unibuckle_fenicsx.la import factor
     from unibuckle_fenicsx.la.eigen import GEPSolver
     from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
     from unibuckle_fenicsx.spec import SolverSpec
@@ -98,6 +121,23 @@ def run(
         return out
 
     section_levels._level = counted
+    # Seconds per section (keyed by its rows): its builds, its shared LDL^T's factorisations.
+    build_s: dict[int, float] = {}
+    factor_s: dict[int, float] = {}
+    dofs_of: dict[int, int] = {}  # a built section's rows by its constrained directions
+
+    def built_rows(args, out) -> int:  # type: ignore[no-untyped-def]
+        rows = int(out.model.A.getSize()[0])
+        dofs_of[out.constraints.size] = rows
+        return rows
+
+    _timed_by_rows(section_levels, "_build", build_s, built_rows)
+    _timed_by_rows(
+        factor.SharedFactorization,
+        "factor",
+        factor_s,
+        lambda args, out: int(args[0].matrix.getSize()[0]),
+    )
 
     geometry = (
         {"width": 0.2, "depth": 0.2, "thickness": 0.002, "length": 0.6}
@@ -150,6 +190,7 @@ def run(
             levels_log = [
                 {
                     "mesh_size": h,
+                    "dofs": dofs_of.get(level.constrained_nodes, ""),
                     "cells": level.mesh,
                     "constrained": level.constrained_nodes,
                     "steps": level.newton_steps,
@@ -164,6 +205,12 @@ def run(
             coarse = details.coarse_eigensolves
         else:
             levels_log = [{"eigensolves": solution.eigensolves, "factorisations": factorisations}]
+        for entry in levels_log:  # the seconds of its section's build and factorisations
+            rows = entry.get("dofs") or dofs_of.get(entry.get("constrained", -1))
+            if rows:
+                entry["dofs"] = rows
+                entry["build_s"] = build_s.get(rows, 0.0)
+                entry["factor_s"] = factor_s.get(rows, 0.0)
             coarse = 0
         per_level_text = "; ".join(
             f"{1e3 * entry['mesh_size']:g} mm{' seeds' if entry.get('seeded') else ''}: "

@@ -106,6 +106,38 @@ def test_change_of_basis_is_a_congruence(shape):
 
 
 @pytest.mark.parametrize(
+    ("shape", "span"), [("box", (0.05, 0.15)), ("box", None), ("tube", (0.05, 0.15))]
+)
+def test_change_of_basis_columns_are_the_normals_from_the_coordinates(shape, span):
+    # Each constrained direction's column of T is its normal n_in at its node's
+    # translations (T is orthogonal on these sections: its inverse's row is the column),
+    # the normals computed here from the coordinates (_normal_rows); every other column
+    # of T is a unit vector, the node's other columns orthonormal to the normals: the
+    # CSR that change_of_basis assembles, checked entry by entry, with the core over
+    # part of the length (nodes outside it keep the identity).
+    params = _parameters(shape, mesh_size=0.025, length=0.2, core_span=span)
+    with build_section(params, MPI.COMM_SELF) as sec:
+        Td = sec.problem.pencil.T.convert("dense").getDenseArray()
+        np.testing.assert_allclose(Td.T @ Td, np.eye(Td.shape[0]), atol=1e-14)
+        C, where = _normal_rows(sec)
+        x = where[:, 0]
+        inside = np.ones(x.size, dtype=bool) if span is None else (x > span[0] - 1e-9)
+        if span is not None:
+            inside &= x < span[1] + 1e-9
+        C = C[inside]
+        rows = sec.rows  # the constrained directions' columns (the new basis' DOFs)
+        assert rows.size == C.shape[0] > 0
+        columns = Td[:, rows].T
+        # The same set of columns as the normal rows (each matched to its own row).
+        for column in columns:
+            assert np.abs(C - column).max(axis=1).min() < 1e-14
+        touched = np.unique(np.concatenate([6 * (r // 6) + np.arange(3) for r in rows]))
+        others = np.setdiff1d(np.arange(Td.shape[0]), touched)
+        np.testing.assert_array_equal(Td[np.ix_(others, others)], np.eye(others.size))
+        assert not Td[np.ix_(others, touched)].any() and not Td[np.ix_(touched, others)].any()
+
+
+@pytest.mark.parametrize(
     ("shape", "changes"), [("box", {}), ("tube", {"mesh_size": 0.08, "length": 0.16})]
 )
 def test_core_matches_dense_enumeration(shape, changes):

@@ -314,23 +314,36 @@ def change_of_basis(model: ShellModel, constraints: CoreConstraints) -> PETSc.Ma
     normals = constraints.normals[constraints.owned_positions]
     for k, n in zip(constraints.owned_nodes.tolist(), normals, strict=True):
         by_node.setdefault(k, []).append(n)
-    # CSR: identity rows, then the 3x3 blocks.
-    cols: list[list[int]] = [[start + r] for r in range(n_local)]
-    vals: list[list[float]] = [[1.0] for _ in range(n_local)]
-    for k, ns in by_node.items():
-        Q = _node_block(np.array(ns))
-        for c in range(3):
-            r = k * bs + c
-            cols[r] = [start + k * bs + j for j in range(3)]
-            vals[r] = Q[c].tolist()
-    indptr = np.zeros(n_local + 1, dtype=PETSc.IntType)
-    indptr[1:] = np.cumsum([len(c) for c in cols])
+    # Q_k depends on the node's normals alone, which repeat (a box's faces, a tube's
+    # generators): each distinct set's block is computed once, the same bits.
+    blocks: dict[bytes, npt.NDArray[np.float64]] = {}
+    nodes = np.fromiter(by_node, dtype=np.int64, count=len(by_node))
+    Qs = np.empty((nodes.size, 3, 3))
+    for i, ns in enumerate(by_node.values()):
+        key = np.array(ns).tobytes()
+        if key not in blocks:
+            blocks[key] = _node_block(np.array(ns))
+        Qs[i] = blocks[key]
+    # CSR: identity rows, the three displacement rows of a constrained node a 3x3 block.
+    blocked = (nodes[:, None] * bs + np.arange(3)).ravel()  # rows, node by node
+    counts = np.ones(n_local, dtype=np.int64)
+    counts[blocked] = 3
+    indptr = np.zeros(n_local + 1, dtype=np.int64)
+    indptr[1:] = np.cumsum(counts)
+    cols = np.empty(indptr[-1], dtype=np.int64)
+    vals = np.empty(indptr[-1], dtype=PETSc.ScalarType)
+    plain = np.flatnonzero(counts == 1)
+    cols[indptr[plain]] = start + plain
+    vals[indptr[plain]] = 1.0
+    first = indptr[blocked][:, None] + np.arange(3)  # (rows, 3) positions of a block row
+    cols[first] = start + (np.repeat(nodes, 3) * bs)[:, None] + np.arange(3)
+    vals[first] = Qs.reshape(-1, 3)
     T = PETSc.Mat().createAIJ(
         ((n_local, None), (n_local, None)),  # type: ignore[arg-type]
         csr=(  # type: ignore[arg-type]
-            indptr,
-            np.asarray([c for row in cols for c in row], dtype=PETSc.IntType),
-            np.asarray([v for row in vals for v in row], dtype=PETSc.ScalarType),
+            indptr.astype(PETSc.IntType),
+            cols.astype(PETSc.IntType),
+            vals,
         ),
         comm=model.mesh.comm,
     )
