@@ -32,29 +32,17 @@ from mpi4py import MPI
 from petsc4py import PETSc
 
 from _results import append_rows, print_header
+from bench_sections import section_parameters
 
 from unibuckle_fenicsx.la.factor import LDL_OPTIONS
 from unibuckle_fenicsx.la.options import ORDERINGS, mumps_ordering
-from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
+from unibuckle_fenicsx.model.shell.section import build_section
 
 COLUMNS = (
     "section", "cell_mm", "rows", "ordering", "package", "analysis_s", "numeric_s",
     "factor_entries", "flops",
 )  # fmt: skip
 _SAME = PETSc.Mat.Structure.SAME_NONZERO_PATTERN
-
-
-def _section(shape: str, size: float) -> SectionParameters:
-    """The section of ``bench_sections.py`` on cells of ``size`` (m)."""
-    geometry = (
-        {"width": 0.2, "depth": 0.2, "thickness": 0.002, "length": 0.6}
-        if shape == "box"
-        else {"diameter": 0.2, "thickness": 0.001, "length": 0.1}
-    )
-    return SectionParameters(
-        shape, E=2.1e11, nu=0.3, mesh_size=size, ends="simply_supported", core=True,
-        **geometry,
-    )  # fmt: skip
 
 
 def _newton_matrix(section, load: float, barrier: float) -> PETSc.Mat:  # type: ignore[no-untyped-def]
@@ -139,7 +127,7 @@ def main() -> None:
     rows = []
     for item in args.sections.split(","):
         shape, size = item.split(":")
-        with build_section(_section(shape, float(size)), MPI.COMM_SELF) as section:
+        with build_section(section_parameters(shape, float(size)), MPI.COMM_SELF) as section:
             K = _newton_matrix(section, args.load, args.barrier)
             n = int(K.getSize()[0])
             package = mumps_ordering(n, reused=True)

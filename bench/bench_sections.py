@@ -41,8 +41,12 @@ from __future__ import annotations
 import argparse
 import math
 import time
+from typing import TYPE_CHECKING
 
 from _results import append_rows, print_header
+
+if TYPE_CHECKING:
+    from unibuckle_fenicsx.model.shell.section import SectionParameters
 
 COLUMNS = (
     "shape", "route", "dofs", "constrained", "cells_around", "free_load/ref", "core_load/ref",
@@ -54,6 +58,23 @@ LEVEL_COLUMNS = (
     "mesh_size", "dofs", "constrained", "seeded", "steps", "eigensolves", "factorisations",
     "build_s", "factor_s", "wall_time_s", "load",
 )  # fmt: skip
+
+
+def section_parameters(
+    shape: str, size: float, corner_cell: float | None = None
+) -> SectionParameters:
+    """The benchmark's box or tube with a rigid core on cells of ``size`` (m)."""
+    from unibuckle_fenicsx.model.shell.section import SectionParameters
+
+    geometry = (
+        {"width": 0.2, "depth": 0.2, "thickness": 0.002, "length": 0.6}
+        if shape == "box"
+        else {"diameter": 0.2, "thickness": 0.001, "length": 0.1}
+    )
+    return SectionParameters(
+        shape, E=2.1e11, nu=0.3, mesh_size=size, ends="simply_supported", core=True,
+        corner_cell=corner_cell if shape == "box" else None, **geometry,
+    )  # fmt: skip
 
 
 def _factorisations() -> int:
@@ -107,7 +128,7 @@ def run(
     from unibuckle_fenicsx.certificate.certify import certify
     from unibuckle_fenicsx.la import factor
     from unibuckle_fenicsx.la.eigen import GEPSolver
-    from unibuckle_fenicsx.model.shell.section import SectionParameters, build_section
+    from unibuckle_fenicsx.model.shell.section import build_section
     from unibuckle_fenicsx.spec import SolverSpec
 
     # Each level's factorisations: the count before and after it (in order, coarsest first).
@@ -139,15 +160,7 @@ def run(
         lambda args, out: int(args[0].matrix.getSize()[0]),
     )
 
-    geometry = (
-        {"width": 0.2, "depth": 0.2, "thickness": 0.002, "length": 0.6}
-        if shape == "box"
-        else {"diameter": 0.2, "thickness": 0.001, "length": 0.1}
-    )
-    params = SectionParameters(
-        shape, E=2.1e11, nu=0.3, mesh_size=size, ends="simply_supported", core=True,
-        corner_cell=corner_cell if shape == "box" else None, **geometry,
-    )  # fmt: skip
+    params = section_parameters(shape, size, corner_cell)
     PETSc.Log.begin()  # the factorisations' counts
     t0 = time.perf_counter()
     with build_section(params, MPI.COMM_WORLD) as section:
