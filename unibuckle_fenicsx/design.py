@@ -242,7 +242,8 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.psi = psi
     slenderness = math.sqrt(design.yield_stress / sigma1)
     out.relative_slenderness = slenderness
-    out.k_sigma = sigma1 / euler_stress(spec, element.loaded)
+    sigma_e = euler_stress(spec, element.loaded)
+    out.k_sigma = sigma1 / sigma_e
     low, _ = psi_range(element.kind, at_free)
     if psi < low:  # only with a fixed part: a scaled one alone is refused beforehand
         out.notes.append(f"psi = {psi:.3g} < {low:g}: outside {out.table}, no rho")
@@ -256,7 +257,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
     out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
     out.xi = sigma1 / column - 1.0
-    short = column > euler_stress(spec, element.loaded)  # sigma_cr,c / sigma_E = (b/a)^2
+    short = column > sigma_e  # sigma_cr,c / sigma_E = (b/a)^2
     rho_c = interpolated_reduction_factor(rho, chi, out.xi) if short else rho
     out.reduction_factor = rho_c
     out.reduced_design_stress_Pa = rho_c * design.yield_stress / design.partial_factor
