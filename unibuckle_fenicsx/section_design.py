@@ -35,12 +35,15 @@ from __future__ import annotations
 import math
 from typing import Protocol
 
+import msgspec
 from msgspec import UNSET, Struct, UnsetType
 
 from unibuckle_fenicsx.design import CALIBRATION, UNPROVEN
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     buckling_factor,
+    column_reduction_factor,
+    interpolated_reduction_factor,
     psi_range,
     reduction_factor,
     stress_ratio,
@@ -60,7 +63,8 @@ __all__ = [
 #: The clauses of a box's face.
 FACE_CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of each face as an "
-    "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma"
+    "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma; "
+    "4.5.3(2), 4.5.4(1): column-type buckling of a face shorter than its width, rho_c"
 )
 #: The clause of a tube's slenderness.
 TUBE_CLAUSES = (
@@ -78,6 +82,12 @@ class DesignSection(Protocol):
     def shape(self) -> str: ...
     @property
     def thickness(self) -> float: ...
+    @property
+    def length(self) -> float: ...
+    @property
+    def E(self) -> float: ...
+    @property
+    def nu(self) -> float: ...
     @property
     def width(self) -> float | None: ...
     @property
@@ -104,8 +114,20 @@ class FaceDesign(Struct, kw_only=True):
         psi: :math:`\psi = \sigma_2/\sigma_1` across the face.
         relative_slenderness: :math:`\bar\lambda_p = \sqrt{f_y/\sigma_1}`.
         k_sigma_table: Table 4.1's :math:`k_\sigma` at :math:`\psi`.
-        reduction_factor: :math:`\rho`, eq. (4.2); None for :math:`\psi < -3`.
-        reduced_design_stress_Pa: :math:`\rho f_y/\gamma_{M1}` (Pa).
+        reduction_factor: The reduction factor to apply: on a face shorter than it is
+            wide (a/b < 1, the note of 4.4(2)) :math:`\rho_c` of 4.5.4(1), the
+            plate-type ``plate_reduction_factor`` interpolated towards the column-type
+            ``column_reduction_factor`` where :math:`\xi < 1`; else
+            ``plate_reduction_factor``. None for :math:`\psi < -3`.
+        plate_reduction_factor: :math:`\rho`, eq. (4.2).
+        column_critical_stress_Pa: :math:`\sigma_{cr,c} = \pi^2 E t^2/(12(1 - \nu^2)
+            a^2)`, a the section's length (4.5.3(2), eq. (4.8)): the face as a column,
+            its corners' support removed, hinged at the ends.
+        column_reduction_factor: :math:`\chi_c` at :math:`\sqrt{f_y/\sigma_{cr,c}}`,
+            curve a (4.5.3(4), (5)).
+        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)).
+        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M1}` (Pa), with
+            ``reduction_factor``.
     """
 
     face: str
@@ -114,6 +136,10 @@ class FaceDesign(Struct, kw_only=True):
     relative_slenderness: float | None = None
     k_sigma_table: float | None = None
     reduction_factor: float | None = None
+    plate_reduction_factor: float | None = None
+    column_critical_stress_Pa: float | None = None
+    column_reduction_factor: float | None = None
+    xi: float | None = None
     reduced_design_stress_Pa: float | None = None
 
 
@@ -131,7 +157,11 @@ class SectionDesignRecord(Struct, kw_only=True):
         faces: A box's faces (:class:`FaceDesign`); empty for a tube.
         governing_face: The face that reaches :math:`\rho f_y/\gamma_{M1}` at the
             smallest multiple of the critical load, the smallest :math:`\rho f_y/\sigma_1`
-            (of faces reaching it together, the widest; None for a tube).
+            (of faces reaching it together, the widest, and of equally wide ones the
+            first of ``faces``; None for a tube).
+        tied_faces: The faces that reach it together with the governing one, itself
+            first (every face of a box in uniform compression without column-type
+            buckling); empty when one face governs alone.
         width_to_thickness: With a core: :math:`h/t` (box, h the greater overall
             dimension) or :math:`d/t` (tube, d the outer diameter); else None.
         width_to_thickness_limit: EN 1994-1-1 Table 6.3's limit of that ratio.
@@ -150,6 +180,7 @@ class SectionDesignRecord(Struct, kw_only=True):
     notes: list[str]
     faces: list[FaceDesign]
     governing_face: str | None = None
+    tied_faces: list[str] = msgspec.field(default_factory=list)
     width_to_thickness: float | None = None
     width_to_thickness_limit: float | None = None
     local_buckling_negligible: bool | None = None
@@ -173,20 +204,35 @@ def face_compressions(section: DesignSection) -> dict[str, tuple[float, float]]:
     }
 
 
-def _face(name: str, ends: tuple[float, float], design: DesignSpec) -> FaceDesign:
-    """The face ``name`` whose edges carry the compressions ``ends`` (Pa)."""
+def _face(
+    section: DesignSection, name: str, ends: tuple[float, float], design: DesignSpec
+) -> FaceDesign:
+    """The face ``name`` of ``section`` whose edges carry the compressions ``ends`` (Pa)."""
     sigma1, sigma2 = max(ends), min(ends)
     if sigma1 <= 0.0:
         return FaceDesign(face=name, sigma_cr_Pa=sigma1)
     psi = stress_ratio(sigma1, sigma2)  # a whole number within rounding: the table's row
     slenderness = math.sqrt(design.yield_stress / sigma1)
     out = FaceDesign(face=name, sigma_cr_Pa=sigma1, psi=psi, relative_slenderness=slenderness)
-    if psi >= psi_range(INTERNAL)[0]:
-        out.k_sigma_table = buckling_factor(INTERNAL, psi)
-        out.reduction_factor = reduction_factor(slenderness, psi, INTERNAL)
-        out.reduced_design_stress_Pa = (
-            out.reduction_factor * design.yield_stress / design.partial_factor
+    if psi < psi_range(INTERNAL)[0]:
+        return out
+    out.k_sigma_table = buckling_factor(INTERNAL, psi)
+    rho = reduction_factor(slenderness, psi, INTERNAL)
+    out.plate_reduction_factor = out.reduction_factor = rho
+    # The face as a column (4.5.3(2), 4.5.4(1)): a face shorter than its width may buckle
+    # like one (the note of 4.4(2)), as a plate's (unibuckle_fenicsx.design).
+    ratio = section.thickness / section.length
+    column = math.pi**2 * section.E * ratio**2 / (12.0 * (1.0 - section.nu**2))
+    out.column_critical_stress_Pa = column
+    out.column_reduction_factor = column_reduction_factor(math.sqrt(design.yield_stress / column))
+    out.xi = sigma1 / column - 1.0
+    if section.length < face_width(section, name):  # a/b < 1
+        out.reduction_factor = interpolated_reduction_factor(
+            rho, out.column_reduction_factor, out.xi
         )
+    out.reduced_design_stress_Pa = (
+        out.reduction_factor * design.yield_stress / design.partial_factor
+    )
     return out
 
 
@@ -229,12 +275,25 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             "that buckles because its neighbours do"
         )
         for name, (a, b) in face_compressions(section).items():
-            out.faces.append(_face(name, (load * a, load * b), design))
+            out.faces.append(_face(section, name, (load * a, load * b), design))
+        column = [f for f in out.faces if f.reduction_factor != f.plate_reduction_factor]
+        if column:
+            out.notes.append(
+                "column-type buckling (EN 1993-1-5 4.4(2) note, 4.5.4(1)): the section's "
+                "length is below the width of face(s) "
+                + ", ".join(
+                    f"{f.face} (xi = {f.xi:.3g}, rho_c = {f.reduction_factor:.4g})" for f in column
+                )
+                + "; sigma_cr,c by eq. (4.8), the ends hinged"
+            )
         rated = [f for f in out.faces if f.reduced_design_stress_Pa is not None]
         if rated:
             first = min(_reaches_reduced_stress(f) for f in rated)
             tied = [f for f in rated if _reaches_reduced_stress(f) <= first * (1.0 + 1e-12)]
             out.governing_face = max(tied, key=lambda f: face_width(section, f.face)).face
+            if len(tied) > 1:
+                others = [f.face for f in tied if f.face != out.governing_face]
+                out.tied_faces = [out.governing_face, *others]
     else:
         out.clauses.append(TUBE_CLAUSES)
     out.notes.append(member_note(section, design))
@@ -297,6 +356,21 @@ def at_lower_bound(
     return record
 
 
+def _governing(d: SectionDesignRecord) -> str:
+    r"""The governing face in the summary: its name, or the faces that tie with it.
+
+    Faces that reach :math:`\rho f_y/\gamma_{M1}` at one load tie (every face of a box in
+    uniform compression): the line names them all and the rule that picked
+    ``governing_face`` (the widest, then the first of ``faces``).
+    """
+    if not d.tied_faces:
+        return f"face {d.governing_face}"
+    return (
+        f"faces {', '.join(d.tied_faces)} tie (one load to rho f_y/gamma_M1; "
+        f"{d.governing_face} named: the widest, then the first)"
+    )
+
+
 def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") -> str:
     """The summary line of a section's design output (stresses in ``unit``, Pa / ``scale``)."""
     text = (
@@ -306,9 +380,16 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
     face = next((f for f in d.faces if f.face == d.governing_face), None)
     if face is not None and face.reduction_factor is not None:
         reduced = face.reduced_design_stress_Pa or 0.0
+        rho = f"rho = {face.reduction_factor:.4g}"
+        if face.reduction_factor != face.plate_reduction_factor:
+            rho = (
+                f"rho_c = {face.reduction_factor:.4g} (column-type, EN 1993-1-5 4.5.4: "
+                f"plate {face.plate_reduction_factor:.4g}, chi_c "
+                f"{face.column_reduction_factor:.4g}, xi {face.xi:.3g})"
+            )
         text += (
-            f"; EN 1993-1-5 face {face.face}: psi = {face.psi:.3g}, rho = "
-            f"{face.reduction_factor:.4g}, rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
+            f"; EN 1993-1-5 {_governing(d)}: psi = {face.psi:.3g}, {rho}, "
+            f"rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
         )
     if d.width_to_thickness is not None and d.width_to_thickness_limit is not None:
         verdict = (
