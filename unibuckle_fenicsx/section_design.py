@@ -100,6 +100,8 @@ class DesignSection(Protocol):
     def bending_stress(self) -> float: ...
     @property
     def core(self) -> bool: ...
+    @property
+    def core_span(self) -> tuple[float, float] | None: ...
     def compression(self) -> float: ...
     def euler_stress(self) -> float: ...
 
@@ -165,7 +167,8 @@ class SectionDesignRecord(Struct, kw_only=True):
         width_to_thickness: With a core: :math:`h/t` (box, h the greater overall
             dimension) or :math:`d/t` (tube, d the outer diameter); else None.
         width_to_thickness_limit: EN 1994-1-1 Table 6.3's limit of that ratio.
-        local_buckling_negligible: Whether the ratio is within the limit (6.7.1(9)).
+        local_buckling_negligible: Whether the ratio is within the limit (6.7.1(9)) and
+            the core fills the whole length (a hollow length is no filled section).
         lower_bound: With a core whose critical load is not proven the lowest (a KKT
             point: the sections' usual certificate), the same quantities at the verified
             lower bound (the hollow section's load by interlacing, unless a closer one was
@@ -312,7 +315,20 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             across = (section.diameter or 0.0) + t
             out.width_to_thickness_limit = 90.0 * epsilon**2
         out.width_to_thickness = across / t
-        out.local_buckling_negligible = out.width_to_thickness <= out.width_to_thickness_limit
+        within = out.width_to_thickness <= out.width_to_thickness_limit
+        span = section.core_span
+        if span is not None and not (span[0] <= 0.0 and span[1] >= section.length):
+            # Table 6.3 is a filled section's: the hollow length is a steel member's.
+            out.notes.append(
+                f"the core fills x/L = {span[0] / section.length:.4g} to "
+                f"{span[1] / section.length:.4g} of the length only: EN 1994-1-1 6.7.1(9) "
+                "and Table 6.3 describe a concrete-filled section, not the hollow length, "
+                "whose walls' local buckling is EN 1993's (EN 1993-1-1 Table 5.2, "
+                "EN 1993-1-5); local_buckling_negligible is false"
+                + (" although the ratio is within the limit" if within else "")
+            )
+            within = False
+        out.local_buckling_negligible = within
     return out
 
 
@@ -396,6 +412,9 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
             "local buckling may be neglected"
             if d.local_buckling_negligible
             else "above it: local buckling to be considered"
+            if d.width_to_thickness > d.width_to_thickness_limit
+            else "within it where filled; the core does not fill the length: local "
+            "buckling to be considered"
         )
         text += (
             f"; EN 1994-1-1 Table 6.3: {d.width_to_thickness:.4g} against "

@@ -343,3 +343,29 @@ def test_the_faces_of_a_square_box_in_uniform_compression_tie():
     # Under bending the bottom face governs alone (the test above): no tie.
     alone = section_design(_section(bending_stress=2.0), DesignSpec(yield_stress=3.55e8), 4e7)
     assert alone.tied_faces == [] and "face bottom: psi = 1" in design_line(alone)
+
+
+def test_a_core_over_part_of_the_length_does_not_make_local_buckling_negligible():
+    """EN 1994-1-1's limit is a filled section's: a hollow length is not one.
+
+    The box 200 x 100 x 5 mm in S235: h/t = 205/5 = 41 <= 52 sqrt(235/235) = 52 (Table
+    6.3), so a core over the whole length lets local buckling be neglected (6.7.1(9));
+    with the core over half the length the other half is a hollow steel section, whose
+    webs' c/t of about 41 - 3 = 38 would be checked by EN 1993-1-1 Table 5.2, not by the
+    composite limit, and the output said "local buckling may be neglected" all the same.
+    """
+    fy = 2.35e8
+    full = section_design(_section(thickness=0.005, core=True), DesignSpec(fy), 3e8)
+    assert full.width_to_thickness == pytest.approx(41.0)
+    assert full.width_to_thickness_limit == pytest.approx(52.0)
+    assert full.local_buckling_negligible is True
+    half = _section(thickness=0.005, core=True, core_span=(0.0, 0.3))
+    out = section_design(half, DesignSpec(fy), 3e8)
+    assert out.width_to_thickness == pytest.approx(41.0)
+    assert out.local_buckling_negligible is False
+    assert any("x/L = 0 to 0.5 of the length only" in note for note in out.notes)
+    assert "may be neglected" not in design_line(out)
+    assert "the core does not fill the length" in design_line(out)
+    # A span given as the whole length is the whole length.
+    whole = _section(thickness=0.005, core=True, core_span=(0.0, 0.6))
+    assert section_design(whole, DesignSpec(fy), 3e8).local_buckling_negligible is True
