@@ -429,5 +429,6 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
         )
         face = next((f for f in low.faces if f.face == low.governing_face), None)
         if face is not None and face.reduction_factor is not None:
-            text += f", face {face.face} rho = {face.reduction_factor:.4g}"
+            name = "rho" if face.reduction_factor == face.plate_reduction_factor else "rho_c"
+            text += f", {_governing(low)} {name} = {face.reduction_factor:.4g}"
     return text

@@ -20,7 +20,7 @@ import pytest
 
 from unibuckle_fenicsx import SectionParameters, solve_section
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.section_design import design_line, section_design
+from unibuckle_fenicsx.section_design import at_lower_bound, design_line, section_design
 from unibuckle_fenicsx.spec import DesignSpec, load_problem
 
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial sections")
@@ -334,12 +334,16 @@ def test_the_faces_of_a_square_box_in_uniform_compression_tie():
     governing, as if it were the weakest. It says now that the four tie, and by which
     rule one is named.
     """
-    out = section_design(_section(width=0.2, depth=0.2), DesignSpec(yield_stress=3.55e8), 1.0e8)
+    square, design = _section(width=0.2, depth=0.2, core=True), DesignSpec(yield_stress=3.55e8)
+    out = section_design(square, design, 1.0e8)
     assert out.tied_faces == ["right", "top", "left", "bottom"]
     assert out.governing_face == "right"
     line = design_line(out)
     assert "faces right, top, left, bottom tie" in line
     assert "the widest, then the first" in line
+    # The line of the verified lower bound (an unproven core's) says so too.
+    at_lower_bound(out, square, design, 5.0e7)
+    assert design_line(out).count("faces right, top, left, bottom tie") == 2
     # Under bending the bottom face governs alone (the test above): no tie.
     alone = section_design(_section(bending_stress=2.0), DesignSpec(yield_stress=3.55e8), 4e7)
     assert alone.tied_faces == [] and "face bottom: psi = 1" in design_line(alone)
