@@ -372,19 +372,21 @@ def at_lower_bound(
     return record
 
 
-def _governing(d: SectionDesignRecord) -> str:
+def _governing(d: SectionDesignRecord, *, rule: bool = True) -> str:
     r"""The governing face in the summary: its name, or the faces that tie with it.
 
     Faces that reach :math:`\rho f_y/\gamma_{M1}` at one load tie (every face of a box in
-    uniform compression): the line names them all and the rule that picked
+    uniform compression): the line names them all and (``rule``) the rule that picked
     ``governing_face`` (the widest, then the first of ``faces``).
     """
     if not d.tied_faces:
         return f"face {d.governing_face}"
-    return (
-        f"faces {', '.join(d.tied_faces)} tie (one load to rho f_y/gamma_M1; "
-        f"{d.governing_face} named: the widest, then the first)"
-    )
+    text = f"faces {', '.join(d.tied_faces)} tie"
+    if rule:
+        text += (
+            f" (one load to rho f_y/gamma_M1; {d.governing_face} named: the widest, then the first)"
+        )
+    return text
 
 
 def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") -> str:
@@ -430,5 +432,5 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
         face = next((f for f in low.faces if f.face == low.governing_face), None)
         if face is not None and face.reduction_factor is not None:
             name = "rho" if face.reduction_factor == face.plate_reduction_factor else "rho_c"
-            text += f", {_governing(low)} {name} = {face.reduction_factor:.4g}"
+            text += f", {_governing(low, rule=False)}, {name} = {face.reduction_factor:.4g}"
     return text
