@@ -29,7 +29,7 @@ such a plate, or a stress ratio outside the tables, before any solve.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -48,6 +48,7 @@ __all__ = [
     "DesignProblem",
     "buckling_factor",
     "check_steel_modulus",
+    "column_end_factor",
     "column_reduction_factor",
     "design_element",
     "interpolated_reduction_factor",
@@ -175,6 +176,92 @@ def column_reduction_factor(slenderness: float, alpha: float = COLUMN_IMPERFECTI
     """
     phi = 0.5 * (1.0 + alpha * (slenderness - 0.2) + slenderness**2)
     return min(1.0, 1.0 / (phi + math.sqrt(phi**2 - slenderness**2)))
+
+
+def column_end_factor(start: float, end: float) -> float:
+    r""":math:`\sigma_{cr,c}` of a column with restrained ends over that of a hinged one.
+
+    EN 1993-1-5 4.5.3(1) defines :math:`\sigma_{cr,c}` as the plate's buckling stress
+    with the supports along its unloaded edges removed: a column (a strip in cylindrical
+    bending) between the loaded edges, as these are supported. Eq. (4.8) is the hinged
+    column's; here each end is held (w = 0) with a rotational restraint
+    :math:`\kappa = k_r a/D` (0 hinged, ``math.inf`` clamped). The smallest root u in
+    :math:`[\pi, 2\pi]` of the determinant of the four end conditions on
+    :math:`w = c_1 \sin us + c_2 \cos us + c_3 s + c_4` (s = x/a; at s = 0
+    :math:`w = 0`, :math:`-w'' + \kappa w' = 0`; at s = 1 :math:`w = 0`,
+    :math:`w'' + \kappa w' = 0`) gives the factor :math:`(u/\pi)^2`: 1 hinged, 4 clamped
+    (effective length a/2), 2.046 clamped and hinged.
+
+    Args:
+        start: :math:`\kappa` of one end, >= 0 (``math.inf``: clamped).
+        end: :math:`\kappa` of the other.
+    """
+    if start < 0.0 or end < 0.0:
+        raise InputError(f"column end restraints must be >= 0, got {start!r}, {end!r}")
+    if start == end == 0.0:
+        return 1.0
+    if start == end == math.inf:
+        return 4.0
+
+    def row(kappa: float, u: float, at_end: bool) -> list[float]:
+        s, c = (math.sin(u), math.cos(u)) if at_end else (0.0, 1.0)
+        slope = [u * c, -u * s, 1.0, 0.0]  # w'
+        if kappa == math.inf:
+            return slope
+        curvature = [-u * u * s, -u * u * c, 0.0, 0.0]  # w''
+        sign = 1.0 if at_end else -1.0
+        pairs = zip(curvature, slope, strict=True)
+        return [(sign * k + kappa * v) / (1.0 + kappa) for k, v in pairs]
+
+    def det(u: float) -> float:
+        rows = [
+            [0.0, 1.0, 0.0, 1.0],
+            row(start, u, False),
+            [math.sin(u), math.cos(u), 1.0, 1.0],
+            row(end, u, True),
+        ]
+        return _det4(rows)
+
+    grid = [math.pi * (1.0 + k / 400.0) for k in range(-2, 403)]
+    values = [det(u) for u in grid]
+    for k in range(len(grid) - 1):
+        (u0, u1), (f0, f1) = grid[k : k + 2], values[k : k + 2]
+        if f0 == 0.0:
+            return (u0 / math.pi) ** 2
+        if f0 * f1 < 0.0:
+            return (_bisect(det, u0, u1, f0) / math.pi) ** 2
+    raise AssertionError("no column buckling load between the hinged and the clamped one")
+
+
+def _det4(m: list[list[float]]) -> float:
+    """The determinant of a 4 x 4 matrix (Laplace expansion along the first row)."""
+
+    def det3(a: list[list[float]]) -> float:
+        return (
+            a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+        )
+
+    total = 0.0
+    for j in range(4):
+        minor = [[r[k] for k in range(4) if k != j] for r in m[1:]]
+        total += (-1.0) ** j * m[0][j] * det3(minor)
+    return total
+
+
+def _bisect(f: Callable[[float], float], a: float, b: float, fa: float) -> float:
+    """A root of f in [a, b] (f(a) = fa and f(b) of opposite signs), to round-off."""
+    for _ in range(200):
+        mid = 0.5 * (a + b)
+        fm = f(mid)
+        if fm == 0.0 or mid in (a, b):
+            return mid
+        if (fm < 0.0) == (fa < 0.0):
+            a, fa = mid, fm
+        else:
+            b = mid
+    return 0.5 * (a + b)
 
 
 def interpolated_reduction_factor(rho: float, chi: float, xi: float) -> float:
