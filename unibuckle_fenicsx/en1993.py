@@ -41,6 +41,7 @@ __all__ = [
     "INTERNAL",
     "OUTSTAND",
     "STEEL_MODULUS",
+    "STEEL_YIELD_STRESS",
     "DesignEdge",
     "DesignElement",
     "DesignLoad",
@@ -48,6 +49,7 @@ __all__ = [
     "DesignProblem",
     "buckling_factor",
     "check_steel_modulus",
+    "check_steel_yield_stress",
     "column_end_factor",
     "column_reduction_factor",
     "design_element",
@@ -82,15 +84,56 @@ def check_steel_modulus(E: float, stress: float, name: str) -> None:
     Raises:
         InputError: ``E`` outside :data:`STEEL_MODULUS`, naming ``material.E``.
     """
-    low, high = STEEL_MODULUS
-    if not low <= E <= high:
+    why = (
+        "(EN 1993-1-5's rho rests on steel, E in [{low:.6g}, {high:.6g}] {name}: 210 GPa, "
+        "stainless 200 GPa); for aluminium use EN 1999-1-1 6.1.4, whose curves this "
+        "output does not give; leave [design] out"
+    )
+    _refuse_outside("design: material.E", E, STEEL_MODULUS, stress, name, why)
+
+
+def _refuse_outside(
+    key: str, value: float, bounds: tuple[float, float], stress: float, name: str, why: str
+) -> None:
+    """Refuse ``value`` (Pa) outside ``bounds``: "KEY = v NAME is not a steel's WHY".
+
+    ``why`` is formatted with the bounds (``low``, ``high``) and ``name`` in the file's
+    stress unit (``stress`` Pa).
+    """
+    low, high = bounds
+    if not low <= value <= high:
         raise InputError(
-            f"design: material.E = {E / stress:.6g} {name} is not a steel's "
-            f"(EN 1993-1-5's rho rests on steel, E in [{low / stress:.6g}, "
-            f"{high / stress:.6g}] {name}: 210 GPa, stainless 200 GPa); for aluminium "
-            "use EN 1999-1-1 6.1.4, whose curves this output does not give; leave "
-            "[design] out"
+            f"{key} = {value / stress:.6g} {name} is not a steel's "
+            + why.format(low=low / stress, high=high / stress, name=name)
         )
+
+
+#: Yield stresses (Pa) taken as a steel's by the design output: EN 1993-1-1 Table 3.1's
+#: structural steels (S235 to S460, f_y from 215 MPa in thick plates), EN 1993-1-12's up
+#: to S700 (and S960 in its revision) and EN 1993-1-4's stainless steels (from 200 MPa),
+#: with a margin. A number in the wrong unit (355 Pa in an SI file, 3.55e8 MPa in a
+#: mm-N-MPa one) lies orders of magnitude outside.
+STEEL_YIELD_STRESS = (1.5e8, 1.0e9)
+
+
+def check_steel_yield_stress(fy: float, stress: float, name: str) -> None:
+    """Refuse a yield stress ``fy`` (Pa) that is not a steel's (:data:`STEEL_YIELD_STRESS`).
+
+    The slenderness sqrt(f_y/sigma_cr) and rho f_y/gamma_M1 take f_y as it is: 355 in an
+    SI file (355 Pa) gave rho = 1 and 355 Pa for a plate whose rho is 0.42. ``stress``
+    and ``name`` are the file's stress unit in Pa and its name, for the message; raises
+    :class:`~unibuckle_fenicsx.errors.InputError` naming ``design.yield_stress``.
+    """
+    _refuse_outside(
+        "design.yield_stress",
+        fy,
+        STEEL_YIELD_STRESS,
+        stress,
+        name,
+        "yield stress (EN 1993-1-1 Table 3.1 and EN 1993-1-12: 235 to 700 MPa, stainless "
+        "steel from 200 MPa; accepted: {low:.6g} to {high:.6g} {name}); give it in the "
+        "file's unit, {name}",
+    )
 
 
 def table_row(element: str, free_edge_most_compressed: bool) -> str:

@@ -96,6 +96,37 @@ def test_bad_design_tables_are_refused(design, extra, match):
         plate({"left": {"normal_stress": -1.0}}, design=design, **extra)
 
 
+@pytest.mark.parametrize(
+    "units, fy, shown",
+    [
+        ("SI", 355.0, "355 Pa"),
+        ("mm-N-MPa", 3.55e8, "3.55e\\+08 MPa"),
+        ("SI", 1.2e9, "1.2e\\+09 Pa"),
+    ],
+)
+def test_a_yield_stress_that_is_no_steel_s_is_refused(units, fy, shown):
+    """f_y in the wrong unit: 355 in an SI file is 355 Pa.
+
+    The 600 x 200 x 2 mm SSSS S355 plate has sigma_cr = 76.9 MPa (k = 4.05), so
+    slenderness sqrt(355/76.9) = 2.148 and rho = (2.148 - 0.22)/2.148^2 = 0.418 (eq.
+    (4.2)); with yield_stress = 355 in its SI file the output gave slenderness 0.002,
+    rho = 1 and rho f_y/gamma_M1 = 355 Pa, exit 0. Structural steels have f_y of 235 to
+    700 MPa (EN 1993-1-1 Table 3.1, EN 1993-1-12), stainless from 200 MPa (EN 1993-1-4
+    Table 2.1): refused outside 150 to 1000 MPa, naming the key, in the file's unit.
+    """
+    scale, length = (1.0, 1.0) if units == "SI" else (1e-6, 1e3)  # Pa, m -> MPa, mm
+    data = {
+        "units": units,
+        "plate": {"corners": [[0, 0], [0.6 * length, 0.2 * length]], "thickness": 0.002 * length},
+        "material": {"E": 2.1e11 * scale, "nu": 0.3},
+        "edges": {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}},
+        "design": {"yield_stress": fy},
+    }
+    with pytest.raises(ValueError, match=rf"design\.yield_stress = {shown} is not a steel's"):
+        problem_from_dict(data)
+    problem_from_dict({**data, "design": {"yield_stress": 355e6 * scale}})
+
+
 def test_design_needs_a_compressive_edge_stress():
     edges = {name: {"inplane": "clamped"} for name in ("left", "right", "bottom", "top")}
     with pytest.raises(ValueError, match=r"design: the EN 1993-1-5 output takes sigma_cr"):
