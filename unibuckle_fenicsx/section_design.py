@@ -14,6 +14,12 @@ asks for the design quantities of its critical state :math:`\lambda_c`:
   bending part across a face spanning the depth), :math:`\bar\lambda_p =
   \sqrt{f_y/\sigma_{cr}}`, the buckling factor of Table 4.1 at that :math:`\psi`, and
   :math:`\rho` by eq. (4.2) (:mod:`unibuckle_fenicsx.en1993`); a face in tension has none;
+  a face shorter than it is wide (:math:`a/b < 1`, a the section's length: a stub), by
+  the note of 4.4(2), :math:`\rho_c` of 4.5.4(1) instead, between :math:`\rho` and the
+  column-type :math:`\chi_c` (curve a; 4.5.3(1): :math:`\sigma_{cr,c}` of the face as a
+  column between the section's ends, eq. (4.8) :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)`
+  between simply supported ones, 4 times it between clamped ones), as a plate's
+  (:mod:`unibuckle_fenicsx.design`);
 - for a **tube**, :math:`\bar\lambda` only: a circular wall is a shell, whose buckling
   reduction (EN 1993-1-6, section 8.5: the fabrication quality class, :math:`\alpha_x`,
   :math:`\chi_x`) this output does not apply;
@@ -42,6 +48,7 @@ from unibuckle_fenicsx.design import CALIBRATION, UNPROVEN
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     buckling_factor,
+    column_end_factor,
     column_reduction_factor,
     interpolated_reduction_factor,
     psi_range,
@@ -89,6 +96,8 @@ class DesignSection(Protocol):
     @property
     def nu(self) -> float: ...
     @property
+    def ends(self) -> str: ...
+    @property
     def width(self) -> float | None: ...
     @property
     def depth(self) -> float | None: ...
@@ -122,9 +131,11 @@ class FaceDesign(Struct, kw_only=True):
             ``column_reduction_factor`` where :math:`\xi < 1`; else
             ``plate_reduction_factor``. None for :math:`\psi < -3`.
         plate_reduction_factor: :math:`\rho`, eq. (4.2).
-        column_critical_stress_Pa: :math:`\sigma_{cr,c} = \pi^2 E t^2/(12(1 - \nu^2)
-            a^2)`, a the section's length (4.5.3(2), eq. (4.8)): the face as a column,
-            its corners' support removed, hinged at the ends.
+        column_critical_stress_Pa: :math:`\sigma_{cr,c}`, the face as a column between
+            the section's ends, its corners' support removed (4.5.3(1)): eq. (4.8),
+            :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)` with a the section's length, between
+            simply supported ends, 4 times it between clamped ones. None, as the two
+            below, on a face not shorter than its width (no column-type check).
         column_reduction_factor: :math:`\chi_c` at :math:`\sqrt{f_y/\sigma_{cr,c}}`,
             curve a (4.5.3(4), (5)).
         xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)).
@@ -222,17 +233,19 @@ def _face(
     out.k_sigma_table = buckling_factor(INTERNAL, psi)
     rho = reduction_factor(slenderness, psi, INTERNAL)
     out.plate_reduction_factor = out.reduction_factor = rho
-    # The face as a column (4.5.3(2), 4.5.4(1)): a face shorter than its width may buckle
-    # like one (the note of 4.4(2)), as a plate's (unibuckle_fenicsx.design).
-    ratio = section.thickness / section.length
-    column = math.pi**2 * section.E * ratio**2 / (12.0 * (1.0 - section.nu**2))
-    out.column_critical_stress_Pa = column
-    out.column_reduction_factor = column_reduction_factor(math.sqrt(design.yield_stress / column))
-    out.xi = sigma1 / column - 1.0
+    # The face as a column (4.5.3(1), 4.5.4(1)): a face shorter than its width may buckle
+    # like one (the note of 4.4(2)), as a plate's (unibuckle_fenicsx.design): between the
+    # section's ends as they are held, eq. (4.8) hinged, 4 times it clamped.
     if section.length < face_width(section, name):  # a/b < 1
-        out.reduction_factor = interpolated_reduction_factor(
-            rho, out.column_reduction_factor, out.xi
+        kappa = math.inf if section.ends == "clamped" else 0.0
+        ratio = section.thickness / section.length
+        column = column_end_factor(kappa, kappa) * (
+            math.pi**2 * section.E * ratio**2 / (12.0 * (1.0 - section.nu**2))
         )
+        chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
+        out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
+        out.xi = sigma1 / column - 1.0
+        out.reduction_factor = interpolated_reduction_factor(rho, chi, out.xi)
     out.reduced_design_stress_Pa = (
         out.reduction_factor * design.yield_stress / design.partial_factor
     )
@@ -287,7 +300,8 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
                 + ", ".join(
                     f"{f.face} (xi = {f.xi:.3g}, rho_c = {f.reduction_factor:.4g})" for f in column
                 )
-                + "; sigma_cr,c by eq. (4.8), the ends hinged"
+                + "; sigma_cr,c: the face as a column between the section's ends "
+                + ("(clamped: 4 x eq. (4.8))" if section.ends == "clamped" else "(eq. (4.8))")
             )
         rated = [f for f in out.faces if f.reduced_design_stress_Pa is not None]
         if rated:

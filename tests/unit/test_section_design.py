@@ -206,15 +206,19 @@ def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):
         assert analysis.result.design is None
 
 
+#: A 200 x 100 x 2 mm box, 200 mm long, as a mm-N-MPa file with [design].
+BOX_MM = (
+    "units = 'mm-N-MPa'\n[section]\nshape = 'box'\nwidth = 200\ndepth = 100\n"
+    "thickness = 2\nlength = 200\n[material]\nE = {E}\nnu = {nu}\n"
+    "[mesh]\nsize = 100\n[design]\nyield_stress = {fy}\n"
+)
+
+
 def test_the_design_of_a_section_not_of_steel_is_refused(tmp_path):
     # EN 1993-1-5 4.4(2)'s rho rests on steel, E = 210 GPa (EN 1993-1-1 3.2.6); an
     # aluminium box (70 GPa) belongs to EN 1999-1-1 6.1.4: refused before any mesh.
     path = tmp_path / "box.toml"
-    path.write_text(
-        "units = 'mm-N-MPa'\n[section]\nshape = 'box'\nwidth = 200\ndepth = 100\n"
-        "thickness = 2\nlength = 200\n[material]\nE = 70000\nnu = 0.33\n"
-        "[mesh]\nsize = 100\n[design]\nyield_stress = 250\n"
-    )
+    path.write_text(BOX_MM.format(E=70000, nu=0.33, fy=250))
     with pytest.raises(InputError, match=r"material\.E = 70000 MPa is not a steel's"):
         load_problem(path)
     aluminium = _section(E=7.0e10, nu=0.33)
@@ -223,6 +227,18 @@ def test_the_design_of_a_section_not_of_steel_is_refused(tmp_path):
     # Without [design] the aluminium box is a fine problem (only the design is refused).
     path.write_text(path.read_text().replace("[design]\nyield_stress = 250\n", ""))
     assert load_problem(path).material.E == pytest.approx(7.0e10)
+
+
+def test_a_section_s_yield_stress_in_the_wrong_unit_is_refused(tmp_path):
+    # 355 in an SI file is 355 Pa: slenderness sqrt(f_y/sigma_cr) near 0 and rho = 1
+    # whatever the walls. Steels have f_y of 235 to 700 MPa (EN 1993-1-1 Table 3.1, EN
+    # 1993-1-12), stainless from 200 MPa (EN 1993-1-4): refused, in the file's unit.
+    path = tmp_path / "box.toml"
+    path.write_text(BOX_MM.format(E=210000, nu=0.3, fy=3.55e8))
+    with pytest.raises(InputError, match=r"design\.yield_stress = 3\.55e\+08 MPa is not"):
+        load_problem(path)
+    with pytest.raises(InputError, match=r"design\.yield_stress = 355 Pa is not a steel's"):
+        solve_section(_section(), MPI.COMM_SELF, design=DesignSpec(yield_stress=355.0))
 
 
 @pytest.mark.parametrize("core", [False, True])
@@ -293,20 +309,29 @@ def test_a_stub_shorter_than_its_faces_gets_rho_c():
         assert face.reduction_factor == pytest.approx(rho_c, rel=1e-12)
         assert face.reduced_design_stress_Pa == pytest.approx(rho_c * fy / 1.1, rel=1e-12)
     assert any("4.5.4(1)" in note for note in out.notes)
-    # Lengthened to a = b the faces are not short (a/b < 1 is the note's condition): rho.
+    # Lengthened to a = b the faces are not short (a/b < 1 is the note's condition): rho,
+    # and no column fields.
     long = section_design(_section(width=b, depth=b, thickness=t, length=b), DesignSpec(fy), load)
     assert all(f.reduction_factor == pytest.approx(rho, rel=1e-12) for f in long.faces)
+    assert all(f.column_critical_stress_Pa is None and f.xi is None for f in long.faces)
+    # Between clamped ends the face as a column (4.5.3(1): the supports along its long
+    # edges removed) is Euler's clamped column, effective length a/2: 4 sigma_cr,c.
+    clamped = _section(width=b, depth=b, thickness=t, length=a, ends="clamped")
+    face = section_design(clamped, DesignSpec(fy), 2.0 * load).faces[0]
+    assert face.column_critical_stress_Pa == pytest.approx(4.0 * column, rel=1e-12)
+    assert face.xi == pytest.approx(2.0 * load / (4.0 * column) - 1.0, rel=1e-12)
 
 
 def test_a_rectangular_stub_s_wide_faces_get_rho_c_and_govern():
-    # The box 200 x 100 x 2 mm, L = 100 mm: the top and bottom faces (200 mm wide) have
-    # a/b = 0.5, the webs (100 mm) a/b = 1, not short. At 100 MPa of uniform compression
-    # (f_y = 355 MPa): lambda_p = sqrt(3.55) = 1.8841, rho = (1.8841 - 0.22)/3.55 =
-    # 0.46877 on every face; the wide faces' sigma_cr,c = pi^2 E (t/a)^2/(12(1 - nu^2))
-    # = 75.92 MPa, xi = 0.3172, chi_c = 0.19281 (curve a): rho_c = 0.34010 (4.5.4(1),
-    # by hand). One compression on every face: the smallest rho governs, the top face's.
+    # The box 200 x 100 x 2 mm, L = 100 mm, simply supported: the top and bottom faces
+    # (200 mm wide) have a/b = 0.5, the webs (100 mm) a/b = 1, not short. At 100 MPa of
+    # uniform compression (f_y = 355 MPa): lambda_p = sqrt(3.55) = 1.8841, rho =
+    # (1.8841 - 0.22)/3.55 = 0.46877 on every face; the wide faces' sigma_cr,c =
+    # pi^2 E (t/a)^2/(12(1 - nu^2)) = 75.92 MPa, xi = 0.3172, chi_c = 0.19281 (curve a):
+    # rho_c = 0.34010 (4.5.4(1), by hand). One compression on every face: the smallest
+    # rho governs, the top face's.
     E, nu, t, a, fy, load = 2.1e11, 0.3, 0.002, 0.1, 3.55e8, 1.0e8
-    section = _section(width=0.2, depth=0.1, thickness=t, length=a)
+    section = _section(width=0.2, depth=0.1, thickness=t, length=a, ends="simply_supported")
     out = section_design(section, DesignSpec(yield_stress=fy), load)
     slenderness = math.sqrt(fy / load)
     rho = (slenderness - 0.22) / slenderness**2
