@@ -79,7 +79,8 @@ __all__ = [
 #: The clauses the design output of an internal element rests on (:func:`clauses`).
 CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of an internal "
-    "compression element; 4.4(2): relative slenderness; Table 4.1: stress ratio psi"
+    "compression element; 4.4(2): relative slenderness; Table 4.1: stress ratio psi; "
+    "4.6(1): rho f_y/gamma_M0"
 )
 
 #: Said with every design output.
@@ -94,7 +95,7 @@ class DesignRecord(Struct, kw_only=True):
 
     Attributes:
         yield_stress_Pa: :math:`f_y`.
-        partial_factor: :math:`\gamma_{M1}`.
+        partial_factor: :math:`\gamma_{M0}`.
         element: "internal" or "outstand" (:func:`~unibuckle_fenicsx.en1993.design_element`).
         free_edge: An outstand's free unloaded edge (None for an internal element).
         table: The table row of :math:`\psi` and :math:`k_\sigma` (Table 4.1 or 4.2).
@@ -130,7 +131,7 @@ class DesignRecord(Struct, kw_only=True):
             \sigma_{cr,c}}`, curve a (:math:`\alpha` = 0.21, 4.5.3(4), (5)).
         xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)); below 1 on a short
             plate column-type buckling lowers the reduction factor.
-        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M1}` (absent without
+        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M0}` (absent without
             :math:`\rho`).
         lower_bound: When the critical load is not proven the lowest (a KKT point, or
             bracketed), the same quantities at the verified lower bound of the critical
@@ -166,7 +167,8 @@ def clauses(element: DesignElement, free_edge_most_compressed: bool = True) -> s
     return (
         "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.3): reduction factor rho of an outstand "
         f"compression element (edges.{element.free_edge} free); 4.4(2): relative "
-        f"slenderness; {table_row(element.kind, free_edge_most_compressed)}: stress ratio psi"
+        f"slenderness; {table_row(element.kind, free_edge_most_compressed)}: stress ratio psi; "
+        "4.6(1): rho f_y/gamma_M0"
     )
 
 

@@ -119,7 +119,7 @@ STEEL_YIELD_STRESS = (1.5e8, 1.0e9)
 def check_steel_yield_stress(fy: float, stress: float, name: str) -> None:
     """Refuse a yield stress ``fy`` (Pa) that is not a steel's (:data:`STEEL_YIELD_STRESS`).
 
-    The slenderness sqrt(f_y/sigma_cr) and rho f_y/gamma_M1 take f_y as it is: 355 in an
+    The slenderness sqrt(f_y/sigma_cr) and rho f_y/gamma_M0 take f_y as it is: 355 in an
     SI file (355 Pa) gave rho = 1 and 355 Pa for a plate whose rho is 0.42. ``stress``
     and ``name`` are the file's stress unit in Pa and its name, for the message; raises
     :class:`~unibuckle_fenicsx.errors.InputError` naming ``design.yield_stress``.

@@ -71,7 +71,8 @@ __all__ = [
 FACE_CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of each face as an "
     "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma; "
-    "4.5.3(2), 4.5.4(1): column-type buckling of a face shorter than its width, rho_c"
+    "4.5.3(2), 4.5.4(1): column-type buckling of a face shorter than its width, rho_c; "
+    "4.6(1): rho f_y/gamma_M0"
 )
 #: The clause of a tube's slenderness.
 TUBE_CLAUSES = (
@@ -139,7 +140,7 @@ class FaceDesign(Struct, kw_only=True):
         column_reduction_factor: :math:`\chi_c` at :math:`\sqrt{f_y/\sigma_{cr,c}}`,
             curve a (4.5.3(4), (5)).
         xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)).
-        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M1}` (Pa), with
+        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M0}` (Pa), with
             ``reduction_factor``.
     """
 
@@ -161,14 +162,14 @@ class SectionDesignRecord(Struct, kw_only=True):
 
     Attributes:
         yield_stress_Pa: :math:`f_y`.
-        partial_factor: :math:`\gamma_{M1}`.
+        partial_factor: :math:`\gamma_{M0}`.
         sigma_cr_Pa: The largest compressive axial stress in the walls at the critical
             state (Pa).
         relative_slenderness: :math:`\sqrt{f_y/\sigma_{cr}}`.
         clauses: The clauses applied.
         notes: What the output rests on, and what it leaves out.
         faces: A box's faces (:class:`FaceDesign`); empty for a tube.
-        governing_face: The face that reaches :math:`\rho f_y/\gamma_{M1}` at the
+        governing_face: The face that reaches :math:`\rho f_y/\gamma_{M0}` at the
             smallest multiple of the critical load, the smallest :math:`\rho f_y/\sigma_1`
             (of faces reaching it together, the widest, and of equally wide ones the
             first of ``faces``; None for a tube).
@@ -253,7 +254,7 @@ def _face(
 
 
 def _reaches_reduced_stress(face: FaceDesign) -> float:
-    r"""The multiple of the critical load at which ``face`` carries :math:`\rho f_y/\gamma_{M1}`.
+    r"""The multiple of the critical load at which ``face`` carries :math:`\rho f_y/\gamma_{M0}`.
 
     Every face's stress grows with the one load factor: the face that reaches its reduced
     stress first governs (with one compression on every face, the one of the smallest
@@ -389,7 +390,7 @@ def at_lower_bound(
 def _governing(d: SectionDesignRecord, *, rule: bool = True) -> str:
     r"""The governing face in the summary: its name, or the faces that tie with it.
 
-    Faces that reach :math:`\rho f_y/\gamma_{M1}` at one load tie (every face of a box in
+    Faces that reach :math:`\rho f_y/\gamma_{M0}` at one load tie (every face of a box in
     uniform compression): the line names them all and (``rule``) the rule that picked
     ``governing_face`` (the widest, then the first of ``faces``).
     """
@@ -398,7 +399,7 @@ def _governing(d: SectionDesignRecord, *, rule: bool = True) -> str:
     text = f"faces {', '.join(d.tied_faces)} tie"
     if rule:
         text += (
-            f" (one load to rho f_y/gamma_M1; {d.governing_face} named: the widest, then the first)"
+            f" (one load to rho f_y/gamma_M0; {d.governing_face} named: the widest, then the first)"
         )
     return text
 
@@ -421,7 +422,7 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
             )
         text += (
             f"; EN 1993-1-5 {_governing(d)}: psi = {face.psi:.3g}, {rho}, "
-            f"rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
+            f"rho f_y/gamma_M0 = {reduced / scale:.4g} {unit}"
         )
     if d.width_to_thickness is not None and d.width_to_thickness_limit is not None:
         verdict = (

@@ -84,7 +84,7 @@ def test_design_keys_are_read_converted_and_written_back():
         # The file is in mm-N-MPa: its unit (MPa) and its number in the message.
         ({"yield_stress": 0.0}, {}, r"design\.yield_stress must be > 0 MPa, got 0\.0$"),
         ({"yield_stress": 355.0, "partial_factor": -1}, {}, r"design\.partial_factor must be >= 1"),
-        # gamma_M1 = 0.9 put rho f_y/gamma_M1 11 % above rho f_y, accepted (EN 1993-1-1,
+        # gamma_M0 = 0.9 put rho f_y/gamma_M0 11 % above rho f_y, accepted (EN 1993-1-1,
         # 6.1: recommended 1.0; a resistance factor is not below 1).
         ({"yield_stress": 355.0, "partial_factor": 0.9}, {}, r"partial_factor must be >= 1"),
         ({"partial_factor": 1.0}, {}, r"\[design\] needs 'yield_stress'"),
@@ -110,7 +110,7 @@ def test_a_yield_stress_that_is_no_steel_s_is_refused(units, fy, shown):
     The 600 x 200 x 2 mm SSSS S355 plate has sigma_cr = 76.9 MPa (k = 4.05), so
     slenderness sqrt(355/76.9) = 2.148 and rho = (2.148 - 0.22)/2.148^2 = 0.418 (eq.
     (4.2)); with yield_stress = 355 in its SI file the output gave slenderness 0.002,
-    rho = 1 and rho f_y/gamma_M1 = 355 Pa, exit 0. Structural steels have f_y of 235 to
+    rho = 1 and rho f_y/gamma_M0 = 355 Pa, exit 0. Structural steels have f_y of 235 to
     700 MPa (EN 1993-1-1 Table 3.1, EN 1993-1-12), stainless from 200 MPa (EN 1993-1-4
     Table 2.1): refused outside 150 to 1000 MPa, naming the key, in the file's unit.
     """
@@ -175,7 +175,7 @@ def test_stainless_steel_keeps_the_design():
 
 
 def test_uniform_compression():
-    """Uniform: psi = 1, sigma_cr = lambda_c; slenderness, rho, rho f_y / gamma_M1 by hand."""
+    """Uniform: psi = 1, sigma_cr = lambda_c; slenderness, rho, rho f_y / gamma_M0 by hand."""
     out = result(plate({"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}))
     d = out.design
     assert d.sigma_cr_Pa == out.critical_load_Pa and d.psi == 1.0
@@ -187,6 +187,10 @@ def test_uniform_compression():
     assert "calibrated on plates buckling freely to both sides" in d.notes[0]
     assert "4.4(2), eq. (4.2)" in d.clauses
     assert "EN 1993-1-5: sigma_cr" in out.summary()
+    # EN 1993-1-5 4.6(1) checks the effective cross-section with gamma_M0 (gamma_M1 is
+    # the member's, EN 1993-1-1 6.3, and section 10's): the factor is named so.
+    assert "4.6(1): rho f_y/gamma_M0" in d.clauses
+    assert "rho f_y/gamma_M0 = " in out.summary() and "gamma_M1" not in out.summary()
 
 
 def test_k_sigma_is_the_plate_s_and_k_sigma_table_the_long_hinged_plate_s():

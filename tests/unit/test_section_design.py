@@ -352,7 +352,7 @@ def test_a_rectangular_stub_s_wide_faces_get_rho_c_and_govern():
 
 
 def test_the_faces_of_a_square_box_in_uniform_compression_tie():
-    """Four equal faces under one stress reach rho f_y/gamma_M1 together.
+    """Four equal faces under one stress reach rho f_y/gamma_M0 together.
 
     The square box 200 x 200 x 2 mm at 100 MPa: every face has psi = 1 and the same
     lambda_p = sqrt(3.55), rho = 0.46877 (eq. (4.2)); the line named the right face as
@@ -366,6 +366,8 @@ def test_the_faces_of_a_square_box_in_uniform_compression_tie():
     line = design_line(out)
     assert "faces right, top, left, bottom tie" in line
     assert "the widest, then the first" in line
+    # EN 1993-1-5 4.6(1): the effective cross-section's factor is gamma_M0.
+    assert "rho f_y/gamma_M0" in line and "4.6(1)" in out.clauses[0]
     # The line of the verified lower bound (an unproven core's) says so too.
     at_lower_bound(out, square, design, 5.0e7)
     assert design_line(out).count("faces right, top, left, bottom tie") == 2

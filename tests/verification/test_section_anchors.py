@@ -323,7 +323,7 @@ def test_a_core_span_without_a_free_node_is_refused_saying_why(span, what):
 def test_a_filled_box_s_design_is_also_given_at_the_hollow_load():
     """KKT only (the sections' usual certificate): rho at the lower bound too, by hand.
 
-    The filled box 100 x 100 x 2 mm, f_y = 355 MPa, gamma_M1 = 1: at the lower bound (the
+    The filled box 100 x 100 x 2 mm, f_y = 355 MPa, gamma_M0 = 1: at the lower bound (the
     hollow load by interlacing) each face has psi = 1, lambda_p = sqrt(f_y/sigma) and
     rho = (lambda_p - 0.22)/lambda_p^2 by EN 1993-1-5 eq. (4.2), or 1 up to 0.673.
     """

@@ -427,7 +427,7 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
         f"EN 1993-1-5: sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit} ({d.edge}), "
         f"psi = {d.psi:.3g}, slenderness {d.relative_slenderness:.4g}, rho = "
         + (
-            f"{rho:.4g}" + column + f", rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
+            f"{rho:.4g}" + column + f", rho f_y/gamma_M0 = {reduced / scale:.4g} {unit}"
             if rho is not None and isinstance(reduced, float)
             else f"none (psi outside {d.table})"
         )
