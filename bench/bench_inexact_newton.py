@@ -583,18 +583,26 @@ def print_tables(rows: list[dict[str, Any]], cap: int) -> None:
 
 
 def print_real(rows: list[dict[str, Any]]) -> None:
-    """The table of the routes run with the policies, against ``today`` where run."""
+    """The table of the routes run with the policies, against ``today`` where run.
+
+    The cost counts every Krylov iteration (the failed tries' too) at the run's own
+    price of an iteration against a numeric factorisation.
+    """
     cols = ["plate", "mesh", "policy", "fine level (steps/fact./eigen)", "reused steps",
-            "Krylov its per reused step (mean)", "route", "load (Pa)",
+            "Krylov its per reused step (mean)", "failed tries (its)",
+            "fine fact. + Krylov its (factorisations' time)", "route", "load (Pa)",
             "relative to today"]  # fmt: skip
     print_header("The route with its fine level run by a policy (counts exact)", cols)
     today = {(r["case"], r["mesh"]): r["load"] for r in rows if r["policy"] == "today"}
     for r in rows:
         ref = today.get((r["case"], r["mesh"]))
         rel = "-" if ref is None else f"{(r['load'] - ref) / ref:+.1e}"
-        its = r["krylov_reused"]
+        its, failed = r["krylov_reused"], r["krylov_failed"]
+        ratio = r["t_iteration"] / r["t_factor"] if r["t_factor"] else 0.0
+        cost = r["fine"][1] + ratio * (sum(its) + sum(failed))
         cells = [r["case"], r["mesh"], r["policy"], "/".join(str(v) for v in r["fine"]),
                  str(r["reused"]), f"{np.mean(its):.1f}" if its else "-",
+                 f"{len(failed)} ({sum(failed)})", f"{cost:.1f}",
                  "+".join(r["route"]), f"{r['load']:.9f}", rel]  # fmt: skip
         print("| " + " | ".join(cells) + " |", flush=True)
 
