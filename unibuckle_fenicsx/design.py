@@ -17,9 +17,13 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
   :math:`\sigma_1` the larger compression.
 - a short plate (:math:`a/b < 1`, the note of 4.4(2)) may buckle like a column: 4.5.4(1)
   interpolates :math:`\rho_c = (\rho - \chi_c)\xi(2 - \xi) + \chi_c` between the
-  plate's :math:`\rho` and the column's :math:`\chi_c` (4.5.3: :math:`\sigma_{cr,c} =
-  \pi^2 E t^2/(12(1 - \nu^2) a^2)`, curve a), :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1`
-  in [0, 1]; at :math:`\xi \ge 1`, and for :math:`a/b \ge 1`, it is :math:`\rho`;
+  plate's :math:`\rho` and the column's :math:`\chi_c` (curve a), :math:`\xi =
+  \sigma_{cr}/\sigma_{cr,c} - 1` in [0, 1], with :math:`\sigma_{cr,c}` the plate's
+  stress with the supports along its unloaded edges removed (4.5.3(1)): eq. (4.8),
+  :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)`, between hinged loaded edges, four times that
+  between clamped ones (:func:`column_stress`); at :math:`\xi \ge 1` it is
+  :math:`\rho`; for :math:`a/b \ge 1` it is :math:`\rho`, the column fields are None
+  and a note says why;
 
 What the clause does not describe is refused when the problem is built (both unloaded
 edges free, biaxial stress, a temperature rise, a plate that is not a rectangle, ...);
@@ -50,6 +54,7 @@ from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     DesignElement,
     buckling_factor,
+    column_end_factor,
     column_reduction_factor,
     design_element,
     interpolated_reduction_factor,
@@ -65,6 +70,7 @@ __all__ = [
     "DesignRecord",
     "at_lower_bound",
     "clauses",
+    "column_stress",
     "design_output",
     "euler_stress",
     "reduction_factor",
@@ -73,8 +79,7 @@ __all__ = [
 #: The clauses the design output of an internal element rests on (:func:`clauses`).
 CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of an internal "
-    "compression element; 4.4(2): relative slenderness; Table 4.1: stress ratio psi; "
-    "4.5.3(2), 4.5.4(1): column-type buckling, rho_c"
+    "compression element; 4.4(2): relative slenderness; Table 4.1: stress ratio psi"
 )
 
 #: Said with every design output.
@@ -115,9 +120,12 @@ class DesignRecord(Struct, kw_only=True):
             ``column_reduction_factor`` where :math:`\xi < 1`; else
             ``plate_reduction_factor``. None outside the table's range of :math:`\psi`.
         plate_reduction_factor: :math:`\rho`, eq. (4.2) or (4.3).
-        column_critical_stress_Pa: :math:`\sigma_{cr,c} = \pi^2 E t^2/(12(1 - \nu^2)
-            a^2)`, a the plate's length along the stress (4.5.3(2), eq. (4.8)): the
-            plate as a column, its unloaded edges' supports removed.
+        column_critical_stress_Pa: :math:`\sigma_{cr,c}`, the plate as a column between
+            its loaded edges, its unloaded edges' supports removed (4.5.3(1)): eq. (4.8),
+            :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)` with a the plate's length along the
+            stress, for hinged loaded edges, times 4 for clamped ones
+            (:func:`column_stress`). None, as ``column_reduction_factor`` and ``xi``,
+            for a/b >= 1, where the column-type check is not applied (a note says so).
         column_reduction_factor: :math:`\chi_c` at :math:`\bar\lambda_c = \sqrt{f_y/
             \sigma_{cr,c}}`, curve a (:math:`\alpha` = 0.21, 4.5.3(4), (5)).
         xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)); below 1 on a short
@@ -158,8 +166,7 @@ def clauses(element: DesignElement, free_edge_most_compressed: bool = True) -> s
     return (
         "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.3): reduction factor rho of an outstand "
         f"compression element (edges.{element.free_edge} free); 4.4(2): relative "
-        f"slenderness; {table_row(element.kind, free_edge_most_compressed)}: stress ratio psi; "
-        "4.5.3(2), 4.5.4(1): column-type buckling, rho_c"
+        f"slenderness; {table_row(element.kind, free_edge_most_compressed)}: stress ratio psi"
     )
 
 
@@ -252,23 +259,94 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.k_sigma_table = buckling_factor(element.kind, psi, at_free)
     rho = reduction_factor(slenderness, psi, element.kind, at_free)
     out.plate_reduction_factor = rho
-    # The plate as a column (4.5.3, 4.5.4): a short plate (a/b < 1) may buckle like one.
-    column = euler_stress(spec, element.loaded, along=True)
+    out.reduction_factor = _column_type(out, spec, design, element, rho)
+    rho_c = out.reduction_factor
+    out.reduced_design_stress_Pa = rho_c * design.yield_stress / design.partial_factor
+    return out
+
+
+def _column_type(
+    out: DesignRecord, spec: ProblemSpec, design: DesignSpec, element: DesignElement, rho: float
+) -> float:
+    """The reduction factor with column-type buckling (EN 1993-1-5 4.5.3, 4.5.4), and its notes.
+
+    A short plate (a/b < 1, the note of 4.4(2)) gets rho_c of 4.5.4(1), with sigma_cr,c the
+    plate as a column between its loaded edges as they are supported (4.5.3(1));
+    otherwise rho, the column fields left None and the reason noted.
+    """
+    sigma1 = out.sigma_cr_Pa
+    column, ends = column_stress(spec, element.loaded)
+    plate = spec.plate
+    aspect = plate.length / plate.width  # a/b, a along the stress
+    if element.loaded == ("bottom", "top"):
+        aspect = 1.0 / aspect
+    if aspect >= 1.0:
+        xi = sigma1 / column - 1.0
+        out.notes.append(
+            f"column-type buckling (EN 1993-1-5 4.5.4) not applied: a/b = {aspect:.3g} >= 1, "
+            "and the note of 4.4(2) asks for it below 1; rho is the plate-type"
+            + (
+                f" (the plate as a column, {ends}, would buckle at sigma_cr,c = "
+                f"{column:.4g} Pa: xi = sigma_cr/sigma_cr,c - 1 = {xi:.3g} < 1, "
+                "so column-like behaviour is not excluded)"
+                if xi < 1.0
+                else ""
+            )
+        )
+        return rho
     chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
     out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
     out.xi = sigma1 / column - 1.0
-    short = column > sigma_e  # sigma_cr,c / sigma_E = (b/a)^2
-    rho_c = interpolated_reduction_factor(rho, chi, out.xi) if short else rho
-    out.reduction_factor = rho_c
-    out.reduced_design_stress_Pa = rho_c * design.yield_stress / design.partial_factor
-    if short and out.xi < 1.0:
+    out.clauses += "; 4.5.3(1), 4.5.4(1): column-type buckling, rho_c"
+    rho_c = interpolated_reduction_factor(rho, chi, out.xi)
+    if out.xi < 1.0:
         out.notes.append(
             f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "
             f"{out.xi:.3g} < 1, rho_c = {rho_c:.4g} between the plate's rho = {rho:.4g} and "
-            f"the column's chi_c = {chi:.4g} (sigma_cr,c by eq. (4.8), the loaded edges "
-            "hinged)"
+            f"the column's chi_c = {chi:.4g} (sigma_cr,c: the plate as a column, {ends})"
         )
-    return out
+    else:
+        out.notes.append(
+            f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "
+            f"{out.xi:.3g} >= 1, rho_c = rho (sigma_cr,c: the plate as a column, {ends})"
+        )
+    return rho_c
+
+
+def column_stress(spec: ProblemSpec, loaded: tuple[str, str]) -> tuple[float, str]:
+    r"""(:math:`\sigma_{cr,c}` (Pa), its ends in words): the plate as a column (4.5.3(1)).
+
+    "The buckling stress with the supports along the longitudinal edges removed": the
+    column between the ``loaded`` edges, each hinged (simply supported, hard or soft),
+    clamped or on its rotational springs (:func:`~unibuckle_fenicsx.en1993.column_end_factor`
+    times eq. (4.8)). A free loaded edge (its deflection free, or on springs) is taken
+    as hinged, eq. (4.8) itself: a smaller sigma_cr,c (a cantilever's, or none) would
+    raise rho_c, so the hinged column is the safe side of it.
+    """
+    hinged = euler_stress(spec, loaded, along=True)
+    named = {e.name: e for e in spec.plate.edges}
+    plate, material = spec.plate, spec.material
+    d = material.E * plate.thickness**3 / (12.0 * (1.0 - material.nu**2))
+    length = plate.length if loaded == ("left", "right") else plate.width  # a
+    kappas, words = [], []
+    for name in loaded:
+        e = named.get(name)
+        if e is None or e.support == "free":
+            return hinged, (
+                f"edges.{name} free: taken hinged, eq. (4.8), the safe side of its column's stress"
+            )
+        if e.support == "clamped":
+            kappas.append(math.inf)
+            words.append(f"{name} clamped")
+        elif e.rotational_stiffness > 0.0:
+            kappas.append(e.rotational_stiffness * length / d)
+            words.append(f"{name} on rotational springs")
+        else:
+            kappas.append(0.0)
+            words.append(f"{name} hinged")
+    factor = column_end_factor(kappas[0], kappas[1])
+    how = "eq. (4.8)" if factor == 1.0 else f"{factor:.4g} x eq. (4.8)"
+    return factor * hinged, f"{' and '.join(words)}: {how}"
 
 
 def euler_stress(spec: ProblemSpec, loaded: tuple[str, str], *, along: bool = False) -> float:

@@ -29,7 +29,7 @@ such a plate, or a stress ratio outside the tables, before any solve.
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -41,6 +41,7 @@ __all__ = [
     "INTERNAL",
     "OUTSTAND",
     "STEEL_MODULUS",
+    "STEEL_YIELD_STRESS",
     "DesignEdge",
     "DesignElement",
     "DesignLoad",
@@ -48,6 +49,8 @@ __all__ = [
     "DesignProblem",
     "buckling_factor",
     "check_steel_modulus",
+    "check_steel_yield_stress",
+    "column_end_factor",
     "column_reduction_factor",
     "design_element",
     "interpolated_reduction_factor",
@@ -81,15 +84,56 @@ def check_steel_modulus(E: float, stress: float, name: str) -> None:
     Raises:
         InputError: ``E`` outside :data:`STEEL_MODULUS`, naming ``material.E``.
     """
-    low, high = STEEL_MODULUS
-    if not low <= E <= high:
+    why = (
+        "(EN 1993-1-5's rho rests on steel, E in [{low:.6g}, {high:.6g}] {name}: 210 GPa, "
+        "stainless 200 GPa); for aluminium use EN 1999-1-1 6.1.4, whose curves this "
+        "output does not give; leave [design] out"
+    )
+    _refuse_outside("design: material.E", E, STEEL_MODULUS, stress, name, why)
+
+
+def _refuse_outside(
+    key: str, value: float, bounds: tuple[float, float], stress: float, name: str, why: str
+) -> None:
+    """Refuse ``value`` (Pa) outside ``bounds``: "KEY = v NAME is not a steel's WHY".
+
+    ``why`` is formatted with the bounds (``low``, ``high``) and ``name`` in the file's
+    stress unit (``stress`` Pa).
+    """
+    low, high = bounds
+    if not low <= value <= high:
         raise InputError(
-            f"design: material.E = {E / stress:.6g} {name} is not a steel's "
-            f"(EN 1993-1-5's rho rests on steel, E in [{low / stress:.6g}, "
-            f"{high / stress:.6g}] {name}: 210 GPa, stainless 200 GPa); for aluminium "
-            "use EN 1999-1-1 6.1.4, whose curves this output does not give; leave "
-            "[design] out"
+            f"{key} = {value / stress:.6g} {name} is not a steel's "
+            + why.format(low=low / stress, high=high / stress, name=name)
         )
+
+
+#: Yield stresses (Pa) taken as a steel's by the design output: EN 1993-1-1 Table 3.1's
+#: structural steels (S235 to S460, f_y from 215 MPa in thick plates), EN 1993-1-12's up
+#: to S700 (and S960 in its revision) and EN 1993-1-4's stainless steels (from 200 MPa),
+#: with a margin. A number in the wrong unit (355 Pa in an SI file, 3.55e8 MPa in a
+#: mm-N-MPa one) lies orders of magnitude outside.
+STEEL_YIELD_STRESS = (1.5e8, 1.0e9)
+
+
+def check_steel_yield_stress(fy: float, stress: float, name: str) -> None:
+    """Refuse a yield stress ``fy`` (Pa) that is not a steel's (:data:`STEEL_YIELD_STRESS`).
+
+    The slenderness sqrt(f_y/sigma_cr) and rho f_y/gamma_M1 take f_y as it is: 355 in an
+    SI file (355 Pa) gave rho = 1 and 355 Pa for a plate whose rho is 0.42. ``stress``
+    and ``name`` are the file's stress unit in Pa and its name, for the message; raises
+    :class:`~unibuckle_fenicsx.errors.InputError` naming ``design.yield_stress``.
+    """
+    _refuse_outside(
+        "design.yield_stress",
+        fy,
+        STEEL_YIELD_STRESS,
+        stress,
+        name,
+        "yield stress (EN 1993-1-1 Table 3.1 and EN 1993-1-12: 235 to 700 MPa, stainless "
+        "steel from 200 MPa; accepted: {low:.6g} to {high:.6g} {name}); give it in the "
+        "file's unit, {name}",
+    )
 
 
 def table_row(element: str, free_edge_most_compressed: bool) -> str:
@@ -175,6 +219,92 @@ def column_reduction_factor(slenderness: float, alpha: float = COLUMN_IMPERFECTI
     """
     phi = 0.5 * (1.0 + alpha * (slenderness - 0.2) + slenderness**2)
     return min(1.0, 1.0 / (phi + math.sqrt(phi**2 - slenderness**2)))
+
+
+def column_end_factor(start: float, end: float) -> float:
+    r""":math:`\sigma_{cr,c}` of a column with restrained ends over that of a hinged one.
+
+    EN 1993-1-5 4.5.3(1) defines :math:`\sigma_{cr,c}` as the plate's buckling stress
+    with the supports along its unloaded edges removed: a column (a strip in cylindrical
+    bending) between the loaded edges, as these are supported. Eq. (4.8) is the hinged
+    column's; here each end is held (w = 0) with a rotational restraint
+    :math:`\kappa = k_r a/D` (0 hinged, ``math.inf`` clamped). The smallest root u in
+    :math:`[\pi, 2\pi]` of the determinant of the four end conditions on
+    :math:`w = c_1 \sin us + c_2 \cos us + c_3 s + c_4` (s = x/a; at s = 0
+    :math:`w = 0`, :math:`-w'' + \kappa w' = 0`; at s = 1 :math:`w = 0`,
+    :math:`w'' + \kappa w' = 0`) gives the factor :math:`(u/\pi)^2`: 1 hinged, 4 clamped
+    (effective length a/2), 2.046 clamped and hinged.
+
+    Args:
+        start: :math:`\kappa` of one end, >= 0 (``math.inf``: clamped).
+        end: :math:`\kappa` of the other.
+    """
+    if start < 0.0 or end < 0.0:
+        raise InputError(f"column end restraints must be >= 0, got {start!r}, {end!r}")
+    if start == end == 0.0:
+        return 1.0
+    if start == end == math.inf:
+        return 4.0
+
+    def row(kappa: float, u: float, at_end: bool) -> list[float]:
+        s, c = (math.sin(u), math.cos(u)) if at_end else (0.0, 1.0)
+        slope = [u * c, -u * s, 1.0, 0.0]  # w'
+        if kappa == math.inf:
+            return slope
+        curvature = [-u * u * s, -u * u * c, 0.0, 0.0]  # w''
+        sign = 1.0 if at_end else -1.0
+        pairs = zip(curvature, slope, strict=True)
+        return [(sign * k + kappa * v) / (1.0 + kappa) for k, v in pairs]
+
+    def det(u: float) -> float:
+        rows = [
+            [0.0, 1.0, 0.0, 1.0],
+            row(start, u, False),
+            [math.sin(u), math.cos(u), 1.0, 1.0],
+            row(end, u, True),
+        ]
+        return _det4(rows)
+
+    grid = [math.pi * (1.0 + k / 400.0) for k in range(-2, 403)]
+    values = [det(u) for u in grid]
+    for k in range(len(grid) - 1):
+        (u0, u1), (f0, f1) = grid[k : k + 2], values[k : k + 2]
+        if f0 == 0.0:
+            return (u0 / math.pi) ** 2
+        if f0 * f1 < 0.0:
+            return (_bisect(det, u0, u1, f0) / math.pi) ** 2
+    raise AssertionError("no column buckling load between the hinged and the clamped one")
+
+
+def _det4(m: list[list[float]]) -> float:
+    """The determinant of a 4 x 4 matrix (Laplace expansion along the first row)."""
+
+    def det3(a: list[list[float]]) -> float:
+        return (
+            a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
+            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
+            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
+        )
+
+    total = 0.0
+    for j in range(4):
+        minor = [[r[k] for k in range(4) if k != j] for r in m[1:]]
+        total += (-1.0) ** j * m[0][j] * det3(minor)
+    return total
+
+
+def _bisect(f: Callable[[float], float], a: float, b: float, fa: float) -> float:
+    """A root of f in [a, b] (f(a) = fa and f(b) of opposite signs), to round-off."""
+    for _ in range(200):
+        mid = 0.5 * (a + b)
+        fm = f(mid)
+        if fm == 0.0 or mid in (a, b):
+            return mid
+        if (fm < 0.0) == (fa < 0.0):
+            a, fa = mid, fm
+        else:
+            b = mid
+    return 0.5 * (a + b)
 
 
 def interpolated_reduction_factor(rho: float, chi: float, xi: float) -> float:

@@ -48,7 +48,7 @@ from unibuckle_fenicsx.algorithms.registry import entry
 from unibuckle_fenicsx.algorithms.section_levels import check_levels
 from unibuckle_fenicsx.analysis import FREE, choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
-from unibuckle_fenicsx.en1993 import check_steel_modulus
+from unibuckle_fenicsx.en1993 import check_steel_modulus, check_steel_yield_stress
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode
@@ -373,6 +373,7 @@ def _check(
         check_levels(parameters, int(levels), units)
     if design is not None:
         check_steel_modulus(parameters.E, *UNITS[units][1:])
+        check_steel_yield_stress(design.yield_stress, *UNITS[units][1:])
     for note in (thick_wall_note(parameters, units), coarse_mesh_note(parameters, units)):
         if note is not None:
             logger.warning("%s", note)

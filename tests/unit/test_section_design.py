@@ -206,15 +206,19 @@ def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):
         assert analysis.result.design is None
 
 
+#: A 200 x 100 x 2 mm box, 200 mm long, as a mm-N-MPa file with [design].
+BOX_MM = (
+    "units = 'mm-N-MPa'\n[section]\nshape = 'box'\nwidth = 200\ndepth = 100\n"
+    "thickness = 2\nlength = 200\n[material]\nE = {E}\nnu = {nu}\n"
+    "[mesh]\nsize = 100\n[design]\nyield_stress = {fy}\n"
+)
+
+
 def test_the_design_of_a_section_not_of_steel_is_refused(tmp_path):
     # EN 1993-1-5 4.4(2)'s rho rests on steel, E = 210 GPa (EN 1993-1-1 3.2.6); an
     # aluminium box (70 GPa) belongs to EN 1999-1-1 6.1.4: refused before any mesh.
     path = tmp_path / "box.toml"
-    path.write_text(
-        "units = 'mm-N-MPa'\n[section]\nshape = 'box'\nwidth = 200\ndepth = 100\n"
-        "thickness = 2\nlength = 200\n[material]\nE = 70000\nnu = 0.33\n"
-        "[mesh]\nsize = 100\n[design]\nyield_stress = 250\n"
-    )
+    path.write_text(BOX_MM.format(E=70000, nu=0.33, fy=250))
     with pytest.raises(InputError, match=r"material\.E = 70000 MPa is not a steel's"):
         load_problem(path)
     aluminium = _section(E=7.0e10, nu=0.33)
@@ -223,6 +227,18 @@ def test_the_design_of_a_section_not_of_steel_is_refused(tmp_path):
     # Without [design] the aluminium box is a fine problem (only the design is refused).
     path.write_text(path.read_text().replace("[design]\nyield_stress = 250\n", ""))
     assert load_problem(path).material.E == pytest.approx(7.0e10)
+
+
+def test_a_section_s_yield_stress_in_the_wrong_unit_is_refused(tmp_path):
+    # 355 in an SI file is 355 Pa: slenderness sqrt(f_y/sigma_cr) near 0 and rho = 1
+    # whatever the walls. Steels have f_y of 235 to 700 MPa (EN 1993-1-1 Table 3.1, EN
+    # 1993-1-12), stainless from 200 MPa (EN 1993-1-4): refused, in the file's unit.
+    path = tmp_path / "box.toml"
+    path.write_text(BOX_MM.format(E=210000, nu=0.3, fy=3.55e8))
+    with pytest.raises(InputError, match=r"design\.yield_stress = 3\.55e\+08 MPa is not"):
+        load_problem(path)
+    with pytest.raises(InputError, match=r"design\.yield_stress = 355 Pa is not a steel's"):
+        solve_section(_section(), MPI.COMM_SELF, design=DesignSpec(yield_stress=355.0))
 
 
 @pytest.mark.parametrize("core", [False, True])

@@ -23,7 +23,21 @@ def warn_plate_model(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
 
     if isinstance(spec, SectionProblemSpec):
         return
-    note = plate_model_note(spec.plate)
+    note = plate_model_note(spec.plate, spec.units)
+    if note is not None and comm.rank == 0:
+        print(f"unibuckle: warning: {note}", file=sys.stderr)
+
+
+def warn_coarse_mesh(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
+    """A warning on stderr, after a solve, when a plate's cells are too coarse for a buckle.
+
+    A section's cells are checked by the section's solve (its log's warnings).
+    """
+    from unibuckle_fenicsx.spec.checks import coarse_mesh_note
+
+    if isinstance(spec, SectionProblemSpec):
+        return
+    note = coarse_mesh_note(spec.plate, spec.mesh, spec.units)
     if note is not None and comm.rank == 0:
         print(f"unibuckle: warning: {note}", file=sys.stderr)
 

@@ -9,7 +9,7 @@ from typing import Any
 from msgspec.structs import replace
 
 from unibuckle_fenicsx.cli.flags import solver_changes, unused_flags
-from unibuckle_fenicsx.cli.problem import spec_from_args, warn_plate_model
+from unibuckle_fenicsx.cli.problem import spec_from_args, warn_coarse_mesh, warn_plate_model
 from unibuckle_fenicsx.cli.status import print_out, report_failure
 from unibuckle_fenicsx.outcome import Outcome
 
@@ -36,6 +36,7 @@ def solve_command(args: argparse.Namespace, comm: Any) -> int:
                 unwritten = f"--output {args.output}: {err}"
     result = analysis.result
     _warn_unused(flags, method, comm, result)
+    warn_coarse_mesh(spec, comm)
     return _report(args, result, comm, unwritten)
 
 

@@ -415,19 +415,19 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
             f"tension {-d.sigma_cr_Pa / scale:.4g} {unit}, {d.edge}): no sigma_cr, slenderness "
             "or rho" + _design_lower(d, scale, unit)
         )
-    column = d.plate_reduction_factor is not None and d.reduction_factor != d.plate_reduction_factor
+    column = ""
+    if d.xi is not None and d.xi < 1.0:
+        column = (
+            f" (column-type: plate {d.plate_reduction_factor:.4g}, chi_c "
+            f"{d.column_reduction_factor:.4g}, xi {d.xi:.3g})"
+        )
+    elif d.xi is not None:
+        column = f" (column-type: xi {d.xi:.3g} >= 1, the plate's)"
     return (
         f"EN 1993-1-5: sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit} ({d.edge}), "
         f"psi = {d.psi:.3g}, slenderness {d.relative_slenderness:.4g}, rho = "
         + (
-            f"{rho:.4g}"
-            + (
-                f" (column-type: plate {d.plate_reduction_factor:.4g}, chi_c "
-                f"{d.column_reduction_factor:.4g}, xi {d.xi:.3g})"
-                if column
-                else ""
-            )
-            + f", rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
+            f"{rho:.4g}" + column + f", rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
             if rho is not None and isinstance(reduced, float)
             else f"none (psi outside {d.table})"
         )

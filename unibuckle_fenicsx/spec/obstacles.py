@@ -205,7 +205,8 @@ class DesignSpec(Table, frozen=True):
     r"""Design output by EN 1993-1-5 (:mod:`~unibuckle_fenicsx.design`; ``[design]``).
 
     Args:
-        yield_stress: :math:`f_y` (Pa), > 0.
+        yield_stress: :math:`f_y` (Pa), > 0: a steel's, 1.5e8 to 1e9 Pa
+            (:data:`~unibuckle_fenicsx.en1993.STEEL_YIELD_STRESS`), else refused.
         partial_factor: :math:`\gamma_{M1}`, >= 1; 1.0, the recommended value of EN
             1993-1-1, 6.1 (a resistance factor below 1 would put the design stress
             above the reduced characteristic one, rho f_y).

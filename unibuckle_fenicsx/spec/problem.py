@@ -8,7 +8,11 @@ from typing import Any, ClassVar, Literal
 import msgspec
 from msgspec.structs import force_setattr, replace
 
-from unibuckle_fenicsx.en1993 import check_steel_modulus, design_element
+from unibuckle_fenicsx.en1993 import (
+    check_steel_modulus,
+    check_steel_yield_stress,
+    design_element,
+)
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.spec.base import UNITS, Table, in_file, stress_ends
 from unibuckle_fenicsx.spec.checks import check_features, check_supports
@@ -184,7 +188,7 @@ class ProblemSpec(Table, frozen=True):
         self._check_steel()
 
     def _check_steel(self) -> None:
-        """Refuse a general stiffness or a Young's modulus that is not a steel's.
+        """Refuse a general stiffness, or a Young's modulus or yield stress not a steel's.
 
         EN 1993-1-5 describes isotropic steel plates
         (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
@@ -204,6 +208,8 @@ class ProblemSpec(Table, frozen=True):
                 "(Eurocode 3) describes isotropic steel plates; leave [design] out"
             )
         check_steel_modulus(self.material.E, stress, name)
+        if self.design is not None:
+            check_steel_yield_stress(self.design.yield_stress, stress, name)
 
     def check_scaled_load(self) -> None:
         """Refuse a problem with nothing for lambda to scale (a fixed part alone)."""

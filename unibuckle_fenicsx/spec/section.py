@@ -13,7 +13,7 @@ from typing import Annotated, ClassVar, Literal
 import msgspec
 from msgspec import Meta
 
-from unibuckle_fenicsx.en1993 import check_steel_modulus
+from unibuckle_fenicsx.en1993 import check_steel_modulus, check_steel_yield_stress
 from unibuckle_fenicsx.errors import FieldError
 from unibuckle_fenicsx.spec.base import UNITS, Table, Units, in_file, unit
 from unibuckle_fenicsx.spec.obstacles import DesignSpec
@@ -213,6 +213,7 @@ class SectionProblemSpec(Table, frozen=True):
         check_section_method(self.solver.method)
         if self.design is not None:
             check_steel_modulus(self.material.E, *UNITS[self.units][1:])
+            check_steel_yield_stress(self.design.yield_stress, *UNITS[self.units][1:])
         default = SolverSpec()
         for key in SolverSpec.__struct_fields__:
             if key not in SOLVER_KEYS and getattr(self.solver, key) != getattr(default, key):
