@@ -39,6 +39,7 @@ Note:
 from __future__ import annotations
 
 import argparse
+import dataclasses
 import math
 import time
 from typing import TYPE_CHECKING
@@ -61,9 +62,14 @@ LEVEL_COLUMNS = (
 
 
 def section_parameters(
-    shape: str, size: float, corner_cell: float | None = None
+    shape: str, size: float, corner_cell: float | None = None, geometric: str = "full"
 ) -> SectionParameters:
-    """The benchmark's box or tube with a rigid core on cells of ``size`` (m)."""
+    """The benchmark's box or tube with a rigid core on cells of ``size`` (m).
+
+    ``geometric``: the geometric stiffness's components
+    (:data:`~unibuckle_fenicsx.model.shell.section.GEOMETRIC`; the package's default
+    "full", or "donnell" as the rows measured before it was the default).
+    """
     from unibuckle_fenicsx.model.shell.section import SectionParameters
 
     geometry = (
@@ -73,7 +79,7 @@ def section_parameters(
     )
     return SectionParameters(
         shape, E=2.1e11, nu=0.3, mesh_size=size, ends="simply_supported", core=True,
-        corner_cell=corner_cell if shape == "box" else None, **geometry,
+        corner_cell=corner_cell if shape == "box" else None, geometric=geometric, **geometry,
     )  # fmt: skip
 
 
@@ -108,13 +114,18 @@ def run(
     repeat: int,
     corner_cell: float | None,
     route: str,
+    geometric: str = "full",
+    release_steps: int | None = None,
 ) -> dict:
     """One section: set-up, free solve, unilateral solve, certificate.
 
     ``route``: "active-set", "interior-point" (the routes of
     :func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`), "auto" (the one
     :func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses) or "single" (the
-    interior-point chain on the section itself).
+    interior-point chain on the section itself). ``geometric``: as
+    :func:`section_parameters`. ``release_steps``: the section route's
+    :attr:`~unibuckle_fenicsx.algorithms.chain.ChainOptions.release_steps` for this run
+    (None: the package's :data:`~unibuckle_fenicsx.algorithms.section_levels.CHAIN_OPTIONS`).
     """
     from mpi4py import MPI
     from petsc4py import PETSc
@@ -142,6 +153,10 @@ def run(
         return out
 
     section_levels._level = counted
+    if release_steps is not None:
+        section_levels.CHAIN_OPTIONS = dataclasses.replace(
+            section_levels.CHAIN_OPTIONS, release_steps=release_steps
+        )
     # Seconds per section (keyed by its rows): its builds, its shared LDL^T's factorisations.
     build_s: dict[int, float] = {}
     factor_s: dict[int, float] = {}
@@ -160,7 +175,7 @@ def run(
         lambda args, out: int(args[0].matrix.getSize()[0]),
     )
 
-    params = section_parameters(shape, size, corner_cell)
+    params = section_parameters(shape, size, corner_cell, geometric)
     PETSc.Log.begin()  # the factorisations' counts
     t0 = time.perf_counter()
     with build_section(params, MPI.COMM_WORLD) as section:
@@ -259,6 +274,8 @@ def run(
             "factorisations": factorisations,
             "levels": levels_log,
             "corner_cell": corner_cell,
+            "geometric": geometric,
+            "release_steps": section_levels.CHAIN_OPTIONS.release_steps,
         }
 
 
@@ -275,10 +292,21 @@ def main() -> None:
         choices=("auto", "active-set", "levels", "interior-point", "single"),
         default="auto",
     )
+    parser.add_argument(
+        "--geometric", choices=("full", "donnell"), default="full",
+        help="the geometric stiffness's components (donnell: as before 2026-11-30)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--release-steps", type=int, default=None,
+        help="the interior point's release_steps on the sections (default: the package's)",
+    )  # fmt: skip
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
     route = "active-set" if args.route == "levels" else args.route
-    row = run(args.shape, args.size, args.levels, args.repeat, args.corner_cell, route)
+    row = run(
+        args.shape, args.size, args.levels, args.repeat, args.corner_cell, route,
+        args.geometric, args.release_steps,
+    )  # fmt: skip
     print_header("Sections with a core (one rank)", COLUMNS)
     cells = []
     for c in COLUMNS:

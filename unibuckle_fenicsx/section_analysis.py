@@ -81,7 +81,7 @@ from unibuckle_fenicsx.spec import (
     SolverSpec,
     problem_to_dict,
 )
-from unibuckle_fenicsx.spec.base import file_units, in_file
+from unibuckle_fenicsx.spec.base import FILE_UNITS, file_units, in_file
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
 
 __all__ = [
@@ -289,6 +289,19 @@ def solve_section(
         Collective on ``comm``. On an error every PETSc/SLEPc object built here is
         destroyed before the error propagates.
     """
+    units = parameters.units if isinstance(parameters, SectionProblemSpec) else "SI"
+    with file_units(units):  # every refusal, warning and note of the run speaks the file's
+        return _solve_section(parameters, comm, levels, solver, design)
+
+
+def _solve_section(
+    parameters: SectionParameters | SectionProblemSpec,
+    comm: MPI.Comm,
+    levels: int,
+    solver: SolverSpec | None,
+    design: DesignSpec | None,
+) -> SectionAnalysis:
+    """:func:`solve_section` in its file's units (set by the caller: ``file_units``)."""
     t0 = time.perf_counter()
     echo: dict[str, object] | None = None
     units, name = "SI", None
@@ -302,13 +315,12 @@ def solve_section(
             f"solve_section: parameters must be a SectionParameters or a SectionProblemSpec, "
             f"got {type(parameters).__name__}"
         )
-    _check(parameters, levels, design, units)
+    _check(parameters, levels, design)
     certificate: Certificate | None = None
     solver = solver or SolverSpec()
     method, reason = choose_section_method(parameters, solver)
     logger.info("section: method %s (%s)", method, reason)
-    with file_units(units):  # the messages of the mesh's checks (the core's span)
-        section, solution = _solve(parameters, int(levels), comm, method, solver)
+    section, solution = _solve(parameters, int(levels), comm, method, solver)
     try:
         problem = section.problem
         t1 = time.perf_counter()
@@ -335,7 +347,7 @@ def solve_section(
         result = _result(section, free, solution, certificate, time.perf_counter() - t0, reason)
         if echo is not None:  # a file's run: its name, its input
             result.case, result.input, result.units = str(name), echo, units
-        column = column_note(parameters, result.critical_load_Pa, solution is not None, units)
+        column = column_note(parameters, result.critical_load_Pa, solution is not None)
         if column is not None:
             logger.warning("%s", column)
         if design is not None:
@@ -361,9 +373,7 @@ MIN_HALF_WAVE_CELLS = 2.5
 MIN_ALONG_CELLS = 5
 
 
-def _check(
-    parameters: SectionParameters, levels: int, design: DesignSpec | None, units: str
-) -> None:
+def _check(parameters: SectionParameters, levels: int, design: DesignSpec | None) -> None:
     """Refuse what no solve should start with, and warn of walls or cells out of range.
 
     Raises:
@@ -374,11 +384,12 @@ def _check(
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
     if parameters.core and parameters.foundation_stiffness is None:  # a rigid core's levels
-        check_levels(parameters, int(levels), units)
+        check_levels(parameters, int(levels))
     if design is not None:
-        check_steel_modulus(parameters.E, *UNITS[units][1:])
-        check_steel_yield_stress(design.yield_stress, *UNITS[units][1:])
-    notes = [thick_wall_note(parameters, units), coarse_mesh_note(parameters, units)]
+        stress = UNITS[FILE_UNITS.get()][1:]
+        check_steel_modulus(parameters.E, *stress)
+        check_steel_yield_stress(design.yield_stress, *stress)
+    notes = [thick_wall_note(parameters), coarse_mesh_note(parameters)]
     if design is not None:
         notes.append(steel_poisson_note(parameters.nu))
     for note in notes:
@@ -413,9 +424,7 @@ def _design(
 COLUMN_FRACTION = 0.8
 
 
-def column_note(
-    parameters: SectionParameters, load: float, cored: bool, units: str = "SI"
-) -> str | None:
+def column_note(parameters: SectionParameters, load: float, cored: bool) -> str | None:
     """A warning when the member's Euler stress is near or below its critical one, else None.
 
     Its uniform axial stress at ``load`` at or above :data:`COLUMN_FRACTION` of the
@@ -425,15 +434,14 @@ def column_note(
     core lets them move only outward, an elastic one resists with springs fixed in
     space), while a real core moves with the member; the critical stress is the walls'
     local one, and the member's flexural buckling is not checked (EN 1994-1-1, 6.7.3).
-    Stresses in the unit system ``units`` (:data:`~unibuckle_fenicsx.spec.base.UNITS`),
-    the file's.
+    Stresses in the units of the file solved (:func:`~unibuckle_fenicsx.spec.base.file_units`).
     """
     p = parameters
     axial = -load * p.axial_stress
     euler = p.euler_stress()
     if axial < COLUMN_FRACTION * euler:
         return None
-    _, scale, unit = UNITS[units]
+    _, scale, unit = UNITS[FILE_UNITS.get()]
     stresses = (
         f"the critical axial stress {axial / scale:.4g} {unit} is {axial / euler:.3g} times "
         f"the member's Euler stress {euler / scale:.4g} {unit}"
@@ -452,7 +460,7 @@ def column_note(
     )
 
 
-def coarse_mesh_note(parameters: SectionParameters, units: str = "SI") -> str | None:
+def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     """A warning when the cells are too coarse for the walls' buckles, else None.
 
     The rule (:data:`MIN_FACE_CELLS`, :data:`MIN_HALF_WAVE_CELLS` across,
@@ -460,7 +468,8 @@ def coarse_mesh_note(parameters: SectionParameters, units: str = "SI") -> str | 
     for the finest cells) is a priori, from the section's
     dimensions and cell size: on cells too coarse for the buckles the shell's critical
     stress is too high (it falls as the cells are refined), and so are k and the design
-    values. Lengths in the unit system ``units``, the file's.
+    values. Lengths in the units of the file solved
+    (:func:`~unibuckle_fenicsx.spec.base.file_units`).
     """
     p = parameters
     width, across = _buckle_width(p)
@@ -476,7 +485,7 @@ def coarse_mesh_note(parameters: SectionParameters, units: str = "SI") -> str | 
     if not short:
         return None
     cells, need, span, where = min(short, key=lambda c: c[0] / c[1])  # the finest cells asked
-    (size, finer, width), unit = in_file((p.mesh_size, span / need, span), "m", units)
+    (size, finer, width), unit = in_file((p.mesh_size, span / need, span), "m")
     return (
         f"mesh.size = {size:.3g} {unit} gives {cells:.2g} cells {where} "
         f"({width:.3g} {unit}), fewer than {need:g}: on cells this coarse the "
@@ -517,20 +526,21 @@ def _buckle_width(parameters: SectionParameters) -> tuple[float, str]:
     return half_wave(p), "the tube's axisymmetric half-wave"
 
 
-def thick_wall_note(parameters: SectionParameters, units: str = "SI") -> str | None:
+def thick_wall_note(parameters: SectionParameters) -> str | None:
     """A warning when the wall is thick for the shell model, else None.
 
     The plate's rule (:func:`~unibuckle_fenicsx.spec.checks.plate_model_note`): the
     shell's Reissner-Mindlin kinematics model walls up to about
     :data:`~unibuckle_fenicsx.spec.plate.THICK_PLATE_RATIO` times the width of their
-    buckles (:func:`_buckle_width`). Lengths in the unit system ``units``, the file's.
+    buckles (:func:`_buckle_width`). Lengths in the units of the file solved
+    (:func:`~unibuckle_fenicsx.spec.base.file_units`).
     """
     p = parameters
     span, what = _buckle_width(p)
     ratio = p.thickness / span
     if ratio <= THICK_PLATE_RATIO:
         return None
-    (t, width), unit = in_file((p.thickness, span), "m", units)
+    (t, width), unit = in_file((p.thickness, span), "m")
     return (
         f"section.thickness = {t:g} {unit} is {ratio:.3g} times {what} "
         f"({width:.3g} {unit}): "

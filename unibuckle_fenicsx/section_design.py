@@ -14,6 +14,12 @@ asks for the design quantities of its critical state :math:`\lambda_c`:
   bending part across a face spanning the depth), :math:`\bar\lambda_p =
   \sqrt{f_y/\sigma_{cr}}`, the buckling factor of Table 4.1 at that :math:`\psi`, and
   :math:`\rho` by eq. (4.2) (:mod:`unibuckle_fenicsx.en1993`); a face in tension has none;
+  a face shorter than it is wide (:math:`a/b < 1`, a the section's length: a stub), by
+  the note of 4.4(2), :math:`\rho_c` of 4.5.4(1) instead, between :math:`\rho` and the
+  column-type :math:`\chi_c` (curve a; 4.5.3(1): :math:`\sigma_{cr,c}` of the face as a
+  column between the section's ends, eq. (4.8) :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)`
+  between simply supported ones, 4 times it between clamped ones), as a plate's
+  (:mod:`unibuckle_fenicsx.design`);
 - for a **tube**, :math:`\bar\lambda` only: a circular wall is a shell, whose buckling
   reduction (EN 1993-1-6, section 8.5: the fabrication quality class, :math:`\alpha_x`,
   :math:`\chi_x`) this output does not apply;
@@ -35,12 +41,16 @@ from __future__ import annotations
 import math
 from typing import Protocol
 
+import msgspec
 from msgspec import UNSET, Struct, UnsetType
 
 from unibuckle_fenicsx.design import CALIBRATION, UNPROVEN
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     buckling_factor,
+    column_end_factor,
+    column_reduction_factor,
+    interpolated_reduction_factor,
     psi_range,
     reduction_factor,
     stress_ratio,
@@ -60,7 +70,8 @@ __all__ = [
 #: The clauses of a box's face.
 FACE_CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of each face as an "
-    "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma"
+    "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma; "
+    "4.5.3(2), 4.5.4(1): column-type buckling of a face shorter than its width, rho_c"
 )
 #: The clause of a tube's slenderness.
 TUBE_CLAUSES = (
@@ -79,6 +90,14 @@ class DesignSection(Protocol):
     @property
     def thickness(self) -> float: ...
     @property
+    def length(self) -> float: ...
+    @property
+    def E(self) -> float: ...
+    @property
+    def nu(self) -> float: ...
+    @property
+    def ends(self) -> str: ...
+    @property
     def width(self) -> float | None: ...
     @property
     def depth(self) -> float | None: ...
@@ -90,6 +109,8 @@ class DesignSection(Protocol):
     def bending_stress(self) -> float: ...
     @property
     def core(self) -> bool: ...
+    @property
+    def core_span(self) -> tuple[float, float] | None: ...
     def compression(self) -> float: ...
     def euler_stress(self) -> float: ...
 
@@ -104,8 +125,22 @@ class FaceDesign(Struct, kw_only=True):
         psi: :math:`\psi = \sigma_2/\sigma_1` across the face.
         relative_slenderness: :math:`\bar\lambda_p = \sqrt{f_y/\sigma_1}`.
         k_sigma_table: Table 4.1's :math:`k_\sigma` at :math:`\psi`.
-        reduction_factor: :math:`\rho`, eq. (4.2); None for :math:`\psi < -3`.
-        reduced_design_stress_Pa: :math:`\rho f_y/\gamma_{M1}` (Pa).
+        reduction_factor: The reduction factor to apply: on a face shorter than it is
+            wide (a/b < 1, the note of 4.4(2)) :math:`\rho_c` of 4.5.4(1), the
+            plate-type ``plate_reduction_factor`` interpolated towards the column-type
+            ``column_reduction_factor`` where :math:`\xi < 1`; else
+            ``plate_reduction_factor``. None for :math:`\psi < -3`.
+        plate_reduction_factor: :math:`\rho`, eq. (4.2).
+        column_critical_stress_Pa: :math:`\sigma_{cr,c}`, the face as a column between
+            the section's ends, its corners' support removed (4.5.3(1)): eq. (4.8),
+            :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)` with a the section's length, between
+            simply supported ends, 4 times it between clamped ones. None, as the two
+            below, on a face not shorter than its width (no column-type check).
+        column_reduction_factor: :math:`\chi_c` at :math:`\sqrt{f_y/\sigma_{cr,c}}`,
+            curve a (4.5.3(4), (5)).
+        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)).
+        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M1}` (Pa), with
+            ``reduction_factor``.
     """
 
     face: str
@@ -114,6 +149,10 @@ class FaceDesign(Struct, kw_only=True):
     relative_slenderness: float | None = None
     k_sigma_table: float | None = None
     reduction_factor: float | None = None
+    plate_reduction_factor: float | None = None
+    column_critical_stress_Pa: float | None = None
+    column_reduction_factor: float | None = None
+    xi: float | None = None
     reduced_design_stress_Pa: float | None = None
 
 
@@ -131,11 +170,16 @@ class SectionDesignRecord(Struct, kw_only=True):
         faces: A box's faces (:class:`FaceDesign`); empty for a tube.
         governing_face: The face that reaches :math:`\rho f_y/\gamma_{M1}` at the
             smallest multiple of the critical load, the smallest :math:`\rho f_y/\sigma_1`
-            (of faces reaching it together, the widest; None for a tube).
+            (of faces reaching it together, the widest, and of equally wide ones the
+            first of ``faces``; None for a tube).
+        tied_faces: The faces that reach it together with the governing one, itself
+            first (every face of a box in uniform compression without column-type
+            buckling); empty when one face governs alone.
         width_to_thickness: With a core: :math:`h/t` (box, h the greater overall
             dimension) or :math:`d/t` (tube, d the outer diameter); else None.
         width_to_thickness_limit: EN 1994-1-1 Table 6.3's limit of that ratio.
-        local_buckling_negligible: Whether the ratio is within the limit (6.7.1(9)).
+        local_buckling_negligible: Whether the ratio is within the limit (6.7.1(9)) and
+            the core fills the whole length (a hollow length is no filled section).
         lower_bound: With a core whose critical load is not proven the lowest (a KKT
             point: the sections' usual certificate), the same quantities at the verified
             lower bound (the hollow section's load by interlacing, unless a closer one was
@@ -150,6 +194,7 @@ class SectionDesignRecord(Struct, kw_only=True):
     notes: list[str]
     faces: list[FaceDesign]
     governing_face: str | None = None
+    tied_faces: list[str] = msgspec.field(default_factory=list)
     width_to_thickness: float | None = None
     width_to_thickness_limit: float | None = None
     local_buckling_negligible: bool | None = None
@@ -173,20 +218,37 @@ def face_compressions(section: DesignSection) -> dict[str, tuple[float, float]]:
     }
 
 
-def _face(name: str, ends: tuple[float, float], design: DesignSpec) -> FaceDesign:
-    """The face ``name`` whose edges carry the compressions ``ends`` (Pa)."""
+def _face(
+    section: DesignSection, name: str, ends: tuple[float, float], design: DesignSpec
+) -> FaceDesign:
+    """The face ``name`` of ``section`` whose edges carry the compressions ``ends`` (Pa)."""
     sigma1, sigma2 = max(ends), min(ends)
     if sigma1 <= 0.0:
         return FaceDesign(face=name, sigma_cr_Pa=sigma1)
     psi = stress_ratio(sigma1, sigma2)  # a whole number within rounding: the table's row
     slenderness = math.sqrt(design.yield_stress / sigma1)
     out = FaceDesign(face=name, sigma_cr_Pa=sigma1, psi=psi, relative_slenderness=slenderness)
-    if psi >= psi_range(INTERNAL)[0]:
-        out.k_sigma_table = buckling_factor(INTERNAL, psi)
-        out.reduction_factor = reduction_factor(slenderness, psi, INTERNAL)
-        out.reduced_design_stress_Pa = (
-            out.reduction_factor * design.yield_stress / design.partial_factor
+    if psi < psi_range(INTERNAL)[0]:
+        return out
+    out.k_sigma_table = buckling_factor(INTERNAL, psi)
+    rho = reduction_factor(slenderness, psi, INTERNAL)
+    out.plate_reduction_factor = out.reduction_factor = rho
+    # The face as a column (4.5.3(1), 4.5.4(1)): a face shorter than its width may buckle
+    # like one (the note of 4.4(2)), as a plate's (unibuckle_fenicsx.design): between the
+    # section's ends as they are held, eq. (4.8) hinged, 4 times it clamped.
+    if section.length < face_width(section, name):  # a/b < 1
+        kappa = math.inf if section.ends == "clamped" else 0.0
+        ratio = section.thickness / section.length
+        column = column_end_factor(kappa, kappa) * (
+            math.pi**2 * section.E * ratio**2 / (12.0 * (1.0 - section.nu**2))
         )
+        chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
+        out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
+        out.xi = sigma1 / column - 1.0
+        out.reduction_factor = interpolated_reduction_factor(rho, chi, out.xi)
+    out.reduced_design_stress_Pa = (
+        out.reduction_factor * design.yield_stress / design.partial_factor
+    )
     return out
 
 
@@ -229,12 +291,26 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             "that buckles because its neighbours do"
         )
         for name, (a, b) in face_compressions(section).items():
-            out.faces.append(_face(name, (load * a, load * b), design))
+            out.faces.append(_face(section, name, (load * a, load * b), design))
+        column = [f for f in out.faces if f.reduction_factor != f.plate_reduction_factor]
+        if column:
+            out.notes.append(
+                "column-type buckling (EN 1993-1-5 4.4(2) note, 4.5.4(1)): the section's "
+                "length is below the width of face(s) "
+                + ", ".join(
+                    f"{f.face} (xi = {f.xi:.3g}, rho_c = {f.reduction_factor:.4g})" for f in column
+                )
+                + "; sigma_cr,c: the face as a column between the section's ends "
+                + ("(clamped: 4 x eq. (4.8))" if section.ends == "clamped" else "(eq. (4.8))")
+            )
         rated = [f for f in out.faces if f.reduced_design_stress_Pa is not None]
         if rated:
             first = min(_reaches_reduced_stress(f) for f in rated)
             tied = [f for f in rated if _reaches_reduced_stress(f) <= first * (1.0 + 1e-12)]
             out.governing_face = max(tied, key=lambda f: face_width(section, f.face)).face
+            if len(tied) > 1:
+                others = [f.face for f in tied if f.face != out.governing_face]
+                out.tied_faces = [out.governing_face, *others]
     else:
         out.clauses.append(TUBE_CLAUSES)
     out.notes.append(member_note(section, design))
@@ -253,7 +329,20 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             across = (section.diameter or 0.0) + t
             out.width_to_thickness_limit = 90.0 * epsilon**2
         out.width_to_thickness = across / t
-        out.local_buckling_negligible = out.width_to_thickness <= out.width_to_thickness_limit
+        within = out.width_to_thickness <= out.width_to_thickness_limit
+        span = section.core_span
+        if span is not None and not (span[0] <= 0.0 and span[1] >= section.length):
+            # Table 6.3 is a filled section's: the hollow length is a steel member's.
+            out.notes.append(
+                f"the core fills x/L = {span[0] / section.length:.4g} to "
+                f"{span[1] / section.length:.4g} of the length only: EN 1994-1-1 6.7.1(9) "
+                "and Table 6.3 describe a concrete-filled section, not the hollow length, "
+                "whose walls' local buckling is EN 1993's (EN 1993-1-1 Table 5.2, "
+                "EN 1993-1-5); local_buckling_negligible is false"
+                + (" although the ratio is within the limit" if within else "")
+            )
+            within = False
+        out.local_buckling_negligible = within
     return out
 
 
@@ -297,6 +386,23 @@ def at_lower_bound(
     return record
 
 
+def _governing(d: SectionDesignRecord, *, rule: bool = True) -> str:
+    r"""The governing face in the summary: its name, or the faces that tie with it.
+
+    Faces that reach :math:`\rho f_y/\gamma_{M1}` at one load tie (every face of a box in
+    uniform compression): the line names them all and (``rule``) the rule that picked
+    ``governing_face`` (the widest, then the first of ``faces``).
+    """
+    if not d.tied_faces:
+        return f"face {d.governing_face}"
+    text = f"faces {', '.join(d.tied_faces)} tie"
+    if rule:
+        text += (
+            f" (one load to rho f_y/gamma_M1; {d.governing_face} named: the widest, then the first)"
+        )
+    return text
+
+
 def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") -> str:
     """The summary line of a section's design output (stresses in ``unit``, Pa / ``scale``)."""
     text = (
@@ -306,15 +412,25 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
     face = next((f for f in d.faces if f.face == d.governing_face), None)
     if face is not None and face.reduction_factor is not None:
         reduced = face.reduced_design_stress_Pa or 0.0
+        rho = f"rho = {face.reduction_factor:.4g}"
+        if face.reduction_factor != face.plate_reduction_factor:
+            rho = (
+                f"rho_c = {face.reduction_factor:.4g} (column-type, EN 1993-1-5 4.5.4: "
+                f"plate {face.plate_reduction_factor:.4g}, chi_c "
+                f"{face.column_reduction_factor:.4g}, xi {face.xi:.3g})"
+            )
         text += (
-            f"; EN 1993-1-5 face {face.face}: psi = {face.psi:.3g}, rho = "
-            f"{face.reduction_factor:.4g}, rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
+            f"; EN 1993-1-5 {_governing(d)}: psi = {face.psi:.3g}, {rho}, "
+            f"rho f_y/gamma_M1 = {reduced / scale:.4g} {unit}"
         )
     if d.width_to_thickness is not None and d.width_to_thickness_limit is not None:
         verdict = (
             "local buckling may be neglected"
             if d.local_buckling_negligible
             else "above it: local buckling to be considered"
+            if d.width_to_thickness > d.width_to_thickness_limit
+            else "within it where filled; the core does not fill the length: local "
+            "buckling to be considered"
         )
         text += (
             f"; EN 1994-1-1 Table 6.3: {d.width_to_thickness:.4g} against "
@@ -329,5 +445,6 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
         )
         face = next((f for f in low.faces if f.face == low.governing_face), None)
         if face is not None and face.reduction_factor is not None:
-            text += f", face {face.face} rho = {face.reduction_factor:.4g}"
+            name = "rho" if face.reduction_factor == face.plate_reduction_factor else "rho_c"
+            text += f", {_governing(low, rule=False)}, {name} = {face.reduction_factor:.4g}"
     return text

@@ -353,12 +353,21 @@ def _orderings_commands(rows: list[dict[str, Any]]) -> str:
     return "`, then `".join(commands)
 
 
-def _sections_commands(rows: list[dict[str, Any]]) -> str:
-    """The ``bench_sections.py`` runs that wrote the rows: one per section, size and levels."""
+def _sections_commands(rows: list[dict[str, Any]], name: str = "sections") -> str:
+    """The ``bench_sections.py`` runs that wrote the rows: one per section, size and levels.
+
+    With a row's ``geometric`` and ``release_steps`` where it has them (``name``: the
+    results file's).
+    """
+
+    def flags(r: dict[str, Any]) -> str:
+        out = f" --geometric {r['geometric']}" if "geometric" in r else ""
+        return out + (f" --release-steps {r['release_steps']}" if "release_steps" in r else "")
+
     return "`, then `".join(
         f"python bench/bench_sections.py --shape {r['shape']} --size {r['size_m']:g} "
-        f"--levels {r['levels_requested']} --route {r['route']} "
-        "--json bench/results/sections.jsonl"
+        f"--levels {r['levels_requested']} --route {r['route']}{flags(r)} "
+        f"--json bench/results/{name}.jsonl"
         for r in rows
     )
 
@@ -384,6 +393,7 @@ COMMANDS = {
     "bracket": lambda rows: _bracket_commands(rows),
     "bracket_compare": lambda rows: _compare_commands(rows),
     "sections": lambda rows: _sections_commands(rows),
+    "sections_full": lambda rows: _sections_commands(rows, "sections_full"),
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"
@@ -445,6 +455,20 @@ def bench_rows(path: Path) -> list[dict[str, Any]]:
     return rows
 
 
+#: The columns of a ``bench_sections.py`` results file's table.
+SECTIONS_COLUMNS = [
+    ("shape", "section"),
+    ("route", "route"),
+    ("dofs", "DOFs"),
+    ("constrained", "constrained directions"),
+    ("per_level", "per level: steps / factorisations / eigen solves"),
+    ("factorisations", "factorisations"),
+    ("ratio", "time (free solves)"),
+    ("process_ratio", "whole run (hollow runs)"),
+    ("core_load/ref", "σ/σ_ref"),
+    ("kkt", "KKT"),
+    ("core_load_Pa", "σ_c (Pa)"),
+]
 #: The columns each results file's table shows, with their headers (words and units);
 #: every other scalar is in the file. A file not listed shows every scalar column.
 BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
@@ -463,18 +487,12 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("k", "k"),
         ("load_Pa", "λ_c (Pa)"),
     ],
-    "sections": [
-        ("shape", "section"),
-        ("route", "route"),
-        ("dofs", "DOFs"),
-        ("constrained", "constrained directions"),
-        ("per_level", "per level: steps / factorisations / eigen solves"),
-        ("factorisations", "factorisations"),
-        ("ratio", "time (free solves)"),
-        ("process_ratio", "whole run (hollow runs)"),
-        ("core_load/ref", "σ/σ_ref"),
-        ("kkt", "KKT"),
-        ("core_load_Pa", "σ_c (Pa)"),
+    "sections": SECTIONS_COLUMNS,
+    "sections_full": [
+        *SECTIONS_COLUMNS[:4],
+        ("geometric", "geometric"),
+        ("release_steps", "release_steps"),
+        *SECTIONS_COLUMNS[4:],
     ],
     "bracket": [
         ("case", "case"),

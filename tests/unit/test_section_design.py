@@ -20,7 +20,7 @@ import pytest
 
 from unibuckle_fenicsx import SectionParameters, solve_section
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.section_design import section_design
+from unibuckle_fenicsx.section_design import at_lower_bound, design_line, section_design
 from unibuckle_fenicsx.spec import DesignSpec, load_problem
 
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial sections")
@@ -268,3 +268,133 @@ def test_the_design_output_says_the_member_s_buckling_is_not_in_it(core):
     note = next(n for n in section_design(tube, DesignSpec(yield_stress=3.55e8), 1e9).notes
                 if "flexural buckling" in n)  # fmt: skip
     assert f"= {math.sqrt(3.55e8 / tube_euler):.3g} " in note
+
+
+def _column_chi(slenderness: float) -> float:
+    # EN 1993-1-1 eq. (6.49) with buckling curve a (alpha = 0.21), as EN 1993-1-5
+    # 4.5.3(5) asks for an unstiffened plate's column-type buckling.
+    phi = 0.5 * (1.0 + 0.21 * (slenderness - 0.2) + slenderness**2)
+    return 1.0 / (phi + math.sqrt(phi**2 - slenderness**2))
+
+
+def test_a_stub_shorter_than_its_faces_gets_rho_c():
+    """A stub's faces gave the plate-type rho of eq. (4.2), 13 % on the unsafe side.
+
+    The square box 100 x 100 x 1 mm, L = 50 mm between simply supported ends: its faces,
+    a/b = 0.5, buckle as plates with hinged edges at (b/a + a/b)^2 sigma_E = 6.25
+    sigma_E = 118.63 MPa (Timoshenko and Gere; sigma_E = pi^2 E t^2/(12(1 - nu^2) b^2)
+    = 18.98 MPa). The note of EN 1993-1-5 4.4(2) sends a plate with a/b < 1 to 4.5.4:
+    sigma_cr,c = pi^2 E t^2/(12(1 - nu^2) a^2) = 4 sigma_E = 75.92 MPa (eq. (4.8)),
+    lambda_c = sqrt(355/75.92) = 2.1624, chi_c = 0.19281 (curve a), xi = 6.25/4 - 1 =
+    0.5625, lambda_p = sqrt(355/118.63) = 1.7299, rho = 0.50455, rho_c = (rho - chi_c)
+    xi (2 - xi) + chi_c = 0.44488 (by hand, 4.5.4(1)); the output gave 0.50455.
+    """
+    E, nu, t, b, a, fy = 2.1e11, 0.3, 0.001, 0.1, 0.05, 3.55e8
+    sigma_e = math.pi**2 * E * t**2 / (12.0 * (1.0 - nu**2) * b**2)
+    load = (b / a + a / b) ** 2 * sigma_e
+    section = _section(width=b, depth=b, thickness=t, length=a, ends="simply_supported")
+    out = section_design(section, DesignSpec(yield_stress=fy, partial_factor=1.1), load)
+    slenderness = math.sqrt(fy / load)
+    rho = (slenderness - 0.055 * 4.0) / slenderness**2
+    column = math.pi**2 * E * t**2 / (12.0 * (1.0 - nu**2) * a**2)
+    chi = _column_chi(math.sqrt(fy / column))
+    xi = load / column - 1.0
+    rho_c = (rho - chi) * xi * (2.0 - xi) + chi
+    assert (rho, chi, xi, rho_c) == pytest.approx((0.50455, 0.19281, 0.5625, 0.44488), abs=1e-5)
+    for face in out.faces:
+        assert face.plate_reduction_factor == pytest.approx(rho, rel=1e-12)
+        assert face.column_critical_stress_Pa == pytest.approx(column, rel=1e-12)
+        assert face.column_reduction_factor == pytest.approx(chi, rel=1e-12)
+        assert face.xi == pytest.approx(xi, rel=1e-12)
+        assert face.reduction_factor == pytest.approx(rho_c, rel=1e-12)
+        assert face.reduced_design_stress_Pa == pytest.approx(rho_c * fy / 1.1, rel=1e-12)
+    assert any("4.5.4(1)" in note for note in out.notes)
+    # Lengthened to a = b the faces are not short (a/b < 1 is the note's condition): rho,
+    # and no column fields.
+    long = section_design(_section(width=b, depth=b, thickness=t, length=b), DesignSpec(fy), load)
+    assert all(f.reduction_factor == pytest.approx(rho, rel=1e-12) for f in long.faces)
+    assert all(f.column_critical_stress_Pa is None and f.xi is None for f in long.faces)
+    # Between clamped ends the face as a column (4.5.3(1): the supports along its long
+    # edges removed) is Euler's clamped column, effective length a/2: 4 sigma_cr,c.
+    clamped = _section(width=b, depth=b, thickness=t, length=a, ends="clamped")
+    face = section_design(clamped, DesignSpec(fy), 2.0 * load).faces[0]
+    assert face.column_critical_stress_Pa == pytest.approx(4.0 * column, rel=1e-12)
+    assert face.xi == pytest.approx(2.0 * load / (4.0 * column) - 1.0, rel=1e-12)
+
+
+def test_a_rectangular_stub_s_wide_faces_get_rho_c_and_govern():
+    # The box 200 x 100 x 2 mm, L = 100 mm, simply supported: the top and bottom faces
+    # (200 mm wide) have a/b = 0.5, the webs (100 mm) a/b = 1, not short. At 100 MPa of
+    # uniform compression (f_y = 355 MPa): lambda_p = sqrt(3.55) = 1.8841, rho =
+    # (1.8841 - 0.22)/3.55 = 0.46877 on every face; the wide faces' sigma_cr,c =
+    # pi^2 E (t/a)^2/(12(1 - nu^2)) = 75.92 MPa, xi = 0.3172, chi_c = 0.19281 (curve a):
+    # rho_c = 0.34010 (4.5.4(1), by hand). One compression on every face: the smallest
+    # rho governs, the top face's.
+    E, nu, t, a, fy, load = 2.1e11, 0.3, 0.002, 0.1, 3.55e8, 1.0e8
+    section = _section(width=0.2, depth=0.1, thickness=t, length=a, ends="simply_supported")
+    out = section_design(section, DesignSpec(yield_stress=fy), load)
+    slenderness = math.sqrt(fy / load)
+    rho = (slenderness - 0.22) / slenderness**2
+    column = math.pi**2 * E * (t / a) ** 2 / (12.0 * (1.0 - nu**2))
+    chi = _column_chi(math.sqrt(fy / column))
+    xi = load / column - 1.0
+    rho_c = (rho - chi) * xi * (2.0 - xi) + chi
+    assert (rho, xi, rho_c) == pytest.approx((0.46877, 0.3172, 0.34010), abs=1e-4)
+    faces = {f.face: f for f in out.faces}
+    for name in ("top", "bottom"):
+        assert faces[name].reduction_factor == pytest.approx(rho_c, rel=1e-12)
+    for name in ("right", "left"):
+        assert faces[name].reduction_factor == pytest.approx(rho, rel=1e-12)
+    assert out.governing_face == "top" and out.tied_faces == ["top", "bottom"]
+    line = design_line(out)
+    assert f"rho_c = {rho_c:.4g} (column-type" in line
+    assert "faces top, bottom tie" in line
+
+
+def test_the_faces_of_a_square_box_in_uniform_compression_tie():
+    """Four equal faces under one stress reach rho f_y/gamma_M1 together.
+
+    The square box 200 x 200 x 2 mm at 100 MPa: every face has psi = 1 and the same
+    lambda_p = sqrt(3.55), rho = 0.46877 (eq. (4.2)); the line named the right face as
+    governing, as if it were the weakest. It says now that the four tie, and by which
+    rule one is named.
+    """
+    square, design = _section(width=0.2, depth=0.2, core=True), DesignSpec(yield_stress=3.55e8)
+    out = section_design(square, design, 1.0e8)
+    assert out.tied_faces == ["right", "top", "left", "bottom"]
+    assert out.governing_face == "right"
+    line = design_line(out)
+    assert "faces right, top, left, bottom tie" in line
+    assert "the widest, then the first" in line
+    # The line of the verified lower bound (an unproven core's) says so too.
+    at_lower_bound(out, square, design, 5.0e7)
+    assert design_line(out).count("faces right, top, left, bottom tie") == 2
+    # Under bending the bottom face governs alone (the test above): no tie.
+    alone = section_design(_section(bending_stress=2.0), DesignSpec(yield_stress=3.55e8), 4e7)
+    assert alone.tied_faces == [] and "face bottom: psi = 1" in design_line(alone)
+
+
+def test_a_core_over_part_of_the_length_does_not_make_local_buckling_negligible():
+    """EN 1994-1-1's limit is a filled section's: a hollow length is not one.
+
+    The box 200 x 100 x 5 mm in S235: h/t = 205/5 = 41 <= 52 sqrt(235/235) = 52 (Table
+    6.3), so a core over the whole length lets local buckling be neglected (6.7.1(9));
+    with the core over half the length the other half is a hollow steel section, whose
+    webs' c/t of about 41 - 3 = 38 would be checked by EN 1993-1-1 Table 5.2, not by the
+    composite limit, and the output said "local buckling may be neglected" all the same.
+    """
+    fy = 2.35e8
+    full = section_design(_section(thickness=0.005, core=True), DesignSpec(fy), 3e8)
+    assert full.width_to_thickness == pytest.approx(41.0)
+    assert full.width_to_thickness_limit == pytest.approx(52.0)
+    assert full.local_buckling_negligible is True
+    half = _section(thickness=0.005, core=True, core_span=(0.0, 0.3))
+    out = section_design(half, DesignSpec(fy), 3e8)
+    assert out.width_to_thickness == pytest.approx(41.0)
+    assert out.local_buckling_negligible is False
+    assert any("x/L = 0 to 0.5 of the length only" in note for note in out.notes)
+    assert "may be neglected" not in design_line(out)
+    assert "the core does not fill the length" in design_line(out)
+    # A span given as the whole length is the whole length.
+    whole = _section(thickness=0.005, core=True, core_span=(0.0, 0.6))
+    assert section_design(whole, DesignSpec(fy), 3e8).local_buckling_negligible is True

@@ -364,16 +364,15 @@ def _most_levels(parameters: SectionParameters) -> int:
     return most
 
 
-def check_levels(parameters: SectionParameters, levels: int, units: str = "SI") -> None:
+def check_levels(parameters: SectionParameters, levels: int) -> None:
     """Refuse ``levels`` whose coarsest section has fewer than 2 cells along the member.
 
-    The message in the unit system ``units`` (:data:`~unibuckle_fenicsx.spec.base.UNITS`),
-    the file's.
+    The message in the units of the file solved (:func:`~unibuckle_fenicsx.spec.base.file_units`).
     """
     most = _most_levels(parameters)
     if levels > most:
-        coarsest, name = in_file(parameters.mesh_size * 2.0**levels, "m", units)
-        length, _ = in_file(parameters.length, "m", units)
+        coarsest, name = in_file(parameters.mesh_size * 2.0**levels, "m")
+        length, _ = in_file(parameters.length, "m")
         raise InputError(
             f"mesh.levels = {levels}: the coarsest section's cells, mesh.size x 2^{levels} = "
             f"{coarsest:g} {name}, are not below section.length = "

@@ -84,6 +84,11 @@ EIGEN_OPTIONS: dict[str, str | float | int | bool] = {
 NEAR_MARGIN = 1e-3
 #: Krylov vectors of a shifted solve (>= 2): the wanted pair dominates after the shift.
 NEAR_NCV = 4
+#: Krylov vectors of the second try of a solve at target 0 that converged no pair (of a
+#: definite pencil): the filled tube 60 x 1 mm, L = 60 mm, clamped, 4 mm cells, has a
+#: contact set whose solve converges nothing in 500 restarts of the default subspace
+#: and converges with 32 vectors.
+WIDER_NCV = 32
 
 #: The smallest eigenpair of the whole pencil given estimates of its lowest eigenvalues
 #: (:meth:`GEPSolver.smallest`; a coarser mesh's) shifts first to ``FREE_ABOVE`` above the
@@ -340,7 +345,31 @@ class GEPSolver(Owner):
         start = initial if initial is not None and self._useful_start(initial, B) else None
         eps = self._run(A, B, start, near)
         self.solves += 1
+        if eps is self.eps and not self.indefinite and eps.getConverged() < 1:
+            return self._wider_pair(start, out)
         return self._pair(eps, out)
+
+    def _wider_pair(self, initial: PETSc.Vec | None, out: PETSc.Vec | None) -> EigenPair:
+        """The solve at target 0 once more, with :data:`WIDER_NCV` Krylov vectors.
+
+        A cluster of loads near the smallest (a tube's, with a contact set holding most of
+        its wall) can keep the default subspace from converging within ``eps_max_it``
+        restarts; a wider one separates them. Raises as :meth:`_pair` if it fails too.
+        Collective.
+        """
+        eps = self.eps
+        nev, ncv, mpd = eps.getDimensions()
+        wider = max(ncv, WIDER_NCV)
+        logger.debug("%s: no pair converged; again with ncv = %d", self.prefix, wider)
+        eps.setDimensions(nev, wider, wider)
+        try:
+            if initial is not None:
+                eps.setInitialSpace([initial])
+            eps.solve()
+            self.solves += 1
+            return self._pair(eps, out)
+        finally:
+            eps.setDimensions(nev, ncv, mpd)
 
     def _run(
         self, A: PETSc.Mat, B: PETSc.Mat, initial: PETSc.Vec | None, near: float | None

@@ -151,3 +151,36 @@ def test_an_option_for_the_first_solve_leaves_the_recovery_alike_both_ways(tmp_p
     command_line_load = json.loads(out.read_text())["critical_load_Pa"]
     assert python_load == pytest.approx(expected, rel=1e-8)
     assert command_line_load == pytest.approx(expected, rel=1e-8)
+
+
+@serial
+def test_a_failed_solve_of_a_definite_pencil_tries_a_wider_subspace(tmp_path):
+    """Uniform compression (B semi-definite), Krylov-Schur cut to 3 vectors, 1 restart.
+
+    The solve at target 0 converges no pair; the second try with WIDER_NCV vectors finds
+    LAPACK's smallest load (``scipy.linalg.eigh`` on the dense pencil: 7.427138e8 Pa,
+    the next 8.35e8) to 1e-8. Before, the failed solve raised EigenSolveError, as a
+    filled tube 60 x 1 mm, L = 60 mm, clamped, on 4 mm cells stopped its run (exit 3)
+    at a contact set whose solve converged nothing in 500 restarts.
+    """
+    path = tmp_path / "uniform.toml"
+    text = STEEP_TOML.replace("[-1.0, 9.0]", "-1.0").replace("nx = 30", "nx = 12")
+    path.write_text(text.replace("ny = 10", "ny = 4"))
+    with build_problem(load_toml(path), MPI.COMM_SELF) as problem:
+        A, B = dense(problem.model.A), dense(problem.model.B)
+        theta = scipy.linalg.eigh(B, A, eigvals_only=True)
+        gep = GEPSolver(
+            problem.model.A,
+            problem.model.B,
+            prefix="test_wider_",
+            options={**EIGEN_OPTIONS, "eps_ncv": 3},
+        )
+        try:
+            gep.eps.setTolerances(max_it=1)
+            pair = gep.solve()
+            assert gep.solves == 2  # the failed solve and the wider one
+            assert gep.eps.getDimensions()[1] == 3  # the solver's own subspace after it
+        finally:
+            gep.destroy()
+    assert pair.value == pytest.approx(1.0 / theta[-1], rel=1e-8)
+    assert 1.0 / theta[-1] == pytest.approx(7.427138e8, rel=1e-6)

@@ -48,7 +48,7 @@ from unibuckle_fenicsx.model.shell.problem import (
     section_problem,
 )
 from unibuckle_fenicsx.spec import Material, SectionProblemSpec, SolverSpec
-from unibuckle_fenicsx.spec.base import in_file
+from unibuckle_fenicsx.spec.base import file_units, in_file
 
 __all__ = [
     "GEOMETRIC",
@@ -247,14 +247,14 @@ class SectionParameters:
         return float(self.diameter or 0.0)
 
 
-def check_cells_along(size: float, length: float, units: str = "SI") -> None:
+def check_cells_along(size: float, length: float) -> None:
     """Refuse a cell size ``size`` not below ``length`` (m): 2 cells along at least.
 
-    The message in the unit system ``units`` (:data:`~unibuckle_fenicsx.spec.base.UNITS`),
-    the file's.
+    The message in the units of the file read or solved
+    (:func:`~unibuckle_fenicsx.spec.base.file_units`).
     """
     if size * (1.0 + 1e-9) >= length:  # geometry's cells along: ceil(L/h)
-        (h, name), (L, _) = in_file(size, "m", units), in_file(length, "m", units)
+        (h, name), (L, _) = in_file(size, "m"), in_file(length, "m")
         raise InputError(
             f"mesh.size = {h:g} {name} must be below section.length = {L:g} {name}: the "
             "section needs at least 2 cells along its length (the nodes of its loaded ends "
@@ -269,7 +269,8 @@ def section_parameters(spec: SectionProblemSpec) -> SectionParameters:
         InputError: A cell size not below the length (in the file's units).
     """
     s, core = spec.section, spec.obstacle
-    check_cells_along(spec.mesh.size, s.length, spec.units)
+    with file_units(spec.units):
+        check_cells_along(spec.mesh.size, s.length)
     return SectionParameters(
         s.shape, thickness=s.thickness, length=s.length, E=spec.material.E,
         nu=spec.material.nu, mesh_size=spec.mesh.size, width=s.width, depth=s.depth,
