@@ -60,6 +60,7 @@ from unibuckle_fenicsx.en1993 import (
     interpolated_reduction_factor,
     psi_range,
     reduction_factor,
+    steel_poisson_note,
     stress_ratio,
     table_row,
 )
@@ -210,6 +211,9 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
         clauses=clauses(element, at_free),
         notes=[CALIBRATION],
     )
+    poisson = steel_poisson_note(spec.material.nu)
+    if poisson is not None:
+        out.notes.append(poisson)
     if spec.plate.holes:
         out.notes.append(
             "the plate has holes (plate.holes): 4.4 describes a plate without openings; "

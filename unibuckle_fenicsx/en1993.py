@@ -41,6 +41,7 @@ __all__ = [
     "INTERNAL",
     "OUTSTAND",
     "STEEL_MODULUS",
+    "STEEL_POISSON",
     "STEEL_YIELD_STRESS",
     "DesignEdge",
     "DesignElement",
@@ -56,6 +57,7 @@ __all__ = [
     "interpolated_reduction_factor",
     "psi_range",
     "reduction_factor",
+    "steel_poisson_note",
     "stress_ratio",
     "table_row",
 ]
@@ -133,6 +135,28 @@ def check_steel_yield_stress(fy: float, stress: float, name: str) -> None:
         "yield stress (EN 1993-1-1 Table 3.1 and EN 1993-1-12: 235 to 700 MPa, stainless "
         "steel from 200 MPa; accepted: {low:.6g} to {high:.6g} {name}); give it in the "
         "file's unit, {name}",
+    )
+
+
+#: Poisson's ratios taken as a steel's by the design output without a warning: EN
+#: 1993-1-1 3.2.6 and EN 1993-1-4 2.2 give nu = 0.3, with a margin for the 0.28-0.29
+#: some texts give. Another nu is warned of, not refused: sigma_cr is then the plate's
+#: with that nu, which EN 1993-1-5's rho (calibrated on steel) does not describe.
+STEEL_POISSON = (0.25, 0.35)
+
+
+def steel_poisson_note(nu: float) -> str | None:
+    """A warning when the design output is asked of a ``nu`` not a steel's, else None.
+
+    :data:`STEEL_POISSON`; the message names ``material.nu``.
+    """
+    low, high = STEEL_POISSON
+    if low <= nu <= high:
+        return None
+    return (
+        f"design: material.nu = {nu:.6g} is not a steel's (EN 1993-1-1 3.2.6: nu = 0.3; "
+        f"no warning in [{low:g}, {high:g}]): sigma_cr is computed with it, and EN 1993-1-5's "
+        "rho rests on steel plates; check material.nu"
     )
 
 

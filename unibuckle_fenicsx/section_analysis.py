@@ -48,7 +48,11 @@ from unibuckle_fenicsx.algorithms.registry import entry
 from unibuckle_fenicsx.algorithms.section_levels import check_levels
 from unibuckle_fenicsx.analysis import FREE, choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
-from unibuckle_fenicsx.en1993 import check_steel_modulus, check_steel_yield_stress
+from unibuckle_fenicsx.en1993 import (
+    check_steel_modulus,
+    check_steel_yield_stress,
+    steel_poisson_note,
+)
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode
@@ -385,7 +389,10 @@ def _check(parameters: SectionParameters, levels: int, design: DesignSpec | None
         stress = UNITS[FILE_UNITS.get()][1:]
         check_steel_modulus(parameters.E, *stress)
         check_steel_yield_stress(design.yield_stress, *stress)
-    for note in (thick_wall_note(parameters), coarse_mesh_note(parameters)):
+    notes = [thick_wall_note(parameters), coarse_mesh_note(parameters)]
+    if design is not None:
+        notes.append(steel_poisson_note(parameters.nu))
+    for note in notes:
         if note is not None:
             logger.warning("%s", note)
 

@@ -174,6 +174,25 @@ def test_stainless_steel_keeps_the_design():
     assert plate(edges, material={"E": 200000.0, "nu": 0.3}).design is not None
 
 
+@pytest.mark.parametrize(
+    ("nu", "warned"), [(-0.2, True), (0.45, True), (0.3, False), (0.28, False)]
+)
+def test_a_poisson_s_ratio_not_a_steel_s_is_noted(nu, warned):
+    """With [design], nu = -0.2 was taken without a word: steel's is 0.3 (EN 1993-1-1 3.2.6).
+
+    A note naming material.nu, not a refusal: sigma_cr is still the plate's with that nu
+    (D = E t^3/(12 (1 - nu^2))), and eq. (4.2) applies to any sigma_cr.
+    """
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    spec = plate(edges, material={"E": 210000.0, "nu": nu})
+    notes = [n for n in result(spec).design.notes if "material.nu" in n]
+    if warned:
+        assert len(notes) == 1 and f"material.nu = {nu:g} is not a steel's" in notes[0]
+        assert "EN 1993-1-1 3.2.6: nu = 0.3" in notes[0]
+    else:
+        assert notes == []
+
+
 def test_uniform_compression():
     """Uniform: psi = 1, sigma_cr = lambda_c; slenderness, rho, rho f_y / gamma_M0 by hand."""
     out = result(plate({"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}))

@@ -303,6 +303,31 @@ def test_the_warnings_of_a_file_in_mm_n_mpa_are_in_its_units(caplog):
     assert "refine mesh.size to 20 mm or less" in messages
 
 
+def test_a_section_s_design_with_a_poisson_s_ratio_not_a_steel_s_is_warned_of(caplog):
+    """[design] of a box with nu = -0.2: a warning naming material.nu, none at 0.3.
+
+    Steel's nu is 0.3 (EN 1993-1-1 3.2.6); a plate's is warned of alike.
+    """
+    from unibuckle_fenicsx import section_from_dict
+
+    def run(nu):
+        spec = section_from_dict({
+            "section": {"shape": "box", "width": 0.1, "depth": 0.1, "thickness": 0.002,
+                        "length": 0.1, "ends": "simply_supported"},
+            "material": {"E": 2.1e11, "nu": nu},
+            "mesh": {"size": 0.025, "levels": 0},
+            "design": {"yield_stress": 3.55e8},
+        })  # fmt: skip
+        caplog.clear()
+        with caplog.at_level(logging.WARNING, logger="unibuckle_fenicsx.section_analysis"):
+            with solve_section(spec, MPI.COMM_SELF):
+                pass
+        return " ".join(r.getMessage() for r in caplog.records)
+
+    assert "design: material.nu = -0.2 is not a steel's" in run(-0.2)
+    assert "material.nu" not in run(0.3)
+
+
 @pytest.mark.parametrize("foundation", [None, 1e10])
 def test_a_filled_member_near_its_euler_stress_is_warned_of_its_column(foundation):
     """The core keeps the walls off the column's mode: the result says nothing of it.

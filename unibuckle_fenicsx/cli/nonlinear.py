@@ -8,7 +8,7 @@ from pathlib import Path
 from typing import Any
 
 from unibuckle_fenicsx.cli.flags import NONLINEAR_FLAGS
-from unibuckle_fenicsx.cli.problem import spec_from_args, warn_plate_model
+from unibuckle_fenicsx.cli.problem import spec_from_args, warn_coarse_mesh, warn_plate_model
 from unibuckle_fenicsx.cli.status import print_out, report_failure
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
@@ -51,6 +51,7 @@ def nonlinear_command(args: argparse.Namespace, comm: Any) -> int:
     analysis = solve_nonlinear(spec, options, comm)
     with analysis:
         result = analysis.result
+    warn_coarse_mesh(spec, comm)
     unwritten = None
     if comm.rank == 0:
         if args.json:

@@ -28,6 +28,20 @@ def warn_plate_model(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
         print(f"unibuckle: warning: {note}", file=sys.stderr)
 
 
+def warn_design_material(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
+    """A warning on stderr when ``[design]`` is asked of a Poisson's ratio not a steel's.
+
+    A section's is warned of by the section's solve (its log's warnings).
+    """
+    from unibuckle_fenicsx.en1993 import steel_poisson_note
+
+    if isinstance(spec, SectionProblemSpec) or spec.design is None:
+        return
+    note = steel_poisson_note(spec.material.nu)
+    if note is not None and comm.rank == 0:
+        print(f"unibuckle: warning: {note}", file=sys.stderr)
+
+
 def warn_coarse_mesh(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
     """A warning on stderr, after a solve, when a plate's cells are too coarse for a buckle.
 

@@ -9,7 +9,12 @@ from typing import Any
 from msgspec.structs import replace
 
 from unibuckle_fenicsx.cli.flags import solver_changes, unused_flags
-from unibuckle_fenicsx.cli.problem import spec_from_args, warn_coarse_mesh, warn_plate_model
+from unibuckle_fenicsx.cli.problem import (
+    spec_from_args,
+    warn_coarse_mesh,
+    warn_design_material,
+    warn_plate_model,
+)
 from unibuckle_fenicsx.cli.status import print_out, report_failure
 from unibuckle_fenicsx.outcome import Outcome
 
@@ -26,6 +31,7 @@ def solve_command(args: argparse.Namespace, comm: Any) -> int:
     method = spec.solver.method  # the flag's, or the problem file's
     _warn_unused(flags, method, comm)
     warn_plate_model(spec, comm)
+    warn_design_material(spec, comm)
     analysis = analyse(spec, comm, candidate_parallel=args.candidate_parallel)
     unwritten = None
     with analysis:

@@ -30,6 +30,35 @@ def _check_chart(base: Any) -> None:
         )
 
 
+def _warn_coarse_points(base: Any, variations: Any, comm: Any) -> None:
+    """One warning on stderr, before any solve, when some plate points' cells are too coarse.
+
+    The note of the first such point (``unibuckle solve``'s warning), and how many there
+    are; a section's cells are checked by its solve (the point's JSON line).
+    """
+    import sys
+
+    from unibuckle_fenicsx.spec.checks import coarse_mesh_note
+    from unibuckle_fenicsx.spec.section import SectionProblemSpec
+    from unibuckle_fenicsx.sweep import point_problem, sweep_points
+
+    coarse = []
+    points = sweep_points(variations)
+    for k, point in enumerate(points):
+        spec = point_problem(base, point)
+        if not isinstance(spec, SectionProblemSpec):
+            note = coarse_mesh_note(spec.plate, spec.mesh, spec.units)
+            if note is not None:
+                coarse.append((k, point, note))
+    if coarse and comm.rank == 0:  # every rank checks the points (a refusal on every rank)
+        k, point, note = coarse[0]
+        print(
+            f"unibuckle: warning: {len(coarse)} of {len(points)} sweep points have cells too "
+            f"coarse; point {k} {point}: {note}",
+            file=sys.stderr,
+        )
+
+
 def sweep_command(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle sweep``: the grid, the JSON lines, the chart."""
     from unibuckle_fenicsx.sweep import base_mapping, parse_variation, run_sweep
@@ -54,6 +83,7 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
         base = load_config(args.config, base_mapping)
         if args.plot:
             _check_chart(base)
+        _warn_coarse_points(base, variations, comm)
         lines = run_sweep(
             base,
             variations,

@@ -488,6 +488,52 @@ def test_a_mesh_too_coarse_for_the_plate_gets_a_warning(tmp_path, capsys, mesh, 
         assert "fewer than 4 cells across it" in err, err
 
 
+def test_nonlinear_warns_of_a_mesh_too_coarse_as_solve_does(tmp_path, capsys):
+    """``unibuckle nonlinear`` on 8 x 2 cells of a 200 x 100 plate: solve's warning too.
+
+    Cells of 0.05 m across b = 0.1 m are 2 across the smaller side, fewer than the 4 that
+    keep the square's k within +9 % (the test above); the nonlinear command said nothing.
+    """
+    config = tmp_path / "coarse.toml"
+    config.write_text(SMALL.replace("nx = 8\nny = 4", "nx = 8\nny = 2"))
+    main(["nonlinear", "--config", str(config), "--max-load", "1.05", "-q"])
+    err = capsys.readouterr().err
+    said = "unibuckle: warning: mesh.nx = 8, mesh.ny = 2: cells up to 0.05 m, more than a quarter"
+    assert said in err, err
+
+
+def test_a_sweep_warns_once_of_its_points_too_coarse(tmp_path, capsys):
+    """A sweep over the thickness on 8 x 2 cells: one warning naming the points' count.
+
+    Every point has cells of 0.05 m across b = 0.1 m (2 across, fewer than 4): the sweep
+    said nothing, as its points' solves are silenced.
+    """
+    config = tmp_path / "coarse.toml"
+    config.write_text(SMALL.replace("nx = 8\nny = 4", "nx = 8\nny = 2"))
+    out = tmp_path / "k.jsonl"
+    args = ["sweep", "--config", str(config), "--vary", "plate.thickness=0.005:0.006:2"]
+    assert main([*args, "--json", str(out), "-q"]) == EXIT_OK
+    err = capsys.readouterr().err
+    assert err.count("unibuckle: warning:") == 1, err
+    assert "2 of 2 sweep points have cells too coarse; point 0" in err, err
+    assert "mesh.nx = 8, mesh.ny = 2: cells up to 0.05 m" in err, err
+
+
+@pytest.mark.parametrize(("nu", "warned"), [(-0.2, True), (0.3, False)])
+def test_solve_warns_of_a_design_poisson_s_ratio_not_a_steel_s(tmp_path, capsys, nu, warned):
+    """[design] with nu = -0.2 ran without a word; EN 1993-1-1 3.2.6 gives steel nu = 0.3."""
+    config = tmp_path / "nu.toml"
+    config.write_text(
+        SMALL
+        + f"[material]\nE = 2.1e11\nnu = {nu}\n[design]\nyield_stress = 3.55e8\n"
+        + "[edges.left]\nnormal_stress = -1.0\n[edges.right]\nnormal_stress = -1.0\n"
+    )
+    assert main(["solve", "--config", str(config)]) == EXIT_OK
+    err = capsys.readouterr().err
+    said = f"unibuckle: warning: design: material.nu = {nu:g} is not a steel's"
+    assert (said in err) == warned, err
+
+
 # -- files and flags named ------------------------------------------------------------------
 def test_missing_config_names_the_option(tmp_path, capsys, nothing_built):
     missing = tmp_path / "nowhere.toml"
