@@ -278,6 +278,8 @@ def test_walls_in_tension_everywhere_are_refused_before_any_mesh(
     err = capsys.readouterr().err
     assert f"load.axial_stress = {axial} with load.bending_stress = {bending}" in err
     assert "tension everywhere" in err
+    # The refusal names the file, as every other refusal of a file's key does.
+    assert f"{path}: load.axial_stress" in err
 
 
 def test_a_filled_box_in_bending_quotes_one_stress_throughout():

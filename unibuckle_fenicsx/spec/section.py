@@ -117,9 +117,29 @@ class AxialLoad(Table, frozen=True):
     bending_stress: float = 0.0
 
     def check(self) -> None:
-        """Some load."""
+        """Some load, and some fibre in compression under it."""
         if self.axial_stress == 0.0 and self.bending_stress == 0.0:
             raise self.error("axial_stress", " and load.bending_stress are 0: no load")
+        tension = tension_everywhere(self.axial_stress, self.bending_stress)
+        if tension:
+            raise self.error("axial_stress", tension)
+
+
+def tension_everywhere(axial_stress: float, bending_stress: float) -> str:
+    """Why these end stresses put every wall fibre in tension ("" when some is compressed).
+
+    The axial stress is sigma_a + sigma_b zeta, zeta from -1 to 1 over the depth: the
+    extreme fibre's compression per unit load is |sigma_b| - sigma_a. The text follows
+    ``load.axial_stress`` in a refusal.
+    """
+    if abs(bending_stress) - axial_stress > 0.0:
+        return ""
+    return (
+        f" = {axial_stress!r} with load.bending_stress = {bending_stress!r} puts the walls "
+        "in tension everywhere (the extreme fibre's compression per unit load, "
+        "|bending_stress| - axial_stress, must be > 0): no buckling under a positive load; "
+        "compression is axial_stress < 0"
+    )
 
 
 class CoreSpec(Table, frozen=True):

@@ -49,6 +49,7 @@ from unibuckle_fenicsx.model.shell.problem import (
 )
 from unibuckle_fenicsx.spec import Material, SectionProblemSpec, SolverSpec
 from unibuckle_fenicsx.spec.base import file_units, in_file
+from unibuckle_fenicsx.spec.section import tension_everywhere
 
 __all__ = [
     "GEOMETRIC",
@@ -173,13 +174,9 @@ class SectionParameters:
                 )
         if self.axial_stress == 0.0 and self.bending_stress == 0.0:
             raise InputError("load.axial_stress and load.bending_stress are both 0: no load")
-        if self.compression() <= 0.0:
-            raise InputError(
-                f"load.axial_stress = {self.axial_stress!r} with load.bending_stress = "
-                f"{self.bending_stress!r} puts the walls in tension everywhere (the extreme "
-                "fibre's compression per unit load, |bending_stress| - axial_stress, must "
-                "be > 0): no buckling under a positive load; compression is axial_stress < 0"
-            )
+        tension = tension_everywhere(self.axial_stress, self.bending_stress)
+        if tension:
+            raise InputError(f"load.axial_stress{tension}")
         if self.foundation_stiffness is not None:
             if not self.core:
                 raise InputError("obstacle.foundation_stiffness needs core = true")
