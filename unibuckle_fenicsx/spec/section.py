@@ -126,11 +126,11 @@ class AxialLoad(Table, frozen=True):
 
 
 def tension_everywhere(axial_stress: float, bending_stress: float) -> str:
-    """Why these end stresses put every wall fibre in tension ("" when some is compressed).
+    r"""Why these end stresses put every wall fibre in tension ("" when some is compressed).
 
-    The axial stress is sigma_a + sigma_b zeta, zeta from -1 to 1 over the depth: the
-    extreme fibre's compression per unit load is |sigma_b| - sigma_a. The text follows
-    ``load.axial_stress`` in a refusal.
+    The axial stress is :math:`\sigma_a + \sigma_b\zeta`, :math:`\zeta` from -1 to 1 over
+    the depth: the extreme fibre's compression per unit load is
+    :math:`|\sigma_b| - \sigma_a`. The text follows ``load.axial_stress`` in a refusal.
     """
     if abs(bending_stress) - axial_stress > 0.0:
         return ""
