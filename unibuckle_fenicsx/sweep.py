@@ -325,9 +325,9 @@ def _add(data: dict[str, object], path: str, text: str, flag: str) -> bool:
     """Add the key ``path`` that ``data`` leaves out, if a problem file may hold it.
 
     The tables on the way are made; the value is read from ``text`` as a boolean
-    (true/false), a list of numbers (``0.05,0.15``), a number, or else a string; the
-    schema then checks it. False (nothing added) if no problem file has that key, or
-    the path runs through a list entry that is not there.
+    (true/false), a list of numbers (``0.05,0.15``, or as in TOML ``[0.05, 0.15]``), a
+    number, or else a string; the schema then checks it. False (nothing added) if no
+    problem file has that key, or the path runs through a list entry that is not there.
 
     Raises:
         InputError: A list with an entry that is not a number (the message names ``flag``
@@ -356,6 +356,9 @@ def _new_value(text: str, path: str, flag: str) -> object:
     """A value for a key the file left out, read from ``text`` (see :func:`_add`)."""
     if text.lower() in ("true", "false"):
         return text.lower() == "true"
+    inner = text.strip()
+    if inner.startswith("[") and inner.endswith("]"):  # a TOML array: [0.05, 0.15]
+        return [_float(part, path, flag) for part in inner[1:-1].split(",")]
     if "," in text:
         return [_float(part, path, flag) for part in text.split(",")]
     if re.fullmatch(r"\s*[+-]?\d+\s*", text):

@@ -267,6 +267,9 @@ def test_set_adds_a_key_the_file_leaves_out():
     spec = spec_from_args(args)
     assert spec.design is not None and spec.design.yield_stress == 3.55e8
     assert spec.obstacle.span == (0.05, 0.15) and spec.mesh.levels == 0
+    # The list as a TOML file writes it is read too (it said "'[0.05' is not a number").
+    args = parser.parse_args(["solve", "--config", box, "--set", "obstacle.span=[0.05, 0.15]"])
+    assert spec_from_args(args).obstacle.span == (0.05, 0.15)
     # A key no problem file has is still refused naming the keys there.
     bad = parser.parse_args(["solve", "--config", box, "--set", "obstacle.spam=1"])
     with pytest.raises(InputError, match=r"--set obstacle\.spam: obstacle has no key 'spam'"):
