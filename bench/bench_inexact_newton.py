@@ -290,6 +290,12 @@ def _apply_policy(p: Policy, kernel: Any, u: PETSc.Vec, e_u: float, wrong: bool)
     return None
 
 
+def _scaled_residual(kernel: Any, lam: float) -> float:
+    """The Newton step's scaled residual |F_u|_inf / (lambda |Bu|_inf) (the route's e_u)."""
+    inf = PETSc.NormType.INFINITY
+    return float(kernel.Fu.norm(inf)) / (lam * float(kernel.Bu.norm(inf)))
+
+
 def _instrument(fine_dofs: int, policies: list[Policy], cap: int, steps: list[dict]) -> dict:
     """Wrap NewtonKernel.direction and .factor on the mesh of ``fine_dofs`` DOFs."""
     cls = kernel_module.NewtonKernel
@@ -305,9 +311,7 @@ def _instrument(fine_dofs: int, policies: list[Policy], cap: int, steps: list[di
                   plain_first: bool = True) -> Any:  # fmt: skip
         if int(self.A.getSize()[0]) != fine_dofs:
             return direction_inner(self, u, lam, nu, gap, mu_abs, plain_first)
-        e_u = float(self.Fu.norm(PETSc.NormType.INFINITY)) / (
-            lam * float(self.Bu.norm(PETSc.NormType.INFINITY))
-        )
+        e_u = _scaled_residual(self, lam)
         f0 = self.factorizations
         state["inside"] = True
         try:
@@ -378,9 +382,7 @@ def _instrument_real(fine_dofs: int, policy: Policy, cap: int, log: list[dict]) 
                   plain_first: bool = True) -> Any:  # fmt: skip
         if int(self.A.getSize()[0]) != fine_dofs:
             return direction_inner(self, u, lam, nu, gap, mu_abs, plain_first)
-        e_u = float(self.Fu.norm(PETSc.NormType.INFINITY)) / (
-            lam * float(self.Bu.norm(PETSc.NormType.INFINITY))
-        )
+        e_u = _scaled_residual(self, lam)
         ref: Reference | None = st["ref"]
         guarded = policy.guard and e_u <= 1e-2
         if ref is not None and st["ok"] and not st["exact"] and not guarded:

@@ -58,6 +58,7 @@ from unibuckle_fenicsx.en1993 import (
     column_reduction_factor,
     design_element,
     interpolated_reduction_factor,
+    plate_euler_stress,
     psi_range,
     reduction_factor,
     steel_poisson_note,
@@ -365,8 +366,8 @@ def euler_stress(spec: ProblemSpec, loaded: tuple[str, str], *, along: bool = Fa
     """
     plate, material = spec.plate, spec.material
     across = (loaded == ("left", "right")) != along
-    ratio = plate.thickness / (plate.width if across else plate.length)
-    return math.pi**2 * material.E * ratio**2 / (12.0 * (1.0 - material.nu**2))
+    length = plate.width if across else plate.length
+    return plate_euler_stress(material.E, material.nu, plate.thickness, length)
 
 
 #: Said when the critical load is not proven the lowest.

@@ -33,6 +33,8 @@ from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
+import numpy as np
+
 from unibuckle_fenicsx.errors import InputError
 
 __all__ = [
@@ -55,6 +57,7 @@ __all__ = [
     "column_reduction_factor",
     "design_element",
     "interpolated_reduction_factor",
+    "plate_euler_stress",
     "psi_range",
     "reduction_factor",
     "steel_poisson_note",
@@ -121,8 +124,8 @@ STEEL_YIELD_STRESS = (1.5e8, 1.0e9)
 def check_steel_yield_stress(fy: float, stress: float, name: str) -> None:
     """Refuse a yield stress ``fy`` (Pa) that is not a steel's (:data:`STEEL_YIELD_STRESS`).
 
-    The slenderness sqrt(f_y/sigma_cr) and rho f_y/gamma_M0 take f_y as it is: 355 in an
-    SI file (355 Pa) gave rho = 1 and 355 Pa for a plate whose rho is 0.42. ``stress``
+    The slenderness sqrt(f_y/sigma_cr) and rho f_y/gamma_M0 take f_y as it is: a number
+    in another unit (355 in an SI file: 355 Pa) would give rho = 1 on any plate. ``stress``
     and ``name`` are the file's stress unit in Pa and its name, for the message; raises
     :class:`~unibuckle_fenicsx.errors.InputError` naming ``design.yield_stress``.
     """
@@ -245,6 +248,16 @@ def column_reduction_factor(slenderness: float, alpha: float = COLUMN_IMPERFECTI
     return min(1.0, 1.0 / (phi + math.sqrt(phi**2 - slenderness**2)))
 
 
+def plate_euler_stress(E: float, nu: float, thickness: float, length: float) -> float:
+    r""":math:`\pi^2 E t^2/(12(1 - \nu^2) l^2)` (Pa): a plate strip of length l, bent.
+
+    With l the loaded edge's length b, the reference stress :math:`\sigma_E` of EN
+    1993-1-5 eq. (A.2); with l the length a along the stress, the hinged column's
+    :math:`\sigma_{cr,c}` of eq. (4.8) (4.5.3(2)).
+    """
+    return math.pi**2 * E * (thickness / length) ** 2 / (12.0 * (1.0 - nu**2))
+
+
 def column_end_factor(start: float, end: float) -> float:
     r""":math:`\sigma_{cr,c}` of a column with restrained ends over that of a hinged one.
 
@@ -287,7 +300,7 @@ def column_end_factor(start: float, end: float) -> float:
             [math.sin(u), math.cos(u), 1.0, 1.0],
             row(end, u, True),
         ]
-        return _det4(rows)
+        return float(np.linalg.det(rows))
 
     grid = [math.pi * (1.0 + k / 400.0) for k in range(-2, 403)]
     values = [det(u) for u in grid]
@@ -300,25 +313,11 @@ def column_end_factor(start: float, end: float) -> float:
     raise AssertionError("no column buckling load between the hinged and the clamped one")
 
 
-def _det4(m: list[list[float]]) -> float:
-    """The determinant of a 4 x 4 matrix (Laplace expansion along the first row)."""
-
-    def det3(a: list[list[float]]) -> float:
-        return (
-            a[0][0] * (a[1][1] * a[2][2] - a[1][2] * a[2][1])
-            - a[0][1] * (a[1][0] * a[2][2] - a[1][2] * a[2][0])
-            + a[0][2] * (a[1][0] * a[2][1] - a[1][1] * a[2][0])
-        )
-
-    total = 0.0
-    for j in range(4):
-        minor = [[r[k] for k in range(4) if k != j] for r in m[1:]]
-        total += (-1.0) ** j * m[0][j] * det3(minor)
-    return total
-
-
 def _bisect(f: Callable[[float], float], a: float, b: float, fa: float) -> float:
-    """A root of f in [a, b] (f(a) = fa and f(b) of opposite signs), to round-off."""
+    """A root of f in [a, b] (f(a) = fa and f(b) of opposite signs), to round-off.
+
+    Hand-written: SciPy's ``brentq`` would do, but SciPy is no dependency of the package.
+    """
     for _ in range(200):
         mid = 0.5 * (a + b)
         fm = f(mid)

@@ -51,6 +51,7 @@ from unibuckle_fenicsx.en1993 import (
     column_end_factor,
     column_reduction_factor,
     interpolated_reduction_factor,
+    plate_euler_stress,
     psi_range,
     reduction_factor,
     stress_ratio,
@@ -71,9 +72,10 @@ __all__ = [
 FACE_CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of each face as an "
     "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma; "
-    "4.5.3(2), 4.5.4(1): column-type buckling of a face shorter than its width, rho_c; "
     "4.6(1): rho f_y/gamma_M0"
 )
+#: Added where a face is shorter than its width (as a plate's record, only where applied).
+COLUMN_CLAUSES = "4.5.3(1), 4.5.4(1): column-type buckling of a face shorter than its width, rho_c"
 #: The clause of a tube's slenderness.
 TUBE_CLAUSES = (
     "relative slenderness sqrt(f_y/sigma_cr) only: a circular wall is a shell (EN 1993-1-6, "
@@ -239,9 +241,8 @@ def _face(
     # section's ends as they are held, eq. (4.8) hinged, 4 times it clamped.
     if section.length < face_width(section, name):  # a/b < 1
         kappa = math.inf if section.ends == "clamped" else 0.0
-        ratio = section.thickness / section.length
-        column = column_end_factor(kappa, kappa) * (
-            math.pi**2 * section.E * ratio**2 / (12.0 * (1.0 - section.nu**2))
+        column = column_end_factor(kappa, kappa) * plate_euler_stress(
+            section.E, section.nu, section.thickness, section.length
         )
         chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
         out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
@@ -295,6 +296,7 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             out.faces.append(_face(section, name, (load * a, load * b), design))
         column = [f for f in out.faces if f.reduction_factor != f.plate_reduction_factor]
         if column:
+            out.clauses.append(COLUMN_CLAUSES)
             out.notes.append(
                 "column-type buckling (EN 1993-1-5 4.4(2) note, 4.5.4(1)): the section's "
                 "length is below the width of face(s) "

@@ -309,11 +309,13 @@ def test_a_stub_shorter_than_its_faces_gets_rho_c():
         assert face.reduction_factor == pytest.approx(rho_c, rel=1e-12)
         assert face.reduced_design_stress_Pa == pytest.approx(rho_c * fy / 1.1, rel=1e-12)
     assert any("4.5.4(1)" in note for note in out.notes)
+    assert any("4.5.4(1)" in clause for clause in out.clauses)
     # Lengthened to a = b the faces are not short (a/b < 1 is the note's condition): rho,
     # and no column fields.
     long = section_design(_section(width=b, depth=b, thickness=t, length=b), DesignSpec(fy), load)
     assert all(f.reduction_factor == pytest.approx(rho, rel=1e-12) for f in long.faces)
     assert all(f.column_critical_stress_Pa is None and f.xi is None for f in long.faces)
+    assert not any("4.5.4" in clause for clause in long.clauses)
     # Between clamped ends the face as a column (4.5.3(1): the supports along its long
     # edges removed) is Euler's clamped column, effective length a/2: 4 sigma_cr,c.
     clamped = _section(width=b, depth=b, thickness=t, length=a, ends="clamped")

@@ -114,8 +114,8 @@ INTERIOR_POINT_DOFS = 10_000
 #: the predicted contact set is read too (``read_predicted``): where a wall lies almost
 #: flat on the core its gaps stay above the tolerance, and only the predicted set holds
 #: them (:doc:`/verification/sections_finest`). The release of the nodes that pull at a
-#: read (``release_steps``) was measured on plates only (:doc:`/verification/fine_level_release`):
-#: off here.
+#: read (``release_steps``, :doc:`/verification/fine_level_release`) is off here: on
+#: sections it saved next to nothing (:doc:`/verification/sections_full_cost`).
 CHAIN_OPTIONS = ChainOptions(arrangements=1, read_predicted=True, release_steps=0)
 #: The interior point starts on a section at least this coarse: the cell size doubled
 #: while the coarser section keeps this many DOFs (more if ``levels`` asks). The

@@ -21,11 +21,8 @@ def warn_plate_model(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
     """
     from unibuckle_fenicsx.spec.checks import plate_model_note
 
-    if isinstance(spec, SectionProblemSpec):
-        return
-    note = plate_model_note(spec.plate, spec.units)
-    if note is not None and comm.rank == 0:
-        print(f"unibuckle: warning: {note}", file=sys.stderr)
+    if not isinstance(spec, SectionProblemSpec):
+        _warn(plate_model_note(spec.plate, spec.units), comm)
 
 
 def warn_design_material(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
@@ -35,11 +32,8 @@ def warn_design_material(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> N
     """
     from unibuckle_fenicsx.en1993 import steel_poisson_note
 
-    if isinstance(spec, SectionProblemSpec) or spec.design is None:
-        return
-    note = steel_poisson_note(spec.material.nu)
-    if note is not None and comm.rank == 0:
-        print(f"unibuckle: warning: {note}", file=sys.stderr)
+    if not isinstance(spec, SectionProblemSpec) and spec.design is not None:
+        _warn(steel_poisson_note(spec.material.nu), comm)
 
 
 def warn_coarse_mesh(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
@@ -49,9 +43,12 @@ def warn_coarse_mesh(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
     """
     from unibuckle_fenicsx.spec.checks import coarse_mesh_note
 
-    if isinstance(spec, SectionProblemSpec):
-        return
-    note = coarse_mesh_note(spec.plate, spec.mesh, spec.units)
+    if not isinstance(spec, SectionProblemSpec):
+        _warn(coarse_mesh_note(spec.plate, spec.mesh, spec.units), comm)
+
+
+def _warn(note: str | None, comm: Any) -> None:
+    """Print ``note``, if any, as a warning on stderr from rank 0."""
     if note is not None and comm.rank == 0:
         print(f"unibuckle: warning: {note}", file=sys.stderr)
 

@@ -85,9 +85,9 @@ NEAR_MARGIN = 1e-3
 #: Krylov vectors of a shifted solve (>= 2): the wanted pair dominates after the shift.
 NEAR_NCV = 4
 #: Krylov vectors of the second try of a solve at target 0 that converged no pair (of a
-#: definite pencil): the filled tube 60 x 1 mm, L = 60 mm, clamped, 4 mm cells, has a
-#: contact set whose solve converges nothing in 500 restarts of the default subspace
-#: and converges with 32 vectors.
+#: definite pencil, :meth:`GEPSolver._wider_pair`): a cluster of loads near the smallest
+#: can keep the default subspace from converging, a wider one separates them (a filled
+#: tube's case: docs/history/2026-11-30c-sections.md).
 WIDER_NCV = 32
 
 #: The smallest eigenpair of the whole pencil given estimates of its lowest eigenvalues

@@ -51,9 +51,9 @@ def plate_model_note(plate: PlateSpec, units: str = "SI") -> str | None:
 
 
 #: Fewer cells than this across the plate's smaller side b (cells larger than b/4) draw a
-#: warning: a buckle between supported edges has a half-wave of about b, and the simply
-#: supported square's k is 4.37 on 4 x 4 cells, 4.70 on 3 x 3 and 5.95 on 2 x 2 (+9 %,
-#: +18 %, +49 % from 4.0).
+#: warning: a buckle between supported edges has a half-wave of about b, and on fewer
+#: cells across it the element's load is several per cent too high (the square's k by
+#: cells across: docs/history/2026-11-30c-plates.md).
 MIN_CELLS_ACROSS = 4
 
 
