@@ -54,6 +54,11 @@ COLUMNS = (
     "kkt", "certificate", "setup_s", "rotation_s", "free_s", "unilateral_s", "ratio",
     "certify_s", "process_ratio", "eigensolves_fine", "eigensolves_coarse", "factorisations",
 )  # fmt: skip
+#: The columns of a link of the finest section (``--links``).
+LINK_COLUMNS = (
+    "link", "seed", "status", "steps", "factorizations", "eigensolves", "contact_nodes",
+    "load", "kkt",
+)  # fmt: skip
 #: The columns of a level's row (coarsest first).
 LEVEL_COLUMNS = (
     "mesh_size", "dofs", "constrained", "seeded", "steps", "eigensolves", "factorisations",
@@ -107,6 +112,20 @@ def _timed_by_rows(owner: object, name: str, seconds: dict[int, float], rows) ->
     setattr(owner, name, timed)
 
 
+def _fine_links(details: object) -> list[dict]:
+    """The interior point's links on the finest section (its route's, or before a fallback)."""
+    import msgspec
+
+    from unibuckle_fenicsx.algorithms.records import InteriorPointDetails, SectionLevelsDetails
+
+    levels = []
+    if isinstance(details, InteriorPointDetails):
+        levels = details.levels
+    elif isinstance(details, SectionLevelsDetails) and details.interior_point_levels:
+        levels = details.interior_point_levels
+    return [msgspec.to_builtins(link) for link in levels[-1].links] if levels else []
+
+
 def run(
     shape: str,
     size: float,
@@ -116,6 +135,7 @@ def run(
     route: str,
     geometric: str = "full",
     release_steps: int | None = None,
+    chain: dict | None = None,
 ) -> dict:
     """One section: set-up, free solve, unilateral solve, certificate.
 
@@ -126,6 +146,8 @@ def run(
     :func:`section_parameters`. ``release_steps``: the section route's
     :attr:`~unibuckle_fenicsx.algorithms.chain.ChainOptions.release_steps` for this run
     (None: the package's :data:`~unibuckle_fenicsx.algorithms.section_levels.CHAIN_OPTIONS`).
+    ``chain``: other fields of those options for this run (``--escape-either``,
+    ``--quick-descent``, ``--max-steps``), by name.
     """
     from mpi4py import MPI
     from petsc4py import PETSc
@@ -153,10 +175,12 @@ def run(
         return out
 
     section_levels._level = counted
+    overrides = dict(chain or {})
     if release_steps is not None:
-        section_levels.CHAIN_OPTIONS = dataclasses.replace(
-            section_levels.CHAIN_OPTIONS, release_steps=release_steps
-        )
+        overrides["release_steps"] = release_steps
+    options = section_levels.CHAIN_OPTIONS = dataclasses.replace(
+        section_levels.CHAIN_OPTIONS, **overrides
+    )
     # Seconds per section (keyed by its rows): its builds, its shared LDL^T's factorisations.
     build_s: dict[int, float] = {}
     factor_s: dict[int, float] = {}
@@ -213,7 +237,8 @@ def run(
             for entry, count in zip(levels_log, per_level, strict=True):
                 entry["factorisations"] = count
             coarse = details.coarse_eigensolves
-        elif isinstance(details, InteriorPointDetails):
+        fine_links = _fine_links(details)
+        if isinstance(details, InteriorPointDetails):
             sizes = [size * 2.0**k for k in range(len(details.levels) - 1, -1, -1)]
             levels_log = [
                 {
@@ -275,7 +300,11 @@ def run(
             "levels": levels_log,
             "corner_cell": corner_cell,
             "geometric": geometric,
-            "release_steps": section_levels.CHAIN_OPTIONS.release_steps,
+            "release_steps": options.release_steps,
+            "escape_either": options.escape_either,
+            "quick_descent": options.quick_descent,
+            "max_steps": options.max_steps,
+            "fine_links": fine_links,
         }
 
 
@@ -300,12 +329,42 @@ def main() -> None:
         "--release-steps", type=int, default=None,
         help="the interior point's release_steps on the sections (default: the package's)",
     )  # fmt: skip
+    parser.add_argument(
+        "--escape-either", action=argparse.BooleanOptionalAction, default=None,
+        help="escape a saddle along either set read (default: the package's)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--quick-descent", action=argparse.BooleanOptionalAction, default=None,
+        help="the feasible descent after the first try's polish (default: the package's)",
+    )  # fmt: skip
+    parser.add_argument(
+        "--max-steps", type=int, default=None,
+        help="Newton steps per run on the sections (default: the package's)",
+    )  # fmt: skip
+    parser.add_argument("--links", action="store_true", help="print the finest section's links too")
+    parser.add_argument(
+        "--progress", action="store_true", help="the route's progress lines on stderr"
+    )
     parser.add_argument("--json", default=None)
     args = parser.parse_args()
+    if args.progress:
+        import logging
+
+        logging.basicConfig(format="%(asctime)s %(message)s", level=logging.WARNING)
+        logging.getLogger("unibuckle_fenicsx.progress").setLevel(logging.INFO)
     route = "active-set" if args.route == "levels" else args.route
+    chain = {
+        name: value
+        for name, value in (
+            ("escape_either", args.escape_either),
+            ("quick_descent", args.quick_descent),
+            ("max_steps", args.max_steps),
+        )
+        if value is not None
+    }
     row = run(
         args.shape, args.size, args.levels, args.repeat, args.corner_cell, route,
-        args.geometric, args.release_steps,
+        args.geometric, args.release_steps, chain,
     )  # fmt: skip
     print_header("Sections with a core (one rank)", COLUMNS)
     cells = []
@@ -322,6 +381,16 @@ def main() -> None:
         )
     print(f"per level (steps / factorisations / eigen solves): {row['per_level']}")
     print(f"core load {row['core_load_Pa']!r} Pa", flush=True)
+    if args.links:
+        print()
+        print_header("The finest section's links", LINK_COLUMNS)
+        for link in row["fine_links"]:
+            cells = [link.get(c, "") for c in LINK_COLUMNS]
+            print(
+                "| "
+                + " | ".join(f"{v:.10g}" if isinstance(v, float) else str(v) for v in cells)
+                + " |"
+            )
     append_rows(args.json, [row])
 
 

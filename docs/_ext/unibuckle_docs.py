@@ -270,8 +270,11 @@ def _listed(rows: list[dict[str, Any]], key: str) -> str:
     return ",".join(dict.fromkeys(str(r[key]) for r in rows))
 
 
-def _plates_commands(rows: list[dict[str, Any]]) -> str:
-    """The ``bench_plates.py`` runs that wrote the rows: one per mesh, with its flags."""
+def _plates_commands(rows: list[dict[str, Any]], name: str = "plates") -> str:
+    """The ``bench_plates.py`` runs that wrote the rows: one per mesh, with its flags.
+
+    ``name``: the results file's.
+    """
     commands = []
     for mesh in dict.fromkeys(str(r["mesh"]) for r in rows):
         group = [r for r in rows if str(r["mesh"]) == mesh]
@@ -283,7 +286,7 @@ def _plates_commands(rows: list[dict[str, Any]]) -> str:
         flags += f" --repeat {repeat}" if repeat > 1 else ""
         commands.append(
             f"python bench/bench_plates.py --meshes {mesh} --cases {_listed(group, 'case')}"
-            f"{flags} --json bench/results/plates.jsonl"
+            f"{flags} --json bench/results/{name}.jsonl"
         )
     return "`, then `".join(commands)
 
@@ -356,13 +359,16 @@ def _orderings_commands(rows: list[dict[str, Any]]) -> str:
 def _sections_commands(rows: list[dict[str, Any]], name: str = "sections") -> str:
     """The ``bench_sections.py`` runs that wrote the rows: one per section, size and levels.
 
-    With a row's ``geometric`` and ``release_steps`` where it has them (``name``: the
-    results file's).
+    With a row's ``geometric`` and ``release_steps`` where it has them, and the chain's
+    settings it turned on (``escape_either``, ``quick_descent``; ``name``: the results
+    file's).
     """
 
     def flags(r: dict[str, Any]) -> str:
         out = f" --geometric {r['geometric']}" if "geometric" in r else ""
-        return out + (f" --release-steps {r['release_steps']}" if "release_steps" in r else "")
+        out += f" --release-steps {r['release_steps']}" if "release_steps" in r else ""
+        out += " --escape-either" if r.get("escape_either") else ""
+        return out + (" --quick-descent" if r.get("quick_descent") else "")
 
     return "`, then `".join(
         f"python bench/bench_sections.py --shape {r['shape']} --size {r['size_m']:g} "
@@ -394,6 +400,10 @@ COMMANDS = {
     "bracket_compare": lambda rows: _compare_commands(rows),
     "sections": lambda rows: _sections_commands(rows),
     "sections_full": lambda rows: _sections_commands(rows, "sections_full"),
+    "sections_first_carry": lambda rows: _sections_commands(rows, "sections_first_carry"),
+    "sections_first_carry_plates": lambda rows: _plates_commands(
+        rows, "sections_first_carry_plates"
+    ),
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"
@@ -492,6 +502,13 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         *SECTIONS_COLUMNS[:4],
         ("geometric", "geometric"),
         ("release_steps", "release_steps"),
+        *SECTIONS_COLUMNS[4:],
+    ],
+    "sections_first_carry": [
+        *SECTIONS_COLUMNS[:4],
+        ("escape_either", "escape_either"),
+        ("quick_descent", "quick_descent"),
+        ("versions", "versions of the levers"),
         *SECTIONS_COLUMNS[4:],
     ],
     "bracket": [
@@ -668,6 +685,8 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("memory_MB", "memory (MB)"),
     ],
 }
+#: The plates measured beside the filled sections, as the plates' file shows them.
+BENCH_COLUMNS["sections_first_carry_plates"] = BENCH_COLUMNS["plates"]
 #: Long texts shown as numbered notes under the table (the cell holds the note's
 #: number and the text up to its first colon).
 BENCH_NOTES = {"plates": "certificate"}

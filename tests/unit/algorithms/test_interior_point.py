@@ -23,7 +23,9 @@ r"""The nested interior-point Newton method (README, "The fast route on thin pla
   load of the mesh read at the end, in fewer Newton steps, and a set predicted at two
   steps in a row the load of the set read where the barrier problem is solved; where
   the gaps' set at a barrier point is no KKT point, ``read_predicted`` reads the
-  predicted set there, the KKT point the gaps give at a smaller parameter.
+  predicted set there, the KKT point the gaps give at a smaller parameter; with
+  ``quick_descent`` the first try's short polish that ends short of a KKT point goes on
+  by the feasible descent to one (dense numpy's KKT check, LAPACK's load).
 - Near a saddle of the barrier problem, the direction of most negative curvature read
   off the regularised factorisation is that of a dense reference (the Schur complement
   onto the DOFs with geometric stiffness, on the tangent space), and the step along it
@@ -35,6 +37,7 @@ from __future__ import annotations
 
 import json
 from dataclasses import replace
+from types import SimpleNamespace
 
 from mpi4py import MPI
 from petsc4py import PETSc
@@ -62,6 +65,7 @@ from unibuckle_fenicsx.algorithms.interior_point.explore import second_free_mode
 from unibuckle_fenicsx.algorithms.interior_point.links import (
     MeshLevel,
     Reader,
+    _saddle,
     critical_state,
     read_contact,
     released,
@@ -75,6 +79,7 @@ from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.results.records import jsonable
 from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.spec.cases import paper_case, plate_case
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference is serial")
 PARALLEL = MPI_SCRIPTS / "interior_point_parallel.py"
@@ -717,6 +722,74 @@ def test_a_state_read_off_the_gaps_short_of_kkt_reads_the_predicted_set_too(thin
     assert links[1].seed == "test (predicted)"
     _, default_links = states[False]
     assert "interior-point" in [link.link for link in default_links]  # ran on
+
+
+def test_the_saddle_escaped_is_the_kept_read_first():
+    """:func:`~.links._saddle`: the first read that crosses the obstacle below the point.
+
+    ``critical_state`` passes the read it kept first (then, with ``escape_either``, the
+    other): a kept saddle is escaped even where the other lies lower; a kept read that
+    is admissible, or crosses at or above the point's load (to rounding), leaves the
+    other's. Hand-made reads (load, admissible) at a point of load 100.
+    """
+    point = SimpleNamespace(load=100.0)
+    read = {
+        name: SimpleNamespace(load=load, feasible=feasible)
+        for name, load, feasible in (
+            ("crossing low", 60.0, False),
+            ("crossing", 90.0, False),
+            ("admissible", 95.0, True),
+            ("crossing above", 101.0, False),
+            ("crossing at", 100.0 * (1.0 - 0.1 * ROUNDING_RTOL), False),
+        )
+    }
+    assert _saddle(point, [read["crossing"], read["crossing low"]]) is read["crossing"]
+    assert _saddle(point, [read["admissible"], read["crossing"]]) is read["crossing"]
+    assert _saddle(point, [read["crossing above"], read["crossing"]]) is read["crossing"]
+    assert _saddle(point, [read["crossing at"], read["admissible"]]) is None
+    assert _saddle(point, [read["admissible"]]) is None
+
+
+@serial
+def test_the_first_tries_short_polish_descends_with_quick_descent(thin_plate):
+    """``quick_descent``: the first try's short polish, short of a KKT point, descends.
+
+    Where that polish ends at an admissible mode short of a KKT point, the feasible
+    descent runs from it and ends at one. Thin SSSS plate, 45x15, a run from the
+    pressure deflection to the barrier problem at 1e-6; :func:`~.links.critical_state`
+    as on the fine mesh's first try (``quick``), no escape, no lower barrier, a polish
+    of 2 iterates, which ends at an admissible mode that is no KKT point (measured). By
+    default the try ends there (no state: the chain carries again); with
+    ``quick_descent`` the descent's KKT point is returned, its load at most the
+    polish's, and checked with dense numpy (KKT conditions on the assembled matrices;
+    LAPACK's load of its contact set).
+    """
+    problem = build_problem(thin_plate("ssss", nx=45, ny=15), MPI.COMM_SELF)
+    options = ChainOptions(escapes=0, last_mu_min=1.0, quick_polish_iterations=2)
+    states = {}
+    for quick_descent in (False, True):
+        with InteriorPointNewton(problem) as newton:
+            newton.kernel.forget_corrections()
+            point, _ = newton.solve(newton.starts.pressure_mode(), mu=1e-2, mu_min=1e-6)
+            level = MeshLevel([45, 15], problem.num_constrained)
+            chosen = replace(options, quick_descent=quick_descent)
+            cand, _ = critical_state(
+                problem, newton, point, level, "test", chosen, carry=False, quick=True
+            )
+            states[quick_descent] = (cand, level.links)
+    cand, links = states[False]
+    polished = links[-1]
+    assert cand is None and polished.link == "active-set polish" and not polished.kkt
+    assert polished.load is not None  # an admissible mode short of a KKT point
+    cand, links = states[True]
+    assert [link.link for link in links[-2:]] == ["active-set polish", "feasible descent"]
+    assert cand is not None and cand.kkt and cand.load <= polished.load
+    A, B = dense(problem.model.A), dense(problem.model.B)
+    x = cand.mode.x.petsc_vec.array.copy()
+    assert satisfies_kkt(problem, A, B, x, cand.load, cand.active)
+    reference = dense_reduced_load(problem, tuple(int(k) for k in cand.active))
+    assert cand.load == pytest.approx(reference, rel=_load_rounding(problem, cand))
+    problem.destroy()
 
 
 def test_result_reports_the_load_resolution(thin_plate):

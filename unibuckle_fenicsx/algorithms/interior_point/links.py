@@ -419,32 +419,70 @@ def _read_state(
     label: str,
     predicted: bool,
     double: float | None = None,
-) -> Candidate:
-    """The critical state read off ``point`` by :func:`critical_state`.
+) -> tuple[Candidate, list[Candidate]]:
+    """The critical state read off ``point`` by :func:`critical_state`, and the reads.
 
     The gaps' set (:func:`read_contact`); with ``predicted``
     (``ChainOptions.read_predicted``), where that is no KKT point, the predicted set too
     (:meth:`~.newton.InteriorPointNewton.predicted_contact_set`: one more factorisation
     and eigen solve), and the one nearer to a KKT point (:func:`_violation`) is kept.
-    ``double``: as :func:`read_contact`'s.
+    ``double``: as :func:`read_contact`'s. Returns the state kept and the states read,
+    the kept one first.
     """
     problem = newton.problem
     cand = read_contact(problem, newton, point, level, label, double=double)
     if cand.kkt or not predicted:
-        return cand
+        return cand, [cand]
     active = newton.predicted_contact_set(point)
     if np.array_equal(active, cand.active):
-        return cand
+        return cand, [cand]
     other = read_contact(
         problem, newton, point, level, f"{label} (predicted)", active, double=double
     )
-    return other if other.kkt or _violation(other) < _violation(cand) else cand
+    if other.kkt or _violation(other) < _violation(cand):
+        return other, [other, cand]
+    return cand, [cand, other]
+
+
+def _saddle(point: BarrierPoint, reads: list[Candidate]) -> Candidate | None:
+    """The first of ``reads`` that crosses the obstacle below ``point``'s load, or None."""
+    for cand in reads:
+        if not cand.feasible and cand.load < point.load * (1.0 - ROUNDING_RTOL):
+            return cand
+    return None
 
 
 def _violation(cand: Candidate) -> float:
     """How far ``cand`` is from a KKT point: its largest value, or largest force on Z."""
     largest = float(cand.values.max()) if cand.values.size else -math.inf
     return max(largest, cand.max_force)
+
+
+def _polish_descend(
+    problem: UnilateralProblem,
+    cand: Candidate,
+    level: MeshLevel,
+    label: str,
+    options: ChainOptions,
+    quick: bool,
+) -> Candidate | None:
+    """The polish of ``cand``'s set, and where it ends short of a KKT point the descent.
+
+    The descent runs from the polish's admissible mode; on the ``quick`` try only with
+    ``quick_descent``, and from the lowest admissible mode met on the mesh.
+    """
+    budget = options.quick_polish_iterations if quick else options.polish_iterations
+    polished = polish(problem, cand, level, label, budget)
+    if polished is not None and polished.kkt:
+        return polished
+    if not quick:
+        if polished is not None and polished.feasible:
+            polished = descend_from(problem, polished, level, label, options.descent_steps)
+        return polished
+    start = level.best_admissible  # the polish's, or a read's
+    if options.quick_descent and start is not None:
+        return descend_from(problem, start, level, label, options.descent_steps)
+    return polished
 
 
 def critical_state(
@@ -468,19 +506,19 @@ def critical_state(
     read double eigenvalues (:func:`double_read`; on the fine mesh).
     """
     push = options.double_push if double else None
-    cand = _read_state(newton, point, level, label, options.read_predicted, push)
+    cand, reads = _read_state(newton, point, level, label, options.read_predicted, push)
     if cand.kkt:
         return cand, point
     for attempt in range(options.escapes):
-        saddle = not cand.feasible and cand.load < point.load * (1.0 - ROUNDING_RTOL)
-        if not (saddle and newton.escape(point, cand.mode.x.petsc_vec)):
+        saddle = _saddle(point, reads if options.escape_either else [cand])
+        if saddle is None or not newton.escape(point, saddle.mode.x.petsc_vec):
             break
         tag = f"{label} (escape {attempt + 1})"
         point, _ = run_from(
             newton, point, level, tag, options, keep_push=False,
             mu=max(point.mu, options.escape_mu), mu_min=max(point.mu, options.fine_mu_min),
         )  # fmt: skip
-        cand = _read_state(newton, point, level, tag, options.read_predicted, push)
+        cand, reads = _read_state(newton, point, level, tag, options.read_predicted, push)
         if cand.kkt:
             return cand, point
     if point.mu > options.last_mu_min:
@@ -492,14 +530,11 @@ def critical_state(
         )  # fmt: skip
         if reader is not None and reader.found is not None:
             return reader.found, point
-        cand = _read_state(newton, point, level, tag, options.read_predicted, push)
+        cand, _ = _read_state(newton, point, level, tag, options.read_predicted, push)
         if cand.kkt:
             return cand, point
     if math.isfinite(cand.load):
-        budget = options.quick_polish_iterations if quick else options.polish_iterations
-        polished = polish(problem, cand, level, label, budget)
-        if polished is not None and polished.feasible and not polished.kkt and not quick:
-            polished = descend_from(problem, polished, level, label, options.descent_steps)
+        polished = _polish_descend(problem, cand, level, label, options, quick)
         if polished is not None and polished.kkt and not carry:
             return polished, point
         if polished is not None and polished.kkt:

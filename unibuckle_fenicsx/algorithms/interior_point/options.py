@@ -270,6 +270,9 @@ class ChainOptions:
             (the least-energy correction lifts those closer to the obstacle to it).
         max_steps: Newton steps per run.
         escapes: Saddle escapes allowed per run.
+        escape_either: With ``read_predicted``, where the set kept at a barrier point
+            is no saddle's (its mode crosses no node, or lies above the point's load),
+            a saddle is escaped along the other set read, if that one's is.
         escape_mu: Barrier parameter the run restarts with after an escape (small: a
             larger one would lift the flattened buckle again).
         carry_margin: Critical states within this (relative) of the lowest on a mesh
@@ -279,6 +282,10 @@ class ChainOptions:
         quick_polish_iterations: ... on the first try of the fine mesh.
         descent_steps: Eigen solves allowed to the feasible descent after a polish that
             ends at an admissible mode short of a KKT point.
+        quick_descent: Where the short polish of the first try ends at no KKT point,
+            the feasible descent runs from the lowest admissible mode met on the mesh
+            (the polish's or a read's) with ``descent_steps`` eigen solves (else the
+            descent runs on the second try only).
         descent_budget: Eigen solves (per ``max_iterations``) of the last descent, from
             the lowest admissible mode met, when the fine mesh ended at no KKT point.
         max_iterations: Iterates per seed of the fallback active-set method.
@@ -314,12 +321,14 @@ class ChainOptions:
     clip_margin: float = 1e-6
     max_steps: int = 100
     escapes: int = 3
+    escape_either: bool = False
     escape_mu: float = 1e-10
     carry_margin: float = 2e-3
     arrangements: int = 3
     polish_iterations: int = 25
     quick_polish_iterations: int = 5
     descent_steps: int = 50
+    quick_descent: bool = False
     descent_budget: int = 1
     max_iterations: int = 100
     bound_budget: int = 64
