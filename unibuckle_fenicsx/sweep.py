@@ -350,7 +350,7 @@ def _list_text(text: str, path: str, flag: str) -> list[Any] | None:
 
     if not finite(value):
         raise InputError(f"{flag} {path}: {text.strip()!r} is not a list of finite numbers")
-    return value  # type: ignore[no-any-return]
+    return value
 
 
 @functools.cache

@@ -627,7 +627,7 @@ def test_no_admissible_mode_exits_3(method, tmp_path, capsys):
 
 
 def test_set_gives_either_form_of_a_key_that_takes_both(tmp_path):
-    """A stress, a temperature or a zone takes a number (a string) or a list, whatever the file holds.
+    """A stress, a temperature or a zone takes a number (a string) or a list, as the file may.
 
     ``edges.left.normal_stress = -1`` set to ``[-1, 0]`` said "'[-1, 0]' is not a number",
     the pair set back to ``-1`` "is a table or a list", and ``obstacle.zone = "all"``
@@ -638,7 +638,7 @@ def test_set_gives_either_form_of_a_key_that_takes_both(tmp_path):
 
     path = tmp_path / "p.toml"
     path.write_text(
-        '[plate]\ncorners = [[0.0, 0.0], [0.3, 0.1]]\nthickness = 0.002\n'
+        "[plate]\ncorners = [[0.0, 0.0], [0.3, 0.1]]\nthickness = 0.002\n"
         "[material]\nE = 2.1e11\nnu = 0.3\nthermal_expansion = 1.2e-5\n"
         "[edges.left]\nnormal_stress = -1.0\n[edges.right]\nnormal_stress = [-1.0, 0.0]\n"
         '[edges.bottom]\ninplane = "roller"\n[edges.top]\n'
