@@ -407,6 +407,12 @@ COMMANDS = {
     "orderings": lambda rows: _orderings_commands(rows),
     "plates": lambda rows: _plates_commands(rows),
     "routes": lambda rows: _routes_commands(rows),
+    "arrangements": lambda rows: "`, then `".join(
+        f"python bench/bench_arrangements.py --meshes {mesh} "
+        f"--cases {_listed([r for r in rows if r['mesh'] == mesh], 'case')} "
+        "--policy h2 --json bench/results/arrangements.jsonl"
+        for mesh in dict.fromkeys(str(r["mesh"]) for r in rows)
+    ),
     "fixed_factor": lambda rows: (
         f"python bench/bench_fixed_factor.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --repeat {rows[0]['runs']} "
@@ -543,6 +549,18 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("solves", "solves"),
         ("ratio", "certificate time (free solves)"),
         ("load_Pa", "λ_c (Pa)"),
+    ],
+    "arrangements": [
+        ("case", "plate"),
+        ("mesh", "mesh"),
+        ("policy", "route"),
+        ("ranking", "ranked lowest by (last, h2, fit)"),
+        ("per_level", "per level: steps / factorisations / eigen solves"),
+        ("load", "λ_c (Pa)"),
+        ("rel_today", "− today's (relative)"),
+        ("contact", "\\|Z\\|"),
+        ("kkt", "KKT"),
+        ("process_s", "process s (shared machine)"),
     ],
     "fixed_factor": [
         ("case", "plate"),
