@@ -27,8 +27,9 @@ t = 0.1 mm, obstacle over the whole face) and mesh, fresh processes run:
 Counts and loads are exact; the process seconds of ``solve`` (in-process: the free run
 and the route) are on a shared machine.
 
-Usage: python bench/bench_arrangements.py [--meshes 90x30,180x60] [--cases cccc,shear]
-[--policy h2] [--json FILE] [--from-json FILE]
+Usage: python bench/bench_arrangements.py [--meshes 90x30,180x60]
+[--cases ssss,cs,sc,cccc,shear] [--policy last|h2|fit] [--json FILE] [--from-json FILE];
+today's route alone on one plate: --worker CASE NX NY today [--json FILE]
 """
 
 from __future__ import annotations
@@ -134,7 +135,7 @@ def instrument(policy: str) -> dict[str, Any]:
     return st
 
 
-def worker(case: str, nx: int, ny: int, policy: str) -> None:
+def worker(case: str, nx: int, ny: int, policy: str) -> dict[str, Any]:
     """One plate in this process, the route run with ``policy``; print a JSON line."""
     logging.basicConfig(level=logging.INFO, stream=sys.stderr)  # the levels as they end
     spec = _spec(case, nx, ny)
@@ -165,6 +166,7 @@ def worker(case: str, nx: int, ny: int, policy: str) -> None:
             "process_s": seconds,
         }
     print("RESULT " + json.dumps(row), flush=True)
+    return row
 
 
 def _short(levels: list[list[Any]]) -> str:
@@ -247,7 +249,9 @@ def main() -> None:
         return
     if args.worker:
         case, nx, ny, policy = args.worker
-        worker(case, int(nx), int(ny), policy)
+        row = worker(case, int(nx), int(ny), policy)
+        if policy == "today":  # a row of its own (the main loop writes the others)
+            append_rows(args.json, [finish(row, row)])
         return
     rows = []
     for m in args.meshes.split(","):
