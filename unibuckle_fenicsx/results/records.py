@@ -425,6 +425,8 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
         )
     elif d.xi is not None:
         column = f" (column-type: xi {d.xi:.3g} >= 1, the plate's)"
+    elif d.column_critical_stress_Pa == 0.0:
+        column = " (column-type: none, the column a mechanism; the plate's)"
     return (
         f"EN 1993-1-5: sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit} ({d.edge}), "
         f"psi = {d.psi:.3g}, slenderness {d.relative_slenderness:.4g}, rho = "
