@@ -118,10 +118,21 @@ def main(argv: Sequence[str] | None = None) -> int:
         return with_broken_pipe(ending.finish(status, raised or bool(PENDING)))
 
 
+#: Seconds between the last line a failed rank writes and its ``MPI_Abort``. A rank's
+#: output reaches the terminal through the process manager (hydra's proxy reads the
+#: rank's pipe and forwards it to mpiexec); an abort kills every process at once, and
+#: what the proxy had not yet read is lost. The pause lets it read.
+ABORT_GRACE_S = 1.0
+
+
 def _abort(comm: Any, status: int, message: str | None) -> NoReturn:
     """Print ``message`` and end every rank of ``comm`` with ``status`` (``MPI_Abort``)."""
+    import time
+
     if message is not None:
         print(f"unibuckle: error: {message}", file=sys.stderr, flush=True)
+    sys.stdout.flush()
+    time.sleep(ABORT_GRACE_S)
     comm.Abort(status)
     os._exit(status)  # MPI_Abort does not return; had it, this process ends all the same
 
