@@ -21,7 +21,9 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
   \sigma_{cr}/\sigma_{cr,c} - 1` in [0, 1], with :math:`\sigma_{cr,c}` the plate's
   stress with the supports along its unloaded edges removed (4.5.3(1)): eq. (4.8),
   :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)`, between hinged loaded edges, four times that
-  between clamped ones (:func:`column_stress`); at :math:`\xi \ge 1` it is
+  between clamped ones, a quarter of it between a clamped and a free one, none (a
+  mechanism, :math:`\rho_c = \rho`) between two free ones (:func:`column_stress`); at
+  :math:`\xi \ge 1` it is
   :math:`\rho`; for :math:`a/b \ge 1` it is :math:`\rho`, the column fields are None
   and a note says why;
 
@@ -127,8 +129,10 @@ class DesignRecord(Struct, kw_only=True):
             its loaded edges, its unloaded edges' supports removed (4.5.3(1)): eq. (4.8),
             :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)` with a the plate's length along the
             stress, for hinged loaded edges, times 4 for clamped ones
-            (:func:`column_stress`). None, as ``column_reduction_factor`` and ``xi``,
-            for a/b >= 1, where the column-type check is not applied (a note says so).
+            (:func:`column_stress`); 0 when free loaded edges leave the column a
+            mechanism (``xi`` None, the reduction factor the plate's). None, as
+            ``column_reduction_factor`` and ``xi``, for a/b >= 1, where the column-type
+            check is not applied (a note says so).
         column_reduction_factor: :math:`\chi_c` at :math:`\bar\lambda_c = \sqrt{f_y/
             \sigma_{cr,c}}`, curve a (:math:`\alpha` = 0.21, 4.5.3(4), (5)).
         xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)); below 1 on a short
@@ -288,7 +292,7 @@ def _column_type(
     if element.loaded == ("bottom", "top"):
         aspect = 1.0 / aspect
     if aspect >= 1.0:
-        xi = sigma1 / column - 1.0
+        xi = sigma1 / column - 1.0 if column > 0.0 else math.inf
         out.notes.append(
             f"column-type buckling (EN 1993-1-5 4.5.4) not applied: a/b = {aspect:.3g} >= 1, "
             "and the note of 4.4(2) asks for it below 1; rho is the plate-type"
@@ -301,10 +305,17 @@ def _column_type(
             )
         )
         return rho
+    out.clauses += "; 4.5.3(1), 4.5.4(1): column-type buckling, rho_c"
+    if column == 0.0:  # the column a mechanism: xi infinite, rho_c = rho
+        out.column_critical_stress_Pa, out.column_reduction_factor = 0.0, 0.0
+        out.notes.append(
+            f"column-type buckling (EN 1993-1-5 4.5.4(1)): the plate as a column ({ends}): "
+            "sigma_cr,c = 0, xi >= 1, rho_c = rho"
+        )
+        return rho
     chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
     out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
     out.xi = sigma1 / column - 1.0
-    out.clauses += "; 4.5.3(1), 4.5.4(1): column-type buckling, rho_c"
     rho_c = interpolated_reduction_factor(rho, chi, out.xi)
     if out.xi < 1.0:
         out.notes.append(
@@ -324,34 +335,37 @@ def column_stress(spec: ProblemSpec, loaded: tuple[str, str]) -> tuple[float, st
     r"""(:math:`\sigma_{cr,c}` (Pa), its ends in words): the plate as a column (4.5.3(1)).
 
     "The buckling stress with the supports along the longitudinal edges removed": the
-    column between the ``loaded`` edges, each hinged (simply supported, hard or soft),
-    clamped or on its rotational springs (:func:`~unibuckle_fenicsx.en1993.column_end_factor`
-    times eq. (4.8)). A free loaded edge (its deflection free, or on springs) is taken
-    as hinged, eq. (4.8) itself: a smaller sigma_cr,c (a cantilever's, or none) would
-    raise rho_c, so the hinged column is the safe side of it.
+    column between the ``loaded`` edges, each as it is supported: hinged (simply
+    supported, hard or soft), clamped, on its rotational springs, or free (its deflection
+    on its translational springs, or on none)
+    (:func:`~unibuckle_fenicsx.en1993.column_end_factor` times eq. (4.8)). 0 when the
+    ends leave the column a mechanism (both loaded edges free, or one free and the other
+    hinged): no column-type buckling.
     """
     hinged = euler_stress(spec, loaded, along=True)
     named = {e.name: e for e in spec.plate.edges}
     plate, material = spec.plate, spec.material
     d = material.E * plate.thickness**3 / (12.0 * (1.0 - material.nu**2))
     length = plate.length if loaded == ("left", "right") else plate.width  # a
-    kappas, words = [], []
+    kappas, taus, words = [], [], []
     for name in loaded:
         e = named.get(name)
-        if e is None or e.support == "free":
-            return hinged, (
-                f"edges.{name} free: taken hinged, eq. (4.8), the safe side of its column's stress"
-            )
-        if e.support == "clamped":
-            kappas.append(math.inf)
-            words.append(f"{name} clamped")
-        elif e.rotational_stiffness > 0.0:
-            kappas.append(e.rotational_stiffness * length / d)
-            words.append(f"{name} on rotational springs")
+        support = "free" if e is None else e.support
+        kappa = 0.0 if e is None else e.rotational_stiffness * length / d
+        tau = 0.0 if e is None else e.translational_stiffness * length**3 / d
+        if support == "clamped":
+            kappa, tau, word = math.inf, math.inf, "clamped"
+        elif support != "free":
+            tau, word = math.inf, "on rotational springs" if kappa > 0.0 else "hinged"
         else:
-            kappas.append(0.0)
-            words.append(f"{name} hinged")
-    factor = column_end_factor(kappas[0], kappas[1])
+            springs = [w for w, v in (("rotational", kappa), ("translational", tau)) if v > 0.0]
+            word = "free" + (f" on {' and '.join(springs)} springs" if springs else "")
+        kappas.append(kappa)
+        taus.append(tau)
+        words.append(f"{name} {word}")
+    factor = column_end_factor(kappas[0], kappas[1], taus[0], taus[1])
+    if factor == 0.0:
+        return 0.0, f"{' and '.join(words)}: a mechanism, no column buckling stress"
     how = "eq. (4.8)" if factor == 1.0 else f"{factor:.4g} x eq. (4.8)"
     return factor * hinged, f"{' and '.join(words)}: {how}"
 

@@ -258,51 +258,79 @@ def plate_euler_stress(E: float, nu: float, thickness: float, length: float) -> 
     return math.pi**2 * E * (thickness / length) ** 2 / (12.0 * (1.0 - nu**2))
 
 
-def column_end_factor(start: float, end: float) -> float:
+def column_end_factor(
+    start: float,
+    end: float,
+    start_translation: float = math.inf,
+    end_translation: float = math.inf,
+) -> float:
     r""":math:`\sigma_{cr,c}` of a column with restrained ends over that of a hinged one.
 
     EN 1993-1-5 4.5.3(1) defines :math:`\sigma_{cr,c}` as the plate's buckling stress
     with the supports along its unloaded edges removed: a column (a strip in cylindrical
     bending) between the loaded edges, as these are supported. Eq. (4.8) is the hinged
-    column's; here each end is held (w = 0) with a rotational restraint
-    :math:`\kappa = k_r a/D` (0 hinged, ``math.inf`` clamped). The smallest root u in
-    :math:`[\pi, 2\pi]` of the determinant of the four end conditions on
-    :math:`w = c_1 \sin us + c_2 \cos us + c_3 s + c_4` (s = x/a; at s = 0
-    :math:`w = 0`, :math:`-w'' + \kappa w' = 0`; at s = 1 :math:`w = 0`,
-    :math:`w'' + \kappa w' = 0`) gives the factor :math:`(u/\pi)^2`: 1 hinged, 4 clamped
-    (effective length a/2), 2.046 clamped and hinged.
+    column's; here each end has a rotational restraint :math:`\kappa = k_r a/D` (0
+    hinged, ``math.inf`` clamped) and a translational one :math:`\tau = k_t a^3/D`
+    (``math.inf``, the default: held, w = 0; 0: free). With s = x/a,
+    :math:`u^2 = P a^2/D` and :math:`w = c_1 + c_2 s + c_3 (1 - \cos us)/u^2 + c_4 (us -
+    \sin us)/u^3` (a basis that stays independent as u tends to 0), the end conditions
+    of the energy (at s = 0: :math:`-w'' + \kappa w' = 0` and :math:`w''' + u^2 w' +
+    \tau w = 0`; at s = 1: :math:`w'' + \kappa w' = 0` and :math:`-w''' - u^2 w' + \tau
+    w = 0`) have a determinant whose smallest root u > 0 gives the factor
+    :math:`(u/\pi)^2`: 1 hinged, 4 clamped (effective length a/2), 2.046 clamped and
+    hinged, 1/4 clamped and free (a cantilever). 0 when the ends leave a rigid motion of
+    the column free (both free, or one free and the other hinged: a mechanism, no column
+    buckling stress).
 
     Args:
         start: :math:`\kappa` of one end, >= 0 (``math.inf``: clamped).
         end: :math:`\kappa` of the other.
+        start_translation: :math:`\tau` of the first end, >= 0 (``math.inf``: held).
+        end_translation: :math:`\tau` of the other.
     """
-    if start < 0.0 or end < 0.0:
-        raise InputError(f"column end restraints must be >= 0, got {start!r}, {end!r}")
-    if start == end == 0.0:
+    restraints = (start, end, start_translation, end_translation)
+    if min(restraints) < 0.0:
+        raise InputError(f"column end restraints must be >= 0, got {restraints!r}")
+    held = start_translation == end_translation == math.inf
+    if held and start == end == 0.0:
         return 1.0
-    if start == end == math.inf:
+    if held and start == end == math.inf:
         return 4.0
+    # The rigid motions c1 + c2 s that the restraints hold: a mechanism if one is free.
+    rigid = [
+        row
+        for row, on in (
+            ([1.0, 0.0], start_translation > 0.0),
+            ([1.0, 1.0], end_translation > 0.0),
+            ([0.0, 1.0], start > 0.0 or end > 0.0),
+        )
+        if on
+    ]
+    if not rigid or np.linalg.matrix_rank(np.array(rigid)) < 2:
+        return 0.0
 
-    def row(kappa: float, u: float, at_end: bool) -> list[float]:
-        s, c = (math.sin(u), math.cos(u)) if at_end else (0.0, 1.0)
-        slope = [u * c, -u * s, 1.0, 0.0]  # w'
-        if kappa == math.inf:
-            return slope
-        curvature = [-u * u * s, -u * u * c, 0.0, 0.0]  # w''
+    def rows(kappa: float, tau: float, u: float, at_end: bool) -> list[list[float]]:
+        s = 1.0 if at_end else 0.0
+        c, n = math.cos(u * s), math.sin(u * s)
+        w = [1.0, s, (1.0 - c) / u**2, (u * s - n) / u**3]
+        slope = [0.0, 1.0, n / u, (1.0 - c) / u**2]
+        curvature = [0.0, 0.0, c, n / u]
+        shear = [0.0, u * u, 0.0, 1.0]  # the third derivative plus u^2 times the slope
         sign = 1.0 if at_end else -1.0
-        pairs = zip(curvature, slope, strict=True)
-        return [(sign * k + kappa * v) / (1.0 + kappa) for k, v in pairs]
+        moment, force = slope, w
+        if kappa != math.inf:
+            pairs = zip(curvature, slope, strict=True)
+            moment = [(sign * k + kappa * v) / (1.0 + kappa) for k, v in pairs]
+        if tau != math.inf:
+            force = [(-sign * q + tau * v) / (1.0 + tau) for q, v in zip(shear, w, strict=True)]
+        return [moment, force]
 
     def det(u: float) -> float:
-        rows = [
-            [0.0, 1.0, 0.0, 1.0],
-            row(start, u, False),
-            [math.sin(u), math.cos(u), 1.0, 1.0],
-            row(end, u, True),
-        ]
-        return float(np.linalg.det(rows))
+        ends = rows(start, start_translation, u, False) + rows(end, end_translation, u, True)
+        return float(np.linalg.det(ends))
 
-    grid = [math.pi * (1.0 + k / 400.0) for k in range(-2, 403)]
+    grid = [2.0 * math.pi * (k / 800.0) ** 2 for k in range(1, 801)]  # fine near u = 0
+    grid += [2.0 * math.pi * (1.0 + k / 400.0) for k in (1, 2)]
     values = [det(u) for u in grid]
     for k in range(len(grid) - 1):
         (u0, u1), (f0, f1) = grid[k : k + 2], values[k : k + 2]
@@ -310,7 +338,7 @@ def column_end_factor(start: float, end: float) -> float:
             return (u0 / math.pi) ** 2
         if f0 * f1 < 0.0:
             return (_bisect(det, u0, u1, f0) / math.pi) ** 2
-    raise AssertionError("no column buckling load between the hinged and the clamped one")
+    raise AssertionError("no column buckling load up to the clamped one")
 
 
 def _bisect(f: Callable[[float], float], a: float, b: float, fa: float) -> float:

@@ -186,6 +186,7 @@ class SectionResult(BucklingResult, kw_only=True):
                 what="critical stress",
                 free="the hollow section's",
                 ratio=sigma / self.critical_load_Pa,
+                bracket=False,  # solver.bracket is a plate's option: a section refuses it
             )
             if bracket:
                 lines.append(bracket)

@@ -56,6 +56,7 @@ Note:
 
 from __future__ import annotations
 
+import contextlib
 import copy
 import functools
 import itertools
@@ -65,6 +66,7 @@ import math
 import os
 import re
 import time
+import tomllib
 from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
@@ -265,10 +267,13 @@ def set_value(data: dict[str, object], path: str, value: float, flag: str = "--v
 def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set") -> None:
     """Set the value at the dotted ``path`` of ``data`` from ``text``, read as the value there.
 
-    A number, a boolean (true/false) or a string replaces one of its kind; the shortcuts
-    of :data:`SHORTCUTS` take a number. A key that ``data`` leaves out but a problem
-    file may hold (``obstacle.span``, ``design.yield_stress``) is added, its value read
-    by its text (see :func:`_add`), and checked by the schema afterwards.
+    A number, a boolean (true/false) or a string replaces one of its kind; a list
+    (``[-1, 0]`` as TOML writes it, or ``-1,0``) replaces a number, a list or a string,
+    and a number a list, for the keys of either form (an edge stress, a temperature,
+    ``obstacle.zone``); the shortcuts of :data:`SHORTCUTS` take a number. A key that
+    ``data`` leaves out but a problem file may hold (``obstacle.span``,
+    ``design.yield_stress``) is added, its value read by its text (see :func:`_add`),
+    and checked by the schema afterwards.
 
     Raises:
         ValueError: ``path`` names nothing in ``data``, or ``text`` is not of the kind of
@@ -284,19 +289,68 @@ def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set")
             return
         raise
     current = node[index]
+    listed = None
+    if _is_number(current) or isinstance(current, list):
+        listed = _list_text(text, path, flag)
+    elif isinstance(current, str):  # a string with commas ("name = 'a,b'") stays one
+        with contextlib.suppress(InputError):
+            listed = _list_text(text, path, flag)
     if isinstance(current, bool):
         if text.lower() not in ("true", "false"):
             raise InputError(f"{flag} {path}: must be true or false, got {text!r}")
         node[index] = text.lower() == "true"
+    elif listed is not None and (_is_number(current) or isinstance(current, list | str)):
+        node[index] = listed  # a key of either form (a stress, a zone): the schema checks
     elif _is_number(current):
         set_value(data, path, _float(text, path, flag), flag)
     elif isinstance(current, str):
         node[index] = text
+    elif isinstance(current, list) and _is_number_text(text):
+        node[index] = _float(text, path, flag)  # a pair's key given one number
     else:
         raise InputError(
             f"{flag} {path}: the value there, {current!r}, is a table or a list: name one "
-            "of its entries"
+            "of its entries, or give a list as TOML writes it ([a, b])"
         )
+
+
+def _is_number_text(text: str) -> bool:
+    try:
+        float(text)
+    except ValueError:
+        return False
+    return True
+
+
+def _list_text(text: str, path: str, flag: str) -> list[Any] | None:
+    """``text`` read as a list of numbers (``[a, b]``, ``[[a, b], [c, d]]``, ``a,b``), or None.
+
+    A key that takes a number or a list (an edge stress, ``[start, end]``; a temperature,
+    ``[T0, dTdx, dTdy]``; ``obstacle.zone``, ``"all"`` or a box) takes either form
+    whatever the file holds there; the schema then checks the value against the key.
+
+    Raises:
+        InputError: A list whose entries are not finite numbers (the message names
+            ``flag`` and ``path``).
+    """
+    inner = text.strip()
+    if not (inner.startswith("[") and inner.endswith("]")):
+        if "," not in inner:
+            return None
+        inner = f"[{inner}]"
+    try:
+        value = tomllib.loads(f"v = {inner}")["v"]
+    except tomllib.TOMLDecodeError:
+        raise InputError(f"{flag} {path}: {text.strip()!r} is not a list of numbers") from None
+
+    def finite(v: object) -> bool:
+        if isinstance(v, list):
+            return all(finite(x) for x in v)
+        return _is_number(v) and math.isfinite(float(v))  # type: ignore[arg-type]
+
+    if not finite(value):
+        raise InputError(f"{flag} {path}: {text.strip()!r} is not a list of finite numbers")
+    return value
 
 
 @functools.cache

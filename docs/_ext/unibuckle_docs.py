@@ -389,6 +389,24 @@ def _compare_commands(rows: list[dict[str, Any]]) -> str:
     return "`, then `".join(commands)
 
 
+def _arrangements_commands(rows: list[dict[str, Any]]) -> Iterator[str]:
+    """The ``bench_arrangements.py`` runs that wrote the rows (today's route alone: a worker)."""
+    for mesh in dict.fromkeys(str(r["mesh"]) for r in rows):
+        group = [r for r in rows if r["mesh"] == mesh]
+        if any(r["policy"] != "today" for r in group):
+            yield (
+                f"python bench/bench_arrangements.py --meshes {mesh} --cases "
+                f"{_listed(group, 'case')} --policy h2 --json bench/results/arrangements.jsonl"
+            )
+        else:
+            nx, ny = mesh.split("x")
+            yield from (
+                f"python bench/bench_arrangements.py --worker {r['case']} {nx} {ny} today "
+                "--json bench/results/arrangements.jsonl"
+                for r in group
+            )
+
+
 COMMANDS = {
     "bracket": lambda rows: _bracket_commands(rows),
     "bracket_compare": lambda rows: _compare_commands(rows),
@@ -407,6 +425,7 @@ COMMANDS = {
     "orderings": lambda rows: _orderings_commands(rows),
     "plates": lambda rows: _plates_commands(rows),
     "routes": lambda rows: _routes_commands(rows),
+    "arrangements": lambda rows: "`, then `".join(_arrangements_commands(rows)),
     "fixed_factor": lambda rows: (
         f"python bench/bench_fixed_factor.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --repeat {rows[0]['runs']} "
@@ -543,6 +562,18 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
         ("solves", "solves"),
         ("ratio", "certificate time (free solves)"),
         ("load_Pa", "λ_c (Pa)"),
+    ],
+    "arrangements": [
+        ("case", "plate"),
+        ("mesh", "mesh"),
+        ("policy", "route"),
+        ("ranking", "ranked lowest by (last, h2, fit)"),
+        ("per_level", "per level: steps / factorisations / eigen solves"),
+        ("load", "λ_c (Pa)"),
+        ("rel_today", "− today's (relative)"),
+        ("contact", "\\|Z\\|"),
+        ("kkt", "KKT"),
+        ("process_s", "process s (shared machine)"),
     ],
     "fixed_factor": [
         ("case", "plate"),

@@ -407,6 +407,71 @@ def test_rotationally_restrained_loaded_edges_give_the_restrained_column():
     assert 1.0 < factor < 4.0
 
 
+def test_free_loaded_edges_give_the_column_their_supports():
+    """Free loaded edges: the column of 4.5.3(1) is a cantilever, on springs, or a mechanism.
+
+    The 50 x 100 x 2 mm S355 plate, unloaded edges hinged, loaded edges free (k = 1.5548
+    on 20 x 40 cells: sigma_cr = 118.04 MPa; Kirchhoff's Rayleigh-Ritz, w = X(x) sin(pi
+    y/b) with X a Legendre series of degree 20, gives 1.5820, the package 1.5817 on 40 x
+    80 cells at t/b = 0.002), took the hinged column (eq. (4.8), 303.7 MPa, above the
+    plate's own sigma_cr): xi = -0.611 clipped to 0 gave rho_c = chi_c = 0.6089 above
+    the plate's rho = 0.5035, 21 % on the unsafe side. Without its unloaded supports the
+    plate between free edges has no buckling stress (a mechanism): xi >= 1 and rho_c =
+    rho. One edge clamped: the cantilever, effective length 2a, a quarter of eq. (4.8)
+    (Timoshenko and Gere, Theory of Elastic Stability, 2.1). Free edges on translational
+    springs k_t (N/mm per mm) small enough: the column turns as a rigid bar on its end
+    springs, P = k_t a/2 per unit width (w = s - 1/2 satisfies the column's equation and
+    both end conditions), sigma_cr,c = k_t a/(2 t); a cantilever on a rotational spring
+    at its root: u tan u = k_r a/D.
+    """
+    from scipy.optimize import brentq
+
+    from unibuckle_fenicsx.design import design_output
+    from unibuckle_fenicsx.en1993 import column_end_factor
+
+    def design(left, right, sigma):
+        data = problem_to_dict(plate({"left": left, "right": right}), units="mm-N-MPa")
+        data["plate"] = {"corners": [[0, 0], [50, 100]], "thickness": 2.0}
+        data["design"] = {"yield_stress": 355.0}
+        spec = problem_from_dict(data)
+        assert spec.design is not None
+        return design_output(spec, spec.design, sigma)
+
+    def rho(sigma):  # eq. (4.2), psi = 1
+        lam = math.sqrt(355e6 / sigma)
+        return (lam - 0.22) / lam**2
+
+    hinged = math.pi**2 * 210000e6 * (2.0 / 50.0) ** 2 / (12 * (1 - 0.3**2))  # eq. (4.8)
+    free = {"normal_stress": -1.0, "support": "free"}
+    d = design(free, free, 118.04e6)
+    assert d.column_critical_stress_Pa == 0.0 and d.xi is None
+    assert d.reduction_factor == pytest.approx(rho(118.04e6), rel=1e-12)
+    assert d.reduction_factor == pytest.approx(0.5035, abs=1e-4)
+    # Clamped and free: the cantilever, at a load where xi < 1.
+    d = design({"normal_stress": -1.0, "support": "clamped"}, free, 100e6)
+    column = hinged / 4
+    lam_c = math.sqrt(355e6 / column)
+    phi = 0.5 * (1 + 0.21 * (lam_c - 0.2) + lam_c**2)  # EN 1993-1-1 6.3.1.2, curve a
+    chi = 1 / (phi + math.sqrt(phi**2 - lam_c**2))
+    xi = 100e6 / column - 1
+    assert d.column_critical_stress_Pa == pytest.approx(column, rel=1e-12)
+    assert d.reduction_factor == pytest.approx((rho(100e6) - chi) * xi * (2 - xi) + chi)
+    # Free edges on translational springs: the rigid bar on its springs.
+    d_plate = 210000.0 * 2.0**3 / (12 * (1 - 0.3**2))  # N mm
+    k_t = d_plate / 50.0**3  # N/mm^2: k_t a^3/D = 1
+    sprung = {**free, "translational_stiffness": k_t}
+    d = design(sprung, sprung, 100e6)
+    assert d.column_critical_stress_Pa == pytest.approx(k_t * 50.0 / (2 * 2.0) * 1e6, rel=1e-9)
+    # The factor itself: hinged, clamped and free, mechanisms, the sprung cantilever.
+    assert column_end_factor(math.inf, 0.0, math.inf, 0.0) == pytest.approx(0.25, rel=1e-12)
+    assert column_end_factor(0.0, 0.0, 0.0, 0.0) == 0.0
+    assert column_end_factor(0.0, 0.0, math.inf, 0.0) == 0.0  # hinged and free
+    kappa = 2.0
+    u = brentq(lambda u: u * math.tan(u) - kappa, 1e-9, math.pi / 2 - 1e-12)
+    factor = column_end_factor(kappa, 0.0, math.inf, 0.0)
+    assert factor == pytest.approx((u / math.pi) ** 2, rel=1e-10)
+
+
 def test_stress_gradient_obstacle_shear_and_fixed_part():
     """The critical state's edge stresses give psi; notes for the obstacle and the shear."""
     edges = {

@@ -109,6 +109,34 @@ def test_sections_are_public_and_lazy():
     assert out.stdout.strip() == "False"
 
 
+def test_an_unproven_section_is_not_sent_to_the_bracket_it_refuses():
+    """The summary's bracket line names no ``--bracket``: a section refuses it.
+
+    The filled square box 100 x 100 x 1 mm, L = 0.2 m, on b/4 cells: a KKT point whose
+    lower bound is the hollow box's by interlacing, with several pencil eigenvalues below
+    the load (where a plate's line adds "--bracket may raise it"); the same file with
+    ``solver.bracket = true`` is refused, naming the key.
+    """
+    from unibuckle_fenicsx.spec import section_from_dict
+
+    data = {
+        "section": {"shape": "box", "width": 0.1, "depth": 0.1, "thickness": 0.001,
+                    "length": 0.2, "ends": "simply_supported"},
+        "material": {"E": E, "nu": NU}, "obstacle": {"core": True},
+        "mesh": {"size": 0.025, "levels": 0},
+    }  # fmt: skip
+    with solve_section(section_from_dict(data), MPI.COMM_SELF) as analysis:
+        r = analysis.result
+        cert = r.certificate
+        assert cert is not None and not cert.global_optimum_proven
+        assert cert.proven_by == "interlacing" and (cert.negative_eigenvalues or 0) >= 2
+        summary = r.summary()
+    assert "not proven: the critical stress lies between" in summary
+    assert "--bracket" not in summary
+    with pytest.raises(InputError, match=r"solver\.bracket"):
+        section_from_dict({**data, "solver": {"bracket": True}})
+
+
 def test_levels_end_no_higher_than_the_seeds_on_the_given_section():
     """The coarse-to-fine route keeps the critical state the seeds find on the given cells.
 

@@ -566,3 +566,38 @@ def test_a_section_chart_names_its_numbers():
     assert axis_label("obstacle.foundation_stiffness", {"units": "SI"}) == (
         "foundation modulus (Pa/m)"
     )
+
+
+def test_a_section_chart_draws_the_extreme_fibre_s_stress(tmp_path, monkeypatch):
+    """With bending the chart's sigma_cr is the extreme fibre's, not the load factor.
+
+    The box of ``BOX`` hollow and filled, axial_stress = -1 and bending_stress = -0.5: the
+    top face carries lambda (|sigma_b| - sigma_a) = 1.5 lambda at the load factor lambda
+    (``critical_load_Pa``), the summary's sigma_cr; the classical stress 4 pi^2 D/(t b^2)
+    (b = 0.1 m, t = 1 mm) = 75.92 MPa by hand. The chart drew lambda over it, 1.5 times low.
+    """
+    import math
+    import tomllib
+
+    from unibuckle_fenicsx.sweep import solve_point
+    from unibuckle_fenicsx.viz import charts
+
+    seen: dict[str, np.ndarray] = {}
+    save = charts._save
+
+    def keep(fig, ax, path):
+        seen.update({line.get_label(): np.asarray(line.get_ydata()) for line in ax.lines})
+        return save(fig, ax, path)
+
+    monkeypatch.setattr(charts, "_save", keep)
+    base = tomllib.loads(BOX)
+    point = {"load.bending_stress": -0.5}
+    line = {"index": 0, "point": point, **solve_point(point_problem(base, point), MPI.COMM_SELF)}
+    assert line["status"] == "ok"
+    E, nu, t, b = 2.1e11, 0.3, 0.001, 0.1
+    classical = 4 * math.pi**2 * E * t**3 / (12 * (1 - nu**2)) / (t * b**2)
+    charts.plot_sweep(
+        [line], [parse_variation("load.bending_stress=-0.5")], base, tmp_path / "c.png"
+    )
+    assert seen["hollow"][0] == pytest.approx(1.5 * line["free_load_Pa"] / classical, rel=1e-5)
+    assert seen["core"][0] == pytest.approx(1.5 * line["critical_load_Pa"] / classical, rel=1e-5)

@@ -311,6 +311,7 @@ class BucklingResult(Struct, kw_only=True):
         what: str = "critical load",
         free: str = "the free plate's",
         ratio: float = 1.0,
+        bracket: bool = True,
     ) -> str:
         """Where the critical load lies when it is not proven: the verified bracket.
 
@@ -318,7 +319,8 @@ class BucklingResult(Struct, kw_only=True):
         it; the verified lower bound is the safe value (the free plate's load when nothing
         closer was verified; ``--bracket`` may raise it). Empty when proven. ``what``,
         ``free`` and ``ratio`` (the printed stress per unit load): a section's words and
-        its extreme fibre's stress.
+        its extreme fibre's stress; ``bracket``: whether the problem takes ``--bracket``
+        (a section refuses it: no hint of it).
         """
         cert = self.certificate
         if not self.constrained_nodes or cert is None or cert.global_optimum_proven:
@@ -332,7 +334,7 @@ class BucklingResult(Struct, kw_only=True):
         # Two or more pencil eigenvalues below: only the low-rank bracket may do better.
         m = cert.negative_eigenvalues
         hint = ""
-        if by == "interlacing" and m is not None and m >= 2:
+        if bracket and by == "interlacing" and m is not None and m >= 2:
             tried = self._input_table("solver").get("bracket")
             hint = "; --bracket verified no higher bound" if tried else "; --bracket may raise it"
         return (
@@ -423,6 +425,8 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
         )
     elif d.xi is not None:
         column = f" (column-type: xi {d.xi:.3g} >= 1, the plate's)"
+    elif d.column_critical_stress_Pa == 0.0:
+        column = " (column-type: none, the column a mechanism; the plate's)"
     return (
         f"EN 1993-1-5: sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit} ({d.edge}), "
         f"psi = {d.psi:.3g}, slenderness {d.relative_slenderness:.4g}, rho = "

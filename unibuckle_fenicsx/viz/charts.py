@@ -310,8 +310,10 @@ def plot_sweep(
     its critical stress over its classical stress instead: the reference being each line's
     ``classical_stress_Pa`` (a box: its widest face as a long simply supported plate,
     k = 4; a tube: :math:`E t/(R\sqrt{3(1-\nu^2)})`), so that 1 is what the design codes'
-    elastic values assume; the hollow section (``free_load_Pa``) solid, with its core
-    (``critical_load_Pa``) dashed and marked by its certificate.
+    elastic values assume; the stress the extreme fibre's, as the summary's sigma_cr (the
+    load factor times the compression per unit load, ``compression_Pa``); the hollow
+    section (``free_load_Pa``) solid, with its core (``critical_load_Pa``) dashed and
+    marked by its certificate.
     """
     if is_section(base):
         return _plot_section_sweep(lines, variations, base, path, title)
@@ -360,6 +362,19 @@ def plot_sweep(
     return _save(fig, ax, path)
 
 
+def _fibre_per_unit_load(line: Mapping[str, Any]) -> float:
+    r"""A section's extreme-fibre compression per unit load factor (its line's numbers).
+
+    ``compression_Pa`` over ``critical_load_Pa``: 1 under ``axial_stress = -1`` alone,
+    :math:`|\sigma_b| - \sigma_a` with bending; 1 for a line written before the field.
+    """
+    compression = line.get("compression_Pa")
+    load = float(line["critical_load_Pa"])
+    if compression is None or not math.isfinite(float(compression)) or load == 0.0:
+        return 1.0
+    return float(compression) / load
+
+
 def _plot_section_sweep(
     lines: Sequence[Mapping[str, Any]],
     variations: Sequence[Variation],
@@ -383,11 +398,15 @@ def _plot_section_sweep(
         solved.sort(key=lambda m: m["point"][first.path])
         x = np.array([m["point"][first.path] for m in solved])
         reference = np.array([float(m["classical_stress_Pa"]) for m in solved])
-        hollow = rounded(np.array([float(m["free_load_Pa"]) for m in solved]) / reference)
+        # The loads are factors on the stresses per unit load; the chart's stress is the
+        # extreme fibre's (the summary's sigma_cr), the factor times its compression.
+        fibre = np.array([_fibre_per_unit_load(m) for m in solved])
+        hollow = rounded(np.array([float(m["free_load_Pa"]) for m in solved]) * fibre / reference)
         ax.plot(x, hollow, "-", color=colour, lw=1.0, marker=".", label=f"hollow{suffix}")
         cored = [i for i, m in enumerate(solved) if m.get("certificate") is not None]
         if cored:
-            ratio = rounded(np.array([float(m["critical_load_Pa"]) for m in solved]) / reference)
+            loads = np.array([float(m["critical_load_Pa"]) for m in solved])
+            ratio = rounded(loads * fibre / reference)
             ax.plot(x[cored], ratio[cored], "--", color=colour, lw=1.0, label=f"core{suffix}")
             for i in cored:
                 _certificate_mark(ax, x[i], ratio[i], solved[i]["certificate"], colour)

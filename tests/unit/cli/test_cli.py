@@ -624,3 +624,45 @@ def test_no_admissible_mode_exits_3(method, tmp_path, capsys):
     err = capsys.readouterr().err
     assert "no admissible mode with a finite load" in err and "lambda_free" in err
     assert not out.exists()
+
+
+def test_set_gives_either_form_of_a_key_that_takes_both(tmp_path):
+    """A stress, a temperature or a zone takes a number (a string) or a list, as the file may.
+
+    ``edges.left.normal_stress = -1`` set to ``[-1, 0]`` said "'[-1, 0]' is not a number",
+    the pair set back to ``-1`` "is a table or a list", and ``obstacle.zone = "all"``
+    set to a box "must be "all" or [[xmin, xmax], [ymin, ymax]], got '[[0, 0.1], ...]'".
+    The values expected are those given.
+    """
+    from unibuckle_fenicsx.cli.problem import spec_from_args
+
+    path = tmp_path / "p.toml"
+    path.write_text(
+        "[plate]\ncorners = [[0.0, 0.0], [0.3, 0.1]]\nthickness = 0.002\n"
+        "[material]\nE = 2.1e11\nnu = 0.3\nthermal_expansion = 1.2e-5\n"
+        "[edges.left]\nnormal_stress = -1.0\n[edges.right]\nnormal_stress = [-1.0, 0.0]\n"
+        '[edges.bottom]\ninplane = "roller"\n[edges.top]\n'
+        "[mesh]\nnx = 6\nny = 2\n[load]\ntemperature = 0.0\n"
+        '[obstacle]\nzone = "all"\n'
+    )
+    parser, _ = build_parser()
+
+    def spec(*settings):
+        sets = [arg for s in settings for arg in ("--set", s)]
+        return spec_from_args(parser.parse_args(["solve", "--config", str(path), *sets]))
+
+    got = spec("edges.left.normal_stress=[-1, 0]", "edges.right.normal_stress=-1")
+    edges = {e.name: e for e in got.plate.edges}
+    assert edges["left"].normal_stress == (-1.0, 0.0) and edges["right"].normal_stress == -1.0
+    got = spec("edges.left.normal_stress=-1,-0.5", "edges.right.normal_stress=[-1, -0.5]")
+    assert all(e.normal_stress == (-1.0, -0.5) for e in got.plate.edges[:2])
+    assert spec("load.temperature=[1, 2, 3]").load.temperature == (1.0, 2.0, 3.0)
+    box = spec("obstacle.zone=[[0, 0.1], [0, 0.05]]").obstacle.zone
+    assert box == ((0.0, 0.1), (0.0, 0.05))
+    # A list where the key takes none is refused by the schema, naming the key.
+    with pytest.raises(InputError, match=r"plate\.thickness"):
+        spec("plate.thickness=[0.001, 0.002]")
+    with pytest.raises(InputError, match=r"--set edges\.left\.normal_stress: .*not a list"):
+        spec("edges.left.normal_stress=[-1, x]")
+    with pytest.raises(InputError, match=r"not a list of finite numbers"):
+        spec("edges.left.normal_stress=[-1, nan]")
