@@ -61,8 +61,11 @@ to 4, and each piece needs only the few columns of its own buckles.)
 :math:`u_a^Tx_b + x_a^T\rho_b` with the error bound of both products, plus
 :math:`\|K^{-1}\rho_a\|\,\|\,|\rho_b| + e_b\|` for the second-order term (one more
 batched solve; estimated, as in the other routes). On thin plates these bounds are
-about 1e-6 of G; the pieces' margins at relative distances :math:`\delta \ge 10^{-4}`
-are far larger.
+about 1e-6 of G, nearly all of it the residual's rounding; the pieces' margins at
+relative distances :math:`\delta \ge 10^{-3}` are far larger. On request
+(``SplitOptions.accurate``, with ``--bracket``) the residual is computed in twice the
+working precision (:class:`~unibuckle_fenicsx.certificate.accurate.AccurateResidual`),
+and the bounds fall to about 1e-9 of G.
 
 Hand-written (no library tests copositivity of large structured matrices); the SDPs are
 Clarabel's (the ``sdp`` extra), the dense algebra NumPy/SciPy's.
@@ -86,8 +89,8 @@ import msgspec
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.certificate.accurate import AccurateResidual, gamma
 from unibuckle_fenicsx.certificate.accurate import U as UNIT_ROUNDOFF
-from unibuckle_fenicsx.certificate.accurate import gamma
 from unibuckle_fenicsx.certificate.copositivity_lowrank import (
     LowRankOutcome,
     _check_piece,
@@ -160,6 +163,11 @@ class SplitOptions:
             interpolated linearly over it before it is split (:func:`_interpolated`): exact
             within one active set of the relaxation, so larger pieces are proven (on by
             default: fewer pieces on the plates with m >= 3).
+        accurate: The residuals K x - u of the columns in twice the working precision
+            (:class:`~unibuckle_fenicsx.certificate.accurate.AccurateResidual`, Dot2), as
+            the low-rank route's: on thin plates the double-precision residual's rounding
+            is the whole of G's error bound, and it stops the smaller distances (on by
+            request, ``--bracket``: it costs about as much as the batched solves).
     """
 
     deltas: tuple[float, ...] = (1e-3, 1e-4)
@@ -181,12 +189,17 @@ class SplitOptions:
     clip_fraction: float = 0.1
     line_extent: int = 4
     interpolate: bool = True
+    accurate: bool = False
 
     @classmethod
     def thorough(cls) -> SplitOptions:
-        """On request (``solver.bracket``): down to 1e-6, larger budgets, no cost limit."""
+        """On request (``solver.bracket``): down to 1e-6, larger budgets, no cost limit.
+
+        And the residuals in twice the working precision (``accurate``).
+        """
         return cls(deltas=(1e-3, 1e-4, 1e-5, 1e-6), fallback=(1e-2,), next_margin=None,
-                   max_columns=480, max_rounds=16, max_pieces=1000, max_cost=None)  # fmt: skip
+                   max_columns=480, max_rounds=16, max_pieces=1000, max_cost=None,
+                   accurate=True)  # fmt: skip
 
 
 @dataclass
@@ -218,12 +231,24 @@ class Basis:
 
     The first m columns are the negative-space vectors W; the others are nonnegative on
     I (oriented) and zero elsewhere. ``values`` keeps each M column's oriented values on I.
+    With ``accurate`` the residuals are computed in twice the working precision (Dot2;
+    the matrix must not change while the basis lives); the owner must :meth:`destroy` it.
     """
 
     def __init__(
-        self, problem: UnilateralProblem, matrix: ShiftedMatrix, m: int, capacity: int
+        self,
+        problem: UnilateralProblem,
+        matrix: ShiftedMatrix,
+        m: int,
+        capacity: int,
+        accurate: bool = False,
     ) -> None:
         self.problem, self.matrix, self.m = problem, matrix, m
+        self._residual: AccurateResidual | None = None
+        if accurate:
+            if matrix.K is None:
+                raise RuntimeError("Basis: the matrix is not factorised (an internal invariant)")
+            self._residual = AccurateResidual(matrix.K)
         self.comm = problem.comm
         self.n = problem.model.A.getSize()[0]
         nloc = problem.model.A.getLocalSize()[0]
@@ -273,12 +298,15 @@ class Basis:
         U, X, rho, err = (self._store[name] for name in ("U", "X", "rho", "err"))
         U[:, new] = columns[:, :k]
         X[:, new] = self.matrix.solve_block(U[:, new])
-        KX, KX_abs = self.matrix.multiply_block(X[:, new])
-        np.subtract(U[:, new], KX, out=rho[:, new])
-        rows = self.matrix.row_length + 1
-        err[:, new] = (gamma(rows) * (np.abs(U[:, new]) + KX_abs) + UNIT_ROUNDOFF
-                       * np.abs(rho[:, new])) * (1 + 2 * gamma(rows + 1))  # fmt: skip
-        del KX, KX_abs
+        if self._residual is not None:
+            rho[:, new], err[:, new] = self._accurate(U[:, new], X[:, new])
+        else:
+            KX, KX_abs = self.matrix.multiply_block(X[:, new])
+            np.subtract(U[:, new], KX, out=rho[:, new])
+            rows = self.matrix.row_length + 1
+            err[:, new] = (gamma(rows) * (np.abs(U[:, new]) + KX_abs) + UNIT_ROUNDOFF
+                           * np.abs(rho[:, new])) * (1 + 2 * gamma(rows + 1))  # fmt: skip
+            del KX, KX_abs
         D = self.matrix.solve_block(rho[:, new])
         dnorm = np.sqrt(self._sum((D * D).sum(axis=0)))
         del D
@@ -288,6 +316,26 @@ class Basis:
         if values is not None:
             self.values += values[:k]
         self._extend(k)
+
+    def _accurate(self, U: Array, X: Array) -> tuple[Array, Array]:
+        r"""(:math:`\hat\rho`, e) of columns U, solves X: :math:`|u - Kx - \hat\rho| \le e`."""
+        assert self._residual is not None
+        A = self.problem.model.A
+        ws = [A.createVecRight() for _ in range(U.shape[1])]
+        xs = [A.createVecRight() for _ in range(U.shape[1])]
+        try:
+            for j, (w, x) in enumerate(zip(ws, xs, strict=True)):
+                w.array[:], x.array[:] = U[:, j], X[:, j]
+            return self._residual(ws, xs)
+        finally:
+            for v in (*ws, *xs):
+                v.destroy()
+
+    def destroy(self) -> None:
+        """Destroy the accurate residual's scatter (if any)."""
+        if self._residual is not None:
+            self._residual.destroy()
+            self._residual = None
 
     def _extend(self, k: int) -> None:
         r"""The new k rows and columns of G and E.
@@ -1093,6 +1141,24 @@ def _attempt(
     basis, attempt.why = _first_basis(problem, matrix, lam, neg, state, opts)
     if basis is None:
         return attempt
+    try:
+        return _cover(problem, basis, candidate, patterns, state, opts, out, attempt)
+    finally:
+        basis.destroy()
+
+
+def _cover(
+    problem: UnilateralProblem,
+    basis: Basis,
+    candidate: Candidate,
+    patterns: Patterns,
+    state: _State,
+    opts: SplitOptions,
+    out: SplitOutcome,
+    attempt: SplitAttempt,
+) -> SplitAttempt:
+    """The pieces of one delta's z-space, proven, bisected or given new columns."""
+    neg = basis.m
     relax = _Relaxation.of(basis)
     # (generators, times bisected, the combinations its parent tried)
     pieces: list[tuple[Array, int, list[Array]]] = [(V, 0, []) for V in _orthants(neg)]
@@ -1198,10 +1264,11 @@ def _first_basis(
     W = _block_product(problem.model.B, psi) * np.sqrt(theta * (lam - theta))[None, :]
     items = distinct_columns(state.columns, [], opts.max_columns)
     capacity = neg + min(opts.max_columns, len(items) + opts.max_rounds * opts.per_round)
-    basis = Basis(problem, matrix, neg, capacity)
+    basis = Basis(problem, matrix, neg, capacity, opts.accurate)
     basis.add(W, [f"W{j}" for j in range(neg)])
     gneg, _, gmargin = _inertia(basis.G, basis.E, opts.margin_factor)
     if gneg != neg or gmargin <= 1.0:
+        basis.destroy()
         return None, "W'K^-1W is not verified negative definite"
     basis.add(scatter_columns(problem, items), [n for n, _ in items], [v for _, v in items])
     return basis, ""

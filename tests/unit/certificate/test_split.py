@@ -126,11 +126,14 @@ def _exact_solve(K, rhs):
 
 
 @serial
-def test_gram_error_bound_holds_exactly_on_a_thin_plate(thin_plate):
+@pytest.mark.parametrize("accurate", [False, True], ids=["double", "dot2"])
+def test_gram_error_bound_holds_exactly_on_a_thin_plate(thin_plate, accurate):
     """|G - C'K^-1C| <= E for the stored K solved exactly (Fraction), t/b = 1e-3.
 
     C = the negative space's vectors and columns on the zone; the entries of G come from
-    double-precision solves and residuals, their bounds from rounding analysis.
+    double-precision solves and residuals (``accurate``: residuals in twice the working
+    precision, as ``--bracket`` computes them), their bounds from rounding analysis. With
+    the accurate residuals the bound must also be far tighter (their point).
     """
     spec = thin_plate("thin", 6, 2)
     with build_problem(spec, MPI.COMM_SELF) as problem:
@@ -141,7 +144,7 @@ def test_gram_error_bound_holds_exactly_on_a_thin_plate(thin_plate):
         assert m >= 1 and space is not None
         psi, _, _ = space
         W = np.column_stack([problem.model.B * _vec(problem, p) for p in psi.T])
-        basis = Basis(problem, matrix, m, m + 3)
+        basis = Basis(problem, matrix, m, m + 3, accurate)
         basis.add(W, [f"W{j}" for j in range(m)])
         i = problem.num_constrained
         items = [("a", np.eye(1, i, 0)[0]), ("b", np.ones(i)), ("c", np.arange(i) % 2)]
@@ -161,6 +164,13 @@ def test_gram_error_bound_holds_exactly_on_a_thin_plate(thin_plate):
                 gap = abs(Fraction(float(basis.G[a, b])) - exact)
                 assert gap <= Fraction(float(basis.E[a, b])), (a, b, float(gap), basis.E[a, b])
                 worst = max(worst, float(gap) / basis.E[a, b])
+        if accurate:  # the same columns with double-precision residuals
+            plain = Basis(problem, matrix, m, m + 3)
+            plain.add(W, [f"W{j}" for j in range(m)])
+            plain.add(scatter_columns(problem, items), ["a", "b", "c"])
+            ratio = float(np.median(basis.E / plain.E))
+            assert ratio < 1e-2, ratio
+        basis.destroy()
         matrix.destroy()
     assert 0 < worst <= 1.0, worst
 
