@@ -85,9 +85,10 @@ NEAR_MARGIN = 1e-3
 #: Krylov vectors of a shifted solve (>= 2): the wanted pair dominates after the shift.
 NEAR_NCV = 4
 #: Krylov vectors of the second try of a solve at target 0 that converged no pair (of a
-#: definite pencil, :meth:`GEPSolver._wider_pair`): a cluster of loads near the smallest
-#: can keep the default subspace from converging, a wider one separates them (a filled
-#: tube's case: docs/history/2026-11-30c-sections.md).
+#: definite pencil, :meth:`GEPSolver._wider_pair`), at least; twice the first try's if
+#: that is more: a cluster of loads near the smallest can keep the default subspace from
+#: converging, a wider one separates them (a filled tube's case:
+#: docs/history/2026-11-30c-sections.md).
 WIDER_NCV = 32
 
 #: The smallest eigenpair of the whole pencil given estimates of its lowest eigenvalues
@@ -350,7 +351,7 @@ class GEPSolver(Owner):
         return self._pair(eps, out)
 
     def _wider_pair(self, initial: PETSc.Vec | None, out: PETSc.Vec | None) -> EigenPair:
-        """The solve at target 0 once more, with :data:`WIDER_NCV` Krylov vectors.
+        """The solve at target 0 once more, in a wider subspace (:data:`WIDER_NCV`).
 
         A cluster of loads near the smallest (a tube's, with a contact set holding most of
         its wall) can keep the default subspace from converging within ``eps_max_it``
@@ -359,7 +360,7 @@ class GEPSolver(Owner):
         """
         eps = self.eps
         nev, ncv, mpd = eps.getDimensions()
-        wider = max(ncv, WIDER_NCV)
+        wider = max(2 * ncv, WIDER_NCV)  # never the same subspace again
         logger.debug("%s: no pair converged; again with ncv = %d", self.prefix, wider)
         eps.setDimensions(nev, wider, wider)
         try:

@@ -153,6 +153,31 @@ def test_an_option_for_the_first_solve_leaves_the_recovery_alike_both_ways(tmp_p
     assert command_line_load == pytest.approx(expected, rel=1e-8)
 
 
+def _one_restart(path, ncv: int) -> tuple[float, float]:
+    """(load of the solve with ``ncv`` vectors and 1 restart, LAPACK's smallest load).
+
+    The solve must take two tries (the first converges no pair) and leave the solver's
+    own subspace as it was.
+    """
+    with build_problem(load_toml(path), MPI.COMM_SELF) as problem:
+        A, B = dense(problem.model.A), dense(problem.model.B)
+        theta = scipy.linalg.eigh(B, A, eigvals_only=True)
+        gep = GEPSolver(
+            problem.model.A,
+            problem.model.B,
+            prefix="test_wider_",
+            options={**EIGEN_OPTIONS, "eps_ncv": ncv},
+        )
+        try:
+            gep.eps.setTolerances(max_it=1)
+            pair = gep.solve()
+            assert gep.solves == 2  # the failed solve and the wider one
+            assert gep.eps.getDimensions()[1] == ncv  # the solver's own subspace after it
+        finally:
+            gep.destroy()
+    return pair.value, 1.0 / theta[-1]
+
+
 @serial
 def test_a_failed_solve_of_a_definite_pencil_tries_a_wider_subspace(tmp_path):
     """Uniform compression (B semi-definite), Krylov-Schur cut to 3 vectors, 1 restart.
@@ -166,21 +191,25 @@ def test_a_failed_solve_of_a_definite_pencil_tries_a_wider_subspace(tmp_path):
     path = tmp_path / "uniform.toml"
     text = STEEP_TOML.replace("[-1.0, 9.0]", "-1.0").replace("nx = 30", "nx = 12")
     path.write_text(text.replace("ny = 10", "ny = 4"))
-    with build_problem(load_toml(path), MPI.COMM_SELF) as problem:
-        A, B = dense(problem.model.A), dense(problem.model.B)
-        theta = scipy.linalg.eigh(B, A, eigvals_only=True)
-        gep = GEPSolver(
-            problem.model.A,
-            problem.model.B,
-            prefix="test_wider_",
-            options={**EIGEN_OPTIONS, "eps_ncv": 3},
-        )
-        try:
-            gep.eps.setTolerances(max_it=1)
-            pair = gep.solve()
-            assert gep.solves == 2  # the failed solve and the wider one
-            assert gep.eps.getDimensions()[1] == 3  # the solver's own subspace after it
-        finally:
-            gep.destroy()
-    assert pair.value == pytest.approx(1.0 / theta[-1], rel=1e-8)
-    assert 1.0 / theta[-1] == pytest.approx(7.427138e8, rel=1e-6)
+    load, lapack = _one_restart(path, 3)
+    assert load == pytest.approx(lapack, rel=1e-8)
+    assert lapack == pytest.approx(7.427138e8, rel=1e-6)
+
+
+@serial
+def test_the_second_try_is_wider_than_a_wide_first(tmp_path, monkeypatch):
+    """A first try already as wide as WIDER_NCV: the second doubles it, not repeats it.
+
+    WIDER_NCV lowered to 8 stands for a user's ``eps_ncv`` at or above it (here 16, 1
+    restart, on 30 x 10 cells: 16 vectors converge no pair, 32 do). The second try
+    used ``max(ncv, WIDER_NCV)`` = 16, the same failing solve once more, and raised
+    EigenSolveError; with twice the first try's vectors it finds LAPACK's smallest load
+    (``scipy.linalg.eigh`` on the dense pencil) to 1e-8.
+    """
+    import unibuckle_fenicsx.la.eigen as eigen
+
+    monkeypatch.setattr(eigen, "WIDER_NCV", 8)
+    path = tmp_path / "uniform.toml"
+    path.write_text(STEEP_TOML.replace("[-1.0, 9.0]", "-1.0"))
+    load, lapack = _one_restart(path, 16)
+    assert load == pytest.approx(lapack, rel=1e-8)
