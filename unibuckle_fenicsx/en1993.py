@@ -365,7 +365,9 @@ def interpolated_reduction_factor(rho: float, chi: float, xi: float) -> float:
     buckling, :math:`\xi = \sigma_{cr,p}/\sigma_{cr,c} - 1` clipped to [0, 1]: at
     :math:`\xi \ge 1` the plate-type :math:`\rho` itself.
     """
-    xi = min(1.0, max(0.0, xi))
+    if xi >= 1.0:
+        return rho  # exactly: (rho - chi) + chi may differ from it in the last bit
+    xi = max(0.0, xi)
     return (rho - chi) * xi * (2.0 - xi) + chi
 
 

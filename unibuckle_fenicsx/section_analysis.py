@@ -386,12 +386,11 @@ def _check(parameters: SectionParameters, levels: int, design: DesignSpec | None
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
     if parameters.core and parameters.foundation_stiffness is None:  # a rigid core's levels
         check_levels(parameters, int(levels))
+    notes = [thick_wall_note(parameters), coarse_mesh_note(parameters)]
     if design is not None:
         stress = UNITS[FILE_UNITS.get()][1:]
         check_steel_modulus(parameters.E, *stress)
         check_steel_yield_stress(design.yield_stress, *stress)
-    notes = [thick_wall_note(parameters), coarse_mesh_note(parameters)]
-    if design is not None:
         notes.append(steel_poisson_note(parameters.nu))
     for note in notes:
         if note is not None:

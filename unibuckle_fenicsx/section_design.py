@@ -294,7 +294,7 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         )
         for name, (a, b) in face_compressions(section).items():
             out.faces.append(_face(section, name, (load * a, load * b), design))
-        column = [f for f in out.faces if f.reduction_factor != f.plate_reduction_factor]
+        column = [f for f in out.faces if f.xi is not None and f.xi < 1.0]  # rho_c, not rho
         if column:
             out.clauses.append(COLUMN_CLAUSES)
             out.notes.append(

@@ -299,7 +299,7 @@ def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set")
         if text.lower() not in ("true", "false"):
             raise InputError(f"{flag} {path}: must be true or false, got {text!r}")
         node[index] = text.lower() == "true"
-    elif listed is not None and (_is_number(current) or isinstance(current, list | str)):
+    elif listed is not None:
         node[index] = listed  # a key of either form (a stress, a zone): the schema checks
     elif _is_number(current):
         set_value(data, path, _float(text, path, flag), flag)
