@@ -99,6 +99,10 @@ def _run(spec: Any, comm: Any, uncapped: bool) -> dict[str, Any]:
                "route": 0.0 if cert.copositivity is None
                else cert.copositivity.time_s / free_s}  # fmt: skip
         out.update(_predicted(analysis, cert.negative_eigenvalues))
+        # The default solve's own certificate and route (with the cost limit), kept apart
+        # from the uncapped bound's below.
+        out.update(default_ratio=out["ratio"], default_route=out["route"],
+                   default_status=cert.status)  # fmt: skip
         if uncapped:
             options = BoundOptions(lowrank=None, split=SplitOptions(max_cost=None))
             bound = copositivity_bound(analysis.problem, sol.candidate, sol.kkt_points, options)
@@ -143,6 +147,9 @@ def _row(name: str, mesh: str, args: Any, runs: list[dict[str, Any]]) -> dict[st
         "route_ratio": min(x["route"] for x in runs),
         "routes": [x["route"] for x in runs],
         "continued": [c.from_load for c in sol.continued],
+        "default_status": run["default_status"],
+        "default_certify_ratio": min(x["default_ratio"] for x in runs),
+        "default_route_ratio": min(x["default_route"] for x in runs),
     }
     if bound is not None:
         # The bound found without the cost limit (not the certificate's status: the
@@ -173,20 +180,31 @@ def fit(path: str) -> dict[str, float]:
     Per row, in free solves (the least of the repeats, each in one process): one
     factorisation (``factor_ratio`` over the factorisations), the right-hand sides per
     free solve (their count over ``solve_ratio``) and one piece's work (the rest of the
-    route's time over the pieces examined). Plates with m <= 3 only: with m = 4 a piece
-    costs about three times more (the SPN programs of the deeper pieces), and their
-    estimate exceeds the limit many times over by the pieces alone (their rows are
-    printed, not fitted). Per mesh the largest factorisation and piece
+    route's time over the pieces examined). Plates with m <= 3 whose route found a
+    bound only: with m = 4 a piece costs about three times more (the SPN programs of the
+    deeper pieces), and their estimate exceeds the limit many times over by the pieces
+    alone; a route that stops on an uncovered direction after a few pieces leaves the
+    Gram products of all its columns to those few (their rows are printed, not
+    fitted). Per mesh the largest factorisation and piece
     and the fewest right-hand sides (the estimate serves a rule that says "at most");
     between the smallest and the largest mesh, each unit's growth with the DOFs (a
-    two-point fit; with one mesh the model's growth is kept). Then, per plate, the
-    estimate by the model at run time, by the fitted one, and the measured cost.
+    two-point fit; with one mesh the model's growth is kept). The pieces expected per
+    attempt: the most examined per attempt by a fitted plate with m = 2, and the ratio
+    of m = 3's to it as the growth per further negative eigenvalue. Then, per plate, the
+    estimate by the model at run time, by the fitted one (one attempt, as the rule
+    prices it), the route's own counts (its attempts, right-hand sides and pieces) priced
+    by the fitted units, and the measured cost (all its attempts).
     """
-    from unibuckle_fenicsx.certificate.copositivity_split import COST_MODEL, CostCounts, price
+    from unibuckle_fenicsx.certificate.copositivity_split import (
+        COST_MODEL,
+        CostCounts,
+        price,
+        unit_costs,
+    )
 
     every = [row for row in map(json.loads, Path(path).read_text().splitlines())
              if row.get("uncapped") and row.get("factor_ratio") is not None]  # fmt: skip
-    rows = [row for row in every if row["m"] <= 3]
+    rows = [row for row in every if row["m"] <= 3 and row["lower_bound_Pa"] is not None]
     units = []
     for row in rows:
         units.append(_units(row))
@@ -203,21 +221,34 @@ def fit(path: str) -> dict[str, float]:
         if len(sizes) > 1:
             model[growth] = sign * math.log(hi / lo) / math.log(sizes[-1] / sizes[0])
         model[name] = lo / (sizes[0] / ref) ** (sign * model[growth])
+    # Pieces expected per attempt: the most examined by one attempt of a plate with m = 2
+    # (its first attempt's share: the pieces over the attempts), and the growth to m = 3.
+    per_attempt = {m: max((row["examined"] / max(row["factorisations"], 1) for row in rows
+                           if row["m"] == m), default=None) for m in (2, 3)}  # fmt: skip
+    if per_attempt[2]:
+        model["pieces"] = per_attempt[2]
+        if per_attempt[3]:
+            model["growth"] = per_attempt[3] / per_attempt[2]
     print("fitted:", {k: round(v, 4) for k, v in model.items()})
     print_header(
         f"{len(rows)} rows of {path}",
         ("case", "mesh", "m", "factorisation / free", "rhs per free solve", "piece / free",
          "factorisations", "rhs", "examined", "pieces expected", "estimate (run time)",
-         "estimate (fitted)", "measured"),
+         "estimate (fitted)", "its counts (fitted)", "measured"),
     )  # fmt: skip
     for row in every:
         u = units[rows.index(row)] if row in rows else _units(row)
         p = row["predicted"]
-        counts = CostCounts(p["attempts"], p["rhs"], p["pieces"], p["size"])
-        print(f"| {row['case']} | {row['mesh']} | {row['m']} | {u[0]:.3f} | {u[1]:.0f} | "
+        m = row["m"]
+        pieces = min(model["pieces"] * model["growth"] ** max(m - 2, 0), 400.0)
+        counts = CostCounts(1, p["rhs"], pieces, p["size"])
+        factor, per_rhs, piece = unit_costs(p["size"], model)
+        spent = (row["factorisations"] * factor + row["rhs"] * per_rhs
+                 + row["examined"] * piece)  # fmt: skip
+        print(f"| {row['case']} | {row['mesh']} | {m} | {u[0]:.3f} | {u[1]:.0f} | "
               f"{u[2]:.4f} | {row['factorisations']} | {row['rhs']} | {row['examined']} | "
-              f"{p['attempts'] * p['pieces']:g} | {row['estimated_cost']:.2f} | "
-              f"{price(counts, model):.2f} | {row['route_ratio']:.2f} |")  # fmt: skip
+              f"{pieces:g} | {row['estimated_cost']:.2f} | "
+              f"{price(counts, model):.2f} | {spent:.2f} | {row['route_ratio']:.2f} |")  # fmt: skip
     return model
 
 

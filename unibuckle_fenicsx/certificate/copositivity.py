@@ -568,11 +568,11 @@ def _split(
             f"{options.max_cost:g}: it runs on request only (solver.bracket = true, --bracket)"
         )
         notes.append(f"{m} pencil eigenvalues lie below the load: {why}")
-        skipped = SplitOutcome(m=m, why=why, estimated_cost=cost)
+        skipped = SplitOutcome(m=m, why=why, estimated_cost=cost, cost_limit=options.max_cost)
         skipped.skipped = True
         return skipped
     outcome = split_certificate(problem, matrix, candidate, others, options, sources)
-    outcome.estimated_cost = cost
+    outcome.estimated_cost, outcome.cost_limit = cost, options.max_cost
     if outcome.value is None:
         notes.append(
             f"split certificate: no verified bound (m = {outcome.m} pencil eigenvalues "

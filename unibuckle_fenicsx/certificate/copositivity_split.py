@@ -208,12 +208,14 @@ class SplitOutcome(LowRankOutcome):
 
     The low-rank route's record (value, delta, m, columns r, pieces, margin, attempts,
     why, refuting mode, right-hand sides solved), plus the estimated cost
-    (:func:`estimate_cost`, when the caller computed it) and whether the route was
-    skipped for it (``skipped``: not run by default).
+    (:func:`estimate_cost`, when the caller computed it), whether the route was
+    skipped for it (``skipped``: not run by default) and the limit it was held to
+    (``cost_limit``, ``SplitOptions.max_cost``; None: none).
     """
 
     estimated_cost: float | None = None
     skipped: bool = False
+    cost_limit: float | None = None
 
     def record(self) -> SplitRecord:
         """The route's record (without the refuting mode's vector)."""
@@ -222,6 +224,7 @@ class SplitOutcome(LowRankOutcome):
             solves=self.solves,
             estimated_cost=self.estimated_cost,
             skipped=self.skipped,
+            cost_limit=self.cost_limit,
         )
 
 
@@ -900,11 +903,13 @@ def _centre(V: Array, metric: Array) -> Array:
 #: meshes, of the largest unit, or the fewest right-hand sides, over the plates of
 #: each); below it as ^``*_small`` (the free solve's fixed work dominates: a piece's
 #: dense work costs more free solves on a coarse mesh, checked at 30x10); the pieces
-#: expected for m = 2 and their growth with each further negative eigenvalue.
+#: one attempt examines for m = 2 (the most of the plates with m = 2, with the
+#: interpolated multipliers) and their growth with each further negative eigenvalue (the
+#: plates with m = 3 over it).
 COST_MODEL = {"factorisation": 0.35, "factor_growth": 0.66, "factor_small": 0.0,
               "rhs_per_solve": 380.0, "rhs_growth": 0.47, "rhs_small": -0.3,
               "piece": 0.029, "piece_growth": 0.91, "piece_small": -1.3,
-              "pieces": 40.0, "growth": 4.0, "reference_dofs": 8463.0}  # fmt: skip
+              "pieces": 68.0, "growth": 2.41, "reference_dofs": 8463.0}  # fmt: skip
 
 
 @dataclass
@@ -924,11 +929,13 @@ class _State:
         columns: The columns met so far (name, oriented values on I).
         movable: The patterns translated on demand (name, oriented values on I).
         start: The negative space's block to restart the inverse iteration from.
+        budget: The counts spent against the cost limit (None: no limit).
     """
 
     columns: list[tuple[str, Array]]
     movable: list[tuple[str, Array]]
     start: Array | None = None
+    budget: _Budget | None = None
 
 
 def column_sources(
@@ -945,7 +952,8 @@ class CostCounts:
     """What :func:`estimate_cost` counts: attempts, right-hand sides and pieces per attempt.
 
     Attributes:
-        attempts: Factorisations (one per distance; two when ``opts.deltas`` holds two).
+        attempts: Factorisations priced: one (the first distance; a further one runs only
+            within the cost limit, :class:`_Budget`).
         rhs: Right-hand sides per attempt (the negative space's block iterations, then two
             per column).
         pieces: Pieces expected per attempt (:data:`COST_MODEL`'s ``pieces`` for m = 2,
@@ -973,39 +981,95 @@ def estimate_counts(
         opts.max_pieces
     )
     return CostCounts(
-        attempts=min(len(opts.deltas), 2),
+        attempts=1,
         rhs=(m + 3) * (opts.mode_iterations + 1) + 2 * (m + columns),
         pieces=float(opts.max_pieces) if capped else model["pieces"] * model["growth"] ** extra,
         size=float(problem.model.A.getSize()[0]) / model["reference_dofs"],
     )
 
 
-def price(counts: CostCounts, model: dict[str, float] | None = None) -> float:
-    """The time of ``counts`` in free solves by ``model`` (default :data:`COST_MODEL`)."""
+def unit_costs(size: float, model: dict[str, float] | None = None) -> tuple[float, float, float]:
+    """(one factorisation, one right-hand side, one piece) in free solves at ``size``.
+
+    ``size``: DOFs over ``model``'s ``reference_dofs`` (default :data:`COST_MODEL`).
+    """
     model = model or COST_MODEL
-    size = counts.size
     regime = "growth" if size >= 1.0 else "small"
 
     def scale(unit: str) -> float:
         return float(size ** model[f"{unit}_{regime}"])
 
-    factorisation = model["factorisation"] * scale("factor")
-    per_rhs = scale("rhs") / model["rhs_per_solve"]
-    piece = model["piece"] * scale("piece")
+    return (model["factorisation"] * scale("factor"), scale("rhs") / model["rhs_per_solve"],
+            model["piece"] * scale("piece"))  # fmt: skip
+
+
+def price(counts: CostCounts, model: dict[str, float] | None = None) -> float:
+    """The time of ``counts`` in free solves by ``model`` (default :data:`COST_MODEL`)."""
+    factorisation, per_rhs, piece = unit_costs(counts.size, model)
     return counts.attempts * (factorisation + counts.rhs * per_rhs + counts.pieces * piece)
 
 
 def estimate_cost(
     problem: UnilateralProblem, sources: Sources, m: int, opts: SplitOptions
 ) -> float:
-    """The split route's expected time in free eigen solves, from counts only (no clock).
+    """The split route's first attempt's expected time in free eigen solves, from counts.
 
-    One attempt: a factorisation, the right-hand sides (the negative space's block
-    iterations, then two per column) and the pieces, by :data:`COST_MODEL`; two attempts
-    when ``opts.deltas`` holds a second distance (tried when the first one's margins
-    allow: the estimate is meant as an upper one, the rule it serves says "at most").
+    One factorisation, the right-hand sides (the negative space's block iterations, then
+    two per column) and the pieces expected for m, by :data:`COST_MODEL` (no clock: the
+    same on every machine). A further attempt (the next distance, or the fallback) runs
+    only while the counts spent, priced the same way, and one more attempt's estimate
+    stay within ``opts.max_cost`` (:class:`_Budget`), and an attempt stops its pieces
+    when the counts spent reach it: with a limit the route's cost is the limit at most,
+    up to the units' error.
     """
     return price(estimate_counts(problem, sources, m, opts))
+
+
+@dataclass
+class _Budget:
+    """The counts the route has spent, priced in free solves, against ``limit``.
+
+    Attributes:
+        limit: ``SplitOptions.max_cost`` (None: no limit, nothing is stopped).
+        units: :func:`unit_costs` at the problem's size.
+        matrix: The shifted matrix (its ``solves`` count the right-hand sides).
+        solves0: Its count when the route began.
+        next_attempt: One more attempt's estimate (:func:`estimate_cost`, from the
+            first attempt's m).
+        examined: Pieces examined by the finished attempts.
+        stopped: Why a further attempt was not tried (empty if none was refused).
+    """
+
+    limit: float | None
+    units: tuple[float, float, float]
+    matrix: ShiftedMatrix
+    solves0: int
+    next_attempt: float | None = None
+    examined: int = 0
+    stopped: str = ""
+
+    def spent(self, attempts: int, examined: int) -> float:
+        """The counts so far in free solves (``examined``: the current attempt's pieces)."""
+        factorisation, per_rhs, piece = self.units
+        rhs = self.matrix.solves - self.solves0
+        return attempts * factorisation + rhs * per_rhs + (self.examined + examined) * piece
+
+    def over(self, attempts: int, examined: int) -> bool:
+        """The counts spent exceed the limit."""
+        return self.limit is not None and self.spent(attempts, examined) > self.limit
+
+    def refuse(self, attempts: int) -> bool:
+        """Another attempt would exceed the limit (after ``attempts``); say why."""
+        if self.limit is None or not attempts:
+            return False
+        total = self.spent(attempts, 0) + (self.next_attempt or 0.0)
+        if total <= self.limit:
+            return False
+        self.stopped = (
+            f"no further distance: the counts spent ({self.spent(attempts, 0):.1f} free "
+            f"solves) and one more attempt's estimate exceed the cost limit {self.limit:g}"
+        )
+        return True
 
 
 def split_certificate(
@@ -1040,15 +1104,27 @@ def split_certificate(
     if sources is None:
         sources = column_sources(problem, candidate, others, opts)
     patterns = sources.patterns
-    state = _State(sources.first, sources.movable)
+    size = float(problem.model.A.getSize()[0]) / COST_MODEL["reference_dofs"]
+    budget = _Budget(opts.max_cost, unit_costs(size), matrix, solves0)
+    state = _State(sources.first, sources.movable, budget=budget)
 
     def attempt(delta: float) -> SplitAttempt:
-        return _attempt(problem, matrix, candidate, delta, patterns, state, opts, out)
+        record = _attempt(problem, matrix, candidate, delta, patterns, state, opts, out)
+        budget.examined += record.examined or 0
+        record.spent = budget.spent(len(out.attempts) + 1, 0)
+        if budget.next_attempt is None and record.m:
+            budget.next_attempt = price(estimate_counts(problem, sources, record.m, opts))
+        return record
 
     def proceed(record: LowRankAttempt) -> bool:
         return opts.next_margin is None or record.margin >= opts.next_margin
 
-    search_deltas(out, candidate.load, opts.deltas, opts.fallback, attempt, proceed=proceed)
+    def stop() -> bool:
+        return out.refuting is None and budget.refuse(len(out.attempts))
+
+    search_deltas(out, candidate.load, opts.deltas, opts.fallback, attempt, stop, proceed)
+    if budget.stopped:
+        out.why = f"{out.why}; {budget.stopped}" if out.why else budget.stopped
     out.solves = matrix.solves - solves0
     return out
 
@@ -1168,6 +1244,12 @@ def _cover(
     while pieces:
         if examined >= opts.max_pieces:
             why = f"the z-space is not covered within {opts.max_pieces} pieces"
+            break
+        if state.budget is not None and state.budget.over(len(out.attempts) + 1, examined):
+            why = (
+                f"the cost limit ({opts.max_cost:g} free solves, counts priced by "
+                f"COST_MODEL) is reached after {examined} pieces"
+            )
             break
         V, level, inherited = pieces.pop()
         examined += 1

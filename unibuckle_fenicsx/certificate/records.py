@@ -222,10 +222,14 @@ class SplitAttempt(LowRankAttempt, kw_only=True):
     Attributes:
         rounds: Rounds of new columns (cuts and translates) added.
         examined: Pieces of the z-space examined (proven or bisected).
+        spent: The route's counts up to this attempt's end (factorisations, right-hand
+            sides, pieces) priced in free solves by the cost model, as its cost limit
+            counts them.
     """
 
     rounds: int = 0
     examined: int | UnsetType = UNSET
+    spent: float | UnsetType = UNSET
 
 
 class SplitRecord(LowRankRecord, kw_only=True):
@@ -237,11 +241,13 @@ class SplitRecord(LowRankRecord, kw_only=True):
         solves: Triangular solve pairs used.
         estimated_cost: Its estimated cost in free solves (None if not estimated).
         skipped: Not run: the estimated cost exceeds the default limit.
+        cost_limit: The limit in free solves it was held to (None: none, ``--bracket``).
     """
 
     solves: int = 0
     estimated_cost: float | None = None
     skipped: bool = False
+    cost_limit: float | None = None
 
 
 class SearchRecord(Struct, kw_only=True):

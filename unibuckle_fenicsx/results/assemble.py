@@ -19,6 +19,7 @@ from unibuckle_fenicsx.results.records import (
     ContactForce,
     EdgeLoad,
     ResultDetails,
+    split_route,
 )
 from unibuckle_fenicsx.spec import (
     ProblemSpec,
@@ -230,6 +231,11 @@ def certificate_record(cert: Certificate) -> CertificateRecord:
         refuting_load_Pa=None if cert.refuting_mode is None else cert.refuting_mode.load,
         copositivity=cert.copositivity,
         notes=list(cert.notes),
+        split_route=split_route(
+            cert.status,
+            cert.proven_by,
+            None if cert.copositivity is None else cert.copositivity.split,
+        ),
     )
 
 

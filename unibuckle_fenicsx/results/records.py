@@ -17,7 +17,7 @@ import numpy as np
 from msgspec import UNSET, Struct, UnsetType, to_builtins
 
 from unibuckle_fenicsx.algorithms.records import ContinuedRecord, MethodDetails
-from unibuckle_fenicsx.certificate.records import CopositivityRecord
+from unibuckle_fenicsx.certificate.records import CopositivityRecord, SplitRecord
 from unibuckle_fenicsx.design import DesignRecord
 from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
@@ -93,6 +93,10 @@ class CertificateRecord(Struct, kw_only=True):
         refuting_load_Pa: An admissible mode's lower load that refutes the returned one.
         copositivity: The copositivity certificate's record (None if it did not run).
         notes: What failed or was skipped, in words.
+        split_route: The split bracket (two or more pencil eigenvalues below the load):
+            "proven", "bracketed" or "not bracketed" when it ran, "skipped" when its
+            estimated cost exceeded the default's limit, each with the estimate
+            ("skipped: estimated cost 4.2 free solves > 3"); None when it did not apply.
     """
 
     feasible: bool
@@ -113,6 +117,7 @@ class CertificateRecord(Struct, kw_only=True):
     refuting_load_Pa: float | None
     copositivity: CopositivityRecord | None
     notes: list[str]
+    split_route: str | None = None
 
 
 class ResultDetails(Struct, kw_only=True):
@@ -482,13 +487,30 @@ def _verified(cert: CertificateRecord | None) -> str:
     refuted = cert.refuting_load_Pa
     if refuted is not None:
         return f"proven=no, refuted: an admissible mode has {refuted:.6e} Pa"
-    split = cert.copositivity.split if cert.copositivity is not None else None
-    if split is not None and split.skipped:
+    if cert.split_route is not None and cert.split_route.startswith("skipped"):
         return (
-            f"proven=no (KKT only{below}; not bracketed by default here: estimated cost "
-            f"{split.estimated_cost or 0.0:.1f} free solves, --bracket runs it)"
+            f"proven=no (KKT only{below}; not bracketed by default here: split bracket "
+            f"{cert.split_route}, --bracket runs it)"
         )
+    if cert.split_route is not None:
+        return f"proven=no (KKT only{below}; split bracket {cert.split_route})"
     return f"proven=no (KKT only{below})"
+
+
+def split_route(status: str, proven_by: str, split: SplitRecord | None) -> str | None:
+    """What the split bracket did, with its estimated cost (None if it did not apply).
+
+    ``status`` and ``proven_by``: the certificate's; ``split``: the route's record.
+    """
+    if split is None or split.estimated_cost is None:
+        return None
+    cost = f"estimated cost {split.estimated_cost:.1f} free solves"
+    if split.skipped:
+        limit = "" if split.cost_limit is None else f" > {split.cost_limit:g}"
+        return f"skipped: {cost}{limit}"
+    if proven_by == "split-spn" and status in ("proven", "bracketed"):
+        return f"{status} ({cost})"
+    return f"not bracketed ({cost})"
 
 
 def _zone_text(zone: ZoneReport) -> str:

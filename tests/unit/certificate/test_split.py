@@ -311,6 +311,7 @@ def test_route_skipped_by_default_where_it_costs_more(thin_plate):
     with solve(thin_plate("ssss", 45, 15), MPI.COMM_SELF) as analysis:
         cert = analysis.certificate
         text = analysis.result.summary()
+        record = analysis.result.certificate
     assert cert is not None and cert.kkt and cert.negative_eigenvalues >= 2
     assert cert.copositivity is not None
     split = cert.copositivity.split
@@ -318,6 +319,9 @@ def test_route_skipped_by_default_where_it_costs_more(thin_plate):
     assert split.estimated_cost is not None and split.estimated_cost > SplitOptions().max_cost
     assert cert.status == "kkt-only" and cert.refuting_mode is None
     assert "not bracketed by default here" in text and "--bracket" in text
+    estimate = f"estimated cost {split.estimated_cost:.1f} free solves"
+    assert record.split_route == f"skipped: {estimate} > 3"
+    assert record.split_route in text
 
 
 @serial
@@ -341,11 +345,13 @@ def test_thin_ssss_plate_is_bracketed_on_request(mesh, thin_plate):
 
 
 def test_cost_estimate_of_hundreds_of_negative_eigenvalues_is_the_cap():
-    """The estimate's pieces: 40 at m = 2, 4 times as many per further one, at most the cap.
+    """The estimate's pieces: COST_MODEL's at m = 2, ``growth`` times as many per further
+    one, at most the cap; one attempt priced.
 
-    COST_MODEL's rule, capped at ``max_pieces``. A filled tube (R/t = 50, L = R, 10 mm
-    cells) has m = 576 pencil eigenvalues below its load: 4**574 overflows a float, and
-    the certificate ended in an OverflowError (an internal error, no result).
+    COST_MODEL's rule (68 pieces and a growth of 2.41), capped at ``max_pieces``. A filled
+    tube (R/t = 50, L = R, 10 mm cells) has m = 576 pencil eigenvalues below its load:
+    4**574 (the growth then) overflows a float, and the certificate ended in an
+    OverflowError (an internal error, no result).
     """
     from types import SimpleNamespace
 
@@ -355,7 +361,74 @@ def test_cost_estimate_of_hundreds_of_negative_eigenvalues_is_the_cap():
     matrix = SimpleNamespace(getSize=lambda: (8463, 8463))
     problem = SimpleNamespace(model=SimpleNamespace(A=matrix))
     sources = SimpleNamespace(first=[("column", None)] * 3)
-    assert estimate_counts(problem, sources, 2, opts).pieces == 40.0
-    assert estimate_counts(problem, sources, 3, opts).pieces == 160.0
+    assert estimate_counts(problem, sources, 2, opts).pieces == 68.0
+    assert estimate_counts(problem, sources, 3, opts).pieces == pytest.approx(68.0 * 2.41)
+    assert estimate_counts(problem, sources, 2, opts).attempts == 1
     for m in (5, 576, 10**6):
         assert estimate_counts(problem, sources, m, opts).pieces == float(opts.max_pieces)
+
+
+@serial
+def test_cost_limit_stops_further_distances_and_pieces(thin_plate):
+    """The thin SSSS plate at 45 x 15: the route held to a cost limit, priced from counts.
+
+    Without a limit the default's distances 1e-3 and 1e-4 are both verified (two
+    attempts; ``spent``: the counts up to each attempt's end, priced by the cost model).
+    With a limit between the first attempt's counts and those plus one more attempt's
+    estimate, the second distance is not tried: the bound is the first attempt's
+    (lambda_c (1 - 1e-3)), and the record says why. With a limit of half the first
+    attempt's counts, that attempt stops among its pieces, and no further distance is
+    tried: no bound, fewer pieces examined.
+    """
+    from unibuckle_fenicsx.certificate.copositivity_split import estimate_counts, price
+
+    with solve(thin_plate("ssss", 45, 15), MPI.COMM_SELF) as analysis:
+        problem, sol = analysis.problem, analysis.solution
+        matrix = ShiftedMatrix(problem.model.A, problem.model.B)
+        try:
+
+            def bound(limit):
+                opts = SplitOptions(max_cost=limit)
+                return split_certificate(problem, matrix, sol.candidate, sol.kkt_points, opts)
+
+            free = bound(None)
+            first = free.attempts[0]
+            sources = column_sources(problem, sol.candidate, sol.kkt_points, SplitOptions())
+            next_attempt = price(estimate_counts(problem, sources, first.m, SplitOptions()))
+            between = bound(first.spent + 0.5 * next_attempt)
+            half = bound(0.5 * first.spent)
+        finally:
+            matrix.destroy()
+    assert [a.proven for a in free.attempts] == [True, True], free.why
+    assert free.attempts[1].spent > first.spent > 0
+    assert [a.delta for a in between.attempts] == [1e-3] and between.attempts[0].proven
+    assert between.value == sol.candidate.load * (1 - 1e-3)
+    assert "no further distance" in between.why
+    assert between.attempts[0].spent == pytest.approx(first.spent, rel=1e-12)
+    assert len(half.attempts) == 1 and not half.attempts[0].proven
+    assert half.value is None and "cost limit" in half.attempts[0].why
+    assert half.attempts[0].examined < first.examined
+
+
+def test_split_route_says_what_the_bracket_did():
+    """The JSON's ``certificate.split_route`` and the summary's words, from the records.
+
+    Skipped (its estimate over the limit), ran and bracketed or proven (the bound is the
+    split route's), ran without a bound; None where the route did not apply.
+    """
+    from unibuckle_fenicsx.certificate.records import SplitRecord
+    from unibuckle_fenicsx.results.records import split_route
+
+    def record(cost, skipped=False):
+        return SplitRecord(value=None, delta=None, m=2, r=0, pieces=0, margin=-math.inf,
+                           why="", attempts=[], estimated_cost=cost, skipped=skipped,
+                           cost_limit=3.0)  # fmt: skip
+
+    assert split_route("kkt-only", "interlacing", None) is None
+    assert (split_route("kkt-only", "interlacing", record(4.25, True))
+            == "skipped: estimated cost 4.2 free solves > 3")  # fmt: skip
+    assert (split_route("bracketed", "split-spn", record(2.08))
+            == "bracketed (estimated cost 2.1 free solves)")  # fmt: skip
+    assert split_route("proven", "split-spn", record(2.08)).startswith("proven (")
+    assert split_route("kkt-only", "interlacing", record(2.08)).startswith("not bracketed (")
+    assert split_route("proven", "rank2-spn", record(2.08)).startswith("not bracketed (")
