@@ -345,9 +345,9 @@ def test_thin_ssss_plate_is_bracketed_on_request(mesh, thin_plate):
 
 
 def test_cost_estimate_of_hundreds_of_negative_eigenvalues_is_the_cap():
-    """The estimate's pieces: COST_MODEL's at m = 2, ``growth`` times as many per further
-    one, at most the cap; one attempt priced.
+    """The estimate's pieces: COST_MODEL's at m = 2, growth-fold per further one, capped.
 
+    One attempt priced.
     COST_MODEL's rule (68 pieces and a growth of 2.41), capped at ``max_pieces``. A filled
     tube (R/t = 50, L = R, 10 mm cells) has m = 576 pencil eigenvalues below its load:
     4**574 (the growth then) overflows a float, and the certificate ended in an
