@@ -893,8 +893,9 @@ def _centre(V: Array, metric: Array) -> Array:
 
 # -- the route --------------------------------------------------------------------------------
 #: Calibration of :func:`estimate_cost` against ``bench/bench_bracket.py --uncapped`` (the
-#: thin plates at 90x30 and 180x60 run with the default's budgets and no cost limit,
-#: each unit timed in free solves in one process; ``--fit`` derives them): one
+#: thin plates run with the default's budgets and no cost limit, each unit timed in free
+#: solves in one process; ``--fit`` derives them; the units at 90x30, their growth
+#: between 90x30 and 180x60): one
 #: factorisation of K(lambda) over one free solve; right-hand sides of a batched solve
 #: (with the residual products and the second solve of the rounding bound) per free
 #: solve; one piece's work over a free solve (its dense programs, and the Gram products
@@ -906,9 +907,9 @@ def _centre(V: Array, metric: Array) -> Array:
 #: one attempt examines for m = 2 (the most of the plates with m = 2, with the
 #: interpolated multipliers) and their growth with each further negative eigenvalue (the
 #: plates with m = 3 over it).
-COST_MODEL = {"factorisation": 0.35, "factor_growth": 0.66, "factor_small": 0.0,
-              "rhs_per_solve": 380.0, "rhs_growth": 0.47, "rhs_small": -0.3,
-              "piece": 0.029, "piece_growth": 0.91, "piece_small": -1.3,
+COST_MODEL = {"factorisation": 0.67, "factor_growth": 0.66, "factor_small": 0.0,
+              "rhs_per_solve": 205.0, "rhs_growth": 0.47, "rhs_small": -0.3,
+              "piece": 0.074, "piece_growth": 0.91, "piece_small": -1.3,
               "pieces": 68.0, "growth": 2.41, "reference_dofs": 8463.0}  # fmt: skip
 
 
