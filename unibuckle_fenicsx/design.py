@@ -78,6 +78,7 @@ __all__ = [
     "design_output",
     "euler_stress",
     "reduction_factor",
+    "significant",
 ]
 
 #: The clauses the design output of an internal element rests on (:func:`clauses`).
@@ -92,6 +93,18 @@ CALIBRATION = (
     "EN 1993-1-5's rho (4.4(2)) was calibrated on plates buckling freely to both sides "
     "(bilateral buckling); it is applied here to this package's sigma_cr"
 )
+
+
+def significant(value: float | None, digits: int = 4) -> str:
+    """``value`` to ``digits`` significant digits, its trailing zeros kept ("none" for None).
+
+    ``format(x, ".4g")`` drops them, and a stress in Pa then reads as one digit:
+    2.000149e8 as "2e+08" (anything from 1.5e8 to 2.5e8), where "2.000e+08" says four.
+    """
+    if value is None:
+        return "none"
+    text = f"{value:#.{digits}g}"
+    return text[:-1] if text.endswith(".") else text
 
 
 class DesignRecord(Struct, kw_only=True):
@@ -253,7 +266,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     if psi is None:
         out.notes.append(
             f"the loaded edges are in tension at the critical state (least tension "
-            f"{-sigma1:.4g} Pa on edges.{edge}: the fixed compression is outgrown by the "
+            f"{significant(-sigma1)} Pa on edges.{edge}: the fixed compression is outgrown by the "
             "scaled tension): no sigma_cr, slenderness or rho"
         )
         return out
@@ -298,7 +311,7 @@ def _column_type(
             "and the note of 4.4(2) asks for it below 1; rho is the plate-type"
             + (
                 f" (the plate as a column, {ends}, would buckle at sigma_cr,c = "
-                f"{column:.4g} Pa: xi = sigma_cr/sigma_cr,c - 1 = {xi:.3g} < 1, "
+                f"{significant(column)} Pa: xi = sigma_cr/sigma_cr,c - 1 = {xi:.3g} < 1, "
                 "so column-like behaviour is not excluded)"
                 if xi < 1.0
                 else ""
@@ -320,8 +333,9 @@ def _column_type(
     if out.xi < 1.0:
         out.notes.append(
             f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "
-            f"{out.xi:.3g} < 1, rho_c = {rho_c:.4g} between the plate's rho = {rho:.4g} and "
-            f"the column's chi_c = {chi:.4g} (sigma_cr,c: the plate as a column, {ends})"
+            f"{out.xi:.3g} < 1, rho_c = {significant(rho_c)} between the plate's rho = "
+            f"{significant(rho)} and the column's chi_c = {significant(chi)} (sigma_cr,c: the "
+            f"plate as a column, {ends})"
         )
     else:
         out.notes.append(

@@ -454,6 +454,12 @@ COMMANDS = {
         "--json bench/results/phases.jsonl"
         for case in dict.fromkeys(str(r["case"]) for r in rows)
     ),
+    "profile": lambda rows: "`, then `".join(
+        f"python bench/bench_profile.py --case {case} "
+        f"--meshes {_listed([r for r in rows if r['case'] == case], 'mesh')} "
+        "--json bench/results/profile.jsonl"
+        for case in dict.fromkeys(str(r["case"]) for r in rows)
+    ),
     "stages": lambda rows: "`, then `".join(
         f"python bench/bench_stages.py --case {case} "
         f"--meshes {_listed([r for r in rows if r['case'] == case], 'mesh')} "
@@ -729,6 +735,19 @@ BENCH_COLUMNS["sections_first_carry_plates"] = BENCH_COLUMNS["plates"]
 BENCH_COLUMNS["sections_box_levels_plates"] = [
     ("thickness", "t (m)"),
     *BENCH_COLUMNS["plates"],
+]
+BENCH_COLUMNS["profile"] = [
+    ("case", "plate"),
+    ("mesh", "mesh"),
+    ("free", "free run"),
+    ("dofs", "DOFs"),
+    ("method", "route"),
+    ("eigensolves", "eigen solves"),
+    ("wall", "solve, wall (s)"),
+    ("process_wall", "process, wall (s)"),
+    ("process_cpu", "process, CPU (s)"),
+    ("maxrss_kib", "peak RSS (KiB)"),
+    ("load_Pa", "load (Pa)"),
 ]
 #: Long texts shown as numbered notes under the table (the cell holds the note's
 #: number and the text up to its first colon).

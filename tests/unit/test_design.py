@@ -15,6 +15,7 @@ formulas between, typed in from the tables.
 from __future__ import annotations
 
 import math
+import re
 
 from mpi4py import MPI
 
@@ -22,7 +23,7 @@ import pytest
 
 from support.paths import ROOT
 from unibuckle_fenicsx.analysis import solve
-from unibuckle_fenicsx.design import euler_stress, reduction_factor
+from unibuckle_fenicsx.design import euler_stress, reduction_factor, significant
 from unibuckle_fenicsx.spec import problem_from_dict, problem_to_dict
 
 
@@ -839,3 +840,39 @@ def test_an_unproven_critical_load_adds_the_design_at_its_lower_bound():
     assert any("not proven the lowest" in note for note in r.design.notes)
     assert f"slenderness {slenderness:.4g}, rho = {rho:.4g}" in r.summary()
     assert r.as_dict()["design"]["lower_bound"]["reduction_factor"] == low.reduction_factor
+
+
+def test_the_summary_keeps_four_significant_digits_in_pa():
+    """A stress in Pa with trailing zeros read as one digit: "2e+08" for 2.000e8.
+
+    The 600 x 200 x 10 mm SSSS steel plate in SI with f_y = 200 MPa and gamma_M0 = 1:
+    sigma_cr = k sigma_E, sigma_E = pi^2 E t^2/(12(1 - nu^2) b^2) = 474.5 MPa, k = 4 for the
+    long simply supported plate (Timoshenko and Gere, section 9.2; 5.8 on these coarse
+    cells): any k above 0.93 puts lambda_p = sqrt(f_y/sigma_cr) below 0.673, where rho =
+    1 (EN 1993-1-5 eq. (4.2)), so rho f_y/gamma_M0 is
+    f_y = 2e8 Pa exactly. The summary printed "rho = 1, rho f_y/gamma_M0 = 2e+08 Pa", one
+    significant digit to the eye where the line gives four elsewhere; it is 2.000e+08.
+    """
+    hinged = {"support": "simply_supported"}
+    spec = problem_from_dict(
+        {
+            "plate": {"corners": [[0, 0], [0.6, 0.2]], "thickness": 0.01},
+            "material": {"E": 2.1e11, "nu": 0.3},
+            "edges": {
+                "left": {**hinged, "normal_stress": -1.0},
+                "right": {**hinged, "normal_stress": -1.0},
+                "bottom": hinged,
+                "top": hinged,
+            },
+            "mesh": {"nx": 6, "ny": 2},
+            "design": {"yield_stress": 2.0e8, "partial_factor": 1.0},
+        }
+    )
+    out = result(spec)
+    assert out.design.relative_slenderness < 0.673
+    line = next(s for s in out.summary().splitlines() if "EN 1993-1-5: " in s)
+    assert "rho = 1.000, rho f_y/gamma_M0 = 2.000e+08 Pa;" in line, line
+    mantissa = re.search(r"sigma_cr = (\d\.\d+)e\+09 Pa", line)
+    assert mantissa is not None and len(mantissa[1]) == 5, line  # d.ddd: four digits
+    assert significant(2.000149e8) == "2.000e+08" and significant(1234.4) == "1234"
+    assert significant(0.45) == "0.4500" and significant(355.0) == "355.0"

@@ -272,3 +272,37 @@ def test_specially_orthotropic_plate_against_a_whole_plate_obstacle():
         k.append(out.buckling_coefficient_k)
     richardson = (16 * k[1] - 9 * k[0]) / 7
     assert richardson == pytest.approx(exact, rel=1e-4), (k, richardson, exact)
+
+
+def test_a_laminate_whose_nu_xy_exceeds_one_half_is_accepted():
+    """A stack's in-plane nu_xy may exceed 0.5, the bound of an isotropic nu.
+
+    The file's reader gives a laminate E_x and nu_xy from its plies, and ``material.nu``
+    was bounded to (-1, 0.5): a balanced +-45 glass stack (nu_xy = 0.513) or a 0 ply with
+    nu12 = 0.6 was refused with "material.nu must be a number, got None (absent)", a key
+    the file did not give. By hand (classical lamination theory): at 45 degrees
+    Qb11 = (Q11 + Q22 + 2 Q12 + 4 Q66)/4, Qb12 = (Q11 + Q22 - 4 Q66)/4 + Q12/2, A16 = 0
+    for the balanced stack, nu_xy = A12/A22 = Qb12/Qb11. The 0 ply (nu_xy = nu12) on the
+    simply supported a/h = 10 square: MITC4 on 16 x 16 and 32 x 32, Richardson, against
+    the first-order shear Navier load with D = Q h^3/12 and H = (5/6) diag(G13, G23) h.
+    """
+    E1, E2, G12, nu12 = (GLASS[k] for k in ("E1", "E2", "G12", "nu12"))
+    nu21 = nu12 * E2 / E1
+    Q11, Q22, Q12 = E1 / (1 - nu12 * nu21), E2 / (1 - nu12 * nu21), nu12 * E2 / (1 - nu12 * nu21)
+    Qb11 = (Q11 + Q22 + 2 * Q12 + 4 * G12) / 4
+    Qb12 = (Q11 + Q22 - 4 * G12) / 4 + Q12 / 2
+    assert Qb12 / Qb11 > 0.5
+    angle_ply = square((45.0, -45.0, -45.0, 45.0), 0.01, 4, GLASS)
+    assert angle_ply.material.nu == pytest.approx(Qb12 / Qb11, rel=1e-12)
+
+    ply = {**GLASS, "nu12": 0.6}  # |nu12| < sqrt(E1/E2) = 2: a positive definite ply
+    h = 0.1
+    nu21 = ply["nu12"] * E2 / E1
+    den = 1 - ply["nu12"] * nu21
+    Q = np.array([[E1 / den, ply["nu12"] * E2 / den, 0], [ply["nu12"] * E2 / den, E2 / den, 0]])
+    D = np.vstack([Q, [0, 0, ply["G12"]]]) * h**3 / 12
+    H = 5 / 6 * np.diag([ply["G13"], ply["G23"]]) * h
+    loads = [result(square((0.0,), h, n, ply)).critical_load_Pa * h for n in (16, 32)]
+    assert square((0.0,), h, 4, ply).material.nu == pytest.approx(0.6, rel=1e-12)
+    richardson = (4 * loads[1] - loads[0]) / 3
+    assert richardson == pytest.approx(navier_fsdt(D, H, 1.0, 1.0), rel=2e-5), loads

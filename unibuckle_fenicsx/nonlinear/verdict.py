@@ -21,6 +21,7 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 from typing import Any
 
+from unibuckle_fenicsx.spec import UNITS
 from unibuckle_fenicsx.tolerances import KNEE_RTOL
 
 __all__ = ["Verdict", "judge"]
@@ -49,11 +50,13 @@ class Verdict:
         if self.gap:
             head = (
                 f"with a gap the knee lies between the free load "
-                f"{result.linear_critical_load_Pa:.6e} Pa and the unilateral load with the "
-                f"gaps closed {_text(result.unilateral_load_Pa)}; no linear load is validated"
+                f"{_text(result.linear_critical_load_Pa, result)} and the unilateral load with "
+                f"the gaps closed {_text(result.unilateral_load_Pa, result)}; no linear load is "
+                "validated"
             )
         else:
-            head = f"against the linear critical load {result.linear_critical_load_Pa:.6e} Pa"
+            linear = _text(result.linear_critical_load_Pa, result)
+            head = f"against the linear critical load {linear}"
         found = ", ".join(self.validated) or "nothing"
         word = "consistent" if self.gap else "validated"
         out = f"verdict ({head}): {word}: {found}"
@@ -62,8 +65,12 @@ class Verdict:
         return out
 
 
-def _text(value: float | None) -> str:
-    return "(not computed)" if value is None else f"{value:.6e} Pa"
+def _text(value: float | None, result: Any) -> str:
+    """A load (Pa) in the problem file's units (``result.units``), as the summary gives it."""
+    if value is None:
+        return "(not computed)"
+    scale, unit = UNITS[getattr(result, "units", "SI")][1:]
+    return f"{value / scale:.6e} {unit}"
 
 
 def judge(result: Any, max_load: float | None = None) -> Verdict:
@@ -88,7 +95,7 @@ def judge(result: Any, max_load: float | None = None) -> Verdict:
             continue
         relative = load / linear - 1.0
         if not gap:
-            text = f"the {name} load {load:.6e} Pa ({relative:+.1e} relative)"
+            text = f"the {name} load {_text(load, result)} ({relative:+.1e} relative)"
             if abs(relative) <= KNEE_RTOL:
                 validated.append(text)
             else:
@@ -98,7 +105,7 @@ def judge(result: Any, max_load: float | None = None) -> Verdict:
                     "critical load)"
                 )
             continue
-        text = f"the {name} load {load:.6e} Pa ({relative:+.1e} relative to the free load)"
+        text = f"the {name} load {_text(load, result)} ({relative:+.1e} relative to the free load)"
         if upper is None:
             missing.append(f"{text}: the unilateral load with the gaps closed is unknown")
         elif linear * (1 - KNEE_RTOL) <= load <= upper * (1 + KNEE_RTOL):

@@ -18,7 +18,7 @@ from msgspec import UNSET, Struct, UnsetType, to_builtins
 
 from unibuckle_fenicsx.algorithms.records import ContinuedRecord, MethodDetails
 from unibuckle_fenicsx.certificate.records import CopositivityRecord
-from unibuckle_fenicsx.design import DesignRecord
+from unibuckle_fenicsx.design import DesignRecord, significant
 from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
 from unibuckle_fenicsx.section_design import SectionDesignRecord
@@ -414,24 +414,26 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
     if d.relative_slenderness is None:  # the loaded edges in tension at the critical state
         return (
             f"EN 1993-1-5: no compression on the loaded edges at the critical state (least "
-            f"tension {-d.sigma_cr_Pa / scale:.4g} {unit}, {d.edge}): no sigma_cr, slenderness "
-            "or rho" + _design_lower(d, scale, unit)
+            f"tension {significant(-d.sigma_cr_Pa / scale)} {unit}, {d.edge}): no sigma_cr, "
+            "slenderness or rho" + _design_lower(d, scale, unit)
         )
     column = ""
     if d.xi is not None and d.xi < 1.0:
         column = (
-            f" (column-type: plate {d.plate_reduction_factor:.4g}, chi_c "
-            f"{d.column_reduction_factor:.4g}, xi {d.xi:.3g})"
+            f" (column-type: plate {significant(d.plate_reduction_factor)}, chi_c "
+            f"{significant(d.column_reduction_factor)}, xi {d.xi:.3g})"
         )
     elif d.xi is not None:
         column = f" (column-type: xi {d.xi:.3g} >= 1, the plate's)"
     elif d.column_critical_stress_Pa == 0.0:
         column = " (column-type: none, the column a mechanism; the plate's)"
     return (
-        f"EN 1993-1-5: sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit} ({d.edge}), "
-        f"psi = {d.psi:.3g}, slenderness {d.relative_slenderness:.4g}, rho = "
+        f"EN 1993-1-5: sigma_cr = {significant(d.sigma_cr_Pa / scale)} {unit} ({d.edge}), "
+        f"psi = {d.psi:.3g}, slenderness {significant(d.relative_slenderness)}, rho = "
         + (
-            f"{rho:.4g}" + column + f", rho f_y/gamma_M0 = {reduced / scale:.4g} {unit}"
+            f"{significant(rho)}"
+            + column
+            + f", rho f_y/gamma_M0 = {significant(reduced / scale)} {unit}"
             if rho is not None and isinstance(reduced, float)
             else f"none (psi outside {d.table})"
         )
@@ -447,13 +449,13 @@ def _design_lower(d: DesignRecord, scale: float, unit: str) -> str:
     low = d.lower_bound
     if not isinstance(low, DesignRecord):
         return ""
-    rho = "none" if low.reduction_factor is None else f"{low.reduction_factor:.4g}"
+    rho = significant(low.reduction_factor)
     if low.relative_slenderness is None:
         return "\n  EN 1993-1-5 at the verified lower bound: no compression on the loaded edges"
     return (
         f"\n  EN 1993-1-5 at the verified lower bound (the safe value, sigma_cr not proven "
-        f"the lowest): sigma_cr = {low.sigma_cr_Pa / scale:.4g} {unit}, slenderness "
-        f"{low.relative_slenderness:.4g}, rho = {rho}"
+        f"the lowest): sigma_cr = {significant(low.sigma_cr_Pa / scale)} {unit}, slenderness "
+        f"{significant(low.relative_slenderness)}, rho = {rho}"
     )
 
 

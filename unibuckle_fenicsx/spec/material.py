@@ -77,14 +77,15 @@ class Material(Table, frozen=True):
             lamination theory with first-order shear (:mod:`~unibuckle_fenicsx.laminate`,
             ``shear_correction`` the factor on the shear); symmetric stacks only. E and nu
             are then the laminate's in-plane constants :math:`E_x, \nu_{xy}` (a file leaves
-            them out; in code: :meth:`from_plies`).
+            them out; in code: :meth:`from_plies`); :math:`\nu_{xy}` may lie outside
+            (-1, 0.5) (0.51 for a balanced +-45 glass stack).
         thermal_expansion: Coefficient of thermal expansion :math:`\alpha` (1/K), >= 0,
             the same in every direction; not for a laminate, whose plies expand differently.
     """
 
     KEY: ClassVar[str] = "material"
     E: Modulus
-    nu: Annotated[float, Meta(gt=-1.0, lt=0.5)]
+    nu: float  # in (-1, 0.5) but for a laminate (check); the schema has the file's range
     shear_correction: Annotated[float, Meta(gt=0)] = 5.0 / 6.0
     membrane_voigt: Annotated[Matrix3, unit("N/m")] | None = None
     bending_voigt: Annotated[Matrix3, unit("N m")] | None = None
@@ -112,6 +113,8 @@ class Material(Table, frozen=True):
             )
         if self.plies:
             self._check_laminate()
+        elif not -1.0 < self.nu < 0.5:  # an isotropic material's; a laminate's nu_xy is not
+            raise self.error("nu", f" must lie in (-1, 0.5), got {self.nu!r}")
         for name in ("membrane_voigt", "bending_voigt"):
             mat = np.array(getattr(self, name) or np.eye(3), dtype=float)
             if not np.allclose(mat, mat.T, rtol=1e-12, atol=0.0):

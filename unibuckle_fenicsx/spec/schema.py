@@ -66,6 +66,9 @@ def json_schema() -> dict[str, object]:
         **obstacle,
     }
     defs["Material"]["required"] = []  # a laminate's E and nu are its plies'
+    # a file's nu is an isotropic material's (a laminate's nu_xy, which may exceed 0.5
+    # as that of a +-45 stack does, comes from its plies)
+    defs["Material"]["properties"]["nu"] |= {"exclusiveMinimum": -1.0, "exclusiveMaximum": 0.5}
     head = {"$schema": "https://json-schema.org/draft/2020-12/schema"}
     head["title"] = "unibuckle_fenicsx problem file"
     return as_table(msgspec.json.decode(msgspec.json.encode(head | schema)))  # lists

@@ -374,3 +374,37 @@ def test_delta_study_on_the_paper_mesh():
                         value = r.as_dict()[key]
                         assert value == pytest.approx(r.linear_critical_load_Pa, rel=KNEE_RTOL)
         assert errors[1e-4] <= errors[1e-2], errors
+
+
+def test_a_mm_file_s_verdict_is_in_mpa():
+    """The verdict line of a mm-N-MPa file gives its loads in MPa, as the lines above it.
+
+    The 200 x 100 x 2 mm SSSS steel plate on 8 x 4 cells, no obstacle: its first line
+    said "Southwell 3.311337e+02 MPa" and its verdict "the Southwell load 3.311337e+08 Pa",
+    two units for one number in one summary. 1 MPa = 1e6 Pa; the JSON's numbers stay SI.
+    """
+    from unibuckle_fenicsx.spec import problem_from_dict
+
+    hinged = {"support": "simply_supported"}
+    spec = problem_from_dict(
+        {
+            "units": "mm-N-MPa",
+            "plate": {"corners": [[0, 0], [200, 100]], "thickness": 2.0},
+            "material": {"E": 210000.0, "nu": 0.3},
+            "edges": {
+                "left": {**hinged, "normal_stress": -1.0},
+                "right": {**hinged, "normal_stress": -1.0},
+                "bottom": hinged,
+                "top": hinged,
+            },
+            "mesh": {"nx": 8, "ny": 4},
+        }
+    )
+    with solve_nonlinear(spec, NonlinearOptions(imperfection=1e-3)) as analysis:
+        result = analysis.result
+    verdict = result.summary().splitlines()[-1]
+    assert verdict.startswith("  verdict ("), verdict
+    linear, southwell = result.linear_critical_load_Pa, result.southwell_load_Pa
+    assert f"against the linear critical load {linear / 1e6:.6e} MPa" in verdict, verdict
+    assert f"the Southwell load {southwell / 1e6:.6e} MPa" in verdict, verdict
+    assert " Pa" not in verdict, verdict
