@@ -284,6 +284,8 @@ def _plates_commands(rows: list[dict[str, Any]], name: str = "plates") -> str:
         flags += " --bracket" if any(r.get("bracket") for r in group) else ""
         repeat = max(len(r.get("ratios", [0])) for r in group)
         flags += f" --repeat {repeat}" if repeat > 1 else ""
+        thickness = {r.get("thickness") for r in group} - {None}
+        flags += f" --thickness {thickness.pop():g}" if len(thickness) == 1 else ""
         commands.append(
             f"python bench/bench_plates.py --meshes {mesh} --cases {_listed(group, 'case')}"
             f"{flags} --json bench/results/{name}.jsonl"
@@ -421,6 +423,11 @@ COMMANDS = {
     "sections_first_carry": lambda rows: _sections_commands(rows, "sections_first_carry"),
     "sections_first_carry_plates": lambda rows: _plates_commands(
         rows, "sections_first_carry_plates"
+    ),
+    "sections_box_levels_plates": lambda rows: _plates_commands(rows, "sections_box_levels_plates"),
+    "step_cost": lambda rows: (
+        f"python bench/bench_step_cost.py --problems {_listed(rows, 'problem')} "
+        f"--orderings {_listed(rows, 'ordering')} --json bench/results/step_cost.jsonl"
     ),
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
@@ -724,6 +731,11 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
 }
 #: The plates measured beside the filled sections, as the plates' file shows them.
 BENCH_COLUMNS["sections_first_carry_plates"] = BENCH_COLUMNS["plates"]
+#: The faces of the filled box as plates (b/t = 100), measured beside it.
+BENCH_COLUMNS["sections_box_levels_plates"] = [
+    ("thickness", "t (m)"),
+    *BENCH_COLUMNS["plates"],
+]
 BENCH_COLUMNS["profile"] = [
     ("case", "plate"),
     ("mesh", "mesh"),
