@@ -39,6 +39,9 @@ With ``--bracket`` the certificate's bracket runs as asked for (``solver.bracket
 distances down to 1e-6, no cost limit; by default it runs where its estimated cost is
 at most 3 free solves; ``bench_bracket.py`` measures it).
 
+With ``--thickness T`` the plates are T thick (m; default 1e-4): 1e-3 is the filled
+box's face of ``bench_sections.py`` (b/t = 100) scaled by one half.
+
 With ``--side below`` the face lies below the plate (w >= 0): the mirror image, the same
 loads (w -> -w), by the same route.
 
@@ -47,7 +50,8 @@ obstacle zones (:func:`~unibuckle_fenicsx.spec.cases.paper_case`), solved and ti
 same way (``--side`` does not apply to them).
 
 Usage: python bench/bench_plates.py [--meshes 90x30,180x60] [--cases ssss,cs,sc,cccc,shear,c1,c3]
-[--side above|below] [--cli] [--baseline PYTHON] [--bracket] [--repeat N] [--json FILE]
+[--side above|below] [--thickness T] [--cli] [--baseline PYTHON] [--bracket] [--repeat N]
+[--json FILE]
 """
 
 from __future__ import annotations
@@ -181,11 +185,16 @@ def main() -> None:
     parser.add_argument(
         "--baseline", metavar="PYTHON", help="with --cli: also time another installation"
     )
+    parser.add_argument(
+        "--thickness", type=float, default=THICKNESS, help="plate thickness (m), > 0"
+    )
     args, meshes = parse_plates(parser)
+    if not args.thickness > 0.0:
+        parser.error(f"--thickness must be > 0, got {args.thickness}")
     comm = MPI.COMM_WORLD
     if comm.rank == 0:
         print_header(
-            f"MPI ranks: {comm.size}; plate {LENGTH} x {WIDTH} m, t = {THICKNESS} m, "
+            f"MPI ranks: {comm.size}; plate {LENGTH} x {WIDTH} m, t = {args.thickness} m, "
             f"zone all, face {args.side} (c1, c2, c3: the paper's plate and zones)",
             (
                 "case", "mesh", "i", "\\|Z\\|", "levels: steps / factorisations / eigen solves",
@@ -195,7 +204,7 @@ def main() -> None:
         )  # fmt: skip
     for nx, ny in meshes:
         for name in args.cases.split(","):
-            spec = _spec(name, nx, ny, args.side)
+            spec = _spec(name, nx, ny, args.side, args.thickness)
             if args.bracket:
                 spec = spec.with_solver(bracket=True)
             runs = []  # (free solve s, ratio, certificate / free) of each repetition
@@ -223,6 +232,7 @@ def main() -> None:
                     "bracket": args.bracket,
                     "edges": CASES[name][2] if name in CASES else "paper",
                     "mesh": f"{nx}x{ny}",
+                    "thickness": args.thickness,
                     "i": r.constrained_nodes,
                     "contact_nodes": r.contact_nodes,
                     "levels": per_level or f"{r.eigensolves} eigen solves",

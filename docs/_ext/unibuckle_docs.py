@@ -284,6 +284,8 @@ def _plates_commands(rows: list[dict[str, Any]], name: str = "plates") -> str:
         flags += " --bracket" if any(r.get("bracket") for r in group) else ""
         repeat = max(len(r.get("ratios", [0])) for r in group)
         flags += f" --repeat {repeat}" if repeat > 1 else ""
+        thickness = {r.get("thickness") for r in group} - {None}
+        flags += f" --thickness {thickness.pop():g}" if len(thickness) == 1 else ""
         commands.append(
             f"python bench/bench_plates.py --meshes {mesh} --cases {_listed(group, 'case')}"
             f"{flags} --json bench/results/{name}.jsonl"
@@ -422,6 +424,11 @@ COMMANDS = {
     "sections_first_carry_plates": lambda rows: _plates_commands(
         rows, "sections_first_carry_plates"
     ),
+    "sections_box_levels_plates": lambda rows: _plates_commands(rows, "sections_box_levels_plates"),
+    "step_cost": lambda rows: (
+        f"python bench/bench_step_cost.py --problems {_listed(rows, 'problem')} "
+        f"--orderings {_listed(rows, 'ordering')} --json bench/results/step_cost.jsonl"
+    ),
     "certify": lambda rows: (
         f"python bench/bench_certify.py --meshes {_listed(rows, 'mesh')} "
         f"--cases {_listed(rows, 'case')} --json bench/results/certify.jsonl"
@@ -445,6 +452,12 @@ COMMANDS = {
         f"python bench/bench_stages.py --phases --case {case} "
         f"--meshes {_listed([r for r in rows if r['case'] == case], 'mesh')} "
         "--json bench/results/phases.jsonl"
+        for case in dict.fromkeys(str(r["case"]) for r in rows)
+    ),
+    "profile": lambda rows: "`, then `".join(
+        f"python bench/bench_profile.py --case {case} "
+        f"--meshes {_listed([r for r in rows if r['case'] == case], 'mesh')} "
+        "--json bench/results/profile.jsonl"
         for case in dict.fromkeys(str(r["case"]) for r in rows)
     ),
     "stages": lambda rows: "`, then `".join(
@@ -718,6 +731,24 @@ BENCH_COLUMNS: dict[str, list[tuple[str, str]]] = {
 }
 #: The plates measured beside the filled sections, as the plates' file shows them.
 BENCH_COLUMNS["sections_first_carry_plates"] = BENCH_COLUMNS["plates"]
+#: The faces of the filled box as plates (b/t = 100), measured beside it.
+BENCH_COLUMNS["sections_box_levels_plates"] = [
+    ("thickness", "t (m)"),
+    *BENCH_COLUMNS["plates"],
+]
+BENCH_COLUMNS["profile"] = [
+    ("case", "plate"),
+    ("mesh", "mesh"),
+    ("free", "free run"),
+    ("dofs", "DOFs"),
+    ("method", "route"),
+    ("eigensolves", "eigen solves"),
+    ("wall", "solve, wall (s)"),
+    ("process_wall", "process, wall (s)"),
+    ("process_cpu", "process, CPU (s)"),
+    ("maxrss_kib", "peak RSS (KiB)"),
+    ("load_Pa", "load (Pa)"),
+]
 #: Long texts shown as numbered notes under the table (the cell holds the note's
 #: number and the text up to its first colon).
 BENCH_NOTES = {"plates": "certificate"}
