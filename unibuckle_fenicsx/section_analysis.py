@@ -56,6 +56,7 @@ from unibuckle_fenicsx.en1993 import (
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode
+from unibuckle_fenicsx.model.shell.geometry import cell_length, face_cell_width, tube_facet_width
 from unibuckle_fenicsx.model.shell.section import (
     Section,
     SectionFigureData,
@@ -95,6 +96,7 @@ __all__ = [
     "coarse_mesh_note",
     "column_note",
     "half_wave",
+    "mesh_cell_counts",
     "solve_section",
     "thick_wall_note",
 ]
@@ -465,26 +467,26 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
 
     The rule (:data:`MIN_FACE_CELLS`, :data:`MIN_HALF_WAVE_CELLS` across,
     :data:`MIN_ALONG_CELLS` along :func:`buckle_length`; the note names the one that asks
-    for the finest cells) is a priori, from the section's
-    dimensions and cell size: on cells too coarse for the buckles the shell's critical
-    stress is too high (it falls as the cells are refined), and so are k and the design
-    values. Lengths in the units of the file solved
+    for the finest cells) is a priori, from the section's dimensions and the cells its
+    mesh will have (:func:`mesh_cell_counts`): on cells too coarse for the buckles the
+    shell's critical stress is too high (it falls as the cells are refined), and so are k
+    and the design values. Lengths in the units of the file solved
     (:func:`~unibuckle_fenicsx.spec.base.file_units`).
     """
     p = parameters
     width, across = _buckle_width(p)
     length, along = buckle_length(p)
     need_across = MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS
-    checks = [(width, need_across, f"across {across}"), (length, MIN_ALONG_CELLS, f"along {along}")]
-    # The mesh's rounding (geometry's cells across: ceil(extent/size - 1e-9)): 0.35/0.07
-    # is 4.999999999999999 cells, and the mesh makes 5 (6 on a box's face).
-    counted = [
-        (span / p.mesh_size * (1.0 + 1e-9), need, span, where) for span, need, where in checks
+    cells_across, cells_along = mesh_cell_counts(p)
+    checks = [
+        (cells_across, width, need_across, f"across {across}"),
+        (cells_along, length, MIN_ALONG_CELLS, f"along {along}"),
     ]
-    short = [c for c in counted if c[0] < c[1]]
+    # A whole number of cells within rounding (5 cells of L/5 over L) counts as that many.
+    short = [c for c in checks if c[0] * (1.0 + 1e-9) < c[2]]
     if not short:
         return None
-    cells, need, span, where = min(short, key=lambda c: c[0] / c[1])  # the finest cells asked
+    cells, span, need, where = min(short, key=lambda c: c[0] / c[2])  # the finest asked
     (size, finer, width), unit = in_file((p.mesh_size, span / need, span), "m")
     return (
         f"mesh.size = {size:.3g} {unit} gives {cells:.2g} cells {where} "
@@ -492,6 +494,26 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
         "critical stress, k and the design values come out too high (refine mesh.size to "
         f'{finer:.3g} {unit} or less; docs/guide/sections.md, "Cell size")'
     )
+
+
+def mesh_cell_counts(parameters: SectionParameters) -> tuple[float, float]:
+    """The cells the mesh puts across the walls' buckles and along the member's.
+
+    What the mesh of ``mesh.size`` has (:mod:`~unibuckle_fenicsx.model.shell.geometry`
+    rounds the cells up: an even number across a box's face, ceil(L/size) along):
+    a box's narrowest face over its widest cell across (uniform faces: their number of
+    cells); a tube's axisymmetric half-wave (:func:`half_wave`) over the larger of its
+    cells' length and its facets' width; and :func:`buckle_length` over the cells'
+    length.
+    """
+    p = parameters
+    along = cell_length(p.length, p.mesh_size)
+    width, _ = _buckle_width(p)
+    if p.shape == "box":
+        across = width / face_cell_width(width, p.mesh_size, p.corner_cell)
+    else:
+        across = width / max(along, tube_facet_width(float(p.diameter or 0.0), p.mesh_size))
+    return across, buckle_length(p)[0] / along
 
 
 def buckle_length(parameters: SectionParameters) -> tuple[float, str]:

@@ -357,15 +357,20 @@ def member_note(section: DesignSection, design: DesignSpec) -> str:
     off it. EN 1993-1-1, 6.3.1.2: the relative slenderness :math:`\sqrt{A f_y/N_{cr}} =
     \sqrt{f_y/\sigma_E}`, :math:`\sigma_E` the Euler stress of the walls' section
     (:meth:`~unibuckle_fenicsx.SectionParameters.euler_stress`);
-    at 0.2 or less buckling may be ignored (6.3.1.2(4)). A filled member's needs the
-    infill's stiffness (EN 1994-1-1, 6.7.3.3), which the output does not have.
+    at 0.2 or less buckling may be ignored (6.3.1.2(4)). With the gross area A: for a
+    Class 4 section eq. (6.51) takes :math:`A_{eff}`, a slenderness lower by
+    :math:`\sqrt{A_{eff}/A}` at the same :math:`N_{cr}`, so the gross one never calls
+    buckling negligible where (6.51) would not, and gives the smaller :math:`\chi`; the
+    note says which it is. A filled member's needs the infill's stiffness (EN 1994-1-1,
+    6.7.3.3), which the output does not have.
     """
     slenderness = math.sqrt(design.yield_stress / section.euler_stress())
     text = (
         "the member's flexural buckling (EN 1993-1-1, 6.3.1) is not part of this output: "
         "its walls' section as a column has relative slenderness sqrt(f_y/sigma_E) = "
         f"{slenderness:.3g} (sigma_E its Euler stress, L_e = L, or L/2 between clamped "
-        "ends; buckling may be ignored at 0.2 or less, 6.3.1.2(4))"
+        "ends; the gross area: a Class 4 section's sqrt(A_eff f_y/N_cr) of 6.3.1.2(1) is "
+        "lower by sqrt(A_eff/A); buckling may be ignored at 0.2 or less, 6.3.1.2(4))"
     )
     if section.core:
         text += (

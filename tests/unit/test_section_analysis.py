@@ -229,9 +229,11 @@ def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
     # Box: cells across the narrowest face, min(width, depth)/mesh.size, here 0.1/0.05 = 2
     # (below MIN_FACE_CELLS = 5); 0.1/0.02 = 5 is not. Tube (R = 0.1 m, t = 2 mm,
     # nu = 0.3): the axisymmetric half-wave pi sqrt(R t)/(12 (1 - nu^2))^(1/4)
-    # = pi * 0.0141421 / 1.81762 = 0.024444 m, so 0.02 m cells give 1.22 of them and
-    # 0.016 m cells 1.53 (below MIN_HALF_WAVE_CELLS = 2.5: this tube, L = 2R, is 9 % high
-    # on 1.5 cells, docs/guide/sections.md "Cell size"), 0.0097 m cells 2.52.
+    # = pi * 0.0141421 / 1.81762 = 0.024444 m, so 0.02 m cells give 1.22 of them (10
+    # cells of 20 mm along, 32 facets of 19.6 mm) and 0.016 m cells 1.56 (13 cells of
+    # 15.4 mm along, 40 facets of 2R sin(pi/40) = 15.69 mm: below MIN_HALF_WAVE_CELLS =
+    # 2.5, this tube, L = 2R, is 9 % high on 1.5 cells, docs/guide/sections.md "Cell
+    # size"), 0.0097 m cells 2.57 (66 facets of 9.52 mm).
     from unibuckle_fenicsx.section_analysis import coarse_mesh_note
 
     assert coarse_mesh_note(_box(mesh_size=0.02)) is None
@@ -244,7 +246,7 @@ def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
     note = coarse_mesh_note(tube)
     assert note is not None and "1.2 cells" in note and "(0.0244 m)" in note
     note = coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.016))
-    assert note is not None and "1.5 cells" in note and "fewer than 2.5" in note
+    assert note is not None and "1.6 cells" in note and "fewer than 2.5" in note
     assert coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.0097)) is None
     # The warning is logged by the solve (a hollow box on two cells a face: a free solve).
     with caplog.at_level(logging.WARNING, logger="unibuckle_fenicsx.section_analysis"):
@@ -270,6 +272,56 @@ def test_cells_exactly_enough_draw_no_warning():
     assert coarse_mesh_note(across) is None
     along = dataclasses.replace(across, width=0.5, depth=0.5, length=0.35)
     assert coarse_mesh_note(along) is None
+
+
+def test_the_coarse_cell_warning_counts_the_cells_the_mesh_has():
+    """The warning counts the mesh's cells, not the nominal width/mesh.size.
+
+    A box 100 x 60 mm on 13 mm cells: 60/13 = 4.6 was reported ("gives 4.6 cells across
+    the narrowest face ..., fewer than 5"), where the mesh puts an even number of cells
+    of at most 13 mm across each face, 6 of 10 mm on the 60 mm faces (the hollow square
+    box with 6 cells across a face is 3.8 % above its converged k, docs/guide/sections.md
+    "Cell size": no warning due). On 17 mm cells it makes 4 (60/17 = 3.5 was reported).
+    A tube D = 0.2 m on 16 mm cells: 40 facets of 15.69 mm and 13 cells of 15.38 mm
+    along; its half-wave of 24.44 mm spans 1.56 facets, not 24.44/16 = 1.53 cells. The
+    counts are read off the meshes themselves (their nodes), independently of the rule.
+    """
+    import numpy as np
+
+    from unibuckle_fenicsx.model.shell.geometry import box_mesh, tube_mesh
+    from unibuckle_fenicsx.section_analysis import coarse_mesh_note, half_wave
+
+    def distinct(values):
+        return np.unique(np.round(values, 9))
+
+    box = SectionParameters(
+        "box", width=0.1, depth=0.06, thickness=0.001, length=0.2, E=E, nu=NU,
+        mesh_size=0.013, ends="simply_supported",
+    )  # fmt: skip
+    assert 0.06 / 0.013 < 5 and coarse_mesh_note(box) is None
+    note = coarse_mesh_note(dataclasses.replace(box, mesh_size=0.017))
+    assert note is not None and "gives 4 cells across the narrowest face (0.06 m)" in note
+    from unibuckle_fenicsx.section_analysis import mesh_cell_counts
+
+    for size, across in ((0.013, 6), (0.017, 4)):
+        x = box_mesh(0.1, 0.06, 0.2, size, MPI.COMM_SELF).mesh.geometry.x
+        face = x[np.isclose(x[:, 1], 0.05) & np.isclose(x[:, 0], 0.0)]  # y = +b/2, depth d
+        assert distinct(face[:, 2]).size - 1 == across
+        along = distinct(x[:, 0]).size - 1
+        counts = mesh_cell_counts(dataclasses.replace(box, mesh_size=size))
+        assert counts == pytest.approx((across, along), rel=1e-12)
+    tube = SectionParameters(
+        "tube", diameter=0.2, thickness=T, length=0.2, E=E, nu=NU, mesh_size=0.016
+    )
+    x = tube_mesh(0.2, 0.2, 0.016, MPI.COMM_SELF).mesh.geometry.x
+    ring = x[np.isclose(x[:, 0], 0.0)]
+    angles = np.sort(np.arctan2(ring[:, 2], ring[:, 1]))
+    chord = 0.2 * math.sin(0.5 * (angles[1] - angles[0]))
+    cell = 0.2 / (distinct(x[:, 0]).size - 1)
+    assert (ring.shape[0], chord, cell) == pytest.approx((40, 0.015692, 0.015385), rel=1e-4)
+    expected = half_wave(tube) / max(chord, cell)
+    assert mesh_cell_counts(tube)[0] == pytest.approx(expected, rel=1e-12)
+    assert expected == pytest.approx(1.5575, rel=1e-4)
 
 
 def test_walls_thick_for_the_shell_model_draw_a_warning():

@@ -262,6 +262,9 @@ def test_the_design_output_says_the_member_s_buckling_is_not_in_it(core):
     assert len(notes) == 1
     assert f"sqrt(f_y/sigma_E) = {math.sqrt(3.55e8 / euler):.3g}" in notes[0]
     assert "0.962" in notes[0] and "EN 1993-1-1, 6.3.1" in notes[0]
+    # The gross area, as eq. (6.50) of 6.3.1.2(1) for Class 1-3; a Class 4 section's
+    # eq. (6.51) takes A_eff (lower slenderness): the note says which one it gives.
+    assert "the gross area" in notes[0] and "sqrt(A_eff f_y/N_cr)" in notes[0]
     assert ("EN 1994-1-1, 6.7.3.3" in notes[0]) == core
     tube = _section("tube", width=None, depth=None, diameter=0.2, length=6.0, core=core)
     tube_euler = math.pi**2 * 2.1e11 * (0.1**2 / 2.0) / 3.0**2  # clamped: L_e = L/2

@@ -189,6 +189,36 @@ def test_a_filled_short_tube_at_its_hollow_load_is_proven():
     assert "certificate proven" in r.summary() and "not proven" not in r.summary()
 
 
+def test_a_filled_short_tube_seeded_on_its_own_cells_is_its_hollow_load():
+    """The same tube with ``levels = 0``: its seeds ran into an eigen solve that failed.
+
+    The seeds run on the given section: free+ is the free mode (KKT at once), free- puts
+    every one of the 632 directions in contact, and that pencil's solve, started from
+    the last mode (nonzero on the rows removed), came back from SLEPc with a spurious
+    load of -7.98e9 on a definite pencil (its least load is 8.077e10, dense scipy): the
+    run ended with "returned a non-positive load" and no result. The solve now runs
+    again from SLEPc's own start. The reference needs no solver: the free mode moves
+    the wall outward only (checked here on its nodes), so it is admissible for the core,
+    and the core never lowers the load (interlacing): the filled load is the hollow one.
+    """
+    import numpy as np
+
+    tube = SectionParameters(
+        "tube", diameter=0.1, thickness=0.001, length=0.01, E=E, nu=NU, mesh_size=0.002,
+        ends="simply_supported", core=True,
+    )  # fmt: skip
+    with solve_section(tube, MPI.COMM_SELF, levels=0) as analysis:
+        r = analysis.result
+        free = analysis.free_mode.x.array.reshape(-1, 6)[:, :3]
+        X = analysis.section.model.W.tabulate_dof_coordinates()
+    radial = (free[:, 1] * X[:, 1] + free[:, 2] * X[:, 2]) / np.hypot(X[:, 1], X[:, 2])
+    scale = np.abs(free).max()
+    assert min(radial.max(), -radial.min()) <= 1e-9 * scale  # one-signed
+    assert np.abs(radial).max() > 0.5 * scale  # and it is the wall's bulge
+    assert r.critical_load_Pa == pytest.approx(r.free_load_Pa, rel=1e-10)
+    assert r.certificate is not None and r.certificate.status == "proven"
+
+
 def test_a_short_tube_on_few_cells_along_draws_the_coarse_mesh_warning(caplog):
     """Cells too few along a short member are warned of, as cells across a face are.
 

@@ -10,7 +10,11 @@ shifted just below the expected load. This is the plate's multilevel route
 rectangle; the answer is always a KKT point of the finest section. The polish runs
 first with the plate's looser tolerances (:func:`_polish`); if they reach no KKT point,
 the plain rule polishes the carried set and the seeds run again on that level, and the
-lower of their KKT points is kept (either may end higher than the other).
+lower of their KKT points is kept (either may end higher than the other). On the given
+(finest) section the seeds run after a successful polish too, and the lower KKT point
+is kept: a coarser section that ranks its arrangements otherwise carries a contact set
+whose polished KKT point can lie well above theirs (a filled tube R/t = 20 in bending,
+13.7 %: :doc:`/history/2026-11-30e-sections`).
 
 That is the ``"active-set"`` route. The ``"interior-point"`` route (:func:`_interior_point`)
 runs the thin plates' nested interior-point chain
@@ -99,6 +103,10 @@ MORE_SEEDS = tuple(name for name in SEED_NAMES if name not in SEEDS)
 #: Steps of the plain rule when the polish at looser tolerances reached no KKT point
 #: (:func:`_polish`); the seeds run on the finer section too, and the lower KKT point wins.
 PLAIN_POLISH_ITERATIONS = 50
+#: On the given section a polished carried set's KKT point is kept over the seeds' unless
+#: theirs is lower by more than this relative load (the same point reached twice agrees
+#: to about 1e-13): the method and records stay the polish's.
+SAME_LOAD = 1e-9
 #: The routes of :func:`solve_levels` (module docstring).
 ROUTES = ("interior-point", "active-set")
 #: "auto" takes the interior point on sections of at least this many DOFs (estimated
@@ -324,7 +332,7 @@ def _active_set(
         try:
             section, polished, polish_iterations, level = _level(
                 parameters, size, prev, best, comm, solver, max_iterations,
-                built[k] if built else None,
+                built[k] if built else None, finest=k == len(sizes) - 1,
             )  # fmt: skip
         except BaseException as err:
             if prev is not None and not built:
@@ -389,12 +397,15 @@ def _level(
     solver: SolverSpec | None,
     max_iterations: int,
     built: Section | None = None,
+    finest: bool = False,
 ) -> tuple[Section, UnilateralSolution, int | None, SectionLevel]:
     """One level: the section on cells of ``size``, solved from the coarser one's ``best``.
 
-    ``built``: that section, built already (the caller's); None: built here. Returns the
-    section (the caller destroys it), its solution, the polish's iterations (None: the
-    seeds ran) and the level's record (its eigen solves: this level's own).
+    ``built``: that section, built already (the caller's); None: built here. ``finest``:
+    the given section, where the seeds run after a polish too and the lower KKT point is
+    kept. Returns the section (the caller destroys it), its solution, the polish's
+    iterations (None: the seeds' KKT point was kept) and the level's record (its eigen
+    solves: this level's own).
     """
     tl = time.perf_counter()
     section = _build(parameters, size, comm, solver) if built is None else built
@@ -404,7 +415,7 @@ def _level(
             section.destroy()
         raise RuntimeError("solve_levels: a core section without constraints")
     solves0 = problem.eigensolver.solves
-    polished, polish_iterations = None, None
+    polished, polish_iterations, seeded_steps = None, None, None
     try:
         plain: tuple[UnilateralSolution | None, int | None] = (None, None)
         if prev is not None and best is not None and prev.constraints is not None:
@@ -413,8 +424,12 @@ def _level(
             if polished is None:
                 budget = min(max_iterations, PLAIN_POLISH_ITERATIONS)
                 plain = _polish(problem, z, best.load, (), POLISH_ITERATIONS, budget)
-        if polished is None:
-            polished = solve_active_set(
+        # On the given section the seeds run even where the carried set polished: the
+        # coarser section may rank its arrangements otherwise, and the carried set's KKT
+        # point be a higher one than theirs (a filled tube in bending: 13.7 %).
+        carried = polished if finest else None
+        if polished is None or carried is not None:
+            seeded = solve_active_set(
                 problem,
                 multilevel=False,
                 max_iterations=max_iterations,
@@ -422,18 +437,20 @@ def _level(
                 seeds=SEEDS,
                 more_seeds=MORE_SEEDS,
             )
+            runs = seeded.details.runs if isinstance(seeded.details, ActiveSetDetails) else []
+            seeded_steps = sum(r.iterations for r in runs)
+            solves = problem.eigensolver.solves
             kept, plain_iterations = plain
-            if kept is not None and kept.load < polished.load:
-                solves = problem.eigensolver.solves
+            if carried is not None and carried.load <= seeded.load * (1.0 + SAME_LOAD):
+                polished = replace(carried, eigensolves=solves)
+            elif kept is not None and kept.load < seeded.load:
                 polished, polish_iterations = replace(kept, eigensolves=solves), plain_iterations
+            else:
+                polished, polish_iterations = seeded, None
     except BaseException:
         if built is None:
             section.destroy()
         raise
-    details = polished.details
-    seeded_steps = (
-        sum(r.iterations for r in details.runs) if isinstance(details, ActiveSetDetails) else 0
-    )
     level = SectionLevel(
         mesh_size=size,
         dofs=section.model.num_dofs,
@@ -441,8 +458,8 @@ def _level(
         load=polished.load,
         kkt=polished.candidate.kkt,
         eigensolves=problem.eigensolver.solves - solves0,
-        steps=seeded_steps if polish_iterations is None else polish_iterations,
-        seeded=polish_iterations is None,
+        steps=(polish_iterations or 0) + (seeded_steps or 0),
+        seeded=seeded_steps is not None,
         wall_time_s=time.perf_counter() - tl,
     )
     return section, polished, polish_iterations, level

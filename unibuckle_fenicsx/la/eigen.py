@@ -171,6 +171,11 @@ def _is_zero(B: PETSc.Mat) -> bool:
     return bool(B.norm(PETSc.NormType.INFINITY) == 0.0)  # type: ignore[arg-type]
 
 
+def _negative(eps: SLEPc.EPS) -> bool:
+    """Whether the first converged eigenvalue of ``eps`` is not positive (collective)."""
+    return eps.getConverged() >= 1 and eps.getEigenvalue(0).real <= 0.0
+
+
 def _no_load(out: PETSc.Vec | None, iterations: int, converged: int) -> EigenPair:
     """The pair of a pencil with no finite load: ``inf``, its vector (into ``out``) zero."""
     if out is not None:
@@ -348,6 +353,16 @@ class GEPSolver(Owner):
         self.solves += 1
         if eps is self.eps and not self.indefinite and eps.getConverged() < 1:
             return self._wider_pair(start, out)
+        if start is not None and eps is self.eps and not self.indefinite and _negative(eps):
+            # A definite pencil has no negative load: a start vector outside the reduced
+            # space (the last mode, nonzero on rows now removed) can leave SLEPc a
+            # spurious one; the same solve from SLEPc's own start.
+            logger.debug("%s: a negative load from the start vector; again without it",
+                         self.prefix)  # fmt: skip
+            eps = self._run(A, B, None, None)
+            self.solves += 1
+            if eps.getConverged() < 1:
+                return self._wider_pair(None, out)
         return self._pair(eps, out)
 
     def _wider_pair(self, initial: PETSc.Vec | None, out: PETSc.Vec | None) -> EigenPair:

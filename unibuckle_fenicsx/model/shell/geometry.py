@@ -44,9 +44,12 @@ __all__ = [
     "SHAPES",
     "SectionMesh",
     "box_mesh",
+    "cell_length",
+    "face_cell_width",
     "flat_face_mesh",
     "grid_nodes",
     "section_mesh",
+    "tube_facet_width",
     "tube_mesh",
 ]
 
@@ -373,6 +376,26 @@ def grid_nodes(
         return _cells_for(across[0], size, even=False, least=1) + 1, along
     b, d = across
     return sum(_face_fractions(e, size, corner).size - 1 for e in (d, b, d, b)), along
+
+
+def cell_length(length: float, size: float) -> float:
+    """The length along x (m) of the cells :func:`section_mesh` makes: L/ceil(L/size)."""
+    return length / _cells_for(length, size, even=False, least=1)
+
+
+def face_cell_width(extent: float, size: float, corner: float | None = None) -> float:
+    """The widest cell (m) across a box's face of width ``extent`` (:func:`box_mesh`).
+
+    An even number of cells of at most ``size``; graded at the corners (``corner``), the
+    uniform middle part's.
+    """
+    return extent * float(np.diff(_face_fractions(extent, size, corner)).max())
+
+
+def tube_facet_width(diameter: float, size: float) -> float:
+    """The width (m) of a tube's facets (:func:`tube_mesh`): the chord 2R sin(pi/n)."""
+    n = _cells_for(math.pi * diameter, size, least=8)
+    return diameter * math.sin(math.pi / n)
 
 
 def section_mesh(
