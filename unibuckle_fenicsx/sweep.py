@@ -304,7 +304,7 @@ def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set")
     elif _is_number(current):
         set_value(data, path, _float(text, path, flag), flag)
     elif isinstance(current, str):
-        node[index] = text
+        node[index] = _string_text(text)
     elif isinstance(current, list) and _is_number_text(text):
         node[index] = _float(text, path, flag)  # a pair's key given one number
     else:
@@ -312,6 +312,19 @@ def set_text(data: dict[str, object], path: str, text: str, flag: str = "--set")
             f"{flag} {path}: the value there, {current!r}, is a table or a list: name one "
             "of its entries, or give a list as TOML writes it ([a, b])"
         )
+
+
+def _string_text(text: str) -> str:
+    """``text`` as a string value: a TOML string (``"tube"``, ``'tube'``) read as TOML reads it.
+
+    ``--set section.shape="tube"`` is the file's line itself; the quotes are not the value's.
+    """
+    if len(text) >= 2 and text[0] == text[-1] and text[0] in "\"'":
+        with contextlib.suppress(tomllib.TOMLDecodeError):
+            value = tomllib.loads(f"value = {text}")["value"]
+            if isinstance(value, str):
+                return value
+    return text
 
 
 def _is_number_text(text: str) -> bool:
@@ -420,7 +433,7 @@ def _new_value(text: str, path: str, flag: str) -> object:
     try:
         return _float(text, path, flag)
     except InputError:
-        return text
+        return _string_text(text)
 
 
 def point_problem(

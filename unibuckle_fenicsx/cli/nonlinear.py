@@ -8,7 +8,12 @@ from pathlib import Path
 from typing import Any
 
 from unibuckle_fenicsx.cli.flags import NONLINEAR_FLAGS
-from unibuckle_fenicsx.cli.problem import spec_from_args, warn_coarse_mesh, warn_plate_model
+from unibuckle_fenicsx.cli.problem import (
+    spec_from_args,
+    warn_coarse_mesh,
+    warn_plate_model,
+    warn_unused_design,
+)
 from unibuckle_fenicsx.cli.status import print_out, report_failure
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
@@ -47,6 +52,7 @@ def nonlinear_command(args: argparse.Namespace, comm: Any) -> int:
             f"an obstacle, and {why}: give --shape free (or auto)"
         )
     warn_plate_model(spec, comm)
+    warn_unused_design(spec, "unibuckle nonlinear", comm)
     # A refused input or a failed solve raises: main() tells the outcome.
     analysis = solve_nonlinear(spec, options, comm)
     with analysis:

@@ -36,6 +36,16 @@ def warn_design_material(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> N
         _warn(steel_poisson_note(spec.material.nu), comm)
 
 
+def warn_unused_design(spec: ProblemSpec, command: str, comm: Any) -> None:
+    """A warning on stderr when ``[design]`` is given to a command that writes no design output."""
+    if spec.design is not None:
+        _warn(
+            f"{command} writes no design output: [design] is read by unibuckle solve and "
+            "unibuckle sweep",
+            comm,
+        )
+
+
 def warn_coarse_mesh(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
     """A warning on stderr, after a solve, when a plate's cells are too coarse for a buckle.
 

@@ -250,6 +250,23 @@ def test_set_changes_the_value_at_its_dotted_path():
     assert spec.plate == paper_case("c1").plate  # and nothing else
 
 
+def test_set_reads_a_string_as_toml_writes_it():
+    """``--set solver.method="penalty"`` (the file's line, quotes and all) sets ``penalty``.
+
+    The quotes were kept as part of the value, which the schema then refused; TOML's basic
+    and literal strings are both read, and a bare word too.
+    """
+    from unibuckle_fenicsx.cli.problem import spec_from_args
+
+    parser, _ = build_parser()
+    for text in ('"penalty"', "'penalty'", "penalty"):
+        args = parser.parse_args(["solve", "--case", "c1", "--set", f"solver.method={text}"])
+        assert spec_from_args(args).solver.method == "penalty", text
+    box = str(ROOT / "demos" / "box.toml")  # a section file's string, a literal string
+    args = parser.parse_args(["solve", "--config", box, "--set", "name='a box'"])
+    assert spec_from_args(args).name == "a box"
+
+
 def test_set_adds_a_key_the_file_leaves_out():
     """--set adds an optional key a problem file may hold: a table, a list, a number.
 

@@ -716,3 +716,15 @@ def test_output_into_a_pipe_closed_early_ends_quietly_with_141(tmp_path):
         err = proc.stderr.read().decode()
         assert proc.wait() == 128 + signal.SIGPIPE, (args, err)
         assert "PETSC ERROR" not in err and "Traceback" not in err, err
+
+
+def test_nonlinear_warns_that_it_writes_no_design_output(tmp_path, capsys):
+    """``[design]`` given to ``unibuckle nonlinear`` is said to be unused, not dropped silently.
+
+    The load path writes no EN 1993-1-5 output; the command read the table and said nothing.
+    """
+    config = tmp_path / "designed.toml"
+    config.write_text(SMALL + "[material]\nE = 2.1e11\nnu = 0.3\n[design]\nyield_stress = 3.55e8\n")
+    main(["nonlinear", "--config", str(config), "--max-load", "1.05", "-q"])
+    err = capsys.readouterr().err
+    assert "unibuckle: warning: unibuckle nonlinear writes no design output" in err, err
