@@ -44,7 +44,7 @@ from typing import Protocol
 import msgspec
 from msgspec import UNSET, Struct, UnsetType
 
-from unibuckle_fenicsx.design import CALIBRATION, UNPROVEN
+from unibuckle_fenicsx.design import CALIBRATION, UNPROVEN, significant
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     buckling_factor,
@@ -301,7 +301,8 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
                 "column-type buckling (EN 1993-1-5 4.4(2) note, 4.5.4(1)): the section's "
                 "length is below the width of face(s) "
                 + ", ".join(
-                    f"{f.face} (xi = {f.xi:.3g}, rho_c = {f.reduction_factor:.4g})" for f in column
+                    f"{f.face} (xi = {f.xi:.3g}, rho_c = {significant(f.reduction_factor)})"
+                    for f in column
                 )
                 + "; sigma_cr,c: the face as a column between the section's ends "
                 + ("(clamped: 4 x eq. (4.8))" if section.ends == "clamped" else "(eq. (4.8))")
@@ -414,22 +415,22 @@ def _governing(d: SectionDesignRecord, *, rule: bool = True) -> str:
 def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") -> str:
     """The summary line of a section's design output (stresses in ``unit``, Pa / ``scale``)."""
     text = (
-        f"design: largest compression sigma_cr = {d.sigma_cr_Pa / scale:.4g} {unit}, "
-        f"slenderness {d.relative_slenderness:.4g}"
+        f"design: largest compression sigma_cr = {significant(d.sigma_cr_Pa / scale)} {unit}, "
+        f"slenderness {significant(d.relative_slenderness)}"
     )
     face = next((f for f in d.faces if f.face == d.governing_face), None)
     if face is not None and face.reduction_factor is not None:
         reduced = face.reduced_design_stress_Pa or 0.0
-        rho = f"rho = {face.reduction_factor:.4g}"
+        rho = f"rho = {significant(face.reduction_factor)}"
         if face.reduction_factor != face.plate_reduction_factor:
             rho = (
-                f"rho_c = {face.reduction_factor:.4g} (column-type, EN 1993-1-5 4.5.4: "
-                f"plate {face.plate_reduction_factor:.4g}, chi_c "
-                f"{face.column_reduction_factor:.4g}, xi {face.xi:.3g})"
+                f"rho_c = {significant(face.reduction_factor)} (column-type, EN 1993-1-5 4.5.4: "
+                f"plate {significant(face.plate_reduction_factor)}, chi_c "
+                f"{significant(face.column_reduction_factor)}, xi {face.xi:.3g})"
             )
         text += (
             f"; EN 1993-1-5 {_governing(d)}: psi = {face.psi:.3g}, {rho}, "
-            f"rho f_y/gamma_M0 = {reduced / scale:.4g} {unit}"
+            f"rho f_y/gamma_M0 = {significant(reduced / scale)} {unit}"
         )
     if d.width_to_thickness is not None and d.width_to_thickness_limit is not None:
         verdict = (

@@ -129,6 +129,11 @@ def test_a_stocky_face_is_fully_effective():
     out = section_design(_section(), DesignSpec(yield_stress=2.35e8), 4 * 2.35e8)
     assert out.faces[0].relative_slenderness == pytest.approx(0.5)
     assert out.faces[0].reduction_factor == 1.0
+    # The summary line keeps four significant digits: f_y itself, 235 MPa, reads
+    # "2.350e+08 Pa" (".4g" wrote "2.35e+08", and 2e8 as "2e+08"), rho = 1 "1.000".
+    line = design_line(out)
+    assert "sigma_cr = 9.400e+08 Pa, slenderness 0.5000" in line, line
+    assert "rho = 1.000, rho f_y/gamma_M0 = 2.350e+08 Pa" in line, line
 
 
 @pytest.mark.parametrize(
@@ -196,7 +201,7 @@ def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):
         summary = analysis.result.summary()
         assert analysis.result.critical_load_Pa == pytest.approx(load, rel=1e-9)
     assert f"sigma_cr = {load / 1e6:.6e} MPa" in summary
-    assert f"largest compression sigma_cr = {load / 1e6:.4g} MPa" in summary
+    assert f"largest compression sigma_cr = {load / 1e6:#.4g}".rstrip(".") + " MPa" in summary
     assert " Pa" not in summary.replace("MPa", "")
     without = SectionParameters(
         "box", width=0.2, depth=0.1, thickness=0.002, length=0.2, E=2.1e11, nu=0.3,
