@@ -142,6 +142,16 @@ def _cells_for(extent: float, size: float, even: bool = True, least: int = 2) ->
     return n + (n % 2) if even else n
 
 
+def _cells_along(length: float, size: float) -> int:
+    """Cells along x of every section mesh: ceil(L/size), at least one."""
+    return _cells_for(length, size, even=False, least=1)
+
+
+def _facets(diameter: float, size: float) -> int:
+    """A tube's facets around: an even number of chords of about ``size``, at least 8."""
+    return _cells_for(math.pi * diameter, size, least=8)
+
+
 #: Growth ratio of neighbouring cells across a graded face (:func:`_face_fractions`).
 GRADING_RATIO = 1.3
 
@@ -270,7 +280,7 @@ def box_mesh(
     _positive(width=width, depth=depth, length=length, size=size)
     if corner_cell is not None:
         _positive(corner_cell=corner_cell)
-    nx = _cells_for(length, size, even=False, least=1)
+    nx = _cells_along(length, size)
     hb, hd = 0.5 * width, 0.5 * depth
     # Counter-clockwise from the corner (+b/2, -d/2); face tags 1..4.
     corners = [(hb, -hd), (hb, hd), (-hb, hd), (-hb, -hd)]
@@ -311,10 +321,10 @@ def tube_mesh(
     """
     _positive(diameter=diameter, length=length, size=size)
     R = 0.5 * diameter
-    nc = _cells_for(2.0 * math.pi * R, size, least=8) if cells_around is None else cells_around
+    nc = _facets(diameter, size) if cells_around is None else cells_around
     if nc < 8 or nc % 2:
         raise InputError(f"cells_around must be an even integer >= 8, got {nc}")
-    nx = _cells_for(length, size, even=False, least=1)
+    nx = _cells_along(length, size)
     phi = 2.0 * math.pi * np.arange(nc) / nc
     ring = np.stack([R * np.cos(phi), R * np.sin(phi)], axis=1)
     msh, _, tags = _surface(comm, ring, np.ones(nc, dtype=np.int32), length, nx, True)
@@ -348,7 +358,7 @@ def flat_face_mesh(
         if size is None:
             raise InputError("flat_face_mesh needs size or cells")
         _positive(size=size)
-        nx, ny = _cells_for(length, size, even=False, least=1), _cells_for(width, size, False, 1)
+        nx, ny = _cells_along(length, size), _cells_for(width, size, False, 1)
     else:
         nx, ny = cells
     ring = np.stack([np.linspace(0.0, width, ny + 1), np.zeros(ny + 1)], axis=1)
@@ -369,9 +379,9 @@ def grid_nodes(
     ``across``: a box's (width, depth), a tube's (diameter, diameter), a flat face's
     (width, 0); ``corner``: a box's ``corner_cell``. No input is checked here.
     """
-    along = _cells_for(length, size, even=False, least=1) + 1
+    along = _cells_along(length, size) + 1
     if shape == "tube":
-        return _cells_for(math.pi * across[0], size, least=8), along
+        return _facets(across[0], size), along
     if shape == "flat":
         return _cells_for(across[0], size, even=False, least=1) + 1, along
     b, d = across
@@ -380,7 +390,7 @@ def grid_nodes(
 
 def cell_length(length: float, size: float) -> float:
     """The length along x (m) of the cells :func:`section_mesh` makes: L/ceil(L/size)."""
-    return length / _cells_for(length, size, even=False, least=1)
+    return length / _cells_along(length, size)
 
 
 def face_cell_width(extent: float, size: float, corner: float | None = None) -> float:
@@ -394,8 +404,7 @@ def face_cell_width(extent: float, size: float, corner: float | None = None) -> 
 
 def tube_facet_width(diameter: float, size: float) -> float:
     """The width (m) of a tube's facets (:func:`tube_mesh`): the chord 2R sin(pi/n)."""
-    n = _cells_for(math.pi * diameter, size, least=8)
-    return diameter * math.sin(math.pi / n)
+    return diameter * math.sin(math.pi / _facets(diameter, size))
 
 
 def section_mesh(
