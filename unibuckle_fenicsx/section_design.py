@@ -422,7 +422,7 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
     if face is not None and face.reduction_factor is not None:
         reduced = face.reduced_design_stress_Pa or 0.0
         rho = f"rho = {significant(face.reduction_factor)}"
-        if face.reduction_factor != face.plate_reduction_factor:
+        if face.xi is not None and face.xi < 1.0:  # rho_c (as the notes name the faces)
             rho = (
                 f"rho_c = {significant(face.reduction_factor)} (column-type, EN 1993-1-5 4.5.4: "
                 f"plate {significant(face.plate_reduction_factor)}, chi_c "
