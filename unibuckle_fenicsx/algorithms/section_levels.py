@@ -13,8 +13,8 @@ the plain rule polishes the carried set and the seeds run again on that level, a
 lower of their KKT points is kept (either may end higher than the other). On the given
 (finest) section the seeds run after a successful polish too, and the lower KKT point
 is kept: a coarser section that ranks its arrangements otherwise carries a contact set
-whose polished KKT point can lie well above theirs (a filled tube R/t = 20 in bending,
-13.7 %: :doc:`/history/2026-11-30e-sections`).
+whose polished KKT point can lie well above theirs (a filled tube in bending:
+:doc:`/history/2026-11-30e-sections`).
 
 That is the ``"active-set"`` route. The ``"interior-point"`` route (:func:`_interior_point`)
 runs the thin plates' nested interior-point chain
@@ -426,7 +426,7 @@ def _level(
                 plain = _polish(problem, z, best.load, (), POLISH_ITERATIONS, budget)
         # On the given section the seeds run even where the carried set polished: the
         # coarser section may rank its arrangements otherwise, and the carried set's KKT
-        # point be a higher one than theirs (a filled tube in bending: 13.7 %).
+        # point be a higher one than theirs (module docstring).
         carried = polished if finest else None
         if polished is None or carried is not None:
             seeded = solve_active_set(
