@@ -57,9 +57,8 @@ from unibuckle_fenicsx.en1993 import (
     DesignElement,
     buckling_factor,
     column_end_factor,
-    column_reduction_factor,
+    column_type,
     design_element,
-    interpolated_reduction_factor,
     plate_euler_stress,
     psi_range,
     reduction_factor,
@@ -326,10 +325,10 @@ def _column_type(
             "sigma_cr,c = 0, xi >= 1, rho_c = rho"
         )
         return rho
-    chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
+    reduced = column_type(rho, sigma1, column, design.yield_stress)
+    chi, rho_c = reduced.chi, reduced.rho
     out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
-    out.xi = sigma1 / column - 1.0
-    rho_c = interpolated_reduction_factor(rho, chi, out.xi)
+    out.xi = reduced.xi
     if out.xi < 1.0:
         out.notes.append(
             f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "

@@ -45,6 +45,7 @@ __all__ = [
     "STEEL_MODULUS",
     "STEEL_POISSON",
     "STEEL_YIELD_STRESS",
+    "ColumnType",
     "DesignEdge",
     "DesignElement",
     "DesignLoad",
@@ -55,6 +56,7 @@ __all__ = [
     "check_steel_yield_stress",
     "column_end_factor",
     "column_reduction_factor",
+    "column_type",
     "design_element",
     "interpolated_reduction_factor",
     "plate_euler_stress",
@@ -369,6 +371,35 @@ def interpolated_reduction_factor(rho: float, chi: float, xi: float) -> float:
         return rho  # exactly: (rho - chi) + chi may differ from it in the last bit
     xi = max(0.0, xi)
     return (rho - chi) * xi * (2.0 - xi) + chi
+
+
+@dataclass(frozen=True)
+class ColumnType:
+    r"""Column-type buckling of a plate (EN 1993-1-5 4.5.3, 4.5.4(1)), :func:`column_type`.
+
+    Attributes:
+        chi: :math:`\chi_c`, curve a at :math:`\bar\lambda_c = \sqrt{f_y/\sigma_{cr,c}}`.
+        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1`, unclipped.
+        rho: :math:`\rho_c`, the plate's :math:`\rho` interpolated towards :math:`\chi_c`.
+    """
+
+    chi: float
+    xi: float
+    rho: float
+
+
+def column_type(rho: float, sigma_cr: float, column: float, yield_stress: float) -> ColumnType:
+    r"""The column-type reduction of a plate or face (EN 1993-1-5 4.5.3(4), (5), 4.5.4(1)).
+
+    Args:
+        rho: The plate-type :math:`\rho` (eq. (4.2) or (4.3)).
+        sigma_cr: The plate's :math:`\sigma_{cr}` (Pa), > 0.
+        column: :math:`\sigma_{cr,c}` (Pa), > 0: the plate as a column (4.5.3(1)).
+        yield_stress: :math:`f_y` (Pa).
+    """
+    chi = column_reduction_factor(math.sqrt(yield_stress / column))
+    xi = sigma_cr / column - 1.0
+    return ColumnType(chi, xi, interpolated_reduction_factor(rho, chi, xi))
 
 
 def buckling_factor(element: str, psi: float, free_edge_most_compressed: bool = True) -> float:

@@ -49,8 +49,7 @@ from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     buckling_factor,
     column_end_factor,
-    column_reduction_factor,
-    interpolated_reduction_factor,
+    column_type,
     plate_euler_stress,
     psi_range,
     reduction_factor,
@@ -244,10 +243,9 @@ def _face(
         column = column_end_factor(kappa, kappa) * plate_euler_stress(
             section.E, section.nu, section.thickness, section.length
         )
-        chi = column_reduction_factor(math.sqrt(design.yield_stress / column))
-        out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
-        out.xi = sigma1 / column - 1.0
-        out.reduction_factor = interpolated_reduction_factor(rho, chi, out.xi)
+        reduced = column_type(rho, sigma1, column, design.yield_stress)
+        out.column_critical_stress_Pa, out.column_reduction_factor = column, reduced.chi
+        out.xi, out.reduction_factor = reduced.xi, reduced.rho
     out.reduced_design_stress_Pa = (
         out.reduction_factor * design.yield_stress / design.partial_factor
     )
