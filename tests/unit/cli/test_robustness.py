@@ -20,6 +20,7 @@ from pathlib import Path
 
 from mpi4py import MPI
 
+import numpy as np
 import pytest
 
 from support.paths import ROOT
@@ -486,6 +487,61 @@ def test_a_mesh_too_coarse_for_the_plate_gets_a_warning(tmp_path, capsys, mesh, 
     else:
         assert f"unibuckle: warning: {said}, more than a quarter of the plate's smaller" in err
         assert "fewer than 4 cells across it" in err, err
+
+
+def _kirchhoff_square_k(psi: float, terms: int = 14) -> float:
+    """The simply supported square's k under sigma(y) = sigma_1 (1 - (1 - psi) y/b), by Ritz.
+
+    w = sum sin(m pi x/b) sin(n pi y/b), m = 1..6, n = 1..terms (Kirchhoff; Gauss
+    quadrature of the stress term), in units of sigma_E = pi^2 D/(t b^2), b = 1.
+    """
+    from scipy.linalg import eigh
+
+    modes = [(m, n) for m in range(1, 7) for n in range(1, terms + 1)]
+    stiffness = np.diag([np.pi**4 * (m * m + n * n) ** 2 / 4.0 for m, n in modes])
+    s, weights = np.polynomial.legendre.leggauss(60)
+    x, w1 = (s + 1.0) / 2.0, weights / 2.0
+    X, Y = np.meshgrid(x, x, indexing="ij")
+    weight = (np.outer(w1, w1) * (1.0 - (1.0 - psi) * Y)).ravel()
+    slopes = np.array(
+        [m * np.pi * np.cos(m * np.pi * X) * np.sin(n * np.pi * Y) for m, n in modes]
+    ).reshape(len(modes), -1)
+    geometric = (slopes * weight) @ slopes.T
+    return float(1.0 / (np.pi**2 * eigh(geometric, stiffness, eigvals_only=True).max()))
+
+
+@pytest.mark.parametrize(("cells", "warned"), [(8, True), (12, False)])
+def test_a_mesh_too_coarse_for_a_stress_gradient_gets_a_warning(tmp_path, capsys, cells, warned):
+    """Cells too coarse for the compressed width b_c = b/(1 - psi): a warning, not silence.
+
+    Under in-plane bending the buckle lies in the compressed part of the plate (EN 1993-1-5
+    Table 4.1's b_c), and the warning counted cells across b alone: the simply supported
+    square 100 x 100 x 0.5 mm at psi = -2 on 8 x 8 cells (8 across b, 2.7 across b_c) gave
+    k = 65.2 without a word, +20 % over Kirchhoff's 54.40 (Ritz, below; Table 4.1's
+    5.98 (1 - psi)^2 = 53.8), where the uniform square's +9 % at 4 cells across is warned
+    of. Now fewer than 4 cells across b_c draw the warning; 12 x 12 (4 across) do not.
+    """
+    config = tmp_path / "bending.toml"
+    config.write_text(
+        "[plate]\ncorners = [[0.0, 0.0], [0.1, 0.1]]\nthickness = 0.0005\n"
+        "[material]\nE = 2.1e11\nnu = 0.3\n"
+        "[edges.left]\nnormal_stress = [-1.0, 2.0]\n[edges.right]\nnormal_stress = [-1.0, 2.0]\n"
+        f"[edges.bottom]\n[edges.top]\n[mesh]\nnx = {cells}\nny = {cells}\n"
+    )
+    out = tmp_path / "k.json"
+    assert main(["solve", "--config", str(config), "--json", str(out), "-q"]) == EXIT_OK
+    err = capsys.readouterr().err
+    k = json.loads(out.read_text())["buckling_coefficient_k"]
+    reference = _kirchhoff_square_k(-2.0)
+    assert reference == pytest.approx(54.40, abs=0.01)
+    if warned:
+        assert k > 1.15 * reference, (k, reference)
+        said = "cells up to 0.0125 m along edges.left, whose normal_stress [-1, 2] is compressive"
+        assert f"unibuckle: warning: mesh.nx = 8, mesh.ny = 8: {said} over 0.0333 m" in err, err
+        assert "fewer than 4 cells across the compressed width" in err, err
+    else:
+        assert k < 1.10 * reference, (k, reference)
+        assert "unibuckle: warning" not in err, err
 
 
 def test_nonlinear_warns_of_a_mesh_too_coarse_as_solve_does(tmp_path, capsys):
