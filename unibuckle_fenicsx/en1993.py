@@ -582,6 +582,7 @@ def design_element(spec: DesignProblem) -> DesignElement:
     fixed = spec.load.fixed_factor != 0.0
     named = {e.name: e for e in spec.plate.edges}
     sides: dict[str, DesignEdge] = {name: named.get(name, _FreeEdge(name)) for name in _NAMES}
+    _check_rectangle_loaded(spec.plate.edges, sides, fixed)
     loaded = _loaded_pair(sides, fixed)
     unloaded = _PAIRS[loaded]
     for name in unloaded:
@@ -624,6 +625,29 @@ def _check_plate(plate: DesignPlate, load: DesignLoad) -> None:
             "supports) that the edge stresses, from which the design output takes sigma_cr "
             "and psi, do not show: leave [design] or the temperature out"
         )
+
+
+def _normal_keys(e: DesignEdge, fixed: bool) -> list[str]:
+    """``edges.NAME.normal_stress`` (and the fixed one, with a fixed part) where ``e`` has one."""
+    keys = [f"edges.{e.name}.normal_stress"] if any(_ends(e.normal_stress)) else []
+    if fixed and any(_ends(e.fixed_normal_stress)):
+        keys.append(f"edges.{e.name}.fixed_normal_stress")
+    return keys
+
+
+def _check_rectangle_loaded(
+    edges: Sequence[DesignEdge], sides: dict[str, DesignEdge], fixed: bool
+) -> None:
+    """Refuse a normal stress given on other boundary parts (the holes) than the rectangle's."""
+    if any(_normal_keys(e, fixed) for e in sides.values()):
+        return
+    given = ", ".join(key for e in edges if e.name not in sides for key in _normal_keys(e, fixed))
+    raise InputError(
+        f"design: {given or 'no normal stress'} on none of the rectangle's edges: EN 1993-1-5 "
+        "4.4 takes the direct stress across two opposite edges of the plate element (its "
+        "loaded edges), from which the design output reads sigma_cr and psi; give "
+        f"edges.NAME.normal_stress on two of {list(_NAMES)} or leave [design] out"
+    )
 
 
 def _loaded_pair(sides: dict[str, DesignEdge], fixed: bool) -> tuple[str, str]:

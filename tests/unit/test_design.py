@@ -777,6 +777,37 @@ def test_an_outline_plate_is_refused():
         problem_from_dict(data)
 
 
+def test_a_stress_on_the_holes_alone_is_refused_naming_its_key():
+    """A normal stress on the holes' boundary only: refused naming that key.
+
+    EN 1993-1-5 4.4 takes the direct stress across two opposite edges of the plate
+    element; the 300 x 100 mm plate with a 20 mm hole, held in its plane at its ends and
+    loaded by a pressure on the hole's edge alone, was refused as "design:  give normal
+    stress in both directions (biaxial)", naming no key and a load it does not have.
+    """
+    data = {
+        "plate": {
+            "corners": [[0, 0], [0.3, 0.1]],
+            "thickness": 0.002,
+            "holes": [{"center": [0.15, 0.05], "radius": 0.02}],
+        },
+        "material": {"E": 2.1e11, "nu": 0.3},
+        "edges": {
+            "left": {"inplane": "clamped"},
+            "right": {"inplane": "clamped"},
+            "bottom": {},
+            "top": {},
+            "holes": {"support": "free", "normal_stress": -1.0},
+        },
+        "mesh": {"size": 0.01},
+        "design": {"yield_stress": 3.55e8},
+    }
+    said = r"design: edges\.holes\.normal_stress on none of the rectangle's edges: EN 1993-1-5"
+    with pytest.raises(ValueError, match=said) as refused:
+        problem_from_dict(data)
+    assert "biaxial" not in str(refused.value)
+
+
 def test_a_rectangle_with_a_hole_is_classified_by_its_edges():
     """The README's plate (clamped all round, a 40 mm hole): an internal element, a note.
 
