@@ -118,6 +118,8 @@ def test_bad_mesh(n):
         ({"max_candidates": 0}, r"solver\.max_candidates"),
         ({"penalty": -1.0}, r"solver\.penalty"),
         ({"prestress_degree": 0}, r"solver\.prestress_degree"),
+        # Degree 30 was taken and its prestress solve did not end in 300 s (12 x 4 cells).
+        ({"prestress_degree": 30}, r"solver\.prestress_degree must be an integer in \[1, 4\]"),
         ({"shear": "reduced"}, r"solver\.shear"),
         ({"complete": "false"}, r"solver\.complete must be true or false, got 'false'"),
         ({"max_candidates": "many"}, r"solver\.max_candidates must be an integer"),
