@@ -444,9 +444,17 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
         )
         + f"; {d.element} element"
         + (f" (free edge {d.free_edge})" if d.free_edge else "")
-        + ", 4.4(2) calibrated on bilateral plates"
+        + f"; {_design_clauses(d)}; rho calibrated on bilateral plates"
         + _design_lower(d, scale, unit)
     )
+
+
+def _design_clauses(d: DesignRecord) -> str:
+    """Where each number of the design line comes from in EN 1993-1-5 (JSON: ``clauses``)."""
+    table = d.table.split(" (")[0]  # "Table 4.1 (internal compression element)"
+    rho = "eq. (4.3)" if d.element == "outstand" else "eq. (4.2)"
+    column = ", rho_c 4.5.4(1)" if d.xi is not None and d.xi < 1.0 else ""
+    return f"psi {table}, slenderness 4.4(2), rho 4.4(2) {rho}{column}, rho f_y/gamma_M0 4.6(1)"
 
 
 def _design_lower(d: DesignRecord, scale: float, unit: str) -> str:
