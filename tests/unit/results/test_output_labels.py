@@ -219,3 +219,29 @@ def test_a_sweep_chart_s_legend_says_what_bilateral_means(tmp_path, monkeypatch)
     charts.plot_sweep(lines, [parse_variation("material.nu=0.2,0.3")], base, tmp_path / "c.png")
     assert "bilateral (no obstacle)" in seen["labels"], seen
     assert "unilateral (with the obstacle)" in seen["labels"], seen
+
+
+def test_a_sweep_prints_its_points_as_a_table_with_units():
+    # The sweep printed "sweep: 3 points in t.jsonl: 3 ok" and nothing of its results: the
+    # table has one row per point, the swept number and the load with their units.
+    from unibuckle_fenicsx.cli.sweep import sweep_table
+
+    cert = {"status": "kkt-only", "kkt": True}
+    lines = [
+        {"index": 0, "point": {"plate.thickness": 2.0}, "status": "ok", "units": "mm-N-MPa",
+         "critical_load_Pa": 7.935676e8, "ratio_to_free": 1.28875, "buckling_coefficient_k":
+         10.45268, "certificate": cert},
+        {"index": 1, "point": {"plate.thickness": 3.0}, "status": "eigen-failure",
+         "units": "mm-N-MPa", "error": "no pair"},
+    ]  # fmt: skip
+    rows = [row.split() for row in sweep_table(lines).splitlines()]
+    assert rows[0][:5] == ["plate.thickness", "(mm)", "lambda_c", "(MPa)", "x"], rows[0]
+    assert rows[1] == ["2", "7.935676e+02", "1.2888", "10.4527", "kkt-only", "ok"], rows[1]
+    assert rows[2] == ["3", "-", "-", "-", "-", "eigen-failure"], rows[2]
+    # A section's row gives the extreme fibre's stress, as its summary's sigma_cr.
+    box = {"point": {"section.thickness": 0.001}, "status": "ok", "units": "SI",
+           "critical_load_Pa": 1.0e8, "compression_Pa": 1.5e8, "classical_stress_Pa": 7.6e7,
+           "ratio_to_free": 2.1, "buckling_coefficient_k": 9.69, "certificate": cert}  # fmt: skip
+    rows = [row.split() for row in sweep_table([box]).splitlines()]
+    assert rows[0][:4] == ["section.thickness", "(m)", "sigma_cr", "(Pa)"], rows[0]
+    assert rows[1][1] == "1.500000e+08", rows[1]
