@@ -309,13 +309,13 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
         metavar="N",
         help="active-set: iterates per seed and mesh level (the feasible descent, the last "
         "fallback, may use 10x as many solves); interior-point: the same for its "
-        "active-set fallback " + _solver_default("max_iterations"),
+        "active-set fallback; N >= 1 " + _solver_default("max_iterations"),
     )
     s.add_argument(
         "--bound-budget",
         type=int,
         metavar="N",
-        help="active-set: eigen solves for the lattice lower bound "
+        help="active-set: eigen solves for the lattice lower bound, N >= 0 "
         + _solver_default("bound_budget"),
     )
     s.add_argument(
@@ -334,11 +334,13 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
         "--penalty",
         type=float,
         metavar="RHO",
-        help="penalty stiffness rho for --method penalty (relative to max diag A) "
+        help="penalty stiffness rho for --method penalty (relative to max diag A), > 0 "
         + _solver_default("penalty"),
     )
     s.add_argument(
-        "--tau", type=float, help="relative feasibility tolerance " + _solver_default("tau")
+        "--tau",
+        type=float,
+        help="relative feasibility tolerance, in (0, 0.01] " + _solver_default("tau"),
     )
     s.add_argument(
         "--candidate-parallel",
@@ -381,13 +383,14 @@ def _method_flags(s: argparse.ArgumentParser) -> None:
         "--max-candidates",
         type=int,
         metavar="N",
-        help="enumerate: refuse above N candidate sets " + _solver_default("max_candidates"),
+        help="enumerate: refuse above N candidate sets, N >= 1 "
+        + _solver_default("max_candidates"),
     )
     s.add_argument(
         "--enumeration-budget",
         type=float,
         metavar="SECONDS",
-        help="auto: enumerate only if the estimated time is below this "
+        help="auto: enumerate only if the estimated time is below this (s, > 0) "
         + _solver_default("enumeration_budget_s"),
     )
 
@@ -443,7 +446,7 @@ def nonlinear_parser(sub: Any, parents: list[Parser]) -> None:
         type=float,
         default=defaults.max_step,
         metavar="FRACTION",
-        help="largest load step, relative to the linear critical load",
+        help="largest load step, relative to the linear critical load, in (0, 1]",
     )
 
 
