@@ -23,6 +23,7 @@ from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
 from unibuckle_fenicsx.section_design import SectionDesignRecord
 from unibuckle_fenicsx.spec import UNITS, PointSpec
+from unibuckle_fenicsx.tolerances import BRACKET_GAP
 
 __all__ = [
     "BucklingResult",
@@ -502,6 +503,14 @@ def _verified(cert: CertificateRecord | None) -> str:
             f"proven=no (KKT only{below}; not bracketed by default here: split bracket "
             f"{cert.split_route}, --bracket runs it)"
         )
+    if cert.split_route is not None and cert.split_route.startswith("not bracketed"):
+        # It ran (by default or on request): say what it verified, not only what it did not.
+        if cert.proven_by == "split-spn" and isinstance(gap, float):
+            return (
+                f"proven=no (KKT only{below}; the split bracket verified a gap of "
+                f"{gap:.1e}, above the {BRACKET_GAP:.0e} of 'bracketed')"
+            )
+        return f"proven=no (KKT only{below}; the split bracket verified no higher bound)"
     if cert.split_route is not None:
         return f"proven=no (KKT only{below}; split bracket {cert.split_route})"
     return f"proven=no (KKT only{below})"

@@ -12,6 +12,7 @@ import math
 
 from mpi4py import MPI
 
+import msgspec
 import numpy as np
 import pytest
 
@@ -245,3 +246,27 @@ def test_a_sweep_prints_its_points_as_a_table_with_units():
     rows = [row.split() for row in sweep_table([box]).splitlines()]
     assert rows[0][:4] == ["section.thickness", "(m)", "sigma_cr", "(Pa)"], rows[0]
     assert rows[1][1] == "1.500000e+08", rows[1]
+
+
+def test_a_bracket_that_ran_says_what_it_verified():
+    # The quickstart's plate with --bracket: the split route verifies 1.735629e9 Pa below
+    # lambda_c = 1.753161e9 (a gap of 1.0e-2, above the 1e-3 that 'bracketed' asks), and
+    # the first line read "split bracket not bracketed (estimated cost 432.6 free solves)".
+    from unibuckle_fenicsx.results.records import CertificateRecord, _verified
+
+    lower, upper = 1.735629e9, 1.753161e9
+    cert = CertificateRecord(
+        feasible=True, feasibility_margin=-1e-5, max_contact_force=-5e-3,
+        max_contact_value=0.0, relative_residual=3e-13, tolerance=1e-8, kkt=True,
+        smallest_of_reduced=True, lower_bound_Pa=lower, upper_bound_Pa=upper,
+        relative_gap=(upper - lower) / upper, global_optimum_proven=False,
+        proven_by="split-spn", status="kkt-only", negative_eigenvalues=4,
+        refuting_load_Pa=None, copositivity=None, notes=[],
+        split_route="not bracketed (estimated cost 432.6 free solves)",
+    )  # fmt: skip
+    text = _verified(cert)
+    assert "the split bracket verified a gap of 1.0e-02, above the 1e-03 of 'bracketed'" in text
+    assert "not bracketed (estimated cost" not in text, text
+    # Run, but nothing closer than the free load verified: it says so.
+    none = msgspec.structs.replace(cert, proven_by="interlacing", relative_gap=0.22)
+    assert "the split bracket verified no higher bound" in _verified(none), _verified(none)
