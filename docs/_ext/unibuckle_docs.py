@@ -425,6 +425,13 @@ COMMANDS = {
         rows, "sections_first_carry_plates"
     ),
     "sections_box_levels_plates": lambda rows: _plates_commands(rows, "sections_box_levels_plates"),
+    "sections_route": lambda rows: _sections_commands(rows, "sections_route"),
+    "sections_route_plates": lambda rows: _plates_commands(rows, "sections_route_plates"),
+    "section_inertia": lambda rows: (
+        "python bench/bench_section_inertia.py --problems "
+        + ",".join(f"{r['problem']}@{r['load_Pa']!r}" for r in rows)
+        + " --json bench/results/section_inertia.jsonl"
+    ),
     "step_cost": lambda rows: (
         f"python bench/bench_step_cost.py --problems {_listed(rows, 'problem')} "
         f"--orderings {_listed(rows, 'ordering')} --json bench/results/step_cost.jsonl"
@@ -735,6 +742,23 @@ BENCH_COLUMNS["sections_first_carry_plates"] = BENCH_COLUMNS["plates"]
 BENCH_COLUMNS["sections_box_levels_plates"] = [
     ("thickness", "t (m)"),
     *BENCH_COLUMNS["plates"],
+]
+#: The section route per level beside its free solve, in seconds too.
+BENCH_COLUMNS["sections_route"] = [
+    *SECTIONS_COLUMNS[:5],
+    ("free_s", "free solve (s)"),
+    ("unilateral_s", "unilateral solve (s)"),
+    *SECTIONS_COLUMNS[5:],
+]
+BENCH_COLUMNS["sections_route_plates"] = BENCH_COLUMNS["sections_box_levels_plates"]
+#: The pencil's eigenvalues below the critical load, section and plate.
+BENCH_COLUMNS["section_inertia"] = [
+    ("problem", "problem"),
+    ("rows", "rows"),
+    ("free_load_Pa", "λ_free (Pa)"),
+    ("load_Pa", "λ_c (Pa)"),
+    ("load/free", "λ_c / λ_free"),
+    ("below", "eigenvalues below λ_c"),
 ]
 BENCH_COLUMNS["profile"] = [
     ("case", "plate"),
