@@ -12,6 +12,7 @@ import dolfinx
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.model.mesh import collapsed
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 
 __all__ = [
@@ -45,7 +46,7 @@ class Prolongation:
     def __init__(self, coarse: UnilateralProblem, fine: UnilateralProblem) -> None:
         self.coarse, self.fine = coarse, fine
         self._subs = [
-            (coarse.model.W.sub(sub).collapse(), fine.model.W.sub(sub).collapse()) for sub in (0, 1)
+            (collapsed(coarse.model.W, sub)[1:], collapsed(fine.model.W, sub)[1:]) for sub in (0, 1)
         ]
         self._grid: list[_BilinearWeights] | None = None
         if coarse.structured:
@@ -61,7 +62,7 @@ class Prolongation:
         """The coarse (w, theta) function ``u`` interpolated on the fine space."""
         out = self.fine.new_mode("prolonged")
         for sub, ((Vc, map_c), (Vf, map_f)) in enumerate(self._subs):
-            coarse_values = u.x.array[np.asarray(map_c[0])]
+            coarse_values = u.x.array[map_c]
             if self._grid is not None:
                 fine_values = self._grid[sub].apply(coarse_values)
             else:
@@ -70,7 +71,7 @@ class Prolongation:
                 ff = dolfinx.fem.Function(Vf)
                 ff.interpolate_nonmatching(fc, self._cells, self._data)
                 fine_values = np.asarray(ff.x.array, dtype=np.float64)
-            out.x.array[np.asarray(map_f[0])] = fine_values
+            out.x.array[map_f] = fine_values
         out.x.scatter_forward()
         return out
 

@@ -386,15 +386,21 @@ def _mirror_maps(problem: UnilateralProblem, tol: float) -> dict[str, npt.NDArra
     cx, cy = 0.5 * (x0 + x1), 0.5 * (y0 + y1)
     size = max(x1 - x0, y1 - y0)
 
-    def keys(p: npt.NDArray[np.float64]) -> list[tuple[int, int]]:
-        k = np.round((p - (cx, cy)) / (tol * size)).astype(np.int64)
-        return [(int(a), int(b)) for a, b in k.tolist()]
+    def keys(p: npt.NDArray[np.float64]) -> npt.NDArray[np.int64]:
+        return np.round((p - (cx, cy)) / (tol * size)).astype(np.int64)
 
-    index = {key: k for k, key in enumerate(keys(xy))}
+    own = keys(xy)
+    n = len(own)
     out = {}
     for name, (sx, sy) in {"x": (-1, 1), "y": (1, -1), "xy": (-1, -1)}.items():
         image = np.column_stack([cx + sx * (xy[:, 0] - cx), cy + sy * (xy[:, 1] - cy)])
-        perm = [index.get(key) for key in keys(image)]
-        if all(k is not None for k in perm):
-            out[name] = np.asarray(perm, dtype=np.int64)
+        # Number the distinct keys of the nodes and of their images together; a node
+        # maps to the (last) node whose key its image's key equals.
+        _, key_id = np.unique(np.vstack([own, keys(image)]), axis=0, return_inverse=True)
+        key_id = key_id.reshape(-1)
+        node_of = np.full(2 * n, -1, dtype=np.int64)
+        node_of[key_id[:n]] = np.arange(n, dtype=np.int64)  # repeated keys: the last wins
+        perm = node_of[key_id[n:]]
+        if np.all(perm >= 0):
+            out[name] = perm
     return out

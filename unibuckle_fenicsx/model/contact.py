@@ -8,7 +8,7 @@ array of these numbers, means the same nodes on every rank and for every partiti
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 from mpi4py import MPI
@@ -258,35 +258,44 @@ class ContactSetManager:
         size = model.extent
         tensionless = kinds == {"tensionless"}
         areas = tributary_areas(model).array if tensionless else None
-        found: dict[int, tuple[int, float]] = {}  # W dof -> (Vw dof, sign)
-        spring: dict[int, float] = {}  # W dof -> stiffness (foundations)
-        gap: dict[int, float] = {}  # W dof -> the smallest gap of its obstacles
-        conflict = False
-        for o in self.obstacles:
-            dofs_W, dofs_Vw = _zone_dofs(model, o, size)
-            for dw, dv in zip(dofs_W.tolist(), dofs_Vw.tolist(), strict=True):
-                conflict |= dw in found and found[dw][1] != o.sign
-                found[dw] = (dv, o.sign)
-                gap[dw] = min(gap.get(dw, o.gap), o.gap)
-                if areas is not None:
-                    if o.foundation_stiffness is None:
-                        raise RuntimeError(
-                            "__init__: expected o.foundation_stiffness is not None (an internal "
-                            "invariant)"
-                        )
-                    spring[dw] = spring.get(dw, 0.0) + o.foundation_stiffness * float(areas[dv])
+        zones = [_zone_dofs(model, o, size) for o in self.obstacles]
+        # Every zone's nodes in the obstacles' order; a node in several zones appears once
+        # per zone, and its entries are merged below in that order.
+        all_W = np.concatenate([dofs_W for dofs_W, _ in zones])
+        all_Vw = np.concatenate([dofs_Vw for _, dofs_Vw in zones])
+
+        counts = [len(dofs_W) for dofs_W, _ in zones]
+
+        def per_node(value: Callable[[ObstacleSpec], float]) -> npt.NDArray[np.float64]:
+            values = [value(o) for o in self.obstacles]
+            return np.repeat(np.asarray(values, dtype=float), counts)
+
+        order_W, first, node = np.unique(all_W, return_index=True, return_inverse=True)
+        dofs_W = order_W.astype(np.int32)
+        dofs_Vw = all_Vw[first].astype(np.int32)  # a W dof has one Vw dof
+        all_signs = per_node(lambda o: o.sign)
+        signs = np.full(len(order_W), np.inf)
+        np.minimum.at(signs, node, all_signs)
+        highest = np.full(len(order_W), -np.inf)
+        np.maximum.at(highest, node, all_signs)
+        conflict = bool(np.any(signs != highest))
+        gaps = np.full(len(order_W), np.inf)
+        np.minimum.at(gaps, node, per_node(lambda o: o.gap))
+        springs = np.zeros(len(order_W))
+        if areas is not None:
+            if any(o.foundation_stiffness is None for o in self.obstacles):
+                raise RuntimeError(
+                    "__init__: expected o.foundation_stiffness is not None (an internal invariant)"
+                )
+            # Summed zone by zone from 0.0, in the obstacles' order (np.add.at is unbuffered).
+            stiffness = per_node(lambda o: float(o.foundation_stiffness or 0.0))
+            np.add.at(springs, node, stiffness * areas[all_Vw])
         if comm.allreduce(conflict, op=MPI.LOR):
             raise BilateralZoneError(
                 "obstacle zones on both sides of the plate share a mesh node: a bilateral "
                 "support (w = 0), not an obstacle; give an edge its [edges.NAME] support, "
                 "or make the zones disjoint"
             )
-        order_W = np.array(sorted(found), dtype=np.int32)
-        dofs_W = order_W
-        dofs_Vw = np.array([found[d][0] for d in order_W.tolist()], dtype=np.int32)
-        signs = np.array([found[d][1] for d in order_W.tolist()], dtype=float)
-        springs = np.array([spring.get(d, 0.0) for d in order_W.tolist()], dtype=float)
-        gaps = np.array([gap[d] for d in order_W.tolist()], dtype=float)
         n_owned = model.num_owned_dofs
         keep = dofs_W < n_owned
         fixed = np.isin(dofs_W, model.bc_dofs)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 from collections.abc import Sequence
+from typing import NamedTuple
 
 from mpi4py import MPI
 
@@ -24,8 +25,10 @@ from unibuckle_fenicsx.spec import (
 )
 
 __all__ = [
+    "Collapsed",
     "build_plate_mesh",
     "check_user_mesh",
+    "collapsed",
     "create_plate_mesh",
     "edge_facets",
     "edge_line",
@@ -33,6 +36,42 @@ __all__ = [
     "edge_tag",
     "edge_tags",
 ]
+
+
+class Collapsed(NamedTuple):
+    """A sub-space of a function space, collapsed (:func:`collapsed`)."""
+
+    #: The sub-space (a view into the parent's DOFs, for boundary conditions).
+    sub: dolfinx.fem.FunctionSpace
+    #: Its collapsed copy (a space of its own).
+    space: dolfinx.fem.FunctionSpace
+    #: The parent's local DOF of each local DOF of ``space``.
+    dofs: npt.NDArray[np.int32]
+
+
+#: Attribute of a function space that holds its collapsed sub-spaces, by path.
+_COLLAPSED = "_unibuckle_collapsed"
+
+
+def collapsed(V: dolfinx.fem.FunctionSpace, *path: int) -> Collapsed:
+    """The sub-space of ``V`` at ``path`` (``V.sub(i).sub(j)...``), collapsed once per ``V``.
+
+    ``FunctionSpace.collapse`` builds a new dofmap each time it is called; the supports'
+    boundary conditions, the MITC operator, the prolongation between meshes and the
+    prestress's pins all need the same few sub-spaces of one space. The result is kept
+    on ``V`` (and goes with it) and is the same on every call.
+
+    Note:
+        Collective on the first call for a ``path``.
+    """
+    cache: dict[tuple[int, ...], Collapsed] = V.__dict__.setdefault(_COLLAPSED, {})
+    if path not in cache:
+        sub = V
+        for i in path:
+            sub = sub.sub(i)
+        space, dofs = sub.collapse()
+        cache[path] = Collapsed(sub, space, np.asarray(dofs[0], dtype=np.int32))
+    return cache[path]
 
 
 def create_plate_mesh(

@@ -40,7 +40,7 @@ from unibuckle_fenicsx.la.options import (
     set_options,
 )
 from unibuckle_fenicsx.model.materials import membrane_voigt
-from unibuckle_fenicsx.model.mesh import edge_line, edge_normal_axis, edge_tags
+from unibuckle_fenicsx.model.mesh import collapsed, edge_line, edge_normal_axis, edge_tags
 from unibuckle_fenicsx.spec import (
     EdgeSpec,
     Material,
@@ -223,11 +223,11 @@ def pin_rigid_motions(
     pins = [(p1, (0, 1)), (p2, (axis,))] if only is None else [(p1, (only,))]
     for point, components in pins:
         for c in components:
-            Vc, _ = V.sub(c).collapse()
+            sub, Vc, _ = collapsed(V, c)
             dofs = dolfinx.fem.locate_dofs_geometrical(
-                (V.sub(c), Vc), lambda y, p=point: np.linalg.norm(y[:2].T - p[:2], axis=1) < tol
+                (sub, Vc), lambda y, p=point: np.linalg.norm(y[:2].T - p[:2], axis=1) < tol
             )
-            bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
+            bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
     return bcs
 
 
@@ -413,9 +413,9 @@ def _inplane_bcs(
             if e.inplane == "roller":
                 components = (edge_normal_axis(msh, facet_tags, tag, e.name),)
             for c in components:
-                Vc, _ = V.sub(c).collapse()
-                dofs = dolfinx.fem.locate_dofs_topological((V.sub(c), Vc), fdim, facets)
-                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
+                sub, Vc, _ = collapsed(V, c)
+                dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
+                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
     return bcs
 
 

@@ -16,7 +16,7 @@ import numpy.typing as npt
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.materials import bending_voigt, transverse_shear
-from unibuckle_fenicsx.model.mesh import edge_normal_axis, edge_tags
+from unibuckle_fenicsx.model.mesh import collapsed, edge_normal_axis, edge_tags
 from unibuckle_fenicsx.model.plate.forms import (
     bending_form,
     geometric_form,
@@ -85,8 +85,9 @@ class PlateModel(MixedDofs, Owner):
         self.material = material
         self.prestress = prestress
         self.W = create_plate_space(msh)
-        self.Vw, map_w = self.W.sub(0).collapse()
-        self.w_dofs = np.asarray(map_w[0], dtype=np.int32)  # Vw local dof -> W local dof
+        w_space = collapsed(self.W, 0)
+        self.Vw = w_space.space
+        self.w_dofs = w_space.dofs  # Vw local dof -> W local dof
         edge_bcs = self._edge_bcs(facet_tags)
         edge_dofs = [bc.dof_indices()[0] for bc in edge_bcs] or [np.empty(0, np.int32)]
         #: The point restraints on the mesh (snapped to nodes; those on held nodes marked).
@@ -226,12 +227,9 @@ def edge_support_bcs(
                 normal = edge_normal_axis(msh, facet_tags, tag, e.name)
                 subs.append((theta_sub, 1 - normal))
             for path in subs:
-                sub = W
-                for i in path:
-                    sub = sub.sub(i)
-                Vc, _ = sub.collapse()
-                dofs = dolfinx.fem.locate_dofs_topological((sub, Vc), fdim, facets)
-                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], sub))
+                c = collapsed(W, *path)
+                dofs = dolfinx.fem.locate_dofs_topological((c.sub, c.space), fdim, facets)
+                bcs.append(dolfinx.fem.dirichletbc(0.0, dofs[0], c.sub))
     return bcs
 
 

@@ -22,6 +22,8 @@ import dolfinx.fem.petsc
 import numpy as np
 import numpy.typing as npt
 
+from unibuckle_fenicsx.model.mesh import collapsed
+
 __all__ = ["MixedDofs", "create_plate_space", "create_shear_space", "mitc_shear_operator"]
 
 
@@ -82,14 +84,14 @@ def mitc_shear_operator(
     Note:
         Collective.
     """
-    Vw, map_w = W.sub(w_sub).collapse()
-    Vt, map_t = W.sub(theta_sub).collapse()
+    _, Vw, map_w = collapsed(W, w_sub)
+    _, Vt, map_t = collapsed(W, theta_sub)
     G = dolfinx.fem.petsc.discrete_gradient(Vw, Vs)
     G.assemble()
     I = dolfinx.fem.petsc.interpolation_matrix(Vt, Vs)  # noqa: E741
     I.assemble()
-    Rw = _restriction(W, Vw, np.asarray(map_w[0], dtype=np.int32))
-    Rt = _restriction(W, Vt, np.asarray(map_t[0], dtype=np.int32))
+    Rw = _restriction(W, Vw, map_w)
+    Rt = _restriction(W, Vt, map_t)
     P = G.matMult(Rw)
     It = I.matMult(Rt)
     P.axpy(-1.0, It, structure=PETSc.Mat.Structure.DIFFERENT_NONZERO_PATTERN)  # type: ignore[arg-type]
