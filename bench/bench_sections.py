@@ -13,8 +13,9 @@ eigen solve (min of ``--repeat`` solves of the same pencil), and the unilateral 
 ``--levels`` coarser copies, its sections' set-up included) by ``--route``:
 ``active-set`` (the active-set seeds on the coarsest section, the contact set polished
 level by level; ``levels`` is its old name), ``interior-point`` (the nested
-interior-point chain, the mode carried from section to section), ``auto`` (the
-interior point, the active set if it reaches no KKT point) or ``single`` (the
+interior-point chain, the mode carried from section to section), ``auto`` (the route
+:func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses: below 10⁴ DOFs both,
+the lower KKT point kept) or ``single`` (the
 interior-point chain on the section itself, no coarser one); then the certificate.
 The factorisations are PETSc's count of numeric ones (MUMPS) in the unilateral solve, in
 all and, for the active set, per section level; the interior point's per level are its

@@ -102,9 +102,10 @@ SANDERS = 0.9601  # Sanders' equations over SIGMA_CL, L = R (tests/support/cylin
 # ## The sections, filled
 #
 # `solve_section` solves the hollow section (its free load, verified the smallest by an
-# inertia count) and, with `core = True`, the filled one with its certificate: the
-# active set, its seeds on a section of twice the cell size (`levels = 1`, the box) or on
-# the section itself (`levels = 0`, the tube). Its modes' arrays go to the 3-D figures.
+# inertia count) and, with `core = True`, the filled one with its certificate: on these
+# sections (below 10^4 DOFs) the interior point and the active set, the lower KKT point
+# kept, starting on a section of twice the cell size (`levels = 1`, the box) or on the
+# section itself (`levels = 0`, the tube). Its modes' arrays go to the 3-D figures.
 
 
 # %%

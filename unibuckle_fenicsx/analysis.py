@@ -21,7 +21,11 @@ import dolfinx
 from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
 from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
 from unibuckle_fenicsx.algorithms.registry import FOUNDATION, entry
-from unibuckle_fenicsx.algorithms.section_levels import INTERIOR_POINT_DOFS, estimated_dofs
+from unibuckle_fenicsx.algorithms.section_levels import (
+    BOTH,
+    INTERIOR_POINT_DOFS,
+    estimated_dofs,
+)
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.ownership import Owner
@@ -120,8 +124,10 @@ def choose_section_method(parameters: SectionParameters, solver: SolverSpec) -> 
     interior point on sections of at least
     :data:`~unibuckle_fenicsx.algorithms.section_levels.INTERIOR_POINT_DOFS` degrees of
     freedom, estimated before meshing
-    (:func:`~unibuckle_fenicsx.algorithms.section_levels.estimated_dofs`), and the active set
-    on smaller ones. The interior point falls back on the active set when it reaches no
+    (:func:`~unibuckle_fenicsx.algorithms.section_levels.estimated_dofs`), and on smaller
+    ones both routes on the same sections, the lower KKT point kept
+    (:data:`~unibuckle_fenicsx.algorithms.section_levels.BOTH`: either alone can end
+    above the other). The interior point falls back on the active set when it reaches no
     KKT point (its route then takes the link "active-set").
 
     Raises:
@@ -135,10 +141,15 @@ def choose_section_method(parameters: SectionParameters, solver: SolverSpec) -> 
     if solver.method != Method.AUTO:
         return solver.method, "given"
     dofs = estimated_dofs(parameters)
-    large = dofs >= INTERIOR_POINT_DOFS
-    return Method.INTERIOR_POINT if large else Method.ACTIVE_SET, (
-        f"auto: about {dofs} DOFs (estimated before meshing) "
-        f"{'>=' if large else '<'} INTERIOR_POINT_DOFS = {INTERIOR_POINT_DOFS}"
+    if dofs >= INTERIOR_POINT_DOFS:
+        return Method.INTERIOR_POINT, (
+            f"auto: about {dofs} DOFs (estimated before meshing) >= "
+            f"INTERIOR_POINT_DOFS = {INTERIOR_POINT_DOFS}"
+        )
+    return BOTH, (
+        f"auto: about {dofs} DOFs (estimated before meshing) < INTERIOR_POINT_DOFS = "
+        f"{INTERIOR_POINT_DOFS}: the interior point and the active set, the lower KKT "
+        "point kept"
     )
 
 

@@ -4,11 +4,11 @@
 (``docs/verification/sections.md``, "Cost"): without a core the free load, with an
 elastic core the spring-set iteration, with a rigid core the ``[solver] method`` given,
 "auto" taking the interior point on sections of at least ``INTERIOR_POINT_DOFS`` = 10^4
-DOFs and the active set on smaller ones. The expected DOFs are worked out here by hand:
-a box of square faces b on uniform cells h has 4 b/h nodes around, L/h + 1 along and six
-DOFs per node (the demo's box: 6 x 32 x 25 = 4 800; the box b/16 of the Cost table:
-6 x 64 x 49 = 18 816). A method given in a file runs that route: its load is the one
-``solve_levels`` gives with that route.
+DOFs and both routes on smaller ones, the lower KKT point kept. The expected DOFs are
+worked out here by hand: a box of square faces b on uniform cells h has 4 b/h nodes
+around, L/h + 1 along and six DOFs per node (the demo's box: 6 x 32 x 25 = 4 800; the
+box b/16 of the Cost table: 6 x 64 x 49 = 18 816). A method given in a file runs that
+route: its load is the one ``solve_levels`` gives with that route.
 """
 
 from __future__ import annotations
@@ -52,8 +52,9 @@ def test_auto_takes_the_interior_point_from_ten_thousand_dofs():
     assert (_dofs(0.1, 0.3, 0.0125), _dofs(0.2, 0.6, 0.0125)) == (4800, 18816)
     auto = SolverSpec()
     assert choose_section_method(small, auto) == (
-        "active-set",
-        "auto: about 4800 DOFs (estimated before meshing) < INTERIOR_POINT_DOFS = 10000",
+        "both",
+        "auto: about 4800 DOFs (estimated before meshing) < INTERIOR_POINT_DOFS = 10000: "
+        "the interior point and the active set, the lower KKT point kept",
     )
     assert choose_section_method(large, auto) == (
         "interior-point",
@@ -124,7 +125,7 @@ def test_the_command_lines_method_reaches_a_section(tmp_path, capsys):
     args = ["solve", "--config", str(path), "--json", str(out)]
     assert main(args) == EXIT_OK
     auto = json.loads(out.read_text())
-    assert auto["method"] == "active-set (section levels)"
+    assert auto["method"] in ("active-set (section levels)", "interior-point (section levels)")
     assert auto["method_chosen_by"].startswith("auto: about 864 DOFs")
     assert main([*args, "--method", "interior-point"]) == EXIT_OK
     given = json.loads(out.read_text())
@@ -199,3 +200,81 @@ def test_the_active_set_route_ends_no_higher_than_an_admissible_mode():
         assert result.method_chosen_by.startswith("auto")
         assert result.certificate.kkt
         assert result.critical_load_Pa <= bound * (1.0 + 1e-7)
+
+
+def test_auto_on_a_small_section_ends_no_higher_than_the_interior_point():
+    """The default method below 10^4 DOFs is not above the interior point's admissible mode.
+
+    A tube D = 0.1 m, t = 2.5 mm (R/t = 20), L = 50 mm between clamped ends, pure
+    bending, 8 mm cells (1 920 DOFs). "auto" took the active set alone below
+    INTERIOR_POINT_DOFS, which ended at a KKT point at 1.1016e10 Pa, where the interior
+    point reaches 1.0831e10 Pa (1.7 % lower; on the same tube L = 0.1 m on 5 mm cells,
+    8 064 DOFs, 0.26 %). The reference is independent of either route: the interior
+    point's mode made admissible by hand and its Rayleigh quotient on the assembled
+    matrices (_admissible_rayleigh_quotient), an upper bound on the critical load.
+    """
+    tube = SectionParameters(
+        "tube", diameter=0.1, thickness=0.0025, length=0.05, E=E, nu=NU, mesh_size=0.008,
+        ends="clamped", axial_stress=0.0, bending_stress=-1.0, core=True,
+    )  # fmt: skip
+    given = SolverSpec(method="interior-point")
+    with solve_section(tube, MPI.COMM_SELF, solver=given) as interior:
+        bound, removed = _admissible_rayleigh_quotient(interior)
+        assert interior.result.certificate.kkt
+        assert removed < 1e-6  # the mode was admissible to the tolerance already
+    assert bound == pytest.approx(1.0831e10, rel=1e-4)
+    with solve_section(tube, MPI.COMM_SELF) as solved:  # "auto"
+        result = solved.result
+        assert result.dofs == 1920
+        assert result.method_chosen_by.startswith("auto: about 1920 DOFs")
+        assert result.certificate.kkt
+        assert result.critical_load_Pa <= bound * (1.0 + 1e-7)
+
+
+@pytest.mark.parametrize("method", ["active-set", "interior-point", "auto"])
+def test_a_sections_eigensolves_count_every_solve_of_the_route(method, monkeypatch):
+    """``eigensolves`` is every eigen solve on every section the route built.
+
+    The reference is the eigen solvers' own counters, read on every section the route
+    built (the coarser ones when they are destroyed, the finest when the certificate
+    starts). The active set counted only its kept run on the given section (47 of the
+    77 on the box of FILE), the interior point its finest section's free solve twice.
+    """
+    import unibuckle_fenicsx.algorithms.section_levels as levels
+    import unibuckle_fenicsx.section_analysis as section_analysis
+
+    counted: dict[int, int] = {}
+    built = []
+    build, certify = levels.build_section, section_analysis.certify
+
+    def read(section):
+        if id(section) in counted:
+            return counted[id(section)]
+        return section.problem.eigensolver.solves
+
+    def recorded_build(*args, **kwargs):
+        section = build(*args, **kwargs)
+        built.append(section)
+        destroy = section.destroy
+
+        def destroy_counted():
+            if id(section) not in counted:  # the first destroy: its objects still there
+                counted[id(section)] = section.problem.eigensolver.solves
+            destroy()
+
+        section.destroy = destroy_counted
+        return section
+
+    before_certificate = []
+
+    def recorded_certify(*args, **kwargs):
+        before_certificate.append(sum(read(section) for section in built))
+        return certify(*args, **kwargs)
+
+    monkeypatch.setattr(levels, "build_section", recorded_build)
+    monkeypatch.setattr(section_analysis, "certify", recorded_certify)
+    spec = section_from_dict({**FILE, "solver": {"method": method}})
+    with solve_section(spec, MPI.COMM_SELF) as solved:
+        result = solved.result
+    assert len(built) == 2 and len(before_certificate) == 1
+    assert result.eigensolves == before_certificate[0]

@@ -182,7 +182,9 @@ def test_a_filled_short_tube_at_its_hollow_load_is_proven():
     design = DesignSpec(yield_stress=3.55e8)
     with solve_section(tube, MPI.COMM_SELF, design=design) as analysis:
         r = analysis.result
-    assert r.method == "active-set (section levels)" and r.contact_nodes == 0
+    # "auto" runs both routes on this small section and keeps the lower (here the same
+    # point): either may be named.
+    assert r.method.split()[0] in ("active-set", "interior-point") and r.contact_nodes == 0
     assert r.critical_load_Pa == pytest.approx(r.free_load_Pa, rel=1e-10)
     assert r.certificate is not None and r.certificate.status == "proven"
     assert not isinstance(r.design.lower_bound, type(r.design))

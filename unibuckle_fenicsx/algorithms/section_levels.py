@@ -31,8 +31,11 @@ starts on: assembled, prestressed and their free modes solved once).
 
 Which route runs is decided with the plate's method, in one place
 (:func:`~unibuckle_fenicsx.analysis.choose_section_method`, ``"auto"``: the interior
-point on sections of at least :data:`INTERIOR_POINT_DOFS` degrees of freedom, the
-active set on smaller ones); :func:`solve_levels` runs the route it is given.
+point on sections of at least :data:`INTERIOR_POINT_DOFS` degrees of freedom; on
+smaller ones both routes (:data:`BOTH`), the active set on the sections the interior
+point built, and the lower KKT point is kept: both are KKT points, neither is proven
+the lowest, and either can end above the other); :func:`solve_levels` runs the route
+it is given.
 
 The seeds are those of :data:`SEEDS`, the plate's others (:data:`MORE_SEEDS`) only if
 these reach no KKT point: a core makes every wall move outward, and the contact set is
@@ -42,6 +45,7 @@ the walls' nodes save where they lift off, which the free mode's signs seed
 
 from __future__ import annotations
 
+import logging
 import time
 from collections.abc import Sequence
 from dataclasses import replace
@@ -78,6 +82,7 @@ from unibuckle_fenicsx.spec import SolverSpec
 from unibuckle_fenicsx.spec.base import in_file
 
 __all__ = [
+    "BOTH",
     "CHAIN_OPTIONS",
     "COARSEST_DOFS",
     "INTERIOR_POINT_DOFS",
@@ -89,6 +94,8 @@ __all__ = [
     "prolong_directions",
     "solve_levels",
 ]
+
+logger = logging.getLogger(__name__)
 
 #: The active set's seeds on a section (of
 #: :data:`~unibuckle_fenicsx.algorithms.active_set.SEED_NAMES`): the free mode's two
@@ -107,13 +114,16 @@ PLAIN_POLISH_ITERATIONS = 50
 #: theirs is lower by more than this relative load (the same point reached twice agrees
 #: to about 1e-13): the method and records stay the polish's.
 SAME_LOAD = 1e-9
+#: The route of ``"auto"`` on sections below :data:`INTERIOR_POINT_DOFS`: both routes on
+#: the same sections, the lower KKT point kept (module docstring).
+BOTH = "both"
 #: The routes of :func:`solve_levels` (module docstring).
-ROUTES = ("interior-point", "active-set")
-#: "auto" takes the interior point on sections of at least this many DOFs (estimated
-#: from the cell size: six per node): below it the active set's few hundred eigen solves
-#: on small pencils cost no more than the interior point's starts on the coarsest
-#: section, and on a small box it ended at a lower KKT point (:doc:`/verification/sections`,
-#: "Cost").
+ROUTES = ("interior-point", "active-set", BOTH)
+#: "auto" takes the interior point alone on sections of at least this many DOFs
+#: (estimated from the cell size: six per node), and both routes on smaller ones
+#: (:data:`BOTH`): there the active set's eigen solves on small pencils cost about what
+#: the interior point's starts on the coarsest section do, and either route ended at a
+#: lower KKT point than the other on some sections (:doc:`/verification/sections`, "Cost").
 INTERIOR_POINT_DOFS = 10_000
 #: The interior point's settings on sections: only the lowest arrangement of the
 #: coarsest section is carried up (``arrangements = 1``). On every section measured it
@@ -202,9 +212,11 @@ def solve_levels(
     if route not in ROUTES:
         raise InputError(f"route must be one of {ROUTES}, got {route!r}")
     check_levels(parameters, levels)
-    if route == "interior-point":
+    if route in ("interior-point", BOTH):
         more = interior_levels(parameters, levels)
-        return _interior_point(parameters, more, comm, solver, levels, max_iterations)
+        return _interior_point(
+            parameters, more, comm, solver, levels, max_iterations, both=route == BOTH
+        )
     return _active_set(parameters, levels, comm, solver, max_iterations)
 
 
@@ -257,6 +269,7 @@ def _interior_point(
     solver: SolverSpec | None,
     asked: int,
     max_iterations: int,
+    both: bool = False,
 ) -> tuple[Section, UnilateralSolution]:
     """The nested interior-point chain over the sections (module docstring).
 
@@ -264,15 +277,21 @@ def _interior_point(
     caller's: a coarser section that cannot be built (its core covers no free node) ends
     the added ones, and is refused among the asked ones. If the chain reaches no KKT
     point, the active-set route (``max_iterations`` per seed) runs on the finest section
-    and the ``asked`` coarser ones, as built here.
+    and the ``asked`` coarser ones, as built here. ``both`` (the route :data:`BOTH`): the
+    active-set route runs on them after a KKT point of the chain too, and the lower KKT
+    point is kept (the chain's where they agree to :data:`SAME_LOAD`). The solution's
+    ``eigensolves`` counts every eigen solve on every section but the finest's free solve
+    (the result adds that one).
     """
+    fell_back = False
 
     def active_set(problem: UnilateralProblem) -> UnilateralSolution:
+        nonlocal fell_back
+        fell_back = True
         _, solution = _active_set(
             parameters, asked, comm, solver, max_iterations, built=sections[-(asked + 1) :]
         )
-        # Every eigen solve on the finest section (the chain adds the coarser ones').
-        return replace(solution, eigensolves=problem.eigensolver.solves)
+        return solution
 
     sections: list[Section] = []
     try:
@@ -298,14 +317,36 @@ def _interior_point(
             carrier=SectionProlongation,
             fallback=active_set,
         )
+        solution.method = "interior-point (section levels)"
+        if both and not fell_back:
+            solution = _lower(solution, active_set(problems[-1]))
+        # Every section's solves, the chain's and the active set's (the finest's free
+        # solve is the result's own).
+        total = sum(p.eigensolver.solves for p in problems) - problems[-1].free_solves
+        solution = replace(solution, eigensolves=total)
     except BaseException:
         for section in sections:
             section.destroy()
         raise
     for section in sections[:-1]:
         section.destroy()
-    solution.method = "interior-point (section levels)"
     return sections[-1], solution
+
+
+def _lower(chain: UnilateralSolution, other: UnilateralSolution) -> UnilateralSolution:
+    """The lower of two KKT points of the same section: the chain's unless ``other`` is lower.
+
+    ``other`` (the active-set route's) is kept only when it is a KKT point below the
+    chain's by more than :data:`SAME_LOAD` (the same point reached twice agrees to
+    about 1e-13).
+    """
+    logger.info(
+        "section: interior point %.10g, active set %.10g (KKT %s): the lower kept",
+        chain.load, other.load, other.candidate.kkt,
+    )  # fmt: skip
+    if other.candidate.kkt and other.load < chain.load * (1.0 - SAME_LOAD):
+        return other
+    return chain
 
 
 def _active_set(
@@ -361,7 +402,10 @@ def _active_set(
         details.polish_iterations = polish_iterations
     elif isinstance(best.details, ActiveSetDetails):
         details.active_set = best.details
-    return prev, replace(best, details=details)
+    # Every level's solves, the polish's and the seeds' (kept or not); the finest's free
+    # solve is the result's own.
+    total = sum(level.eigensolves for level in log) - prev.problem.free_solves
+    return prev, replace(best, details=details, eigensolves=total)
 
 
 def _most_levels(parameters: SectionParameters) -> int:
