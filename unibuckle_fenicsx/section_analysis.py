@@ -163,7 +163,14 @@ class SectionResult(BucklingResult, kw_only=True):
             f"{self.case}: sigma_cr = {sigma / scale:.6e} {unit}{factor} "
             f"({self.ratio_to_free:.4f} x hollow {hollow / scale:.6e} {unit}){k}, "
             f"{sigma / self.classical_stress_Pa:.4f} x classical "
-            f"{self.classical_stress_Pa / scale:.6e} {unit}"
+            f"{self.classical_stress_Pa / scale:.6e} {unit} "
+            # What "classical" is: a box's widest face as a long hinged plate, a tube's
+            # sigma_cl (the chart's and the figures' reference, docs/guide/sections.md).
+            + (
+                "(sigma_cl = E t/(R sqrt(3(1 - nu^2))))"
+                if k_value is None
+                else "(the widest face's k = 4)"
+            )
         )
         lines = [
             f"{head}, method {self.method}, {self.eigensolves} eigensolves, "

@@ -416,6 +416,8 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
         f"design: largest compression sigma_cr = {significant(d.sigma_cr_Pa / scale)} {unit}, "
         f"slenderness {significant(d.relative_slenderness)}"
     )
+    if not d.faces:  # a tube: a shell, whose reduction (EN 1993-1-6) is not applied
+        text += " (sqrt(f_y/sigma_cr) only: EN 1993-1-6's buckling reduction not applied)"
     face = next((f for f in d.faces if f.face == d.governing_face), None)
     if face is not None and face.reduction_factor is not None:
         reduced = face.reduced_design_stress_Pa or 0.0
@@ -426,9 +428,11 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
                 f"plate {significant(face.plate_reduction_factor)}, chi_c "
                 f"{significant(face.column_reduction_factor)}, xi {face.xi:.3g})"
             )
+        column = ", rho_c 4.5.4(1)" if face.xi is not None and face.xi < 1.0 else ""
         text += (
             f"; EN 1993-1-5 {_governing(d)}: psi = {face.psi:.3g}, {rho}, "
-            f"rho f_y/gamma_M0 = {significant(reduced / scale)} {unit}"
+            f"rho f_y/gamma_M0 = {significant(reduced / scale)} {unit} (psi Table 4.1, "
+            f"slenderness 4.4(2), rho 4.4(2) eq. (4.2){column}, rho f_y/gamma_M0 4.6(1))"
         )
     if d.width_to_thickness is not None and d.width_to_thickness_limit is not None:
         verdict = (
@@ -439,19 +443,23 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
             else "within it where filled; the core does not fill the length: local "
             "buckling to be considered"
         )
+        # A box has faces (h the greater overall dimension), a tube none (d its diameter).
+        ratio, limit = ("h/t", "52 eps") if d.faces else ("d/t", "90 eps^2")
         text += (
-            f"; EN 1994-1-1 Table 6.3: {d.width_to_thickness:.4g} against "
-            f"{d.width_to_thickness_limit:.4g} ({verdict})"
+            f"; EN 1994-1-1 6.7.1(9), Table 6.3: {ratio} = {significant(d.width_to_thickness)}"
+            f" against {limit} = {significant(d.width_to_thickness_limit)} ({verdict})"
         )
     low = d.lower_bound
     if isinstance(low, SectionDesignRecord):
         text += (
             f"\n  design at the verified lower bound (the safe value, sigma_cr not proven "
-            f"the lowest): sigma_cr = {low.sigma_cr_Pa / scale:.4g} {unit}, slenderness "
-            f"{low.relative_slenderness:.4g}"
+            f"the lowest): sigma_cr = {significant(low.sigma_cr_Pa / scale)} {unit}, "
+            f"slenderness {significant(low.relative_slenderness)}"
         )
         face = next((f for f in low.faces if f.face == low.governing_face), None)
         if face is not None and face.reduction_factor is not None:
             name = "rho" if face.reduction_factor == face.plate_reduction_factor else "rho_c"
-            text += f", {_governing(low, rule=False)}, {name} = {face.reduction_factor:.4g}"
+            text += (
+                f", {_governing(low, rule=False)}, {name} = {significant(face.reduction_factor)}"
+            )
     return text

@@ -33,6 +33,13 @@ JSON_HELP = """\
 is solved: a path that cannot be written is refused (exit status 2)."""
 
 EPILOG = f"""\
+examples:
+  unibuckle solve --config demos/plate.toml --json plate.json --output out/
+  unibuckle solve --case c1 --nx 20 --ny 20        # the paper's plate, zone c1
+  unibuckle solve --config demos/box.toml --set obstacle.core=false   # the hollow box
+  unibuckle solve --config plate.toml --set design.yield_stress=3.55e8 --bracket
+  unibuckle solve --config plate.json              # re-run the problem a result holds
+
 {OUTPUT_HELP}
 
 exit status:
@@ -53,6 +60,14 @@ prefixes, e.g. -unibuckle_eps_view, -unibuckle_eps_tol 1e-12, -unibuckle_ldl_ksp
 """
 
 SWEEP_EPILOG = f"""\
+examples:
+  unibuckle sweep --config demos/plate.toml --vary plate.thickness=0.002:0.004:3 \\
+      --json t.jsonl --plot t.png
+  unibuckle sweep --config ssss.toml --vary plate.length=0.5:4:15 \\
+      --vary plate.thickness=0.001,0.01 --json grid.jsonl
+  unibuckle sweep --config demos/box.toml --vary section.thickness=0.001:0.002:5 \\
+      --json box_bt.jsonl --plot box_bt.png
+
 --vary PATH=START:STOP:N gives N values from START to STOP (ends included);
 --vary PATH=V1,V2,... gives a list. PATH is the dotted path of a number of the
 problem file, list entries by index: plate.thickness, material.nu,
@@ -86,6 +101,10 @@ exit status:
 """
 
 NONLINEAR_EPILOG = f"""\
+examples:
+  unibuckle nonlinear --case c1 --nx 20 --ny 20 --imperfection 1e-3 --json nl.json
+  unibuckle nonlinear --config plate.toml --no-obstacle --control displacement
+
 The linear critical load and mode come first (as 'unibuckle solve'); the von Karman
 plate, given the imperfection delta t times that mode (the unilateral mode with the
 obstacle, the free mode without), is loaded step by step against the obstacle (PETSc
@@ -253,9 +272,9 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
     w.add_argument(
         "--plot",
         metavar="PNG",
-        help="draw k against the first --vary (bilateral and unilateral, with the "
-        "exact curves where they exist; a section: sigma_cr over the classical stress, "
-        "hollow and with its core)",
+        help="draw k against the first --vary (bilateral: without the obstacle, and "
+        "unilateral: with it, with the exact curves where they exist; a section: sigma_cr "
+        "over the classical stress, hollow and with its core)",
     )
     w.add_argument(
         "--ranks-per-point",
@@ -268,9 +287,13 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
     k = sub.add_parser(
         "schema",
         help="print the JSON Schema of a problem file (or its dotted keys)",
-        description="Print the JSON Schema of a problem file: for editor completion of "
-        "TOML files (e.g. a '#:schema' line for taplo) and the reference of the keys. "
+        description="Print the JSON Schema of a problem file: for editor completion of\n"
+        "TOML files (e.g. a '#:schema' line for taplo) and the reference of the keys.\n"
         "The repository keeps it in schema/unibuckle-problem.schema.json.",
+        epilog="examples:\n"
+        "  unibuckle schema --keys                  # every dotted key of a problem file\n"
+        "  unibuckle schema --output problem.schema.json",
+        formatter_class=Formatter,
     )
     k.add_argument("--keys", action="store_true", help="print the dotted keys instead")
     k.add_argument("--output", metavar="PATH", help="write to PATH instead of stdout")
@@ -286,13 +309,13 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
         metavar="N",
         help="active-set: iterates per seed and mesh level (the feasible descent, the last "
         "fallback, may use 10x as many solves); interior-point: the same for its "
-        "active-set fallback " + _solver_default("max_iterations"),
+        "active-set fallback; N >= 1 " + _solver_default("max_iterations"),
     )
     s.add_argument(
         "--bound-budget",
         type=int,
         metavar="N",
-        help="active-set: eigen solves for the lattice lower bound "
+        help="active-set: eigen solves for the lattice lower bound, N >= 0 "
         + _solver_default("bound_budget"),
     )
     s.add_argument(
@@ -311,11 +334,13 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
         "--penalty",
         type=float,
         metavar="RHO",
-        help="penalty stiffness rho for --method penalty (relative to max diag A) "
+        help="penalty stiffness rho for --method penalty (relative to max diag A), > 0 "
         + _solver_default("penalty"),
     )
     s.add_argument(
-        "--tau", type=float, help="relative feasibility tolerance " + _solver_default("tau")
+        "--tau",
+        type=float,
+        help="relative feasibility tolerance, in (0, 0.01] " + _solver_default("tau"),
     )
     s.add_argument(
         "--candidate-parallel",
@@ -358,13 +383,14 @@ def _method_flags(s: argparse.ArgumentParser) -> None:
         "--max-candidates",
         type=int,
         metavar="N",
-        help="enumerate: refuse above N candidate sets " + _solver_default("max_candidates"),
+        help="enumerate: refuse above N candidate sets, N >= 1 "
+        + _solver_default("max_candidates"),
     )
     s.add_argument(
         "--enumeration-budget",
         type=float,
         metavar="SECONDS",
-        help="auto: enumerate only if the estimated time is below this "
+        help="auto: enumerate only if the estimated time is below this (s, > 0) "
         + _solver_default("enumeration_budget_s"),
     )
 
@@ -380,8 +406,8 @@ def nonlinear_parser(sub: Any, parents: list[Parser]) -> None:
         parents=parents,
         help="validate the critical load by the load path of the imperfect plate "
         "(von Karman, against the obstacle)",
-        description="Follow the load path of the imperfect von Karman plate against the "
-        "obstacle and read the buckling load off it (Southwell, steepest rise), next to "
+        description="Follow the load path of the imperfect von Karman plate against the\n"
+        "obstacle and read the buckling load off it (Southwell, steepest rise), next to\n"
         "the linear critical load.",
         epilog=NONLINEAR_EPILOG,
         formatter_class=Formatter,
@@ -420,7 +446,7 @@ def nonlinear_parser(sub: Any, parents: list[Parser]) -> None:
         type=float,
         default=defaults.max_step,
         metavar="FRACTION",
-        help="largest load step, relative to the linear critical load",
+        help="largest load step, relative to the linear critical load, in (0, 1]",
     )
 
 

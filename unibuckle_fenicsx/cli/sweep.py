@@ -59,6 +59,56 @@ def _warn_coarse_points(base: Any, variations: Any, comm: Any) -> None:
         )
 
 
+def sweep_table(lines: list[dict[str, Any]]) -> str:
+    """The sweep's points as a table for the terminal, one row per point.
+
+    The swept values as the file gives them (in its units, named), the critical load (a section's:
+    the extreme fibre's stress, as its summary's ``sigma_cr``) in the results' stress
+    unit, its ratio to the load without the obstacle (the hollow section's), k, the
+    certificate's status and the point's status; ``-`` where a point has no value.
+    """
+    from unibuckle_fenicsx.spec import UNITS
+    from unibuckle_fenicsx.viz.charts import _unit
+
+    if not lines:
+        return ""
+    units = str(lines[0].get("units", "SI"))
+    scale, unit = UNITS[units][1:]
+    section = any("classical_stress_Pa" in line for line in lines)
+    paths = list(lines[0].get("point", {}))
+    header = [
+        *(f"{path} ({_unit(path, units)})" if _unit(path, units) else path for path in paths),
+        f"{'sigma_cr' if section else 'lambda_c'} ({unit})",
+        "x hollow" if section else "x free",
+        "k",
+        "certificate",
+        "status",
+    ]
+
+    def number(value: Any, text: str) -> str:
+        return "-" if not isinstance(value, (int, float)) else format(value, text)
+
+    rows = []
+    for line in lines:
+        load = line.get("compression_Pa") if section else line.get("critical_load_Pa")
+        cert = line.get("certificate")
+        rows.append(
+            [
+                *(number(line.get("point", {}).get(path), ".6g") for path in paths),
+                number(None if load is None else load / scale, ".6e"),
+                number(line.get("ratio_to_free"), ".4f"),
+                number(line.get("buckling_coefficient_k"), ".4f"),
+                str(cert.get("status", "-")) if isinstance(cert, dict) else "-",
+                str(line.get("status", "-")),
+            ]
+        )
+    widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
+    return "\n".join(
+        "  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip()
+        for row in [header, *rows]
+    )
+
+
 def sweep_command(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle sweep``: the grid, the JSON lines, the chart."""
     from unibuckle_fenicsx.sweep import base_mapping, parse_variation, run_sweep
@@ -98,6 +148,7 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
         from collections import Counter
 
         counts = Counter(line["status"] for line in lines)
+        print_out(sweep_table(lines))
         print_out(
             f"sweep: {len(lines)} points in {args.json}: "
             + ", ".join(f"{n} {status}" for status, n in sorted(counts.items()))

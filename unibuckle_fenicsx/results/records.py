@@ -23,6 +23,7 @@ from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
 from unibuckle_fenicsx.section_design import SectionDesignRecord
 from unibuckle_fenicsx.spec import UNITS, PointSpec
+from unibuckle_fenicsx.tolerances import BRACKET_GAP
 
 __all__ = [
     "BucklingResult",
@@ -444,9 +445,17 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
         )
         + f"; {d.element} element"
         + (f" (free edge {d.free_edge})" if d.free_edge else "")
-        + ", 4.4(2) calibrated on bilateral plates"
+        + f"; {_design_clauses(d)}; rho calibrated on bilateral plates"
         + _design_lower(d, scale, unit)
     )
+
+
+def _design_clauses(d: DesignRecord) -> str:
+    """Where each number of the design line comes from in EN 1993-1-5 (JSON: ``clauses``)."""
+    table = d.table.split(" (")[0]  # "Table 4.1 (internal compression element)"
+    rho = "eq. (4.3)" if d.element == "outstand" else "eq. (4.2)"
+    column = ", rho_c 4.5.4(1)" if d.xi is not None and d.xi < 1.0 else ""
+    return f"psi {table}, slenderness 4.4(2), rho 4.4(2) {rho}{column}, rho f_y/gamma_M0 4.6(1)"
 
 
 def _design_lower(d: DesignRecord, scale: float, unit: str) -> str:
@@ -494,6 +503,14 @@ def _verified(cert: CertificateRecord | None) -> str:
             f"proven=no (KKT only{below}; not bracketed by default here: split bracket "
             f"{cert.split_route}, --bracket runs it)"
         )
+    if cert.split_route is not None and cert.split_route.startswith("not bracketed"):
+        # It ran (by default or on request): say what it verified, not only what it did not.
+        if cert.proven_by == "split-spn" and isinstance(gap, float):
+            return (
+                f"proven=no (KKT only{below}; the split bracket verified a gap of "
+                f"{gap:.1e}, above the {BRACKET_GAP:.0e} of 'bracketed')"
+            )
+        return f"proven=no (KKT only{below}; the split bracket verified no higher bound)"
     if cert.split_route is not None:
         return f"proven=no (KKT only{below}; split bracket {cert.split_route})"
     return f"proven=no (KKT only{below})"

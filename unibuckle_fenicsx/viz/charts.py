@@ -343,11 +343,12 @@ def plot_sweep(
         k_free = rounded(k * np.array([m["free_load_Pa"] / m["critical_load_Pa"] for m in solved]))
         order = np.argsort(x)
         ax.plot(x[order], k_free[order], "-", color=colour, lw=1.0, marker=".",
-                label=f"bilateral{suffix}")  # fmt: skip
+                label=f"bilateral (no obstacle){suffix}")  # fmt: skip
         unilateral = [m.get("certificate") is not None for m in solved]
         if any(unilateral):
             idx = [int(i) for i in order if unilateral[i]]
-            ax.plot(x[idx], k[idx], "--", color=colour, lw=1.0, label=f"unilateral{suffix}")
+            ax.plot(x[idx], k[idx], "--", color=colour, lw=1.0,
+                    label=f"unilateral (with the obstacle){suffix}")  # fmt: skip
             for i in idx:
                 _certificate_mark(ax, x[i], k[i], solved[i]["certificate"], colour)
         # Exact curves on a fine grid of the swept number.

@@ -18,7 +18,45 @@ from unibuckle_fenicsx.viz.plotting import THEME, _prepare, _pyvista, annotate, 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.model.shell.section import SectionFigureData
 
-__all__ = ["plot_section_mode_3d"]
+__all__ = ["plot_section_mode_3d", "view_turn"]
+
+#: The camera's offset from the section's centre before :func:`view_turn` (it sees a box's
+#: top face, z = +d/2, and its face y = -b/2).
+EYE = np.array([-0.6, -1.4, 1.0])
+
+
+def view_turn(data: SectionFigureData) -> float:
+    """The angle (rad) about the section's axis x that brings its largest buckle into view.
+
+    The camera looks from :data:`EYE`; a buckle on the far side would not be seen (a
+    filled tube's single outward buckle lies anywhere round the wall). A box turns by
+    quarter turns, so that the face of the largest outward displacement (in magnitude) is
+    one of the two seen; a tube by the angle between the eye and that node, unless it
+    lies within 60 degrees of the eye's side already.
+
+    Args:
+        data: The figure's arrays (:class:`SectionFigureData`).
+
+    Returns:
+        The angle, 0 when the largest buckle is seen from :data:`EYE`.
+    """
+    if data.shape not in ("box", "tube") or not len(data.outward):
+        return 0.0
+    _, y, z = data.points[int(np.argmax(np.abs(data.outward)))]
+    eye = np.arctan2(EYE[2], EYE[1])
+    if data.shape == "box":
+        width, depth = data.size[1], data.size[2]
+        # The face of the node: the coordinate nearer its half-dimension.
+        if abs(z) / (0.5 * depth) >= abs(y) / (0.5 * width):
+            face = 0.5 * np.pi if z > 0 else -0.5 * np.pi
+        else:
+            face = 0.0 if y > 0 else np.pi
+        seen = (0.5 * np.pi, np.pi)  # the top face and the face y = -b/2
+        if any(np.isclose(np.cos(face - f), 1.0) for f in seen):
+            return 0.0
+        return 0.5 * np.pi if np.isclose(face, -0.5 * np.pi) else -0.5 * np.pi
+    turn = float(np.angle(np.exp(1j * (np.arctan2(z, y) - eye))))  # in (-pi, pi]
+    return 0.0 if abs(turn) <= np.pi / 3 else turn
 
 
 def plot_section_mode_3d(
@@ -92,8 +130,11 @@ def plot_section_mode_3d(
     annotate(plotter, legend, title, font)
     plotter.add_axes(color="black", viewport=(0.72, 0.0, 0.86, 0.18))
     centre = np.array([0.5 * length, 0.0, 0.0])
-    eye = centre + np.array([-0.6, -1.4, 1.0])
-    plotter.camera_position = [tuple(eye), tuple(centre), (0.0, 0.0, 1.0)]
+    turn = view_turn(data)
+    c, s = np.cos(turn), np.sin(turn)
+    about_x = np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]])
+    eye = centre + about_x @ EYE
+    plotter.camera_position = [tuple(eye), tuple(centre), tuple(about_x @ (0.0, 0.0, 1.0))]
     plotter.reset_camera()
     plotter.camera.zoom(1.1)
     plotter.screenshot(str(path))

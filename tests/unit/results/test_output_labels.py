@@ -1,0 +1,272 @@
+"""What an engineer reads: every number of the summaries and the help says what it is.
+
+The design lines name the clause of the standard each value comes from and the ratio a
+limit applies to; the section summary says what its "classical" stress is; the help of
+every subcommand shows examples and fits the terminal; the 3-D figure of a section looks
+at its largest buckle. Expected values come from the formulas quoted beside them.
+"""
+
+from __future__ import annotations
+
+import math
+
+from mpi4py import MPI
+
+import msgspec
+import numpy as np
+import pytest
+
+from unibuckle_fenicsx import SectionParameters, solve_section
+from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.cli.flags import build_parser
+from unibuckle_fenicsx.model.shell.section import SectionFigureData
+from unibuckle_fenicsx.section_design import at_lower_bound, design_line, section_design
+from unibuckle_fenicsx.spec import DesignSpec, problem_from_dict
+
+pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial summaries")
+
+
+def _section(shape: str = "box", **changes: object) -> SectionParameters:
+    base = {
+        "thickness": 0.002, "width": 0.2, "depth": 0.1, "diameter": None, "length": 0.6,
+        "E": 2.1e11, "nu": 0.3, "mesh_size": 0.02,
+        "axial_stress": -1.0, "bending_stress": 0.0, "core": True,
+    }  # fmt: skip
+    return SectionParameters(shape, **{**base, **changes})
+
+
+@pytest.mark.parametrize("command", ["solve", "sweep", "nonlinear", "schema"])
+def test_every_subcommand_s_help_shows_examples_within_100_columns(command, monkeypatch):
+    # argparse wraps the options' help to $COLUMNS; descriptions and epilogs are printed as
+    # written, and the nonlinear description was one line of 180 characters.
+    monkeypatch.setenv("COLUMNS", "100")
+    _, subcommands = build_parser()
+    text = subcommands[command].format_help()
+    assert "\nexamples:\n  unibuckle " + command in text, text
+    wide = [line for line in text.splitlines() if len(line) > 100]
+    assert not wide, wide
+
+
+@pytest.mark.parametrize(
+    ("shape", "changes", "text"),
+    [
+        # EN 1994-1-1 Table 6.3: box h/t <= 52 eps, h = 0.2 + 0.002 (overall), t = 0.002:
+        # 101; eps = sqrt(235/355), 52 eps = 42.31.
+        ("box", {}, "h/t = 101.0 against 52 eps = 42.31"),
+        # tube d/t <= 90 eps^2: d = 0.3 + 0.002, 151; 90 x 235/355 = 59.58.
+        ("tube", {"width": None, "depth": None, "diameter": 0.3}, "d/t = 151.0 against 90 eps^2"),
+    ],
+)
+def test_the_section_design_line_names_the_ratio_its_limit_and_the_clause(shape, changes, text):
+    out = section_design(_section(shape, **changes), DesignSpec(yield_stress=3.55e8), 3.0e8)
+    line = design_line(out)
+    assert f"EN 1994-1-1 6.7.1(9), Table 6.3: {text}" in line, line
+    # The line printed "101 against 42.31": two numbers without the ratio they compare.
+    assert f"{52 * math.sqrt(235 / 355):.2f}" in line or "59.58" in line, line
+    if shape == "box":  # EN 1993-1-5 per face: where psi, the slenderness and rho come from
+        assert "(psi Table 4.1, slenderness 4.4(2), rho 4.4(2) eq. (4.2)" in line, line
+    else:  # a tube: the slenderness only, EN 1993-1-6's reduction is not applied
+        assert "sqrt(f_y/sigma_cr) only: EN 1993-1-6" in line, line
+
+
+def test_the_section_design_line_at_the_lower_bound_keeps_four_digits():
+    # 9.44e7 Pa at the lower bound printed as "9.44e+07" (".4g" drops the zero) where the
+    # line above it printed "2.121e+08": four significant digits on both lines.
+    section, design = _section(), DesignSpec(yield_stress=3.55e8)
+    record = at_lower_bound(section_design(section, design, 2.0e8), section, design, 9.44e7)
+    low = design_line(record).splitlines()[-1]
+    assert "at the verified lower bound" in low, low
+    assert "sigma_cr = 9.440e+07 Pa" in low, low
+    slenderness = math.sqrt(3.55e8 / 9.44e7)  # 1.939
+    rho = (slenderness - 0.055 * 4.0) / slenderness**2  # eq. (4.2), psi = 1: 0.4572
+    assert f"slenderness {slenderness:#.4g}" in low and f"rho = {rho:#.4g}" in low, low
+
+
+def _plate(edges_top: dict[str, object]) -> str:
+    hinged = {"support": "simply_supported"}
+    spec = problem_from_dict(
+        {
+            "plate": {"corners": [[0, 0], [0.6, 0.2]], "thickness": 0.004},
+            "material": {"E": 2.1e11, "nu": 0.3},
+            "edges": {
+                "left": {**hinged, "normal_stress": -1.0},
+                "right": {**hinged, "normal_stress": -1.0},
+                "bottom": hinged,
+                "top": edges_top,
+            },
+            "mesh": {"nx": 6, "ny": 2},
+            "design": {"yield_stress": 3.55e8},
+        }
+    )
+    with solve(spec, MPI.COMM_WORLD) as analysis:
+        summary = analysis.result.summary()
+    return next(s for s in summary.splitlines() if "EN 1993-1-5: " in s)
+
+
+@pytest.mark.parametrize(
+    ("top", "clauses"),
+    [
+        # Internal element: psi from Table 4.1, rho by eq. (4.2) of 4.4(2).
+        (
+            {"support": "simply_supported"},
+            "psi Table 4.1, slenderness 4.4(2), rho 4.4(2) eq. (4.2)",
+        ),
+        # Top edge free: an outstand, psi from Table 4.2, rho by eq. (4.3).
+        ({"support": "free"}, "psi Table 4.2, slenderness 4.4(2), rho 4.4(2) eq. (4.3)"),
+    ],
+)
+def test_the_plate_design_line_names_the_clause_of_each_value(top, clauses):
+    line = _plate(top)
+    assert clauses in line, line
+    assert "rho f_y/gamma_M0 4.6(1)" in line, line
+
+
+@pytest.mark.parametrize(
+    ("shape", "changes", "what"),
+    [
+        # A box's classical stress is its widest face's as a long hinged plate, k = 4.
+        ("box", {"width": 0.2, "depth": 0.1}, "(the widest face's k = 4)"),
+        # A tube's is sigma_cl = E t / (R sqrt(3 (1 - nu^2))).
+        ("tube", {"width": None, "depth": None, "diameter": 0.2}, "(sigma_cl = E t/(R sqrt("),
+    ],
+)
+def test_the_section_summary_says_what_its_classical_stress_is(shape, changes, what):
+    # "2.4236 x classical 7.592003e+07 Pa" did not say of what; the hollow box's value is
+    # 4 pi^2 D/(t b^2) with b = 0.2 m, the tube's E t/(R sqrt(3(1 - nu^2))).
+    section = _section(shape, length=0.2, mesh_size=0.1, core=False, **changes)
+    with solve_section(section, MPI.COMM_SELF) as analysis:
+        result = analysis.result
+    first = result.summary().splitlines()[0]
+    assert f"x classical {result.classical_stress_Pa:.6e} Pa {what}" in first, first
+    t, E, nu = 0.002, 2.1e11, 0.3
+    if shape == "box":
+        D = E * t**3 / (12 * (1 - nu**2))
+        expected = 4 * math.pi**2 * D / (t * 0.2**2)
+    else:
+        expected = E * t / (0.1 * math.sqrt(3 * (1 - nu**2)))
+    assert result.classical_stress_Pa == pytest.approx(expected, rel=1e-12)
+
+
+def _ring(shape: str, peak: tuple[float, float]) -> SectionFigureData:
+    """A section's nodes at x = 0.1 round its wall, the outward buckle largest at ``peak``."""
+    if shape == "tube":
+        phi = np.linspace(0.0, 2.0 * np.pi, 72, endpoint=False)
+        y, z = 0.1 * np.cos(phi), 0.1 * np.sin(phi)
+    else:  # a 0.2 x 0.1 box's perimeter
+        s = np.linspace(-1.0, 1.0, 9)
+        y = np.concatenate([0.1 * s, np.full(9, 0.1), 0.1 * s, np.full(9, -0.1)])
+        z = np.concatenate([np.full(9, 0.05), 0.05 * s, np.full(9, -0.05), 0.05 * s])
+    points = np.column_stack([np.full(y.size, 0.1), y, z])
+    outward = np.exp(-50.0 * ((y - peak[0]) ** 2 + (z - peak[1]) ** 2))
+    none = np.zeros((0, 3))
+    return SectionFigureData(
+        points, np.zeros((0, 4), dtype=np.int64), np.zeros_like(points), outward, none, none,
+        shape, (0.2, 0.2, 0.2 if shape == "tube" else 0.1),
+    )  # fmt: skip
+
+
+def _eye(turn: float) -> np.ndarray:
+    from unibuckle_fenicsx.viz.section import EYE
+
+    c, s = math.cos(turn), math.sin(turn)
+    return np.array([[1.0, 0.0, 0.0], [0.0, c, -s], [0.0, s, c]]) @ EYE
+
+
+def test_the_section_figure_looks_at_its_largest_buckle():
+    # The filled tube of the demo buckles outward at its bottom (z < 0); the camera, fixed
+    # above it at EYE = (-0.6, -1.4, 1.0), showed a tube with no visible buckle.
+    from unibuckle_fenicsx.viz.section import EYE, view_turn
+
+    bottom = _ring("tube", (0.0, -0.1))
+    eye = _eye(view_turn(bottom))
+    assert eye[2] < 0 and abs(eye[1]) < 1e-9, eye  # straight below, where the buckle is
+    assert np.hypot(eye[1], eye[2]) == pytest.approx(np.hypot(EYE[1], EYE[2]))
+    # A buckle the camera sees already keeps the view (the stored figures' views).
+    assert view_turn(_ring("tube", (-0.1 * 0.8, 0.1 * 0.6))) == 0.0
+    assert view_turn(_ring("box", (0.0, 0.05))) == 0.0  # the top face
+    assert view_turn(_ring("box", (-0.1, 0.0))) == 0.0  # the face y = -b/2
+    # A box turns by quarter turns: the bottom face and the face y = +b/2 come into view.
+    for peak, face in (((0.0, -0.05), (0.0, -1.0)), ((0.1, 0.0), (1.0, 0.0))):
+        eye = _eye(view_turn(_ring("box", peak)))
+        assert np.dot(eye[1:], face) > 0, (peak, eye)
+
+
+def test_a_sweep_chart_s_legend_says_what_bilateral_means(tmp_path, monkeypatch):
+    # "bilateral" alone reads as a two-sided obstacle to an engineer: it is the plate
+    # without its obstacle (the points' free loads), "unilateral" the plate against it.
+    from unibuckle_fenicsx.sweep import parse_variation
+    from unibuckle_fenicsx.viz import charts
+
+    seen, save = {}, charts._save
+
+    def keep(fig, ax, path):
+        seen["labels"] = ax.get_legend_handles_labels()[1]
+        return save(fig, ax, path)
+
+    monkeypatch.setattr(charts, "_save", keep)
+    base = {
+        "name": "small",
+        "plate": {"corners": [[-0.1, -0.05], [0.1, 0.05]], "thickness": 0.006},
+        "material": {"E": 1.0e9, "nu": 0.3},
+        "mesh": {"nx": 6, "ny": 4},
+        "obstacle": {"zone": [[-0.04, 0.04], [-0.05, 0.05]]},
+    }
+    cert = {"kkt": True, "global_optimum_proven": True, "status": "proven"}
+    lines = [
+        {"point": {"material.nu": nu}, "status": "ok", "buckling_coefficient_k": 4.4,
+         "free_load_Pa": 1.0, "critical_load_Pa": 1.1, "certificate": cert}
+        for nu in (0.2, 0.3)
+    ]  # fmt: skip
+    charts.plot_sweep(lines, [parse_variation("material.nu=0.2,0.3")], base, tmp_path / "c.png")
+    assert "bilateral (no obstacle)" in seen["labels"], seen
+    assert "unilateral (with the obstacle)" in seen["labels"], seen
+
+
+def test_a_sweep_prints_its_points_as_a_table_with_units():
+    # The sweep printed "sweep: 3 points in t.jsonl: 3 ok" and nothing of its results: the
+    # table has one row per point, the swept number and the load with their units.
+    from unibuckle_fenicsx.cli.sweep import sweep_table
+
+    cert = {"status": "kkt-only", "kkt": True}
+    lines = [
+        {"index": 0, "point": {"plate.thickness": 2.0}, "status": "ok", "units": "mm-N-MPa",
+         "critical_load_Pa": 7.935676e8, "ratio_to_free": 1.28875, "buckling_coefficient_k":
+         10.45268, "certificate": cert},
+        {"index": 1, "point": {"plate.thickness": 3.0}, "status": "eigen-failure",
+         "units": "mm-N-MPa", "error": "no pair"},
+    ]  # fmt: skip
+    rows = [row.split() for row in sweep_table(lines).splitlines()]
+    assert rows[0][:5] == ["plate.thickness", "(mm)", "lambda_c", "(MPa)", "x"], rows[0]
+    assert rows[1] == ["2", "7.935676e+02", "1.2888", "10.4527", "kkt-only", "ok"], rows[1]
+    assert rows[2] == ["3", "-", "-", "-", "-", "eigen-failure"], rows[2]
+    # A section's row gives the extreme fibre's stress, as its summary's sigma_cr.
+    box = {"point": {"section.thickness": 0.001}, "status": "ok", "units": "SI",
+           "critical_load_Pa": 1.0e8, "compression_Pa": 1.5e8, "classical_stress_Pa": 7.6e7,
+           "ratio_to_free": 2.1, "buckling_coefficient_k": 9.69, "certificate": cert}  # fmt: skip
+    rows = [row.split() for row in sweep_table([box]).splitlines()]
+    assert rows[0][:4] == ["section.thickness", "(m)", "sigma_cr", "(Pa)"], rows[0]
+    assert rows[1][1] == "1.500000e+08", rows[1]
+
+
+def test_a_bracket_that_ran_says_what_it_verified():
+    # The quickstart's plate with --bracket: the split route verifies 1.735629e9 Pa below
+    # lambda_c = 1.753161e9 (a gap of 1.0e-2, above the 1e-3 that 'bracketed' asks), and
+    # the first line read "split bracket not bracketed (estimated cost 432.6 free solves)".
+    from unibuckle_fenicsx.results.records import CertificateRecord, _verified
+
+    lower, upper = 1.735629e9, 1.753161e9
+    cert = CertificateRecord(
+        feasible=True, feasibility_margin=-1e-5, max_contact_force=-5e-3,
+        max_contact_value=0.0, relative_residual=3e-13, tolerance=1e-8, kkt=True,
+        smallest_of_reduced=True, lower_bound_Pa=lower, upper_bound_Pa=upper,
+        relative_gap=(upper - lower) / upper, global_optimum_proven=False,
+        proven_by="split-spn", status="kkt-only", negative_eigenvalues=4,
+        refuting_load_Pa=None, copositivity=None, notes=[],
+        split_route="not bracketed (estimated cost 432.6 free solves)",
+    )  # fmt: skip
+    text = _verified(cert)
+    assert "the split bracket verified a gap of 1.0e-02, above the 1e-03 of 'bracketed'" in text
+    assert "not bracketed (estimated cost" not in text, text
+    # Run, but nothing closer than the free load verified: it says so.
+    none = msgspec.structs.replace(cert, proven_by="interlacing", relative_gap=0.22)
+    assert "the split bracket verified no higher bound" in _verified(none), _verified(none)
