@@ -46,8 +46,8 @@ Penalty = Annotated[float, Meta(gt=0)]
 
 #: The highest Lagrange degree of the prestress solve's in-plane displacement: degree 2
 #: resolves compression with in-plane bending exactly, and the cells' count of the
-#: membrane DOFs grows as the degree squared (degree 9 took 3 s on 12 x 4 cells, 30
-#: did not end in 300 s).
+#: membrane DOFs grows as the degree squared (the cost measured:
+#: docs/history/2026-11-30f-platehunt.md).
 MAX_PRESTRESS_DEGREE = 4
 
 
