@@ -104,10 +104,6 @@ class SolverSpec(Table, frozen=True):
     prestress_degree: Annotated[int, Meta(ge=1, le=MAX_PRESTRESS_DEGREE)] = 1
     shear: Literal["mitc", "full"] = "mitc"
 
-    def options(self, method: Method | str | None = None) -> Any:
-        """The options of ``method`` (default: this table's) as its :data:`OPTIONS` Struct."""
-        return msgspec.convert(self, OPTIONS[Method(method or self.method)], from_attributes=True)
-
 
 def default(name: str) -> Any:
     """The default of the ``[solver]`` option ``name``."""

@@ -372,6 +372,7 @@ def test_each_method_reads_its_options_from_the_solver_table(capsys):
     """
     from msgspec.structs import fields
 
+    from unibuckle_fenicsx.algorithms.registry import entry
     from unibuckle_fenicsx.cli import main
     from unibuckle_fenicsx.spec import METHODS, OPTIONS, Method, json_schema
     from unibuckle_fenicsx.spec.base import hints
@@ -387,8 +388,10 @@ def test_each_method_reads_its_options_from_the_solver_table(capsys):
         for f in fields(options):
             assert (hints(options)[f.name], f.default) == (table[f.name], defaults[f.name])
     spec = SolverSpec(method="enumerate", complete=True, max_candidates=7)
-    assert spec.options() == EnumerateOptions(complete=True, max_candidates=7)
-    assert spec.options(Method.PENALTY) == PenaltyOptions()
+    assert entry(Method.ENUMERATE).options_of(spec) == EnumerateOptions(
+        complete=True, max_candidates=7
+    )
+    assert entry(Method.PENALTY).options_of(spec) == PenaltyOptions()
     with pytest.raises(ValueError, match=r"solver\.max_candidates must be an integer >= 1"):
         EnumerateOptions(max_candidates=0)
 
