@@ -64,7 +64,7 @@ examples:
   unibuckle sweep --config demos/plate.toml --vary plate.thickness=0.002:0.004:3 \\
       --json t.jsonl --plot t.png
   unibuckle sweep --config ssss.toml --vary plate.length=0.5:4:15 \\
-      --vary plate.thickness=0.001,0.01 --json grid.jsonl
+      --vary plate.thickness=0.001,0.01 --json grid.jsonl --csv grid.csv
   unibuckle sweep --config demos/box.toml --vary section.thickness=0.001:0.002:5 \\
       --json box_bt.jsonl --plot box_bt.png
 
@@ -270,6 +270,12 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         required=True,
         help="JSON-lines output (the folder must exist); an existing file of the same "
         "sweep is resumed",
+    )
+    w.add_argument(
+        "--csv",
+        metavar="PATH",
+        help="also write the table printed at the end as CSV (the folder must exist): its "
+        "columns, numbers at full precision, an empty cell where it shows -",
     )
     w.add_argument(
         "--plot",
