@@ -278,3 +278,60 @@ def test_a_sections_eigensolves_count_every_solve_of_the_route(method, monkeypat
         result = solved.result
     assert len(built) == 2 and len(before_certificate) == 1
     assert result.eigensolves == before_certificate[0]
+
+
+@pytest.mark.parametrize("method", ["active-set", "auto"])
+def test_a_sections_eigensolves_count_the_penalty_continuations(method, monkeypatch):
+    """A stalled seed's penalty continuation counts: it has its own eigen solver.
+
+    The seeds' first fallback check is made to fail, so that the penalty continuation
+    runs on the coarser section (a stall needs a larger section: the 10 mm tube of the
+    sections' verification pages stalls on its 20 mm section). The reference is the
+    eigen solvers' own counters on every section plus the solves each continuation
+    returned; the starting code left the latter out.
+    """
+    import unibuckle_fenicsx.algorithms.active_set as active_set
+    import unibuckle_fenicsx.algorithms.section_levels as levels
+    import unibuckle_fenicsx.section_analysis as section_analysis
+
+    built, penalty, before_certificate = [], [], []
+    build, certify = levels.build_section, section_analysis.certify
+    reached, continuation = active_set._reached, active_set.penalty_continuation
+    counted: dict[int, int] = {}
+
+    def recorded_build(*args, **kwargs):
+        section = build(*args, **kwargs)
+        built.append(section)
+        destroy = section.destroy
+
+        def destroy_counted():
+            if id(section) not in counted:  # the first destroy: its objects still there
+                counted[id(section)] = section.problem.eigensolver.solves
+            destroy()
+
+        section.destroy = destroy_counted
+        return section
+
+    def stalled_once(problem, runs):
+        return reached(problem, runs) if penalty else False
+
+    def recorded_continuation(*args, **kwargs):
+        run, solves = continuation(*args, **kwargs)
+        penalty.append(solves)
+        return run, solves
+
+    def recorded_certify(*args, **kwargs):
+        solves = [counted[id(s)] if id(s) in counted else s.problem.eigensolver.solves
+                  for s in built]  # fmt: skip
+        before_certificate.append(sum(solves))
+        return certify(*args, **kwargs)
+
+    monkeypatch.setattr(levels, "build_section", recorded_build)
+    monkeypatch.setattr(active_set, "_reached", stalled_once)
+    monkeypatch.setattr(active_set, "penalty_continuation", recorded_continuation)
+    monkeypatch.setattr(section_analysis, "certify", recorded_certify)
+    spec = section_from_dict({**FILE, "solver": {"method": method}})
+    with solve_section(spec, MPI.COMM_SELF) as solved:
+        result = solved.result
+    assert len(penalty) == 1 and penalty[0] > 0
+    assert result.eigensolves == before_certificate[0] + penalty[0]

@@ -359,7 +359,10 @@ class SectionLevel(Struct, kw_only=True):
         constrained: The core's constrained directions.
         load: The critical stress found there (Pa).
         kkt: Its state satisfies the KKT conditions.
-        eigensolves: Eigen solves on it (its free solve included).
+        eigensolves: Eigen solves on it (its free solve and its penalty continuation's
+            included).
+        penalty_eigensolves: Those of its penalty continuation (the seeds' fallback,
+            which has its own eigen solver).
         steps: Active-set steps on it: the polish's from the carried contact set, or,
             where the seeds ran (``seeded``), all of theirs and any fallback's.
         seeded: The seeds ran on it (the coarsest section, or a carried set that did
@@ -373,6 +376,7 @@ class SectionLevel(Struct, kw_only=True):
     load: float
     kkt: bool
     eigensolves: int
+    penalty_eigensolves: int = 0
     steps: int = 0
     seeded: bool = False
     wall_time_s: float

@@ -286,13 +286,16 @@ def _interior_point(
     (the result adds that one).
     """
     fell_back = False
+    penalty = 0  # the active set's penalty continuations (their own eigen solvers)
 
     def active_set(problem: UnilateralProblem) -> UnilateralSolution:
-        nonlocal fell_back
+        nonlocal fell_back, penalty
         fell_back = True
         _, solution = _active_set(
             parameters, asked, comm, solver, max_iterations, built=sections[-(asked + 1) :]
         )
+        if isinstance(solution.details, SectionLevelsDetails):
+            penalty += sum(level.penalty_eigensolves for level in solution.details.levels)
         return solution
 
     sections: list[Section] = []
@@ -322,9 +325,9 @@ def _interior_point(
         solution.method = "interior-point (section levels)"
         if both and not fell_back:
             solution = _lower(solution, active_set(problems[-1]))
-        # Every section's solves, the chain's and the active set's (the finest's free
-        # solve is the result's own).
-        total = sum(p.eigensolver.solves for p in problems) - problems[-1].free_solves
+        # Every section's solves, the chain's, the active set's and its penalty
+        # continuations' (the finest's free solve is the result's own).
+        total = sum(p.eigensolver.solves for p in problems) - problems[-1].free_solves + penalty
         solution = replace(solution, eigensolves=total)
     except BaseException:
         for section in sections:
@@ -462,6 +465,7 @@ def _level(
         raise RuntimeError("solve_levels: a core section without constraints")
     solves0 = problem.eigensolver.solves
     polished, polish_iterations, seeded_steps = None, None, None
+    penalty = 0  # the seeds' penalty continuation has its own eigen solver
     try:
         plain: tuple[UnilateralSolution | None, int | None] = (None, None)
         if prev is not None and best is not None and prev.constraints is not None:
@@ -483,7 +487,9 @@ def _level(
                 seeds=SEEDS,
                 more_seeds=MORE_SEEDS,
             )
-            runs = seeded.details.runs if isinstance(seeded.details, ActiveSetDetails) else []
+            runs, penalty = [], 0
+            if isinstance(seeded.details, ActiveSetDetails):
+                runs, penalty = seeded.details.runs, seeded.details.penalty_eigensolves
             seeded_steps = sum(r.iterations for r in runs)
             solves = problem.eigensolver.solves
             kept, plain_iterations = plain
@@ -503,7 +509,8 @@ def _level(
         constrained=section.constraints.size,
         load=polished.load,
         kkt=polished.candidate.kkt,
-        eigensolves=problem.eigensolver.solves - solves0,
+        eigensolves=problem.eigensolver.solves - solves0 + penalty,
+        penalty_eigensolves=penalty,
         steps=(polish_iterations or 0) + (seeded_steps or 0),
         seeded=seeded_steps is not None,
         wall_time_s=time.perf_counter() - tl,
