@@ -147,6 +147,14 @@ class SectionResult(BucklingResult, kw_only=True):
     compression_Pa: float = math.nan
     faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
 
+    def _bending(self) -> float:
+        """The input's ``bending_stress`` (0 by default in a file's ``[load]``); NaN unknown."""
+        for key in ("load", "section"):  # a file's echo; solve_section's parameters
+            table = self.input.get(key) if isinstance(self.input, dict) else None
+            if isinstance(table, dict) and (key == "load" or "bending_stress" in table):
+                return float(table.get("bending_stress", 0.0))
+        return math.nan
+
     def summary(self) -> str:
         """Lines for the terminal: the critical stress, the hollow one, the reference.
 
@@ -158,10 +166,11 @@ class SectionResult(BucklingResult, kw_only=True):
         sigma = self.compression_Pa  # the stresses printed are the extreme fibre's
         if math.isnan(sigma):  # a result written before the field: the load factor
             sigma = self.critical_load_Pa
+        where = " (uniform)" if self._bending() == 0.0 else " at the extreme fibre"
         factor = (
             ""
             if sigma == self.critical_load_Pa
-            else f" at the extreme fibre, load factor {self.critical_load_Pa / scale:.6e} {unit}"
+            else f"{where}, load factor {self.critical_load_Pa / scale:.6e} {unit}"
         )
         hollow = self.free_load_Pa * (sigma / self.critical_load_Pa)  # its extreme fibre's
         head = (

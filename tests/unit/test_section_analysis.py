@@ -508,3 +508,28 @@ def test_a_filled_member_near_its_euler_stress_is_warned_of_its_column(foundatio
     # The hollow member's warning is the column's mode itself (unchanged).
     hollow = dataclasses.replace(member, core=False, foundation_stiffness=None)
     assert "the mode is the column's" in (column_note(hollow, 0.9 * euler, False) or "")
+
+
+def test_a_uniform_stress_is_not_called_the_extreme_fibre_s():
+    """``axial_stress = -2`` and no bending: every fibre carries twice the load factor.
+
+    The summary said "sigma_cr = ... at the extreme fibre, load factor ..." for this
+    uniform stress; it names the stress uniform. With bending it keeps "the extreme fibre"
+    (tests/verification/test_section_anchors.py). The compression is 2 x the load factor
+    by the load's definition (compression per unit load 2).
+    """
+    tube = SectionParameters(
+        "tube", diameter=0.1, thickness=0.001, length=0.01, E=E, nu=NU, mesh_size=0.002,
+        ends="simply_supported", core=False, axial_stress=-2.0,
+    )  # fmt: skip
+    with solve_section(tube, MPI.COMM_SELF) as analysis:
+        result = analysis.result
+    assert result.compression_Pa == pytest.approx(2 * result.critical_load_Pa, rel=1e-14)
+    summary = result.summary()
+    assert f"sigma_cr = {result.compression_Pa:.6e} Pa (uniform), load factor" in summary
+    assert "fibre" not in summary
+    # A file's run echoes its [load] table (bending_stress 0 by default): the same words.
+    result.input = {"load": {"axial_stress": -2.0, "bending_stress": 0.0}}
+    assert "(uniform), load factor" in result.summary()
+    result.input = {"load": {"axial_stress": -2.0, "bending_stress": 0.5}}
+    assert "at the extreme fibre, load factor" in result.summary()
