@@ -513,7 +513,8 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     need_across = MIN_FACE_CELLS if p.shape == "box" else min_half_wave_cells(p)
     cells_across, cells_along = mesh_cell_counts(p)
     checks = [
-        (cells_across, width, need_across, f"across {across}"),
+        # a box's buckle spans its face; a tube's half-wave runs along the axis
+        (cells_across, width, need_across, f"{'across' if p.shape == 'box' else 'along'} {across}"),
         (cells_along, length, MIN_ALONG_CELLS, f"along {along}"),
     ]
     # A whole number of cells within rounding (5 cells of L/5 over L) counts as that many.
