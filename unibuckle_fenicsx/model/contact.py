@@ -391,6 +391,8 @@ class ContactSetManager:
         fixed = np.isin(dofs_W, model.bc_dofs)
         self.num_edge_fixed = int(comm.allreduce(int((fixed & keep).sum()), op=MPI.SUM))
         keep &= ~fixed
+        if tensionless:  # a zone node on no cell of the discrete zone has no foundation
+            keep &= springs > 0.0
         dofs_W, dofs_Vw, signs, springs = dofs_W[keep], dofs_Vw[keep], signs[keep], springs[keep]
         gaps = gaps[keep]
         xy = Vw.tabulate_dof_coordinates()[dofs_Vw, :2]

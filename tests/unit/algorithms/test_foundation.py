@@ -41,7 +41,7 @@ from unibuckle_fenicsx.model.contact import (
     tributary_areas,
 )
 from unibuckle_fenicsx.model.materials import bending_stiffness
-from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.spec import Circle, ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.spec.cases import plate_case
 
 THICKNESS = 1e-3  # b = 1 m: t/b = 1e-3, the thin limit
@@ -222,6 +222,28 @@ def test_foundation_springs_are_the_zone_integral_of_the_hat_functions():
     assert total == pytest.approx(0.5 * (2.0 / 3.0), rel=1e-13)
     assert contact.stiffness.max() == pytest.approx(kf * h * h, rel=1e-12)
     assert contact.stiffness.min() == pytest.approx(kf * h * h / 4, rel=1e-12)  # its corners
+
+
+def test_a_zone_node_on_no_covered_cell_carries_no_tensionless_spring():
+    """A circle's nodes that lie on no cell inside it carry no foundation, and no spring.
+
+    1.5 x 1 m plate, 9 x 6 cells (h = 1/6), circle of radius 0.34 m about the node (0.5,
+    0.5): 13 nodes lie in it (offsets (i, j) h with i^2 + j^2 <= 4), but only the four
+    cells about the centre have all their nodes in it (their far corners at 0.236 m;
+    the next cells' at 0.373 m). The foundation is those cells, 4 h^2, carried by their
+    9 nodes; the 4 nodes at 2h lie on no such cell. Before, the 13 nodes carried their
+    whole areas (13 h^2); a node with no area would be a tensionless spring of zero
+    stiffness, which the spring-set iteration refuses.
+    """
+    h = 1.0 / 6
+    zone = ObstacleSpec(Circle((0.5, 0.5), 0.34), foundation_stiffness=1.0)
+    with build_problem(strip(1.5, 6, zone), MPI.COMM_WORLD) as problem:
+        contact = problem.contact
+        assert contact.size == 9
+        assert contact.stiffness.sum() == pytest.approx(4 * h * h, rel=1e-12)
+        assert np.abs(contact.coordinates - 0.5).max() == pytest.approx(h, rel=1e-9)
+    with solve(strip(1.5, 6, zone)) as analysis:
+        assert analysis.result.method == "foundation"
 
 
 def test_a_foundation_split_in_two_zones_is_the_whole_foundation():
