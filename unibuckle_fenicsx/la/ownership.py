@@ -35,7 +35,7 @@ def _destroy_after_error(obj: Any, error: BaseException) -> None:
 
 
 @contextmanager
-def destroyed_after[T](obj: T) -> Iterator[T]:
+def destroyed_after(obj: Any) -> Iterator[Any]:
     """Destroy ``obj`` on leaving the ``with`` block, never masking the block's error.
 
     ``with destroyed_after(SLEPc.EPS().create(comm)) as eps: ...``. If the block
@@ -47,7 +47,7 @@ def destroyed_after[T](obj: T) -> Iterator[T]:
     except BaseException as error:
         _destroy_after_error(obj, error)
         raise
-    obj.destroy()  # type: ignore[attr-defined]
+    obj.destroy()
 
 
 def release(owner: object, *names: str) -> None:
