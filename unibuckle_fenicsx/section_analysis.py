@@ -45,8 +45,8 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.registry import entry
-from unibuckle_fenicsx.algorithms.section_levels import BOTH, check_levels, solve_levels
-from unibuckle_fenicsx.analysis import FREE, choose_section_method
+from unibuckle_fenicsx.algorithms.section_levels import check_levels
+from unibuckle_fenicsx.analysis import choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.en1993 import (
     check_steel_modulus,
@@ -619,22 +619,10 @@ def _faces(
 def _solve(
     parameters: SectionParameters, levels: int, comm: MPI.Comm, method: str, solver: SolverSpec
 ) -> tuple[Section, UnilateralSolution | None]:
-    """The section and, with a core, its solution by ``method`` (a registry key, or free)."""
-    if method == FREE:
+    """The section and, with a core, its solution by ``method`` (a registry key)."""
+    if not parameters.core:  # the hollow section's free load is the answer
         return build_section(parameters, comm, solver), None
-    if method == BOTH:  # "auto" on a small section: both routes, the lower kept
-        return solve_levels(
-            parameters,
-            route=BOTH,
-            levels=levels,
-            comm=comm,
-            solver=solver,
-            max_iterations=solver.max_iterations,
-        )
-    run = entry(method).section
-    if run is None:
-        raise RuntimeError(f"solve_section: the method {method!r} has no section runner")
-    return run(parameters, levels, comm, solver)
+    return entry(method).solve_section(parameters, levels, comm, solver)
 
 
 def _result(
