@@ -43,7 +43,7 @@ from unibuckle_fenicsx.la.options import (
     ordering_options,
     set_options,
 )
-from unibuckle_fenicsx.la.ownership import Owner, release
+from unibuckle_fenicsx.la.ownership import Owner, destroyed_after, release
 from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
 
 __all__ = [
@@ -873,8 +873,7 @@ def swapped_eigenpairs(
     Note:
         Collective.
     """
-    eps = SLEPc.EPS().create(A.comm)
-    try:
+    with destroyed_after(SLEPc.EPS().create(A.comm)) as eps:
         eps.setOperators(B, A)
         eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
         eps.setDimensions(nev)
@@ -890,8 +889,6 @@ def swapped_eigenpairs(
             v = A.createVecRight() if vectors else None
             pairs.append((float(eps.getEigenpair(k, v).real), v))
         return pairs
-    finally:
-        eps.destroy()
 
 
 def lowest_eigenvalues(
@@ -947,8 +944,7 @@ def extreme_eigenvalues(
     options = EXTREME_OPTIONS if options is None else options
     values = []
     for which in ("smallest", "largest"):
-        eps = SLEPc.EPS().create(mat.comm)
-        try:
+        with destroyed_after(SLEPc.EPS().create(mat.comm)) as eps:
             eps.setOperators(mat)
             eps.setProblemType(SLEPc.EPS.ProblemType.HEP)
             eps.setDimensions(1)
@@ -967,6 +963,4 @@ def extreme_eigenvalues(
             if eps.getConverged() < 1:
                 raise EigenSolveError(f"SLEPc ({prefix}): the {which} eigenvalue did not converge")
             values.append(float(eps.getEigenvalue(0).real))
-        finally:
-            eps.destroy()
     return values[0], values[1]

@@ -28,13 +28,23 @@ from unibuckle_fenicsx.spec.base import in_file
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
+    "ZONE_TOLERANCE_CELLS",
     "ContactSetManager",
     "check_zone_has_nodes",
     "foundation_springs",
     "orientation",
+    "smallest_cell_side",
     "tributary_areas",
+    "zone_cells",
 ]
 
+
+#: ``obstacle.tolerance`` may reach this fraction of the mesh's smallest cell side. The
+#: tolerance is there to catch the nodes that lie on the zone's edge up to rounding or a
+#: mesher's placement (1e-15 to 1e-9 of the plate); a tenth of a cell is far above that
+#: and far below the next line of nodes, so it can never widen the zone by a row of
+#: nodes (a wider zone is written as a wider zone).
+ZONE_TOLERANCE_CELLS = 0.1
 
 #: One obstacle, or several of them (a sequence).
 ObstacleLike = ObstacleSpec | Sequence[ObstacleSpec]
@@ -58,9 +68,10 @@ def check_zone_has_nodes(
 ) -> None:
     """Cheap pre-checks of the obstacle zones on the mesh nodes, before any solve.
 
-    Raises :class:`EmptyZoneError` if a zone holds no mesh node, and
-    :class:`BilateralZoneError` if a node lies in zones on both sides of the plate (a
-    bilateral support there, not an obstacle).
+    Raises :class:`InputError` if a zone's ``tolerance`` exceeds
+    :data:`ZONE_TOLERANCE_CELLS` times the smallest cell side, :class:`EmptyZoneError` if
+    a zone holds no mesh node, and :class:`BilateralZoneError` if a node lies in zones on
+    both sides of the plate (a bilateral support there, not an obstacle).
 
     Args:
         msh: The mesh.
@@ -73,6 +84,7 @@ def check_zone_has_nodes(
         Collective.
     """
     found = _as_tuple(obstacles)
+    _check_tolerances(msh, found, labels)
     x = msh.geometry.x
     n_owned = msh.geometry.index_map().size_local
     points = x[:n_owned].T
@@ -109,6 +121,39 @@ def check_zone_has_nodes(
                 "obstacle; give an edge its [edges.NAME] support, or make the zones disjoint"
             )
         )
+
+
+def smallest_cell_side(msh: dolfinx.mesh.Mesh) -> float:
+    """The shortest cell edge of the mesh (m).
+
+    Note:
+        Collective.
+    """
+    msh.topology.create_entities(1)
+    edges = np.arange(msh.topology.index_map(1).size_local, dtype=np.int32)
+    local = float(msh.h(1, edges).min()) if edges.size else np.inf
+    return float(msh.comm.allreduce(local, op=MPI.MIN))
+
+
+def _check_tolerances(
+    msh: dolfinx.mesh.Mesh, found: tuple[ObstacleSpec, ...], labels: Sequence[str] | None
+) -> None:
+    """Refuse a zone ``tolerance`` above :data:`ZONE_TOLERANCE_CELLS` of the smallest cell."""
+    given = [(k, o) for k, o in enumerate(found) if o.tolerance is not None]
+    if not given:
+        return
+    h = smallest_cell_side(msh)
+    bound = ZONE_TOLERANCE_CELLS * h
+    for k, o in given:
+        if o.tolerance is not None and o.tolerance > bound:
+            (tol, high, cell), name = in_file([o.tolerance, bound, h], "m")
+            raise InputError(
+                f"{_label(found, k, labels)}.tolerance = {tol:g} {name} must lie in [0, "
+                f"{high:.3g}] {name} (a tenth of the smallest cell side, {cell:.3g} {name}): "
+                "the tolerance only catches nodes on the zone's edge up to rounding; a "
+                "larger one would widen the zone by whole rows of nodes. To widen the "
+                f"zone, enlarge {_label(found, k, labels)}.{o.zone_key}"
+            )
 
 
 def orientation(
@@ -157,20 +202,57 @@ class _Owned:
     global_dofs: npt.NDArray[np.int64]  # W global dof of each
 
 
-def tributary_areas(model: NodalDofs) -> dolfinx.la.Vector:
-    r"""Lumped areas :math:`\int \varphi_k\,dx` of the w-space's nodes (owned and ghosts).
+def tributary_areas(model: NodalDofs, obstacle: ObstacleSpec | None = None) -> dolfinx.la.Vector:
+    r"""Lumped areas :math:`\int_{\omega_h} \varphi_k\,dx` of the w-space's nodes.
 
-    The row sums of the Q1 mass matrix: a lumped Winkler foundation puts the spring
-    :math:`k_f \int \varphi_k\,dx` at node k.
+    The row sums of the Q1 mass matrix restricted to :math:`\omega_h`: a lumped Winkler
+    foundation puts the spring :math:`k_f \int_{\omega_h} \varphi_k\,dx` at node k. With
+    an ``obstacle``, :math:`\omega_h` is its *discrete zone*, the cells whose nodes all lie
+    in the closed zone (:mod:`~unibuckle_fenicsx.model.zones`), so a node on the zone's
+    boundary carries only the covered part of its area (half on a straight edge, a quarter
+    at a convex corner); without one, the whole plate. Owned nodes and ghosts.
+
+    Raises:
+        EmptyZoneError: The obstacle's discrete zone holds no cell (a foundation acts on
+            an area; a zone thinner than a cell has none on this mesh).
 
     Note:
         Collective.
     """
     v = ufl.TestFunction(model.Vw)
-    areas = dolfinx.fem.assemble_vector(dolfinx.fem.form(v * ufl.dx))
+    if obstacle is None or obstacle.zone == "all":
+        dx = ufl.dx(domain=model.mesh)
+    else:
+        dx = ufl.Measure(
+            "dx", domain=model.mesh, subdomain_data=zone_cells(model, obstacle), subdomain_id=1
+        )
+    areas = dolfinx.fem.assemble_vector(dolfinx.fem.form(v * dx))
     areas.scatter_reverse(dolfinx.la.InsertMode.add)
     areas.scatter_forward()
+    if obstacle is not None:
+        n_owned = model.Vw.dofmap.index_map.size_local
+        total = model.mesh.comm.allreduce(float(areas.array[:n_owned].sum()), op=MPI.SUM)
+        if total <= 0.0:
+            raise EmptyZoneError(
+                f"obstacle.{obstacle.zone_key} {obstacle.describe(None)} of a foundation "
+                "(foundation_stiffness) covers no cell of the mesh: its springs act on the "
+                "cells whose nodes all lie in the zone; widen the zone to at least one cell, "
+                'refine the mesh, or give a line or point of springs as [[points]] kind = "spring"'
+            )
     return areas
+
+
+def zone_cells(model: NodalDofs, obstacle: ObstacleSpec) -> dolfinx.mesh.MeshTags:
+    """Cell tags (value 1) of the obstacle's discrete zone: cells with every node in the zone.
+
+    Not collective.
+    """
+    msh = model.mesh
+    tdim = msh.topology.dim
+    size = model.extent
+    cells = dolfinx.mesh.locate_entities(msh, tdim, lambda x: obstacle.contains(x, size))
+    cells = np.unique(np.asarray(cells, dtype=np.int32))
+    return dolfinx.mesh.meshtags(msh, tdim, cells, np.ones(cells.size, dtype=np.int32))
 
 
 def _zone_dofs(
@@ -188,14 +270,14 @@ def foundation_springs(
 ) -> tuple[npt.NDArray[np.int64], npt.NDArray[np.float64]]:
     r"""Global W rows owned by this rank and lumped spring stiffnesses of ``foundations``.
 
-    Node k of a zone gets :math:`k_f \int \varphi_k\,dx` (N/m), summed over the zones
-    holding it; nodes held by supports (edges, bilateral points) are left out.
+    Node k of a zone gets :math:`k_f \int_{\omega_h} \varphi_k\,dx` (N/m) over the zone's
+    discrete zone :math:`\omega_h` (:func:`tributary_areas`), summed over the zones holding
+    it; nodes held by supports (edges, bilateral points) are left out.
 
     Note:
         Collective.
     """
     size = model.extent
-    areas = tributary_areas(model).array
     springs: dict[int, float] = {}
     for o in foundations:
         if o.foundation_stiffness is None:
@@ -203,6 +285,7 @@ def foundation_springs(
                 "foundation_springs: expected o.foundation_stiffness is not None (an internal "
                 "invariant)"
             )
+        areas = tributary_areas(model, o).array
         dofs_W, dofs_Vw = _zone_dofs(model, o, size)
         for dw, dv in zip(dofs_W.tolist(), dofs_Vw.tolist(), strict=True):
             springs[dw] = springs.get(dw, 0.0) + o.foundation_stiffness * float(areas[dv])
@@ -257,7 +340,6 @@ class ContactSetManager:
         Vw = model.Vw
         size = model.extent
         tensionless = kinds == {"tensionless"}
-        areas = tributary_areas(model).array if tensionless else None
         zones = [_zone_dofs(model, o, size) for o in self.obstacles]
         # Every zone's nodes in the obstacles' order; a node in several zones appears once
         # per zone, and its entries are merged below in that order.
@@ -282,14 +364,22 @@ class ContactSetManager:
         gaps = np.full(len(order_W), np.inf)
         np.minimum.at(gaps, node, per_node(lambda o: o.gap))
         springs = np.zeros(len(order_W))
-        if areas is not None:
+        if tensionless:
             if any(o.foundation_stiffness is None for o in self.obstacles):
                 raise RuntimeError(
                     "__init__: expected o.foundation_stiffness is not None (an internal invariant)"
                 )
-            # Summed zone by zone from 0.0, in the obstacles' order (np.add.at is unbuffered).
-            stiffness = per_node(lambda o: float(o.foundation_stiffness or 0.0))
-            np.add.at(springs, node, stiffness * areas[all_Vw])
+            # Each zone's springs on its own discrete zone (the same weights as a bilateral
+            # foundation's), summed zone by zone from 0.0 in the obstacles' order
+            # (np.add.at is unbuffered).
+            weights = np.concatenate(
+                [
+                    float(o.foundation_stiffness or 0.0)
+                    * tributary_areas(model, o).array[dofs_Vw_k]
+                    for o, (_, dofs_Vw_k) in zip(self.obstacles, zones, strict=True)
+                ]
+            )
+            np.add.at(springs, node, weights)
         if comm.allreduce(conflict, op=MPI.LOR):
             raise BilateralZoneError(
                 "obstacle zones on both sides of the plate share a mesh node: a bilateral "
@@ -301,6 +391,8 @@ class ContactSetManager:
         fixed = np.isin(dofs_W, model.bc_dofs)
         self.num_edge_fixed = int(comm.allreduce(int((fixed & keep).sum()), op=MPI.SUM))
         keep &= ~fixed
+        if tensionless:  # a zone node on no cell of the discrete zone has no foundation
+            keep &= springs > 0.0
         dofs_W, dofs_Vw, signs, springs = dofs_W[keep], dofs_Vw[keep], signs[keep], springs[keep]
         gaps = gaps[keep]
         xy = Vw.tabulate_dof_coordinates()[dofs_Vw, :2]

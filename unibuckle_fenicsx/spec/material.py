@@ -13,7 +13,22 @@ from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.laminate import laminate
 from unibuckle_fenicsx.spec.base import Matrix3, Table, in_file, unit
 
-Modulus = Annotated[float, unit("Pa", gt=0)]
+#: Elastic moduli (Pa) accepted: from three decades below the softest elastomers'
+#: (about 1e6 Pa) to ten times diamond's (1.2e12 Pa). The buckling load is proportional
+#: to E, so nothing physical lies outside; far outside (1e200, 1e-300 Pa) the stiffness
+#: matrices overflow or underflow in double precision and SLEPc fails in the solve.
+MIN_MODULUS, MAX_MODULUS = 1.0e3, 1.0e13
+Modulus = Annotated[float, unit("Pa", ge=MIN_MODULUS, le=MAX_MODULUS)]
+#: Shear correction factors accepted. kappa_s G t is the shear stiffness of the section
+#: (energy-equivalent to its shear stress tau(z)): kappa_s = (int tau dz)^2 /
+#: (G_mean t int tau^2/G dz) <= 1 by the Cauchy-Schwarz inequality, for any layering;
+#: 5/6 for a homogeneous plate, pi^2/12 Mindlin's, down to about 1e-3 for a sandwich
+#: plate with a soft core written with its faces' mean modulus. Above 1 the shear
+#: stiffness exceeds any section's and aggravates the rounding of thin plates (kappa_s
+#: = 10 on an outstand with t/b = 2.5e-4 failed the inertia check that 5/6 and 1 pass);
+#: far outside (1e30, 1e-300) the solve fails. A plate nearly rigid in shear
+#: (Kirchhoff's) is a thin plate, not a large factor.
+MIN_SHEAR_CORRECTION, MAX_SHEAR_CORRECTION = 1.0e-3, 1.0
 
 #: The largest fibre angle magnitude accepted (degrees): one turn.
 MAX_PLY_ANGLE = 360.0
@@ -27,13 +42,14 @@ class Ply(Table, frozen=True):
         angle: Fibre angle from the x axis, counter-clockwise (degrees), in [-360, 360]:
             one turn either way covers every angle; a larger value is a typing error (a
             ply at 1e300 degrees has no meaningful cosine).
-        E1: Young's modulus along the fibres (Pa), > 0.
-        E2: Young's modulus across the fibres (Pa), > 0.
-        G12: In-plane shear modulus (Pa), > 0.
+        E1: Young's modulus along the fibres (Pa), in [1e3, 1e13] (:data:`MIN_MODULUS`,
+            :data:`MAX_MODULUS`: from far below the softest elastomer to ten times diamond).
+        E2: Young's modulus across the fibres (Pa), in [1e3, 1e13].
+        G12: In-plane shear modulus (Pa), in [1e3, 1e13].
         nu12: Major Poisson's ratio, :math:`|\nu_{12}| < \sqrt{E_1/E_2}` (a positive
             definite ply).
-        G13: Transverse shear modulus in the 1-3 plane (Pa), > 0.
-        G23: Transverse shear modulus in the 2-3 plane (Pa), > 0.
+        G13: Transverse shear modulus in the 1-3 plane (Pa), in [1e3, 1e13].
+        G23: Transverse shear modulus in the 2-3 plane (Pa), in [1e3, 1e13].
     """
 
     KEY: ClassVar[str] = "material.plies"
@@ -61,10 +77,16 @@ class Material(Table, frozen=True):
     r"""Linear elastic material (the file's ``[material]``).
 
     Args:
-        E: Young's modulus (Pa), > 0.
+        E: Young's modulus (Pa), in [1e3, 1e13] (:data:`MIN_MODULUS`,
+            :data:`MAX_MODULUS`): from far below the softest elastomer (1e6 Pa) to ten
+            times diamond (1.2e12 Pa); beyond, the stiffness overflows double precision.
         nu: Poisson's ratio, in (-1, 0.5).
-        shear_correction: Reissner-Mindlin shear correction factor, > 0; 5/6, the value
-            of a homogeneous plate (parabolic shear stress across the thickness).
+        shear_correction: Reissner-Mindlin shear correction factor, in [0.001, 1]
+            (:data:`MIN_SHEAR_CORRECTION`, :data:`MAX_SHEAR_CORRECTION`): no section's
+            factor exceeds 1 (Cauchy-Schwarz on its shear stress), a sandwich plate's with
+            a soft core reaches about 1e-3; 5/6, the value of a homogeneous plate
+            (parabolic shear stress across the thickness). A plate nearly rigid in shear
+            is a thin plate, not a large factor.
         membrane_voigt: Optional general membrane stiffness (the paper's
             :math:`E_{\alpha\beta\nu\mu}` integrated over the thickness), a symmetric
             positive definite 3x3 Voigt matrix (N/m) acting on
@@ -86,7 +108,9 @@ class Material(Table, frozen=True):
     KEY: ClassVar[str] = "material"
     E: Modulus
     nu: float  # in (-1, 0.5) but for a laminate (check); the schema has the file's range
-    shear_correction: Annotated[float, Meta(gt=0)] = 5.0 / 6.0
+    shear_correction: Annotated[float, Meta(ge=MIN_SHEAR_CORRECTION, le=MAX_SHEAR_CORRECTION)] = (
+        5.0 / 6.0
+    )
     membrane_voigt: Annotated[Matrix3, unit("N/m")] | None = None
     bending_voigt: Annotated[Matrix3, unit("N m")] | None = None
     plies: tuple[Ply, ...] = ()

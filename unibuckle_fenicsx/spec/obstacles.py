@@ -63,10 +63,17 @@ class ObstacleSpec(Table, frozen=True):
         side: One of :data:`SIDES`: where the obstacle lies (w, the deflection, is
             positive towards "above"); "both" only with a foundation.
         foundation_stiffness: Winkler modulus :math:`k_f` (N/m^3, Pa/m), > 0; ``None`` for
-            a rigid obstacle. The springs are lumped at the zone's nodes: node k carries
-            :math:`k_f \int \varphi_k\,dx` (its tributary area).
+            a rigid obstacle. A tensionless one at most :math:`K = k_f b^4/(\pi^4 D) \le
+            10^8` (b the smaller side, :math:`D = E t^3/12`): stiffer, it is the rigid
+            obstacle to the load's 1e-8, and its springs swamp the plate in double
+            precision. The springs are lumped at the zone's nodes: node k carries
+            :math:`k_f \int_{\omega_h} \varphi_k\,dx`, the part of its tributary area in
+            the discrete zone :math:`\omega_h` (the cells whose nodes all lie in the zone:
+            half the area on the zone's edge).
         tolerance: Geometric tolerance (m), >= 0, for a node to count as inside a box,
-            polygon or circle; ``None`` uses 1e-8 times the plate size.
+            polygon or circle; ``None`` uses 1e-8 times the plate size. At most a tenth
+            of the mesh's smallest cell side (refused above, before any solve): it
+            catches nodes on the zone's edge up to rounding, it does not widen the zone.
         gap: Clearance g (m) >= 0 between the flat plate and a rigid obstacle: w <= g
             (above), w >= -g (below). The nonlinear analysis follows the plate onto it; the
             linear critical state ignores an obstacle with a gap (an infinitesimal buckle

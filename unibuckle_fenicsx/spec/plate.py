@@ -43,6 +43,18 @@ INPLANE_SUPPORTS: tuple[str, ...] = typing.get_args(Inplane)
 THICK_PLATE_RATIO = 0.2
 #: Above this thickness over the plate's smaller side the body is not a plate: refused.
 MAX_THICKNESS_RATIO = 0.5
+#: Below this thickness over the plate's smaller side, refused: the bending stiffness
+#: (:math:`\propto t^3`) against the shear stiffness (:math:`\propto t`) of the same
+#: deflection is about :math:`(t/b)^2`, which at 1e-8 lies below the double precision's
+#: unit round-off (1.1e-16): no digit of the load is left (SLEPc returned a negative
+#: load at t/b = 1e-8). Between this and about 1e-5 the load is computed with the
+#: digits it keeps (the ``load_resolution`` warning says how many).
+MIN_THICKNESS_RATIO = 1e-7
+#: Plate sides and corner coordinates accepted (m): from a micro-machined membrane to
+#: far beyond a bridge deck; beyond, lengths to the fourth power (the bending stiffness
+#: against the geometric stiffness) leave double precision (a plate of 1e300 m failed
+#: in MUMPS), and coordinates far from the origin keep few digits of the cells.
+MIN_SIDE, MAX_COORDINATE = 1e-6, 1e6
 
 Length = Annotated[float, unit("m", gt=0)]
 Vertices = Annotated[
@@ -97,6 +109,11 @@ Segments = Annotated[
 
 #: The edge stresses that an edge held in its plane does not take (the prestress solve's
 #: Dirichlet condition replaces the traction): "roller" holds the normal displacement,
+#: Largest magnitude of an edge stress (Pa, or Pa per unit load): a hundred times the
+#: strength of the strongest structural materials (about 1e10 Pa), the modulus of
+#: diamond. Far beyond (1e300) the membrane forces overflow double precision and the
+#: solve fails; a stress per unit load only scales the load factor, so nothing is lost.
+MAX_EDGE_STRESS = 1e12
 #: "clamped" both.
 HELD_STRESSES = {
     "roller": ("normal_stress", "fixed_normal_stress"),
@@ -114,8 +131,11 @@ class EdgeSpec(Table, frozen=True):
             the stress on a held edge is its support's reaction, so a stress given in a
             held direction (:data:`HELD_STRESSES`) is refused.
         normal_stress: Normal edge stress per unit load (Pa/Pa), tension positive; the
-            paper's compressed edges have -1. A pair ``(start, end)`` varies linearly along
-            the edge (:func:`~unibuckle_fenicsx.model.mesh.edge_line` gives the direction):
+            paper's compressed edges have -1. Every edge stress (this, the shear and the
+            fixed ones) lies in [-1e12, 1e12] (:data:`MAX_EDGE_STRESS`: a hundred times the
+            strength of any structural material; beyond, double precision overflows). A
+            pair ``(start, end)`` varies linearly along the edge
+            (:func:`~unibuckle_fenicsx.model.mesh.edge_line` gives the direction):
             in-plane bending is ``(1, -1)``, the stress-gradient ratio of design codes is
             :math:`\psi` = end/start.
         shear_stress: Tangential edge stress per unit load (Pa/Pa), along the
@@ -170,6 +190,24 @@ class EdgeSpec(Table, frozen=True):
                 f': support = "{self.support}" fixes the deflection already; an elastically '
                 'supported edge has support = "free"',
             )
+        for name in ("normal_stress", "shear_stress", "fixed_normal_stress", "fixed_shear_stress"):
+            value = getattr(self, name)
+            if max(abs(v) for v in stress_ends(value)) > MAX_EDGE_STRESS:
+                fixed = name.startswith("fixed_")
+                given, unit_text = in_file(plain(value), "Pa") if fixed else (value, "")
+                bound = in_file(MAX_EDGE_STRESS, "Pa")[0] if fixed else MAX_EDGE_STRESS
+                raise self.error(
+                    name,
+                    f" = {plain(given)!r} must lie in [-{bound:g}, {bound:g}]"
+                    + (f" {unit_text}" if fixed else " (Pa per unit load)")
+                    + ": a hundred times the strength of any structural material"
+                    + (
+                        ""
+                        if fixed
+                        else " (give the load's pattern, e.g. -1, and read the load factor "
+                        "as the stress)"
+                    ),
+                )
         for name in HELD_STRESSES.get(self.inplane, ()):
             if any(stress_ends(getattr(self, name))):
                 raise self.error(
@@ -246,9 +284,12 @@ class PlateSpec(Table, frozen=True):
     Args:
         corners: Opposite corners ``((x0, y0), (x1, y1))`` of the rectangle (m); for an
             outline, its bounding box (set from it); for a file, its bounding box once
-            meshed.
-        thickness: Plate thickness t = 2 epsilon (m), > 0, at most
-            :data:`MAX_THICKNESS_RATIO` times the smaller side.
+            meshed. Coordinates within +-1e6 m and sides of at least 1e-6 m
+            (:data:`MAX_COORDINATE`, :data:`MIN_SIDE`): beyond, double precision fails.
+        thickness: Plate thickness t = 2 epsilon (m), > 0, from
+            :data:`MIN_THICKNESS_RATIO` (1e-7: below, double precision keeps no digit of
+            the bending stiffness beside the shear stiffness) to
+            :data:`MAX_THICKNESS_RATIO` (0.5: above, not a plate) times the smaller side.
         edges: One :class:`EdgeSpec` per edge part: the rectangle's are named as in
             :data:`EDGE_NAMES`, an outline's parts by their ``segments``, a file's by its
             physical groups of dimension 1; the part ``holes`` is the holes' boundary.
@@ -293,16 +334,42 @@ class PlateSpec(Table, frozen=True):
         self._check_file()
         self._check_holes()
         self._check_edges()
+        self._check_extent()
         b = min(self.length, self.width)
-        if self.file is None and self.thickness > MAX_THICKNESS_RATIO * b:
+        ratio = self.thickness / b
+        if self.file is None and not MIN_THICKNESS_RATIO <= ratio <= MAX_THICKNESS_RATIO:
             (t, name), (side, _) = in_file(self.thickness, "m"), in_file(b, "m")
+            why = (
+                f"plate.thickness must be at least {MIN_THICKNESS_RATIO:g} times it (t/b in "
+                f"[{MIN_THICKNESS_RATIO:g}, {MAX_THICKNESS_RATIO:g}]): below, the bending "
+                "stiffness (t^3) is lost in the rounding of the shear stiffness (t) in double "
+                "precision and no digit of the load is left"
+                if ratio < MIN_THICKNESS_RATIO
+                else f"not a plate; plate.thickness must be at most {MAX_THICKNESS_RATIO:g} "
+                "times it (Reissner-Mindlin theory is a model of plates up to t/b of about "
+                f"{THICK_PLATE_RATIO:g})"
+            )
             raise self.error(
                 "thickness",
-                f" = {t:g} {name} is {self.thickness / b:.3g} times the plate's smaller "
-                f"side {side:g} {name}: not a plate; plate.thickness must be at most "
-                f"{MAX_THICKNESS_RATIO:g} times it (Reissner-Mindlin theory is a model of "
-                f"plates up to t/b of about {THICK_PLATE_RATIO:g})",
+                f" = {t:g} {name} is {ratio:.3g} times the plate's smaller side {side:g} "
+                f"{name}: {why}",
             )
+
+    def _check_extent(self) -> None:
+        """Sides and coordinates within :data:`MIN_SIDE` and :data:`MAX_COORDINATE`."""
+        if self.file is not None:
+            return
+        far = max(abs(c) for corner in self.corners for c in corner)
+        side = min(self.length, self.width)
+        if far <= MAX_COORDINATE and side >= MIN_SIDE:
+            return
+        (far, side, low, high), name = in_file([far, side, MIN_SIDE, MAX_COORDINATE], "m")
+        raise self.error(
+            "outline" if self.outline is not None else "corners",
+            f" has a coordinate of magnitude {far:g} {name} and a smaller side of {side:g} "
+            f"{name}: coordinates must lie in [-{high:g}, {high:g}] {name} (put the origin "
+            f"on the plate) and the sides be at least {low:g} {name}",
+        )
 
     def _check_file(self) -> None:
         if self.file is None:

@@ -21,6 +21,16 @@ from unibuckle_fenicsx.spec.obstacles import DesignSpec, LoadSpec, ObstacleSpec,
 from unibuckle_fenicsx.spec.plate import MeshSpec, PlateSpec
 from unibuckle_fenicsx.spec.solver import SolverSpec
 
+#: Largest non-dimensional stiffness :math:`K = k_f b^4/(\pi^4 D)` of a tensionless
+#: foundation. The gap to the rigid obstacle's load falls tenfold or more per decade of
+#: K (docs/methods/foundations.md: 1.3e-3 and 9e-5 at K = 1e3 and 1e4, a/b = 3, loaded
+#: edges clamped), so at 1e8 the foundation is the rigid obstacle to the load's 1e-8,
+#: while its springs, K times the plate's bending stiffness, swamp it in double
+#: precision: the spring-set iteration fails to certify (K = 5.7e12 on the paper's
+#: plate). Soils and elastomer beds give K below 1e4 on practical plates, a concrete face
+#: (1e11 N/m^3) under a 3 mm steel plate 0.1 m wide about 2e2.
+MAX_FOUNDATION_K = 1e8
+
 
 def _paper_material() -> Material:
     return Material(E=1.0e9, nu=0.3)
@@ -102,10 +112,36 @@ class ProblemSpec(Table, frozen=True):
             raise InputError("mesh.size: a .msh file is meshed already; leave size out")
         check_features(plate, size)
 
+    def _check_foundation_stiffness(self) -> None:
+        r"""A tensionless foundation's :math:`K = k_f b^4/(\pi^4 D)`: at most 1e8."""
+        plate = self.plate
+        if plate.file is not None:  # its sides are known once meshed
+            return
+        b = min(plate.length, plate.width)
+        D = self.material.E * plate.thickness**3 / 12.0
+        for k, o in enumerate(self.all_obstacles):
+            if o.kind != "tensionless" or o.foundation_stiffness is None:
+                continue
+            K = o.foundation_stiffness * b**4 / (math.pi**4 * D)
+            if K > MAX_FOUNDATION_K:
+                (kf, high), name = in_file(
+                    [o.foundation_stiffness, MAX_FOUNDATION_K * math.pi**4 * D / b**4], "N/m^3"
+                )
+                raise InputError(
+                    f"{self.obstacle_label(k)}.foundation_stiffness = {kf:g} {name} is "
+                    f"K = k_f b^4/(pi^4 D) = {K:.3g} times the plate's bending stiffness "
+                    f"(D = E t^3/12, b its smaller side): a tensionless foundation needs "
+                    f"K <= {MAX_FOUNDATION_K:g}, foundation_stiffness <= {high:.3g} {name} "
+                    "here. Stiffer, it is a rigid obstacle to within 1e-8 of the load, and "
+                    "its springs swamp the plate's stiffness in double precision: leave "
+                    "foundation_stiffness out (a rigid obstacle)"
+                )
+
     def _check_obstacles(self) -> None:
         """Obstacles of one kind, their method, no zone on both sides, points they allow."""
         found = self.all_obstacles
         kinds = {o.kind for o in found}
+        self._check_foundation_stiffness()
         if self.one_sided_points and "tensionless" in kinds:
             raise InputError(
                 'points: one-sided points (kind = "one-sided") join a rigid obstacle\'s cone; '

@@ -61,7 +61,10 @@ class SolverSpec(Table, frozen=True):
             interior-point method on thin plates (thickness below
             :data:`~unibuckle_fenicsx.algorithms.chain.THIN_PLATE` of the shorter side) and
             the multilevel active-set method on the others.
-        tau: Relative feasibility/contact tolerance (:doc:`/methods/problem`), in (0, 1e-2].
+        tau: Relative feasibility/contact tolerance (:doc:`/methods/problem`), in
+            [1e-12, 1e-2]: below, the rounding of a computed mode (the unit round-off
+            times the pencil's condition number) can exceed it, and no answer passes the
+            KKT test.
         eps_tol: SLEPc convergence tolerance, in (0, 1e-4].
         max_candidates: Largest candidate count the enumeration accepts, >= 1.
         enumeration_budget_s: "auto" enumerates only if the estimate (2^i times the time
@@ -90,7 +93,7 @@ class SolverSpec(Table, frozen=True):
 
     KEY: ClassVar[str] = "solver"
     method: Method = Method.AUTO
-    tau: Annotated[float, Meta(gt=0.0, le=1e-2)] = 1e-8
+    tau: Annotated[float, Meta(ge=1e-12, le=1e-2)] = 1e-8
     eps_tol: Annotated[float, Meta(gt=0.0, le=1e-4)] = 1e-10
     max_candidates: MaxCandidates = 100_000
     enumeration_budget_s: Seconds = 60.0

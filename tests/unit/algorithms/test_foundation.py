@@ -35,9 +35,13 @@ from unibuckle_fenicsx.algorithms.foundation import solve_foundation
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.certificate.certify import certify_foundation
 from unibuckle_fenicsx.model.build import build_problem
-from unibuckle_fenicsx.model.contact import tributary_areas
+from unibuckle_fenicsx.model.contact import (
+    ContactSetManager,
+    foundation_springs,
+    tributary_areas,
+)
 from unibuckle_fenicsx.model.materials import bending_stiffness
-from unibuckle_fenicsx.spec import ObstacleSpec, problem_from_dict, problem_to_dict
+from unibuckle_fenicsx.spec import Circle, ObstacleSpec, problem_from_dict, problem_to_dict
 from unibuckle_fenicsx.spec.cases import plate_case
 
 THICKNESS = 1e-3  # b = 1 m: t/b = 1e-3, the thin limit
@@ -167,6 +171,116 @@ def test_tributary_areas_sum_to_the_plate_area():
         # Interior nodes of a uniform grid carry one cell: h^2.
         assert problem.contact.stiffness.max() == pytest.approx((1.5 / 9) * (1.0 / 6), rel=1e-12)
     assert total == pytest.approx(1.5, rel=1e-13)
+
+
+def _hat_integral(x, lo, hi, h):
+    """Exact 1-D integral over [lo, hi] of the hat function of spacing h at x (on the grid)."""
+    left = np.clip(np.minimum(x, hi) - np.maximum(x - h, lo), 0.0, None)  # rising half
+    right = np.clip(np.minimum(x + h, hi) - np.maximum(x, lo), 0.0, None)  # falling half
+    # The rising half of the hat over [x - h, x] covers [a, b] with weight
+    # ((b - (x - h))^2 - (a - (x - h))^2) / (2 h); likewise the falling half.
+    a, b = np.maximum(x - h, lo), np.minimum(x, hi)
+    rise = np.where(left > 0, ((b - x + h) ** 2 - (a - x + h) ** 2) / (2 * h), 0.0)
+    a, b = np.maximum(x, lo), np.minimum(x + h, hi)
+    fall = np.where(right > 0, ((x + h - a) ** 2 - (x + h - b) ** 2) / (2 * h), 0.0)
+    return rise + fall
+
+
+def test_foundation_springs_are_the_zone_integral_of_the_hat_functions():
+    """Node k of a foundation carries k_f times the integral of its hat function over the zone.
+
+    1.5 x 1 m plate, 9 x 6 cells (h = 1/6), zone [0.5, 1] x [1/3, 1] on grid lines. The
+    Q1 hat function is a product of 1-D hats, so its integral over the box is the product
+    of the 1-D integrals over [0.5, 1] and [1/3, 1] (computed in closed form here): h on
+    a node inside, h/2 on the zone's edge, 0 outside. The zone's nodes on its edges
+    carried their whole area h^2 before (the springs overstated the foundation). The sum
+    is the zone's area, 1/3 m^2. A bilateral foundation's springs and a tensionless one's
+    are the same numbers.
+    """
+    h = 1.0 / 6
+    zone = ((0.5, 1.0), (1.0 / 3, 1.0))
+    kf = 2.0e3
+    spec = strip(1.5, 6)
+    with build_problem(spec, MPI.COMM_WORLD) as problem:
+        model = problem.model
+        owned = model.Vw.dofmap.index_map.size_local
+        xy = model.Vw.tabulate_dof_coordinates()[:owned, :2]
+        areas = tributary_areas(model, ObstacleSpec(zone, foundation_stiffness=kf)).array[:owned]
+        exact = _hat_integral(xy[:, 0], 0.5, 1.0, h) * _hat_integral(xy[:, 1], 1 / 3, 1.0, h)
+        np.testing.assert_allclose(areas, exact, rtol=1e-12, atol=1e-15)
+        total = MPI.COMM_WORLD.allreduce(float(areas.sum()), op=MPI.SUM)
+        contact = ContactSetManager(model, ObstacleSpec(zone, foundation_stiffness=kf))
+        xc = contact.coordinates
+        expected = kf * _hat_integral(xc[:, 0], 0.5, 1.0, h) * _hat_integral(xc[:, 1], 1 / 3, 1, h)
+        # The manager's coordinates are rounded to 1e-12 m: rtol 1e-9 on h/2 = 0.08 m.
+        np.testing.assert_allclose(contact.stiffness, expected, rtol=1e-9)
+        _, springs = foundation_springs(
+            model, [ObstacleSpec(zone, foundation_stiffness=kf, side="both")]
+        )
+        gathered = np.sort(np.concatenate(MPI.COMM_WORLD.allgather(springs)))
+        np.testing.assert_allclose(gathered, np.sort(contact.stiffness), rtol=1e-12)
+    assert total == pytest.approx(0.5 * (2.0 / 3.0), rel=1e-13)
+    assert contact.stiffness.max() == pytest.approx(kf * h * h, rel=1e-12)
+    assert contact.stiffness.min() == pytest.approx(kf * h * h / 4, rel=1e-12)  # its corners
+
+
+def test_a_zone_node_on_no_covered_cell_carries_no_tensionless_spring():
+    """A circle's nodes that lie on no cell inside it carry no foundation, and no spring.
+
+    1.5 x 1 m plate, 9 x 6 cells (h = 1/6), circle of radius 0.34 m about the node (0.5,
+    0.5): 13 nodes lie in it (offsets (i, j) h with i^2 + j^2 <= 4), but only the four
+    cells about the centre have all their nodes in it (their far corners at 0.236 m;
+    the next cells' at 0.373 m). The foundation is those cells, 4 h^2, carried by their
+    9 nodes; the 4 nodes at 2h lie on no such cell. Before, the 13 nodes carried their
+    whole areas (13 h^2); a node with no area would be a tensionless spring of zero
+    stiffness, which the spring-set iteration refuses.
+    """
+    h = 1.0 / 6
+    zone = ObstacleSpec(Circle((0.5, 0.5), 0.34), foundation_stiffness=1.0)
+    with build_problem(strip(1.5, 6, zone), MPI.COMM_WORLD) as problem:
+        contact = problem.contact
+        assert contact.size == 9
+        assert contact.stiffness.sum() == pytest.approx(4 * h * h, rel=1e-12)
+        assert np.abs(contact.coordinates - 0.5).max() == pytest.approx(h, rel=1e-9)
+    with solve(strip(1.5, 6, zone)) as analysis:
+        assert analysis.result.method == "foundation"
+
+
+def test_a_foundation_split_in_two_zones_is_the_whole_foundation():
+    """Zones [0, 0.75] and [0.75, 2] of a 2 x 1 plate together are the whole-plate foundation.
+
+    The integral over the plate is the sum of the integrals over the two parts, so the
+    loads agree to rounding. Before, the line x = 0.75 carried both zones' whole areas (a
+    strip of width h counted twice): 16 x 8 cells, K = 15, 3.2 % too high.
+    """
+    kf = modulus(15.0)
+    halves = tuple(
+        ObstacleSpec(z, foundation_stiffness=kf, side="both")
+        for z in (((0.0, 0.75), (0.0, 1.0)), ((0.75, 2.0), (0.0, 1.0)))
+    )
+    whole = ObstacleSpec("all", foundation_stiffness=kf, side="both")
+    loads = []
+    for obstacles in (halves, (whole,)):
+        with solve(structs.replace(strip(2.0, 8), obstacles=obstacles)) as analysis:
+            loads.append(analysis.result.critical_load_Pa)
+    assert loads[0] == pytest.approx(loads[1], rel=1e-10)
+
+
+def test_a_partial_foundation_converges_at_the_element_rate():
+    """A bilateral foundation on [0.5, 1.5] x [0, 1] of a 2 x 1 plate: loads converge at h^2.
+
+    The element converges at rate 2 (MITC4); springs whose zone-edge nodes take their
+    whole area add an O(h) error (a strip h/2 wide along each zone edge), and the
+    successive differences on b/12, b/24, b/48 then shrink by 2.6 (rate 1.4) instead
+    of 4.
+    """
+    zone = ObstacleSpec(((0.5, 1.5), (0.0, 1.0)), foundation_stiffness=modulus(15.0), side="both")
+    loads = []
+    for ny in (12, 24, 48):
+        with solve(strip(2.0, ny, zone)) as analysis:
+            loads.append(analysis.result.critical_load_Pa)
+    rate = math.log2((loads[0] - loads[1]) / (loads[1] - loads[2]))
+    assert 1.8 < rate < 2.2, (rate, loads)
 
 
 @pytest.mark.parametrize("aspect, K", [(2.0, 15.0), (3.0, 3.0)])

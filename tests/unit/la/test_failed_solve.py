@@ -10,6 +10,8 @@ values are LAPACK's (``scipy.linalg.eigh`` on the dense pencil), never the solve
 from __future__ import annotations
 
 from mpi4py import MPI
+from petsc4py import PETSc
+from slepc4py import SLEPc
 
 import numpy as np
 import pytest
@@ -18,8 +20,9 @@ import scipy.linalg
 from support.exhaustive import dense
 from support.plates import STEEP_TOML
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
-from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver
+from unibuckle_fenicsx.la.eigen import EIGEN_OPTIONS, GEPSolver, swapped_eigenpairs
 from unibuckle_fenicsx.model.build import build_problem
+from unibuckle_fenicsx.outcome import petsc_failure
 from unibuckle_fenicsx.spec.files import load_toml
 
 serial = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="dense reference: serial")
@@ -213,3 +216,38 @@ def test_the_second_try_is_wider_than_a_wide_first(tmp_path, monkeypatch):
     path.write_text(STEEP_TOML.replace("[-1.0, 9.0]", "-1.0"))
     load, lapack = _one_restart(path, 16)
     assert load == pytest.approx(lapack, rel=1e-8)
+
+
+def _diagonal(values, comm):
+    mat = PETSc.Mat().createAIJ([len(values), len(values)], nnz=1, comm=comm)
+    start, end = mat.getOwnershipRange()
+    for i in range(start, end):
+        mat.setValue(i, i, values[i])
+    mat.assemble()
+    return mat
+
+
+def test_a_failed_slepc_solve_reports_its_own_error_not_the_destroys():
+    """SLEPc's error reaches the user even when destroying the failed EPS fails too.
+
+    The swapped pencil puts A in the inner-product slot; an indefinite A (what rounding
+    makes of the stiffness of a plate too thin for double precision) makes SLEPc refuse
+    the B-inner product ("The inner product is not well defined", PETSc error 95) with a
+    work matrix still checked out, and the EPS's destroy then fails with "Need to call
+    MatDenseRestoreSubMatrix() first" (58). That second error used to replace the first.
+    """
+    comm = MPI.COMM_WORLD
+    n = 20
+    A = _diagonal([(-1.0) ** i * (i + 1) for i in range(n)], comm)  # indefinite
+    B = _diagonal([1.0] * n, comm)
+    try:
+        with pytest.raises(Exception) as raised:
+            swapped_eigenpairs(A, B, "test_masked_", which=SLEPc.EPS.Which.LARGEST_MAGNITUDE)
+    finally:
+        A.destroy()
+        B.destroy()
+    failure = petsc_failure(raised.value)
+    assert failure is not None, raised.value
+    assert failure.first_line == "error code 95", failure
+    assert "inner product is not well defined" in failure.reason, failure
+    assert "MatDenseRestoreSubMatrix" not in failure.reason, failure

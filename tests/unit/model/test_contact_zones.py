@@ -1,7 +1,9 @@
-"""Overlapping obstacle zones merged node by node by the contact manager.
+r"""Overlapping obstacle zones merged node by node by the contact manager.
 
 A node in two tensionless zones carries both springs, :math:`(k_1 + k_2) h^2` on the
-interior nodes of a uniform grid of spacing h (a node's tributary area is one cell);
+interior nodes of a uniform grid of spacing h (a node's tributary area is one cell), and
+on a zone's edge only the covered half of that area, :math:`k h^2/2` from that zone
+(:math:`\int_{zone}\varphi_k`: the hat function's integral over the half cells inside);
 a node in two rigid zones with gaps keeps the smaller gap. Expected values from the
 grid's spacing and the zones' bounds written here.
 """
@@ -49,8 +51,14 @@ def test_springs_of_overlapping_foundations_add_up():
     assert contact.size == 8 * 5  # interior nodes: the edges are simply supported
     pairs = _expected(x, k1, k2)
     assert sum(None not in pair for pair in pairs) == 4 * 5  # x = 0.5 ... 1: in both zones
-    for sk, pair in zip(stiffness, pairs, strict=True):
-        assert sk == pytest.approx(sum(k for k in pair if k is not None) * H * H, rel=1e-12)
+    # Covered fraction of a node's cell of area h^2: 1/2 on the zone's edge line x = 1
+    # (left zone) or x = 0.5 (right zone), 1 inside (the other edges are the plate's).
+    half = {0: np.isclose(x, 1.0), 1: np.isclose(x, 0.5)}
+    for j, (sk, pair) in enumerate(zip(stiffness, pairs, strict=True)):
+        expected = sum(
+            k * (0.5 if half[z][j] else 1.0) for z, k in enumerate(pair) if k is not None
+        )
+        assert sk == pytest.approx(expected * H * H, rel=1e-12)
 
 
 def test_overlapping_rigid_zones_keep_the_smaller_gap():

@@ -18,7 +18,7 @@ from msgspec.structs import replace
 from support.exhaustive import RTOL, exhaustive_minimum
 from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.cli import main as cli_main
-from unibuckle_fenicsx.errors import BilateralZoneError
+from unibuckle_fenicsx.errors import BilateralZoneError, InputError
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.spec import (
     Circle,
@@ -124,6 +124,24 @@ def test_polygon_and_circle_contain_their_closed_zone():
     disc = ObstacleSpec(Circle((0.0, 0.0), 1.0))
     y = np.array([[1.0, 0.6, 0.8, 0.0], [0.0, 0.8, 0.6 + 1e-6, 0.0], [0.0] * 4])
     assert disc.contains(y, size).tolist() == [True, True, False, True]
+
+
+def test_a_zone_tolerance_above_a_tenth_of_a_cell_is_refused_before_any_solve():
+    """``obstacle.tolerance`` catches nodes on the zone's edge, it never widens the zone.
+
+    The paper's plate, 20 x 20 cells of 0.01 x 0.005 m: the smallest cell side is 0.005 m,
+    so tolerances up to 5e-4 m are accepted (the zone's nodes are the zone's: 8 cells of
+    0.01 m across [-0.04, 0.04], 9 node columns times 21 rows, the edge rows held by the
+    supports), and 0.05 m, which used to take the whole plate (21 columns), is refused
+    naming the key and the allowed range.
+    """
+    c1 = paper_case("c1")
+    with build_problem(replace(c1, obstacle=replace(c1.obstacle, tolerance=4e-4))) as problem:
+        assert problem.contact.size == 9 * 19
+    with pytest.raises(
+        InputError, match=r"obstacle\.tolerance = 0\.05 m must lie in \[0, 0\.0005\] m"
+    ):
+        build_problem(replace(c1, obstacle=replace(c1.obstacle, tolerance=0.05)))
 
 
 # -- solves -------------------------------------------------------------------------------
