@@ -90,6 +90,14 @@ NEAR_NCV = 4
 #: converging, a wider one separates them (a filled tube's case:
 #: docs/history/2026-11-30c-sections.md).
 WIDER_NCV = 32
+#: Relative residual above which a returned pair of a definite pencil is none (a
+#: converged pair's is about the solver's tolerance): solved again with
+#: :data:`SPURIOUS_NCV` Krylov vectors (:meth:`GEPSolver._spurious`).
+SPURIOUS_RESIDUAL = 1e-6
+#: Krylov vectors of that second solve, at least: a pencil whose B has lost most of its
+#: rank to the removed rows needs more than :data:`WIDER_NCV`
+#: (tests/unit/la/test_spurious_pair.py).
+SPURIOUS_NCV = 64
 
 #: The smallest eigenpair of the whole pencil given estimates of its lowest eigenvalues
 #: (:meth:`GEPSolver.smallest`; a coarser mesh's) shifts first to ``FREE_ABOVE`` above the
@@ -363,19 +371,41 @@ class GEPSolver(Owner):
             self.solves += 1
             if eps.getConverged() < 1:
                 return self._wider_pair(None, out)
+        if eps is self.eps and not self.indefinite and self._spurious(eps):
+            # A negative load or a residual far above the tolerance is no eigenpair of a
+            # definite pencil: Krylov-Schur in shift-and-invert, on a pencil whose B has
+            # lost most of its rank to the removed rows (a section with most of its wall
+            # on the core), can return one from any start; a wider subspace finds the pair.
+            logger.debug("%s: a pair (%.6g, residual %.3g); again in a wider subspace",
+                         self.prefix, eps.getEigenvalue(0).real, eps.computeError(0))  # fmt: skip
+            return self._wider_pair(None, out, SPURIOUS_NCV)
         return self._pair(eps, out)
 
-    def _wider_pair(self, initial: PETSc.Vec | None, out: PETSc.Vec | None) -> EigenPair:
+    def _spurious(self, eps: SLEPc.EPS) -> bool:
+        """Whether the first pair of ``eps`` is none of a definite pencil (collective).
+
+        A negative load, or a relative residual above :data:`SPURIOUS_RESIDUAL` (and a
+        thousand times the solver's tolerance).
+        """
+        if eps.getConverged() < 1:
+            return False
+        bound = max(SPURIOUS_RESIDUAL, 1e3 * self.tol)
+        return _negative(eps) or bool(eps.computeError(0) > bound)
+
+    def _wider_pair(
+        self, initial: PETSc.Vec | None, out: PETSc.Vec | None, least: int = WIDER_NCV
+    ) -> EigenPair:
         """The solve at target 0 once more, in a wider subspace (:data:`WIDER_NCV`).
 
         A cluster of loads near the smallest (a tube's, with a contact set holding most of
         its wall) can keep the default subspace from converging within ``eps_max_it``
-        restarts; a wider one separates them. Raises as :meth:`_pair` if it fails too.
-        Collective.
+        restarts; a wider one separates them. ``least``: the fewest Krylov vectors.
+        Raises as :meth:`_pair` if it fails too, and if its pair is none
+        (:meth:`_spurious`). Collective.
         """
         eps = self.eps
         nev, ncv, mpd = eps.getDimensions()
-        wider = max(2 * ncv, WIDER_NCV)  # never the same subspace again
+        wider = max(2 * ncv, least)  # never the same subspace again
         logger.debug("%s: no pair converged; again with ncv = %d", self.prefix, wider)
         eps.setDimensions(nev, wider, wider)
         try:
@@ -383,6 +413,13 @@ class GEPSolver(Owner):
                 eps.setInitialSpace([initial])
             eps.solve()
             self.solves += 1
+            if self._spurious(eps):
+                raise EigenSolveError(
+                    f"SLEPc ({self.prefix}) returned no eigenpair of the definite pencil "
+                    f"(load {eps.getEigenvalue(0).real:.6g}, relative residual "
+                    f"{eps.computeError(0):.3g}) with {wider} Krylov vectors; try a larger "
+                    f"-{self.prefix}eps_ncv"
+                )
             return self._pair(eps, out)
         finally:
             eps.setDimensions(nev, ncv, mpd)
