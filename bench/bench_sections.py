@@ -233,13 +233,13 @@ def run(
         cert = certify(fine.problem, solution)
         certify_s = time.perf_counter() - t2
         details = solution.details
+        fine_links = _fine_links(details)
         if isinstance(details, SectionLevelsDetails):
             levels_log = [msgspec.to_builtins(level) for level in details.levels]
             for entry, count in zip(levels_log, per_level, strict=True):
                 entry["factorisations"] = count
             coarse = details.coarse_eigensolves
-        fine_links = _fine_links(details)
-        if isinstance(details, InteriorPointDetails):
+        elif isinstance(details, InteriorPointDetails):
             sizes = [size * 2.0**k for k in range(len(details.levels) - 1, -1, -1)]
             levels_log = [
                 {
@@ -259,13 +259,13 @@ def run(
             coarse = details.coarse_eigensolves
         else:
             levels_log = [{"eigensolves": solution.eigensolves, "factorisations": factorisations}]
+            coarse = 0
         for entry in levels_log:  # the seconds of its section's build and factorisations
             rows = entry.get("dofs") or dofs_of.get(entry.get("constrained", -1))
             if rows:
                 entry["dofs"] = rows
                 entry["build_s"] = build_s.get(rows, 0.0)
                 entry["factor_s"] = factor_s.get(rows, 0.0)
-            coarse = 0
         per_level_text = "; ".join(
             f"{1e3 * entry['mesh_size']:g} mm{' seeds' if entry.get('seeded') else ''}: "
             f"{entry.get('steps', '-')} / {entry['factorisations']} / {entry['eigensolves']}"

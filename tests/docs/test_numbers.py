@@ -37,7 +37,7 @@ def _pages() -> list[Path]:
 
 def test_readme_quotes_the_numbers_of_the_file() -> None:
     assert f"{NUMBERS['tests']} tests" in README
-    assert f"({NUMBERS['make_demo_time']} on 2 cores)" in README
+    assert f"{NUMBERS['make_demo_time']} on 2 cores" in README
     assert f"{NUMBERS['make_test_time']} on 2 cores" in README
 
 
