@@ -321,7 +321,7 @@ def _analyse(
                 f"lambda_free = {free.load!r} Pa"
             )
         t1 = time.perf_counter()
-        if method == FOUNDATION:
+        if problem.tensionless:  # springs, not obstacles: their own certificate
             certificate = certify_foundation(problem, solution)
         else:
             certificate = certify(problem, solution)

@@ -147,8 +147,10 @@ class DesignRecord(Struct, kw_only=True):
             check is not applied (a note says so).
         column_reduction_factor: :math:`\chi_c` at :math:`\bar\lambda_c = \sqrt{f_y/
             \sigma_{cr,c}}`, curve a (:math:`\alpha` = 0.21, 4.5.3(4), (5)).
-        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)); below 1 on a short
+        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` bounded to
+            :math:`0 \le \xi \le 1` (4.5.4(1)), the value used; below 1 on a short
             plate column-type buckling lowers the reduction factor.
+        xi_unclipped: :math:`\sigma_{cr}/\sigma_{cr,c} - 1` itself, before the bounds.
         reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M0}` (absent without
             :math:`\rho`).
         lower_bound: When the critical load is not proven the lowest (a KKT point, or
@@ -174,6 +176,7 @@ class DesignRecord(Struct, kw_only=True):
     column_critical_stress_Pa: float | None = None
     column_reduction_factor: float | None = None
     xi: float | None = None
+    xi_unclipped: float | None = None
     reduced_design_stress_Pa: float | UnsetType = UNSET
     lower_bound: DesignRecord | UnsetType = UNSET
 
@@ -328,18 +331,19 @@ def _column_type(
     reduced = column_type(rho, sigma1, column, design.yield_stress)
     chi, rho_c = reduced.chi, reduced.rho
     out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
-    out.xi = reduced.xi
+    out.xi, out.xi_unclipped = min(1.0, max(0.0, reduced.xi)), reduced.xi
     if out.xi < 1.0:
         out.notes.append(
             f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "
-            f"{out.xi:.3g} < 1, rho_c = {significant(rho_c)} between the plate's rho = "
+            f"{reduced.xi:.3g} < 1, rho_c = {significant(rho_c)} between the plate's rho = "
             f"{significant(rho)} and the column's chi_c = {significant(chi)} (sigma_cr,c: the "
             f"plate as a column, {ends})"
         )
     else:
         out.notes.append(
-            f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "
-            f"{out.xi:.3g} >= 1, rho_c = rho (sigma_cr,c: the plate as a column, {ends})"
+            f"column-type buckling (EN 1993-1-5 4.5.4(1)): sigma_cr/sigma_cr,c - 1 = "
+            f"{reduced.xi:.3g} >= 1, xi = 1, rho_c = rho (sigma_cr,c: the plate as a column, "
+            f"{ends})"
         )
     return rho_c
 

@@ -45,8 +45,8 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.registry import entry
-from unibuckle_fenicsx.algorithms.section_levels import BOTH, check_levels, solve_levels
-from unibuckle_fenicsx.analysis import FREE, choose_section_method
+from unibuckle_fenicsx.algorithms.section_levels import check_levels
+from unibuckle_fenicsx.analysis import choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.en1993 import (
     check_steel_modulus,
@@ -87,9 +87,13 @@ from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
 
 __all__ = [
     "COLUMN_FRACTION",
+    "LONG_TUBE_HALF_WAVES",
+    "MAX_CALIBRATED_RADIUS_RATIO",
     "MIN_ALONG_CELLS",
     "MIN_FACE_CELLS",
     "MIN_HALF_WAVE_CELLS",
+    "MIN_HALF_WAVE_CELLS_LONG",
+    "SHORT_TUBE_HALF_WAVES",
     "SectionAnalysis",
     "SectionResult",
     "buckle_length",
@@ -97,6 +101,7 @@ __all__ = [
     "column_note",
     "half_wave",
     "mesh_cell_counts",
+    "min_half_wave_cells",
     "solve_section",
     "thick_wall_note",
 ]
@@ -142,6 +147,14 @@ class SectionResult(BucklingResult, kw_only=True):
     compression_Pa: float = math.nan
     faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
 
+    def _bending(self) -> float:
+        """The input's ``bending_stress`` (0 by default in a file's ``[load]``); NaN unknown."""
+        for key in ("load", "section"):  # a file's echo; solve_section's parameters
+            table = self.input.get(key) if isinstance(self.input, dict) else None
+            if isinstance(table, dict) and (key == "load" or "bending_stress" in table):
+                return float(table.get("bending_stress", 0.0))
+        return math.nan
+
     def summary(self) -> str:
         """Lines for the terminal: the critical stress, the hollow one, the reference.
 
@@ -153,10 +166,11 @@ class SectionResult(BucklingResult, kw_only=True):
         sigma = self.compression_Pa  # the stresses printed are the extreme fibre's
         if math.isnan(sigma):  # a result written before the field: the load factor
             sigma = self.critical_load_Pa
+        where = " (uniform)" if self._bending() == 0.0 else " at the extreme fibre"
         factor = (
             ""
             if sigma == self.critical_load_Pa
-            else f" at the extreme fibre, load factor {self.critical_load_Pa / scale:.6e} {unit}"
+            else f"{where}, load factor {self.critical_load_Pa / scale:.6e} {unit}"
         )
         hollow = self.free_load_Pa * (sigma / self.critical_load_Pa)  # its extreme fibre's
         head = (
@@ -373,10 +387,21 @@ def _solve_section(
 #: shorter buckles make it worse (:doc:`/guide/sections`, "Cell size").
 MIN_FACE_CELLS = 5
 #: Fewer cells than this along a tube's axisymmetric half-wave
-#: :math:`\pi\sqrt{Rt}/(12(1-\nu^2))^{1/4}` draw a warning, by the same measure: the
-#: hollow tube is then about 5 % or less above its converged load at R/t = 50 and 100
-#: (:doc:`/guide/sections`, "Cell size").
-MIN_HALF_WAVE_CELLS = 2.5
+#: :math:`\pi\sqrt{Rt}/(12(1-\nu^2))^{1/4}` draw a warning between clamped ends, and
+#: between simply supported ends up to :data:`SHORT_TUBE_HALF_WAVES` half-waves long: the
+#: hollow tube's error on n cells is about C/n\ :sup:`2`, C up to 81 % over R/t = 12.5 to
+#: 800, so 4 cells keep it to about 5 % (:doc:`/verification/tube_cells`).
+MIN_HALF_WAVE_CELLS = 4.0
+#: ... and this many along a simply supported tube at least :data:`LONG_TUBE_HALF_WAVES`
+#: half-waves long (C up to 23 %; the count asked falls linearly in between).
+MIN_HALF_WAVE_CELLS_LONG = 2.5
+#: The simply supported tube's lengths (in half-waves) between which the cells asked fall.
+SHORT_TUBE_HALF_WAVES = 5.0
+#: See :data:`SHORT_TUBE_HALF_WAVES`.
+LONG_TUBE_HALF_WAVES = 8.0
+#: The largest R/t the rule on the half-wave is measured at: thinner tubes draw a warning
+#: whatever their cells (:func:`coarse_mesh_note`).
+MAX_CALIBRATED_RADIUS_RATIO = 800.0
 #: Fewer cells than this along the longest buckle the ends allow (:func:`buckle_length`)
 #: draw a warning, by the same measure: a short section buckles in one wave as long as
 #: the member, whatever its walls' own buckles (:doc:`/guide/sections`, "Cell size").
@@ -472,18 +497,20 @@ def column_note(parameters: SectionParameters, load: float, cored: bool) -> str 
 def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     """A warning when the cells are too coarse for the walls' buckles, else None.
 
-    The rule (:data:`MIN_FACE_CELLS`, :data:`MIN_HALF_WAVE_CELLS` across,
-    :data:`MIN_ALONG_CELLS` along :func:`buckle_length`; the note names the one that asks
-    for the finest cells) is a priori, from the section's dimensions and the cells its
-    mesh will have (:func:`mesh_cell_counts`): on cells too coarse for the buckles the
-    shell's critical stress is too high (it falls as the cells are refined), and so are k
-    and the design values. Lengths in the units of the file solved
+    The rule (:data:`MIN_FACE_CELLS` across a box's face, :func:`min_half_wave_cells`
+    along a tube's half-wave, :data:`MIN_ALONG_CELLS` along :func:`buckle_length`; the
+    note names the one that asks for the finest cells) is a priori, from the section's
+    dimensions and the cells its mesh will have (:func:`mesh_cell_counts`): on cells too
+    coarse for the buckles the shell's critical stress is too high (it falls as the cells
+    are refined), and so are k and the design values. A tube thinner than
+    :data:`MAX_CALIBRATED_RADIUS_RATIO` draws a warning whatever its cells: the rule is
+    not measured there. Lengths in the units of the file solved
     (:func:`~unibuckle_fenicsx.spec.base.file_units`).
     """
     p = parameters
     width, across = _buckle_width(p)
     length, along = buckle_length(p)
-    need_across = MIN_FACE_CELLS if p.shape == "box" else MIN_HALF_WAVE_CELLS
+    need_across = MIN_FACE_CELLS if p.shape == "box" else min_half_wave_cells(p)
     cells_across, cells_along = mesh_cell_counts(p)
     checks = [
         (cells_across, width, need_across, f"across {across}"),
@@ -492,7 +519,7 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     # A whole number of cells within rounding (5 cells of L/5 over L) counts as that many.
     short = [c for c in checks if c[0] * (1.0 + 1e-9) < c[2]]
     if not short:
-        return None
+        return _thin_tube_note(p)
     cells, span, need, where = min(short, key=lambda c: c[0] / c[2])  # the finest asked
     (size, finer, width), unit = in_file((p.mesh_size, span / need, span), "m")
     return (
@@ -500,6 +527,42 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
         f"({width:.3g} {unit}), fewer than {need:g}: on cells this coarse the "
         "critical stress, k and the design values come out too high (refine mesh.size to "
         f'{finer:.3g} {unit} or less; docs/guide/sections.md, "Cell size")'
+    )
+
+
+def min_half_wave_cells(parameters: SectionParameters) -> float:
+    """The cells a tube's mesh needs along its axisymmetric half-wave (:func:`half_wave`).
+
+    :data:`MIN_HALF_WAVE_CELLS` between clamped ends and along a simply supported tube
+    of up to :data:`SHORT_TUBE_HALF_WAVES` half-waves, :data:`MIN_HALF_WAVE_CELLS_LONG`
+    from :data:`LONG_TUBE_HALF_WAVES` on, linear in the length in between (rounded up
+    to a tenth).
+    """
+    p = parameters
+    if p.ends == "clamped":
+        return MIN_HALF_WAVE_CELLS
+    waves = p.length / half_wave(p)
+    cells = np.interp(
+        waves,
+        (SHORT_TUBE_HALF_WAVES, LONG_TUBE_HALF_WAVES),
+        (MIN_HALF_WAVE_CELLS, MIN_HALF_WAVE_CELLS_LONG),
+    )
+    return math.ceil(10.0 * float(cells) - 1e-9) / 10.0  # up to a tenth of a cell
+
+
+def _thin_tube_note(parameters: SectionParameters) -> str | None:
+    """The warning of :func:`coarse_mesh_note` for a tube thinner than the rule's range."""
+    p = parameters
+    if p.shape != "tube":
+        return None
+    ratio = 0.5 * float(p.diameter or 0.0) / p.thickness
+    if ratio <= MAX_CALIBRATED_RADIUS_RATIO:
+        return None
+    return (
+        f"R/t = {ratio:.4g} is above {MAX_CALIBRATED_RADIUS_RATIO:g}, the thinnest tube "
+        "the rule on the cells along the half-wave is measured at: the critical stress, k "
+        "and the design values may come out too high on these cells (compare with a "
+        'solve on a finer mesh.size; docs/guide/sections.md, "Cell size")'
     )
 
 
@@ -619,22 +682,10 @@ def _faces(
 def _solve(
     parameters: SectionParameters, levels: int, comm: MPI.Comm, method: str, solver: SolverSpec
 ) -> tuple[Section, UnilateralSolution | None]:
-    """The section and, with a core, its solution by ``method`` (a registry key, or free)."""
-    if method == FREE:
+    """The section and, with a core, its solution by ``method`` (a registry key)."""
+    if not parameters.core:  # the hollow section's free load is the answer
         return build_section(parameters, comm, solver), None
-    if method == BOTH:  # "auto" on a small section: both routes, the lower kept
-        return solve_levels(
-            parameters,
-            route=BOTH,
-            levels=levels,
-            comm=comm,
-            solver=solver,
-            max_iterations=solver.max_iterations,
-        )
-    run = entry(method).section
-    if run is None:
-        raise RuntimeError(f"solve_section: the method {method!r} has no section runner")
-    return run(parameters, levels, comm, solver)
+    return entry(method).solve_section(parameters, levels, comm, solver)
 
 
 def _result(

@@ -140,7 +140,9 @@ class FaceDesign(Struct, kw_only=True):
             below, on a face not shorter than its width (no column-type check).
         column_reduction_factor: :math:`\chi_c` at :math:`\sqrt{f_y/\sigma_{cr,c}}`,
             curve a (4.5.3(4), (5)).
-        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` (4.5.4(1)).
+        xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` bounded to
+            :math:`0 \le \xi \le 1` (4.5.4(1)), the value used.
+        xi_unclipped: :math:`\sigma_{cr}/\sigma_{cr,c} - 1` itself, before the bounds.
         reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M0}` (Pa), with
             ``reduction_factor``.
     """
@@ -155,6 +157,7 @@ class FaceDesign(Struct, kw_only=True):
     column_critical_stress_Pa: float | None = None
     column_reduction_factor: float | None = None
     xi: float | None = None
+    xi_unclipped: float | None = None
     reduced_design_stress_Pa: float | None = None
 
 
@@ -245,7 +248,8 @@ def _face(
         )
         reduced = column_type(rho, sigma1, column, design.yield_stress)
         out.column_critical_stress_Pa, out.column_reduction_factor = column, reduced.chi
-        out.xi, out.reduction_factor = reduced.xi, reduced.rho
+        out.xi, out.xi_unclipped = min(1.0, max(0.0, reduced.xi)), reduced.xi
+        out.reduction_factor = reduced.rho
     out.reduced_design_stress_Pa = (
         out.reduction_factor * design.yield_stress / design.partial_factor
     )

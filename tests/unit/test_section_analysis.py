@@ -233,9 +233,10 @@ def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
     # nu = 0.3): the axisymmetric half-wave pi sqrt(R t)/(12 (1 - nu^2))^(1/4)
     # = pi * 0.0141421 / 1.81762 = 0.024444 m, so 0.02 m cells give 1.22 of them (10
     # cells of 20 mm along, 32 facets of 19.6 mm) and 0.016 m cells 1.56 (13 cells of
-    # 15.4 mm along, 40 facets of 2R sin(pi/40) = 15.69 mm: below MIN_HALF_WAVE_CELLS =
-    # 2.5, this tube, L = 2R, is 9 % high on 1.5 cells, docs/guide/sections.md "Cell
-    # size"), 0.0097 m cells 2.57 (66 facets of 9.52 mm).
+    # 15.4 mm along, 40 facets of 2R sin(pi/40) = 15.69 mm: simply supported, L = 2R =
+    # 8.2 half-waves, below MIN_HALF_WAVE_CELLS_LONG = 2.5, this tube is 9 % high on 1.5
+    # cells, docs/guide/sections.md "Cell size"), 0.0097 m cells 2.57 (66 facets of
+    # 9.52 mm). Between clamped ends 2.57 cells are below MIN_HALF_WAVE_CELLS = 4.
     from unibuckle_fenicsx.section_analysis import coarse_mesh_note
 
     assert coarse_mesh_note(_box(mesh_size=0.02)) is None
@@ -243,18 +244,87 @@ def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
     assert note is not None and "2 cells across the narrowest face" in note
     assert "mesh.size to 0.02 m" in note
     tube = SectionParameters(
-        "tube", diameter=0.2, thickness=T, length=0.2, E=E, nu=NU, mesh_size=0.02
-    )
+        "tube", diameter=0.2, thickness=T, length=0.2, E=E, nu=NU, mesh_size=0.02,
+        ends="simply_supported",
+    )  # fmt: skip
     note = coarse_mesh_note(tube)
     assert note is not None and "1.2 cells" in note and "(0.0244 m)" in note
     note = coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.016))
     assert note is not None and "1.6 cells" in note and "fewer than 2.5" in note
     assert coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.0097)) is None
+    note = coarse_mesh_note(dataclasses.replace(tube, mesh_size=0.0097, ends="clamped"))
+    assert note is not None and "2.6 cells" in note and "fewer than 4" in note
     # The warning is logged by the solve (a hollow box on two cells a face: a free solve).
     with caplog.at_level(logging.WARNING, logger="unibuckle_fenicsx.section_analysis"):
         with solve_section(_box(mesh_size=0.05, core=False), MPI.COMM_SELF, levels=0):
             pass
     assert any("cells across the narrowest face" in r.getMessage() for r in caplog.records)
+
+
+def test_a_short_thin_tube_on_coarse_cells_draws_a_warning(caplog):
+    """A hollow tube R/t = 200, L = 40 mm, simply supported, on 4.79 mm cells.
+
+    Its axisymmetric half-wave pi sqrt(R t)/(12 (1 - nu^2))^(1/4) = 12.22 mm spans 2.57
+    of its cells (9 of 4.44 mm along, 132 facets of 4.76 mm): the rule asked 2.5 and
+    said nothing, while its load is 1.0545 sigma_cl, 6.9 % above the converged 0.987
+    sigma_cl (h^2 extrapolation of 4.0 and 5.0 cells; docs/verification/tube_cells.md).
+    The independent value here: Donnell's critical stress, the minimum over m, n of
+    D (a^2 + b^2)^2/(t a^2) + E a^2/(R^2 (a^2 + b^2)^2), a = m pi/L, b = n/R, which is
+    sigma_cl = E t/(R sqrt(3 (1 - nu^2))) to 1e-4 at this length; the load on these
+    cells lies more than 5 % above it. A short simply supported tube asks for 4 cells.
+    """
+    import numpy as np
+
+    R, t, L = 0.1, 0.0005, 0.04
+    D = E * t**3 / (12 * (1 - NU**2))
+    a = np.arange(1, 20)[:, None] * math.pi / L
+    b = np.arange(0, 80)[None, :] / R
+    donnell = float(
+        (D * (a**2 + b**2) ** 2 / (t * a**2) + E * a**2 / (R**2 * (a**2 + b**2) ** 2)).min()
+    )
+    classical = E * t / (R * math.sqrt(3 * (1 - NU**2)))
+    assert donnell == pytest.approx(classical, rel=1e-4)
+    tube = SectionParameters(
+        "tube", diameter=2 * R, thickness=t, length=L, E=E, nu=NU, mesh_size=0.00479,
+        ends="simply_supported", core=False,
+    )  # fmt: skip
+    with caplog.at_level(logging.WARNING, logger="unibuckle_fenicsx.section_analysis"):
+        with solve_section(tube, MPI.COMM_SELF) as analysis:
+            load = analysis.result.critical_load_Pa
+    assert load > 1.05 * donnell
+    notes = [r.getMessage() for r in caplog.records if "half-wave" in r.getMessage()]
+    assert len(notes) == 1 and "2.6 cells" in notes[0] and "fewer than 4" in notes[0]
+
+
+def test_the_cells_asked_along_a_tube_fall_with_its_length_and_stop_at_thin_walls():
+    """The cells asked along a tube's half-wave: 4, 2.5 on long simply supported tubes.
+
+    Measured (docs/verification/tube_cells.md): on n cells along the half-wave the hollow
+    tube lies about C/n^2 above its converged load, C up to 81 % between clamped ends and
+    on simply supported tubes of up to 5 half-waves, 23 % from 8 half-waves.
+
+    R = 0.1 m, t = 1 mm: half-wave 17.28 mm. Simply supported: L = 100 mm (5.79
+    half-waves) asks 4 - 1.5 (0.79/3) = 3.61, 3.7 rounded up (this tube is 4.9 % high on
+    2.5 cells), and 6.8 mm cells give 2.6 (15 of 6.67 mm along); L = 150 mm (8.7
+    half-waves) asks 2.5; clamped, 4 at any length. R/t = 1000 lies beyond the R/t = 800
+    measured: a warning on any cells.
+    """
+    from unibuckle_fenicsx.section_analysis import coarse_mesh_note, min_half_wave_cells
+
+    tube = SectionParameters(
+        "tube", diameter=0.2, thickness=0.001, length=0.1, E=E, nu=NU, mesh_size=0.0068,
+        ends="simply_supported",
+    )  # fmt: skip
+    assert min_half_wave_cells(tube) == 3.7
+    note = coarse_mesh_note(tube)
+    assert note is not None and "2.6 cells" in note and "fewer than 3.7" in note
+    long = dataclasses.replace(tube, length=0.15)
+    assert min_half_wave_cells(long) == 2.5 and coarse_mesh_note(long) is None
+    assert min_half_wave_cells(dataclasses.replace(long, ends="clamped")) == 4.0
+    thin = dataclasses.replace(tube, thickness=0.0001, mesh_size=0.001)
+    note = coarse_mesh_note(thin)
+    assert note is not None and "R/t = 1000 is above 800" in note
+    assert coarse_mesh_note(dataclasses.replace(thin, thickness=0.000125)) is None
 
 
 def test_cells_exactly_enough_draw_no_warning():
@@ -438,3 +508,28 @@ def test_a_filled_member_near_its_euler_stress_is_warned_of_its_column(foundatio
     # The hollow member's warning is the column's mode itself (unchanged).
     hollow = dataclasses.replace(member, core=False, foundation_stiffness=None)
     assert "the mode is the column's" in (column_note(hollow, 0.9 * euler, False) or "")
+
+
+def test_a_uniform_stress_is_not_called_the_extreme_fibre_s():
+    """``axial_stress = -2`` and no bending: every fibre carries twice the load factor.
+
+    The summary said "sigma_cr = ... at the extreme fibre, load factor ..." for this
+    uniform stress; it names the stress uniform. With bending it keeps "the extreme fibre"
+    (tests/verification/test_section_anchors.py). The compression is 2 x the load factor
+    by the load's definition (compression per unit load 2).
+    """
+    tube = SectionParameters(
+        "tube", diameter=0.1, thickness=0.001, length=0.01, E=E, nu=NU, mesh_size=0.002,
+        ends="simply_supported", core=False, axial_stress=-2.0,
+    )  # fmt: skip
+    with solve_section(tube, MPI.COMM_SELF) as analysis:
+        result = analysis.result
+    assert result.compression_Pa == pytest.approx(2 * result.critical_load_Pa, rel=1e-14)
+    summary = result.summary()
+    assert f"sigma_cr = {result.compression_Pa:.6e} Pa (uniform), load factor" in summary
+    assert "fibre" not in summary
+    # A file's run echoes its [load] table (bending_stress 0 by default): the same words.
+    result.input = {"load": {"axial_stress": -2.0, "bending_stress": 0.0}}
+    assert "(uniform), load factor" in result.summary()
+    result.input = {"load": {"axial_stress": -2.0, "bending_stress": 0.5}}
+    assert "at the extreme fibre, load factor" in result.summary()

@@ -329,7 +329,28 @@ def test_a_stub_shorter_than_its_faces_gets_rho_c():
     clamped = _section(width=b, depth=b, thickness=t, length=a, ends="clamped")
     face = section_design(clamped, DesignSpec(fy), 2.0 * load).faces[0]
     assert face.column_critical_stress_Pa == pytest.approx(4.0 * column, rel=1e-12)
-    assert face.xi == pytest.approx(2.0 * load / (4.0 * column) - 1.0, rel=1e-12)
+    # The ratio minus 1 is -0.22: xi = 0 (bounded, 4.5.4(1)) and rho_c = chi_c.
+    assert face.xi_unclipped == pytest.approx(2.0 * load / (4.0 * column) - 1.0, rel=1e-12)
+    assert face.xi_unclipped < 0.0 and face.xi == 0.0
+    assert face.reduction_factor == pytest.approx(face.column_reduction_factor, rel=1e-12)
+
+
+def test_xi_is_reported_as_used_bounded_to_one():
+    """EN 1993-1-5 4.5.4(1) bounds xi = sigma_cr/sigma_cr,c - 1 to 0 <= xi <= 1.
+
+    The stub of :func:`test_a_stub_shorter_than_its_faces_gets_rho_c` (sigma_cr,c =
+    75.92 MPa by eq. (4.8)) at sigma_cr = 3 sigma_cr,c: the ratio minus 1 is 2, xi = 1 and
+    rho_c = rho (4.5.4(1) by hand). The output gave ``xi`` = 2 while rho_c used 1; now
+    ``xi`` is 1 and ``xi_unclipped`` the ratio minus 1, 2.
+    """
+    E, nu, t, b, a, fy = 2.1e11, 0.3, 0.001, 0.1, 0.05, 3.55e8
+    column = math.pi**2 * E * t**2 / (12.0 * (1.0 - nu**2) * a**2)
+    section = _section(width=b, depth=b, thickness=t, length=a, ends="simply_supported")
+    out = section_design(section, DesignSpec(yield_stress=fy), 3.0 * column)
+    for face in out.faces:
+        assert face.xi == 1.0
+        assert face.xi_unclipped == pytest.approx(2.0, rel=1e-12)
+        assert face.reduction_factor == face.plate_reduction_factor
 
 
 def test_a_rectangular_stub_s_wide_faces_get_rho_c_and_govern():

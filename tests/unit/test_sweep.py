@@ -601,3 +601,82 @@ def test_a_section_chart_draws_the_extreme_fibre_s_stress(tmp_path, monkeypatch)
     )
     assert seen["hollow"][0] == pytest.approx(1.5 * line["free_load_Pa"] / classical, rel=1e-5)
     assert seen["core"][0] == pytest.approx(1.5 * line["critical_load_Pa"] / classical, rel=1e-5)
+
+
+# -- the table as CSV -----------------------------------------------------------------
+
+
+def _printed_table(out: str) -> list[list[str]]:
+    """The rows of the table ``unibuckle sweep`` printed (cells apart by 2 spaces or more)."""
+    import re
+
+    rows = out.splitlines()
+    end = next(k for k, row in enumerate(rows) if row.startswith("sweep: "))
+    return [re.split(r"\s{2,}", row.strip()) for row in rows[:end]]
+
+
+def test_the_sweep_table_is_written_as_csv(tmp_path, capsys):
+    """``--csv`` holds the printed table: its header, and each cell at full precision.
+
+    Read back with the csv module, each number formatted as the terminal's table formats
+    it (6 significant digits for the swept value, 7 for the load, 4 decimals for the ratio
+    and k) is the printed cell, and the load is the point's JSON line's to the last bit.
+    """
+    import csv
+
+    from unibuckle_fenicsx.cli import main
+
+    base = tmp_path / "small.toml"
+    base.write_text(SMALL)
+    out, table = tmp_path / "k.jsonl", tmp_path / "k.csv"
+    args = ["sweep", "--config", str(base), "--vary", "plate.thickness=0.005,0.006"]
+    assert main([*args, "--json", str(out), "--csv", str(table)]) == EXIT_OK
+    printed = _printed_table(capsys.readouterr().out)
+    with table.open(newline="", encoding="utf-8") as f:
+        written = list(csv.reader(f))
+    assert written[0] == printed[0] == [
+        "plate.thickness (m)", "lambda_c (Pa)", "x free", "k", "certificate", "status"
+    ]  # fmt: skip
+    assert len(written) == len(printed) == 3
+    formats = (".6g", ".6e", ".4f", ".4f")
+    for line, row, shown in zip(read_lines(out), written[1:], printed[1:], strict=True):
+        numbers = [float(cell) for cell in row[:4]]
+        assert [format(v, f) for v, f in zip(numbers, formats, strict=True)] == shown[:4]
+        assert row[4:] == shown[4:] == [line["certificate"]["status"], "ok"]
+        assert numbers[0] == line["point"]["plate.thickness"]
+        assert numbers[1] == line["critical_load_Pa"]  # SI: the stress unit is Pa
+        assert numbers[3] == line["buckling_coefficient_k"]
+
+
+def test_a_point_without_values_has_empty_csv_cells(tmp_path):
+    # The terminal table shows "-" where a point has no value; the CSV leaves it empty.
+    import csv
+
+    from unibuckle_fenicsx.cli.sweep import sweep_table, write_sweep_csv
+
+    lines = [
+        {"index": 0, "point": {"plate.thickness": 2.0}, "status": "ok", "units": "mm-N-MPa",
+         "critical_load_Pa": 7.935676e8, "ratio_to_free": 1.28875,
+         "buckling_coefficient_k": 10.45268, "certificate": {"status": "kkt-only"}},
+        {"index": 1, "point": {"plate.thickness": 3.0}, "status": "eigen-failure",
+         "units": "mm-N-MPa", "error": "no pair"},
+    ]  # fmt: skip
+    path = tmp_path / "t.csv"
+    write_sweep_csv(lines, str(path))
+    with path.open(newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    assert rows[0][:2] == ["plate.thickness (mm)", "lambda_c (MPa)"]
+    assert rows[1] == ["2.0", "793.5676", "1.28875", "10.45268", "kkt-only", "ok"]
+    assert rows[2] == ["3.0", "", "", "", "", "eigen-failure"]
+    assert sweep_table(lines).splitlines()[2].split() == ["3", "-", "-", "-", "-", "eigen-failure"]
+
+
+def test_a_csv_in_a_missing_folder_is_refused_before_any_solve(tmp_path):
+    base = tmp_path / "small.toml"
+    base.write_text(SMALL)
+    proc = run_sweep_cli(
+        "--config", str(base), *VARY, "--json", "k.jsonl", "--csv", "no/k.csv", cwd=tmp_path
+    )  # fmt: skip
+    assert proc.returncode == EXIT_BAD_INPUT, proc.stderr
+    assert "--csv: the folder no does not exist" in proc.stderr
+    assert not (tmp_path / "k.jsonl").exists()

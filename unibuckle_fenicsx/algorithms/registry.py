@@ -9,16 +9,22 @@ command line reads them there, so that building its parser imports no PETSc).
 algorithms: the function that runs each method on a
 :class:`~unibuckle_fenicsx.model.problem.UnilateralProblem`, and the links its route may
 take (a result's ``route`` starts with the method and takes only those).
-:func:`unibuckle_fenicsx.analysis.solve` runs the method through it. An entry that also
-runs on a box or tube with a core has a ``section`` runner: it builds the section
-(with its coarser sections) from its parameters and solves it;
-:func:`unibuckle_fenicsx.section_analysis.solve_section` runs it.
+:func:`unibuckle_fenicsx.analysis.solve` runs a plate's method through it
+(:meth:`MethodEntry.solve`). An entry that runs on a box or tube with a core has a
+``section`` runner: it builds the section (with its coarser sections) from its
+parameters and solves it; :func:`unibuckle_fenicsx.section_analysis.solve_section` runs
+it (:meth:`MethodEntry.solve_section`). An entry without one of the two refuses that
+kind of problem, naming ``solver.method``.
 
-"auto" chooses among the others (:func:`unibuckle_fenicsx.analysis.choose_method` for a
+"auto" chooses among the entries (:func:`unibuckle_fenicsx.analysis.choose_method` for a
 plate, :func:`unibuckle_fenicsx.analysis.choose_section_method` for a section) and runs
-nothing of its own. A tensionless foundation's spring-set iteration is chosen by the
-problem, never named in a file: it is registered under :data:`FOUNDATION` and is no
-:class:`~unibuckle_fenicsx.spec.Method`.
+nothing of its own. Two entries are chosen, never named in a file, and are no
+:class:`~unibuckle_fenicsx.spec.Method`: a tensionless foundation's spring-set iteration
+(:data:`FOUNDATION`, chosen by the problem) and, on a section of fewer than
+:data:`~unibuckle_fenicsx.algorithms.section_levels.INTERIOR_POINT_DOFS` degrees of
+freedom, "auto"'s route :data:`~unibuckle_fenicsx.algorithms.section_levels.BOTH` (the
+interior point and the active set on the same sections, the lower KKT point kept), which
+has a section runner only.
 """
 
 from __future__ import annotations
@@ -38,8 +44,8 @@ from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.algorithms.foundation import solve_foundation
 from unibuckle_fenicsx.algorithms.interior_point.options import ChainOptions
 from unibuckle_fenicsx.algorithms.penalty import solve_penalty
-from unibuckle_fenicsx.algorithms.section_levels import solve_levels
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.algorithms.section_levels import BOTH, solve_levels
+from unibuckle_fenicsx.errors import FieldError, InputError
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import OPTIONS, FoundationOptions, Method, SolverSpec
@@ -51,10 +57,16 @@ from unibuckle_fenicsx.spec.solver import (
     PenaltyOptions,
 )
 
-__all__ = ["FOUNDATION", "REGISTRY", "MethodEntry", "SectionRun", "entry"]
+__all__ = ["FOUNDATION", "REGISTRY", "MethodEntry", "PlateRun", "SectionRun", "entry"]
 
 #: The name of a tensionless foundation's spring-set iteration (a result's ``method``).
 FOUNDATION = "foundation"
+
+#: Runs a method on a plate's problem: the problem, the method's options and the
+#: communicator over which the enumeration splits its candidate sets (None: each rank
+#: holds a part of the mesh; the other methods take None only) in, the solution out.
+#: Collective.
+PlateRun = Callable[[UnilateralProblem, Any, MPI.Comm | None], UnilateralSolution]
 
 #: Runs a method on a section with a core: its parameters, its coarser sections (``mesh.levels``,
 #: >= 0), the communicator and the ``[solver]`` table in; the finest section (the caller
@@ -69,21 +81,21 @@ class MethodEntry:
     """One method of the registry.
 
     Attributes:
-        name: The method's name (a result's ``method``): a :class:`Method` value, or
-            :data:`FOUNDATION`.
+        name: The method's name: a :class:`Method` value, :data:`FOUNDATION` or
+            :data:`~unibuckle_fenicsx.algorithms.section_levels.BOTH` (the name a choice
+            returns; a result's ``method`` is that of the route that answered).
         options: Its options Struct: the ``[solver]`` keys it reads, with their defaults.
-        run: Runs it on a problem with those options; the third argument is the
-            communicator over which the enumeration splits its candidate sets (None:
-            each rank holds a part of the mesh; the other methods take None only).
-        links: The links its route may take (the first is the method itself, with which
-            every route starts).
+        run: Runs it on a plate with those options (:data:`PlateRun`); None: it runs on
+            sections only.
+        links: The links a plate's route may take (the first is the method itself, with
+            which every such route starts).
         section: Runs it on a box or tube with a core (:data:`SectionRun`); None: it runs
             on plates only.
     """
 
     name: str
     options: type[Table]
-    run: Callable[[UnilateralProblem, Any, MPI.Comm | None], UnilateralSolution]
+    run: PlateRun | None
     links: tuple[str, ...]
     section: SectionRun | None = None
 
@@ -96,9 +108,38 @@ class MethodEntry:
     ) -> UnilateralSolution:
         """Run this method on ``problem`` with the options of its ``[solver]`` table.
 
-        Collective on ``problem``'s communicator.
+        Raises:
+            FieldError: This entry runs on sections only (naming ``solver.method``).
+
+        Note:
+            Collective on ``problem``'s communicator.
         """
+        if self.run is None:
+            raise FieldError("", "solver.method", self._refusal("a plate", "run"))
         return self.run(problem, self.options_of(problem.spec.solver), candidate_comm)
+
+    def _refusal(self, what: str, runner: str) -> str:
+        """A :class:`FieldError`'s text at ``solver.method``: no ``runner`` for ``what``."""
+        runs = [name for name, e in REGISTRY.items() if getattr(e, runner) is not None]
+        return f" = {str(self.name)!r} does not run on {what}: {', '.join(runs)} do"
+
+    def solve_section(
+        self, parameters: SectionParameters, levels: int, comm: MPI.Comm, solver: SolverSpec
+    ) -> tuple[Section, UnilateralSolution]:
+        """Run this method on the section ``parameters`` with a core (:data:`SectionRun`).
+
+        Returns:
+            The finest section (the caller destroys it) and the solution on it.
+
+        Raises:
+            FieldError: This entry runs on plates only (naming ``solver.method``).
+
+        Note:
+            Collective on ``comm``.
+        """
+        if self.section is None:
+            raise FieldError("", "solver.method", self._refusal("a section", "section"))
+        return self.section(parameters, levels, comm, solver)
 
 
 def _enumerate(
@@ -171,7 +212,8 @@ def _section_foundation(
         raise
 
 
-#: Every method that runs, by name (``auto`` is a choice among them, not one of them).
+#: Every method that runs, by name (``auto`` is a choice among them, not one of them):
+#: adding a method is adding its entry here.
 REGISTRY: dict[str, MethodEntry] = {
     e.name: e
     for e in (
@@ -205,6 +247,15 @@ REGISTRY: dict[str, MethodEntry] = {
             _foundation,
             ("foundation", "arc-descent"),
             _section_foundation,
+        ),
+        # "auto" on a small section: both section routes, the lower KKT point kept (its
+        # solution's method and route are those of the route kept).
+        MethodEntry(
+            BOTH,
+            OPTIONS[Method.INTERIOR_POINT],
+            None,
+            ("interior-point", "active-set", "penalty-continuation", "feasible-descent"),
+            _section_levels(BOTH),
         ),
     )
 }

@@ -35,7 +35,8 @@ point on sections of at least :data:`INTERIOR_POINT_DOFS` degrees of freedom; on
 smaller ones both routes (:data:`BOTH`), the active set on the sections the interior
 point built, and the lower KKT point is kept: both are KKT points, neither is proven
 the lowest, and either can end above the other); :func:`solve_levels` runs the route
-it is given.
+it is given, and each route is an entry of
+:data:`~unibuckle_fenicsx.algorithms.registry.REGISTRY` (:data:`BOTH` is one of its own).
 
 The seeds are those of :data:`SEEDS`, the plate's others (:data:`MORE_SEEDS`) only if
 these reach no KKT point: a core makes every wall move outward, and the contact set is
@@ -115,7 +116,8 @@ PLAIN_POLISH_ITERATIONS = 50
 #: to about 1e-13): the method and records stay the polish's.
 SAME_LOAD = 1e-9
 #: The route of ``"auto"`` on sections below :data:`INTERIOR_POINT_DOFS`: both routes on
-#: the same sections, the lower KKT point kept (module docstring).
+#: the same sections, the lower KKT point kept (module docstring); a registry entry of
+#: its own, with a section runner only.
 BOTH = "both"
 #: The routes of :func:`solve_levels` (module docstring).
 ROUTES = ("interior-point", "active-set", BOTH)

@@ -64,7 +64,7 @@ examples:
   unibuckle sweep --config demos/plate.toml --vary plate.thickness=0.002:0.004:3 \\
       --json t.jsonl --plot t.png
   unibuckle sweep --config ssss.toml --vary plate.length=0.5:4:15 \\
-      --vary plate.thickness=0.001,0.01 --json grid.jsonl
+      --vary plate.thickness=0.001,0.01 --json grid.jsonl --csv grid.csv
   unibuckle sweep --config demos/box.toml --vary section.thickness=0.001:0.002:5 \\
       --json box_bt.jsonl --plot box_bt.png
 
@@ -239,7 +239,9 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         description="Compute the critical load of one problem and print its summary.\n"
         "The problem is a plate (a paper case or a TOML file) or a section: a file with a\n"
         "[section] table (a box or a tube, with a core or hollow), solved on its [mesh]\n"
-        "size and levels (--nx, --ny, --output and --candidate-parallel: plates only).",
+        "size and levels. Of the solver's flags a section takes --method (auto,\n"
+        "interior-point or active-set), --tau and --max-iterations; the others, and --nx,\n"
+        "--ny, --output and --candidate-parallel, are a plate's (refused: exit status 2).",
         epilog=EPILOG,
         formatter_class=Formatter,
     )
@@ -268,6 +270,12 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         required=True,
         help="JSON-lines output (the folder must exist); an existing file of the same "
         "sweep is resumed",
+    )
+    w.add_argument(
+        "--csv",
+        metavar="PATH",
+        help="also write the table printed at the end as CSV (the folder must exist): its "
+        "columns, numbers at full precision, an empty cell where it shows -",
     )
     w.add_argument(
         "--plot",
@@ -327,8 +335,8 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
         "--bracket",
         action="store_true",
         help="run the verified bracket when several pencil eigenvalues lie below the load "
-        "(long plates) whatever its cost, down to 1e-6 (by default: where it costs at most "
-        "3 free solves)",
+        "(long plates) whatever its cost, down to a relative width of 1e-6 (by default: "
+        "only where it costs at most 3 free solves)",
     )
     s.add_argument(
         "--penalty",
@@ -363,10 +371,13 @@ def _method_flags(s: argparse.ArgumentParser) -> None:
     s.add_argument(
         "--method",
         choices=list(METHODS),
-        help="unilateral algorithm (auto: exact enumeration when 2^i <= --max-candidates "
-        "and its estimated time fits --enumeration-budget, else interior-point on thin "
-        "plates (t/b < 0.02) and active-set on thicker ones; enumerate alone = the "
-        "paper's stopping rule) " + _solver_default("method"),
+        help="unilateral algorithm. A plate's auto: exact enumeration when 2^i <= "
+        "--max-candidates (i: the nodes the obstacle acts on) and its estimated time fits "
+        "--enumeration-budget, else interior-point on thin plates (t/b < 0.02) and "
+        "active-set on thicker ones; enumerate alone = the paper's stopping rule. A "
+        "section's auto: interior-point from about 10^4 DOFs, below that both "
+        "interior-point and active-set, the lower load kept; a section takes no other "
+        "method " + _solver_default("method"),
     )
     s.add_argument(
         "--complete",

@@ -31,14 +31,19 @@ def _missing_folder(flag: str, folder: Path) -> str:
 
 
 def check_outputs(args: argparse.Namespace) -> str | None:
-    """Why --json, --plot or --output cannot be written, or None; run before any solve.
+    """Why --json, --plot, --csv or --output cannot be written, or None; run before any solve.
 
-    --json PATH (and --plot PNG) needs an existing folder in which a file can be created (tried, not
-    inferred from permission bits, which root and /proc ignore); --output DIR is
-    created later if missing, so its parent must exist and take a new entry. Nothing is
-    left behind.
+    --json PATH (and --plot PNG, --csv PATH) needs an existing folder in which a file can
+    be created (tried, not inferred from permission bits, which root and /proc ignore);
+    --output DIR is created later if missing, so its parent must exist and take a new
+    entry. Nothing is left behind.
     """
-    files = [("--json", args.json), ("--plot", getattr(args, "plot", None))]  # plot: sweep
+    # --plot and --csv: the sweep's
+    files = [
+        ("--json", args.json),
+        ("--plot", getattr(args, "plot", None)),
+        ("--csv", getattr(args, "csv", None)),
+    ]
     for flag, value in files:
         if value and (problem := _check_file(flag, Path(value))):
             return problem

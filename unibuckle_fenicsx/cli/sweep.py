@@ -59,19 +59,19 @@ def _warn_coarse_points(base: Any, variations: Any, comm: Any) -> None:
         )
 
 
-def sweep_table(lines: list[dict[str, Any]]) -> str:
-    """The sweep's points as a table for the terminal, one row per point.
+def sweep_columns(lines: list[dict[str, Any]]) -> tuple[list[str], list[list[Any]]]:
+    """The sweep table's header and its rows' values, one row per point.
 
-    The swept values as the file gives them (in its units, named), the critical load (a section's:
-    the extreme fibre's stress, as its summary's ``sigma_cr``) in the results' stress
-    unit, its ratio to the load without the obstacle (the hollow section's), k, the
-    certificate's status and the point's status; ``-`` where a point has no value.
+    The swept values as the file gives them (in its units, named), the critical load (a
+    section's: the extreme fibre's stress, as its summary's ``sigma_cr``) in the results'
+    stress unit, its ratio to the load without the obstacle (the hollow section's), k,
+    the certificate's status and the point's status; None where a point has no value.
     """
     from unibuckle_fenicsx.spec import UNITS
     from unibuckle_fenicsx.viz.charts import _unit
 
     if not lines:
-        return ""
+        return [], []
     units = str(lines[0].get("units", "SI"))
     scale, unit = UNITS[units][1:]
     section = any("classical_stress_Pa" in line for line in lines)
@@ -85,28 +85,69 @@ def sweep_table(lines: list[dict[str, Any]]) -> str:
         "status",
     ]
 
-    def number(value: Any, text: str) -> str:
-        return "-" if not isinstance(value, (int, float)) else format(value, text)
+    def number(value: Any) -> float | None:
+        return value if isinstance(value, (int, float)) else None
 
     rows = []
     for line in lines:
-        load = line.get("compression_Pa") if section else line.get("critical_load_Pa")
+        load = number(line.get("compression_Pa") if section else line.get("critical_load_Pa"))
         cert = line.get("certificate")
         rows.append(
             [
-                *(number(line.get("point", {}).get(path), ".6g") for path in paths),
-                number(None if load is None else load / scale, ".6e"),
-                number(line.get("ratio_to_free"), ".4f"),
-                number(line.get("buckling_coefficient_k"), ".4f"),
-                str(cert.get("status", "-")) if isinstance(cert, dict) else "-",
-                str(line.get("status", "-")),
+                *(number(line.get("point", {}).get(path)) for path in paths),
+                None if load is None else load / scale,
+                number(line.get("ratio_to_free")),
+                number(line.get("buckling_coefficient_k")),
+                str(cert.get("status")) if isinstance(cert, dict) and "status" in cert else None,
+                None if line.get("status") is None else str(line["status"]),
             ]
         )
-    widths = [max(len(r[i]) for r in [header, *rows]) for i in range(len(header))]
+    return header, rows
+
+
+def sweep_table(lines: list[dict[str, Any]]) -> str:
+    """The sweep's points as a table for the terminal (:func:`sweep_columns`).
+
+    Swept values to 6 significant digits, the load in exponent form to 7, its ratio and k
+    to 4 decimals; ``-`` where a point has no value.
+    """
+    header, rows = sweep_columns(lines)
+    if not header:
+        return ""
+    formats = [".6g"] * (len(header) - 5) + [".6e", ".4f", ".4f", "", ""]
+    cells = [
+        [
+            "-" if value is None else format(value, text)
+            for value, text in zip(row, formats, strict=True)
+        ]
+        for row in rows
+    ]
+    widths = [max(len(r[i]) for r in [header, *cells]) for i in range(len(header))]
     return "\n".join(
         "  ".join(cell.ljust(w) for cell, w in zip(row, widths, strict=True)).rstrip()
-        for row in [header, *rows]
+        for row in [header, *cells]
     )
+
+
+def write_sweep_csv(lines: list[dict[str, Any]], path: str) -> None:
+    """Write the sweep table (:func:`sweep_columns`) to ``path`` as CSV.
+
+    The terminal table's columns and header; numbers at full precision (Python's
+    shortest repr, read back exactly), an empty cell where the table shows ``-``.
+
+    Raises:
+        OSError: ``path`` cannot be written.
+    """
+    import csv
+
+    header, rows = sweep_columns(lines)
+    with open(path, "w", newline="", encoding="utf-8") as f:
+        writer = csv.writer(f)
+        writer.writerow(header)
+        for row in rows:
+            writer.writerow(
+                ["" if v is None else repr(v) if isinstance(v, float) else v for v in row]
+            )
 
 
 def sweep_command(args: argparse.Namespace, comm: Any) -> int:
@@ -144,6 +185,7 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
         )
     except OSError as err:  # a refused input or a failed point raises: main() tells
         return fail(str(err))
+    unwritten = None
     if comm.rank == 0:
         from collections import Counter
 
@@ -153,9 +195,18 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
             f"sweep: {len(lines)} points in {args.json}: "
             + ", ".join(f"{n} {status}" for status, n in sorted(counts.items()))
         )
+        if args.csv:
+            try:
+                write_sweep_csv(lines, args.csv)
+                print_out(f"sweep: table {args.csv}")
+            except OSError as err:  # the folder went away during the sweep
+                unwritten = f"--csv {args.csv}: {err}"
         if args.plot:
             from unibuckle_fenicsx.viz.charts import plot_sweep
 
             print_out(f"sweep: chart {plot_sweep(lines, variations, base, args.plot)}")
+    unwritten = comm.bcast(unwritten, root=0)
+    if unwritten is not None:
+        return fail(f"could not write {unwritten}; the table is above, the points in {args.json}")
     ok = all(line["status"] == Outcome.OK for line in lines)
     return (Outcome.OK if ok else Outcome.NOT_CERTIFIED).exit_status

@@ -430,7 +430,7 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
             f"{significant(d.column_reduction_factor)}, xi {d.xi:.3g})"
         )
     elif d.xi is not None:
-        column = f" (column-type: xi {d.xi:.3g} >= 1, the plate's)"
+        column = f" (column-type: xi {d.xi:.3g}, the plate's)"
     elif d.column_critical_stress_Pa == 0.0:
         column = " (column-type: none, the column a mechanism; the plate's)"
     return (

@@ -47,6 +47,26 @@ def test_every_subcommand_s_help_shows_examples_within_100_columns(command, monk
     assert not wide, wide
 
 
+def test_solve_help_says_which_flags_a_section_takes(monkeypatch):
+    # A section's file takes of [solver] only SOLVER_KEYS (eps_tol has no flag) and only
+    # SECTION_METHODS; "auto" switches at INTERIOR_POINT_DOFS (choose_section_method). The
+    # help named four plate-only flags of the twelve a section refuses.
+    from unibuckle_fenicsx.algorithms.section_levels import INTERIOR_POINT_DOFS
+    from unibuckle_fenicsx.spec.section import SECTION_METHODS, SOLVER_KEYS
+
+    monkeypatch.setenv("COLUMNS", "100")
+    _, subcommands = build_parser()
+    flat = " ".join(subcommands["solve"].format_help().split())
+    assert set(SOLVER_KEYS) == {"method", "tau", "eps_tol", "max_iterations"}
+    assert [str(m) for m in SECTION_METHODS] == ["auto", "interior-point", "active-set"]
+    assert (
+        "a section takes --method (auto, interior-point or active-set), --tau and "
+        "--max-iterations; the others," in flat
+    ), flat
+    assert INTERIOR_POINT_DOFS == 10**4
+    assert "section's auto: interior-point from about 10^4 DOFs" in flat, flat
+
+
 @pytest.mark.parametrize(
     ("shape", "changes", "text"),
     [
