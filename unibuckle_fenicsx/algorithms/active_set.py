@@ -697,7 +697,7 @@ def solve_active_set(
         candidate=chosen,
         method="active-set",
         eigensolves=problem.eigensolver.solves - solves0 + extra,
-        lower_bound=min(lower, chosen.load),
+        lower_bound=lower,
         global_optimum_proven=proven,
         upper_bound=chosen.load if chosen.feasible else math.inf,
         kkt_points=kkt,

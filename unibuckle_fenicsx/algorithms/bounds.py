@@ -18,10 +18,11 @@ from dataclasses import dataclass
 import numpy as np
 
 from unibuckle_fenicsx.algorithms.descent import descend
+from unibuckle_fenicsx.errors import EigenSolveError
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
-from unibuckle_fenicsx.tolerances import PROOF_RTOL
+from unibuckle_fenicsx.tolerances import PROOF_RTOL, SMALLEST_RTOL_FACTOR
 
-__all__ = ["Bracket", "bracket", "lattice_bound"]
+__all__ = ["Bracket", "bounded_below", "bracket", "lattice_bound"]
 
 
 def lattice_bound(
@@ -118,5 +119,60 @@ def bracket(
             evaluations += run.iterations
         chosen = better
     lower = max(lower, free_load)
-    proven = bool(lower >= chosen.load * (1 - PROOF_RTOL))
+    chosen, lower, again = bounded_below(problem, chosen, lower, free_load, route)
+    if again:
+        warning = again if warning is None else f"{warning}; {again}"
+    # Only an admissible mode's load bounds the critical load from above.
+    proven = bool(chosen.feasible and lower >= chosen.load * (1 - PROOF_RTOL))
     return Bracket(chosen, lower, proven, evaluations, complete, warning)
+
+
+def _floor(cand: Candidate, lower: float, free_load: float) -> float:
+    """The least load ``cand`` can have: ``lower`` if admissible, the free load if an eigenpair."""
+    if cand.feasible:
+        return lower  # an admissible mode's quotient bounds the critical load from above
+    return free_load if cand.eigen is not None else -math.inf  # interlacing
+
+
+def bounded_below(
+    problem: UnilateralProblem, chosen: Candidate, lower: float, free_load: float, route: str
+) -> tuple[Candidate, float, str | None]:
+    r"""``chosen`` and the proven lower bound ``lower`` beside it, which it cannot lie below.
+
+    An admissible mode's load is at least the critical load, so at least ``lower`` (the
+    free load by interlacing, or the lattice's bound); any eigenpair of a reduced pencil
+    lies at or above the free load. A load below its floor by more than the eigen
+    solver's accuracy (:data:`~unibuckle_fenicsx.tolerances.SMALLEST_RTOL_FACTOR` times
+    ``eps_tol``) is a contradiction, never a lower bound: the free pair is verified the
+    smallest (inertia), the contact set solved again from SLEPc's own start, and if the
+    load still lies below, :class:`~unibuckle_fenicsx.errors.EigenSolveError` says the
+    pair is not an eigenpair. Within that accuracy the two agree, and the bound is
+    lowered to an admissible load (the bracket is not inverted by rounding).
+
+    Returns:
+        (the candidate, solved again if it had to be; the lower bound; what was done, in
+        words, or None).
+
+    Note:
+        Collective.
+    """
+    agree = 1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol
+    message = None
+    if chosen.load < _floor(chosen, lower, free_load) * agree:
+        problem.verify_free()  # raises if the free pair, not this one, is the wrong one
+        again = problem.evaluate(chosen.active)
+        message = (
+            f"the {route} critical state's load {chosen.load:.10g} lay below the proven "
+            f"lower bound {lower:.10g}: no eigenpair; its contact set solved again gave "
+            f"{again.load:.10g}"
+        )
+        if again.load < _floor(again, lower, free_load) * agree:
+            raise EigenSolveError(
+                f"{message}, still below: the eigen solver returns a pair that is not an "
+                f"eigenpair of the pencil with |Z| = {again.active.size} removed; try a "
+                f"larger -{problem.eigensolver.prefix}eps_ncv"
+            )
+        chosen = again
+    if chosen.feasible and chosen.load < lower:
+        lower = chosen.load  # equal within the eigen solver's accuracy
+    return chosen, lower, message

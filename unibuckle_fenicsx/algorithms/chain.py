@@ -452,7 +452,7 @@ def solve_interior_point(
         candidate=chosen,
         method="interior-point",
         eigensolves=problem.eigensolver.solves - solves0 + other_solves,
-        lower_bound=min(lower, chosen.load),
+        lower_bound=lower,
         global_optimum_proven=proven,
         upper_bound=chosen.load if chosen.feasible else math.inf,
         kkt_points=[chosen],

@@ -46,6 +46,7 @@ from unibuckle_fenicsx.algorithms.foundation import pressing_nodes
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.records import CopositivityRecord, Refuting
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, rayleigh
+from unibuckle_fenicsx.errors import EigenSolveError
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
@@ -250,7 +251,7 @@ def certify(
         raise ValueError("certify: the candidate has no finite load")
     notes: list[str] = []
     kkt, residual, on_contact = _local(problem, cand, notes)
-    br = _Bracket.of(solution, notes)
+    br = _Bracket.of(solution, notes, SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
     algorithm_proof = solution.global_optimum_proven
     smallest: bool | None = None
     # One matrix for the copositivity attempt and the smallest-eigenvalue check, both
@@ -310,8 +311,15 @@ class _Bracket:
     refuting: Candidate | None = None
 
     @classmethod
-    def of(cls, solution: UnilateralSolution, notes: list[str]) -> _Bracket:
-        """The algorithm's bracket, the candidate's load its upper end if it may be."""
+    def of(cls, solution: UnilateralSolution, notes: list[str], agree: float) -> _Bracket:
+        """The algorithm's bracket, the candidate's load its upper end if it may be.
+
+        An upper end below the proven lower end by more than ``agree`` (relative: the
+        eigen solver's accuracy) is a contradiction, not a bracket: raises
+        :class:`~unibuckle_fenicsx.errors.EigenSolveError` (the mode is no eigenvector
+        of its reduced pencil, or the lower bound no bound). Within it they agree, and
+        the lower end is the upper.
+        """
         cand = solution.candidate
         # Only the eigenvalue of a reduced pencil whose mode is admissible bounds the
         # critical load from above (a penalised quotient lies below it).
@@ -322,6 +330,12 @@ class _Bracket:
             notes.append("the mode crosses the obstacle: its load is not an upper bound")
         # No stated proof: the lower bound is the free load, by interlacing.
         proven_by = solution.lower_bound_by or "interlacing"
+        if upper < solution.lower_bound * (1.0 - agree):
+            raise EigenSolveError(
+                f"the admissible load {upper!r} lies below the proven lower bound "
+                f"{solution.lower_bound!r} (by {proven_by}): the mode is not an eigenvector "
+                "of its reduced pencil, and no bracket holds"
+            )
         return cls(min(solution.lower_bound, upper), upper, proven_by, notes)
 
 

@@ -1,0 +1,103 @@
+"""An admissible load below a proven lower bound is flagged, never made the lower bound.
+
+No eigenvalue of a reduced pencil lies below the free load (interlacing: removing DOFs
+never lowers the smallest eigenvalue), and no admissible mode's load below the critical
+load. A filled tube's active set (D = 0.1 m, t = 1 mm, 5 mm cells) once took a pair that
+was no eigenpair for an admissible mode at 2.026e9 Pa, below the hollow tube's 2.366e9,
+and reported ``lower_bound = min(lower, load)``: that load, as a "verified lower bound".
+Here a pair is made spurious on purpose (its load scaled below the free load) on the
+paper's plate c1 at 8 x 4 cells; the references are dense scipy eigenvalues of the pencil.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+
+from mpi4py import MPI
+
+import numpy as np
+import pytest
+
+from support.exhaustive import dense_free_load, dense_reduced_load
+from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+from unibuckle_fenicsx.algorithms.bounds import bracket
+from unibuckle_fenicsx.certificate.certify import certify
+from unibuckle_fenicsx.errors import EigenSolveError
+from unibuckle_fenicsx.model.build import build_problem
+from unibuckle_fenicsx.spec.cases import paper_case
+
+pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial")
+
+
+@pytest.fixture
+def problem():
+    p = build_problem(paper_case("c1", 8, 4), MPI.COMM_SELF)
+    yield p
+    p.destroy()
+
+
+def _spurious(cand, load):
+    """``cand`` claiming the load ``load``, as a pair that is no eigenpair would."""
+    return dataclasses.replace(cand, load=load)
+
+
+def test_a_load_below_the_free_load_is_solved_again(problem):
+    free = problem.solve_free().load
+    assert free == pytest.approx(dense_free_load(problem), rel=1e-8)  # scipy
+    active = np.arange(3)
+    true = dense_reduced_load(problem, tuple(active))
+    cand = _spurious(problem.evaluate(active), 0.8 * free)
+    closed = bracket(problem, free, cand, 0, "active-set")
+    assert closed.chosen.load == pytest.approx(true, rel=1e-8)
+    assert closed.lower == free  # the proven bound, not the spurious load
+    assert "no eigenpair" in closed.warning
+    assert not closed.proven or closed.chosen.load <= free * (1 + 1e-10)
+
+
+def test_a_load_that_stays_below_is_an_error_not_a_bound(problem, monkeypatch):
+    free = problem.solve_free().load
+    active = np.arange(3)
+    cand = _spurious(problem.evaluate(active), 0.8 * free)
+    monkeypatch.setattr(problem, "evaluate", lambda z, **_: cand)  # the solver stays wrong
+    with pytest.raises(EigenSolveError, match="not an eigenpair"):
+        bracket(problem, free, cand, 0, "active-set")
+
+
+def test_the_active_set_reports_the_proven_bound(problem, monkeypatch):
+    """A pair from a start vector made spurious; solved again from SLEPc's own start."""
+    free = problem.solve_free().load
+    evaluate = problem.evaluate
+
+    def from_a_start(active, initial=None, near=None):
+        cand = evaluate(active, initial=initial, near=near)
+        if initial is not None or near is not None:
+            return _spurious(cand, 0.9 * free)
+        return cand
+
+    monkeypatch.setattr(problem, "evaluate", from_a_start)
+    solution = solve_active_set(problem, multilevel=False, bound_budget=0)
+    assert solution.lower_bound == free  # the proven bound (interlacing), not 0.9 of it
+    assert solution.load >= free
+    assert solution.load == pytest.approx(
+        dense_reduced_load(problem, tuple(solution.active)), rel=1e-8
+    )
+    assert "no eigenpair" in solution.details.warning
+
+
+def test_the_certificate_refuses_a_bracket_upside_down(problem):
+    free = problem.solve_free().load
+    cand = problem.evaluate(np.arange(problem.contact.size))  # Z = I: admissible
+    assert cand.feasible and cand.eigen is not None
+    solution = UnilateralSolution(
+        candidate=cand,
+        method="candidate",
+        eigensolves=0,
+        lower_bound=1.1 * cand.load,  # claimed proven, and above an admissible load
+        global_optimum_proven=False,
+        upper_bound=cand.load,
+        lower_bound_by="lattice",
+    )
+    assert cand.load > free
+    with pytest.raises(EigenSolveError, match="below the proven lower bound"):
+        certify(problem, solution, global_bound=False)
