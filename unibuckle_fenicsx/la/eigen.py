@@ -93,12 +93,11 @@ WIDER_NCV = 32
 #: A returned pair :math:`(\lambda, x)` of a definite pencil is none when the Rayleigh
 #: quotient :math:`\rho(x) = x^TAx / x^TBx` differs from :math:`\lambda` by more than this,
 #: relatively (or :data:`~unibuckle_fenicsx.tolerances.SMALLEST_RTOL_FACTOR` times a
-#: looser ``eps_tol``). An eigenpair's agree to second order in the vector's error:
-#: measured up to 1.4e-4 where the vector mixes a cluster of loads within 0.1 % (a filled
-#: tube with most of its wall on the core) and 8e-5 where double precision fixes the load
-#: loosely (a plate of b/t = 1e6). Krylov-Schur in shift-and-invert measures the error
-#: in the B-norm, blind to the null space of a semidefinite B, and its spurious pairs'
-#: differed by 0.17 to 59 (docs/history/2026-11-30g-spurious.md).
+#: looser ``eps_tol``). An eigenpair's agree to second order in the vector's error, even
+#: where the vector mixes a cluster of nearly equal loads; Krylov-Schur in shift-and-invert
+#: measures the error in the B-norm, blind to the null space of a semidefinite B, and
+#: its spurious pairs' differ by far more. The constant sits between the two, as
+#: measured in docs/history/2026-11-30g-spurious.md.
 SPURIOUS_RTOL = 1e-2
 #: Krylov vectors of the solve again after such a pair (or a negative load), at least: a
 #: pencil whose B has lost most of its rank to the removed rows needs more than

@@ -23,12 +23,12 @@ from unibuckle_fenicsx.spec.solver import SolverSpec
 
 #: Largest non-dimensional stiffness :math:`K = k_f b^4/(\pi^4 D)` of a tensionless
 #: foundation. The gap to the rigid obstacle's load falls tenfold or more per decade of
-#: K (docs/methods/foundations.md: 1.3e-3 and 9e-5 at K = 1e3 and 1e4, a/b = 3, loaded
-#: edges clamped), so at 1e8 the foundation is the rigid obstacle to the load's 1e-8,
-#: while its springs, K times the plate's bending stiffness, swamp it in double
-#: precision: the spring-set iteration fails to certify (K = 5.7e12 on the paper's
-#: plate). Soils and elastomer beds give K below 1e4 on practical plates, a concrete face
-#: (1e11 N/m^3) under a 3 mm steel plate 0.1 m wide about 2e2.
+#: K (docs/methods/foundations.md), so far below this bound the foundation already is
+#: the rigid obstacle to the load's accuracy, while far above it its springs, K times the
+#: plate's bending stiffness, swamp the plate in double precision and the spring-set
+#: iteration cannot certify (docs/history/2026-11-30g-inputs.md). Soils and elastomer
+#: beds give K far below it; concrete under a thin, wide steel liner can exceed it, and
+#: is then modelled as the rigid obstacle it is to the load's accuracy.
 MAX_FOUNDATION_K = 1e8
 
 
