@@ -49,9 +49,10 @@ from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.arc import ArcPlane
 from unibuckle_fenicsx.algorithms.pdas import Run
 from unibuckle_fenicsx.algorithms.records import ContinuedRecord
+from unibuckle_fenicsx.errors import EigenSolveError
 from unibuckle_fenicsx.la.options import Prefix, option_defaults, ordering_options, set_options
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
-from unibuckle_fenicsx.tolerances import ROUNDING_RTOL, ZERO_STEP
+from unibuckle_fenicsx.tolerances import ROUNDING_RTOL, SMALLEST_RTOL_FACTOR, ZERO_STEP
 
 __all__ = ["admissible_start", "continue_from", "descend"]
 
@@ -341,6 +342,10 @@ def continue_from(
         start: The admissible mode (``start.feasible``, its contact set where it vanishes).
         max_steps: Solves allowed for the descent, >= 1.
 
+    Raises:
+        EigenSolveError: The answer's load lies below ``solution``'s proven lower bound
+            beyond the eigen solver's accuracy (a contradiction, never a lower bound).
+
     Note:
         Collective.
     """
@@ -352,6 +357,15 @@ def continue_from(
     # not an eigenvector, would fail the certificate's KKT test).
     if final is None or not final.feasible or final.load > start.load * (1.0 + ROUNDING_RTOL):
         final = start
+    # An admissible mode's load is at least the critical load, so at least a proven lower
+    # bound: below it beyond the eigen solver's accuracy is a contradiction, never a bound.
+    lower = solution.lower_bound
+    if final.load < lower * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol):
+        raise EigenSolveError(
+            f"the continued solve's admissible load {final.load!r} lies below the proven "
+            f"lower bound {lower!r} (by {solution.lower_bound_by or 'interlacing'}): the "
+            "mode is not an eigenvector of its reduced pencil, or the bound is none"
+        )
     record = ContinuedRecord(
         from_load=start.load,
         to_load=final.load,
@@ -363,7 +377,7 @@ def continue_from(
         candidate=final,
         method=solution.method,
         eigensolves=solution.eigensolves + run.iterations - steps.get("gradient", 0),
-        lower_bound=min(solution.lower_bound, final.load),
+        lower_bound=min(lower, final.load),  # equal within the solver's accuracy
         global_optimum_proven=False,
         upper_bound=min(solution.upper_bound, final.load),
         kkt_points=[*solution.kkt_points, solution.candidate],

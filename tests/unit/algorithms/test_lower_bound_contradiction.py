@@ -101,3 +101,22 @@ def test_the_certificate_refuses_a_bracket_upside_down(problem):
     assert cand.load > free
     with pytest.raises(EigenSolveError, match="below the proven lower bound"):
         certify(problem, solution, global_bound=False)
+
+
+def test_a_continued_solve_below_the_proven_bound_is_an_error(problem):
+    """The solve continued from a refuting mode cannot end below the proven bound.
+
+    A refuting mode is admissible, so its load is at least the critical load, at least
+    the free load (interlacing; scipy's reference above). One made to claim 0.8 of the
+    free load (as a pair that is no eigenpair would) was kept as the answer and made the
+    lower bound (``min(lower, load)``) by the starting code.
+    """
+    from unibuckle_fenicsx.algorithms.descent import continue_from
+
+    free = problem.solve_free().load
+    solution = solve_active_set(problem, multilevel=False, bound_budget=0)
+    assert solution.lower_bound == pytest.approx(free, rel=1e-12)
+    start = _spurious(problem.evaluate(np.arange(problem.contact.size)), 0.8 * free)
+    assert start.feasible
+    with pytest.raises(EigenSolveError, match="below the proven lower bound"):
+        continue_from(problem, solution, start, 5)
