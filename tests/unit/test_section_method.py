@@ -231,20 +231,19 @@ def test_auto_on_a_small_section_ends_no_higher_than_the_interior_point():
         assert result.critical_load_Pa <= bound * (1.0 + 1e-7)
 
 
-@pytest.mark.parametrize("method", ["active-set", "interior-point", "auto"])
-def test_a_sections_eigensolves_count_every_solve_of_the_route(method, monkeypatch):
-    """``eigensolves`` is every eigen solve on every section the route built.
+def _solver_counters(monkeypatch):
+    """The eigen solves of every section the route builds, read before the certificate.
 
     The reference is the eigen solvers' own counters, read on every section the route
     built (the coarser ones when they are destroyed, the finest when the certificate
-    starts). The active set counted only its kept run on the given section (47 of the
-    77 on the box of FILE), the interior point its finest section's free solve twice.
+    starts). Returns the sections built and the list the sum is appended to.
     """
     import unibuckle_fenicsx.algorithms.section_levels as levels
     import unibuckle_fenicsx.section_analysis as section_analysis
 
     counted: dict[int, int] = {}
-    built = []
+    built: list = []
+    before_certificate: list[int] = []
     build, certify = levels.build_section, section_analysis.certify
 
     def read(section):
@@ -265,14 +264,24 @@ def test_a_sections_eigensolves_count_every_solve_of_the_route(method, monkeypat
         section.destroy = destroy_counted
         return section
 
-    before_certificate = []
-
     def recorded_certify(*args, **kwargs):
         before_certificate.append(sum(read(section) for section in built))
         return certify(*args, **kwargs)
 
     monkeypatch.setattr(levels, "build_section", recorded_build)
     monkeypatch.setattr(section_analysis, "certify", recorded_certify)
+    return built, before_certificate
+
+
+@pytest.mark.parametrize("method", ["active-set", "interior-point", "auto"])
+def test_a_sections_eigensolves_count_every_solve_of_the_route(method, monkeypatch):
+    """``eigensolves`` is every eigen solve on every section the route built.
+
+    The reference is the eigen solvers' own counters (:func:`_solver_counters`). The
+    active set counted only its kept run on the given section (47 of the 77 on the box
+    of FILE), the interior point its finest section's free solve twice.
+    """
+    built, before_certificate = _solver_counters(monkeypatch)
     spec = section_from_dict({**FILE, "solver": {"method": method}})
     with solve_section(spec, MPI.COMM_SELF) as solved:
         result = solved.result
@@ -291,26 +300,10 @@ def test_a_sections_eigensolves_count_the_penalty_continuations(method, monkeypa
     returned; the starting code left the latter out.
     """
     import unibuckle_fenicsx.algorithms.active_set as active_set
-    import unibuckle_fenicsx.algorithms.section_levels as levels
-    import unibuckle_fenicsx.section_analysis as section_analysis
 
-    built, penalty, before_certificate = [], [], []
-    build, certify = levels.build_section, section_analysis.certify
+    _, before_certificate = _solver_counters(monkeypatch)
+    penalty: list[int] = []
     reached, continuation = active_set._reached, active_set.penalty_continuation
-    counted: dict[int, int] = {}
-
-    def recorded_build(*args, **kwargs):
-        section = build(*args, **kwargs)
-        built.append(section)
-        destroy = section.destroy
-
-        def destroy_counted():
-            if id(section) not in counted:  # the first destroy: its objects still there
-                counted[id(section)] = section.problem.eigensolver.solves
-            destroy()
-
-        section.destroy = destroy_counted
-        return section
 
     def stalled_once(problem, runs):
         return reached(problem, runs) if penalty else False
@@ -320,16 +313,8 @@ def test_a_sections_eigensolves_count_the_penalty_continuations(method, monkeypa
         penalty.append(solves)
         return run, solves
 
-    def recorded_certify(*args, **kwargs):
-        solves = [counted[id(s)] if id(s) in counted else s.problem.eigensolver.solves
-                  for s in built]  # fmt: skip
-        before_certificate.append(sum(solves))
-        return certify(*args, **kwargs)
-
-    monkeypatch.setattr(levels, "build_section", recorded_build)
     monkeypatch.setattr(active_set, "_reached", stalled_once)
     monkeypatch.setattr(active_set, "penalty_continuation", recorded_continuation)
-    monkeypatch.setattr(section_analysis, "certify", recorded_certify)
     spec = section_from_dict({**FILE, "solver": {"method": method}})
     with solve_section(spec, MPI.COMM_SELF) as solved:
         result = solved.result

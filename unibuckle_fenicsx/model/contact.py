@@ -23,6 +23,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import BilateralZoneError, EmptyZoneError, InputError
 from unibuckle_fenicsx.model.structure import NodalDofs
+from unibuckle_fenicsx.model.zones import discrete_zone
 from unibuckle_fenicsx.spec import ObstacleSpec
 from unibuckle_fenicsx.spec.base import in_file
 from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
@@ -248,11 +249,9 @@ def zone_cells(model: NodalDofs, obstacle: ObstacleSpec) -> dolfinx.mesh.MeshTag
     Not collective.
     """
     msh = model.mesh
-    tdim = msh.topology.dim
-    size = model.extent
-    cells = dolfinx.mesh.locate_entities(msh, tdim, lambda x: obstacle.contains(x, size))
-    cells = np.unique(np.asarray(cells, dtype=np.int32))
-    return dolfinx.mesh.meshtags(msh, tdim, cells, np.ones(cells.size, dtype=np.int32))
+    whole, _ = discrete_zone(msh, obstacle, model.extent)
+    cells = np.flatnonzero(whole).astype(np.int32)  # owned cells: those the form integrates
+    return dolfinx.mesh.meshtags(msh, msh.topology.dim, cells, np.ones(cells.size, np.int32))
 
 
 def _zone_dofs(

@@ -93,6 +93,19 @@ def cell_areas(msh: dolfinx.mesh.Mesh) -> tuple[npt.NDArray[np.float64], npt.NDA
     return areas, nodes
 
 
+def discrete_zone(
+    msh: dolfinx.mesh.Mesh, obstacle: ObstacleSpec, size: float
+) -> tuple[npt.NDArray[np.bool_], npt.NDArray[np.float64]]:
+    """The obstacle's *discrete zone*: which owned cells have every node in the zone.
+
+    ``size``: the plate's larger side (the zone's tolerance scale). Returns the mask over
+    the owned cells and their areas. Not collective.
+    """
+    areas, nodes = cell_areas(msh)
+    inside = obstacle.contains(msh.geometry.x.T, size)
+    return inside[nodes].all(axis=1), areas
+
+
 def zone_report(
     msh: dolfinx.mesh.Mesh,
     obstacles: Sequence[ObstacleSpec],
@@ -109,20 +122,19 @@ def zone_report(
     """
     size = max(plate.length, plate.width)
     comm = msh.comm
-    areas, nodes = cell_areas(msh)
     x = msh.geometry.x
     n_owned = msh.geometry.index_map().size_local
     report = []
     for label, obstacle in zip(labels, obstacles, strict=True):
-        inside = obstacle.contains(x.T, size)
-        whole = inside[nodes].all(axis=1)
+        inside = obstacle.contains(x[:n_owned].T, size)
+        whole, areas = discrete_zone(msh, obstacle, size)
         report.append(
             ZoneReport(
                 obstacle=label,
                 zone=obstacle.describe(),
                 area_m2=zone_area(obstacle, plate),
                 discrete_area_m2=comm.allreduce(float(areas[whole].sum()), op=MPI.SUM),
-                nodes=comm.allreduce(int(np.count_nonzero(inside[:n_owned])), op=MPI.SUM),
+                nodes=comm.allreduce(int(np.count_nonzero(inside)), op=MPI.SUM),
             )
         )
     return report
