@@ -130,7 +130,7 @@ class ProblemSpec(Table, frozen=True):
                     f"K <= {MAX_FOUNDATION_K:g}, foundation_stiffness <= {high:.3g} {name} "
                     "here (the largest measured). The rigid obstacle's load is an upper "
                     "bound of the foundation's at any stiffness, and close to it: on a mesh "
-                    "the gap was measured as C/K with C from 1.5 to 8, growing as the mesh "
+                    "the gap was measured as C/K with C from 0.8 to 4, growing as the mesh "
                     "is refined: leave foundation_stiffness out for that bound (a rigid "
                     "obstacle)"
                 )
