@@ -36,7 +36,7 @@ node presses by less than that fraction of max|w|, and would otherwise leave and
 without end. The quotient has
 several local minima on long plates, and each start finds one; the arc descent (below)
 runs from every start that cycles (:doc:`/verification/tuning`). A section's elastic core
-adds a third start (``stiff_start``): the iteration on springs that many times stiffer,
+adds a start (``stiff_start``): the iteration on springs that many times stiffer,
 from the free section, whose pressing set then starts the iteration on the true springs:
 a stiffer foundation's critical state lies nearer the rigid core's one-signed mode, and
 without it a filled box's answer came out above the stiffer foundation's (which the
