@@ -27,6 +27,12 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
   :math:`\rho`; for :math:`a/b \ge 1` it is :math:`\rho`, the column fields are None
   and a note says why;
 
+- a loaded edge in compression plus bending (:math:`\psi < 0`) carries tension at its
+  other end: where it reaches :math:`f_y/\gamma_{M0}` (EN 1993-1-1 6.2.1(5)) before
+  :math:`\sigma_1` reaches :math:`\rho f_y/\gamma_{M0}` (:math:`\sigma_t/\sigma_1 >
+  \rho`, the critical state's stresses scaled together), yield governs, and the output
+  says so with the :math:`\sigma_1` at which it yields.
+
 What the clause does not describe is refused when the problem is built (both unloaded
 edges free, biaxial stress, a temperature rise, a plate that is not a rectangle, ...);
 a rectangle with holes is classified by its edges, and the output notes that the
@@ -153,6 +159,18 @@ class DesignRecord(Struct, kw_only=True):
         xi_unclipped: :math:`\sigma_{cr}/\sigma_{cr,c} - 1` itself, before the bounds.
         reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M0}` (absent without
             :math:`\rho`).
+        tension_Pa: The largest tensile normal stress on the loaded edges at the
+            critical state (Pa, > 0; an edge in compression plus bending, psi < 0);
+            None without tension.
+        sigma_1_at_tension_yield_Pa: :math:`\sigma_1` when that tension reaches
+            :math:`f_y/\gamma_{M0}` (EN 1993-1-1 6.2.1(5)), the critical state's
+            stresses scaled together: :math:`f_y\sigma_1/(\gamma_{M0}\sigma_t)`; None
+            without tension.
+        tension_yield_first: Whether the tension edge yields before :math:`\sigma_1`
+            reaches :math:`\rho f_y/\gamma_{M0}` (:math:`\sigma_t/\sigma_1 > \rho`):
+            then the element's stress is limited by yield, not by its buckling, and
+            ``sigma_1_at_tension_yield_Pa``, below ``reduced_design_stress_Pa``, governs.
+            None without tension or without :math:`\rho`.
         lower_bound: When the critical load is not proven the lowest (a KKT point, or
             bracketed), the same quantities at the verified lower bound of the critical
             load, the safe value (:func:`at_lower_bound`); absent when proven.
@@ -178,6 +196,9 @@ class DesignRecord(Struct, kw_only=True):
     xi: float | None = None
     xi_unclipped: float | None = None
     reduced_design_stress_Pa: float | UnsetType = UNSET
+    tension_Pa: float | None = None
+    sigma_1_at_tension_yield_Pa: float | None = None
+    tension_yield_first: bool | None = None
     lower_bound: DesignRecord | UnsetType = UNSET
 
 
@@ -212,6 +233,21 @@ def _critical_edge_stress(
             if ends[k] > best[0]:
                 best = (ends[k], ends[1 - k], k, e.name)
     return best
+
+
+def _critical_edge_tension(spec: ProblemSpec, load: float, edges: tuple[str, str]) -> float:
+    """The largest tensile normal stress (Pa, > 0) on the loaded ``edges`` at the critical state.
+
+    0 when they carry none (as :func:`_critical_edge_stress`, fixed part included).
+    """
+    factor = spec.load.fixed_factor
+    tension = 0.0
+    for e in spec.plate.edges:
+        if e.name in edges:
+            scaled, fixed = stress_ends(e.normal_stress), stress_ends(e.fixed_normal_stress)
+            for s, f in zip(scaled, fixed, strict=True):
+                tension = max(tension, factor * f + load * s)
+    return tension
 
 
 def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignRecord:
@@ -273,6 +309,12 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
         )
         return out
     out.psi = psi
+    tension = _critical_edge_tension(spec, load, element.loaded)
+    if tension > 0.0:
+        out.tension_Pa = tension
+        out.sigma_1_at_tension_yield_Pa = (
+            design.yield_stress / design.partial_factor * sigma1 / tension
+        )
     slenderness = math.sqrt(design.yield_stress / sigma1)
     out.relative_slenderness = slenderness
     sigma_e = euler_stress(spec, element.loaded)
@@ -288,7 +330,23 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.reduction_factor = _column_type(out, spec, design, element, rho)
     rho_c = out.reduction_factor
     out.reduced_design_stress_Pa = rho_c * design.yield_stress / design.partial_factor
+    if out.tension_Pa is not None:
+        out.tension_yield_first = out.tension_Pa / sigma1 > rho_c
+        if out.tension_yield_first:
+            out.notes.append(tension_note(out, rho_c))
     return out
+
+
+def tension_note(out: DesignRecord, rho: float) -> str:
+    """The note that the tension edge yields before sigma_1 reaches rho f_y/gamma_M0."""
+    return (
+        f"the tension edge yields first (EN 1993-1-1 6.2.1(5)): its {significant(out.tension_Pa)} "
+        f"Pa at the critical state, {significant((out.tension_Pa or 0.0) / out.sigma_cr_Pa)} "
+        f"times sigma_1, reaches f_y/gamma_M0 when sigma_1 = "
+        f"{significant(out.sigma_1_at_tension_yield_Pa)} Pa, below rho f_y/gamma_M0 = "
+        f"{significant(rho * out.yield_stress_Pa / out.partial_factor)} Pa (rho = "
+        f"{significant(rho)}): yield governs the element, not its buckling"
+    )
 
 
 def _column_type(

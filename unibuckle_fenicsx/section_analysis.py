@@ -66,7 +66,7 @@ from unibuckle_fenicsx.model.shell.section import (
     section_parameters,
 )
 from unibuckle_fenicsx.results.assemble import record_contact, versions
-from unibuckle_fenicsx.results.records import BucklingResult, ResultDetails
+from unibuckle_fenicsx.results.records import BucklingResult, ResultDetails, coefficient_text
 from unibuckle_fenicsx.section_design import (
     SectionDesignRecord,
     at_lower_bound,
@@ -162,7 +162,7 @@ class SectionResult(BucklingResult, kw_only=True):
         """
         scale, unit = UNITS[self.units][1:]
         k_value = self.buckling_coefficient_k
-        k = "" if k_value is None else f", k = {k_value:.4f}"
+        k = "" if k_value is None else f", k = {coefficient_text(k_value)}"
         sigma = self.compression_Pa  # the stresses printed are the extreme fibre's
         if math.isnan(sigma):  # a result written before the field: the load factor
             sigma = self.critical_load_Pa

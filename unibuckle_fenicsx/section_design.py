@@ -20,6 +20,13 @@ asks for the design quantities of its critical state :math:`\lambda_c`:
   column between the section's ends, eq. (4.8) :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)`
   between simply supported ones, 4 times it between clamped ones), as a plate's
   (:mod:`unibuckle_fenicsx.design`);
+- a face whose :math:`\psi` lies below -3 (a web under bending with an axial tension) is
+  outside Table 4.1 and eq. (4.2): no :math:`k_\sigma` or :math:`\rho`, a note and the
+  summary say so (``faces_outside_table``);
+- the tension fibre against yield, EN 1993-1-1 6.2.1(5): under bending with an axial
+  tension it may reach :math:`f_y/\gamma_{M0}` at a smaller multiple of the critical load
+  than the governing face reaches :math:`\rho f_y/\gamma_{M0}`; then yield governs, and
+  the output says so (``tension_yield_first``); a tube's tension fibre gets its multiple;
 - for a **tube**, :math:`\bar\lambda` only: a circular wall is a shell, whose buckling
   reduction (EN 1993-1-6, section 8.5: the fabrication quality class, :math:`\alpha_x`,
   :math:`\chi_x`) this output does not apply;
@@ -185,6 +192,19 @@ class SectionDesignRecord(Struct, kw_only=True):
         width_to_thickness_limit: EN 1994-1-1 Table 6.3's limit of that ratio.
         local_buckling_negligible: Whether the ratio is within the limit (6.7.1(9)) and
             the core fills the whole length (a hollow length is no filled section).
+        faces_outside_table: The faces whose :math:`\psi` lies below -3 (a web under
+            bending with an axial tension), outside Table 4.1 (:math:`1 \ge \psi \ge
+            -3`): they get no :math:`k_\sigma` or :math:`\rho`, and a note says so.
+        tension_Pa: The largest tensile axial stress in the walls at the critical state
+            (Pa, > 0: the extreme fibre's :math:`\lambda_c(\sigma_a + |\sigma_b|)`); None
+            without tension.
+        tension_face: A box's face that carries it (``top`` or ``bottom``); None for a tube.
+        tension_yield_multiple: The multiple of the critical load at which that fibre
+            reaches :math:`f_y/\gamma_{M0}` (EN 1993-1-1 6.2.1(5)).
+        tension_yield_first: A box's: whether that multiple is below the governing face's
+            (:math:`\rho f_y/(\gamma_{M0}\sigma_1)`): the tension face yields before the
+            compressed faces reach their reduced stress, and yield governs. None for a
+            tube (no :math:`\rho`) and without tension.
         lower_bound: With a core whose critical load is not proven the lowest (a KKT
             point: the sections' usual certificate), the same quantities at the verified
             lower bound (the hollow section's load by interlacing, unless a closer one was
@@ -203,6 +223,11 @@ class SectionDesignRecord(Struct, kw_only=True):
     width_to_thickness: float | None = None
     width_to_thickness_limit: float | None = None
     local_buckling_negligible: bool | None = None
+    faces_outside_table: list[str] = msgspec.field(default_factory=list)
+    tension_Pa: float | None = None
+    tension_face: str | None = None
+    tension_yield_multiple: float | None = None
+    tension_yield_first: bool | None = None
     lower_bound: SectionDesignRecord | UnsetType = UNSET
 
 
@@ -269,6 +294,48 @@ def _reaches_reduced_stress(face: FaceDesign) -> float:
     return (face.reduced_design_stress_Pa or 0.0) / face.sigma_cr_Pa
 
 
+def _tension(
+    out: SectionDesignRecord,
+    section: DesignSection,
+    design: DesignSpec,
+    load: float,
+    rated: list[FaceDesign],
+) -> None:
+    r"""The tension fibre against yield (EN 1993-1-1 6.2.1(5)): ``out``'s tension fields.
+
+    The axial stress (tension > 0) is :math:`\sigma_a + \sigma_b\zeta`, largest at the
+    extreme fibre, :math:`\sigma_a + |\sigma_b|`, on the top face for :math:`\sigma_b >
+    0`; every stress grows with the load factor, so the fibre reaches
+    :math:`f_y/\gamma_{M0}` at the multiple :math:`f_y/(\gamma_{M0}\sigma_t)` of the
+    critical load. A box's governing face (``rated``: the faces with a :math:`\rho`)
+    reaches its reduced stress at its own multiple: the smaller governs.
+    """
+    tension = load * (section.axial_stress + abs(section.bending_stress))
+    if tension <= 0.0:
+        return
+    out.tension_Pa = tension
+    multiple = design.yield_stress / design.partial_factor / tension
+    out.tension_yield_multiple = multiple
+    clause = "EN 1993-1-1 6.2.1(5)"
+    if section.shape != "box":
+        out.notes.append(
+            f"the tension fibre ({significant(tension)} Pa at the critical load) reaches "
+            f"f_y/gamma_M0 at {significant(multiple)} x the critical load ({clause})"
+        )
+        return
+    out.tension_face = "top" if section.bending_stress > 0.0 else "bottom"
+    compressed = min((_reaches_reduced_stress(f) for f in rated), default=math.inf)
+    out.tension_yield_first = multiple < compressed
+    if out.tension_yield_first:
+        out.notes.append(
+            f"the {out.tension_face} face yields in tension first ({clause}): its "
+            f"{significant(tension)} Pa at the critical load reaches f_y/gamma_M0 at "
+            f"{significant(multiple)} x the critical load, before face {out.governing_face} "
+            f"reaches rho f_y/gamma_M0 (at {significant(compressed)} x): yield governs the "
+            "section, not the buckling of its faces"
+        )
+
+
 def face_width(section: DesignSection, name: str) -> float:
     """The width (m) of the box's face ``name``: the right and left faces span the depth."""
     return float((section.depth if name in ("right", "left") else section.width) or 0.0)
@@ -317,8 +384,21 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             if len(tied) > 1:
                 others = [f.face for f in tied if f.face != out.governing_face]
                 out.tied_faces = [out.governing_face, *others]
+        low = psi_range(INTERNAL)[0]
+        off_table = [f for f in out.faces if f.psi is not None and f.psi < low]
+        if off_table:
+            out.faces_outside_table = [f.face for f in off_table]
+            out.notes.append(
+                f"face(s) {', '.join(f'{f.face} (psi = {f.psi:.3g})' for f in off_table)}: "
+                f"psi < {low:g}, outside EN 1993-1-5 Table 4.1 (1 >= psi >= {low:g}; eq. "
+                "(4.2) likewise): no k_sigma or rho is given for them, and they are left out "
+                "of the governing face; their compressed width b/(1 - psi) is checked by no "
+                "rule here"
+            )
+        _tension(out, section, design, load, rated)
     else:
         out.clauses.append(TUBE_CLAUSES)
+        _tension(out, section, design, load, [])
     out.notes.append(member_note(section, design))
     if section.core:
         outside = ": outside the calibration of EN 1993-1-5 4.4(2)"
@@ -397,6 +477,25 @@ def at_lower_bound(
     return record
 
 
+def _tension_text(d: SectionDesignRecord, scale: float, unit: str) -> str:
+    """The design line's words on the tension fibre ('' without tension).
+
+    A box's only when it yields first; a tube's (no rho) always, with its multiple.
+    """
+    if d.tension_Pa is None or d.tension_yield_multiple is None:
+        return ""
+    tension = f"{significant(d.tension_Pa / scale)} {unit} of tension at sigma_cr"
+    multiple = f"{significant(d.tension_yield_multiple)} x the critical load"
+    if d.tension_face is None:  # a tube
+        return f"; the tension fibre ({tension}) reaches f_y/gamma_M0 at {multiple}"
+    if not d.tension_yield_first:
+        return ""
+    return (
+        f"; face {d.tension_face} yields in tension first (EN 1993-1-1 6.2.1(5): {tension}, "
+        f"f_y/gamma_M0 at {multiple}): yield governs, not rho"
+    )
+
+
 def _governing(d: SectionDesignRecord, *, rule: bool = True) -> str:
     r"""The governing face in the summary: its name, or the faces that tie with it.
 
@@ -438,6 +537,12 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
             f"rho f_y/gamma_M0 = {significant(reduced / scale)} {unit} (psi Table 4.1, "
             f"slenderness 4.4(2), rho 4.4(2) eq. (4.2){column}, rho f_y/gamma_M0 4.6(1))"
         )
+    if d.faces_outside_table:
+        text += (
+            f"; face(s) {', '.join(d.faces_outside_table)}: psi < -3, outside Table 4.1: "
+            "no k_sigma or rho"
+        )
+    text += _tension_text(d, scale, unit)
     if d.width_to_thickness is not None and d.width_to_thickness_limit is not None:
         verdict = (
             "local buckling may be neglected"
@@ -466,4 +571,6 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
             text += (
                 f", {_governing(low, rule=False)}, {name} = {significant(face.reduction_factor)}"
             )
+        if low.tension_yield_first:
+            text += _tension_text(low, scale, unit)
     return text

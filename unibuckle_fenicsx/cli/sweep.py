@@ -108,16 +108,24 @@ def sweep_columns(lines: list[dict[str, Any]]) -> tuple[list[str], list[list[Any
 def sweep_table(lines: list[dict[str, Any]]) -> str:
     """The sweep's points as a table for the terminal (:func:`sweep_columns`).
 
-    Swept values to 6 significant digits, the load in exponent form to 7, its ratio and k
-    to 4 decimals; ``-`` where a point has no value.
+    Swept values to 6 significant digits, the load in exponent form to 7, its ratio to 4
+    decimals, k to 4 decimals (4 significant digits below 0.1,
+    :func:`~unibuckle_fenicsx.results.records.coefficient_text`); ``-`` where a point has
+    no value.
     """
+    from unibuckle_fenicsx.results.records import coefficient_text
+
     header, rows = sweep_columns(lines)
     if not header:
         return ""
-    formats = [".6g"] * (len(header) - 5) + [".6e", ".4f", ".4f", "", ""]
+    formats = [".6g"] * (len(header) - 5) + [".6e", ".4f", "k", "", ""]
     cells = [
         [
-            "-" if value is None else format(value, text)
+            "-"
+            if value is None
+            else coefficient_text(value)
+            if text == "k"
+            else format(value, text)
             for value, text in zip(row, formats, strict=True)
         ]
         for row in rows

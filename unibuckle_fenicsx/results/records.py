@@ -31,11 +31,24 @@ __all__ = [
     "ContactForce",
     "EdgeLoad",
     "ResultDetails",
+    "coefficient_text",
     "jsonable",
 ]
 
 #: An edge stress as a problem file writes it: a number, or [start, end] (linear).
 Stress = float | list[float]
+
+
+def coefficient_text(k: float | None) -> str:
+    """A buckling coefficient for the summary: 4 decimals, or 4 significant digits below 0.1.
+
+    Four decimals keep the digits of the usual k (0.43 to 100); a strut's k = (b/a)^2,
+    9.104e-05 on a 2000 x 20 mm plate with free long edges, would read "0.0001", its one
+    digit wrong.
+    """
+    if k is None:
+        return "none"
+    return f"{k:.4f}" if abs(k) >= 0.1 else significant(k)
 
 
 class EdgeLoad(Struct, kw_only=True):
@@ -298,7 +311,7 @@ class BucklingResult(Struct, kw_only=True):
                 f"lambda_c = {self.critical_load_Pa / scale:.6e} {unit} "
                 f"({self.critical_load_Pa / self.free_load_Pa:.4f} x free "
                 f"{self.free_load_Pa / scale:.6e} {unit}), "
-                f"k = {self.buckling_coefficient_k:.4f}"
+                f"k = {coefficient_text(self.buckling_coefficient_k)}"
             )
             second = f"\n  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}"
             second += self._stress_line(scale, unit)
@@ -474,10 +487,23 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
             if rho is not None and isinstance(reduced, float)
             else f"none (psi outside {d.table})"
         )
+        + _tension_text(d, scale, unit)
         + f"; {d.element} element"
         + (f" (free edge {d.free_edge})" if d.free_edge else "")
         + f"; {_design_clauses(d)}; rho calibrated on bilateral plates"
         + _design_lower(d, scale, unit)
+    )
+
+
+def _tension_text(d: DesignRecord, scale: float, unit: str) -> str:
+    """The design line's words when the tension edge yields before rho f_y/gamma_M0 ('' if not)."""
+    if not d.tension_yield_first:
+        return ""
+    return (
+        f"; the tension edge yields first (EN 1993-1-1 6.2.1(5): "
+        f"{significant((d.tension_Pa or 0.0) / scale)} {unit} of tension at sigma_cr), at "
+        f"sigma_1 = {significant((d.sigma_1_at_tension_yield_Pa or 0.0) / scale)} {unit}: "
+        "yield governs, not rho"
     )
 
 
@@ -500,7 +526,7 @@ def _design_lower(d: DesignRecord, scale: float, unit: str) -> str:
     return (
         f"\n  EN 1993-1-5 at the verified lower bound (the safe value, sigma_cr not proven "
         f"the lowest): sigma_cr = {significant(low.sigma_cr_Pa / scale)} {unit}, slenderness "
-        f"{significant(low.relative_slenderness)}, rho = {rho}"
+        f"{significant(low.relative_slenderness)}, rho = {rho}" + _tension_text(low, scale, unit)
     )
 
 

@@ -1,0 +1,211 @@
+r"""The design output at the edges of EN 1993-1-5 4.4: tension yield, psi < -3, small k.
+
+Expected values are written out here from the codes, not read from the package:
+
+- EN 1993-1-1:2005 6.2.1(5): a point of a cross-section is within its elastic resistance
+  while its stress is at most :math:`f_y/\gamma_{M0}`. Under compression plus bending the
+  tension edge (or fibre) carries :math:`\sigma_t`; with every stress scaled by one load
+  factor it reaches :math:`f_y/\gamma_{M0}` when the compressed edge carries
+  :math:`\sigma_1 f_y/(\gamma_{M0}\sigma_t)`, before :math:`\sigma_1` reaches
+  :math:`\rho f_y/\gamma_{M0}` (EN 1993-1-5 4.4(2), 4.6(1)) exactly when
+  :math:`\sigma_t/\sigma_1 > \rho`. The reduction factor is eq. (4.2),
+  :math:`\rho = (\bar\lambda_p - 0.055(3 + \psi))/\bar\lambda_p^2`,
+  :math:`\bar\lambda_p = \sqrt{f_y/\sigma_1}`.
+- EN 1993-1-5 Table 4.1 and eq. (4.2) cover :math:`1 \ge \psi \ge -3` only.
+- A strut (a plate with both long edges free, hinged at its loaded ends) buckles at the
+  Euler stress :math:`\pi^2 E t^2/(12 a^2)` (Timoshenko and Gere, *Theory of Elastic
+  Stability*, 2nd ed., section 2.1), so its :math:`k = \sigma t b^2/(\pi^2 D) =
+  (1 - \nu^2)(b/a)^2`.
+"""
+
+from __future__ import annotations
+
+import math
+
+from mpi4py import MPI
+
+import pytest
+
+from unibuckle_fenicsx import SectionParameters
+from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.cli.sweep import sweep_table
+from unibuckle_fenicsx.design import design_output, significant
+from unibuckle_fenicsx.section_design import design_line, section_design
+from unibuckle_fenicsx.spec import DesignSpec, problem_from_dict
+
+FY = 3.55e8
+
+
+def _web(pair, *, partial_factor=1.0, mesh=None):
+    """A 900 x 300 x 4 mm SSSS plate, ``pair`` on its ends (mm-N-MPa), S355."""
+    return problem_from_dict(
+        {
+            "units": "mm-N-MPa",
+            "plate": {"corners": [[0, 0], [900, 300]], "thickness": 4.0},
+            "material": {"E": 210000.0, "nu": 0.3},
+            "edges": {
+                "left": {"normal_stress": pair},
+                "right": {"normal_stress": pair},
+                "bottom": {},
+                "top": {},
+            },
+            "mesh": mesh or {"nx": 6, "ny": 2},
+            "design": {"yield_stress": 355.0, "partial_factor": partial_factor},
+        }
+    )
+
+
+def test_a_plate_s_tension_edge_that_yields_first_governs():
+    """At psi = -2 and sigma_1 = 400 MPa the tension edge carries 800 MPa.
+
+    By hand: lambda_p = sqrt(355/400) = 0.9421, above 0.5 + sqrt(0.085 + 0.11) = 0.9416,
+    so rho = (0.9421 - 0.055)/0.8875 = 0.9995 (eq. (4.2)); sigma_t/sigma_1 = 2 > rho: the
+    tension edge reaches f_y/gamma_M0 = 355/1.1 MPa when sigma_1 = 355/1.1/2 = 161.4 MPa,
+    far below rho f_y/gamma_M0 = 322.6 MPa. Before, only 322.6 MPa was given.
+    """
+    spec = _web([-1.0, 2.0], partial_factor=1.1)
+    d = design_output(spec, spec.design, 4.0e8)
+    slenderness = math.sqrt(FY / 4.0e8)
+    rho = (slenderness - 0.055 * (3.0 - 2.0)) / slenderness**2
+    assert d.psi == -2.0 and d.reduction_factor == pytest.approx(rho, rel=1e-14)
+    assert d.tension_Pa == pytest.approx(8.0e8, rel=1e-14)
+    assert d.sigma_1_at_tension_yield_Pa == pytest.approx(FY / 1.1 / 2.0, rel=1e-14)
+    assert d.tension_yield_first is True
+    assert any("the tension edge yields first (EN 1993-1-1 6.2.1(5))" in n for n in d.notes)
+
+
+def test_a_plate_s_tension_edge_below_rho_does_not_govern():
+    """At psi = -0.5 and sigma_1 = 400 MPa, sigma_t/sigma_1 = 0.5 < rho.
+
+    lambda_p = 0.9421 above 0.5 + sqrt(0.085 + 0.0275) = 0.8354, so rho = (0.9421 -
+    0.1375)/0.8875 = 0.9066 (eq. (4.2)): sigma_1 reaches rho f_y first, tension does not
+    govern (it would yield at sigma_1 = 2 f_y).
+    """
+    spec = _web([-1.0, 0.5])
+    d = design_output(spec, spec.design, 4.0e8)
+    slenderness = math.sqrt(FY / 4.0e8)
+    assert d.reduction_factor == pytest.approx(
+        (slenderness - 0.055 * 2.5) / slenderness**2, rel=1e-14
+    )
+    assert d.tension_Pa == pytest.approx(2.0e8, rel=1e-14)
+    assert d.sigma_1_at_tension_yield_Pa == pytest.approx(2.0 * FY, rel=1e-14)
+    assert d.tension_yield_first is False
+    # Uniform compression: no tension, nothing said.
+    uniform = _web(-1.0)
+    d = design_output(uniform, uniform.design, 4.0e8)
+    assert d.tension_Pa is None and d.tension_yield_first is None
+
+
+def test_the_summary_says_the_tension_edge_yields_first():
+    """The solve's summary line names it, in the file's MPa (sigma_1 = f_y/|psi| = 177.5)."""
+    spec = _web([-1.0, 2.0], mesh={"nx": 12, "ny": 9})
+    with solve(spec, MPI.COMM_SELF) as analysis:
+        out = analysis.result
+    lam = out.critical_load_Pa  # sigma_1 = lambda_c: psi = -2 on a stocky web, rho = 1
+    assert out.design.reduction_factor == 1.0 and out.design.tension_yield_first is True
+    line = next(s for s in out.summary().splitlines() if "EN 1993-1-5: " in s)
+    assert (
+        f"the tension edge yields first (EN 1993-1-1 6.2.1(5): {significant(2 * lam / 1e6)} "
+        "MPa of tension at sigma_cr), at sigma_1 = 177.5 MPa: yield governs, not rho"
+    ) in line, line
+
+
+def _box(**changes: object) -> SectionParameters:
+    base = {
+        "thickness": 0.004, "width": 0.2, "depth": 0.3, "diameter": None, "length": 0.6,
+        "E": 2.1e11, "nu": 0.3, "mesh_size": 0.04, "ends": "simply_supported",
+        "axial_stress": 0.6, "bending_stress": 1.0, "core": False,
+    }  # fmt: skip
+    return SectionParameters(changes.pop("shape", "box"), **{**base, **changes})
+
+
+def test_a_box_s_webs_outside_table_4_1_and_its_tension_face_are_said():
+    """Axial +0.6 (tension) and bending 1 at z = +d/2: top -1.6, bottom +0.4 compression.
+
+    The webs run from 0.4 to -1.6: psi = -4, outside Table 4.1 (1 >= psi >= -3), no rho,
+    and the output said nothing of them. The top face's tension 1.6 lambda reaches f_y at
+    f_y/(1.6 lambda) = 0.3698 x lambda (lambda = 6e8 Pa); the bottom face (sigma_1 =
+    2.4e8 Pa, psi = 1): lambda_p = sqrt(355/240) = 1.2162, rho = (1.2162 - 0.22)/1.2162^2
+    = 0.6735, reaches rho f_y at 0.6735 x 355/240 = 0.9962 x lambda: the tension face
+    yields first, which the output did not say.
+    """
+    load = 6.0e8
+    out = section_design(_box(), DesignSpec(yield_stress=FY), load)
+    faces = {f.face: f for f in out.faces}
+    assert faces["right"].psi == -4.0 and faces["right"].reduction_factor is None
+    assert out.faces_outside_table == ["right", "left"]
+    assert any("outside EN 1993-1-5 Table 4.1" in n and "right (psi = -4)" in n for n in out.notes)
+    slenderness = math.sqrt(FY / (0.4 * load))
+    rho = (slenderness - 0.22) / slenderness**2
+    assert faces["bottom"].reduction_factor == pytest.approx(rho, rel=1e-14)
+    assert rho * FY / (0.4 * load) == pytest.approx(0.9962, abs=1e-4)
+    assert out.governing_face == "bottom"
+    assert out.tension_face == "top" and out.tension_Pa == pytest.approx(1.6 * load)
+    assert out.tension_yield_multiple == pytest.approx(FY / (1.6 * load), rel=1e-14)
+    assert out.tension_yield_first is True
+    line = design_line(out, 1e6, "MPa")
+    assert "face(s) right, left: psi < -3, outside Table 4.1: no k_sigma or rho" in line
+    assert (
+        "face top yields in tension first (EN 1993-1-1 6.2.1(5): 960.0 MPa of tension at "
+        "sigma_cr, f_y/gamma_M0 at 0.3698 x the critical load): yield governs, not rho"
+    ) in line, line
+
+
+def test_a_box_whose_compressed_faces_govern_says_nothing_of_tension():
+    """Axial -1, bending 2: top +1 (tension), bottom -3.
+
+    At lambda = 4e7 Pa the bottom face (120 MPa, lambda_p = 1.720, rho = 0.5071) reaches
+    rho f_y at 1.50 x lambda, the top face f_y at 355/40 = 8.875 x lambda.
+    """
+    out = section_design(
+        _box(axial_stress=-1.0, bending_stress=2.0), DesignSpec(yield_stress=FY), 4.0e7
+    )
+    assert out.tension_Pa == pytest.approx(4.0e7) and out.tension_face == "top"
+    assert out.tension_yield_multiple == pytest.approx(8.875)
+    assert out.tension_yield_first is False and out.faces_outside_table == []
+    assert "tension" not in design_line(out)
+
+
+def test_a_tube_s_tension_fibre_gets_its_multiple():
+    """A tube (no rho) in bending with a tension: the fibre's multiple f_y/sigma_t is given."""
+    tube = _box(shape="tube", width=None, depth=None, diameter=0.2, axial_stress=-0.5)
+    out = section_design(tube, DesignSpec(yield_stress=FY), 1.0e9)
+    assert out.tension_Pa == pytest.approx(0.5e9) and out.tension_face is None
+    assert out.tension_yield_multiple == pytest.approx(0.71)
+    assert out.tension_yield_first is None
+    assert "the tension fibre (500.0 MPa of tension at sigma_cr) reaches f_y/gamma_M0 at " \
+        "0.7100 x the critical load" in design_line(out, 1e6, "MPa")  # fmt: skip
+
+
+def test_a_strut_s_small_k_keeps_four_significant_digits():
+    """2000 x 20 x 4 mm, the long edges free: k = (1 - nu^2)(b/a)^2 = 9.1e-5 (Euler).
+
+    The summary printed "k = 0.0001", its one digit wrong; now four significant digits
+    (and the sweep table likewise).
+    """
+    spec = problem_from_dict(
+        {
+            "units": "mm-N-MPa",
+            "plate": {"corners": [[0, 0], [2000, 20]], "thickness": 4.0},
+            "material": {"E": 210000.0, "nu": 0.3},
+            "edges": {
+                "left": {"normal_stress": -1.0},
+                "right": {"normal_stress": -1.0},
+                "bottom": {"support": "free"},
+                "top": {"support": "free"},
+            },
+            "mesh": {"nx": 40, "ny": 2},
+        }
+    )
+    with solve(spec, MPI.COMM_SELF) as analysis:
+        out = analysis.result
+    k = out.buckling_coefficient_k
+    assert k == pytest.approx((1 - 0.3**2) * (20 / 2000) ** 2, rel=0.01)
+    assert f"k = {significant(k)}," in out.summary() and significant(k).startswith("9.1")
+    from unibuckle_fenicsx.results.records import coefficient_text
+
+    assert coefficient_text(9.104e-5) == "9.104e-05" and coefficient_text(0.43) == "0.4300"
+    assert coefficient_text(4.0) == "4.0000"
+    line = {"point": {"plate.length": 2000.0}, "critical_load_Pa": 6.9e5, "ratio_to_free": 1.0,
+            "buckling_coefficient_k": 9.104e-5, "units": "mm-N-MPa"}  # fmt: skip
+    assert "9.104e-05" in sweep_table([line])
