@@ -14,8 +14,11 @@ import pytest
 
 
 @pytest.fixture(autouse=True)
-def _collective_teardown():
-    """Run collective PETSc destructors together on every rank (dolfinx conftest)."""
+def _collective_teardown(_petsc_options_restored):
+    """Run collective PETSc destructors together on every rank (dolfinx conftest).
+
+    Before the options are checked: an object's destructor may take its own back.
+    """
     yield
     gc.collect()
     MPI.COMM_WORLD.Barrier()
