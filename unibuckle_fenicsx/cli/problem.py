@@ -68,9 +68,15 @@ def spec_from_args(args: argparse.Namespace) -> ProblemSpec | SectionProblemSpec
     from unibuckle_fenicsx.spec import load_problem
     from unibuckle_fenicsx.spec.cases import paper_case
 
-    spec = paper_case(args.case) if args.case else load_config(args.config, load_problem)
-    if args.settings:
-        spec = _with_settings(spec, args.settings)
+    if args.case:
+        spec = _with_settings(paper_case(args.case), args.settings)
+    else:
+        try:
+            spec = load_config(args.config, load_problem)
+        except InputError as err:
+            spec = _repaired(args.config, args.settings, err)
+        else:
+            spec = _with_settings(spec, args.settings)
     if isinstance(spec, SectionProblemSpec):
         if args.nx is not None or args.ny is not None:
             raise InputError("--nx, --ny set a plate's cells; a section takes [mesh] size = h")
@@ -97,19 +103,70 @@ def _with_settings(
         ValueError: A setting without '=', a path the problem file does not have, or a
             value the schema refuses (the message names the path).
     """
-    from unibuckle_fenicsx.spec import problem_to_dict, spec_from_dict
+    from unibuckle_fenicsx.spec import problem_to_dict
+
+    if not settings:
+        return spec
+    return _set(problem_to_dict(spec, units=spec.units), settings, spec.name)
+
+
+def _repaired(
+    path: str, settings: Sequence[str], error: InputError
+) -> ProblemSpec | SectionProblemSpec:
+    """The problem file at ``path`` that its checks refuse, with ``--set`` applied first.
+
+    A file refused by a check (``error``) may be repaired by the settings: they are
+    applied to the file's tables as written, then checked (an error then names the
+    settings). ``error`` itself is raised when there is nothing to apply, when the file
+    cannot be read as tables or is a result's JSON (its ``input`` is in SI, its settings
+    in the units it solved), or when a setting cannot be applied to the file as written
+    (a key it leaves out).
+    """
+    from pathlib import Path
+
+    from unibuckle_fenicsx.spec import spec_from_dict
+    from unibuckle_fenicsx.spec.files import read_problem_data
+
+    if not settings:
+        raise error
+    try:
+        data, units = read_problem_data(path)
+    except (InputError, OSError):
+        raise error from None
+    if units is not None:
+        raise error
+    try:
+        _apply(data, settings)
+    except InputError:
+        raise error from None
+    try:
+        return spec_from_dict(data, name=Path(path).stem)
+    except ValueError as err:
+        raise InputError(f"{path}: with --set {' --set '.join(settings)}: {err}") from None
+
+
+def _set(
+    data: dict[str, Any], settings: Sequence[str], name: str
+) -> ProblemSpec | SectionProblemSpec:
+    """The problem of the tables ``data`` with the ``--set PATH=VALUE`` changes applied."""
+    from unibuckle_fenicsx.spec import spec_from_dict
+
+    _apply(data, settings)
+    try:
+        return spec_from_dict(data, name=name)
+    except ValueError as err:
+        raise InputError(f"--set {' '.join(settings)}: {err}") from None
+
+
+def _apply(data: dict[str, Any], settings: Sequence[str]) -> None:
+    """Apply the ``--set PATH=VALUE`` changes to the tables ``data`` in place."""
     from unibuckle_fenicsx.sweep import set_text
 
-    data = problem_to_dict(spec, units=spec.units)
     for setting in settings:
         path, sep, text = setting.partition("=")
         if not sep or not path.strip():
             raise InputError(f"--set {setting!r}: give PATH=VALUE, e.g. solver.tau=1e-9")
         set_text(data, path.strip(), text.strip())
-    try:
-        return spec_from_dict(data, name=spec.name)
-    except ValueError as err:
-        raise InputError(f"--set {' '.join(settings)}: {err}") from None
 
 
 def load_config(path: str, load: Any) -> Any:

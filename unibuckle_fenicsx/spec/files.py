@@ -22,6 +22,7 @@ import json
 import tomllib
 from collections.abc import Mapping, Sequence
 from pathlib import Path
+from typing import Any
 
 import msgspec
 
@@ -435,6 +436,38 @@ def load_toml(path: str | Path) -> ProblemSpec | SectionProblemSpec:
         OSError: The file cannot be read.
     """
     path = Path(path)
+    data, _ = read_problem_data(path)
+    try:
+        return spec_from_dict(data, name=path.stem)
+    except ValueError as err:
+        raise InputError(f"{path}: {err}") from None
+
+
+def read_problem_data(path: str | Path) -> tuple[dict[str, Any], str | None]:
+    """The mapping a problem file holds, unchecked, and the units of a result's re-run.
+
+    A TOML file's tables (a gmsh file's path made absolute, as it is found next to the
+    problem file), or a JSON result's ``input`` (in SI) with the ``units`` of the file it
+    solved; ``None`` for a problem file. :func:`spec_from_dict` checks the mapping.
+
+    Raises:
+        InputError: The file is not UTF-8 TOML or a JSON result or problem.
+        OSError: The file cannot be read.
+    """
+    path = Path(path)
+    if path.suffix.lower() == ".json":
+        try:
+            data = json.loads(path.read_bytes().decode("utf-8"))
+        except (UnicodeDecodeError, json.JSONDecodeError) as err:
+            raise InputError(f"{path}: not a JSON result or problem file: {err}") from None
+        if not (isinstance(data, dict) and "input" in data):
+            return _table(data, path), None
+        units = data.get("units", "SI")
+        if units not in UNITS:
+            raise InputError(f"{path}: units must be one of {tuple(UNITS)}, got {units!r}")
+        if data["input"] is None:
+            raise InputError(f"{path}: this result's problem has no file form (a predicate zone)")
+        return _table(data["input"], path), units
     try:
         data = tomllib.loads(path.read_bytes().decode("utf-8"))
     except UnicodeDecodeError as err:
@@ -447,10 +480,14 @@ def load_toml(path: str | Path) -> ProblemSpec | SectionProblemSpec:
     if isinstance(plate, dict) and isinstance(plate.get("file"), str):
         # A gmsh file is found next to the problem file.
         plate["file"] = str((path.parent / plate["file"]).resolve())
-    try:
-        return spec_from_dict(data, name=path.stem)
-    except ValueError as err:
-        raise InputError(f"{path}: {err}") from None
+    return data, None
+
+
+def _table(data: object, path: Path) -> dict[str, Any]:
+    """``data`` if it is a JSON object (a problem's tables), else an error naming ``path``."""
+    if not isinstance(data, dict):
+        raise InputError(f"{path}: a problem is a JSON object of tables, got {type(data).__name__}")
+    return data
 
 
 def load_problem(path: str | Path) -> ProblemSpec | SectionProblemSpec:
@@ -466,18 +503,7 @@ def load_problem(path: str | Path) -> ProblemSpec | SectionProblemSpec:
     path = Path(path)
     if path.suffix.lower() != ".json":
         return load_toml(path)
-    try:
-        data = json.loads(path.read_bytes().decode("utf-8"))
-    except (UnicodeDecodeError, json.JSONDecodeError) as err:
-        raise InputError(f"{path}: not a JSON result or problem file: {err}") from None
-    units = None
-    if isinstance(data, dict) and "input" in data:
-        units = data.get("units", "SI")
-        if units not in UNITS:
-            raise InputError(f"{path}: units must be one of {tuple(UNITS)}, got {units!r}")
-        data = data["input"]
-        if data is None:
-            raise InputError(f"{path}: this result's problem has no file form (a predicate zone)")
+    data, units = read_problem_data(path)
     try:
         spec = spec_from_dict(data, name=path.stem)
     except ValueError as err:

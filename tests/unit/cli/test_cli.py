@@ -297,6 +297,34 @@ def test_set_adds_a_key_the_file_leaves_out():
         spec_from_args(bad)
 
 
+def test_set_repairs_a_file_its_checks_refuse(tmp_path):
+    """--set applies to a file that fails a check, so that the setting can repair it.
+
+    The file was checked before the setting was applied: a plate too thick for the
+    plate model's check (t/b <= 0.5, b = 0.1 m) stayed refused with
+    ``--set plate.thickness=0.006``.
+    """
+    from unibuckle_fenicsx.cli.problem import spec_from_args
+
+    path = tmp_path / "thick.toml"
+    path.write_text(FREE_TOML.replace("0.006", "0.08"))
+    parser, _ = build_parser()
+    with pytest.raises(InputError, match=r"thick\.toml: .*thickness"):
+        spec_from_args(parser.parse_args(["solve", "--config", str(path)]))
+    args = parser.parse_args(["solve", "--config", str(path), "--set", "plate.thickness=0.006"])
+    assert spec_from_args(args).plate.thickness == 0.006
+    # A setting that does not repair it names the file, the setting and what is wrong.
+    worse = parser.parse_args(["solve", "--config", str(path), "--set", "plate.thickness=0.07"])
+    refused = r"thick\.toml: with --set plate\.thickness=0\.07: .*thickness"
+    with pytest.raises(InputError, match=refused):
+        spec_from_args(worse)
+    # A setting that cannot be applied to the file as written: the file's own error.
+    other = parser.parse_args(["solve", "--config", str(path), "--set", "mesh.spam=1"])
+    with pytest.raises(InputError, match=r"thick\.toml: .*thickness") as refused:
+        spec_from_args(other)
+    assert "--set" not in str(refused.value)
+
+
 @pytest.mark.parametrize(
     ("setting", "match"),
     [
