@@ -39,6 +39,7 @@ def test_readme_quotes_the_numbers_of_the_file() -> None:
     assert f"{NUMBERS['tests']} tests" in README
     assert f"{NUMBERS['make_demo_time']} on 2 cores" in README
     assert f"{NUMBERS['make_test_time']} on 2 cores" in README
+    assert f"{NUMBERS['make_setup_time']} on 2 cores" in README
 
 
 @pytest.mark.parametrize(

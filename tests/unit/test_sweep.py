@@ -490,6 +490,38 @@ def test_an_aspect_chart_s_title_names_its_axis(tmp_path, monkeypatch):
     assert seen["title"] == "small: k against the aspect ratio a/b"
 
 
+def test_an_aspect_chart_shows_every_point(tmp_path, monkeypatch):
+    """Every k of an aspect sweep lies within the chart's k axis, however short the plate.
+
+    The axis was cut at 2.5 times the smallest k: the clamped garland's a/b = 0.5 point
+    (k = 21.70, its stored record) lay above it, with the long plates' 4.29 the smallest.
+    The k values here are that record's (bilateral = unilateral at a/b = 0.5).
+    """
+    import tomllib
+
+    from unibuckle_fenicsx.viz import charts
+
+    seen, save = {}, charts._save
+
+    def keep(fig, ax, path):
+        seen.update(ylim=ax.get_ylim(), scale=ax.get_yscale(), ylabel=ax.get_ylabel())
+        return save(fig, ax, path)
+
+    monkeypatch.setattr(charts, "_save", keep)
+    base = tomllib.loads(SMALL)
+    k = {0.1: 21.702549, 0.2: 6.9752, 0.8: 4.2855}  # the record's a/b = 0.5, 1, 4
+    lines = [
+        {"point": {"plate.length": a}, "status": "ok", "buckling_coefficient_k": value,
+         "free_load_Pa": 1.0, "critical_load_Pa": 1.0, "certificate": None}
+        for a, value in k.items()
+    ]  # fmt: skip
+    variation = parse_variation("plate.length=0.1,0.2,0.8")
+    charts.plot_sweep(lines, [variation], base, tmp_path / "c.png")
+    low, high = seen["ylim"]
+    assert all(low < value < high for value in k.values()), (seen, k)
+    assert seen["scale"] == "log" and seen["ylabel"].endswith("(log scale)")
+
+
 # -- sections -----------------------------------------------------------------------
 
 #: A filled square box 100 x 100 mm, L = 200 mm, on 25 mm cells: each point about 1 s.

@@ -213,7 +213,10 @@ def problem_flags() -> Parser:
         "(repeatable; the file's units)",
     )
     problem.add_argument(
-        "--json", metavar="PATH", help="write the result as JSON (the folder must exist)"
+        "--json",
+        metavar="PATH",
+        help="write the result as JSON: every number in SI (Pa, m, N/m) whatever the "
+        "file's units (the folder must exist)",
     )
     return problem
 
@@ -235,7 +238,7 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
     s = sub.add_parser(
         "solve",
         parents=[problem, common],
-        help="solve one problem (a paper case or a TOML file)",
+        help="solve one plate (a paper case or a TOML file) or box or tube section",
         description="Compute the critical load of one problem and print its summary.\n"
         "The problem is a plate (a paper case or a TOML file) or a section: a file with a\n"
         "[section] table (a box or a tube, with a core or hollow), solved on its [mesh]\n"
@@ -268,8 +271,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "--json",
         metavar="PATH",
         required=True,
-        help="JSON-lines output (the folder must exist); an existing file of the same "
-        "sweep is resumed",
+        help="JSON-lines output, numbers in SI (the folder must exist); an existing file "
+        "of the same sweep is resumed",
     )
     w.add_argument(
         "--csv",
@@ -280,7 +283,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
     w.add_argument(
         "--plot",
         metavar="PNG",
-        help="draw k against the first --vary (bilateral: without the obstacle, and "
+        help="draw the buckling coefficient k = sigma t b^2/(pi^2 D) against the first "
+        "--vary (bilateral: without the obstacle, and "
         "unilateral: with it, with the exact curves where they exist; a section: sigma_cr "
         "over the classical stress, hollow and with its core)",
     )

@@ -278,6 +278,10 @@ class BucklingResult(Struct, kw_only=True):
         """Lines for the terminal: the result, the load it is a multiple of, the model."""
         scale, unit = UNITS[self.units][1:]
         z = ""
+        if self.method == "free" and not self.constrained_nodes:
+            # No node held: the pencil's smallest eigenpair, checked (analysis.solve).
+            springs = "; free: with the bilateral foundation" if self._bilateral() else ""
+            z = f"  proven=yes (the smallest eigenvalue, by an LDL^T inertia count{springs})"
         if self.constrained_nodes:
             cert = self.certificate
             z = (
@@ -301,6 +305,7 @@ class BucklingResult(Struct, kw_only=True):
                 f"k = {self.buckling_coefficient_k:.4f}"
             )
             second = f"\n  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}"
+            second += self._stress_line(scale, unit)
         else:  # a temperature rise alone is scaled: lambda is a factor on it
             head = (
                 f"lambda_c = {self.critical_load_Pa:.6e} (factor on the temperature rise; "
@@ -311,6 +316,32 @@ class BucklingResult(Struct, kw_only=True):
         return (
             f"{self.case}: {head}, method {self.method}{z}, "
             f"{self.eigensolves} eigensolves, {self.wall_time_s:.2f} s{bound}{second}{extra}"
+        )
+
+    def _bilateral(self) -> bool:
+        """Whether the problem has a bilateral foundation (its springs are in the free pencil)."""
+        tables = [self._input_table("obstacle")]
+        listed = (self.input or {}).get("obstacles")
+        tables += [t for t in listed if isinstance(t, dict)] if isinstance(listed, list) else []
+        return any(t.get("foundation_stiffness") and t.get("side") == "both" for t in tables)
+
+    def _stress_line(self, scale: float, unit: str) -> str:
+        """The critical edge stress when the edge stress per unit lambda is not 1 ('' else).
+
+        lambda_c is printed in the stress's unit because with a unit edge stress it is the
+        critical stress; with an edge stress of -100 per unit lambda, lambda_c = 8.2 MPa
+        means an edge stress of 820 MPa at buckling, which this line says: k's sigma,
+        lambda_c times the largest compressive edge stress per unit lambda (without one,
+        the largest shear stress).
+        """
+        reference = _reference_stress(self.edge_loads)
+        if reference is None or math.isclose(reference[0], 1.0, rel_tol=1e-12):
+            return ""
+        value, kind = reference
+        sigma = self.critical_load_Pa * value / scale
+        return (
+            f"\n  critical edge stress: lambda_c x {value:g} = {sigma:.6e} {unit} (the largest "
+            f"{kind} edge stress at lambda_c; k's sigma)"
         )
 
     def _bound_line(
@@ -546,6 +577,24 @@ def _zone_text(zone: ZoneReport) -> str:
         f"{discrete / area:.2%} of its area ({zone.nodes} nodes); the obstacle acts on "
         "the mesh nodes in the zone"
     )
+
+
+def _reference_stress(loads: dict[str, EdgeLoad]) -> tuple[float, str] | None:
+    """The largest compressive edge stress per unit load and "compressive", else shear's.
+
+    As :meth:`~unibuckle_fenicsx.spec.plate.PlateSpec.reference_load` takes it for k:
+    without a compressive normal stress, the largest absolute shear stress; None when the
+    edges carry no compression and no shear.
+    """
+
+    def ends(value: Stress) -> list[float]:
+        return [float(v) for v in value] if isinstance(value, list | tuple) else [float(value)]
+
+    compression = max((-v for e in loads.values() for v in ends(e.normal_stress)), default=0.0)
+    if compression > 0.0:
+        return compression, "compressive"
+    shear = max((abs(v) for e in loads.values() for v in ends(e.shear_stress)), default=0.0)
+    return (shear, "shear") if shear > 0.0 else None
 
 
 def _load_text(load: EdgeLoad, fixed: bool = False, scale: float = 1.0, unit: str = "") -> str:

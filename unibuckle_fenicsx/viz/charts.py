@@ -284,16 +284,39 @@ def _marker_legend(ax: Any) -> None:
         ax.plot([], [], style, color="0.2", mfc=mfc, label=text)
 
 
+#: Above this ratio of the largest k to the smallest an aspect sweep's k axis is
+#: logarithmic (:func:`_k_range`).
+LOG_K_SPAN = 2.5
+#: The labelled ticks of a logarithmic k axis, per decade.
+_LOG_K_TICKS = (1.0, 1.5, 2.0, 3.0, 4.0, 5.0, 6.0, 7.0, 8.0)
+
+
 def _k_range(ax: Any, lines: Sequence[Mapping[str, Any]], aspect: bool) -> None:
-    """Keep the interesting range readable: very short plates have large k (aspect sweeps)."""
+    """Show every point, with the interesting range readable.
+
+    Very short plates have large k (aspect sweeps): where the largest k shown is above
+    ``LOG_K_SPAN`` times the smallest, the axis is logarithmic (ticks labelled as
+    numbers), so that the short plates' points stay on the chart and the long plates'
+    flat range keeps its height.
+    """
     solved_lines = [m for m in lines if m.get("buckling_coefficient_k") is not None]
     shown = [float(m["buckling_coefficient_k"]) for m in solved_lines] + [
         float(m["buckling_coefficient_k"]) * m["free_load_Pa"] / m["critical_load_Pa"]
         for m in solved_lines
     ]
-    if shown:
-        low, high = min(shown), max(shown)
-        ax.set_ylim(0.9 * low, min(1.05 * high, 2.5 * low) if aspect else 1.05 * high)
+    if not shown:
+        return
+    low, high = min(shown), max(shown)
+    if aspect and low > 0 and high > LOG_K_SPAN * low:
+        from matplotlib import ticker
+
+        ax.set_yscale("log")
+        ax.set_ylim(0.9 * low, 1.05 * high)
+        ax.yaxis.set_major_locator(ticker.LogLocator(base=10.0, subs=_LOG_K_TICKS))
+        ax.yaxis.set_major_formatter(ticker.FormatStrFormatter("%g"))
+        ax.yaxis.set_minor_formatter(ticker.NullFormatter())
+        return
+    ax.set_ylim(0.9 * low, 1.05 * high)
 
 
 def plot_sweep(
@@ -358,7 +381,8 @@ def plot_sweep(
     _k_range(ax, lines, aspect)
     xlabel = "aspect ratio a/b" if aspect else axis_label(first.path, base)
     ax.set_xlabel(xlabel)
-    ax.set_ylabel(r"buckling coefficient $k = N b^2 / (\pi^2 D)$")
+    log = " (log scale)" if ax.get_yscale() == "log" else ""
+    ax.set_ylabel(r"buckling coefficient $k = N b^2 / (\pi^2 D)$" + log)
     ax.set_title(title or f"{base.get('name', 'plate')}: k against the {xlabel}")
     return _save(fig, ax, path)
 

@@ -290,3 +290,63 @@ def test_a_bracket_that_ran_says_what_it_verified():
     # Run, but nothing closer than the free load verified: it says so.
     none = msgspec.structs.replace(cert, proven_by="interlacing", relative_gap=0.22)
     assert "the split bracket verified no higher bound" in _verified(none), _verified(none)
+
+
+@pytest.mark.parametrize(
+    ("units", "stress", "shown"), [("SI", -1.0e8, "1e+08"), ("mm-N-MPa", -100.0, "100")]
+)
+def test_the_summary_gives_the_critical_stress_of_a_non_unit_edge_stress(units, stress, shown):
+    """lambda_c is the critical stress only with a unit edge stress: otherwise a line says it.
+
+    A 600 x 200 x 4 mm SSSS steel plate (6 x 2 cells) with an edge stress of -1e8 Pa (or
+    -100 MPa) per unit lambda printed "lambda_c = 1.7e+01 Pa" and no stress at buckling.
+    The expected stress is the same plate's lambda_c under a unit edge stress (the load is
+    linear in the edge stress: lambda scales by its inverse).
+    """
+    length = 1.0 if units == "SI" else 1.0e3  # m or mm
+    modulus = 2.1e11 if units == "SI" else 2.1e5  # Pa or MPa
+
+    def summary(edge: float) -> tuple[str, float]:
+        spec = problem_from_dict(
+            {
+                "units": units,
+                "plate": {"corners": [[0, 0], [0.6 * length, 0.2 * length]],
+                          "thickness": 0.004 * length},
+                "material": {"E": modulus, "nu": 0.3},
+                "edges": {"left": {"normal_stress": edge}, "right": {"normal_stress": edge}},
+                "mesh": {"nx": 6, "ny": 2},
+            }
+        )  # fmt: skip
+        with solve(spec, MPI.COMM_WORLD) as analysis:
+            return analysis.result.summary(), analysis.result.critical_load_Pa
+
+    unit_text, unit_load = summary(-1.0)
+    assert "critical edge stress" not in unit_text, unit_text  # lambda_c is that stress
+    text, _ = summary(stress)
+    scale, unit = (1.0, "Pa") if units == "SI" else (1.0e6, "MPa")
+    expected = f"critical edge stress: lambda_c x {shown} = {unit_load / scale:.6e} {unit}"
+    assert expected in text, (expected, text)
+
+
+def test_a_free_plate_s_summary_says_its_load_is_proven_the_smallest():
+    """A free plate's summary said nothing of proof; its load is checked the smallest.
+
+    A plate with no node held is the pencil's smallest eigenpair, verified by an LDL^T
+    inertia count (analysis.solve); with a bilateral foundation the springs are in that
+    pencil, so its "free" load is the plate's on the foundation, which the line says.
+    """
+    plate = {
+        "plate": {"corners": [[0, 0], [0.6, 0.2]], "thickness": 0.004},
+        "material": {"E": 2.1e11, "nu": 0.3},
+        "edges": {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}},
+        "mesh": {"nx": 6, "ny": 2},
+    }
+    springs = {"zone": "all", "side": "both", "foundation_stiffness": 2.0e8}
+    texts = []
+    for problem in (plate, {**plate, "obstacle": springs}):
+        with solve(problem_from_dict(problem), MPI.COMM_WORLD) as analysis:
+            assert analysis.result.method == "free"
+            texts.append(analysis.result.summary().splitlines()[0])
+    proof = "proven=yes (the smallest eigenvalue, by an LDL^T inertia count"
+    assert proof + ")" in texts[0], texts[0]
+    assert proof + "; free: with the bilateral foundation)" in texts[1], texts[1]
