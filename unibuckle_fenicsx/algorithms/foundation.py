@@ -23,13 +23,20 @@ of ranks, and the iteration would take another path. Its limits:
 :math:`k_f \to 0` gives the free plate, :math:`k_f \to \infty` the rigid obstacle; springs
 on both sides (a bilateral foundation, ``side = "both"``) are simply added to A.
 
-Bounds: :math:`\lambda_{free} \le \lambda_f` (the spring term is non-negative), and the
-returned load, a value of the quotient, is an upper bound of :math:`\lambda_f`. The
-iteration starts from the free plate (no springs) and from every spring active (the
-bilateral foundation's mode); the smallest quotient is returned. The quotient has
+Bounds: :math:`\lambda_{free} \le \lambda_f \le \lambda_{rigid}` (the spring term is
+non-negative, and vanishes on the rigid obstacle's mode), and the returned load, a value
+of the quotient, is an upper bound of :math:`\lambda_f`. The iteration starts from the
+free plate (no springs) and from every spring active (the bilateral foundation's mode);
+for stiff springs (:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`) also from
+the set a continuation in the stiffness ends on, and above :data:`RIGID_START_RATIO`
+from the rigid obstacle's contact set (the active set's); the smallest quotient is
+returned. A node of the spring set keeps pressing while its spring force exceeds
+:data:`~unibuckle_fenicsx.tolerances.PRESSING_RTOL` of the largest: a stiff spring's
+node presses by less than that fraction of max|w|, and would otherwise leave and return
+without end. The quotient has
 several local minima on long plates, and each start finds one; the arc descent (below)
 runs from every start that cycles (:doc:`/verification/tuning`). A section's elastic core
-adds a third start (``stiff_start``): the iteration on springs that many times stiffer,
+adds a start (``stiff_start``): the iteration on springs that many times stiffer,
 from the free section, whose pressing set then starts the iteration on the true springs:
 a stiffer foundation's critical state lies nearer the rigid core's one-signed mode, and
 without it a filled box's answer came out above the stiffer foundation's (which the
@@ -56,6 +63,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
+from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.algorithms.records import FoundationDetails
 from unibuckle_fenicsx.errors import InputError
@@ -68,6 +76,14 @@ __all__ = ["STIFF_START_FACTOR", "pressing_nodes", "solve_foundation"]
 
 logger = logging.getLogger(__name__)
 
+#: Above this :func:`stiffness_ratio` a start continues in the stiffness from
+#: :math:`\kappa` = 10 by tenfold steps: stiff springs have stationary points far from
+#: the free plate's and the bilateral foundation's (:doc:`/verification/stiff_foundations`).
+CONTINUATION_RATIO = 10.0
+#: Above this :func:`stiffness_ratio` a start from the rigid obstacle's contact set
+#: (the active set's) joins the others: on long plates the other starts end at stationary
+#: points above the rigid obstacle's load, which no foundation exceeds.
+RIGID_START_RATIO = 1e3
 #: Angles sampled on the circle before the golden-section refinement.
 ARC_SAMPLES = 720
 #: Golden-section steps in the bracket around the best sample: 0.618^60 of a sample's
@@ -116,6 +132,8 @@ def solve_foundation(
         raise InputError(f"stiff_start must be a finite factor > 1, got {stiff_start!r}")
     lower = problem.solve_free().load
     springs = contact.stiffness
+    ratio = stiffness_ratio(problem, springs)
+    rigid = _rigid_set(problem) if ratio > RIGID_START_RATIO else None
     runs: dict[str, SpringIteration] = {}
     finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
     with PenaltySolver(problem, prefix=Prefix.FOUNDATION, eps_options=eps_options) as solver:
@@ -130,10 +148,20 @@ def solve_foundation(
                 lower_bound=lower,
                 label="foundation (stiffer springs)",
                 threshold=PRESSING_RTOL,
+                hold_pressed=True,
             )
             start = stiff.candidate.active
             runs["stiff"], finals["stiff"] = _from_start(
                 solver, "stiff", start, lower, max_iterations
+            )
+        if rigid is not None:
+            runs["rigid"], finals["rigid"] = _from_start(
+                solver, "rigid", rigid[0], lower, max_iterations
+            )
+        if ratio > CONTINUATION_RATIO:
+            start = _continued_start(solver, springs, ratio, lower, max_iterations)
+            runs["continued"], finals["continued"] = _from_start(
+                solver, "continued", start, lower, max_iterations
             )
         # The smallest quotient; within TWIN_RTOL of it (mirror images, whose loads differ
         # by rounding that changes with the ranks) the earlier start, the free plate first.
@@ -143,7 +171,7 @@ def solve_foundation(
         candidate, status, arc_steps = finals[name]
         if arc_steps:
             name += "+arc"
-        solves = solver.solves
+        solves = solver.solves + (rigid[1] if rigid is not None else 0)
     load = candidate.load
     proven = status is RunStatus.CONVERGED and not candidate.active.size
     proven = proven and load <= lower * (1.0 + TWIN_RTOL)
@@ -176,6 +204,63 @@ def solve_foundation(
     )
 
 
+def stiffness_ratio(problem: UnilateralProblem, springs: npt.NDArray[np.float64]) -> float:
+    r"""The springs' energy on the free mode over its bending energy: :math:`\kappa`.
+
+    :math:`\kappa = \sum_k \rho_k u_k^2 / a(u, u)`, u the free mode: a non-dimensional
+    foundation stiffness for any structure (on a plate wholly on the foundation about
+    :math:`K/k`, K = :math:`k_f b^4/(\pi^4 D)`). Collective.
+    """
+    u = problem.solve_free().function.x.petsc_vec
+    Au = u.duplicate()
+    try:
+        problem.model.A.mult(u, Au)
+        energy = float(u.dot(Au))
+    finally:
+        Au.destroy()
+    z = problem.contact.values(u)
+    return float(np.sum(springs * z * z)) / energy if energy > 0.0 else 0.0
+
+
+def _rigid_set(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], int]:
+    """The rigid obstacle's contact set on the foundation's nodes, and its eigen solves.
+
+    The active set (its coarse levels, no bracket). Collective.
+    """
+    rigid = solve_active_set(problem, bound_budget=0)
+    logger.info("foundation: the rigid obstacle's load %.10g starts a run", rigid.candidate.load)
+    return rigid.candidate.active, rigid.eigensolves
+
+
+def _continued_start(
+    solver: PenaltySolver,
+    springs: npt.NDArray[np.float64],
+    ratio: float,
+    lower: float,
+    max_iterations: int,
+) -> npt.NDArray[np.int64]:
+    r"""The spring set reached by continuation in the stiffness, for the last stage's start.
+
+    Springs scaled by tenfold steps from :math:`\kappa` = :data:`CONTINUATION_RATIO`
+    towards the given ones, each stage started from the set the previous one ended on
+    (the free plate first). Collective.
+    """
+    stages = math.ceil(math.log10(ratio / CONTINUATION_RATIO))
+    active = np.empty(0, np.int64)
+    for j in range(stages, 0, -1):
+        run = solver.iterate_springs(
+            springs * 10.0 ** (-j),
+            initial_active=active,
+            max_iterations=max_iterations,
+            lower_bound=lower,
+            label=f"foundation (continuation, springs / 10^{j})",
+            threshold=PRESSING_RTOL,
+            hold_pressed=True,
+        )
+        active = run.candidate.active
+    return active
+
+
 def _from_start(
     solver: PenaltySolver,
     name: str,
@@ -197,6 +282,7 @@ def _from_start(
         lower_bound=lower,
         label=f"foundation ({name} start)",
         threshold=PRESSING_RTOL,
+        hold_pressed=True,
     )
     final, status, arc_steps = run.candidate, run.status, 0
     if status is not RunStatus.CONVERGED and math.isfinite(final.load):

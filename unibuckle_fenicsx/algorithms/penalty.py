@@ -138,6 +138,28 @@ class _Iteration:
     status: RunStatus = RunStatus.MAX_ITERATIONS
     cycle_length: int = 0
     ties: int = 0
+    hold_pressed: bool = False
+
+
+def held_nodes(
+    values: npt.NDArray[np.float64],
+    weights: npt.NDArray[np.float64],
+    active: npt.NDArray[np.int64],
+    threshold: float,
+) -> npt.NDArray[np.int64]:
+    r"""The nodes of ``active`` whose spring force exceeds ``threshold`` of the largest.
+
+    A stiff spring lets its node press by only :math:`f_k/\rho_k`, below any threshold
+    on the values once :math:`\rho_k` is large; its force :math:`f_k = \rho_k v_k` is
+    what says it presses. ``values`` are oriented, scaled by max|w|.
+    """
+    if not active.size:
+        return active
+    force = weights[active] * values[active]
+    scale = float(force.max())
+    if not scale > 0.0:
+        return active[:0]
+    return active[force > threshold * scale].astype(np.int64)
 
 
 def _orientation(
@@ -364,6 +386,7 @@ class PenaltySolver(Owner):
         lower_bound: float | None = None,
         tie_rtol: float = ENERGY_TIE_RTOL,
         label: str = "springs",
+        hold_pressed: bool = False,
     ) -> SpringIteration:
         r"""The iteration on the spring set S for the springs ``rho_abs`` (N/m).
 
@@ -380,6 +403,10 @@ class PenaltySolver(Owner):
             lower_bound: :math:`\lambda_{free}` if known (see :meth:`solve`).
             tie_rtol: Tie tolerance of the two orientations' spring energies, in [0, 1).
             label: Name in log messages.
+            hold_pressed: A node of S also presses while its spring force
+                :math:`\rho_k v_k` exceeds ``threshold`` times the largest force of S,
+                however small :math:`v_k` (:func:`held_nodes`): stiff springs press
+                deep below ``threshold`` * max|w|.
 
         Returns:
             The iteration (the returned candidate, every step, how it ended).
@@ -390,7 +417,7 @@ class PenaltySolver(Owner):
         weights, active = self._check_iteration(
             rho_abs, initial_active, max_iterations, threshold, tie_rtol
         )
-        run = _Iteration(weights, active, lower_bound)
+        run = _Iteration(weights, active, lower_bound, hold_pressed=hold_pressed)
         for it in range(int(max_iterations)):
             if self._spring_step(run, it, threshold, tie_rtol, label):
                 break
@@ -444,6 +471,10 @@ class PenaltySolver(Owner):
         vals = sign * vals
         q = self.quotient(vec, run.weights)
         penetrating = np.flatnonzero(vals > threshold).astype(np.int64)
+        if run.hold_pressed:
+            penetrating = np.union1d(
+                penetrating, held_nodes(vals, run.weights, run.active, threshold)
+            )
         run.steps.append(
             PenaltyStep(run.active, pair.value, q, max(float(vals.max()), 0.0), penetrating)
         )

@@ -43,6 +43,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.foundation import pressing_nodes
+from unibuckle_fenicsx.algorithms.penalty import held_nodes
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.records import CopositivityRecord, Refuting
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, rayleigh
@@ -50,7 +51,13 @@ from unibuckle_fenicsx.errors import EigenSolveError
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
-from unibuckle_fenicsx.tolerances import BRACKET_GAP, PROOF_GAP, ROUNDING_RTOL, SMALLEST_RTOL_FACTOR
+from unibuckle_fenicsx.tolerances import (
+    BRACKET_GAP,
+    PRESSING_RTOL,
+    PROOF_GAP,
+    ROUNDING_RTOL,
+    SMALLEST_RTOL_FACTOR,
+)
 
 __all__ = [
     "BRACKET_GAP",
@@ -500,7 +507,10 @@ def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution)
     if not math.isfinite(cand.load):
         raise ValueError("certify_foundation: the candidate has no finite load")
     z, residual = _spring_residual(problem, cand)
-    pressing = pressing_nodes(z, 1.0)  # as the solver counts them
+    # As the solver counts them: beyond PRESSING_RTOL of max|w|, or (stiff springs) a node
+    # of the returned set whose spring force is beyond PRESSING_RTOL of the largest.
+    held = held_nodes(z, contact.stiffness, cand.active, PRESSING_RTOL)
+    pressing = np.union1d(pressing_nodes(z, 1.0), held).astype(np.int64)
     status = solution.status
     if status is None:
         raise ValueError(

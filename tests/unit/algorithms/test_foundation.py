@@ -41,8 +41,14 @@ from unibuckle_fenicsx.model.contact import (
     tributary_areas,
 )
 from unibuckle_fenicsx.model.materials import bending_stiffness
-from unibuckle_fenicsx.spec import Circle, ObstacleSpec, problem_from_dict, problem_to_dict
-from unibuckle_fenicsx.spec.cases import plate_case
+from unibuckle_fenicsx.spec import (
+    Circle,
+    Material,
+    ObstacleSpec,
+    problem_from_dict,
+    problem_to_dict,
+)
+from unibuckle_fenicsx.spec.cases import paper_case, plate_case
 
 THICKNESS = 1e-3  # b = 1 m: t/b = 1e-3, the thin limit
 D = bending_stiffness(1.0e9, 0.3, THICKNESS)
@@ -419,3 +425,60 @@ def test_nonlinear_analysis_refuses_a_foundation():
     spec = strip(3.0, 6, ObstacleSpec("all", foundation_stiffness=modulus(10.0)))
     with pytest.raises(ValueError, match=r"rigid obstacles only, not Winkler foundations"):
         solve_nonlinear(spec)
+
+
+# -- stiff foundations: the rigid obstacle is the limit and the bound ---------------------
+def _gap_to_rigid(spec, Ks):
+    """The rigid obstacle's load, and each K's load and certificate, on one mesh."""
+    with solve(spec) as analysis:
+        rigid = analysis.result.critical_load_Pa
+    b = min(spec.plate.length, spec.plate.width)
+    D12 = spec.material.E * spec.plate.thickness**3 / 12.0  # the input check's D
+    loads = []
+    for K in Ks:
+        zone = structs.replace(spec.obstacle, foundation_stiffness=K * math.pi**4 * D12 / b**4)
+        with solve(structs.replace(spec, obstacle=zone)) as analysis:
+            result = analysis.result
+            assert result.method == "foundation" and result.certificate.kkt, (K, result)
+            loads.append(result.critical_load_Pa)
+    return rigid, loads
+
+
+def test_a_thin_liner_on_concrete_is_answered_below_the_rigid_obstacle():
+    """A 4 x 2 m, 1 mm steel liner on concrete, k_f = 1e11 N/m^3 (K = 9.4e8).
+
+    Refused before (K above 1e8); past the refusal the spring-set iteration ended 1.8e-4
+    above the rigid obstacle's load at K = 1e9, not KKT, where no foundation's load can
+    exceed it (the rigid obstacle's mode presses no spring: its quotient is its load).
+    Expected: the rigid obstacle's load on the same mesh, from below, within 1e-7 (the
+    gap measured 1.1e-9).
+    """
+    spec = plate_case(
+        "liner", length=4.0, width=2.0, thickness=1e-3, nx=16, ny=8,
+        supports={"left": "clamped", "right": "clamped"},
+        zone=ObstacleSpec("all", foundation_stiffness=1e11),
+        material=Material(E=2.1e11, nu=0.3),
+    )  # fmt: skip
+    with solve(spec) as analysis:
+        load = analysis.result.critical_load_Pa
+        assert analysis.result.certificate.kkt
+    with solve(structs.replace(spec, obstacle=ObstacleSpec("all"))) as analysis:
+        rigid = analysis.result.critical_load_Pa
+    assert rigid * (1 - 1e-7) <= load <= rigid * (1 + 1e-12), (load, rigid)
+
+
+def test_a_stiff_foundation_tends_to_the_rigid_obstacle_as_one_over_K():
+    """The paper's plate, zone omega_c1 (the mode presses it), 40 x 20 cells.
+
+    K = 1e6, 1e9, 1e11: the load grows with K, stays below the rigid obstacle's load,
+    and the gap falls as 1/K (the Winkler boundary layer below one cell: the springs of
+    the touch-down nodes act as a penalty). Before, K > 1e8 was refused, and past the
+    refusal, on zone omega_c2, K = 1e10 ended 1.1e-5 above the rigid obstacle's load,
+    not KKT. Expected: the rigid obstacle's load and the rate 1/K.
+    """
+    rigid, loads = _gap_to_rigid(paper_case("c1", 40, 20), (1e6, 1e9, 1e11))
+    assert all(x < y for x, y in itertools.pairwise(loads)), loads
+    assert loads[-1] <= rigid * (1 + 1e-12), (loads, rigid)
+    scaled = [(rigid - x) / rigid * K for x, K in zip(loads, (1e6, 1e9, 1e11), strict=True)]
+    assert scaled[0] == pytest.approx(scaled[1], rel=0.05), scaled
+    assert scaled[1] == pytest.approx(scaled[2], rel=0.1), scaled

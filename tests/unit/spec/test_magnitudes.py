@@ -52,7 +52,7 @@ from unibuckle_fenicsx.spec import problem_from_dict
             "obstacle.foundation_stiffness=1e20",
             # K = 1e20 * 0.1^4 / (pi^4 * 1e9 * 0.006^3 / 12) = 5.70e12
             r"obstacle\.foundation_stiffness = 1e\+20 N/m\^3 is K = k_f b\^4/\(pi\^4 D\) = "
-            r"5\.7e\+12 .* needs K <= 1e\+08",
+            r"5\.7e\+12 .* needs K <= 1e\+12",
         ),
         ("solver.tau=1e-300", r"solver\.tau must lie in \[1e-12, 0\.01\], got 1e-300"),
     ],
