@@ -1,4 +1,4 @@
-"""Shared fixtures: teardown, random active problems, nothing built early, the thin plate.
+"""Shared fixtures: teardown, PETSc options, random problems, nothing built, thin plate.
 
 What the tests share that is not a fixture (references, families, subprocesses) is the
 package ``tests/support/``.
@@ -14,11 +14,29 @@ import pytest
 
 
 @pytest.fixture(autouse=True)
-def _collective_teardown():
-    """Run collective PETSc destructors together on every rank (dolfinx conftest)."""
+def _collective_teardown(_petsc_options_restored):
+    """Run collective PETSc destructors together on every rank (dolfinx conftest).
+
+    Before the options are checked: an object's destructor may take its own back.
+    """
     yield
     gc.collect()
     MPI.COMM_WORLD.Barrier()
+
+
+@pytest.fixture(autouse=True)
+def _petsc_options_restored():
+    """Take back the PETSc options a test left (the database is global), and say so.
+
+    A test that leaves options behind is an error of that test only: the options are
+    removed before the next test starts, so its failure cannot fail the tests after it.
+    """
+    from support.options import options_restored
+
+    with options_restored() as leaked:
+        yield
+    if leaked:
+        pytest.fail(f"the test left PETSc options behind (taken back): {leaked}")
 
 
 @pytest.fixture(scope="session")

@@ -327,7 +327,7 @@ def _analyse(
             certificate = certify(problem, solution)
             solution, certificate = _continue(problem, solution, certificate)
         problem.timings["certify_s"] = time.perf_counter() - t1
-        if not certificate.kkt:
+        if certificate.status == "not-kkt":
             logger.warning(
                 "the %s result fails its certificate: %s",
                 method, "; ".join(certificate.notes) or certificate.status,

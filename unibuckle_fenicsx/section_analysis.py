@@ -363,7 +363,7 @@ def _solve_section(
                 else certify(cored, solution)
             )
             problem.timings["certify_s"] = time.perf_counter() - t1
-            if not certificate.kkt:
+            if certificate.status == "not-kkt":
                 logger.warning(
                     "the section's result fails its certificate: %s",
                     "; ".join(certificate.notes) or certificate.status,

@@ -88,10 +88,14 @@ def holed_plate_load(
                 (V.sub(c), Vc), lambda x, p=point: np.hypot(x[0] - p[0], x[1] - p[1]) < 1e-9 * b
             )
             pins.append(dolfinx.fem.dirichletbc(0.0, dofs[0], V.sub(c)))
-    lu = {"ksp_type": "preonly", "pc_type": "lu", "pc_factor_mat_solver_type": "mumps"}
     problem = dolfinx.fem.petsc.LinearProblem(
-        a, L, bcs=pins, petsc_options_prefix="test_tri_prestress_", petsc_options=lu
+        a, L, bcs=pins, petsc_options_prefix="test_tri_prestress_"
     )
+    # Set on the KSP, not as petsc_options: DOLFINx's LinearProblem deletes those from
+    # the global options database without their prefix, so they stayed there.
+    problem.solver.setType("preonly")
+    problem.solver.getPC().setType("lu")
+    problem.solver.getPC().setFactorSolverType("mumps")
     up = problem.solve()
     N0 = t * stress(up)
     # Reissner-Mindlin, P3 x P3^2, full integration.

@@ -136,13 +136,21 @@ class Certificate:
 
     @property
     def status(self) -> str:
-        """One of proven, bracketed (verified gap <= BRACKET_GAP), kkt-only, not-kkt."""
+        """One of proven, bracketed (verified gap <= BRACKET_GAP), kkt-only, not-kkt.
+
+        "kkt-only" says a critical state: the load must also be its reduced pencil's
+        smallest eigenvalue (paper, Lemma 5.1). A pair checked and found not to be
+        (``smallest_of_reduced`` False) is "not-kkt" unless its verified bracket closes
+        (proven, bracketed): an admissible load above a verified bound stands on its own.
+        """
         if not self.kkt:
             return "not-kkt"
         if self.global_optimum_proven:
             return "proven"
         if self.proven_by != "interlacing" and _within(self.relative_gap, BRACKET_GAP):
             return "bracketed"
+        if self.smallest_of_reduced is False:
+            return "not-kkt"
         return "kkt-only"
 
     @property
@@ -316,6 +324,18 @@ class _Bracket:
     notes: list[str]
     record: CopositivityRecord | None = None
     refuting: Candidate | None = None
+    agree: float = 0.0
+
+    def closed_within(self) -> None:
+        """The lower end at most the upper, or an error: never a bound clipped to a load.
+
+        A proven lower bound above an admissible load by more than ``agree`` (relative:
+        the eigen solver's accuracy) is a contradiction: the bound is none, or the load
+        is no mode's. Raises :class:`~unibuckle_fenicsx.errors.EigenSolveError` then;
+        within it the two agree and the lower end is the upper.
+        """
+        _ordered(self.lower, self.upper, self.proven_by, self.agree)
+        self.lower = min(self.lower, self.upper)
 
     @classmethod
     def of(cls, solution: UnilateralSolution, notes: list[str], agree: float) -> _Bracket:
@@ -337,13 +357,23 @@ class _Bracket:
             notes.append("the mode crosses the obstacle: its load is not an upper bound")
         # No stated proof: the lower bound is the free load, by interlacing.
         proven_by = solution.lower_bound_by or "interlacing"
-        if upper < solution.lower_bound * (1.0 - agree):
-            raise EigenSolveError(
-                f"the admissible load {upper!r} lies below the proven lower bound "
-                f"{solution.lower_bound!r} (by {proven_by}): the mode is not an eigenvector "
-                "of its reduced pencil, and no bracket holds"
-            )
-        return cls(min(solution.lower_bound, upper), upper, proven_by, notes)
+        br = cls(solution.lower_bound, upper, proven_by, notes, agree=agree)
+        br.closed_within()
+        return br
+
+
+def _ordered(lower: float, upper: float, proven_by: str, agree: float) -> None:
+    """Raise :class:`EigenSolveError` if the admissible load ``upper`` lies below ``lower``.
+
+    Beyond the relative accuracy ``agree``: a load below a proven bound is an error,
+    never the bound.
+    """
+    if upper < lower * (1.0 - agree):
+        raise EigenSolveError(
+            f"the admissible load {upper!r} lies below the proven lower bound {lower!r} "
+            f"(by {proven_by}): the mode is not an eigenvector of its pencil, or the "
+            "bound is none, and no bracket holds"
+        )
 
 
 def _local(
@@ -398,8 +428,8 @@ def _copositivity(
                 f"{cand.load!r} (Certificate.refuting_mode)"
             )
     if bound.value is not None and bound.value > br.lower:
-        br.lower, br.proven_by = min(bound.value, br.upper), bound.method
-    br.lower = min(br.lower, br.upper)
+        br.lower, br.proven_by = bound.value, bound.method
+    br.closed_within()  # a bound above a refuting mode's or the candidate's load: an error
 
 
 def _smallest(
@@ -490,7 +520,11 @@ def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution)
     kkt = residual <= math.sqrt(tau) and status is RunStatus.CONVERGED
     if status is not RunStatus.CONVERGED:
         notes.append(f"the spring-set iteration did not converge ({status})")
-    lower = min(solution.lower_bound, cand.load)
+    # The springs only stiffen: no eigenvalue of the pencil with them lies below the
+    # free load (the lower end), so a load below it is no eigenpair's, never the bound.
+    agree = SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol
+    _ordered(solution.lower_bound, cand.load, "interlacing", agree)
+    lower = min(solution.lower_bound, cand.load)  # equal within the solver's accuracy
     upper = cand.load
     gap = (upper - lower) / upper
     proven = bool(kkt and solution.global_optimum_proven and _within(gap, PROOF_GAP))

@@ -342,8 +342,8 @@ class GEPSolver(Owner):
                 second EPS (options prefix ``<prefix>near_``) shifts to
                 :data:`NEAR_MARGIN` below it, and its factorisation's inertia
                 (:attr:`factorization`, prefix ``<prefix>ldl_``) proves that no
-                eigenvalue lies below the shift; if one does (or nothing converges),
-                the solve at target 0 runs instead.
+                eigenvalue lies below the shift; if one does (or nothing converges, or
+                its pair is none of the pencil), the solve at target 0 runs instead.
 
         Returns:
             The eigenpair, with value ``inf`` when no finite load exists (the removed DOFs
@@ -364,6 +364,16 @@ class GEPSolver(Owner):
         start = initial if initial is not None and self._useful_start(initial, B) else None
         eps = self._run(A, B, start, near)
         self.solves += 1
+        if eps is not self.eps and not self.indefinite and self._spurious(eps):
+            # The shifted solve's pair is none of the pencil (its load may even lie below
+            # the least, under the shift's inertia): the solve at target 0 from SLEPc's
+            # own start, checked below as every other.
+            logger.debug("%s: no eigenpair from the shifted solve (%.6g); at 0 instead",
+                         self.prefix, eps.getEigenvalue(0).real)  # fmt: skip
+            self.unshifted_again += 1
+            start = None
+            eps = self._run(A, B, None, None)
+            self.solves += 1
         if eps is self.eps and not self.indefinite and eps.getConverged() < 1:
             return self._wider_pair(start, out)
         if start is not None and eps is self.eps and not self.indefinite and _negative(eps):
@@ -387,22 +397,27 @@ class GEPSolver(Owner):
         return self._pair(eps, out)
 
     @staticmethod
-    def _spurious(eps: SLEPc.EPS) -> bool:
-        """Whether the first pair of ``eps`` is none of its definite pencil (collective).
+    def _spurious(eps: SLEPc.EPS, index: int = 0) -> bool:
+        """Whether pair ``index`` of ``eps`` is none of its definite pencil (collective).
 
         A load that is not positive, or one its vector's Rayleigh quotient disagrees
         with beyond :data:`SPURIOUS_RTOL` (relative; a thousand times the EPS's
-        tolerance if that is looser). False when nothing converged.
+        tolerance if that is looser). False when that pair did not converge. Every
+        solve of the pencil (A, B), B semidefinite, is checked so: at target 0, near
+        an estimate (:meth:`solve`, :meth:`lowest_pairs`) and the free one
+        (:class:`SmallestSearch`). The swapped pencil's solves (``indefinite``,
+        :func:`swapped_eigenpairs`) measure in the norm of A, positive definite, and
+        need no check.
         """
-        if eps.getConverged() < 1:
+        if eps.getConverged() <= index:
             return False
-        value = eps.getEigenvalue(0).real
+        value = eps.getEigenvalue(index).real
         if not value > 0.0:
             return True
         A, B = eps.getOperators()
         x, y = A.createVecs()
         try:
-            eps.getEigenvector(0, x)
+            eps.getEigenvector(index, x)
             A.mult(x, y)
             stiffness = x.dot(y)
             B.mult(x, y)
@@ -600,8 +615,8 @@ class GEPSolver(Owner):
         Solved as :meth:`solve` with ``near`` (the shared factorisation at the shift
         :data:`NEAR_MARGIN` below ``near``, one eigen solve), for ``count`` pairs, in
         ascending order of load; the vectors are the caller's to destroy. Empty when the
-        inertia shows an eigenvalue below the shift or fewer pairs converge: the pairs
-        returned are then proven the smallest.
+        inertia shows an eigenvalue below the shift, fewer pairs converge or one is none
+        of the pencil (:meth:`_spurious`): the pairs returned are then proven the smallest.
 
         Args:
             removed: Global row indices owned by this rank to remove.
@@ -628,6 +643,8 @@ class GEPSolver(Owner):
             self.shifted_solves += 1
             if eps.getConverged() < count:
                 return []
+            if not self.indefinite and any(self._spurious(eps, k) for k in range(count)):
+                return []  # a pair that is none of the pencil proves nothing
             its = int(eps.getIterationNumber())
             pairs: list[tuple[EigenPair, PETSc.Vec]] = []
             for k in range(count):
@@ -801,7 +818,8 @@ class SmallestSearch:
 
     More than :data:`FREE_MAX_BELOW` below :math:`\sigma`, or fewer pairs found below
     it than lie there: the next shift lies below the estimate (``FREE_BELOW``)
-    and the pencil is factorised again. If no shift proves it (or nothing converges,
+    and the pencil is factorised again. If no shift proves it (or nothing converges, or
+    a pair is none of the pencil, :meth:`GEPSolver._spurious`,
     or there is no estimate) the pair comes from :meth:`GEPSolver.solve` at target 0 (a
     MUMPS LU), unproven: the caller checks it (:meth:`GEPSolver.count_below`).
 
@@ -870,6 +888,8 @@ class SmallestSearch:
             loads = [self._load(eps.getEigenvalue(k).real) for k in range(eps.getConverged())]
             if not loads:
                 return None
+            if not solver.indefinite and any(solver._spurious(eps, k) for k in range(len(loads))):
+                return None  # a pair that is none of the pencil: the checked solve at 0
             under = [k for k, load in enumerate(loads) if load <= shift * (1.0 - rtol)]
             if below and len(under) >= below:
                 return self._indexed_pair(eps, min(under, key=loads.__getitem__), out), below

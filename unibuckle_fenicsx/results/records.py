@@ -261,8 +261,12 @@ class BucklingResult(Struct, kw_only=True):
 
     @property
     def certified(self) -> bool:
-        """No certificate (no obstacle: the free load, verified the smallest), or a KKT one."""
-        return self.certificate is None or self.certificate.kkt
+        """No certificate (the free load, verified the smallest), or one not "not-kkt".
+
+        A KKT point whose inertia shows a lower eigenvalue of its reduced pencil is no
+        critical state (``Certificate.status``).
+        """
+        return self.certificate is None or self.certificate.status != "not-kkt"
 
     def as_dict(self, timings: bool = True) -> dict[str, object]:
         """JSON-ready mapping (non-finite floats become ``null``: JSON has no infinity).

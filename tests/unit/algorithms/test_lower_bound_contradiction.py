@@ -18,14 +18,16 @@ from mpi4py import MPI
 import numpy as np
 import pytest
 
-from support.exhaustive import dense_free_load, dense_reduced_load
+from support.exhaustive import RTOL, dense_free_load, dense_reduced_load, exhaustive_minimum
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.bounds import bracket
-from unibuckle_fenicsx.certificate.certify import certify
+from unibuckle_fenicsx.algorithms.foundation import solve_foundation
+from unibuckle_fenicsx.certificate.certify import certify, certify_foundation
 from unibuckle_fenicsx.errors import EigenSolveError
 from unibuckle_fenicsx.model.build import build_problem
-from unibuckle_fenicsx.spec.cases import paper_case
+from unibuckle_fenicsx.spec import ObstacleSpec
+from unibuckle_fenicsx.spec.cases import paper_case, plate_case
 
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial")
 
@@ -34,6 +36,22 @@ pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial")
 def problem():
     p = build_problem(paper_case("c1", 8, 4), MPI.COMM_SELF)
     yield p
+    p.destroy()
+
+
+#: The counts a route's record reads.
+TIMINGS = {"factorisations": 0.0, "solves": 0.0, "total_s": 0.0}
+
+
+@pytest.fixture
+def foundation():
+    """A 2 x 1 plate (16 x 8 cells) on a whole-face tensionless foundation, solved."""
+    spec = plate_case(
+        "strip", length=2.0, width=1.0, thickness=1e-3, nx=16, ny=8,
+        zone=ObstacleSpec("all", foundation_stiffness=1.0e3), supports="simply_supported",
+    )  # fmt: skip
+    p = build_problem(spec, MPI.COMM_SELF)
+    yield p, solve_foundation(p)
     p.destroy()
 
 
@@ -120,3 +138,47 @@ def test_a_continued_solve_below_the_proven_bound_is_an_error(problem):
     assert start.feasible
     with pytest.raises(EigenSolveError, match="below the proven lower bound"):
         continue_from(problem, solution, start, 5)
+
+
+def test_a_copositivity_bound_above_the_load_is_an_error_not_a_proof(problem, monkeypatch):
+    """A route's bound above the KKT point's own (admissible) load is refused.
+
+    No admissible mode has a load below the critical load, which is at most the KKT
+    point's: a bound above it is none. The starting code clipped it to the load
+    (``min(bound, upper)``), closing the bracket: "proven" by a false bound. The
+    reference: the exhaustive minimum over the 2^i contact sets by dense LAPACK lies at
+    the KKT point's load, below the claimed bound.
+    """
+    from unibuckle_fenicsx.certificate import certify as certify_module
+    from unibuckle_fenicsx.certificate.copositivity import LowerBound
+
+    solution = solve_active_set(problem, multilevel=False, bound_budget=0)
+    cand = solution.candidate
+    assert cand.feasible and cand.eigen is not None
+    minimum, _, _ = exhaustive_minimum(problem)
+    assert minimum <= cand.load * (1 + RTOL)  # the critical load: no bound lies above it
+    false = 1.1 * cand.load
+
+    def wrong_bound(*args, **kwargs):
+        return LowerBound(false, "rank2-spn", -0.1, timings=TIMINGS)
+
+    monkeypatch.setattr(certify_module, "copositivity_bound", wrong_bound)
+    with pytest.raises(EigenSolveError, match="below the proven lower bound"):
+        certify(problem, solution, global_bound=True)
+
+
+def test_a_foundation_load_below_the_free_load_is_an_error(foundation):
+    """The tensionless foundation's load cannot lie below the free load.
+
+    The springs only stiffen (a positive semidefinite term added to A): every eigenvalue
+    of the pencil with them lies at or above the free plate's (scipy's dense value, as
+    the reference). A pair claiming 0.8 of the free load (as one that is no eigenpair
+    would) was made the lower bound and the upper by the starting code (``min``).
+    """
+    problem, solution = foundation
+    free = problem.solve_free().load
+    assert free == pytest.approx(dense_free_load(problem), rel=1e-8)  # scipy
+    wrong = dataclasses.replace(solution, candidate=_spurious(solution.candidate, 0.8 * free))
+    with pytest.raises(EigenSolveError, match="below the proven lower bound"):
+        certify_foundation(problem, wrong)
+    assert certify_foundation(problem, solution).lower_bound == pytest.approx(free, rel=1e-12)

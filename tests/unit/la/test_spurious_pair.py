@@ -21,7 +21,7 @@ import pytest
 import scipy.linalg
 
 from support.exhaustive import dense
-from unibuckle_fenicsx import SectionParameters
+from support.tubes import filled_tube
 from unibuckle_fenicsx.model.shell.section import build_section
 
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial")
@@ -43,11 +43,7 @@ def _loads_below(a: np.ndarray, b: np.ndarray, sigma: float) -> int:
 
 
 def test_a_pair_that_is_no_eigenpair_is_solved_again():
-    tube = SectionParameters(
-        "tube", diameter=0.1, thickness=0.001, length=0.1, E=2.1e11, nu=0.3,
-        mesh_size=0.01, ends="simply_supported", core=True,
-    )  # fmt: skip
-    section = build_section(tube, MPI.COMM_SELF)
+    section = build_section(filled_tube(), MPI.COMM_SELF)
     try:
         problem = section.problem
         solver = problem.eigensolver
