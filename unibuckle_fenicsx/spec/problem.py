@@ -129,10 +129,9 @@ class ProblemSpec(Table, frozen=True):
                     f"(D = E t^3/12, b its smaller side): a tensionless foundation needs "
                     f"K <= {MAX_FOUNDATION_K:g}, foundation_stiffness <= {high:.3g} {name} "
                     "here (the largest measured). The rigid obstacle's load is an upper "
-                    "bound of the foundation's at any stiffness, and close to it: on a mesh "
-                    "the gap was measured as C/K with C from 0.8 to 4, growing as the mesh "
-                    "is refined: leave foundation_stiffness out for that bound (a rigid "
-                    "obstacle)"
+                    "bound of the foundation's at any stiffness, and the gap to it falls as "
+                    "1/K (the documentation's 'Stiff tensionless foundations'): leave "
+                    "foundation_stiffness out for that bound (a rigid obstacle)"
                 )
 
     def _check_obstacles(self) -> None:
