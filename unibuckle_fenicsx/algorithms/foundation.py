@@ -35,12 +35,10 @@ returned. A node of the spring set keeps pressing while its spring force exceeds
 node presses by less than that fraction of max|w|, and would otherwise leave and return
 without end. The quotient has
 several local minima on long plates, and each start finds one; the arc descent (below)
-runs from every start that cycles (:doc:`/verification/tuning`). A section's elastic core
-adds a start (``stiff_start``): the iteration on springs that many times stiffer,
-from the free section, whose pressing set then starts the iteration on the true springs:
-a stiffer foundation's critical state lies nearer the rigid core's one-signed mode, and
-without it a filled box's answer came out above the stiffer foundation's (which the
-minimum, growing with :math:`k_f`, cannot exceed).
+runs from every start that cycles (:doc:`/verification/tuning`). The stiff springs'
+starts serve a section's elastic core too: with the two first starts alone a filled
+box's answer came out above a stiffer core's (which the minimum, growing with
+:math:`k_f`, cannot exceed; :doc:`/history/2026-11-30h-sechunt`).
 
 The iteration on S need not decrease the quotient, and it can cycle. When a start
 reaches no fixed point, an *arc descent* takes over from its best iterate v: with S the
@@ -72,7 +70,7 @@ from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, requir
 from unibuckle_fenicsx.spec.solver import FoundationOptions
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
-__all__ = ["STIFF_START_FACTOR", "pressing_nodes", "solve_foundation"]
+__all__ = ["pressing_nodes", "solve_foundation"]
 
 logger = logging.getLogger(__name__)
 
@@ -89,10 +87,6 @@ ARC_SAMPLES = 720
 #: Golden-section steps in the bracket around the best sample: 0.618^60 of a sample's
 #: spacing, below the rounding of an angle.
 GOLDEN_STEPS = 60
-#: A section's elastic core: the third start's springs over the true ones
-#: (:func:`solve_foundation`'s ``stiff_start``); larger factors gave the same start for
-#: more solves (:doc:`/history/2026-11-30h-sechunt`).
-STIFF_START_FACTOR = 10.0
 
 
 def solve_foundation(
@@ -100,7 +94,6 @@ def solve_foundation(
     *,
     max_iterations: int = 100,
     eps_options: dict[str, str | float | int] | None = None,
-    stiff_start: float | None = None,
 ) -> UnilateralSolution:
     r"""Critical load of the plate on its tensionless foundation (module docstring).
 
@@ -109,9 +102,6 @@ def solve_foundation(
             (``problem.tensionless``).
         max_iterations: Eigen solves allowed per start, >= 1.
         eps_options: Extra EPS options under ``unibuckle_foundation_``.
-        stiff_start: With a factor c > 1, a third start: the nodes pressing at the end
-            of the iteration on c times the springs from the free plate (module
-            docstring; :data:`STIFF_START_FACTOR` for a section's core); None: two starts.
 
     Returns:
         The solution; its candidate's load is the quotient of the returned mode, its
@@ -128,8 +118,6 @@ def solve_foundation(
     if contact.stiffness is None:
         raise InputError("solve_foundation needs a problem with a tensionless foundation")
     FoundationOptions(max_iterations=max_iterations)  # the [solver] key's range
-    if stiff_start is not None and not (math.isfinite(stiff_start) and stiff_start > 1.0):
-        raise InputError(f"stiff_start must be a finite factor > 1, got {stiff_start!r}")
     lower = problem.solve_free().load
     springs = contact.stiffness
     ratio = stiffness_ratio(problem, springs)
@@ -140,20 +128,6 @@ def solve_foundation(
         starts = {"free": np.empty(0, np.int64), "bilateral": np.arange(contact.size)}
         for name, start in starts.items():
             runs[name], finals[name] = _from_start(solver, name, start, lower, max_iterations)
-        if stiff_start is not None:
-            stiff = solver.iterate_springs(
-                springs * stiff_start,
-                initial_active=starts["free"],
-                max_iterations=max_iterations,
-                lower_bound=lower,
-                label="foundation (stiffer springs)",
-                threshold=PRESSING_RTOL,
-                hold_pressed=True,
-            )
-            start = stiff.candidate.active
-            runs["stiff"], finals["stiff"] = _from_start(
-                solver, "stiff", start, lower, max_iterations
-            )
         if rigid is not None:
             runs["rigid"], finals["rigid"] = _from_start(
                 solver, "rigid", rigid[0], lower, max_iterations

@@ -41,7 +41,7 @@ from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.chain import solve_interior_point
 from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
-from unibuckle_fenicsx.algorithms.foundation import STIFF_START_FACTOR, solve_foundation
+from unibuckle_fenicsx.algorithms.foundation import solve_foundation
 from unibuckle_fenicsx.algorithms.interior_point.options import ChainOptions
 from unibuckle_fenicsx.algorithms.penalty import solve_penalty
 from unibuckle_fenicsx.algorithms.section_levels import BOTH, solve_levels
@@ -206,9 +206,7 @@ def _section_foundation(
     """An elastic core: the spring-set iteration on the section itself (no coarser ones)."""
     section = build_section(parameters, comm, solver)
     try:
-        solution = solve_foundation(
-            section.cored, max_iterations=solver.max_iterations, stiff_start=STIFF_START_FACTOR
-        )
+        solution = solve_foundation(section.cored, max_iterations=solver.max_iterations)
     except BaseException:
         section.destroy()
         raise

@@ -12,7 +12,8 @@ The box 0.12 × 0.06 × 0.001 m, L = 0.2 m between clamped ends, an axial force 
 bending, a core over 0.02–0.15 m on cells of 10 mm: with k_f = 3·10¹⁰ N/m³ the
 spring-set iteration's two starts ended at 8.2929e7 and 8.3572e7 Pa, above the
 quotient 8.0327e7 Pa of the mode of k_f = 10¹¹ N/m³ (itself 8.0727e7 Pa there), and
-above the rigid core's 8.1351e7 Pa.
+above the rigid core's 8.1351e7 Pa; the stiff springs' starts (a continuation in the
+stiffness, the rigid core's contact set) end below it.
 """
 
 from __future__ import annotations
@@ -70,13 +71,3 @@ def test_a_softer_core_ends_at_or_below_a_stiffer_core_s_mode():
         load = analysis.result.critical_load_Pa
         assert analysis.result.free_load_Pa <= load
     assert load <= bound * (1.0 + 1e-9), (load, bound)
-
-
-def test_the_stiff_start_is_refused_unless_a_factor_above_one():
-    section = build_section(_box(3e10), MPI.COMM_WORLD, SolverSpec())
-    try:
-        for bad in (1.0, 0.5, float("nan"), float("inf")):
-            with pytest.raises(Exception, match="stiff_start"):
-                solve_foundation(section.cored, stiff_start=bad)
-    finally:
-        section.destroy()
