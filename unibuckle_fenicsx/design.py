@@ -214,6 +214,24 @@ def clauses(element: DesignElement, free_edge_most_compressed: bool = True) -> s
     )
 
 
+def _critical_edge_ends(
+    spec: ProblemSpec, load: float, edges: tuple[str, str]
+) -> list[tuple[str, list[float]]]:
+    """Each loaded edge's normal stress at its two ends at the critical state (tension > 0).
+
+    Pa, over the ``edges`` named, the fixed part included: its stress per unit load
+    times ``load`` plus the fixed stress times the fixed part's factor.
+    """
+    factor = spec.load.fixed_factor
+    return [
+        (e.name, [factor * f + load * s for s, f in zip(
+            stress_ends(e.normal_stress), stress_ends(e.fixed_normal_stress), strict=True
+        )])
+        for e in spec.plate.edges
+        if e.name in edges
+    ]  # fmt: skip
+
+
 def _critical_edge_stress(
     spec: ProblemSpec, load: float, edges: tuple[str, str]
 ) -> tuple[float, float, int, str]:
@@ -223,31 +241,20 @@ def _critical_edge_stress(
     start, 1 end) of the same edge. Edges in tension alone: the least tension, negative.
     """
     best = (-math.inf, 0.0, 0, "")
-    factor = spec.load.fixed_factor
-    for e in spec.plate.edges:
-        if e.name not in edges:
-            continue
-        scaled, fixed = stress_ends(e.normal_stress), stress_ends(e.fixed_normal_stress)
-        ends = [-(factor * f + load * s) for s, f in zip(scaled, fixed, strict=True)]
+    for name, stresses in _critical_edge_ends(spec, load, edges):
+        ends = [-v for v in stresses]
         for k in (0, 1):
             if ends[k] > best[0]:
-                best = (ends[k], ends[1 - k], k, e.name)
+                best = (ends[k], ends[1 - k], k, name)
     return best
 
 
 def _critical_edge_tension(spec: ProblemSpec, load: float, edges: tuple[str, str]) -> float:
     """The largest tensile normal stress (Pa, > 0) on the loaded ``edges`` at the critical state.
 
-    0 when they carry none (as :func:`_critical_edge_stress`, fixed part included).
+    0 when they carry none.
     """
-    factor = spec.load.fixed_factor
-    tension = 0.0
-    for e in spec.plate.edges:
-        if e.name in edges:
-            scaled, fixed = stress_ends(e.normal_stress), stress_ends(e.fixed_normal_stress)
-            for s, f in zip(scaled, fixed, strict=True):
-                tension = max(tension, factor * f + load * s)
-    return tension
+    return max([0.0, *(v for _, ends in _critical_edge_ends(spec, load, edges) for v in ends)])
 
 
 def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignRecord:
@@ -389,7 +396,7 @@ def _column_type(
     reduced = column_type(rho, sigma1, column, design.yield_stress)
     chi, rho_c = reduced.chi, reduced.rho
     out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
-    out.xi, out.xi_unclipped = min(1.0, max(0.0, reduced.xi)), reduced.xi
+    out.xi, out.xi_unclipped = reduced.xi_used, reduced.xi
     if out.xi < 1.0:
         out.notes.append(
             f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "

@@ -54,6 +54,7 @@ __all__ = [
     "buckling_factor",
     "check_steel_modulus",
     "check_steel_yield_stress",
+    "clipped_xi",
     "column_end_factor",
     "column_reduction_factor",
     "column_type",
@@ -367,10 +368,15 @@ def interpolated_reduction_factor(rho: float, chi: float, xi: float) -> float:
     buckling, :math:`\xi = \sigma_{cr,p}/\sigma_{cr,c} - 1` clipped to [0, 1]: at
     :math:`\xi \ge 1` the plate-type :math:`\rho` itself.
     """
-    if xi >= 1.0:
+    xi = clipped_xi(xi)
+    if xi == 1.0:
         return rho  # exactly: (rho - chi) + chi may differ from it in the last bit
-    xi = max(0.0, xi)
     return (rho - chi) * xi * (2.0 - xi) + chi
+
+
+def clipped_xi(xi: float) -> float:
+    r""":math:`\xi` as EN 1993-1-5 4.5.4(1) uses it: bounded to :math:`0 \le \xi \le 1`."""
+    return min(1.0, max(0.0, xi))
 
 
 @dataclass(frozen=True)
@@ -386,6 +392,11 @@ class ColumnType:
     chi: float
     xi: float
     rho: float
+
+    @property
+    def xi_used(self) -> float:
+        """``xi`` bounded to [0, 1], the value 4.5.4(1) uses (:func:`clipped_xi`)."""
+        return clipped_xi(self.xi)
 
 
 def column_type(rho: float, sigma_cr: float, column: float, yield_stress: float) -> ColumnType:

@@ -273,7 +273,7 @@ def _face(
         )
         reduced = column_type(rho, sigma1, column, design.yield_stress)
         out.column_critical_stress_Pa, out.column_reduction_factor = column, reduced.chi
-        out.xi, out.xi_unclipped = min(1.0, max(0.0, reduced.xi)), reduced.xi
+        out.xi, out.xi_unclipped = reduced.xi_used, reduced.xi
         out.reduction_factor = reduced.rho
     out.reduced_design_stress_Pa = (
         out.reduction_factor * design.yield_stress / design.partial_factor

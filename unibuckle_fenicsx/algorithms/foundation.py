@@ -222,17 +222,36 @@ def _continued_start(
     stages = math.ceil(math.log10(ratio / CONTINUATION_RATIO))
     active = np.empty(0, np.int64)
     for j in range(stages, 0, -1):
-        run = solver.iterate_springs(
-            springs * 10.0 ** (-j),
-            initial_active=active,
-            max_iterations=max_iterations,
-            lower_bound=lower,
-            label=f"foundation (continuation, springs / 10^{j})",
-            threshold=PRESSING_RTOL,
-            hold_pressed=True,
-        )
+        run = _iterate(
+            solver, springs * 10.0 ** (-j), active, lower, max_iterations,
+            f"continuation, springs / 10^{j}",
+        )  # fmt: skip
         active = run.candidate.active
     return active
+
+
+def _iterate(
+    solver: PenaltySolver,
+    springs: npt.NDArray[np.float64],
+    start: npt.NDArray[np.int64],
+    lower: float,
+    max_iterations: int,
+    name: str,
+) -> SpringIteration:
+    """The foundation's spring-set iteration on ``springs`` from ``start``. Collective.
+
+    Pressing beyond :data:`~unibuckle_fenicsx.tolerances.PRESSING_RTOL`, a node of the
+    set held by its spring force (``hold_pressed``).
+    """
+    return solver.iterate_springs(
+        springs,
+        initial_active=start,
+        max_iterations=max_iterations,
+        lower_bound=lower,
+        label=f"foundation ({name})",
+        threshold=PRESSING_RTOL,
+        hold_pressed=True,
+    )
 
 
 def _from_start(
@@ -249,15 +268,7 @@ def _from_start(
     problem = solver.problem
     springs = problem.contact.stiffness
     assert springs is not None
-    run = solver.iterate_springs(
-        springs,
-        initial_active=start,
-        max_iterations=max_iterations,
-        lower_bound=lower,
-        label=f"foundation ({name} start)",
-        threshold=PRESSING_RTOL,
-        hold_pressed=True,
-    )
+    run = _iterate(solver, springs, start, lower, max_iterations, f"{name} start")
     final, status, arc_steps = run.candidate, run.status, 0
     if status is not RunStatus.CONVERGED and math.isfinite(final.load):
         final, status, arc_steps = _arc_descent(problem, solver, springs, final, max_iterations)

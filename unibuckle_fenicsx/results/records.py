@@ -23,6 +23,7 @@ from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
 from unibuckle_fenicsx.section_design import SectionDesignRecord
 from unibuckle_fenicsx.spec import UNITS, PointSpec
+from unibuckle_fenicsx.spec.plate import reference_edge
 from unibuckle_fenicsx.tolerances import BRACKET_GAP
 
 __all__ = [
@@ -606,21 +607,24 @@ def _zone_text(zone: ZoneReport) -> str:
 
 
 def _reference_stress(loads: dict[str, EdgeLoad]) -> tuple[float, str] | None:
-    """The largest compressive edge stress per unit load and "compressive", else shear's.
+    """The reference stress of k per unit load and its kind (``compressive`` or ``shear``).
 
-    As :meth:`~unibuckle_fenicsx.spec.plate.PlateSpec.reference_load` takes it for k:
-    without a compressive normal stress, the largest absolute shear stress; None when the
-    edges carry no compression and no shear.
+    :func:`~unibuckle_fenicsx.spec.plate.reference_edge` on the loaded edges; None when
+    they carry no compression and no shear.
     """
 
     def ends(value: Stress) -> list[float]:
         return [float(v) for v in value] if isinstance(value, list | tuple) else [float(value)]
 
-    compression = max((-v for e in loads.values() for v in ends(e.normal_stress)), default=0.0)
-    if compression > 0.0:
-        return compression, "compressive"
-    shear = max((abs(v) for e in loads.values() for v in ends(e.shear_stress)), default=0.0)
-    return (shear, "shear") if shear > 0.0 else None
+    loaded = [
+        (ends(e.normal_stress), ends(e.shear_stress))
+        for e in loads.values()
+        if any(v != 0.0 for v in (*ends(e.normal_stress), *ends(e.shear_stress)))
+    ]
+    if not loaded:
+        return None
+    _, value, kind = reference_edge([n for n, _ in loaded], [s for _, s in loaded])
+    return (value, kind) if value > 0.0 else None
 
 
 def _load_text(load: EdgeLoad, fixed: bool = False, scale: float = 1.0, unit: str = "") -> str:

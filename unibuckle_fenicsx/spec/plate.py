@@ -264,6 +264,26 @@ class EdgeSpec(Table, frozen=True):
         )
 
 
+def reference_edge(
+    normal: typing.Sequence[typing.Sequence[float]], shear: typing.Sequence[typing.Sequence[float]]
+) -> tuple[int, float, Literal["compressive", "shear"]]:
+    """The loaded edge whose stress per unit load is k's reference, its stress and kind.
+
+    ``normal``, ``shear``: each loaded edge's normal and shear stresses per unit load
+    at its ends (tension > 0), in the edges' order (at least one edge). The largest
+    compressive normal stress (positive); without one, the largest absolute shear
+    stress; edges in tension alone, neither sheared: the least tensile stress,
+    negative. Ties: the first edge. :meth:`PlateSpec.reference_load` and the result's
+    summary take it so.
+    """
+    compression = [max(-v for v in ends) for ends in normal]
+    sheared = [max(abs(v) for v in ends) for ends in shear]
+    is_normal = max(compression) > 0.0 or max(sheared) == 0.0
+    values = compression if is_normal else sheared
+    k = int(np.argmax(values))  # the first of equal values
+    return k, values[k], "compressive" if is_normal else "shear"
+
+
 def paper_edges() -> tuple[EdgeSpec, ...]:
     """Simply supported on the whole edge, unit compression on the short edges x = const."""
     return (
@@ -492,17 +512,12 @@ class PlateSpec(Table, frozen=True):
         stresses are not in it: (0, y extent) when no edge is loaded.
         """
         edges = [e for e in self.edges if e.loaded]
-        compression = [max(-v for v in e.normal_ends) for e in edges]
-        shear = [max(abs(v) for v in e.shear_ends) for e in edges]
         if not edges:
             return 0.0, self.width
-        normal = max(compression) > 0.0 or max(shear) == 0.0
-        values = compression if normal else shear
-        k = int(np.argmax(values))  # the first of equal values
+        normal, shear = [e.normal_ends for e in edges], [e.shear_ends for e in edges]
+        k, value, kind = reference_edge(normal, shear)
         along, across = self._edge_extents(edges[k])
-        if normal:
-            return values[k], along
-        return values[k], min(along, across)
+        return value, along if kind == "compressive" else min(along, across)
 
     def _edge_extents(self, edge: EdgeSpec) -> tuple[float, float]:
         """The plate's extents (m) along and across ``edge`` (see :meth:`reference_load`)."""
