@@ -30,7 +30,7 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
 - a loaded edge in compression plus bending (:math:`\psi < 0`) carries tension at its
   other end: where it reaches :math:`f_y/\gamma_{M0}` (EN 1993-1-1 6.2.1(5)) before
   :math:`\sigma_1` reaches :math:`\rho f_y/\gamma_{M0}` (:math:`\sigma_t/\sigma_1 >
-  \rho`, the critical state's stresses scaled together), yield governs, and the output
+  1/\rho`, the critical state's stresses scaled together), yield governs, and the output
   says so with the :math:`\sigma_1` at which it yields.
 
 What the clause does not describe is refused when the problem is built (both unloaded
@@ -167,7 +167,7 @@ class DesignRecord(Struct, kw_only=True):
             stresses scaled together: :math:`f_y\sigma_1/(\gamma_{M0}\sigma_t)`; None
             without tension.
         tension_yield_first: Whether the tension edge yields before :math:`\sigma_1`
-            reaches :math:`\rho f_y/\gamma_{M0}` (:math:`\sigma_t/\sigma_1 > \rho`):
+            reaches :math:`\rho f_y/\gamma_{M0}` (:math:`\sigma_t/\sigma_1 > 1/\rho`):
             then the element's stress is limited by yield, not by its buckling, and
             ``sigma_1_at_tension_yield_Pa``, below ``reduced_design_stress_Pa``, governs.
             None without tension or without :math:`\rho`.
@@ -338,7 +338,8 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     rho_c = out.reduction_factor
     out.reduced_design_stress_Pa = rho_c * design.yield_stress / design.partial_factor
     if out.tension_Pa is not None:
-        out.tension_yield_first = out.tension_Pa / sigma1 > rho_c
+        # sigma_1 f_y/(gamma_M0 sigma_t) < rho f_y/gamma_M0: sigma_t/sigma_1 > 1/rho
+        out.tension_yield_first = out.tension_Pa * rho_c > sigma1
         if out.tension_yield_first:
             out.notes.append(tension_note(out, rho_c))
     return out

@@ -8,8 +8,8 @@ Expected values are written out here from the codes, not read from the package:
   factor it reaches :math:`f_y/\gamma_{M0}` when the compressed edge carries
   :math:`\sigma_1 f_y/(\gamma_{M0}\sigma_t)`, before :math:`\sigma_1` reaches
   :math:`\rho f_y/\gamma_{M0}` (EN 1993-1-5 4.4(2), 4.6(1)) exactly when
-  :math:`\sigma_t/\sigma_1 > \rho`. The reduction factor is eq. (4.2),
-  :math:`\rho = (\bar\lambda_p - 0.055(3 + \psi))/\bar\lambda_p^2`,
+  :math:`\sigma_1/\sigma_t < \rho`, i.e. :math:`\sigma_t/\sigma_1 > 1/\rho`. The
+  reduction factor is eq. (4.2), :math:`\rho = (\bar\lambda_p - 0.055(3 + \psi))/\bar\lambda_p^2`,
   :math:`\bar\lambda_p = \sqrt{f_y/\sigma_1}`.
 - EN 1993-1-5 Table 4.1 and eq. (4.2) cover :math:`1 \ge \psi \ge -3` only.
 - A strut (a plate with both long edges free, hinged at its loaded ends) buckles at the
@@ -59,7 +59,7 @@ def test_a_plate_s_tension_edge_that_yields_first_governs():
     """At psi = -2 and sigma_1 = 400 MPa the tension edge carries 800 MPa.
 
     By hand: lambda_p = sqrt(355/400) = 0.9421, above 0.5 + sqrt(0.085 + 0.11) = 0.9416,
-    so rho = (0.9421 - 0.055)/0.8875 = 0.9995 (eq. (4.2)); sigma_t/sigma_1 = 2 > rho: the
+    so rho = (0.9421 - 0.055)/0.8875 = 0.9995 (eq. (4.2)); sigma_t/sigma_1 = 2 > 1/rho: the
     tension edge reaches f_y/gamma_M0 = 355/1.1 MPa when sigma_1 = 355/1.1/2 = 161.4 MPa,
     far below rho f_y/gamma_M0 = 322.6 MPa. Before, only 322.6 MPa was given.
     """
@@ -75,7 +75,7 @@ def test_a_plate_s_tension_edge_that_yields_first_governs():
 
 
 def test_a_plate_s_tension_edge_below_rho_does_not_govern():
-    """At psi = -0.5 and sigma_1 = 400 MPa, sigma_t/sigma_1 = 0.5 < rho.
+    """At psi = -0.5 and sigma_1 = 400 MPa, sigma_t/sigma_1 = 0.5 < 1/rho.
 
     lambda_p = 0.9421 above 0.5 + sqrt(0.085 + 0.0275) = 0.8354, so rho = (0.9421 -
     0.1375)/0.8875 = 0.9066 (eq. (4.2)): sigma_1 reaches rho f_y first, tension does not
@@ -94,6 +94,35 @@ def test_a_plate_s_tension_edge_below_rho_does_not_govern():
     uniform = _web(-1.0)
     d = design_output(uniform, uniform.design, 4.0e8)
     assert d.tension_Pa is None and d.tension_yield_first is None
+
+
+@pytest.mark.parametrize(
+    ("pair", "sigma1", "rho"),
+    [
+        # psi = -1: lambda_p = sqrt(355/200) = 1.3323 > 0.5 + sqrt(0.14) = 0.8742, rho =
+        # (1.3323 - 0.11)/1.775 = 0.68861; the tension edge (200 MPa) yields at sigma_1 = f_y
+        # = 355 MPa, above rho f_y = 244.5 MPa: buckling governs, whatever rho < 1.
+        ([-1.0, 1.0], 2.0e8, 0.688615),
+        # psi = -2: lambda_p = sqrt(355/88.75) = 2, rho = (2 - 0.055)/4 = 0.48625; the
+        # tension edge yields at sigma_1 = f_y/2 = 177.5 MPa, above rho f_y = 172.6 MPa.
+        ([-1.0, 2.0], 8.875e7, 0.48625),
+    ],
+)
+def test_a_plate_s_tension_edge_between_rho_and_one_does_not_govern(pair, sigma1, rho):
+    """With rho < sigma_t/sigma_1 < 1/rho, sigma_1 reaches rho f_y/gamma_M0 first (6.2.1(5)).
+
+    The comparison is of sigma_1 at tension yield, f_y sigma_1/sigma_t, with rho f_y;
+    sigma_t/sigma_1 > rho alone called yield first here, with a sigma_1 at yield above
+    rho f_y/gamma_M0 (unsafe: it is not a stress the element carries).
+    """
+    spec = _web(pair)
+    d = design_output(spec, spec.design, sigma1)
+    assert d.reduction_factor == pytest.approx(rho, abs=1e-6)
+    ratio = d.tension_Pa / d.sigma_cr_Pa
+    assert d.reduction_factor < ratio < 1.0 / d.reduction_factor
+    assert d.sigma_1_at_tension_yield_Pa > d.reduction_factor * FY
+    assert d.tension_yield_first is False
+    assert not any("yields first" in n for n in d.notes)
 
 
 def test_the_summary_says_the_tension_edge_yields_first():
