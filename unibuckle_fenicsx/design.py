@@ -67,6 +67,7 @@ from unibuckle_fenicsx.en1993 import (
     design_element,
     plate_euler_stress,
     psi_range,
+    ratio_text,
     reduction_factor,
     steel_poisson_note,
     stress_ratio,
@@ -283,16 +284,18 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
             "the element is the rectangle's, and sigma_cr (computed with the holes) "
             "includes their effect"
         )
-    if spec.one_sided_points or spec.unilateral_obstacles:
-        out.notes.append(
-            "with an obstacle sigma_cr is the unilateral critical stress: outside the "
-            "calibration of 4.4(2)"
-        )
-    elif spec.bilateral_foundations:
-        out.notes.append(
-            'with a bilateral foundation (obstacle.side = "both") sigma_cr includes the '
-            "foundation's stiffness: outside the calibration of 4.4(2)"
-        )
+    foundation = 'a bilateral foundation (obstacle.side = "both")'
+    unilateral = "sigma_cr is the unilateral critical stress"
+    restrained = {
+        (True, False): f"with an obstacle {unilateral}",
+        (False, True): f"with {foundation} sigma_cr includes the foundation's stiffness",
+        (True, True): f"with an obstacle and {foundation} {unilateral} and includes the "
+        "foundation's stiffness",
+    }.get(
+        (bool(spec.one_sided_points or spec.unilateral_obstacles), bool(spec.bilateral_foundations))
+    )
+    if restrained is not None:
+        out.notes.append(f"{restrained}: outside the calibration of 4.4(2)")
     if any(p.kind != "one-sided" for p in spec.points):
         out.notes.append(
             "with point restraints (points: bilateral ties or springs) sigma_cr includes "
@@ -328,7 +331,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.k_sigma = sigma1 / sigma_e
     low, _ = psi_range(element.kind, at_free)
     if psi < low:  # only with a fixed part: a scaled one alone is refused beforehand
-        out.notes.append(f"psi = {psi:.3g} < {low:g}: outside {out.table}, no rho")
+        out.notes.append(f"psi = {ratio_text(psi)} < {low:g}: outside {out.table}, no rho")
         return out
     psi = min(psi, 1.0)
     out.k_sigma_table = buckling_factor(element.kind, psi, at_free)
@@ -341,11 +344,11 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
         # sigma_1 f_y/(gamma_M0 sigma_t) < rho f_y/gamma_M0: sigma_t/sigma_1 > 1/rho
         out.tension_yield_first = out.tension_Pa * rho_c > sigma1
         if out.tension_yield_first:
-            out.notes.append(tension_note(out, rho_c))
+            out.notes.append(_tension_note(out, rho_c))
     return out
 
 
-def tension_note(out: DesignRecord, rho: float) -> str:
+def _tension_note(out: DesignRecord, rho: float) -> str:
     """The note that the tension edge yields before sigma_1 reaches rho f_y/gamma_M0."""
     return (
         f"the tension edge yields first (EN 1993-1-1 6.2.1(5)): its {significant(out.tension_Pa)} "
@@ -375,11 +378,12 @@ def _column_type(
     if aspect >= 1.0:
         xi = sigma1 / column - 1.0 if column > 0.0 else math.inf
         out.notes.append(
-            f"column-type buckling (EN 1993-1-5 4.5.4) not applied: a/b = {aspect:.3g} >= 1, "
-            "and the note of 4.4(2) asks for it below 1; rho is the plate-type"
+            "column-type buckling (EN 1993-1-5 4.5.4) not applied: a/b = "
+            f"{ratio_text(aspect)} >= 1, and the note of 4.4(2) asks for it below 1; rho is "
+            "the plate-type"
             + (
                 f" (the plate as a column, {ends}, would buckle at sigma_cr,c = "
-                f"{significant(column)} Pa: xi = sigma_cr/sigma_cr,c - 1 = {xi:.3g} < 1, "
+                f"{significant(column)} Pa: xi = sigma_cr/sigma_cr,c - 1 = {ratio_text(xi)} < 1, "
                 "so column-like behaviour is not excluded)"
                 if xi < 1.0
                 else ""
@@ -401,15 +405,15 @@ def _column_type(
     if out.xi < 1.0:
         out.notes.append(
             f"column-type buckling (EN 1993-1-5 4.5.4(1)): xi = sigma_cr/sigma_cr,c - 1 = "
-            f"{reduced.xi:.3g} < 1, rho_c = {significant(rho_c)} between the plate's rho = "
+            f"{ratio_text(reduced.xi)} < 1, rho_c = {significant(rho_c)} between the plate's rho = "
             f"{significant(rho)} and the column's chi_c = {significant(chi)} (sigma_cr,c: the "
             f"plate as a column, {ends})"
         )
     else:
         out.notes.append(
             f"column-type buckling (EN 1993-1-5 4.5.4(1)): sigma_cr/sigma_cr,c - 1 = "
-            f"{reduced.xi:.3g} >= 1, xi = 1, rho_c = rho (sigma_cr,c: the plate as a column, "
-            f"{ends})"
+            f"{ratio_text(reduced.xi)} >= 1, xi = 1, rho_c = rho (sigma_cr,c: the plate as a "
+            f"column, {ends})"
         )
     return rho_c
 

@@ -62,6 +62,7 @@ __all__ = [
     "interpolated_reduction_factor",
     "plate_euler_stress",
     "psi_range",
+    "ratio_text",
     "reduction_factor",
     "steel_poisson_note",
     "stress_ratio",
@@ -195,9 +196,33 @@ def stress_ratio(sigma1: float, sigma2: float) -> float:
     off one (``[-0.7, 2.1]`` gives -3.0000000000000004) is that number, not outside the
     table.
     """
-    psi = sigma2 / sigma1 + 0.0  # no -0.0
-    whole = float(round(psi))
-    return whole + 0.0 if abs(psi - whole) <= 1e-12 * max(1.0, abs(psi)) else psi
+    return _whole(sigma2 / sigma1)
+
+
+def _whole(ratio: float) -> float:
+    """``ratio``, or the whole number within 1e-12 (relative, above 1) of it; no -0.0."""
+    whole = float(round(ratio))
+    return (whole if abs(ratio - whole) <= 1e-12 * max(1.0, abs(ratio)) else ratio) + 0.0
+
+
+def ratio_text(value: float | None, digits: int = 3) -> str:
+    r"""A ratio (:math:`\psi`, :math:`\xi`, a/b) to ``digits`` significant digits, or more.
+
+    The tables' rows and the clauses' bounds lie at whole numbers (:math:`\psi` = 1, 0,
+    -1, -3; :math:`\xi` = 0, 1; a/b = 1): a ratio that is not one is printed with the
+    digits that show it, so that the row or branch taken is visible (:math:`\psi` =
+    -0.9996 is in Table 4.1's row 0 > psi > -1: "-0.9996", not "-1"); one within 1e-12
+    of a whole number is that number, as in :func:`stress_ratio` (a/b = 0.6/0.2 =
+    2.9999999999999996 prints "3"). "none" for None.
+    """
+    if value is None:
+        return "none"
+    value = _whole(value)
+    for n in range(digits, 18):
+        text = f"{value:.{n}g}"
+        if value == round(value) or float(text) != round(float(text)):
+            return text
+    return repr(value)
 
 
 def _check(element: str, psi: float, free_edge_most_compressed: bool) -> None:
@@ -716,6 +741,6 @@ def _check_stress_ratio(loaded: list[DesignEdge], element: DesignElement) -> Non
     if psi < low:
         raise InputError(
             f"design: edges.{name}.normal_stress gives the stress ratio psi = sigma_2/sigma_1 "
-            f"= {psi:.4g}, outside EN 1993-1-5 {table_row(element.kind, at_free)}, which "
-            f"covers 1 >= psi >= {low:g}: leave [design] out or change the stress gradient"
+            f"= {ratio_text(psi, 4)}, outside EN 1993-1-5 {table_row(element.kind, at_free)}, "
+            f"which covers 1 >= psi >= {low:g}: leave [design] out or change the stress gradient"
         )

@@ -59,6 +59,7 @@ from unibuckle_fenicsx.en1993 import (
     column_type,
     plate_euler_stress,
     psi_range,
+    ratio_text,
     reduction_factor,
     stress_ratio,
 )
@@ -370,7 +371,7 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
                 "column-type buckling (EN 1993-1-5 4.4(2) note, 4.5.4(1)): the section's "
                 "length is below the width of face(s) "
                 + ", ".join(
-                    f"{f.face} (xi = {f.xi:.3g}, rho_c = {significant(f.reduction_factor)})"
+                    f"{f.face} (xi = {ratio_text(f.xi)}, rho_c = {significant(f.reduction_factor)})"
                     for f in column
                 )
                 + "; sigma_cr,c: the face as a column between the section's ends "
@@ -389,7 +390,7 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         if off_table:
             out.faces_outside_table = [f.face for f in off_table]
             out.notes.append(
-                f"face(s) {', '.join(f'{f.face} (psi = {f.psi:.3g})' for f in off_table)}: "
+                f"face(s) {', '.join(f'{f.face} (psi = {ratio_text(f.psi)})' for f in off_table)}: "
                 f"psi < {low:g}, outside EN 1993-1-5 Table 4.1 (1 >= psi >= {low:g}; eq. "
                 "(4.2) likewise): no k_sigma or rho is given for them, and they are left out "
                 "of the governing face; their compressed width b/(1 - psi) is checked by no "
@@ -529,11 +530,11 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
             rho = (
                 f"rho_c = {significant(face.reduction_factor)} (column-type, EN 1993-1-5 4.5.4: "
                 f"plate {significant(face.plate_reduction_factor)}, chi_c "
-                f"{significant(face.column_reduction_factor)}, xi {face.xi:.3g})"
+                f"{significant(face.column_reduction_factor)}, xi {ratio_text(face.xi)})"
             )
         column = ", rho_c 4.5.4(1)" if face.xi is not None and face.xi < 1.0 else ""
         text += (
-            f"; EN 1993-1-5 {_governing(d)}: psi = {face.psi:.3g}, {rho}, "
+            f"; EN 1993-1-5 {_governing(d)}: psi = {ratio_text(face.psi)}, {rho}, "
             f"rho f_y/gamma_M0 = {significant(reduced / scale)} {unit} (psi Table 4.1, "
             f"slenderness 4.4(2), rho 4.4(2) eq. (4.2){column}, rho f_y/gamma_M0 4.6(1))"
         )

@@ -512,6 +512,30 @@ def test_a_bilateral_foundation_is_not_called_unilateral():
         assert side != "both" or not any("unilateral" in n for n in notes), notes
 
 
+def test_an_obstacle_and_a_bilateral_foundation_are_both_noted():
+    """A rigid obstacle on part of the plate, a foundation on both sides over the rest.
+
+    sigma_cr is then unilateral (the obstacle's cone) and includes the foundation's
+    springs: the note says both, not the obstacle alone.
+    """
+    from unibuckle_fenicsx.design import design_output
+
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    spec = plate(
+        edges,
+        obstacles=[
+            {"zone": [[0, 300], [0, 200]], "side": "below"},
+            {"zone": [[400, 600], [0, 200]], "side": "both", "foundation_stiffness": 1e-3},
+        ],
+    )
+    assert spec.design is not None
+    notes = [n for n in design_output(spec, spec.design, 100.0).notes if "4.4(2)" in n]
+    said = [n for n in notes if "unilateral" in n or "foundation" in n]
+    assert len(said) == 1, notes
+    assert "unilateral critical stress" in said[0], said
+    assert 'bilateral foundation (obstacle.side = "both")' in said[0], said
+
+
 def test_an_obstacle_with_a_gap_is_not_called_unilateral():
     """An obstacle with a gap leaves sigma_cr the free plate's: no unilateral note.
 
@@ -911,3 +935,45 @@ def test_the_summary_keeps_four_significant_digits_in_pa():
     assert mantissa is not None and len(mantissa[1]) == 5, line  # d.ddd: four digits
     assert significant(2.000149e8) == "2.000e+08" and significant(1234.4) == "1234"
     assert significant(0.45) == "0.4500" and significant(355.0) == "355.0"
+
+
+def test_a_ratio_beside_a_row_boundary_prints_the_digits_that_show_its_row():
+    """A stress ratio psi = -0.9996 is in Table 4.1's row 0 > psi > -1, not at psi = -1.
+
+    That row's k_sigma = 7.81 - 6.29 psi + 9.78 psi^2 = 23.8697 (EN 1993-1-5 Table 4.1),
+    not the -1 column's 23.9; the summary printed "psi = -1" (three significant
+    digits) while the middle row was used. Likewise xi = 0.9996 < 1 interpolates
+    (4.5.4(1)), where xi = 1 is rho itself: the note printed "xi = ... = 1 < 1".
+    """
+    from unibuckle_fenicsx.design import design_output
+
+    pair = [-1.0, 0.9996]
+    hinged = {"support": "simply_supported"}
+    spec = problem_from_dict(
+        {
+            "plate": {"corners": [[0, 0], [0.6, 0.2]], "thickness": 0.01},
+            "material": {"E": 2.1e11, "nu": 0.3},
+            "edges": {
+                "left": {**hinged, "normal_stress": pair},
+                "right": {**hinged, "normal_stress": pair},
+                "bottom": hinged,
+                "top": hinged,
+            },
+            "mesh": {"nx": 6, "ny": 2},
+            "design": {"yield_stress": 3.55e8, "partial_factor": 1.0},
+        }
+    )
+    out = result(spec)
+    psi = -0.9996
+    assert out.design.psi == pytest.approx(psi, rel=1e-12)
+    assert out.design.k_sigma_table == pytest.approx(7.81 - 6.29 * psi + 9.78 * psi**2, 1e-12)
+    line = next(s for s in out.summary().splitlines() if "EN 1993-1-5: " in s)
+    assert "psi = -0.9996, " in line, line
+    # A short plate (a/b = 0.5) at sigma_cr = 1.9996 sigma_cr,c: xi = 0.9996.
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    short = plate(edges, plate={"corners": [[0, 0], [100, 200]], "thickness": 4.0})
+    column = math.pi**2 * 210000e6 * (4.0 / 100.0) ** 2 / (12 * (1 - 0.3**2))  # eq. (4.8)
+    assert short.design is not None
+    d = design_output(short, short.design, 1.9996 * column)
+    assert d.xi == pytest.approx(0.9996, rel=1e-9) and d.reduction_factor < d.plate_reduction_factor
+    assert any("sigma_cr/sigma_cr,c - 1 = 0.9996 < 1" in n for n in d.notes), d.notes

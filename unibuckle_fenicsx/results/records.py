@@ -19,6 +19,7 @@ from msgspec import UNSET, Struct, UnsetType, to_builtins
 from unibuckle_fenicsx.algorithms.records import ContinuedRecord, MethodDetails
 from unibuckle_fenicsx.certificate.records import CopositivityRecord, SplitRecord
 from unibuckle_fenicsx.design import DesignRecord, significant
+from unibuckle_fenicsx.en1993 import ratio_text
 from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
 from unibuckle_fenicsx.section_design import SectionDesignRecord
@@ -476,15 +477,15 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
     if d.xi is not None and d.xi < 1.0:
         column = (
             f" (column-type: plate {significant(d.plate_reduction_factor)}, chi_c "
-            f"{significant(d.column_reduction_factor)}, xi {d.xi:.3g})"
+            f"{significant(d.column_reduction_factor)}, xi {ratio_text(d.xi)})"
         )
     elif d.xi is not None:
-        column = f" (column-type: xi {d.xi:.3g}, the plate's)"
+        column = f" (column-type: xi {ratio_text(d.xi)}, the plate's)"
     elif d.column_critical_stress_Pa == 0.0:
         column = " (column-type: none, the column a mechanism; the plate's)"
     return (
         f"EN 1993-1-5: sigma_cr = {significant(d.sigma_cr_Pa / scale)} {unit} ({d.edge}), "
-        f"psi = {d.psi:.3g}, slenderness {significant(d.relative_slenderness)}, rho = "
+        f"psi = {ratio_text(d.psi)}, slenderness {significant(d.relative_slenderness)}, rho = "
         + (
             f"{significant(rho)}"
             + column
