@@ -67,7 +67,7 @@ import os
 import re
 import time
 import tomllib
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -645,6 +645,8 @@ def run_sweep(
     *,
     ranks_per_point: int = 1,
     progress: bool = True,
+    check: Callable[[list[dict[str, float]], list[ProblemSpec | SectionProblemSpec]], None]
+    | None = None,
 ) -> list[dict[str, object]]:
     """Solve every point of the grid of ``variations`` and write ``out`` (JSON lines).
 
@@ -656,6 +658,9 @@ def run_sweep(
         ranks_per_point: Ranks of each point's mesh, >= 1, dividing ``comm.size``.
         progress: Show a progress bar (tqdm, the 'progress' extra) or progress lines,
             on rank 0.
+        check: Called once, on every rank, with the grid's points and their problems
+            (each point read once) before anything is solved: the command line's
+            warnings on them.
 
     Returns:
         The lines of the whole sweep in point order (on every rank).
@@ -670,6 +675,8 @@ def run_sweep(
     _check_ranks(ranks_per_point, comm)
     points = sweep_points(variations)
     specs = [point_problem(base, p) for p in points]  # every point checked before solving
+    if check is not None:
+        check(points, specs)
     path = Path(out)
     done, stale = _resume(path, points, specs, comm)
     todo = [k for k in range(len(points)) if k not in done]

@@ -30,22 +30,21 @@ def _check_chart(base: Any) -> None:
         )
 
 
-def _warn_coarse_points(base: Any, variations: Any, comm: Any) -> None:
+def _warn_coarse_points(points: list[Any], specs: list[Any], comm: Any) -> None:
     """One warning on stderr, before any solve, when some plate points' cells are too coarse.
 
     The note of the first such point (``unibuckle solve``'s warning), and how many there
-    are; a section's cells are checked by its solve (the point's JSON line).
+    are; a section's cells are checked by its solve (the point's JSON line). ``points``
+    and their problems ``specs`` are those :func:`~unibuckle_fenicsx.sweep.run_sweep`
+    read (its ``check``).
     """
     import sys
 
     from unibuckle_fenicsx.spec.checks import coarse_mesh_note
     from unibuckle_fenicsx.spec.section import SectionProblemSpec
-    from unibuckle_fenicsx.sweep import point_problem, sweep_points
 
     coarse = []
-    points = sweep_points(variations)
-    for k, point in enumerate(points):
-        spec = point_problem(base, point)
+    for k, (point, spec) in enumerate(zip(points, specs, strict=True)):
         if not isinstance(spec, SectionProblemSpec):
             note = coarse_mesh_note(spec.plate, spec.mesh, spec.units)
             if note is not None:
@@ -182,7 +181,6 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
         base = load_config(args.config, base_mapping)
         if args.plot:
             _check_chart(base)
-        _warn_coarse_points(base, variations, comm)
         lines = run_sweep(
             base,
             variations,
@@ -190,6 +188,7 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
             comm,
             ranks_per_point=args.ranks_per_point,
             progress=not args.quiet,
+            check=lambda points, specs: _warn_coarse_points(points, specs, comm),
         )
     except OSError as err:  # a refused input or a failed point raises: main() tells
         return fail(str(err))

@@ -575,6 +575,30 @@ def test_a_sweep_warns_once_of_its_points_too_coarse(tmp_path, capsys):
     assert "mesh.nx = 8, mesh.ny = 2: cells up to 0.05 m" in err, err
 
 
+def test_a_sweep_reads_each_of_its_points_once(tmp_path, capsys, monkeypatch):
+    """Two points, two problems read: the coarse-cell warning uses the sweep's own.
+
+    The warning read every point's problem, and the sweep read them all again.
+    """
+    import unibuckle_fenicsx.sweep as sweep
+
+    read = []
+
+    def counted(data, name):
+        read.append(name)
+        return spec_from_dict(data, name)
+
+    spec_from_dict = sweep.spec_from_dict
+    monkeypatch.setattr(sweep, "spec_from_dict", counted)
+    config = tmp_path / "coarse.toml"
+    config.write_text(SMALL.replace("nx = 8\nny = 4", "nx = 8\nny = 2"))
+    out = tmp_path / "k.jsonl"
+    args = ["sweep", "--config", str(config), "--vary", "plate.thickness=0.005:0.006:2"]
+    assert main([*args, "--json", str(out), "-q"]) == EXIT_OK
+    assert len(read) == 2, read  # the grid's two points
+    assert "2 of 2 sweep points have cells too coarse" in capsys.readouterr().err
+
+
 @pytest.mark.parametrize(("nu", "warned"), [(-0.2, True), (0.3, False)])
 def test_solve_warns_of_a_design_poisson_s_ratio_not_a_steel_s(tmp_path, capsys, nu, warned):
     """[design] with nu = -0.2 ran without a word; EN 1993-1-1 3.2.6 gives steel nu = 0.3."""
