@@ -131,9 +131,12 @@ def choose_section_method(parameters: SectionParameters, solver: SolverSpec) -> 
     KKT point (its route then takes the link "active-set").
 
     Raises:
-        InputError: A method no section runs (``solver.method``, the allowed named).
+        InputError: A method no section runs, or one other than "auto" without a rigid
+            core (``solver.method``, the allowed named).
     """
-    check_section_method(solver.method)
+    check_section_method(
+        solver.method, parameters.core, parameters.foundation_stiffness is not None
+    )
     if not parameters.core:
         return FREE, "no core"
     if parameters.foundation_stiffness is not None:

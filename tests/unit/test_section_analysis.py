@@ -31,6 +31,11 @@ E, NU, T = 2.1e11, 0.3, 0.002
 D = E * T**3 / (12.0 * (1.0 - NU**2))
 
 
+def _tube(**changes):
+    base = {"diameter": 0.2, "thickness": T, "length": 0.2, "E": E, "nu": NU, "mesh_size": 0.02}
+    return SectionParameters("tube", **{**base, **changes})
+
+
 def _box(**changes):
     base = {
         "width": 0.2, "depth": 0.1, "thickness": T, "length": 0.2, "E": E, "nu": NU,
@@ -91,6 +96,14 @@ def test_tube_without_a_core_is_its_free_load():
         (lambda: _box(diameter=0.2), InputError, "section.diameter"),
         (lambda: _box(core=False, core_span=(0.0, 0.1)), InputError, "core_span"),
         (lambda: _box(thickness=0.05), InputError, "section.thickness"),
+        # corner_cell grades a box's faces: a tube has no corners, and cells no finer
+        # than mesh_size at the corners are the uniform mesh (either would be ignored).
+        (
+            lambda: _tube(corner_cell=0.005),
+            InputError,
+            "corner_cell = 0.005 grades a box's faces at its corners; a tube has no corners",
+        ),
+        (lambda: _box(corner_cell=0.1), InputError, r"corner_cell = 0.1 m must be < mesh_size"),
     ],
 )
 def test_bad_section_input_is_refused_before_any_mesh(call, error, words):

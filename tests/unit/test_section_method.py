@@ -320,3 +320,33 @@ def test_a_sections_eigensolves_count_the_penalty_continuations(method, monkeypa
         result = solved.result
     assert len(penalty) == 1 and penalty[0] > 0
     assert result.eigensolves == before_certificate[0] + penalty[0]
+
+
+@pytest.mark.parametrize("method", ["interior-point", "active-set"])
+@pytest.mark.parametrize(
+    ("changes", "which"),
+    [({"core": False}, "without a core"), ({"foundation_stiffness": 1e9}, "an elastic core")],
+)
+def test_a_rigid_cores_method_without_one_is_refused_naming_the_key(
+    method, changes, which, tmp_path, capsys
+):
+    # A hollow section has one route (its free solve), an elastic core one (the
+    # spring-set iteration): a route named for them would be ignored, so it is refused
+    # before any mesh, in the API, in a file and on the command line (exit status 2).
+    box = _square_box(0.1, 0.3, 0.0125, **changes)
+    refused = f"solver.method = '{method}' chooses a rigid core's route; .*{which}"
+    with pytest.raises(InputError, match=refused):
+        choose_section_method(box, SolverSpec(method=method))
+    with pytest.raises(InputError, match=refused):
+        solve_section(box, solver=SolverSpec(method=method))
+    obstacle = {"core": True, "foundation_stiffness": 1e9} if changes.get("core", True) else {}
+    file = {**FILE, "obstacle": obstacle}
+    with pytest.raises(InputError, match=refused):
+        section_from_dict({**file, "solver": {"method": method}})
+    path = tmp_path / "box.json"
+    path.write_text(json.dumps(file))
+    capsys.readouterr()
+    assert main(["solve", "--config", str(path), "--method", method]) == EXIT_BAD_INPUT
+    assert "solver.method" in capsys.readouterr().err
+    # "auto" (the default) stays accepted.
+    assert choose_section_method(box, SolverSpec())[0] in ("free", "foundation")

@@ -243,8 +243,9 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "The problem is a plate (a paper case or a TOML file) or a section: a file with a\n"
         "[section] table (a box or a tube, with a core or hollow), solved on its [mesh]\n"
         "size and levels. Of the solver's flags a section takes --method (auto,\n"
-        "interior-point or active-set), --tau and --max-iterations; the others, and --nx,\n"
-        "--ny, --output and --candidate-parallel, are a plate's (refused: exit status 2).",
+        "interior-point or active-set: the last two with a rigid core only), --tau and\n"
+        "--max-iterations; the others, and --nx, --ny, --output and --candidate-parallel,\n"
+        "are a plate's (refused: exit status 2).",
         epilog=EPILOG,
         formatter_class=Formatter,
     )

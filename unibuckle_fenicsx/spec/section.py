@@ -30,17 +30,35 @@ SOLVER_KEYS = ("method", "tau", "eps_tol", "max_iterations")
 SECTION_METHODS: tuple[Method, ...] = (Method.AUTO, Method.INTERIOR_POINT, Method.ACTIVE_SET)
 
 
-def check_section_method(method: str) -> None:
-    """Refuse a ``[solver] method`` no section runs (one of :data:`SECTION_METHODS` runs).
+def check_section_method(method: str, core: bool = True, elastic: bool = False) -> None:
+    """Refuse a ``[solver] method`` no section runs, or one this section would not run.
+
+    One of :data:`SECTION_METHODS` runs a rigid core's search; a hollow section
+    (``core`` false: the free solve) and an elastic core (``elastic``: the spring-set
+    iteration) have one route each, so only "auto" is taken there (a method named for
+    them would be ignored).
 
     Raises:
-        FieldError: ``method`` is not one of :data:`SECTION_METHODS` (an
-            :class:`~unibuckle_fenicsx.errors.InputError` naming ``solver.method``).
+        FieldError: ``method`` is not one of :data:`SECTION_METHODS`, or is not "auto"
+            without a rigid core (an :class:`~unibuckle_fenicsx.errors.InputError`
+            naming ``solver.method``).
     """
     if method not in SECTION_METHODS:
         allowed = ", ".join(f'"{m}"' for m in SECTION_METHODS)
         raise FieldError(
             "", "solver.method", f" must be one of {allowed} for a section, got {str(method)!r}"
+        )
+    if method != Method.AUTO and (not core or elastic):
+        which = (
+            "a section without a core (its free solve)"
+            if not core
+            else "an elastic core (obstacle.foundation_stiffness: its spring-set iteration)"
+        )
+        raise FieldError(
+            "",
+            "solver.method",
+            f" = {str(method)!r} chooses a rigid core's route; {which} has one route: "
+            'leave it out or give "auto"',
         )
 
 
@@ -230,7 +248,9 @@ class SectionProblemSpec(Table, frozen=True):
                 f" must satisfy 0 <= x0 < x1 <= section.length = {L:g} {name}, "
                 f"got [{x0:g}, {x1:g}]",
             )
-        check_section_method(self.solver.method)
+        check_section_method(
+            self.solver.method, self.obstacle.core, self.obstacle.foundation_stiffness is not None
+        )
         if self.design is not None:
             check_steel_modulus(self.material.E, *UNITS[self.units][1:])
             check_steel_yield_stress(self.design.yield_stress, *UNITS[self.units][1:])

@@ -105,7 +105,8 @@ class SectionParameters:
         drilling: Drilling stiffness relative to Gt
             (:data:`~unibuckle_fenicsx.model.shell.forms.DRILLING_FACTOR`).
         corner_cell: A box's faces graded to cells this wide (m) at the corners
-            (:func:`~unibuckle_fenicsx.model.shell.geometry.box_mesh`); None: uniform.
+            (:func:`~unibuckle_fenicsx.model.shell.geometry.box_mesh`), > 0 and below
+            ``mesh_size``; None: uniform. Not for a tube.
     """
 
     shape: str
@@ -139,7 +140,18 @@ class SectionParameters:
         _positive("mesh_size", self.mesh_size)
         check_cells_along(self.mesh_size, self.length)
         if self.corner_cell is not None:
+            if self.shape != "box":
+                raise InputError(
+                    f"corner_cell = {self.corner_cell!r} grades a box's faces at its corners; "
+                    "a tube has no corners (its facets are uniform): leave it None"
+                )
             _positive("corner_cell", self.corner_cell)
+            if self.corner_cell >= self.mesh_size:
+                raise InputError(
+                    f"corner_cell = {self.corner_cell:g} m must be < mesh_size = "
+                    f"{self.mesh_size:g} m (cells no finer at the corners are the uniform "
+                    "mesh's): leave it None for uniform cells"
+                )
         if not (isinstance(self.E, int | float) and math.isfinite(self.E) and self.E > 0):
             raise InputError(f"material.E must be a finite number > 0 (Pa), got {self.E!r}")
         if not (isinstance(self.nu, int | float) and -1.0 < self.nu < 0.5):
