@@ -23,6 +23,7 @@ from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
 from unibuckle_fenicsx.algorithms.registry import FOUNDATION, entry
 from unibuckle_fenicsx.algorithms.section_levels import (
     BOTH,
+    CHECKED,
     INTERIOR_POINT_DOFS,
     estimated_dofs,
 )
@@ -121,7 +122,8 @@ def choose_section_method(parameters: SectionParameters, solver: SolverSpec) -> 
     core runs the spring-set iteration (:data:`~.algorithms.registry.FOUNDATION`), as a
     plate's tensionless foundation does. A rigid core runs the ``[solver] method`` given,
     one of :data:`~unibuckle_fenicsx.spec.section.SECTION_METHODS`; "auto" runs the
-    interior point on sections of at least
+    interior point, checked by the active set's seeds on its coarsest section
+    (:data:`~unibuckle_fenicsx.algorithms.section_levels.CHECKED`), on sections of at least
     :data:`~unibuckle_fenicsx.algorithms.section_levels.INTERIOR_POINT_DOFS` degrees of
     freedom, estimated before meshing
     (:func:`~unibuckle_fenicsx.algorithms.section_levels.estimated_dofs`), and on smaller
@@ -145,9 +147,10 @@ def choose_section_method(parameters: SectionParameters, solver: SolverSpec) -> 
         return solver.method, "given"
     dofs = estimated_dofs(parameters)
     if dofs >= INTERIOR_POINT_DOFS:
-        return Method.INTERIOR_POINT, (
+        return CHECKED, (
             f"auto: about {dofs} DOFs (estimated before meshing) >= "
-            f"INTERIOR_POINT_DOFS = {INTERIOR_POINT_DOFS}"
+            f"INTERIOR_POINT_DOFS = {INTERIOR_POINT_DOFS}: the interior point, checked by "
+            "the active set's seeds on its coarsest section, the lower KKT point kept"
         )
     return BOTH, (
         f"auto: about {dofs} DOFs (estimated before meshing) < INTERIOR_POINT_DOFS = "

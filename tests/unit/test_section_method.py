@@ -4,7 +4,8 @@
 (``docs/verification/sections.md``, "Cost"): without a core the free load, with an
 elastic core the spring-set iteration, with a rigid core the ``[solver] method`` given,
 "auto" taking the interior point on sections of at least ``INTERIOR_POINT_DOFS`` = 10^4
-DOFs and both routes on smaller ones, the lower KKT point kept. The expected DOFs are
+DOFs, checked by the active set's seeds on its coarsest section, and both routes on
+smaller ones, the lower KKT point kept. The expected DOFs are
 worked out here by hand: a box of square faces b on uniform cells h has 4 b/h nodes
 around, L/h + 1 along and six DOFs per node (the demo's box: 6 x 32 x 25 = 4 800; the
 box b/16 of the Cost table: 6 x 64 x 49 = 18 816). A method given in a file runs that
@@ -47,7 +48,7 @@ def _dofs(b, length, h):
     return 6 * round(4 * b / h) * (round(length / h) + 1)
 
 
-def test_auto_takes_the_interior_point_from_ten_thousand_dofs():
+def test_auto_takes_the_checked_interior_point_from_ten_thousand_dofs():
     small, large = _square_box(0.1, 0.3, 0.0125), _square_box(0.2, 0.6, 0.0125)
     assert (_dofs(0.1, 0.3, 0.0125), _dofs(0.2, 0.6, 0.0125)) == (4800, 18816)
     auto = SolverSpec()
@@ -57,8 +58,10 @@ def test_auto_takes_the_interior_point_from_ten_thousand_dofs():
         "the interior point and the active set, the lower KKT point kept",
     )
     assert choose_section_method(large, auto) == (
-        "interior-point",
-        "auto: about 18816 DOFs (estimated before meshing) >= INTERIOR_POINT_DOFS = 10000",
+        "interior-point+seeds",
+        "auto: about 18816 DOFs (estimated before meshing) >= INTERIOR_POINT_DOFS = 10000: "
+        "the interior point, checked by the active set's seeds on its coarsest section, "
+        "the lower KKT point kept",
     )
 
 
@@ -66,7 +69,7 @@ def test_auto_counts_a_section_of_exactly_the_threshold_as_large(monkeypatch):
     # "at least INTERIOR_POINT_DOFS": a threshold equal to the section's DOFs.
     monkeypatch.setattr(analysis, "INTERIOR_POINT_DOFS", 4800)
     method, _ = choose_section_method(_square_box(0.1, 0.3, 0.0125), SolverSpec())
-    assert method == "interior-point"
+    assert method == "interior-point+seeds"
 
 
 def test_a_given_method_runs_whatever_the_size():
@@ -350,3 +353,94 @@ def test_a_rigid_cores_method_without_one_is_refused_naming_the_key(
     assert "solver.method" in capsys.readouterr().err
     # "auto" (the default) stays accepted.
     assert choose_section_method(box, SolverSpec())[0] in ("free", "foundation")
+
+
+def _box_admissible_rayleigh_quotient(analysis, width, depth) -> tuple[float, float]:
+    """The box's :func:`_admissible_rayleigh_quotient`: each face's inward part removed.
+
+    A wall node on the face y = +b/2 may only move to +y, on y = -b/2 to -y, and so on
+    for z (a corner node both ways): the translation's component into the core is set
+    to zero wherever it points inward, and the Rayleigh quotient of the result on the
+    assembled A and B is an upper bound on the critical load.
+    """
+    import numpy as np
+    import scipy.sparse as sp
+
+    model = analysis.section.model
+    u = analysis.mode.x.array.copy().reshape(-1, 6)
+    X = model.W.tabulate_dof_coordinates()
+    scale = float(np.abs(u[:, :3]).max())
+    removed = 0.0
+    for axis, half in ((1, 0.5 * width), (2, 0.5 * depth)):
+        for side in (1.0, -1.0):
+            on = np.abs(X[:, axis] - side * half) < 1e-9
+            inward = np.maximum(-side * u[on, axis], 0.0)
+            removed = max(removed, float(inward.max(initial=0.0)) / scale)
+            u[on, axis] += side * inward
+    vec = u.ravel()
+
+    def dense(mat):
+        indptr, indices, values = mat.getValuesCSR()
+        return sp.csr_matrix((values, indices, indptr), shape=mat.getSize())
+
+    A, B = dense(model.A), dense(model.B)
+    curvature = vec @ (B @ vec)
+    assert curvature > 0.0
+    return float(vec @ (A @ vec) / curvature), removed
+
+
+#: A small clamped square box with a core (b = 0.1 m, t = 2 mm, L = 0.2 m, 25 mm
+#: cells: 6 x 16 x 9 = 864 DOFs).
+CLAMPED_BOX = {"ends": "clamped"}
+
+
+def test_auto_on_a_large_section_ends_no_higher_than_the_active_sets_mode(monkeypatch):
+    """The default method from 10^4 DOFs is not above the active set's admissible mode.
+
+    At INTERIOR_POINT_DOFS and more "auto" ran the interior point alone. Its starts can
+    settle in a higher arrangement than the active set's seeds: on the clamped box
+    b = d = 0.1 m, t = 2 mm, L = 0.2 m on 6.25 mm cells (12 672 DOFs, ``levels = 1``)
+    it ended at 7.1143e8 Pa, the active set at 7.1060e8 Pa (1.2e-3 lower;
+    ``test_auto_on_a_clamped_box_of_twelve_thousand_dofs``). The same happens on the
+    small box on 25 mm cells solved on its own cells (``levels = 0``): 8.9768e8 against
+    8.9575e8 Pa; the threshold is lowered here so that "auto" takes its large-section
+    route on it. The reference is independent of the interior point: the active set's
+    mode made admissible by hand and its Rayleigh quotient on the assembled matrices
+    (_box_admissible_rayleigh_quotient), an upper bound on the critical load.
+    """
+    box = _square_box(0.1, 0.2, 0.025, **CLAMPED_BOX)
+    given = SolverSpec(method="active-set")
+    with solve_section(box, MPI.COMM_SELF, levels=0, solver=given) as seeded:
+        bound, removed = _box_admissible_rayleigh_quotient(seeded, 0.1, 0.1)
+        assert seeded.result.certificate.kkt
+        assert removed < 1e-6  # the mode was admissible to the tolerance already
+        assert seeded.result.dofs == 864
+    assert bound == pytest.approx(8.9575e8, rel=1e-4)
+    monkeypatch.setattr(analysis, "INTERIOR_POINT_DOFS", 500)
+    with solve_section(box, MPI.COMM_SELF, levels=0) as solved:  # "auto"
+        result = solved.result
+        assert result.method_chosen_by.startswith("auto: about 864 DOFs")
+        assert result.certificate.kkt
+        assert result.critical_load_Pa <= bound * (1.0 + 1e-7)
+
+
+@pytest.mark.slow
+def test_auto_on_a_clamped_box_of_twelve_thousand_dofs():
+    """The section of the defect: "auto" at 12 672 DOFs ends no higher than the active set.
+
+    The clamped box b = d = 0.1 m, t = 2 mm, L = 0.2 m on 6.25 mm cells, ``levels = 1``:
+    the interior point alone ended at 7.1143e8 Pa, 1.2e-3 above the active set's
+    7.1060e8 Pa. The reference: the active set's mode made admissible by hand, its
+    Rayleigh quotient (an upper bound on the critical load).
+    """
+    box = _square_box(0.1, 0.2, 0.00625, **CLAMPED_BOX)
+    given = SolverSpec(method="active-set")
+    with solve_section(box, MPI.COMM_SELF, solver=given) as seeded:
+        bound, removed = _box_admissible_rayleigh_quotient(seeded, 0.1, 0.1)
+        assert seeded.result.certificate.kkt and removed < 1e-6
+    assert bound == pytest.approx(7.1060e8, rel=1e-4)
+    with solve_section(box, MPI.COMM_SELF) as solved:  # "auto"
+        result = solved.result
+        assert result.method_chosen_by.startswith("auto: about 12672 DOFs")
+        assert result.certificate.kkt
+        assert result.critical_load_Pa <= bound * (1.0 + 1e-7)

@@ -23,8 +23,10 @@ nothing of its own. Two entries are chosen, never named in a file, and are no
 (:data:`FOUNDATION`, chosen by the problem) and, on a section of fewer than
 :data:`~unibuckle_fenicsx.algorithms.section_levels.INTERIOR_POINT_DOFS` degrees of
 freedom, "auto"'s route :data:`~unibuckle_fenicsx.algorithms.section_levels.BOTH` (the
-interior point and the active set on the same sections, the lower KKT point kept), which
-has a section runner only.
+interior point and the active set on the same sections, the lower KKT point kept), and
+on larger ones :data:`~unibuckle_fenicsx.algorithms.section_levels.CHECKED` (the interior
+point, checked by the active set's seeds on its coarsest section), which have a section
+runner only.
 """
 
 from __future__ import annotations
@@ -44,7 +46,7 @@ from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.algorithms.foundation import solve_foundation
 from unibuckle_fenicsx.algorithms.interior_point.options import ChainOptions
 from unibuckle_fenicsx.algorithms.penalty import solve_penalty
-from unibuckle_fenicsx.algorithms.section_levels import BOTH, solve_levels
+from unibuckle_fenicsx.algorithms.section_levels import BOTH, CHECKED, solve_levels
 from unibuckle_fenicsx.errors import FieldError, InputError
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
@@ -257,6 +259,15 @@ REGISTRY: dict[str, MethodEntry] = {
             None,
             ("interior-point", "active-set", "penalty-continuation", "feasible-descent"),
             _section_levels(BOTH),
+        ),
+        # "auto" on a large section: the interior point, checked by the active set's
+        # seeds on its coarsest section, carried up where they rank lower there.
+        MethodEntry(
+            CHECKED,
+            OPTIONS[Method.INTERIOR_POINT],
+            None,
+            ("interior-point", "active-set", "penalty-continuation", "feasible-descent"),
+            _section_levels(CHECKED),
         ),
     )
 }

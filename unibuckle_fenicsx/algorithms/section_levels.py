@@ -46,6 +46,7 @@ the walls' nodes save where they lift off, which the free mode's signs seed
 
 from __future__ import annotations
 
+import itertools
 import logging
 import time
 from collections.abc import Sequence
@@ -68,6 +69,7 @@ from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_interior_poin
 from unibuckle_fenicsx.algorithms.pdas import iterate
 from unibuckle_fenicsx.algorithms.records import (
     ActiveSetDetails,
+    InteriorPointDetails,
     SectionLevel,
     SectionLevelsDetails,
 )
@@ -85,6 +87,8 @@ from unibuckle_fenicsx.spec.base import in_file
 __all__ = [
     "BOTH",
     "CHAIN_OPTIONS",
+    "CHECKED",
+    "CHECK_SEEDS_DOFS",
     "COARSEST_DOFS",
     "INTERIOR_POINT_DOFS",
     "MORE_SEEDS",
@@ -119,8 +123,20 @@ SAME_LOAD = 1e-9
 #: the same sections, the lower KKT point kept (module docstring); a registry entry of
 #: its own, with a section runner only.
 BOTH = "both"
+#: The route of ``"auto"`` on sections of :data:`INTERIOR_POINT_DOFS` and more: the
+#: interior point, then the active set's seeds on its coarsest section only; where they
+#: reach a KKT point below the chain's there, their contact set is carried to each finer
+#: section and polished (no seeds above the coarsest), and the lower KKT point on the
+#: given section is kept (:func:`_seeds_carried`). A registry entry of its own.
+CHECKED = "interior-point+seeds"
+#: On the route :data:`CHECKED`, the seeds run again on a finer section whose carried set
+#: polishes to no KKT point only below this many DOFs: there they take one to two
+#: hundred eigen solves, a few times the interior point's cost; above, the active set's
+#: route is out of reach (:doc:`/verification/sections`, "Cost") and the chain's KKT
+#: point stands.
+CHECK_SEEDS_DOFS = 20_000
 #: The routes of :func:`solve_levels` (module docstring).
-ROUTES = ("interior-point", "active-set", BOTH)
+ROUTES = ("interior-point", "active-set", BOTH, CHECKED)
 #: "auto" takes the interior point alone on sections of at least this many DOFs
 #: (estimated from the cell size: six per node), and both routes on smaller ones
 #: (:data:`BOTH`): there the active set's eigen solves on small pencils cost about what
@@ -214,11 +230,9 @@ def solve_levels(
     if route not in ROUTES:
         raise InputError(f"route must be one of {ROUTES}, got {route!r}")
     check_levels(parameters, levels)
-    if route in ("interior-point", BOTH):
+    if route in ("interior-point", BOTH, CHECKED):
         more = interior_levels(parameters, levels)
-        return _interior_point(
-            parameters, more, comm, solver, levels, max_iterations, both=route == BOTH
-        )
+        return _interior_point(parameters, more, comm, solver, levels, max_iterations, route=route)
     return _active_set(parameters, levels, comm, solver, max_iterations)
 
 
@@ -271,7 +285,7 @@ def _interior_point(
     solver: SolverSpec | None,
     asked: int,
     max_iterations: int,
-    both: bool = False,
+    route: str = "interior-point",
 ) -> tuple[Section, UnilateralSolution]:
     """The nested interior-point chain over the sections (module docstring).
 
@@ -279,9 +293,11 @@ def _interior_point(
     caller's: a coarser section that cannot be built (its core covers no free node) ends
     the added ones, and is refused among the asked ones. If the chain reaches no KKT
     point, the active-set route (``max_iterations`` per seed) runs on the finest section
-    and the ``asked`` coarser ones, as built here. ``both`` (the route :data:`BOTH`): the
+    and the ``asked`` coarser ones, as built here. ``route`` :data:`BOTH`: the
     active-set route runs on them after a KKT point of the chain too, and the lower KKT
-    point is kept (the chain's where they agree to :data:`SAME_LOAD`). The solution's
+    point is kept (the chain's where they agree to :data:`SAME_LOAD`); :data:`CHECKED`:
+    the active set's seeds on the coarsest section and their contact set carried up
+    (:func:`_seeds_carried`), the lower kept likewise. The solution's
     ``eigensolves`` counts every eigen solve on every section but the finest's free solve
     (the result adds that one).
     """
@@ -300,20 +316,7 @@ def _interior_point(
 
     sections: list[Section] = []
     try:
-        for k, size in enumerate(_sizes(parameters, levels)[::-1]):  # finest first
-            try:
-                sections.insert(0, _build(parameters, size, comm, solver))
-            except InputError as err:
-                if k == 0:  # the given cells' own error
-                    raise
-                if k > asked:  # a level added by interior_levels: fewer of them
-                    break
-                cells, unit = in_file(size, "m")
-                raise InputError(
-                    f"mesh.levels = {asked}: the coarser section of cells {cells:g} {unit} "
-                    f"(mesh.size doubled): {err}; lower mesh.levels (0: the search starts "
-                    "on the given cells)"
-                ) from None
+        _build_all(parameters, levels, asked, comm, solver, sections)
         problems = [section.cored for section in sections]
         solution = solve_interior_point(
             problems[-1],
@@ -323,8 +326,13 @@ def _interior_point(
             fallback=active_set,
         )
         solution.method = "interior-point (section levels)"
-        if both and not fell_back:
+        if route == BOTH and not fell_back:
             solution = _lower(solution, active_set(problems[-1]))
+        elif route == CHECKED and not fell_back:
+            carried, seeds_penalty = _seeds_carried(sections, solution, max_iterations)
+            penalty += seeds_penalty
+            if carried is not None:
+                solution = _lower(solution, carried)
         # Every section's solves, the chain's, the active set's and its penalty
         # continuations' (the finest's free solve is the result's own).
         total = sum(p.eigensolver.solves for p in problems) - problems[-1].free_solves + penalty
@@ -336,6 +344,111 @@ def _interior_point(
     for section in sections[:-1]:
         section.destroy()
     return sections[-1], solution
+
+
+def _build_all(
+    parameters: SectionParameters,
+    levels: int,
+    asked: int,
+    comm: MPI.Comm,
+    solver: SolverSpec | None,
+    sections: list[Section],
+) -> None:
+    """Build the interior point's sections into ``sections``, coarsest first.
+
+    The finest first; a coarser section that cannot be built ends the ones
+    :func:`interior_levels` added, and is refused among the ``asked`` ones. The caller
+    destroys ``sections`` (those built before an error too).
+    """
+    for k, size in enumerate(_sizes(parameters, levels)[::-1]):  # finest first
+        try:
+            sections.insert(0, _build(parameters, size, comm, solver))
+        except InputError as err:
+            if k == 0:  # the given cells' own error
+                raise
+            if k > asked:  # a level added by interior_levels: fewer of them
+                break
+            cells, unit = in_file(size, "m")
+            raise InputError(
+                f"mesh.levels = {asked}: the coarser section of cells {cells:g} {unit} "
+                f"(mesh.size doubled): {err}; lower mesh.levels (0: the search starts "
+                "on the given cells)"
+            ) from None
+
+
+def _seeds_carried(
+    sections: Sequence[Section], chain: UnilateralSolution, max_iterations: int
+) -> tuple[UnilateralSolution | None, int]:
+    """The active set's seeds on the coarsest section, carried up: a check of the chain.
+
+    The interior point's starts settle in one arrangement of the lift-off on the
+    coarsest section, and it is carried up; the active set's seeds (:data:`SEEDS`, the
+    free mode's sign patterns) can reach another, lower one (:doc:`/verification/sections`,
+    "Cost"). They run on ``sections[0]`` (``max_iterations`` each); where their KKT point
+    lies below the chain's lowest there by more than :data:`SAME_LOAD`, their contact set
+    is carried to each finer section and polished (:func:`_polish`, the looser
+    tolerances, then the plain rule), and where neither reaches a KKT point the seeds run
+    on that section (as on the active-set route) if it has fewer than
+    :data:`CHECK_SEEDS_DOFS`: the lower arrangement the seeds found may polish into no
+    KKT point on a finer section, and the seeds there find it. With
+    one section the seeds' KKT point is the candidate itself. Returns the candidate on
+    the finest section as a solution of the chain's record (None: the seeds found no
+    lower KKT point, or no KKT point on a finer section) and the seeds' penalty
+    continuations' eigen solves. Collective.
+    """
+    coarse = sections[0].cored
+    seeded = solve_active_set(
+        coarse, multilevel=False, max_iterations=max_iterations, bound_budget=0, seeds=SEEDS
+    )
+    penalty = 0
+    if isinstance(seeded.details, ActiveSetDetails):
+        penalty = seeded.details.penalty_eigensolves
+    if not seeded.candidate.kkt:
+        return None, penalty
+    best = seeded
+    logger.info("section: the seeds on the coarsest section %.10g (KKT)", seeded.load)
+    if len(sections) > 1:
+        details = chain.details
+        loads = details.coarse_kkt_loads if isinstance(details, InteriorPointDetails) else []
+        if loads and seeded.load >= min(loads) * (1.0 - SAME_LOAD):
+            return None, penalty  # the chain's arrangement there is as low
+        for prev, section in itertools.pairwise(sections):
+            if prev.constraints is None or section.constraints is None:
+                raise RuntimeError("solve_levels: a core section without constraints")
+            z = prolong_directions(best.active, prev.constraints, section.constraints)
+            polished, _ = _polish(section.cored, z, best.load, THRESHOLDS, 0)
+            if polished is None:
+                budget = min(max_iterations, PLAIN_POLISH_ITERATIONS)
+                polished, _ = _polish(section.cored, z, best.load, (), POLISH_ITERATIONS, budget)
+            logger.info(
+                "section: the seeds' contact set carried and polished: %s",
+                "no KKT point" if polished is None else f"{polished.load:.10g}",
+            )
+            if polished is None and section.model.num_dofs >= CHECK_SEEDS_DOFS:
+                return None, penalty  # the seeds' cost there is the active set's route's
+            if polished is None:  # as the active-set route does: the seeds on this section
+                polished = solve_active_set(
+                    section.cored, multilevel=False, max_iterations=max_iterations,
+                    bound_budget=0, seeds=SEEDS,
+                )  # fmt: skip
+                if isinstance(polished.details, ActiveSetDetails):
+                    penalty += polished.details.penalty_eigensolves
+                logger.info("section: the seeds on it %.10g", polished.load)
+                if not polished.candidate.kkt:
+                    return None, penalty
+            best = polished
+    found = replace(
+        chain,
+        candidate=best.candidate,
+        method="active-set (section levels)",
+        route=[*chain.route, "active-set"],
+        kkt_points=[best.candidate, chain.candidate],
+        lower_bound=best.lower_bound,
+        global_optimum_proven=best.global_optimum_proven,
+        upper_bound=best.load,
+        lower_bound_by=best.lower_bound_by,
+    )
+    return found, penalty
 
 
 def _lower(chain: UnilateralSolution, other: UnilateralSolution) -> UnilateralSolution:

@@ -380,8 +380,9 @@ def _method_flags(s: argparse.ArgumentParser) -> None:
         "--max-candidates (i: the nodes the obstacle acts on) and its estimated time fits "
         "--enumeration-budget, else interior-point on thin plates (t/b < 0.02) and "
         "active-set on thicker ones; enumerate alone = the paper's stopping rule. A "
-        "section's auto: interior-point from about 10^4 DOFs, below that both "
-        "interior-point and active-set, the lower load kept; a section takes no other "
+        "section's auto: interior-point from about 10^4 DOFs, checked by the active "
+        "set's seeds on its coarsest section, below that both interior-point and active-set, "
+        "the lower load kept; a section takes no other "
         "method " + _solver_default("method"),
     )
     s.add_argument(

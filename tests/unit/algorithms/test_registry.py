@@ -5,13 +5,14 @@ them, runs through one entry of ``algorithms.registry.REGISTRY``; the entry's op
 Struct is the one ``spec.OPTIONS`` gives (the command line's method flags come from it),
 read from the problem's ``[solver]`` table; a result's ``route`` starts with its method
 and takes only the links its entry lists. Two entries no file names: a tensionless
-foundation's spring-set iteration and "auto"'s route on a small section, both section
-routes (``section_levels.BOTH``, a section runner only). Every name the command line and
-the schema accept resolves, through the choice of a plate's or a section's method, to an
-entry that runs on that kind of problem; an entry asked of the other kind is refused
-naming ``solver.method``. The problems are the paper's plate C1 (section 6.1) on coarse
-meshes and a square plate on a tensionless foundation; the checks are of names and
-options, not of loads (those are tested per method).
+foundation's spring-set iteration and "auto"'s routes on a section, both section routes
+on a small one (``section_levels.BOTH``) and the interior point checked by the active
+set's seeds on a large one (``section_levels.CHECKED``), section runners only. Every
+name the command line and the schema accept resolves, through the choice of a plate's or
+a section's method, to an entry that runs on that kind of problem; an entry asked of the
+other kind is refused naming ``solver.method``. The problems are the paper's plate C1
+(section 6.1) on coarse meshes and a square plate on a tensionless foundation; the
+checks are of names and options, not of loads (those are tested per method).
 """
 
 from __future__ import annotations
@@ -24,7 +25,7 @@ import pytest
 from msgspec import structs
 
 from unibuckle_fenicsx.algorithms.registry import FOUNDATION, REGISTRY, entry
-from unibuckle_fenicsx.algorithms.section_levels import BOTH, INTERIOR_POINT_DOFS
+from unibuckle_fenicsx.algorithms.section_levels import BOTH, CHECKED, INTERIOR_POINT_DOFS
 from unibuckle_fenicsx.analysis import choose_method, choose_section_method, solve
 from unibuckle_fenicsx.errors import FieldError, InputError
 from unibuckle_fenicsx.model.build import build_problem
@@ -38,7 +39,7 @@ from unibuckle_fenicsx.spec.solver import PenaltyOptions
 
 def test_every_method_but_auto_has_one_entry_with_the_specs_options():
     named = {m.value for m in Method if m is not Method.AUTO}
-    assert set(REGISTRY) == named | {FOUNDATION, BOTH}
+    assert set(REGISTRY) == named | {FOUNDATION, BOTH, CHECKED}
     for method in Method:
         if method is not Method.AUTO:
             assert REGISTRY[method].options is OPTIONS[method]
@@ -51,10 +52,10 @@ def test_every_method_but_auto_has_one_entry_with_the_specs_options():
 def test_the_entries_that_run_on_sections_are_the_methods_a_section_names():
     # A section file may name SECTION_METHODS (spec, no PETSc); each but "auto" must run
     # through an entry with a section runner, an elastic core through the foundation's
-    # and "auto" on a small section through both routes'.
+    # and "auto" through both routes' (small) or the checked interior point's (large).
     on_sections = {name for name, e in REGISTRY.items() if e.section is not None}
     named = {m.value for m in SECTION_METHODS if m is not Method.AUTO}
-    assert on_sections == named | {FOUNDATION, BOTH}
+    assert on_sections == named | {FOUNDATION, BOTH, CHECKED}
 
 
 def test_the_entries_that_run_on_plates_are_every_method_a_plate_names():
@@ -143,7 +144,7 @@ def test_every_accepted_method_resolves_to_a_section_entry_or_is_refused(method)
     chosen = {choose_section_method(p, solver)[0] for p in (small, large)}
     for name in chosen:
         assert entry(name).section is not None, name
-    assert chosen == ({BOTH, "interior-point"} if method == "auto" else {method})
+    assert chosen == ({BOTH, CHECKED} if method == "auto" else {method})
 
 
 def test_an_elastic_core_and_a_tensionless_foundation_resolve_to_the_foundations_entry():
@@ -174,5 +175,5 @@ def test_a_plate_only_entry_is_refused_for_a_section_naming_the_key():
     assert refused.value.field == "solver.method"
     assert str(refused.value) == (
         "solver.method = 'penalty' does not run on a section: interior-point, active-set, "
-        "foundation, both do"
+        "foundation, both, interior-point+seeds do"
     )

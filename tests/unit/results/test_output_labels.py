@@ -60,11 +60,14 @@ def test_solve_help_says_which_flags_a_section_takes(monkeypatch):
     assert set(SOLVER_KEYS) == {"method", "tau", "eps_tol", "max_iterations"}
     assert [str(m) for m in SECTION_METHODS] == ["auto", "interior-point", "active-set"]
     assert (
-        "a section takes --method (auto, interior-point or active-set), --tau and "
-        "--max-iterations; the others," in flat
+        "a section takes --method (auto, interior-point or active-set: the last two with a "
+        "rigid core only), --tau and --max-iterations; the others," in flat
     ), flat
     assert INTERIOR_POINT_DOFS == 10**4
-    assert "section's auto: interior-point from about 10^4 DOFs" in flat, flat
+    assert (
+        "section's auto: interior-point from about 10^4 DOFs, checked by the active set's seeds "
+        "on its coarsest section" in flat
+    ), flat
 
 
 @pytest.mark.parametrize(
