@@ -140,6 +140,20 @@ def test_the_command_lines_method_reaches_a_section(tmp_path, capsys):
     assert REFUSED in capsys.readouterr().err
 
 
+def _rayleigh_quotient(model, vec) -> float:
+    """u'Au/u'Bu of ``vec`` on the model's assembled A and B (scipy copies of them)."""
+    import scipy.sparse as sp
+
+    def dense(mat):
+        indptr, indices, values = mat.getValuesCSR()
+        return sp.csr_matrix((values, indices, indptr), shape=mat.getSize())
+
+    A, B = dense(model.A), dense(model.B)
+    curvature = vec @ (B @ vec)
+    assert curvature > 0.0
+    return float(vec @ (A @ vec) / curvature)
+
+
 def _admissible_rayleigh_quotient(analysis) -> tuple[float, float]:
     """An upper bound on the filled section's critical load from its mode, by hand.
 
@@ -152,7 +166,6 @@ def _admissible_rayleigh_quotient(analysis) -> tuple[float, float]:
     Returns the quotient and the largest inward part removed (relative to max |u|).
     """
     import numpy as np
-    import scipy.sparse as sp
 
     model = analysis.section.model
     u = analysis.mode.x.array.copy().reshape(-1, 6)
@@ -163,16 +176,7 @@ def _admissible_rayleigh_quotient(analysis) -> tuple[float, float]:
     removed = float(np.max(along, initial=0.0)) / float(np.abs(u[:, :3]).max())
     u[:, :3] -= np.maximum(along, 0.0)[:, None] * inward
     assert np.einsum("ij,ij->i", u[:, :3], inward).max() <= 1e-14
-    vec = u.ravel()
-
-    def dense(mat):
-        indptr, indices, values = mat.getValuesCSR()
-        return sp.csr_matrix((values, indices, indptr), shape=mat.getSize())
-
-    A, B = dense(model.A), dense(model.B)
-    curvature = vec @ (B @ vec)
-    assert curvature > 0.0
-    return float(vec @ (A @ vec) / curvature), removed
+    return _rayleigh_quotient(model, u.ravel()), removed
 
 
 def test_the_active_set_route_ends_no_higher_than_an_admissible_mode():
@@ -364,7 +368,6 @@ def _box_admissible_rayleigh_quotient(analysis, width, depth) -> tuple[float, fl
     assembled A and B is an upper bound on the critical load.
     """
     import numpy as np
-    import scipy.sparse as sp
 
     model = analysis.section.model
     u = analysis.mode.x.array.copy().reshape(-1, 6)
@@ -377,16 +380,7 @@ def _box_admissible_rayleigh_quotient(analysis, width, depth) -> tuple[float, fl
             inward = np.maximum(-side * u[on, axis], 0.0)
             removed = max(removed, float(inward.max(initial=0.0)) / scale)
             u[on, axis] += side * inward
-    vec = u.ravel()
-
-    def dense(mat):
-        indptr, indices, values = mat.getValuesCSR()
-        return sp.csr_matrix((values, indices, indptr), shape=mat.getSize())
-
-    A, B = dense(model.A), dense(model.B)
-    curvature = vec @ (B @ vec)
-    assert curvature > 0.0
-    return float(vec @ (A @ vec) / curvature), removed
+    return _rayleigh_quotient(model, u.ravel()), removed
 
 
 #: A small clamped square box with a core (b = 0.1 m, t = 2 mm, L = 0.2 m, 25 mm
