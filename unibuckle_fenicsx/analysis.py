@@ -19,7 +19,7 @@ from mpi4py import MPI
 import dolfinx
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
-from unibuckle_fenicsx.algorithms.chain import THIN_PLATE
+from unibuckle_fenicsx.algorithms.chain import THIN_PLATE, thin_plate
 from unibuckle_fenicsx.algorithms.registry import FOUNDATION, entry
 from unibuckle_fenicsx.algorithms.section_levels import (
     BOTH,
@@ -94,7 +94,7 @@ def choose_method(
         return options.method, "given"
     plate = spec.plate
     slenderness = plate.thickness / min(plate.length, plate.width)
-    thin = slenderness < THIN_PLATE
+    thin = thin_plate(spec)
     local = Method.INTERIOR_POINT if thin else Method.ACTIVE_SET
     why = f"t/b = {slenderness:.3g} {'<' if thin else '>='} {THIN_PLATE:g}"
     if count > options.max_candidates:

@@ -6,6 +6,8 @@
 - :mod:`support.brackets`: soundness of a bracket route against that minimum;
 - :mod:`support.families`: seeded random problem families;
 - :mod:`support.stress`: the stress family's check against the exhaustive minimum;
+- :mod:`support.metamorphic`: relations between the answers of related problems, and
+  the random plates the sweep checks them on;
 - :mod:`support.problem_files`: base problem files holding every key of the schema;
 - :mod:`support.plates`: plate set-ups used by several test modules and MPI scripts;
 - :mod:`support.hermite_plate`, :mod:`support.kirchhoff`, :mod:`support.rm_triangles`:

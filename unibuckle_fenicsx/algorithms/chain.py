@@ -79,7 +79,7 @@ from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, requir
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.spec import ProblemSpec
 
-__all__ = ["THIN_PLATE", "ChainOptions", "solve_interior_point"]
+__all__ = ["THIN_PLATE", "ChainOptions", "solve_interior_point", "thin_plate"]
 
 logger = logging.getLogger(__name__)
 
@@ -89,6 +89,12 @@ logger = logging.getLogger(__name__)
 #: answers of "auto" have been (:doc:`/verification/tuning`, and the benchmarks' "Which
 #: route").
 THIN_PLATE = 0.02
+
+
+def thin_plate(spec: ProblemSpec) -> bool:
+    """Whether ``spec``'s plate is thinner than :data:`THIN_PLATE` of its shorter side."""
+    plate = spec.plate
+    return plate.thickness / min(plate.length, plate.width) < THIN_PLATE
 
 
 class Carry(Protocol):

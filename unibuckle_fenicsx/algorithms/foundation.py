@@ -26,11 +26,15 @@ on both sides (a bilateral foundation, ``side = "both"``) are simply added to A.
 Bounds: :math:`\lambda_{free} \le \lambda_f \le \lambda_{rigid}` (the spring term is
 non-negative, and vanishes on the rigid obstacle's mode), and the returned load, a value
 of the quotient, is an upper bound of :math:`\lambda_f`. The iteration starts from the
-free plate (no springs) and from every spring active (the bilateral foundation's mode);
-for stiff springs (:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`) also from
-the set a continuation in the stiffness ends on, and above :data:`RIGID_START_RATIO`
-from the rigid obstacle's contact set (the active set's); the smallest quotient is
-returned. A node of the spring set keeps pressing while its spring force exceeds
+free plate (no springs), from every spring active (the bilateral foundation's mode) and,
+on a plate, from the contact set of the rigid obstacle's answer (:func:`_rigid_set`; a
+section's core above :data:`RIGID_START_RATIO`, from the active set's); for stiff springs
+(:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`) also from the set a
+continuation in the stiffness ends on; the smallest quotient is returned. The rigid start
+is what keeps the answer at or below the rigid obstacle's load, and non-decreasing in
+:math:`k_f`: without it, a thin plate with a foundation under part of it ended up to
+1.3 % above the minimum of every spring set (:doc:`/history/2026-12-01a-metamorph`).
+A node of the spring set keeps pressing while its spring force exceeds
 :data:`~unibuckle_fenicsx.tolerances.PRESSING_RTOL` of the largest: a stiff spring's
 node presses by less than that fraction of max|w|, and would otherwise leave and return
 without end. The quotient has
@@ -59,14 +63,18 @@ import math
 
 import numpy as np
 import numpy.typing as npt
+from msgspec.structs import replace
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
+from unibuckle_fenicsx.algorithms.chain import thin_plate
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.algorithms.records import FoundationDetails
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
+from unibuckle_fenicsx.model.shell.problem import SectionProblem
+from unibuckle_fenicsx.spec import Method, ObstacleSpec
 from unibuckle_fenicsx.spec.solver import FoundationOptions
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
@@ -78,9 +86,10 @@ logger = logging.getLogger(__name__)
 #: :math:`\kappa` = 10 by tenfold steps: stiff springs have stationary points far from
 #: the free plate's and the bilateral foundation's (:doc:`/verification/stiff_foundations`).
 CONTINUATION_RATIO = 10.0
-#: Above this :func:`stiffness_ratio` a start from the rigid obstacle's contact set
-#: (the active set's) joins the others: on long plates the other starts end at stationary
-#: points above the rigid obstacle's load, which no foundation exceeds.
+#: Above this :func:`stiffness_ratio` a section's core also starts from the rigid core's
+#: contact set (the active set's; a plate always does, :func:`_rigid_set`): on long plates
+#: the other starts end at stationary points above the rigid obstacle's load, which no
+#: foundation exceeds.
 RIGID_START_RATIO = 1e3
 #: Angles sampled on the circle before the golden-section refinement.
 ARC_SAMPLES = 720
@@ -121,7 +130,7 @@ def solve_foundation(
     lower = problem.solve_free().load
     springs = contact.stiffness
     ratio = stiffness_ratio(problem, springs)
-    rigid = _rigid_set(problem) if ratio > RIGID_START_RATIO else None
+    rigid = _rigid_set(problem) if ratio > RIGID_START_RATIO or _plate(problem) else None
     runs: dict[str, SpringIteration] = {}
     finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
     with PenaltySolver(problem, prefix=Prefix.FOUNDATION, eps_options=eps_options) as solver:
@@ -196,14 +205,73 @@ def stiffness_ratio(problem: UnilateralProblem, springs: npt.NDArray[np.float64]
     return float(np.sum(springs * z * z)) / energy if energy > 0.0 else 0.0
 
 
+def _plate(problem: UnilateralProblem) -> bool:
+    """Whether ``problem`` is a plate (not a section's shell, whose spec is its unrolled walls)."""
+    return not isinstance(problem, SectionProblem)
+
+
 def _rigid_set(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], int]:
     """The rigid obstacle's contact set on the foundation's nodes, and its eigen solves.
 
-    The active set (its coarse levels, no bracket). Collective.
+    On a plate, the answer of the plate with its foundations made rigid, by the route
+    "auto" runs when it does not enumerate (:func:`_rigid_answer`): the foundation's
+    minimum lies at or below that load, and from its contact set the iteration starts at
+    or below it. On a section's shell, the active set on the problem itself (its coarse
+    levels, no bracket). Collective.
     """
+    if _plate(problem):
+        return _rigid_answer(problem)
     rigid = solve_active_set(problem, bound_budget=0)
     logger.info("foundation: the rigid obstacle's load %.10g starts a run", rigid.candidate.load)
     return rigid.candidate.active, rigid.eigensolves
+
+
+def _rigid_answer(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], int]:
+    """The contact set of the rigid twin's answer, as the foundation's nodes; its solves.
+
+    The twin is ``problem.spec`` with every tensionless foundation made rigid, solved by
+    :func:`~unibuckle_fenicsx.analysis.solve` (certified, continued from a refuting
+    mode) with the method "auto" runs on its plate besides the enumeration (the interior
+    point on a thin plate, :func:`~.chain.thin_plate`, else the active set): the
+    enumeration's cost would be paid again at every stiffness. On the problem's own mesh
+    when it is the user's. A contact node is matched to the foundation's node at the same
+    coordinates (a twin's zone node on no whole cell of the zone carries no spring and is
+    left out). Without an admissible rigid mode, the empty set (the free start's).
+    Collective.
+    """
+    # analysis runs the methods of the registry, which runs this module: imported here.
+    from unibuckle_fenicsx.analysis import solve
+
+    spec = problem.spec
+
+    def rigid(o: ObstacleSpec) -> ObstacleSpec:
+        return replace(o, foundation_stiffness=None) if o.kind == "tensionless" else o
+
+    if spec.obstacle is not None:
+        spec = replace(spec, obstacle=rigid(spec.obstacle))
+    else:
+        spec = replace(spec, obstacles=tuple(rigid(o) for o in spec.obstacles))
+    method = Method.INTERIOR_POINT if thin_plate(spec) else Method.ACTIVE_SET
+    spec = replace(spec, solver=replace(spec.solver, method=method))
+    own = problem.custom_mesh
+    mesh, tags = (problem.mesh, problem.facet_tags) if own else (None, None)
+    try:
+        twin = solve(spec, problem.comm, mesh=mesh, facet_tags=tags)
+    except NoAdmissibleModeError:  # the rigid obstacle leaves no mode: no start from it
+        logger.info("foundation: the rigid obstacle has no admissible mode; no rigid start")
+        return np.empty(0, np.int64), 0
+    with twin:
+        solution = twin.solution
+        if not isinstance(twin.problem, UnilateralProblem) or solution is None:
+            raise RuntimeError(
+                "_rigid_answer: expected the rigid twin to have an obstacle (an internal invariant)"
+            )
+        coordinates = twin.problem.contact.coordinates[solution.candidate.active]
+        load, solves = solution.load, twin.result.eigensolves
+    logger.info("foundation: the rigid obstacle's load %.10g starts a run", load)
+    index = {tuple(c): k for k, c in enumerate(problem.contact.coordinates)}
+    active = sorted(index[tuple(c)] for c in coordinates if tuple(c) in index)
+    return np.asarray(active, dtype=np.int64), solves
 
 
 def _continued_start(
