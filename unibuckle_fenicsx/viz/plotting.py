@@ -68,6 +68,7 @@ class Theme(TypedDict):
     warp: float  # 3-D height (m) of |w| = 1 (plate 0.2 m x 0.1 m)
     obstacle_color: str
     contact_color: str
+    touch_color: str  # a contact node that only touches (no force): visible on white
     free_color: str
     unilateral_color: str
 
@@ -85,6 +86,7 @@ THEME: Theme = {
     "warp": 0.035,  # 3-D height (m) of |w| = 1 (plate 0.2 m x 0.1 m)
     "obstacle_color": "dimgray",
     "contact_color": "black",
+    "touch_color": "#a0a0a0",
     "free_color": "tab:blue",
     "unilateral_color": "tab:red",
 }
@@ -172,16 +174,21 @@ def colour_scale(wn: npt.NDArray[np.float64]) -> tuple[str, tuple[float, float]]
 
 
 # -- 3-D mode ----------------------------------------------------------------------------
-def annotate(plotter: Any, legend: Sequence[tuple[str, str]], title: str, font: str | None) -> None:
-    """The legend (label, colour) at the lower left and the title at the upper left."""
+def annotate(
+    plotter: Any, legend: Sequence[tuple[str, str, str]], title: str, font: str | None
+) -> None:
+    """The legend (label, colour, face) at the lower left and the title at the upper left.
+
+    ``face`` is pyvista's legend glyph of the entry: "line" for an outline, "circle" for
+    nodes drawn as spheres, so that an outline and nodes of the same colour differ.
+    """
     if legend:
         plotter.add_legend(
-            labels=[[label, color] for label, color in legend],
+            labels=[[label, color, face] for label, color, face in legend],
             bcolor="white",
             border=True,
             size=(0.3, 0.1),
             loc="lower left",
-            face="rectangle",
         )
     if title:
         plotter.add_text(
@@ -264,7 +271,7 @@ def plot_mode_3d(
     The surface is coloured by w / max|w| (:func:`colour_scale`: sequential for a
     one-signed mode); the obstacle is a translucent grey plane just above w = 0 over its
     zone, outlined in black; contact nodes (|Z|) are black spheres where they press the
-    obstacle and white ones where they only touch it (``contact_pressing``).
+    obstacle and grey ones where they only touch it (``contact_pressing``).
 
     Args:
         problem: The solved problem (serial).
@@ -334,10 +341,11 @@ def _add_obstacle(
     warp: float,
     contact_coordinates: npt.ArrayLike | None,
     contact_pressing: npt.ArrayLike | None,
-) -> list[tuple[str, str]]:
+) -> list[tuple[str, str, str]]:
     """The obstacle zone (a translucent plane just off w = 0) and the contact nodes.
 
-    Nodes that press the obstacle are drawn black, those that only touch it white.
+    Nodes that press the obstacle are drawn black, those that only touch it grey (a
+    one-signed mode is white at w = 0, where they lie).
     Returns the legend's entries.
     """
     pv = _pyvista()
@@ -346,7 +354,7 @@ def _add_obstacle(
     sides = {o.side for o in problem.spec.all_obstacles}
     below = sides == {"below"}
     lift = (-0.02 if below else 0.02) * warp
-    legend: list[tuple[str, str]] = []
+    legend: list[tuple[str, str, str]] = []
     if box is not None:
         (x0, x1), (y0, y1) = box
         plane = pv.Rectangle([[x0, y0, lift], [x1, y0, lift], [x1, y1, lift]])
@@ -356,19 +364,23 @@ def _add_obstacle(
             frozenset({"above"}): "obstacle zone (w <= 0 there)",
             frozenset({"below"}): "obstacle zone below (w >= 0 there)",
         }.get(frozenset(sides), "obstacle zones (both sides)")
-        legend.append((text, "#303030"))
+        legend.append((text, "black", "line"))
     cxy = np.asarray(contact_coordinates if contact_coordinates is not None else [], dtype=float)
     cxy = cxy.reshape(-1, 2)
     presses = _pressing_mask(contact_pressing, len(cxy))
-    for mask, colour in ((presses, THEME["contact_color"]), (~presses, "white")):
+    for mask, colour in ((presses, THEME["contact_color"]), (~presses, THEME["touch_color"])):
         if mask.any():
             pts = np.column_stack([cxy[mask, 0], cxy[mask, 1], np.full(mask.sum(), 0.5 * lift)])
             plotter.add_points(pts, color=colour, point_size=12, render_points_as_spheres=True)
     if box is not None and contact_pressing is None:
-        legend.append((f"contact nodes: {len(cxy)}", "black"))
+        legend.append((f"contact nodes: {len(cxy)}", THEME["contact_color"], "circle"))
     elif box is not None:
-        legend.append((f"pressing the obstacle: {int(presses.sum())}", "black"))
-        legend.append((f"touching, no force: {int((~presses).sum())}", "#a0a0a0"))
+        legend.append(
+            (f"pressing the obstacle: {int(presses.sum())}", THEME["contact_color"], "circle")
+        )
+        legend.append(
+            (f"touching, no force: {int((~presses).sum())}", THEME["touch_color"], "circle")
+        )
     return legend
 
 

@@ -13,7 +13,14 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from unibuckle_fenicsx.viz.plotting import THEME, _prepare, _pyvista, annotate, coloured_surface
+from unibuckle_fenicsx.viz.plotting import (
+    THEME,
+    _prepare,
+    _pyvista,
+    annotate,
+    colour_scale,
+    coloured_surface,
+)
 
 if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.model.shell.section import SectionFigureData
@@ -69,6 +76,10 @@ def plot_section_mode_3d(
 ) -> Path:
     """Warped section coloured by the outward displacement, the core, the pressing nodes.
 
+    The colour map is :func:`~unibuckle_fenicsx.viz.plotting.colour_scale`'s: sequential
+    from 0 for a mode that moves only outward (a core over the whole length), diverging
+    on [-1, 1] otherwise.
+
     Args:
         data: The arrays to draw
             (:class:`~unibuckle_fenicsx.model.shell.section.SectionFigureData`).
@@ -95,6 +106,8 @@ def plot_section_mode_3d(
     surface = grid.extract_surface(algorithm="dataset_surface").compute_normals(
         flip_normals=True, consistent_normals=False, split_vertices=True, feature_angle=30.0
     )
+    # A filled section's mode moves only outward: the sequential map, as a plate's.
+    cmap, clim = colour_scale(np.asarray(data.outward, dtype=float))
     plotter, font = coloured_surface(
         pv,
         surface,
@@ -103,8 +116,10 @@ def plot_section_mode_3d(
         edges=n <= 4000,
         line_width=0.3,
         ambient=0.4,
+        cmap=cmap,
+        clim=clim,
     )
-    legend: list[tuple[str, str]] = []
+    legend: list[tuple[str, str, str]] = []
     if show_core and data.shape != "flat":
         if data.shape == "box":
             core = pv.Box(
@@ -119,14 +134,14 @@ def plot_section_mode_3d(
                 resolution=96,
             )
         plotter.add_mesh(core.extract_feature_edges(), color="black", line_width=2)
-        legend.append(("core (outline)", "black"))
+        legend.append(("core (outline)", "black", "line"))
     for pts, color, label in (
         (data.pressing, THEME["contact_color"], "presses on the core"),
         (data.touching, "gold", "on the core, no force"),
     ):
         if len(pts):
             plotter.add_points(pts, color=color, point_size=7, render_points_as_spheres=True)
-            legend.append((f"{label}: {len(pts)}", color))
+            legend.append((f"{label}: {len(pts)}", color, "circle"))
     annotate(plotter, legend, title, font)
     plotter.add_axes(color="black", viewport=(0.72, 0.0, 0.86, 0.18))
     centre = np.array([0.5 * length, 0.0, 0.0])

@@ -353,3 +353,98 @@ def test_a_free_plate_s_summary_says_its_load_is_proven_the_smallest():
     proof = "proven=yes (the smallest eigenvalue, by an LDL^T inertia count"
     assert proof + ")" in texts[0], texts[0]
     assert proof + "; free: with the bilateral foundation)" in texts[1], texts[1]
+
+
+def _strip(signs: float) -> SectionFigureData:
+    """One face of a box, 2 x 1 cells, its outward displacement ``signs`` x (0, ..., 1)."""
+    x, y = np.meshgrid([0.0, 0.1, 0.2], [-0.05, 0.05])
+    points = np.column_stack([x.ravel(), y.ravel(), np.full(6, 0.05)])
+    quads = np.array([[0, 1, 4, 3], [1, 2, 5, 4]], dtype=np.int64)
+    outward = signs * np.array([0.0, 0.5, 0.0, 1.0, 0.5, 0.0])
+    if signs < 0:
+        outward[0] = 1.0  # both signs
+    return SectionFigureData(
+        points, quads, np.zeros_like(points), outward, points[:1], points[1:2], "box",
+        (0.2, 0.1, 0.1),
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize(("signs", "cmap"), [(1.0, "Blues"), (-1.0, "coolwarm")])
+def test_a_section_figure_s_legend_tells_the_core_from_the_nodes(
+    tmp_path, monkeypatch, signs, cmap
+):
+    """The core's outline is a line in the legend, the contact nodes dots (both black).
+
+    Before, each entry was a black square: the outline and the pressing nodes alike. A
+    mode that moves only outward gets the sequential map from 0, as a plate's one-signed
+    mode (``viz.plotting.colour_scale``; THEME's "Blues"), one of both signs the diverging
+    "coolwarm" on [-1, 1].
+    """
+    pytest.importorskip("pyvista")
+    import pyvista as pv
+
+    from unibuckle_fenicsx.viz import section
+
+    seen: dict[str, object] = {}
+    add_legend, coloured = pv.Plotter.add_legend, section.coloured_surface
+
+    def keep_legend(self, labels=None, **kwargs):
+        seen["labels"] = labels
+        return add_legend(self, labels=labels, **kwargs)
+
+    def keep_map(*args, **kwargs):
+        seen["cmap"], seen["clim"] = kwargs["cmap"], kwargs["clim"]
+        return coloured(*args, **kwargs)
+
+    monkeypatch.setattr(pv.Plotter, "add_legend", keep_legend)
+    monkeypatch.setattr(section, "coloured_surface", keep_map)
+    section.plot_section_mode_3d(_strip(signs), tmp_path / "strip.png", title="strip")
+    faces = {label.split(":")[0]: (colour, face) for label, colour, face in seen["labels"]}
+    assert faces == {
+        "core (outline)": ("black", "line"),
+        "presses on the core": ("black", "circle"),
+        "on the core, no force": ("gold", "circle"),
+    }
+    assert seen["cmap"] == cmap
+    assert seen["clim"] == ((0.0, 1.0) if signs > 0 else (-1.0, 1.0))
+
+
+def test_a_plate_figure_s_legend_tells_the_zone_from_the_nodes(tmp_path, monkeypatch):
+    """The zone's outline is a line, the contact nodes dots; a touching node is drawn grey.
+
+    Before, the zone (dark grey) and the pressing nodes (black) were both squares, and the
+    touching nodes were drawn white, which a one-signed mode's map shows at w = 0, where
+    they lie, while the legend said grey. The paper's plate c1 on 10 x 10 cells (9 contact
+    nodes: figures/stdout/demo_obstacle_c1.txt).
+    """
+    pytest.importorskip("pyvista")
+    import pyvista as pv
+
+    from unibuckle_fenicsx.spec import paper_case
+    from unibuckle_fenicsx.viz import plotting
+
+    seen: dict[str, list] = {"points": []}
+    add_legend, add_points = pv.Plotter.add_legend, pv.Plotter.add_points
+
+    def keep_legend(self, labels=None, **kwargs):
+        seen["labels"] = labels
+        return add_legend(self, labels=labels, **kwargs)
+
+    def keep_points(self, points, **kwargs):
+        seen["points"].append(kwargs["color"])
+        return add_points(self, points, **kwargs)
+
+    monkeypatch.setattr(pv.Plotter, "add_legend", keep_legend)
+    monkeypatch.setattr(pv.Plotter, "add_points", keep_points)
+    with solve(paper_case("c1", nx=10, ny=10), MPI.COMM_SELF) as analysis:
+        xy = np.asarray(analysis.result.contact_coordinates)
+        pressing = np.arange(len(xy)) % 2 == 0  # both kinds drawn
+        plotting.plot_mode_3d(
+            analysis.problem, analysis.mode, tmp_path / "c1.png",
+            contact_coordinates=xy, contact_pressing=pressing,
+        )  # fmt: skip
+    assert len(xy) >= 2
+    entries = [(colour, face) for _, colour, face in seen["labels"]]
+    touch = plotting.THEME["touch_color"]
+    assert entries == [("black", "line"), ("black", "circle"), (touch, "circle")]
+    assert seen["points"] == ["black", touch]
