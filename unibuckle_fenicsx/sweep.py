@@ -84,6 +84,7 @@ from unibuckle_fenicsx.spec import (
     problem_to_dict,
     spec_from_dict,
 )
+from unibuckle_fenicsx.spec.base import did_you_mean
 
 __all__ = [
     "STATUSES",
@@ -214,6 +215,7 @@ def _locate(data: dict[str, object], path: str, flag: str) -> tuple[Any, Any]:
                 shortcuts = f"; shortcuts: {sorted(SHORTCUTS)}" if "plate" in data else ""
                 raise InputError(
                     f"{flag} {path}: {where} has no key {key!r} (keys: {sorted(node)}{shortcuts})"
+                    + did_you_mean([key], list(node))
                 )
         elif isinstance(node, list):
             if not (key.isdigit() and int(key) < len(node)):

@@ -25,6 +25,13 @@ def warn_plate_model(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
         _warn(plate_model_note(spec.plate, spec.units), comm)
 
 
+def warn_modulus_unit(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
+    """A warning on stderr when E lies below any structural material's: another unit?"""
+    from unibuckle_fenicsx.spec.material import modulus_note
+
+    _warn(modulus_note(spec.material.E, spec.units), comm)
+
+
 def warn_design_material(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
     """A warning on stderr when ``[design]`` is asked of a Poisson's ratio not a steel's.
 

@@ -13,6 +13,7 @@ from unibuckle_fenicsx.cli.problem import (
     spec_from_args,
     warn_coarse_mesh,
     warn_design_material,
+    warn_modulus_unit,
     warn_plate_model,
 )
 from unibuckle_fenicsx.cli.status import print_out, report_failure
@@ -30,6 +31,7 @@ def solve_command(args: argparse.Namespace, comm: Any) -> int:
     spec = replace(spec, solver=replace(spec.solver, **changes))
     method = spec.solver.method  # the flag's, or the problem file's
     _warn_unused(flags, method, comm)
+    warn_modulus_unit(spec, comm)
     warn_plate_model(spec, comm)
     warn_design_material(spec, comm)
     analysis = analyse(spec, comm, candidate_parallel=args.candidate_parallel)

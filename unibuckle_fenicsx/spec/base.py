@@ -18,13 +18,14 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import difflib
 import enum
 import functools
 import math
 import re
 import types
 import typing
-from collections.abc import Iterator, Mapping
+from collections.abc import Iterator, Mapping, Sequence
 from typing import Annotated, Any, ClassVar, Literal, Union
 
 import msgspec
@@ -358,7 +359,7 @@ def reason(key: str, value: Any, tp: Any) -> str:
         tag = table.__struct_config__.tag_field
         unknown = [k for k in value if k not in fields and k != tag]
         if unknown:
-            return f"unknown key(s) {unknown} in {where}; allowed: {table.file_keys()}"
+            return unknown_keys(unknown, where, table.file_keys())
         missing = [
             k for k in fields[: len(fields) - len(table.__struct_defaults__)] if k not in value
         ]
@@ -367,10 +368,35 @@ def reason(key: str, value: Any, tp: Any) -> str:
     for m in members(tp):  # the right type, out of its range
         if bare(m) is not type(None) and not is_table(m) and _converts(value, bare(m)):
             text = form(m) if bare(m) is int else _range(m)
-            return f"{key} must {'lie' if text.startswith('in ') else 'be'} {text}, got {value!r}"
+            return (
+                f"{key} must {'lie' if text.startswith('in ') else 'be'} {text}, got {value!r}"
+                + _si_hint(value, m)
+            )
     kinds = {_kind(bare(m)) for m in members(tp)}
     got = "" if _kind(value) in kinds else f" ({_kind(value)})"
     return f"{key or 'the file'} must be {form(tp)}, got {value!r}{got}"
+
+
+def unknown_keys(unknown: Sequence[str], where: str, allowed: Sequence[str]) -> str:
+    """The refusal of the keys ``unknown`` in the table ``where``, with the allowed ones."""
+    return f"unknown key(s) {list(unknown)} in {where}; allowed: {list(allowed)}" + did_you_mean(
+        unknown, allowed
+    )
+
+
+def did_you_mean(unknown: Sequence[str], allowed: Sequence[str]) -> str:
+    """The hint ``(did you mean 'thickness'?)``: the nearest allowed key, or nothing.
+
+    ``difflib.get_close_matches`` (its default cutoff 0.6); with several keys, each
+    guess names the key it is for.
+    """
+    near = {key: difflib.get_close_matches(key, list(allowed), n=1) for key in unknown}
+    hints = [
+        repr(found[0]) + (f" for {key!r}" if len(unknown) > 1 else "")
+        for key, found in near.items()
+        if found
+    ]
+    return f" (did you mean {', '.join(hints)}?)" if hints else ""
 
 
 def form(tp: Any) -> str:
@@ -405,12 +431,36 @@ def _range(tp: Any) -> str:
             "string of at least {} characters" if bare(tp) is str else "list of at least {} entries"
         )
         return "a " + text.format(size)
-    bounds = {op: v for op in _SIGNS if (v := metadata(tp, op)) is not None}
-    suffix = f" {unit_name(metadata(tp, 'unit'))}" if metadata(tp, "unit") else ""
+    name = metadata(tp, "unit")
+    # The bounds are SI; a message speaks the file's units (1e3 Pa is 1e-3 MPa).
+    bounds = {
+        op: in_file(v, name)[0] if name else v
+        for op in _SIGNS
+        if (v := metadata(tp, op)) is not None
+    }
+    suffix = f" {unit_name(name)}" if name else ""
     if len(bounds) == 2:  # an interval
         (low, a), (high, b) = bounds.items()
         return f"in {'(['[low == 'ge']}{a:g}, {b:g}{')]'[high == 'le']}{suffix}"
     return "".join(f"{_SIGNS[op]} {v:g}{suffix}" for op, v in bounds.items())
+
+
+def _si_hint(value: Any, tp: Any) -> str:
+    """In a file not in SI, a hint when ``value`` would be in ``tp``'s range as SI.
+
+    2.1e11 for E in a mm-N-MPa file is steel's modulus in Pa: the message then says that
+    the file's units take MPa (``tp``'s bounds are SI, so the raw number is checked
+    against them as it is).
+    """
+    units, name = FILE_UNITS.get(), metadata(tp, "unit")
+    if units == "SI" or not name or not isinstance(DIMENSIONS.get(name), tuple):
+        return ""
+    if not _converts(value, tp):
+        return ""
+    return (
+        f" (in range as {value:g} {name}: units = {units!r} takes "
+        f"{unit_name(name, units)}, here {in_file(value, name, units)[0]:g})"
+    )
 
 
 def _converts(value: Any, tp: Any) -> bool:

@@ -48,6 +48,7 @@ from unibuckle_fenicsx.spec.base import (
     plain,
     reason,
     table_of,
+    unknown_keys,
     walk,
 )
 from unibuckle_fenicsx.spec.material import Ply
@@ -261,7 +262,7 @@ def _plate(plate: dict[str, object], edges: object, load: object) -> dict[str, o
 def _unknown(table: Mapping[str, object], allowed: Sequence[str], where: str) -> None:
     """Refuse the keys of ``table`` not in ``allowed``."""
     if found := [key for key in table if key not in allowed]:
-        raise InputError(f"unknown key(s) {found} in [{where}]; allowed: {list(allowed)}")
+        raise InputError(unknown_keys(found, f"[{where}]", allowed))
 
 
 def _hole(table: object, where: str) -> object:

@@ -19,6 +19,35 @@ from unibuckle_fenicsx.spec.base import Matrix3, Table, in_file, unit
 #: matrices overflow or underflow in double precision and SLEPc fails in the solve.
 MIN_MODULUS, MAX_MODULUS = 1.0e3, 1.0e13
 Modulus = Annotated[float, unit("Pa", ge=MIN_MODULUS, le=MAX_MODULUS)]
+#: Below this modulus (Pa) no structural material lies (polymers about 3e9 Pa, timber
+#: about 1e10 Pa): an E accepted by the range but below it is most likely in another unit
+#: (210000, steel's E in MPa, in an SI file), and draws a warning (:func:`modulus_note`).
+STRUCTURAL_MODULUS = 1.0e8
+
+
+def modulus_note(E: float, units: str = "SI") -> str | None:
+    """A warning when ``E`` (Pa) lies below :data:`STRUCTURAL_MODULUS`, else None.
+
+    The buckling load is proportional to E, so a modulus in MPa in an SI file gives every
+    stress in MPa printed as Pa. ``units``: the file's unit system, in which the message
+    writes E and says what to change.
+    """
+    if E >= STRUCTURAL_MODULUS:
+        return None
+    (given, low), name = in_file((E, STRUCTURAL_MODULUS), "Pa", units)
+    if units == "SI":
+        fix = (
+            'if it is in MPa and the lengths in mm, put units = "mm-N-MPa" at the top of the '
+            "file (as given, the stresses printed in Pa are in the unit of E)"
+        )
+    else:
+        fix = f"give it in {name} (steel: 210000 {name})"
+    return (
+        f"material.E = {given:g} {name} is below any structural material's modulus "
+        f"({low:g} {name}; polymers about 3 GPa, steel 210 GPa): {fix}"
+    )
+
+
 #: Shear correction factors accepted. kappa_s G t is the shear stiffness of the section
 #: (energy-equivalent to its shear stress tau(z)): kappa_s = (int tau dz)^2 /
 #: (G_mean t int tau^2/G dz) <= 1 by the Cauchy-Schwarz inequality, for any layering;

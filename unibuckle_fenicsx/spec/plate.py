@@ -24,7 +24,16 @@ from unibuckle_fenicsx.geometry import (
     polygon_inside,
     polygons_disjoint,
 )
-from unibuckle_fenicsx.spec.base import Point, Stress, Table, in_file, plain, stress_ends, unit
+from unibuckle_fenicsx.spec.base import (
+    Point,
+    Stress,
+    Table,
+    in_file,
+    plain,
+    stress_ends,
+    unit,
+    unknown_keys,
+)
 
 #: Edge names of a rectangular plate, in facet-tag order 1..4.
 EDGE_NAMES = ("left", "right", "bottom", "top")
@@ -430,7 +439,7 @@ class PlateSpec(Table, frozen=True):
             where = f"edges.{e.name}"
             allowed = [*EDGE_NAMES, HOLES] if self.holes else list(EDGE_NAMES)
             if self.outline is None and e.name not in allowed:
-                raise InputError(f"unknown key(s) [{e.name!r}] in [edges]; allowed: {allowed}")
+                raise InputError(unknown_keys([e.name], "[edges]", allowed))
             if e.name == HOLES:
                 _check_holes_edge(e, bool(self.holes))
             elif (self.outline is None) != (e.segments is None):

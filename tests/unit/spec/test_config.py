@@ -259,6 +259,28 @@ def test_toml_bad_input_names_parameter(data, match):
         problem_from_dict(data)
 
 
+@pytest.mark.parametrize(
+    ("data", "guess"),
+    [
+        ({"plate": {"thicknes": 0.006}}, " (did you mean 'thickness'?)"),
+        ({"edges": {"lef": {}}}, " (did you mean 'left'?)"),
+        ({"solver": {"methd": "auto", "tua": 1e-8}}, " (did you mean 'method' for 'methd', "),
+        ({"plate": {"colour": 1}}, ""),  # nothing near: no guess
+    ],
+)
+def test_a_misspelt_key_is_given_the_nearest_allowed_one(data, guess):
+    """The guess is difflib's nearest allowed key (a cutoff of 0.6), after the allowed list.
+
+    Expected: the keys of the tables (``PlateSpec``, the edge names, ``SolverSpec``) one
+    letter off the misspelt ones; "colour" is near none of [plate]'s.
+    """
+    with pytest.raises(ValueError) as err:
+        problem_from_dict(data)
+    text = str(err.value)
+    assert ("did you mean" in text) == bool(guess)
+    assert guess in text
+
+
 def test_toml_unknown_key_from_file(tmp_path):
     path = tmp_path / "bad.toml"
     path.write_text(SCHEMA_TOML.replace("thickness = 0.006", "thickness = 0.006\ncolour = 1"))

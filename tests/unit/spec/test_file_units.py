@@ -313,3 +313,51 @@ def test_an_empty_zone_found_on_the_mesh_speaks_the_file_s_units():
         spec = problem_from_dict(_plate(units, obstacle__zone=zone, mesh={"nx": 4, "ny": 4}))
         with pytest.raises(ValueError, match=f"^{re.escape(expected)}"):
             solve(spec)
+
+
+def test_a_range_is_written_in_the_file_s_units_with_the_si_number_named():
+    """E = 2.1e11 (steel in Pa) in a mm-N-MPa file: the range in MPa, and what to write.
+
+    Expected: the SI range of E, [1e3, 1e13] Pa (``spec.material.MIN_MODULUS`` and
+    ``MAX_MODULUS``), over 1e6 Pa per MPa: [0.001, 1e7] MPa; 2.1e11 Pa is 210000 MPa.
+    Before, the message wrote the SI bounds with the unit MPa ([1000, 1e+13] MPa).
+    """
+    data = _plate("mm-N-MPa", material__E=2.1e11)
+    assert _refused(problem_from_dict, data) == (
+        "material.E must lie in [0.001, 1e+07] MPa, got 210000000000.0 (in range as "
+        "2.1e+11 Pa: units = 'mm-N-MPa' takes MPa, here 210000)"
+    )
+    # A number out of range in both unit systems draws no hint; an SI file none either.
+    assert _refused(problem_from_dict, _plate("mm-N-MPa", material__E=1e20)) == (
+        "material.E must lie in [0.001, 1e+07] MPa, got 1e+20"
+    )
+    assert _refused(problem_from_dict, _plate("SI", material__E=1e20)) == (
+        "material.E must lie in [1000, 1e+13] Pa, got 1e+20"
+    )
+
+
+@pytest.mark.parametrize(
+    ("E", "units", "expected"),
+    [
+        (2.1e5, "SI", "material.E = 210000 Pa is below any structural material"),
+        (2.1e5 * MPA, "SI", None),  # steel in Pa
+        (1.0e8, "SI", None),  # the threshold itself
+        (210.0 * MPA, "mm-N-MPa", None),
+        (21.0 * MPA, "mm-N-MPa", "material.E = 21 MPa is below any structural material"),
+    ],
+)
+def test_a_modulus_below_any_structural_material_s_is_warned_of(E, units, expected):
+    """E in MPa in an SI file (210000 for steel) gives stresses in MPa printed as Pa.
+
+    The threshold 1e8 Pa (``spec.material.STRUCTURAL_MODULUS``) lies below the softest
+    structural materials (polymers about 3e9 Pa); an SI file is told of units =
+    "mm-N-MPa", a mm-N-MPa file to write E in MPa.
+    """
+    from unibuckle_fenicsx.spec.material import modulus_note
+
+    note = modulus_note(E, units)
+    if expected is None:
+        assert note is None
+    else:
+        assert note is not None and note.startswith(expected)
+        assert ('units = "mm-N-MPa"' in note) == (units == "SI")
