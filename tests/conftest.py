@@ -7,6 +7,13 @@ package ``tests/support/``.
 from __future__ import annotations
 
 import gc
+import os
+
+# Before numpy, MUMPS or BLAS load (nothing imports them before this file): one thread,
+# as `make test` runs, unless the caller chose. Threaded BLAS reductions change the last
+# bits between runs, and some tests compare a fresh process's result with this one's
+# to the bit.
+os.environ.setdefault("OMP_NUM_THREADS", "1")
 
 from mpi4py import MPI
 

@@ -20,6 +20,7 @@ removed (paper, Lemma 5.1).
 
 from __future__ import annotations
 
+import weakref
 from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
@@ -186,6 +187,9 @@ class Problem(Owner):
         self.eigensolver = parts.eigensolver
         self._estimate = parts.estimate
         self._run_options = parts.run_options
+        # Taking the options back is local to the process (not collective, unlike
+        # destroy): a problem discarded without destroy() does it when collected.
+        weakref.finalize(self, pop_run_options, self._run_options)
         self.timings = parts.timings
         self.free: Mode | None = None
         #: Why the free pair is the smallest, if its solve proved it (:meth:`solve_free`).

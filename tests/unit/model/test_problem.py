@@ -166,6 +166,25 @@ def test_command_line_option_wins_and_defaults_do_not_leak():
     mat.destroy()
 
 
+def test_a_discarded_problem_takes_its_run_options_back():
+    """A problem that is never destroyed leaves nothing in PETSc's options database.
+
+    The run's EPS options go into the database for every solver the run creates
+    (``push_run_options``); ``destroy()`` takes them back, and so does the problem's
+    collection when a user drops it without ``destroy()`` (or a ``with`` block).
+    """
+    import gc
+
+    from petsc4py import PETSc
+
+    problem = build_problem(paper_case("c1", 8, 4), eps_options={"eps_ncv": 40})
+    opts = PETSc.Options()
+    assert opts.getInt("unibuckle_eps_ncv") == 40  # in the database while the problem lives
+    del problem
+    gc.collect()
+    assert not opts.hasName("unibuckle_eps_ncv")
+
+
 def test_the_factorisations_of_a_mesh_share_one_symbolic_analysis():
     """One MUMPS analysis per mesh for the Newton matrix, shifted solves and certificate.
 
