@@ -7,7 +7,10 @@ then every :math:`u \in C` has :math:`u^T K u \ge u_I^T N u_I \ge 0`, so no admi
 mode has a Rayleigh quotient below :math:`\lambda`: :math:`\lambda \le \lambda_c`. The
 certificate tries :math:`\lambda_{lb} = \lambda(1 - \delta)` below the load found, for
 :math:`\delta` on a 1-2-5 grid from the smallest the rounding allows (predicted from
-matrix-vector products), one sparse :math:`LDL^T` of :math:`K(\lambda_{lb})` each.
+matrix-vector products), one sparse :math:`LDL^T` of :math:`K(\lambda_{lb})` each:
+upward until one certifies, or, once a dense SDP route (below) has failed at one, by
+bisection of the grid above it (the smallest that certifies, if success grows with
+:math:`\delta`; an SDP costs far more than a factorisation).
 
 **Rank-2 route** (exactly one pencil eigenvalue below :math:`\lambda_{lb}`, i.e. one
 negative eigenvalue of K). With :math:`N = c(w_+w_-^T + w_-w_+^T)`, :math:`w_\pm \ge 0`
@@ -55,6 +58,7 @@ from mpi4py import MPI
 import msgspec
 import numpy as np
 import numpy.typing as npt
+from msgspec import UnsetType
 
 from unibuckle_fenicsx.certificate.records import (
     AttemptRecord,
@@ -360,16 +364,29 @@ def copositivity_bound(
             notes.append("the KKT point has no contact force (w+ = 0)")
         predicted = _predict_delta(problem, matrix, candidate, opts.safety)
         deltas = [d for d in opts.deltas if d >= opts.slack * predicted] or [opts.deltas[-1]]
-        for delta in deltas:
+        untried, bisect = list(deltas), False
+        while untried:
+            # Upward from the smallest while a shift costs one factorisation; once a
+            # dense SDP has failed (seconds each), by bisection of what is left.
+            index = len(untried) // 2 if bisect else 0
+            delta = untried[index]
             lam = candidate.load * (1.0 - delta)
             neg, zero, pos = matrix.factor(lam)
             attempt = AttemptRecord(delta=delta, inertia=[neg, zero, pos])
             attempts.append(attempt)
             m = neg if m is None else m
             several |= neg >= 2
-            result, stop = _at_shift(problem, matrix, nappes, lam, attempt, opts, notes)
-            if stop:
+            found, stop = _at_shift(problem, matrix, nappes, lam, attempt, opts, notes)
+            if found is not None:
+                result = found  # smaller than any earlier success: it is tried below them
+                if not bisect:
+                    break
+                untried = untried[:index]
+            elif stop:
                 break
+            else:
+                untried = untried[index + 1 :]
+                bisect |= not isinstance(attempt.sdp, UnsetType)
         if result is None and several:
             routes = _split_routes(problem, matrix, candidate, others or [], opts, notes)
             result, split, lowrank, refuting = routes
