@@ -404,8 +404,9 @@ LONG_TUBE_HALF_WAVES = 8.0
 MAX_CALIBRATED_RADIUS_RATIO = 800.0
 #: Fewer cells than this along the longest buckle the ends allow (:func:`buckle_length`)
 #: draw a warning, by the same measure: a short section buckles in one wave as long as
-#: the member, whatever its walls' own buckles. 5 let short boxes and tubes through up to
-#: about 7 % high, 6 keeps them to about 5 % (:doc:`/guide/sections`, "Cell size").
+#: the member, whatever its walls' own buckles: the count that keeps short boxes and
+#: tubes to the guide's accuracy (:doc:`/guide/sections`, "Cell size", where it is
+#: measured).
 MIN_ALONG_CELLS = 6
 
 

@@ -32,8 +32,9 @@ section's core above :data:`RIGID_START_RATIO`, from the active set's); for stif
 (:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`) also from the set a
 continuation in the stiffness ends on; the smallest quotient is returned. The rigid start
 is what keeps the answer at or below the rigid obstacle's load, and non-decreasing in
-:math:`k_f`: without it, a thin plate with a foundation under part of it ended up to
-1.3 % above the minimum of every spring set (:doc:`/history/2026-12-01a-metamorph`).
+:math:`k_f`: without it, the other starts can all end at stationary points above the
+minimum of every spring set, and above the rigid obstacle's load
+(:doc:`/history/2026-12-01a-metamorph`).
 A node of the spring set keeps pressing while its spring force exceeds
 :data:`~unibuckle_fenicsx.tolerances.PRESSING_RTOL` of the largest: a stiff spring's
 node presses by less than that fraction of max|w|, and would otherwise leave and return

@@ -130,9 +130,9 @@ BOTH = "both"
 #: given section is kept (:func:`_seeds_carried`). A registry entry of its own.
 CHECKED = "interior-point+seeds"
 #: On the route :data:`CHECKED`, the seeds run again on a finer section whose carried set
-#: polishes to no KKT point only below this many DOFs: there they take one to two
-#: hundred eigen solves, a few times the interior point's cost; above, the active set's
-#: route is out of reach (:doc:`/verification/sections`, "Cost") and the chain's KKT
+#: polishes to no KKT point only below this many DOFs: there they cost a few times the
+#: interior point's route; above, the active set's route is out of reach
+#: (:doc:`/verification/sections`, "Cost", where both are measured) and the chain's KKT
 #: point stands.
 CHECK_SEEDS_DOFS = 20_000
 #: The routes of :func:`solve_levels` (module docstring).
