@@ -27,11 +27,20 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
   :math:`\rho`; for :math:`a/b \ge 1` it is :math:`\rho`, the column fields are None
   and a note says why;
 
+- the stress limit :math:`\rho f_y/\gamma_M` (:func:`~unibuckle_fenicsx.en1993.stress_limit`):
+  at :math:`\psi = 1` 4.6(1) with :math:`\gamma_{M0}` (:math:`A_{eff} = \rho A`); at
+  :math:`\psi < 1` the reduced stress method of section 10 for direct stress alone
+  (eq. (10.1), :math:`\gamma_{M1}`), as 4.6(1) then checks the effective section
+  (:math:`A_{eff}`, :math:`W_{eff}`, :math:`e_N`), not computed here; ``[design]
+  partial_factor`` is the factor of the one applied (EN 1993-1-1 6.1 recommends 1.0 for
+  both);
+- the effective widths of Table 4.1 or 4.2 with that reduction factor, and where they
+  lie (:func:`~unibuckle_fenicsx.en1993.effective_widths`);
 - a loaded edge in compression plus bending (:math:`\psi < 0`) carries tension at its
   other end: where it reaches :math:`f_y/\gamma_{M0}` (EN 1993-1-1 6.2.1(5)) before
-  :math:`\sigma_1` reaches :math:`\rho f_y/\gamma_{M0}` (:math:`\sigma_t/\sigma_1 >
-  1/\rho`, the critical state's stresses scaled together), yield governs, and the output
-  says so with the :math:`\sigma_1` at which it yields.
+  :math:`\sigma_1` reaches :math:`\rho f_y/\gamma_{M1}` (:math:`\sigma_t/\sigma_1 >
+  1/\rho`, the critical state's stresses scaled together, one partial factor for both),
+  yield governs, and the output says so with the :math:`\sigma_1` at which it yields.
 
 What the clause does not describe is refused when the problem is built (both unloaded
 edges free, biaxial stress, a temperature rise, a plate that is not a rectangle, ...);
@@ -61,15 +70,18 @@ from msgspec import UNSET, Struct, UnsetType
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     DesignElement,
+    EffectiveWidths,
     buckling_factor,
     column_end_factor,
     column_type,
     design_element,
+    effective_widths,
     plate_euler_stress,
     psi_range,
     ratio_text,
     reduction_factor,
     steel_poisson_note,
+    stress_limit,
     stress_ratio,
     table_row,
 )
@@ -78,11 +90,14 @@ from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
 __all__ = [
     "CLAUSES",
     "DesignRecord",
+    "ElementLimits",
     "at_lower_bound",
     "clauses",
     "column_stress",
     "design_output",
+    "effective_widths_text",
     "euler_stress",
+    "limit_clause_text",
     "reduction_factor",
     "significant",
 ]
@@ -90,8 +105,8 @@ __all__ = [
 #: The clauses the design output of an internal element rests on (:func:`clauses`).
 CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of an internal "
-    "compression element; 4.4(2): relative slenderness; Table 4.1: stress ratio psi; "
-    "4.6(1): rho f_y/gamma_M0"
+    "compression element; 4.4(2): relative slenderness; Table 4.1: stress ratio psi, "
+    "effective widths"
 )
 
 #: Said with every design output.
@@ -113,12 +128,60 @@ def significant(value: float | None, digits: int = 4) -> str:
     return text[:-1] if text.endswith(".") else text
 
 
-class DesignRecord(Struct, kw_only=True):
+class ElementLimits(Struct, kw_only=True):
+    r"""An element's stress limit and effective widths (a plate's design, a box's face).
+
+    The base of :class:`DesignRecord` and
+    :class:`~unibuckle_fenicsx.section_design.FaceDesign`; None without :math:`\rho`.
+
+    Attributes:
+        partial_factor_name: "gamma_M0" (:math:`\psi = 1`) or "gamma_M1"
+            (:math:`\psi < 1`): what ``partial_factor`` stands for in the limit
+            ``reduced_design_stress_Pa``.
+        stress_limit_clause: The clause of that limit
+            (:func:`~unibuckle_fenicsx.en1993.stress_limit`): 4.6(1) at :math:`\psi =
+            1`; section 10, eq. (10.1), the reduced stress method with direct stress
+            alone, at :math:`\psi < 1`.
+        element_width_m: :math:`\bar b` (internal) or :math:`c` (outstand): the loaded
+            edge's length.
+        compressed_width_m: :math:`b_c`, its compressed part (``element_width_m`` for
+            :math:`\psi \ge 0`, ``element_width_m``/(1 - psi) below).
+        effective_width_m: :math:`b_{eff}`, Table 4.1 or 4.2 with ``reduction_factor``.
+        effective_width_1_m: :math:`b_{e1}` (internal element; None for an outstand).
+        effective_width_2_m: :math:`b_{e2}` (internal element; None for an outstand).
+        effective_widths_row: The table row applied.
+        effective_widths_placed: Where the widths lie, naming the edges.
+    """
+
+    partial_factor_name: str | None = None
+    stress_limit_clause: str | None = None
+    element_width_m: float | None = None
+    compressed_width_m: float | None = None
+    effective_width_m: float | None = None
+    effective_width_1_m: float | None = None
+    effective_width_2_m: float | None = None
+    effective_widths_row: str | None = None
+    effective_widths_placed: str | None = None
+
+    def put_limit_and_widths(self, w: EffectiveWidths, psi: float, named: str) -> None:
+        """Set the fields from ``psi`` and the widths ``w``; ``named``: where its ends lie."""
+        self.partial_factor_name, self.stress_limit_clause = stress_limit(psi)
+        self.element_width_m, self.compressed_width_m = w.width, w.compressed
+        self.effective_width_m = w.effective
+        self.effective_width_1_m, self.effective_width_2_m = w.first, w.second
+        self.effective_widths_row = w.row
+        self.effective_widths_placed = f"{w.placed} ({named})"
+
+
+class DesignRecord(ElementLimits, kw_only=True):
     r"""The design quantities of a critical load (the JSON's ``design``).
 
     Attributes:
         yield_stress_Pa: :math:`f_y`.
-        partial_factor: :math:`\gamma_{M0}`.
+        partial_factor: ``[design] partial_factor``: :math:`\gamma_{M0}` at
+            :math:`\psi = 1` (4.6(1)) and in the tension-yield check (EN 1993-1-1
+            6.2.1(5)), :math:`\gamma_{M1}` at :math:`\psi < 1` (section 10); which one
+            the stress limit uses: ``partial_factor_name``.
         element: "internal" or "outstand" (:func:`~unibuckle_fenicsx.en1993.design_element`).
         free_edge: An outstand's free unloaded edge (None for an internal element).
         table: The table row of :math:`\psi` and :math:`k_\sigma` (Table 4.1 or 4.2).
@@ -158,8 +221,9 @@ class DesignRecord(Struct, kw_only=True):
             :math:`0 \le \xi \le 1` (4.5.4(1)), the value used; below 1 on a short
             plate column-type buckling lowers the reduction factor.
         xi_unclipped: :math:`\sigma_{cr}/\sigma_{cr,c} - 1` itself, before the bounds.
-        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M0}` (absent without
-            :math:`\rho`).
+        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_M`, the stress limit of
+            :math:`\sigma_1` (absent without :math:`\rho`), by ``stress_limit_clause``
+            (that and the effective widths: :class:`ElementLimits`).
         tension_Pa: The largest tensile normal stress on the loaded edges at the
             critical state (Pa, > 0; an edge in compression plus bending, psi < 0);
             None without tension.
@@ -168,7 +232,8 @@ class DesignRecord(Struct, kw_only=True):
             stresses scaled together: :math:`f_y\sigma_1/(\gamma_{M0}\sigma_t)`; None
             without tension.
         tension_yield_first: Whether the tension edge yields before :math:`\sigma_1`
-            reaches :math:`\rho f_y/\gamma_{M0}` (:math:`\sigma_t/\sigma_1 > 1/\rho`):
+            reaches :math:`\rho f_y/\gamma_M` (:math:`\sigma_t/\sigma_1 > 1/\rho`, one
+            partial factor for both):
             then the element's stress is limited by yield, not by its buckling, and
             ``sigma_1_at_tension_yield_Pa``, below ``reduced_design_stress_Pa``, governs.
             None without tension or without :math:`\rho`.
@@ -210,8 +275,8 @@ def clauses(element: DesignElement, free_edge_most_compressed: bool = True) -> s
     return (
         "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.3): reduction factor rho of an outstand "
         f"compression element (edges.{element.free_edge} free); 4.4(2): relative "
-        f"slenderness; {table_row(element.kind, free_edge_most_compressed)}: stress ratio psi; "
-        "4.6(1): rho f_y/gamma_M0"
+        f"slenderness; {table_row(element.kind, free_edge_most_compressed)}: stress ratio psi, "
+        "effective width"
     )
 
 
@@ -340,21 +405,46 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.reduction_factor = _column_type(out, spec, design, element, rho)
     rho_c = out.reduction_factor
     out.reduced_design_stress_Pa = rho_c * design.yield_stress / design.partial_factor
+    _widths(out, element, rho_c, end, at_free, euler_length(spec, element.loaded))
+    out.clauses += f"; {out.stress_limit_clause}"
     if out.tension_Pa is not None:
-        # sigma_1 f_y/(gamma_M0 sigma_t) < rho f_y/gamma_M0: sigma_t/sigma_1 > 1/rho
+        # sigma_1 f_y/(gamma sigma_t) < rho f_y/gamma (gamma = partial_factor in both):
+        # sigma_t/sigma_1 > 1/rho
         out.tension_yield_first = out.tension_Pa * rho_c > sigma1
         if out.tension_yield_first:
             out.notes.append(_tension_note(out, rho_c))
     return out
 
 
+def _widths(
+    out: DesignRecord, element: DesignElement, rho: float, end: int, at_free: bool, width: float
+) -> None:
+    """Put the effective widths of Table 4.1 or 4.2 in ``out``, naming the edges they lie at.
+
+    ``end`` is the end (0 start, 1 end) of the loaded edge where sigma_1 acts, ``width``
+    the loaded edge's length.
+    """
+    assert out.psi is not None
+    psi = min(out.psi, 1.0)
+    if element.free_edge is None:
+        named = (
+            f"sigma_1 end: edges.{element.unloaded[end]}, "
+            f"other end: edges.{element.unloaded[1 - end]}"
+        )
+    else:
+        supported = next(e for e in element.unloaded if e != element.free_edge)
+        named = f"supported edge: edges.{supported}, free edge: edges.{element.free_edge}"
+    out.put_limit_and_widths(effective_widths(element.kind, rho, width, psi, at_free), psi, named)
+
+
 def _tension_note(out: DesignRecord, rho: float) -> str:
-    """The note that the tension edge yields before sigma_1 reaches rho f_y/gamma_M0."""
+    """The note that the tension edge yields before sigma_1 reaches rho f_y/gamma_M."""
     return (
         f"the tension edge yields first (EN 1993-1-1 6.2.1(5)): its {significant(out.tension_Pa)} "
         f"Pa at the critical state, {significant((out.tension_Pa or 0.0) / out.sigma_cr_Pa)} "
         f"times sigma_1, reaches f_y/gamma_M0 when sigma_1 = "
-        f"{significant(out.sigma_1_at_tension_yield_Pa)} Pa, below rho f_y/gamma_M0 = "
+        f"{significant(out.sigma_1_at_tension_yield_Pa)} Pa, below "
+        f"rho f_y/{out.partial_factor_name} = "
         f"{significant(rho * out.yield_stress_Pa / out.partial_factor)} Pa (rho = "
         f"{significant(rho)}): yield governs the element, not its buckling"
     )
@@ -457,6 +547,12 @@ def column_stress(spec: ProblemSpec, loaded: tuple[str, str]) -> tuple[float, st
     return factor * hinged, f"{' and '.join(words)}: {how}"
 
 
+def euler_length(spec: ProblemSpec, loaded: tuple[str, str]) -> float:
+    """The length (m) of the ``loaded`` edges: the y extent for left and right, else x."""
+    plate = spec.plate
+    return plate.width if loaded == ("left", "right") else plate.length
+
+
 def euler_stress(spec: ProblemSpec, loaded: tuple[str, str], *, along: bool = False) -> float:
     r""":math:`\sigma_E = \pi^2 E t^2/(12(1 - \nu^2) b^2)` (Pa), EN 1993-1-5 eq. (A.2).
 
@@ -469,6 +565,30 @@ def euler_stress(spec: ProblemSpec, loaded: tuple[str, str], *, along: bool = Fa
     across = (loaded == ("left", "right")) != along
     length = plate.width if across else plate.length
     return plate_euler_stress(material.E, material.nu, plate.thickness, length)
+
+
+def effective_widths_text(d: ElementLimits, length: float, name: str) -> str:
+    """The design line's effective widths, '' without them (in ``name``, m / ``length``)."""
+    if d.effective_width_m is None:
+        return ""
+    text = f"; effective width b_eff = {significant(d.effective_width_m / length)} {name}"
+    if d.effective_width_1_m is not None and d.effective_width_2_m is not None:
+        text += (
+            f" (b_e1 {significant(d.effective_width_1_m / length)}, "
+            f"b_e2 {significant(d.effective_width_2_m / length)} {name})"
+        )
+    if d.compressed_width_m != d.element_width_m:
+        text += f" of b_c = {significant((d.compressed_width_m or 0.0) / length)} {name}"
+    return text
+
+
+def limit_clause_text(psi: float | None, factor: str | None) -> str:
+    """The design line's clause of rho f_y/gamma_M ('' without it)."""
+    if factor is None:
+        return ""
+    if psi == 1.0:
+        return f", rho f_y/{factor} 4.6(1)"
+    return f", rho f_y/{factor} section 10 eq. (10.1) (reduced stress method, direct stress)"
 
 
 #: Said when the critical load is not proven the lowest.

@@ -24,6 +24,20 @@ no maintained library implements them for a given :math:`\sigma_{cr}`, hence thi
 not describe; the module imports no other of the package (it reads a problem through
 :class:`DesignProblem`), so that the problem checks (:mod:`unibuckle_fenicsx.spec`) can refuse
 such a plate, or a stress ratio outside the tables, before any solve.
+
+:func:`effective_widths` gives the widths of Tables 4.1 and 4.2 (what part of the element
+carries the stress), and :func:`stress_limit` the clause and partial factor of the
+stress limit :math:`\rho f_y/\gamma_M`: at :math:`\psi = 1` the lone element's
+effective area is :math:`A_{eff} = \rho A`, and 4.6(1), eq. (4.14), with
+:math:`\gamma_{M0}`, reads :math:`\sigma_1 \le \rho f_y/\gamma_{M0}`; at
+:math:`\psi < 1`, 4.6(1) checks the effective section (:math:`A_{eff}`,
+:math:`W_{eff}` and the shift :math:`e_N`), which is not computed here, and
+:math:`\sigma_1 \le \rho f_y/\gamma_{M1}` is the reduced stress method of section 10
+with direct stress alone: eq. (10.1), :math:`\rho\,\alpha_{ult,k}/\gamma_{M1} \ge 1`,
+with :math:`\alpha_{ult,k} = f_y/\sigma_1` (eq. (10.3) without :math:`\sigma_z`,
+:math:`\tau`), :math:`\alpha_{cr} = \sigma_{cr}/\sigma_1`, so that eq. (10.2),
+:math:`\bar\lambda_p = \sqrt{\alpha_{ult,k}/\alpha_{cr}} = \sqrt{f_y/\sigma_{cr}}`,
+and :math:`\rho = \rho_x` of 4.5.4(1) (10(5)).
 """
 
 from __future__ import annotations
@@ -51,6 +65,7 @@ __all__ = [
     "DesignLoad",
     "DesignPlate",
     "DesignProblem",
+    "EffectiveWidths",
     "buckling_factor",
     "check_steel_modulus",
     "check_steel_yield_stress",
@@ -59,12 +74,14 @@ __all__ = [
     "column_reduction_factor",
     "column_type",
     "design_element",
+    "effective_widths",
     "interpolated_reduction_factor",
     "plate_euler_stress",
     "psi_range",
     "ratio_text",
     "reduction_factor",
     "steel_poisson_note",
+    "stress_limit",
     "stress_ratio",
     "table_row",
 ]
@@ -173,6 +190,121 @@ def table_row(element: str, free_edge_most_compressed: bool) -> str:
         return "Table 4.1 (internal compression element)"
     where = "free" if free_edge_most_compressed else "supported"
     return f"Table 4.2 (outstand compression element, larger compression at the {where} edge)"
+
+
+def stress_limit(psi: float) -> tuple[str, str]:
+    r"""(partial factor's name, clause) of the stress limit :math:`\rho f_y/\gamma_M` at ``psi``.
+
+    The module docstring says why: 4.6(1) with :math:`\gamma_{M0}` at :math:`\psi = 1`,
+    the reduced stress method of section 10 with :math:`\gamma_{M1}` below.
+    """
+    if psi == 1.0:
+        return "gamma_M0", (
+            "4.6(1): rho f_y/gamma_M0 (eq. (4.14) at psi = 1: A_eff = rho A, no shift e_N)"
+        )
+    return "gamma_M1", (
+        "section 10, reduced stress method, direct stress only: eq. (10.1) rho "
+        "alpha_ult,k/gamma_M1 >= 1 with alpha_ult,k = f_y/sigma_1 and eq. (10.2) "
+        "slenderness sqrt(f_y/sigma_cr), rho = rho_x of 4.5.4(1) (10(5)): sigma_1 <= rho "
+        "f_y/gamma_M1 (psi < 1: 4.6(1) checks A_eff, W_eff and e_N, not computed here)"
+    )
+
+
+@dataclass(frozen=True)
+class EffectiveWidths:
+    r"""The effective widths of EN 1993-1-5 Table 4.1 or 4.2 (m), :func:`effective_widths`.
+
+    Attributes:
+        width: :math:`\bar b` (internal) or :math:`c` (outstand), the element's width.
+        compressed: :math:`b_c`, its compressed part: the width for :math:`\psi \ge 0`,
+            width/(1 - psi) below.
+        effective: :math:`b_{eff}`, rho times ``width`` (:math:`\psi \ge 0`) or times
+            ``compressed``.
+        first: :math:`b_{e1}`, the internal element's part at its :math:`\sigma_1` end;
+            None for an outstand.
+        second: :math:`b_{e2}`, the rest of ``effective``; None for an outstand.
+        row: The table's row applied.
+        placed: Where the widths lie, from the element's edges ``sigma_1 end`` and
+            ``other end`` (internal) or ``supported`` and ``free`` (outstand).
+    """
+
+    width: float
+    compressed: float
+    effective: float
+    first: float | None
+    second: float | None
+    row: str
+    placed: str
+
+
+def effective_widths(
+    element: str, rho: float, width: float, psi: float, free_edge_most_compressed: bool = True
+) -> EffectiveWidths:
+    r"""The effective widths of EN 1993-1-5 Table 4.1 (internal) or 4.2 (outstand).
+
+    Table 4.1: :math:`\psi = 1`: :math:`b_{eff} = \rho\bar b`, :math:`b_{e1} = b_{e2} =
+    0.5 b_{eff}`; :math:`1 > \psi \ge 0`: :math:`b_{eff} = \rho\bar b`, :math:`b_{e1} =
+    2b_{eff}/(5 - \psi)`, :math:`b_{e2} = b_{eff} - b_{e1}`; :math:`\psi < 0`:
+    :math:`b_c = \bar b/(1 - \psi)`, :math:`b_{eff} = \rho b_c`, :math:`b_{e1} = 0.4
+    b_{eff}`, :math:`b_{e2} = 0.6 b_{eff}`. :math:`b_{e1}` lies at the :math:`\sigma_1`
+    end; :math:`b_{e2}` at the other end (:math:`\psi \ge 0`) or next to the
+    tension zone :math:`b_t = \bar b - b_c`, which is effective (:math:`\psi < 0`).
+    Table 4.2, both rows (larger compression at the free or at the supported edge):
+    :math:`b_{eff} = \rho c` for :math:`1 \ge \psi \ge 0`, :math:`\rho b_c = \rho
+    c/(1 - \psi)` for :math:`\psi < 0`; the effective part lies at the supported edge,
+    after the tension zone when that is there (larger compression at the free edge),
+    else from the edge, the tension zone at the free edge then effective too.
+
+    Args:
+        element: :data:`INTERNAL` or :data:`OUTSTAND`.
+        rho: The reduction factor applied (:math:`\rho`, or :math:`\rho_c`, 4.5.4(1)).
+        width: :math:`\bar b` or :math:`c` (m).
+        psi: :math:`\psi` in the table's range (:func:`psi_range`).
+        free_edge_most_compressed: For an outstand, the row of Table 4.2.
+    """
+    _check(element, psi, free_edge_most_compressed)
+    compressed = width if psi >= 0.0 else width / (1.0 - psi)
+    effective = rho * compressed
+    row = table_row(element, free_edge_most_compressed).split(" (")[0]
+    if element == INTERNAL:
+        if psi == 1.0:
+            first, cell = 0.5 * effective, "psi = 1"
+        elif psi >= 0.0:
+            first, cell = 2.0 * effective / (5.0 - psi), "1 > psi >= 0"
+        else:
+            first, cell = 0.4 * effective, "psi < 0"
+        placed = (
+            "b_e1 from the sigma_1 end, b_e2 from the other end"
+            if psi >= 0.0
+            else "b_e1 from the sigma_1 end, b_e2 ending at b_c from it (where the "
+            "compression ends); the tension zone b_t = b - b_c at the other end effective"
+        )
+        return EffectiveWidths(
+            width, compressed, effective, first, effective - first, f"{row}, {cell}", placed
+        )
+    where = "free" if free_edge_most_compressed else "supported"
+    cell = "1 >= psi >= 0" if psi >= 0.0 else "psi < 0"
+    if psi >= 0.0:
+        placed = "b_eff from the supported edge; c - b_eff at the free edge ineffective"
+    elif free_edge_most_compressed:
+        placed = (
+            "the tension zone b_t = c - b_c from the supported edge, then b_eff, effective; "
+            "b_c - b_eff at the free edge ineffective"
+        )
+    else:
+        placed = (
+            "b_eff from the supported edge and the tension zone b_t = c - b_c at the free "
+            "edge effective; b_c - b_eff between them ineffective"
+        )
+    return EffectiveWidths(
+        width,
+        compressed,
+        effective,
+        None,
+        None,
+        f"{row}, larger compression at the {where} edge, {cell}",
+        placed,
+    )
 
 
 def psi_range(element: str, free_edge_most_compressed: bool = True) -> tuple[float, float]:

@@ -214,7 +214,10 @@ class SectionResult(BucklingResult, kw_only=True):
             if bracket:
                 lines.append(bracket)
         if isinstance(self.design, SectionDesignRecord):
-            lines.append(design_line(self.design, scale, unit))
+            length = UNITS[self.units][0]
+            lines.append(
+                design_line(self.design, scale, unit, (length, "m" if self.units == "SI" else "mm"))
+            )
         return "\n  ".join(lines)
 
 

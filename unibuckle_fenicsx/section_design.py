@@ -19,13 +19,19 @@ asks for the design quantities of its critical state :math:`\lambda_c`:
   column-type :math:`\chi_c` (curve a; 4.5.3(1): :math:`\sigma_{cr,c}` of the face as a
   column between the section's ends, eq. (4.8) :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)`
   between simply supported ones, 4 times it between clamped ones), as a plate's
-  (:mod:`unibuckle_fenicsx.design`);
+  (:mod:`unibuckle_fenicsx.design`); the face's stress limit :math:`\rho f_y/\gamma_M`
+  (4.6(1) with :math:`\gamma_{M0}` at :math:`\psi = 1`, the reduced stress method of
+  section 10 with :math:`\gamma_{M1}` below,
+  :func:`~unibuckle_fenicsx.en1993.stress_limit`) and its effective widths of Table 4.1
+  (:func:`~unibuckle_fenicsx.en1993.effective_widths`; :math:`\bar b` the face's
+  mid-line width, the one computed);
 - a face whose :math:`\psi` lies below -3 (a web under bending with an axial tension) is
   outside Table 4.1 and eq. (4.2): no :math:`k_\sigma` or :math:`\rho`, a note and the
   summary say so (``faces_outside_table``);
 - the tension fibre against yield, EN 1993-1-1 6.2.1(5): under bending with an axial
   tension it may reach :math:`f_y/\gamma_{M0}` at a smaller multiple of the critical load
-  than the governing face reaches :math:`\rho f_y/\gamma_{M0}`; then yield governs, and
+  than the governing face reaches :math:`\rho f_y/\gamma_M` (one ``partial_factor``
+  for both); then yield governs, and
   the output says so (``tension_yield_first``); a tube's tension fibre gets its multiple;
 - for a **tube**, :math:`\bar\lambda` only: a circular wall is a shell, whose buckling
   reduction (EN 1993-1-6, section 8.5: the fabrication quality class, :math:`\alpha_x`,
@@ -51,12 +57,20 @@ from typing import Protocol
 import msgspec
 from msgspec import UNSET, Struct, UnsetType
 
-from unibuckle_fenicsx.design import CALIBRATION, UNPROVEN, significant
+from unibuckle_fenicsx.design import (
+    CALIBRATION,
+    UNPROVEN,
+    ElementLimits,
+    effective_widths_text,
+    limit_clause_text,
+    significant,
+)
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
     buckling_factor,
     column_end_factor,
     column_type,
+    effective_widths,
     plate_euler_stress,
     psi_range,
     ratio_text,
@@ -78,8 +92,8 @@ __all__ = [
 #: The clauses of a box's face.
 FACE_CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of each face as an "
-    "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma; "
-    "4.6(1): rho f_y/gamma_M0"
+    "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma, "
+    "effective widths"
 )
 #: Added where a face is shorter than its width (as a plate's record, only where applied).
 COLUMN_CLAUSES = "4.5.3(1), 4.5.4(1): column-type buckling of a face shorter than its width, rho_c"
@@ -125,7 +139,7 @@ class DesignSection(Protocol):
     def euler_stress(self) -> float: ...
 
 
-class FaceDesign(Struct, kw_only=True):
+class FaceDesign(ElementLimits, kw_only=True):
     r"""One face of a box as an internal compression element (EN 1993-1-5, 4.4(2)).
 
     Attributes:
@@ -151,8 +165,11 @@ class FaceDesign(Struct, kw_only=True):
         xi: :math:`\xi = \sigma_{cr}/\sigma_{cr,c} - 1` bounded to
             :math:`0 \le \xi \le 1` (4.5.4(1)), the value used.
         xi_unclipped: :math:`\sigma_{cr}/\sigma_{cr,c} - 1` itself, before the bounds.
-        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_{M0}` (Pa), with
-            ``reduction_factor``.
+        reduced_design_stress_Pa: :math:`\rho_c f_y/\gamma_M` (Pa), with
+            ``reduction_factor``: the stress limit of the face's :math:`\sigma_1`;
+            its clause and the face's effective widths of Table 4.1 (``element_width_m``
+            its mid-line width, ``effective_widths_placed`` naming the neighbouring
+            faces): :class:`~unibuckle_fenicsx.design.ElementLimits`.
     """
 
     face: str
@@ -169,19 +186,31 @@ class FaceDesign(Struct, kw_only=True):
     reduced_design_stress_Pa: float | None = None
 
 
+#: The faces at the two ends of each face's width, in the order of
+#: :func:`face_compressions`' two compressions.
+CORNERS = {
+    "right": ("top", "bottom"),
+    "top": ("right", "left"),
+    "left": ("top", "bottom"),
+    "bottom": ("right", "left"),
+}
+
+
 class SectionDesignRecord(Struct, kw_only=True):
     r"""The design quantities of a section's critical state (its JSON's ``design``).
 
     Attributes:
         yield_stress_Pa: :math:`f_y`.
-        partial_factor: :math:`\gamma_{M0}`.
+        partial_factor: ``[design] partial_factor``: :math:`\gamma_{M0}` in the tension
+            fibre's check and a face's limit at :math:`\psi = 1`, :math:`\gamma_{M1}` in a
+            face's at :math:`\psi < 1` (each face's ``partial_factor_name``).
         sigma_cr_Pa: The largest compressive axial stress in the walls at the critical
             state (Pa).
         relative_slenderness: :math:`\sqrt{f_y/\sigma_{cr}}`.
         clauses: The clauses applied.
         notes: What the output rests on, and what it leaves out.
         faces: A box's faces (:class:`FaceDesign`); empty for a tube.
-        governing_face: The face that reaches :math:`\rho f_y/\gamma_{M0}` at the
+        governing_face: The face that reaches :math:`\rho f_y/\gamma_M` at the
             smallest multiple of the critical load, the smallest :math:`\rho f_y/\sigma_1`
             (of faces reaching it together, the widest, and of equally wide ones the
             first of ``faces``; None for a tube).
@@ -203,7 +232,7 @@ class SectionDesignRecord(Struct, kw_only=True):
         tension_yield_multiple: The multiple of the critical load at which that fibre
             reaches :math:`f_y/\gamma_{M0}` (EN 1993-1-1 6.2.1(5)).
         tension_yield_first: A box's: whether that multiple is below the governing face's
-            (:math:`\rho f_y/(\gamma_{M0}\sigma_1)`): the tension face yields before the
+            (:math:`\rho f_y/(\gamma_M\sigma_1)`): the tension face yields before the
             compressed faces reach their reduced stress, and yield governs. None for a
             tube (no :math:`\rho`) and without tension.
         lower_bound: With a core whose critical load is not proven the lowest (a KKT
@@ -279,11 +308,19 @@ def _face(
     out.reduced_design_stress_Pa = (
         out.reduction_factor * design.yield_stress / design.partial_factor
     )
+    first = ends.index(sigma1)
+    corners = CORNERS[name]
+    out.put_limit_and_widths(
+        effective_widths(INTERNAL, out.reduction_factor, face_width(section, name), psi),
+        psi,
+        f"sigma_1 end: the corner with face {corners[first]}, other end: the corner with "
+        f"face {corners[1 - first]}",
+    )
     return out
 
 
 def _reaches_reduced_stress(face: FaceDesign) -> float:
-    r"""The multiple of the critical load at which ``face`` carries :math:`\rho f_y/\gamma_{M0}`.
+    r"""The multiple of the critical load at which ``face`` carries :math:`\rho f_y/\gamma_M`.
 
     Every face's stress grows with the one load factor: the face that reaches its reduced
     stress first governs (with one compression on every face, the one of the smallest
@@ -332,7 +369,7 @@ def _tension(
             f"the {out.tension_face} face yields in tension first ({clause}): its "
             f"{significant(tension)} Pa at the critical load reaches f_y/gamma_M0 at "
             f"{significant(multiple)} x the critical load, before face {out.governing_face} "
-            f"reaches rho f_y/gamma_M0 (at {significant(compressed)} x): yield governs the "
+            f"reaches rho f_y/gamma_M (at {significant(compressed)} x): yield governs the "
             "section, not the buckling of its faces"
         )
 
@@ -378,6 +415,11 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
                 + ("(clamped: 4 x eq. (4.8))" if section.ends == "clamped" else "(eq. (4.8))")
             )
         rated = [f for f in out.faces if f.reduced_design_stress_Pa is not None]
+        for clause in dict.fromkeys(f.stress_limit_clause for f in rated):
+            out.clauses[0] += (
+                f"; faces {', '.join(f.face for f in rated if f.stress_limit_clause == clause)}: "
+                f"{clause}"
+            )
         if rated:
             first = min(_reaches_reduced_stress(f) for f in rated)
             tied = [f for f in rated if _reaches_reduced_stress(f) <= first * (1.0 + 1e-12)]
@@ -500,7 +542,7 @@ def _tension_text(d: SectionDesignRecord, scale: float, unit: str) -> str:
 def _governing(d: SectionDesignRecord, *, rule: bool = True) -> str:
     r"""The governing face in the summary: its name, or the faces that tie with it.
 
-    Faces that reach :math:`\rho f_y/\gamma_{M0}` at one load tie (every face of a box in
+    Faces that reach :math:`\rho f_y/\gamma_M` at one load tie (every face of a box in
     uniform compression): the line names them all and (``rule``) the rule that picked
     ``governing_face`` (the widest, then the first of ``faces``).
     """
@@ -509,13 +551,21 @@ def _governing(d: SectionDesignRecord, *, rule: bool = True) -> str:
     text = f"faces {', '.join(d.tied_faces)} tie"
     if rule:
         text += (
-            f" (one load to rho f_y/gamma_M0; {d.governing_face} named: the widest, then the first)"
+            f" (one load to rho f_y/gamma_M; {d.governing_face} named: the widest, then the first)"
         )
     return text
 
 
-def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") -> str:
-    """The summary line of a section's design output (stresses in ``unit``, Pa / ``scale``)."""
+def design_line(
+    d: SectionDesignRecord,
+    scale: float = 1.0,
+    unit: str = "Pa",
+    lengths: tuple[float, str] = (1.0, "m"),
+) -> str:
+    """The summary line of a section's design output (stresses in ``unit``, Pa / ``scale``).
+
+    Lengths in ``lengths[1]``, m / ``lengths[0]``.
+    """
     text = (
         f"design: largest compression sigma_cr = {significant(d.sigma_cr_Pa / scale)} {unit}, "
         f"slenderness {significant(d.relative_slenderness)}"
@@ -535,8 +585,11 @@ def design_line(d: SectionDesignRecord, scale: float = 1.0, unit: str = "Pa") ->
         column = ", rho_c 4.5.4(1)" if face.xi is not None and face.xi < 1.0 else ""
         text += (
             f"; EN 1993-1-5 {_governing(d)}: psi = {ratio_text(face.psi)}, {rho}, "
-            f"rho f_y/gamma_M0 = {significant(reduced / scale)} {unit} (psi Table 4.1, "
-            f"slenderness 4.4(2), rho 4.4(2) eq. (4.2){column}, rho f_y/gamma_M0 4.6(1))"
+            f"rho f_y/{face.partial_factor_name} = {significant(reduced / scale)} {unit} "
+            f"(psi Table 4.1, slenderness 4.4(2), "
+            f"rho 4.4(2) eq. (4.2){column}"
+            f"{limit_clause_text(face.psi, face.partial_factor_name)}, "
+            f"b_eff {face.effective_widths_row}){effective_widths_text(face, *lengths)}"
         )
     if d.faces_outside_table:
         text += (

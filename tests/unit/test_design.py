@@ -207,8 +207,9 @@ def test_uniform_compression():
     assert "calibrated on plates buckling freely to both sides" in d.notes[0]
     assert "4.4(2), eq. (4.2)" in d.clauses
     assert "EN 1993-1-5: sigma_cr" in out.summary()
-    # EN 1993-1-5 4.6(1) checks the effective cross-section with gamma_M0 (gamma_M1 is
-    # the member's, EN 1993-1-1 6.3, and section 10's): the factor is named so.
+    # psi = 1: EN 1993-1-5 4.6(1) checks the effective cross-section, A_eff = rho A, with
+    # gamma_M0 (gamma_M1 is the member's, EN 1993-1-1 6.3, and section 10's, which is the
+    # limit at psi < 1: tests/unit/test_effective_widths.py): the factor is named so.
     assert "4.6(1): rho f_y/gamma_M0" in d.clauses
     assert "rho f_y/gamma_M0 = " in out.summary() and "gamma_M1" not in out.summary()
 

@@ -7,7 +7,9 @@ Expected values are written out here from the codes, not read from the package:
   tension edge (or fibre) carries :math:`\sigma_t`; with every stress scaled by one load
   factor it reaches :math:`f_y/\gamma_{M0}` when the compressed edge carries
   :math:`\sigma_1 f_y/(\gamma_{M0}\sigma_t)`, before :math:`\sigma_1` reaches
-  :math:`\rho f_y/\gamma_{M0}` (EN 1993-1-5 4.4(2), 4.6(1)) exactly when
+  :math:`\rho f_y/\gamma_{M1}` (EN 1993-1-5 4.4(2); at :math:`\psi < 1` the reduced
+  stress method, section 10, eq. (10.1), with direct stress alone; the one
+  ``partial_factor`` stands for both factors) exactly when
   :math:`\sigma_1/\sigma_t < \rho`, i.e. :math:`\sigma_t/\sigma_1 > 1/\rho`. The
   reduction factor is eq. (4.2), :math:`\rho = (\bar\lambda_p - 0.055(3 + \psi))/\bar\lambda_p^2`,
   :math:`\bar\lambda_p = \sqrt{f_y/\sigma_1}`.
@@ -61,7 +63,9 @@ def test_a_plate_s_tension_edge_that_yields_first_governs():
     By hand: lambda_p = sqrt(355/400) = 0.9421, above 0.5 + sqrt(0.085 + 0.11) = 0.9416,
     so rho = (0.9421 - 0.055)/0.8875 = 0.9995 (eq. (4.2)); sigma_t/sigma_1 = 2 > 1/rho: the
     tension edge reaches f_y/gamma_M0 = 355/1.1 MPa when sigma_1 = 355/1.1/2 = 161.4 MPa,
-    far below rho f_y/gamma_M0 = 322.6 MPa. Before, only 322.6 MPa was given.
+    far below rho f_y/gamma_M1 = 322.6 MPa (psi < 1: section 10's limit, gamma_M1; the
+    note said gamma_M0, 4.6(1)'s, which checks A_eff and W_eff, not sigma_1 alone).
+    Before, only 322.6 MPa was given.
     """
     spec = _web([-1.0, 2.0], partial_factor=1.1)
     d = design_output(spec, spec.design, 4.0e8)
@@ -72,6 +76,7 @@ def test_a_plate_s_tension_edge_that_yields_first_governs():
     assert d.sigma_1_at_tension_yield_Pa == pytest.approx(FY / 1.1 / 2.0, rel=1e-14)
     assert d.tension_yield_first is True
     assert any("the tension edge yields first (EN 1993-1-1 6.2.1(5))" in n for n in d.notes)
+    assert any(f"below rho f_y/gamma_M1 = {rho * FY / 1.1:#.4g} Pa" in n for n in d.notes)
 
 
 def test_a_plate_s_tension_edge_below_rho_does_not_govern():
@@ -109,11 +114,11 @@ def test_a_plate_s_tension_edge_below_rho_does_not_govern():
     ],
 )
 def test_a_plate_s_tension_edge_between_rho_and_one_does_not_govern(pair, sigma1, rho):
-    """With rho < sigma_t/sigma_1 < 1/rho, sigma_1 reaches rho f_y/gamma_M0 first (6.2.1(5)).
+    """With rho < sigma_t/sigma_1 < 1/rho, sigma_1 reaches rho f_y/gamma_M1 first (6.2.1(5)).
 
     The comparison is of sigma_1 at tension yield, f_y sigma_1/sigma_t, with rho f_y;
     sigma_t/sigma_1 > rho alone called yield first here, with a sigma_1 at yield above
-    rho f_y/gamma_M0 (unsafe: it is not a stress the element carries).
+    rho f_y/gamma_M1 (unsafe: it is not a stress the element carries).
     """
     spec = _web(pair)
     d = design_output(spec, spec.design, sigma1)

@@ -18,7 +18,12 @@ from msgspec import UNSET, Struct, UnsetType, to_builtins
 
 from unibuckle_fenicsx.algorithms.records import ContinuedRecord, MethodDetails
 from unibuckle_fenicsx.certificate.records import CopositivityRecord, SplitRecord
-from unibuckle_fenicsx.design import DesignRecord, significant
+from unibuckle_fenicsx.design import (
+    DesignRecord,
+    effective_widths_text,
+    limit_clause_text,
+    significant,
+)
 from unibuckle_fenicsx.en1993 import ratio_text
 from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
@@ -428,7 +433,11 @@ class BucklingResult(Struct, kw_only=True):
                 f"times the scaled one): {self.critical_total_temperature_K:.6g} K"
             )
         if isinstance(self.design, DesignRecord):
-            lines.append(_design_line(self.design, scale, unit))
+            lines.append(
+                _design_line(
+                    self.design, scale, unit, (length, "m" if self.units == "SI" else "mm")
+                )
+            )
         factor = load.get("fixed_factor", 1.0)
         if fixed and factor:
             times = "" if factor == 1.0 else f"{factor:g} x "
@@ -463,8 +472,10 @@ def _idle_text(idle: list[list[float]], length: float, name: str) -> str:
     )
 
 
-def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
-    """The summary line of the design output."""
+def _design_line(
+    d: DesignRecord, scale: float, unit: str, lengths: tuple[float, str] = (1.0, "m")
+) -> str:
+    """The summary line of the design output (lengths in ``lengths[1]``, m / ``lengths[0]``)."""
     rho = d.reduction_factor
     reduced = d.reduced_design_stress_Pa
     if d.relative_slenderness is None:  # the loaded edges in tension at the critical state
@@ -489,7 +500,8 @@ def _design_line(d: DesignRecord, scale: float, unit: str) -> str:
         + (
             f"{significant(rho)}"
             + column
-            + f", rho f_y/gamma_M0 = {significant(reduced / scale)} {unit}"
+            + f", rho f_y/{d.partial_factor_name} = {significant(reduced / scale)} {unit}"
+            + effective_widths_text(d, *lengths)
             if rho is not None and isinstance(reduced, float)
             else f"none (psi outside {d.table})"
         )
@@ -516,9 +528,15 @@ def _tension_text(d: DesignRecord, scale: float, unit: str) -> str:
 def _design_clauses(d: DesignRecord) -> str:
     """Where each number of the design line comes from in EN 1993-1-5 (JSON: ``clauses``)."""
     table = d.table.split(" (")[0]  # "Table 4.1 (internal compression element)"
+    if d.element == "outstand":  # the row: "larger compression at the free edge"
+        table += f" ({d.table.split(', ')[-1].rstrip(')')})"
     rho = "eq. (4.3)" if d.element == "outstand" else "eq. (4.2)"
     column = ", rho_c 4.5.4(1)" if d.xi is not None and d.xi < 1.0 else ""
-    return f"psi {table}, slenderness 4.4(2), rho 4.4(2) {rho}{column}, rho f_y/gamma_M0 4.6(1)"
+    return (
+        f"psi {table}, slenderness 4.4(2), rho 4.4(2) {rho}{column}"
+        + limit_clause_text(d.psi, d.partial_factor_name)
+        + (f", b_eff {d.effective_widths_row}" if d.effective_widths_row else "")
+    )
 
 
 def _design_lower(d: DesignRecord, scale: float, unit: str) -> str:

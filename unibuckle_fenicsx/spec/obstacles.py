@@ -214,10 +214,14 @@ class DesignSpec(Table, frozen=True):
     Args:
         yield_stress: :math:`f_y` (Pa), > 0: a steel's, 1.5e8 to 1e9 Pa
             (:data:`~unibuckle_fenicsx.en1993.STEEL_YIELD_STRESS`), else refused.
-        partial_factor: :math:`\gamma_{M0}`, >= 1, the factor of EN 1993-1-5 4.6(1)'s
-            check of the effective cross-section (:math:`f_y A_{eff}/\gamma_{M0}`); 1.0,
-            the recommended value of EN 1993-1-1, 6.1 (a resistance factor below 1 would
-            put the design stress above the reduced characteristic one, rho f_y).
+        partial_factor: :math:`\gamma_M`, >= 1, of the stress limit :math:`\rho
+            f_y/\gamma_M`: :math:`\gamma_{M0}` at :math:`\psi = 1` (EN 1993-1-5 4.6(1),
+            the effective cross-section, :math:`f_y A_{eff}/\gamma_{M0}`) and in the
+            tension-yield check (EN 1993-1-1 6.2.1(5)); :math:`\gamma_{M1}` at
+            :math:`\psi < 1` (EN 1993-1-5 section 10, the reduced stress method); the
+            output names which (``partial_factor_name``). 1.0, the recommended value of
+            both (EN 1993-1-1, 6.1; a resistance factor below 1 would put the design
+            stress above the reduced characteristic one, rho f_y).
     """
 
     KEY: ClassVar[str] = "design"

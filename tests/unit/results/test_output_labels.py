@@ -134,13 +134,22 @@ def _plate(edges_top: dict[str, object]) -> str:
             {"support": "simply_supported"},
             "psi Table 4.1, slenderness 4.4(2), rho 4.4(2) eq. (4.2)",
         ),
-        # Top edge free: an outstand, psi from Table 4.2, rho by eq. (4.3).
-        ({"support": "free"}, "psi Table 4.2, slenderness 4.4(2), rho 4.4(2) eq. (4.3)"),
+        # Top edge free: an outstand, psi from Table 4.2, rho by eq. (4.3). Uniform
+        # compression (psi = 1) reaches the free edge: the table's upper row, "larger
+        # compression at the free edge" (psi = 1 lies in both rows; the package takes the
+        # free edge's, as the JSON's ``table``). The line said "psi Table 4.2" without the
+        # row, which decides psi's range and k_sigma: now it names it.
+        (
+            {"support": "free"},
+            "psi Table 4.2 (larger compression at the free edge), slenderness 4.4(2), rho "
+            "4.4(2) eq. (4.3)",
+        ),
     ],
 )
 def test_the_plate_design_line_names_the_clause_of_each_value(top, clauses):
     line = _plate(top)
     assert clauses in line, line
+    # psi = 1: 4.6(1), eq. (4.14), with A_eff = rho A, reads sigma_1 <= rho f_y/gamma_M0.
     assert "rho f_y/gamma_M0 4.6(1)" in line, line
 
 
