@@ -438,3 +438,71 @@ def test_auto_on_a_clamped_box_of_twelve_thousand_dofs():
         assert result.method_chosen_by.startswith("auto: about 12672 DOFs")
         assert result.certificate.kkt
         assert result.critical_load_Pa <= bound * (1.0 + 1e-7)
+
+
+#: A rectangular filled box, b = 0.2 m, d = 0.1 m, t = 2 mm, L = 0.3 m between simply
+#: supported ends, 25 mm cells: 6 x 24 x 13 = 1 872 DOFs, "auto" runs both routes from
+#: a coarser section of 6 x 12 x 7 = 504 DOFs (levels = 1).
+RECTANGULAR_BOX = {
+    "width": 0.2, "depth": 0.1, "thickness": 0.002, "length": 0.3, "E": E, "nu": NU,
+    "mesh_size": 0.025, "ends": "simply_supported", "core": True,
+}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def rectangular_box_bound() -> float:
+    """The interior point's mode on the box's own cells, made admissible: an upper bound.
+
+    ``levels = 0``: the starts run on the given section and reach a KKT point at
+    1.500221e8 Pa; its mode made admissible by hand and its Rayleigh quotient on the
+    assembled matrices (_box_admissible_rayleigh_quotient) bound the critical load
+    from above, whatever the route that produced the mode.
+    """
+    box = SectionParameters("box", **RECTANGULAR_BOX)
+    given = SolverSpec(method="interior-point")
+    with solve_section(box, MPI.COMM_SELF, levels=0, solver=given) as interior:
+        bound, removed = _box_admissible_rayleigh_quotient(interior, 0.2, 0.1)
+        assert interior.result.certificate.kkt
+        assert removed < 1e-6  # the mode was admissible to the tolerance already
+    return bound
+
+
+def test_auto_on_a_rectangular_box_ends_no_higher_than_the_starts_on_its_cells(
+    rectangular_box_bound,
+):
+    """The default route's coarser section of fewer than COARSEST_DOFS is not trusted alone.
+
+    With ``levels = 1`` the interior point started on 50 mm cells (2 across the 0.1 m
+    face, about 500 DOFs): its starts met one arrangement there, carried up to a KKT
+    point at 1.506630e8 Pa, where the active set's seeds ended too; the starts on the
+    given cells reach 1.500221e8 Pa (0.43 % lower). The reference is the admissible
+    mode's Rayleigh quotient of the fixture (an upper bound on the critical load).
+    """
+    assert rectangular_box_bound == pytest.approx(1.500221e8, rel=1e-5)
+    box = SectionParameters("box", **RECTANGULAR_BOX)
+    with solve_section(box, MPI.COMM_SELF) as solved:  # "auto", levels 1
+        result = solved.result
+        assert result.method_chosen_by.startswith("auto: about 1872 DOFs")
+        assert result.certificate.kkt
+        assert result.critical_load_Pa <= rectangular_box_bound * (1.0 + 1e-7)
+
+
+@pytest.mark.parametrize("stiffness", [6e11, 1e13])
+def test_an_elastic_core_ends_no_higher_than_the_rigid_cores_admissible_mode(
+    stiffness, rectangular_box_bound
+):
+    """A foundation's critical load is at most the rigid core's (its quotient's springs).
+
+    The spring quotient of a mode that presses no spring is its Rayleigh quotient, so
+    the rigid core's admissible mode bounds every elastic core's critical load from
+    above (the fixture's bound). The spring-set iteration's start from the rigid core's
+    contact set took the active set's KKT point on the elastic core's problem, 1.506630e8
+    Pa, and the core of 6e11 N/m^3 ended at 1.505791e8 Pa, of 1e13 at 1.506577e8 Pa:
+    above the bound. It now takes the rigid core's route.
+    """
+    box = SectionParameters("box", **RECTANGULAR_BOX, foundation_stiffness=stiffness)
+    with solve_section(box, MPI.COMM_SELF) as solved:
+        result = solved.result
+        assert result.method == "foundation"
+        assert result.free_load_Pa <= result.critical_load_Pa
+        assert result.critical_load_Pa <= rectangular_box_bound * (1.0 + 1e-7)

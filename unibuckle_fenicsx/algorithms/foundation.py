@@ -29,7 +29,8 @@ of the quotient, is an upper bound of :math:`\lambda_f`. The iteration starts fr
 free plate (no springs) and from every spring active (the bilateral foundation's mode);
 for stiff springs (:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`) also from
 the set a continuation in the stiffness ends on, and above :data:`RIGID_START_RATIO`
-from the rigid obstacle's contact set (the active set's); the smallest quotient is
+from the rigid obstacle's contact set (the active set's, or a section's rigid core's
+route); the smallest quotient is
 returned. A node of the spring set keeps pressing while its spring force exceeds
 :data:`~unibuckle_fenicsx.tolerances.PRESSING_RTOL` of the largest: a stiff spring's
 node presses by less than that fraction of max|w|, and would otherwise leave and return
@@ -56,6 +57,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -94,6 +96,7 @@ def solve_foundation(
     *,
     max_iterations: int = 100,
     eps_options: dict[str, str | float | int] | None = None,
+    rigid_set: Callable[[], tuple[npt.NDArray[np.int64], int]] | None = None,
 ) -> UnilateralSolution:
     r"""Critical load of the plate on its tensionless foundation (module docstring).
 
@@ -102,6 +105,11 @@ def solve_foundation(
             (``problem.tensionless``).
         max_iterations: Eigen solves allowed per start, >= 1.
         eps_options: Extra EPS options under ``unibuckle_foundation_``.
+        rigid_set: Gives the rigid obstacle's contact set on the problem's contact
+            directions and its eigen solves, for the start from it (run only above
+            :data:`RIGID_START_RATIO`); None: the active set on ``problem``. A section
+            passes its rigid core's route, whose KKT point can lie below the active
+            set's (:doc:`/history/2026-12-01a-coreroute`).
 
     Returns:
         The solution; its candidate's load is the quotient of the returned mode, its
@@ -121,7 +129,9 @@ def solve_foundation(
     lower = problem.solve_free().load
     springs = contact.stiffness
     ratio = stiffness_ratio(problem, springs)
-    rigid = _rigid_set(problem) if ratio > RIGID_START_RATIO else None
+    rigid = None
+    if ratio > RIGID_START_RATIO:
+        rigid = _rigid_set(problem) if rigid_set is None else rigid_set()
     runs: dict[str, SpringIteration] = {}
     finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
     with PenaltySolver(problem, prefix=Prefix.FOUNDATION, eps_options=eps_options) as solver:
