@@ -359,8 +359,10 @@ def test_a_rigid_cores_method_without_one_is_refused_naming_the_key(
     assert choose_section_method(box, SolverSpec())[0] in ("free", "foundation")
 
 
-def _box_admissible_rayleigh_quotient(analysis, width, depth) -> tuple[float, float]:
+def _box_admissible_rayleigh_quotient(analysis, width, depth, span=None) -> tuple[float, float]:
     """The box's :func:`_admissible_rayleigh_quotient`: each face's inward part removed.
+
+    ``span``: the core's (x from, x to); None: the whole length.
 
     A wall node on the face y = +b/2 may only move to +y, on y = -b/2 to -y, and so on
     for z (a corner node both ways): the translation's component into the core is set
@@ -377,6 +379,8 @@ def _box_admissible_rayleigh_quotient(analysis, width, depth) -> tuple[float, fl
     for axis, half in ((1, 0.5 * width), (2, 0.5 * depth)):
         for side in (1.0, -1.0):
             on = np.abs(X[:, axis] - side * half) < 1e-9
+            if span is not None:
+                on &= (X[:, 0] > span[0] - 1e-9) & (X[:, 0] < span[1] + 1e-9)
             inward = np.maximum(-side * u[on, axis], 0.0)
             removed = max(removed, float(inward.max(initial=0.0)) / scale)
             u[on, axis] += side * inward
@@ -506,3 +510,24 @@ def test_an_elastic_core_ends_no_higher_than_the_rigid_cores_admissible_mode(
         assert result.method == "foundation"
         assert result.free_load_Pa <= result.critical_load_Pa
         assert result.critical_load_Pa <= rectangular_box_bound * (1.0 + 1e-7)
+
+
+def test_an_elastic_core_whose_coarser_section_holds_no_core_node_is_solved():
+    """The elastic core's rigid start drops the levels a rigid core would refuse.
+
+    The box b = d = 0.2 m, L = 0.6 m on 25 mm cells with a core over 0.31..0.34 m holds
+    core nodes at 0.325 m, none on 50 mm cells: a rigid core with ``levels = 1`` is
+    refused naming mesh.levels. The elastic core asks no levels; its start from the
+    rigid core's set runs on the given section. The bound is the rigid core's
+    ``levels = 0`` mode made admissible by hand, its Rayleigh quotient (a foundation's
+    load is at most it: the mode presses no spring).
+    """
+    rigid = _square_box(0.2, 0.6, 0.025, core_span=(0.31, 0.34))
+    with solve_section(rigid, MPI.COMM_SELF, levels=0) as solved:
+        bound, removed = _box_admissible_rayleigh_quotient(solved, 0.2, 0.2, (0.31, 0.34))
+        assert solved.result.certificate.kkt and removed < 1e-6
+    elastic = _square_box(0.2, 0.6, 0.025, core_span=(0.31, 0.34), foundation_stiffness=1e15)
+    with solve_section(elastic, MPI.COMM_SELF) as solved:  # levels 1
+        result = solved.result
+        assert result.method == "foundation"
+        assert result.free_load_Pa <= result.critical_load_Pa <= bound * (1.0 + 1e-7)

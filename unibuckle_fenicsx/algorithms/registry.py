@@ -242,7 +242,8 @@ def _rigid_core_set(
 
     The route "auto" takes for the same section with a rigid core
     (:func:`~unibuckle_fenicsx.analysis.choose_section_method`), on ``levels`` coarser
-    sections or as many as it allows (:func:`~.section_levels.most_levels`); its contact
+    sections or as many as it allows (:func:`~.section_levels.most_levels`), none if a
+    coarser section cannot be built (the elastic core asks no levels); its contact
     set is carried to ``section``'s directions (the same mesh:
     :func:`~.section_levels.prolong_directions` maps each direction to itself). The
     active set on the elastic core's own problem can end at a higher KKT point than the
@@ -256,7 +257,13 @@ def _rigid_core_set(
     runner = entry(method).solve_section
     if runner is None or section.constraints is None:
         raise RuntimeError("the rigid core's route has no section runner")
-    rigid_section, solution = runner(rigid, min(levels, most_levels(rigid)), comm, solver)
+    levels = min(levels, most_levels(rigid))
+    try:
+        rigid_section, solution = runner(rigid, levels, comm, solver)
+    except InputError:  # a coarser section the core covers no node of: the given one's
+        if levels == 0:
+            raise
+        rigid_section, solution = runner(rigid, 0, comm, solver)
     try:
         if rigid_section.constraints is None:
             raise RuntimeError("a core section without constraints")
