@@ -359,8 +359,10 @@ def test_a_rigid_cores_method_without_one_is_refused_naming_the_key(
     assert choose_section_method(box, SolverSpec())[0] in ("free", "foundation")
 
 
-def _box_admissible_rayleigh_quotient(analysis, width, depth) -> tuple[float, float]:
+def _box_admissible_rayleigh_quotient(analysis, width, depth, span=None) -> tuple[float, float]:
     """The box's :func:`_admissible_rayleigh_quotient`: each face's inward part removed.
+
+    ``span``: the core's (x from, x to); None: the whole length.
 
     A wall node on the face y = +b/2 may only move to +y, on y = -b/2 to -y, and so on
     for z (a corner node both ways): the translation's component into the core is set
@@ -377,6 +379,8 @@ def _box_admissible_rayleigh_quotient(analysis, width, depth) -> tuple[float, fl
     for axis, half in ((1, 0.5 * width), (2, 0.5 * depth)):
         for side in (1.0, -1.0):
             on = np.abs(X[:, axis] - side * half) < 1e-9
+            if span is not None:
+                on &= (X[:, 0] > span[0] - 1e-9) & (X[:, 0] < span[1] + 1e-9)
             inward = np.maximum(-side * u[on, axis], 0.0)
             removed = max(removed, float(inward.max(initial=0.0)) / scale)
             u[on, axis] += side * inward
@@ -438,3 +442,92 @@ def test_auto_on_a_clamped_box_of_twelve_thousand_dofs():
         assert result.method_chosen_by.startswith("auto: about 12672 DOFs")
         assert result.certificate.kkt
         assert result.critical_load_Pa <= bound * (1.0 + 1e-7)
+
+
+#: A rectangular filled box, b = 0.2 m, d = 0.1 m, t = 2 mm, L = 0.3 m between simply
+#: supported ends, 25 mm cells: 6 x 24 x 13 = 1 872 DOFs, "auto" runs both routes from
+#: a coarser section of 6 x 12 x 7 = 504 DOFs (levels = 1).
+RECTANGULAR_BOX = {
+    "width": 0.2, "depth": 0.1, "thickness": 0.002, "length": 0.3, "E": E, "nu": NU,
+    "mesh_size": 0.025, "ends": "simply_supported", "core": True,
+}  # fmt: skip
+
+
+@pytest.fixture(scope="module")
+def rectangular_box_bound() -> float:
+    """The interior point's mode on the box's own cells, made admissible: an upper bound.
+
+    ``levels = 0``: the starts run on the given section and reach a KKT point at
+    1.500221e8 Pa; its mode made admissible by hand and its Rayleigh quotient on the
+    assembled matrices (_box_admissible_rayleigh_quotient) bound the critical load
+    from above, whatever the route that produced the mode.
+    """
+    box = SectionParameters("box", **RECTANGULAR_BOX)
+    given = SolverSpec(method="interior-point")
+    with solve_section(box, MPI.COMM_SELF, levels=0, solver=given) as interior:
+        bound, removed = _box_admissible_rayleigh_quotient(interior, 0.2, 0.1)
+        assert interior.result.certificate.kkt
+        assert removed < 1e-6  # the mode was admissible to the tolerance already
+    return bound
+
+
+def test_auto_on_a_rectangular_box_ends_no_higher_than_the_starts_on_its_cells(
+    rectangular_box_bound,
+):
+    """The default route's coarser section of fewer than COARSEST_DOFS is not trusted alone.
+
+    With ``levels = 1`` the interior point started on 50 mm cells (2 across the 0.1 m
+    face, about 500 DOFs): its starts met one arrangement there, carried up to a KKT
+    point at 1.506630e8 Pa, where the active set's seeds ended too; the starts on the
+    given cells reach 1.500221e8 Pa (0.43 % lower). The reference is the admissible
+    mode's Rayleigh quotient of the fixture (an upper bound on the critical load).
+    """
+    assert rectangular_box_bound == pytest.approx(1.500221e8, rel=1e-5)
+    box = SectionParameters("box", **RECTANGULAR_BOX)
+    with solve_section(box, MPI.COMM_SELF) as solved:  # "auto", levels 1
+        result = solved.result
+        assert result.method_chosen_by.startswith("auto: about 1872 DOFs")
+        assert result.certificate.kkt
+        assert result.critical_load_Pa <= rectangular_box_bound * (1.0 + 1e-7)
+
+
+@pytest.mark.parametrize("stiffness", [6e11, 1e13])
+def test_an_elastic_core_ends_no_higher_than_the_rigid_cores_admissible_mode(
+    stiffness, rectangular_box_bound
+):
+    """A foundation's critical load is at most the rigid core's (its quotient's springs).
+
+    The spring quotient of a mode that presses no spring is its Rayleigh quotient, so
+    the rigid core's admissible mode bounds every elastic core's critical load from
+    above (the fixture's bound). The spring-set iteration's start from the rigid core's
+    contact set took the active set's KKT point on the elastic core's problem, 1.506630e8
+    Pa, and the core of 6e11 N/m^3 ended at 1.505791e8 Pa, of 1e13 at 1.506577e8 Pa:
+    above the bound. It now takes the rigid core's route.
+    """
+    box = SectionParameters("box", **RECTANGULAR_BOX, foundation_stiffness=stiffness)
+    with solve_section(box, MPI.COMM_SELF) as solved:
+        result = solved.result
+        assert result.method == "foundation"
+        assert result.free_load_Pa <= result.critical_load_Pa
+        assert result.critical_load_Pa <= rectangular_box_bound * (1.0 + 1e-7)
+
+
+def test_an_elastic_core_whose_coarser_section_holds_no_core_node_is_solved():
+    """The elastic core's rigid start drops the levels a rigid core would refuse.
+
+    The box b = d = 0.2 m, L = 0.6 m on 25 mm cells with a core over 0.31..0.34 m holds
+    core nodes at 0.325 m, none on 50 mm cells: a rigid core with ``levels = 1`` is
+    refused naming mesh.levels. The elastic core asks no levels; its start from the
+    rigid core's set runs on the given section. The bound is the rigid core's
+    ``levels = 0`` mode made admissible by hand, its Rayleigh quotient (a foundation's
+    load is at most it: the mode presses no spring).
+    """
+    rigid = _square_box(0.2, 0.6, 0.025, core_span=(0.31, 0.34))
+    with solve_section(rigid, MPI.COMM_SELF, levels=0) as solved:
+        bound, removed = _box_admissible_rayleigh_quotient(solved, 0.2, 0.2, (0.31, 0.34))
+        assert solved.result.certificate.kkt and removed < 1e-6
+    elastic = _square_box(0.2, 0.6, 0.025, core_span=(0.31, 0.34), foundation_stiffness=1e15)
+    with solve_section(elastic, MPI.COMM_SELF) as solved:  # levels 1
+        result = solved.result
+        assert result.method == "foundation"
+        assert result.free_load_Pa <= result.critical_load_Pa <= bound * (1.0 + 1e-7)

@@ -28,8 +28,8 @@ non-negative, and vanishes on the rigid obstacle's mode), and the returned load,
 of the quotient, is an upper bound of :math:`\lambda_f`. The iteration starts from the
 free plate (no springs), from every spring active (the bilateral foundation's mode) and,
 on a plate, from the contact set of the rigid obstacle's answer (:func:`_rigid_set`; a
-section's core above :data:`RIGID_START_RATIO`, from the active set's); for stiff springs
-(:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`) also from the set a
+section's core above :data:`RIGID_START_RATIO`, from its rigid core's route); for stiff
+springs (:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`) also from the set a
 continuation in the stiffness ends on; the smallest quotient is returned. The rigid start
 is what keeps the answer at or below the rigid obstacle's load, and non-decreasing in
 :math:`k_f`: without it, the other starts can all end at stationary points above the
@@ -61,6 +61,7 @@ from __future__ import annotations
 
 import logging
 import math
+from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
@@ -104,6 +105,7 @@ def solve_foundation(
     *,
     max_iterations: int = 100,
     eps_options: dict[str, str | float | int] | None = None,
+    rigid_set: Callable[[], tuple[npt.NDArray[np.int64], int]] | None = None,
 ) -> UnilateralSolution:
     r"""Critical load of the plate on its tensionless foundation (module docstring).
 
@@ -112,6 +114,11 @@ def solve_foundation(
             (``problem.tensionless``).
         max_iterations: Eigen solves allowed per start, >= 1.
         eps_options: Extra EPS options under ``unibuckle_foundation_``.
+        rigid_set: Gives the rigid obstacle's contact set on the problem's contact
+            directions and its eigen solves, for the start from it (on a section, run
+            only above :data:`RIGID_START_RATIO`); None: :func:`_rigid_set`. A section
+            passes its rigid core's route, whose KKT point can lie below the active
+            set's (:doc:`/history/2026-12-01a-coreroute`).
 
     Returns:
         The solution; its candidate's load is the quotient of the returned mode, its
@@ -131,7 +138,9 @@ def solve_foundation(
     lower = problem.solve_free().load
     springs = contact.stiffness
     ratio = stiffness_ratio(problem, springs)
-    rigid = _rigid_set(problem) if ratio > RIGID_START_RATIO or _plate(problem) else None
+    rigid = None
+    if ratio > RIGID_START_RATIO or _plate(problem):
+        rigid = _rigid_set(problem) if rigid_set is None else rigid_set()
     runs: dict[str, SpringIteration] = {}
     finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
     with PenaltySolver(problem, prefix=Prefix.FOUNDATION, eps_options=eps_options) as solver:

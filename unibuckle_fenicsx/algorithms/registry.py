@@ -32,12 +32,14 @@ runner only.
 from __future__ import annotations
 
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Any
 
 from mpi4py import MPI
 
 import msgspec
+import numpy as np
+import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
@@ -46,7 +48,13 @@ from unibuckle_fenicsx.algorithms.enumeration import enumerate_contact_sets
 from unibuckle_fenicsx.algorithms.foundation import solve_foundation
 from unibuckle_fenicsx.algorithms.interior_point.options import ChainOptions
 from unibuckle_fenicsx.algorithms.penalty import solve_penalty
-from unibuckle_fenicsx.algorithms.section_levels import BOTH, CHECKED, solve_levels
+from unibuckle_fenicsx.algorithms.section_levels import (
+    BOTH,
+    CHECKED,
+    most_levels,
+    prolong_directions,
+    solve_levels,
+)
 from unibuckle_fenicsx.errors import FieldError, InputError
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
@@ -205,14 +213,65 @@ def _section_levels(route: str) -> SectionRun:
 def _section_foundation(
     parameters: SectionParameters, levels: int, comm: MPI.Comm, solver: SolverSpec
 ) -> tuple[Section, UnilateralSolution]:
-    """An elastic core: the spring-set iteration on the section itself (no coarser ones)."""
+    """An elastic core: the spring-set iteration on the section itself (no coarser ones).
+
+    Its start from the rigid core's contact set takes the rigid core's route
+    (:func:`_rigid_core_set`, ``levels`` as far as the rigid core allows them).
+    """
     section = build_section(parameters, comm, solver)
     try:
-        solution = solve_foundation(section.cored, max_iterations=solver.max_iterations)
+        solution = solve_foundation(
+            section.cored,
+            max_iterations=solver.max_iterations,
+            rigid_set=lambda: _rigid_core_set(parameters, section, levels, comm, solver),
+        )
     except BaseException:
         section.destroy()
         raise
     return section, solution
+
+
+def _rigid_core_set(
+    parameters: SectionParameters,
+    section: Section,
+    levels: int,
+    comm: MPI.Comm,
+    solver: SolverSpec,
+) -> tuple[npt.NDArray[np.int64], int]:
+    """The rigid core's contact set on the elastic core's ``section``, and its eigen solves.
+
+    The route "auto" takes for the same section with a rigid core
+    (:func:`~unibuckle_fenicsx.analysis.choose_section_method`), on ``levels`` coarser
+    sections or as many as it allows (:func:`~.section_levels.most_levels`), none if a
+    coarser section cannot be built (the elastic core asks no levels); its contact
+    set is carried to ``section``'s directions (the same mesh:
+    :func:`~.section_levels.prolong_directions` maps each direction to itself). The
+    active set on the elastic core's own problem can end at a higher KKT point than the
+    rigid core's route, and the elastic core then above the rigid core's load, which no
+    foundation exceeds (:doc:`/history/2026-12-01a-coreroute`). Collective.
+    """
+    from unibuckle_fenicsx.analysis import choose_section_method  # imports this module
+
+    rigid = replace(parameters, foundation_stiffness=None)
+    method, _ = choose_section_method(rigid, solver)  # an elastic core's method is auto
+    runner = entry(method).solve_section
+    if runner is None or section.constraints is None:
+        raise RuntimeError("the rigid core's route has no section runner")
+    levels = min(levels, most_levels(rigid))
+    try:
+        rigid_section, solution = runner(rigid, levels, comm, solver)
+    except InputError:  # a coarser section the core covers no node of: the given one's
+        if levels == 0:
+            raise
+        rigid_section, solution = runner(rigid, 0, comm, solver)
+    try:
+        if rigid_section.constraints is None:
+            raise RuntimeError("a core section without constraints")
+        active = prolong_directions(solution.active, rigid_section.constraints, section.constraints)
+        solves = solution.eigensolves + rigid_section.problem.free_solves
+    finally:
+        rigid_section.destroy()
+    return active, solves
 
 
 #: Every method that runs, by name (``auto`` is a choice among them, not one of them):

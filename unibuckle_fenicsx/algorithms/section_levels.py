@@ -27,7 +27,11 @@ eigenpair checked against the KKT conditions. Near where a wall lifts off the co
 mode's tails make the active set's steps flip directions a few at a time, more the finer
 the mesh; the barrier moves them all at once. If it reaches no KKT point, the active-set
 route runs on the sections it built (the finest and the coarser ones the active set
-starts on: assembled, prestressed and their free modes solved once).
+starts on: assembled, prestressed and their free modes solved once). Where the
+``levels`` asked make the chain start on a section of fewer than :data:`COARSEST_DOFS`,
+its starts run once more on the coarsest section of at least that many (or the given
+one), and the lower KKT point is kept (:func:`_starts_coarse_enough`): so coarse a
+section can merge arrangements that the finer ones tell apart.
 
 Which route runs is decided with the plate's method, in one place
 (:func:`~unibuckle_fenicsx.analysis.choose_section_method`, ``"auto"``: the interior
@@ -49,7 +53,7 @@ from __future__ import annotations
 import itertools
 import logging
 import time
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from dataclasses import replace
 
 from mpi4py import MPI
@@ -96,6 +100,7 @@ __all__ = [
     "SEEDS",
     "estimated_dofs",
     "interior_levels",
+    "most_levels",
     "prolong_directions",
     "solve_levels",
 ]
@@ -157,7 +162,8 @@ CHAIN_OPTIONS = ChainOptions(arrangements=1, read_predicted=True, release_steps=
 #: while the coarser section keeps this many DOFs (more if ``levels`` asks). The
 #: starts take a few hundred Newton steps there; on the sections of
 #: :doc:`/verification/sections` ("Cost") a coarsest section of 1 000 to 2 500 DOFs
-#: ranked their arrangements as the finest did.
+#: ranked their arrangements as the finest did. Where ``levels`` makes the chain start
+#: on a coarser one, the starts run on such a section too (:func:`_starts_coarse_enough`).
 COARSEST_DOFS = 1_000
 
 
@@ -250,7 +256,7 @@ def interior_levels(parameters: SectionParameters, levels: int) -> int:
 
     More while the coarsest keeps :data:`COARSEST_DOFS` (estimated: :func:`estimated_dofs`).
     """
-    k, most = 0, _most_levels(parameters)
+    k, most = 0, most_levels(parameters)
     while k < most and estimated_dofs(_at(parameters, 2.0 ** (k + 1))) >= COARSEST_DOFS:
         k += 1
     return max(levels, k)
@@ -318,14 +324,7 @@ def _interior_point(
     try:
         _build_all(parameters, levels, asked, comm, solver, sections)
         problems = [section.cored for section in sections]
-        solution = solve_interior_point(
-            problems[-1],
-            CHAIN_OPTIONS,
-            coarser=problems[:-1],
-            carrier=SectionProlongation,
-            fallback=active_set,
-        )
-        solution.method = "interior-point (section levels)"
+        solution = _chain(sections, active_set)
         if route == BOTH and not fell_back:
             solution = _lower(solution, active_set(problems[-1]))
         elif route == CHECKED and not fell_back:
@@ -333,6 +332,7 @@ def _interior_point(
             penalty += seeds_penalty
             if carried is not None:
                 solution = _lower(solution, carried)
+        solution = _starts_coarse_enough(sections, solution)
         # Every section's solves, the chain's, the active set's and its penalty
         # continuations' (the finest's free solve is the result's own).
         total = sum(p.eigensolver.solves for p in problems) - problems[-1].free_solves + penalty
@@ -451,6 +451,65 @@ def _seeds_carried(
     return found, penalty
 
 
+class _NoKKTPoint(Exception):
+    """The chain of :func:`_starts_coarse_enough` reached no KKT point (no fallback)."""
+
+
+def _starts_coarse_enough(
+    sections: Sequence[Section], solution: UnilateralSolution
+) -> UnilateralSolution:
+    """The chain's starts again on the coarsest section of :data:`COARSEST_DOFS` or more.
+
+    The ``levels`` asked may make the chain start on a section of fewer DOFs than
+    :data:`COARSEST_DOFS`, where the starts merge arrangements the finer sections tell
+    apart: a rectangular filled box's coarser section (2 cells across its narrower face)
+    gave one KKT point, carried up to a higher one than the starts on the given section
+    reach (:doc:`/history/2026-12-01a-coreroute`). There the chain runs once more from
+    the first section (coarsest first) of at least :data:`COARSEST_DOFS`, or the given
+    one, and its KKT point is kept where it is lower than ``solution``'s by more than
+    :data:`SAME_LOAD`. ``solution`` is returned otherwise, also when that chain reaches
+    no KKT point (no fallback runs for it). Collective.
+    """
+    dofs = [section.model.num_dofs for section in sections]
+    first = next((k for k, n in enumerate(dofs) if n >= COARSEST_DOFS), len(sections) - 1)
+    if first == 0:  # the chain started there
+        return solution
+
+    def no_fallback(_: UnilateralProblem) -> UnilateralSolution:
+        raise _NoKKTPoint
+
+    try:
+        again = _chain(sections[first:], no_fallback)
+    except _NoKKTPoint:
+        logger.info("section: the starts on %d DOFs reach no KKT point", dofs[first])
+        return solution
+    logger.info(
+        "section: the starts on %d DOFs %.10g (KKT %s), the route's %.10g: the lower kept",
+        dofs[first], again.load, again.candidate.kkt, solution.load,
+    )  # fmt: skip
+    lower = not solution.candidate.kkt or again.load < solution.load * (1.0 - SAME_LOAD)
+    return again if again.candidate.kkt and lower else solution
+
+
+def _chain(
+    sections: Sequence[Section], fallback: Callable[[UnilateralProblem], UnilateralSolution]
+) -> UnilateralSolution:
+    """The interior point's chain from ``sections[0]`` to ``sections[-1]`` (coarsest first).
+
+    ``fallback`` solves the finest when the chain reaches no KKT point. Collective.
+    """
+    problems = [section.cored for section in sections]
+    solution = solve_interior_point(
+        problems[-1],
+        CHAIN_OPTIONS,
+        coarser=problems[:-1],
+        carrier=SectionProlongation,
+        fallback=fallback,
+    )
+    solution.method = "interior-point (section levels)"
+    return solution
+
+
 def _lower(chain: UnilateralSolution, other: UnilateralSolution) -> UnilateralSolution:
     """The lower of two KKT points of the same section: the chain's unless ``other`` is lower.
 
@@ -526,7 +585,7 @@ def _active_set(
     return prev, replace(best, details=details, eigensolves=total)
 
 
-def _most_levels(parameters: SectionParameters) -> int:
+def most_levels(parameters: SectionParameters) -> int:
     """The most coarser sections with 2 cells along the member (SectionParameters accepts)."""
     most = 0
     while parameters.mesh_size * 2.0 ** (most + 1) * (1.0 + 1e-9) < parameters.length:
@@ -539,7 +598,7 @@ def check_levels(parameters: SectionParameters, levels: int) -> None:
 
     The message in the units of the file solved (:func:`~unibuckle_fenicsx.spec.base.file_units`).
     """
-    most = _most_levels(parameters)
+    most = most_levels(parameters)
     if levels > most:
         coarsest, name = in_file(parameters.mesh_size * 2.0**levels, "m")
         length, _ = in_file(parameters.length, "m")
