@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import re
+from importlib import metadata
 from typing import Any
 
 from unibuckle_fenicsx.cli.status import (
@@ -232,6 +233,9 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
             "Arguments starting with a single dash that argparse does not know "
             "(-unibuckle_eps_view, ...) go to PETSc/SLEPc."
         ),
+    )
+    parser.add_argument(
+        "--version", action="version", version=f"%(prog)s {metadata.version('unibuckle_fenicsx')}"
     )
     sub = parser.add_subparsers(dest="command", required=True, metavar="COMMAND")
     common, problem = common_flags(), problem_flags()

@@ -55,6 +55,16 @@ def run_script(*args: str, cwd: Path) -> subprocess.CompletedProcess[str]:
     return subprocess.run([str(SCRIPT), *args], capture_output=True, text=True, env=env, cwd=cwd)
 
 
+def test_version(tmp_path):
+    """``unibuckle --version`` prints the version pyproject.toml declares, and exits 0."""
+    import tomllib
+
+    declared = tomllib.loads((ROOT / "pyproject.toml").read_text())["project"]["version"]
+    out = run_script("--version", cwd=tmp_path)
+    assert out.returncode == 0, out.stderr
+    assert out.stdout.strip() == f"unibuckle {declared}"
+
+
 def test_help(tmp_path):
     top = run_script("--help", cwd=tmp_path)
     assert top.returncode == 0, top.stderr
