@@ -38,7 +38,14 @@ from unibuckle_fenicsx.results.records import BucklingResult
 from unibuckle_fenicsx.spec import Method, ProblemSpec, SolverSpec
 from unibuckle_fenicsx.spec.section import check_section_method
 
-__all__ = ["FREE", "Analysis", "choose_method", "choose_section_method", "solve"]
+__all__ = [
+    "FREE",
+    "Analysis",
+    "choose_method",
+    "choose_section_method",
+    "method_without_enumeration",
+    "solve",
+]
 
 #: The "method" of a problem without obstacle (a section without core): its free load.
 FREE = "free"
@@ -92,11 +99,7 @@ def choose_method(
         return Method.ENUMERATE, f"--candidate-parallel: 2^{i} = {shown} candidate sets"
     if options.method != Method.AUTO:
         return options.method, "given"
-    plate = spec.plate
-    slenderness = plate.thickness / min(plate.length, plate.width)
-    thin = thin_plate(spec)
-    local = Method.INTERIOR_POINT if thin else Method.ACTIVE_SET
-    why = f"t/b = {slenderness:.3g} {'<' if thin else '>='} {THIN_PLATE:g}"
+    local, why = method_without_enumeration(spec)
     if count > options.max_candidates:
         return local, (
             f"auto: 2^{i} = {shown} candidate sets exceed max_candidates = "
@@ -113,6 +116,19 @@ def choose_method(
         f"({solve_time_s:.3g} s per eigen solve), within enumeration_budget_s = "
         f"{options.enumeration_budget_s:g}"
     )
+
+
+def method_without_enumeration(spec: ProblemSpec) -> tuple[str, str]:
+    """The method "auto" runs on ``spec``'s plate when it does not enumerate, and why.
+
+    The interior point on a thin plate (thickness below ``THIN_PLATE`` of the shorter
+    side), the active set on the others.
+    """
+    plate = spec.plate
+    slenderness = plate.thickness / min(plate.length, plate.width)
+    thin = thin_plate(spec)
+    method = Method.INTERIOR_POINT if thin else Method.ACTIVE_SET
+    return method, f"t/b = {slenderness:.3g} {'<' if thin else '>='} {THIN_PLATE:g}"
 
 
 def choose_section_method(parameters: SectionParameters, solver: SolverSpec) -> tuple[str, str]:

@@ -69,14 +69,13 @@ from msgspec.structs import replace
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
-from unibuckle_fenicsx.algorithms.chain import thin_plate
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.algorithms.records import FoundationDetails
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.model.shell.problem import SectionProblem
-from unibuckle_fenicsx.spec import Method, ObstacleSpec
+from unibuckle_fenicsx.spec import ObstacleSpec
 from unibuckle_fenicsx.spec.solver import FoundationOptions
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
@@ -241,8 +240,8 @@ def _rigid_answer(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], in
 
     The twin is ``problem.spec`` with every tensionless foundation made rigid, solved by
     :func:`~unibuckle_fenicsx.analysis.solve` (certified, continued from a refuting
-    mode) with the method "auto" runs on its plate besides the enumeration (the interior
-    point on a thin plate, :func:`~.chain.thin_plate`, else the active set): the
+    mode) with the method "auto" runs on its plate besides the enumeration
+    (:func:`~unibuckle_fenicsx.analysis.method_without_enumeration`): the
     enumeration's cost would be paid again at every stiffness. On the problem's own mesh
     when it is the user's. A contact node is matched to the foundation's node at the same
     coordinates (a twin's zone node on no whole cell of the zone carries no spring and is
@@ -250,7 +249,7 @@ def _rigid_answer(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], in
     Collective.
     """
     # analysis runs the methods of the registry, which runs this module: imported here.
-    from unibuckle_fenicsx.analysis import solve
+    from unibuckle_fenicsx.analysis import method_without_enumeration, solve
 
     spec = problem.spec
 
@@ -261,7 +260,7 @@ def _rigid_answer(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], in
         spec = replace(spec, obstacle=rigid(spec.obstacle))
     else:
         spec = replace(spec, obstacles=tuple(rigid(o) for o in spec.obstacles))
-    method = Method.INTERIOR_POINT if thin_plate(spec) else Method.ACTIVE_SET
+    method, _ = method_without_enumeration(spec)
     spec = replace(spec, solver=replace(spec.solver, method=method))
     own = problem.custom_mesh
     mesh, tags = (problem.mesh, problem.facet_tags) if own else (None, None)
