@@ -24,7 +24,8 @@ from mpi4py import MPI
 from _results import append_rows, print_header
 from bench_plates import CASES, LENGTH, WIDTH, _spec, _times
 
-from unibuckle_fenicsx.analysis import choose_method, solve
+from unibuckle_fenicsx.algorithms.registry import choose_method
+from unibuckle_fenicsx.analysis import solve
 
 METHODS = ("interior-point", "active-set")
 

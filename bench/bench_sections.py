@@ -14,7 +14,7 @@ eigen solve (min of ``--repeat`` solves of the same pencil), and the unilateral 
 ``active-set`` (the active-set seeds on the coarsest section, the contact set polished
 level by level; ``levels`` is its old name), ``interior-point`` (the nested
 interior-point chain, the mode carried from section to section), ``auto`` (the route
-:func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses: below 10⁴ DOFs both,
+:func:`~unibuckle_fenicsx.algorithms.registry.choose_section_method` chooses: below 10⁴ DOFs both,
 the lower KKT point kept) or ``single`` (the
 interior-point chain on the section itself, no coarser one); then the certificate.
 The factorisations are PETSc's count of numeric ones (MUMPS) in the unilateral solve, in
@@ -142,7 +142,7 @@ def run(
 
     ``route``: "active-set", "interior-point" (the routes of
     :func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`), "auto" (the one
-    :func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses) or "single" (the
+    :func:`~unibuckle_fenicsx.algorithms.registry.choose_section_method` chooses) or "single" (the
     interior-point chain on the section itself). ``geometric``: as
     :func:`section_parameters`. ``release_steps``: the section route's
     :attr:`~unibuckle_fenicsx.algorithms.chain.ChainOptions.release_steps` for this run
@@ -158,7 +158,7 @@ def run(
     from unibuckle_fenicsx.algorithms import section_levels
     from unibuckle_fenicsx.algorithms.chain import solve_interior_point
     from unibuckle_fenicsx.algorithms.records import InteriorPointDetails, SectionLevelsDetails
-    from unibuckle_fenicsx.analysis import choose_section_method
+    from unibuckle_fenicsx.algorithms.registry import choose_section_method
     from unibuckle_fenicsx.certificate.certify import certify
     from unibuckle_fenicsx.la import factor
     from unibuckle_fenicsx.la.eigen import GEPSolver

@@ -1,10 +1,10 @@
 """High-level entry point: :func:`solve` a :class:`~unibuckle_fenicsx.spec.ProblemSpec`.
 
-The method of every unilateral problem is decided here: a plate's by :func:`choose_method`
-(once its mesh is built and its free eigen solve timed), a section's by
-:func:`choose_section_method` (before any mesh). Each returns a key of
-:data:`~unibuckle_fenicsx.algorithms.registry.REGISTRY`, through which the method runs,
-and the reason a result records as ``method_chosen_by``.
+Set-up, method, certificate, result. The method is chosen by the registry
+(:func:`~unibuckle_fenicsx.algorithms.registry.choose_method`, once the mesh is built and
+the free eigen solve timed), which runs it; the reason a result records as
+``method_chosen_by``. A tensionless foundation's start from the rigid obstacle is its
+rigid twin solved here as a whole problem (:func:`solve`).
 """
 
 from __future__ import annotations
@@ -18,161 +18,29 @@ from mpi4py import MPI
 
 import dolfinx
 
-from unibuckle_fenicsx.algorithms import UnilateralSolution, candidate_count
-from unibuckle_fenicsx.algorithms.chain import THIN_PLATE, thin_plate
-from unibuckle_fenicsx.algorithms.registry import FOUNDATION, entry
-from unibuckle_fenicsx.algorithms.section_levels import (
-    BOTH,
-    CHECKED,
-    INTERIOR_POINT_DOFS,
-    estimated_dofs,
+import numpy as np
+import numpy.typing as npt
+from msgspec.structs import replace
+
+from unibuckle_fenicsx.algorithms import UnilateralSolution
+from unibuckle_fenicsx.algorithms.registry import (
+    FREE,
+    PlateContext,
+    choose_method,
+    entry,
+    method_without_enumeration,
 )
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
-from unibuckle_fenicsx.model.shell.section import SectionParameters
 from unibuckle_fenicsx.results.assemble import assemble_result
 from unibuckle_fenicsx.results.records import BucklingResult
-from unibuckle_fenicsx.spec import Method, ProblemSpec, SolverSpec
-from unibuckle_fenicsx.spec.section import check_section_method
+from unibuckle_fenicsx.spec import ObstacleSpec, ProblemSpec
 
-__all__ = [
-    "FREE",
-    "Analysis",
-    "choose_method",
-    "choose_section_method",
-    "method_without_enumeration",
-    "solve",
-]
-
-#: The "method" of a problem without obstacle (a section without core): its free load.
-FREE = "free"
-
+__all__ = ["Analysis", "solve"]
 logger = logging.getLogger(__name__)
-
-
-def choose_method(
-    spec: ProblemSpec, i: int, solve_time_s: float, *, candidate_parallel: bool = False
-) -> tuple[str, str]:
-    """The method to run, and why ("auto" decides by estimated cost).
-
-    "auto" enumerates (with ``until_proven``: exact) when the 2^i candidate sets are at
-    most ``max_candidates`` and their estimated time, 2^i times ``solve_time_s`` (the
-    timed free eigen solve), is at most ``enumeration_budget_s``; otherwise it runs
-    the interior-point method on thin plates (thickness below ``THIN_PLATE`` of the
-    shorter side) and the active-set method on the others. "enumerate" alone follows
-    the paper's stopping rule. A tensionless foundation runs its spring-set iteration
-    (:data:`~.algorithms.registry.FOUNDATION`). The name returned is a key of
-    :data:`~.algorithms.registry.REGISTRY`.
-
-    Raises:
-        InputError: ``candidate_parallel`` with a method other than enumeration, or with
-            more candidate sets than ``max_candidates``.
-    """
-    options = spec.solver
-    if spec.tensionless:
-        if candidate_parallel:
-            raise InputError(
-                "--candidate-parallel splits the enumeration's candidate sets; a tensionless "
-                "foundation is solved by its spring-set iteration: drop --candidate-parallel"
-            )
-        return FOUNDATION, "tensionless foundation: spring-set iteration"
-    count = candidate_count(i)
-    # 2^i in words a reader can take in (2^2581 has 777 digits).
-    shown = str(count) if i <= 64 else f"10^{int(i * math.log10(2))}"
-    estimate = math.inf if i > 1000 else count * solve_time_s
-    if candidate_parallel:
-        if options.method not in (Method.AUTO, Method.ENUMERATE):
-            raise InputError(
-                f"--candidate-parallel splits the enumeration's candidate sets: it needs "
-                f'method "enumerate" or "auto", not \'{options.method}\''
-            )
-        if count > options.max_candidates:
-            raise InputError(
-                f"--candidate-parallel runs the enumeration, but i = {i} constrained nodes "
-                f"give 2^{i} = {shown} candidate sets, above max_candidates = "
-                f"{options.max_candidates}: drop --candidate-parallel (the active-set "
-                "method distributes the mesh instead)"
-            )
-        return Method.ENUMERATE, f"--candidate-parallel: 2^{i} = {shown} candidate sets"
-    if options.method != Method.AUTO:
-        return options.method, "given"
-    local, why = method_without_enumeration(spec)
-    if count > options.max_candidates:
-        return local, (
-            f"auto: 2^{i} = {shown} candidate sets exceed max_candidates = "
-            f"{options.max_candidates}; {why}"
-        )
-    if estimate > options.enumeration_budget_s:
-        return local, (
-            f"auto: enumerating 2^{i} = {shown} sets would take about {estimate:.3g} s "
-            f"({solve_time_s:.3g} s per eigen solve), above enumeration_budget_s = "
-            f"{options.enumeration_budget_s:g}; {why}"
-        )
-    return Method.ENUMERATE, (
-        f"auto: 2^{i} = {shown} candidate sets, about {estimate:.3g} s "
-        f"({solve_time_s:.3g} s per eigen solve), within enumeration_budget_s = "
-        f"{options.enumeration_budget_s:g}"
-    )
-
-
-def method_without_enumeration(spec: ProblemSpec) -> tuple[str, str]:
-    """The method "auto" runs on ``spec``'s plate when it does not enumerate, and why.
-
-    The interior point on a thin plate (thickness below ``THIN_PLATE`` of the shorter
-    side), the active set on the others.
-    """
-    plate = spec.plate
-    slenderness = plate.thickness / min(plate.length, plate.width)
-    thin = thin_plate(spec)
-    method = Method.INTERIOR_POINT if thin else Method.ACTIVE_SET
-    return method, f"t/b = {slenderness:.3g} {'<' if thin else '>='} {THIN_PLATE:g}"
-
-
-def choose_section_method(parameters: SectionParameters, solver: SolverSpec) -> tuple[str, str]:
-    """The method to run on a section, and why ("auto" decides by the section's size).
-
-    Without a core, :data:`FREE` (the hollow section's smallest eigenvalue); an elastic
-    core runs the spring-set iteration (:data:`~.algorithms.registry.FOUNDATION`), as a
-    plate's tensionless foundation does. A rigid core runs the ``[solver] method`` given,
-    one of :data:`~unibuckle_fenicsx.spec.section.SECTION_METHODS`; "auto" runs the
-    interior point, checked by the active set's seeds on its coarsest section
-    (:data:`~unibuckle_fenicsx.algorithms.section_levels.CHECKED`), on sections of at least
-    :data:`~unibuckle_fenicsx.algorithms.section_levels.INTERIOR_POINT_DOFS` degrees of
-    freedom, estimated before meshing
-    (:func:`~unibuckle_fenicsx.algorithms.section_levels.estimated_dofs`), and on smaller
-    ones both routes on the same sections, the lower KKT point kept
-    (:data:`~unibuckle_fenicsx.algorithms.section_levels.BOTH`: either alone can end
-    above the other). The interior point falls back on the active set when it reaches no
-    KKT point (its route then takes the link "active-set").
-
-    Raises:
-        InputError: A method no section runs, or one other than "auto" without a rigid
-            core (``solver.method``, the allowed named).
-    """
-    check_section_method(
-        solver.method, parameters.core, parameters.foundation_stiffness is not None
-    )
-    if not parameters.core:
-        return FREE, "no core"
-    if parameters.foundation_stiffness is not None:
-        return FOUNDATION, "elastic core: spring-set iteration"
-    if solver.method != Method.AUTO:
-        return solver.method, "given"
-    dofs = estimated_dofs(parameters)
-    if dofs >= INTERIOR_POINT_DOFS:
-        return CHECKED, (
-            f"auto: about {dofs} DOFs (estimated before meshing) >= "
-            f"INTERIOR_POINT_DOFS = {INTERIOR_POINT_DOFS}: the interior point, checked by "
-            "the active set's seeds on its coarsest section, the lower KKT point kept"
-        )
-    return BOTH, (
-        f"auto: about {dofs} DOFs (estimated before meshing) < INTERIOR_POINT_DOFS = "
-        f"{INTERIOR_POINT_DOFS}: the interior point and the active set, the lower KKT "
-        "point kept"
-    )
 
 
 #: Times a refuted answer is continued from its refuting mode (each time certified again).
@@ -201,6 +69,51 @@ def _continue(
         solution = continue_from(problem, solution, start, problem.spec.solver.max_iterations)
         certificate = certify(problem, solution)
     return solution, certificate
+
+
+def _rigid_twin(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], int]:
+    """The contact set of the rigid twin's answer, as the foundation's nodes; its solves.
+
+    The twin is ``problem.spec`` with every tensionless foundation made rigid, solved by
+    :func:`solve` (certified, continued from a refuting mode) with the method "auto"
+    runs on its plate besides the enumeration
+    (:func:`~unibuckle_fenicsx.algorithms.registry.method_without_enumeration`): the
+    enumeration's cost would be paid again at every stiffness. On the problem's own mesh
+    when it is the user's. A contact node is matched to the foundation's node at the same
+    coordinates (a twin's zone node on no whole cell of the zone carries no spring and is
+    left out). Without an admissible rigid mode, the empty set (the free start's).
+    Collective.
+    """
+    spec = problem.spec
+
+    def rigid(o: ObstacleSpec) -> ObstacleSpec:
+        return replace(o, foundation_stiffness=None) if o.kind == "tensionless" else o
+
+    if spec.obstacle is not None:
+        spec = replace(spec, obstacle=rigid(spec.obstacle))
+    else:
+        spec = replace(spec, obstacles=tuple(rigid(o) for o in spec.obstacles))
+    method, _ = method_without_enumeration(spec)
+    spec = replace(spec, solver=replace(spec.solver, method=method))
+    own = problem.custom_mesh
+    mesh, tags = (problem.mesh, problem.facet_tags) if own else (None, None)
+    try:
+        twin = solve(spec, problem.comm, mesh=mesh, facet_tags=tags)
+    except NoAdmissibleModeError:  # the rigid obstacle leaves no mode: no start from it
+        logger.info("foundation: the rigid obstacle has no admissible mode; no rigid start")
+        return np.empty(0, np.int64), 0
+    with twin:
+        solution = twin.solution
+        if not isinstance(twin.problem, UnilateralProblem) or solution is None:
+            raise RuntimeError(
+                "_rigid_twin: expected the rigid twin to have an obstacle (an internal invariant)"
+            )
+        coordinates = twin.problem.contact.coordinates[solution.candidate.active]
+        load, solves = solution.load, twin.result.eigensolves
+    logger.info("foundation: the rigid obstacle's load %.10g starts a run", load)
+    index = {tuple(c): k for k, c in enumerate(problem.contact.coordinates)}
+    active = sorted(index[tuple(c)] for c in coordinates if tuple(c) in index)
+    return np.asarray(active, dtype=np.int64), solves
 
 
 @dataclass
@@ -335,7 +248,11 @@ def _analyse(
             "i = %d constrained nodes; method %s (%s)", problem.num_constrained, method, reason
         )
         t1 = time.perf_counter()
-        solution = entry(method).solve(problem, comm if candidate_parallel else None)
+        context = PlateContext(
+            candidate_comm=comm if candidate_parallel else None,
+            rigid_start=(lambda: _rigid_twin(problem)) if problem.tensionless else None,
+        )
+        solution = entry(method).solve(problem, context)
         problem.timings["unilateral_s"] = time.perf_counter() - t1
         if not math.isfinite(solution.load):
             raise NoAdmissibleModeError(

@@ -10,7 +10,7 @@ it covers, the wall may only move away from it (:mod:`~unibuckle_fenicsx.model.s
 - Without a core the critical load is the pencil's smallest eigenvalue, verified the
   smallest by the inertia of :math:`A - \sigma B` (as a plate without obstacle).
 - With a core the free load is the hollow section's; the unilateral critical state is
-  found by the method :func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses,
+  found by the method :func:`~unibuckle_fenicsx.algorithms.registry.choose_section_method` chooses,
   run through the registry (:data:`~unibuckle_fenicsx.algorithms.registry.REGISTRY`):
   with a rigid core coarse to fine
   (:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`: the interior
@@ -44,9 +44,8 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
-from unibuckle_fenicsx.algorithms.registry import entry
+from unibuckle_fenicsx.algorithms.registry import choose_section_method, entry
 from unibuckle_fenicsx.algorithms.section_levels import check_levels
-from unibuckle_fenicsx.analysis import choose_section_method
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.en1993 import (
     check_steel_modulus,
@@ -298,7 +297,7 @@ def solve_section(
             starts' many steps on a section of a quarter of the DOFs, a few on the given one.
         solver: Solver options (the method, one of
             :data:`~unibuckle_fenicsx.spec.section.SECTION_METHODS`, chosen by
-            :func:`~unibuckle_fenicsx.analysis.choose_section_method`; tolerances, the
+            :func:`~unibuckle_fenicsx.algorithms.registry.choose_section_method`; tolerances, the
             feasibility tolerance tau); the package's defaults when None.
         design: The yield stress and partial factor of the design output
             (:mod:`~unibuckle_fenicsx.section_design`); None: none.
@@ -705,7 +704,7 @@ def _result(
     """The :class:`SectionResult` of a solved section (collective: gathers the contact rows).
 
     ``method_chosen_by``: why its method ran
-    (:func:`~unibuckle_fenicsx.analysis.choose_section_method`).
+    (:func:`~unibuckle_fenicsx.algorithms.registry.choose_section_method`).
     """
     p = section.parameters
     problem = section.problem

@@ -1,6 +1,6 @@
 """A section's method: chosen where a plate's is, named in its file or on the command line.
 
-``analysis.choose_section_method`` decides it before any mesh, by the documented rule
+``registry.choose_section_method`` decides it before any mesh, by the documented rule
 (``docs/verification/sections.md``, "Cost"): without a core the free load, with an
 elastic core the spring-set iteration, with a rigid core the ``[solver] method`` given,
 "auto" taking the interior point on sections of at least ``INTERIOR_POINT_DOFS`` = 10^4
@@ -20,10 +20,10 @@ from mpi4py import MPI
 
 import pytest
 
-import unibuckle_fenicsx.analysis as analysis
+import unibuckle_fenicsx.algorithms.registry as registry
 from unibuckle_fenicsx import SectionParameters, section_from_dict, solve_section
+from unibuckle_fenicsx.algorithms.registry import choose_section_method
 from unibuckle_fenicsx.algorithms.section_levels import solve_levels
-from unibuckle_fenicsx.analysis import choose_section_method
 from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, EXIT_OK, main
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.shell.section import section_parameters
@@ -67,7 +67,7 @@ def test_auto_takes_the_checked_interior_point_from_ten_thousand_dofs():
 
 def test_auto_counts_a_section_of_exactly_the_threshold_as_large(monkeypatch):
     # "at least INTERIOR_POINT_DOFS": a threshold equal to the section's DOFs.
-    monkeypatch.setattr(analysis, "INTERIOR_POINT_DOFS", 4800)
+    monkeypatch.setattr(registry, "INTERIOR_POINT_DOFS", 4800)
     method, _ = choose_section_method(_square_box(0.1, 0.3, 0.0125), SolverSpec())
     assert method == "interior-point+seeds"
 
@@ -414,7 +414,7 @@ def test_auto_on_a_large_section_ends_no_higher_than_the_active_sets_mode(monkey
         assert removed < 1e-6  # the mode was admissible to the tolerance already
         assert seeded.result.dofs == 864
     assert bound == pytest.approx(8.9575e8, rel=1e-4)
-    monkeypatch.setattr(analysis, "INTERIOR_POINT_DOFS", 500)
+    monkeypatch.setattr(registry, "INTERIOR_POINT_DOFS", 500)
     with solve_section(box, MPI.COMM_SELF, levels=0) as solved:  # "auto"
         result = solved.result
         assert result.method_chosen_by.startswith("auto: about 864 DOFs")

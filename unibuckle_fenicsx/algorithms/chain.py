@@ -31,7 +31,7 @@ For a rigid obstacle (any side, several zones) the chain is
    continuation) from scratch.
 
 Tensionless foundations run their spring-set iteration (:mod:`.foundation`); small
-zones are enumerated (:mod:`.enumeration`; :func:`~unibuckle_fenicsx.analysis.choose_method`
+zones are enumerated (:mod:`.enumeration`; :func:`~.registry.choose_method`
 decides).
 
 Every link leaves a typed record (:class:`~.records.LinkRecord`); the solution's

@@ -27,8 +27,9 @@ Bounds: :math:`\lambda_{free} \le \lambda_f \le \lambda_{rigid}` (the spring ter
 non-negative, and vanishes on the rigid obstacle's mode), and the returned load, a value
 of the quotient, is an upper bound of :math:`\lambda_f`. The iteration starts from the
 free plate (no springs), from every spring active (the bilateral foundation's mode) and,
-on a plate, from the contact set of the rigid obstacle's answer (:func:`_rigid_set`; a
-section's core above :data:`RIGID_START_RATIO`, from its rigid core's route); for stiff
+on a plate, from the contact set of the rigid obstacle's answer (the caller's
+``rigid_set``; a section's core above :data:`RIGID_START_RATIO`, from its rigid core's
+route); for stiff
 springs (:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`) also from the set a
 continuation in the stiffness ends on; the smallest quotient is returned. The rigid start
 is what keeps the answer at or below the rigid obstacle's load, and non-decreasing in
@@ -65,17 +66,15 @@ from collections.abc import Callable
 
 import numpy as np
 import numpy.typing as npt
-from msgspec.structs import replace
 
 from unibuckle_fenicsx.algorithms import RunStatus, UnilateralSolution
 from unibuckle_fenicsx.algorithms.active_set import solve_active_set
 from unibuckle_fenicsx.algorithms.penalty import PenaltySolver, SpringIteration
 from unibuckle_fenicsx.algorithms.records import FoundationDetails
-from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.model.shell.problem import SectionProblem
-from unibuckle_fenicsx.spec import ObstacleSpec
 from unibuckle_fenicsx.spec.solver import FoundationOptions
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
@@ -88,7 +87,7 @@ logger = logging.getLogger(__name__)
 #: the free plate's and the bilateral foundation's (:doc:`/verification/stiff_foundations`).
 CONTINUATION_RATIO = 10.0
 #: Above this :func:`stiffness_ratio` a section's core also starts from the rigid core's
-#: contact set (the active set's; a plate always does, :func:`_rigid_set`): on long plates
+#: contact set (its caller's or the active set's; a plate always does): on long plates
 #: the other starts end at stationary points above the rigid obstacle's load, which no
 #: foundation exceeds.
 RIGID_START_RATIO = 1e3
@@ -115,9 +114,11 @@ def solve_foundation(
         eps_options: Extra EPS options under ``unibuckle_foundation_``.
         rigid_set: Gives the rigid obstacle's contact set on the problem's contact
             directions and its eigen solves, for the start from it (on a section, run
-            only above :data:`RIGID_START_RATIO`); None: :func:`_rigid_set`. A section
-            passes its rigid core's route, whose KKT point can lie below the active
-            set's (:doc:`/history/2026-12-01a-coreroute`).
+            only above :data:`RIGID_START_RATIO`); None: :func:`_rigid_set`, the active
+            set on the problem itself. :func:`~unibuckle_fenicsx.analysis.solve` passes
+            a plate's rigid twin, solved as a whole problem, and a section its rigid
+            core's route: their KKT points can lie below the active set's
+            (:doc:`/history/2026-12-01a-metamorph`, :doc:`/history/2026-12-01a-coreroute`).
 
     Returns:
         The solution; its candidate's load is the quotient of the returned mode, its
@@ -222,65 +223,13 @@ def _plate(problem: UnilateralProblem) -> bool:
 def _rigid_set(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], int]:
     """The rigid obstacle's contact set on the foundation's nodes, and its eigen solves.
 
-    On a plate, the answer of the plate with its foundations made rigid, by the route
-    "auto" runs when it does not enumerate (:func:`_rigid_answer`): the foundation's
-    minimum lies at or below that load, and from its contact set the iteration starts at
-    or below it. On a section's shell, the active set on the problem itself (its coarse
-    levels, no bracket). Collective.
+    The active set on the problem itself, its springs made rigid (its coarse levels, no
+    bracket): the start :func:`solve_foundation` takes when its caller gives none.
+    Collective.
     """
-    if _plate(problem):
-        return _rigid_answer(problem)
     rigid = solve_active_set(problem, bound_budget=0)
     logger.info("foundation: the rigid obstacle's load %.10g starts a run", rigid.candidate.load)
     return rigid.candidate.active, rigid.eigensolves
-
-
-def _rigid_answer(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], int]:
-    """The contact set of the rigid twin's answer, as the foundation's nodes; its solves.
-
-    The twin is ``problem.spec`` with every tensionless foundation made rigid, solved by
-    :func:`~unibuckle_fenicsx.analysis.solve` (certified, continued from a refuting
-    mode) with the method "auto" runs on its plate besides the enumeration
-    (:func:`~unibuckle_fenicsx.analysis.method_without_enumeration`): the
-    enumeration's cost would be paid again at every stiffness. On the problem's own mesh
-    when it is the user's. A contact node is matched to the foundation's node at the same
-    coordinates (a twin's zone node on no whole cell of the zone carries no spring and is
-    left out). Without an admissible rigid mode, the empty set (the free start's).
-    Collective.
-    """
-    # analysis runs the methods of the registry, which runs this module: imported here.
-    from unibuckle_fenicsx.analysis import method_without_enumeration, solve
-
-    spec = problem.spec
-
-    def rigid(o: ObstacleSpec) -> ObstacleSpec:
-        return replace(o, foundation_stiffness=None) if o.kind == "tensionless" else o
-
-    if spec.obstacle is not None:
-        spec = replace(spec, obstacle=rigid(spec.obstacle))
-    else:
-        spec = replace(spec, obstacles=tuple(rigid(o) for o in spec.obstacles))
-    method, _ = method_without_enumeration(spec)
-    spec = replace(spec, solver=replace(spec.solver, method=method))
-    own = problem.custom_mesh
-    mesh, tags = (problem.mesh, problem.facet_tags) if own else (None, None)
-    try:
-        twin = solve(spec, problem.comm, mesh=mesh, facet_tags=tags)
-    except NoAdmissibleModeError:  # the rigid obstacle leaves no mode: no start from it
-        logger.info("foundation: the rigid obstacle has no admissible mode; no rigid start")
-        return np.empty(0, np.int64), 0
-    with twin:
-        solution = twin.solution
-        if not isinstance(twin.problem, UnilateralProblem) or solution is None:
-            raise RuntimeError(
-                "_rigid_answer: expected the rigid twin to have an obstacle (an internal invariant)"
-            )
-        coordinates = twin.problem.contact.coordinates[solution.candidate.active]
-        load, solves = solution.load, twin.result.eigensolves
-    logger.info("foundation: the rigid obstacle's load %.10g starts a run", load)
-    index = {tuple(c): k for k, c in enumerate(problem.contact.coordinates)}
-    active = sorted(index[tuple(c)] for c in coordinates if tuple(c) in index)
-    return np.asarray(active, dtype=np.int64), solves
 
 
 def _continued_start(

@@ -34,7 +34,7 @@ one), and the lower KKT point is kept (:func:`_starts_coarse_enough`): so coarse
 section can merge arrangements that the finer ones tell apart.
 
 Which route runs is decided with the plate's method, in one place
-(:func:`~unibuckle_fenicsx.analysis.choose_section_method`, ``"auto"``: the interior
+(:func:`~.registry.choose_section_method`, ``"auto"``: the interior
 point on sections of at least :data:`INTERIOR_POINT_DOFS` degrees of freedom; on
 smaller ones both routes (:data:`BOTH`), the active set on the sections the interior
 point built, and the lower KKT point is kept: both are KKT points, neither is proven
@@ -219,7 +219,7 @@ def solve_levels(
         solver: Solver options.
         route: One of :data:`ROUTES` (module docstring): "interior-point" (the active
             set on its sections if it reaches no KKT point) or "active-set";
-            :func:`~unibuckle_fenicsx.analysis.choose_section_method` chooses it for
+            :func:`~.registry.choose_section_method` chooses it for
             :func:`~unibuckle_fenicsx.section_analysis.solve_section`.
         max_iterations: Iterates per seed on the coarsest level, >= 1.
 

@@ -24,7 +24,7 @@ Length = Annotated[float, unit("m", gt=0)]
 SOLVER_KEYS = ("method", "tau", "eps_tol", "max_iterations")
 #: The methods a section with a rigid core may name (``[solver] method``, ``--method``):
 #: "auto" chooses between the other two by the section's size
-#: (:func:`~unibuckle_fenicsx.analysis.choose_section_method`). The enumeration's 2^i
+#: (:func:`~unibuckle_fenicsx.algorithms.registry.choose_section_method`). The enumeration's 2^i
 #: candidate sets are out of reach with a core's hundreds of directions, and the penalty
 #: was never verified on a shell.
 SECTION_METHODS: tuple[Method, ...] = (Method.AUTO, Method.INTERIOR_POINT, Method.ACTIVE_SET)

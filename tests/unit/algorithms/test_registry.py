@@ -24,9 +24,15 @@ from mpi4py import MPI
 import pytest
 from msgspec import structs
 
-from unibuckle_fenicsx.algorithms.registry import FOUNDATION, REGISTRY, entry
+from unibuckle_fenicsx.algorithms.registry import (
+    FOUNDATION,
+    REGISTRY,
+    choose_method,
+    choose_section_method,
+    entry,
+)
 from unibuckle_fenicsx.algorithms.section_levels import BOTH, CHECKED, INTERIOR_POINT_DOFS
-from unibuckle_fenicsx.analysis import choose_method, choose_section_method, solve
+from unibuckle_fenicsx.analysis import solve
 from unibuckle_fenicsx.errors import FieldError, InputError
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.materials import bending_stiffness
