@@ -20,9 +20,10 @@ The method of every unilateral problem is decided here, once: "auto" chooses amo
 entries (:func:`choose_method` for a plate, once its mesh is built and its free eigen
 solve timed; :func:`choose_section_method` for a section, before any mesh), each
 returning a key of :data:`REGISTRY` and the reason a result records as
-``method_chosen_by``; "auto" runs nothing of its own. Two entries are chosen, never named in a file, and are no
-:class:`~unibuckle_fenicsx.spec.Method`: a tensionless foundation's spring-set iteration
-(:data:`FOUNDATION`, chosen by the problem) and, on a section of fewer than
+``method_chosen_by``; "auto" runs nothing of its own. Two entries are chosen, never
+named in a file, and are no :class:`~unibuckle_fenicsx.spec.Method`: a tensionless
+foundation's spring-set iteration (:data:`FOUNDATION`, chosen by the problem) and, on a
+section of fewer than
 :data:`~unibuckle_fenicsx.algorithms.section_levels.INTERIOR_POINT_DOFS` degrees of
 freedom, "auto"'s route :data:`~unibuckle_fenicsx.algorithms.section_levels.BOTH` (the
 interior point and the active set on the same sections, the lower KKT point kept), and
