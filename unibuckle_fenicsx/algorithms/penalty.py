@@ -463,7 +463,8 @@ class PenaltySolver(Owner):
         self.solves += 1
         if run.lower_bound is None and not run.active.size:
             run.lower_bound = pair.value
-        wmax = problem.max_abs_w(vec)
+        # A mode without deflection (w = 0: b(v, v) = 0, an infinite load) is not scaled.
+        wmax = problem.max_abs_w(vec) or 1.0
         vals = problem.contact.values(vec) / wmax
         sign, tie = _orientation(vals, run.weights, tie_rtol, threshold)
         run.ties += tie

@@ -188,3 +188,64 @@ def test_cli_penalty_end_to_end(tmp_path, capsys, c1_small):
     assert main([*args, "--penalty", "-1"]) == 2
     if MPI.COMM_WORLD.rank == 0:  # errors are printed on rank 0
         assert "penalty" in capsys.readouterr().err
+
+
+def _no_load_in_the_cone():
+    """A plate whose cone holds no mode with a positive load, though the free plate has one.
+
+    0.2 x 0.1 m, t = 0.1 mm, 7 x 3 cells; the long edge y = 0 clamped, y = 0.1 free, the
+    short edges simply supported under sigma_x = -1 at y = 0 to +2 at y = 0.1 (psi = -2);
+    a face below over the whole plate, so every free deflection must be >= 0. The free
+    plate buckles at 19.77 MPa with a mode of both signs; every one-signed mode has
+    b(w, w) <= 0 (the dense minimum over all 2^18 contact sets, :func:`support.exhaustive.
+    exhaustive_minimum`, is inf: checked by the slow test below).
+    """
+    from unibuckle_fenicsx import problem_from_dict
+
+    edge = {"support": "simply_supported", "normal_stress": [-1.0, 2.0]}
+    return problem_from_dict(
+        {
+            "name": "no_load_in_the_cone",
+            "plate": {"corners": [[0.0, 0.0], [0.2, 0.1]], "thickness": 1e-4},
+            "material": {"E": 1e9, "nu": 0.3},
+            "edges": {
+                "left": edge,
+                "right": edge,
+                "bottom": {"support": "clamped"},
+                "top": {"support": "free"},
+            },
+            "mesh": {"nx": 7, "ny": 3},
+            "obstacle": {"zone": "all", "side": "below"},
+        }
+    )
+
+
+def test_a_cone_without_a_positive_load_is_reported_not_a_division_by_zero():
+    """The penalty fallback met a mode with no deflection (w = 0) and divided by max|w| = 0.
+
+    Before: ``ZeroDivisionError`` from auto, the active set and the interior point (each
+    falls back to the penalty continuation here); now the documented
+    NoAdmissibleModeError (exit status 3 on the command line), as the slow test's dense
+    reference (no positive load over any contact set) requires.
+    """
+    from unibuckle_fenicsx.analysis import solve
+    from unibuckle_fenicsx.errors import NoAdmissibleModeError
+
+    with pytest.raises(NoAdmissibleModeError, match="no admissible mode with a finite load"):
+        with solve(_no_load_in_the_cone(), MPI.COMM_WORLD):
+            pass
+
+
+@pytest.mark.slow
+@pytest.mark.serial
+def test_the_cone_without_a_positive_load_by_dense_enumeration():
+    """Every one of the 2^18 contact sets, by LAPACK: no admissible mode with b(w, w) > 0."""
+    from support.exhaustive import dense_free_load, exhaustive_minimum
+
+    problem = build_problem(_no_load_in_the_cone(), MPI.COMM_SELF)
+    try:
+        assert problem.num_constrained == 18
+        assert dense_free_load(problem) == pytest.approx(1.97737e7, rel=1e-5)
+        assert exhaustive_minimum(problem)[0] == np.inf
+    finally:
+        problem.destroy()
