@@ -29,6 +29,7 @@ from unibuckle_fenicsx.model.points import PointReport
 from unibuckle_fenicsx.model.zones import ZoneReport
 from unibuckle_fenicsx.section_design import SectionDesignRecord
 from unibuckle_fenicsx.spec import UNITS, PointSpec
+from unibuckle_fenicsx.spec.base import in_file
 from unibuckle_fenicsx.spec.plate import reference_edge
 from unibuckle_fenicsx.tolerances import BRACKET_GAP
 
@@ -416,8 +417,9 @@ class BucklingResult(Struct, kw_only=True):
             lines.append(self.details.gapped_obstacles)
         load = self._input_table("load")
         if self.critical_temperature_K is not None:
+            rise = _rise_text(load.get("temperature"), self.units)
             lines.append(
-                f"temperature rise per unit lambda {load.get('temperature')}: critical rise "
+                f"temperature rise per unit lambda {rise}: critical rise "
                 f"{self.critical_temperature_K:.6g} K"
             )
         fixed = [
@@ -426,7 +428,7 @@ class BucklingResult(Struct, kw_only=True):
             if not isinstance(edge.fixed_normal_stress, UnsetType)
         ]
         if load.get("fixed_temperature"):
-            fixed.append(f"temperature rise {load['fixed_temperature']} K")
+            fixed.append(f"temperature rise {_rise_text(load['fixed_temperature'], self.units)}")
         if self.critical_total_temperature_K is not None:
             lines.append(
                 "total temperature rise at the critical state (the fixed rise and lambda "
@@ -644,6 +646,18 @@ def _reference_stress(loads: dict[str, EdgeLoad]) -> tuple[float, str] | None:
         return None
     _, value, kind = reference_edge([n for n, _ in loaded], [s for _, s in loaded])
     return (value, kind) if value > 0.0 else None
+
+
+def _rise_text(value: object, units: str) -> str:
+    """A temperature rise of the input (SI: K, or [T0, dT/dx, dT/dy] in K, K/m) in ``units``.
+
+    The input echoed is in SI; the summary speaks the file's units, where a gradient of
+    0.01 K/mm is 10 K/m.
+    """
+    shown, name = in_file(value, "K, K/m", units)
+    if isinstance(shown, list | tuple):
+        return f"[{', '.join(f'{v:g}' for v in shown)}] ({name})"
+    return f"{shown:g} K" if isinstance(shown, int | float) else f"{shown} K"
 
 
 def _load_text(load: EdgeLoad, fixed: bool = False, scale: float = 1.0, unit: str = "") -> str:

@@ -100,22 +100,30 @@ def unit_name(name: str, units: str | None = None) -> str:
 def in_file(value: Any, name: str, units: str | None = None) -> tuple[Any, str]:
     """The SI ``value`` in the unit ``name`` as ``units`` writes it, and the unit's name.
 
-    ``value``: a number, or lists or tuples of numbers; ``units``: None for the file's
+    ``value``: a number, or lists or tuples of numbers (a unit of one entry each, as
+    "K, K/m": a list of as many); ``units``: None for the file's
     being read (:data:`FILE_UNITS`). In SI the value itself (its messages unchanged);
     else rounded to 12 digits, the conversion's last-bit noise dropped (2 mm -> 0.002 m
     -> 2.0000000000000004 mm).
     """
     units, dims = FILE_UNITS.get() if units is None else units, DIMENSIONS.get(name)
-    if units == "SI" or not isinstance(dims, tuple):
+    if units == "SI" or dims is None:
         return value, name
-    per = factor(dims, units)
 
-    def convert(x: Any) -> Any:
+    def convert(x: Any, per: float) -> Any:
         if isinstance(x, list | tuple):
-            return type(x)(convert(v) for v in x)
+            return type(x)(convert(v, per) for v in x)
         return float(f"{x / per:.12g}") if isinstance(x, int | float) else x
 
-    return convert(value), unit_name(name, units)
+    if isinstance(dims, tuple):
+        return convert(value, factor(dims, units)), unit_name(name, units)
+    # one unit per entry of a list ("K, K/m": [T0, dT/dx, dT/dy]), or the first for a number
+    if not isinstance(value, list | tuple):
+        return convert(value, factor(dims[0], units)), unit_name(name, units)
+    if len(value) != len(dims):
+        return value, name
+    entries = (convert(v, factor(d, units)) for v, d in zip(value, dims, strict=True))
+    return type(value)(entries), unit_name(name, units)
 
 
 def unit(name: str, **bounds: Any) -> Meta:

@@ -420,3 +420,29 @@ def test_an_interaction_curve_by_a_sweep_over_the_fixed_factor(tmp_path):
     )
     assert loads[1] == pytest.approx(result(half).critical_load_Pa, rel=1e-9)
     assert point_problem(base, {"load.fixed_factor": 0.5}).load.fixed_factor == 0.5
+
+
+def test_the_summary_gives_a_rise_gradient_in_the_file_s_units():
+    """A rise of 10 K + 0.03 K/mm y in a mm-N-MPa file: the summary says 0.03 K/mm.
+
+    The input echoed is in SI (30 K/m), which the summary printed as it was, bare
+    ("[10.0, 0.0, 30.0]") in a file that wrote 0.03; the fixed rise the same. Expected:
+    the file's own numbers (1 K/mm = 1000 K/m), and in SI the SI ones.
+    """
+    rollers = {"left": {"inplane": "roller"}, "right": {"inplane": "roller"}}
+    load = {"temperature": [10.0, 0.0, 0.03], "fixed_temperature": [1.0, 0.0, 0.002]}
+    mm = problem_from_dict(
+        {
+            "units": "mm-N-MPa",
+            "plate": {"corners": [[0, 0], [1000, 500]], "thickness": 2.0},
+            "material": {"E": E / 1e6, "nu": NU, "thermal_expansion": ALPHA},
+            "edges": rollers,
+            "mesh": {"nx": 8, "ny": 4},
+            "load": load,
+        }
+    )
+    text = result(mm).summary()
+    assert "temperature rise per unit lambda [10, 0, 0.03] (K, K/mm)" in text
+    assert "temperature rise [1, 0, 0.002] (K, K/mm)" in text
+    si = steel_plate(4, rollers, {"temperature": [10.0, 0.0, 30.0]})
+    assert "temperature rise per unit lambda [10, 0, 30] (K, K/m)" in result(si).summary()
