@@ -123,7 +123,14 @@ def _seeds(
     tau: float,
     names: tuple[str, ...] = SEED_NAMES,
 ) -> list[tuple[str, npt.NDArray[np.int64]]]:
-    """Seed contact sets (deduplicated, in the order of ``names``, a part of :data:`SEED_NAMES`)."""
+    """Seed contact sets (deduplicated, in the order of ``names``, a part of :data:`SEED_NAMES`).
+
+    A seed whose set is the image of an earlier one's under a symmetry of the problem
+    (``problem.contact.symmetries``: a square box's quarter turns, where the free mode's
+    two sign patterns are such images) is left out too: its run is that one's image, and
+    its KKT point has the same load (rounding may break a tie otherwise in either run, which
+    then ends at another image; :doc:`/verification/sections_cost_symmetry`).
+    """
     xy = problem.contact.coordinates
     plate = problem.spec.plate
     (x0, y0), (x1, y1) = plate.corners
@@ -137,6 +144,7 @@ def _seeds(
     }
     n = problem.num_constrained
     scale = np.abs(free_values).max() if free_values.size else 1.0
+    images = problem.contact.symmetries
     out: list[tuple[str, npt.NDArray[np.int64]]] = []
     seen: set[bytes] = set()
     for name in names:
@@ -158,9 +166,14 @@ def _seeds(
             c = xy[:, axis]
             z = np.flatnonzero((c < a - 1e-12 * half) | (c > b + 1e-12 * half))
         z = z.astype(np.int64)
-        if z.tobytes() not in seen:
-            seen.add(z.tobytes())
-            out.append((name, z))
+        if z.tobytes() in seen:
+            continue
+        image = next((e for e, y in out for p in images if np.array_equal(np.sort(p[y]), z)), None)
+        if image is not None:
+            logger.info("active set: seed %s, the image of %s by symmetry: not run", name, image)
+            continue
+        seen.add(z.tobytes())
+        out.append((name, z))
     return out
 
 

@@ -318,11 +318,18 @@ class ContactSetManager:
         gaps: (i,) the obstacle's gap g (m) at each node (the constraint is
             :math:`s_k w_k \le g_k`), same on all ranks; zero but in the nonlinear
             analysis (the linear problem leaves obstacles with a gap out).
+        symmetries: Permutations ``perm`` of the constrained nodes (node k to
+            ``perm[k]``) under which the whole problem is invariant, so that a contact
+            set and its image have the same KKT points' loads: empty for a plate; a
+            square box's quarter turns
+            (:class:`~unibuckle_fenicsx.model.shell.problem.SectionContact`).
 
     Note:
         Construction is collective. Raises :class:`EmptyZoneError` if the zones hold no
         free mesh node.
     """
+
+    symmetries: tuple[npt.NDArray[np.int64], ...] = ()
 
     def __init__(self, model: NodalDofs, obstacles: ObstacleLike) -> None:
         self.model = model

@@ -48,6 +48,7 @@ __all__ = [
     "core_constraints",
     "core_springs",
     "perimeter_coordinate",
+    "quarter_turns",
 ]
 
 
@@ -171,6 +172,43 @@ def core_constraints(model: ShellModel, span: tuple[float, float] | None = None)
         owned_nodes=owned_nodes,
         num_held=int(model.mesh.comm.allreduce(num_held, op=MPI.SUM)),
     )
+
+
+def quarter_turns(constraints: CoreConstraints) -> tuple[npt.NDArray[np.int64], ...]:
+    r"""The constrained directions' permutations under a square box's quarter turns.
+
+    A turn by :math:`k\pi/2` (k = 1, 2, 3) about the member's axis (the x-axis through the
+    section's centre) maps the point :math:`(x, y, z)` and its normal to
+    :math:`(x, y\cos\theta - z\sin\theta, y\sin\theta + z\cos\theta)`. Each turn
+    that maps every constrained direction onto one (its node onto a node and its normal
+    onto that node's normal, to :data:`~unibuckle_fenicsx.tolerances.GEOMETRY_RTOL` of
+    the section's size) is returned as the array ``perm``: direction ``k`` goes to
+    ``perm[k]``, a set ``Z`` to ``perm[Z]``. Whether the section's pencil is invariant
+    under them (a square box, a load that is the same on every face) is the caller's
+    to decide (:func:`~unibuckle_fenicsx.model.shell.section.build_section`); this
+    checks the mesh. The same on every rank (the constraints are).
+    """
+    from scipy.spatial import cKDTree
+
+    points = np.hstack([constraints.coordinates, constraints.normals])
+    n = points.shape[0]
+    if n == 0:
+        return ()
+    size = float(np.abs(constraints.coordinates).max())
+    scale = np.array([size] * 3 + [1.0] * 3)
+    tree = cKDTree(points / scale)
+    turns = []
+    for k in (1, 2, 3):
+        c, s = (0.0, 1.0) if k == 1 else (-1.0, 0.0) if k == 2 else (0.0, -1.0)
+        image = points.copy()
+        for j in (0, 3):  # the node, then its normal
+            y, z = points[:, j + 1], points[:, j + 2]
+            image[:, j + 1] = c * y - s * z
+            image[:, j + 2] = s * y + c * z
+        dist, perm = tree.query(image / scale)
+        if np.all(dist <= GEOMETRY_RTOL) and np.unique(perm).size == n:
+            turns.append(perm.astype(np.int64))
+    return tuple(turns)
 
 
 def _directions(

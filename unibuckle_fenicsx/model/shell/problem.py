@@ -128,8 +128,10 @@ class SectionContact(ContactSetManager):
         pencil: RotatedPencil,
         constraints: CoreConstraints,
         springs: npt.NDArray[np.float64] | None = None,
+        symmetries: tuple[npt.NDArray[np.int64], ...] = (),
     ) -> None:
         self.model = cast(Any, pencil)
+        self.symmetries = symmetries
         self.obstacles = (ObstacleSpec(zone="all"),)
         self.constraints = constraints
         self.coordinates = constraints.unrolled
@@ -154,6 +156,7 @@ def section_problem(
     eps_options: dict[str, str | float | int] | None = None,
     springs: npt.NDArray[np.float64] | None = None,
     compression: float = 1.0,
+    symmetries: tuple[npt.NDArray[np.int64], ...] = (),
 ) -> SectionProblem:
     """A section set up for its free solve, and with a core for the unilateral algorithms.
 
@@ -173,6 +176,9 @@ def section_problem(
         compression: The largest compressive stress per unit load (Pa/Pa,
             ``SectionParameters.compression()``): the buckling coefficient's stress is the
             load times it; 1 for a uniform unit compression.
+        symmetries: Permutations of the constrained directions under which the rotated
+            pencil is invariant (the contact manager's ``symmetries``): a square box's
+            quarter turns (:func:`~unibuckle_fenicsx.model.shell.core.quarter_turns`).
 
     Returns:
         A :class:`CoredSectionProblem` with a core, else a :class:`SectionProblem`; the
@@ -224,7 +230,7 @@ def section_problem(
     problem = (
         SectionProblem(parts)
         if constraints is None
-        else CoredSectionProblem(parts, SectionContact(pencil, constraints, springs))
+        else CoredSectionProblem(parts, SectionContact(pencil, constraints, springs, symmetries))
     )
     problem.compression = compression
     problem.timings["setup_s"] = time.perf_counter() - t0

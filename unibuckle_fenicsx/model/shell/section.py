@@ -37,6 +37,7 @@ from unibuckle_fenicsx.model.shell.core import (
     change_of_basis,
     core_constraints,
     core_springs,
+    quarter_turns,
 )
 from unibuckle_fenicsx.model.shell.forms import DRILLING_FACTOR
 from unibuckle_fenicsx.model.shell.geometry import SectionMesh, section_mesh
@@ -421,9 +422,32 @@ def build_section(
         springs = core_springs(model, constraints, p.foundation_stiffness, p.core_span)
     problem = section_problem(
         model, prestress, constraints, T, material, solver, springs=springs,
-        compression=p.compression(),
+        compression=p.compression(), symmetries=_symmetries(p, constraints, springs),
     )  # fmt: skip
     return Section(p, msh, prestress, model, constraints, problem)
+
+
+def _symmetries(
+    p: SectionParameters,
+    constraints: CoreConstraints | None,
+    springs: npt.NDArray[np.float64] | None,
+) -> tuple[npt.NDArray[np.int64], ...]:
+    """The quarter turns under which the section's pencil and core are invariant.
+
+    A square box (width = depth) under a load the same on every face (no bending
+    stress): its walls, supports, core span and prestress are the same after a quarter
+    turn about its axis, and so are its pencil's eigenvalues and the normal components of
+    its modes. The turns that map its mesh's constrained directions onto themselves
+    (:func:`~unibuckle_fenicsx.model.shell.core.quarter_turns`) and a foundation's
+    springs onto equal springs; none for any other section.
+    """
+    square = p.shape == "box" and p.width == p.depth and p.bending_stress == 0.0
+    if constraints is None or not square:
+        return ()
+    turns = quarter_turns(constraints)
+    if springs is not None:
+        turns = tuple(t for t in turns if np.allclose(springs[t], springs, rtol=1e-12, atol=0.0))
+    return turns
 
 
 @dataclass(frozen=True)
