@@ -581,6 +581,8 @@ def _verified(cert: CertificateRecord | None) -> str:
     refuted = cert.refuting_load_Pa
     if refuted is not None:
         return f"proven=no, refuted: an admissible mode has {refuted:.6e} Pa"
+    if cert.status == "not-kkt":  # not even a critical state: not "KKT only"
+        return f"proven=no (not a KKT point{below})"
     if cert.split_route is not None and cert.split_route.startswith("skipped"):
         return (
             f"proven=no (KKT only{below}; not bracketed by default here: split bracket "

@@ -457,3 +457,22 @@ def test_a_plate_figure_s_legend_tells_the_zone_from_the_nodes(tmp_path, monkeyp
     touch = plotting.THEME["touch_color"]
     assert entries == [("black", "line"), ("black", "circle"), (touch, "circle")]
     assert seen["points"] == ["black", touch]
+
+
+def test_a_state_that_fails_kkt_is_not_called_kkt_only():
+    # A tensionless foundation of 1e9 N/m^3 under the plate of test_penalty's cone without
+    # a positive load: certificate status "not-kkt" (a lower eigenvalue of the pencil with
+    # the pressing springs), and the first line read "KKT=NO  proven=no (KKT only)".
+    from unibuckle_fenicsx.results.records import CertificateRecord, _verified
+
+    cert = CertificateRecord(
+        feasible=True, feasibility_margin=-1e-3, max_contact_force=None,
+        max_contact_value=0.0, relative_residual=10.3, tolerance=1e-8, kkt=False,
+        smallest_of_reduced=False, lower_bound_Pa=1.977372e7, upper_bound_Pa=3.432653e10,
+        relative_gap=None, global_optimum_proven=False, proven_by="interlacing",
+        status="not-kkt", negative_eigenvalues=None, refuting_load_Pa=None,
+        copositivity=None, notes=[], split_route=None,
+    )  # fmt: skip
+    assert _verified(cert) == "proven=no (not a KKT point)"
+    kkt_only = msgspec.structs.replace(cert, kkt=True, status="kkt-only")
+    assert _verified(kkt_only) == "proven=no (KKT only)"
