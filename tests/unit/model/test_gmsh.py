@@ -510,6 +510,33 @@ def test_geo_and_msh_files(tmp_path):
         build_problem(triangles, MPI.COMM_WORLD)
 
 
+def test_file_zone_is_reported_against_its_area(tmp_path, capsys):
+    """A .geo plate and zones off its nodes: the zone's area from the cells, and the note.
+
+    The file's plate is known by its cells only: the zone's area was null and the
+    summary said nothing, where the structured mesh's off-grid zone draws the note. The
+    box [0.03, 0.13] x [0, 0.1] lies on the 0.2 x 0.1 m plate: 0.01 m^2; the arrowhead
+    polygon 0.16 x 0.1 m less a 0.08 x 0.1 m triangle: 0.012 m^2 (a non-convex zone).
+    """
+    (tmp_path / "plate.geo").write_text(GEO)
+    for zone, area in (
+        ("zone = [[0.03, 0.13], [0.0, 0.1]]", 0.01),
+        ("polygon = [[0.02, 0.0], [0.18, 0.0], [0.1, 0.05], [0.18, 0.1], [0.02, 0.1]]", 0.012),
+    ):
+        toml, out = tmp_path / "file.toml", tmp_path / "file.json"
+        toml.write_text(
+            '[plate]\nfile = "plate.geo"\nthickness = 0.006\n'
+            f"[edges.ends]\nnormal_stress = -1.0\n[edges.sides]\n[obstacle]\n{zone}\n"
+        )
+        assert cli_main(["solve", "--config", str(toml), "--json", str(out), "-q"]) == 0
+        assert "obstacle zone on the mesh: the cells with every node in it cover" in (
+            capsys.readouterr().out
+        )
+        (report,) = json.loads(out.read_text())["obstacle_zones"]
+        assert report["area_m2"] == pytest.approx(area, rel=1e-12)
+        assert report["discrete_area_m2"] < area
+
+
 def test_file_edge_names_must_exist(tmp_path, capsys):
     (tmp_path / "plate.geo").write_text(GEO)
     toml = tmp_path / "typo.toml"
