@@ -26,6 +26,7 @@ __all__ = [
     "is_convex",
     "is_simple",
     "narrowest_neck",
+    "narrowest_width",
     "points_in_circle",
     "points_in_polygon",
     "polygon_area",
@@ -289,6 +290,37 @@ def narrowest_neck(v: npt.NDArray[np.float64]) -> float:
         for j in (j for j in range(n) if j not in (k, (k - 1) % n)):
             segment = np.array([v[j], v[(j + 1) % n]])
             best = min(best, float(distance_to_polygon(v[k : k + 1], segment)[0]))
+    return best
+
+
+def narrowest_width(vertices: Vertices) -> float:
+    """The polygon's narrowest width: the shortest way across it from a side's midpoint.
+
+    From the midpoint of each segment along its inward normal to the first other segment
+    it meets; the smallest of these lengths. A rectangle's smaller side, a parallelogram's
+    smaller height, the width of an L-shape's arm, however the polygon is rotated (a
+    slot cut into it is not the plate's width: the normal from its walls runs into the
+    plate).
+    """
+    v = np.asarray(vertices, dtype=float)
+    a, b = v, np.roll(v, -1, axis=0)
+    d = b - a
+    size = float(np.ptp(v, axis=0).max())
+    turn = 1.0 if polygon_area(v) > 0 else -1.0  # inward normal: left of a counter-clockwise side
+    best = math.inf
+    for j in range(len(v)):
+        start = 0.5 * (a[j] + b[j])
+        normal = turn * np.array([-d[j][1], d[j][0]]) / np.linalg.norm(d[j])
+        for k in range(len(v)):
+            if k == j:
+                continue
+            # start + s normal = a_k + u d_k, solved for (s, u)
+            matrix = np.column_stack([normal, -d[k]])
+            if abs(np.linalg.det(matrix)) <= 1e-12 * np.linalg.norm(d[k]):
+                continue  # parallel to the normal
+            s, u = np.linalg.solve(matrix, a[k] - start)
+            if s > 1e-9 * size and -1e-9 <= u <= 1.0 + 1e-9:
+                best = min(best, float(s))
     return best
 
 

@@ -7,7 +7,8 @@ area of the zone given (its part on the plate), says how far the mesh follows th
 On a gmsh plate the zone's edges are mesh lines
 (:func:`~unibuckle_fenicsx.model.gmsh_mesh.gmsh_plate_mesh`) and the two agree, up to the
 polygon a circle's cells inscribe; on the structured rectangle they agree when the grid
-has lines on the zone's edges.
+has lines on the zone's edges; a gmsh file's plate is known by its cells, on which the
+zone's area is measured (:func:`meshed_zone_area`).
 """
 
 from __future__ import annotations
@@ -23,10 +24,10 @@ import numpy as np
 import numpy.typing as npt
 from msgspec import Struct
 
-from unibuckle_fenicsx.geometry import disc_polygon, intersection_area, polygon_area
+from unibuckle_fenicsx.geometry import disc_polygon, intersection_area, is_convex, polygon_area
 from unibuckle_fenicsx.spec import Circle, ObstacleSpec, PlateSpec, Polygon
 
-__all__ = ["ZoneReport", "cell_areas", "zone_area", "zone_report"]
+__all__ = ["ZoneReport", "cell_areas", "meshed_zone_area", "zone_area", "zone_report"]
 
 
 class ZoneReport(Struct, kw_only=True):
@@ -35,7 +36,8 @@ class ZoneReport(Struct, kw_only=True):
     Attributes:
         obstacle: The obstacle's label in the problem file.
         zone: The zone, described.
-        area_m2: The zone's part on the plate (None if unknown: a predicate zone).
+        area_m2: The zone's part on the plate (a gmsh file's: on its cells; None if
+            unknown: a predicate zone).
         discrete_area_m2: The cells with every node in the closed zone.
         nodes: Mesh nodes in the closed zone, edge nodes included.
     """
@@ -78,6 +80,30 @@ def zone_area(obstacle: ObstacleSpec, plate: PlateSpec) -> float | None:
             raise RuntimeError("zone_area: expected hole_shape is not None (an internal invariant)")
         area -= intersection_area(shape, hole_shape)
     return max(area, 0.0)
+
+
+def meshed_zone_area(msh: dolfinx.mesh.Mesh, obstacle: ObstacleSpec, size: float) -> float:
+    """Area (m^2) of the zone's part on the owned cells: a gmsh file's plate. Not collective.
+
+    The plate of a file is known only by its cells, so the zone is intersected with each
+    of them (:func:`~unibuckle_fenicsx.geometry.intersection_area`); cells off the zone's
+    bounding box add nothing, and the cells with every node in a convex zone their area.
+    (A predicate zone has no area: :func:`zone_report` gives None.)
+    """
+    areas, nodes = cell_areas(msh)
+    if obstacle.zone == "all":
+        return float(areas.sum())
+    shape = _shape(obstacle.zone)
+    if shape is None or abs(polygon_area(shape)) == 0.0:
+        return 0.0
+    ring = msh.geometry.x[:, :2][nodes[:, [0, 1, 3, 2]]]  # (cells, 4, 2), in order round
+    low, high = shape.min(axis=0), shape.max(axis=0)
+    near = (ring.max(axis=1) >= low).all(axis=1) & (ring.min(axis=1) <= high).all(axis=1)
+    whole = obstacle.contains(msh.geometry.x.T, size)[nodes].all(axis=1) & is_convex(shape)
+    area = float(areas[near & whole].sum())
+    for cell in np.flatnonzero(near & ~whole):
+        area += intersection_area(shape, ring[cell])
+    return area
 
 
 def cell_areas(msh: dolfinx.mesh.Mesh) -> tuple[npt.NDArray[np.float64], npt.NDArray[np.int32]]:
@@ -132,7 +158,9 @@ def zone_report(
             ZoneReport(
                 obstacle=label,
                 zone=obstacle.describe(),
-                area_m2=zone_area(obstacle, plate),
+                area_m2=zone_area(obstacle, plate)
+                if plate.file is None or callable(obstacle.zone)
+                else comm.allreduce(meshed_zone_area(msh, obstacle, size), op=MPI.SUM),
                 discrete_area_m2=comm.allreduce(float(areas[whole].sum()), op=MPI.SUM),
                 nodes=comm.allreduce(int(np.count_nonzero(inside)), op=MPI.SUM),
             )

@@ -10,7 +10,14 @@ from __future__ import annotations
 import numpy as np
 
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.geometry import Shape, collinear, narrowest_neck, segment_lengths, shape_gap
+from unibuckle_fenicsx.geometry import (
+    Shape,
+    collinear,
+    narrowest_neck,
+    narrowest_width,
+    segment_lengths,
+    shape_gap,
+)
 from unibuckle_fenicsx.spec.base import in_file
 from unibuckle_fenicsx.spec.plate import (
     EDGE_NAMES,
@@ -31,21 +38,35 @@ FEATURE_RATIO = 100.0
 TOUCH_TOLERANCE = 1e-9
 
 
+def plate_width(plate: PlateSpec) -> tuple[float, str]:
+    """The width b of the plate's warnings (m), and its name for their messages.
+
+    The rectangle's smaller side; for a plate given by its outline, the smaller of its
+    bounding box's sides and its narrowest width
+    (:func:`~unibuckle_fenicsx.geometry.narrowest_width`: a rotated rectangle's smaller
+    side, an L-shape's arm), which the bounding box is not.
+    """
+    b = min(plate.length, plate.width)
+    if plate.outline is None:
+        return b, "the plate's smaller side"
+    return min(b, narrowest_width(plate.outline)), "the plate's narrowest width"
+
+
 def plate_model_note(plate: PlateSpec, units: str = "SI") -> str | None:
-    """A warning when t/b exceeds :data:`THICK_PLATE_RATIO`, else None.
+    """A warning when t/b exceeds :data:`THICK_PLATE_RATIO` (b: :func:`plate_width`), else None.
 
     Lengths in the unit system ``units`` (the file's; the JSON's are SI).
     """
     if plate.file is not None:
         return None
-    b = min(plate.length, plate.width)
+    b, side_name = plate_width(plate)
     ratio = plate.thickness / b
     if ratio <= THICK_PLATE_RATIO:
         return None
     (t, side), name = in_file((plate.thickness, b), "m", units)
     return (
-        f"plate.thickness = {t:g} {name} is {ratio:.3g} times the plate's smaller "
-        f"side {side:g} {name}: Reissner-Mindlin theory (transverse shear, no thickness "
+        f"plate.thickness = {t:g} {name} is {ratio:.3g} times {side_name} "
+        f"{side:g} {name}: Reissner-Mindlin theory (transverse shear, no thickness "
         f"stretch) is a model of plates up to t/b of about {THICK_PLATE_RATIO:g}; beyond, "
         "compare with a 3-D solid model"
     )
@@ -59,7 +80,9 @@ MIN_CELLS_ACROSS = 4
 
 
 def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str | None:
-    """A warning when the cells are larger than the plate's smaller side over 4, else None.
+    """A warning when the cells are larger than the plate's width over 4, else None.
+
+    The width is :func:`plate_width`'s (an outline's narrowest width).
 
     Under a stress gradient into tension, the same for the compressed width of a loaded
     edge (:func:`_gradient_note`). The cells of the rectangle (``nx`` and ``ny``, or
@@ -69,7 +92,7 @@ def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str
     """
     if plate.file is not None:
         return None
-    b = min(plate.length, plate.width)
+    b, side_name = plate_width(plate)
     if plate.meshed_by_gmsh:
         h = mesh.size if mesh.size is not None else 0.0
     else:
@@ -84,8 +107,8 @@ def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str
     if h * MIN_CELLS_ACROSS > b * (1.0 + 1e-9):
         (cell, side, finer), name = in_file((h, b, b / MIN_CELLS_ACROSS), "m", units)
         return (
-            f"{what}: cells up to {cell:.3g} {name}, more than a quarter of the plate's smaller "
-            f"side {side:.3g} {name} (fewer than {MIN_CELLS_ACROSS} cells across it): on cells "
+            f"{what}: cells up to {cell:.3g} {name}, more than a quarter of {side_name} "
+            f"{side:.3g} {name} (fewer than {MIN_CELLS_ACROSS} cells across it): on cells "
             "this coarse the critical load, k and the design values come out too high (+18 % "
             f"at 3 cells across a simply supported square); cells of {finer:.3g} {name} or less"
         )

@@ -24,6 +24,7 @@ from support.rm_triangles import holed_plate_load, navier_check  # noqa: E402
 from unibuckle_fenicsx.algorithms.chain import ChainOptions, solve_interior_point  # noqa: E402
 from unibuckle_fenicsx.analysis import solve  # noqa: E402
 from unibuckle_fenicsx.cli import main as cli_main  # noqa: E402
+from unibuckle_fenicsx.geometry import narrowest_width  # noqa: E402
 from unibuckle_fenicsx.model.build import build_problem  # noqa: E402
 from unibuckle_fenicsx.model.gmsh_mesh import GMSH_OPTIONS  # noqa: E402
 from unibuckle_fenicsx.model.materials import navier_load_mindlin  # noqa: E402
@@ -36,6 +37,7 @@ from unibuckle_fenicsx.spec import (  # noqa: E402
     problem_to_dict,
 )
 from unibuckle_fenicsx.spec.cases import paper_case  # noqa: E402
+from unibuckle_fenicsx.spec.checks import coarse_mesh_note, plate_model_note  # noqa: E402
 
 #: The paper's plate as an outline: segment 0 bottom, 1 right, 2 top, 3 left.
 PAPER_OUTLINE = [[-0.1, -0.05], [0.1, -0.05], [0.1, 0.05], [-0.1, 0.05]]
@@ -380,6 +382,54 @@ def test_unnamed_boundary_parts_are_free():
     assert ours == pytest.approx(reference, rel=1e-10)
 
 
+def _rotated_square(side, degrees):
+    c, s = np.cos(np.radians(degrees)), np.sin(np.radians(degrees))
+    corners = [(0.0, 0.0), (1.0, 0.0), (1.0, 1.0), (0.0, 1.0)]
+    return [[side * (c * x - s * y), side * (s * x + c * y)] for x, y in corners]
+
+
+L_SHAPE = [[0.0, 0.0], [0.2, 0.0], [0.2, 0.1], [0.1, 0.1], [0.1, 0.2], [0.0, 0.2]]
+
+
+@pytest.mark.parametrize(
+    ("outline", "width"),
+    [
+        (PAPER_OUTLINE, 0.1),
+        (_rotated_square(0.2, 30.0), 0.2),  # bounding box 0.273 m a side
+        (L_SHAPE, 0.1),  # bounding box 0.2 m: the arms are 0.1 m wide
+        ([[0.0, 0.0], [0.2, 0.0], [0.25, 0.1], [0.05, 0.1]], 0.1),  # a skew parallelogram
+    ],
+)
+def test_plate_warnings_take_the_outline_width(outline, width):
+    """Fewer than 4 cells across the plate's width: warned however the outline lies.
+
+    The rule is the rectangle's (b/4; the simply supported square's k is +18 % at 3
+    cells across, ``tests/unit/cli/test_robustness.py``). It read the outline's bounding
+    box: the square of side 0.2 m turned by 30 degrees, at mesh.size = 0.2/3 m, gave the
+    axis-parallel square's k = 4.7009 (Navier's k = 4) without the warning the latter
+    draws; the L-shape with 0.1 m arms at 0.05 m (2 cells across an arm) gave k = 18.10
+    silently against 8.56 at 0.0125 m. Expected widths: the side, the arm, the height.
+    The thick-plate note (t/b above 0.2) takes the same width.
+    """
+    assert narrowest_width(outline) == pytest.approx(width, rel=1e-12)
+    for size, warned in ((width / 3, True), (width / 4, False)):
+        spec = problem_from_dict(
+            {
+                "plate": {"outline": outline, "thickness": 0.001},
+                "edges": {"all": {"segments": list(range(len(outline)))}},
+                "mesh": {"size": size},
+            }
+        )
+        note = coarse_mesh_note(spec.plate, spec.mesh)
+        assert (note is not None) == warned, note
+        if warned:
+            assert f"the plate's narrowest width {width:.3g} m" in note
+    # the thick-plate note's t/b > 0.2 (the rectangle's rule) by the same width
+    for ratio, warned in ((0.25, True), (0.15, False)):
+        plate = replace(spec.plate, thickness=ratio * width)
+        assert (plate_model_note(plate) is not None) == warned
+
+
 def test_inclined_edge_needs_soft_support_or_clamping():
     """Hard simple support fixes the tangential rotation: only on axis-parallel edges."""
     outline = [[0.0, 0.0], [0.3, 0.0], [0.25, 0.1], [0.0, 0.1]]
@@ -458,6 +508,33 @@ def test_geo_and_msh_files(tmp_path):
     message = r"triangles\.msh: the gmsh mesh must consist of bilinear quadrilaterals .*Triangle"
     with pytest.raises(ValueError, match=message):
         build_problem(triangles, MPI.COMM_WORLD)
+
+
+def test_file_zone_is_reported_against_its_area(tmp_path, capsys):
+    """A .geo plate and zones off its nodes: the zone's area from the cells, and the note.
+
+    The file's plate is known by its cells only: the zone's area was null and the
+    summary said nothing, where the structured mesh's off-grid zone draws the note. The
+    box [0.03, 0.13] x [0, 0.1] lies on the 0.2 x 0.1 m plate: 0.01 m^2; the arrowhead
+    polygon 0.16 x 0.1 m less a 0.08 x 0.1 m triangle: 0.012 m^2 (a non-convex zone).
+    """
+    (tmp_path / "plate.geo").write_text(GEO)
+    for zone, area in (
+        ("zone = [[0.03, 0.13], [0.0, 0.1]]", 0.01),
+        ("polygon = [[0.02, 0.0], [0.18, 0.0], [0.1, 0.05], [0.18, 0.1], [0.02, 0.1]]", 0.012),
+    ):
+        toml, out = tmp_path / "file.toml", tmp_path / "file.json"
+        toml.write_text(
+            '[plate]\nfile = "plate.geo"\nthickness = 0.006\n'
+            f"[edges.ends]\nnormal_stress = -1.0\n[edges.sides]\n[obstacle]\n{zone}\n"
+        )
+        assert cli_main(["solve", "--config", str(toml), "--json", str(out), "-q"]) == 0
+        assert "obstacle zone on the mesh: the cells with every node in it cover" in (
+            capsys.readouterr().out
+        )
+        (report,) = json.loads(out.read_text())["obstacle_zones"]
+        assert report["area_m2"] == pytest.approx(area, rel=1e-12)
+        assert report["discrete_area_m2"] < area
 
 
 def test_file_edge_names_must_exist(tmp_path, capsys):
