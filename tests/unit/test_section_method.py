@@ -491,7 +491,7 @@ def test_auto_on_a_rectangular_box_ends_no_higher_than_the_starts_on_its_cells(
         assert result.critical_load_Pa <= rectangular_box_bound * (1.0 + 1e-7)
 
 
-@pytest.mark.parametrize("stiffness", [6e11, 1e13])
+@pytest.mark.parametrize("stiffness", [8e10, 6e11, 1e13])
 def test_an_elastic_core_ends_no_higher_than_the_rigid_cores_admissible_mode(
     stiffness, rectangular_box_bound
 ):
@@ -502,7 +502,10 @@ def test_an_elastic_core_ends_no_higher_than_the_rigid_cores_admissible_mode(
     above (the fixture's bound). The spring-set iteration's start from the rigid core's
     contact set took the active set's KKT point on the elastic core's problem, 1.506630e8
     Pa, and the core of 6e11 N/m^3 ended at 1.505791e8 Pa, of 1e13 at 1.506577e8 Pa:
-    above the bound. It now takes the rigid core's route.
+    above the bound. It now takes the rigid core's route. The core of 8e10 N/m^3
+    (kappa = 940, springs' energy over bending energy on the free mode) took no rigid
+    start (only above kappa = 1e3): its other starts ended at 1.501033e8 Pa, above the
+    bound and above the stiffer 1e11 N/m^3's 1.497063e8; every core now takes it.
     """
     box = SectionParameters("box", **RECTANGULAR_BOX, foundation_stiffness=stiffness)
     with solve_section(box, MPI.COMM_SELF) as solved:
@@ -531,3 +534,33 @@ def test_an_elastic_core_whose_coarser_section_holds_no_core_node_is_solved():
         result = solved.result
         assert result.method == "foundation"
         assert result.free_load_Pa <= result.critical_load_Pa <= bound * (1.0 + 1e-7)
+
+
+def test_an_elastic_core_whose_starts_all_end_high_takes_the_rigid_mode(
+    rectangular_box_bound, monkeypatch
+):
+    """The rigid core's mode is a candidate itself: the answer is at most its load.
+
+    Its spring quotient is its load (it presses no spring), and the arc descent from it
+    never rises. Here the start from the rigid core's contact set is made the free
+    start (the other starts of the 8e10 N/m^3 core end at 1.501033e8 Pa, above the
+    bound): only the rigid mode keeps the answer at or below the fixture's bound, the
+    rigid core's admissible mode's Rayleigh quotient.
+    """
+    from unibuckle_fenicsx.algorithms import foundation
+
+    original = foundation._from_start
+
+    def no_rigid_start(solver, name, start, lower, max_iterations):
+        if name == "rigid":
+            start = start[:0]  # the free start's empty set
+        return original(solver, name, start, lower, max_iterations)
+
+    monkeypatch.setattr(foundation, "_from_start", no_rigid_start)
+    box = SectionParameters("box", **RECTANGULAR_BOX, foundation_stiffness=8e10)
+    with solve_section(box, MPI.COMM_SELF) as solved:
+        result, details = solved.result, solved.solution.details
+    assert details.foundation_start == foundation.RIGID_MODE
+    assert details.foundation_loads["free"] > rectangular_box_bound
+    assert result.free_load_Pa <= result.critical_load_Pa
+    assert result.critical_load_Pa <= rectangular_box_bound * (1.0 + 1e-7)

@@ -26,16 +26,18 @@ on both sides (a bilateral foundation, ``side = "both"``) are simply added to A.
 Bounds: :math:`\lambda_{free} \le \lambda_f \le \lambda_{rigid}` (the spring term is
 non-negative, and vanishes on the rigid obstacle's mode), and the returned load, a value
 of the quotient, is an upper bound of :math:`\lambda_f`. The iteration starts from the
-free plate (no springs), from every spring active (the bilateral foundation's mode) and,
-on a plate, from the contact set of the rigid obstacle's answer (the caller's
-``rigid_set``; a section's core above :data:`RIGID_START_RATIO`, from its rigid core's
-route); for stiff
-springs (:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`) also from the set a
-continuation in the stiffness ends on; the smallest quotient is returned. The rigid start
-is what keeps the answer at or below the rigid obstacle's load, and non-decreasing in
-:math:`k_f`: without it, the other starts can all end at stationary points above the
-minimum of every spring set, and above the rigid obstacle's load
-(:doc:`/history/2026-12-01a-metamorph`).
+free plate (no springs), from every spring active (the bilateral foundation's mode),
+from the contact set of the rigid obstacle's answer (the caller's ``rigid_set``: a
+plate's rigid twin, a section's rigid core's route) and, for stiff springs
+(:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`), from the set a continuation
+in the stiffness ends on; the smallest quotient is returned. The rigid obstacle's mode
+itself is a candidate too (:func:`_rigid_mode`): it presses no spring, so its quotient
+is the rigid load, and the arc descent from it only lowers it: the answer is at or below
+the rigid obstacle's load by construction. The rigid start is what keeps the answer
+there, and non-decreasing in :math:`k_f`: without it, the other starts can all end at
+stationary points above the minimum of every spring set, and above the rigid obstacle's
+load, on plates (:doc:`/history/2026-12-01a-metamorph`) and on a section's soft cores
+(:doc:`/history/2026-12-01b-schunt`).
 A node of the spring set keeps pressing while its spring force exceeds
 :data:`~unibuckle_fenicsx.tolerances.PRESSING_RTOL` of the largest: a stiff spring's
 node presses by less than that fraction of max|w|, and would otherwise leave and return
@@ -74,11 +76,10 @@ from unibuckle_fenicsx.algorithms.records import FoundationDetails
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
-from unibuckle_fenicsx.model.shell.problem import SectionProblem
 from unibuckle_fenicsx.spec.solver import FoundationOptions
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
-__all__ = ["pressing_nodes", "solve_foundation"]
+__all__ = ["RIGID_MODE", "pressing_nodes", "solve_foundation"]
 
 logger = logging.getLogger(__name__)
 
@@ -86,11 +87,8 @@ logger = logging.getLogger(__name__)
 #: :math:`\kappa` = 10 by tenfold steps: stiff springs have stationary points far from
 #: the free plate's and the bilateral foundation's (:doc:`/verification/stiff_foundations`).
 CONTINUATION_RATIO = 10.0
-#: Above this :func:`stiffness_ratio` a section's core also starts from the rigid core's
-#: contact set (its caller's or the active set's; a plate always does): on long plates
-#: the other starts end at stationary points above the rigid obstacle's load, which no
-#: foundation exceeds.
-RIGID_START_RATIO = 1e3
+#: The name of the candidate :func:`_rigid_mode` (a result's ``foundation_start``).
+RIGID_MODE = "rigid mode"
 #: Angles sampled on the circle before the golden-section refinement.
 ARC_SAMPLES = 720
 #: Golden-section steps in the bracket around the best sample: 0.618^60 of a sample's
@@ -113,12 +111,12 @@ def solve_foundation(
         max_iterations: Eigen solves allowed per start, >= 1.
         eps_options: Extra EPS options under ``unibuckle_foundation_``.
         rigid_set: Gives the rigid obstacle's contact set on the problem's contact
-            directions and its eigen solves, for the start from it (on a section, run
-            only above :data:`RIGID_START_RATIO`); None: :func:`_rigid_set`, the active
-            set on the problem itself. :func:`~unibuckle_fenicsx.analysis.solve` passes
-            a plate's rigid twin, solved as a whole problem, and a section its rigid
-            core's route: their KKT points can lie below the active set's
-            (:doc:`/history/2026-12-01a-metamorph`, :doc:`/history/2026-12-01a-coreroute`).
+            directions and its eigen solves, for the start from it; None:
+            :func:`_rigid_set`, the active set on the problem itself.
+            :func:`~unibuckle_fenicsx.analysis.solve` passes a plate's rigid twin,
+            solved as a whole problem, and a section its rigid core's route: their KKT
+            points can lie below the active set's (:doc:`/history/2026-12-01a-metamorph`,
+            :doc:`/history/2026-12-01a-coreroute`).
 
     Returns:
         The solution; its candidate's load is the quotient of the returned mode, its
@@ -138,33 +136,35 @@ def solve_foundation(
     lower = problem.solve_free().load
     springs = contact.stiffness
     ratio = stiffness_ratio(problem, springs)
-    rigid = None
-    if ratio > RIGID_START_RATIO or _plate(problem):
-        rigid = _rigid_set(problem) if rigid_set is None else rigid_set()
+    rigid = _rigid_set(problem) if rigid_set is None else rigid_set()
     runs: dict[str, SpringIteration] = {}
     finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
     with PenaltySolver(problem, prefix=Prefix.FOUNDATION, eps_options=eps_options) as solver:
         starts = {"free": np.empty(0, np.int64), "bilateral": np.arange(contact.size)}
         for name, start in starts.items():
             runs[name], finals[name] = _from_start(solver, name, start, lower, max_iterations)
-        if rigid is not None:
-            runs["rigid"], finals["rigid"] = _from_start(
-                solver, "rigid", rigid[0], lower, max_iterations
-            )
+        runs["rigid"], finals["rigid"] = _from_start(
+            solver, "rigid", rigid[0], lower, max_iterations
+        )
         if ratio > CONTINUATION_RATIO:
             start = _continued_start(solver, springs, ratio, lower, max_iterations)
             runs["continued"], finals["continued"] = _from_start(
                 solver, "continued", start, lower, max_iterations
             )
+        lowest = min(final.load for final, _, _ in finals.values())
+        mode = _rigid_mode(solver, rigid[0], lowest, max_iterations)
+        if mode is not None:
+            finals[RIGID_MODE] = mode
         # The smallest quotient; within TWIN_RTOL of it (mirror images, whose loads differ
         # by rounding that changes with the ranks) the earlier start, the free plate first.
         lowest = min(final.load for final, _, _ in finals.values())
         name = next(n for n, (c, _, _) in finals.items() if c.load <= lowest * (1 + TWIN_RTOL))
-        best = runs[name]
         candidate, status, arc_steps = finals[name]
-        if arc_steps:
+        history = [s.quotient for s in runs[name].steps] if name in runs else [candidate.load]
+        if arc_steps and name != RIGID_MODE:
             name += "+arc"
-        solves = solver.solves + (rigid[1] if rigid is not None else 0)
+        # The rigid set's reduced eigen solve is the problem's own eigen solver's.
+        solves = solver.solves + rigid[1] + (0 if mode is None else 1)
     load = candidate.load
     proven = status is RunStatus.CONVERGED and not candidate.active.size
     proven = proven and load <= lower * (1.0 + TWIN_RTOL)
@@ -172,12 +172,14 @@ def solve_foundation(
         foundation_start=name,
         foundation_arc_steps=arc_steps,
         foundation_iterations={n: len(r.steps) for n, r in runs.items()},
-        foundation_loads={n: r.candidate.load for n, r in runs.items()},
-        foundation_statuses={n: str(r.status) for n, r in runs.items()},
+        foundation_loads={n: r.candidate.load for n, r in runs.items()}
+        | ({} if mode is None else {RIGID_MODE: mode[0].load}),
+        foundation_statuses={n: str(r.status) for n, r in runs.items()}
+        | ({} if mode is None else {RIGID_MODE: str(mode[1])}),
         foundation_pressing_nodes=int(candidate.active.size),
         foundation_max_penetration=max(float(candidate.values.max()), 0.0),
         foundation_spring_range_N_per_m=[float(springs.min()), float(springs.max())],
-        foundation_history=[s.quotient for s in best.steps],
+        foundation_history=history,
         foundation_status=str(status),
     )
     logger.info(
@@ -215,9 +217,34 @@ def stiffness_ratio(problem: UnilateralProblem, springs: npt.NDArray[np.float64]
     return float(np.sum(springs * z * z)) / energy if energy > 0.0 else 0.0
 
 
-def _plate(problem: UnilateralProblem) -> bool:
-    """Whether ``problem`` is a plate (not a section's shell, whose spec is its unrolled walls)."""
-    return not isinstance(problem, SectionProblem)
+def _rigid_mode(
+    solver: PenaltySolver, active: npt.NDArray[np.int64], lowest: float, max_iterations: int
+) -> tuple[Candidate, RunStatus, int] | None:
+    r"""The rigid obstacle's mode as a candidate, when its quotient is below ``lowest``.
+
+    The smallest eigenpair with the rigid answer's contact set ``active`` removed is the
+    rigid obstacle's mode; admissible, it presses no spring (by at most the feasibility
+    tolerance), so its spring quotient is the rigid load. Where that lies below
+    ``lowest`` (the starts' smallest quotient), the arc descent runs from it
+    (:func:`_arc_descent`, never increasing): the answer is then at or below the rigid
+    obstacle's load whatever the starts did. Returns (mode, how the descent ended, its
+    steps), or None (no set, or not lower: nothing run after the one eigen solve).
+    Collective.
+    """
+    if not active.size:
+        return None
+    problem = solver.problem
+    springs = problem.contact.stiffness
+    assert springs is not None
+    rigid = problem.evaluate(active)
+    vec = rigid.mode.x.petsc_vec
+    quotient = solver.quotient(vec, springs)
+    logger.info("foundation: the rigid mode's quotient %.10g, the starts' %.10g", quotient, lowest)
+    if not quotient < lowest * (1.0 - TWIN_RTOL):
+        return None
+    pressing = pressing_nodes(problem.contact.values(vec), problem.max_abs_w(vec))
+    start = problem.candidate(rigid.mode, quotient, pressing, sign=1.0)
+    return _arc_descent(problem, solver, springs, start, max_iterations)
 
 
 def _rigid_set(problem: UnilateralProblem) -> tuple[npt.NDArray[np.int64], int]:
