@@ -238,8 +238,7 @@ class SectionMeshSpec(Table, frozen=True):
         levels: With a rigid core, coarser sections (each with twice the cell size) the
             search starts on, >= 0, as long as the coarsest keeps 2 cells along; 1: its
             many steps on a quarter of the DOFs, a few on the given cells. An elastic core:
-            those of its start from the rigid core's contact set (a stiff core's, above
-            :data:`~unibuckle_fenicsx.algorithms.foundation.RIGID_START_RATIO`). Refused
+            those of its start from the rigid core's contact set. Refused
             without a core (:func:`check_core_options`).
     """
 
