@@ -69,6 +69,7 @@ from msgspec import UNSET, Struct, UnsetType
 
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
+    SHEAR_NOT_CHECKED,
     DesignElement,
     EffectiveWidths,
     buckling_factor,
@@ -163,9 +164,14 @@ class ElementLimits(Struct, kw_only=True):
     effective_widths_row: str | None = None
     effective_widths_placed: str | None = None
 
-    def put_limit_and_widths(self, w: EffectiveWidths, psi: float, named: str) -> None:
-        """Set the fields from ``psi`` and the widths ``w``; ``named``: where its ends lie."""
-        self.partial_factor_name, self.stress_limit_clause = stress_limit(psi)
+    def put_limit_and_widths(
+        self, w: EffectiveWidths, psi: float, named: str, shear: bool = False
+    ) -> None:
+        """Set the fields from ``psi`` and the widths ``w``; ``named``: where its ends lie.
+
+        ``shear``: the load has shear, which the stress limit does not check.
+        """
+        self.partial_factor_name, self.stress_limit_clause = stress_limit(psi, shear)
         self.element_width_m, self.compressed_width_m = w.width, w.compressed
         self.effective_width_m = w.effective
         self.effective_width_1_m, self.effective_width_2_m = w.first, w.second
@@ -405,7 +411,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     out.reduction_factor = _column_type(out, spec, design, element, rho)
     rho_c = out.reduction_factor
     out.reduced_design_stress_Pa = rho_c * design.yield_stress / design.partial_factor
-    _widths(out, element, rho_c, end, at_free, euler_length(spec, element.loaded))
+    _widths(out, element, rho_c, end, at_free, euler_length(spec, element.loaded), shear)
     out.clauses += f"; {out.stress_limit_clause}"
     if out.tension_Pa is not None:
         # sigma_1 f_y/(gamma sigma_t) < rho f_y/gamma (gamma = partial_factor in both):
@@ -417,12 +423,18 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
 
 
 def _widths(
-    out: DesignRecord, element: DesignElement, rho: float, end: int, at_free: bool, width: float
+    out: DesignRecord,
+    element: DesignElement,
+    rho: float,
+    end: int,
+    at_free: bool,
+    width: float,
+    shear: bool,
 ) -> None:
     """Put the effective widths of Table 4.1 or 4.2 in ``out``, naming the edges they lie at.
 
     ``end`` is the end (0 start, 1 end) of the loaded edge where sigma_1 acts, ``width``
-    the loaded edge's length.
+    the loaded edge's length; ``shear``: the load has shear (the stress limit's clause).
     """
     assert out.psi is not None
     psi = min(out.psi, 1.0)
@@ -434,7 +446,8 @@ def _widths(
     else:
         supported = next(e for e in element.unloaded if e != element.free_edge)
         named = f"supported edge: edges.{supported}, free edge: edges.{element.free_edge}"
-    out.put_limit_and_widths(effective_widths(element.kind, rho, width, psi, at_free), psi, named)
+    widths = effective_widths(element.kind, rho, width, psi, at_free)
+    out.put_limit_and_widths(widths, psi, named, shear)
 
 
 def _tension_note(out: DesignRecord, rho: float) -> str:
@@ -547,24 +560,27 @@ def column_stress(spec: ProblemSpec, loaded: tuple[str, str]) -> tuple[float, st
     return factor * hinged, f"{' and '.join(words)}: {how}"
 
 
-def euler_length(spec: ProblemSpec, loaded: tuple[str, str]) -> float:
-    """The length (m) of the ``loaded`` edges: the y extent for left and right, else x."""
+def euler_length(spec: ProblemSpec, loaded: tuple[str, str], *, along: bool = False) -> float:
+    """The length (m) of the ``loaded`` edges: the y extent for left and right, else x.
+
+    With ``along``, the plate's length along the stress instead (the other extent).
+    """
     plate = spec.plate
-    return plate.width if loaded == ("left", "right") else plate.length
+    return plate.width if (loaded == ("left", "right")) != along else plate.length
 
 
 def euler_stress(spec: ProblemSpec, loaded: tuple[str, str], *, along: bool = False) -> float:
     r""":math:`\sigma_E = \pi^2 E t^2/(12(1 - \nu^2) b^2)` (Pa), EN 1993-1-5 eq. (A.2).
 
-    b is the length of the ``loaded`` edges: the y extent for left and right, the x
-    extent for bottom and top; with ``along``, the plate's length a along the stress
-    instead: :math:`\sigma_{cr,c}`, the plate as a column (4.5.3(2), eq. (4.8)). The
-    material is isotropic (the design output refuses a laminate and a Voigt matrix).
+    b is the length of the ``loaded`` edges (:func:`euler_length`): the y extent for left
+    and right, the x extent for bottom and top; with ``along``, the plate's length a along
+    the stress instead: :math:`\sigma_{cr,c}`, the plate as a column (4.5.3(2), eq.
+    (4.8)). The material is isotropic (the design output refuses a laminate and a Voigt
+    matrix).
     """
-    plate, material = spec.plate, spec.material
-    across = (loaded == ("left", "right")) != along
-    length = plate.width if across else plate.length
-    return plate_euler_stress(material.E, material.nu, plate.thickness, length)
+    material = spec.material
+    length = euler_length(spec, loaded, along=along)
+    return plate_euler_stress(material.E, material.nu, spec.plate.thickness, length)
 
 
 def effective_widths_text(d: ElementLimits, length: float, name: str) -> str:
@@ -582,13 +598,21 @@ def effective_widths_text(d: ElementLimits, length: float, name: str) -> str:
     return text
 
 
-def limit_clause_text(psi: float | None, factor: str | None) -> str:
-    """The design line's clause of rho f_y/gamma_M ('' without it)."""
+def limit_clause_text(psi: float | None, factor: str | None, clause: str | None = None) -> str:
+    """The design line's clause of rho f_y/gamma_M ('' without it).
+
+    ``clause``: the record's ``stress_limit_clause``; the line says when it leaves the
+    load's shear unchecked (:data:`~unibuckle_fenicsx.en1993.SHEAR_NOT_CHECKED`).
+    """
     if factor is None:
         return ""
+    shear = clause is not None and SHEAR_NOT_CHECKED in clause
     if psi == 1.0:
-        return f", rho f_y/{factor} 4.6(1)"
-    return f", rho f_y/{factor} section 10 eq. (10.1) (reduced stress method, direct stress)"
+        return f", rho f_y/{factor} 4.6(1)" + (
+            f" (direct stress; {SHEAR_NOT_CHECKED})" if shear else ""
+        )
+    stresses = f"tau = 0: {SHEAR_NOT_CHECKED}" if shear else "direct stress"
+    return f", rho f_y/{factor} section 10 eq. (10.1) (reduced stress method, {stresses})"
 
 
 #: Said when the critical load is not proven the lowest.

@@ -56,6 +56,7 @@ __all__ = [
     "ELEMENTS",
     "INTERNAL",
     "OUTSTAND",
+    "SHEAR_NOT_CHECKED",
     "STEEL_MODULUS",
     "STEEL_POISSON",
     "STEEL_YIELD_STRESS",
@@ -145,7 +146,7 @@ STEEL_YIELD_STRESS = (1.5e8, 1.0e9)
 def check_steel_yield_stress(fy: float, stress: float, name: str) -> None:
     """Refuse a yield stress ``fy`` (Pa) that is not a steel's (:data:`STEEL_YIELD_STRESS`).
 
-    The slenderness sqrt(f_y/sigma_cr) and rho f_y/gamma_M0 take f_y as it is: a number
+    The slenderness sqrt(f_y/sigma_cr) and rho f_y/gamma_M take f_y as it is: a number
     in another unit (355 in an SI file: 355 Pa) would give rho = 1 on any plate. ``stress``
     and ``name`` are the file's stress unit in Pa and its name, for the message; raises
     :class:`~unibuckle_fenicsx.errors.InputError` naming ``design.yield_stress``.
@@ -192,18 +193,34 @@ def table_row(element: str, free_edge_most_compressed: bool) -> str:
     return f"Table 4.2 (outstand compression element, larger compression at the {where} edge)"
 
 
-def stress_limit(psi: float) -> tuple[str, str]:
+#: Said of the stress limit of a load with shear: it checks the direct stress alone.
+SHEAR_NOT_CHECKED = "the load's shear not checked"
+
+
+def stress_limit(psi: float, shear: bool = False) -> tuple[str, str]:
     r"""(partial factor's name, clause) of the stress limit :math:`\rho f_y/\gamma_M` at ``psi``.
 
     The module docstring says why: 4.6(1) with :math:`\gamma_{M0}` at :math:`\psi = 1`,
-    the reduced stress method of section 10 with :math:`\gamma_{M1}` below.
+    the reduced stress method of section 10 with :math:`\gamma_{M1}` below. Both check
+    the direct stress alone; with ``shear`` (the load has shear) the clause says that
+    its shear is not checked (:data:`SHEAR_NOT_CHECKED`): section 5 and the interaction
+    of 7.1, or section 10 with :math:`\tau` in eq. (10.3), would include it.
     """
     if psi == 1.0:
-        return "gamma_M0", (
-            "4.6(1): rho f_y/gamma_M0 (eq. (4.14) at psi = 1: A_eff = rho A, no shift e_N)"
-        )
+        clause = "4.6(1): rho f_y/gamma_M0 (eq. (4.14) at psi = 1: A_eff = rho A, no shift e_N)"
+        if shear:
+            clause += (
+                f"; direct stress only, {SHEAR_NOT_CHECKED} (section 5 and the interaction "
+                "of 7.1, or section 10 with tau in eq. (10.3), would include it)"
+            )
+        return "gamma_M0", clause
+    stresses = (
+        f"with tau = 0 ({SHEAR_NOT_CHECKED}: eq. (10.3) would include it)"
+        if shear
+        else "direct stress only"
+    )
     return "gamma_M1", (
-        "section 10, reduced stress method, direct stress only: eq. (10.1) rho "
+        f"section 10, reduced stress method, {stresses}: eq. (10.1) rho "
         "alpha_ult,k/gamma_M1 >= 1 with alpha_ult,k = f_y/sigma_1 and eq. (10.2) "
         "slenderness sqrt(f_y/sigma_cr), rho = rho_x of 4.5.4(1) (10(5)): sigma_1 <= rho "
         "f_y/gamma_M1 (psi < 1: 4.6(1) checks A_eff, W_eff and e_N, not computed here)"

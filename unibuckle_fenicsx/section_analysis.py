@@ -83,6 +83,7 @@ from unibuckle_fenicsx.spec import (
 )
 from unibuckle_fenicsx.spec.base import FILE_UNITS, file_units, in_file
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
+from unibuckle_fenicsx.spec.section import DEFAULT_LEVELS
 
 __all__ = [
     "COLUMN_FRACTION",
@@ -276,7 +277,7 @@ def solve_section(
     parameters: SectionParameters | SectionProblemSpec,
     comm: MPI.Comm = MPI.COMM_WORLD,
     *,
-    levels: int = 1,
+    levels: int = DEFAULT_LEVELS,
     solver: SolverSpec | None = None,
     design: DesignSpec | None = None,
 ) -> SectionAnalysis:
@@ -416,13 +417,16 @@ def _check(parameters: SectionParameters, levels: int, design: DesignSpec | None
     """Refuse what no solve should start with, and warn of walls or cells out of range.
 
     Raises:
-        InputError: ``levels`` not an integer >= 0, or (a rigid core) its coarsest
-            section without 2 cells along; a design output asked of a wall whose
+        InputError: ``levels`` not an integer >= 0, or (a rigid core, or an elastic one
+            given other than the default levels) its coarsest section without 2 cells
+            along; a design output asked of a wall whose
             E is not a steel's (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
     """
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    if parameters.core and parameters.foundation_stiffness is None:  # a rigid core's levels
+    # A rigid core's levels; an elastic core's when given (its rigid start's, which
+    # takes the default's as far as the section allows them).
+    if parameters.core and (parameters.foundation_stiffness is None or levels != DEFAULT_LEVELS):
         check_levels(parameters, int(levels))
     notes = [thick_wall_note(parameters), coarse_mesh_note(parameters)]
     if design is not None:

@@ -248,8 +248,8 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         "[section] table (a box or a tube, with a core or hollow), solved on its [mesh]\n"
         "size and levels. Of the solver's flags a section takes --method (auto,\n"
         "interior-point or active-set: the last two with a rigid core only), --tau and\n"
-        "--max-iterations; the others, and --nx, --ny, --output and --candidate-parallel,\n"
-        "are a plate's (refused: exit status 2).",
+        "--max-iterations (with a core only); the others, and --nx, --ny and\n"
+        "--candidate-parallel, are a plate's (refused: exit status 2).",
         epilog=EPILOG,
         formatter_class=Formatter,
     )
@@ -370,8 +370,9 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
         metavar="DIR",
         help="write the mode, obstacle zone and contact set for ParaView (VTX .bp) and "
         "as VTK (.pvd/.vtu, readable by pyvista.read) into DIR (created if missing; its "
-        "parent must exist): NAME_w.bp, NAME_theta.bp, NAME.pvd, with NAME the problem's "
-        "name, characters other than letters, digits, '.', '-' and '_' replaced by '_'",
+        "parent must exist): NAME_w.bp, NAME_theta.bp, NAME.pvd (a section: NAME_u.bp, "
+        "NAME_outward.bp, NAME.pvd), with NAME the problem's name, characters other than "
+        "letters, digits, '.', '-' and '_' replaced by '_'",
     )
 
 

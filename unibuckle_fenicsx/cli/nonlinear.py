@@ -11,8 +11,7 @@ from unibuckle_fenicsx.cli.flags import NONLINEAR_FLAGS
 from unibuckle_fenicsx.cli.problem import (
     spec_from_args,
     warn_coarse_mesh,
-    warn_modulus_unit,
-    warn_plate_model,
+    warn_input,
     warn_unused_design,
 )
 from unibuckle_fenicsx.cli.status import print_out, report_failure
@@ -52,8 +51,7 @@ def nonlinear_command(args: argparse.Namespace, comm: Any) -> int:
             f"--shape unilateral takes the imperfection from the unilateral mode, which needs "
             f"an obstacle, and {why}: give --shape free (or auto)"
         )
-    warn_modulus_unit(spec, comm)
-    warn_plate_model(spec, comm)
+    warn_input(spec, comm, design=False)
     warn_unused_design(spec, "unibuckle nonlinear", comm)
     # A refused input or a failed solve raises: main() tells the outcome.
     analysis = solve_nonlinear(spec, options, comm)

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import argparse
+import re
 import sys
 from collections.abc import Sequence
 from typing import TYPE_CHECKING, Any
@@ -14,33 +15,32 @@ if TYPE_CHECKING:  # pragma: no cover
 from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
 
-def warn_plate_model(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
-    """A warning on stderr when a plate lies outside the plate model's usual range.
+def input_notes(spec: ProblemSpec | SectionProblemSpec, design: bool = True) -> dict[str, str]:
+    """The warnings a problem draws before its solve, by kind (none: an empty dict).
 
-    A section's walls are checked by the section's solve (its log's warnings).
-    """
-    from unibuckle_fenicsx.spec.checks import plate_model_note
-
-    if not isinstance(spec, SectionProblemSpec):
-        _warn(plate_model_note(spec.plate, spec.units), comm)
-
-
-def warn_modulus_unit(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
-    """A warning on stderr when E lies below any structural material's: another unit?"""
-    from unibuckle_fenicsx.spec.material import modulus_note
-
-    _warn(modulus_note(spec.material.E, spec.units), comm)
-
-
-def warn_design_material(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
-    """A warning on stderr when ``[design]`` is asked of a Poisson's ratio not a steel's.
-
-    A section's is warned of by the section's solve (its log's warnings).
+    ``"modulus"``: E below any structural material's (another unit?); ``"plate model"``:
+    a plate outside the plate model's usual range; with ``design``, ``"design
+    material"``: ``[design]`` asked of a Poisson's ratio not a steel's. A section's walls
+    and its design material are checked by the section's solve (its log's warnings).
+    ``unibuckle solve`` and ``unibuckle nonlinear`` print them (:func:`warn_input`),
+    ``unibuckle sweep`` once per kind over its points.
     """
     from unibuckle_fenicsx.en1993 import steel_poisson_note
+    from unibuckle_fenicsx.spec.checks import plate_model_note
+    from unibuckle_fenicsx.spec.material import modulus_note
 
-    if not isinstance(spec, SectionProblemSpec) and spec.design is not None:
-        _warn(steel_poisson_note(spec.material.nu), comm)
+    notes = {"modulus": modulus_note(spec.material.E, spec.units)}
+    if not isinstance(spec, SectionProblemSpec):
+        notes["plate model"] = plate_model_note(spec.plate, spec.units)
+        if design and spec.design is not None:
+            notes["design material"] = steel_poisson_note(spec.material.nu)
+    return {kind: note for kind, note in notes.items() if note is not None}
+
+
+def warn_input(spec: ProblemSpec | SectionProblemSpec, comm: Any, design: bool = True) -> None:
+    """Print the problem's :func:`input_notes` as warnings on stderr (rank 0)."""
+    for note in input_notes(spec, design).values():
+        _warn(note, comm)
 
 
 def warn_unused_design(spec: ProblemSpec, command: str, comm: Any) -> None:
@@ -62,6 +62,20 @@ def warn_coarse_mesh(spec: ProblemSpec | SectionProblemSpec, comm: Any) -> None:
 
     if not isinstance(spec, SectionProblemSpec):
         _warn(coarse_mesh_note(spec.plate, spec.mesh, spec.units), comm)
+
+
+def name_flag(error: InputError, flags: dict[str, str]) -> InputError:
+    """``error`` led by the flag that set the key it names (``flags``: key -> flag).
+
+    A value given by a flag is checked as the problem file's key ("solver.tau must lie
+    in ..."); the message then names the flag typed too ("--tau: solver.tau ..."). Other
+    errors are returned as they are.
+    """
+    text = str(error)
+    for key, flag in flags.items():
+        if re.match(rf"{re.escape(key)}\b(?![.\[])", text):
+            return InputError(f"{flag}: {text}")
+    return error
 
 
 def _warn(note: str | None, comm: Any) -> None:
@@ -87,17 +101,15 @@ def spec_from_args(args: argparse.Namespace) -> ProblemSpec | SectionProblemSpec
     if isinstance(spec, SectionProblemSpec):
         if args.nx is not None or args.ny is not None:
             raise InputError("--nx, --ny set a plate's cells; a section takes [mesh] size = h")
-        if getattr(args, "output", None):
-            raise InputError(
-                f"--output {args.output}: a section's fields are not written (its mode: the "
-                "Python API's SectionAnalysis.figure_data); give --json for the result"
-            )
         return spec
     if args.nx is not None or args.ny is not None:
-        spec = spec.with_mesh(
-            spec.mesh.nx if args.nx is None else args.nx,
-            spec.mesh.ny if args.ny is None else args.ny,
-        )
+        try:
+            spec = spec.with_mesh(
+                spec.mesh.nx if args.nx is None else args.nx,
+                spec.mesh.ny if args.ny is None else args.ny,
+            )
+        except InputError as err:
+            raise name_flag(err, {"mesh.nx": "--nx", "mesh.ny": "--ny"}) from None
     return spec
 
 

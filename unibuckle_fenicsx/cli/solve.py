@@ -8,38 +8,43 @@ from typing import Any
 
 from msgspec.structs import replace
 
-from unibuckle_fenicsx.cli.flags import solver_changes, unused_flags
+from unibuckle_fenicsx.cli.flags import METHOD_FLAGS, solver_changes, unused_flags
 from unibuckle_fenicsx.cli.problem import (
+    name_flag,
     spec_from_args,
     warn_coarse_mesh,
-    warn_design_material,
-    warn_modulus_unit,
-    warn_plate_model,
+    warn_input,
 )
 from unibuckle_fenicsx.cli.status import print_out, report_failure
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
 
 
 def solve_command(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle solve``: one problem, its summary, JSON and fields."""
-    from unibuckle_fenicsx.results.files import write_fields
+    from unibuckle_fenicsx.results.files import write_fields, write_section_fields
     from unibuckle_fenicsx.run import analyse
+    from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
     # A refused input or a failed solve raises: main() tells the outcome.
     spec = spec_from_args(args)
     changes, flags = solver_changes(args)
-    spec = replace(spec, solver=replace(spec.solver, **changes))
+    named = {f"solver.{key}": f"--{key}" for key in ("method", "tau") if key in changes}
+    named.update({f"solver.{METHOD_FLAGS[flag][1]}": flag for flag in flags})
+    try:
+        spec = replace(spec, solver=replace(spec.solver, **changes))
+    except InputError as err:  # name the flag typed, beside the key it sets
+        raise name_flag(err, named) from None
     method = spec.solver.method  # the flag's, or the problem file's
     _warn_unused(flags, method, comm)
-    warn_modulus_unit(spec, comm)
-    warn_plate_model(spec, comm)
-    warn_design_material(spec, comm)
+    warn_input(spec, comm)
     analysis = analyse(spec, comm, candidate_parallel=args.candidate_parallel)
     unwritten = None
     with analysis:
-        if args.output:  # a plate's (spec_from_args refuses it for a section)
+        if args.output:
+            writer = write_section_fields if isinstance(spec, SectionProblemSpec) else write_fields
             try:
-                write_fields(analysis, args.output)  # type: ignore[arg-type]
+                writer(analysis, args.output)  # type: ignore[arg-type]
             except OSError as err:  # the folder went away during the solve
                 unwritten = f"--output {args.output}: {err}"
     result = analysis.result

@@ -30,30 +30,39 @@ def _check_chart(base: Any) -> None:
         )
 
 
-def _warn_coarse_points(points: list[Any], specs: list[Any], comm: Any) -> None:
-    """One warning on stderr, before any solve, when some plate points' cells are too coarse.
+def _warn_points(points: list[Any], specs: list[Any], comm: Any) -> None:
+    """Warnings on stderr, before any solve, of the sweep points' inputs: one per kind.
 
-    The note of the first such point (``unibuckle solve``'s warning), and how many there
-    are; a section's cells are checked by its solve (the point's JSON line). ``points``
-    and their problems ``specs`` are those :func:`~unibuckle_fenicsx.sweep.run_sweep`
-    read (its ``check``).
+    Each kind of ``unibuckle solve``'s warnings before its solve
+    (:func:`~unibuckle_fenicsx.cli.problem.input_notes`: E in another unit, the plate
+    model's range, a design material) and of a plate's cells too coarse: the note of the
+    first such point, and how many there are; a section's cells are checked by its
+    solve (the point's JSON line). ``points`` and their problems ``specs`` are those
+    :func:`~unibuckle_fenicsx.sweep.run_sweep` read (its ``check``).
     """
     import sys
 
+    from unibuckle_fenicsx.cli.problem import input_notes
     from unibuckle_fenicsx.spec.checks import coarse_mesh_note
     from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
-    coarse = []
+    found: dict[str, list[tuple[int, Any, str]]] = {}
     for k, (point, spec) in enumerate(zip(points, specs, strict=True)):
+        notes = input_notes(spec)
         if not isinstance(spec, SectionProblemSpec):
-            note = coarse_mesh_note(spec.plate, spec.mesh, spec.units)
-            if note is not None:
-                coarse.append((k, point, note))
-    if coarse and comm.rank == 0:  # every rank checks the points (a refusal on every rank)
-        k, point, note = coarse[0]
+            coarse = coarse_mesh_note(spec.plate, spec.mesh, spec.units)
+            if coarse is not None:
+                notes["coarse"] = coarse
+        for kind, note in notes.items():
+            found.setdefault(kind, []).append((k, point, note))
+    if comm.rank != 0:  # every rank checks the points (a refusal on every rank)
+        return
+    for kind, hits in found.items():
+        k, point, note = hits[0]
+        which = "have cells too coarse" if kind == "coarse" else "draw this warning"
         print(
-            f"unibuckle: warning: {len(coarse)} of {len(points)} sweep points have cells too "
-            f"coarse; point {k} {point}: {note}",
+            f"unibuckle: warning: {len(hits)} of {len(points)} sweep points {which}; "
+            f"point {k} {point}: {note}",
             file=sys.stderr,
         )
 
@@ -188,7 +197,7 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
             comm,
             ranks_per_point=args.ranks_per_point,
             progress=not args.quiet,
-            check=lambda points, specs: _warn_coarse_points(points, specs, comm),
+            check=lambda points, specs: _warn_points(points, specs, comm),
         )
     except OSError as err:  # a refused input or a failed point raises: main() tells
         return fail(str(err))

@@ -5,7 +5,7 @@ from __future__ import annotations
 import json
 import re
 from pathlib import Path
-from typing import TYPE_CHECKING, Protocol
+from typing import TYPE_CHECKING, Any, Protocol
 
 import numpy as np
 
@@ -15,8 +15,9 @@ if TYPE_CHECKING:  # pragma: no cover
     from unibuckle_fenicsx.algorithms import UnilateralSolution
     from unibuckle_fenicsx.model.problem import Problem
     from unibuckle_fenicsx.results.records import BucklingResult
+    from unibuckle_fenicsx.section_analysis import SectionAnalysis
 
-__all__ = ["Solved", "file_stem", "write_fields", "write_json"]
+__all__ = ["Solved", "file_stem", "write_fields", "write_json", "write_section_fields"]
 
 
 class Solved(Protocol):
@@ -114,4 +115,84 @@ def write_fields(analysis: Solved, directory: str | Path) -> list[Path]:
         )
     with dolfinx.io.VTKFile(problem.comm, paths[-1], "w") as vtk:
         vtk.write_function([*fields, theta], 0.0)
+    return paths
+
+
+def write_section_fields(analysis: SectionAnalysis, directory: str | Path) -> list[Path]:
+    """Write a section's mode, its hollow mode and the core's contact for viewing.
+
+    The section's counterpart of :func:`write_fields`, on its shell's nodes (3-D
+    coordinates, m): ``<case>_u.bp`` (ADIOS2 VTX) holds the vectors ``u``, the critical
+    mode's displacement in x, y, z scaled to max |u| = 1, ``u_free``, the hollow
+    section's, scaled alike, and ``omega``, the mode's rotations (rad for max |u| = 1 m);
+    ``<case>_outward.bp`` the scalars ``outward``, u along the wall's outward normal (a
+    box's corner: the larger of its two faces'), ``core``, 1 on the nodes the core
+    holds, and ``contact``, 1 where the mode touches the core (both 0 without a core);
+    ``<case>.pvd`` (VTK) all of them.
+
+    Returns:
+        The paths of the two ``.bp`` directories and of the ``.pvd`` file.
+
+    Note:
+        Collective on the section's communicator.
+    """
+    from mpi4py import MPI
+
+    import dolfinx.fem
+    import dolfinx.io
+
+    from unibuckle_fenicsx.model.shell.section import outward_component
+
+    section = analysis.section
+    comm = section.problem.comm
+    directory = Path(directory)
+    if comm.rank == 0:
+        directory.mkdir(parents=True, exist_ok=True)
+    comm.barrier()
+    W = section.model.W
+    mesh = W.mesh
+    V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (3,)))
+    S = dolfinx.fem.functionspace(mesh, ("Lagrange", 1))
+    points = W.tabulate_dof_coordinates()
+    if not all(
+        np.array_equal(space.tabulate_dof_coordinates(), points) for space in (V, S)
+    ):  # the same P1 nodes, in the same order, on every space of the mesh
+        raise RuntimeError("write_section_fields: the output spaces' nodes differ from W's")
+
+    def vectors(mode: dolfinx.fem.Function) -> tuple[np.ndarray, np.ndarray]:
+        """(displacement, rotation) per node, scaled to max |u| = 1 over every rank."""
+        values = mode.x.array.real.reshape(-1, 6)
+        largest = comm.allreduce(float(np.abs(values[:, :3]).max(initial=0.0)), op=MPI.MAX)
+        values = values / (largest or 1.0)
+        return values[:, :3], values[:, 3:]
+
+    def function(space: dolfinx.fem.FunctionSpace, name: str, values: np.ndarray) -> Any:
+        f = dolfinx.fem.Function(space, name=name)
+        f.x.array[:] = np.asarray(values, dtype=float).ravel()
+        f.x.scatter_forward()
+        return f
+
+    u, omega = vectors(analysis.mode)
+    u_free, _ = vectors(analysis.free_mode)
+    core = np.zeros(points.shape[0])
+    contact = np.zeros(points.shape[0])
+    constraints = section.constraints
+    if constraints is not None:  # each owned direction's node: its local DOF // 6
+        nodes = constraints.owned_local_dofs // 6
+        core[nodes] = 1.0
+        if analysis.solution is not None:
+            held = np.isin(constraints.owned_positions, analysis.solution.active)
+            contact[nodes[held]] = 1.0
+    vector_fields = [function(V, "u", u), function(V, "u_free", u_free)]
+    vector_fields.append(function(V, "omega", omega))
+    scalar_fields = [function(S, "outward", outward_component(section, points, u))]
+    scalar_fields += [function(S, "core", core), function(S, "contact", contact)]
+    case = file_stem(analysis.result.case)
+    paths = [directory / f"{case}_u.bp", directory / f"{case}_outward.bp"]
+    for path, funcs in ((paths[0], vector_fields), (paths[1], scalar_fields)):
+        with dolfinx.io.VTXWriter(comm, path, funcs, engine="BP4") as writer:
+            writer.write(0.0)
+    paths.append(directory / f"{case}.pvd")
+    with dolfinx.io.VTKFile(comm, paths[-1], "w") as vtk:
+        vtk.write_function([*vector_fields, *scalar_fields], 0.0)
     return paths

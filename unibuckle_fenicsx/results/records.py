@@ -325,6 +325,8 @@ class BucklingResult(Struct, kw_only=True):
                 f"{self.free_load_Pa / scale:.6e} {unit}), "
                 f"k = {coefficient_text(self.buckling_coefficient_k)}"
             )
+            if self._fixed_parts(scale, unit):  # k's sigma is lambda_c's alone
+                head += " (of the scaled load alone, the fixed load not in it)"
             second = f"\n  edge stress per unit lambda (tension > 0): {'; '.join(loaded)}"
             second += self._stress_line(scale, unit)
         else:  # a temperature rise alone is scaled: lambda is a factor on it
@@ -409,6 +411,22 @@ class BucklingResult(Struct, kw_only=True):
         table = (self.input or {}).get(key)
         return table if isinstance(table, dict) else {}
 
+    def _fixed_parts(self, scale: float, unit: str) -> list[str]:
+        """The fixed load's parts applied (edges, a temperature rise), as the summary says them.
+
+        Empty without a fixed load, or with ``load.fixed_factor = 0``: then k and the
+        design's k_sigma describe the same stresses.
+        """
+        load = self._input_table("load")
+        fixed = [
+            f"{name} {_load_text(edge, True, scale, ' ' + unit)}"
+            for name, edge in self.edge_loads.items()
+            if not isinstance(edge.fixed_normal_stress, UnsetType)
+        ]
+        if load.get("fixed_temperature"):
+            fixed.append(f"temperature rise {_rise_text(load['fixed_temperature'], self.units)}")
+        return fixed if load.get("fixed_factor", 1.0) else []
+
     def _model_lines(self) -> list[str]:
         """Summary lines of what the model holds beyond plate, edges and obstacle."""
         length, scale, unit = UNITS[self.units]
@@ -422,13 +440,7 @@ class BucklingResult(Struct, kw_only=True):
                 f"temperature rise per unit lambda {rise}: critical rise "
                 f"{self.critical_temperature_K:.6g} K"
             )
-        fixed = [
-            f"{name} {_load_text(edge, True, scale, ' ' + unit)}"
-            for name, edge in self.edge_loads.items()
-            if not isinstance(edge.fixed_normal_stress, UnsetType)
-        ]
-        if load.get("fixed_temperature"):
-            fixed.append(f"temperature rise {_rise_text(load['fixed_temperature'], self.units)}")
+        fixed = self._fixed_parts(scale, unit)
         if self.critical_total_temperature_K is not None:
             lines.append(
                 "total temperature rise at the critical state (the fixed rise and lambda "
@@ -437,11 +449,15 @@ class BucklingResult(Struct, kw_only=True):
         if isinstance(self.design, DesignRecord):
             lines.append(
                 _design_line(
-                    self.design, scale, unit, (length, "m" if self.units == "SI" else "mm")
+                    self.design,
+                    scale,
+                    unit,
+                    (length, "m" if self.units == "SI" else "mm"),
+                    fixed=bool(fixed),
                 )
             )
         factor = load.get("fixed_factor", 1.0)
-        if fixed and factor:
+        if fixed:
             times = "" if factor == 1.0 else f"{factor:g} x "
             lines.append(f"fixed load (applied as is): {times}{'; '.join(fixed)}")
         reports = self.details.point_restraints
@@ -475,9 +491,17 @@ def _idle_text(idle: list[list[float]], length: float, name: str) -> str:
 
 
 def _design_line(
-    d: DesignRecord, scale: float, unit: str, lengths: tuple[float, str] = (1.0, "m")
+    d: DesignRecord,
+    scale: float,
+    unit: str,
+    lengths: tuple[float, str] = (1.0, "m"),
+    fixed: bool = False,
 ) -> str:
-    """The summary line of the design output (lengths in ``lengths[1]``, m / ``lengths[0]``)."""
+    """The summary line of the design output (lengths in ``lengths[1]``, m / ``lengths[0]``).
+
+    ``fixed``: the load has a fixed part, which sigma_cr includes and the first line's k
+    does not: the line then gives k_sigma = sigma_cr/sigma_E, which includes it too.
+    """
     rho = d.reduction_factor
     reduced = d.reduced_design_stress_Pa
     if d.relative_slenderness is None:  # the loaded edges in tension at the critical state
@@ -497,7 +521,13 @@ def _design_line(
     elif d.column_critical_stress_Pa == 0.0:
         column = " (column-type: none, the column a mechanism; the plate's)"
     return (
-        f"EN 1993-1-5: sigma_cr = {significant(d.sigma_cr_Pa / scale)} {unit} ({d.edge}), "
+        f"EN 1993-1-5: sigma_cr = {significant(d.sigma_cr_Pa / scale)} {unit} ({d.edge}"
+        + (
+            f", the fixed load included: k_sigma = {coefficient_text(d.k_sigma)}"
+            if fixed and d.k_sigma is not None
+            else ""
+        )
+        + "), "
         f"psi = {ratio_text(d.psi)}, slenderness {significant(d.relative_slenderness)}, rho = "
         + (
             f"{significant(rho)}"
@@ -516,7 +546,7 @@ def _design_line(
 
 
 def _tension_text(d: DesignRecord, scale: float, unit: str) -> str:
-    """The design line's words when the tension edge yields before rho f_y/gamma_M0 ('' if not)."""
+    """The design line's words when the tension edge yields before rho f_y/gamma_M ('' if not)."""
     if not d.tension_yield_first:
         return ""
     return (
@@ -536,7 +566,7 @@ def _design_clauses(d: DesignRecord) -> str:
     column = ", rho_c 4.5.4(1)" if d.xi is not None and d.xi < 1.0 else ""
     return (
         f"psi {table}, slenderness 4.4(2), rho 4.4(2) {rho}{column}"
-        + limit_clause_text(d.psi, d.partial_factor_name)
+        + limit_clause_text(d.psi, d.partial_factor_name, d.stress_limit_clause)
         + (f", b_eff {d.effective_widths_row}" if d.effective_widths_row else "")
     )
 

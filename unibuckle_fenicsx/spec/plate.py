@@ -415,15 +415,23 @@ class PlateSpec(Table, frozen=True):
         for k, hole in enumerate(self.holes):
             if isinstance(hole, Circle):
                 center = np.array([hole.center])
-                inside = bool(points_in_polygon(center, outer)[0]) and (
-                    float(distance_to_polygon(center, outer)[0]) > hole.radius
+                room = float(distance_to_polygon(center, outer)[0])
+                within = bool(points_in_polygon(center, outer)[0])
+                inside = within and room > hole.radius
+                (r, free, c), name = in_file([hole.radius, room, list(hole.center)], "m")
+                why = (
+                    f": its radius must be below its centre's distance to the plate's edge, "
+                    f"{free:g} {name}, got radius = {r:g} {name}"
+                    if within
+                    else f": its centre [{c[0]:g}, {c[1]:g}] {name} lies outside the plate"
                 )
             else:
                 inside = polygon_inside(hole.vertices, outer)
+                why = ": every vertex of its outline inside the plate's boundary"
             if not inside:
                 raise self.error(
                     f"holes[{k}]",
-                    " must lie inside the plate, without touching its edge",
+                    f" must lie inside the plate, without touching its edge{why}",
                 )
             for j in range(k):
                 if not _disjoint(self.holes[j], hole):

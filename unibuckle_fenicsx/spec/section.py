@@ -17,9 +17,11 @@ from unibuckle_fenicsx.en1993 import check_steel_modulus, check_steel_yield_stre
 from unibuckle_fenicsx.errors import FieldError
 from unibuckle_fenicsx.spec.base import UNITS, Table, Units, in_file, unit
 from unibuckle_fenicsx.spec.obstacles import DesignSpec
-from unibuckle_fenicsx.spec.solver import Method, SolverSpec
+from unibuckle_fenicsx.spec.solver import Method, SolverSpec, default
 
 Length = Annotated[float, unit("m", gt=0)]
+#: The default of ``mesh.levels``: the search's many steps on a quarter of the DOFs.
+DEFAULT_LEVELS = 1
 #: The ``[solver]`` options a section uses (the others are the plate's methods').
 SOLVER_KEYS = ("method", "tau", "eps_tol", "max_iterations")
 #: The methods a section with a rigid core may name (``[solver] method``, ``--method``):
@@ -60,6 +62,41 @@ def check_section_method(method: str, core: bool = True, elastic: bool = False) 
             f" = {str(method)!r} chooses a rigid core's route; {which} has one route: "
             'leave it out or give "auto"',
         )
+
+
+#: The options only a core's search reads (a rigid core's route: its coarser sections,
+#: its KKT tolerance, its iterates per seed), with what each sets.
+SEARCH_OPTIONS = {
+    "mesh.levels": "the core's search's coarser sections",
+    "solver.tau": "the core's contact tolerance (its KKT test)",
+    "solver.max_iterations": "the core's search's iterates per seed",
+}
+
+
+def check_core_options(core: bool, levels: int, solver: SolverSpec) -> None:
+    """Refuse a search option given (other than its default) to a section without a core.
+
+    Such a section is its free solve: none of :data:`SEARCH_OPTIONS` applies. A default
+    value is taken, as a result's echoed ``input`` holds every key.
+
+    Raises:
+        FieldError: Such an option given (an :class:`~unibuckle_fenicsx.errors.InputError`
+            naming it and saying why).
+    """
+    if core:
+        return
+    given = {"mesh.levels": levels, "solver.tau": solver.tau}
+    given["solver.max_iterations"] = solver.max_iterations
+    defaults = {"mesh.levels": DEFAULT_LEVELS, "solver.tau": default("tau")}
+    defaults["solver.max_iterations"] = default("max_iterations")
+    for key, what in SEARCH_OPTIONS.items():
+        if given[key] != defaults[key]:
+            raise FieldError(
+                "",
+                key,
+                f" = {given[key]!r} sets {what}; a section without a core (obstacle.core = "
+                "false) is its free solve: leave it out",
+            )
 
 
 class SectionSpec(Table, frozen=True):
@@ -200,12 +237,14 @@ class SectionMeshSpec(Table, frozen=True):
             least); a box's faces get an even number of cells.
         levels: With a rigid core, coarser sections (each with twice the cell size) the
             search starts on, >= 0, as long as the coarsest keeps 2 cells along; 1: its
-            many steps on a quarter of the DOFs, a few on the given cells.
+            many steps on a quarter of the DOFs, a few on the given cells. An elastic core:
+            those of its start from the rigid core's contact set. Refused
+            without a core (:func:`check_core_options`).
     """
 
     KEY: ClassVar[str] = "mesh"
     size: Length
-    levels: Annotated[int, Meta(ge=0)] = 1
+    levels: Annotated[int, Meta(ge=0)] = DEFAULT_LEVELS
 
 
 class SectionProblemSpec(Table, frozen=True):
@@ -248,15 +287,14 @@ class SectionProblemSpec(Table, frozen=True):
                 f" must satisfy 0 <= x0 < x1 <= section.length = {L:g} {name}, "
                 f"got [{x0:g}, {x1:g}]",
             )
-        check_section_method(
-            self.solver.method, self.obstacle.core, self.obstacle.foundation_stiffness is not None
-        )
+        elastic = self.obstacle.foundation_stiffness is not None
+        check_section_method(self.solver.method, self.obstacle.core, elastic)
+        check_core_options(self.obstacle.core, self.mesh.levels, self.solver)
         if self.design is not None:
             check_steel_modulus(self.material.E, *UNITS[self.units][1:])
             check_steel_yield_stress(self.design.yield_stress, *UNITS[self.units][1:])
         default = SolverSpec()
         for key in SolverSpec.__struct_fields__:
             if key not in SOLVER_KEYS and getattr(self.solver, key) != getattr(default, key):
-                raise self.error(
-                    f"solver.{key}", f" is a plate's option; a section takes {SOLVER_KEYS}"
-                )
+                takes = ", ".join(f"solver.{k}" for k in SOLVER_KEYS)
+                raise self.error(f"solver.{key}", f" is a plate's option; a section takes {takes}")

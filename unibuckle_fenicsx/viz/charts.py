@@ -226,19 +226,39 @@ def _group_key(line: Mapping[str, Any], others: Sequence[str]) -> tuple[float, .
     return tuple(line["point"][p] for p in others)
 
 
-def _certificate_mark(ax: Any, x: float, k: float, cert: Mapping[str, Any], colour: str) -> None:
-    """A point's marker: proven, bracketed (with its gap), KKT only or not certified."""
+#: The certificate markers: a point's kind -> (marker, face colour; None: the line's, size).
+CERTIFICATE_MARKERS: dict[str, tuple[str, str | None, float]] = {
+    "proven optimal": ("o", None, 6),
+    "bracketed (verified gap)": ("D", None, 5),
+    "KKT only": ("o", "white", 6),
+    "not certified": ("x", None, 7),
+}
+
+
+def _certificate_kind(cert: Mapping[str, Any]) -> str:
+    """A point's key of :data:`CERTIFICATE_MARKERS`."""
     if not cert.get("kkt"):
-        ax.plot(x, k, "x", color=colour, ms=7)
-    elif cert.get("global_optimum_proven"):
-        ax.plot(x, k, "o", color=colour, ms=6)
-    elif cert.get("status") == "bracketed":
-        ax.plot(x, k, "D", color=colour, ms=5)
+        return "not certified"
+    if cert.get("global_optimum_proven"):
+        return "proven optimal"
+    if cert.get("status") == "bracketed":
+        return "bracketed (verified gap)"
+    return "KKT only"
+
+
+def _certificate_mark(ax: Any, x: float, k: float, cert: Mapping[str, Any], colour: str) -> str:
+    """Draw a point's marker (proven, bracketed with its gap, KKT only, not certified).
+
+    Returns its kind (:data:`CERTIFICATE_MARKERS`), for the legend.
+    """
+    kind = _certificate_kind(cert)
+    marker, face, size = CERTIFICATE_MARKERS[kind]
+    ax.plot(x, k, marker, color=colour, mfc=face or colour, ms=size)
+    if kind.startswith("bracketed"):
         ax.annotate(f"{float(cert['relative_gap']):.0e}", (x, k),
                     textcoords="offset points", xytext=(4, 4), fontsize=6,
                     color=colour)  # fmt: skip
-    else:
-        ax.plot(x, k, "o", mfc="white", color=colour, ms=6)
+    return kind
 
 
 def _exact_curves(
@@ -272,16 +292,14 @@ def _exact_curves(
             ax.plot(xs[o], ys[o], style, color="0.35", lw=1.2, label=label)
 
 
-def _marker_legend(ax: Any) -> None:
-    """Legend entries for the certificate markers."""
-    markers = (
-        ("o", "0.2", "proven optimal"),
-        ("D", "0.2", "bracketed (verified gap)"),
-        ("o", "white", "KKT only"),
-        ("x", "0.2", "not certified"),
-    )
-    for style, mfc, text in markers:
-        ax.plot([], [], style, color="0.2", mfc=mfc, label=text)
+def _marker_legend(ax: Any, drawn: set[str]) -> None:
+    """Legend entries for the certificate markers drawn, none for those not shown.
+
+    ``drawn``: the kinds (:data:`CERTIFICATE_MARKERS`) of the chart's points.
+    """
+    for kind, (marker, face, _) in CERTIFICATE_MARKERS.items():
+        if kind in drawn:
+            ax.plot([], [], marker, color="0.2", mfc=face or "0.2", label=kind)
 
 
 #: Above this ratio of the largest k to the smallest an aspect sweep's k axis is
@@ -354,6 +372,7 @@ def plot_sweep(
 
     fig, ax = plt.subplots(figsize=(7.5, 5.0))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    drawn: set[str] = set()
     for g, (key, suffix, members) in enumerate(_groups(lines, others)):
         colour = colours[g % len(colours)]
         solved = [m for m in members if m.get("buckling_coefficient_k") is not None]
@@ -373,11 +392,11 @@ def plot_sweep(
             ax.plot(x[idx], k[idx], "--", color=colour, lw=1.0,
                     label=f"unilateral (with the obstacle){suffix}")  # fmt: skip
             for i in idx:
-                _certificate_mark(ax, x[i], k[i], solved[i]["certificate"], colour)
+                drawn.add(_certificate_mark(ax, x[i], k[i], solved[i]["certificate"], colour))
         # Exact curves on a fine grid of the swept number.
         point = dict(zip(others, key, strict=True))
         _exact_curves(ax, base, first, point, abscissa, suffix)
-    _marker_legend(ax)
+    _marker_legend(ax, drawn)
     _k_range(ax, lines, aspect)
     xlabel = "aspect ratio a/b" if aspect else axis_label(first.path, base)
     ax.set_xlabel(xlabel)
@@ -417,6 +436,7 @@ def _plot_section_sweep(
     others = [v.path for v in variations[1:]]
     fig, ax = plt.subplots(figsize=(7.5, 5.0))
     colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    drawn: set[str] = set()
     for g, (_, suffix, members) in enumerate(_groups(lines, others)):
         colour = colours[g % len(colours)]
         solved = [m for m in members if m.get("classical_stress_Pa") is not None]
@@ -434,9 +454,9 @@ def _plot_section_sweep(
             ratio = rounded(loads * fibre / reference)
             ax.plot(x[cored], ratio[cored], "--", color=colour, lw=1.0, label=f"core{suffix}")
             for i in cored:
-                _certificate_mark(ax, x[i], ratio[i], solved[i]["certificate"], colour)
+                drawn.add(_certificate_mark(ax, x[i], ratio[i], solved[i]["certificate"], colour))
     ax.axhline(1.0, ls=":", color="0.35", lw=1.2, label="classical stress")
-    _marker_legend(ax)
+    _marker_legend(ax, drawn)
     ax.set_xlabel(axis_label(first.path, base))
     ax.set_ylabel(r"$\sigma_{cr}$ / classical stress")
     ax.set_title(

@@ -32,38 +32,50 @@ __all__ = ["plot_section_mode_3d", "view_turn"]
 EYE = np.array([-0.6, -1.4, 1.0])
 
 
+#: The view keeps :data:`EYE` when a buckle it sees is at least this fraction of the
+#: largest: a hollow section buckles alike on every face (or all round), and its largest
+#: node, decided by rounding, would turn each figure (and its axes triad) another way.
+SEEN_FRACTION = 0.9
+
+
 def view_turn(data: SectionFigureData) -> float:
     """The angle (rad) about the section's axis x that brings its largest buckle into view.
 
     The camera looks from :data:`EYE`; a buckle on the far side would not be seen (a
-    filled tube's single outward buckle lies anywhere round the wall). A box turns by
-    quarter turns, so that the face of the largest outward displacement (in magnitude) is
-    one of the two seen; a tube by the angle between the eye and that node, unless it
-    lies within 60 degrees of the eye's side already.
+    filled tube's single outward buckle lies anywhere round the wall). The view stays
+    (0) when the largest outward displacement (in magnitude) on the wall seen reaches
+    :data:`SEEN_FRACTION` of the largest anywhere: the figures then share one view and
+    one axes triad. Else a box turns by quarter turns, so that the face of the largest
+    displacement is one of the two seen; a tube by the angle between the eye and that
+    node. The wall seen: a box's top face (z = +d/2) and its face y = -b/2; a tube's
+    nodes within 60 degrees of the eye's side.
 
     Args:
         data: The figure's arrays (:class:`SectionFigureData`).
 
     Returns:
-        The angle, 0 when the largest buckle is seen from :data:`EYE`.
+        The angle, 0 when the largest buckle is seen from :data:`EYE`, or one nearly as
+        large.
     """
     if data.shape not in ("box", "tube") or not len(data.outward):
         return 0.0
-    _, y, z = data.points[int(np.argmax(np.abs(data.outward)))]
+    size = np.abs(np.asarray(data.outward, dtype=float))
+    y, z = data.points[:, 1], data.points[:, 2]
     eye = np.arctan2(EYE[2], EYE[1])
     if data.shape == "box":
         width, depth = data.size[1], data.size[2]
-        # The face of the node: the coordinate nearer its half-dimension.
-        if abs(z) / (0.5 * depth) >= abs(y) / (0.5 * width):
-            face = 0.5 * np.pi if z > 0 else -0.5 * np.pi
-        else:
-            face = 0.0 if y > 0 else np.pi
-        seen = (0.5 * np.pi, np.pi)  # the top face and the face y = -b/2
-        if any(np.isclose(np.cos(face - f), 1.0) for f in seen):
-            return 0.0
-        return 0.5 * np.pi if np.isclose(face, -0.5 * np.pi) else -0.5 * np.pi
-    turn = float(np.angle(np.exp(1j * (np.arctan2(z, y) - eye))))  # in (-pi, pi]
-    return 0.0 if abs(turn) <= np.pi / 3 else turn
+        # A node's face: the coordinate nearer its half-dimension.
+        vertical = np.abs(z) / (0.5 * depth) >= np.abs(y) / (0.5 * width)
+        seen = (vertical & (z > 0)) | (~vertical & (y < 0))  # the top face, the face y = -b/2
+    else:
+        seen = np.abs(np.angle(np.exp(1j * (np.arctan2(z, y) - eye)))) <= np.pi / 3
+    if seen.any() and size[seen].max() >= SEEN_FRACTION * size.max():
+        return 0.0
+    largest = int(np.argmax(size))
+    if data.shape == "box":
+        bottom = bool(vertical[largest]) and z[largest] < 0
+        return 0.5 * np.pi if bottom else -0.5 * np.pi
+    return float(np.angle(np.exp(1j * (np.arctan2(z[largest], y[largest]) - eye))))
 
 
 def plot_section_mode_3d(

@@ -61,7 +61,7 @@ def test_solve_help_says_which_flags_a_section_takes(monkeypatch):
     assert [str(m) for m in SECTION_METHODS] == ["auto", "interior-point", "active-set"]
     assert (
         "a section takes --method (auto, interior-point or active-set: the last two with a "
-        "rigid core only), --tau and --max-iterations; the others," in flat
+        "rigid core only), --tau and --max-iterations (with a core only); the others," in flat
     ), flat
     assert INTERIOR_POINT_DOFS == 10**4
     assert (
@@ -223,9 +223,8 @@ def test_the_section_figure_looks_at_its_largest_buckle():
         assert np.dot(eye[1:], face) > 0, (peak, eye)
 
 
-def test_a_sweep_chart_s_legend_says_what_bilateral_means(tmp_path, monkeypatch):
-    # "bilateral" alone reads as a two-sided obstacle to an engineer: it is the plate
-    # without its obstacle (the points' free loads), "unilateral" the plate against it.
+def _chart_legend(tmp_path, monkeypatch, certificates: list[dict]) -> list[str]:
+    """The legend's labels of a plate's sweep chart over nu, one point per certificate."""
     from unibuckle_fenicsx.sweep import parse_variation
     from unibuckle_fenicsx.viz import charts
 
@@ -243,15 +242,37 @@ def test_a_sweep_chart_s_legend_says_what_bilateral_means(tmp_path, monkeypatch)
         "mesh": {"nx": 6, "ny": 4},
         "obstacle": {"zone": [[-0.04, 0.04], [-0.05, 0.05]]},
     }
-    cert = {"kkt": True, "global_optimum_proven": True, "status": "proven"}
+    values = [0.2 + 0.1 * k for k in range(len(certificates))]
     lines = [
         {"point": {"material.nu": nu}, "status": "ok", "buckling_coefficient_k": 4.4,
          "free_load_Pa": 1.0, "critical_load_Pa": 1.1, "certificate": cert}
-        for nu in (0.2, 0.3)
+        for nu, cert in zip(values, certificates, strict=True)
     ]  # fmt: skip
-    charts.plot_sweep(lines, [parse_variation("material.nu=0.2,0.3")], base, tmp_path / "c.png")
-    assert "bilateral (no obstacle)" in seen["labels"], seen
-    assert "unilateral (with the obstacle)" in seen["labels"], seen
+    variation = parse_variation("material.nu=" + ",".join(f"{nu:g}" for nu in values))
+    charts.plot_sweep(lines, [variation], base, tmp_path / "c.png")
+    return seen["labels"]
+
+
+def test_a_sweep_chart_s_legend_says_what_bilateral_means(tmp_path, monkeypatch):
+    # "bilateral" alone reads as a two-sided obstacle to an engineer: it is the plate
+    # without its obstacle (the points' free loads), "unilateral" the plate against it.
+    cert = {"kkt": True, "global_optimum_proven": True, "status": "proven"}
+    labels = _chart_legend(tmp_path, monkeypatch, [cert, cert])
+    assert "bilateral (no obstacle)" in labels, labels
+    assert "unilateral (with the obstacle)" in labels, labels
+
+
+def test_a_sweep_chart_s_legend_lists_only_the_markers_drawn(tmp_path, monkeypatch):
+    # Every point KKT only: the legend listed proven, bracketed and not certified too.
+    from unibuckle_fenicsx.viz.charts import CERTIFICATE_MARKERS
+
+    kkt = {"kkt": True, "global_optimum_proven": False, "status": "kkt-only"}
+    failed = {"kkt": False, "global_optimum_proven": False, "status": "not-kkt"}
+    markers = set(CERTIFICATE_MARKERS)
+    labels = _chart_legend(tmp_path, monkeypatch, [kkt, kkt])
+    assert markers & set(labels) == {"KKT only"}, labels
+    labels = _chart_legend(tmp_path, monkeypatch, [kkt, failed])
+    assert markers & set(labels) == {"KKT only", "not certified"}, labels
 
 
 def test_a_sweep_prints_its_points_as_a_table_with_units():

@@ -59,6 +59,7 @@ __all__ = [
     "SectionParameters",
     "build_section",
     "figure_data",
+    "outward_component",
     "section_parameters",
 ]
 
@@ -476,6 +477,21 @@ class SectionFigureData:
     size: tuple[float, float, float]
 
 
+def outward_component(
+    section: Section, points: npt.NDArray[np.float64], displacement: npt.NDArray[np.float64]
+) -> npt.NDArray[np.float64]:
+    """The component (n,) of each node's ``displacement`` (n, 3) along the outward normal.
+
+    ``points`` (n, 3): the nodes. A box's corner node has two normals: the larger in
+    magnitude of its two components is kept.
+    """
+    normals = section.mesh.inward_normals(np.asarray(points, dtype=float).T)
+    return np.array(
+        [max((-(n @ d) for n in ns), key=abs) for ns, d in zip(normals, displacement, strict=True)],
+        dtype=float,
+    )
+
+
 def figure_data(
     section: Section, candidate: Candidate | None = None, mode: dolfinx.fem.Function | None = None
 ) -> SectionFigureData:
@@ -505,10 +521,7 @@ def figure_data(
     disp = u.x.array.reshape(-1, 6)[:, :3]
     scale = float(np.abs(disp).max()) or 1.0
     disp = disp / scale
-    normals = section.mesh.inward_normals(np.asarray(x).T)
-    outward = np.array(
-        [max((-(n @ d) for n in ns), key=abs) for ns, d in zip(normals, disp, strict=True)]
-    )
+    outward = outward_component(section, np.asarray(x), disp)
     pressing = touching = np.zeros((0, 3))
     if candidate is not None and section.constraints is not None and candidate.active.size:
         active = candidate.active
