@@ -647,6 +647,7 @@ def solve_active_set(
     bound_budget: int = 64,
     seeds: tuple[str, ...] = SEED_NAMES,
     more_seeds: tuple[str, ...] = (),
+    check: bool = False,
 ) -> UnilateralSolution:
     """Unilateral critical load by a multi-seed primal-dual active-set method.
 
@@ -666,6 +667,10 @@ def solve_active_set(
             the middle, and small contact sets come first on plates).
         more_seeds: Seeds run after ``seeds`` (on the same level) only if none of those
             reached a KKT point; none by default.
+        check: The run checks another route's answer, which stands if the seeds find
+            nothing: where they stall, no fallback runs (the penalty continuation and the
+            feasible descent), and what the run did is logged as information, not as
+            warnings.
 
     Returns:
         The best KKT point found (or, flagged in the record's ``warning``, the best
@@ -688,7 +693,7 @@ def solve_active_set(
     coarse = _coarse_levels(problem, levels, max_iterations, refine_margin, seeds, more_seeds)
     runs, seeded_on = _fine_level(problem, coarse, max_iterations, seeds, more_seeds)
     warnings: list[str] = []
-    fallbacks = _fall_back(problem, runs, max_iterations, warnings)
+    fallbacks = _Fallbacks() if check else _fall_back(problem, runs, max_iterations, warnings)
     kkt = distinct_kkt(runs)
     cycles = [r.seed for r in runs + coarse.runs if r.status is RunStatus.CYCLE]
     if cycles:
@@ -700,7 +705,7 @@ def solve_active_set(
         warnings.append(closed.warning)
     chosen, lower, proven = closed.chosen, closed.lower, closed.proven
     for w in warnings:
-        logger.warning("active-set: %s", w)
+        logger.log(logging.INFO if check else logging.WARNING, "active-set: %s", w)
     details = _details(problem, free_load, seeded_on, coarse, fallbacks, runs, kkt, closed)
     details.fine_eigensolves = problem.eigensolver.solves - solves0
     details.wall_time_s = time.perf_counter() - t0

@@ -384,7 +384,8 @@ def _seeds_carried(
     The interior point's starts settle in one arrangement of the lift-off on the
     coarsest section, and it is carried up; the active set's seeds (:data:`SEEDS`, the
     free mode's sign patterns) can reach another, lower one (:doc:`/verification/sections`,
-    "Cost"). They run on ``sections[0]`` (``max_iterations`` each); where their KKT point
+    "Cost"). They run on ``sections[0]`` (``max_iterations`` each, as a check: where they
+stall, no fallback runs, and the chain's answer stands); where their KKT point
     lies below the chain's lowest there by more than :data:`SAME_LOAD`, their contact set
     is carried to each finer section and polished (:func:`_polish`, the looser
     tolerances, then the plain rule), and where neither reaches a KKT point the seeds run
@@ -398,7 +399,12 @@ def _seeds_carried(
     """
     coarse = sections[0].cored
     seeded = solve_active_set(
-        coarse, multilevel=False, max_iterations=max_iterations, bound_budget=0, seeds=SEEDS
+        coarse,
+        multilevel=False,
+        max_iterations=max_iterations,
+        bound_budget=0,
+        seeds=SEEDS,
+        check=True,
     )
     penalty = 0
     if isinstance(seeded.details, ActiveSetDetails):
@@ -429,7 +435,7 @@ def _seeds_carried(
             if polished is None:  # as the active-set route does: the seeds on this section
                 polished = solve_active_set(
                     section.cored, multilevel=False, max_iterations=max_iterations,
-                    bound_budget=0, seeds=SEEDS,
+                    bound_budget=0, seeds=SEEDS, check=True,
                 )  # fmt: skip
                 if isinstance(polished.details, ActiveSetDetails):
                     penalty += polished.details.penalty_eigensolves

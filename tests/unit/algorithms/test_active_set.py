@@ -394,3 +394,37 @@ def test_unilateral_load_converges(case):
     assert np.all((rates > 1.9) & (rates < 2.1)), rates
     np.testing.assert_allclose(loads / 1e6, README_LOADS_MPA[case], rtol=0, atol=5e-7)
     assert abs(richardson / 1e6 - README_RICHARDSON_MPA[case]) <= 5e-5, richardson
+
+
+def test_a_check_that_stalls_runs_no_fallback_and_warns_of_nothing(monkeypatch, caplog):
+    """``check=True``: where the seeds stall, the answer checked stands.
+
+    The seeds are made to count as stalled (``_reached`` false), so the plain run takes
+    its fallbacks (the penalty continuation, with a warning); a check takes none, logs
+    nothing as a warning, and its route is the active set's alone. The contract of
+    ``solve_active_set``'s ``check`` (a section's seeds checking the interior point: a
+    filled tube's check ran a 1 000-solve continuation and warned of it).
+    """
+    import logging
+
+    import unibuckle_fenicsx.algorithms.active_set as active_set
+
+    continuations: list[int] = []
+    continuation = active_set.penalty_continuation
+
+    def recorded(*args, **kwargs):
+        run, solves = continuation(*args, **kwargs)
+        continuations.append(solves)
+        return run, solves
+
+    monkeypatch.setattr(active_set, "_reached", lambda problem, runs: False)
+    monkeypatch.setattr(active_set, "penalty_continuation", recorded)
+    with build_problem(paper_case("c1", 8, 4)) as problem:
+        plain = solve_active_set(problem, multilevel=False, bound_budget=0)
+        assert continuations and "penalty-continuation" in plain.route
+        continuations.clear()
+        caplog.clear()
+        with caplog.at_level(logging.INFO, logger=active_set.logger.name):
+            checked = solve_active_set(problem, multilevel=False, bound_budget=0, check=True)
+    assert not continuations and checked.route == ["active-set"]
+    assert not [r for r in caplog.records if r.levelno >= logging.WARNING]
