@@ -385,7 +385,7 @@ def _seeds_carried(
     coarsest section, and it is carried up; the active set's seeds (:data:`SEEDS`, the
     free mode's sign patterns) can reach another, lower one (:doc:`/verification/sections`,
     "Cost"). They run on ``sections[0]`` (``max_iterations`` each, as a check: where they
-stall, no fallback runs, and the chain's answer stands); where their KKT point
+    stall, no fallback runs, and the chain's answer stands); where their KKT point
     lies below the chain's lowest there by more than :data:`SAME_LOAD`, their contact set
     is carried to each finer section and polished (:func:`_polish`, the looser
     tolerances, then the plain rule), and where neither reaches a KKT point the seeds run
