@@ -80,15 +80,9 @@ def write_fields(analysis: Solved, directory: str | Path) -> list[Path]:
     Note:
         Collective on the mesh communicator.
     """
-    import dolfinx.io
-
     from unibuckle_fenicsx.model.problem import UnilateralProblem
 
     problem = analysis.problem
-    directory = Path(directory)
-    if problem.comm.rank == 0:
-        directory.mkdir(parents=True, exist_ok=True)
-    problem.comm.barrier()
     w, theta = problem.model.split(analysis.mode)
     w_free, _ = problem.model.split(analysis.free_mode)
     w_free.name = "w_free"
@@ -102,19 +96,30 @@ def write_fields(analysis: Solved, directory: str | Path) -> list[Path]:
             fields.append(
                 problem.contact.node_function(analysis.solution.active, "contact_force", push)
             )
-    case = file_stem(analysis.result.case)
-    paths = [directory / f"{case}_w.bp", directory / f"{case}_theta.bp"]
-    for path, funcs in ((paths[0], fields), (paths[1], [theta])):
-        with dolfinx.io.VTXWriter(problem.comm, path, funcs, engine="BP4") as writer:
+    groups = {"w": fields, "theta": [theta]}
+    return _write(problem.comm, directory, file_stem(analysis.result.case), groups)
+
+
+def _write(comm: Any, directory: str | Path, case: str, groups: dict[str, list[Any]]) -> list[Path]:
+    """Each group of functions to ``<case>_<group>.bp`` (VTX), all to ``<case>.pvd`` (VTK).
+
+    ``directory`` is created (its parent must exist). Returns the paths, the ``.pvd``
+    last. Collective on ``comm``.
+    """
+    import dolfinx.io
+
+    directory = Path(directory)
+    if comm.rank == 0:
+        directory.mkdir(parents=True, exist_ok=True)
+    comm.barrier()
+    paths = []
+    for group, funcs in groups.items():
+        paths.append(directory / f"{case}_{group}.bp")
+        with dolfinx.io.VTXWriter(comm, paths[-1], funcs, engine="BP4") as writer:
             writer.write(0.0)
     paths.append(directory / f"{case}.pvd")
-    if not all(path.parent == directory for path in paths):
-        raise RuntimeError(
-            "write_fields: expected all(path.parent == directory for path in paths) (an internal "
-            "invariant)"
-        )
-    with dolfinx.io.VTKFile(problem.comm, paths[-1], "w") as vtk:
-        vtk.write_function([*fields, theta], 0.0)
+    with dolfinx.io.VTKFile(comm, paths[-1], "w") as vtk:
+        vtk.write_function([f for funcs in groups.values() for f in funcs], 0.0)
     return paths
 
 
@@ -139,16 +144,11 @@ def write_section_fields(analysis: SectionAnalysis, directory: str | Path) -> li
     from mpi4py import MPI
 
     import dolfinx.fem
-    import dolfinx.io
 
     from unibuckle_fenicsx.model.shell.section import outward_component
 
     section = analysis.section
     comm = section.problem.comm
-    directory = Path(directory)
-    if comm.rank == 0:
-        directory.mkdir(parents=True, exist_ok=True)
-    comm.barrier()
     W = section.model.W
     mesh = W.mesh
     V = dolfinx.fem.functionspace(mesh, ("Lagrange", 1, (3,)))
@@ -187,12 +187,5 @@ def write_section_fields(analysis: SectionAnalysis, directory: str | Path) -> li
     vector_fields.append(function(V, "omega", omega))
     scalar_fields = [function(S, "outward", outward_component(section, points, u))]
     scalar_fields += [function(S, "core", core), function(S, "contact", contact)]
-    case = file_stem(analysis.result.case)
-    paths = [directory / f"{case}_u.bp", directory / f"{case}_outward.bp"]
-    for path, funcs in ((paths[0], vector_fields), (paths[1], scalar_fields)):
-        with dolfinx.io.VTXWriter(comm, path, funcs, engine="BP4") as writer:
-            writer.write(0.0)
-    paths.append(directory / f"{case}.pvd")
-    with dolfinx.io.VTKFile(comm, paths[-1], "w") as vtk:
-        vtk.write_function([*vector_fields, *scalar_fields], 0.0)
-    return paths
+    groups = {"u": vector_fields, "outward": scalar_fields}
+    return _write(comm, directory, file_stem(analysis.result.case), groups)

@@ -85,16 +85,18 @@ def check_core_options(core: bool, levels: int, solver: SolverSpec) -> None:
     """
     if core:
         return
-    given = {"mesh.levels": levels, "solver.tau": solver.tau}
-    given["solver.max_iterations"] = solver.max_iterations
-    defaults = {"mesh.levels": DEFAULT_LEVELS, "solver.tau": default("tau")}
-    defaults["solver.max_iterations"] = default("max_iterations")
+    given = {  # each option: (its value, its default)
+        "mesh.levels": (levels, DEFAULT_LEVELS),
+        "solver.tau": (solver.tau, default("tau")),
+        "solver.max_iterations": (solver.max_iterations, default("max_iterations")),
+    }
     for key, what in SEARCH_OPTIONS.items():
-        if given[key] != defaults[key]:
+        value, unset = given[key]
+        if value != unset:
             raise FieldError(
                 "",
                 key,
-                f" = {given[key]!r} sets {what}; a section without a core (obstacle.core = "
+                f" = {value!r} sets {what}; a section without a core (obstacle.core = "
                 "false) is its free solve: leave it out",
             )
 
@@ -293,8 +295,8 @@ class SectionProblemSpec(Table, frozen=True):
         if self.design is not None:
             check_steel_modulus(self.material.E, *UNITS[self.units][1:])
             check_steel_yield_stress(self.design.yield_stress, *UNITS[self.units][1:])
-        default = SolverSpec()
+        plate_default = SolverSpec()
         for key in SolverSpec.__struct_fields__:
-            if key not in SOLVER_KEYS and getattr(self.solver, key) != getattr(default, key):
+            if key not in SOLVER_KEYS and getattr(self.solver, key) != getattr(plate_default, key):
                 takes = ", ".join(f"solver.{k}" for k in SOLVER_KEYS)
                 raise self.error(f"solver.{key}", f" is a plate's option; a section takes {takes}")
