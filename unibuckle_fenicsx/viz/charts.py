@@ -210,15 +210,12 @@ def _groups(
 
 def _save(fig: Any, ax: Any, path: str | Path) -> Path:
     """Grid, legend, and the figure written to ``path`` (its folder made); returns it."""
-    import matplotlib.pyplot as plt
-
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=150)
-    plt.close(fig)
     return path
 
 
@@ -359,9 +356,7 @@ def plot_sweep(
     if is_section(base):
         return _plot_section_sweep(lines, variations, base, path, title)
     import matplotlib as mpl
-
-    mpl.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     first = variations[0]
     others = [v.path for v in variations[1:]]
@@ -370,8 +365,9 @@ def plot_sweep(
     def abscissa(spec: ProblemSpec, value: float) -> float:
         return spec.plate.length / spec.plate.width if aspect else value
 
-    fig, ax = plt.subplots(figsize=(7.5, 5.0))
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig = Figure(figsize=(7.5, 5.0))
+    ax = fig.subplots()
+    colours = mpl.rcParams["axes.prop_cycle"].by_key()["color"]
     drawn: set[str] = set()
     for g, (key, suffix, members) in enumerate(_groups(lines, others)):
         colour = colours[g % len(colours)]
@@ -428,14 +424,13 @@ def _plot_section_sweep(
 ) -> Path:
     """A section's chart (:func:`plot_sweep`); returns ``path``."""
     import matplotlib as mpl
-
-    mpl.use("Agg")
-    import matplotlib.pyplot as plt
+    from matplotlib.figure import Figure
 
     first = variations[0]
     others = [v.path for v in variations[1:]]
-    fig, ax = plt.subplots(figsize=(7.5, 5.0))
-    colours = plt.rcParams["axes.prop_cycle"].by_key()["color"]
+    fig = Figure(figsize=(7.5, 5.0))
+    ax = fig.subplots()
+    colours = mpl.rcParams["axes.prop_cycle"].by_key()["color"]
     drawn: set[str] = set()
     for g, (_, suffix, members) in enumerate(_groups(lines, others)):
         colour = colours[g % len(colours)]

@@ -22,8 +22,9 @@ only the drawing helpers at the top.
 
 from __future__ import annotations
 
+import functools
 import os
-from collections.abc import Mapping, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import TYPE_CHECKING, Any, TypedDict
 
@@ -120,16 +121,36 @@ def _font_file() -> str | None:
 _VTK_FONT_FILE = 4  # vtkTextProperty font family "VTK_FONT_FILE"
 
 
-def _pyplot() -> Any:
+def _matplotlib() -> Any:
     try:
         import matplotlib as mpl
     except ImportError as err:  # pragma: no cover
         raise ImportError("figures need matplotlib: pip install 'unibuckle_fenicsx[demo]'") from err
-    mpl.use("Agg")
-    import matplotlib.pyplot as plt
+    return mpl
 
-    plt.rcParams.update({"font.size": THEME["mpl_font_size"]})
-    return plt
+
+def _themed[**P, R](draw: Callable[P, R]) -> Callable[P, R]:
+    """``draw`` run in the package's font size, matplotlib's own settings left alone.
+
+    The figures are :class:`matplotlib.figure.Figure` objects, not pyplot's: drawing one
+    neither switches the caller's backend nor changes its ``rcParams`` nor registers a
+    figure in pyplot's list (a user's notebook or GUI session stays as it was).
+    """
+
+    @functools.wraps(draw)
+    def themed(*args: P.args, **kwargs: P.kwargs) -> R:
+        with _matplotlib().rc_context({"font.size": THEME["mpl_font_size"]}):
+            return draw(*args, **kwargs)
+
+    return themed
+
+
+def _subplots(*args: Any, **kwargs: Any) -> tuple[Any, Any]:
+    """``pyplot.subplots`` without pyplot: a figure of its own and its axes."""
+    from matplotlib.figure import Figure
+
+    fig = Figure(figsize=kwargs.pop("figsize"), dpi=kwargs.pop("dpi"))
+    return fig, fig.subplots(*args, **kwargs)
 
 
 def _prepare(path: str | Path) -> Path:
@@ -138,11 +159,10 @@ def _prepare(path: str | Path) -> Path:
     return path
 
 
-def _save(plt: Any, fig: Any, path: Path) -> Path:
-    """Lay out ``fig``, write it to ``path``, close it; ``path``."""
+def _save(fig: Any, path: Path) -> Path:
+    """Lay out ``fig``, write it to ``path``; ``path``."""
     fig.tight_layout()
     fig.savefig(path)
-    plt.close(fig)
     return path
 
 
@@ -385,6 +405,7 @@ def _add_obstacle(
 
 
 # -- section A -------------------------------------------------------------------------
+@_themed
 def plot_section(
     path: str | Path,
     x_free: npt.ArrayLike,
@@ -413,14 +434,13 @@ def plot_section(
     Returns:
         The written path.
     """
-    plt = _pyplot()
     path = _prepare(path)
     # At the records' digits: the same picture on every machine (results.rounded).
     x_free, w_free, x_unilateral, w_unilateral = map(
         rounded, (x_free, w_free, x_unilateral, w_unilateral)
     )
     extra = [(rounded(xe), rounded(we), label) for xe, we, label in extra]
-    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    fig, ax = _subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
     ax.axhline(0.0, color="lightgray", lw=1.0, zorder=0)
     ax.plot(x_free, w_free, "-o", ms=3.5, color=THEME["free_color"], label=labels[0])
     ax.plot(
@@ -450,7 +470,7 @@ def plot_section(
     if title:
         ax.set_title(title)
     ax.legend(loc="best", fontsize=THEME["mpl_font_size"] - 2, framealpha=0.9)
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 # -- contact set -----------------------------------------------------------------------
@@ -521,14 +541,13 @@ def _contact_markers(
 
 
 def _finish_top_view(
-    plt: Any,
     fig: Any,
     ax: Any,
     path: Path,
     title: str,
     corners: tuple[tuple[float, float], tuple[float, float]] | None = None,
 ) -> Path:
-    """Equal axes in metres (over ``corners``), the title, the legend below; write, close."""
+    """Equal axes in metres (over ``corners``), the title, the legend below; write."""
     if corners is not None:
         (px0, py0), (px1, py1) = corners
         ax.set_xlim(px0, px1)
@@ -541,9 +560,10 @@ def _finish_top_view(
     if ax.get_legend_handles_labels()[0]:
         ax.legend(loc="upper center", bbox_to_anchor=(0.5, -0.18), ncol=3,
                   fontsize=THEME["mpl_font_size"] - 2, frameon=False)  # fmt: skip
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
+@_themed
 def plot_contact_set(
     path: str | Path,
     xy: npt.ArrayLike,
@@ -576,15 +596,16 @@ def plot_contact_set(
     Returns:
         The written path.
     """
-    plt = _pyplot()
+    from matplotlib.patches import Rectangle
+
     path = _prepare(path)
     xy, w = rounded(xy), rounded(w)  # the records' digits: the same picture on any machine
-    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    fig, ax = _subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
     _mode_bands(fig, ax, xy, w, tau)
     if zone is not None:
         (x0, x1), (y0, y1) = zone
         ax.add_patch(
-            plt.Rectangle(
+            Rectangle(
                 (x0, y0),
                 x1 - x0,
                 y1 - y0,
@@ -608,10 +629,11 @@ def plot_contact_set(
             label=f"constrained nodes I ({len(cxy)})",
         )
     _contact_markers(ax, contact_coordinates, sizes=(5, 3), many=500, pressing=contact_pressing)
-    return _finish_top_view(plt, fig, ax, path, title, corners)
+    return _finish_top_view(fig, ax, path, title, corners)
 
 
 # -- contact force ---------------------------------------------------------------------
+@_themed
 def plot_contact_force(
     path: str | Path,
     contact_coordinates: npt.ArrayLike,
@@ -642,18 +664,18 @@ def plot_contact_force(
         The written path.
     """
     from matplotlib.colors import LogNorm
+    from matplotlib.patches import Rectangle
 
-    plt = _pyplot()
     path = _prepare(path)
     z = np.asarray(contact_coordinates, dtype=float).reshape(-1, 2)
     f = np.asarray(push, dtype=float).reshape(-1)
     presses = f > resolution
-    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    fig, ax = _subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
     (px0, py0), (px1, py1) = corners
-    ax.add_patch(plt.Rectangle((px0, py0), px1 - px0, py1 - py0, fill=False, ec="black", lw=1))
+    ax.add_patch(Rectangle((px0, py0), px1 - px0, py1 - py0, fill=False, ec="black", lw=1))
     if zone is not None:
         (x0, x1), (y0, y1) = zone
-        ax.add_patch(plt.Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, ec="dimgray",
+        ax.add_patch(Rectangle((x0, y0), x1 - x0, y1 - y0, fill=False, ec="dimgray",
                                    lw=2.0, ls="--", label="obstacle zone"))  # fmt: skip
     ms = 16 if len(z) < 500 else 5
     if presses.any():
@@ -667,10 +689,11 @@ def plot_contact_force(
         touching = f"touching, no force ({int((~presses).sum())})"
         ax.scatter(z[~presses, 0], z[~presses, 1], s=ms, facecolors="none", edgecolors="black",
                    linewidths=0.6, label=touching)  # fmt: skip
-    return _finish_top_view(plt, fig, ax, path, title, corners)
+    return _finish_top_view(fig, ax, path, title, corners)
 
 
 # -- contact map on the plate's own mesh -------------------------------------------------
+@_themed
 def plot_contact_map(
     path: str | Path,
     xy: npt.ArrayLike,
@@ -708,10 +731,9 @@ def plot_contact_map(
     Returns:
         The written path.
     """
-    plt = _pyplot()
     path = _prepare(path)
     xy = np.asarray(xy, dtype=float)
-    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    fig, ax = _subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
     points = np.asarray(ties, dtype=float).reshape(-1, 2)
     if len(points):
         ax.plot(points[:, 0], points[:, 1], "x", color="red", ms=9, mew=2.2, zorder=5,
@@ -735,7 +757,7 @@ def plot_contact_map(
     pad = 0.02 * float((hi - lo).max())
     ax.set_xlim(lo[0] - pad, hi[0] + pad)
     ax.set_ylim(lo[1] - pad, hi[1] + pad)
-    return _finish_top_view(plt, fig, ax, path, title)
+    return _finish_top_view(fig, ax, path, title)
 
 
 # -- convergence -----------------------------------------------------------------------
@@ -787,6 +809,7 @@ def _mesh_axes(ax0: Any, ax1: Any, studies: Mapping[str, Sequence[tuple[int, int
     ax1.legend(fontsize=THEME["mpl_font_size"] - 3)
 
 
+@_themed
 def plot_convergence(
     path: str | Path,
     studies: Mapping[str, Sequence[tuple[int, int, float]]],
@@ -811,9 +834,8 @@ def plot_convergence(
     Returns:
         The written path.
     """
-    plt = _pyplot()
     path = _prepare(path)
-    fig, (ax0, ax1) = plt.subplots(
+    fig, (ax0, ax1) = _subplots(
         1, 2, figsize=(THEME["figsize"][0] * 1.3, THEME["figsize"][1]), dpi=THEME["dpi"]
     )
     markers = "osD^v<>"
@@ -848,7 +870,7 @@ def plot_convergence(
     _mesh_axes(ax0, ax1, studies)
     if title:
         fig.suptitle(title)
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 # -- nonlinear load paths ----------------------------------------------------------------
@@ -856,6 +878,7 @@ def plot_convergence(
 PathCurve = tuple[npt.ArrayLike, npt.ArrayLike, str, str, str]
 
 
+@_themed
 def plot_load_paths(
     path: str | Path,
     curves: Sequence[PathCurve],
@@ -879,10 +902,9 @@ def plot_load_paths(
     Returns:
         The written path.
     """
-    plt = _pyplot()
     path = _prepare(path)
     fw, fh = THEME["figsize"]
-    fig, axes = plt.subplots(1, 2, figsize=(1.6 * fw, 1.1 * fh), dpi=THEME["dpi"])
+    fig, axes = _subplots(1, 2, figsize=(1.6 * fw, 1.1 * fh), dpi=THEME["dpi"])
     for ax in axes:
         for loads, max_w, label, color, style in curves:
             lam = np.asarray(loads, dtype=float) / 1e6
@@ -898,7 +920,7 @@ def plot_load_paths(
     axes[0].legend(fontsize=THEME["mpl_font_size"] - 3, loc="upper left", framealpha=0.9)
     if title:
         fig.suptitle(title)
-    return _save(plt, fig, path)
+    return _save(fig, path)
 
 
 #: One series of :func:`plot_southwell`: additional deflection (m), loads (Pa), mask of
@@ -906,6 +928,7 @@ def plot_load_paths(
 SouthwellSeries = tuple[npt.ArrayLike, npt.ArrayLike, npt.ArrayLike, float, str, str]
 
 
+@_themed
 def plot_southwell(
     path: str | Path, series: Sequence[SouthwellSeries], *, thickness: float, title: str = ""
 ) -> Path:
@@ -923,9 +946,8 @@ def plot_southwell(
     Returns:
         The written path.
     """
-    plt = _pyplot()
     path = _prepare(path)
-    fig, ax = plt.subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
+    fig, ax = _subplots(figsize=THEME["figsize"], dpi=THEME["dpi"])
     for dw, loads, mask, southwell, label, color in series:
         x = np.asarray(dw, dtype=float) / thickness
         lam = np.asarray(loads, dtype=float) / 1e6
@@ -946,4 +968,4 @@ def plot_southwell(
     ax.legend(fontsize=THEME["mpl_font_size"] - 2, loc="upper left")
     if title:
         ax.set_title(title)
-    return _save(plt, fig, path)
+    return _save(fig, path)
