@@ -223,6 +223,40 @@ def _require_direct_solve(eps: SLEPc.EPS, prefix: str) -> None:
     )
 
 
+def _agrees(A: PETSc.Mat, B: PETSc.Mat, x: PETSc.Vec, value: float, tol: float) -> bool:
+    """Whether ``x``'s Rayleigh quotient x·Ax / x·Bx is the load ``value`` (collective).
+
+    Within :data:`SPURIOUS_RTOL` (relative), or a thousand times the solve's tolerance
+    ``tol`` if that is looser; never for a vector on which B is not positive.
+    """
+    y = A.createVecLeft()
+    try:
+        A.mult(x, y)
+        stiffness = float(x.dot(y).real)
+        B.mult(x, y)
+        geometric = float(x.dot(y).real)
+    finally:
+        y.destroy()
+    rtol = max(SPURIOUS_RTOL, SMALLEST_RTOL_FACTOR * tol)
+    return bool(geometric > 0.0 and abs(stiffness / geometric - value) <= rtol * value)
+
+
+def _residual(A: PETSc.Mat, B: PETSc.Mat, x: PETSc.Vec, value: float) -> float:
+    r"""The pair's relative residual :math:`\|Ax-\lambda Bx\|/(|\lambda|\|x\|)` (collective).
+
+    As SLEPc's ``computeError`` with its default relative error.
+    """
+    ax, bx = A.createVecLeft(), B.createVecLeft()
+    try:
+        A.mult(x, ax)
+        B.mult(x, bx)
+        ax.axpy(-value, bx)
+        return float(ax.norm() / (abs(value) * x.norm()))  # type: ignore[operator]
+    finally:
+        ax.destroy()
+        bx.destroy()
+
+
 class GEPSolver(Owner):
     """Smallest eigenpair of :math:`(A, B)` with optional removed DOFs.
 
@@ -415,18 +449,12 @@ class GEPSolver(Owner):
         if not value > 0.0:
             return True
         A, B = eps.getOperators()
-        x, y = A.createVecs()
+        x = A.createVecRight()
         try:
             eps.getEigenvector(index, x)
-            A.mult(x, y)
-            stiffness = x.dot(y)
-            B.mult(x, y)
-            geometric = x.dot(y)
+            return not _agrees(A, B, x, value, eps.getTolerances()[0])
         finally:
             x.destroy()
-            y.destroy()
-        tol = max(SPURIOUS_RTOL, SMALLEST_RTOL_FACTOR * eps.getTolerances()[0])
-        return not (geometric > 0.0 and abs(stiffness / geometric - value) <= tol * value)
 
     def _wider_pair(
         self, initial: PETSc.Vec | None, out: PETSc.Vec | None, least: int = WIDER_NCV
@@ -450,15 +478,53 @@ class GEPSolver(Owner):
             eps.solve()
             self.solves += 1
             if self._spurious(eps):
-                raise EigenSolveError(
-                    f"SLEPc ({self.prefix}) returned a pair that is not an eigenpair of the "
-                    f"definite pencil (load {eps.getEigenvalue(0).real:.6g}, relative "
-                    f"residual {eps.computeError(0):.3g}) with {wider} Krylov vectors; try "
-                    f"a larger -{self.prefix}eps_ncv"
-                )
+                value, error = eps.getEigenvalue(0).real, eps.computeError(0)
+                logger.debug("%s: no eigenpair with %d Krylov vectors (%.6g); swapped",
+                             self.prefix, wider, value)  # fmt: skip
+                return self._swapped_pair(out, wider, value, error)
             return self._pair(eps, out)
         finally:
             eps.setDimensions(nev, ncv, mpd)
+
+    def _swapped_pair(
+        self, out: PETSc.Vec | None, ncv: int, value: float, error: float
+    ) -> EigenPair:
+        r"""The least load from the swapped pencil :math:`Bx = \theta Ax`, checked.
+
+        The last resort after :meth:`_wider_pair` returned a pair that is none of the
+        pencil (``value``, ``error`` its load and residual, for the message): the same
+        reduced pencil with A, positive definite, in the inner-product slot and the
+        largest :math:`\theta = 1/\lambda` wanted (spectral transformation "shift", options
+        prefix ``<prefix>swapped_``, :func:`swapped_eigenpairs`). Its largest eigenvalue is
+        well separated wherever B has lost most of its rank (the removed rows' zero
+        eigenvalues lie at the other end of its spectrum). Its pair is kept only if its
+        Rayleigh quotient agrees with it (:func:`_agrees`); otherwise raises
+        :class:`EigenSolveError`. Collective.
+        """
+        A, B = self.eps.getOperators()
+        tol = self.eps.getTolerances()[0]
+        largest = SLEPc.EPS.Which.LARGEST_REAL
+        pairs = swapped_eigenpairs(
+            A, B, self.prefix + "swapped_", which=largest, tol=tol, vectors=True, ncv=ncv
+        )
+        try:
+            for theta, vec in pairs[:1]:
+                if vec is not None and theta > 0.0 and _agrees(A, B, vec, 1.0 / theta, tol):
+                    if out is not None:
+                        vec.copy(out)
+                    its = int(self.eps.getIterationNumber())
+                    residual = _residual(A, B, vec, 1.0 / theta)
+                    return EigenPair(1.0 / theta, residual, its, len(pairs))
+        finally:
+            for _, vec in pairs:
+                if vec is not None:
+                    vec.destroy()
+        raise EigenSolveError(
+            f"SLEPc ({self.prefix}) returned a pair that is not an eigenpair of the "
+            f"definite pencil (load {value:.6g}, relative residual {error:.3g}) with {ncv} "
+            f"Krylov vectors, nor did the swapped pencil (-{self.prefix}swapped_*); try a "
+            f"larger -{self.prefix}eps_ncv"
+        )
 
     def _run(
         self, A: PETSc.Mat, B: PETSc.Mat, initial: PETSc.Vec | None, near: float | None
@@ -927,6 +993,7 @@ def swapped_eigenpairs(
     tol: float = 1e-6,
     conv: Any = None,
     vectors: bool = False,
+    ncv: int | None = None,
 ) -> list[tuple[float, PETSc.Vec | None]]:
     """Extreme eigenpairs theta of the swapped pencil B x = theta A x (theta = 1/lambda).
 
@@ -944,6 +1011,7 @@ def swapped_eigenpairs(
         tol: Tolerance.
         conv: SLEPc ``EPS.Conv`` convergence test (default relative).
         vectors: Also return the eigenvectors (the caller destroys them).
+        ncv: Krylov vectors (default SLEPc's); the options may change it.
 
     Returns:
         The converged pairs (theta, vector or None), at most ``nev``, in SLEPc's order.
@@ -954,7 +1022,10 @@ def swapped_eigenpairs(
     with destroyed_after(SLEPc.EPS().create(A.comm)) as eps:
         eps.setOperators(B, A)
         eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-        eps.setDimensions(nev)
+        if ncv is None:
+            eps.setDimensions(nev)
+        else:
+            eps.setDimensions(nev, max(ncv, 2 * nev + 1))
         eps.setWhichEigenpairs(which)
         eps.setConvergenceTest(SLEPc.EPS.Conv.REL if conv is None else conv)
         eps.setTolerances(tol)

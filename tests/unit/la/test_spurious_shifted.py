@@ -112,3 +112,38 @@ def test_a_free_pair_that_is_none_is_not_proven_the_smallest(tube, monkeypatch):
         assert pair.value == pytest.approx(least, rel=1e-8)
     finally:
         out.destroy()
+
+
+def test_pairs_that_are_none_in_every_subspace_leave_it_to_the_swapped_pencil(tube, monkeypatch):
+    """A pair that is none at 0 and in the widest subspace: the swapped pencil's, checked.
+
+    Seen on one machine's rounding (the filled short tube of the section anchors): the
+    solve at 0 and its retry with 64 Krylov vectors both returned a pair whose residual
+    was 3.7e-4, and the run stopped with an error. The check is made to flag every pair
+    of the solve at 0 here; the swapped pencil B x = theta A x (A in the inner-product
+    slot) must then give the least load, with a vector whose Rayleigh quotient is it.
+    The reference: scipy's dense ``eigh`` of the reduced pencil.
+    """
+    solver = tube.eigensolver
+    checked = GEPSolver._spurious
+    flagged = []
+
+    def flag_at_zero(eps, index=0):
+        if eps is solver.eps:
+            flagged.append(index)
+            return True
+        return checked(eps, index)
+
+    monkeypatch.setattr(GEPSolver, "_spurious", staticmethod(flag_at_zero))
+    rows = tube.contact.removed_rows(np.arange(tube.contact.size))
+    out = solver.A.createVecRight()
+    try:
+        pair = solver.solve(rows, out=out)
+        A, B = solver.reduced(rows)
+        least = _least_loads(A, B, rows, 1)[0]  # 8.0533462e10 Pa
+        assert len(flagged) == 2  # the solve at 0, then the widest subspace
+        assert pair.value == pytest.approx(least, rel=1e-8)
+        assert _quotient(A, B, out) == pytest.approx(pair.value, rel=1e-10)
+        assert pair.error < 1e-6
+    finally:
+        out.destroy()
