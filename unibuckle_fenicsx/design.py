@@ -29,7 +29,9 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
 
 - the stress limit :math:`\rho f_y/\gamma_M` (:func:`~unibuckle_fenicsx.en1993.stress_limit`):
   at :math:`\psi = 1` 4.6(1) with :math:`\gamma_{M0}` (:math:`A_{eff} = \rho A`); at
-  :math:`\psi < 1` the reduced stress method of section 10 for direct stress alone
+  :math:`\psi < 1`, and for an outstand with :math:`\rho < 1` at :math:`\psi = 1`
+  (its :math:`b_{eff}` at the supported edge: a shift :math:`e_N = (1 - \rho)c/2`),
+  the reduced stress method of section 10 for direct stress alone
   (eq. (10.1), :math:`\gamma_{M1}`), as 4.6(1) then checks the effective section
   (:math:`A_{eff}`, :math:`W_{eff}`, :math:`e_N`), not computed here; ``[design]
   partial_factor`` is the factor of the one applied (EN 1993-1-1 6.1 recommends 1.0 for
@@ -69,6 +71,8 @@ from msgspec import UNSET, Struct, UnsetType
 
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
+    OUTSTAND,
+    OUTSTAND_SHIFT,
     SHEAR_NOT_CHECKED,
     DesignElement,
     EffectiveWidths,
@@ -136,13 +140,14 @@ class ElementLimits(Struct, kw_only=True):
     :class:`~unibuckle_fenicsx.section_design.FaceDesign`; None without :math:`\rho`.
 
     Attributes:
-        partial_factor_name: "gamma_M0" (:math:`\psi = 1`) or "gamma_M1"
-            (:math:`\psi < 1`): what ``partial_factor`` stands for in the limit
-            ``reduced_design_stress_Pa``.
+        partial_factor_name: "gamma_M0" (4.6(1)) or "gamma_M1" (section 10): what
+            ``partial_factor`` stands for in the limit ``reduced_design_stress_Pa``.
         stress_limit_clause: The clause of that limit
             (:func:`~unibuckle_fenicsx.en1993.stress_limit`): 4.6(1) at :math:`\psi =
-            1`; section 10, eq. (10.1), the reduced stress method with direct stress
-            alone, at :math:`\psi < 1`.
+            1` where the effective section is :math:`\rho A` without a shift
+            :math:`e_N`; section 10, eq. (10.1), the reduced stress method with direct
+            stress alone, at :math:`\psi < 1`, for an outstand with :math:`\rho < 1`
+            and for a face of a section under bending.
         element_width_m: :math:`\bar b` (internal) or :math:`c` (outstand): the loaded
             edge's length.
         compressed_width_m: :math:`b_c`, its compressed part (``element_width_m`` for
@@ -165,13 +170,20 @@ class ElementLimits(Struct, kw_only=True):
     effective_widths_placed: str | None = None
 
     def put_limit_and_widths(
-        self, w: EffectiveWidths, psi: float, named: str, shear: bool = False
+        self,
+        w: EffectiveWidths,
+        psi: float,
+        named: str,
+        shear: bool = False,
+        shift: str | None = None,
     ) -> None:
         """Set the fields from ``psi`` and the widths ``w``; ``named``: where its ends lie.
 
-        ``shear``: the load has shear, which the stress limit does not check.
+        ``shear``: the load has shear, which the stress limit does not check; ``shift``:
+        why the effective section at psi = 1 is shifted (4.6(1) not applied,
+        :func:`~unibuckle_fenicsx.en1993.stress_limit`), None where it is not.
         """
-        self.partial_factor_name, self.stress_limit_clause = stress_limit(psi, shear)
+        self.partial_factor_name, self.stress_limit_clause = stress_limit(psi, shear, shift)
         self.element_width_m, self.compressed_width_m = w.width, w.compressed
         self.effective_width_m = w.effective
         self.effective_width_1_m, self.effective_width_2_m = w.first, w.second
@@ -186,8 +198,9 @@ class DesignRecord(ElementLimits, kw_only=True):
         yield_stress_Pa: :math:`f_y`.
         partial_factor: ``[design] partial_factor``: :math:`\gamma_{M0}` at
             :math:`\psi = 1` (4.6(1)) and in the tension-yield check (EN 1993-1-1
-            6.2.1(5)), :math:`\gamma_{M1}` at :math:`\psi < 1` (section 10); which one
-            the stress limit uses: ``partial_factor_name``.
+            6.2.1(5)), :math:`\gamma_{M1}` at :math:`\psi < 1` and for an outstand
+            with :math:`\rho < 1` (section 10); which one the stress limit uses:
+            ``partial_factor_name``.
         element: "internal" or "outstand" (:func:`~unibuckle_fenicsx.en1993.design_element`).
         free_edge: An outstand's free unloaded edge (None for an internal element).
         table: The table row of :math:`\psi` and :math:`k_\sigma` (Table 4.1 or 4.2).
@@ -447,7 +460,10 @@ def _widths(
         supported = next(e for e in element.unloaded if e != element.free_edge)
         named = f"supported edge: edges.{supported}, free edge: edges.{element.free_edge}"
     widths = effective_widths(element.kind, rho, width, psi, at_free)
-    out.put_limit_and_widths(widths, psi, named, shear)
+    # An outstand's b_eff = rho c lies at its supported edge: with rho < 1 its centroid
+    # shifts by (1 - rho) c/2, and 4.6(1) would need e_N (and W_eff) even at psi = 1.
+    shift = OUTSTAND_SHIFT if element.kind == OUTSTAND and rho < 1.0 else None
+    out.put_limit_and_widths(widths, psi, named, shear, shift)
 
 
 def _tension_note(out: DesignRecord, rho: float) -> str:
@@ -598,16 +614,18 @@ def effective_widths_text(d: ElementLimits, length: float, name: str) -> str:
     return text
 
 
-def limit_clause_text(psi: float | None, factor: str | None, clause: str | None = None) -> str:
+def limit_clause_text(factor: str | None, clause: str | None = None) -> str:
     """The design line's clause of rho f_y/gamma_M ('' without it).
 
-    ``clause``: the record's ``stress_limit_clause``; the line says when it leaves the
-    load's shear unchecked (:data:`~unibuckle_fenicsx.en1993.SHEAR_NOT_CHECKED`).
+    ``factor``: the record's ``partial_factor_name``, "gamma_M0" for 4.6(1), "gamma_M1"
+    for section 10 (:func:`~unibuckle_fenicsx.en1993.stress_limit`); ``clause``: the
+    record's ``stress_limit_clause``; the line says when it leaves the load's shear
+    unchecked (:data:`~unibuckle_fenicsx.en1993.SHEAR_NOT_CHECKED`).
     """
     if factor is None:
         return ""
     shear = clause is not None and SHEAR_NOT_CHECKED in clause
-    if psi == 1.0:
+    if factor == "gamma_M0":
         return f", rho f_y/{factor} 4.6(1)" + (
             f" (direct stress; {SHEAR_NOT_CHECKED})" if shear else ""
         )

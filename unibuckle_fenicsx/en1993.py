@@ -27,11 +27,15 @@ such a plate, or a stress ratio outside the tables, before any solve.
 
 :func:`effective_widths` gives the widths of Tables 4.1 and 4.2 (what part of the element
 carries the stress), and :func:`stress_limit` the clause and partial factor of the
-stress limit :math:`\rho f_y/\gamma_M`: at :math:`\psi = 1` the lone element's
-effective area is :math:`A_{eff} = \rho A`, and 4.6(1), eq. (4.14), with
-:math:`\gamma_{M0}`, reads :math:`\sigma_1 \le \rho f_y/\gamma_{M0}`; at
-:math:`\psi < 1`, 4.6(1) checks the effective section (:math:`A_{eff}`,
-:math:`W_{eff}` and the shift :math:`e_N`), which is not computed here, and
+stress limit :math:`\rho f_y/\gamma_M`: at :math:`\psi = 1` the lone internal
+element's effective area is :math:`A_{eff} = \rho A` (:math:`b_{e1} = b_{e2}`, about
+the gross centroid), and 4.6(1), eq. (4.14), with :math:`\gamma_{M0}`, reads
+:math:`\sigma_1 \le \rho f_y/\gamma_{M0}`; at :math:`\psi < 1`, and at :math:`\psi
+= 1` where the effective area lies off the gross centroid (an outstand with
+:math:`\rho < 1`: :math:`b_{eff} = \rho c` at the supported edge, :math:`e_N = (1 -
+\rho)c/2`; a box's face in a section under bending), 4.6(1) checks the effective
+section (:math:`A_{eff}`, :math:`W_{eff}` and the shift :math:`e_N`), which is not
+computed here, and
 :math:`\sigma_1 \le \rho f_y/\gamma_{M1}` is the reduced stress method of section 10
 with direct stress alone: eq. (10.1), :math:`\rho\,\alpha_{ult,k}/\gamma_{M1} \ge 1`,
 with :math:`\alpha_{ult,k} = f_y/\sigma_1` (eq. (10.3) without :math:`\sigma_z`,
@@ -56,6 +60,7 @@ __all__ = [
     "ELEMENTS",
     "INTERNAL",
     "OUTSTAND",
+    "OUTSTAND_SHIFT",
     "SHEAR_NOT_CHECKED",
     "STEEL_MODULUS",
     "STEEL_POISSON",
@@ -197,16 +202,26 @@ def table_row(element: str, free_edge_most_compressed: bool) -> str:
 SHEAR_NOT_CHECKED = "the load's shear not checked"
 
 
-def stress_limit(psi: float, shear: bool = False) -> tuple[str, str]:
+def stress_limit(psi: float, shear: bool = False, shift: str | None = None) -> tuple[str, str]:
     r"""(partial factor's name, clause) of the stress limit :math:`\rho f_y/\gamma_M` at ``psi``.
 
-    The module docstring says why: 4.6(1) with :math:`\gamma_{M0}` at :math:`\psi = 1`,
-    the reduced stress method of section 10 with :math:`\gamma_{M1}` below. Both check
-    the direct stress alone; with ``shear`` (the load has shear) the clause says that
-    its shear is not checked (:data:`SHEAR_NOT_CHECKED`): section 5 and the interaction
-    of 7.1, or section 10 with :math:`\tau` in eq. (10.3), would include it.
+    The module docstring says why: 4.6(1) with :math:`\gamma_{M0}` where the effective
+    section is :math:`A_{eff} = \rho A` without a shift :math:`e_N` (:math:`\psi = 1`,
+    ``shift`` None), the reduced stress method of section 10 with :math:`\gamma_{M1}`
+    elsewhere. Both check the direct stress alone; with ``shear`` (the load has shear)
+    the clause says that its shear is not checked (:data:`SHEAR_NOT_CHECKED`): section 5
+    and the interaction of 7.1, or section 10 with :math:`\tau` in eq. (10.3), would
+    include it.
+
+    Args:
+        psi: :math:`\psi`.
+        shear: Whether the load has shear.
+        shift: At :math:`\psi = 1`, why the effective section is not :math:`\rho A`
+            about the gross centroid (an outstand's :math:`b_{eff}` at its supported edge,
+            a section's bending), so that 4.6(1) would need :math:`e_N` and
+            :math:`W_{eff}`; None where it is.
     """
-    if psi == 1.0:
+    if psi == 1.0 and shift is None:
         clause = "4.6(1): rho f_y/gamma_M0 (eq. (4.14) at psi = 1: A_eff = rho A, no shift e_N)"
         if shear:
             clause += (
@@ -219,12 +234,20 @@ def stress_limit(psi: float, shear: bool = False) -> tuple[str, str]:
         if shear
         else "direct stress only"
     )
+    why = "psi < 1" if psi != 1.0 else f"psi = 1, but {shift}"
     return "gamma_M1", (
         f"section 10, reduced stress method, {stresses}: eq. (10.1) rho "
         "alpha_ult,k/gamma_M1 >= 1 with alpha_ult,k = f_y/sigma_1 and eq. (10.2) "
         "slenderness sqrt(f_y/sigma_cr), rho = rho_x of 4.5.4(1) (10(5)): sigma_1 <= rho "
-        "f_y/gamma_M1 (psi < 1: 4.6(1) checks A_eff, W_eff and e_N, not computed here)"
+        f"f_y/gamma_M1 ({why}: 4.6(1) checks A_eff, W_eff and e_N, not computed here)"
     )
+
+
+#: Why an outstand's effective section is shifted (:func:`stress_limit`'s ``shift``).
+OUTSTAND_SHIFT = (
+    "the outstand's b_eff = rho c lies at its supported edge (Table 4.2): its centroid is "
+    "shifted by e_N = (1 - rho) c/2"
+)
 
 
 @dataclass(frozen=True)

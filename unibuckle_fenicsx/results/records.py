@@ -566,7 +566,7 @@ def _design_clauses(d: DesignRecord) -> str:
     column = ", rho_c 4.5.4(1)" if d.xi is not None and d.xi < 1.0 else ""
     return (
         f"psi {table}, slenderness 4.4(2), rho 4.4(2) {rho}{column}"
-        + limit_clause_text(d.psi, d.partial_factor_name, d.stress_limit_clause)
+        + limit_clause_text(d.partial_factor_name, d.stress_limit_clause)
         + (f", b_eff {d.effective_widths_row}" if d.effective_widths_row else "")
     )
 
