@@ -22,8 +22,11 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
   stress with the supports along its unloaded edges removed (4.5.3(1)): eq. (4.8),
   :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)`, between hinged loaded edges, four times that
   between clamped ones, a quarter of it between a clamped and a free one, none (a
-  mechanism, :math:`\rho_c = \rho`) between two free ones (:func:`column_stress`); at
-  :math:`\xi \ge 1` it is
+  mechanism, :math:`\rho_c = \rho`) between two free ones (:func:`column_stress`),
+  bounded by the plate's :math:`\sigma_{cr}` (the plate with those supports removed
+  buckles at no higher a stress: :math:`\xi = 0`, :math:`\rho_c = \chi_c` at
+  :math:`\sqrt{f_y/\sigma_{cr}}`, where a hole, say, puts :math:`\sigma_{cr}` below
+  eq. (4.8)); at :math:`\xi \ge 1` it is
   :math:`\rho`; for :math:`a/b \ge 1` it is :math:`\rho`, the column fields are None
   and a note says why;
 
@@ -230,8 +233,10 @@ class DesignRecord(ElementLimits, kw_only=True):
             its loaded edges, its unloaded edges' supports removed (4.5.3(1)): eq. (4.8),
             :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)` with a the plate's length along the
             stress, for hinged loaded edges, times 4 for clamped ones
-            (:func:`column_stress`); 0 when free loaded edges leave the column a
-            mechanism (``xi`` None, the reduction factor the plate's). None, as
+            (:func:`column_stress`), bounded by ``sigma_cr_Pa`` (the plate with those
+            supports removed buckles at no higher a stress; a note says when); 0 when
+            free loaded edges leave the column a mechanism (``xi`` None, the reduction
+            factor the plate's). None, as
             ``column_reduction_factor`` and ``xi``, for a/b >= 1, where the column-type
             check is not applied (a note says so).
         column_reduction_factor: :math:`\chi_c` at :math:`\bar\lambda_c = \sqrt{f_y/
@@ -517,6 +522,19 @@ def _column_type(
             "sigma_cr,c = 0, xi >= 1, rho_c = rho"
         )
         return rho
+    # The plate with the supports along its unloaded edges removed (4.5.3(1)) buckles at
+    # no higher a stress than with them (fewer constraints: a smaller Rayleigh quotient):
+    # sigma_cr,c <= sigma_cr,p. A column stress above the plate's (eq. (4.8) knows no
+    # hole, no fixed shear, no shear deformation) is bounded by it: xi = 0, rho_c = chi_c
+    # at sqrt(f_y/sigma_cr,p), not the larger chi_c of the column's own stress.
+    if column > sigma1:
+        out.notes.append(
+            f"column-type buckling (EN 1993-1-5 4.5.3(1), 4.5.4(1)): the plate as a column "
+            f"({ends}) gives {significant(column)} Pa, above the plate's sigma_cr = "
+            f"{significant(sigma1)} Pa; with the supports along its unloaded edges removed "
+            "the plate buckles at no higher a stress, so sigma_cr,c = sigma_cr (xi = 0)"
+        )
+        column = sigma1
     reduced = column_type(rho, sigma1, column, design.yield_stress)
     chi, rho_c = reduced.chi, reduced.rho
     out.column_critical_stress_Pa, out.column_reduction_factor = column, chi

@@ -278,6 +278,50 @@ def test_a_short_plate_gets_the_column_type_reduction_factor():
     assert d.reduction_factor < 0.9 * rho
 
 
+def test_a_column_stress_above_the_plate_s_is_bounded_by_it():
+    """sigma_cr,c <= sigma_cr,p (EN 1993-1-5 4.5.3(1), 4.5.4(1)): a plate with a hole.
+
+    150 x 300 x 6 mm SSSS, loaded on left and right (a/b = 0.5), a hole of radius 60 mm
+    at its centre, gmsh cells of 15 mm. 4.5.3(1) defines sigma_cr,c as the plate's
+    buckling stress with the supports along its unloaded edges removed: fewer
+    constraints, so by the Rayleigh quotient never above the plate's own sigma_cr,p.
+    Eq. (4.8), pi^2 E t^2/(12 (1 - nu^2) a^2) = 303.68 MPa, knows no hole; the holed
+    plate buckles at about 203 MPa. So sigma_cr,c = sigma_cr,p, xi = 0 and rho_c = chi_c
+    at sqrt(f_y/sigma_cr,p) (EN 1993-1-1 6.3.1.2, curve a, alpha = 0.21, by hand here):
+    0.4575. Before, xi = -0.33 was clipped to 0 with chi_c of 303.68 MPa: rho_c =
+    0.6089, 33 % on the unsafe side.
+    """
+    hinged = {"support": "simply_supported"}
+    edges = {
+        "left": {**hinged, "normal_stress": -1.0},
+        "right": {**hinged, "normal_stress": -1.0},
+        "bottom": hinged,
+        "top": hinged,
+    }
+    holed = {"corners": [[0, 0], [150, 300]], "thickness": 6.0}
+    holed["holes"] = [{"center": [75.0, 150.0], "radius": 60.0}]
+    d = result(plate(edges, plate=holed, mesh={"size": 15.0})).design
+    equation_4_8 = math.pi**2 * 210000e6 * (6.0 / 150.0) ** 2 / (12 * (1 - 0.3**2))
+    assert equation_4_8 == pytest.approx(303.68e6, rel=1e-5)
+    sigma = d.sigma_cr_Pa
+    assert 180e6 < sigma < 0.75 * equation_4_8  # the hole: well below the column's
+
+    def chi(column):  # EN 1993-1-1 eq. (6.49), curve a
+        lam = math.sqrt(355e6 / column)
+        phi = 0.5 * (1 + 0.21 * (lam - 0.2) + lam**2)
+        return min(1.0, 1 / (phi + math.sqrt(phi**2 - lam**2)))
+
+    assert chi(sigma) == pytest.approx(0.4575, abs=1e-3)  # at about 203 MPa
+    assert chi(equation_4_8) == pytest.approx(0.6089, abs=1e-4)  # the value before
+    assert d.column_critical_stress_Pa == pytest.approx(sigma, rel=1e-12)
+    assert d.xi == 0.0 and d.xi_unclipped == pytest.approx(0.0, abs=1e-12)
+    assert d.column_reduction_factor == pytest.approx(chi(sigma), rel=1e-12)
+    assert d.reduction_factor == pytest.approx(chi(sigma), rel=1e-12)
+    assert d.reduction_factor < d.plate_reduction_factor
+    assert d.reduced_design_stress_Pa == pytest.approx(chi(sigma) * 355e6 / 1.1, rel=1e-12)
+    assert any("sigma_cr,c = sigma_cr (xi = 0)" in n for n in d.notes), d.notes
+
+
 def test_a_long_plate_keeps_the_plate_type_reduction_factor():
     """At a/b = 3 (the 600 x 200 x 4 mm plate) rho_c = rho, and the record says why.
 
@@ -407,7 +451,9 @@ def test_rotationally_restrained_loaded_edges_give_the_restrained_column():
     data["plate"] = {"corners": [[0, 0], [150, 300]], "thickness": 2.0}
     spec = problem_from_dict(data)
     assert spec.design is not None
-    d = design_output(spec, spec.design, 100e6)
+    # A sigma_cr above the column's 111.6 MPa: the plate buckles at no lower a stress than
+    # its column (4.5.3(1); below it the column stress would be bounded by sigma_cr).
+    d = design_output(spec, spec.design, 150e6)
     hinged = math.pi**2 * 210000e6 * (2.0 / 150.0) ** 2 / (12 * (1 - 0.3**2))
     assert d.column_critical_stress_Pa == pytest.approx(factor * hinged, rel=1e-12)
     assert 1.0 < factor < 4.0
