@@ -92,6 +92,7 @@ from unibuckle_fenicsx.en1993 import (
     stress_limit,
     stress_ratio,
     table_row,
+    yield_stress_note,
 )
 from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
 
@@ -364,9 +365,12 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
         clauses=clauses(element, at_free),
         notes=[CALIBRATION],
     )
-    poisson = steel_poisson_note(spec.material.nu)
-    if poisson is not None:
-        out.notes.append(poisson)
+    for note in (
+        steel_poisson_note(spec.material.nu),
+        yield_stress_note(design.yield_stress, spec.plate.thickness, "plate.thickness"),
+    ):
+        if note is not None:
+            out.notes.append(note)
     if spec.plate.holes:
         out.notes.append(
             "the plate has holes (plate.holes): 4.4 describes a plate without openings; "

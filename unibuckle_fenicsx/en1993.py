@@ -65,6 +65,7 @@ __all__ = [
     "STEEL_MODULUS",
     "STEEL_POISSON",
     "STEEL_YIELD_STRESS",
+    "YIELD_STRESS_ABOVE_40_MM",
     "ColumnType",
     "DesignEdge",
     "DesignElement",
@@ -90,6 +91,7 @@ __all__ = [
     "stress_limit",
     "stress_ratio",
     "table_row",
+    "yield_stress_note",
 ]
 
 #: An element with both unloaded edges supported (EN 1993-1-5 Table 4.1).
@@ -165,6 +167,46 @@ def check_steel_yield_stress(fy: float, stress: float, name: str) -> None:
         "yield stress (EN 1993-1-1 Table 3.1 and EN 1993-1-12: 235 to 700 MPa, stainless "
         "steel from 200 MPa; accepted: {low:.6g} to {high:.6g} {name}); give it in the "
         "file's unit, {name}",
+    )
+
+
+#: EN 1993-1-1 Table 3.1 (EN 10025-2 to -6, EN 10210-1): the nominal f_y (N/mm^2) of the
+#: hot rolled structural steels at t <= 40 mm, and the table's value at 40 mm < t <= 80 mm.
+YIELD_STRESS_ABOVE_40_MM = {
+    235.0: "215",
+    275.0: "255",
+    355.0: "335",
+    420.0: "390",
+    440.0: "410",
+    460.0: "430 (EN 10025-3, -4, EN 10210-1) or 440 (EN 10025-6)",
+}
+
+
+def yield_stress_note(fy: float, thickness: float, key: str) -> str | None:
+    """A note when ``fy`` (Pa) is Table 3.1's t <= 40 mm value of a plate ``thickness`` (m) > 40 mm.
+
+    EN 1993-1-1 Table 3.1 lowers the nominal f_y of every grade above t = 40 mm (S355:
+    335 N/mm^2 for 40 < t <= 80 mm) and stops at 80 mm (the product standard's values
+    below it). The output takes f_y as given; the note names ``design.yield_stress`` and
+    ``key``, the thickness's key. None for t <= 40 mm or another f_y.
+    """
+    t_mm, fy_mm2 = thickness * 1e3, fy / 1e6
+    nominal = next((v for v in YIELD_STRESS_ABOVE_40_MM if abs(fy_mm2 - v) <= 1e-9 * v), None)
+    if t_mm <= 40.0 or nominal is None:
+        return None
+    where = (
+        f"design.yield_stress: f_y = {nominal:g} N/mm^2 is EN 1993-1-1 Table 3.1's for t <= 40 mm"
+    )
+    if t_mm <= 80.0:
+        return (
+            f"{where}; at t = {t_mm:.4g} mm ({key}, 40 < t <= 80 mm) the table gives "
+            f"{YIELD_STRESS_ABOVE_40_MM[nominal]} N/mm^2: the output takes f_y as given "
+            "(slenderness, rho, rho f_y/gamma_M), check design.yield_stress"
+        )
+    return (
+        f"{where}; at t = {t_mm:.4g} mm ({key}) the table, which stops at 80 mm, gives less "
+        "already at 40 < t <= 80 mm: take f_y from the product standard (EN 10025) at this "
+        "thickness; the output takes f_y as given, check design.yield_stress"
     )
 
 

@@ -77,6 +77,7 @@ from unibuckle_fenicsx.en1993 import (
     ratio_text,
     reduction_factor,
     stress_ratio,
+    yield_stress_note,
 )
 from unibuckle_fenicsx.spec import DesignSpec
 
@@ -453,6 +454,9 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         out.clauses.append(TUBE_CLAUSES)
         _tension(out, section, design, load, [])
     out.notes.append(member_note(section, design))
+    thick = yield_stress_note(design.yield_stress, section.thickness, "section.thickness")
+    if thick is not None:
+        out.notes.append(thick)
     if section.core:
         outside = ": outside the calibration of EN 1993-1-5 4.4(2)"
         out.notes.append(
