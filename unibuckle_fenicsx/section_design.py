@@ -638,6 +638,8 @@ def design_line(
             name = "rho" if face.reduction_factor == face.plate_reduction_factor else "rho_c"
             text += (
                 f", {_governing(low, rule=False)}, {name} = {significant(face.reduction_factor)}"
+                f", rho f_y/{face.partial_factor_name} = "
+                f"{significant((face.reduced_design_stress_Pa or 0.0) / scale)} {unit}"
             )
         if low.tension_yield_first:
             text += _tension_text(low, scale, unit)

@@ -946,6 +946,9 @@ def test_an_unproven_critical_load_adds_the_design_at_its_lower_bound():
     assert any("not proven the lowest" in note for note in r.design.notes)
     assert f"slenderness {slenderness:.4g}, rho = {rho:.4g}" in r.summary()
     assert r.as_dict()["design"]["lower_bound"]["reduction_factor"] == low.reduction_factor
+    # The safe line gives the safe stress limit too (it gave rho alone): rho f_y/gamma_M0.
+    safe = next(s for s in r.summary().splitlines() if "at the verified lower bound" in s)
+    assert f"rho f_y/gamma_M0 = {rho * 355 / 1.1:#.4g} MPa" in safe, safe
 
 
 def test_the_summary_keeps_four_significant_digits_in_pa():

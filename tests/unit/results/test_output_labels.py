@@ -103,6 +103,8 @@ def test_the_section_design_line_at_the_lower_bound_keeps_four_digits():
     slenderness = math.sqrt(3.55e8 / 9.44e7)  # 1.939
     rho = (slenderness - 0.055 * 4.0) / slenderness**2  # eq. (4.2), psi = 1: 0.4572
     assert f"slenderness {slenderness:#.4g}" in low and f"rho = {rho:#.4g}" in low, low
+    # and the safe stress limit (the line gave rho alone): rho f_y/gamma_M0, psi = 1.
+    assert f"rho f_y/gamma_M0 = {rho * 3.55e8:#.4g} Pa" in low, low
 
 
 def _plate(edges_top: dict[str, object]) -> str:
