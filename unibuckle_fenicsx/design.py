@@ -88,6 +88,7 @@ from unibuckle_fenicsx.en1993 import (
     psi_range,
     ratio_text,
     reduction_factor,
+    stainless_note,
     steel_poisson_note,
     stress_limit,
     stress_ratio,
@@ -366,6 +367,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
         notes=[CALIBRATION],
     )
     for note in (
+        stainless_note(spec.material.E),
         steel_poisson_note(spec.material.nu),
         yield_stress_note(design.yield_stress, spec.plate.thickness, "plate.thickness"),
     ):

@@ -62,6 +62,7 @@ __all__ = [
     "OUTSTAND",
     "OUTSTAND_SHIFT",
     "SHEAR_NOT_CHECKED",
+    "STAINLESS_MODULUS",
     "STEEL_MODULUS",
     "STEEL_POISSON",
     "STEEL_YIELD_STRESS",
@@ -87,6 +88,7 @@ __all__ = [
     "psi_range",
     "ratio_text",
     "reduction_factor",
+    "stainless_note",
     "steel_poisson_note",
     "stress_limit",
     "stress_ratio",
@@ -167,6 +169,28 @@ def check_steel_yield_stress(fy: float, stress: float, name: str) -> None:
         "yield stress (EN 1993-1-1 Table 3.1 and EN 1993-1-12: 235 to 700 MPa, stainless "
         "steel from 200 MPa; accepted: {low:.6g} to {high:.6g} {name}); give it in the "
         "file's unit, {name}",
+    )
+
+
+#: Young's modulus (Pa) below which the design output reads the material as possibly
+#: stainless steel (EN 1993-1-4 Table 2.1: 200 GPa; EN 1993-1-1 3.2.6: 210 GPa).
+STAINLESS_MODULUS = 2.05e11
+
+
+def stainless_note(E: float) -> str | None:
+    """A note when ``E`` (Pa) is stainless steel's (below :data:`STAINLESS_MODULUS`), else None.
+
+    EN 1993-1-4 5.2.3 replaces EN 1993-1-5's eq. (4.2) and (4.3) for stainless steel by its
+    own reduction factors, which reduce more; the output applies EN 1993-1-5's. The note
+    names ``material.E``.
+    """
+    if E >= STAINLESS_MODULUS:
+        return None
+    return (
+        f"design: material.E = {E / 1e9:.4g} GPa is stainless steel's (EN 1993-1-4 Table "
+        "2.1: 200 GPa; structural steel's 210 GPa, EN 1993-1-1 3.2.6): for stainless steel "
+        "EN 1993-1-4 5.2.3 gives its own reduction factor rho, which reduces more than EN "
+        "1993-1-5's eq. (4.2) and (4.3) applied here"
     )
 
 

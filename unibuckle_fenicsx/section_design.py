@@ -76,6 +76,7 @@ from unibuckle_fenicsx.en1993 import (
     psi_range,
     ratio_text,
     reduction_factor,
+    stainless_note,
     stress_ratio,
     yield_stress_note,
 )
@@ -454,9 +455,7 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         out.clauses.append(TUBE_CLAUSES)
         _tension(out, section, design, load, [])
     out.notes.append(member_note(section, design))
-    thick = yield_stress_note(design.yield_stress, section.thickness, "section.thickness")
-    if thick is not None:
-        out.notes.append(thick)
+    out.notes += _material_notes(section, design)
     if section.core:
         outside = ": outside the calibration of EN 1993-1-5 4.4(2)"
         out.notes.append(
@@ -487,6 +486,15 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             within = False
         out.local_buckling_negligible = within
     return out
+
+
+def _material_notes(section: DesignSection, design: DesignSpec) -> list[str]:
+    """The notes on the steel: stainless (a box's rho), f_y at a wall thicker than 40 mm."""
+    notes = (
+        stainless_note(section.E) if section.shape == "box" else None,  # a tube gets no rho
+        yield_stress_note(design.yield_stress, section.thickness, "section.thickness"),
+    )
+    return [note for note in notes if note is not None]
 
 
 def member_note(section: DesignSection, design: DesignSpec) -> str:

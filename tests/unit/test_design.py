@@ -175,6 +175,39 @@ def test_stainless_steel_keeps_the_design():
     assert plate(edges, material={"E": 200000.0, "nu": 0.3}).design is not None
 
 
+@pytest.mark.parametrize(("E", "noted"), [(200000.0, True), (210000.0, False), (205000.0, False)])
+def test_stainless_steel_s_design_notes_en_1993_1_4(E, noted):
+    """E = 200 GPa, stainless steel's: a note that EN 1993-1-4 5.2.3 gives its own rho.
+
+    EN 1993-1-4 5.2.3 replaces eq. (4.2) and (4.3) for stainless steel by reduction
+    factors that reduce more (its internal element's 0.772/lambda_p - ... against
+    (lambda_p - 0.22)/lambda_p^2); the output applies EN 1993-1-5's, and said nothing.
+    A box's faces get the note too, a tube (no rho) not.
+    """
+    from unibuckle_fenicsx import SectionParameters
+    from unibuckle_fenicsx.cli.problem import input_notes
+    from unibuckle_fenicsx.design import design_output
+    from unibuckle_fenicsx.section_design import section_design
+    from unibuckle_fenicsx.spec import DesignSpec
+
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    spec = plate(edges, material={"E": E, "nu": 0.3})
+    notes = [n for n in design_output(spec, spec.design, 2e8).notes if "EN 1993-1-4 5.2.3" in n]
+    assert len(notes) == int(noted), notes
+    assert ("design stainless" in input_notes(spec)) == noted
+    if noted:
+        assert notes[0].startswith("design: material.E = 200 GPa is stainless steel's")
+    for shape, sizes in (("box", {"width": 0.2, "depth": 0.1}), ("tube", {"diameter": 0.2})):
+        section = SectionParameters(
+            shape, thickness=0.002, length=0.6, E=E * 1e6, nu=0.3, mesh_size=0.02,
+            axial_stress=-1.0, bending_stress=0.0, core=False,
+            **{"width": None, "depth": None, "diameter": None, **sizes},
+        )  # fmt: skip
+        out = section_design(section, DesignSpec(yield_stress=3.55e8), 1.0e8)
+        said = [n for n in out.notes if "EN 1993-1-4 5.2.3" in n]
+        assert len(said) == int(noted and shape == "box"), (shape, out.notes)
+
+
 @pytest.mark.parametrize(
     ("nu", "warned"), [(-0.2, True), (0.45, True), (0.3, False), (0.28, False)]
 )
