@@ -22,14 +22,19 @@ elements*, with its corrigendum AC:2009), clause 4.4 (the formulas:
   stress with the supports along its unloaded edges removed (4.5.3(1)): eq. (4.8),
   :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)`, between hinged loaded edges, four times that
   between clamped ones, a quarter of it between a clamped and a free one, none (a
-  mechanism, :math:`\rho_c = \rho`) between two free ones (:func:`column_stress`); at
-  :math:`\xi \ge 1` it is
+  mechanism, :math:`\rho_c = \rho`) between two free ones (:func:`column_stress`),
+  bounded by the plate's :math:`\sigma_{cr}` (the plate with those supports removed
+  buckles at no higher a stress: :math:`\xi = 0`, :math:`\rho_c = \chi_c` at
+  :math:`\sqrt{f_y/\sigma_{cr}}`, where a hole, say, puts :math:`\sigma_{cr}` below
+  eq. (4.8)); at :math:`\xi \ge 1` it is
   :math:`\rho`; for :math:`a/b \ge 1` it is :math:`\rho`, the column fields are None
   and a note says why;
 
 - the stress limit :math:`\rho f_y/\gamma_M` (:func:`~unibuckle_fenicsx.en1993.stress_limit`):
   at :math:`\psi = 1` 4.6(1) with :math:`\gamma_{M0}` (:math:`A_{eff} = \rho A`); at
-  :math:`\psi < 1` the reduced stress method of section 10 for direct stress alone
+  :math:`\psi < 1`, and for an outstand with :math:`\rho < 1` at :math:`\psi = 1`
+  (its :math:`b_{eff}` at the supported edge: a shift :math:`e_N = (1 - \rho)c/2`),
+  the reduced stress method of section 10 for direct stress alone
   (eq. (10.1), :math:`\gamma_{M1}`), as 4.6(1) then checks the effective section
   (:math:`A_{eff}`, :math:`W_{eff}`, :math:`e_N`), not computed here; ``[design]
   partial_factor`` is the factor of the one applied (EN 1993-1-1 6.1 recommends 1.0 for
@@ -69,6 +74,8 @@ from msgspec import UNSET, Struct, UnsetType
 
 from unibuckle_fenicsx.en1993 import (
     INTERNAL,
+    OUTSTAND,
+    OUTSTAND_SHIFT,
     SHEAR_NOT_CHECKED,
     DesignElement,
     EffectiveWidths,
@@ -81,10 +88,12 @@ from unibuckle_fenicsx.en1993 import (
     psi_range,
     ratio_text,
     reduction_factor,
+    stainless_note,
     steel_poisson_note,
     stress_limit,
     stress_ratio,
     table_row,
+    yield_stress_note,
 )
 from unibuckle_fenicsx.spec import DesignSpec, ProblemSpec, stress_ends
 
@@ -136,13 +145,14 @@ class ElementLimits(Struct, kw_only=True):
     :class:`~unibuckle_fenicsx.section_design.FaceDesign`; None without :math:`\rho`.
 
     Attributes:
-        partial_factor_name: "gamma_M0" (:math:`\psi = 1`) or "gamma_M1"
-            (:math:`\psi < 1`): what ``partial_factor`` stands for in the limit
-            ``reduced_design_stress_Pa``.
+        partial_factor_name: "gamma_M0" (4.6(1)) or "gamma_M1" (section 10): what
+            ``partial_factor`` stands for in the limit ``reduced_design_stress_Pa``.
         stress_limit_clause: The clause of that limit
             (:func:`~unibuckle_fenicsx.en1993.stress_limit`): 4.6(1) at :math:`\psi =
-            1`; section 10, eq. (10.1), the reduced stress method with direct stress
-            alone, at :math:`\psi < 1`.
+            1` where the effective section is :math:`\rho A` without a shift
+            :math:`e_N`; section 10, eq. (10.1), the reduced stress method with direct
+            stress alone, at :math:`\psi < 1`, for an outstand with :math:`\rho < 1`
+            and for a face of a section under bending.
         element_width_m: :math:`\bar b` (internal) or :math:`c` (outstand): the loaded
             edge's length.
         compressed_width_m: :math:`b_c`, its compressed part (``element_width_m`` for
@@ -165,13 +175,20 @@ class ElementLimits(Struct, kw_only=True):
     effective_widths_placed: str | None = None
 
     def put_limit_and_widths(
-        self, w: EffectiveWidths, psi: float, named: str, shear: bool = False
+        self,
+        w: EffectiveWidths,
+        psi: float,
+        named: str,
+        shear: bool = False,
+        shift: str | None = None,
     ) -> None:
         """Set the fields from ``psi`` and the widths ``w``; ``named``: where its ends lie.
 
-        ``shear``: the load has shear, which the stress limit does not check.
+        ``shear``: the load has shear, which the stress limit does not check; ``shift``:
+        why the effective section at psi = 1 is shifted (4.6(1) not applied,
+        :func:`~unibuckle_fenicsx.en1993.stress_limit`), None where it is not.
         """
-        self.partial_factor_name, self.stress_limit_clause = stress_limit(psi, shear)
+        self.partial_factor_name, self.stress_limit_clause = stress_limit(psi, shear, shift)
         self.element_width_m, self.compressed_width_m = w.width, w.compressed
         self.effective_width_m = w.effective
         self.effective_width_1_m, self.effective_width_2_m = w.first, w.second
@@ -186,8 +203,9 @@ class DesignRecord(ElementLimits, kw_only=True):
         yield_stress_Pa: :math:`f_y`.
         partial_factor: ``[design] partial_factor``: :math:`\gamma_{M0}` at
             :math:`\psi = 1` (4.6(1)) and in the tension-yield check (EN 1993-1-1
-            6.2.1(5)), :math:`\gamma_{M1}` at :math:`\psi < 1` (section 10); which one
-            the stress limit uses: ``partial_factor_name``.
+            6.2.1(5)), :math:`\gamma_{M1}` at :math:`\psi < 1` and for an outstand
+            with :math:`\rho < 1` (section 10); which one the stress limit uses:
+            ``partial_factor_name``.
         element: "internal" or "outstand" (:func:`~unibuckle_fenicsx.en1993.design_element`).
         free_edge: An outstand's free unloaded edge (None for an internal element).
         table: The table row of :math:`\psi` and :math:`k_\sigma` (Table 4.1 or 4.2).
@@ -217,8 +235,10 @@ class DesignRecord(ElementLimits, kw_only=True):
             its loaded edges, its unloaded edges' supports removed (4.5.3(1)): eq. (4.8),
             :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)` with a the plate's length along the
             stress, for hinged loaded edges, times 4 for clamped ones
-            (:func:`column_stress`); 0 when free loaded edges leave the column a
-            mechanism (``xi`` None, the reduction factor the plate's). None, as
+            (:func:`column_stress`), bounded by ``sigma_cr_Pa`` (the plate with those
+            supports removed buckles at no higher a stress; a note says when); 0 when
+            free loaded edges leave the column a mechanism (``xi`` None, the reduction
+            factor the plate's). None, as
             ``column_reduction_factor`` and ``xi``, for a/b >= 1, where the column-type
             check is not applied (a note says so).
         column_reduction_factor: :math:`\chi_c` at :math:`\bar\lambda_c = \sqrt{f_y/
@@ -346,9 +366,13 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
         clauses=clauses(element, at_free),
         notes=[CALIBRATION],
     )
-    poisson = steel_poisson_note(spec.material.nu)
-    if poisson is not None:
-        out.notes.append(poisson)
+    for note in (
+        stainless_note(spec.material.E),
+        steel_poisson_note(spec.material.nu),
+        yield_stress_note(design.yield_stress, spec.plate.thickness, "plate.thickness"),
+    ):
+        if note is not None:
+            out.notes.append(note)
     if spec.plate.holes:
         out.notes.append(
             "the plate has holes (plate.holes): 4.4 describes a plate without openings; "
@@ -447,7 +471,10 @@ def _widths(
         supported = next(e for e in element.unloaded if e != element.free_edge)
         named = f"supported edge: edges.{supported}, free edge: edges.{element.free_edge}"
     widths = effective_widths(element.kind, rho, width, psi, at_free)
-    out.put_limit_and_widths(widths, psi, named, shear)
+    # An outstand's b_eff = rho c lies at its supported edge: with rho < 1 its centroid
+    # shifts by (1 - rho) c/2, and 4.6(1) would need e_N (and W_eff) even at psi = 1.
+    shift = OUTSTAND_SHIFT if element.kind == OUTSTAND and rho < 1.0 else None
+    out.put_limit_and_widths(widths, psi, named, shear, shift)
 
 
 def _tension_note(out: DesignRecord, rho: float) -> str:
@@ -501,6 +528,19 @@ def _column_type(
             "sigma_cr,c = 0, xi >= 1, rho_c = rho"
         )
         return rho
+    # The plate with the supports along its unloaded edges removed (4.5.3(1)) buckles at
+    # no higher a stress than with them (fewer constraints: a smaller Rayleigh quotient):
+    # sigma_cr,c <= sigma_cr,p. A column stress above the plate's (eq. (4.8) knows no
+    # hole, no fixed shear, no shear deformation) is bounded by it: xi = 0, rho_c = chi_c
+    # at sqrt(f_y/sigma_cr,p), not the larger chi_c of the column's own stress.
+    if column > sigma1:
+        out.notes.append(
+            f"column-type buckling (EN 1993-1-5 4.5.3(1), 4.5.4(1)): the plate as a column "
+            f"({ends}) gives {significant(column)} Pa, above the plate's sigma_cr = "
+            f"{significant(sigma1)} Pa; with the supports along its unloaded edges removed "
+            "the plate buckles at no higher a stress, so sigma_cr,c = sigma_cr (xi = 0)"
+        )
+        column = sigma1
     reduced = column_type(rho, sigma1, column, design.yield_stress)
     chi, rho_c = reduced.chi, reduced.rho
     out.column_critical_stress_Pa, out.column_reduction_factor = column, chi
@@ -598,16 +638,18 @@ def effective_widths_text(d: ElementLimits, length: float, name: str) -> str:
     return text
 
 
-def limit_clause_text(psi: float | None, factor: str | None, clause: str | None = None) -> str:
+def limit_clause_text(factor: str | None, clause: str | None = None) -> str:
     """The design line's clause of rho f_y/gamma_M ('' without it).
 
-    ``clause``: the record's ``stress_limit_clause``; the line says when it leaves the
-    load's shear unchecked (:data:`~unibuckle_fenicsx.en1993.SHEAR_NOT_CHECKED`).
+    ``factor``: the record's ``partial_factor_name``, "gamma_M0" for 4.6(1), "gamma_M1"
+    for section 10 (:func:`~unibuckle_fenicsx.en1993.stress_limit`); ``clause``: the
+    record's ``stress_limit_clause``; the line says when it leaves the load's shear
+    unchecked (:data:`~unibuckle_fenicsx.en1993.SHEAR_NOT_CHECKED`).
     """
     if factor is None:
         return ""
     shear = clause is not None and SHEAR_NOT_CHECKED in clause
-    if psi == 1.0:
+    if factor == "gamma_M0":
         return f", rho f_y/{factor} 4.6(1)" + (
             f" (direct stress; {SHEAR_NOT_CHECKED})" if shear else ""
         )

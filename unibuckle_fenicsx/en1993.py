@@ -27,11 +27,15 @@ such a plate, or a stress ratio outside the tables, before any solve.
 
 :func:`effective_widths` gives the widths of Tables 4.1 and 4.2 (what part of the element
 carries the stress), and :func:`stress_limit` the clause and partial factor of the
-stress limit :math:`\rho f_y/\gamma_M`: at :math:`\psi = 1` the lone element's
-effective area is :math:`A_{eff} = \rho A`, and 4.6(1), eq. (4.14), with
-:math:`\gamma_{M0}`, reads :math:`\sigma_1 \le \rho f_y/\gamma_{M0}`; at
-:math:`\psi < 1`, 4.6(1) checks the effective section (:math:`A_{eff}`,
-:math:`W_{eff}` and the shift :math:`e_N`), which is not computed here, and
+stress limit :math:`\rho f_y/\gamma_M`: at :math:`\psi = 1` the lone internal
+element's effective area is :math:`A_{eff} = \rho A` (:math:`b_{e1} = b_{e2}`, about
+the gross centroid), and 4.6(1), eq. (4.14), with :math:`\gamma_{M0}`, reads
+:math:`\sigma_1 \le \rho f_y/\gamma_{M0}`; at :math:`\psi < 1`, and at :math:`\psi
+= 1` where the effective area lies off the gross centroid (an outstand with
+:math:`\rho < 1`: :math:`b_{eff} = \rho c` at the supported edge, :math:`e_N = (1 -
+\rho)c/2`; a box's face in a section under bending), 4.6(1) checks the effective
+section (:math:`A_{eff}`, :math:`W_{eff}` and the shift :math:`e_N`), which is not
+computed here, and
 :math:`\sigma_1 \le \rho f_y/\gamma_{M1}` is the reduced stress method of section 10
 with direct stress alone: eq. (10.1), :math:`\rho\,\alpha_{ult,k}/\gamma_{M1} \ge 1`,
 with :math:`\alpha_{ult,k} = f_y/\sigma_1` (eq. (10.3) without :math:`\sigma_z`,
@@ -56,10 +60,13 @@ __all__ = [
     "ELEMENTS",
     "INTERNAL",
     "OUTSTAND",
+    "OUTSTAND_SHIFT",
     "SHEAR_NOT_CHECKED",
+    "STAINLESS_MODULUS",
     "STEEL_MODULUS",
     "STEEL_POISSON",
     "STEEL_YIELD_STRESS",
+    "YIELD_STRESS_ABOVE_40_MM",
     "ColumnType",
     "DesignEdge",
     "DesignElement",
@@ -81,10 +88,12 @@ __all__ = [
     "psi_range",
     "ratio_text",
     "reduction_factor",
+    "stainless_note",
     "steel_poisson_note",
     "stress_limit",
     "stress_ratio",
     "table_row",
+    "yield_stress_note",
 ]
 
 #: An element with both unloaded edges supported (EN 1993-1-5 Table 4.1).
@@ -163,6 +172,68 @@ def check_steel_yield_stress(fy: float, stress: float, name: str) -> None:
     )
 
 
+#: Young's modulus (Pa) below which the design output reads the material as possibly
+#: stainless steel (EN 1993-1-4 Table 2.1: 200 GPa; EN 1993-1-1 3.2.6: 210 GPa).
+STAINLESS_MODULUS = 2.05e11
+
+
+def stainless_note(E: float) -> str | None:
+    """A note when ``E`` (Pa) is stainless steel's (below :data:`STAINLESS_MODULUS`), else None.
+
+    EN 1993-1-4 5.2.3 replaces EN 1993-1-5's eq. (4.2) and (4.3) for stainless steel by its
+    own reduction factors, which reduce more; the output applies EN 1993-1-5's. The note
+    names ``material.E``.
+    """
+    if E >= STAINLESS_MODULUS:
+        return None
+    return (
+        f"design: material.E = {E / 1e9:.4g} GPa is stainless steel's (EN 1993-1-4 Table "
+        "2.1: 200 GPa; structural steel's 210 GPa, EN 1993-1-1 3.2.6): for stainless steel "
+        "EN 1993-1-4 5.2.3 gives its own reduction factor rho, which reduces more than EN "
+        "1993-1-5's eq. (4.2) and (4.3) applied here"
+    )
+
+
+#: EN 1993-1-1 Table 3.1 (EN 10025-2 to -6, EN 10210-1): the nominal f_y (N/mm^2) of the
+#: hot rolled structural steels at t <= 40 mm, and the table's value at 40 mm < t <= 80 mm.
+YIELD_STRESS_ABOVE_40_MM = {
+    235.0: "215",
+    275.0: "255",
+    355.0: "335",
+    420.0: "390",
+    440.0: "410",
+    460.0: "430 (EN 10025-3, -4, EN 10210-1) or 440 (EN 10025-6)",
+}
+
+
+def yield_stress_note(fy: float, thickness: float, key: str) -> str | None:
+    """A note when ``fy`` (Pa) is Table 3.1's t <= 40 mm value of a plate ``thickness`` (m) > 40 mm.
+
+    EN 1993-1-1 Table 3.1 lowers the nominal f_y of every grade above t = 40 mm (S355:
+    335 N/mm^2 for 40 < t <= 80 mm) and stops at 80 mm (the product standard's values
+    below it). The output takes f_y as given; the note names ``design.yield_stress`` and
+    ``key``, the thickness's key. None for t <= 40 mm or another f_y.
+    """
+    t_mm, fy_mm2 = thickness * 1e3, fy / 1e6
+    nominal = next((v for v in YIELD_STRESS_ABOVE_40_MM if abs(fy_mm2 - v) <= 1e-9 * v), None)
+    if t_mm <= 40.0 or nominal is None:
+        return None
+    where = (
+        f"design.yield_stress: f_y = {nominal:g} N/mm^2 is EN 1993-1-1 Table 3.1's for t <= 40 mm"
+    )
+    if t_mm <= 80.0:
+        return (
+            f"{where}; at t = {t_mm:.4g} mm ({key}, 40 < t <= 80 mm) the table gives "
+            f"{YIELD_STRESS_ABOVE_40_MM[nominal]} N/mm^2: the output takes f_y as given "
+            "(slenderness, rho, rho f_y/gamma_M), check design.yield_stress"
+        )
+    return (
+        f"{where}; at t = {t_mm:.4g} mm ({key}) the table, which stops at 80 mm, gives less "
+        "already at 40 < t <= 80 mm: take f_y from the product standard (EN 10025) at this "
+        "thickness; the output takes f_y as given, check design.yield_stress"
+    )
+
+
 #: Poisson's ratios taken as a steel's by the design output without a warning: EN
 #: 1993-1-1 3.2.6 and EN 1993-1-4 2.2 give nu = 0.3, with a margin for the 0.28-0.29
 #: some texts give. Another nu is warned of, not refused: sigma_cr is then the plate's
@@ -197,16 +268,26 @@ def table_row(element: str, free_edge_most_compressed: bool) -> str:
 SHEAR_NOT_CHECKED = "the load's shear not checked"
 
 
-def stress_limit(psi: float, shear: bool = False) -> tuple[str, str]:
+def stress_limit(psi: float, shear: bool = False, shift: str | None = None) -> tuple[str, str]:
     r"""(partial factor's name, clause) of the stress limit :math:`\rho f_y/\gamma_M` at ``psi``.
 
-    The module docstring says why: 4.6(1) with :math:`\gamma_{M0}` at :math:`\psi = 1`,
-    the reduced stress method of section 10 with :math:`\gamma_{M1}` below. Both check
-    the direct stress alone; with ``shear`` (the load has shear) the clause says that
-    its shear is not checked (:data:`SHEAR_NOT_CHECKED`): section 5 and the interaction
-    of 7.1, or section 10 with :math:`\tau` in eq. (10.3), would include it.
+    The module docstring says why: 4.6(1) with :math:`\gamma_{M0}` where the effective
+    section is :math:`A_{eff} = \rho A` without a shift :math:`e_N` (:math:`\psi = 1`,
+    ``shift`` None), the reduced stress method of section 10 with :math:`\gamma_{M1}`
+    elsewhere. Both check the direct stress alone; with ``shear`` (the load has shear)
+    the clause says that its shear is not checked (:data:`SHEAR_NOT_CHECKED`): section 5
+    and the interaction of 7.1, or section 10 with :math:`\tau` in eq. (10.3), would
+    include it.
+
+    Args:
+        psi: :math:`\psi`.
+        shear: Whether the load has shear.
+        shift: At :math:`\psi = 1`, why the effective section is not :math:`\rho A`
+            about the gross centroid (an outstand's :math:`b_{eff}` at its supported edge,
+            a section's bending), so that 4.6(1) would need :math:`e_N` and
+            :math:`W_{eff}`; None where it is.
     """
-    if psi == 1.0:
+    if psi == 1.0 and shift is None:
         clause = "4.6(1): rho f_y/gamma_M0 (eq. (4.14) at psi = 1: A_eff = rho A, no shift e_N)"
         if shear:
             clause += (
@@ -219,12 +300,20 @@ def stress_limit(psi: float, shear: bool = False) -> tuple[str, str]:
         if shear
         else "direct stress only"
     )
+    why = "psi < 1" if psi != 1.0 else f"psi = 1, but {shift}"
     return "gamma_M1", (
         f"section 10, reduced stress method, {stresses}: eq. (10.1) rho "
         "alpha_ult,k/gamma_M1 >= 1 with alpha_ult,k = f_y/sigma_1 and eq. (10.2) "
         "slenderness sqrt(f_y/sigma_cr), rho = rho_x of 4.5.4(1) (10(5)): sigma_1 <= rho "
-        "f_y/gamma_M1 (psi < 1: 4.6(1) checks A_eff, W_eff and e_N, not computed here)"
+        f"f_y/gamma_M1 ({why}: 4.6(1) checks A_eff, W_eff and e_N, not computed here)"
     )
+
+
+#: Why an outstand's effective section is shifted (:func:`stress_limit`'s ``shift``).
+OUTSTAND_SHIFT = (
+    "the outstand's b_eff = rho c lies at its supported edge (Table 4.2): its centroid is "
+    "shifted by e_N = (1 - rho) c/2"
+)
 
 
 @dataclass(frozen=True)

@@ -51,6 +51,7 @@ from unibuckle_fenicsx.en1993 import (
     check_steel_modulus,
     check_steel_yield_stress,
     steel_poisson_note,
+    yield_stress_note,
 )
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
@@ -434,6 +435,9 @@ def _check(parameters: SectionParameters, levels: int, design: DesignSpec | None
         check_steel_modulus(parameters.E, *stress)
         check_steel_yield_stress(design.yield_stress, *stress)
         notes.append(steel_poisson_note(parameters.nu))
+        notes.append(
+            yield_stress_note(design.yield_stress, parameters.thickness, "section.thickness")
+        )
     for note in notes:
         if note is not None:
             logger.warning("%s", note)

@@ -20,8 +20,9 @@ asks for the design quantities of its critical state :math:`\lambda_c`:
   column between the section's ends, eq. (4.8) :math:`\pi^2 E t^2/(12(1 - \nu^2) a^2)`
   between simply supported ones, 4 times it between clamped ones), as a plate's
   (:mod:`unibuckle_fenicsx.design`); the face's stress limit :math:`\rho f_y/\gamma_M`
-  (4.6(1) with :math:`\gamma_{M0}` at :math:`\psi = 1`, the reduced stress method of
-  section 10 with :math:`\gamma_{M1}` below,
+  (4.6(1) with :math:`\gamma_{M0}` at :math:`\psi = 1` in a section without bending,
+  whose effective section has no shift :math:`e_N`; the reduced stress method of
+  section 10 with :math:`\gamma_{M1}` below, and on every face of a bent section,
   :func:`~unibuckle_fenicsx.en1993.stress_limit`) and its effective widths of Table 4.1
   (:func:`~unibuckle_fenicsx.en1993.effective_widths`; :math:`\bar b` the face's
   mid-line width, the one computed);
@@ -75,7 +76,9 @@ from unibuckle_fenicsx.en1993 import (
     psi_range,
     ratio_text,
     reduction_factor,
+    stainless_note,
     stress_ratio,
+    yield_stress_note,
 )
 from unibuckle_fenicsx.spec import DesignSpec
 
@@ -97,6 +100,11 @@ FACE_CLAUSES = (
 )
 #: Added where a face is shorter than its width (as a plate's record, only where applied).
 COLUMN_CLAUSES = "4.5.3(1), 4.5.4(1): column-type buckling of a face shorter than its width, rho_c"
+#: Why a face's stress limit is not 4.6(1) in a section under bending (even at psi = 1).
+BENDING_SHIFT = (
+    "the section is bent: its effective section (the compressed faces reduced) has its own "
+    "W_eff and shift e_N"
+)
 #: The clause of a tube's slenderness.
 TUBE_CLAUSES = (
     "relative slenderness sqrt(f_y/sigma_cr) only: a circular wall is a shell (EN 1993-1-6, "
@@ -202,8 +210,9 @@ class SectionDesignRecord(Struct, kw_only=True):
     Attributes:
         yield_stress_Pa: :math:`f_y`.
         partial_factor: ``[design] partial_factor``: :math:`\gamma_{M0}` in the tension
-            fibre's check and a face's limit at :math:`\psi = 1`, :math:`\gamma_{M1}` in a
-            face's at :math:`\psi < 1` (each face's ``partial_factor_name``).
+            fibre's check and a face's limit at :math:`\psi = 1` without bending,
+            :math:`\gamma_{M1}` in a face's at :math:`\psi < 1` or under bending (each
+            face's ``partial_factor_name``).
         sigma_cr_Pa: The largest compressive axial stress in the walls at the critical
             state (Pa).
         relative_slenderness: :math:`\sqrt{f_y/\sigma_{cr}}`.
@@ -310,11 +319,14 @@ def _face(
     )
     first = ends.index(sigma1)
     corners = CORNERS[name]
+    # Under bending the effective section (the compressed faces reduced, the others not)
+    # has its own W_eff and shift e_N, which 4.6(1) needs even for a face at psi = 1.
     out.put_limit_and_widths(
         effective_widths(INTERNAL, out.reduction_factor, face_width(section, name), psi),
         psi,
         f"sigma_1 end: the corner with face {corners[first]}, other end: the corner with "
         f"face {corners[1 - first]}",
+        shift=BENDING_SHIFT if section.bending_stress != 0.0 else None,
     )
     return out
 
@@ -443,6 +455,7 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         out.clauses.append(TUBE_CLAUSES)
         _tension(out, section, design, load, [])
     out.notes.append(member_note(section, design))
+    out.notes += _material_notes(section, design)
     if section.core:
         outside = ": outside the calibration of EN 1993-1-5 4.4(2)"
         out.notes.append(
@@ -473,6 +486,15 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
             within = False
         out.local_buckling_negligible = within
     return out
+
+
+def _material_notes(section: DesignSection, design: DesignSpec) -> list[str]:
+    """The notes on the steel: stainless (a box's rho), f_y at a wall thicker than 40 mm."""
+    notes = (
+        stainless_note(section.E) if section.shape == "box" else None,  # a tube gets no rho
+        yield_stress_note(design.yield_stress, section.thickness, "section.thickness"),
+    )
+    return [note for note in notes if note is not None]
 
 
 def member_note(section: DesignSection, design: DesignSpec) -> str:
@@ -588,7 +610,7 @@ def design_line(
             f"rho f_y/{face.partial_factor_name} = {significant(reduced / scale)} {unit} "
             f"(psi Table 4.1, slenderness 4.4(2), "
             f"rho 4.4(2) eq. (4.2){column}"
-            f"{limit_clause_text(face.psi, face.partial_factor_name)}, "
+            f"{limit_clause_text(face.partial_factor_name)}, "
             f"b_eff {face.effective_widths_row}){effective_widths_text(face, *lengths)}"
         )
     if d.faces_outside_table:
@@ -624,6 +646,8 @@ def design_line(
             name = "rho" if face.reduction_factor == face.plate_reduction_factor else "rho_c"
             text += (
                 f", {_governing(low, rule=False)}, {name} = {significant(face.reduction_factor)}"
+                f", rho f_y/{face.partial_factor_name} = "
+                f"{significant((face.reduced_design_stress_Pa or 0.0) / scale)} {unit}"
             )
         if low.tension_yield_first:
             text += _tension_text(low, scale, unit)

@@ -175,6 +175,39 @@ def test_stainless_steel_keeps_the_design():
     assert plate(edges, material={"E": 200000.0, "nu": 0.3}).design is not None
 
 
+@pytest.mark.parametrize(("E", "noted"), [(200000.0, True), (210000.0, False), (205000.0, False)])
+def test_stainless_steel_s_design_notes_en_1993_1_4(E, noted):
+    """E = 200 GPa, stainless steel's: a note that EN 1993-1-4 5.2.3 gives its own rho.
+
+    EN 1993-1-4 5.2.3 replaces eq. (4.2) and (4.3) for stainless steel by reduction
+    factors that reduce more (its internal element's 0.772/lambda_p - ... against
+    (lambda_p - 0.22)/lambda_p^2); the output applies EN 1993-1-5's, and said nothing.
+    A box's faces get the note too, a tube (no rho) not.
+    """
+    from unibuckle_fenicsx import SectionParameters
+    from unibuckle_fenicsx.cli.problem import input_notes
+    from unibuckle_fenicsx.design import design_output
+    from unibuckle_fenicsx.section_design import section_design
+    from unibuckle_fenicsx.spec import DesignSpec
+
+    edges = {"left": {"normal_stress": -1.0}, "right": {"normal_stress": -1.0}}
+    spec = plate(edges, material={"E": E, "nu": 0.3})
+    notes = [n for n in design_output(spec, spec.design, 2e8).notes if "EN 1993-1-4 5.2.3" in n]
+    assert len(notes) == int(noted), notes
+    assert ("design stainless" in input_notes(spec)) == noted
+    if noted:
+        assert notes[0].startswith("design: material.E = 200 GPa is stainless steel's")
+    for shape, sizes in (("box", {"width": 0.2, "depth": 0.1}), ("tube", {"diameter": 0.2})):
+        section = SectionParameters(
+            shape, thickness=0.002, length=0.6, E=E * 1e6, nu=0.3, mesh_size=0.02,
+            axial_stress=-1.0, bending_stress=0.0, core=False,
+            **{"width": None, "depth": None, "diameter": None, **sizes},
+        )  # fmt: skip
+        out = section_design(section, DesignSpec(yield_stress=3.55e8), 1.0e8)
+        said = [n for n in out.notes if "EN 1993-1-4 5.2.3" in n]
+        assert len(said) == int(noted and shape == "box"), (shape, out.notes)
+
+
 @pytest.mark.parametrize(
     ("nu", "warned"), [(-0.2, True), (0.45, True), (0.3, False), (0.28, False)]
 )
@@ -276,6 +309,50 @@ def test_a_short_plate_gets_the_column_type_reduction_factor():
     assert d.reduction_factor == pytest.approx(rho_c, rel=1e-12)
     assert d.reduced_design_stress_Pa == pytest.approx(rho_c * 355e6 / 1.1, rel=1e-12)
     assert d.reduction_factor < 0.9 * rho
+
+
+def test_a_column_stress_above_the_plate_s_is_bounded_by_it():
+    """sigma_cr,c <= sigma_cr,p (EN 1993-1-5 4.5.3(1), 4.5.4(1)): a plate with a hole.
+
+    150 x 300 x 6 mm SSSS, loaded on left and right (a/b = 0.5), a hole of radius 60 mm
+    at its centre, gmsh cells of 15 mm. 4.5.3(1) defines sigma_cr,c as the plate's
+    buckling stress with the supports along its unloaded edges removed: fewer
+    constraints, so by the Rayleigh quotient never above the plate's own sigma_cr,p.
+    Eq. (4.8), pi^2 E t^2/(12 (1 - nu^2) a^2) = 303.68 MPa, knows no hole; the holed
+    plate buckles at about 203 MPa. So sigma_cr,c = sigma_cr,p, xi = 0 and rho_c = chi_c
+    at sqrt(f_y/sigma_cr,p) (EN 1993-1-1 6.3.1.2, curve a, alpha = 0.21, by hand here):
+    0.4575. Before, xi = -0.33 was clipped to 0 with chi_c of 303.68 MPa: rho_c =
+    0.6089, 33 % on the unsafe side.
+    """
+    hinged = {"support": "simply_supported"}
+    edges = {
+        "left": {**hinged, "normal_stress": -1.0},
+        "right": {**hinged, "normal_stress": -1.0},
+        "bottom": hinged,
+        "top": hinged,
+    }
+    holed = {"corners": [[0, 0], [150, 300]], "thickness": 6.0}
+    holed["holes"] = [{"center": [75.0, 150.0], "radius": 60.0}]
+    d = result(plate(edges, plate=holed, mesh={"size": 15.0})).design
+    equation_4_8 = math.pi**2 * 210000e6 * (6.0 / 150.0) ** 2 / (12 * (1 - 0.3**2))
+    assert equation_4_8 == pytest.approx(303.68e6, rel=1e-5)
+    sigma = d.sigma_cr_Pa
+    assert 180e6 < sigma < 0.75 * equation_4_8  # the hole: well below the column's
+
+    def chi(column):  # EN 1993-1-1 eq. (6.49), curve a
+        lam = math.sqrt(355e6 / column)
+        phi = 0.5 * (1 + 0.21 * (lam - 0.2) + lam**2)
+        return min(1.0, 1 / (phi + math.sqrt(phi**2 - lam**2)))
+
+    assert chi(sigma) == pytest.approx(0.4575, abs=1e-3)  # at about 203 MPa
+    assert chi(equation_4_8) == pytest.approx(0.6089, abs=1e-4)  # the value before
+    assert d.column_critical_stress_Pa == pytest.approx(sigma, rel=1e-12)
+    assert d.xi == 0.0 and d.xi_unclipped == pytest.approx(0.0, abs=1e-12)
+    assert d.column_reduction_factor == pytest.approx(chi(sigma), rel=1e-12)
+    assert d.reduction_factor == pytest.approx(chi(sigma), rel=1e-12)
+    assert d.reduction_factor < d.plate_reduction_factor
+    assert d.reduced_design_stress_Pa == pytest.approx(chi(sigma) * 355e6 / 1.1, rel=1e-12)
+    assert any("sigma_cr,c = sigma_cr (xi = 0)" in n for n in d.notes), d.notes
 
 
 def test_a_long_plate_keeps_the_plate_type_reduction_factor():
@@ -407,7 +484,9 @@ def test_rotationally_restrained_loaded_edges_give_the_restrained_column():
     data["plate"] = {"corners": [[0, 0], [150, 300]], "thickness": 2.0}
     spec = problem_from_dict(data)
     assert spec.design is not None
-    d = design_output(spec, spec.design, 100e6)
+    # A sigma_cr above the column's 111.6 MPa: the plate buckles at no lower a stress than
+    # its column (4.5.3(1); below it the column stress would be bounded by sigma_cr).
+    d = design_output(spec, spec.design, 150e6)
     hinged = math.pi**2 * 210000e6 * (2.0 / 150.0) ** 2 / (12 * (1 - 0.3**2))
     assert d.column_critical_stress_Pa == pytest.approx(factor * hinged, rel=1e-12)
     assert 1.0 < factor < 4.0
@@ -900,6 +979,9 @@ def test_an_unproven_critical_load_adds_the_design_at_its_lower_bound():
     assert any("not proven the lowest" in note for note in r.design.notes)
     assert f"slenderness {slenderness:.4g}, rho = {rho:.4g}" in r.summary()
     assert r.as_dict()["design"]["lower_bound"]["reduction_factor"] == low.reduction_factor
+    # The safe line gives the safe stress limit too (it gave rho alone): rho f_y/gamma_M0.
+    safe = next(s for s in r.summary().splitlines() if "at the verified lower bound" in s)
+    assert f"rho f_y/gamma_M0 = {rho * 355 / 1.1:#.4g} MPa" in safe, safe
 
 
 def test_the_summary_keeps_four_significant_digits_in_pa():

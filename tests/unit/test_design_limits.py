@@ -243,3 +243,74 @@ def test_a_strut_s_small_k_keeps_four_significant_digits():
     line = {"point": {"plate.length": 2000.0}, "critical_load_Pa": 6.9e5, "ratio_to_free": 1.0,
             "buckling_coefficient_k": 9.104e-5, "units": "mm-N-MPa"}  # fmt: skip
     assert "9.104e-05" in sweep_table([line])
+
+
+def _thick_plate(thickness_mm, fy):
+    """A 2000 x 1000 mm SSSS steel plate, uniform compression across left and right."""
+    hinged = {"support": "simply_supported"}
+    return problem_from_dict(
+        {
+            "units": "mm-N-MPa",
+            "plate": {"corners": [[0, 0], [2000, 1000]], "thickness": thickness_mm},
+            "material": {"E": 210000.0, "nu": 0.3},
+            "edges": {
+                "left": {**hinged, "normal_stress": -1.0},
+                "right": {**hinged, "normal_stress": -1.0},
+                "bottom": hinged,
+                "top": hinged,
+            },
+            "mesh": {"nx": 8, "ny": 4},
+            "design": {"yield_stress": fy, "partial_factor": 1.0},
+        }
+    )
+
+
+@pytest.mark.parametrize(
+    ("thickness", "fy", "said"),
+    [
+        # EN 1993-1-1 Table 3.1, EN 10025-2: S355 355 N/mm^2 up to 40 mm, 335 above.
+        (50.0, 355.0, "at t = 50 mm (plate.thickness, 40 < t <= 80 mm) the table gives 335"),
+        (60.0, 235.0, "gives 215 N/mm^2"),  # S235: 235, 215
+        (45.0, 275.0, "gives 255 N/mm^2"),  # S275: 275, 255
+        (70.0, 420.0, "gives 390 N/mm^2"),  # S420 N/NL, M/ML: 420, 390
+        (100.0, 355.0, "the table, which stops at 80 mm"),
+        (40.0, 355.0, None),  # Table 3.1's first column: t <= 40 mm
+        (50.0, 335.0, None),  # the value for 40 < t <= 80 mm itself
+    ],
+)
+def test_a_thick_plate_s_t_40_yield_stress_is_noted(thickness, fy, said):
+    """f_y of a grade at t <= 40 mm on a thicker plate: the output notes Table 3.1's value.
+
+    EN 1993-1-1 Table 3.1 gives each hot rolled grade a lower nominal f_y for 40 mm < t
+    <= 80 mm (S355: 335 N/mm^2) and stops at 80 mm. The output takes ``yield_stress`` as
+    given; a 50 mm plate given 355 N/mm^2 got its slenderness, rho and rho f_y/gamma_M
+    from 355 without a word (at sigma_cr = 400 MPa: rho f_y = 288.8 against 278.1
+    N/mm^2 with 335, 4 % on the unsafe side).
+    """
+    from unibuckle_fenicsx.cli.problem import input_notes
+
+    spec = _thick_plate(thickness, fy)
+    d = design_output(spec, spec.design, 400e6)
+    notes = [n for n in d.notes if "Table 3.1" in n]
+    warned = input_notes(spec).get("design yield stress")
+    if said is None:
+        assert not notes and warned is None, notes
+        return
+    assert len(notes) == 1 and said in notes[0], notes
+    assert notes[0].startswith(f"design.yield_stress: f_y = {fy:g} N/mm^2 is EN 1993-1-1")
+    assert warned == notes[0]
+    # The numbers of the docstring, eq. (4.2) at psi = 1 by hand.
+    lam355, lam335 = math.sqrt(355 / 400), math.sqrt(335 / 400)
+    assert 355 * min(1, (lam355 - 0.22) / lam355**2) == pytest.approx(288.8, abs=0.05)
+    assert 335 * min(1, (lam335 - 0.22) / lam335**2) == pytest.approx(278.1, abs=0.05)
+
+
+def test_a_thick_box_s_t_40_yield_stress_is_noted():
+    """A box of 50 mm walls given S355's 355 N/mm^2: its design notes say 335 (Table 3.1)."""
+    box = _box(thickness=0.05, width=1.0, depth=1.0, length=3.0, mesh_size=0.25)
+    out = section_design(box, DesignSpec(yield_stress=FY), 1.0)
+    notes = [n for n in out.notes if "Table 3.1" in n]
+    assert len(notes) == 1 and "at t = 50 mm (section.thickness" in notes[0], out.notes
+    assert "the table gives 335 N/mm^2" in notes[0]
+    thin = section_design(_box(), DesignSpec(yield_stress=FY), 1.0)
+    assert not [n for n in thin.notes if "Table 3.1" in n]

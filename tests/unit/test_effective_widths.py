@@ -92,6 +92,69 @@ def test_the_stress_limit_is_4_6_1_at_psi_1_and_section_10_below():
         assert "eq. (10.1)" in clause and "rho f_y/gamma_M1" in clause
 
 
+def _outstand(thickness=2.0):
+    """A 600 x 200 mm steel outstand (top free) in uniform compression across left and right."""
+    hinged = {"support": "simply_supported"}
+    return problem_from_dict(
+        {
+            "units": "mm-N-MPa",
+            "plate": {"corners": [[0, 0], [600, 200]], "thickness": thickness},
+            "material": {"E": 210000.0, "nu": 0.3},
+            "edges": {
+                "left": {**hinged, "normal_stress": -1.0},
+                "right": {**hinged, "normal_stress": -1.0},
+                "bottom": hinged,
+                "top": {"support": "free"},
+            },
+            "mesh": {"nx": 12, "ny": 4},
+            "design": {"yield_stress": 355.0, "partial_factor": 1.1},
+        }
+    )
+
+
+def test_an_outstand_with_rho_below_1_at_psi_1_gets_section_10():
+    """An outstand at psi = 1 with rho < 1: section 10 and gamma_M1, not 4.6(1).
+
+    Table 4.2 puts b_eff = rho c at the supported edge: the effective area's centroid
+    lies (1 - rho) c/2 off the gross one, so 4.6(1), eq. (4.14), needs the shift e_N and
+    W_eff even at psi = 1, and sigma_1 <= rho f_y/gamma_M0 is not what it reads. The
+    output's own rule for an effective section it does not compute is the reduced stress
+    method, eq. (10.1) with gamma_M1. By hand, at sigma_cr = 50 MPa (f_y = 355 MPa):
+    slenderness sqrt(355/50) = 2.6646, rho = (2.6646 - 0.188)/2.6646^2 = 0.34881
+    (eq. (4.3)), rho f_y/gamma_M1 = 0.34881 x 355/1.1 = 112.57 MPa, e_N = (1 - rho) 200/2
+    = 65.1 mm. Before: "gamma_M0", 4.6(1) "A_eff = rho A, no shift e_N".
+    """
+    from unibuckle_fenicsx.design import design_output
+
+    spec = _outstand()
+    d = design_output(spec, spec.design, 50.0e6)  # the load in Pa: sigma_cr = 50 MPa
+    lam = math.sqrt(355.0 / 50.0)
+    rho = (lam - 0.188) / lam**2
+    assert rho == pytest.approx(0.34881, abs=5e-6)
+    assert d.element == "outstand" and d.psi == 1.0
+    assert d.reduction_factor == pytest.approx(rho, rel=1e-12)
+    assert d.partial_factor_name == "gamma_M1", d.stress_limit_clause
+    assert d.stress_limit_clause.startswith("section 10, reduced stress method")
+    assert "psi = 1, but the outstand's b_eff = rho c lies at its supported edge" in (
+        d.stress_limit_clause
+    )
+    assert "4.6(1): rho f_y" not in d.clauses
+    assert d.reduced_design_stress_Pa == pytest.approx(rho * 355e6 / 1.1, rel=1e-12)
+    assert d.reduced_design_stress_Pa == pytest.approx(112.57e6, rel=5e-5)
+    assert d.effective_width_m == pytest.approx(rho * 0.2, rel=1e-12)
+
+
+def test_an_outstand_with_rho_1_at_psi_1_keeps_4_6_1():
+    """At rho = 1 (slenderness 0.596 <= 0.748, sigma_cr = 1000 MPa): A_eff = A, no shift."""
+    from unibuckle_fenicsx.design import design_output
+
+    spec = _outstand()
+    d = design_output(spec, spec.design, 1000.0e6)
+    assert math.sqrt(355.0 / 1000.0) <= 0.748 and d.reduction_factor == 1.0
+    assert d.partial_factor_name == "gamma_M0" and d.stress_limit_clause.startswith("4.6(1)")
+    assert d.reduced_design_stress_Pa == pytest.approx(355e6 / 1.1, rel=1e-12)
+
+
 def _plate(left_right, thickness, top=None):
     """A 600 x 200 mm steel plate loaded across left and right (b = 200 mm)."""
     hinged = {"support": "simply_supported"}
@@ -192,7 +255,12 @@ def test_a_box_in_bending_gives_each_face_its_widths_and_limit():
     faces = {f.face: f for f in out.faces}
     top, right = faces["top"], faces["right"]
     rho_top = _rho(3e8, 1.0)  # width 0.2 m, length 0.6 m: no column-type check
-    assert top.partial_factor_name == "gamma_M0" and top.stress_limit_clause.startswith("4.6(1)")
+    # The top face has psi = 1, but the bent section's effective section (top face
+    # reduced, bottom face not) has its own W_eff and shift e_N, which 4.6(1), eq.
+    # (4.14), needs: the reduced stress method, section 10, gamma_M1 (it had gamma_M0).
+    assert top.partial_factor_name == "gamma_M1", top.stress_limit_clause
+    assert top.stress_limit_clause.startswith("section 10")
+    assert "psi = 1, but the section is bent" in top.stress_limit_clause
     assert top.effective_width_m == pytest.approx(rho_top * 0.2, rel=1e-12)
     assert top.effective_width_1_m == pytest.approx(0.1 * rho_top, rel=1e-12)
     psi = -1.0 / 3.0
@@ -209,10 +277,11 @@ def test_a_box_in_bending_gives_each_face_its_widths_and_limit():
     )
     assert faces["bottom"].effective_width_m is None  # in tension
     assert "faces right, left: section 10" in out.clauses[0]
-    assert "faces top: 4.6(1)" in out.clauses[0]
+    assert "faces top: section 10" in out.clauses[0] and "4.6(1): rho" not in out.clauses[0]
     # The governing face: the smallest rho f_y/sigma_1; both carry 3e8, the right face's
-    # rho (psi = -1/3) exceeds the top's, so the top governs, at gamma_M0.
+    # rho (psi = -1/3) exceeds the top's, so the top governs, at gamma_M1.
     assert rho > rho_top and out.governing_face == "top"
     line = design_line(out, 1e6, "MPa", (1e-3, "mm"))
-    assert f"rho f_y/gamma_M0 = {rho_top * 355 / 1.1:#.4g} MPa" in line, line
+    assert f"rho f_y/gamma_M1 = {rho_top * 355 / 1.1:#.4g} MPa" in line, line
+    assert "rho f_y/gamma_M1 section 10 eq. (10.1)" in line and "4.6(1)" not in line, line
     assert f"effective width b_eff = {rho_top * 200:#.4g} mm" in line, line

@@ -183,7 +183,7 @@ def test_the_stress_limit_says_it_leaves_the_shear_unchecked(normal):
     d = design_output(spec, DesignSpec(yield_stress=3.55e8), 7.0e8)
     clause, factor = d.stress_limit_clause, d.partial_factor_name
     assert SHEAR_NOT_CHECKED in clause, clause
-    line = limit_clause_text(d.psi, factor, clause)
+    line = limit_clause_text(factor, clause)
     assert SHEAR_NOT_CHECKED in line, line
     if d.psi == 1.0:
         assert factor == "gamma_M0" and clause.startswith("4.6(1): rho f_y/gamma_M0")
@@ -194,9 +194,9 @@ def test_the_stress_limit_says_it_leaves_the_shear_unchecked(normal):
         assert "direct stress only" not in clause and "tau = 0" in line, line
     # Without shear: no such words, as before.
     for psi in (1.0, 0.0):
-        _, plain = stress_limit(psi)
+        factor, plain = stress_limit(psi)
         assert SHEAR_NOT_CHECKED not in plain
-        assert SHEAR_NOT_CHECKED not in limit_clause_text(psi, "gamma_M1", plain)
+        assert SHEAR_NOT_CHECKED not in limit_clause_text(factor, plain)
     assert "direct stress only" in stress_limit(0.0)[1]
 
 

@@ -20,12 +20,14 @@ def input_notes(spec: ProblemSpec | SectionProblemSpec, design: bool = True) -> 
 
     ``"modulus"``: E below any structural material's (another unit?); ``"plate model"``:
     a plate outside the plate model's usual range; with ``design``, ``"design
-    material"``: ``[design]`` asked of a Poisson's ratio not a steel's. A section's walls
+    material"``: ``[design]`` asked of a Poisson's ratio not a steel's; ``"design yield
+    stress"``: a t <= 40 mm f_y of EN 1993-1-1 Table 3.1 on a thicker plate; ``"design
+    stainless"``: E = 200 GPa, stainless steel's, whose rho EN 1993-1-4 gives. A section's walls
     and its design material are checked by the section's solve (its log's warnings).
     ``unibuckle solve`` and ``unibuckle nonlinear`` print them (:func:`warn_input`),
     ``unibuckle sweep`` once per kind over its points.
     """
-    from unibuckle_fenicsx.en1993 import steel_poisson_note
+    from unibuckle_fenicsx.en1993 import stainless_note, steel_poisson_note, yield_stress_note
     from unibuckle_fenicsx.spec.checks import plate_model_note
     from unibuckle_fenicsx.spec.material import modulus_note
 
@@ -34,6 +36,10 @@ def input_notes(spec: ProblemSpec | SectionProblemSpec, design: bool = True) -> 
         notes["plate model"] = plate_model_note(spec.plate, spec.units)
         if design and spec.design is not None:
             notes["design material"] = steel_poisson_note(spec.material.nu)
+            notes["design stainless"] = stainless_note(spec.material.E)
+            notes["design yield stress"] = yield_stress_note(
+                spec.design.yield_stress, spec.plate.thickness, "plate.thickness"
+            )
     return {kind: note for kind, note in notes.items() if note is not None}
 
 

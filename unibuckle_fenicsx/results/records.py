@@ -566,7 +566,7 @@ def _design_clauses(d: DesignRecord) -> str:
     column = ", rho_c 4.5.4(1)" if d.xi is not None and d.xi < 1.0 else ""
     return (
         f"psi {table}, slenderness 4.4(2), rho 4.4(2) {rho}{column}"
-        + limit_clause_text(d.psi, d.partial_factor_name, d.stress_limit_clause)
+        + limit_clause_text(d.partial_factor_name, d.stress_limit_clause)
         + (f", b_eff {d.effective_widths_row}" if d.effective_widths_row else "")
     )
 
@@ -579,10 +579,17 @@ def _design_lower(d: DesignRecord, scale: float, unit: str) -> str:
     rho = significant(low.reduction_factor)
     if low.relative_slenderness is None:
         return "\n  EN 1993-1-5 at the verified lower bound: no compression on the loaded edges"
+    reduced = low.reduced_design_stress_Pa
+    limit = (
+        f", rho f_y/{low.partial_factor_name} = {significant(reduced / scale)} {unit}"
+        if isinstance(reduced, float)
+        else ""
+    )
     return (
         f"\n  EN 1993-1-5 at the verified lower bound (the safe value, sigma_cr not proven "
         f"the lowest): sigma_cr = {significant(low.sigma_cr_Pa / scale)} {unit}, slenderness "
-        f"{significant(low.relative_slenderness)}, rho = {rho}" + _tension_text(low, scale, unit)
+        f"{significant(low.relative_slenderness)}, rho = {rho}{limit}"
+        + _tension_text(low, scale, unit)
     )
 
 

@@ -103,6 +103,8 @@ def test_the_section_design_line_at_the_lower_bound_keeps_four_digits():
     slenderness = math.sqrt(3.55e8 / 9.44e7)  # 1.939
     rho = (slenderness - 0.055 * 4.0) / slenderness**2  # eq. (4.2), psi = 1: 0.4572
     assert f"slenderness {slenderness:#.4g}" in low and f"rho = {rho:#.4g}" in low, low
+    # and the safe stress limit (the line gave rho alone): rho f_y/gamma_M0, psi = 1.
+    assert f"rho f_y/gamma_M0 = {rho * 3.55e8:#.4g} Pa" in low, low
 
 
 def _plate(edges_top: dict[str, object]) -> str:
@@ -127,30 +129,34 @@ def _plate(edges_top: dict[str, object]) -> str:
 
 
 @pytest.mark.parametrize(
-    ("top", "clauses"),
+    ("top", "clauses", "limit"),
     [
-        # Internal element: psi from Table 4.1, rho by eq. (4.2) of 4.4(2).
+        # Internal element: psi from Table 4.1, rho by eq. (4.2) of 4.4(2). psi = 1:
+        # 4.6(1), eq. (4.14), with A_eff = rho A, reads sigma_1 <= rho f_y/gamma_M0.
         (
             {"support": "simply_supported"},
             "psi Table 4.1, slenderness 4.4(2), rho 4.4(2) eq. (4.2)",
+            "rho f_y/gamma_M0 4.6(1)",
         ),
         # Top edge free: an outstand, psi from Table 4.2, rho by eq. (4.3). Uniform
         # compression (psi = 1) reaches the free edge: the table's upper row, "larger
         # compression at the free edge" (psi = 1 lies in both rows; the package takes the
         # free edge's, as the JSON's ``table``). The line said "psi Table 4.2" without the
-        # row, which decides psi's range and k_sigma: now it names it.
+        # row, which decides psi's range and k_sigma: now it names it. Its rho = 0.32 < 1
+        # puts b_eff = rho c at the supported edge, off the gross centroid: 4.6(1) needs
+        # e_N, and the limit is section 10's with gamma_M1 (it said gamma_M0 4.6(1)).
         (
             {"support": "free"},
             "psi Table 4.2 (larger compression at the free edge), slenderness 4.4(2), rho "
             "4.4(2) eq. (4.3)",
+            "rho f_y/gamma_M1 section 10 eq. (10.1)",
         ),
     ],
 )
-def test_the_plate_design_line_names_the_clause_of_each_value(top, clauses):
+def test_the_plate_design_line_names_the_clause_of_each_value(top, clauses, limit):
     line = _plate(top)
     assert clauses in line, line
-    # psi = 1: 4.6(1), eq. (4.14), with A_eff = rho A, reads sigma_1 <= rho f_y/gamma_M0.
-    assert "rho f_y/gamma_M0 4.6(1)" in line, line
+    assert limit in line, line
 
 
 @pytest.mark.parametrize(
