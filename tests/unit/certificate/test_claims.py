@@ -24,11 +24,12 @@ import scipy.linalg
 
 from support.exhaustive import dense
 from unibuckle_fenicsx.certificate.certify import (
-    _spring_inertia,
     certify,
     pencil_inertia,
     reduced_inertia,
+    spring_inertia,
 )
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.eigen import EigenPair
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.spec import ObstacleSpec
@@ -115,4 +116,11 @@ def test_the_spring_inertia_counts_what_dense_eigenvalues_count():
         for factor in (0.999, 1.5, 3.0, 10.0):
             sigma = factor * free
             expected = _below(a + springs, b, sigma)
-            assert _spring_inertia(problem, pressing, sigma)[0] == expected, factor
+            assert spring_inertia(problem, pressing, sigma)[0] == expected, factor
+
+
+def test_the_spring_inertia_of_a_rigid_obstacle_is_refused_naming_the_foundation():
+    # A rigid obstacle has no springs: the count it asks for is reduced_inertia's.
+    with build_problem(paper_case("c3", 6, 3), MPI.COMM_SELF) as problem:
+        with pytest.raises(InputError, match="foundation_stiffness"):
+            spring_inertia(problem, np.arange(2, dtype=np.int64), 1.0)
