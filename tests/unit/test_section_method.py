@@ -310,7 +310,7 @@ def test_a_sections_eigensolves_count_the_penalty_continuations(method, monkeypa
 
     _, before_certificate = _solver_counters(monkeypatch)
     penalty: list[int] = []
-    reached, continuation = active_set._reached, active_set.penalty_continuation
+    reached, continuation = active_set.reached_kkt, active_set.penalty_continuation
 
     def stalled_once(problem, runs):
         return reached(problem, runs) if penalty else False
@@ -320,7 +320,7 @@ def test_a_sections_eigensolves_count_the_penalty_continuations(method, monkeypa
         penalty.append(solves)
         return run, solves
 
-    monkeypatch.setattr(active_set, "_reached", stalled_once)
+    monkeypatch.setattr(active_set, "reached_kkt", stalled_once)
     monkeypatch.setattr(active_set, "penalty_continuation", recorded_continuation)
     spec = section_from_dict({**FILE, "solver": {"method": method}})
     with solve_section(spec, MPI.COMM_SELF) as solved:
