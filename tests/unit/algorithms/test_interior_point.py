@@ -65,10 +65,10 @@ from unibuckle_fenicsx.algorithms.interior_point.explore import second_free_mode
 from unibuckle_fenicsx.algorithms.interior_point.links import (
     MeshLevel,
     Reader,
-    _saddle,
     critical_state,
     read_contact,
     released,
+    saddle_read,
 )
 from unibuckle_fenicsx.algorithms.interior_point.newton import StallWatch
 from unibuckle_fenicsx.algorithms.interior_point.options import PUSH_MARGIN
@@ -725,7 +725,7 @@ def test_a_state_read_off_the_gaps_short_of_kkt_reads_the_predicted_set_too(thin
 
 
 def test_the_saddle_escaped_is_the_kept_read_first():
-    """:func:`~.links._saddle`: the first read that crosses the obstacle below the point.
+    """:func:`~.links.saddle_read`: the first read that crosses the obstacle below the point.
 
     ``critical_state`` passes the read it kept first (then, with ``escape_either``, the
     other): a kept saddle is escaped even where the other lies lower; a kept read that
@@ -743,11 +743,11 @@ def test_the_saddle_escaped_is_the_kept_read_first():
             ("crossing at", 100.0 * (1.0 - 0.1 * ROUNDING_RTOL), False),
         )
     }
-    assert _saddle(point, [read["crossing"], read["crossing low"]]) is read["crossing"]
-    assert _saddle(point, [read["admissible"], read["crossing"]]) is read["crossing"]
-    assert _saddle(point, [read["crossing above"], read["crossing"]]) is read["crossing"]
-    assert _saddle(point, [read["crossing at"], read["admissible"]]) is None
-    assert _saddle(point, [read["admissible"]]) is None
+    assert saddle_read(point, [read["crossing"], read["crossing low"]]) is read["crossing"]
+    assert saddle_read(point, [read["admissible"], read["crossing"]]) is read["crossing"]
+    assert saddle_read(point, [read["crossing above"], read["crossing"]]) is read["crossing"]
+    assert saddle_read(point, [read["crossing at"], read["admissible"]]) is None
+    assert saddle_read(point, [read["admissible"]]) is None
 
 
 @serial
