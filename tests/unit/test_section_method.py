@@ -549,14 +549,14 @@ def test_an_elastic_core_whose_starts_all_end_high_takes_the_rigid_mode(
     """
     from unibuckle_fenicsx.algorithms import foundation
 
-    original = foundation._from_start
+    original = foundation.run_from_start
 
     def no_rigid_start(solver, name, start, lower, max_iterations):
         if name == "rigid":
             start = start[:0]  # the free start's empty set
         return original(solver, name, start, lower, max_iterations)
 
-    monkeypatch.setattr(foundation, "_from_start", no_rigid_start)
+    monkeypatch.setattr(foundation, "run_from_start", no_rigid_start)
     box = SectionParameters("box", **RECTANGULAR_BOX, foundation_stiffness=8e10)
     with solve_section(box, MPI.COMM_SELF) as solved:
         result, details = solved.result, solved.solution.details

@@ -79,7 +79,7 @@ from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, requir
 from unibuckle_fenicsx.spec.solver import FoundationOptions
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
-__all__ = ["RIGID_MODE", "pressing_nodes", "solve_foundation"]
+__all__ = ["RIGID_MODE", "pressing_nodes", "run_from_start", "solve_foundation"]
 
 logger = logging.getLogger(__name__)
 
@@ -181,7 +181,7 @@ def _run_starts(
     The free plate, every spring active, the rigid obstacle's contact set ``rigid`` and,
     above :data:`CONTINUATION_RATIO` (``ratio``: :func:`stiffness_ratio`), the
     continuation's set, in that order. Returns the runs and, by start, (mode, how it
-    ended, arc steps) (:func:`_from_start`). Collective.
+    ended, arc steps) (:func:`run_from_start`). Collective.
     """
     springs = solver.problem.contact.stiffness
     assert springs is not None
@@ -193,10 +193,10 @@ def _run_starts(
     runs: dict[str, SpringIteration] = {}
     finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
     for name, start in starts.items():
-        runs[name], finals[name] = _from_start(solver, name, start, lower, max_iterations)
+        runs[name], finals[name] = run_from_start(solver, name, start, lower, max_iterations)
     if ratio > CONTINUATION_RATIO:
         start = _continued_start(solver, springs, ratio, lower, max_iterations)
-        runs["continued"], finals["continued"] = _from_start(
+        runs["continued"], finals["continued"] = run_from_start(
             solver, "continued", start, lower, max_iterations
         )
     return runs, finals
@@ -352,7 +352,7 @@ def _iterate(
     )
 
 
-def _from_start(
+def run_from_start(
     solver: PenaltySolver,
     name: str,
     start: npt.NDArray[np.int64],
@@ -361,7 +361,9 @@ def _from_start(
 ) -> tuple[SpringIteration, tuple[Candidate, RunStatus, int]]:
     """The spring-set iteration from ``start``, then the arc descent if it has no fixed point.
 
-    Returns the iteration, and (mode, how it ended, arc steps). Collective.
+    One start of :func:`solve_foundation` (``name``: "free", "bilateral", "rigid" or
+    "continued"), which asks this function for each. Returns the iteration, and (mode,
+    how it ended, arc steps). Collective.
     """
     problem = solver.problem
     springs = problem.contact.stiffness
