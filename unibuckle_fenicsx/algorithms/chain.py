@@ -449,7 +449,10 @@ def solve_interior_point(
     require_obstacle(problem, "solve_interior_point")
     options = options or ChainOptions()
     if problem.tensionless:
-        raise ValueError("solve_interior_point needs a problem with a rigid obstacle")
+        raise InputError(
+            "solve_interior_point needs a problem with a rigid obstacle; this one has a "
+            "tensionless foundation (obstacle.foundation_stiffness): solve_foundation"
+        )
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     free_load = problem.solve_free().load

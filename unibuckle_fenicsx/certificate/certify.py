@@ -498,10 +498,13 @@ def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution)
     Note:
         Collective.
     """
-    problem.verify_free()  # the bracket's lower end
     contact = problem.contact
     if contact.stiffness is None:
-        raise ValueError("certify_foundation: the problem has rigid obstacles, no foundation")
+        raise InputError(
+            "certify_foundation needs a problem with a tensionless foundation "
+            "(obstacle.foundation_stiffness); this one has rigid obstacles: certify"
+        )
+    problem.verify_free()  # the bracket's lower end
     cand = solution.candidate
     tau = problem.tau
     notes: list[str] = []

@@ -74,6 +74,7 @@ from unibuckle_fenicsx.algorithms.interior_point.newton import StallWatch
 from unibuckle_fenicsx.algorithms.interior_point.options import PUSH_MARGIN
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.results.records import jsonable
@@ -920,3 +921,16 @@ def test_a_read_pulled_at_nodes_of_its_set_is_released_to_a_kkt_point(thin_plate
     reference = dense_reduced_load(problem, tuple(expected))
     assert found.load == pytest.approx(reference, rel=_load_rounding(problem, found))
     problem.destroy()
+
+
+def test_a_tensionless_foundation_is_refused_naming_its_route():
+    # The interior point solves rigid obstacles; a foundation's route is solve_foundation
+    # (as solve_foundation refuses a rigid obstacle), refused before any solve.
+    spec = plate_case(
+        "strip", length=2.0, width=1.0, thickness=1e-3, nx=8, ny=4,
+        zone=ObstacleSpec("all", foundation_stiffness=1.0e3),
+    )  # fmt: skip
+    with build_problem(spec, MPI.COMM_SELF) as problem:
+        with pytest.raises(InputError, match="solve_foundation"):
+            solve_interior_point(problem)
+        assert problem.eigensolver.solves == 0

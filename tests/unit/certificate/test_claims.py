@@ -25,6 +25,7 @@ import scipy.linalg
 from support.exhaustive import dense
 from unibuckle_fenicsx.certificate.certify import (
     certify,
+    certify_foundation,
     pencil_inertia,
     reduced_inertia,
     spring_inertia,
@@ -124,3 +125,12 @@ def test_the_spring_inertia_of_a_rigid_obstacle_is_refused_naming_the_foundation
     with build_problem(paper_case("c3", 6, 3), MPI.COMM_SELF) as problem:
         with pytest.raises(InputError, match="foundation_stiffness"):
             spring_inertia(problem, np.arange(2, dtype=np.int64), 1.0)
+
+
+def test_a_rigid_obstacles_state_is_refused_by_the_foundations_certificate():
+    # certify_foundation reads the springs; a rigid obstacle's state is certify's. The
+    # solution is not read: the refusal comes before any solve.
+    with build_problem(paper_case("c3", 6, 3), MPI.COMM_SELF) as problem:
+        with pytest.raises(InputError, match="foundation_stiffness"):
+            certify_foundation(problem, None)  # type: ignore[arg-type]
+        assert problem.eigensolver.solves == 0
