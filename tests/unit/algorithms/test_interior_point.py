@@ -923,13 +923,11 @@ def test_a_read_pulled_at_nodes_of_its_set_is_released_to_a_kkt_point(thin_plate
     problem.destroy()
 
 
-def test_a_tensionless_foundation_is_refused_naming_its_route():
+def test_a_tensionless_foundation_is_refused_naming_its_route(thin_plate):
     # The interior point solves rigid obstacles; a foundation's route is solve_foundation
     # (as solve_foundation refuses a rigid obstacle), refused before any solve.
-    spec = plate_case(
-        "strip", length=2.0, width=1.0, thickness=1e-3, nx=8, ny=4,
-        zone=ObstacleSpec("all", foundation_stiffness=1.0e3),
-    )  # fmt: skip
+    foundation = ObstacleSpec("all", foundation_stiffness=1.0e3)
+    spec = structs.replace(thin_plate(), obstacle=foundation)
     with build_problem(spec, MPI.COMM_SELF) as problem:
         with pytest.raises(InputError, match="solve_foundation"):
             solve_interior_point(problem)
