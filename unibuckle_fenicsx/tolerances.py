@@ -131,8 +131,8 @@ GEOMETRY_RTOL = 1e-9
 #: reference load: the residual of a converged state in double precision, with margin.
 NONLINEAR_ATOL = 1e-11
 #: A load read off the nonlinear path (Southwell, inflection) agrees with a linear load
-#: within this: the knee of the imperfect plate lies within O(delta) of the critical load,
-#: measured 1e-4 at delta/t = 1e-3 and 3e-3 at 1e-2 on the paper's plate; 1 % leaves
-#: a margin for other plates and larger imperfections and still refuses a load that is
-#: another buckling load (the next mode, the free load beside the unilateral one).
+#: within this: the knee of the imperfect plate lies within O(delta) of the critical load
+#: (the paper's plate's distances: docs/methods/nonlinear.md); 1 % leaves a margin for
+#: other plates and larger imperfections and still refuses a load that is another
+#: buckling load (the next mode, the free load beside the unilateral one).
 KNEE_RTOL = 1e-2

@@ -310,7 +310,7 @@ def test_a_sections_eigensolves_count_the_penalty_continuations(method, monkeypa
 
     _, before_certificate = _solver_counters(monkeypatch)
     penalty: list[int] = []
-    reached, continuation = active_set._reached, active_set.penalty_continuation
+    reached, continuation = active_set.reached_kkt, active_set.penalty_continuation
 
     def stalled_once(problem, runs):
         return reached(problem, runs) if penalty else False
@@ -320,7 +320,7 @@ def test_a_sections_eigensolves_count_the_penalty_continuations(method, monkeypa
         penalty.append(solves)
         return run, solves
 
-    monkeypatch.setattr(active_set, "_reached", stalled_once)
+    monkeypatch.setattr(active_set, "reached_kkt", stalled_once)
     monkeypatch.setattr(active_set, "penalty_continuation", recorded_continuation)
     spec = section_from_dict({**FILE, "solver": {"method": method}})
     with solve_section(spec, MPI.COMM_SELF) as solved:
@@ -549,14 +549,14 @@ def test_an_elastic_core_whose_starts_all_end_high_takes_the_rigid_mode(
     """
     from unibuckle_fenicsx.algorithms import foundation
 
-    original = foundation._from_start
+    original = foundation.run_from_start
 
     def no_rigid_start(solver, name, start, lower, max_iterations):
         if name == "rigid":
             start = start[:0]  # the free start's empty set
         return original(solver, name, start, lower, max_iterations)
 
-    monkeypatch.setattr(foundation, "_from_start", no_rigid_start)
+    monkeypatch.setattr(foundation, "run_from_start", no_rigid_start)
     box = SectionParameters("box", **RECTANGULAR_BOX, foundation_stiffness=8e10)
     with solve_section(box, MPI.COMM_SELF) as solved:
         result, details = solved.result, solved.solution.details

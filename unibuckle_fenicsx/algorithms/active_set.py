@@ -88,7 +88,7 @@ from unibuckle_fenicsx.progress import LOGGER as PROGRESS
 from unibuckle_fenicsx.spec.solver import ActiveSetOptions
 from unibuckle_fenicsx.tolerances import PROOF_RTOL, ROUNDING_RTOL, TWIN_RTOL
 
-__all__ = ["SEED_NAMES", "solve_active_set"]
+__all__ = ["SEED_NAMES", "reached_kkt", "solve_active_set"]
 
 logger = logging.getLogger(__name__)
 
@@ -449,7 +449,7 @@ class _Fallbacks:
     route: list[str] = field(default_factory=list)
 
 
-#: How a run ends when it gave up before a KKT point (:func:`_reached`).
+#: How a run ends when it gave up before a KKT point (:func:`reached_kkt`).
 _STALLS = (RunStatus.CYCLE, RunStatus.MAX_ITERATIONS, RunStatus.STALLED)
 
 
@@ -463,10 +463,11 @@ def _pinned(problem: UnilateralProblem, run: Run) -> bool:
     )
 
 
-def _reached(problem: UnilateralProblem, runs: list[Run]) -> bool:
+def reached_kkt(problem: UnilateralProblem, runs: list[Run]) -> bool:
     """Whether ``runs`` reached a KKT point the fallbacks need not look below.
 
-    (:func:`_fall_back`: not the all-contact one alone while another run stalled.)
+    The rule :func:`solve_active_set` asks before each fallback (:func:`_fall_back`): a
+    KKT point other than the all-contact one, or that one while no run stalled.
     """
     kkt = [r for r in runs if r.status is RunStatus.KKT and r.final is not None]
     stalled = any(r.status in _STALLS for r in runs)
@@ -486,7 +487,7 @@ def _fall_back(
     Their runs are appended to ``runs``, what they did to ``warnings``. Collective.
     """
     out = _Fallbacks()
-    if _reached(problem, runs):
+    if reached_kkt(problem, runs):
         return out
     # The iteration stalled on this mesh: penalty continuation, started from the free
     # plate (on thin plates a stalled contact set is a poorer start).
@@ -502,7 +503,7 @@ def _fall_back(
         f"the active-set iteration stalled; penalty continuation ({out.penalty_solves} "
         f"eigen solves) ended {'at a KKT point' if run.status == 'kkt' else run.status}"
     )
-    if _reached(problem, runs):
+    if reached_kkt(problem, runs):
         return out
     # Both stalled: the feasible descent cannot cycle (docs: methods/active_set); not
     # from the all-contact point, a KKT point it cannot leave.
@@ -703,7 +704,6 @@ def solve_active_set(
     closed = bracket(problem, free_load, chosen, bound_budget, "active-set")
     if closed.warning:
         warnings.append(closed.warning)
-    chosen, lower, proven = closed.chosen, closed.lower, closed.proven
     for w in warnings:
         logger.log(logging.INFO if check else logging.WARNING, "active-set: %s", w)
     details = _details(problem, free_load, seeded_on, coarse, fallbacks, runs, kkt, closed)
@@ -711,15 +711,31 @@ def solve_active_set(
     details.wall_time_s = time.perf_counter() - t0
     details.warning = "; ".join(warnings) if warnings else UNSET
     extra = coarse.solves + fallbacks.penalty_solves
+    return _solution(closed, kkt, details, extra, fallbacks.route)
+
+
+def _solution(
+    closed: Bracket,
+    kkt: list[Candidate],
+    details: ActiveSetDetails,
+    other_solves: int,
+    fallback_route: list[str],
+) -> UnilateralSolution:
+    """The answer ``closed.chosen`` with its bracket and record.
+
+    Its eigen solves: the fine mesh's (``details``) and ``other_solves`` (the coarse
+    levels' and the penalty continuation's, which have their own eigen solvers).
+    """
+    chosen = closed.chosen
     return UnilateralSolution(
         candidate=chosen,
         method="active-set",
-        eigensolves=problem.eigensolver.solves - solves0 + extra,
-        lower_bound=lower,
-        global_optimum_proven=proven,
+        eigensolves=details.fine_eigensolves + other_solves,
+        lower_bound=closed.lower,
+        global_optimum_proven=closed.proven,
         upper_bound=chosen.load if chosen.feasible else math.inf,
         kkt_points=kkt,
         lower_bound_by="lattice" if closed.evaluations else "interlacing",
         details=details,
-        route=["active-set", *fallbacks.route],
+        route=["active-set", *fallback_route],
     )

@@ -379,6 +379,42 @@ def _fallback(problem: UnilateralProblem, options: ChainOptions) -> UnilateralSo
     )
 
 
+def _descend_to_kkt(
+    problem: UnilateralProblem, options: ChainOptions, levels: list[MeshLevel]
+) -> Candidate | None:
+    """The fine mesh's lowest admissible mode taken to a KKT point, or None.
+
+    The feasible descent (monotone: it cannot cycle), before anything starts afresh.
+    Collective.
+    """
+    if not levels or levels[-1].best_admissible is None:
+        return None
+    budget = options.descent_budget * options.max_iterations
+    final = descend_from(problem, levels[-1].best_admissible, levels[-1], "fallback", budget)
+    return final if final.kkt else None
+
+
+def _fallback_solution(
+    problem: UnilateralProblem,
+    options: ChainOptions,
+    fallback: Callable[[UnilateralProblem], UnilateralSolution] | None,
+    levels: list[MeshLevel],
+    other_solves: int,
+) -> UnilateralSolution:
+    """``fallback``'s answer (the active set's by default), as the route's, with its levels.
+
+    Collective.
+    """
+    logger.warning("interior point: no KKT point on the fine mesh; the active-set chain runs")
+    solution = _fallback(problem, options) if fallback is None else fallback(problem)
+    if isinstance(solution.details, ActiveSetDetails | SectionLevelsDetails):
+        solution.details.interior_point_levels = [lv.record() for lv in levels]
+    solution.method = "interior-point"
+    solution.route = ["interior-point", *solution.route]
+    solution.eigensolves += other_solves
+    return solution
+
+
 def solve_interior_point(
     problem: UnilateralProblem,
     options: ChainOptions | None = None,
@@ -413,28 +449,19 @@ def solve_interior_point(
     require_obstacle(problem, "solve_interior_point")
     options = options or ChainOptions()
     if problem.tensionless:
-        raise ValueError("solve_interior_point needs a problem with a rigid obstacle")
+        raise InputError(
+            "solve_interior_point needs a problem with a rigid obstacle; this one has a "
+            "tensionless foundation (obstacle.foundation_stiffness): solve_foundation"
+        )
     t0 = time.perf_counter()
     solves0 = problem.eigensolver.solves
     free_load = problem.solve_free().load
     levels, explored, chosen, other_solves = _nested(problem, options, coarser, carrier)
-    if (chosen is None or not chosen.kkt) and levels and levels[-1].best_admissible is not None:
-        # The lowest admissible mode met, taken to a critical state by the feasible
-        # descent (monotone: it cannot cycle), before anything starts afresh.
-        budget = options.descent_budget * options.max_iterations
-        final = descend_from(problem, levels[-1].best_admissible, levels[-1], "fallback", budget)
-        if final.kkt:
-            chosen = final
     if chosen is None or not chosen.kkt:
-        logger.warning("interior point: no KKT point on the fine mesh; the active-set chain runs")
-        solution = _fallback(problem, options) if fallback is None else fallback(problem)
-        if isinstance(solution.details, ActiveSetDetails | SectionLevelsDetails):
-            solution.details.interior_point_levels = [lv.record() for lv in levels]
-        solution.method = "interior-point"
-        solution.route = ["interior-point", *solution.route]
-        solution.eigensolves += other_solves
-        return solution
-
+        descended = _descend_to_kkt(problem, options, levels)
+        if descended is None:
+            return _fallback_solution(problem, options, fallback, levels, other_solves)
+        chosen = descended
     closed = bracket(problem, free_load, chosen, options.bound_budget, "interior-point")
     chosen, lower, proven = closed.chosen, closed.lower, closed.proven
     route = ["interior-point"]

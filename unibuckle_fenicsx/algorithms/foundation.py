@@ -79,7 +79,7 @@ from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, requir
 from unibuckle_fenicsx.spec.solver import FoundationOptions
 from unibuckle_fenicsx.tolerances import ARC_RTOL, PRESSING_RTOL, TWIN_RTOL
 
-__all__ = ["RIGID_MODE", "pressing_nodes", "solve_foundation"]
+__all__ = ["RIGID_MODE", "pressing_nodes", "run_from_start", "solve_foundation"]
 
 logger = logging.getLogger(__name__)
 
@@ -137,51 +137,21 @@ def solve_foundation(
     springs = contact.stiffness
     ratio = stiffness_ratio(problem, springs)
     rigid = _rigid_set(problem) if rigid_set is None else rigid_set()
-    runs: dict[str, SpringIteration] = {}
-    finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
     with PenaltySolver(problem, prefix=Prefix.FOUNDATION, eps_options=eps_options) as solver:
-        starts = {"free": np.empty(0, np.int64), "bilateral": np.arange(contact.size)}
-        for name, start in starts.items():
-            runs[name], finals[name] = _from_start(solver, name, start, lower, max_iterations)
-        runs["rigid"], finals["rigid"] = _from_start(
-            solver, "rigid", rigid[0], lower, max_iterations
-        )
-        if ratio > CONTINUATION_RATIO:
-            start = _continued_start(solver, springs, ratio, lower, max_iterations)
-            runs["continued"], finals["continued"] = _from_start(
-                solver, "continued", start, lower, max_iterations
-            )
+        runs, finals = _run_starts(solver, ratio, rigid[0], lower, max_iterations)
         lowest = min(final.load for final, _, _ in finals.values())
         mode = _rigid_mode(solver, rigid[0], lowest, max_iterations)
         if mode is not None:
             finals[RIGID_MODE] = mode
-        # The smallest quotient; within TWIN_RTOL of it (mirror images, whose loads differ
-        # by rounding that changes with the ranks) the earlier start, the free plate first.
-        lowest = min(final.load for final, _, _ in finals.values())
-        name = next(n for n, (c, _, _) in finals.items() if c.load <= lowest * (1 + TWIN_RTOL))
-        candidate, status, arc_steps = finals[name]
-        history = [s.quotient for s in runs[name].steps] if name in runs else [candidate.load]
-        if arc_steps and name != RIGID_MODE:
-            name += "+arc"
+        start = _lowest_start(finals)
+        candidate, status, arc_steps = finals[start]
         # The rigid set's reduced eigen solve is the problem's own eigen solver's.
         solves = solver.solves + rigid[1] + (0 if mode is None else 1)
+    name = f"{start}+arc" if arc_steps and start != RIGID_MODE else start
     load = candidate.load
     proven = status is RunStatus.CONVERGED and not candidate.active.size
     proven = proven and load <= lower * (1.0 + TWIN_RTOL)
-    details = FoundationDetails(
-        foundation_start=name,
-        foundation_arc_steps=arc_steps,
-        foundation_iterations={n: len(r.steps) for n, r in runs.items()},
-        foundation_loads={n: r.candidate.load for n, r in runs.items()}
-        | ({} if mode is None else {RIGID_MODE: mode[0].load}),
-        foundation_statuses={n: str(r.status) for n, r in runs.items()}
-        | ({} if mode is None else {RIGID_MODE: str(mode[1])}),
-        foundation_pressing_nodes=int(candidate.active.size),
-        foundation_max_penetration=max(float(candidate.values.max()), 0.0),
-        foundation_spring_range_N_per_m=[float(springs.min()), float(springs.max())],
-        foundation_history=history,
-        foundation_status=str(status),
-    )
+    details = _details(runs, finals, mode, start, name, springs)
     logger.info(
         "foundation: lambda = %.10g (start %s, %s, %d pressing nodes, %d eigen solves)",
         load, name, status, candidate.active.size, solves,
@@ -196,6 +166,81 @@ def solve_foundation(
         status=status,
         details=details,
         route=["foundation", "arc-descent"] if arc_steps else ["foundation"],
+    )
+
+
+def _run_starts(
+    solver: PenaltySolver,
+    ratio: float,
+    rigid: npt.NDArray[np.int64],
+    lower: float,
+    max_iterations: int,
+) -> tuple[dict[str, SpringIteration], dict[str, tuple[Candidate, RunStatus, int]]]:
+    """The iteration from each start (module docstring), each followed by its arc descent.
+
+    The free plate, every spring active, the rigid obstacle's contact set ``rigid`` and,
+    above :data:`CONTINUATION_RATIO` (``ratio``: :func:`stiffness_ratio`), the
+    continuation's set, in that order. Returns the runs and, by start, (mode, how it
+    ended, arc steps) (:func:`run_from_start`). Collective.
+    """
+    springs = solver.problem.contact.stiffness
+    assert springs is not None
+    starts = {
+        "free": np.empty(0, np.int64),
+        "bilateral": np.arange(solver.problem.contact.size),
+        "rigid": rigid,
+    }
+    runs: dict[str, SpringIteration] = {}
+    finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
+    for name, start in starts.items():
+        runs[name], finals[name] = run_from_start(solver, name, start, lower, max_iterations)
+    if ratio > CONTINUATION_RATIO:
+        start = _continued_start(solver, springs, ratio, lower, max_iterations)
+        runs["continued"], finals["continued"] = run_from_start(
+            solver, "continued", start, lower, max_iterations
+        )
+    return runs, finals
+
+
+def _lowest_start(finals: dict[str, tuple[Candidate, RunStatus, int]]) -> str:
+    """The start with the smallest quotient.
+
+    Within :data:`~unibuckle_fenicsx.tolerances.TWIN_RTOL` of it (mirror images, whose
+    loads differ by rounding that changes with the ranks) the earlier start, the free
+    plate first.
+    """
+    lowest = min(final.load for final, _, _ in finals.values())
+    return next(n for n, (c, _, _) in finals.items() if c.load <= lowest * (1 + TWIN_RTOL))
+
+
+def _details(
+    runs: dict[str, SpringIteration],
+    finals: dict[str, tuple[Candidate, RunStatus, int]],
+    mode: tuple[Candidate, RunStatus, int] | None,
+    start: str,
+    name: str,
+    springs: npt.NDArray[np.float64],
+) -> FoundationDetails:
+    """The run's record: every start's iteration, the rigid mode's, and the answer's.
+
+    ``start`` is the answer's start in ``finals``, ``name`` its label (``+arc`` where an
+    arc descent followed).
+    """
+    candidate, status, arc_steps = finals[start]
+    history = [s.quotient for s in runs[start].steps] if start in runs else [candidate.load]
+    return FoundationDetails(
+        foundation_start=name,
+        foundation_arc_steps=arc_steps,
+        foundation_iterations={n: len(r.steps) for n, r in runs.items()},
+        foundation_loads={n: r.candidate.load for n, r in runs.items()}
+        | ({} if mode is None else {RIGID_MODE: mode[0].load}),
+        foundation_statuses={n: str(r.status) for n, r in runs.items()}
+        | ({} if mode is None else {RIGID_MODE: str(mode[1])}),
+        foundation_pressing_nodes=int(candidate.active.size),
+        foundation_max_penetration=max(float(candidate.values.max()), 0.0),
+        foundation_spring_range_N_per_m=[float(springs.min()), float(springs.max())],
+        foundation_history=history,
+        foundation_status=str(status),
     )
 
 
@@ -307,7 +352,7 @@ def _iterate(
     )
 
 
-def _from_start(
+def run_from_start(
     solver: PenaltySolver,
     name: str,
     start: npt.NDArray[np.int64],
@@ -316,7 +361,9 @@ def _from_start(
 ) -> tuple[SpringIteration, tuple[Candidate, RunStatus, int]]:
     """The spring-set iteration from ``start``, then the arc descent if it has no fixed point.
 
-    Returns the iteration, and (mode, how it ended, arc steps). Collective.
+    One start of :func:`solve_foundation` (``name``: "free", "bilateral", "rigid" or
+    "continued"), which asks this function for each. Returns the iteration, and (mode,
+    how it ended, arc steps). Collective.
     """
     problem = solver.problem
     springs = problem.contact.stiffness

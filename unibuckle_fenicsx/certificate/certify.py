@@ -47,7 +47,7 @@ from unibuckle_fenicsx.algorithms.penalty import held_nodes
 from unibuckle_fenicsx.certificate.copositivity import BoundOptions, copositivity_bound
 from unibuckle_fenicsx.certificate.records import CopositivityRecord, Refuting
 from unibuckle_fenicsx.certificate.shifted import ShiftedMatrix, rayleigh
-from unibuckle_fenicsx.errors import EigenSolveError
+from unibuckle_fenicsx.errors import EigenSolveError, InputError
 from unibuckle_fenicsx.la.factor import SymmetricFactorization
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem
@@ -67,6 +67,7 @@ __all__ = [
     "certify_foundation",
     "pencil_inertia",
     "reduced_inertia",
+    "spring_inertia",
 ]
 
 logger = logging.getLogger(__name__)
@@ -497,10 +498,13 @@ def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution)
     Note:
         Collective.
     """
-    problem.verify_free()  # the bracket's lower end
     contact = problem.contact
     if contact.stiffness is None:
-        raise ValueError("certify_foundation: the problem has rigid obstacles, no foundation")
+        raise InputError(
+            "certify_foundation needs a problem with a tensionless foundation "
+            "(obstacle.foundation_stiffness); this one has rigid obstacles: certify"
+        )
+    problem.verify_free()  # the bracket's lower end
     cand = solution.candidate
     tau = problem.tau
     notes: list[str] = []
@@ -511,15 +515,7 @@ def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution)
     # of the returned set whose spring force is beyond PRESSING_RTOL of the largest.
     held = held_nodes(z, contact.stiffness, cand.active, PRESSING_RTOL)
     pressing = np.union1d(pressing_nodes(z, 1.0), held).astype(np.int64)
-    status = solution.status
-    if status is None:
-        raise ValueError(
-            "certify_foundation: the solution carries no spring-set status (solution.status); "
-            "it needs one from solve_foundation"
-        )
-    kkt = residual <= math.sqrt(tau) and status is RunStatus.CONVERGED
-    if status is not RunStatus.CONVERGED:
-        notes.append(f"the spring-set iteration did not converge ({status})")
+    kkt = _spring_kkt(solution, residual, tau, notes)
     # The springs only stiffen: no eigenvalue of the pencil with them lies below the
     # free load (the lower end), so a load below it is no eigenpair's, never the bound.
     agree = SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol
@@ -528,14 +524,7 @@ def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution)
     upper = cand.load
     gap = (upper - lower) / upper
     proven = bool(kkt and solution.global_optimum_proven and _within(gap, PROOF_GAP))
-    sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
-    neg, _, _ = _spring_inertia(problem, pressing, sigma)
-    smallest = neg == 0
-    if not smallest:
-        notes.append(
-            f"the pencil with the springs of the pressing nodes has {neg} eigenvalue(s) "
-            "below the returned load"
-        )
+    smallest = _spring_smallest(problem, cand, pressing, notes)
     if not proven:
         notes.append(
             f"tensionless foundation: {pressing.size} of {contact.size} nodes press it; a "
@@ -556,6 +545,45 @@ def certify_foundation(problem: UnilateralProblem, solution: UnilateralSolution)
         proven_by="interlacing",
         notes=tuple(notes),
     )
+
+
+def _spring_kkt(
+    solution: UnilateralSolution, residual: float, tau: float, notes: list[str]
+) -> bool:
+    """Whether the spring quotient is stationary: ``residual`` within sqrt(tau), converged.
+
+    Raises:
+        ValueError: ``solution`` carries no spring-set status (not from solve_foundation).
+    """
+    status = solution.status
+    if status is None:
+        raise ValueError(
+            "certify_foundation: the solution carries no spring-set status (solution.status); "
+            "it needs one from solve_foundation"
+        )
+    if status is not RunStatus.CONVERGED:
+        notes.append(f"the spring-set iteration did not converge ({status})")
+    return residual <= math.sqrt(tau) and status is RunStatus.CONVERGED
+
+
+def _spring_smallest(
+    problem: UnilateralProblem,
+    cand: Candidate,
+    pressing: npt.NDArray[np.int64],
+    notes: list[str],
+) -> bool:
+    """Whether the load is the smallest eigenvalue with the springs of ``pressing`` (inertia).
+
+    Collective.
+    """
+    sigma = cand.load * (1.0 - SMALLEST_RTOL_FACTOR * problem.spec.solver.eps_tol)
+    neg, _, _ = spring_inertia(problem, pressing, sigma)
+    if neg:
+        notes.append(
+            f"the pencil with the springs of the pressing nodes has {neg} eigenvalue(s) "
+            "below the returned load"
+        )
+    return neg == 0
 
 
 def _spring_residual(
@@ -580,13 +608,28 @@ def _spring_residual(
     return z, float(r.norm()) / au_2  # type: ignore[arg-type]
 
 
-def _spring_inertia(
+def spring_inertia(
     problem: UnilateralProblem, pressing: npt.NDArray[np.int64], sigma: float
 ) -> tuple[int, int, int]:
-    r"""Inertia of :math:`A + \sum_{k \in S} \rho_k e_k e_k^T - \sigma B` (collective)."""
+    r"""Inertia of :math:`A + \sum_{k \in S} \rho_k e_k e_k^T - \sigma B`.
+
+    The foundation's pencil with the springs :math:`\rho_k` of the nodes S = ``pressing``
+    (contact indices): its negative count is the number of its eigenvalues in
+    :math:`(0, \sigma)` (Sylvester's law of inertia), as :func:`reduced_inertia`'s for a
+    rigid obstacle.
+
+    Raises:
+        InputError: The problem has rigid obstacles, no foundation.
+
+    Note:
+        Collective.
+    """
     contact = problem.contact
     if contact.stiffness is None:
-        raise RuntimeError("_spring_inertia: the problem has no foundation (an internal invariant)")
+        raise InputError(
+            "spring_inertia needs a problem with a tensionless foundation "
+            "(obstacle.foundation_stiffness); this one has rigid obstacles"
+        )
     diag = problem.model.A.createVecLeft()
     try:
         rows, nodes = contact.node_rows(pressing)

@@ -353,9 +353,6 @@ def copositivity_bound(
             problem.model.A, problem.model.B, shared=problem.eigensolver.factorization
         )
     start = (matrix.factorisations, matrix.solves, matrix.factor_s, matrix.solve_s)
-    result: LowerBound | None = None
-    m: int | None = None
-    several = False  # two or more pencil eigenvalues below some shift tried
     lowrank: LowRankRecord | None = None
     split: SplitRecord | None = None
     refuting: Refuting | None = None
@@ -364,29 +361,9 @@ def copositivity_bound(
             notes.append("the KKT point has no contact force (w+ = 0)")
         predicted = _predict_delta(problem, matrix, candidate, opts.safety)
         deltas = [d for d in opts.deltas if d >= opts.slack * predicted] or [opts.deltas[-1]]
-        untried, bisect = list(deltas), False
-        while untried:
-            # Upward from the smallest while a shift costs one factorisation; once a
-            # dense SDP has failed (seconds each), by bisection of what is left.
-            index = len(untried) // 2 if bisect else 0
-            delta = untried[index]
-            lam = candidate.load * (1.0 - delta)
-            neg, zero, pos = matrix.factor(lam)
-            attempt = AttemptRecord(delta=delta, inertia=[neg, zero, pos])
-            attempts.append(attempt)
-            m = neg if m is None else m
-            several |= neg >= 2
-            found, stop = _at_shift(problem, matrix, nappes, lam, attempt, opts, notes)
-            if found is not None:
-                result = found  # smaller than any earlier success: it is tried below them
-                if not bisect:
-                    break
-                untried = untried[:index]
-            elif stop:
-                break
-            else:
-                untried = untried[index + 1 :]
-                bisect |= not isinstance(attempt.sdp, UnsetType)
+        result = _search_shifts(problem, matrix, nappes, candidate, deltas, opts, attempts, notes)
+        # Two or more pencil eigenvalues below some shift tried: the rank-2 route cannot.
+        several = any(a.inertia[0] >= 2 for a in attempts)
         if result is None and several:
             routes = _split_routes(problem, matrix, candidate, others or [], opts, notes)
             result, split, lowrank, refuting = routes
@@ -406,11 +383,50 @@ def copositivity_bound(
         attempts=tuple(attempts),
         notes=tuple(notes),
         timings=timings,
-        negative_eigenvalues=m,
+        negative_eigenvalues=attempts[0].inertia[0] if attempts else None,
         lowrank=lowrank,
         refuting=refuting,
         split=split,
     )
+
+
+def _search_shifts(
+    problem: UnilateralProblem,
+    matrix: ShiftedMatrix,
+    nappes: _Nappes,
+    candidate: Candidate,
+    deltas: list[float],
+    opts: BoundOptions,
+    attempts: list[AttemptRecord],
+    notes: list[str],
+) -> LowerBound | None:
+    r"""The smallest shift :math:`\lambda(1 - \delta)` of ``deltas`` :func:`_at_shift` verifies.
+
+    Upward from the smallest while a shift costs one factorisation; once a dense SDP has
+    failed (seconds each), by bisection of what is left. Each shift tried is appended to
+    ``attempts``. Returns the bound, or None. Collective.
+    """
+    result: LowerBound | None = None
+    untried, bisect = list(deltas), False
+    while untried:
+        index = len(untried) // 2 if bisect else 0
+        delta = untried[index]
+        lam = candidate.load * (1.0 - delta)
+        neg, zero, pos = matrix.factor(lam)
+        attempt = AttemptRecord(delta=delta, inertia=[neg, zero, pos])
+        attempts.append(attempt)
+        found, stop = _at_shift(problem, matrix, nappes, lam, attempt, opts, notes)
+        if found is not None:
+            result = found  # smaller than any earlier success: it is tried below them
+            if not bisect:
+                break
+            untried = untried[:index]
+        elif stop:
+            break
+        else:
+            untried = untried[index + 1 :]
+            bisect |= not isinstance(attempt.sdp, UnsetType)
+    return result
 
 
 def _split_routes(

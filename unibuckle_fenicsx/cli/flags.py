@@ -254,6 +254,14 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         formatter_class=Formatter,
     )
     solve_flags(s)
+    _sweep_parser(sub, common)
+    nonlinear_parser(sub, [problem, common])
+    _schema_parser(sub)
+    return parser, dict(sub.choices)
+
+
+def _sweep_parser(sub: Any, common: argparse.ArgumentParser) -> None:
+    """The ``sweep`` subcommand: a problem file over a grid of values."""
     w = sub.add_parser(
         "sweep",
         parents=[common],
@@ -300,7 +308,10 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
         metavar="R",
         help="under mpiexec: ranks of each point's mesh (1: one point per rank)",
     )
-    nonlinear_parser(sub, [problem, common])
+
+
+def _schema_parser(sub: Any) -> None:
+    """The ``schema`` subcommand: the JSON Schema of a problem file."""
     k = sub.add_parser(
         "schema",
         help="print the JSON Schema of a problem file (or its dotted keys)",
@@ -314,7 +325,6 @@ def build_parser() -> tuple[argparse.ArgumentParser, dict[str, argparse.Argument
     )
     k.add_argument("--keys", action="store_true", help="print the dotted keys instead")
     k.add_argument("--output", metavar="PATH", help="write to PATH instead of stdout")
-    return parser, dict(sub.choices)
 
 
 def solve_flags(s: argparse.ArgumentParser) -> None:

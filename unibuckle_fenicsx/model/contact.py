@@ -295,6 +295,66 @@ def foundation_springs(
     return model.global_dofs(local), values
 
 
+def _merge_zones(
+    model: NodalDofs,
+    obstacles: tuple[ObstacleSpec, ...],
+    zones: list[tuple[npt.NDArray[np.int32], npt.NDArray[np.int32]]],
+    tensionless: bool,
+) -> tuple[
+    npt.NDArray[np.int32],
+    npt.NDArray[np.int32],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    npt.NDArray[np.float64],
+    bool,
+]:
+    """The zones' nodes united (this process's): W and Vw dofs, signs, gaps, springs.
+
+    A node in several zones takes the smallest gap and the sum of its zones' springs
+    (each zone's on its own discrete zone); the last item says whether zones on both
+    sides share one of this process's nodes. ``zones``: each obstacle's (W dofs, Vw dofs)
+    (:func:`_zone_dofs`).
+    """
+    # Every zone's nodes in the obstacles' order; a node in several zones appears once
+    # per zone, and its entries are merged below in that order.
+    all_W = np.concatenate([dofs_W for dofs_W, _ in zones])
+    all_Vw = np.concatenate([dofs_Vw for _, dofs_Vw in zones])
+    counts = [len(dofs_W) for dofs_W, _ in zones]
+
+    def per_node(value: Callable[[ObstacleSpec], float]) -> npt.NDArray[np.float64]:
+        values = [value(o) for o in obstacles]
+        return np.repeat(np.asarray(values, dtype=float), counts)
+
+    order_W, first, node = np.unique(all_W, return_index=True, return_inverse=True)
+    dofs_W = order_W.astype(np.int32)
+    dofs_Vw = all_Vw[first].astype(np.int32)  # a W dof has one Vw dof
+    all_signs = per_node(lambda o: o.sign)
+    signs = np.full(len(order_W), np.inf)
+    np.minimum.at(signs, node, all_signs)
+    highest = np.full(len(order_W), -np.inf)
+    np.maximum.at(highest, node, all_signs)
+    conflict = bool(np.any(signs != highest))
+    gaps = np.full(len(order_W), np.inf)
+    np.minimum.at(gaps, node, per_node(lambda o: o.gap))
+    springs = np.zeros(len(order_W))
+    if tensionless:
+        if any(o.foundation_stiffness is None for o in obstacles):
+            raise RuntimeError(
+                "_merge_zones: expected o.foundation_stiffness is not None (an internal invariant)"
+            )
+        # Each zone's springs on its own discrete zone (the same weights as a bilateral
+        # foundation's), summed zone by zone from 0.0 in the obstacles' order
+        # (np.add.at is unbuffered).
+        weights = np.concatenate(
+            [
+                float(o.foundation_stiffness or 0.0) * tributary_areas(model, o).array[dofs_Vw_k]
+                for o, (_, dofs_Vw_k) in zip(obstacles, zones, strict=True)
+            ]
+        )
+        np.add.at(springs, node, weights)
+    return dofs_W, dofs_Vw, signs, gaps, springs, conflict
+
+
 class ContactSetManager:
     r"""Constrained w-DOFs of the obstacle zones, and candidate sets as removed DOFs.
 
@@ -347,45 +407,9 @@ class ContactSetManager:
         size = model.extent
         tensionless = kinds == {"tensionless"}
         zones = [_zone_dofs(model, o, size) for o in self.obstacles]
-        # Every zone's nodes in the obstacles' order; a node in several zones appears once
-        # per zone, and its entries are merged below in that order.
-        all_W = np.concatenate([dofs_W for dofs_W, _ in zones])
-        all_Vw = np.concatenate([dofs_Vw for _, dofs_Vw in zones])
-
-        counts = [len(dofs_W) for dofs_W, _ in zones]
-
-        def per_node(value: Callable[[ObstacleSpec], float]) -> npt.NDArray[np.float64]:
-            values = [value(o) for o in self.obstacles]
-            return np.repeat(np.asarray(values, dtype=float), counts)
-
-        order_W, first, node = np.unique(all_W, return_index=True, return_inverse=True)
-        dofs_W = order_W.astype(np.int32)
-        dofs_Vw = all_Vw[first].astype(np.int32)  # a W dof has one Vw dof
-        all_signs = per_node(lambda o: o.sign)
-        signs = np.full(len(order_W), np.inf)
-        np.minimum.at(signs, node, all_signs)
-        highest = np.full(len(order_W), -np.inf)
-        np.maximum.at(highest, node, all_signs)
-        conflict = bool(np.any(signs != highest))
-        gaps = np.full(len(order_W), np.inf)
-        np.minimum.at(gaps, node, per_node(lambda o: o.gap))
-        springs = np.zeros(len(order_W))
-        if tensionless:
-            if any(o.foundation_stiffness is None for o in self.obstacles):
-                raise RuntimeError(
-                    "__init__: expected o.foundation_stiffness is not None (an internal invariant)"
-                )
-            # Each zone's springs on its own discrete zone (the same weights as a bilateral
-            # foundation's), summed zone by zone from 0.0 in the obstacles' order
-            # (np.add.at is unbuffered).
-            weights = np.concatenate(
-                [
-                    float(o.foundation_stiffness or 0.0)
-                    * tributary_areas(model, o).array[dofs_Vw_k]
-                    for o, (_, dofs_Vw_k) in zip(self.obstacles, zones, strict=True)
-                ]
-            )
-            np.add.at(springs, node, weights)
+        dofs_W, dofs_Vw, signs, gaps, springs, conflict = _merge_zones(
+            model, self.obstacles, zones, tensionless
+        )
         if comm.allreduce(conflict, op=MPI.LOR):
             raise BilateralZoneError(
                 "obstacle zones on both sides of the plate share a mesh node: a bilateral "

@@ -8,7 +8,7 @@ On a gmsh plate the zone's edges are mesh lines
 (:func:`~unibuckle_fenicsx.model.gmsh_mesh.gmsh_plate_mesh`) and the two agree, up to the
 polygon a circle's cells inscribe; on the structured rectangle they agree when the grid
 has lines on the zone's edges; a gmsh file's plate is known by its cells, on which the
-zone's area is measured (:func:`meshed_zone_area`).
+zone's area is computed (:func:`meshed_zone_area`).
 """
 
 from __future__ import annotations

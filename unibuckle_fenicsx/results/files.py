@@ -14,10 +14,17 @@ if TYPE_CHECKING:  # pragma: no cover
 
     from unibuckle_fenicsx.algorithms import UnilateralSolution
     from unibuckle_fenicsx.model.problem import Problem
+    from unibuckle_fenicsx.model.shell.section import Section
     from unibuckle_fenicsx.results.records import BucklingResult
-    from unibuckle_fenicsx.section_analysis import SectionAnalysis
 
-__all__ = ["Solved", "file_stem", "write_fields", "write_json", "write_section_fields"]
+__all__ = [
+    "Solved",
+    "SolvedSection",
+    "file_stem",
+    "write_fields",
+    "write_json",
+    "write_section_fields",
+]
 
 
 class Solved(Protocol):
@@ -41,6 +48,38 @@ class Solved(Protocol):
     @property
     def free_mode(self) -> dolfinx.fem.Function:
         """The free plate's mode."""
+        ...
+
+
+class SolvedSection(Protocol):
+    """What :func:`write_section_fields` reads of a section's solve.
+
+    (:class:`~unibuckle_fenicsx.section_analysis.SectionAnalysis`.)
+    """
+
+    @property
+    def result(self) -> BucklingResult:
+        """The result's records (their ``case`` names the files)."""
+        ...
+
+    @property
+    def section(self) -> Section:
+        """The finest section (mesh, shell model, the core's constraints, problem)."""
+        ...
+
+    @property
+    def solution(self) -> UnilateralSolution | None:
+        """The unilateral solution (None without a core)."""
+        ...
+
+    @property
+    def mode(self) -> dolfinx.fem.Function:
+        """The critical mode in global components."""
+        ...
+
+    @property
+    def free_mode(self) -> dolfinx.fem.Function:
+        """The hollow section's mode in global components."""
         ...
 
 
@@ -123,7 +162,7 @@ def _write(comm: Any, directory: str | Path, case: str, groups: dict[str, list[A
     return paths
 
 
-def write_section_fields(analysis: SectionAnalysis, directory: str | Path) -> list[Path]:
+def write_section_fields(analysis: SolvedSection, directory: str | Path) -> list[Path]:
     """Write a section's mode, its hollow mode and the core's contact for viewing.
 
     The section's counterpart of :func:`write_fields`, on its shell's nodes (3-D

@@ -41,6 +41,7 @@ __all__ = [
     "ResultDetails",
     "coefficient_text",
     "jsonable",
+    "verified_text",
 ]
 
 #: An edge stress as a problem file writes it: a number, or [start, end] (linear).
@@ -307,7 +308,7 @@ class BucklingResult(Struct, kw_only=True):
             cert = self.certificate
             z = (
                 f"  i={self.constrained_nodes} |Z|={self.contact_nodes}"
-                f"  KKT={'yes' if cert is not None and cert.kkt else 'NO'}  {_verified(cert)}"
+                f"  KKT={'yes' if cert is not None and cert.kkt else 'NO'}  {verified_text(cert)}"
             )
         loaded = [
             f"{name} {_load_text(load)}"
@@ -604,8 +605,8 @@ def _gap_text(gap: float) -> str:
     return f"{digit}e{exponent:+03d}"
 
 
-def _verified(cert: CertificateRecord | None) -> str:
-    """What the certificate verified, for the summary line."""
+def verified_text(cert: CertificateRecord | None) -> str:
+    """What the certificate verified, as the summary's first line says it (None: KKT only)."""
     if cert is None:
         return "proven=no (KKT only)"
     m = cert.negative_eigenvalues

@@ -22,9 +22,9 @@ from unibuckle_fenicsx.spec.plate import MeshSpec, PlateSpec
 from unibuckle_fenicsx.spec.solver import SolverSpec
 
 #: Largest non-dimensional stiffness :math:`K = k_f b^4/(\pi^4 D)` of a tensionless
-#: foundation: the largest measured (docs/verification/stiff_foundations.md). Below it the
+#: foundation: the largest verified (docs/verification/stiff_foundations.md). Below it the
 #: spring-set iteration holds the nodes its stiff springs press by their force; above it
-#: no answer was measured. The rigid obstacle's load bounds every foundation's from above.
+#: no answer is verified. The rigid obstacle's load bounds every foundation's from above.
 MAX_FOUNDATION_K = 1e12
 
 
@@ -128,7 +128,7 @@ class ProblemSpec(Table, frozen=True):
                     f"K = k_f b^4/(pi^4 D) = {K:.3g} times the plate's bending stiffness "
                     f"(D = E t^3/12, b its smaller side): a tensionless foundation needs "
                     f"K <= {MAX_FOUNDATION_K:g}, foundation_stiffness <= {high:.3g} {name} "
-                    "here (the largest measured). The rigid obstacle's load is an upper "
+                    "here (the largest verified). The rigid obstacle's load is an upper "
                     "bound of the foundation's at any stiffness, and the gap to it falls as "
                     "1/K (the documentation's 'Stiff tensionless foundations'): leave "
                     "foundation_stiffness out for that bound (a rigid obstacle)"

@@ -46,7 +46,7 @@ Penalty = Annotated[float, Meta(gt=0)]
 
 #: The highest Lagrange degree of the prestress solve's in-plane displacement: degree 2
 #: resolves compression with in-plane bending exactly, and the cells' count of the
-#: membrane DOFs grows as the degree squared (the cost measured:
+#: membrane DOFs grows as the degree squared (its cost:
 #: docs/history/2026-11-30f-platehunt.md).
 MAX_PRESTRESS_DEGREE = 4
 

@@ -399,7 +399,7 @@ def test_unilateral_load_converges(case):
 def test_a_check_that_stalls_runs_no_fallback_and_warns_of_nothing(monkeypatch, caplog):
     """``check=True``: where the seeds stall, the answer checked stands.
 
-    The seeds are made to count as stalled (``_reached`` false), so the plain run takes
+    The seeds are made to count as stalled (``reached_kkt`` false), so the plain run takes
     its fallbacks (the penalty continuation, with a warning); a check takes none, logs
     nothing as a warning, and its route is the active set's alone. The contract of
     ``solve_active_set``'s ``check`` (a section's seeds checking the interior point: a
@@ -417,7 +417,7 @@ def test_a_check_that_stalls_runs_no_fallback_and_warns_of_nothing(monkeypatch, 
         continuations.append(solves)
         return run, solves
 
-    monkeypatch.setattr(active_set, "_reached", lambda problem, runs: False)
+    monkeypatch.setattr(active_set, "reached_kkt", lambda problem, runs: False)
     monkeypatch.setattr(active_set, "penalty_continuation", recorded)
     with build_problem(paper_case("c1", 8, 4)) as problem:
         plain = solve_active_set(problem, multilevel=False, bound_budget=0)

@@ -65,15 +65,16 @@ from unibuckle_fenicsx.algorithms.interior_point.explore import second_free_mode
 from unibuckle_fenicsx.algorithms.interior_point.links import (
     MeshLevel,
     Reader,
-    _saddle,
     critical_state,
     read_contact,
     released,
+    saddle_read,
 )
 from unibuckle_fenicsx.algorithms.interior_point.newton import StallWatch
 from unibuckle_fenicsx.algorithms.interior_point.options import PUSH_MARGIN
 from unibuckle_fenicsx.algorithms.multilevel import Prolongation
 from unibuckle_fenicsx.analysis import solve
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.results.records import jsonable
@@ -725,7 +726,7 @@ def test_a_state_read_off_the_gaps_short_of_kkt_reads_the_predicted_set_too(thin
 
 
 def test_the_saddle_escaped_is_the_kept_read_first():
-    """:func:`~.links._saddle`: the first read that crosses the obstacle below the point.
+    """:func:`~.links.saddle_read`: the first read that crosses the obstacle below the point.
 
     ``critical_state`` passes the read it kept first (then, with ``escape_either``, the
     other): a kept saddle is escaped even where the other lies lower; a kept read that
@@ -743,11 +744,11 @@ def test_the_saddle_escaped_is_the_kept_read_first():
             ("crossing at", 100.0 * (1.0 - 0.1 * ROUNDING_RTOL), False),
         )
     }
-    assert _saddle(point, [read["crossing"], read["crossing low"]]) is read["crossing"]
-    assert _saddle(point, [read["admissible"], read["crossing"]]) is read["crossing"]
-    assert _saddle(point, [read["crossing above"], read["crossing"]]) is read["crossing"]
-    assert _saddle(point, [read["crossing at"], read["admissible"]]) is None
-    assert _saddle(point, [read["admissible"]]) is None
+    assert saddle_read(point, [read["crossing"], read["crossing low"]]) is read["crossing"]
+    assert saddle_read(point, [read["admissible"], read["crossing"]]) is read["crossing"]
+    assert saddle_read(point, [read["crossing above"], read["crossing"]]) is read["crossing"]
+    assert saddle_read(point, [read["crossing at"], read["admissible"]]) is None
+    assert saddle_read(point, [read["admissible"]]) is None
 
 
 @serial
@@ -920,3 +921,14 @@ def test_a_read_pulled_at_nodes_of_its_set_is_released_to_a_kkt_point(thin_plate
     reference = dense_reduced_load(problem, tuple(expected))
     assert found.load == pytest.approx(reference, rel=_load_rounding(problem, found))
     problem.destroy()
+
+
+def test_a_tensionless_foundation_is_refused_naming_its_route(thin_plate):
+    # The interior point solves rigid obstacles; a foundation's route is solve_foundation
+    # (as solve_foundation refuses a rigid obstacle), refused before any solve.
+    foundation = ObstacleSpec("all", foundation_stiffness=1.0e3)
+    spec = structs.replace(thin_plate(), obstacle=foundation)
+    with build_problem(spec, MPI.COMM_SELF) as problem:
+        with pytest.raises(InputError, match="solve_foundation"):
+            solve_interior_point(problem)
+        assert problem.eigensolver.solves == 0

@@ -24,11 +24,13 @@ import scipy.linalg
 
 from support.exhaustive import dense
 from unibuckle_fenicsx.certificate.certify import (
-    _spring_inertia,
     certify,
+    certify_foundation,
     pencil_inertia,
     reduced_inertia,
+    spring_inertia,
 )
+from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.eigen import EigenPair
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.spec import ObstacleSpec
@@ -115,4 +117,20 @@ def test_the_spring_inertia_counts_what_dense_eigenvalues_count():
         for factor in (0.999, 1.5, 3.0, 10.0):
             sigma = factor * free
             expected = _below(a + springs, b, sigma)
-            assert _spring_inertia(problem, pressing, sigma)[0] == expected, factor
+            assert spring_inertia(problem, pressing, sigma)[0] == expected, factor
+
+
+def test_the_spring_inertia_of_a_rigid_obstacle_is_refused_naming_the_foundation():
+    # A rigid obstacle has no springs: the count it asks for is reduced_inertia's.
+    with build_problem(paper_case("c3", 6, 3), MPI.COMM_SELF) as problem:
+        with pytest.raises(InputError, match="foundation_stiffness"):
+            spring_inertia(problem, np.arange(2, dtype=np.int64), 1.0)
+
+
+def test_a_rigid_obstacles_state_is_refused_by_the_foundations_certificate():
+    # certify_foundation reads the springs; a rigid obstacle's state is certify's. The
+    # solution is not read: the refusal comes before any solve.
+    with build_problem(paper_case("c3", 6, 3), MPI.COMM_SELF) as problem:
+        with pytest.raises(InputError, match="foundation_stiffness"):
+            certify_foundation(problem, None)  # type: ignore[arg-type]
+        assert problem.eigensolver.solves == 0

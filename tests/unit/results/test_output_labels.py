@@ -307,11 +307,11 @@ def test_a_sweep_prints_its_points_as_a_table_with_units():
     assert rows[1][1] == "1.500000e+08", rows[1]
 
 
-def test_a_bracket_that_ran_says_what_it_verified():
+def test_a_bracket_that_ran_says_what_itverified_text():
     # The quickstart's plate with --bracket: the split route verifies 1.735629e9 Pa below
     # lambda_c = 1.753161e9 (a gap of 1.0e-2, above the 1e-3 that 'bracketed' asks), and
     # the first line read "split bracket not bracketed (estimated cost 432.6 free solves)".
-    from unibuckle_fenicsx.results.records import CertificateRecord, _verified
+    from unibuckle_fenicsx.results.records import CertificateRecord, verified_text
 
     lower, upper = 1.735629e9, 1.753161e9
     cert = CertificateRecord(
@@ -323,12 +323,12 @@ def test_a_bracket_that_ran_says_what_it_verified():
         refuting_load_Pa=None, copositivity=None, notes=[],
         split_route="not bracketed (estimated cost 432.6 free solves)",
     )  # fmt: skip
-    text = _verified(cert)
+    text = verified_text(cert)
     assert "the split bracket verified a gap of 1.0e-02, above the 1e-03 of 'bracketed'" in text
     assert "not bracketed (estimated cost" not in text, text
     # Run, but nothing closer than the free load verified: it says so.
     none = msgspec.structs.replace(cert, proven_by="interlacing", relative_gap=0.22)
-    assert "the split bracket verified no higher bound" in _verified(none), _verified(none)
+    assert "the split bracket verified no higher bound" in verified_text(none), verified_text(none)
 
 
 @pytest.mark.parametrize(
@@ -490,7 +490,7 @@ def test_a_state_that_fails_kkt_is_not_called_kkt_only():
     # A tensionless foundation of 1e9 N/m^3 under the plate of test_penalty's cone without
     # a positive load: certificate status "not-kkt" (a lower eigenvalue of the pencil with
     # the pressing springs), and the first line read "KKT=NO  proven=no (KKT only)".
-    from unibuckle_fenicsx.results.records import CertificateRecord, _verified
+    from unibuckle_fenicsx.results.records import CertificateRecord, verified_text
 
     cert = CertificateRecord(
         feasible=True, feasibility_margin=-1e-3, max_contact_force=None,
@@ -500,6 +500,6 @@ def test_a_state_that_fails_kkt_is_not_called_kkt_only():
         status="not-kkt", negative_eigenvalues=None, refuting_load_Pa=None,
         copositivity=None, notes=[], split_route=None,
     )  # fmt: skip
-    assert _verified(cert) == "proven=no (not a KKT point)"
+    assert verified_text(cert) == "proven=no (not a KKT point)"
     kkt_only = msgspec.structs.replace(cert, kkt=True, status="kkt-only")
-    assert _verified(kkt_only) == "proven=no (KKT only)"
+    assert verified_text(kkt_only) == "proven=no (KKT only)"

@@ -52,6 +52,7 @@ __all__ = [
     "read_contact",
     "released",
     "run_from",
+    "saddle_read",
 ]
 
 
@@ -444,7 +445,7 @@ def _read_state(
     return cand, [cand, other]
 
 
-def _saddle(point: BarrierPoint, reads: list[Candidate]) -> Candidate | None:
+def saddle_read(point: BarrierPoint, reads: list[Candidate]) -> Candidate | None:
     """The first of ``reads`` that crosses the obstacle below ``point``'s load, or None."""
     for cand in reads:
         if not cand.feasible and cand.load < point.load * (1.0 - ROUNDING_RTOL):
@@ -510,7 +511,7 @@ def critical_state(
     if cand.kkt:
         return cand, point
     for attempt in range(options.escapes):
-        saddle = _saddle(point, reads if options.escape_either else [cand])
+        saddle = saddle_read(point, reads if options.escape_either else [cand])
         if saddle is None or not newton.escape(point, saddle.mode.x.petsc_vec):
             break
         tag = f"{label} (escape {attempt + 1})"

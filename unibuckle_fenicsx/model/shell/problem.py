@@ -146,6 +146,36 @@ class SectionContact(ContactSetManager):
         )
 
 
+def _unrolled_spec(
+    model: ShellModel,
+    material: Material,
+    solver: SolverSpec,
+    *,
+    core: bool,
+    springs: npt.NDArray[np.float64] | None,
+) -> ProblemSpec:
+    """The plate spec of the section's unrolled walls (length by perimeter).
+
+    With a core its obstacle covers it all, a foundation where ``springs`` are given
+    (their stiffness is the springs', not the spec's).
+    """
+    section = model.section
+    k_f = None if springs is None else 1.0  # marks a foundation; the springs are given
+    plate = PlateSpec(
+        corners=((0.0, 0.0), (section.length, section.perimeter)),
+        thickness=model.thickness,
+        edges=tuple(EdgeSpec(name) for name in ("left", "right", "bottom", "top")),
+    )
+    return ProblemSpec(
+        name=f"section-{section.shape}",
+        plate=plate,
+        material=material,
+        mesh=MeshSpec(section.cells_along, section.cells_around),
+        obstacle=ObstacleSpec("all", foundation_stiffness=k_f) if core else None,
+        solver=solver,
+    )
+
+
 def section_problem(
     model: ShellModel,
     prestress: SectionPrestress,
@@ -190,20 +220,7 @@ def section_problem(
     t0 = time.perf_counter()
     section = model.section
     solver = solver if solver is not None else SolverSpec()
-    k_f = None if springs is None else 1.0  # marks a foundation; the springs are given
-    plate = PlateSpec(
-        corners=((0.0, 0.0), (section.length, section.perimeter)),
-        thickness=model.thickness,
-        edges=tuple(EdgeSpec(name) for name in ("left", "right", "bottom", "top")),
-    )
-    spec = ProblemSpec(
-        name=f"section-{section.shape}",
-        plate=plate,
-        material=material,
-        mesh=MeshSpec(section.cells_along, section.cells_around),
-        obstacle=None if constraints is None else ObstacleSpec("all", foundation_stiffness=k_f),
-        solver=solver,
-    )
+    spec = _unrolled_spec(model, material, solver, core=constraints is not None, springs=springs)
     pencil = RotatedPencil(model, T)
     eigensolver = GEPSolver(
         pencil.A,
