@@ -521,13 +521,13 @@ class PlateSpec(Table, frozen=True):
         the x extent (bottom, top); for an outline, the extent of the part's segments on
         the line of its longest one (a rotated rectangle's side; a skew plate's loaded
         end, not the plate's extent along it, which takes in the offset of the opposite
-        end). Without a
-        compressive normal stress, the largest absolute shear stress per unit load, and b
-        the plate's smaller extent along and across the sheared edge (for the rectangle
-        its shorter side, the b of :math:`k_\tau = 5.34 + 4(b/a)^2`). An edge whose
-        direction the plate does not give (a file's or a mesh's part, the holes): b the y
-        extent, or for shear the smaller of the x and y extents. Ties: the first edge
-        listed. Edges in tension alone: the least tensile stress, negative. The fixed
+        end). Without a compressive normal stress, the largest absolute shear stress per
+        unit load, and b the smaller of the sheared edge's length (as above) and the
+        plate's extent across it (for the rectangle its shorter side, the b of
+        :math:`k_\tau = 5.34 + 4(b/a)^2`). An edge whose direction the plate does not give
+        (a file's or a mesh's part, the holes): b the y extent, or for shear the smaller
+        of the x and y extents. Ties: the first edge listed. Edges in tension alone: the
+        least tensile stress, negative. The fixed
         stresses are not in it: (0, y extent) when no edge is loaded.
         """
         edges = [e for e in self.edges if e.loaded]
@@ -536,9 +536,8 @@ class PlateSpec(Table, frozen=True):
         normal, shear = [e.normal_ends for e in edges], [e.shear_ends for e in edges]
         k, value, kind = reference_edge(normal, shear)
         along, across = self._edge_extents(edges[k])
-        if kind == "compressive":
-            return value, self._edge_length(edges[k], along)
-        return value, min(along, across)
+        length = self._edge_length(edges[k], along)
+        return value, length if kind == "compressive" else min(length, across)
 
     def _edge_length(self, edge: EdgeSpec, along: float) -> float:
         """The length (m) of a loaded outline part: its segments on its longest one's line.

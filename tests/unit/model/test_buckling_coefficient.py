@@ -143,6 +143,27 @@ def test_k_of_a_skew_plate_uses_its_loaded_edge():
     assert k == pytest.approx(THICKNESS * load * end**2 / (math.pi**2 * D), rel=1e-12)
 
 
+def test_k_of_a_skew_plate_in_shear_uses_its_sheared_edge():
+    """The same parallelogram sheared, its ends listed first: b the end's 0.1118 m.
+
+    It was the smaller of the plate's extents along the ends (0.2460 m, the offset
+    between the ends taken in) and across them (0.2683 m): 0.2460 m, for a plate whose
+    sides are 0.3 m and 0.1118 m long (k_tau's b is the shorter side).
+    """
+    skew = [[0.0, 0.0], [0.3, 0.0], [0.35, 0.1], [0.05, 0.1]]
+    spec = problem_from_dict(
+        {
+            "plate": {"outline": skew, "thickness": THICKNESS},
+            "edges": {
+                "ends": {"segments": [1, 3], "shear_stress": 1.0},
+                "long": {"segments": [0, 2], "shear_stress": 1.0},
+            },
+            "mesh": {"size": 0.0125},
+        }
+    )
+    assert spec.plate.reference_load() == pytest.approx((1.0, math.hypot(0.05, 0.1)), rel=1e-12)
+
+
 def test_k_of_a_plate_in_shear_uses_its_shorter_side():
     lying = plate_case("k", length=0.3, width=0.1, thickness=THICKNESS, nx=24, ny=8, load="shear")
     tall = plate_case("k", length=0.1, width=0.3, thickness=THICKNESS, nx=8, ny=24, load="shear")
