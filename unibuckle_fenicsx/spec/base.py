@@ -18,6 +18,7 @@ from __future__ import annotations
 
 import contextlib
 import contextvars
+import datetime as dt
 import difflib
 import enum
 import functools
@@ -382,7 +383,9 @@ def reason(key: str, value: Any, tp: Any) -> str:
             )
     kinds = {_kind(bare(m)) for m in members(tp)}
     got = "" if _kind(value) in kinds else f" ({_kind(value)})"
-    return f"{key or 'the file'} must be {form(tp)}, got {value!r}{got}"
+    # TOML's dates and times as the file writes them, not as Python's repr
+    shown = value.isoformat() if isinstance(value, dt.date | dt.time) else repr(value)
+    return f"{key or 'the file'} must be {form(tp)}, got {shown}{got}"
 
 
 def unknown_keys(unknown: Sequence[str], where: str, allowed: Sequence[str]) -> str:
@@ -488,6 +491,7 @@ def _kind(x: Any) -> str:
         (str | enum.Enum, "a string"),
         (list | tuple, "a list"),
         (Mapping | Struct, "a table"),
+        (dt.date | dt.time, "a TOML date or time"),
     ):
         if isinstance(x, cls) or (isinstance(x, type) and issubclass(x, cls)):
             return name

@@ -77,6 +77,16 @@ def plate_model_note(plate: PlateSpec, units: str = "SI") -> str | None:
 #: cells across it the element's load is several per cent too high (the square's k by
 #: cells across: docs/history/2026-11-30c-plates.md).
 MIN_CELLS_ACROSS = 4
+#: Under a scaled shear stress at least as large as the largest compression, fewer cells
+#: than this across b draw the warning: the buckle's diagonal waves are shorter than b,
+#: and the simply supported square in pure shear has k +78 % too high on 4 x 4 cells,
+#: +14 % on 8 x 8 and +8.5 % on 10 x 10 (against 48 x 48; compression's +9 % at 4 across).
+MIN_SHEAR_CELLS_ACROSS = 10
+#: With two opposite edges of the rectangle clamped, fewer cells than this across b draw
+#: the warning: the buckle's half-waves between clamped edges are shorter than b, and the
+#: clamped square's k is +55 % on 4 x 4 cells, +20 % on 6 x 6, +10 % on 8 x 8 (against
+#: 48 x 48; the simply supported square's +9 % at 4 across).
+MIN_CLAMPED_CELLS_ACROSS = 8
 
 
 def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str | None:
@@ -112,7 +122,52 @@ def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str
             "this coarse the critical load, k and the design values come out too high (+18 % "
             f"at 3 cells across a simply supported square); cells of {finer:.3g} {name} or less"
         )
+    if _shear_dominated(plate) and h * MIN_SHEAR_CELLS_ACROSS > b * (1.0 + 1e-9):
+        (cell, side, finer), name = in_file((h, b, b / MIN_SHEAR_CELLS_ACROSS), "m", units)
+        return (
+            f"{what}: cells up to {cell:.3g} {name}, fewer than {MIN_SHEAR_CELLS_ACROSS} "
+            f"across {side_name} {side:.3g} {name} under a shear stress at least as large as "
+            "the compression (edges.*.shear_stress): a shear buckle's diagonal waves are "
+            "shorter than the plate's width, and on cells this coarse the critical load and k "
+            "come out too high (a simply supported square in shear: +78 % on 4 x 4 cells, "
+            f"+14 % on 8 x 8); cells of {finer:.3g} {name} or less"
+        )
+    clamped = _opposite_clamped(plate)
+    if clamped and h * MIN_CLAMPED_CELLS_ACROSS > b * (1.0 + 1e-9):
+        (cell, side, finer), name = in_file((h, b, b / MIN_CLAMPED_CELLS_ACROSS), "m", units)
+        return (
+            f"{what}: cells up to {cell:.3g} {name}, fewer than {MIN_CLAMPED_CELLS_ACROSS} "
+            f"across {side_name} {side:.3g} {name} with edges.{clamped[0]} and "
+            f"edges.{clamped[1]} clamped: the half-waves between clamped edges are shorter "
+            "than the plate's width, and on cells this coarse the critical load, k and the "
+            "design values come out too high (the clamped square: +55 % on 4 x 4 cells, +20 % "
+            f"on 6 x 6); cells of {finer:.3g} {name} or less"
+        )
     return _gradient_note(plate, mesh, what, units)
+
+
+def _opposite_clamped(plate: PlateSpec) -> tuple[str, str] | None:
+    """The first pair of opposite rectangle edges both clamped (left, right; bottom, top)."""
+    clamped = {
+        e.name
+        for e in plate.edges
+        if e.support == "clamped" and e.segments is None and e.tag is None
+    }
+    for pair in (("left", "right"), ("bottom", "top")):
+        if set(pair) <= clamped:
+            return pair
+    return None
+
+
+def _shear_dominated(plate: PlateSpec) -> bool:
+    """Whether the largest scaled shear stress of an edge is at least its largest compression.
+
+    The edges' stresses per unit load (the fixed part's share depends on the load); the
+    holes' boundary and a file's parts count as the rectangle's edges do.
+    """
+    shear = max((abs(v) for e in plate.edges for v in e.shear_ends), default=0.0)
+    compression = max((-v for e in plate.edges for v in e.normal_ends), default=0.0)
+    return shear > 0.0 and shear >= compression
 
 
 def _gradient_note(plate: PlateSpec, mesh: MeshSpec, what: str, units: str) -> str | None:

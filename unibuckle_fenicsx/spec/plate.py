@@ -518,14 +518,16 @@ class PlateSpec(Table, frozen=True):
 
         The largest compressive normal edge stress per unit load (Pa/Pa, positive), and b
         (m) the length of the loaded edge: for the rectangle the y extent (left, right) or
-        the x extent (bottom, top); for an outline, the plate's extent across the
-        direction of that edge's traction (its longest segment's normal). Without a
-        compressive normal stress, the largest absolute shear stress per unit load, and b
-        the plate's smaller extent along and across the sheared edge (for the rectangle
-        its shorter side, the b of :math:`k_\tau = 5.34 + 4(b/a)^2`). An edge whose
-        direction the plate does not give (a file's or a mesh's part, the holes): b the y
-        extent, or for shear the smaller of the x and y extents. Ties: the first edge
-        listed. Edges in tension alone: the least tensile stress, negative. The fixed
+        the x extent (bottom, top); for an outline, the extent of the part's segments on
+        the line of its longest one (a rotated rectangle's side; a skew plate's loaded
+        end, not the plate's extent along it, which takes in the offset of the opposite
+        end). Without a compressive normal stress, the largest absolute shear stress per
+        unit load, and b the smaller of the sheared edge's length (as above) and the
+        plate's extent across it (for the rectangle its shorter side, the b of
+        :math:`k_\tau = 5.34 + 4(b/a)^2`). An edge whose direction the plate does not give
+        (a file's or a mesh's part, the holes): b the y extent, or for shear the smaller
+        of the x and y extents. Ties: the first edge listed. Edges in tension alone: the
+        least tensile stress, negative. The fixed
         stresses are not in it: (0, y extent) when no edge is loaded.
         """
         edges = [e for e in self.edges if e.loaded]
@@ -534,7 +536,25 @@ class PlateSpec(Table, frozen=True):
         normal, shear = [e.normal_ends for e in edges], [e.shear_ends for e in edges]
         k, value, kind = reference_edge(normal, shear)
         along, across = self._edge_extents(edges[k])
-        return value, along if kind == "compressive" else min(along, across)
+        length = self._edge_length(edges[k], along)
+        return value, length if kind == "compressive" else min(length, across)
+
+    def _edge_length(self, edge: EdgeSpec, along: float) -> float:
+        """The length (m) of a loaded outline part: its segments on its longest one's line.
+
+        ``along``, the plate's extent along the edge, for a part that is not an
+        outline's (the rectangle's edge, whose extent it is).
+        """
+        if self.outline is None or edge.segments is None:
+            return along
+        v = np.asarray(self.outline, dtype=float)
+        ends = [(v[k], v[(k + 1) % len(v)]) for k in edge.segments]
+        start, end = max(ends, key=lambda pair: float(np.hypot(*(pair[1] - pair[0]))))
+        t = (end - start) / np.hypot(*(end - start))
+        normal = np.array([-t[1], t[0]])
+        off = 1e-9 * max(self.length, self.width)  # on the line, up to rounding
+        points = np.array([q for pair in ends for q in pair if abs((q - start) @ normal) <= off])
+        return float(np.ptp(points @ t))
 
     def _edge_extents(self, edge: EdgeSpec) -> tuple[float, float]:
         """The plate's extents (m) along and across ``edge`` (see :meth:`reference_load`)."""

@@ -107,6 +107,63 @@ def test_k_of_a_rotated_outline_is_that_of_the_rectangle():
     assert k == pytest.approx(4.0, rel=0.05)
 
 
+def test_k_of_a_skew_plate_uses_its_loaded_edge():
+    """A parallelogram compressed on its slanted ends: b is the end's length.
+
+    The 0.3 x 0.1 m plate with its top edge shifted by 0.05 m along x, both ends
+    (length sqrt(0.05^2 + 0.1^2) = 0.1118 m, by Pythagoras) loaded. b was the plate's
+    extent along the ends' direction, 0.2460 m, which takes in the offset between the two
+    ends: at t = 1 mm, k = 40.59 where the plate's k on its loaded edge is 8.39 (and 6.70
+    on the 0.1 m between its long edges). An end split in two collinear segments has the
+    same b.
+    """
+    skew = [[0.0, 0.0], [0.3, 0.0], [0.35, 0.1], [0.05, 0.1]]
+    data = {
+        "plate": {"outline": skew, "thickness": THICKNESS},
+        "edges": {
+            "ends": {"segments": [1, 3], "normal_stress": -1.0, "support": "clamped"},
+            "long": {"segments": [0, 2], "support": "clamped", "inplane": "roller"},
+        },
+        "mesh": {"size": 0.0125},
+    }
+    end = math.hypot(0.05, 0.1)
+    assert problem_from_dict(data).plate.reference_load() == pytest.approx((1.0, end), rel=1e-12)
+    split = dict(data, plate={"outline": [*skew[:2], [0.325, 0.05], *skew[2:]]})
+    split["edges"] = {
+        "ends": {"segments": [1, 2, 4], "normal_stress": -1.0},
+        "long": {"segments": [0, 3]},
+    }
+    assert problem_from_dict(split).plate.reference_load() == pytest.approx((1.0, end), rel=1e-12)
+    pytest.importorskip("gmsh")
+    spec = problem_from_dict(data)
+    with solve(spec, MPI.COMM_WORLD) as analysis:
+        load, k = analysis.result.critical_load_Pa, analysis.result.buckling_coefficient_k
+    E, nu = spec.material.E, spec.material.nu
+    D = E * THICKNESS**3 / (12.0 * (1.0 - nu**2))
+    assert k == pytest.approx(THICKNESS * load * end**2 / (math.pi**2 * D), rel=1e-12)
+
+
+def test_k_of_a_skew_plate_in_shear_uses_its_sheared_edge():
+    """The same parallelogram sheared, its ends listed first: b the end's 0.1118 m.
+
+    It was the smaller of the plate's extents along the ends (0.2460 m, the offset
+    between the ends taken in) and across them (0.2683 m): 0.2460 m, for a plate whose
+    sides are 0.3 m and 0.1118 m long (k_tau's b is the shorter side).
+    """
+    skew = [[0.0, 0.0], [0.3, 0.0], [0.35, 0.1], [0.05, 0.1]]
+    spec = problem_from_dict(
+        {
+            "plate": {"outline": skew, "thickness": THICKNESS},
+            "edges": {
+                "ends": {"segments": [1, 3], "shear_stress": 1.0},
+                "long": {"segments": [0, 2], "shear_stress": 1.0},
+            },
+            "mesh": {"size": 0.0125},
+        }
+    )
+    assert spec.plate.reference_load() == pytest.approx((1.0, math.hypot(0.05, 0.1)), rel=1e-12)
+
+
 def test_k_of_a_plate_in_shear_uses_its_shorter_side():
     lying = plate_case("k", length=0.3, width=0.1, thickness=THICKNESS, nx=24, ny=8, load="shear")
     tall = plate_case("k", length=0.1, width=0.3, thickness=THICKNESS, nx=8, ny=24, load="shear")

@@ -338,6 +338,31 @@ def test_toml_types_are_checked_and_the_file_named(tmp_path, text, match):
     assert str(err.value).startswith(f"{path}: ")
 
 
+@pytest.mark.parametrize(
+    ("text", "said"),
+    [
+        ("[plate]\nthickness = 1979-05-27\n", "plate.thickness must be a number, got 1979-05-27"),
+        (
+            '[obstacle]\nzone = "all"\ngap = 12:30:00\n',
+            "obstacle.gap must be a number, got 12:30:00",
+        ),
+    ],
+)
+def test_a_toml_date_is_named_a_date_not_absent(tmp_path, text, said):
+    """A TOML date or time where a number belongs: named so, as the file writes it.
+
+    TOML has dates and times (TOML 1.0, "Offset Date-Time" to "Local Time"); the message
+    said ``got datetime.date(1979, 5, 27) (absent)``, Python's repr and a key said absent
+    that the file gives.
+    """
+    path = tmp_path / "dated.toml"
+    path.write_text(text)
+    with pytest.raises(ValueError) as err:
+        load_toml(path)
+    assert f"{said} (a TOML date or time)" in str(err.value), err.value
+    assert "absent" not in str(err.value) and "datetime" not in str(err.value)
+
+
 def test_toml_syntax_error_and_binary_file_name_the_file(tmp_path):
     bad = tmp_path / "broken.toml"
     bad.write_text("[plate\nthickness = 0.006\n")
