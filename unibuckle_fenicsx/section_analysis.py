@@ -45,7 +45,6 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.registry import choose_section_method, entry
-from unibuckle_fenicsx.algorithms.section_levels import check_levels
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.en1993 import (
     check_steel_modulus,
@@ -83,7 +82,12 @@ from unibuckle_fenicsx.spec import (
 )
 from unibuckle_fenicsx.spec.base import FILE_UNITS, file_units, in_file
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
-from unibuckle_fenicsx.spec.section import DEFAULT_LEVELS
+from unibuckle_fenicsx.spec.section import (
+    DEFAULT_LEVELS,
+    check_core_options,
+    check_section_mesh,
+    check_section_solver,
+)
 
 __all__ = [
     "COLUMN_FRACTION",
@@ -296,6 +300,7 @@ def solve_section(
             starts on, >= 0 (:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`:
             the interior point's starts, or the active set's seeds). 1 by default: the
             starts' many steps on a section of a quarter of the DOFs, a few on the given one.
+            Without a core, refused (as the file's ``mesh.levels``) if not the default.
         solver: Solver options (the method, one of
             :data:`~unibuckle_fenicsx.spec.section.SECTION_METHODS`, chosen by
             :func:`~unibuckle_fenicsx.algorithms.registry.choose_section_method`; tolerances, the
@@ -308,8 +313,11 @@ def solve_section(
 
     Raises:
         TypeError: ``parameters`` is not a SectionParameters.
-        InputError: ``levels`` out of range, or a method no section runs
-            (``solver.method``).
+        InputError: ``levels`` out of range (its coarsest section without 2 cells
+            along, or a core's span without a free node on it), a method no section runs
+            (``solver.method``), or what the problem file refuses: a core's search
+            options (``levels``, ``solver.tau``, ``solver.max_iterations``) given to a
+            section without a core, a plate's solver option; all before any mesh.
         NumericalError: An eigen solve did not converge.
 
     Note:
@@ -342,9 +350,9 @@ def _solve_section(
             f"solve_section: parameters must be a SectionParameters or a SectionProblemSpec, "
             f"got {type(parameters).__name__}"
         )
-    _check(parameters, levels, design)
-    certificate: Certificate | None = None
     solver = solver or SolverSpec()
+    _check(parameters, levels, solver, design)
+    certificate: Certificate | None = None
     method, reason = choose_section_method(parameters, solver)
     logger.info("section: method %s (%s)", method, reason)
     section, solution = _solve(parameters, int(levels), comm, method, solver)
@@ -413,21 +421,33 @@ MAX_CALIBRATED_RADIUS_RATIO = 800.0
 MIN_ALONG_CELLS = 6
 
 
-def _check(parameters: SectionParameters, levels: int, design: DesignSpec | None) -> None:
+def _check(
+    parameters: SectionParameters, levels: int, solver: SolverSpec, design: DesignSpec | None
+) -> None:
     """Refuse what no solve should start with, and warn of walls or cells out of range.
 
     Raises:
-        InputError: ``levels`` not an integer >= 0, or (a rigid core, or an elastic one
-            given other than the default levels) its coarsest section without 2 cells
-            along; a design output asked of a wall whose
-            E is not a steel's (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
+        InputError: ``levels`` not an integer >= 0; a hollow section given a core's
+            search options (``levels``, ``solver.tau``, ``solver.max_iterations``:
+            :func:`~unibuckle_fenicsx.spec.section.check_core_options`) or any section a
+            plate's solver option; cells or levels the section cannot have, or a core's
+            span holding no free node of a section the search runs on
+            (:func:`~unibuckle_fenicsx.spec.section.check_section_mesh`); a design output
+            asked of a wall whose E is not a steel's
+            (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
     """
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    # A rigid core's levels; an elastic core's when given (its rigid start's, which
-    # takes the default's as far as the section allows them).
-    if parameters.core and (parameters.foundation_stiffness is None or levels != DEFAULT_LEVELS):
-        check_levels(parameters, int(levels))
+    p = parameters
+    # The file's own checks (its reader ran them already): a core's options on a hollow
+    # section, a plate's options, the cells, levels and span.
+    check_core_options(p.core, int(levels), solver, {"mesh.levels": "levels"})
+    check_section_solver(solver)
+    check_section_mesh(
+        size=p.mesh_size, length=p.length, levels=int(levels), core=p.core,
+        elastic=p.foundation_stiffness is not None, span=p.core_span,
+        across=max(float(v or 0.0) for v in (p.width, p.depth, p.diameter)),
+    )  # fmt: skip
     notes = [thick_wall_note(parameters), coarse_mesh_note(parameters)]
     if design is not None:
         stress = UNITS[FILE_UNITS.get()][1:]

@@ -37,6 +37,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec.section import cells_along
 
 __all__ = [
     "END_FINISH",
@@ -143,8 +144,12 @@ def _cells_for(extent: float, size: float, even: bool = True, least: int = 2) ->
 
 
 def _cells_along(length: float, size: float) -> int:
-    """Cells along x of every section mesh: ceil(L/size), at least one."""
-    return _cells_for(length, size, even=False, least=1)
+    """Cells along x of every section mesh: ceil(L/size), at least one.
+
+    :func:`~unibuckle_fenicsx.spec.section.cells_along`: the problem file's checks count
+    them the same way before any mesh is made.
+    """
+    return cells_along(length, size)
 
 
 def _facets(diameter: float, size: float) -> int:

@@ -1,0 +1,176 @@
+"""A section's inputs that cannot work, refused before any mesh, naming the key and its range.
+
+Each number is the mesh's arithmetic (``unibuckle_fenicsx.model.shell.geometry``): ceil(L/h)
+cells along the member, its nodes at x = i L/n; the end nodes' normal motion is held by
+the end supports. ``mesh.levels`` doubles the cell size that many times; the coarsest
+section needs 2 cells along (docs/guide/sections.md, ``[mesh]``).
+
+The box below: L = 0.3 m, cells of 12.5 mm. Doubled k times: 25, 50, 100, 200, 400 mm,
+so 4 levels keep 2 cells along (200 mm < 300 mm) and 5 do not (400 mm).
+"""
+
+from __future__ import annotations
+
+from mpi4py import MPI
+
+import pytest
+
+from unibuckle_fenicsx import SectionParameters, solve_section
+from unibuckle_fenicsx.cli import EXIT_BAD_INPUT, main
+from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec import SolverSpec, load_toml
+
+pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial sections")
+
+BOX = """name = "b"
+[section]
+shape = "box"
+width = 0.1
+depth = 0.1
+thickness = 0.001
+length = 0.3
+ends = "simply_supported"
+[material]
+E = 2.1e11
+nu = 0.3
+[obstacle]
+core = true
+{obstacle}
+[mesh]
+size = {size}
+levels = {levels}
+"""
+
+
+def _file(tmp_path, size=0.0125, levels=1, obstacle=""):
+    path = tmp_path / "box.toml"
+    path.write_text(BOX.format(size=size, levels=levels, obstacle=obstacle))
+    return path
+
+
+def _no_mesh(*args, **kwargs):
+    raise AssertionError("a mesh was built")
+
+
+def test_too_many_levels_are_refused_when_the_file_is_read(tmp_path):
+    """5 levels of 12.5 mm cells on 0.3 m: 400 mm cells; the range (<= 4) is said."""
+    path = _file(tmp_path, levels=5)
+    with pytest.raises(InputError) as err:
+        load_toml(path)
+    text = str(err.value)
+    assert text.startswith(f"{path}: mesh.levels = 5")
+    assert "mesh.levels <= 4" in text
+    assert load_toml(_file(tmp_path, levels=4)).mesh.levels == 4
+
+
+def test_cells_not_below_the_length_are_refused_when_the_file_is_read(tmp_path):
+    """mesh.size 0.3 m on a 0.3 m member: 1 cell along, the ends' nodes only."""
+    path = _file(tmp_path, size=0.3, levels=0)
+    with pytest.raises(InputError, match=r"box.toml: mesh.size = 0.3 m must be below"):
+        load_toml(path)
+
+
+def test_an_elastic_core_takes_the_default_levels_on_any_mesh(tmp_path):
+    """An elastic core's rigid start takes as many levels as the section allows (none here).
+
+    Cells of 200 mm on 0.3 m: 2 along, no coarser section; the default levels = 1 is not
+    refused (the solve takes 0), a levels = 1 written out is the same value and is not
+    refused either; 2 are.
+    """
+    stiff = "foundation_stiffness = 1e10"
+    assert load_toml(_file(tmp_path, size=0.2, levels=1, obstacle=stiff)).mesh.levels == 1
+    with pytest.raises(InputError, match=r"mesh.levels = 2.*mesh.levels <= 0"):
+        load_toml(_file(tmp_path, size=0.2, levels=2, obstacle=stiff))
+
+
+def test_a_span_without_a_node_on_a_coarser_section_is_refused_when_read(tmp_path):
+    """A span 0.11-0.12 m: the 12.5 mm cells have a node at 0.1125 m, the 25 mm ones none.
+
+    It was refused only once the solve had built the sections, without the file's name.
+    """
+    span = "span = [0.11, 0.12]"
+    path = _file(tmp_path, levels=1, obstacle=span)
+    with pytest.raises(InputError) as err:
+        load_toml(path)
+    text = str(err.value)
+    assert text.startswith(f"{path}: obstacle.span = [0.11, 0.12]")
+    assert "mesh.levels" in text and "25 mm" not in text and "0.025 m" in text
+    assert load_toml(_file(tmp_path, levels=0, obstacle=span)).obstacle.span == (0.11, 0.12)
+    # Between two nodes of the given cells: refused whatever the levels.
+    with pytest.raises(InputError, match=r"obstacle.span = \[0.11, 0.112\].* no node"):
+        load_toml(_file(tmp_path, levels=0, obstacle="span = [0.11, 0.112]"))
+    # Only the end's nodes (held by the supports): refused.
+    with pytest.raises(InputError, match=r"only nodes held by the end supports"):
+        load_toml(_file(tmp_path, levels=0, obstacle="span = [0.0, 0.01]"))
+
+
+def test_the_command_line_refuses_them_before_any_mesh(tmp_path, monkeypatch, capsys):
+    monkeypatch.setattr("unibuckle_fenicsx.model.shell.section.section_mesh", _no_mesh)
+    path = _file(tmp_path)
+    for args in (["--set", "mesh.levels=5"], ["--set", "obstacle.span=[0.11,0.12]"]):
+        assert main(["solve", "--config", str(path), *args]) == EXIT_BAD_INPUT
+        err = capsys.readouterr().err
+        assert str(path) in err or "--set" in err, err
+
+
+def _hollow() -> SectionParameters:
+    return SectionParameters(
+        "box", width=0.1, depth=0.1, thickness=0.001, length=0.3, E=2.1e11, nu=0.3,
+        mesh_size=0.0125,
+    )  # fmt: skip
+
+
+@pytest.mark.parametrize(
+    ("options", "key"),
+    [
+        ({"levels": 2}, "mesh.levels"),
+        ({"solver": SolverSpec(tau=1e-6)}, "solver.tau"),
+        ({"solver": SolverSpec(max_iterations=7)}, "solver.max_iterations"),
+        ({"solver": SolverSpec(bracket=True)}, "solver.bracket"),
+    ],
+)
+def test_solve_section_refuses_a_core_s_options_on_a_hollow_section(monkeypatch, options, key):
+    """The file's route refuses them (``check_core_options``); the API said nothing.
+
+    A hollow section is its free solve: levels, tau and max_iterations are a core's
+    search's; a plate's option (bracket) is no section's.
+    """
+    monkeypatch.setattr("unibuckle_fenicsx.model.shell.section.section_mesh", _no_mesh)
+    with pytest.raises(InputError, match=rf"^{key}\b"):
+        solve_section(_hollow(), MPI.COMM_SELF, **options)
+
+
+def test_solve_section_refuses_too_many_levels_before_any_mesh(monkeypatch):
+    monkeypatch.setattr("unibuckle_fenicsx.model.shell.section.section_mesh", _no_mesh)
+    cored = SectionParameters(
+        "box", width=0.1, depth=0.1, thickness=0.001, length=0.3, E=2.1e11, nu=0.3,
+        mesh_size=0.0125, core=True,
+    )  # fmt: skip
+    with pytest.raises(InputError, match=r"mesh.levels = 5.*mesh.levels <= 4"):
+        solve_section(cored, MPI.COMM_SELF, levels=5)
+    spanned = SectionParameters(
+        "box", width=0.1, depth=0.1, thickness=0.001, length=0.3, E=2.1e11, nu=0.3,
+        mesh_size=0.0125, core=True, core_span=(0.11, 0.12),
+    )  # fmt: skip
+    with pytest.raises(InputError, match=r"obstacle.span"):
+        solve_section(spanned, MPI.COMM_SELF, levels=1)
+
+
+def test_a_sweep_refuses_a_point_with_too_many_levels_before_solving_any(tmp_path, monkeypatch):
+    """Points of mesh.size 12.5 mm and 200 mm with levels = 1: the second is refused first.
+
+    It has no coarser section of 2 cells along (400 mm on 0.3 m). It was refused as that
+    point's line, after the first had been solved.
+    """
+    from unibuckle_fenicsx import sweep
+
+    solved = []
+    monkeypatch.setattr(
+        sweep, "solve_point", lambda spec, comm: solved.append(spec) or {"status": "ok"}
+    )
+    base = sweep.base_mapping(_file(tmp_path))
+    variation = sweep.parse_variation("mesh.size=0.0125,0.2")
+    with pytest.raises(InputError, match=r"sweep point .*mesh.size.*mesh.levels = 1"):
+        sweep.run_sweep(base, [variation], tmp_path / "s.jsonl", MPI.COMM_SELF, progress=False)
+    assert solved == []
+
