@@ -125,7 +125,11 @@ class SectionResult(BucklingResult, kw_only=True):
     (None for a tube); ``mesh`` is [cells along, cells around]; ``dofs`` counts the
     six components of every node; ``constrained_nodes`` counts the core's constrained
     *directions* (a box's corner node has two), ``contact_coordinates`` their unrolled
-    (x, s) (m along the member, m around the mid-line); ``input`` is the section's
+    (x, s) (m along the member, m around the mid-line), ``contact_indices`` their numbers
+    (ordered by (x, s), the same on any number of ranks); ``contact_dofs`` are the
+    rows of the rotated pencil in DOLFINx's numbering of the distributed mesh, which
+    depends on the number of MPI ranks (its partition): compare runs by
+    ``contact_indices`` or ``contact_coordinates``, not by them; ``input`` is the section's
     problem file (:func:`~unibuckle_fenicsx.spec.problem_to_dict`) when one was solved,
     else ``{"section": the parameters}``; ``critical_force_N_per_m`` is the extreme
     fibre's :math:`t\sigma` (``compression_Pa``); ``design``, with a ``[design]`` table, is a

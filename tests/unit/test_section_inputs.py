@@ -174,3 +174,17 @@ def test_a_sweep_refuses_a_point_with_too_many_levels_before_solving_any(tmp_pat
         sweep.run_sweep(base, [variation], tmp_path / "s.jsonl", MPI.COMM_SELF, progress=False)
     assert solved == []
 
+
+def test_a_section_s_contact_dofs_are_documented_as_depending_on_the_ranks():
+    """The same filled box on 1 and 2 ranks: contact_indices equal, contact_dofs not.
+
+    Measured (tests/mpi/section_parallel.py's box, 62 directions in contact): the DOFs
+    [30, 72, 126, ...] on 1 rank, [0, 6, 12, ...] on 2 (DOLFINx numbers the distributed
+    mesh's DOFs by rank). A section's result did not say what its contact_dofs were.
+    """
+    from unibuckle_fenicsx.results.records import BucklingResult
+    from unibuckle_fenicsx.section_analysis import SectionResult
+
+    for doc in (SectionResult.__doc__, BucklingResult.__doc__):
+        text = " ".join(doc.split())
+        assert "contact_dofs" in text and "number of MPI ranks" in text
