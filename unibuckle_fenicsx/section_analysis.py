@@ -45,6 +45,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.registry import choose_section_method, entry
+from unibuckle_fenicsx.algorithms.section_levels import estimated_dofs
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.en1993 import (
     check_steel_modulus,
@@ -54,6 +55,7 @@ from unibuckle_fenicsx.en1993 import (
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode
+from unibuckle_fenicsx.model.resources import check_section_memory
 from unibuckle_fenicsx.model.shell.geometry import cell_length, face_cell_width, tube_facet_width
 from unibuckle_fenicsx.model.shell.section import (
     Section,
@@ -355,7 +357,7 @@ def _solve_section(
             f"got {type(parameters).__name__}"
         )
     solver = solver or SolverSpec()
-    _check(parameters, levels, solver, design)
+    _check(parameters, levels, solver, design, comm)
     certificate: Certificate | None = None
     method, reason = choose_section_method(parameters, solver)
     logger.info("section: method %s (%s)", method, reason)
@@ -426,7 +428,11 @@ MIN_ALONG_CELLS = 6
 
 
 def _check(
-    parameters: SectionParameters, levels: int, solver: SolverSpec, design: DesignSpec | None
+    parameters: SectionParameters,
+    levels: int,
+    solver: SolverSpec,
+    design: DesignSpec | None,
+    comm: MPI.Comm,
 ) -> None:
     """Refuse what no solve should start with, and warn of walls or cells out of range.
 
@@ -438,7 +444,9 @@ def _check(
             span holding no free node of a section the search runs on
             (:func:`~unibuckle_fenicsx.spec.section.check_section_mesh`); a design output
             asked of a wall whose E is not a steel's
-            (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
+            (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`); cells whose DOFs,
+            estimated before meshing, need more memory than the ranks have
+            (:func:`~unibuckle_fenicsx.model.resources.check_section_memory`). Collective.
     """
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
@@ -452,6 +460,7 @@ def _check(
         elastic=p.foundation_stiffness is not None, span=p.core_span,
         across=max(float(v or 0.0) for v in (p.width, p.depth, p.diameter)),
     )  # fmt: skip
+    check_section_memory(estimated_dofs(p), p.mesh_size, comm)
     notes = [thick_wall_note(parameters), coarse_mesh_note(parameters)]
     if design is not None:
         stress = UNITS[FILE_UNITS.get()][1:]

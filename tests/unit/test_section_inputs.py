@@ -188,3 +188,24 @@ def test_a_section_s_contact_dofs_are_documented_as_depending_on_the_ranks():
     for doc in (SectionResult.__doc__, BucklingResult.__doc__):
         text = " ".join(doc.split())
         assert "contact_dofs" in text and "number of MPI ranks" in text
+
+
+def test_a_section_needing_more_memory_than_there_is_is_refused_before_any_mesh(monkeypatch):
+    """A plate's mesh was checked against the machine's memory; a section's was not.
+
+    The box 0.1 x 0.1 x 0.3 m on 2.5 mm cells: 160 nodes around, 121 along, 6 DOFs each
+    (116 160); at 13 kB per DOF (the least measured, ``BYTES_PER_SECTION_DOF``) 1.51 GB,
+    refused with 1 GB available. On this machine's 24 GB, mesh.size = 0.1 mm (72 million
+    DOFs) went on to mesh.
+    """
+    from unibuckle_fenicsx.model import resources
+
+    monkeypatch.setattr("unibuckle_fenicsx.model.shell.section.section_mesh", _no_mesh)
+    monkeypatch.setattr(resources, "available_memory", lambda: 10**9)
+    box = SectionParameters(
+        "box", width=0.1, depth=0.1, thickness=0.001, length=0.3, E=2.1e11, nu=0.3,
+        mesh_size=0.0025,
+    )  # fmt: skip
+    match = r"mesh.size = 0.0025 m gives about 116,160 DOFs, which need about 1.51 GB"
+    with pytest.raises(InputError, match=match):
+        solve_section(box, MPI.COMM_SELF)
