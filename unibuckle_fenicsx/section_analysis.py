@@ -298,9 +298,9 @@ def solve_section(
             checked when built: bad keys raise :class:`~unibuckle_fenicsx.errors.InputError`),
             or a section's problem file
             (:class:`~unibuckle_fenicsx.spec.section.SectionProblemSpec`: its
-            ``mesh.levels``, ``[solver]`` and ``[design]`` replace ``levels``, ``solver``
-            and ``design``, the result's ``case`` is the file's ``name`` and its ``input``
-            the file, which re-runs it).
+            ``mesh.levels``, ``[solver]`` and ``[design]`` are solved, and ``levels``,
+            ``solver`` and ``design`` given beside it refused; the result's ``case`` is
+            the file's ``name`` and its ``input`` the file, which re-runs it).
         comm: Communicator; the mesh is distributed over it.
         levels: With a core, coarser sections (each with twice the mesh size) the search
             starts on, >= 0 (:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`:
@@ -347,6 +347,7 @@ def _solve_section(
     echo: dict[str, object] | None = None
     units, name = "SI", None
     if isinstance(parameters, SectionProblemSpec):
+        _file_holds_them(parameters, levels, solver, design)
         echo, name = problem_to_dict(parameters), parameters.name
         levels, solver, design = parameters.mesh.levels, parameters.solver, parameters.design
         units = parameters.units
@@ -397,6 +398,33 @@ def _solve_section(
         section.destroy()
         raise
     return SectionAnalysis(result, section, solution, certificate)
+
+
+def _file_holds_them(
+    spec: SectionProblemSpec, levels: int, solver: SolverSpec | None, design: DesignSpec | None
+) -> None:
+    """Refuse ``levels``, ``solver`` or ``design`` given beside a problem file, which holds them.
+
+    The file's ``mesh.levels``, ``[solver]`` and ``[design]`` are the ones solved; an
+    argument beside it was ignored.
+    """
+    given = {  # argument: (its key in the file, the spec's field, given)
+        "levels": ("mesh.levels", "mesh", levels != DEFAULT_LEVELS),
+        "solver": ("[solver]", "solver", solver is not None),
+        "design": ("[design]", "design", design is not None),
+    }
+    for argument, (key, field, set_) in given.items():
+        if set_:
+            value = (
+                f"msgspec.structs.replace(spec.mesh, levels={levels!r})"
+                if argument == "levels"
+                else argument
+            )
+            raise InputError(
+                f"solve_section: {argument} is given with a problem file "
+                f"(SectionProblemSpec), whose {key} is the one solved: set it in the file "
+                f"(msgspec.structs.replace(spec, {field}={value}))"
+            )
 
 
 #: Fewer cells than this across a box's narrowest face draw a warning: there the hollow

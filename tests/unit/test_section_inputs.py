@@ -209,3 +209,21 @@ def test_a_section_needing_more_memory_than_there_is_is_refused_before_any_mesh(
     match = r"mesh.size = 0.0025 m gives about 116,160 DOFs, which need about 1.51 GB"
     with pytest.raises(InputError, match=match):
         solve_section(box, MPI.COMM_SELF)
+
+
+def test_solve_section_refuses_options_beside_a_problem_file(tmp_path, monkeypatch):
+    """A file's mesh.levels, [solver] and [design] are solved: the arguments were ignored.
+
+    ``solve_section(spec, levels=0)`` ran the file's levels = 1 and said nothing.
+    """
+    from unibuckle_fenicsx.spec import DesignSpec
+
+    monkeypatch.setattr("unibuckle_fenicsx.model.shell.section.section_mesh", _no_mesh)
+    spec = load_toml(_file(tmp_path))
+    for options, key in (
+        ({"levels": 0}, "mesh.levels"),
+        ({"solver": SolverSpec(tau=1e-6)}, r"\[solver\]"),
+        ({"design": DesignSpec(yield_stress=3.55e8)}, r"\[design\]"),
+    ):
+        with pytest.raises(InputError, match=rf"with a problem file .*whose {key} is the one"):
+            solve_section(spec, MPI.COMM_SELF, **options)
