@@ -151,11 +151,16 @@ class SectionResult(BucklingResult, kw_only=True):
             (Pa, <= 0: none), its own buckling coefficient :math:`\sigma t w^2/(\pi^2 D)`
             with that stress (NaN, null in JSON, without compression), its constrained
             directions and those in contact with the core (pressing a foundation).
+        warnings: The warnings the solve logged, in its order: a thick wall, cells too
+            coarse (or a tube thinner than the cell rule's range), a design's Poisson's
+            ratio not a steel's, the member's column mode near its load (kept here
+            for a sweep's points, whose solves print none).
     """
 
     classical_stress_Pa: float = math.nan
     compression_Pa: float = math.nan
     faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
+    warnings: list[str] = msgspec.field(default_factory=list)
 
     def _bending(self) -> float:
         """The input's ``bending_stress`` (0 by default in a file's ``[load]``); NaN unknown."""
@@ -358,7 +363,7 @@ def _solve_section(
             f"got {type(parameters).__name__}"
         )
     solver = solver or SolverSpec()
-    _check(parameters, levels, solver, design, comm)
+    warnings = _check(parameters, levels, solver, design, comm)
     certificate: Certificate | None = None
     method, reason = choose_section_method(parameters, solver)
     logger.info("section: method %s (%s)", method, reason)
@@ -392,6 +397,7 @@ def _solve_section(
         column = column_note(parameters, result.critical_load_Pa, solution is not None)
         if column is not None:
             logger.warning("%s", column)
+        result.warnings = [*warnings, *([] if column is None else [column])]
         if design is not None:
             result.design = _design(parameters, design, result, certificate, column)
     except BaseException:
@@ -461,8 +467,10 @@ def _check(
     solver: SolverSpec,
     design: DesignSpec | None,
     comm: MPI.Comm,
-) -> None:
+) -> list[str]:
     """Refuse what no solve should start with, and warn of walls or cells out of range.
+
+    Returns the warnings logged (the result's ``warnings``).
 
     Raises:
         InputError: ``levels`` not an integer >= 0; a hollow section given a core's
@@ -495,9 +503,10 @@ def _check(
         check_steel_modulus(parameters.E, *stress)
         check_steel_yield_stress(design.yield_stress, *stress)
         notes.append(steel_poisson_note(parameters.nu))
-    for note in notes:
-        if note is not None:
-            logger.warning("%s", note)
+    found = [note for note in notes if note is not None]
+    for note in found:
+        logger.warning("%s", note)
+    return found
 
 
 def _design(

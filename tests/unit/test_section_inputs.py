@@ -227,3 +227,49 @@ def test_solve_section_refuses_options_beside_a_problem_file(tmp_path, monkeypat
     ):
         with pytest.raises(InputError, match=rf"with a problem file .*whose {key} is the one"):
             solve_section(spec, MPI.COMM_SELF, **options)
+
+
+def test_a_section_sweep_warns_of_coarse_cells_and_keeps_each_point_s_warnings(tmp_path, capsys):
+    """A hollow box swept over mesh.size 50 and 40 mm: 2 and 4 cells across a face (even).
+
+    The sweep silences its points' solves, so a section's warnings were said nowhere:
+    k came out 7.549 and 5.321 (the box's 4.51 on fine cells: 67 % and 18 % high) with
+    no word, and nothing in the points' lines. The plate's sweep says them once before
+    solving; a section's now too, and each line keeps its solve's ``warnings``.
+    """
+    import json
+
+    path = tmp_path / "hollow.toml"
+    path.write_text(
+        BOX.format(size=0.05, levels=1, obstacle="")
+        .replace("[obstacle]\ncore = true\n", "")
+        .replace("levels = 1\n", "")
+    )
+    out = tmp_path / "s.jsonl"
+    args = ["sweep", "--config", str(path), "--vary", "mesh.size=0.05,0.04"]
+    assert main([*args, "--json", str(out), "-q"]) == 0
+    err = capsys.readouterr().err
+    assert "2 of 2 sweep points have cells too coarse; point 0" in err, err
+    assert "mesh.size = 0.05 m gives 2 cells across the narrowest face" in err, err
+    lines = [json.loads(line) for line in out.read_text().splitlines()]
+    assert [len(line["warnings"]) for line in lines] == [1, 1]
+    assert "gives 2 cells across" in lines[0]["warnings"][0]
+    assert "gives 4 cells across" in lines[1]["warnings"][0]
+
+
+def test_a_hollow_column_s_warning_is_in_its_result():
+    """The column note, said after the solve, is kept in the result's warnings.
+
+    The hollow box 50 x 50 x 5 mm, 0.6 m between simply supported ends, on 12.5 mm cells
+    (tests/mpi/test_mpi.py's column): its critical stress is 0.94 times the Euler stress
+    pi^2 E (b^2/6)/L^2 = 2.40e9 Pa, and its cells 4 across a face (fewer than 5).
+    """
+    column = SectionParameters(
+        "box", width=0.05, depth=0.05, thickness=0.005, length=0.6, E=2.1e11, nu=0.3,
+        mesh_size=0.0125, ends="simply_supported",
+    )  # fmt: skip
+    with solve_section(column, MPI.COMM_SELF) as analysis:
+        warnings = analysis.result.warnings
+    assert len(warnings) == 2, warnings
+    assert "cells across the narrowest face" in warnings[0]
+    assert "Euler stress" in warnings[1] and "the mode is the column's" in warnings[1]
