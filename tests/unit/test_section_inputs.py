@@ -273,3 +273,17 @@ def test_a_hollow_column_s_warning_is_in_its_result():
     assert len(warnings) == 2, warnings
     assert "cells across the narrowest face" in warnings[0]
     assert "Euler stress" in warnings[1] and "the mode is the column's" in warnings[1]
+
+
+def test_cells_of_a_nanometre_are_counted_not_listed(tmp_path, monkeypatch):
+    """mesh.size = 1e-12 m on 0.3 m: 3e11 cells along, refused by the memory check at once.
+
+    Counting the span's nodes, the faces' cells and their widths built arrays of them
+    (a read of mesh.size = 1e-9 m ran out of the 120 s it was given, at 4 GB); they are
+    counted now (the mesh's own arithmetic, tested equal to its arrays in
+    tests/unit/model/test_shell_model.py).
+    """
+    monkeypatch.setattr("unibuckle_fenicsx.model.shell.section.section_mesh", _no_mesh)
+    spec = load_toml(_file(tmp_path, size=1e-12, levels=0, obstacle="span = [0.1, 0.2]"))
+    with pytest.raises(InputError, match=r"mesh.size = 1e-12 m gives about .* DOFs"):
+        solve_section(spec, MPI.COMM_SELF)

@@ -205,10 +205,19 @@ def check_span_nodes(
     (a, b), unit = in_file((x0, x1), "m", units)
     for k in range(levels + 1):
         n = cells_along(length, size * 2.0**k)
-        inside = [i for i in range(n + 1) if x0 - tol <= i * length / n <= x1 + tol]
-        if any(0 < i < n for i in inside):
+
+        def first(least: int, n: int = n) -> int:
+            """The first node i >= least at or past x0 (n + 1: none): O(1), any n."""
+            i = max(least, math.floor((x0 - tol) * n / length))
+            while i <= n and i * length / n < x0 - tol:
+                i += 1
+            return i
+
+        interior, any_node = first(1), first(0)
+        if interior < n and interior * length / n <= x1 + tol:
             continue
-        what = "only nodes held by the end supports" if inside else "no node of the mesh"
+        held = any_node <= n and any_node * length / n <= x1 + tol
+        what = "only nodes held by the end supports" if held else "no node of the mesh"
         cells, _ = in_file(size * 2.0**k, "m", units)
         where = (
             f"the cells of mesh.size = {cells:g} {unit}"
