@@ -45,7 +45,7 @@ import numpy.typing as npt
 
 from unibuckle_fenicsx.algorithms import UnilateralSolution
 from unibuckle_fenicsx.algorithms.registry import choose_section_method, entry
-from unibuckle_fenicsx.algorithms.section_levels import check_levels
+from unibuckle_fenicsx.algorithms.section_levels import estimated_dofs
 from unibuckle_fenicsx.certificate.certify import Certificate, certify, certify_foundation
 from unibuckle_fenicsx.en1993 import (
     check_steel_modulus,
@@ -56,6 +56,7 @@ from unibuckle_fenicsx.en1993 import (
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.problem import Mode
+from unibuckle_fenicsx.model.resources import check_section_memory
 from unibuckle_fenicsx.model.shell.geometry import cell_length, face_cell_width, tube_facet_width
 from unibuckle_fenicsx.model.shell.section import (
     Section,
@@ -84,7 +85,12 @@ from unibuckle_fenicsx.spec import (
 )
 from unibuckle_fenicsx.spec.base import FILE_UNITS, file_units, in_file
 from unibuckle_fenicsx.spec.plate import THICK_PLATE_RATIO
-from unibuckle_fenicsx.spec.section import DEFAULT_LEVELS
+from unibuckle_fenicsx.spec.section import (
+    DEFAULT_LEVELS,
+    check_core_options,
+    check_section_mesh,
+    check_section_solver,
+)
 
 __all__ = [
     "COLUMN_FRACTION",
@@ -122,7 +128,11 @@ class SectionResult(BucklingResult, kw_only=True):
     (None for a tube); ``mesh`` is [cells along, cells around]; ``dofs`` counts the
     six components of every node; ``constrained_nodes`` counts the core's constrained
     *directions* (a box's corner node has two), ``contact_coordinates`` their unrolled
-    (x, s) (m along the member, m around the mid-line); ``input`` is the section's
+    (x, s) (m along the member, m around the mid-line), ``contact_indices`` their numbers
+    (ordered by (x, s), the same on any number of ranks); ``contact_dofs`` are the
+    rows of the rotated pencil in DOLFINx's numbering of the distributed mesh, which
+    depends on the number of MPI ranks (its partition): compare runs by
+    ``contact_indices`` or ``contact_coordinates``, not by them; ``input`` is the section's
     problem file (:func:`~unibuckle_fenicsx.spec.problem_to_dict`) when one was solved,
     else ``{"section": the parameters}``; ``critical_force_N_per_m`` is the extreme
     fibre's :math:`t\sigma` (``compression_Pa``); ``design``, with a ``[design]`` table, is a
@@ -142,11 +152,16 @@ class SectionResult(BucklingResult, kw_only=True):
             (Pa, <= 0: none), its own buckling coefficient :math:`\sigma t w^2/(\pi^2 D)`
             with that stress (NaN, null in JSON, without compression), its constrained
             directions and those in contact with the core (pressing a foundation).
+        warnings: The warnings the solve logged, in its order: a thick wall, cells too
+            coarse (or a tube thinner than the cell rule's range), a design's Poisson's
+            ratio not a steel's, the member's column mode near its load (kept here
+            for a sweep's points, whose solves print none).
     """
 
     classical_stress_Pa: float = math.nan
     compression_Pa: float = math.nan
     faces: list[dict[str, str | float]] = msgspec.field(default_factory=list)
+    warnings: list[str] = msgspec.field(default_factory=list)
 
     def _bending(self) -> float:
         """The input's ``bending_stress`` (0 by default in a file's ``[load]``); NaN unknown."""
@@ -289,14 +304,15 @@ def solve_section(
             checked when built: bad keys raise :class:`~unibuckle_fenicsx.errors.InputError`),
             or a section's problem file
             (:class:`~unibuckle_fenicsx.spec.section.SectionProblemSpec`: its
-            ``mesh.levels``, ``[solver]`` and ``[design]`` replace ``levels``, ``solver``
-            and ``design``, the result's ``case`` is the file's ``name`` and its ``input``
-            the file, which re-runs it).
+            ``mesh.levels``, ``[solver]`` and ``[design]`` are solved, and ``levels``,
+            ``solver`` and ``design`` given beside it refused; the result's ``case`` is
+            the file's ``name`` and its ``input`` the file, which re-runs it).
         comm: Communicator; the mesh is distributed over it.
         levels: With a core, coarser sections (each with twice the mesh size) the search
             starts on, >= 0 (:func:`~unibuckle_fenicsx.algorithms.section_levels.solve_levels`:
             the interior point's starts, or the active set's seeds). 1 by default: the
             starts' many steps on a section of a quarter of the DOFs, a few on the given one.
+            Without a core, refused (as the file's ``mesh.levels``) if not the default.
         solver: Solver options (the method, one of
             :data:`~unibuckle_fenicsx.spec.section.SECTION_METHODS`, chosen by
             :func:`~unibuckle_fenicsx.algorithms.registry.choose_section_method`; tolerances, the
@@ -309,8 +325,11 @@ def solve_section(
 
     Raises:
         TypeError: ``parameters`` is not a SectionParameters.
-        InputError: ``levels`` out of range, or a method no section runs
-            (``solver.method``).
+        InputError: ``levels`` out of range (its coarsest section without 2 cells
+            along, or a core's span without a free node on it), a method no section runs
+            (``solver.method``), or what the problem file refuses: a core's search
+            options (``levels``, ``solver.tau``, ``solver.max_iterations``) given to a
+            section without a core, a plate's solver option; all before any mesh.
         NumericalError: An eigen solve did not converge.
 
     Note:
@@ -334,6 +353,7 @@ def _solve_section(
     echo: dict[str, object] | None = None
     units, name = "SI", None
     if isinstance(parameters, SectionProblemSpec):
+        _file_holds_them(parameters, levels, solver, design)
         echo, name = problem_to_dict(parameters), parameters.name
         levels, solver, design = parameters.mesh.levels, parameters.solver, parameters.design
         units = parameters.units
@@ -343,9 +363,9 @@ def _solve_section(
             f"solve_section: parameters must be a SectionParameters or a SectionProblemSpec, "
             f"got {type(parameters).__name__}"
         )
-    _check(parameters, levels, design)
-    certificate: Certificate | None = None
     solver = solver or SolverSpec()
+    warnings = _check(parameters, levels, solver, design, comm)
+    certificate: Certificate | None = None
     method, reason = choose_section_method(parameters, solver)
     logger.info("section: method %s (%s)", method, reason)
     section, solution = _solve(parameters, int(levels), comm, method, solver)
@@ -378,12 +398,40 @@ def _solve_section(
         column = column_note(parameters, result.critical_load_Pa, solution is not None)
         if column is not None:
             logger.warning("%s", column)
+        result.warnings = [*warnings, *([] if column is None else [column])]
         if design is not None:
             result.design = _design(parameters, design, result, certificate, column)
     except BaseException:
         section.destroy()
         raise
     return SectionAnalysis(result, section, solution, certificate)
+
+
+def _file_holds_them(
+    spec: SectionProblemSpec, levels: int, solver: SolverSpec | None, design: DesignSpec | None
+) -> None:
+    """Refuse ``levels``, ``solver`` or ``design`` given beside a problem file, which holds them.
+
+    The file's ``mesh.levels``, ``[solver]`` and ``[design]`` are the ones solved; an
+    argument beside it was ignored.
+    """
+    given = {  # argument: (its key in the file, the spec's field, given)
+        "levels": ("mesh.levels", "mesh", levels != DEFAULT_LEVELS),
+        "solver": ("[solver]", "solver", solver is not None),
+        "design": ("[design]", "design", design is not None),
+    }
+    for argument, (key, field, set_) in given.items():
+        if set_:
+            value = (
+                f"msgspec.structs.replace(spec.mesh, levels={levels!r})"
+                if argument == "levels"
+                else argument
+            )
+            raise InputError(
+                f"solve_section: {argument} is given with a problem file "
+                f"(SectionProblemSpec), whose {key} is the one solved: set it in the file "
+                f"(msgspec.structs.replace(spec, {field}={value}))"
+            )
 
 
 #: Fewer cells than this across a box's narrowest face draw a warning: there the hollow
@@ -414,21 +462,42 @@ MAX_CALIBRATED_RADIUS_RATIO = 800.0
 MIN_ALONG_CELLS = 6
 
 
-def _check(parameters: SectionParameters, levels: int, design: DesignSpec | None) -> None:
+def _check(
+    parameters: SectionParameters,
+    levels: int,
+    solver: SolverSpec,
+    design: DesignSpec | None,
+    comm: MPI.Comm,
+) -> list[str]:
     """Refuse what no solve should start with, and warn of walls or cells out of range.
 
+    Returns the warnings logged (the result's ``warnings``).
+
     Raises:
-        InputError: ``levels`` not an integer >= 0, or (a rigid core, or an elastic one
-            given other than the default levels) its coarsest section without 2 cells
-            along; a design output asked of a wall whose
-            E is not a steel's (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`).
+        InputError: ``levels`` not an integer >= 0; a hollow section given a core's
+            search options (``levels``, ``solver.tau``, ``solver.max_iterations``:
+            :func:`~unibuckle_fenicsx.spec.section.check_core_options`) or any section a
+            plate's solver option; cells or levels the section cannot have, or a core's
+            span holding no free node of a section the search runs on
+            (:func:`~unibuckle_fenicsx.spec.section.check_section_mesh`); a design output
+            asked of a wall whose E is not a steel's
+            (:func:`~unibuckle_fenicsx.en1993.check_steel_modulus`); cells whose DOFs,
+            estimated before meshing, need more memory than the ranks have
+            (:func:`~unibuckle_fenicsx.model.resources.check_section_memory`). Collective.
     """
     if isinstance(levels, bool) or int(levels) != levels or levels < 0:
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
-    # A rigid core's levels; an elastic core's when given (its rigid start's, which
-    # takes the default's as far as the section allows them).
-    if parameters.core and (parameters.foundation_stiffness is None or levels != DEFAULT_LEVELS):
-        check_levels(parameters, int(levels))
+    p = parameters
+    # The file's own checks (its reader ran them already): a core's options on a hollow
+    # section, a plate's options, the cells, levels and span.
+    check_core_options(p.core, int(levels), solver, {"mesh.levels": "levels"})
+    check_section_solver(solver)
+    check_section_mesh(
+        size=p.mesh_size, length=p.length, levels=int(levels), core=p.core,
+        elastic=p.foundation_stiffness is not None, span=p.core_span,
+        across=max(float(v or 0.0) for v in (p.width, p.depth, p.diameter)),
+    )  # fmt: skip
+    check_section_memory(estimated_dofs(p), p.mesh_size, comm)
     notes = [thick_wall_note(parameters), coarse_mesh_note(parameters)]
     if design is not None:
         stress = UNITS[FILE_UNITS.get()][1:]
@@ -438,9 +507,10 @@ def _check(parameters: SectionParameters, levels: int, design: DesignSpec | None
         notes.append(
             yield_stress_note(design.yield_stress, parameters.thickness, "section.thickness")
         )
-    for note in notes:
-        if note is not None:
-            logger.warning("%s", note)
+    found = [note for note in notes if note is not None]
+    for note in found:
+        logger.warning("%s", note)
+    return found
 
 
 def _design(

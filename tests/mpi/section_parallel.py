@@ -3,7 +3,8 @@
 ``mpiexec -n P python tests/mpi/section_parallel.py`` solves :data:`SECTIONS` (a small box
 hollow, with a rigid core and with an elastic one) with
 :func:`~unibuckle_fenicsx.section_analysis.solve_section` on ``COMM_WORLD`` and prints
-``{name: [critical load, free load, contact directions, KKT]}``; :func:`collect` is the
+``{name: [critical load, free load, contact directions, KKT]}`` (and the rigid core's
+``contact_indices`` and ``contact_dofs``); :func:`collect` is the
 same on any communicator (the serial run of ``tests/test_mpi.py``).
 """
 
@@ -32,10 +33,13 @@ def collect(comm: MPI.Comm) -> dict[str, Any]:
     out = {}
     for name, changes in SECTIONS.items():
         params = SectionParameters("box", **BOX, **changes)
-        with solve_section(params, comm, levels=0) as analysis:
+        levels = {"levels": 0} if params.core else {}  # a hollow section takes none
+        with solve_section(params, comm, **levels) as analysis:
             r = analysis.result
             kkt = None if r.certificate is None else r.certificate.kkt
             out[name] = [r.critical_load_Pa, r.free_load_Pa, r.contact_nodes, kkt]
+            if name == "rigid core":
+                out["rigid core's contact"] = [r.contact_indices, r.contact_dofs]
     return out
 
 

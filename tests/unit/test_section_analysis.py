@@ -269,7 +269,7 @@ def test_cells_too_coarse_for_the_buckles_draw_a_warning(caplog):
     assert note is not None and "2.6 cells" in note and "fewer than 4" in note
     # The warning is logged by the solve (a hollow box on two cells a face: a free solve).
     with caplog.at_level(logging.WARNING, logger="unibuckle_fenicsx.section_analysis"):
-        with solve_section(_box(mesh_size=0.05, core=False), MPI.COMM_SELF, levels=0):
+        with solve_section(_box(mesh_size=0.05, core=False), MPI.COMM_SELF):
             pass
     assert any("cells across the narrowest face" in r.getMessage() for r in caplog.records)
 

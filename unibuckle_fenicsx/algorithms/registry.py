@@ -57,7 +57,6 @@ from unibuckle_fenicsx.algorithms.section_levels import (
     CHECKED,
     INTERIOR_POINT_DOFS,
     estimated_dofs,
-    most_levels,
     prolong_directions,
     solve_levels,
 )
@@ -66,7 +65,7 @@ from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import OPTIONS, FoundationOptions, Method, ProblemSpec, SolverSpec
 from unibuckle_fenicsx.spec.base import Table
-from unibuckle_fenicsx.spec.section import check_section_method
+from unibuckle_fenicsx.spec.section import check_section_method, most_levels
 from unibuckle_fenicsx.spec.solver import (
     ActiveSetOptions,
     EnumerateOptions,
@@ -290,8 +289,9 @@ def _rigid_core_set(
 
     The route "auto" takes for the same section with a rigid core
     (:func:`~unibuckle_fenicsx.algorithms.registry.choose_section_method`), on ``levels`` coarser
-    sections or as many as it allows (:func:`~.section_levels.most_levels`), none if a
-    coarser section cannot be built (the elastic core asks no levels); its contact
+    sections or as many as it allows
+    (:func:`~unibuckle_fenicsx.spec.section.most_levels`), none if a coarser section
+    cannot be built (the elastic core asks no levels); its contact
     set is carried to ``section``'s directions (the same mesh:
     :func:`~.section_levels.prolong_directions` maps each direction to itself). The
     active set on the elastic core's own problem can end at a higher KKT point than the
@@ -303,7 +303,7 @@ def _rigid_core_set(
     runner = entry(method).solve_section
     if runner is None or section.constraints is None:
         raise RuntimeError("the rigid core's route has no section runner")
-    levels = min(levels, most_levels(rigid))
+    levels = min(levels, most_levels(rigid.mesh_size, rigid.length))
     try:
         rigid_section, solution = runner(rigid, levels, comm, solver)
     except InputError:  # a coarser section the core covers no node of: the given one's

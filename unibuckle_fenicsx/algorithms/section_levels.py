@@ -87,6 +87,7 @@ from unibuckle_fenicsx.model.shell.prolong import SectionProlongation
 from unibuckle_fenicsx.model.shell.section import Section, SectionParameters, build_section
 from unibuckle_fenicsx.spec import SolverSpec
 from unibuckle_fenicsx.spec.base import in_file
+from unibuckle_fenicsx.spec.section import check_levels, most_levels
 
 __all__ = [
     "BOTH",
@@ -100,7 +101,6 @@ __all__ = [
     "SEEDS",
     "estimated_dofs",
     "interior_levels",
-    "most_levels",
     "prolong_directions",
     "solve_levels",
 ]
@@ -235,7 +235,7 @@ def solve_levels(
         raise InputError(f"levels must be an integer >= 0, got {levels!r}")
     if route not in ROUTES:
         raise InputError(f"route must be one of {ROUTES}, got {route!r}")
-    check_levels(parameters, levels)
+    check_levels(parameters.mesh_size, parameters.length, levels)
     if route in ("interior-point", BOTH, CHECKED):
         more = interior_levels(parameters, levels)
         return _interior_point(parameters, more, comm, solver, levels, max_iterations, route=route)
@@ -256,7 +256,7 @@ def interior_levels(parameters: SectionParameters, levels: int) -> int:
 
     More while the coarsest keeps :data:`COARSEST_DOFS` (estimated: :func:`estimated_dofs`).
     """
-    k, most = 0, most_levels(parameters)
+    k, most = 0, most_levels(parameters.mesh_size, parameters.length)
     while k < most and estimated_dofs(_at(parameters, 2.0 ** (k + 1))) >= COARSEST_DOFS:
         k += 1
     return max(levels, k)
@@ -589,30 +589,6 @@ def _active_set(
     # solve is the result's own.
     total = sum(level.eigensolves for level in log) - prev.problem.free_solves
     return prev, replace(best, details=details, eigensolves=total)
-
-
-def most_levels(parameters: SectionParameters) -> int:
-    """The most coarser sections with 2 cells along the member (SectionParameters accepts)."""
-    most = 0
-    while parameters.mesh_size * 2.0 ** (most + 1) * (1.0 + 1e-9) < parameters.length:
-        most += 1
-    return most
-
-
-def check_levels(parameters: SectionParameters, levels: int) -> None:
-    """Refuse ``levels`` whose coarsest section has fewer than 2 cells along the member.
-
-    The message in the units of the file solved (:func:`~unibuckle_fenicsx.spec.base.file_units`).
-    """
-    most = most_levels(parameters)
-    if levels > most:
-        coarsest, name = in_file(parameters.mesh_size * 2.0**levels, "m")
-        length, _ = in_file(parameters.length, "m")
-        raise InputError(
-            f"mesh.levels = {levels}: the coarsest section's cells, mesh.size x 2^{levels} = "
-            f"{coarsest:g} {name}, are not below section.length = "
-            f"{length:g} {name} (at least 2 cells along): mesh.levels <= {most} here"
-        )
 
 
 def _level(

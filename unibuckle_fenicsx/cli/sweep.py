@@ -35,9 +35,10 @@ def _warn_points(points: list[Any], specs: list[Any], comm: Any) -> None:
 
     Each kind of ``unibuckle solve``'s warnings before its solve
     (:func:`~unibuckle_fenicsx.cli.problem.input_notes`: E in another unit, the plate
-    model's range, a design material) and of a plate's cells too coarse: the note of the
-    first such point, and how many there are; a section's cells are checked by its
-    solve (the point's JSON line). ``points`` and their problems ``specs`` are those
+    model's range, a design material) and of cells too coarse: the note of the first
+    such point, and how many there are. A section's are those its solve logs before
+    it starts (:func:`_section_notes`), which the sweep's silenced solves do not print.
+    ``points`` and their problems ``specs`` are those
     :func:`~unibuckle_fenicsx.sweep.run_sweep` read (its ``check``).
     """
     import sys
@@ -49,7 +50,9 @@ def _warn_points(points: list[Any], specs: list[Any], comm: Any) -> None:
     found: dict[str, list[tuple[int, Any, str]]] = {}
     for k, (point, spec) in enumerate(zip(points, specs, strict=True)):
         notes = input_notes(spec)
-        if not isinstance(spec, SectionProblemSpec):
+        if isinstance(spec, SectionProblemSpec):
+            notes.update(_section_notes(spec))
+        else:
             coarse = coarse_mesh_note(spec.plate, spec.mesh, spec.units)
             if coarse is not None:
                 notes["coarse"] = coarse
@@ -65,6 +68,30 @@ def _warn_points(points: list[Any], specs: list[Any], comm: Any) -> None:
             f"point {k} {point}: {note}",
             file=sys.stderr,
         )
+
+
+def _section_notes(spec: Any) -> dict[str, str]:
+    """A section's warnings before its solve, by kind: cells too coarse, a thick wall.
+
+    Those :func:`~unibuckle_fenicsx.section_analysis.solve_section` logs before it
+    starts (its ``coarse_mesh_note``, ``thick_wall_note``, and with ``[design]`` the
+    steel's Poisson's ratio), in the file's units.
+    """
+    from unibuckle_fenicsx.en1993 import steel_poisson_note
+    from unibuckle_fenicsx.model.shell.section import section_parameters
+    from unibuckle_fenicsx.section_analysis import coarse_mesh_note, thick_wall_note
+    from unibuckle_fenicsx.spec.base import file_units
+
+    parameters = section_parameters(spec)
+    with file_units(spec.units):
+        notes = {
+            "coarse": coarse_mesh_note(parameters),
+            "thick wall": thick_wall_note(parameters),
+            "design material": None
+            if spec.design is None
+            else steel_poisson_note(spec.material.nu),
+        }
+    return {kind: note for kind, note in notes.items() if note is not None}
 
 
 def sweep_columns(lines: list[dict[str, Any]]) -> tuple[list[str], list[list[Any]]]:
@@ -179,7 +206,8 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
         except ImportError:
             return fail("--plot needs matplotlib: pip install 'unibuckle_fenicsx[demo]'")
     # Each point's own progress lines and warnings would interleave with the sweep's
-    # (the warnings are in the point's JSON line, under details).
+    # (a plate's warnings are in the point's JSON line, under details; those before the
+    # solve, a plate's and a section's, are said once for all points: _warn_points).
     if args.verbose == 0:
         logging.getLogger("unibuckle_fenicsx").setLevel(logging.ERROR)
         logging.getLogger("unibuckle_fenicsx.progress").setLevel(logging.ERROR)

@@ -196,7 +196,9 @@ class BucklingResult(Struct, kw_only=True):
         p_star: Enumeration: the contact-set size where it stopped.
         contact_coordinates: Coordinates of Z, (|Z|, 2).
         contact_indices: Node numbers of Z (lexicographic (y, x) order of the zone).
-        contact_dofs: Global W DOF indices of Z (partition-dependent numbering).
+        contact_dofs: Global W DOF indices of Z, in DOLFINx's numbering of the
+            distributed mesh: they depend on the number of MPI ranks (its partition);
+            ``contact_indices`` and ``contact_coordinates`` do not.
         load_resolution: How closely double precision fixes the critical load, relative
             to it (:meth:`~unibuckle_fenicsx.model.problem.Problem.load_resolution`);
             digits beyond it are rounding. None for a tensionless foundation (the

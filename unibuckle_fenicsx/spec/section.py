@@ -8,13 +8,14 @@ the compressive axial stress in Pa when ``axial_stress = -1``.
 
 from __future__ import annotations
 
+import math
 from typing import Annotated, ClassVar, Literal
 
 import msgspec
 from msgspec import Meta
 
 from unibuckle_fenicsx.en1993 import check_steel_modulus, check_steel_yield_stress
-from unibuckle_fenicsx.errors import FieldError
+from unibuckle_fenicsx.errors import FieldError, InputError
 from unibuckle_fenicsx.spec.base import UNITS, Table, Units, in_file, unit
 from unibuckle_fenicsx.spec.obstacles import DesignSpec
 from unibuckle_fenicsx.spec.solver import Method, SolverSpec, default
@@ -73,11 +74,15 @@ SEARCH_OPTIONS = {
 }
 
 
-def check_core_options(core: bool, levels: int, solver: SolverSpec) -> None:
+def check_core_options(
+    core: bool, levels: int, solver: SolverSpec, names: dict[str, str] | None = None
+) -> None:
     """Refuse a search option given (other than its default) to a section without a core.
 
     Such a section is its free solve: none of :data:`SEARCH_OPTIONS` applies. A default
-    value is taken, as a result's echoed ``input`` holds every key.
+    value is taken, as a result's echoed ``input`` holds every key. The same table and
+    message for a file and for :func:`~unibuckle_fenicsx.section_analysis.solve_section`'s
+    arguments (``names``: a key's argument, named after it, e.g. ``levels``).
 
     Raises:
         FieldError: Such an option given (an :class:`~unibuckle_fenicsx.errors.InputError`
@@ -93,12 +98,172 @@ def check_core_options(core: bool, levels: int, solver: SolverSpec) -> None:
     for key, what in SEARCH_OPTIONS.items():
         value, unset = given[key]
         if value != unset:
+            argument = (names or {}).get(key)
             raise FieldError(
                 "",
                 key,
-                f" = {value!r} sets {what}; a section without a core (obstacle.core = "
-                "false) is its free solve: leave it out",
+                f" = {value!r}{f' ({argument})' if argument else ''} sets {what}; a section "
+                "without a core (obstacle.core = false) is its free solve: leave it out",
             )
+
+
+def check_section_solver(solver: SolverSpec) -> None:
+    """Refuse a plate's ``[solver]`` option (one not of :data:`SOLVER_KEYS`) given to a section.
+
+    Raises:
+        FieldError: Such an option other than its default (naming ``solver.KEY``).
+    """
+    plate_default = SolverSpec()
+    for key in SolverSpec.__struct_fields__:
+        if key not in SOLVER_KEYS and getattr(solver, key) != getattr(plate_default, key):
+            takes = ", ".join(f"solver.{k}" for k in SOLVER_KEYS)
+            raise FieldError("", f"solver.{key}", f" is a plate's option; a section takes {takes}")
+
+
+#: Relative rounding of the mesh's arithmetic: L/h within it of a whole number n gives n
+#: cells along, and a node within it (of the section's size) of a span's end lies in it.
+_ROUNDING = 1e-9
+
+
+def cells_along(length: float, size: float) -> int:
+    """The cells of ``size`` (m) a section's mesh puts along its ``length``: ceil(L/h), >= 1.
+
+    :mod:`~unibuckle_fenicsx.model.shell.geometry` meshes with it; the checks of a file's
+    ``[mesh]`` read it before any mesh is made.
+    """
+    return max(1, math.ceil(length / size - _ROUNDING))
+
+
+def check_cells_along(size: float, length: float, units: str | None = None) -> None:
+    """Refuse a cell size ``size`` not below ``length`` (m): 2 cells along at least.
+
+    The message in ``units`` (None: those of the file read or solved,
+    :func:`~unibuckle_fenicsx.spec.base.file_units`).
+
+    Raises:
+        InputError: Naming ``mesh.size`` and its range.
+    """
+    if size * (1.0 + _ROUNDING) >= length:  # cells_along: ceil(L/h)
+        (h, name), (L, _) = in_file(size, "m", units), in_file(length, "m", units)
+        raise InputError(
+            f"mesh.size = {h:g} {name} must be below section.length = {L:g} {name}: the "
+            "section needs at least 2 cells along its length (the nodes of its loaded ends "
+            "are supported)"
+        )
+
+
+def most_levels(size: float, length: float) -> int:
+    """The most coarser sections (cells of ``size`` doubled) keeping 2 cells along ``length``."""
+    most = 0
+    while size * 2.0 ** (most + 1) * (1.0 + _ROUNDING) < length:
+        most += 1
+    return most
+
+
+def check_levels(size: float, length: float, levels: int, units: str | None = None) -> None:
+    """Refuse ``levels`` whose coarsest section has fewer than 2 cells along the member.
+
+    The message in ``units`` (None: those of the file read or solved).
+
+    Raises:
+        InputError: Naming ``mesh.levels`` and its range here (<= :func:`most_levels`).
+    """
+    most = most_levels(size, length)
+    if levels > most:
+        coarsest, name = in_file(size * 2.0**levels, "m", units)
+        L, _ = in_file(length, "m", units)
+        raise InputError(
+            f"mesh.levels = {levels}: the coarsest section's cells, mesh.size x 2^{levels} = "
+            f"{coarsest:g} {name}, are not below section.length = "
+            f"{L:g} {name} (at least 2 cells along): mesh.levels <= {most} here"
+        )
+
+
+def check_span_nodes(
+    span: tuple[float, float],
+    length: float,
+    size: float,
+    levels: int,
+    across: float,
+    units: str | None = None,
+) -> None:
+    """Refuse a core's ``span`` holding no free node of the section or of a coarser one.
+
+    The nodes along the member lie at :math:`x_i = iL/n`, n = :func:`cells_along`; those
+    of the loaded ends (i = 0, n) are held by the end supports (their normal motion, at
+    both kinds of ends), so the span needs some :math:`0 < i < n` within it (to the
+    mesh's tolerance, :data:`_ROUNDING` of the section's largest dimension, ``across``
+    or ``length``), on the given cells and on each of the ``levels`` coarser sections
+    a rigid core's search starts on (each with twice the cells' size).
+
+    Raises:
+        InputError: Naming ``obstacle.span`` (and ``mesh.levels`` when a coarser section
+            has no node in it), with what to change.
+    """
+    x0, x1 = span
+    tol = _ROUNDING * max(length, across)
+    (a, b), unit = in_file((x0, x1), "m", units)
+    for k in range(levels + 1):
+        n = cells_along(length, size * 2.0**k)
+
+        def first(least: int, n: int = n) -> int:
+            """The first node i >= least at or past x0 (n + 1: none): O(1), any n."""
+            i = max(least, math.floor((x0 - tol) * n / length))
+            while i <= n and i * length / n < x0 - tol:
+                i += 1
+            return i
+
+        interior, any_node = first(1), first(0)
+        if interior < n and interior * length / n <= x1 + tol:
+            continue
+        held = any_node <= n and any_node * length / n <= x1 + tol
+        what = "only nodes held by the end supports" if held else "no node of the mesh"
+        cells, _ = in_file(size * 2.0**k, "m", units)
+        where = (
+            f"the cells of mesh.size = {cells:g} {unit}"
+            if k == 0
+            else f"the coarser section of mesh.levels = {levels} with cells {cells:g} {unit} "
+            f"(mesh.size doubled {k} time{'s' if k > 1 else ''})"
+        )
+        change = "lengthen obstacle.span or refine mesh.size" + (
+            f", or lower mesh.levels to {k - 1}{' or less' if k > 1 else ''}" if k else ""
+        )
+        raise InputError(
+            f"obstacle.span = [{a:g}, {b:g}] {unit}: the core covers no free node: its span "
+            f"(obstacle.span) holds {what} on {where}; {change}"
+        )
+
+
+def check_section_mesh(
+    *,
+    size: float,
+    length: float,
+    levels: int,
+    core: bool,
+    elastic: bool,
+    span: tuple[float, float] | None,
+    across: float,
+    units: str | None = None,
+) -> None:
+    """What a section's cells and ``mesh.levels`` must allow, checked before any mesh.
+
+    2 cells along (:func:`check_cells_along`); with a rigid core, ``levels`` coarser
+    sections of 2 cells along (:func:`check_levels`), each with a free node in the core's
+    ``span`` (:func:`check_span_nodes`). An elastic core's rigid start takes the default
+    levels as far as the section allows them, so only levels given other than the default
+    are checked, and its span on the given cells only (its start falls back on them). The
+    problem file's :meth:`SectionProblemSpec.check` and
+    :func:`~unibuckle_fenicsx.section_analysis.solve_section` call it.
+
+    Raises:
+        InputError: Naming ``mesh.size``, ``mesh.levels`` or ``obstacle.span`` and the
+            range allowed.
+    """
+    check_cells_along(size, length, units)
+    if core and (not elastic or levels != DEFAULT_LEVELS):
+        check_levels(size, length, levels, units)
+    if core and span is not None:
+        check_span_nodes(span, length, size, 0 if elastic else levels, across, units)
 
 
 class SectionSpec(Table, frozen=True):
@@ -292,11 +457,14 @@ class SectionProblemSpec(Table, frozen=True):
         elastic = self.obstacle.foundation_stiffness is not None
         check_section_method(self.solver.method, self.obstacle.core, elastic)
         check_core_options(self.obstacle.core, self.mesh.levels, self.solver)
+        check_section_solver(self.solver)
+        s = self.section
+        check_section_mesh(
+            size=self.mesh.size, length=s.length, levels=self.mesh.levels,
+            core=self.obstacle.core, elastic=elastic, span=span,
+            across=max(float(v or 0.0) for v in (s.width, s.depth, s.diameter)),
+            units=self.units,
+        )  # fmt: skip
         if self.design is not None:
             check_steel_modulus(self.material.E, *UNITS[self.units][1:])
             check_steel_yield_stress(self.design.yield_stress, *UNITS[self.units][1:])
-        plate_default = SolverSpec()
-        for key in SolverSpec.__struct_fields__:
-            if key not in SOLVER_KEYS and getattr(self.solver, key) != getattr(plate_default, key):
-                takes = ", ".join(f"solver.{k}" for k in SOLVER_KEYS)
-                raise self.error(f"solver.{key}", f" is a plate's option; a section takes {takes}")

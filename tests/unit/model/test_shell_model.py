@@ -241,3 +241,21 @@ def test_bad_section_input_is_refused(changes, key):
     }  # fmt: skip
     with pytest.raises(InputError, match=key.replace(".", r"\.")):
         SectionParameters(**{**base, **changes})
+
+
+@pytest.mark.parametrize("corner", [None, 0.001, 0.004])
+def test_a_face_s_cells_are_counted_as_the_mesh_places_them(corner):
+    """grid_nodes and face_cell_width count a face's cells without its arrays: equal to them.
+
+    Box faces 0.013 to 0.3 m on cells of 5 mm to 0.2 m, uniform and graded at the corners
+    (a box_mesh face's nodes: _face_fractions).
+    """
+    from unibuckle_fenicsx.model.shell.geometry import _face_fractions, face_cell_width, grid_nodes
+
+    for extent in (0.013, 0.05, 0.1, 0.2, 0.3):
+        for size in (0.005, 0.0125, 0.02, 0.07, 0.2):
+            nodes = _face_fractions(extent, size, corner)
+            around, _ = grid_nodes("box", (extent, extent), 1.0, size, corner)
+            assert around == 4 * (nodes.size - 1), (extent, size)
+            widest = extent * float(np.diff(nodes).max())
+            assert face_cell_width(extent, size, corner) == pytest.approx(widest, rel=1e-12)

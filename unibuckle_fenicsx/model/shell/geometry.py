@@ -37,6 +37,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.spec.section import cells_along
 
 __all__ = [
     "END_FINISH",
@@ -143,8 +144,12 @@ def _cells_for(extent: float, size: float, even: bool = True, least: int = 2) ->
 
 
 def _cells_along(length: float, size: float) -> int:
-    """Cells along x of every section mesh: ceil(L/size), at least one."""
-    return _cells_for(length, size, even=False, least=1)
+    """Cells along x of every section mesh: ceil(L/size), at least one.
+
+    :func:`~unibuckle_fenicsx.spec.section.cells_along`: the problem file's checks count
+    them the same way before any mesh is made.
+    """
+    return cells_along(length, size)
 
 
 def _facets(diameter: float, size: float) -> int:
@@ -164,19 +169,29 @@ def _face_fractions(extent: float, size: float, first: float | None) -> npt.NDAr
     ``size``, symmetrically, with an even number of cells in the uniform middle part
     (a node at the middle of the face).
     """
+    widths, n_mid, middle = _face_grading(extent, size, first)
     if first is None or first >= size:
-        n = _cells_for(extent, size)
-        return np.arange(n + 1) / n
-    widths: list[float] = []
-    w = first
-    while w < size and 2.0 * (sum(widths) + w) < extent - 2.0 * size:
-        widths.append(w)
-        w *= GRADING_RATIO
-    middle = extent - 2.0 * sum(widths)
-    n_mid = _cells_for(middle, size)
+        return np.arange(n_mid + 1) / n_mid
     cells = widths + [middle / n_mid] * n_mid + widths[::-1]
     edges = np.concatenate([[0.0], np.cumsum(cells)])
     return edges / edges[-1]
+
+
+def _face_grading(
+    extent: float, size: float, first: float | None
+) -> tuple[list[float], int, float]:
+    """A face's graded cells at one corner, its middle part's cell count and width (m).
+
+    :func:`_face_fractions`'s cells without their arrays (uniform: no graded cells).
+    """
+    widths: list[float] = []
+    if first is not None and first < size:
+        w = first
+        while w < size and 2.0 * (sum(widths) + w) < extent - 2.0 * size:
+            widths.append(w)
+            w *= GRADING_RATIO
+    middle = extent - 2.0 * sum(widths)
+    return widths, _cells_for(middle, size), middle
 
 
 def _surface(
@@ -385,7 +400,13 @@ def grid_nodes(
     if shape == "flat":
         return _cells_for(across[0], size, even=False, least=1) + 1, along
     b, d = across
-    return sum(_face_fractions(e, size, corner).size - 1 for e in (d, b, d, b)), along
+    return sum(_face_cells(e, size, corner) for e in (d, b, d, b)), along
+
+
+def _face_cells(extent: float, size: float, first: float | None) -> int:
+    """The cells :func:`_face_fractions` puts across a face, counted without its arrays."""
+    widths, n_mid, _ = _face_grading(extent, size, first)
+    return 2 * len(widths) + n_mid
 
 
 def cell_length(length: float, size: float) -> float:
@@ -399,7 +420,8 @@ def face_cell_width(extent: float, size: float, corner: float | None = None) -> 
     An even number of cells of at most ``size``; graded at the corners (``corner``), the
     uniform middle part's.
     """
-    return extent * float(np.diff(_face_fractions(extent, size, corner)).max())
+    widths, n_mid, middle = _face_grading(extent, size, corner)
+    return max([middle / n_mid, *widths])
 
 
 def tube_facet_width(diameter: float, size: float) -> float:

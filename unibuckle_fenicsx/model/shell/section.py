@@ -49,8 +49,7 @@ from unibuckle_fenicsx.model.shell.problem import (
     section_problem,
 )
 from unibuckle_fenicsx.spec import Material, SectionProblemSpec, SolverSpec
-from unibuckle_fenicsx.spec.base import file_units, in_file
-from unibuckle_fenicsx.spec.section import tension_everywhere
+from unibuckle_fenicsx.spec.section import check_cells_along, tension_everywhere
 
 __all__ = [
     "GEOMETRIC",
@@ -258,30 +257,13 @@ class SectionParameters:
         return float(self.diameter or 0.0)
 
 
-def check_cells_along(size: float, length: float) -> None:
-    """Refuse a cell size ``size`` not below ``length`` (m): 2 cells along at least.
-
-    The message in the units of the file read or solved
-    (:func:`~unibuckle_fenicsx.spec.base.file_units`).
-    """
-    if size * (1.0 + 1e-9) >= length:  # geometry's cells along: ceil(L/h)
-        (h, name), (L, _) = in_file(size, "m"), in_file(length, "m")
-        raise InputError(
-            f"mesh.size = {h:g} {name} must be below section.length = {L:g} {name}: the "
-            "section needs at least 2 cells along its length (the nodes of its loaded ends "
-            "are supported)"
-        )
-
-
 def section_parameters(spec: SectionProblemSpec) -> SectionParameters:
     """The :class:`SectionParameters` of a section's problem file (checked already).
 
-    Raises:
-        InputError: A cell size not below the length (in the file's units).
+    Its cells and levels were checked when it was read
+    (:func:`~unibuckle_fenicsx.spec.section.check_section_mesh`).
     """
     s, core = spec.section, spec.obstacle
-    with file_units(spec.units):
-        check_cells_along(spec.mesh.size, s.length)
     return SectionParameters(
         s.shape, thickness=s.thickness, length=s.length, E=spec.material.E,
         nu=spec.material.nu, mesh_size=spec.mesh.size, width=s.width, depth=s.depth,
