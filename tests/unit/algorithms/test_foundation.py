@@ -324,6 +324,33 @@ def test_foundation_the_free_mode_turns_away_from_is_proven_inactive():
     assert result.certificate.kkt and result.certificate.global_optimum_proven
 
 
+@pytest.mark.parametrize(("stiffness", "proven"), [(1e-300, True), (modulus(1.0), False)])
+def test_a_foundation_is_proven_when_its_bracket_closes(stiffness, proven):
+    """The bracket [lambda_free, lambda] proves the answer when it closes, nodes pressing.
+
+    a/b = 3 on 12 x 4 cells, simply supported: the free mode has three half-waves and
+    presses the whole-plate foundation which way it turns. Springs of 1e-300 N/m^3 add
+    nothing a double can hold, so the expected load is the free plate's (the same plate
+    solved without an obstacle) and the bracket closes: proven (before: ``kkt-only``,
+    "between L and L"). At K = 1 the springs raise the load (the strip formula's
+    bilateral k = 2 + 2 sqrt(2) bounds it above, k = 4 of the free plate below): a gap,
+    never proven.
+    """
+    base = strip(3.0, 4)
+    with solve(base) as analysis:
+        free = analysis.result.critical_load_Pa
+    spec = structs.replace(base, obstacle=ObstacleSpec("all", foundation_stiffness=stiffness))
+    with solve(spec) as analysis:
+        result = analysis.result
+    assert result.method == "foundation" and result.contact_nodes > 0
+    assert result.certificate.kkt
+    if proven:
+        assert result.critical_load_Pa == pytest.approx(free, rel=1e-9)  # eigen tolerance
+    else:
+        assert result.critical_load_Pa > free * (1 + 1e-3)
+    assert result.certificate.global_optimum_proven is proven
+
+
 def test_the_foundation_certificate_reads_the_typed_status_never_a_default():
     """The certificate takes the spring-set status from ``solution.status``.
 
