@@ -84,6 +84,22 @@ def name_flag(error: InputError, flags: dict[str, str]) -> InputError:
     return error
 
 
+def refuse_flag_and_set(settings: Sequence[str], flags: dict[str, str]) -> None:
+    """Refuse a value given twice: by a flag and by ``--set`` on its key (or its table).
+
+    ``flags``: key -> the flag typed that sets it (``{"mesh.nx": "--nx"}``). Neither is
+    taken over the other in silence: the message names both.
+
+    Raises:
+        InputError: A ``--set`` path that is one of the keys or a table holding one.
+    """
+    for setting in settings:
+        path = setting.partition("=")[0].strip()
+        for key, flag in flags.items():
+            if path and (path == key or key.startswith(path + ".")):
+                raise InputError(f"{flag} and --set {setting} both set {key}: give one of them")
+
+
 def _warn(note: str | None, comm: Any) -> None:
     """Print ``note``, if any, as a warning on stderr from rank 0."""
     if note is not None and comm.rank == 0:
@@ -95,6 +111,8 @@ def spec_from_args(args: argparse.Namespace) -> ProblemSpec | SectionProblemSpec
     from unibuckle_fenicsx.spec import load_problem
     from unibuckle_fenicsx.spec.cases import paper_case
 
+    cells = {"mesh.nx": ("--nx", args.nx), "mesh.ny": ("--ny", args.ny)}
+    refuse_flag_and_set(args.settings, {k: f for k, (f, v) in cells.items() if v is not None})
     if args.case:
         spec = _with_settings(paper_case(args.case), args.settings)
     else:

@@ -11,6 +11,7 @@ from msgspec.structs import replace
 from unibuckle_fenicsx.cli.flags import METHOD_FLAGS, solver_changes, unused_flags
 from unibuckle_fenicsx.cli.problem import (
     name_flag,
+    refuse_flag_and_set,
     spec_from_args,
     warn_coarse_mesh,
     warn_input,
@@ -18,6 +19,9 @@ from unibuckle_fenicsx.cli.problem import (
 from unibuckle_fenicsx.cli.status import print_out, report_failure
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
+
+#: The solver's switches as flags: their key's name -> the flag.
+SWITCHES = {"certify": "--no-certify", "bracket": "--bracket"}
 
 
 def solve_command(args: argparse.Namespace, comm: Any) -> int:
@@ -27,10 +31,12 @@ def solve_command(args: argparse.Namespace, comm: Any) -> int:
     from unibuckle_fenicsx.spec.section import SectionProblemSpec
 
     # A refused input or a failed solve raises: main() tells the outcome.
-    spec = spec_from_args(args)
     changes, flags = solver_changes(args)
     named = {f"solver.{key}": f"--{key}" for key in ("method", "tau") if key in changes}
+    named.update({f"solver.{key}": flag for key, flag in SWITCHES.items() if key in changes})
     named.update({f"solver.{METHOD_FLAGS[flag][1]}": flag for flag in flags})
+    refuse_flag_and_set(args.settings, named)
+    spec = spec_from_args(args)
     try:
         spec = replace(spec, solver=replace(spec.solver, **changes))
     except InputError as err:  # name the flag typed, beside the key it sets

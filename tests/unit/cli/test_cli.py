@@ -260,6 +260,30 @@ def test_set_changes_the_value_at_its_dotted_path():
     assert spec.plate == paper_case("c1").plate  # and nothing else
 
 
+@pytest.mark.parametrize(
+    ("flags", "setting", "named"),
+    [
+        (["--nx", "6"], "mesh.nx=8", "--nx and --set mesh.nx=8 both set mesh.nx"),
+        (["--ny", "4"], "mesh={nx = 8, ny = 2}", "--ny and --set mesh={nx"),
+        (["--tau", "1e-9"], "solver.tau=1e-8", "--tau and --set solver.tau=1e-8"),
+        (["--method", "penalty"], "solver.method=active-set", "--method and --set solver"),
+        (["--penalty", "1e4"], "solver.penalty=1e5", "--penalty and --set solver.penalty"),
+        (["--no-certify"], "solver.certify=true", "--no-certify and --set solver.certify"),
+        (["--bracket"], "solver.bracket=false", "--bracket and --set solver.bracket"),
+    ],
+)
+def test_a_flag_and_set_on_the_same_key_are_refused(capsys, flags, setting, named):
+    """A value given by a flag and by --set is refused, naming both, before any solve.
+
+    Before, the flag was taken in silence (``--nx 6 --set mesh.nx=8`` solved 6 cells).
+    """
+    argv = ["solve", "--case", "c1", *flags, "--set", setting]
+    assert main(argv) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert named in err and "give one of them" in err, err
+    assert "lambda_c" not in err
+
+
 def test_set_reads_a_string_as_toml_writes_it():
     """``--set solver.method="penalty"`` (the file's line, quotes and all) sets ``penalty``.
 
