@@ -361,7 +361,7 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
         "--penalty",
         type=float,
         metavar="RHO",
-        help="penalty stiffness rho for --method penalty (relative to max diag A), > 0 "
+        help="penalty stiffness rho for --method penalty (relative to max diag A), 1e-6 to 1e16 "
         + _solver_default("penalty"),
     )
     s.add_argument(

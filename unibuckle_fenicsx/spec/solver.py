@@ -41,7 +41,12 @@ MaxCandidates = Annotated[int, Meta(ge=1)]
 Iterations = Annotated[int, Meta(ge=1)]
 BoundBudget = Annotated[int, Meta(ge=0)]
 Seconds = Annotated[float, Meta(gt=0, extra={"unit": "s"})]
-Penalty = Annotated[float, Meta(gt=0)]
+#: The relative penalty's range, the one :doc:`/methods/penalty` measured (c1, c2, c3,
+#: 1e-6 to 1e16): below 1e-6 the springs raise the free load by less than 3e-4 of it
+#: (its mode crosses the obstacle freely: never a KKT point), above 1e16 nothing is
+#: measured and nothing is gained (the gap to lambda_c reaches rounding at 3e10).
+PENALTY_RANGE = (1e-6, 1e16)
+Penalty = Annotated[float, Meta(ge=PENALTY_RANGE[0], le=PENALTY_RANGE[1])]
 
 
 #: The highest Lagrange degree of the prestress solve's in-plane displacement: degree 2
@@ -85,7 +90,7 @@ class SolverSpec(Table, frozen=True):
             (:doc:`/methods/certificates`); by default it runs only where its estimated
             cost is at most 3 free solves (the summary says when it did not).
         penalty: Penalty stiffness rho for ``method="penalty"`` (relative to the largest
-            diagonal entry of A), > 0.
+            diagonal entry of A), 1e-6 to 1e16 (:data:`PENALTY_RANGE`).
         prestress_degree: Lagrange degree of the in-plane displacement, 1 to 4.
         shear: "mitc" (MacNeal/MITC4, locking-free) or "full" (plain full integration,
             locks; for comparison only).

@@ -284,6 +284,29 @@ def test_a_flag_and_set_on_the_same_key_are_refused(capsys, flags, setting, name
     assert "lambda_c" not in err
 
 
+@pytest.mark.parametrize(
+    ("argv", "named"),
+    [
+        (["--method", "penalty", "--penalty", "1e-30"], "--penalty: solver.penalty"),
+        (["--method", "penalty", "--set", "solver.penalty=1e17"], "--set solver.penalty=1e17"),
+    ],
+)
+def test_a_penalty_out_of_its_measured_range_is_refused_before_solving(capsys, argv, named):
+    """solver.penalty outside [1e-6, 1e16] is refused, naming the key and the range.
+
+    The range is the one docs/methods/penalty.md measured: below 1e-6 the springs raise
+    the free load by less than 3e-4 of it; before, 1e-30 was solved and failed its
+    certificate (exit 3). The ends themselves are taken.
+    """
+    from unibuckle_fenicsx.spec import SolverSpec
+
+    assert main(["solve", "--case", "c1", *argv]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert named in err and "solver.penalty must lie in [1e-06, 1e+16]" in err, err
+    assert "lambda_c" not in err
+    assert SolverSpec(penalty=1e-6).penalty == 1e-6 and SolverSpec(penalty=1e16).penalty == 1e16
+
+
 def test_set_reads_a_string_as_toml_writes_it():
     """``--set solver.method="penalty"`` (the file's line, quotes and all) sets ``penalty``.
 
