@@ -35,6 +35,7 @@ from unibuckle_fenicsx.errors import InputError, NoAdmissibleModeError
 from unibuckle_fenicsx.la.ownership import Owner
 from unibuckle_fenicsx.model.build import build_problem
 from unibuckle_fenicsx.model.problem import Problem, UnilateralProblem
+from unibuckle_fenicsx.progress import warn_once
 from unibuckle_fenicsx.results.assemble import assemble_result
 from unibuckle_fenicsx.results.records import BucklingResult
 from unibuckle_fenicsx.spec import ObstacleSpec, ProblemSpec
@@ -267,8 +268,8 @@ def _analyse(
             solution, certificate = _continue(problem, solution, certificate)
         problem.timings["certify_s"] = time.perf_counter() - t1
         if certificate.status == "not-kkt":
-            logger.warning(
-                "the %s result fails its certificate: %s",
+            warn_once(
+                logger, comm, "the %s result fails its certificate: %s",
                 method, "; ".join(certificate.notes) or certificate.status,
             )  # fmt: skip
     result = assemble_result(

@@ -3,7 +3,8 @@
 The command line shows them on stderr (``-q`` hides them). :class:`Progress` rate-limits
 the lines of a loop and estimates the time left from the rate so far; asked for a bar
 (the sweep), it draws one with tqdm (the ``progress`` extra) instead of the lines, and
-falls back to the lines, saying so, when tqdm is not installed.
+falls back to the lines, saying so, when tqdm is not installed. :func:`warn_once` logs a
+warning that every rank computes on one rank only.
 """
 
 from __future__ import annotations
@@ -12,10 +13,21 @@ import logging
 import time
 from typing import Any
 
-__all__ = ["LOGGER", "Progress"]
+__all__ = ["LOGGER", "Progress", "warn_once"]
 
 #: The progress logger (INFO lines; the CLI shows them unless ``-q``).
 LOGGER = logging.getLogger("unibuckle_fenicsx.progress")
+
+
+def warn_once(logger: logging.Logger, comm: Any, message: str, *args: object) -> None:
+    """``logger.warning(message, *args)`` on rank 0 of ``comm`` only.
+
+    For a warning every rank computes alike (from values reduced over the ranks): a
+    script's logging, unlike the command line's, shows every rank's records, and would
+    show it once per rank. Not collective.
+    """
+    if comm.rank == 0:
+        logger.warning(message, *args)
 
 
 class Progress:

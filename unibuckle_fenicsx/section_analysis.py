@@ -66,6 +66,7 @@ from unibuckle_fenicsx.model.shell.section import (
     figure_data,
     section_parameters,
 )
+from unibuckle_fenicsx.progress import warn_once
 from unibuckle_fenicsx.results.assemble import record_contact, versions
 from unibuckle_fenicsx.results.records import BucklingResult, ResultDetails, coefficient_text
 from unibuckle_fenicsx.section_design import (
@@ -388,7 +389,9 @@ def _solve_section(
             )
             problem.timings["certify_s"] = time.perf_counter() - t1
             if certificate.status == "not-kkt":
-                logger.warning(
+                warn_once(
+                    logger,
+                    comm,
                     "the section's result fails its certificate: %s",
                     "; ".join(certificate.notes) or certificate.status,
                 )
@@ -397,7 +400,7 @@ def _solve_section(
             result.case, result.input, result.units = str(name), echo, units
         column = column_note(parameters, result.critical_load_Pa, solution is not None)
         if column is not None:
-            logger.warning("%s", column)
+            warn_once(logger, comm, "%s", column)
         result.warnings = [*warnings, *([] if column is None else [column])]
         if design is not None:
             result.design = _design(parameters, design, result, certificate, column)
@@ -509,7 +512,7 @@ def _check(
         )
     found = [note for note in notes if note is not None]
     for note in found:
-        logger.warning("%s", note)
+        warn_once(logger, comm, "%s", note)
     return found
 
 

@@ -420,3 +420,27 @@ def test_a_warning_is_printed_once_on_two_ranks(tmp_path):
     assert proc.stderr.count("fewer than 5: on cells this coarse") == 1, proc.stderr
     assert proc.stderr.count("times the member's Euler stress") == 1, proc.stderr
     assert proc.stdout.count("column: sigma_cr = ") == 1, proc.stdout
+
+
+def test_a_section_solved_from_python_logs_its_warnings_once_on_two_ranks():
+    """``solve_section`` on 2 ranks from a script logs each warning once, from rank 0.
+
+    The column above (two warnings: the coarse cells, the column's mode), solved by
+    ``tests/mpi/section_warnings.py`` with every rank's log on stderr: each warning was
+    logged by both ranks. The result keeps both on every rank.
+    """
+    import os
+    import subprocess
+    import sys
+
+    from support.processes import mpiexec
+
+    proc = subprocess.run(
+        [mpiexec(), "-n", "2", sys.executable, str(MPI_SCRIPTS / "section_warnings.py")],
+        capture_output=True, text=True, env={**os.environ, "OMP_NUM_THREADS": "1"},
+    )  # fmt: skip
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.split() == ["2"], proc.stdout
+    assert proc.stderr.count("fewer than 5: on cells this coarse") == 1, proc.stderr
+    assert proc.stderr.count("times the member's Euler stress") == 1, proc.stderr
+    assert "rank 1 WARNING" not in proc.stderr, proc.stderr

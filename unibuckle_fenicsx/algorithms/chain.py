@@ -77,6 +77,7 @@ from unibuckle_fenicsx.errors import EmptyZoneError, InputError, NoAdmissibleMod
 from unibuckle_fenicsx.model.build import build_unilateral_problem
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
 from unibuckle_fenicsx.progress import LOGGER as PROGRESS
+from unibuckle_fenicsx.progress import warn_once
 from unibuckle_fenicsx.spec import ProblemSpec
 
 __all__ = ["THIN_PLATE", "ChainOptions", "solve_interior_point", "thin_plate"]
@@ -405,7 +406,8 @@ def _fallback_solution(
 
     Collective.
     """
-    logger.warning("interior point: no KKT point on the fine mesh; the active-set chain runs")
+    note = "interior point: no KKT point on the fine mesh; the active-set chain runs"
+    warn_once(logger, problem.comm, note)
     solution = _fallback(problem, options) if fallback is None else fallback(problem)
     if isinstance(solution.details, ActiveSetDetails | SectionLevelsDetails):
         solution.details.interior_point_levels = [lv.record() for lv in levels]

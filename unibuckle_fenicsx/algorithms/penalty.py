@@ -63,6 +63,7 @@ from unibuckle_fenicsx.la.eigen import (
 from unibuckle_fenicsx.la.options import Prefix
 from unibuckle_fenicsx.la.ownership import Owner, release
 from unibuckle_fenicsx.model.problem import Candidate, UnilateralProblem, require_obstacle
+from unibuckle_fenicsx.progress import warn_once
 from unibuckle_fenicsx.tolerances import ENERGY_TIE_RTOL
 
 __all__ = [
@@ -422,9 +423,10 @@ class PenaltySolver(Owner):
             if self._spring_step(run, it, threshold, tie_rtol, label):
                 break
         if run.status is RunStatus.MAX_ITERATIONS:
-            logger.warning(
-                "%s: no fixed point after %d solves (-max_iterations)", label, max_iterations
-            )
+            warn_once(
+                logger, self.problem.comm,
+                "%s: no fixed point after %d solves (-max_iterations)", label, max_iterations,
+            )  # fmt: skip
         return self._spring_result(run)
 
     def _check_iteration(
@@ -499,7 +501,8 @@ class PenaltySolver(Owner):
         if penetrating in run.seen:
             run.status = RunStatus.CYCLE
             run.cycle_length = run.seen.cycle_length(penetrating, it)
-            logger.warning(
+            warn_once(
+                logger, self.problem.comm,
                 "%s: the penetrating set cycles (length %d) after %d solves; "
                 "returning the iterate with the smallest penalised quotient",
                 label, run.cycle_length, it + 1,

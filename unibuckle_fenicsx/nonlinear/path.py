@@ -52,7 +52,7 @@ from unibuckle_fenicsx.nonlinear.model import (
 )
 from unibuckle_fenicsx.nonlinear.options import NonlinearOptions
 from unibuckle_fenicsx.nonlinear.verdict import judge
-from unibuckle_fenicsx.progress import LOGGER
+from unibuckle_fenicsx.progress import LOGGER, warn_once
 from unibuckle_fenicsx.results.assemble import versions
 from unibuckle_fenicsx.results.records import BucklingResult
 from unibuckle_fenicsx.spec import UNITS, ProblemSpec
@@ -676,5 +676,7 @@ def _gaps_closed_load(spec: ProblemSpec, linear: Analysis) -> float | None:
         ) as analysis:
             return analysis.result.critical_load_Pa
     except NumericalError as err:
-        logger.warning("%s: the unilateral load with the gaps closed: %s", spec.name, err)
+        warn_once(
+            logger, problem.comm, "%s: the unilateral load with the gaps closed: %s", spec.name, err
+        )
         return None
