@@ -7,7 +7,10 @@ each raises :class:`~unibuckle_fenicsx.errors.InputError` naming the keys
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
+import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.geometry import (
@@ -82,10 +85,11 @@ MIN_CELLS_ACROSS = 4
 #: and the simply supported square in pure shear has k +78 % too high on 4 x 4 cells,
 #: +14 % on 8 x 8 and +8.5 % on 10 x 10 (against 48 x 48; compression's +9 % at 4 across).
 MIN_SHEAR_CELLS_ACROSS = 10
-#: With two opposite edges of the rectangle clamped, fewer cells than this across b draw
-#: the warning: the buckle's half-waves between clamped edges are shorter than b, and the
-#: clamped square's k is +55 % on 4 x 4 cells, +20 % on 6 x 6, +10 % on 8 x 8 (against
-#: 48 x 48; the simply supported square's +9 % at 4 across).
+#: With two opposite edges clamped (the rectangle's, or an outline's segments facing each
+#: other), fewer cells than this across b draw the warning: the buckle's half-waves
+#: between clamped edges are shorter than b, and the clamped square's k is +55 % on 4 x 4
+#: cells, +20 % on 6 x 6, +10 % on 8 x 8 (against 48 x 48; the simply supported square's
+#: +9 % at 4 across), the same square given by its outline alike.
 MIN_CLAMPED_CELLS_ACROSS = 8
 
 
@@ -137,8 +141,8 @@ def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str
         (cell, side, finer), name = in_file((h, b, b / MIN_CLAMPED_CELLS_ACROSS), "m", units)
         return (
             f"{what}: cells up to {cell:.3g} {name}, fewer than {MIN_CLAMPED_CELLS_ACROSS} "
-            f"across {side_name} {side:.3g} {name} with edges.{clamped[0]} and "
-            f"edges.{clamped[1]} clamped: the half-waves between clamped edges are shorter "
+            f"across {side_name} {side:.3g} {name} with {clamped} clamped: the "
+            "half-waves between clamped edges are shorter "
             "than the plate's width, and on cells this coarse the critical load, k and the "
             "design values come out too high (the clamped square: +55 % on 4 x 4 cells, +20 % "
             f"on 6 x 6); cells of {finer:.3g} {name} or less"
@@ -146,17 +150,54 @@ def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str
     return _gradient_note(plate, mesh, what, units)
 
 
-def _opposite_clamped(plate: PlateSpec) -> tuple[str, str] | None:
-    """The first pair of opposite rectangle edges both clamped (left, right; bottom, top)."""
-    clamped = {
-        e.name
-        for e in plate.edges
-        if e.support == "clamped" and e.segments is None and e.tag is None
-    }
-    for pair in (("left", "right"), ("bottom", "top")):
-        if set(pair) <= clamped:
-            return pair
+def _opposite_clamped(plate: PlateSpec) -> str | None:
+    """The first two opposite clamped edges, named for a message, or None.
+
+    The rectangle's opposite edges (left, right; bottom, top); an outline's clamped
+    segments that face each other (:func:`_facing`), named by their edges
+    (``edges.a and edges.b``, or ``edges.a's segments 1 and 3``).
+    """
+    clamped = [e for e in plate.edges if e.support == "clamped" and e.tag is None]
+    if plate.outline is None:
+        names = {e.name for e in clamped if e.segments is None}
+        for pair in (("left", "right"), ("bottom", "top")):
+            if set(pair) <= names:
+                return f"edges.{pair[0]} and edges.{pair[1]}"
+        return None
+    v = np.asarray(plate.outline, dtype=float)
+    parts = [(e.name, k) for e in clamped for k in e.segments or ()]
+    for i, (name_i, k) in enumerate(parts):
+        for name_j, j in parts[i + 1 :]:
+            if _facing(v, k, j):
+                if name_i == name_j:
+                    return f"edges.{name_i}'s segments {min(k, j)} and {max(k, j)}"
+                return f"edges.{name_i} and edges.{name_j}"
     return None
+
+
+#: Two outline segments face each other when their directions differ by more than 135
+#: degrees (cosine below this) and their extents along the first overlap.
+FACING_COSINE = -math.sqrt(0.5)
+
+
+def _facing(v: npt.NDArray[np.float64], k: int, j: int) -> bool:
+    """Whether outline segments k and j face each other across the plate (or a part).
+
+    Antiparallel within 45 degrees (a simple polygon runs opposite sides of a strip in
+    opposite directions) and overlapping in their extent along segment k, by more than
+    1e-9 of it: a rectangle's opposite sides, an L's arm between its sides, a tapered
+    strip's converging sides.
+    """
+    n = len(v)
+    a0, a1, b0, b1 = v[k], v[(k + 1) % n], v[j], v[(j + 1) % n]
+    da, db = a1 - a0, b1 - b0
+    la, lb = float(np.linalg.norm(da)), float(np.linalg.norm(db))
+    if float(da @ db) > FACING_COSINE * la * lb:
+        return False
+    u = da / la
+    lo = max(0.0, min(float(u @ (b0 - a0)), float(u @ (b1 - a0))))
+    hi = min(la, max(float(u @ (b0 - a0)), float(u @ (b1 - a0))))
+    return hi - lo > 1e-9 * la
 
 
 def _shear_dominated(plate: PlateSpec) -> bool:

@@ -122,3 +122,84 @@ def test_one_clamped_edge_keeps_the_rule_of_four(tmp_path, capsys):
     )
     assert main(["solve", "--config", str(config), "-q"]) == EXIT_OK
     assert "unibuckle: warning" not in capsys.readouterr().err
+
+
+def _clamped_outline(size: float) -> str:
+    """The clamped square of the test above given by its outline (gmsh cells of ``size``).
+
+    Segments 0 to 3 run along the bottom, right, top and left sides; the right and left
+    ones are loaded.
+    """
+    sides = "".join(
+        f'[edges.s{k}]\nsegments = [{k}]\nsupport = "clamped"\n'
+        + ("normal_stress = -1.0\n" if k in (1, 3) else "")
+        for k in range(4)
+    )
+    return (
+        "[plate]\noutline = [[0.0, 0.0], [0.1, 0.0], [0.1, 0.1], [0.0, 0.1]]\n"
+        "thickness = 0.0005\n[material]\nE = 2.1e11\nnu = 0.3\n"
+        f"{sides}[mesh]\nsize = {size}\n"
+    )
+
+
+@pytest.mark.parametrize(("cells", "warned"), [(4, True), (8, False)])
+def test_an_outline_with_opposite_clamped_sides_keeps_the_clamped_rule(
+    tmp_path, capsys, cells, warned
+):
+    """The clamped square by its outline: k +55 % on 4 cells across, warned; 8 not.
+
+    Before, the rule looked at the rectangle's edges only and held an outline to the
+    rule of four: 4 cells across drew nothing. gmsh's cells of b/4 and b/8 on the square
+    are the rectangle's grid: k = 15.674 and 11.126 against 10.0956 on b/48 (+55.3 %,
+    +10.2 %); the expected value is Timoshenko and Gere's 10.07, as above.
+    """
+    config = tmp_path / "clamped_outline.toml"
+    config.write_text(_clamped_outline(0.1 / cells))
+    out = tmp_path / "k.json"
+    assert main(["solve", "--config", str(config), "--json", str(out), "-q"]) == EXIT_OK
+    err = capsys.readouterr().err
+    k = json.loads(out.read_text())["buckling_coefficient_k"]
+    if warned:
+        assert k > 1.5 * K_CLAMPED_SQUARE, k  # what went unwarned
+        said = f"mesh.size = {0.1 / cells:.3g} m: cells up to {0.1 / cells:.3g} m, fewer than 8"
+        assert f"unibuckle: warning: {said} across the plate's narrowest width" in err, err
+        assert "with edges.s0 and edges.s2 clamped" in err, err
+    else:
+        assert k < 1.11 * K_CLAMPED_SQUARE, k
+        assert "unibuckle: warning" not in err, err
+
+
+@pytest.mark.parametrize(
+    ("clamped", "named"),
+    [
+        ({"a": [0]}, None),  # one side: the outstand, the rule of four (+1.9 %)
+        ({"a": [0], "b": [1]}, None),  # adjacent sides meet at a corner, face nothing
+        ({"a": [1, 5]}, "edges.a's segments 1 and 5"),  # the horizontal arm's ends
+        ({"a": [2], "b": [0]}, "edges.a and edges.b"),  # its long sides
+    ],
+)
+def test_which_outline_sides_face_each_other(clamped, named):
+    """Clamped outline segments facing each other across the plate, by the geometry.
+
+    The L of arms 0.1 m wide and 0.3 m long: segment 0 its bottom (x from 0 to 0.3 m),
+    1 the horizontal arm's end (x = 0.3 m, upwards), 2 the arm's upper side running back
+    (y = 0.1 m), 3 the vertical arm's right side, 4 its end (loaded), 5 the left side
+    (x = 0, downwards).
+    """
+    from unibuckle_fenicsx.spec import problem_from_dict
+    from unibuckle_fenicsx.spec.checks import _opposite_clamped
+
+    outline = [[0.0, 0.0], [0.3, 0.0], [0.3, 0.1], [0.1, 0.1], [0.1, 0.3], [0.0, 0.3]]
+    edges = {
+        name: {"segments": segments, "support": "clamped"} for name, segments in clamped.items()
+    }
+    edges["loaded"] = {"segments": [4], "normal_stress": -1.0, "support": "simply_supported"}
+    spec = problem_from_dict(
+        {
+            "plate": {"outline": outline, "thickness": 0.001},
+            "material": {"E": 2.1e11, "nu": 0.3},
+            "edges": edges,
+            "mesh": {"size": 0.0125},
+        }
+    )
+    assert _opposite_clamped(spec.plate) == named
