@@ -88,13 +88,21 @@ def refuse_flag_and_set(settings: Sequence[str], flags: dict[str, str]) -> None:
     """Refuse a value given twice: by a flag and by ``--set`` on its key (or its table).
 
     ``flags``: key -> the flag typed that sets it (``{"mesh.nx": "--nx"}``). Neither is
-    taken over the other in silence: the message names both.
+    taken over the other in silence: the message names both. The same for one path
+    given to ``--set`` twice (the last would be taken).
 
     Raises:
-        InputError: A ``--set`` path that is one of the keys or a table holding one.
+        InputError: A ``--set`` path that is one of the keys or a table holding one, or
+            a path set twice.
     """
+    seen: dict[str, str] = {}
     for setting in settings:
         path = setting.partition("=")[0].strip()
+        if path in seen:
+            raise InputError(
+                f"--set {seen[path]} and --set {setting} both set {path}: give one of them"
+            )
+        seen[path] = setting
         for key, flag in flags.items():
             if path and (path == key or key.startswith(path + ".")):
                 raise InputError(f"{flag} and --set {setting} both set {key}: give one of them")

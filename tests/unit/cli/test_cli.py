@@ -270,12 +270,14 @@ def test_set_changes_the_value_at_its_dotted_path():
         (["--penalty", "1e4"], "solver.penalty=1e5", "--penalty and --set solver.penalty"),
         (["--no-certify"], "solver.certify=true", "--no-certify and --set solver.certify"),
         (["--bracket"], "solver.bracket=false", "--bracket and --set solver.bracket"),
+        (["--set", "solver.tau=1e-9"], "solver.tau=1e-7", "--set solver.tau=1e-9 and --set"),
     ],
 )
 def test_a_flag_and_set_on_the_same_key_are_refused(capsys, flags, setting, named):
     """A value given by a flag and by --set is refused, naming both, before any solve.
 
-    Before, the flag was taken in silence (``--nx 6 --set mesh.nx=8`` solved 6 cells).
+    Before, the flag was taken in silence (``--nx 6 --set mesh.nx=8`` solved 6 cells),
+    and of one path set twice the last.
     """
     argv = ["solve", "--case", "c1", *flags, "--set", setting]
     assert main(argv) == EXIT_BAD_INPUT
