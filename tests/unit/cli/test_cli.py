@@ -309,6 +309,28 @@ def test_a_penalty_out_of_its_measured_range_is_refused_before_solving(capsys, a
     assert SolverSpec(penalty=1e-6).penalty == 1e-6 and SolverSpec(penalty=1e16).penalty == 1e16
 
 
+def test_the_petsc_eps_tol_is_the_solver_eps_tol_it_overrides(tmp_path):
+    """``-unibuckle_eps_tol`` sets solver.eps_tol: the result records the tolerance used.
+
+    SLEPc takes the command line's option over the file's key; before, the result's
+    ``input`` said 1e-10 (the default) after solves to 1e-6. With ``--set
+    solver.eps_tol`` it is refused, naming both; out of the key's range, named too.
+    (A subprocess: PETSc reads its command line once per process.)
+    """
+    out = tmp_path / "free.json"
+    base = ["solve", "--case", "free", "--nx", "4", "--ny", "2", "-q"]
+    done = run_script(*base, "-unibuckle_eps_tol", "1e-6", "--json", str(out), cwd=tmp_path)
+    assert done.returncode == EXIT_OK, done.stderr
+    assert json.loads(out.read_text())["input"]["solver"]["eps_tol"] == 1e-6
+    both = run_script(*base, "-unibuckle_eps_tol", "1e-6", "--set", "solver.eps_tol=1e-8",
+                      cwd=tmp_path)  # fmt: skip
+    assert both.returncode == EXIT_BAD_INPUT
+    assert "-unibuckle_eps_tol and --set solver.eps_tol=1e-8 both set" in both.stderr
+    loose = run_script(*base, "-unibuckle_eps_tol", "1e-2", cwd=tmp_path)
+    assert loose.returncode == EXIT_BAD_INPUT
+    assert "-unibuckle_eps_tol: solver.eps_tol must lie in (0, 0.0001]" in loose.stderr
+
+
 def test_set_reads_a_string_as_toml_writes_it():
     """``--set solver.method="penalty"`` (the file's line, quotes and all) sets ``penalty``.
 
