@@ -96,8 +96,8 @@ WIDER_NCV = 32
 #: looser ``eps_tol``). An eigenpair's agree to second order in the vector's error, even
 #: where the vector mixes a cluster of nearly equal loads; Krylov-Schur in shift-and-invert
 #: measures the error in the B-norm, blind to the null space of a semidefinite B, and
-#: its spurious pairs' differ by far more. The constant sits between the two, as
-#: measured in docs/history/2026-11-30g-spurious.md.
+#: its spurious pairs' differ by far more. The constant sits between the two
+#: (docs/history/2026-11-30g-spurious.md holds both).
 SPURIOUS_RTOL = 1e-2
 #: Krylov vectors of the solve again after such a pair (or a negative load), at least: a
 #: pencil whose B has lost most of its rank to the removed rows needs more than
