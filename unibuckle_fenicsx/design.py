@@ -355,6 +355,7 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     sigma1, sigma2, end, edge = _critical_edge_stress(spec, load, element.loaded)
     psi = stress_ratio(sigma1, sigma2) if sigma1 > 0.0 else None
     at_free = element.free_end is None or end == element.free_end or psi == 1.0
+    shear = _has_shear(spec)
     out = DesignRecord(
         yield_stress_Pa=design.yield_stress,
         partial_factor=design.partial_factor,
@@ -364,48 +365,8 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
         edge=edge,
         sigma_cr_Pa=sigma1,
         clauses=clauses(element, at_free),
-        notes=[CALIBRATION],
+        notes=[CALIBRATION, *_scope_notes(spec, design, shear)],
     )
-    for note in (
-        stainless_note(spec.material.E),
-        steel_poisson_note(spec.material.nu),
-        yield_stress_note(design.yield_stress, spec.plate.thickness, "plate.thickness"),
-    ):
-        if note is not None:
-            out.notes.append(note)
-    if spec.plate.holes:
-        out.notes.append(
-            "the plate has holes (plate.holes): 4.4 describes a plate without openings; "
-            "the element is the rectangle's, and sigma_cr (computed with the holes) "
-            "includes their effect"
-        )
-    foundation = 'a bilateral foundation (obstacle.side = "both")'
-    unilateral = "sigma_cr is the unilateral critical stress"
-    restrained = {
-        (True, False): f"with an obstacle {unilateral}",
-        (False, True): f"with {foundation} sigma_cr includes the foundation's stiffness",
-        (True, True): f"with an obstacle and {foundation} {unilateral} and includes the "
-        "foundation's stiffness",
-    }.get(
-        (bool(spec.one_sided_points or spec.unilateral_obstacles), bool(spec.bilateral_foundations))
-    )
-    if restrained is not None:
-        out.notes.append(f"{restrained}: outside the calibration of 4.4(2)")
-    if any(p.kind != "one-sided" for p in spec.points):
-        out.notes.append(
-            "with point restraints (points: bilateral ties or springs) sigma_cr includes "
-            "them: 4.4 describes a plate held by its edges alone, outside the calibration "
-            "of 4.4(2)"
-        )
-    shear = any(
-        any(stress_ends(e.shear_stress)) or any(stress_ends(e.fixed_shear_stress))
-        for e in spec.plate.edges
-    )
-    if shear:
-        out.notes.append(
-            "the load has shear: EN 1993-1-5 section 10 (reduced stress method) would "
-            "combine it; rho here is the direct stress's, with this sigma_cr"
-        )
     if psi is None:
         out.notes.append(
             f"the loaded edges are in tension at the critical state (least tension "
@@ -428,7 +389,77 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
     if psi < low:  # only with a fixed part: a scaled one alone is refused beforehand
         out.notes.append(f"psi = {ratio_text(psi)} < {low:g}: outside {out.table}, no rho")
         return out
-    psi = min(psi, 1.0)
+    _reduced_stress(out, spec, design, element, min(psi, 1.0), slenderness, end, at_free, shear)
+    return out
+
+
+def _has_shear(spec: ProblemSpec) -> bool:
+    """Whether an edge of the plate carries a shear stress (scaled or fixed)."""
+    return any(
+        any(stress_ends(e.shear_stress)) or any(stress_ends(e.fixed_shear_stress))
+        for e in spec.plate.edges
+    )
+
+
+def _scope_notes(spec: ProblemSpec, design: DesignSpec, shear: bool) -> list[str]:
+    """The notes on what lies outside 4.4's scope (material, holes, restraints, shear)."""
+    notes = []
+    for note in (
+        stainless_note(spec.material.E),
+        steel_poisson_note(spec.material.nu),
+        yield_stress_note(design.yield_stress, spec.plate.thickness, "plate.thickness"),
+    ):
+        if note is not None:
+            notes.append(note)
+    if spec.plate.holes:
+        notes.append(
+            "the plate has holes (plate.holes): 4.4 describes a plate without openings; "
+            "the element is the rectangle's, and sigma_cr (computed with the holes) "
+            "includes their effect"
+        )
+    foundation = 'a bilateral foundation (obstacle.side = "both")'
+    unilateral = "sigma_cr is the unilateral critical stress"
+    restrained = {
+        (True, False): f"with an obstacle {unilateral}",
+        (False, True): f"with {foundation} sigma_cr includes the foundation's stiffness",
+        (True, True): f"with an obstacle and {foundation} {unilateral} and includes the "
+        "foundation's stiffness",
+    }.get(
+        (bool(spec.one_sided_points or spec.unilateral_obstacles), bool(spec.bilateral_foundations))
+    )
+    if restrained is not None:
+        notes.append(f"{restrained}: outside the calibration of 4.4(2)")
+    if any(p.kind != "one-sided" for p in spec.points):
+        notes.append(
+            "with point restraints (points: bilateral ties or springs) sigma_cr includes "
+            "them: 4.4 describes a plate held by its edges alone, outside the calibration "
+            "of 4.4(2)"
+        )
+    if shear:
+        notes.append(
+            "the load has shear: EN 1993-1-5 section 10 (reduced stress method) would "
+            "combine it; rho here is the direct stress's, with this sigma_cr"
+        )
+    return notes
+
+
+def _reduced_stress(
+    out: DesignRecord,
+    spec: ProblemSpec,
+    design: DesignSpec,
+    element: DesignElement,
+    psi: float,
+    slenderness: float,
+    end: int,
+    at_free: bool,
+    shear: bool,
+) -> None:
+    """Fill ``out`` from the table's k and rho on: the reduced stress and the widths.
+
+    ``psi`` is the stress ratio (at most 1) within the table's range, ``slenderness``
+    the relative slenderness; ``out`` holds sigma_cr (``sigma_cr_Pa``) already.
+    """
+    sigma1 = out.sigma_cr_Pa
     out.k_sigma_table = buckling_factor(element.kind, psi, at_free)
     rho = reduction_factor(slenderness, psi, element.kind, at_free)
     out.plate_reduction_factor = rho
@@ -443,7 +474,6 @@ def design_output(spec: ProblemSpec, design: DesignSpec, load: float) -> DesignR
         out.tension_yield_first = out.tension_Pa * rho_c > sigma1
         if out.tension_yield_first:
             out.notes.append(_tension_note(out, rho_c))
-    return out
 
 
 def _widths(

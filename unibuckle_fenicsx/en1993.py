@@ -575,24 +575,9 @@ def column_end_factor(
     if not rigid or np.linalg.matrix_rank(np.array(rigid)) < 2:
         return 0.0
 
-    def rows(kappa: float, tau: float, u: float, at_end: bool) -> list[list[float]]:
-        s = 1.0 if at_end else 0.0
-        c, n = math.cos(u * s), math.sin(u * s)
-        w = [1.0, s, (1.0 - c) / u**2, (u * s - n) / u**3]
-        slope = [0.0, 1.0, n / u, (1.0 - c) / u**2]
-        curvature = [0.0, 0.0, c, n / u]
-        shear = [0.0, u * u, 0.0, 1.0]  # the third derivative plus u^2 times the slope
-        sign = 1.0 if at_end else -1.0
-        moment, force = slope, w
-        if kappa != math.inf:
-            pairs = zip(curvature, slope, strict=True)
-            moment = [(sign * k + kappa * v) / (1.0 + kappa) for k, v in pairs]
-        if tau != math.inf:
-            force = [(-sign * q + tau * v) / (1.0 + tau) for q, v in zip(shear, w, strict=True)]
-        return [moment, force]
-
     def det(u: float) -> float:
-        ends = rows(start, start_translation, u, False) + rows(end, end_translation, u, True)
+        ends = _end_rows(start, start_translation, u, False)
+        ends += _end_rows(end, end_translation, u, True)
         return float(np.linalg.det(ends))
 
     grid = [2.0 * math.pi * (k / 800.0) ** 2 for k in range(1, 801)]  # fine near u = 0
@@ -605,6 +590,29 @@ def column_end_factor(
         if f0 * f1 < 0.0:
             return (_bisect(det, u0, u1, f0) / math.pi) ** 2
     raise AssertionError("no column buckling load up to the clamped one")
+
+
+def _end_rows(kappa: float, tau: float, u: float, at_end: bool) -> list[list[float]]:
+    r"""The two rows of one column end's conditions in :func:`column_end_factor`'s basis.
+
+    The moment row (:math:`\pm w'' + \kappa w'`) and the force row (:math:`\mp(w''' +
+    u^2 w') + \tau w`), upper signs at s = 1 (``at_end``), lower at s = 0, divided by
+    :math:`1 + \kappa` (:math:`1 + \tau`): a clamped (held) end keeps w' (w) alone.
+    """
+    s = 1.0 if at_end else 0.0
+    c, n = math.cos(u * s), math.sin(u * s)
+    w = [1.0, s, (1.0 - c) / u**2, (u * s - n) / u**3]
+    slope = [0.0, 1.0, n / u, (1.0 - c) / u**2]
+    curvature = [0.0, 0.0, c, n / u]
+    shear = [0.0, u * u, 0.0, 1.0]  # the third derivative plus u^2 times the slope
+    sign = 1.0 if at_end else -1.0
+    moment, force = slope, w
+    if kappa != math.inf:
+        pairs = zip(curvature, slope, strict=True)
+        moment = [(sign * k + kappa * v) / (1.0 + kappa) for k, v in pairs]
+    if tau != math.inf:
+        force = [(-sign * q + tau * v) / (1.0 + tau) for q, v in zip(shear, w, strict=True)]
+    return [moment, force]
 
 
 def _bisect(f: Callable[[float], float], a: float, b: float, fa: float) -> float:

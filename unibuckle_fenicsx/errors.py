@@ -10,6 +10,9 @@
   :class:`EigenSolveError` (an eigen solve did not converge),
   :class:`NoAdmissibleModeError` (no admissible mode with a finite load),
   :class:`NonlinearError` (no load step of the nonlinear path converged).
+- :class:`NoKKTPointError`: a signal inside a route, never the end of a run: a chain of
+  starts asked to run without a fallback reached no KKT point, and its caller keeps the
+  solution it had.
 - Anything else is a bug.
 
 How each ends a run (its exit status, a sweep line's status) is
@@ -28,6 +31,7 @@ __all__ = [
     "FieldError",
     "InputError",
     "NoAdmissibleModeError",
+    "NoKKTPointError",
     "NoLoadError",
     "NonlinearError",
     "NumericalError",
@@ -82,3 +86,7 @@ class NoAdmissibleModeError(NumericalError):
 
 class NonlinearError(NumericalError):
     """The nonlinear solve failed before any load step converged."""
+
+
+class NoKKTPointError(UnibuckleError):
+    """A chain of starts run without a fallback reached no KKT point (its caller catches it)."""

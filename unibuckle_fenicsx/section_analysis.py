@@ -454,14 +454,14 @@ MIN_HALF_WAVE_CELLS_LONG = 2.5
 SHORT_TUBE_HALF_WAVES = 5.0
 #: See :data:`SHORT_TUBE_HALF_WAVES`.
 LONG_TUBE_HALF_WAVES = 8.0
-#: The largest R/t the rule on the half-wave is measured at: thinner tubes draw a warning
+#: The largest R/t the rule on the half-wave is calibrated at: thinner tubes draw a warning
 #: whatever their cells (:func:`coarse_mesh_note`).
 MAX_CALIBRATED_RADIUS_RATIO = 800.0
 #: Fewer cells than this along the longest buckle the ends allow (:func:`buckle_length`)
 #: draw a warning, by the same measure: a short section buckles in one wave as long as
 #: the member, whatever its walls' own buckles: the count that keeps short boxes and
-#: tubes to the guide's accuracy (:doc:`/guide/sections`, "Cell size", where it is
-#: measured).
+#: tubes to the guide's accuracy (:doc:`/guide/sections`, "Cell size", holds the
+#: calibration).
 MIN_ALONG_CELLS = 6
 
 
@@ -589,7 +589,7 @@ def coarse_mesh_note(parameters: SectionParameters) -> str | None:
     coarse for the buckles the shell's critical stress is too high (it falls as the cells
     are refined), and so are k and the design values. A tube thinner than
     :data:`MAX_CALIBRATED_RADIUS_RATIO` draws a warning whatever its cells: the rule is
-    not measured there. Lengths in the units of the file solved
+    not calibrated there. Lengths in the units of the file solved
     (:func:`~unibuckle_fenicsx.spec.base.file_units`).
     """
     p = parameters
@@ -646,7 +646,7 @@ def _thin_tube_note(parameters: SectionParameters) -> str | None:
         return None
     return (
         f"R/t = {ratio:.4g} is above {MAX_CALIBRATED_RADIUS_RATIO:g}, the thinnest tube "
-        "the rule on the cells along the half-wave is measured at: the critical stress, k "
+        "the rule on the cells along the half-wave is calibrated at: the critical stress, k "
         "and the design values may come out too high on these cells (compare with a "
         'solve on a finer mesh.size; docs/guide/sections.md, "Cell size")'
     )

@@ -393,7 +393,6 @@ def face_width(section: DesignSection, name: str) -> float:
 
 def section_design(section: DesignSection, design: DesignSpec, load: float) -> SectionDesignRecord:
     """The design quantities of the section's critical load ``load`` (the module docstring)."""
-    t = section.thickness
     compression = load * section.compression()
     out = SectionDesignRecord(
         yield_stress_Pa=design.yield_stress,
@@ -405,87 +404,103 @@ def section_design(section: DesignSection, design: DesignSpec, load: float) -> S
         faces=[],
     )
     if section.shape == "box":  # a tube's output applies no rho: no note of its calibration
-        out.clauses.append(FACE_CLAUSES)
-        out.notes.append(CALIBRATION)
-        out.notes.append(
-            "every face at the section's critical load factor: conservative for a face "
-            "that buckles because its neighbours do"
-        )
-        for name, (a, b) in face_compressions(section).items():
-            out.faces.append(_face(section, name, (load * a, load * b), design))
-        column = [f for f in out.faces if f.xi is not None and f.xi < 1.0]  # rho_c, not rho
-        if column:
-            out.clauses.append(COLUMN_CLAUSES)
-            out.notes.append(
-                "column-type buckling (EN 1993-1-5 4.4(2) note, 4.5.4(1)): the section's "
-                "length is below the width of face(s) "
-                + ", ".join(
-                    f"{f.face} (xi = {ratio_text(f.xi)}, rho_c = {significant(f.reduction_factor)})"
-                    for f in column
-                )
-                + "; sigma_cr,c: the face as a column between the section's ends "
-                + ("(clamped: 4 x eq. (4.8))" if section.ends == "clamped" else "(eq. (4.8))")
-            )
-        rated = [f for f in out.faces if f.reduced_design_stress_Pa is not None]
-        for clause in dict.fromkeys(f.stress_limit_clause for f in rated):
-            out.clauses[0] += (
-                f"; faces {', '.join(f.face for f in rated if f.stress_limit_clause == clause)}: "
-                f"{clause}"
-            )
-        if rated:
-            first = min(_reaches_reduced_stress(f) for f in rated)
-            tied = [f for f in rated if _reaches_reduced_stress(f) <= first * (1.0 + 1e-12)]
-            out.governing_face = max(tied, key=lambda f: face_width(section, f.face)).face
-            if len(tied) > 1:
-                others = [f.face for f in tied if f.face != out.governing_face]
-                out.tied_faces = [out.governing_face, *others]
-        low = psi_range(INTERNAL)[0]
-        off_table = [f for f in out.faces if f.psi is not None and f.psi < low]
-        if off_table:
-            out.faces_outside_table = [f.face for f in off_table]
-            out.notes.append(
-                f"face(s) {', '.join(f'{f.face} (psi = {ratio_text(f.psi)})' for f in off_table)}: "
-                f"psi < {low:g}, outside EN 1993-1-5 Table 4.1 (1 >= psi >= {low:g}; eq. "
-                "(4.2) likewise): no k_sigma or rho is given for them, and they are left out "
-                "of the governing face; their compressed width b/(1 - psi) is checked by no "
-                "rule here"
-            )
-        _tension(out, section, design, load, rated)
+        _box_faces(out, section, design, load)
     else:
         out.clauses.append(TUBE_CLAUSES)
         _tension(out, section, design, load, [])
     out.notes.append(member_note(section, design))
     out.notes += _material_notes(section, design)
     if section.core:
-        outside = ": outside the calibration of EN 1993-1-5 4.4(2)"
-        out.notes.append(
-            "with the core sigma_cr is the unilateral critical stress"
-            + (outside if section.shape == "box" else "")
-        )
-        out.clauses.append(FILLED_CLAUSES)
-        epsilon = math.sqrt(235.0e6 / design.yield_stress)
-        if section.shape == "box":
-            across = max(section.width or 0.0, section.depth or 0.0) + t
-            out.width_to_thickness_limit = 52.0 * epsilon
-        else:
-            across = (section.diameter or 0.0) + t
-            out.width_to_thickness_limit = 90.0 * epsilon**2
-        out.width_to_thickness = across / t
-        within = out.width_to_thickness <= out.width_to_thickness_limit
-        span = section.core_span
-        if span is not None and not (span[0] <= 0.0 and span[1] >= section.length):
-            # Table 6.3 is a filled section's: the hollow length is a steel member's.
-            out.notes.append(
-                f"the core fills x/L = {span[0] / section.length:.4g} to "
-                f"{span[1] / section.length:.4g} of the length only: EN 1994-1-1 6.7.1(9) "
-                "and Table 6.3 describe a concrete-filled section, not the hollow length, "
-                "whose walls' local buckling is EN 1993's (EN 1993-1-1 Table 5.2, "
-                "EN 1993-1-5); local_buckling_negligible is false"
-                + (" although the ratio is within the limit" if within else "")
-            )
-            within = False
-        out.local_buckling_negligible = within
+        _core_limits(out, section, design)
     return out
+
+
+def _box_faces(
+    out: SectionDesignRecord, section: DesignSection, design: DesignSpec, load: float
+) -> None:
+    """A box's faces in ``out``: their design quantities, the governing face, the notes.
+
+    Every face at the section's critical load factor ``load``.
+    """
+    out.clauses.append(FACE_CLAUSES)
+    out.notes.append(CALIBRATION)
+    out.notes.append(
+        "every face at the section's critical load factor: conservative for a face "
+        "that buckles because its neighbours do"
+    )
+    for name, (a, b) in face_compressions(section).items():
+        out.faces.append(_face(section, name, (load * a, load * b), design))
+    column = [f for f in out.faces if f.xi is not None and f.xi < 1.0]  # rho_c, not rho
+    if column:
+        out.clauses.append(COLUMN_CLAUSES)
+        out.notes.append(
+            "column-type buckling (EN 1993-1-5 4.4(2) note, 4.5.4(1)): the section's "
+            "length is below the width of face(s) "
+            + ", ".join(
+                f"{f.face} (xi = {ratio_text(f.xi)}, rho_c = {significant(f.reduction_factor)})"
+                for f in column
+            )
+            + "; sigma_cr,c: the face as a column between the section's ends "
+            + ("(clamped: 4 x eq. (4.8))" if section.ends == "clamped" else "(eq. (4.8))")
+        )
+    rated = [f for f in out.faces if f.reduced_design_stress_Pa is not None]
+    for clause in dict.fromkeys(f.stress_limit_clause for f in rated):
+        out.clauses[0] += (
+            f"; faces {', '.join(f.face for f in rated if f.stress_limit_clause == clause)}: "
+            f"{clause}"
+        )
+    if rated:
+        first = min(_reaches_reduced_stress(f) for f in rated)
+        tied = [f for f in rated if _reaches_reduced_stress(f) <= first * (1.0 + 1e-12)]
+        out.governing_face = max(tied, key=lambda f: face_width(section, f.face)).face
+        if len(tied) > 1:
+            others = [f.face for f in tied if f.face != out.governing_face]
+            out.tied_faces = [out.governing_face, *others]
+    low = psi_range(INTERNAL)[0]
+    off_table = [f for f in out.faces if f.psi is not None and f.psi < low]
+    if off_table:
+        out.faces_outside_table = [f.face for f in off_table]
+        out.notes.append(
+            f"face(s) {', '.join(f'{f.face} (psi = {ratio_text(f.psi)})' for f in off_table)}: "
+            f"psi < {low:g}, outside EN 1993-1-5 Table 4.1 (1 >= psi >= {low:g}; eq. "
+            "(4.2) likewise): no k_sigma or rho is given for them, and they are left out "
+            "of the governing face; their compressed width b/(1 - psi) is checked by no "
+            "rule here"
+        )
+    _tension(out, section, design, load, rated)
+
+
+def _core_limits(out: SectionDesignRecord, section: DesignSection, design: DesignSpec) -> None:
+    """A filled section's note, clauses and width-to-thickness limits in ``out``."""
+    t = section.thickness
+    outside = ": outside the calibration of EN 1993-1-5 4.4(2)"
+    out.notes.append(
+        "with the core sigma_cr is the unilateral critical stress"
+        + (outside if section.shape == "box" else "")
+    )
+    out.clauses.append(FILLED_CLAUSES)
+    epsilon = math.sqrt(235.0e6 / design.yield_stress)
+    if section.shape == "box":
+        across = max(section.width or 0.0, section.depth or 0.0) + t
+        out.width_to_thickness_limit = 52.0 * epsilon
+    else:
+        across = (section.diameter or 0.0) + t
+        out.width_to_thickness_limit = 90.0 * epsilon**2
+    out.width_to_thickness = across / t
+    within = out.width_to_thickness <= out.width_to_thickness_limit
+    span = section.core_span
+    if span is not None and not (span[0] <= 0.0 and span[1] >= section.length):
+        # Table 6.3 is a filled section's: the hollow length is a steel member's.
+        out.notes.append(
+            f"the core fills x/L = {span[0] / section.length:.4g} to "
+            f"{span[1] / section.length:.4g} of the length only: EN 1994-1-1 6.7.1(9) "
+            "and Table 6.3 describe a concrete-filled section, not the hollow length, "
+            "whose walls' local buckling is EN 1993's (EN 1993-1-1 Table 5.2, "
+            "EN 1993-1-5); local_buckling_negligible is false"
+            + (" although the ratio is within the limit" if within else "")
+        )
+        within = False
+    out.local_buckling_negligible = within
 
 
 def _material_notes(section: DesignSection, design: DesignSpec) -> list[str]:

@@ -639,6 +639,59 @@ def _say_resumed(path: Path, done: int, stale: int, points: int) -> None:
         )
 
 
+def _solve_points(
+    path: Path,
+    points: list[dict[str, float]],
+    specs: list[ProblemSpec | SectionProblemSpec],
+    done: Mapping[int, object],
+    stale: int,
+    comm: MPI.Comm,
+    ranks_per_point: int,
+    progress: bool,
+) -> None:
+    """Solve the points not ``done`` (by index: those in ``path``), each group its share.
+
+    Each point's line is appended to ``path`` as it is solved (by its group's rank 0);
+    rank 0 shows the progress (:func:`run_sweep`). Collective on ``comm``.
+    """
+    todo = [k for k in range(len(points)) if k not in done]
+    groups = comm.size // ranks_per_point
+    color = comm.rank // ranks_per_point
+    sub = comm.Split(color, comm.rank)
+    try:
+        mine = todo[color::groups]
+        show = progress and comm.rank == 0
+        if show:
+            _say_resumed(path, len(done), stale, len(points))
+        lines = Progress(
+            "sweep",
+            len(todo),
+            interval=0.0,
+            enabled=show,
+            logger=PROGRESS,
+            bar=True,
+            initial=len(done),
+            unit="point",
+        )
+        t0 = time.perf_counter()
+        for count, k in enumerate(mine, start=1):
+            body = solve_point(specs[k], sub)
+            if sub.rank == 0:
+                _append(path, {"index": k, "point": points[k], **body})
+            if comm.rank == 0:
+                # Lines on disk, every group's (a newline ends each complete line).
+                finished = path.read_bytes().count(b"\n") - len(done)
+                lines.update(
+                    finished,
+                    f"point {k} {points[k]}: {body['status']} "
+                    f"({time.perf_counter() - t0:.1f} s for {count} point(s) on this rank)",
+                )
+        comm.Barrier()
+        lines.close()
+    finally:
+        sub.Free()
+
+
 def run_sweep(
     base: Mapping[str, object],
     variations: Sequence[Variation],
@@ -681,42 +734,7 @@ def run_sweep(
         check(points, specs)
     path = Path(out)
     done, stale = _resume(path, points, specs, comm)
-    todo = [k for k in range(len(points)) if k not in done]
-    groups = comm.size // ranks_per_point
-    color = comm.rank // ranks_per_point
-    sub = comm.Split(color, comm.rank)
-    try:
-        mine = todo[color::groups]
-        show = progress and comm.rank == 0
-        if show:
-            _say_resumed(path, len(done), stale, len(points))
-        lines = Progress(
-            "sweep",
-            len(todo),
-            interval=0.0,
-            enabled=show,
-            logger=PROGRESS,
-            bar=True,
-            initial=len(done),
-            unit="point",
-        )
-        t0 = time.perf_counter()
-        for count, k in enumerate(mine, start=1):
-            body = solve_point(specs[k], sub)
-            if sub.rank == 0:
-                _append(path, {"index": k, "point": points[k], **body})
-            if comm.rank == 0:
-                # Lines on disk, every group's (a newline ends each complete line).
-                finished = path.read_bytes().count(b"\n") - len(done)
-                lines.update(
-                    finished,
-                    f"point {k} {points[k]}: {body['status']} "
-                    f"({time.perf_counter() - t0:.1f} s for {count} point(s) on this rank)",
-                )
-        comm.Barrier()
-        lines.close()
-    finally:
-        sub.Free()
+    _solve_points(path, points, specs, done, stale, comm, ranks_per_point, progress)
     final = None
     if comm.rank == 0:
         everything = {index_of(line): line for line in read_lines(path)}

@@ -463,7 +463,7 @@ def test_chart_axes_name_the_swept_number_in_words():
     assert axis_label("obstacle.foundation_stiffness", base) == "foundation modulus (Pa/m)"
 
 
-def test_an_aspect_chart_s_title_names_its_axis(tmp_path, monkeypatch):
+def test_an_aspect_chart_s_title_names_its_axis():
     """A sweep of plate.length is drawn against a/b: its title says so, as its axis does.
 
     The title read "k against the plate length (m)" over an axis of a/b.
@@ -472,25 +472,18 @@ def test_an_aspect_chart_s_title_names_its_axis(tmp_path, monkeypatch):
 
     from unibuckle_fenicsx.viz import charts
 
-    seen, save = {}, charts._save
-
-    def keep(fig, ax, path):
-        seen.update(title=ax.get_title(), xlabel=ax.get_xlabel())
-        return save(fig, ax, path)
-
-    monkeypatch.setattr(charts, "_save", keep)
     base = tomllib.loads(SMALL)
     lines = [
         {"point": {"plate.length": a}, "status": "ok", "buckling_coefficient_k": 4.4,
          "free_load_Pa": 1.0, "critical_load_Pa": 1.1, "certificate": None}
         for a in (0.2, 0.3)
     ]  # fmt: skip
-    charts.plot_sweep(lines, [parse_variation("plate.length=0.2,0.3")], base, tmp_path / "c.png")
-    assert seen["xlabel"] == "aspect ratio a/b"
-    assert seen["title"] == "small: k against the aspect ratio a/b"
+    ax = charts.sweep_figure(lines, [parse_variation("plate.length=0.2,0.3")], base).axes[0]
+    assert ax.get_xlabel() == "aspect ratio a/b"
+    assert ax.get_title() == "small: k against the aspect ratio a/b"
 
 
-def test_an_aspect_chart_shows_every_point(tmp_path, monkeypatch):
+def test_an_aspect_chart_shows_every_point():
     """Every k of an aspect sweep lies within the chart's k axis, however short the plate.
 
     The axis was cut at 2.5 times the smallest k: the clamped garland's a/b = 0.5 point
@@ -501,13 +494,6 @@ def test_an_aspect_chart_shows_every_point(tmp_path, monkeypatch):
 
     from unibuckle_fenicsx.viz import charts
 
-    seen, save = {}, charts._save
-
-    def keep(fig, ax, path):
-        seen.update(ylim=ax.get_ylim(), scale=ax.get_yscale(), ylabel=ax.get_ylabel())
-        return save(fig, ax, path)
-
-    monkeypatch.setattr(charts, "_save", keep)
     base = tomllib.loads(SMALL)
     k = {0.1: 21.702549, 0.2: 6.9752, 0.8: 4.2855}  # the record's a/b = 0.5, 1, 4
     lines = [
@@ -516,10 +502,10 @@ def test_an_aspect_chart_shows_every_point(tmp_path, monkeypatch):
         for a, value in k.items()
     ]  # fmt: skip
     variation = parse_variation("plate.length=0.1,0.2,0.8")
-    charts.plot_sweep(lines, [variation], base, tmp_path / "c.png")
-    low, high = seen["ylim"]
-    assert all(low < value < high for value in k.values()), (seen, k)
-    assert seen["scale"] == "log" and seen["ylabel"].endswith("(log scale)")
+    ax = charts.sweep_figure(lines, [variation], base).axes[0]
+    low, high = ax.get_ylim()
+    assert all(low < value < high for value in k.values()), (ax.get_ylim(), k)
+    assert ax.get_yscale() == "log" and ax.get_ylabel().endswith("(log scale)")
 
 
 # -- sections -----------------------------------------------------------------------
@@ -600,7 +586,7 @@ def test_a_section_chart_names_its_numbers():
     )
 
 
-def test_a_section_chart_draws_the_extreme_fibre_s_stress(tmp_path, monkeypatch):
+def test_a_section_chart_draws_the_extreme_fibre_s_stress():
     """With bending the chart's sigma_cr is the extreme fibre's, not the load factor.
 
     The box of ``BOX`` hollow and filled, axial_stress = -1 and bending_stress = -0.5: the
@@ -614,23 +600,14 @@ def test_a_section_chart_draws_the_extreme_fibre_s_stress(tmp_path, monkeypatch)
     from unibuckle_fenicsx.sweep import solve_point
     from unibuckle_fenicsx.viz import charts
 
-    seen: dict[str, np.ndarray] = {}
-    save = charts._save
-
-    def keep(fig, ax, path):
-        seen.update({line.get_label(): np.asarray(line.get_ydata()) for line in ax.lines})
-        return save(fig, ax, path)
-
-    monkeypatch.setattr(charts, "_save", keep)
     base = tomllib.loads(BOX)
     point = {"load.bending_stress": -0.5}
     line = {"index": 0, "point": point, **solve_point(point_problem(base, point), MPI.COMM_SELF)}
     assert line["status"] == "ok"
     E, nu, t, b = 2.1e11, 0.3, 0.001, 0.1
     classical = 4 * math.pi**2 * E * t**3 / (12 * (1 - nu**2)) / (t * b**2)
-    charts.plot_sweep(
-        [line], [parse_variation("load.bending_stress=-0.5")], base, tmp_path / "c.png"
-    )
+    fig = charts.sweep_figure([line], [parse_variation("load.bending_stress=-0.5")], base)
+    seen = {line.get_label(): np.asarray(line.get_ydata()) for line in fig.axes[0].lines}
     assert seen["hollow"][0] == pytest.approx(1.5 * line["free_load_Pa"] / classical, rel=1e-5)
     assert seen["core"][0] == pytest.approx(1.5 * line["critical_load_Pa"] / classical, rel=1e-5)
 

@@ -77,7 +77,7 @@ from unibuckle_fenicsx.algorithms.records import (
     SectionLevel,
     SectionLevelsDetails,
 )
-from unibuckle_fenicsx.errors import InputError
+from unibuckle_fenicsx.errors import InputError, NoKKTPointError
 from unibuckle_fenicsx.model.problem import UnilateralProblem
 from unibuckle_fenicsx.model.shell.core import CoreConstraints
 from unibuckle_fenicsx.model.shell.geometry import grid_nodes
@@ -137,7 +137,7 @@ CHECKED = "interior-point+seeds"
 #: On the route :data:`CHECKED`, the seeds run again on a finer section whose carried set
 #: polishes to no KKT point only below this many DOFs: there they cost a few times the
 #: interior point's route; above, the active set's route is out of reach
-#: (:doc:`/verification/sections`, "Cost", where both are measured) and the chain's KKT
+#: (:doc:`/verification/sections`, "Cost", holds both) and the chain's KKT
 #: point stands.
 CHECK_SEEDS_DOFS = 20_000
 #: The routes of :func:`solve_levels` (module docstring).
@@ -148,15 +148,16 @@ ROUTES = ("interior-point", "active-set", BOTH, CHECKED)
 #: the interior point's starts on the coarsest section do, and either route ended at a
 #: lower KKT point than the other on some sections (:doc:`/verification/sections`, "Cost").
 INTERIOR_POINT_DOFS = 10_000
-#: The interior point's settings on sections: only the lowest arrangement of the
-#: coarsest section is carried up (``arrangements = 1``). On every section measured it
-#: gave the lowest KKT point on the finest, and each further arrangement costs a whole
-#: run of Newton steps on the finest section. Where a read of the gaps is no KKT point,
-#: the predicted contact set is read too (``read_predicted``): where a wall lies almost
-#: flat on the core its gaps stay above the tolerance, and only the predicted set holds
-#: them (:doc:`/verification/sections_finest`). The release of the nodes that pull at a
-#: read (``release_steps``, :doc:`/verification/fine_level_release`) is off here: on
-#: sections it saved next to nothing (:doc:`/verification/sections_full_cost`).
+#: The interior point's settings on sections: only the lowest arrangement of the coarsest
+#: section is carried up (``arrangements = 1``). On every section of
+#: :doc:`/verification/sections` it gave the lowest KKT point on the finest, and each
+#: further arrangement costs a whole run of Newton steps on the finest section. Where a
+#: read of the gaps is no KKT point, the predicted contact set is read too
+#: (``read_predicted``): where a wall lies almost flat on the core its gaps stay above
+#: the tolerance, and only the predicted set holds them
+#: (:doc:`/verification/sections_finest`). The release of the nodes that pull at a read
+#: (``release_steps``, :doc:`/verification/fine_level_release`) is off here: on sections
+#: it saved next to nothing (:doc:`/verification/sections_full_cost`).
 CHAIN_OPTIONS = ChainOptions(arrangements=1, read_predicted=True, release_steps=0)
 #: The interior point starts on a section at least this coarse: the cell size doubled
 #: while the coarser section keeps this many DOFs (more if ``levels`` asks). The
@@ -457,10 +458,6 @@ def _seeds_carried(
     return found, penalty
 
 
-class _NoKKTPoint(Exception):
-    """The chain of :func:`_starts_coarse_enough` reached no KKT point (no fallback)."""
-
-
 def _starts_coarse_enough(
     sections: Sequence[Section], solution: UnilateralSolution
 ) -> UnilateralSolution:
@@ -482,11 +479,11 @@ def _starts_coarse_enough(
         return solution
 
     def no_fallback(_: UnilateralProblem) -> UnilateralSolution:
-        raise _NoKKTPoint
+        raise NoKKTPointError
 
     try:
         again = _chain(sections[first:], no_fallback)
-    except _NoKKTPoint:
+    except NoKKTPointError:
         logger.info("section: the starts on %d DOFs reach no KKT point", dofs[first])
         return solution
     logger.info(

@@ -53,10 +53,12 @@ __all__ = [
     "NEAR_NCV",
     "EigenPair",
     "GEPSolver",
+    "ShiftedSolves",
     "SmallestProof",
     "SmallestSearch",
     "extreme_eigenvalues",
     "lowest_eigenvalues",
+    "spurious_pair",
     "swapped_eigenpairs",
 ]
 
@@ -96,8 +98,8 @@ WIDER_NCV = 32
 #: looser ``eps_tol``). An eigenpair's agree to second order in the vector's error, even
 #: where the vector mixes a cluster of nearly equal loads; Krylov-Schur in shift-and-invert
 #: measures the error in the B-norm, blind to the null space of a semidefinite B, and
-#: its spurious pairs' differ by far more. The constant sits between the two, as
-#: measured in docs/history/2026-11-30g-spurious.md.
+#: its spurious pairs' differ by far more. The constant sits between the two
+#: (docs/history/2026-11-30g-spurious.md holds both).
 SPURIOUS_RTOL = 1e-2
 #: Krylov vectors of the solve again after such a pair (or a negative load), at least: a
 #: pencil whose B has lost most of its rank to the removed rows needs more than
@@ -257,6 +259,295 @@ def _residual(A: PETSc.Mat, B: PETSc.Mat, x: PETSc.Vec, value: float) -> float:
         bx.destroy()
 
 
+def spurious_pair(eps: SLEPc.EPS, index: int = 0) -> bool:
+    """Whether pair ``index`` of ``eps`` is none of its definite pencil (collective).
+
+    A load that is not positive, or one its vector's Rayleigh quotient disagrees
+    with beyond :data:`SPURIOUS_RTOL` (relative; a thousand times the EPS's
+    tolerance if that is looser). False when that pair did not converge. Every
+    solve of the pencil (A, B), B semidefinite, is checked so: at target 0, near
+    an estimate (:meth:`GEPSolver.solve`, :meth:`GEPSolver.lowest_pairs`) and the free one
+    (:class:`SmallestSearch`). The swapped pencil's solves (``indefinite``,
+    :func:`swapped_eigenpairs`) measure in the norm of A, positive definite, and
+    need no check.
+    """
+    if eps.getConverged() <= index:
+        return False
+    value = eps.getEigenvalue(index).real
+    if not value > 0.0:
+        return True
+    A, B = eps.getOperators()
+    x = A.createVecRight()
+    try:
+        eps.getEigenvector(index, x)
+        return not _agrees(A, B, x, value, eps.getTolerances()[0])
+    finally:
+        x.destroy()
+
+
+def _swapped_pair(
+    eps: SLEPc.EPS, prefix: str, out: PETSc.Vec | None, ncv: int, value: float, error: float
+) -> EigenPair:
+    r"""The least load from the swapped pencil :math:`Bx = \theta Ax`, checked.
+
+    The last resort after :meth:`GEPSolver._wider_pair` returned a pair that is none of the
+    pencil (``value``, ``error`` its load and residual, for the message): the same
+    reduced pencil (``eps``'s operators) with A, positive definite, in the inner-product
+    slot and the largest :math:`\theta = 1/\lambda` wanted (spectral transformation
+    "shift", options prefix ``<prefix>swapped_``, :func:`swapped_eigenpairs`). Its
+    largest eigenvalue is
+    well separated wherever B has lost most of its rank (the removed rows' zero
+    eigenvalues lie at the other end of its spectrum). Its pair is kept only if its
+    Rayleigh quotient agrees with it (:func:`_agrees`); otherwise raises
+    :class:`EigenSolveError`. Collective.
+    """
+    A, B = eps.getOperators()
+    tol = eps.getTolerances()[0]
+    largest = SLEPc.EPS.Which.LARGEST_REAL
+    pairs = swapped_eigenpairs(
+        A, B, prefix + "swapped_", which=largest, tol=tol, vectors=True, ncv=ncv
+    )
+    try:
+        for theta, vec in pairs[:1]:
+            if vec is not None and theta > 0.0 and _agrees(A, B, vec, 1.0 / theta, tol):
+                if out is not None:
+                    vec.copy(out)
+                its = int(eps.getIterationNumber())
+                residual = _residual(A, B, vec, 1.0 / theta)
+                return EigenPair(1.0 / theta, residual, its, len(pairs))
+    finally:
+        for _, vec in pairs:
+            if vec is not None:
+                vec.destroy()
+    raise EigenSolveError(
+        f"SLEPc ({prefix}) returned a pair that is not an eigenpair of the "
+        f"definite pencil (load {value:.6g}, relative residual {error:.3g}) with {ncv} "
+        f"Krylov vectors, nor did the swapped pencil (-{prefix}swapped_*); try a "
+        f"larger -{prefix}eps_ncv"
+    )
+
+
+class ShiftedSolves(Owner):
+    r"""The solves of a :class:`GEPSolver`'s pencils at a shift, through the shared :math:`LDL^T`.
+
+    One MUMPS :math:`LDL^T` of the mesh (:attr:`factorization`, made on first use) and
+    the two Krylov-Schur EPS that solve with it (the solves near an estimate,
+    :meth:`near_eps`, and the smallest pair's, :meth:`free_eps`): the pencil shifted to
+    :math:`\sigma` is factorised once (:meth:`shift_to`), and its inertia counts the
+    eigenvalues below :math:`\sigma` (Sylvester's law).
+
+    Args:
+        A: The stiffness matrix (owned by the caller), whose pattern the factorisation has.
+        main: The solver's EPS at target 0 (owned by the solver): the shifted EPS take its
+            tolerance.
+        prefix: The solver's options prefix.
+        options: The solver's options (the smallest pair's EPS takes them).
+        indefinite: B is indefinite: the swapped pencil is shifted.
+        reused: As :class:`GEPSolver`'s.
+
+    Attributes:
+        free_ncv: Krylov vectors of the smallest pair's EPS for one pair (the options').
+
+    Note:
+        Collective on ``A.comm``. The solver owns it and destroys it.
+    """
+
+    def __init__(
+        self,
+        A: PETSc.Mat,
+        main: SLEPc.EPS,
+        prefix: str,
+        options: Options,
+        indefinite: bool,
+        reused: bool,
+    ) -> None:
+        self.A, self.main, self.prefix, self.options = A, main, prefix, options
+        self.indefinite, self.reused = indefinite, reused
+        self._near: SLEPc.EPS | None = None  # the shifted solves' EPS, made when needed
+        self._free: SLEPc.EPS | None = None  # the smallest pair's EPS, made when needed
+        self.free_ncv = FREE_NCV
+        self._ldl: SharedFactorization | None = None  # made when needed
+
+    def count_below(self, A: PETSc.Mat, B: PETSc.Mat, shift: float) -> int:
+        r"""Negative pivots of :math:`A - \sigma B` (one numeric :math:`LDL^T`). Collective."""
+        ldl = self.factorization
+        same, subset = PETSc.Mat.Structure.SAME_NONZERO_PATTERN, PETSc.Mat.Structure.SUBSET
+        A.copy(ldl.matrix, structure=same)  # type: ignore[arg-type]
+        ldl.matrix.axpy(-shift, B, structure=subset)  # type: ignore[arg-type]
+        negative, _, _ = ldl.factor(self)
+        return int(negative)
+
+    @property
+    def factorization(self) -> SharedFactorization:
+        """The mesh's :class:`SharedFactorization` (prefix ``<prefix>ldl_``), made on first use.
+
+        The shifted solves factorise through it, and so do the interior-point method and
+        the certificate on the same problem: one symbolic analysis per mesh.
+        """
+        if self._ldl is None:
+            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_", self.reused)
+        return self._ldl
+
+    def near_eps(self) -> SLEPc.EPS:
+        """The shifted solves' EPS (prefix ``<prefix>near_``), made on first use."""
+        if self._near is None:
+            self._near = self._eps(self.prefix + "near_", NEAR_NCV)
+        return self._near
+
+    def _eps(self, prefix: str, ncv: int) -> SLEPc.EPS:
+        """A Krylov-Schur EPS whose spectral transformation solves with the shared LDLᵀ.
+
+        Its spectral transformation shifts the first operator in place and solves with
+        the :attr:`factorization`'s KSP: the operator passed is that factorisation's
+        matrix, filled by :meth:`shift_to` before each solve. It takes the EPS options
+        (not the ``st_`` ones: its solver is the shared one) under ``prefix``: the
+        solver's ``options`` under its own prefix (the smallest pair's EPS), else
+        :data:`EIGEN_OPTIONS`'s. The shifted solves (``<prefix>near_``), which recover from
+        a failed solve at target 0 (:meth:`GEPSolver._by_inertia`), take an option given for the
+        solver's prefix (in Python or on the command line) by its tolerance only: an
+        iteration limit meant for the first solve leaves the recovery alone.
+        """
+        eps = SLEPc.EPS().create(self.A.comm)
+        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
+        eps.setDimensions(1, ncv)
+        eps.setTolerances(self.main.getTolerances()[0])
+        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
+        st = eps.getST()
+        st.setType(SLEPc.ST.Type.SINVERT)
+        given = self.options if prefix == self.prefix else EIGEN_OPTIONS
+        eps_only = {k: v for k, v in given.items() if not k.startswith("st_")}
+        set_options(eps, prefix, eps_only)
+        st.setMatMode(SLEPc.ST.MatMode.INPLACE)
+        st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
+        st.setKSP(self.factorization.ksp)
+        return eps
+
+    def shift_to(
+        self, eps: SLEPc.EPS, A: PETSc.Mat, B: PETSc.Mat, shift: float, initial: PETSc.Vec | None
+    ) -> int:
+        r"""Factorise the pencil (A, B) shifted to ``shift`` for ``eps``; eigenvalues below it.
+
+        The first operator goes into the shared matrix (A's pattern), which the spectral
+        transformation shifts in place and factorises (numeric only, after the first
+        analysis): :math:`A - \sigma B`, or for the swapped pencil :math:`B - A/\sigma`,
+        whose positive eigenvalues count the pencil's eigenvalues in :math:`(0,
+        \sigma)`. Returns that count (the inertia). Collective.
+        """
+        ldl = self.factorization
+        if self.indefinite:
+            ldl.matrix.zeroEntries()
+            ldl.matrix.axpy(1.0, B, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)  # type: ignore[arg-type]
+            eps.setOperators(ldl.matrix, A)
+            eps.setTarget(1.0 / shift)
+        else:
+            A.copy(ldl.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)  # type: ignore[arg-type]
+            eps.setOperators(ldl.matrix, B)
+            eps.setTarget(shift)
+        if initial is not None:
+            eps.setInitialSpace([initial])
+        eps.setUp()
+        ldl.claim(self)
+        negative, _, positive = ldl.inertia()
+        return int(positive if self.indefinite else negative)
+
+    def solve_below(
+        self, A: PETSc.Mat, B: PETSc.Mat, near: float, initial: PETSc.Vec | None
+    ) -> bool:
+        r"""Solve at the shift :data:`NEAR_MARGIN` below ``near``; whether that answers.
+
+        False when the inertia of :math:`A - \sigma B` (the shared
+        :attr:`factorization`) shows an eigenvalue below the shift :math:`\sigma` (the
+        pair found would be the nearest to it, not necessarily the smallest), or when
+        nothing converged. Collective.
+        """
+        eps = self.near_eps()
+        if self.shift_to(eps, A, B, near * (1.0 - NEAR_MARGIN), initial) != 0:
+            return False
+        eps.solve()
+        return eps.getConverged() >= 1
+
+    def free_eps(self) -> SLEPc.EPS:
+        """The smallest pair's EPS (prefix ``<prefix>``, :data:`FREE_NCV`), made on first use."""
+        if self._free is None:
+            self._free = self._eps(self.prefix, FREE_NCV)
+            self.free_ncv = int(self._free.getDimensions()[1])
+        return self._free
+
+    def lowest_pairs(
+        self, A: PETSc.Mat, B: PETSc.Mat, near: float, count: int, start: PETSc.Vec | None
+    ) -> list[tuple[EigenPair, PETSc.Vec]] | None:
+        """The ``count`` smallest pairs of (A, B) by one solve :data:`NEAR_MARGIN` below ``near``.
+
+        None when the inertia shows an eigenvalue below the shift (nothing solved); after
+        the solve, empty when fewer pairs converge or one is none of the pencil
+        (:func:`spurious_pair`). See :meth:`GEPSolver.lowest_pairs`. Collective.
+        """
+        eps = self.near_eps()
+        nev, ncv, mpd = eps.getDimensions()
+        eps.setDimensions(count, max(ncv, 2 * count + 2))
+        try:
+            below = self.shift_to(eps, A, B, near * (1.0 - NEAR_MARGIN), start)
+            if below != 0:
+                return None
+            eps.solve()
+            if eps.getConverged() < count:
+                return []
+            if not self.indefinite and any(spurious_pair(eps, k) for k in range(count)):
+                return []  # a pair that is none of the pencil proves nothing
+            its = int(eps.getIterationNumber())
+            pairs: list[tuple[EigenPair, PETSc.Vec]] = []
+            for k in range(count):
+                vec = A.createVecRight()
+                eps.getEigenvector(k, vec)
+                theta = eps.getEigenvalue(k).real
+                value = 1.0 / theta if self.indefinite else theta
+                pair = EigenPair(float(value), float(eps.computeError(k)), its, count)
+                pairs.append((pair, vec))
+        finally:
+            eps.setDimensions(nev, ncv, mpd)
+        return sorted(pairs, key=lambda p: p[0].value)
+
+    def solve_by_inertia(self, A: PETSc.Mat, B: PETSc.Mat, radius: float) -> bool:
+        r"""Bracket the swapped pencil's smallest load by inertias, then solve below it.
+
+        A relative tolerance cannot be met by eigenvalues that are round-off (a load that
+        does not buckle the plate on this mesh, as a steep stress gradient on a coarse
+        mesh), nor always by a small one in a cluster, and an eigen solve with an
+        absolute tolerance need not converge either. The inertia of :math:`B - A/\sigma`
+        (one :math:`LDL^T` through the shared :attr:`factorization`) counts the loads in
+        :math:`(0, \sigma)` with no eigen solve: none below :math:`\sigma = 10^{10}/r`
+        (r = ``radius``, the spectral radius of :math:`A^{-1}B`, the round-off ceiling of
+        :meth:`GEPSolver._is_roundoff`) means no finite load: False (nothing solved).
+        Else geometric bisection between :math:`1/2r`, below every load, and that ceiling
+        brackets the smallest load to a ratio of :data:`INERTIA_BRACKET`, and the
+        :meth:`near_eps` shifted :data:`NEAR_MARGIN` below the bracket (no load below
+        it) solves for it, the nearest to the shift: True. Collective.
+        """
+        eps = self.near_eps()
+        # Every load is at least 1/r; the radius is converged to 1e-6 only, hence 1/2r.
+        low, high = 0.5 / radius, 1e10 / radius
+        if self.shift_to(eps, A, B, high, None) == 0:
+            return False
+        while high > low * INERTIA_BRACKET:
+            middle = float(np.sqrt(low * high))
+            if self.shift_to(eps, A, B, middle, None) == 0:
+                low = middle
+            else:
+                high = middle
+        # Just below the bracket (a shift may sit on a load within MUMPS's null pivot
+        # threshold, counted as none below): the nearest load above is the smallest.
+        self.shift_to(eps, A, B, low * (1.0 - NEAR_MARGIN), None)
+        eps.solve()
+        return True
+
+    def destroy(self) -> None:
+        """Destroy the EPS and the factorisation (collective)."""
+        release(self, "_near", "_free", "_ldl")
+
+    def __del__(self) -> None:
+        self.destroy()
+
+
 class GEPSolver(Owner):
     """Smallest eigenpair of :math:`(A, B)` with optional removed DOFs.
 
@@ -329,10 +620,7 @@ class GEPSolver(Owner):
         except InputError:
             self.destroy()  # collective: every rank reads the same options
             raise
-        self._near: SLEPc.EPS | None = None  # the shifted solves' EPS, made when needed
-        self._free: SLEPc.EPS | None = None  # the smallest pair's EPS, made when needed
-        self._free_ncv = FREE_NCV  # its Krylov subspace for one pair (the options')
-        self._ldl: SharedFactorization | None = None  # made when needed
+        self.shifted = ShiftedSolves(A, eps, prefix, self._options, indefinite, reused)
         self.shifted_solves = 0  # solves at a shift below an estimate (near=...)
         self.unshifted_again = 0  # ... of which an eigenvalue lay below the shift
 
@@ -398,7 +686,7 @@ class GEPSolver(Owner):
         start = initial if initial is not None and self._useful_start(initial, B) else None
         eps = self._run(A, B, start, near)
         self.solves += 1
-        if eps is not self.eps and not self.indefinite and self._spurious(eps):
+        if eps is not self.eps and not self.indefinite and spurious_pair(eps):
             # The shifted solve's pair is none of the pencil (its load may even lie below
             # the least, under the shift's inertia): the solve at target 0 from SLEPc's
             # own start, checked below as every other.
@@ -420,7 +708,7 @@ class GEPSolver(Owner):
             self.solves += 1
             if eps.getConverged() < 1:
                 return self._wider_pair(None, out)
-        if eps is self.eps and not self.indefinite and self._spurious(eps):
+        if eps is self.eps and not self.indefinite and spurious_pair(eps):
             # A negative load, or one its vector's Rayleigh quotient contradicts, is no eigenpair
             # of a definite pencil: Krylov-Schur in shift-and-invert, on a pencil whose B
             # has lost most of its rank to the removed rows (a section with most of its
@@ -429,32 +717,6 @@ class GEPSolver(Owner):
                          self.prefix, eps.getEigenvalue(0).real, eps.computeError(0))  # fmt: skip
             return self._wider_pair(None, out, SPURIOUS_NCV)
         return self._pair(eps, out)
-
-    @staticmethod
-    def _spurious(eps: SLEPc.EPS, index: int = 0) -> bool:
-        """Whether pair ``index`` of ``eps`` is none of its definite pencil (collective).
-
-        A load that is not positive, or one its vector's Rayleigh quotient disagrees
-        with beyond :data:`SPURIOUS_RTOL` (relative; a thousand times the EPS's
-        tolerance if that is looser). False when that pair did not converge. Every
-        solve of the pencil (A, B), B semidefinite, is checked so: at target 0, near
-        an estimate (:meth:`solve`, :meth:`lowest_pairs`) and the free one
-        (:class:`SmallestSearch`). The swapped pencil's solves (``indefinite``,
-        :func:`swapped_eigenpairs`) measure in the norm of A, positive definite, and
-        need no check.
-        """
-        if eps.getConverged() <= index:
-            return False
-        value = eps.getEigenvalue(index).real
-        if not value > 0.0:
-            return True
-        A, B = eps.getOperators()
-        x = A.createVecRight()
-        try:
-            eps.getEigenvector(index, x)
-            return not _agrees(A, B, x, value, eps.getTolerances()[0])
-        finally:
-            x.destroy()
 
     def _wider_pair(
         self, initial: PETSc.Vec | None, out: PETSc.Vec | None, least: int = WIDER_NCV
@@ -465,7 +727,7 @@ class GEPSolver(Owner):
         its wall) can keep the default subspace from converging within ``eps_max_it``
         restarts; a wider one separates them. ``least``: the fewest Krylov vectors.
         Raises as :meth:`_pair` if it fails too, and if its pair is none
-        (:meth:`_spurious`). Collective.
+        (:func:`spurious_pair`). Collective.
         """
         eps = self.eps
         nev, ncv, mpd = eps.getDimensions()
@@ -477,63 +739,23 @@ class GEPSolver(Owner):
                 eps.setInitialSpace([initial])
             eps.solve()
             self.solves += 1
-            if self._spurious(eps):
+            if spurious_pair(eps):
                 value, error = eps.getEigenvalue(0).real, eps.computeError(0)
                 logger.debug("%s: no eigenpair with %d Krylov vectors (%.6g); swapped",
                              self.prefix, wider, value)  # fmt: skip
-                return self._swapped_pair(out, wider, value, error)
+                return _swapped_pair(eps, self.prefix, out, wider, value, error)
             return self._pair(eps, out)
         finally:
             eps.setDimensions(nev, ncv, mpd)
-
-    def _swapped_pair(
-        self, out: PETSc.Vec | None, ncv: int, value: float, error: float
-    ) -> EigenPair:
-        r"""The least load from the swapped pencil :math:`Bx = \theta Ax`, checked.
-
-        The last resort after :meth:`_wider_pair` returned a pair that is none of the
-        pencil (``value``, ``error`` its load and residual, for the message): the same
-        reduced pencil with A, positive definite, in the inner-product slot and the
-        largest :math:`\theta = 1/\lambda` wanted (spectral transformation "shift", options
-        prefix ``<prefix>swapped_``, :func:`swapped_eigenpairs`). Its largest eigenvalue is
-        well separated wherever B has lost most of its rank (the removed rows' zero
-        eigenvalues lie at the other end of its spectrum). Its pair is kept only if its
-        Rayleigh quotient agrees with it (:func:`_agrees`); otherwise raises
-        :class:`EigenSolveError`. Collective.
-        """
-        A, B = self.eps.getOperators()
-        tol = self.eps.getTolerances()[0]
-        largest = SLEPc.EPS.Which.LARGEST_REAL
-        pairs = swapped_eigenpairs(
-            A, B, self.prefix + "swapped_", which=largest, tol=tol, vectors=True, ncv=ncv
-        )
-        try:
-            for theta, vec in pairs[:1]:
-                if vec is not None and theta > 0.0 and _agrees(A, B, vec, 1.0 / theta, tol):
-                    if out is not None:
-                        vec.copy(out)
-                    its = int(self.eps.getIterationNumber())
-                    residual = _residual(A, B, vec, 1.0 / theta)
-                    return EigenPair(1.0 / theta, residual, its, len(pairs))
-        finally:
-            for _, vec in pairs:
-                if vec is not None:
-                    vec.destroy()
-        raise EigenSolveError(
-            f"SLEPc ({self.prefix}) returned a pair that is not an eigenpair of the "
-            f"definite pencil (load {value:.6g}, relative residual {error:.3g}) with {ncv} "
-            f"Krylov vectors, nor did the swapped pencil (-{self.prefix}swapped_*); try a "
-            f"larger -{self.prefix}eps_ncv"
-        )
 
     def _run(
         self, A: PETSc.Mat, B: PETSc.Mat, initial: PETSc.Vec | None, near: float | None
     ) -> SLEPc.EPS:
         """Solve the reduced pencil (A, B): shifted below ``near`` if that answers, else at 0."""
         if near is not None and near > 0.0:
-            if self._solve_below(A, B, near, initial):
+            if self.shifted.solve_below(A, B, near, initial):
                 self.shifted_solves += 1
-                return self._near
+                return self.shifted.near_eps()
             self.unshifted_again += 1
             logger.debug("%s: an eigenvalue below %.6g; solved at 0", self.prefix, near)
         eps = self.eps
@@ -580,95 +802,6 @@ class GEPSolver(Owner):
         error = eps.computeError(0)
         return EigenPair(float(value), float(error), int(its), int(nconv))
 
-    @property
-    def factorization(self) -> SharedFactorization:
-        """The mesh's :class:`SharedFactorization` (prefix ``<prefix>ldl_``), made on first use.
-
-        The shifted solves factorise through it, and so do the interior-point method and
-        the certificate on the same problem: one symbolic analysis per mesh.
-        """
-        if self._ldl is None:
-            self._ldl = SharedFactorization(self.A, self.prefix + "ldl_", self.reused)
-        return self._ldl
-
-    def _near_eps(self) -> SLEPc.EPS:
-        """The shifted solves' EPS (prefix ``<prefix>near_``), made on first use."""
-        if self._near is None:
-            self._near = self._shifted_eps(self.prefix + "near_", NEAR_NCV)
-        return self._near
-
-    def _shifted_eps(self, prefix: str, ncv: int) -> SLEPc.EPS:
-        """A Krylov-Schur EPS whose spectral transformation solves with the shared LDLᵀ.
-
-        Its spectral transformation shifts the first operator in place and solves with
-        the :attr:`factorization`'s KSP: the operator passed is that factorisation's
-        matrix, filled by :meth:`_shift_to` before each solve. It takes the EPS options
-        (not the ``st_`` ones: its solver is the shared one) under ``prefix``: the
-        solver's ``options`` under its own prefix (the smallest pair's EPS), else
-        :data:`EIGEN_OPTIONS`'s. The shifted solves (``<prefix>near_``), which recover from
-        a failed solve at target 0 (:meth:`_by_inertia`), take an option given for the
-        solver's prefix (in Python or on the command line) by its tolerance only: an
-        iteration limit meant for the first solve leaves the recovery alone.
-        """
-        eps = SLEPc.EPS().create(self.A.comm)
-        eps.setProblemType(SLEPc.EPS.ProblemType.GHEP)
-        eps.setDimensions(1, ncv)
-        eps.setTolerances(self.eps.getTolerances()[0])
-        eps.setWhichEigenpairs(SLEPc.EPS.Which.TARGET_REAL)
-        st = eps.getST()
-        st.setType(SLEPc.ST.Type.SINVERT)
-        given = self._options if prefix == self.prefix else EIGEN_OPTIONS
-        eps_only = {k: v for k, v in given.items() if not k.startswith("st_")}
-        set_options(eps, prefix, eps_only)
-        st.setMatMode(SLEPc.ST.MatMode.INPLACE)
-        st.setMatStructure(PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)
-        st.setKSP(self.factorization.ksp)
-        return eps
-
-    def _shift_to(
-        self, eps: SLEPc.EPS, A: PETSc.Mat, B: PETSc.Mat, shift: float, initial: PETSc.Vec | None
-    ) -> int:
-        r"""Factorise the pencil (A, B) shifted to ``shift`` for ``eps``; eigenvalues below it.
-
-        The first operator goes into the shared matrix (A's pattern), which the spectral
-        transformation shifts in place and factorises (numeric only, after the first
-        analysis): :math:`A - \sigma B`, or for the swapped pencil :math:`B - A/\sigma`,
-        whose positive eigenvalues count the pencil's eigenvalues in :math:`(0,
-        \sigma)`. Returns that count (the inertia). Collective.
-        """
-        ldl = self.factorization
-        if self.indefinite:
-            ldl.matrix.zeroEntries()
-            ldl.matrix.axpy(1.0, B, structure=PETSc.Mat.Structure.SUBSET_NONZERO_PATTERN)  # type: ignore[arg-type]
-            eps.setOperators(ldl.matrix, A)
-            eps.setTarget(1.0 / shift)
-        else:
-            A.copy(ldl.matrix, structure=PETSc.Mat.Structure.SAME_NONZERO_PATTERN)  # type: ignore[arg-type]
-            eps.setOperators(ldl.matrix, B)
-            eps.setTarget(shift)
-        if initial is not None:
-            eps.setInitialSpace([initial])
-        eps.setUp()
-        ldl.claim(self)
-        negative, _, positive = ldl.inertia()
-        return int(positive if self.indefinite else negative)
-
-    def _solve_below(
-        self, A: PETSc.Mat, B: PETSc.Mat, near: float, initial: PETSc.Vec | None
-    ) -> bool:
-        r"""Solve at the shift :data:`NEAR_MARGIN` below ``near``; whether that answers.
-
-        False when the inertia of :math:`A - \sigma B` (the shared
-        :attr:`factorization`) shows an eigenvalue below the shift :math:`\sigma` (the
-        pair found would be the nearest to it, not necessarily the smallest), or when
-        nothing converged. Collective.
-        """
-        eps = self._near_eps()
-        if self._shift_to(eps, A, B, near * (1.0 - NEAR_MARGIN), initial) != 0:
-            return False
-        eps.solve()
-        return eps.getConverged() >= 1
-
     def lowest_pairs(
         self,
         removed: npt.NDArray[np.int64],
@@ -682,7 +815,7 @@ class GEPSolver(Owner):
         :data:`NEAR_MARGIN` below ``near``, one eigen solve), for ``count`` pairs, in
         ascending order of load; the vectors are the caller's to destroy. Empty when the
         inertia shows an eigenvalue below the shift, fewer pairs converge or one is none
-        of the pencil (:meth:`_spurious`): the pairs returned are then proven the smallest.
+        of the pencil (:func:`spurious_pair`): the pairs returned are then proven the smallest.
 
         Args:
             removed: Global row indices owned by this rank to remove.
@@ -697,32 +830,16 @@ class GEPSolver(Owner):
         if _is_zero(B):
             return []
         start = initial if initial is not None and self._useful_start(initial, B) else None
-        eps = self._near_eps()
-        nev, ncv, mpd = eps.getDimensions()
-        eps.setDimensions(count, max(ncv, 2 * count + 2))
-        try:
-            below = self._shift_to(eps, A, B, near * (1.0 - NEAR_MARGIN), start)
-            if below != 0:
-                return []
-            eps.solve()
+        pairs = self.shifted.lowest_pairs(A, B, near, count, start)
+        if pairs is not None:
             self.solves += 1
             self.shifted_solves += 1
-            if eps.getConverged() < count:
-                return []
-            if not self.indefinite and any(self._spurious(eps, k) for k in range(count)):
-                return []  # a pair that is none of the pencil proves nothing
-            its = int(eps.getIterationNumber())
-            pairs: list[tuple[EigenPair, PETSc.Vec]] = []
-            for k in range(count):
-                vec = A.createVecRight()
-                eps.getEigenvector(k, vec)
-                theta = eps.getEigenvalue(k).real
-                value = 1.0 / theta if self.indefinite else theta
-                pair = EigenPair(float(value), float(eps.computeError(k)), its, count)
-                pairs.append((pair, vec))
-        finally:
-            eps.setDimensions(nev, ncv, mpd)
-        return sorted(pairs, key=lambda p: p[0].value)
+        return pairs or []
+
+    @property
+    def factorization(self) -> SharedFactorization:
+        """The mesh's :class:`SharedFactorization`: :attr:`ShiftedSolves.factorization`."""
+        return self.shifted.factorization
 
     def count_below(self, shift: float) -> int:
         r"""Eigenvalues of the whole pencil in :math:`(0, \sigma)`, by an inertia.
@@ -733,12 +850,7 @@ class GEPSolver(Owner):
         :math:`\sigma`, which on a small or stiff pencil is the computed eigenvalue
         itself. Collective.
         """
-        ldl = self.factorization
-        same, subset = PETSc.Mat.Structure.SAME_NONZERO_PATTERN, PETSc.Mat.Structure.SUBSET
-        self.A.copy(ldl.matrix, structure=same)  # type: ignore[arg-type]
-        ldl.matrix.axpy(-shift, self.B, structure=subset)  # type: ignore[arg-type]
-        negative, _, _ = ldl.factor(self)
-        return int(negative)
+        return self.shifted.count_below(self.A, self.B, shift)
 
     def smallest(
         self, out: PETSc.Vec | None = None, estimate: tuple[float, ...] = ()
@@ -761,13 +873,6 @@ class GEPSolver(Owner):
         """
         return SmallestSearch(self, estimate).run(out)
 
-    def _free_eps(self) -> SLEPc.EPS:
-        """The smallest pair's EPS (prefix ``<prefix>``, :data:`FREE_NCV`), made on first use."""
-        if self._free is None:
-            self._free = self._shifted_eps(self.prefix, FREE_NCV)
-            self._free_ncv = int(self._free.getDimensions()[1])
-        return self._free
-
     def operators_changed(self) -> None:
         """Forget the scales cached from A and B (call after changing them in place)."""
         self._norm_ratio = None
@@ -789,36 +894,16 @@ class GEPSolver(Owner):
     def _by_inertia(self, out: PETSc.Vec | None) -> EigenPair | None:
         r"""After a failed solve of :math:`B x = \theta A x`: the smallest load, by inertias.
 
-        A relative tolerance cannot be met by eigenvalues that are round-off (a load that
-        does not buckle the plate on this mesh, as a steep stress gradient on a coarse
-        mesh), nor always by a small one in a cluster, and an eigen solve with an
-        absolute tolerance need not converge either. The inertia of :math:`B - A/\sigma`
-        (one :math:`LDL^T` through the shared :attr:`factorization`) counts the loads in
-        :math:`(0, \sigma)` with no eigen solve: none below :math:`\sigma = 10^{10}/r`
-        (r the spectral radius of :math:`A^{-1}B`, the round-off ceiling of
-        :meth:`_is_roundoff`) means no finite load. Else geometric bisection between
-        :math:`1/2r`, below every load, and that ceiling brackets the smallest load to a
-        ratio of :data:`INERTIA_BRACKET`, and Krylov-Schur shifted :data:`NEAR_MARGIN`
-        below the bracket (no load below it) finds it, the nearest to the shift. None if that solve
-        converges no pair. Collective.
+        A relative tolerance cannot be met by eigenvalues that are round-off, nor always
+        by a small one in a cluster: :meth:`ShiftedSolves.solve_by_inertia`, with r the
+        spectral radius of :math:`A^{-1}B` (the round-off ceiling of :meth:`_is_roundoff`).
+        None if that solve converges no pair. Collective.
         """
         B, A = self.eps.getOperators()
-        eps = self._near_eps()
+        eps = self.shifted.near_eps()
         radius = self._spectral_radius()
-        # Every load is at least 1/r; the radius is converged to 1e-6 only, hence 1/2r.
-        low, high = 0.5 / radius, 1e10 / radius
-        if self._shift_to(eps, A, B, high, None) == 0:
+        if not self.shifted.solve_by_inertia(A, B, radius):
             return _no_load(out, int(self.eps.getIterationNumber()), 0)
-        while high > low * INERTIA_BRACKET:
-            middle = float(np.sqrt(low * high))
-            if self._shift_to(eps, A, B, middle, None) == 0:
-                low = middle
-            else:
-                high = middle
-        # Just below the bracket (a shift may sit on a load within MUMPS's null pivot
-        # threshold, counted as none below): the nearest load above is the smallest.
-        self._shift_to(eps, A, B, low * (1.0 - NEAR_MARGIN), None)
-        eps.solve()
         self.solves += 1
         if eps.getConverged() < 1:
             return None
@@ -857,7 +942,7 @@ class GEPSolver(Owner):
 
     def destroy(self) -> None:
         """Destroy the EPS and work matrices (collective)."""
-        release(self, "eps", "_near", "_free", "_ldl", "_Aw", "_Bw", "_Bx", "B")
+        release(self, "eps", "shifted", "_Aw", "_Bw", "_Bx", "B")
 
     def __del__(self) -> None:
         self.destroy()
@@ -885,7 +970,7 @@ class SmallestSearch:
     More than :data:`FREE_MAX_BELOW` below :math:`\sigma`, or fewer pairs found below
     it than lie there: the next shift lies below the estimate (``FREE_BELOW``)
     and the pencil is factorised again. If no shift proves it (or nothing converges, or
-    a pair is none of the pencil, :meth:`GEPSolver._spurious`,
+    a pair is none of the pencil, :func:`spurious_pair`,
     or there is no estimate) the pair comes from :meth:`GEPSolver.solve` at target 0 (a
     MUMPS LU), unproven: the caller checks it (:meth:`GEPSolver.count_below`).
 
@@ -940,13 +1025,13 @@ class SmallestSearch:
         it). Collective.
         """
         solver, rtol = self.solver, self.rtol
-        eps = solver._free_eps()
-        below = solver._shift_to(eps, solver.A, solver.B, shift, None)
+        eps = solver.shifted.free_eps()
+        below = solver.shifted.shift_to(eps, solver.A, solver.B, shift, None)
         if below > FREE_MAX_BELOW:
             return None, below
         # As many pairs as lie below the shift; then, if pairs above it lay nearer, more.
         for wanted in (below, 2 * below + 1) if below else (1,):
-            ncv = max(solver._free_ncv, 2 * wanted)
+            ncv = max(solver.shifted.free_ncv, 2 * wanted)
             # mpd with ncv: left unset it keeps its first value, below ncv - nev.
             eps.setDimensions(wanted, ncv, ncv)
             eps.solve()
@@ -954,7 +1039,7 @@ class SmallestSearch:
             loads = [self._load(eps.getEigenvalue(k).real) for k in range(eps.getConverged())]
             if not loads:
                 return None
-            if not solver.indefinite and any(solver._spurious(eps, k) for k in range(len(loads))):
+            if not solver.indefinite and any(spurious_pair(eps, k) for k in range(len(loads))):
                 return None  # a pair that is none of the pencil: the checked solve at 0
             under = [k for k, load in enumerate(loads) if load <= shift * (1.0 - rtol)]
             if below and len(under) >= below:

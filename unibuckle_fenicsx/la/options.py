@@ -87,7 +87,7 @@ ORDERINGS = {"amd": 0, "amf": 2, "scotch": 3, "pord": 4, "metis": 5, "qamd": 6}
 #: plate's (w, theta) matrices (the pencil's factorisations, the stiffness's LU) by
 #: approximate minimum fill, the membrane stiffness of the prestress by approximate
 #: minimum degree; of the orderings whose analysis costs little, each gives the
-#: fastest factorisation there (measured on :doc:`/verification/floor`).
+#: fastest factorisation there (:doc:`/verification/floor`).
 ORDERING_BELOW = {"plate": "amf", "membrane": "amd"}
 #: Rows from which a factorisation is ordered by nested dissection (METIS) instead, by
 #: kind and by whether its analysis serves one numeric factorisation or many (the eigen
@@ -97,7 +97,7 @@ ORDERING_BELOW = {"plate": "amf", "membrane": "amd"}
 #: the largest meshes, for a route's many on much smaller ones. On the membrane
 #: stiffness of a large mesh a minimum-degree ordering needs several times METIS's
 #: operations on some plates (AMD on one, AMF on another), METIS never much more than
-#: the least (measured up to 10^6 rows on :doc:`/verification/floor`). The package
+#: the least (up to 10^6 rows: :doc:`/verification/floor`). The package
 #: factorises a membrane stiffness once.
 NESTED_DISSECTION_ROWS = {
     "plate": {False: 600_000, True: 100_000},

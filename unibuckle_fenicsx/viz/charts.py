@@ -35,7 +35,7 @@ from unibuckle_fenicsx.results import rounded
 from unibuckle_fenicsx.spec import EDGE_NAMES, UNITS, ProblemSpec, is_section
 from unibuckle_fenicsx.sweep import Variation, point_problem
 
-__all__ = ["axis_label", "plot_sweep", "reference_k"]
+__all__ = ["axis_label", "plot_sweep", "reference_k", "sweep_figure"]
 
 _SS = ("simply_supported", "simply_supported_soft")
 
@@ -208,11 +208,16 @@ def _groups(
     return out
 
 
-def _save(fig: Any, ax: Any, path: str | Path) -> Path:
-    """Grid, legend, and the figure written to ``path`` (its folder made); returns it."""
+def _finish(fig: Any, ax: Any) -> Any:
+    """Grid, legend and layout of a chart; returns ``fig``."""
     ax.grid(True, alpha=0.3)
     ax.legend(fontsize=8, loc="best")
     fig.tight_layout()
+    return fig
+
+
+def _write(fig: Any, path: str | Path) -> Path:
+    """The figure written to ``path`` (its folder made); returns it."""
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=150)
@@ -342,7 +347,21 @@ def plot_sweep(
     *,
     title: str | None = None,
 ) -> Path:
-    r"""Draw k against the first variation (see the module docstring); returns ``path``.
+    """Write :func:`sweep_figure`'s chart to ``path`` (PNG, 150 dpi); returns ``path``."""
+    return _write(sweep_figure(lines, variations, base, title=title), path)
+
+
+def sweep_figure(
+    lines: Sequence[Mapping[str, Any]],
+    variations: Sequence[Variation],
+    base: Mapping[str, Any],
+    *,
+    title: str | None = None,
+) -> Any:
+    r"""The chart of k against the first variation (the module docstring), a ``Figure``.
+
+    One ``Axes`` (``fig.axes[0]``) holds the curves, the legend and the grid; the figure
+    is drawn and not written (:func:`plot_sweep` writes it).
 
     A section's sweep (``base`` with a ``[section]`` table) draws
     its critical stress over its classical stress instead: the reference being each line's
@@ -354,7 +373,7 @@ def plot_sweep(
     marked by its certificate.
     """
     if is_section(base):
-        return _plot_section_sweep(lines, variations, base, path, title)
+        return _section_figure(lines, variations, base, title)
     import matplotlib as mpl
     from matplotlib.figure import Figure
 
@@ -399,7 +418,7 @@ def plot_sweep(
     log = " (log scale)" if ax.get_yscale() == "log" else ""
     ax.set_ylabel(r"buckling coefficient $k = N b^2 / (\pi^2 D)$" + log)
     ax.set_title(title or f"{base.get('name', 'plate')}: k against the {xlabel}")
-    return _save(fig, ax, path)
+    return _finish(fig, ax)
 
 
 def _fibre_per_unit_load(line: Mapping[str, Any]) -> float:
@@ -415,14 +434,13 @@ def _fibre_per_unit_load(line: Mapping[str, Any]) -> float:
     return float(compression) / load
 
 
-def _plot_section_sweep(
+def _section_figure(
     lines: Sequence[Mapping[str, Any]],
     variations: Sequence[Variation],
     base: Mapping[str, Any],
-    path: str | Path,
     title: str | None,
-) -> Path:
-    """A section's chart (:func:`plot_sweep`); returns ``path``."""
+) -> Any:
+    """A section's chart (:func:`sweep_figure`)."""
     import matplotlib as mpl
     from matplotlib.figure import Figure
 
@@ -459,4 +477,4 @@ def _plot_section_sweep(
         or f"{base.get('name', 'section')}: critical stress against the "
         f"{axis_label(first.path, base)}"
     )
-    return _save(fig, ax, path)
+    return _finish(fig, ax)

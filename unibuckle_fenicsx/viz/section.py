@@ -9,7 +9,7 @@ set-up of :mod:`unibuckle_fenicsx.viz.plotting`.
 from __future__ import annotations
 
 from pathlib import Path
-from typing import TYPE_CHECKING
+from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
@@ -78,6 +78,36 @@ def view_turn(data: SectionFigureData) -> float:
     return float(np.angle(np.exp(1j * (np.arctan2(z[largest], y[largest]) - eye))))
 
 
+def _warped_surface(pv: Any, data: SectionFigureData, warp: float) -> Any:
+    """The section's walls displaced by ``warp`` (:func:`plot_section_mode_3d`), lit outside."""
+    width, depth = data.size[1:]
+    across = max(width, depth)
+    n = data.quads.shape[0]
+    cells = np.hstack([np.full((n, 1), 4, dtype=np.int64), data.quads]).ravel()
+    celltypes = np.full(n, pv.CellType.QUAD, dtype=np.uint8)
+    grid = pv.UnstructuredGrid(cells, celltypes, data.points + warp * across * data.displacement)
+    grid.point_data["outward"] = data.outward
+    # The cells' normals point into the section (toward the core): flip them, so that the
+    # walls seen from outside are lit; split at the box's corners for crisp edges.
+    return grid.extract_surface(algorithm="dataset_surface").compute_normals(
+        flip_normals=True, consistent_normals=False, split_vertices=True, feature_angle=30.0
+    )
+
+
+def _core(pv: Any, data: SectionFigureData) -> Any:
+    """The core's solid (a box or a cylinder) over the section's length."""
+    length, width, depth = data.size
+    if data.shape == "box":
+        return pv.Box(bounds=(0.0, length, -0.5 * width, 0.5 * width, -0.5 * depth, 0.5 * depth))
+    return pv.Cylinder(
+        center=(0.5 * length, 0.0, 0.0),
+        direction=(1.0, 0.0, 0.0),
+        radius=0.5 * width,
+        height=length,
+        resolution=96,
+    )
+
+
 def plot_section_mode_3d(
     data: SectionFigureData,
     path: str | Path,
@@ -106,18 +136,9 @@ def plot_section_mode_3d(
     """
     pv = _pyvista()
     path = _prepare(path)
-    length, width, depth = data.size
-    across = max(width, depth)
+    length = data.size[0]
     n = data.quads.shape[0]
-    cells = np.hstack([np.full((n, 1), 4, dtype=np.int64), data.quads]).ravel()
-    celltypes = np.full(n, pv.CellType.QUAD, dtype=np.uint8)
-    grid = pv.UnstructuredGrid(cells, celltypes, data.points + warp * across * data.displacement)
-    grid.point_data["outward"] = data.outward
-    # The cells' normals point into the section (toward the core): flip them, so that the
-    # walls seen from outside are lit; split at the box's corners for crisp edges.
-    surface = grid.extract_surface(algorithm="dataset_surface").compute_normals(
-        flip_normals=True, consistent_normals=False, split_vertices=True, feature_angle=30.0
-    )
+    surface = _warped_surface(pv, data, warp)
     # A filled section's mode moves only outward: the sequential map, as a plate's.
     cmap, clim = colour_scale(np.asarray(data.outward, dtype=float))
     plotter, font = coloured_surface(
@@ -133,19 +154,7 @@ def plot_section_mode_3d(
     )
     legend: list[tuple[str, str, str]] = []
     if show_core and data.shape != "flat":
-        if data.shape == "box":
-            core = pv.Box(
-                bounds=(0.0, length, -0.5 * width, 0.5 * width, -0.5 * depth, 0.5 * depth)
-            )
-        else:
-            core = pv.Cylinder(
-                center=(0.5 * length, 0.0, 0.0),
-                direction=(1.0, 0.0, 0.0),
-                radius=0.5 * width,
-                height=length,
-                resolution=96,
-            )
-        plotter.add_mesh(core.extract_feature_edges(), color="black", line_width=2)
+        plotter.add_mesh(_core(pv, data).extract_feature_edges(), color="black", line_width=2)
         legend.append(("core (outline)", "black", "line"))
     for pts, color, label in (
         (data.pressing, THEME["contact_color"], "presses on the core"),

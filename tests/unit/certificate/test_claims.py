@@ -91,8 +91,8 @@ def test_the_inertias_count_what_dense_eigenvalues_count(load):
                 if not active:
                     assert pencil_inertia(problem.model.A, problem.model.B, sigma)[0] == expected
                     if solver.indefinite:  # the swapped pencil's count: positive pivots
-                        eps = solver._near_eps()
-                        count = solver._shift_to(eps, solver.A, solver.B, sigma, None)
+                        eps = solver.shifted.near_eps()
+                        count = solver.shifted.shift_to(eps, solver.A, solver.B, sigma, None)
                     else:
                         count = solver.count_below(sigma)
                     assert count == expected, (factor, count)

@@ -286,7 +286,7 @@ def test_python_eps_options_reach_the_free_solve(monkeypatch):
     with build_problem(paper_case("free", 48, 24), eps_options={"eps_ncv": 5}) as problem:
         problem.solve_free()
         assert problem.free_proof is not None
-        assert problem.eigensolver._free.getDimensions()[1] == 5
+        assert problem.eigensolver.shifted.free_eps().getDimensions()[1] == 5
 
 
 @serial
@@ -303,7 +303,7 @@ def test_command_line_eps_options_reach_the_free_solve(monkeypatch):
         with build_problem(paper_case("free", 48, 24)) as problem:
             problem.solve_free()
             assert problem.free_proof is not None
-            assert problem.eigensolver._free.getDimensions()[1] == 6
+            assert problem.eigensolver.shifted.free_eps().getDimensions()[1] == 6
         opts["unibuckle_eps_max_it"] = 1
         opts["unibuckle_eps_tol"] = 1e-300
         with build_problem(paper_case("free", 48, 24)) as problem:

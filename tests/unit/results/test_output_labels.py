@@ -229,18 +229,11 @@ def test_the_section_figure_looks_at_its_largest_buckle():
         assert np.dot(eye[1:], face) > 0, (peak, eye)
 
 
-def _chart_legend(tmp_path, monkeypatch, certificates: list[dict]) -> list[str]:
+def _chart_legend(certificates: list[dict]) -> list[str]:
     """The legend's labels of a plate's sweep chart over nu, one point per certificate."""
     from unibuckle_fenicsx.sweep import parse_variation
     from unibuckle_fenicsx.viz import charts
 
-    seen, save = {}, charts._save
-
-    def keep(fig, ax, path):
-        seen["labels"] = ax.get_legend_handles_labels()[1]
-        return save(fig, ax, path)
-
-    monkeypatch.setattr(charts, "_save", keep)
     base = {
         "name": "small",
         "plate": {"corners": [[-0.1, -0.05], [0.1, 0.05]], "thickness": 0.006},
@@ -255,29 +248,28 @@ def _chart_legend(tmp_path, monkeypatch, certificates: list[dict]) -> list[str]:
         for nu, cert in zip(values, certificates, strict=True)
     ]  # fmt: skip
     variation = parse_variation("material.nu=" + ",".join(f"{nu:g}" for nu in values))
-    charts.plot_sweep(lines, [variation], base, tmp_path / "c.png")
-    return seen["labels"]
+    return charts.sweep_figure(lines, [variation], base).axes[0].get_legend_handles_labels()[1]
 
 
-def test_a_sweep_chart_s_legend_says_what_bilateral_means(tmp_path, monkeypatch):
+def test_a_sweep_chart_s_legend_says_what_bilateral_means():
     # "bilateral" alone reads as a two-sided obstacle to an engineer: it is the plate
     # without its obstacle (the points' free loads), "unilateral" the plate against it.
     cert = {"kkt": True, "global_optimum_proven": True, "status": "proven"}
-    labels = _chart_legend(tmp_path, monkeypatch, [cert, cert])
+    labels = _chart_legend([cert, cert])
     assert "bilateral (no obstacle)" in labels, labels
     assert "unilateral (with the obstacle)" in labels, labels
 
 
-def test_a_sweep_chart_s_legend_lists_only_the_markers_drawn(tmp_path, monkeypatch):
+def test_a_sweep_chart_s_legend_lists_only_the_markers_drawn():
     # Every point KKT only: the legend listed proven, bracketed and not certified too.
     from unibuckle_fenicsx.viz.charts import CERTIFICATE_MARKERS
 
     kkt = {"kkt": True, "global_optimum_proven": False, "status": "kkt-only"}
     failed = {"kkt": False, "global_optimum_proven": False, "status": "not-kkt"}
     markers = set(CERTIFICATE_MARKERS)
-    labels = _chart_legend(tmp_path, monkeypatch, [kkt, kkt])
+    labels = _chart_legend([kkt, kkt])
     assert markers & set(labels) == {"KKT only"}, labels
-    labels = _chart_legend(tmp_path, monkeypatch, [kkt, failed])
+    labels = _chart_legend([kkt, failed])
     assert markers & set(labels) == {"KKT only", "not certified"}, labels
 
 
