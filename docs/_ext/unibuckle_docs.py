@@ -1056,7 +1056,10 @@ INVENTORIES: dict[str, tuple[str, dict[str, tuple[str, str]]]] = {
     ),
     "slepc4py": (
         "https://slepc.upv.es/slepc4py-current/docs/apiref/",
-        {"slepc4py.SLEPc.EPS": ("class", "slepc4py.SLEPc.EPS-class.html")},
+        {
+            f"{prefix}SLEPc.EPS": ("class", "slepc4py.SLEPc.EPS-class.html")
+            for prefix in ("slepc4py.", "")  # as the hints write it: from slepc4py import SLEPc
+        },
     ),
     "mpi4py": (
         "https://mpi4py.readthedocs.io/en/stable/",
