@@ -41,10 +41,10 @@ MaxCandidates = Annotated[int, Meta(ge=1)]
 Iterations = Annotated[int, Meta(ge=1)]
 BoundBudget = Annotated[int, Meta(ge=0)]
 Seconds = Annotated[float, Meta(gt=0, extra={"unit": "s"})]
-#: The relative penalty's range, the one :doc:`/methods/penalty` measured (c1, c2, c3,
-#: 1e-6 to 1e16): below 1e-6 the springs raise the free load by less than 3e-4 of it
-#: (its mode crosses the obstacle freely: never a KKT point), above 1e16 nothing is
-#: measured and nothing is gained (the gap to lambda_c reaches rounding at 3e10).
+#: The relative penalty's range, the one :doc:`/methods/penalty` studies (c1, c2, c3):
+#: below its low end the springs barely raise the free load (the mode crosses the
+#: obstacle freely: never a KKT point); above its high end nothing is gained (the gap
+#: to lambda_c has reached rounding).
 PENALTY_RANGE = (1e-6, 1e16)
 Penalty = Annotated[float, Meta(ge=PENALTY_RANGE[0], le=PENALTY_RANGE[1])]
 
