@@ -162,7 +162,7 @@ def test_json_into_an_existing_folder_and_output_creating_one(tmp_path, capsys):
     ("option", "reason"),
     [
         (["-unibuckle_st_type", "nonsense"], "Unable to find requested ST type nonsense"),
-        (["-unibuckle_eps_tol", "abc"], "Input string abc has no numeric value"),
+        (["-unibuckle_st_shift", "abc"], "Input string abc has no numeric value"),
     ],
 )
 def test_bad_petsc_option_exit_2(tmp_path, option, reason):
@@ -171,6 +171,16 @@ def test_bad_petsc_option_exit_2(tmp_path, option, reason):
     assert "Traceback" not in proc.stderr and proc.stdout == ""
     assert "PETSc/SLEPc refused an option" in proc.stderr and reason in proc.stderr
     assert " ".join(option) in proc.stderr
+
+
+@serial
+def test_a_bad_eps_tol_option_is_refused_before_petsc(tmp_path):
+    """``-unibuckle_eps_tol`` is ``solver.eps_tol``'s: the package reads and refuses it."""
+    args = ("solve", "--case", "c1", "--nx", "8", "--ny", "4", "-unibuckle_eps_tol", "abc")
+    proc = run_script(*args, cwd=tmp_path)
+    assert proc.returncode == EXIT_BAD_INPUT, proc.stderr
+    assert proc.stdout == ""
+    assert proc.stderr == "unibuckle: error: -unibuckle_eps_tol takes a number, got 'abc'\n"
 
 
 @serial
