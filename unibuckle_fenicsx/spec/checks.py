@@ -126,28 +126,45 @@ def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str
             "this coarse the critical load, k and the design values come out too high (+18 % "
             f"at 3 cells across a simply supported square); cells of {finer:.3g} {name} or less"
         )
-    if _shear_dominated(plate) and h * MIN_SHEAR_CELLS_ACROSS > b * (1.0 + 1e-9):
-        (cell, side, finer), name = in_file((h, b, b / MIN_SHEAR_CELLS_ACROSS), "m", units)
-        return (
-            f"{what}: cells up to {cell:.3g} {name}, fewer than {MIN_SHEAR_CELLS_ACROSS} "
-            f"across {side_name} {side:.3g} {name} under a shear stress at least as large as "
-            "the compression (edges.*.shear_stress): a shear buckle's diagonal waves are "
-            "shorter than the plate's width, and on cells this coarse the critical load and k "
-            "come out too high (a simply supported square in shear: +78 % on 4 x 4 cells, "
-            f"+14 % on 8 x 8); cells of {finer:.3g} {name} or less"
+    for cells, why in _stricter_rules(plate):
+        if h * cells > b * (1.0 + 1e-9):
+            (cell, side, finer), name = in_file((h, b, b / cells), "m", units)
+            return (
+                f"{what}: cells up to {cell:.3g} {name}, fewer than {cells} across "
+                f"{side_name} {side:.3g} {name} {why}; cells of {finer:.3g} {name} or less"
+            )
+    return _gradient_note(plate, mesh, what, units)
+
+
+def _stricter_rules(plate: PlateSpec) -> list[tuple[int, str]]:
+    """The rules above four cells across b that ``plate`` falls under: (cells, why).
+
+    Shear at least as large as the compression (:data:`MIN_SHEAR_CELLS_ACROSS`), two
+    opposite edges clamped (:data:`MIN_CLAMPED_CELLS_ACROSS`); ``why`` ends the warning.
+    """
+    rules = []
+    if _shear_dominated(plate):
+        rules.append(
+            (
+                MIN_SHEAR_CELLS_ACROSS,
+                "under a shear stress at least as large as the compression "
+                "(edges.*.shear_stress): a shear buckle's diagonal waves are shorter than the "
+                "plate's width, and on cells this coarse the critical load and k come out too "
+                "high (a simply supported square in shear: +78 % on 4 x 4 cells, +14 % on 8 x 8)",
+            )
         )
     clamped = _opposite_clamped(plate)
-    if clamped and h * MIN_CLAMPED_CELLS_ACROSS > b * (1.0 + 1e-9):
-        (cell, side, finer), name = in_file((h, b, b / MIN_CLAMPED_CELLS_ACROSS), "m", units)
-        return (
-            f"{what}: cells up to {cell:.3g} {name}, fewer than {MIN_CLAMPED_CELLS_ACROSS} "
-            f"across {side_name} {side:.3g} {name} with {clamped} clamped: the "
-            "half-waves between clamped edges are shorter "
-            "than the plate's width, and on cells this coarse the critical load, k and the "
-            "design values come out too high (the clamped square: +55 % on 4 x 4 cells, +20 % "
-            f"on 6 x 6); cells of {finer:.3g} {name} or less"
+    if clamped:
+        rules.append(
+            (
+                MIN_CLAMPED_CELLS_ACROSS,
+                f"with {clamped} clamped: the half-waves between clamped edges are shorter than "
+                "the plate's width, and on cells this coarse the critical load, k and the design "
+                "values come out too high (the clamped square: +55 % on 4 x 4 cells, +20 % on "
+                "6 x 6)",
+            )
         )
-    return _gradient_note(plate, mesh, what, units)
+    return rules
 
 
 def _opposite_clamped(plate: PlateSpec) -> str | None:
