@@ -10,9 +10,10 @@ asks for the design quantities of its critical state :math:`\lambda_c`:
   4.4(2) (both its edges held by the neighbouring faces): the face's
   :math:`\sigma_{cr}` is its largest compression at the section's critical state (the walls
   buckle together, one load factor for all), :math:`\psi = \sigma_2/\sigma_1` the ratio of
-  the axial stresses at its two edges (1 on a face at constant z, the gradient of the
-  bending part across a face spanning the depth), :math:`\bar\lambda_p =
-  \sqrt{f_y/\sigma_{cr}}`, the buckling factor of Table 4.1 at that :math:`\psi`, and
+  the axial stresses at its two edges (on a flange, a face at constant z, the gross
+  section's: 1; on a web, a face spanning the depth, 4.4(3)'s, below),
+  :math:`\bar\lambda_p = \sqrt{f_y/\sigma_{cr}}`, the buckling factor of Table 4.1 at
+  that :math:`\psi`, and
   :math:`\rho` by eq. (4.2) (:mod:`unibuckle_fenicsx.en1993`); a face in tension has none;
   a face shorter than it is wide (:math:`a/b < 1`, a the section's length: a stub), by
   the note of 4.4(2), :math:`\rho_c` of 4.5.4(1) instead, between :math:`\rho` and the
@@ -26,6 +27,35 @@ asks for the design quantities of its critical state :math:`\lambda_c`:
   :func:`~unibuckle_fenicsx.en1993.stress_limit`) and its effective widths of Table 4.1
   (:func:`~unibuckle_fenicsx.en1993.effective_widths`; :math:`\bar b` the face's
   mid-line width, the one computed);
+- a web's :math:`\psi` by EN 1993-1-5 4.4(3): "for web elements the stress ratio
+  :math:`\psi` used in Table 4.1 should be obtained using a stress distribution based on
+  the effective area of the compression flange and the gross area of the web" (a
+  flange's from the gross section). The compression flange is the one the bending
+  compresses (:func:`web_compressions`), reduced to its effective area :math:`\rho b t`
+  (its ``reduction_factor``, :math:`\rho_c` on a stub; at :math:`\psi = 1` its
+  :math:`b_{e1} = b_{e2}` lie at its corners, all of it at the flange's mid-line z); the
+  webs and the other flange gross; mid-line widths throughout (the faces' :math:`\bar
+  b`, not 4.4(2)'s :math:`b - 3t` of a hollow section's flange). The input is the gross
+  section's stress per unit load, :math:`\sigma_a + \sigma_b z/(d/2)`, an axial and a
+  bending part; the web's distribution is the axial part plus the bending part about
+  the neutral axis :math:`z'` of that section (its first moment of area), linear, and
+  equal at the compression flange to the gross bending stress there, so that the
+  compression edge keeps the computed stress (the web's :math:`\sigma_1`, its
+  :math:`\sigma_{cr}` and slenderness stay the computed ones): :math:`\sigma(z) =
+  \sigma_a - |\sigma_b|(z - z')/(z_c - z')`, :math:`z_c` the compression flange's z.
+  This follows EN 1993-1-5 on an axial force with a moment: 4.3(3) takes :math:`A_{eff}` under
+  uniform compression (for the doubly symmetric box centred, no shift :math:`e_N`, a
+  uniform stress), 4.3(4) :math:`W_{eff}` under bending alone, where only the
+  compression flange is reduced and 4.4(3) gives the web's :math:`\psi`; their ratio is
+  the input's :math:`\sigma_a/\sigma_b` (the factors :math:`A/A_{eff}` and
+  :math:`W/W_{eff}` of eq. (4.14) are not computed). Reducing a flange the axial force
+  compresses too, with the gross N at the gross centroid, would shift :math:`z'` by the
+  per-face :math:`\rho` of a section nearly in uniform compression, where 4.3(3) shifts
+  nothing. The neutral axis moves towards the tension side: the web's compressed part
+  and :math:`\psi` grow (never below the gross :math:`\psi`) and :math:`\rho` of eq.
+  (4.2) falls. Without bending, or with the compression flange fully effective
+  (:math:`\rho = 1`), :math:`\psi` is the gross one. ``psi_gross`` keeps the gross ratio;
+  a note, the clauses and the summary line cite 4.4(3);
 - a face whose :math:`\psi` lies below -3 (a web under bending with an axial tension) is
   outside Table 4.1 and eq. (4.2): no :math:`k_\sigma` or :math:`\rho`, a note and the
   summary say so (``faces_outside_table``);
@@ -53,7 +83,7 @@ evaluates them for a computed :math:`\sigma_{cr}`, hence this module.
 from __future__ import annotations
 
 import math
-from typing import Protocol
+from typing import NamedTuple, Protocol
 
 import msgspec
 from msgspec import UNSET, Struct, UnsetType
@@ -90,13 +120,15 @@ __all__ = [
     "face_width",
     "member_note",
     "section_design",
+    "web_compressions",
 ]
 
 #: The clauses of a box's face.
 FACE_CLAUSES = (
     "EN 1993-1-5:2006+AC:2009, 4.4(2), eq. (4.2): reduction factor rho of each face as an "
     "internal compression element; 4.4(2): relative slenderness; Table 4.1: psi, k_sigma, "
-    "effective widths"
+    "effective widths; 4.4(3): psi of a flange from the gross section, of a web from the "
+    "effective compression flange and the gross webs"
 )
 #: Added where a face is shorter than its width (as a plate's record, only where applied).
 COLUMN_CLAUSES = "4.5.3(1), 4.5.4(1): column-type buckling of a face shorter than its width, rho_c"
@@ -154,7 +186,12 @@ class FaceDesign(ElementLimits, kw_only=True):
         face: ``right``, ``top``, ``left`` or ``bottom`` (the result's ``faces``).
         sigma_cr_Pa: :math:`\sigma_1`, its largest compression at the critical state (Pa);
             <= 0: the face is in tension, and the fields below are None.
-        psi: :math:`\psi = \sigma_2/\sigma_1` across the face.
+        psi: :math:`\psi = \sigma_2/\sigma_1` across the face: a web's by EN 1993-1-5
+            4.4(3), from the section with its compression flange effective
+            (:func:`web_compressions`), a flange's from the gross section.
+        psi_gross: A web's :math:`\psi` of the gross section's stresses, where 4.4(3)'s
+            ``psi`` differs from it (a compression flange with :math:`\rho < 1`); None
+            otherwise.
         relative_slenderness: :math:`\bar\lambda_p = \sqrt{f_y/\sigma_1}`.
         k_sigma_table: Table 4.1's :math:`k_\sigma` at :math:`\psi`.
         reduction_factor: The reduction factor to apply: on a face shorter than it is
@@ -183,6 +220,7 @@ class FaceDesign(ElementLimits, kw_only=True):
     face: str
     sigma_cr_Pa: float
     psi: float | None = None
+    psi_gross: float | None = None
     relative_slenderness: float | None = None
     k_sigma_table: float | None = None
     reduction_factor: float | None = None
@@ -287,16 +325,70 @@ def face_compressions(section: DesignSection) -> dict[str, tuple[float, float]]:
     }
 
 
+class WebStresses(NamedTuple):
+    """A web's stresses by EN 1993-1-5 4.4(3) (:func:`web_compressions`).
+
+    Attributes:
+        top: The compression (> 0; per unit load, as the section's stresses) at the
+            web's top end, z = +d/2.
+        bottom: The same at its bottom end, z = -d/2.
+        shift: :math:`z'`, the centroid of the section with the effective flanges above
+            the gross one (m; < 0: towards the bottom).
+    """
+
+    top: float
+    bottom: float
+    shift: float
+
+
+def web_compressions(section: DesignSection, rho: float) -> WebStresses:
+    r"""A web's end compressions with the compression flange effective, EN 1993-1-5 4.4(3).
+
+    The flange that the bending compresses (the top one for ``bending_stress`` < 0, at
+    :math:`z_c = +d/2`; else the bottom one, :math:`z_c = -d/2`) reduced to :math:`\rho b
+    t` on its mid-line, the other flange and the two webs gross (mid-line dimensions):
+    the neutral axis of bending from the first moment of area, :math:`z' = -(1 - \rho) b
+    t z_c/((1 + \rho) b t + 2 d t)`. The axial part :math:`\sigma_a` plus the bending part
+    linear through :math:`z'` and equal to :math:`-|\sigma_b|` (the gross value, the
+    computed compression) at :math:`z_c`: :math:`\sigma(z) = \sigma_a - |\sigma_b| (z -
+    z')/(z_c - z')` (tension > 0, per unit load; the module docstring). Without bending,
+    or with :math:`\rho = 1`, the gross stresses.
+    """
+    b, d, t = face_width(section, "top"), face_width(section, "right"), section.thickness
+    z_c = 0.5 * d if section.bending_stress < 0.0 else -0.5 * d
+    shift = -(1.0 - rho) * b * t * z_c / ((1.0 + rho) * b * t + 2.0 * d * t)
+    bending = abs(section.bending_stress)
+
+    def stress(z: float) -> float:
+        return section.axial_stress - bending * (z - shift) / (z_c - shift)
+
+    return WebStresses(-stress(0.5 * d), -stress(-0.5 * d), shift)
+
+
 def _face(
-    section: DesignSection, name: str, ends: tuple[float, float], design: DesignSpec
+    section: DesignSection,
+    name: str,
+    ends: tuple[float, float],
+    design: DesignSpec,
+    effective: tuple[float, float] | None = None,
 ) -> FaceDesign:
-    """The face ``name`` of ``section`` whose edges carry the compressions ``ends`` (Pa)."""
+    """The face ``name`` of ``section`` whose edges carry the compressions ``ends`` (Pa).
+
+    ``effective``: a web's end compressions by 4.4(3) (:func:`web_compressions`, in the
+    order of ``ends``), from which its psi is taken; None: psi from ``ends``.
+    """
     sigma1, sigma2 = max(ends), min(ends)
     if sigma1 <= 0.0:
         return FaceDesign(face=name, sigma_cr_Pa=sigma1)
     psi = stress_ratio(sigma1, sigma2)  # a whole number within rounding: the table's row
+    first = ends.index(sigma1)
     slenderness = math.sqrt(design.yield_stress / sigma1)
     out = FaceDesign(face=name, sigma_cr_Pa=sigma1, psi=psi, relative_slenderness=slenderness)
+    if effective is not None and max(effective) > 0.0:
+        own = stress_ratio(max(effective), min(effective))
+        if own != psi:
+            out.psi_gross, out.psi = psi, own
+            psi, first = own, effective.index(max(effective))
     if psi < psi_range(INTERNAL)[0]:
         return out
     out.k_sigma_table = buckling_factor(INTERNAL, psi)
@@ -317,7 +409,6 @@ def _face(
     out.reduced_design_stress_Pa = (
         out.reduction_factor * design.yield_stress / design.partial_factor
     )
-    first = ends.index(sigma1)
     corners = CORNERS[name]
     # Under bending the effective section (the compressed faces reduced, the others not)
     # has its own W_eff and shift e_N, which 4.6(1) needs even for a face at psi = 1.
@@ -428,8 +519,22 @@ def _box_faces(
         "every face at the section's critical load factor: conservative for a face "
         "that buckles because its neighbours do"
     )
-    for name, (a, b) in face_compressions(section).items():
-        out.faces.append(_face(section, name, (load * a, load * b), design))
+    ends = {name: (load * a, load * b) for name, (a, b) in face_compressions(section).items()}
+    flanges = {name: _face(section, name, ends[name], design) for name in ("top", "bottom")}
+    # EN 1993-1-5 4.4(3): the webs' psi with the compression flange effective, the one
+    # that the bending compresses (none without bending: psi = 1 as in the gross section).
+    compressed = "top" if section.bending_stress < 0.0 else "bottom"
+    rho = flanges[compressed].reduction_factor or 1.0  # compressed: |sigma_b| > sigma_a
+    webs = None
+    if section.bending_stress != 0.0 and rho < 1.0:
+        webs = web_compressions(section, rho)
+    for name in CORNERS:
+        if name in flanges:
+            out.faces.append(flanges[name])
+        else:
+            effective = None if webs is None else (load * webs.top, load * webs.bottom)
+            out.faces.append(_face(section, name, ends[name], design, effective))
+    _web_note(out, compressed, rho, webs)
     column = [f for f in out.faces if f.xi is not None and f.xi < 1.0]  # rho_c, not rho
     if column:
         out.clauses.append(COLUMN_CLAUSES)
@@ -468,6 +573,42 @@ def _box_faces(
             "rule here"
         )
     _tension(out, section, design, load, rated)
+
+
+def _web_ratios(faces: list[FaceDesign], with_rho: bool = False) -> str:
+    """The webs whose psi is 4.4(3)'s: "web(s) right, left: psi = ... (gross ...)".
+
+    Webs of one value share the words (with ``with_rho``, their rho too); '' without such
+    webs.
+    """
+    words: dict[str, list[str]] = {}
+    for f in faces:
+        if f.psi_gross is not None:
+            said = f"psi = {ratio_text(f.psi, 4)} (gross {ratio_text(f.psi_gross, 4)})"
+            if with_rho:
+                said += f", rho = {significant(f.reduction_factor)}"
+            words.setdefault(said, []).append(f.face)
+    return "; ".join(f"web(s) {', '.join(names)}: {said}" for said, names in words.items())
+
+
+def _web_note(out: SectionDesignRecord, flange: str, rho: float, webs: WebStresses | None) -> None:
+    """The note on the webs' psi of EN 1993-1-5 4.4(3), where it is not the gross one.
+
+    ``flange``: the compression flange, ``rho`` its reduction factor; ``webs``: the webs'
+    stresses (None: the gross ones).
+    """
+    changed = _web_ratios(out.faces)
+    if webs is None or not changed:
+        return
+    where = "above" if webs.shift > 0.0 else "below"
+    out.notes.append(
+        f"{changed} by EN 1993-1-5 4.4(3): the stress distribution with the compression "
+        f"flange {flange} effective (rho = {significant(rho)}) and the webs and the other "
+        "flange gross: the axial part plus the bending part about the neutral axis of that "
+        f"section, {significant(abs(webs.shift) * 1e3)} mm {where} the gross one, the "
+        "compression flange's stress the computed one; sigma_cr and the slenderness stay "
+        "the computed ones"
+    )
 
 
 def _core_limits(out: SectionDesignRecord, section: DesignSection, design: DesignSpec) -> None:
@@ -623,11 +764,15 @@ def design_line(
         text += (
             f"; EN 1993-1-5 {_governing(d)}: psi = {ratio_text(face.psi)}, {rho}, "
             f"rho f_y/{face.partial_factor_name} = {significant(reduced / scale)} {unit} "
-            f"(psi Table 4.1, slenderness 4.4(2), "
+            f"(psi {'4.4(3), ' if face.psi_gross is not None else ''}Table 4.1, "
+            "slenderness 4.4(2), "
             f"rho 4.4(2) eq. (4.2){column}"
             f"{limit_clause_text(face.partial_factor_name)}, "
             f"b_eff {face.effective_widths_row}){effective_widths_text(face, *lengths)}"
         )
+    webs = _web_ratios(d.faces, with_rho=True)
+    if webs:  # EN 1993-1-5 4.4(3): not the gross section's psi
+        text += f"; {webs} (psi 4.4(3): the effective compression flange, the gross webs)"
     if d.faces_outside_table:
         text += (
             f"; face(s) {', '.join(d.faces_outside_table)}: psi < -3, outside Table 4.1: "

@@ -10,6 +10,7 @@
   the random plates the sweep checks them on;
 - :mod:`support.problem_files`: base problem files holding every key of the schema;
 - :mod:`support.plates`: plate set-ups used by several test modules and MPI scripts;
+- :mod:`support.fibres`: a box section as thin fibres, the stress of an effective section;
 - :mod:`support.hermite_plate`, :mod:`support.kirchhoff`, :mod:`support.rm_triangles`:
   independent thin-plate and holed-plate references (no code of the package's
   discretisation).

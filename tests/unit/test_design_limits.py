@@ -156,21 +156,34 @@ def _box(**changes: object) -> SectionParameters:
 def test_a_box_s_webs_outside_table_4_1_and_its_tension_face_are_said():
     """Axial +0.6 (tension) and bending 1 at z = +d/2: top -1.6, bottom +0.4 compression.
 
-    The webs run from 0.4 to -1.6: psi = -4, outside Table 4.1 (1 >= psi >= -3), no rho,
-    and the output said nothing of them. The top face's tension 1.6 lambda reaches f_y at
-    f_y/(1.6 lambda) = 0.3698 x lambda (lambda = 6e8 Pa); the bottom face (sigma_1 =
-    2.4e8 Pa, psi = 1): lambda_p = sqrt(355/240) = 1.2162, rho = (1.2162 - 0.22)/1.2162^2
-    = 0.6735, reaches rho f_y at 0.6735 x 355/240 = 0.9962 x lambda: the tension face
-    yields first, which the output did not say.
+    The webs run from 0.4 to -1.6 in the gross section: psi = -4. The top face's tension
+    1.6 lambda reaches f_y at f_y/(1.6 lambda) = 0.3698 x lambda (lambda = 6e8 Pa); the
+    bottom face (sigma_1 = 2.4e8 Pa, psi = 1): lambda_p = sqrt(355/240) = 1.2162, rho =
+    (1.2162 - 0.22)/1.2162^2 = 0.6735, reaches rho f_y at 0.6735 x 355/240 = 0.9962 x
+    lambda: the tension face yields first, which the output did not say. The webs' psi is
+    EN 1993-1-5 4.4(3)'s, the bottom (compression) flange effective, 0.6735 x 200 mm, the
+    other flange and the webs gross (200 x 300 mm mid-line, t = 1 mm): the neutral axis
+    by the first moment of area z' = (134.70 x (-150) - 200 x (-150))/(134.70 + 200 +
+    600) = 10.480 mm; the axial part 0.6 plus the bending part, -1 at the bottom (z_c =
+    -150 mm) and (150 - 10.48)/(150 + 10.48) = 0.8694 at the top: 1.4694 at the top end,
+    -0.4 at the bottom, psi = -3.6735, still outside Table 4.1 (1 >= psi >= -3): no rho,
+    and the output said nothing of them.
     """
     load = 6.0e8
     out = section_design(_box(), DesignSpec(yield_stress=FY), load)
     faces = {f.face: f for f in out.faces}
-    assert faces["right"].psi == -4.0 and faces["right"].reduction_factor is None
-    assert out.faces_outside_table == ["right", "left"]
-    assert any("outside EN 1993-1-5 Table 4.1" in n and "right (psi = -4)" in n for n in out.notes)
     slenderness = math.sqrt(FY / (0.4 * load))
     rho = (slenderness - 0.22) / slenderness**2
+    z_na = (200.0 * rho * -150.0 - 200.0 * -150.0) / (200.0 * rho + 200.0 + 600.0)
+    top, bottom = (0.6 - 1.0 * (z - z_na) / (-150.0 - z_na) for z in (150.0, -150.0))
+    psi = top / bottom
+    assert (z_na, top, bottom, psi) == pytest.approx((10.480, 1.4694, -0.4, -3.6735), abs=1e-3)
+    assert faces["right"].psi == pytest.approx(psi, rel=1e-12)
+    assert faces["right"].psi_gross == -4.0 and faces["right"].reduction_factor is None
+    assert out.faces_outside_table == ["right", "left"]
+    assert any(
+        "outside EN 1993-1-5 Table 4.1" in n and "right (psi = -3.67)" in n for n in out.notes
+    )
     assert faces["bottom"].reduction_factor == pytest.approx(rho, rel=1e-14)
     assert rho * FY / (0.4 * load) == pytest.approx(0.9962, abs=1e-4)
     assert out.governing_face == "bottom"

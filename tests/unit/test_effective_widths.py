@@ -243,10 +243,28 @@ def test_an_outstand_in_bending_gets_its_row_s_widths(stress, row, placed):
     assert f"psi Table 4.2 (larger compression at the {row} edge), " in line, line
 
 
+def _web_psi(b, d, axial, bending, rho_top):
+    """A web's psi by EN 1993-1-5 4.4(3), by hand: the compression (top) flange rho_top b.
+
+    Mid-line dimensions, t = 1, bending < 0 (the top compressed): the neutral axis of
+    the section of the effective top flange, the gross bottom flange and webs by the
+    first moment of area, z' = (rho_top b - b)(d/2)/(rho_top b + b + 2 d); the axial part
+    plus the bending part through z', -|bending| at the top: sigma(z) = axial - |bending|
+    (z - z')/(d/2 - z'); psi = sigma(-d/2)/sigma(+d/2).
+    """
+    z_na = (rho_top * b - b) * (d / 2) / (rho_top * b + b + 2 * d)
+    top, bottom = (axial - abs(bending) * (z - z_na) / (d / 2 - z_na) for z in (d / 2, -d / 2))
+    return bottom / top
+
+
 def test_a_box_in_bending_gives_each_face_its_widths_and_limit():
     # Axial -1, bending -2 (Pa per unit load): the top fibre carries 3, the bottom -1
     # (tension). At load 1e8: the top face sigma_1 = 3e8, psi = 1; the right and left faces
-    # (depth 0.1 m) 3e8 at the top corner, -1e8 at the bottom: psi = -1/3.
+    # (depth 0.1 m) 3e8 at the top corner, -1e8 at the bottom in the gross section (psi =
+    # -1/3). EN 1993-1-5 4.4(3) takes the webs' psi from the section with the top flange
+    # effective (rho = 0.73336 at 3e8, eq. (4.2)) and the webs gross: by hand (_web_psi)
+    # z' = -4.8775 mm, the bottom end at -1 + 2 (50 - 4.8775)/(50 + 4.8775) = +0.6445,
+    # psi = -0.21483, b_c = 0.1/(1 - psi) = 82.316 mm (the gross psi gave 75 mm).
     section = SectionParameters(
         "box", thickness=0.002, width=0.2, depth=0.1, diameter=None, length=0.6, E=2.1e11,
         nu=0.3, mesh_size=0.02, axial_stress=-1.0, bending_stress=-2.0, core=False,
@@ -263,12 +281,15 @@ def test_a_box_in_bending_gives_each_face_its_widths_and_limit():
     assert "psi = 1, but the section is bent" in top.stress_limit_clause
     assert top.effective_width_m == pytest.approx(rho_top * 0.2, rel=1e-12)
     assert top.effective_width_1_m == pytest.approx(0.1 * rho_top, rel=1e-12)
-    psi = -1.0 / 3.0
+    psi = _web_psi(0.2, 0.1, -1.0, -2.0, rho_top)
+    assert psi == pytest.approx(-0.21483, abs=1e-5)
     rho = _rho(3e8, psi)
-    b_c = 0.1 / (1.0 - psi)  # 0.075
-    assert right.psi == pytest.approx(psi, rel=1e-14)
+    b_c = 0.1 / (1.0 - psi)
+    assert right.psi == pytest.approx(psi, rel=1e-12)
+    assert right.psi_gross == pytest.approx(-1.0 / 3.0, rel=1e-14)
     assert right.partial_factor_name == "gamma_M1"
-    assert right.compressed_width_m == pytest.approx(0.075, rel=1e-14)
+    assert right.compressed_width_m == pytest.approx(0.082316, rel=1e-5)
+    assert right.compressed_width_m == pytest.approx(b_c, rel=1e-12)
     assert right.effective_width_m == pytest.approx(rho * b_c, rel=1e-12)
     assert right.effective_width_1_m == pytest.approx(0.4 * rho * b_c, rel=1e-12)
     assert right.effective_width_2_m == pytest.approx(0.6 * rho * b_c, rel=1e-12)
@@ -279,7 +300,7 @@ def test_a_box_in_bending_gives_each_face_its_widths_and_limit():
     assert "faces right, left: section 10" in out.clauses[0]
     assert "faces top: section 10" in out.clauses[0] and "4.6(1): rho" not in out.clauses[0]
     # The governing face: the smallest rho f_y/sigma_1; both carry 3e8, the right face's
-    # rho (psi = -1/3) exceeds the top's, so the top governs, at gamma_M1.
+    # rho (psi = -0.215) exceeds the top's (psi = 1), so the top governs, at gamma_M1.
     assert rho > rho_top and out.governing_face == "top"
     line = design_line(out, 1e6, "MPa", (1e-3, "mm"))
     assert f"rho f_y/gamma_M1 = {rho_top * 355 / 1.1:#.4g} MPa" in line, line
