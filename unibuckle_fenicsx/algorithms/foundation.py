@@ -30,7 +30,12 @@ free plate (no springs), from every spring active (the bilateral foundation's mo
 from the contact set of the rigid obstacle's answer (the caller's ``rigid_set``: a
 plate's rigid twin, a section's rigid core's route) and, for stiff springs
 (:func:`stiffness_ratio` above :data:`CONTINUATION_RATIO`), from the set a continuation
-in the stiffness ends on; the smallest quotient is returned. The rigid obstacle's mode
+in the stiffness ends on; the smallest quotient is returned. The free start runs first:
+when its answer satisfies the KKT conditions at a load within
+:data:`~unibuckle_fenicsx.tolerances.TWIN_RTOL` of :math:`\lambda_{free}`
+(:func:`_free_start_suffices`: springs too soft to change the free plate's answer, or a
+free mode that turns away from the foundation), no other start can lower it and none is
+run, nor the rigid obstacle's contact set solved for. The rigid obstacle's mode
 itself is a candidate too (:func:`_rigid_mode`): it presses no spring, so its quotient
 is the rigid load, and the arc descent from it only lowers it: the answer is at or below
 the rigid obstacle's load by construction. The rigid start is what keeps the answer
@@ -137,17 +142,22 @@ def solve_foundation(
     lower = problem.solve_free().load
     springs = contact.stiffness
     ratio = stiffness_ratio(problem, springs)
-    rigid = _rigid_set(problem) if rigid_set is None else rigid_set()
     with PenaltySolver(problem, prefix=Prefix.FOUNDATION, eps_options=eps_options) as solver:
-        runs, finals = _run_starts(solver, ratio, rigid[0], lower, max_iterations)
-        lowest = min(final.load for final, _, _ in finals.values())
-        mode = _rigid_mode(solver, rigid[0], lowest, max_iterations)
-        if mode is not None:
-            finals[RIGID_MODE] = mode
+        free = run_from_start(solver, "free", np.empty(0, np.int64), lower, max_iterations)
+        runs, finals = {"free": free[0]}, {"free": free[1]}
+        mode, rigid_solves = None, 0
+        if not _free_start_suffices(free[1], lower):
+            rigid = _rigid_set(problem) if rigid_set is None else rigid_set()
+            _run_starts(solver, ratio, rigid[0], lower, max_iterations, runs, finals)
+            lowest = min(final.load for final, _, _ in finals.values())
+            mode = _rigid_mode(solver, rigid[0], lowest, max_iterations)
+            if mode is not None:
+                finals[RIGID_MODE] = mode
+            rigid_solves = rigid[1]
         start = _lowest_start(finals)
         candidate, status, arc_steps = finals[start]
         # The rigid set's reduced eigen solve is the problem's own eigen solver's.
-        solves = solver.solves + rigid[1] + (0 if mode is None else 1)
+        solves = solver.solves + rigid_solves + (0 if mode is None else 1)
     name = f"{start}+arc" if arc_steps and start != RIGID_MODE else start
     load = candidate.load
     # [lambda_free, load] holds the minimum whatever the springs press: the spring term
@@ -172,29 +182,60 @@ def solve_foundation(
     )
 
 
+def _free_start_suffices(final: tuple[Candidate, RunStatus, int], lower: float) -> bool:
+    r"""Whether the free start's answer is the foundation's: no other start can lower it.
+
+    ``final``: the free start's (mode, how it ended, arc steps) (:func:`run_from_start`);
+    ``lower``: :math:`\lambda_{free}`. True when its spring-set iteration reached a fixed
+    point, with no arc descent, at a load :math:`\lambda` within
+    :data:`~unibuckle_fenicsx.tolerances.TWIN_RTOL` of :math:`\lambda_{free}`:
+
+    .. math::
+
+        (A + \sum_{k \in S} \rho_k e_k e_k^T)\, v = \lambda B v, \quad
+        S = \{k : s_k v_k > \epsilon \max|w|\}, \qquad
+        \lambda \le \lambda_{free} (1 + \text{TWIN\_RTOL}).
+
+    (:math:`\epsilon` = :data:`~unibuckle_fenicsx.tolerances.PRESSING_RTOL`; a node of S
+    also stays while its spring force holds it, :func:`_iterate`). The first
+    is the stationarity of the quotient at v with the spring set it presses (the KKT
+    conditions of the foundation problem; the certificate's ``kkt``); the second
+    makes it the global minimum to that tolerance, since every quotient is at least
+    :math:`\lambda_{free}` (the spring term is non-negative). The other starts and the
+    rigid mode then end at or above :math:`\lambda_{free}`, which
+    :func:`_lowest_start` would not take over the free start (it keeps the earlier start
+    within the same tolerance): they are not run, nor the rigid obstacle's set solved.
+    Springs too soft to change the free answer stop here; a free mode that turns away from
+    the foundation (S empty) gives :math:`\lambda = \lambda_{free}` exactly.
+    """
+    candidate, status, arc_steps = final
+    return (
+        status is RunStatus.CONVERGED
+        and arc_steps == 0
+        and candidate.load <= lower * (1.0 + TWIN_RTOL)
+    )
+
+
 def _run_starts(
     solver: PenaltySolver,
     ratio: float,
     rigid: npt.NDArray[np.int64],
     lower: float,
     max_iterations: int,
-) -> tuple[dict[str, SpringIteration], dict[str, tuple[Candidate, RunStatus, int]]]:
-    """The iteration from each start (module docstring), each followed by its arc descent.
+    runs: dict[str, SpringIteration],
+    finals: dict[str, tuple[Candidate, RunStatus, int]],
+) -> None:
+    """The iteration from each start after the free plate's, each with its arc descent.
 
-    The free plate, every spring active, the rigid obstacle's contact set ``rigid`` and,
-    above :data:`CONTINUATION_RATIO` (``ratio``: :func:`stiffness_ratio`), the
-    continuation's set, in that order. Returns the runs and, by start, (mode, how it
-    ended, arc steps) (:func:`run_from_start`). Collective.
+    Every spring active, the rigid obstacle's contact set ``rigid`` and, above
+    :data:`CONTINUATION_RATIO` (``ratio``: :func:`stiffness_ratio`), the continuation's
+    set, in that order (the module docstring; the free plate's, run first, is in
+    ``runs`` and ``finals`` already). Adds to ``runs`` the runs and to ``finals``, by
+    start, (mode, how it ended, arc steps) (:func:`run_from_start`). Collective.
     """
     springs = solver.problem.contact.stiffness
     assert springs is not None
-    starts = {
-        "free": np.empty(0, np.int64),
-        "bilateral": np.arange(solver.problem.contact.size),
-        "rigid": rigid,
-    }
-    runs: dict[str, SpringIteration] = {}
-    finals: dict[str, tuple[Candidate, RunStatus, int]] = {}
+    starts = {"bilateral": np.arange(solver.problem.contact.size), "rigid": rigid}
     for name, start in starts.items():
         runs[name], finals[name] = run_from_start(solver, name, start, lower, max_iterations)
     if ratio > CONTINUATION_RATIO:
@@ -202,7 +243,6 @@ def _run_starts(
         runs["continued"], finals["continued"] = run_from_start(
             solver, "continued", start, lower, max_iterations
         )
-    return runs, finals
 
 
 def _lowest_start(finals: dict[str, tuple[Candidate, RunStatus, int]]) -> str:

@@ -7,8 +7,12 @@ import sys
 from pathlib import Path
 from typing import Any
 
+from msgspec.structs import replace
+
 from unibuckle_fenicsx.cli.flags import NONLINEAR_FLAGS
 from unibuckle_fenicsx.cli.problem import (
+    petsc_solver_changes,
+    refuse_flag_and_set,
     spec_from_args,
     warn_coarse_mesh,
     warn_input,
@@ -42,6 +46,8 @@ def nonlinear_command(args: argparse.Namespace, comm: Any) -> int:
             if message.startswith(name):
                 message = "--" + name.replace("_", "-") + message[len(name) :]
         raise InputError(message) from None
+    changes, named = petsc_solver_changes()  # the linear solves' -unibuckle_eps_tol
+    refuse_flag_and_set(args.settings, named)
     spec = spec_from_args(args)
     if isinstance(spec, SectionProblemSpec):
         raise InputError("unibuckle nonlinear: a section's load path is not modelled (plates only)")
@@ -51,6 +57,7 @@ def nonlinear_command(args: argparse.Namespace, comm: Any) -> int:
             f"--shape unilateral takes the imperfection from the unilateral mode, which needs "
             f"an obstacle, and {why}: give --shape free (or auto)"
         )
+    spec = replace(spec, solver=replace(spec.solver, **changes))  # in range: checked above
     warn_input(spec, comm, design=False)
     warn_unused_design(spec, "unibuckle nonlinear", comm)
     # A refused input or a failed solve raises: main() tells the outcome.

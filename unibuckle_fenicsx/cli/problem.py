@@ -108,6 +108,45 @@ def refuse_flag_and_set(settings: Sequence[str], flags: dict[str, str]) -> None:
                 raise InputError(f"{flag} and --set {setting} both set {key}: give one of them")
 
 
+#: The PETSc option that sets the buckling eigen solves' tolerance, solver.eps_tol's
+#: (docs/guide/cli.md): given on the command line, it wins over the file's key.
+EPS_TOL_OPTION = "unibuckle_eps_tol"
+
+
+def petsc_solver_changes() -> tuple[dict[str, float], dict[str, str]]:
+    """The solver keys the PETSc command line sets, checked, and the options naming them.
+
+    ``-unibuckle_eps_tol`` is ``solver.eps_tol``: SLEPc takes it over the file's key,
+    which would then read in the result's ``input`` (a sweep's lines, the nonlinear
+    JSON's ``options``) and in the certificate's checks a tolerance the solves did not
+    use. Returns ``({"eps_tol": value}, {"solver.eps_tol": "-unibuckle_eps_tol"})``, or
+    two empty dicts when the option is not given. ``unibuckle solve``, ``sweep`` and
+    ``nonlinear`` read it before the problem file.
+
+    Raises:
+        InputError: A value that is not a number, or outside ``solver.eps_tol``'s range
+            (the message names the option, the key and the range).
+    """
+    from petsc4py import PETSc
+
+    from unibuckle_fenicsx.spec import SolverSpec
+
+    options = PETSc.Options()
+    if not options.hasName(EPS_TOL_OPTION):
+        return {}, {}
+    text = options.getString(EPS_TOL_OPTION)
+    try:
+        value = float(text)
+    except ValueError:
+        raise InputError(f"-{EPS_TOL_OPTION} takes a number, got {text!r}") from None
+    named = {"solver.eps_tol": f"-{EPS_TOL_OPTION}"}
+    try:
+        SolverSpec(eps_tol=value)  # the key's range
+    except InputError as err:
+        raise name_flag(err, named) from None
+    return {"eps_tol": value}, named
+
+
 def _warn(note: str | None, comm: Any) -> None:
     """Print ``note``, if any, as a warning on stderr from rank 0."""
     if note is not None and comm.rank == 0:

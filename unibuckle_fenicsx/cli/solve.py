@@ -11,6 +11,7 @@ from msgspec.structs import replace
 from unibuckle_fenicsx.cli.flags import METHOD_FLAGS, solver_changes, unused_flags
 from unibuckle_fenicsx.cli.problem import (
     name_flag,
+    petsc_solver_changes,
     refuse_flag_and_set,
     spec_from_args,
     warn_coarse_mesh,
@@ -35,10 +36,9 @@ def solve_command(args: argparse.Namespace, comm: Any) -> int:
     named = {f"solver.{key}": f"--{key}" for key in ("method", "tau") if key in changes}
     named.update({f"solver.{key}": flag for key, flag in SWITCHES.items() if key in changes})
     named.update({f"solver.{METHOD_FLAGS[flag][1]}": flag for flag in flags})
-    eps_tol = _petsc_eps_tol()
-    if eps_tol is not None:  # the eigen solves take it: the record and the checks too
-        changes["eps_tol"] = eps_tol
-        named["solver.eps_tol"] = f"-{EPS_TOL_OPTION}"
+    petsc_changes, petsc_named = petsc_solver_changes()
+    changes.update(petsc_changes)  # the eigen solves take them: the record and checks too
+    named.update(petsc_named)
     refuse_flag_and_set(args.settings, named)
     spec = spec_from_args(args)
     try:
@@ -61,32 +61,6 @@ def solve_command(args: argparse.Namespace, comm: Any) -> int:
     _warn_unused(flags, method, comm, result)
     warn_coarse_mesh(spec, comm)
     return _report(args, result, comm, unwritten)
-
-
-#: The PETSc option that sets the buckling eigen solves' tolerance, solver.eps_tol's
-#: (docs/guide/cli.md): given on the command line, it wins over the file's key.
-EPS_TOL_OPTION = "unibuckle_eps_tol"
-
-
-def _petsc_eps_tol() -> float | None:
-    """``-unibuckle_eps_tol`` of the command line (PETSc's options), or None.
-
-    SLEPc takes it over ``solver.eps_tol``, which then read in the result's ``input``
-    and in the certificate's checks a tolerance the solves did not use.
-
-    Raises:
-        InputError: A value that is not a number.
-    """
-    from petsc4py import PETSc
-
-    options = PETSc.Options()
-    if not options.hasName(EPS_TOL_OPTION):
-        return None
-    text = options.getString(EPS_TOL_OPTION)
-    try:
-        return float(text)
-    except ValueError:
-        raise InputError(f"-{EPS_TOL_OPTION} takes a number, got {text!r}") from None
 
 
 def _report(args: argparse.Namespace, result: Any, comm: Any, unwritten: str | None) -> int:

@@ -6,7 +6,7 @@ import argparse
 import logging
 from typing import Any
 
-from unibuckle_fenicsx.cli.problem import load_config
+from unibuckle_fenicsx.cli.problem import load_config, petsc_solver_changes
 from unibuckle_fenicsx.cli.status import print_out, report_failure
 from unibuckle_fenicsx.errors import InputError
 from unibuckle_fenicsx.outcome import Outcome
@@ -193,9 +193,34 @@ def write_sweep_csv(lines: list[dict[str, Any]], path: str) -> None:
             )
 
 
+def _base_problem(path: str, variations: list[Any], vary: list[str]) -> dict[str, Any]:
+    """The base problem of ``--config path``, with the solver keys PETSc's options set.
+
+    ``-unibuckle_eps_tol`` is every point's ``solver.eps_tol``, recorded in each line's
+    ``input`` as in ``unibuckle solve``'s result
+    (:func:`~unibuckle_fenicsx.cli.problem.petsc_solver_changes`).
+
+    Raises:
+        InputError: The option out of its range, or given with ``--vary`` on its key
+            (the texts ``vary`` of the ``variations``).
+    """
+    from unibuckle_fenicsx.sweep import base_mapping
+
+    changes, named = petsc_solver_changes()
+    for v, text in zip(variations, vary, strict=True):
+        if v.path in named:
+            raise InputError(
+                f"{named[v.path]} and --vary {text} both set {v.path}: give one of them"
+            )
+    base: dict[str, Any] = load_config(path, base_mapping)
+    if changes:
+        base["solver"] = {**base["solver"], **changes}
+    return base
+
+
 def sweep_command(args: argparse.Namespace, comm: Any) -> int:
     """``unibuckle sweep``: the grid, the JSON lines, the chart."""
-    from unibuckle_fenicsx.sweep import base_mapping, parse_variation, run_sweep
+    from unibuckle_fenicsx.sweep import parse_variation, run_sweep
 
     def fail(message: str) -> int:
         return report_failure(comm, message)
@@ -215,7 +240,7 @@ def sweep_command(args: argparse.Namespace, comm: Any) -> int:
         sweep_lines.setLevel(logging.ERROR if args.quiet or comm.rank else logging.INFO)
     try:
         variations = [parse_variation(v) for v in args.vary]
-        base = load_config(args.config, base_mapping)
+        base = _base_problem(args.config, variations, args.vary)
         if args.plot:
             _check_chart(base)
         lines = run_sweep(

@@ -154,7 +154,8 @@ class NonlinearResult:
         verdict: The verdict in words (:func:`~unibuckle_fenicsx.nonlinear.verdict.judge`).
         contact_check: The contact conditions at the last state (see
             :func:`contact_check`).
-        options: The options used.
+        options: The options used, with the in-plane degree (``degree``) and the linear
+            eigen solves' tolerance (``eps_tol``: solver.eps_tol, or -unibuckle_eps_tol).
         wall_time_s: Total wall time (linear solve included).
         timings: Seconds per phase.
         mpi_size: Ranks used.
@@ -648,7 +649,7 @@ def _result(
         gapped=gapped,
         unilateral_load_Pa=closed,
         contact_check=check,
-        options={**structs.asdict(options), "degree": degree},
+        options={**structs.asdict(options), "degree": degree, "eps_tol": spec.solver.eps_tol},
         wall_time_s=time.perf_counter() - t0,
         timings=timings,
         mpi_size=comm.size,

@@ -17,7 +17,6 @@ from unibuckle_fenicsx.geometry import (
     Shape,
     collinear,
     narrowest_neck,
-    narrowest_width,
     segment_lengths,
     shape_gap,
 )
@@ -41,28 +40,15 @@ FEATURE_RATIO = 100.0
 TOUCH_TOLERANCE = 1e-9
 
 
-def plate_width(plate: PlateSpec) -> tuple[float, str]:
-    """The width b of the plate's warnings (m), and its name for their messages.
-
-    The rectangle's smaller side; for a plate given by its outline, the smaller of its
-    bounding box's sides and its narrowest width
-    (:func:`~unibuckle_fenicsx.geometry.narrowest_width`: a rotated rectangle's smaller
-    side, an L-shape's arm), which the bounding box is not.
-    """
-    b = min(plate.length, plate.width)
-    if plate.outline is None:
-        return b, "the plate's smaller side"
-    return min(b, narrowest_width(plate.outline)), "the plate's narrowest width"
-
-
 def plate_model_note(plate: PlateSpec, units: str = "SI") -> str | None:
-    """A warning when t/b exceeds :data:`THICK_PLATE_RATIO` (b: :func:`plate_width`), else None.
+    """A warning when t/b exceeds :data:`THICK_PLATE_RATIO`, else None.
 
-    Lengths in the unit system ``units`` (the file's; the JSON's are SI).
+    b is :attr:`~unibuckle_fenicsx.spec.plate.PlateSpec.narrowest` (an outline's narrowest
+    width). Lengths in the unit system ``units`` (the file's; the JSON's are SI).
     """
     if plate.file is not None:
         return None
-    b, side_name = plate_width(plate)
+    b, side_name = plate.narrowest
     ratio = plate.thickness / b
     if ratio <= THICK_PLATE_RATIO:
         return None
@@ -96,7 +82,8 @@ MIN_CLAMPED_CELLS_ACROSS = 8
 def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str | None:
     """A warning when the cells are larger than the plate's width over 4, else None.
 
-    The width is :func:`plate_width`'s (an outline's narrowest width).
+    The width is :attr:`~unibuckle_fenicsx.spec.plate.PlateSpec.narrowest` (an outline's
+    narrowest width).
 
     Under a stress gradient into tension, the same for the compressed width of a loaded
     edge (:func:`_gradient_note`). The cells of the rectangle (``nx`` and ``ny``, or
@@ -106,7 +93,7 @@ def coarse_mesh_note(plate: PlateSpec, mesh: MeshSpec, units: str = "SI") -> str
     """
     if plate.file is not None:
         return None
-    b, side_name = plate_width(plate)
+    b, side_name = plate.narrowest
     if plate.meshed_by_gmsh:
         h = mesh.size if mesh.size is not None else 0.0
     else:

@@ -477,6 +477,7 @@ def read_problem_data(path: str | Path) -> tuple[dict[str, Any], str | None]:
         ) from None
     except tomllib.TOMLDecodeError as err:
         raise InputError(f"{path}: invalid TOML: {err}") from None
+    _refuse_empty(data, path)
     plate = data.get("plate")
     if isinstance(plate, dict) and isinstance(plate.get("file"), str):
         # A gmsh file is found next to the problem file.
@@ -488,7 +489,22 @@ def _table(data: object, path: Path) -> dict[str, Any]:
     """``data`` if it is a JSON object (a problem's tables), else an error naming ``path``."""
     if not isinstance(data, dict):
         raise InputError(f"{path}: a problem is a JSON object of tables, got {type(data).__name__}")
+    _refuse_empty(data, path)
     return data
+
+
+def _refuse_empty(data: Mapping[str, object], path: Path) -> None:
+    """Refuse a problem file that holds no key: empty, or comments only.
+
+    Every key has a default, so an empty file would solve the default plate in silence
+    (a file emptied by mistake, the wrong path): it names no problem.
+    """
+    if not data:
+        raise InputError(
+            f"{path}: holds no table or key (an empty file, comments only, or {{}}): a problem "
+            "file needs at least one table, e.g. [plate] (the plate's corners or outline, "
+            "thickness) or [section] (a section); the keys it leaves out take their defaults"
+        )
 
 
 def load_problem(path: str | Path) -> ProblemSpec | SectionProblemSpec:

@@ -18,6 +18,7 @@ from unibuckle_fenicsx.geometry import (
     circle_points,
     distance_to_polygon,
     is_simple,
+    narrowest_width,
     points_in_circle,
     points_in_polygon,
     polygon_area,
@@ -46,11 +47,13 @@ Inplane = Literal["free", "clamped", "roller"]
 BENDING_SUPPORTS: tuple[str, ...] = typing.get_args(Support)
 #: In-plane conditions for the prestress solve ("roller": the normal displacement only).
 INPLANE_SUPPORTS: tuple[str, ...] = typing.get_args(Inplane)
-#: Above this thickness over the plate's smaller side, a warning: Reissner-Mindlin
-#: theory (transverse shear, plane sections, no thickness stretch) is the usual model of
-#: moderately thick plates up to t/b of about 0.2.
+#: Above this thickness over the plate's smaller side (an outline's narrowest width,
+#: :attr:`PlateSpec.narrowest`), a warning: Reissner-Mindlin theory (transverse shear,
+#: plane sections, no thickness stretch) is the usual model of moderately thick plates
+#: up to t/b of about 0.2.
 THICK_PLATE_RATIO = 0.2
-#: Above this thickness over the plate's smaller side the body is not a plate: refused.
+#: Above this thickness over the plate's smaller side (as above) the body is not a plate:
+#: refused.
 MAX_THICKNESS_RATIO = 0.5
 #: Below this thickness over the plate's smaller side, refused: the bending stiffness
 #: (:math:`\propto t^3`) against the shear stiffness (:math:`\propto t`) of the same
@@ -318,7 +321,8 @@ class PlateSpec(Table, frozen=True):
         thickness: Plate thickness t = 2 epsilon (m), > 0, from
             :data:`MIN_THICKNESS_RATIO` (1e-7: below, double precision keeps no digit of
             the bending stiffness beside the shear stiffness) to
-            :data:`MAX_THICKNESS_RATIO` (0.5: above, not a plate) times the smaller side.
+            :data:`MAX_THICKNESS_RATIO` (0.5: above, not a plate) times the smaller side
+            (an outline's narrowest width: :attr:`narrowest`).
         edges: One :class:`EdgeSpec` per edge part: the rectangle's are named as in
             :data:`EDGE_NAMES`, an outline's parts by their ``segments``, a file's by its
             physical groups of dimension 1; the part ``holes`` is the holes' boundary.
@@ -364,7 +368,7 @@ class PlateSpec(Table, frozen=True):
         self._check_holes()
         self._check_edges()
         self._check_extent()
-        b = min(self.length, self.width)
+        b, side_name = self.narrowest
         ratio = self.thickness / b
         if self.file is None and not MIN_THICKNESS_RATIO <= ratio <= MAX_THICKNESS_RATIO:
             (t, name), (side, _) = in_file(self.thickness, "m"), in_file(b, "m")
@@ -380,8 +384,7 @@ class PlateSpec(Table, frozen=True):
             )
             raise self.error(
                 "thickness",
-                f" = {t:g} {name} is {ratio:.3g} times the plate's smaller side {side:g} "
-                f"{name}: {why}",
+                f" = {t:g} {name} is {ratio:.3g} times {side_name} {side:g} {name}: {why}",
             )
 
     def _check_extent(self) -> None:
@@ -481,6 +484,21 @@ class PlateSpec(Table, frozen=True):
             return self.outline
         (x0, y0), (x1, y1) = self.corners
         return ((x0, y0), (x1, y0), (x1, y1), (x0, y1))
+
+    @property
+    def narrowest(self) -> tuple[float, str]:
+        """The width b of the plate's rules on t/b and on its cells (m), and its name.
+
+        The rectangle's smaller side; for a plate given by its outline, the smaller of its
+        bounding box's sides and its narrowest width
+        (:func:`~unibuckle_fenicsx.geometry.narrowest_width`: a rotated rectangle's smaller
+        side, an L-shape's arm), which the bounding box is not. The name is the one the
+        messages give it ("the plate's smaller side", "the plate's narrowest width").
+        """
+        b = min(self.length, self.width)
+        if self.outline is None:
+            return b, "the plate's smaller side"
+        return min(b, narrowest_width(self.outline)), "the plate's narrowest width"
 
     @property
     def area(self) -> float:

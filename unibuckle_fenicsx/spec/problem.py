@@ -109,11 +109,16 @@ class ProblemSpec(Table, frozen=True):
         check_features(plate, size)
 
     def _check_foundation_stiffness(self) -> None:
-        r"""A tensionless foundation's :math:`K = k_f b^4/(\pi^4 D)`: at most 1e12."""
+        r"""A tensionless foundation's :math:`K = k_f b^4/(\pi^4 D)`: at most 1e12.
+
+        b is :attr:`~unibuckle_fenicsx.spec.plate.PlateSpec.narrowest`, the width of the
+        thickness rules: a rotated rectangle's smaller side, not its bounding box's, which
+        would refuse the same plate turned at a smaller K (:math:`b^4` of a wider box).
+        """
         plate = self.plate
         if plate.file is not None:  # its sides are known once meshed
             return
-        b = min(plate.length, plate.width)
+        b, side_name = plate.narrowest
         D = self.material.E * plate.thickness**3 / 12.0
         for k, o in enumerate(self.all_obstacles):
             if o.kind != "tensionless" or o.foundation_stiffness is None:
@@ -126,7 +131,7 @@ class ProblemSpec(Table, frozen=True):
                 raise InputError(
                     f"{self.obstacle_label(k)}.foundation_stiffness = {kf:g} {name} is "
                     f"K = k_f b^4/(pi^4 D) = {K:.3g} times the plate's bending stiffness "
-                    f"(D = E t^3/12, b its smaller side): a tensionless foundation needs "
+                    f"(D = E t^3/12, b {side_name}): a tensionless foundation needs "
                     f"K <= {MAX_FOUNDATION_K:g}, foundation_stiffness <= {high:.3g} {name} "
                     "here (the largest verified). The rigid obstacle's load is an upper "
                     "bound of the foundation's at any stiffness, and the gap to it falls as "

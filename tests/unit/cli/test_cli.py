@@ -331,6 +331,32 @@ def test_the_petsc_eps_tol_is_the_solver_eps_tol_it_overrides(tmp_path):
     assert "-unibuckle_eps_tol: solver.eps_tol must lie in (0, 0.0001]" in loose.stderr
 
 
+@pytest.mark.parametrize(
+    ("name", "text"), [("empty.toml", ""), ("comments.toml", "# a plate\n\n"), ("p.json", "{}")]
+)
+@pytest.mark.parametrize("command", ["solve", "sweep", "nonlinear"])
+def test_an_empty_problem_file_is_refused_at_read(tmp_path, capsys, nothing_built, name, text,
+                                                  command):  # fmt: skip
+    """A problem file with no table, empty or comments only, is refused: exit 2, no solve.
+
+    Every key has a default: before, such a file solved the default plate (the paper's
+    0.2 x 0.1 m, exit 0) in silence. Expected: the message names the file and says what
+    is missing (a table: [plate] or [section]), before any mesh.
+    """
+    path = tmp_path / name
+    path.write_text(text)
+    args = {
+        "solve": ["solve"],
+        "sweep": ["sweep", "--vary", "plate.thickness=0.006", "--json", str(tmp_path / "k")],
+        "nonlinear": ["nonlinear"],
+    }[command]
+    assert main([*args, "--config", str(path)]) == EXIT_BAD_INPUT
+    captured = capsys.readouterr()
+    assert captured.out == ""
+    assert captured.err.startswith(f"unibuckle: error: {path}: holds no table or key"), captured.err
+    assert "needs at least one table, e.g. [plate]" in captured.err and "[section]" in captured.err
+
+
 def test_set_reads_a_string_as_toml_writes_it():
     """``--set solver.method="penalty"`` (the file's line, quotes and all) sets ``penalty``.
 

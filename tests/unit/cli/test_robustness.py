@@ -184,6 +184,40 @@ def test_a_bad_eps_tol_option_is_refused_before_petsc(tmp_path):
 
 
 @serial
+@pytest.mark.parametrize("command", ["sweep", "nonlinear"])
+def test_sweep_and_nonlinear_check_and_record_the_eps_tol_option(tmp_path, command):
+    """``-unibuckle_eps_tol`` is ``solver.eps_tol`` under every command, as under solve.
+
+    Out of the key's range (0, 1e-4] (``SolverSpec.eps_tol``) it is refused, exit 2,
+    naming the option, the key and the range; in range, the output records it: each
+    sweep point's ``input``, the nonlinear JSON's ``options``. Before, both commands
+    solved with 1e-2 (exit 0) and the sweep's lines read the file's 1e-10.
+    """
+    (tmp_path / "base.toml").write_text(SMALL)
+    out = tmp_path / "out.json"
+    args = {
+        "sweep": ["sweep", "--config", "base.toml", "--vary", "plate.thickness=0.006"],
+        "nonlinear": ["nonlinear", "--config", "base.toml", "--imperfection", "1e-3"],
+    }[command]
+    loose = run_script(*args, "--json", str(out), "-unibuckle_eps_tol", "1e-2", cwd=tmp_path)
+    assert loose.returncode == EXIT_BAD_INPUT, loose.stderr
+    assert loose.stdout == "" and not out.exists()
+    assert loose.stderr == (
+        "unibuckle: error: -unibuckle_eps_tol: solver.eps_tol must lie in (0, 0.0001], got 0.01\n"
+    )
+    done = run_script(*args, "--json", str(out), "-q", "-unibuckle_eps_tol", "1e-6", cwd=tmp_path)
+    assert done.returncode == EXIT_OK, done.stderr
+    if command == "sweep":
+        assert json.loads(out.read_text().splitlines()[0])["input"]["solver"]["eps_tol"] == 1e-6
+        vary = ["sweep", "--config", "base.toml", "--vary", "solver.eps_tol=1e-8"]
+        both = run_script(*vary, "--json", "k.jsonl", "-unibuckle_eps_tol", "1e-6", cwd=tmp_path)
+        assert both.returncode == EXIT_BAD_INPUT
+        assert "-unibuckle_eps_tol and --vary solver.eps_tol=1e-8 both set" in both.stderr
+    else:
+        assert json.loads(out.read_text())["options"]["eps_tol"] == 1e-6
+
+
+@serial
 def test_ctrl_c_during_a_sweep(tmp_path):
     """SIGINT: a one-line message, exit 130, the finished lines intact and resumable.
 

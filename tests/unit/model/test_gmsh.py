@@ -430,6 +430,72 @@ def test_plate_warnings_take_the_outline_width(outline, width):
         assert (plate_model_note(plate) is not None) == warned
 
 
+def _outline_plate(outline, thickness, **extra):
+    return problem_from_dict(
+        {
+            "plate": {"outline": outline, "thickness": thickness},
+            "edges": {"all": {"segments": list(range(len(outline)))}},
+            "mesh": {"size": 0.01},
+            **extra,
+        }
+    )
+
+
+@pytest.mark.parametrize(
+    ("outline", "width"),
+    [
+        (PAPER_OUTLINE, 0.1),
+        (_rotated_square(0.2, 30.0), 0.2),  # bounding box 0.273 m a side
+        (L_SHAPE, 0.1),  # bounding box 0.2 m: the arms are 0.1 m wide
+    ],
+)
+def test_the_thickness_range_takes_the_outline_width(outline, width):
+    """t/b at most 0.5 (not a plate above), b the outline's narrowest width.
+
+    The rule is the rectangle's t/b in [1e-7, 0.5] (:data:`MAX_THICKNESS_RATIO`), with b
+    the width the warnings take. It read the bounding box: the L-shape with 0.1 m arms at
+    t = 0.06 m (t/b = 0.6 on an arm) was accepted as t/b = 0.06/0.2 = 0.3, and the turned
+    square of side 0.2 m at t = 0.12 m (0.6) as 0.12/0.273 = 0.44. Expected: refused at
+    0.6 times the width, naming the key, the width and the range; accepted at 0.45.
+    """
+    with pytest.raises(ValueError, match=r"plate\.thickness") as err:
+        _outline_plate(outline, 0.6 * width)
+    message = str(err.value)
+    assert f"0.6 times the plate's narrowest width {width:g} m" in message, message
+    assert "must be at most 0.5 times it" in message
+    assert _outline_plate(outline, 0.45 * width).plate.thickness == 0.45 * width
+
+
+def test_a_foundation_s_stiffness_limit_takes_the_outline_width():
+    r"""K = k_f b^4/(pi^4 D) <= 1e12 with b the outline's width, not its bounding box's.
+
+    The square of side b = 0.2 m turned by 45 degrees has a bounding box of side
+    b sqrt(2): read there, K came out (sqrt 2)^4 = 4 times the axis-parallel square's,
+    and a foundation of K = 5e11 (accepted on that square) was refused as K = 2e12.
+    Expected (the formula, D = E t^3/12): K = 5e11 accepted, K = 2e12 refused naming
+    the key and the limit, on both squares alike.
+    """
+    t, E = 0.002, 1.0e9
+    D = E * t**3 / 12.0
+
+    def foundation(K):
+        kf = K * np.pi**4 * D / 0.2**4
+        return {
+            "material": {"E": E, "nu": 0.3},
+            "obstacle": {"zone": "all", "foundation_stiffness": kf},
+        }
+
+    squares = (_rotated_square(0.2, 0.0), _rotated_square(0.2, 45.0))
+    for outline in squares:
+        assert _outline_plate(outline, t, **foundation(5e11)).tensionless
+    for outline in squares:
+        with pytest.raises(ValueError, match=r"obstacle\.foundation_stiffness") as err:
+            _outline_plate(outline, t, **foundation(2e12))
+        message = str(err.value)
+        assert "K = k_f b^4/(pi^4 D) = 2e+12" in message, message
+        assert "b the plate's narrowest width" in message and "K <= 1e+12" in message
+
+
 def test_inclined_edge_needs_soft_support_or_clamping():
     """Hard simple support fixes the tangential rotation: only on axis-parallel edges."""
     outline = [[0.0, 0.0], [0.3, 0.0], [0.25, 0.1], [0.0, 0.1]]
