@@ -84,9 +84,9 @@ class SectionParameters:
         E: Young's modulus (Pa), > 0.
         nu: Poisson's ratio, in (-1, 0.5).
         mesh_size: Target cell size (m), a file's ``mesh.size``: > 0 and below ``length``
-            (at least 2 cells along; a box's faces get an even number of cells; with a
-            core, :func:`~unibuckle_fenicsx.section_analysis.solve_section` asks for at
-            least 4 across the narrowest face).
+            (at least 2 cells along; a box's faces get an even number of cells; a box
+            with a core, :func:`~unibuckle_fenicsx.section_analysis.solve_section` asks
+            for at least 4 across its narrowest face).
         width: Box: mid-line width b along y (m).
         depth: Box: mid-line depth d along z (m).
         diameter: Tube: mid-surface diameter 2R (m).
