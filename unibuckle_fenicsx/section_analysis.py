@@ -91,6 +91,7 @@ from unibuckle_fenicsx.spec.section import (
     check_core_options,
     check_section_mesh,
     check_section_solver,
+    narrowest_face,
 )
 
 __all__ = [
@@ -327,7 +328,10 @@ def solve_section(
     Raises:
         TypeError: ``parameters`` is not a SectionParameters.
         InputError: ``levels`` out of range (its coarsest section without 2 cells
-            along, or a core's span without a free node on it), a method no section runs
+            along, or a core's span without a free node on it), a core on a box whose
+            narrowest face gets fewer than 4 cells (``mesh_size``, the file's
+            ``mesh.size``: :func:`~unibuckle_fenicsx.spec.section.check_core_face_cells`),
+            a method no section runs
             (``solver.method``), or what the problem file refuses: a core's search
             options (``levels``, ``solver.tau``, ``solver.max_iterations``) given to a
             section without a core, a plate's solver option; all before any mesh.
@@ -439,7 +443,8 @@ def _file_holds_them(
 
 #: Fewer cells than this across a box's narrowest face draw a warning: there the hollow
 #: box's load is already more than about 5 % above its converged value, and a core's
-#: shorter buckles make it worse (:doc:`/guide/sections`, "Cell size").
+#: shorter buckles make it worse (:doc:`/guide/sections`, "Cell size"); a core on fewer
+#: than :data:`~unibuckle_fenicsx.spec.section.MIN_CORE_FACE_CELLS` is refused.
 MIN_FACE_CELLS = 5
 #: Fewer cells than this along a tube's axisymmetric half-wave
 #: :math:`\pi\sqrt{Rt}/(12(1-\nu^2))^{1/4}` draw a warning between clamped ends, and
@@ -480,7 +485,8 @@ def _check(
         InputError: ``levels`` not an integer >= 0; a hollow section given a core's
             search options (``levels``, ``solver.tau``, ``solver.max_iterations``:
             :func:`~unibuckle_fenicsx.spec.section.check_core_options`) or any section a
-            plate's solver option; cells or levels the section cannot have, or a core's
+            plate's solver option; cells or levels the section cannot have (a core on a
+            box: 4 cells across its narrowest face at least), or a core's
             span holding no free node of a section the search runs on
             (:func:`~unibuckle_fenicsx.spec.section.check_section_mesh`); a design output
             asked of a wall whose E is not a steel's
@@ -499,6 +505,7 @@ def _check(
         size=p.mesh_size, length=p.length, levels=int(levels), core=p.core,
         elastic=p.foundation_stiffness is not None, span=p.core_span,
         across=max(float(v or 0.0) for v in (p.width, p.depth, p.diameter)),
+        narrowest=narrowest_face(p.shape, p.width, p.depth),
     )  # fmt: skip
     check_section_memory(estimated_dofs(p), p.mesh_size, comm)
     notes = [thick_wall_note(parameters), coarse_mesh_note(parameters)]

@@ -116,19 +116,19 @@ def test_a_hollow_section_takes_the_search_s_defaults_as_its_result_echoes_them(
 
 
 def test_an_elastic_core_s_levels_beyond_its_section_are_refused(tmp_path, monkeypatch, capsys):
-    # 50 mm cells on 0.3 m: 2 coarser sections keep 2 cells along (0.2 m < 0.3 m), 3 do
-    # not (0.4 m). The rigid core refused levels = 3; the elastic core's start from the
-    # rigid core's set took 2 without a word.
+    # 25 mm cells on 0.3 m (4 across a 0.1 m face, as a core needs): 3 coarser sections
+    # keep 2 cells along (0.2 m < 0.3 m), 4 do not (0.4 m). The rigid core refused
+    # levels = 4; the elastic core's start from the rigid core's set took 3 without a word.
     _no_mesh(monkeypatch)
     path = tmp_path / "elastic.toml"
     path.write_text(
-        HOLLOW.replace("size = 0.05", "size = 0.05\nlevels = 3")
+        HOLLOW.replace("size = 0.05", "size = 0.025\nlevels = 4")
         + "[obstacle]\ncore = true\nfoundation_stiffness = 1e12\n"
     )
     assert main(["solve", "--config", str(path)]) == EXIT_BAD_INPUT
     err = capsys.readouterr().err
-    assert "mesh.levels = 3: the coarsest section's cells, mesh.size x 2^3 = 0.4 m" in err, err
-    assert "mesh.levels <= 2 here" in err, err
+    assert "mesh.levels = 4: the coarsest section's cells, mesh.size x 2^4 = 0.4 m" in err, err
+    assert "mesh.levels <= 3 here" in err, err
 
 
 def test_sweep_and_solve_warn_alike_of_a_modulus_in_mpa(tmp_path, capsys):
@@ -267,7 +267,8 @@ def test_a_section_figure_keeps_its_view_when_it_sees_a_buckle_nearly_the_larges
 
 
 def test_a_section_s_fields_are_written_for_paraview_and_read_back(tmp_path):
-    # A filled box on 50 mm cells (2 across a face): the I/O, not the load, is tested.
+    # A filled box on 25 mm cells (4 across a face, the fewest a core is solved on): the
+    # I/O, not the load, is tested.
     from types import SimpleNamespace
 
     import pyvista
@@ -276,7 +277,7 @@ def test_a_section_s_fields_are_written_for_paraview_and_read_back(tmp_path):
 
     path = tmp_path / "filled.toml"
     path.write_text(
-        HOLLOW.replace("size = 0.05", "size = 0.05\nlevels = 0")
+        HOLLOW.replace("size = 0.05", "size = 0.025\nlevels = 0")
         + '[obstacle]\ncore = true\n[solver]\nmethod = "active-set"\n'
     )
     out, result_path = tmp_path / "fields", tmp_path / "r.json"

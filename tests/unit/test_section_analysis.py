@@ -45,7 +45,9 @@ def _box(**changes):
 
 
 def test_box_with_a_core_gives_the_plate_record():
-    with solve_section(_box(), MPI.COMM_SELF, levels=0) as analysis:
+    # 40 mm cells: 4 across the 0.1 m faces (the fewest a core is solved on), 6 across the
+    # 0.2 m ones, 5 along 0.2 m.
+    with solve_section(_box(mesh_size=0.04), MPI.COMM_SELF, levels=0) as analysis:
         r = analysis.result
         assert isinstance(r, unibuckle_fenicsx.results.records.BucklingResult)
         load = r.critical_load_Pa
@@ -58,7 +60,9 @@ def test_box_with_a_core_gives_the_plate_record():
         assert cert is not None and cert.kkt
         assert r.lower_bound_Pa <= load * (1 + 1e-9)
         assert r.upper_bound_Pa is None or load <= r.upper_bound_Pa * (1 + 1e-9)
-        assert r.constrained_nodes == 12 and 0 < r.contact_nodes == len(r.contact_coordinates)
+        # By hand: 20 nodes around (4 + 6 + 4 + 6 cells), the 4 corners with 2 directions
+        # each: 24 directions at each of the 4 stations between the supported ends.
+        assert r.constrained_nodes == 96 and 0 < r.contact_nodes == len(r.contact_coordinates)
         assert r.contact_force is not None
         push = r.contact_force.push
         assert len(push) == r.contact_nodes
@@ -109,6 +113,55 @@ def test_tube_without_a_core_is_its_free_load():
 def test_bad_section_input_is_refused_before_any_mesh(call, error, words):
     with pytest.raises(error, match=words):
         call()
+
+
+@pytest.mark.parametrize(
+    ("changes", "cells"),
+    [
+        ({}, 2),  # the 0.1 m depth on 0.1 m cells: ceil(1) = 1, at least 2
+        ({"mesh_size": 0.05}, 2),  # ceil(2) = 2 across the depth (4 across the width)
+        ({"mesh_size": 0.05, "foundation_stiffness": 1e12}, 2),  # an elastic core too
+    ],
+)
+def test_a_core_on_a_box_face_of_too_few_cells_is_refused_before_any_mesh(
+    monkeypatch, changes, cells
+):
+    """solve_section refuses a core on a face of 2 cells, naming mesh.size and its range.
+
+    The box 0.2 x 0.1 m: its narrowest face 0.1 m needs 4 cells with a core, mesh.size
+    below 0.05 m (a face's cells are ceil(width/mesh.size) made even).
+    """
+
+    def no_mesh(*args, **kwargs):
+        raise AssertionError("a mesh was built")
+
+    monkeypatch.setattr("unibuckle_fenicsx.model.shell.section.section_mesh", no_mesh)
+    box = _box(**changes)
+    size = box.mesh_size
+    with pytest.raises(InputError) as caught:
+        solve_section(box, MPI.COMM_SELF, levels=0)
+    text = str(caught.value)
+    assert text.startswith(
+        f"mesh.size = {size:g} m gives {cells} cells across the box's narrowest face (0.1 m)"
+    ), text
+    assert "mesh.size must be < 0.05 m here" in text
+    # The hollow box on these cells is solved (its coarse cells only warned of).
+    with pytest.raises(AssertionError, match="a mesh was built"):
+        solve_section(dataclasses.replace(box, core=False, foundation_stiffness=None))
+
+
+def test_the_check_counts_a_box_s_cells_as_its_mesh_does():
+    """The refusal's count is the mesh's: the box's nodes around from the same helper."""
+    from unibuckle_fenicsx.model.shell.geometry import grid_nodes
+    from unibuckle_fenicsx.spec.section import face_cells
+
+    # ceil(w/h) made even, at least 2: by hand
+    assert [face_cells(0.1, h) for h in (0.1, 0.05, 0.0499, 0.034, 0.025, 0.0249)] == [
+        2, 2, 4, 4, 4, 6,
+    ]  # fmt: skip
+    for size in (0.1, 0.05, 0.0499, 0.03, 0.02):
+        around, _ = grid_nodes("box", (0.2, 0.1), 0.2, size, None)
+        assert around == 2 * (face_cells(0.2, size) + face_cells(0.1, size))
 
 
 def test_sections_are_public_and_lazy():

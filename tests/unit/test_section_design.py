@@ -341,11 +341,12 @@ def test_a_tube_gets_its_slenderness_only():
 
 
 def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):
+    # 40 mm cells: 4 across the 0.1 m faces, the fewest a core is solved on.
     path = tmp_path / "box.toml"
     path.write_text(
         "[section]\nshape = 'box'\nwidth = 0.2\ndepth = 0.1\nthickness = 0.002\n"
         "length = 0.2\nends = 'simply_supported'\n[material]\nE = 2.1e11\nnu = 0.3\n"
-        "[obstacle]\ncore = true\n[mesh]\nsize = 0.1\nlevels = 0\n"
+        "[obstacle]\ncore = true\n[mesh]\nsize = 0.04\nlevels = 0\n"
         "[design]\nyield_stress = 3.55e8\n"
     )
     spec = load_problem(path)
@@ -363,7 +364,7 @@ def test_a_section_file_with_design_writes_it_to_its_json(tmp_path):
     path.write_text(
         "units = 'mm-N-MPa'\n[section]\nshape = 'box'\nwidth = 200\ndepth = 100\n"
         "thickness = 2\nlength = 200\nends = 'simply_supported'\n[material]\nE = 2.1e5\n"
-        "nu = 0.3\n[obstacle]\ncore = true\n[mesh]\nsize = 100\nlevels = 0\n"
+        "nu = 0.3\n[obstacle]\ncore = true\n[mesh]\nsize = 40\nlevels = 0\n"
         "[design]\nyield_stress = 355\n"
     )
     with solve_section(load_problem(path), MPI.COMM_SELF) as analysis:

@@ -73,14 +73,20 @@ def test_cells_not_below_the_length_are_refused_when_the_file_is_read(tmp_path):
 def test_an_elastic_core_takes_the_default_levels_on_any_mesh(tmp_path):
     """An elastic core's rigid start takes as many levels as the section allows (none here).
 
-    Cells of 200 mm on 0.3 m: 2 along, no coarser section; the default levels = 1 is not
-    refused (the solve takes 0), a levels = 1 written out is the same value and is not
-    refused either; 2 are.
+    Cells of 25 mm on a member 50 mm long: 2 along (4 across a face, the fewest a core is
+    solved on), no coarser section; the default levels = 1 is not refused (the solve takes
+    0), a levels = 1 written out is the same value and is not refused either; 2 are.
     """
     stiff = "foundation_stiffness = 1e10"
-    assert load_toml(_file(tmp_path, size=0.2, levels=1, obstacle=stiff)).mesh.levels == 1
+
+    def short(levels):
+        path = _file(tmp_path, size=0.025, levels=levels, obstacle=stiff)
+        path.write_text(path.read_text().replace("length = 0.3", "length = 0.05"))
+        return path
+
+    assert load_toml(short(1)).mesh.levels == 1
     with pytest.raises(InputError, match=r"mesh.levels = 2.*mesh.levels <= 0"):
-        load_toml(_file(tmp_path, size=0.2, levels=2, obstacle=stiff))
+        load_toml(short(2))
 
 
 def test_a_span_without_a_node_on_a_coarser_section_is_refused_when_read(tmp_path):

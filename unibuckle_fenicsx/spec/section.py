@@ -134,6 +134,51 @@ def cells_along(length: float, size: float) -> int:
     return max(1, math.ceil(length / size - _ROUNDING))
 
 
+def face_cells(extent: float, size: float) -> int:
+    """The cells of about ``size`` (m) a box's uniform face of width ``extent`` (m) gets.
+
+    ceil(extent/size) made even (a node at the middle of the face), at least 2.
+    :mod:`~unibuckle_fenicsx.model.shell.geometry` meshes a box's faces with it (and the
+    uniform middle part of a graded face); the checks of a file's ``[mesh]`` read it
+    before any mesh is made.
+    """
+    n = max(2, math.ceil(extent / size - _ROUNDING))
+    return n + n % 2
+
+
+#: The fewest cells across a box's narrowest face a core (rigid or elastic) is solved on.
+#: With the core every face's buckle must lie on one side of it between the corners,
+#: where the adjacent faces' turning meets it: 2 cells (one node inside the face) cannot
+#: hold such a buckle, and the critical stress comes out many times too high
+#: (:doc:`/guide/sections`, "Cell size").
+MIN_CORE_FACE_CELLS = 4
+
+
+def check_core_face_cells(size: float, narrowest: float, units: str | None = None) -> None:
+    """Refuse a box with a core whose narrowest face gets too few cells.
+
+    At least :data:`MIN_CORE_FACE_CELLS` cells (:func:`face_cells`) across the narrowest
+    face of width ``narrowest`` (m): ``size`` below narrowest/2, from where the even
+    count is 4. The message in ``units`` (None: those of the file read or solved).
+
+    Raises:
+        InputError: Naming ``mesh.size`` and its range here.
+    """
+    cells = face_cells(narrowest, size)
+    if cells >= MIN_CORE_FACE_CELLS:
+        return
+    (h, name), (w, _) = in_file(size, "m", units), in_file(narrowest, "m", units)
+    bound, _ = in_file(narrowest / (MIN_CORE_FACE_CELLS - 2), "m", units)
+    raise InputError(
+        f"mesh.size = {h:g} {name} gives {cells} cells across the box's narrowest face "
+        f"({w:g} {name}); with a core (obstacle.core) a face needs at least "
+        f"{MIN_CORE_FACE_CELLS}, or its buckle cannot lie on one side of the core between "
+        f"the corners and the critical stress comes out many times too high: mesh.size "
+        f"must be < {bound:g} {name} here (a face's cells are ceil(width/mesh.size) made "
+        'even; docs/guide/sections.md, "Cell size")'
+    )
+
+
 def check_cells_along(size: float, length: float, units: str | None = None) -> None:
     """Refuse a cell size ``size`` not below ``length`` (m): 2 cells along at least.
 
@@ -243,13 +288,16 @@ def check_section_mesh(
     elastic: bool,
     span: tuple[float, float] | None,
     across: float,
+    narrowest: float | None = None,
     units: str | None = None,
 ) -> None:
     """What a section's cells and ``mesh.levels`` must allow, checked before any mesh.
 
     2 cells along (:func:`check_cells_along`); with a rigid core, ``levels`` coarser
     sections of 2 cells along (:func:`check_levels`), each with a free node in the core's
-    ``span`` (:func:`check_span_nodes`). An elastic core's rigid start takes the default
+    ``span`` (:func:`check_span_nodes`); with a core (rigid or elastic) on a box,
+    :data:`MIN_CORE_FACE_CELLS` across its ``narrowest`` face (m; None: a tube,
+    :func:`check_core_face_cells`). An elastic core's rigid start takes the default
     levels as far as the section allows them, so only levels given other than the default
     are checked, and its span on the given cells only (its start falls back on them). The
     problem file's :meth:`SectionProblemSpec.check` and
@@ -264,6 +312,15 @@ def check_section_mesh(
         check_levels(size, length, levels, units)
     if core and span is not None:
         check_span_nodes(span, length, size, 0 if elastic else levels, across, units)
+    if core and narrowest is not None:
+        check_core_face_cells(size, narrowest, units)
+
+
+def narrowest_face(shape: str, width: float | None, depth: float | None) -> float | None:
+    """A box's narrowest face (m), the smaller of ``width`` and ``depth``; None: a tube."""
+    if shape != "box" or width is None or depth is None:
+        return None
+    return min(width, depth)
 
 
 class SectionSpec(Table, frozen=True):
@@ -401,7 +458,8 @@ class SectionMeshSpec(Table, frozen=True):
 
     Args:
         size: Target cell size (m), > 0 and below the section's length (2 cells along at
-            least); a box's faces get an even number of cells.
+            least); a box's faces get an even number of cells, with a core at least 4
+            across the narrowest face (size below half its width).
         levels: With a rigid core, coarser sections (each with twice the cell size) the
             search starts on, >= 0, as long as the coarsest keeps 2 cells along; 1: its
             many steps on a quarter of the DOFs, a few on the given cells. An elastic core:
@@ -463,7 +521,7 @@ class SectionProblemSpec(Table, frozen=True):
             size=self.mesh.size, length=s.length, levels=self.mesh.levels,
             core=self.obstacle.core, elastic=elastic, span=span,
             across=max(float(v or 0.0) for v in (s.width, s.depth, s.diameter)),
-            units=self.units,
+            narrowest=narrowest_face(s.shape, s.width, s.depth), units=self.units,
         )  # fmt: skip
         if self.design is not None:
             check_steel_modulus(self.material.E, *UNITS[self.units][1:])

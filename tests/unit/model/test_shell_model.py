@@ -229,7 +229,7 @@ def test_drilling_stiffness_does_not_change_the_load():
         ({"shape": "tube", "diameter": 0.2, "width": 0.2}, "section.width"),
         ({"depth": None}, "section.depth"),
         ({"thickness": 0.1}, "section.thickness"),
-        ({"core_span": (0.0, 0.1)}, "obstacle.core_span"),
+        ({"core_span": (0.0, 0.1)}, "obstacle.span"),
         ({"ends": "pinned"}, "section.ends"),
         ({"shape": "tube", "width": None, "depth": None}, "section.diameter"),
     ],

@@ -65,6 +65,10 @@ EVERY_KEY = {
 }  # fmt: skip
 
 
+def _no_mesh(*args, **kwargs):
+    raise AssertionError("a mesh was built")
+
+
 def _write(tmp_path, text=BOX, name="box.toml"):
     path = tmp_path / name
     path.write_text(text)
@@ -349,3 +353,61 @@ def test_cells_too_coarse_are_refused_naming_size_or_levels(tmp_path, capsys):
         assert main(["solve", "--config", str(_write(tmp_path, text)), "-q"]) == EXIT_BAD_INPUT
         err = capsys.readouterr().err
         assert message in err, err
+
+
+@pytest.mark.parametrize(
+    ("size", "obstacle", "refused"),
+    [
+        (0.05, "", True),  # ceil(0.1/0.05) = 2 cells across every face
+        (0.07, "foundation_stiffness = 1e12", True),  # ceil(1.43) = 2: an elastic core too
+        (0.0499, "", False),  # ceil(2.004) = 3, made even: 4 cells, the fewest allowed
+    ],
+)
+def test_a_core_on_a_box_with_too_few_cells_across_a_face_exits_2(
+    tmp_path, monkeypatch, capsys, size, obstacle, refused
+):
+    """A core on a box face of 2 cells: refused when the file is read, naming mesh.size.
+
+    With the core a face's buckle must lie on one side of it between the corners; on 2
+    cells it cannot (docs/guide/sections.md, "Cell size"). The count is the mesh's:
+    ceil(width/mesh.size) made even, so the range is mesh.size < width/2 = 0.05 m.
+    """
+    import unibuckle_fenicsx.model.shell.section as section
+
+    monkeypatch.setattr(section, "section_mesh", _no_mesh)
+    text = BOX.replace("[mesh]", f"[obstacle]\ncore = true\n{obstacle}\n[mesh]")
+    path = _write(tmp_path, text.replace("size = 0.0125", f"size = {size}\nlevels = 0"))
+    if not refused:
+        assert load_problem(path).mesh.size == size
+        return
+    assert main(["solve", "--config", str(path), "-q"]) == EXIT_BAD_INPUT
+    err = capsys.readouterr().err
+    assert (
+        f"mesh.size = {size:g} m gives 2 cells across the box's narrowest face (0.1 m); with "
+        "a core (obstacle.core) a face needs at least 4" in err
+    ), err
+    assert "mesh.size must be < 0.05 m here" in err, err
+    # The hollow box on the same cells is read (a warning of coarse cells, no refusal).
+    hollow = _write(tmp_path, BOX.replace("size = 0.0125", f"size = {size}"), "hollow.toml")
+    assert load_problem(hollow).mesh.size == size
+
+
+def test_a_core_on_a_box_with_too_few_cells_is_refused_in_the_file_s_units():
+    """A file in mm-N-MPa: the narrowest face 50 mm (a box 100 x 50 mm), cells of 30 mm."""
+    from unibuckle_fenicsx.errors import InputError
+
+    data = {
+        "units": "mm-N-MPa",
+        "section": {"shape": "box", "width": 100.0, "depth": 50.0, "thickness": 2.0,
+                    "length": 200.0, "ends": "simply_supported"},
+        "material": {"E": 2.1e5, "nu": NU},
+        "obstacle": {"core": True},
+        "mesh": {"size": 30.0, "levels": 0},
+    }  # fmt: skip
+    with pytest.raises(InputError) as caught:
+        section_from_dict(data)
+    text = str(caught.value)
+    assert "mesh.size = 30 mm gives 2 cells across the box's narrowest face (50 mm)" in text
+    assert "mesh.size must be < 25 mm here" in text
+    data["mesh"]["size"] = 24.0  # ceil(50/24) = 3, made even: 4 cells
+    assert section_from_dict(data).mesh.size == pytest.approx(0.024)  # read into SI

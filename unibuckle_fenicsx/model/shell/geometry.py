@@ -37,7 +37,7 @@ import numpy as np
 import numpy.typing as npt
 
 from unibuckle_fenicsx.errors import InputError
-from unibuckle_fenicsx.spec.section import cells_along
+from unibuckle_fenicsx.spec.section import cells_along, face_cells
 
 __all__ = [
     "END_FINISH",
@@ -191,7 +191,7 @@ def _face_grading(
             widths.append(w)
             w *= GRADING_RATIO
     middle = extent - 2.0 * sum(widths)
-    return widths, _cells_for(middle, size), middle
+    return widths, face_cells(middle, size), middle
 
 
 def _surface(

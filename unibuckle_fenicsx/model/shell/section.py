@@ -83,8 +83,10 @@ class SectionParameters:
         length: Length L between the loaded ends (m), > 0.
         E: Young's modulus (Pa), > 0.
         nu: Poisson's ratio, in (-1, 0.5).
-        mesh_size: Target cell size (m), > 0 and below ``length`` (at least 2 cells along;
-            a box's faces get an even number of cells).
+        mesh_size: Target cell size (m), a file's ``mesh.size``: > 0 and below ``length``
+            (at least 2 cells along; a box's faces get an even number of cells; a box
+            with a core, :func:`~unibuckle_fenicsx.section_analysis.solve_section` asks
+            for at least 4 across its narrowest face).
         width: Box: mid-line width b along y (m).
         depth: Box: mid-line depth d along z (m).
         diameter: Tube: mid-surface diameter 2R (m).
@@ -96,7 +98,8 @@ class SectionParameters:
             value at z = +d/2 (box) or +R (tube) per unit load (an axial force with
             bending), 0 by default.
         core: A rigid core fills the section: the walls may only move outward.
-        core_span: The core's extent (x0, x1) along the member (m); None: the whole length.
+        core_span: The core's extent (x0, x1) along the member (m), a file's
+            ``obstacle.span``; None: the whole length.
         foundation_stiffness: The core as a tensionless Winkler foundation of this
             modulus (N/m^3), > 0 (:func:`~unibuckle_fenicsx.model.shell.core.core_springs`);
             None: a rigid core.
@@ -138,7 +141,7 @@ class SectionParameters:
                 f"({0.5 * across:g} m): the walls would meet"
             )
         _positive("length", self.length)
-        _positive("mesh_size", self.mesh_size)
+        _positive("size", self.mesh_size, "mesh")
         check_cells_along(self.mesh_size, self.length)
         if self.corner_cell is not None:
             if self.shape != "box":
@@ -196,12 +199,12 @@ class SectionParameters:
             _positive("foundation_stiffness", self.foundation_stiffness, "obstacle", "N/m^3")
         if self.core_span is not None:
             if not self.core:
-                raise InputError("obstacle.core_span needs core = true")
+                raise InputError("obstacle.span (core_span) needs core = true")
             x0, x1 = self.core_span
             if not (0.0 <= x0 < x1 <= self.length):
                 raise InputError(
-                    f"obstacle.core_span must satisfy 0 <= x0 < x1 <= length = {self.length:g} m, "
-                    f"got {self.core_span}"
+                    f"obstacle.span (core_span) must satisfy 0 <= x0 < x1 <= length = "
+                    f"{self.length:g} m, got {self.core_span}"
                 )
 
     def compression(self) -> float:
