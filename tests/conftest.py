@@ -20,6 +20,29 @@ from mpi4py import MPI
 import pytest
 
 
+@pytest.fixture(scope="module", autouse=True)
+def _long_lived_objects_frozen():
+    """Keep what outlives a module's tests out of every later collection (``gc.freeze``).
+
+    The teardown below collects after every test, and a full collection walks every
+    object the collector tracks: the imported DOLFINx, UFL and SciPy and the collected
+    test modules, so that the teardowns of a module of small tests took about as long
+    as its tests (docs/history/2026-12-02b-testspeed.md). What survives a collection at
+    a module's start lives on (modules, session fixtures, caches): it is frozen, and
+    each test's collection walks only what was made since. Frozen objects are still
+    freed by their reference counts; the session's end unfreezes them.
+    """
+    gc.collect()
+    MPI.COMM_WORLD.Barrier()
+    gc.freeze()
+    yield
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """Give back to the collector what the modules froze (see above)."""
+    gc.unfreeze()
+
+
 @pytest.fixture(autouse=True)
 def _collective_teardown(_petsc_options_restored):
     """Run collective PETSc destructors together on every rank (dolfinx conftest).

@@ -515,7 +515,15 @@ def test_an_elastic_core_ends_no_higher_than_the_rigid_cores_admissible_mode(
         assert result.critical_load_Pa <= rectangular_box_bound * (1.0 + 1e-7)
 
 
-def test_an_elastic_core_whose_coarser_section_holds_no_core_node_is_solved():
+@pytest.mark.parametrize(
+    ("b", "length", "span"),
+    [
+        (0.1, 0.2, (0.11, 0.14)),
+        # slow: the same property on the box b = 0.1 m, L = 0.2 m is the case above.
+        pytest.param(0.2, 0.6, (0.31, 0.34), marks=pytest.mark.slow),
+    ],
+)
+def test_an_elastic_core_whose_coarser_section_holds_no_core_node_is_solved(b, length, span):
     """The elastic core's rigid start drops the levels a rigid core would refuse.
 
     The box b = d = 0.2 m, L = 0.6 m on 25 mm cells with a core over 0.31..0.34 m holds
@@ -523,13 +531,14 @@ def test_an_elastic_core_whose_coarser_section_holds_no_core_node_is_solved():
     refused naming mesh.levels. The elastic core asks no levels; its start from the
     rigid core's set runs on the given section. The bound is the rigid core's
     ``levels = 0`` mode made admissible by hand, its Rayleigh quotient (a foundation's
-    load is at most it: the mode presses no spring).
+    load is at most it: the mode presses no spring). The same on the box b = d = 0.1 m,
+    L = 0.2 m, a core over 0.11..0.14 m: its node at 0.125 m, none on 50 mm cells.
     """
-    rigid = _square_box(0.2, 0.6, 0.025, core_span=(0.31, 0.34))
+    rigid = _square_box(b, length, 0.025, core_span=span)
     with solve_section(rigid, MPI.COMM_SELF, levels=0) as solved:
-        bound, removed = _box_admissible_rayleigh_quotient(solved, 0.2, 0.2, (0.31, 0.34))
+        bound, removed = _box_admissible_rayleigh_quotient(solved, b, b, span)
         assert solved.result.certificate.kkt and removed < 1e-6
-    elastic = _square_box(0.2, 0.6, 0.025, core_span=(0.31, 0.34), foundation_stiffness=1e15)
+    elastic = _square_box(b, length, 0.025, core_span=span, foundation_stiffness=1e15)
     with solve_section(elastic, MPI.COMM_SELF) as solved:  # levels 1
         result = solved.result
         assert result.method == "foundation"

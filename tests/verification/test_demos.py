@@ -57,13 +57,29 @@ def _expected_pngs() -> dict[str, tuple[int, int]]:
     return pngs
 
 
+def _assert_not_blank(path, height, width, image):
+    """The PNG's size, and not blank (test_run_all_coarse_writes_every_figure says how)."""
+    pixels = image.imread(path)[..., :3]
+    assert pixels.shape[:2] == (height, width), f"{path}: {pixels.shape}"
+    away_from_white = np.mean(np.any(pixels < 0.9, axis=-1))
+    assert pixels.std() > 0.03 and away_from_white > 0.02, (
+        f"{path} looks blank (std {pixels.std():.3g}, non-white {away_from_white:.3g})"
+    )
+
+
+# demo: every demo's run (minutes); two demos end to end with their figures, checked the
+# same way, are test_a_plate_and_a_section_demo_write_their_figures, and every demo's
+# imports test_demos_use_the_public_api.
+@pytest.mark.demo
 @serial_only
 @pytest.mark.serial
 def test_run_all_coarse_writes_every_figure(tmp_path):
     """run_all --coarse exits 0, prints the table and writes non-blank PNGs of the right size.
 
-    In the default selection (about two minutes of one worker): ``make demo`` is one of the
-    README's two commands, and a change of the package's API has broken its scripts before.
+    ``make demo`` is one of the README's two commands, and a change of the package's API
+    has broken its scripts before: every demo runs here (``-m demo``, several minutes of
+    one worker), two of them by default
+    (test_a_plate_and_a_section_demo_write_their_figures).
 
     Sizes come from plotting.THEME (pyvista window, matplotlib figsize x dpi); "not blank"
     means a pixel standard deviation above 0.03 (on [0, 1]) and at least 2 % of the pixels
@@ -91,12 +107,7 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
     for rel, (height, width) in _expected_pngs().items():
         path = figures / rel
         assert path.is_file(), f"missing {rel}"
-        pixels = image.imread(path)[..., :3]
-        assert pixels.shape[:2] == (height, width), f"{rel}: {pixels.shape}"
-        away_from_white = np.mean(np.any(pixels < 0.9, axis=-1))
-        assert pixels.std() > 0.03 and away_from_white > 0.02, (
-            f"{rel} looks blank (std {pixels.std():.3g}, non-white {away_from_white:.3g})"
-        )
+        _assert_not_blank(path, height, width, image)
 
     column = json.loads((figures / "column" / "results.json").read_text())
     assert column["certificate"]["kkt"] and 0.0 < column["design"]["reduction_factor"] <= 1.0
@@ -111,6 +122,35 @@ def test_run_all_coarse_writes_every_figure(tmp_path):
             assert r["critical_load_Pa"] >= r["free_load_Pa"] * (1 - 1e-7)
         for mesh in COARSE:
             assert (vtx / case / mesh / f"{case}_w.bp").exists()
+
+
+@serial_only
+@pytest.mark.serial
+def test_a_plate_and_a_section_demo_write_their_figures(tmp_path):
+    """A plate's and a section's demo run --coarse as run_all runs them, and draw.
+
+    The two quickest demos of ``make demo``, one through the plate's mesh study (modes,
+    convergence figure, results.json, VTX files), one through the sections' API: each
+    exits 0 (its own assertions passed) and writes its PNGs at the sizes of
+    plotting.THEME, not blank (_expected_pngs, the criterion of the full run).
+    """
+    pytest.importorskip("pyvista")
+    image = pytest.importorskip("matplotlib.image")
+    figures, vtx = tmp_path / "figures", tmp_path / "vtx"
+    env = {**os.environ, "PYVISTA_OFF_SCREEN": "true", "OMP_NUM_THREADS": "1"}
+    for script, folder in (("demo_free_plate.py", "free"), ("demo_sections.py", "sections")):
+        cmd = [sys.executable, str(ROOT / "demos" / script), "--figures", str(figures)]
+        cmd += ["--coarse", "--output", str(vtx)]
+        proc = subprocess.run(cmd, capture_output=True, text=True, env=env, cwd=ROOT)
+        assert proc.returncode == 0, proc.stdout + proc.stderr
+        pngs = {rel: hw for rel, hw in _expected_pngs().items() if rel.startswith(f"{folder}/")}
+        assert pngs  # the figures this demo writes in the full run
+        for rel, (height, width) in pngs.items():
+            assert (figures / rel).is_file(), f"missing {rel}"
+            _assert_not_blank(figures / rel, height, width, image)
+    assert json.loads((figures / "free" / "results.json").read_text())["results"]
+    for mesh in COARSE:
+        assert (vtx / "free" / mesh / "free_w.bp").exists()
 
 
 @serial_only

@@ -31,10 +31,10 @@ from unibuckle_fenicsx.spec.solver import SolverSpec
 pytestmark = pytest.mark.skipif(MPI.COMM_WORLD.size > 1, reason="serial sections")
 
 
-def _box(stiffness: float) -> SectionParameters:
+def _box(stiffness: float, cell: float) -> SectionParameters:
     return SectionParameters(
         "box", width=0.12, depth=0.06, thickness=0.001, length=0.2, E=2.1e11, nu=0.3,
-        mesh_size=0.01, ends="clamped", axial_stress=-0.6, bending_stress=0.9, core=True,
+        mesh_size=cell, ends="clamped", axial_stress=-0.6, bending_stress=0.9, core=True,
         core_span=(0.02, 0.15), foundation_stiffness=stiffness,
     )  # fmt: skip
 
@@ -54,9 +54,12 @@ def _quotient(problem, vec, springs) -> float:  # type: ignore[no-untyped-def]
         Bv.destroy()
 
 
-def test_a_softer_core_ends_at_or_below_a_stiffer_core_s_mode():
-    stiff = build_section(_box(1e11), MPI.COMM_WORLD, SolverSpec())
-    soft = build_section(_box(3e10), MPI.COMM_WORLD, SolverSpec())
+# slow: the same bound on 20 mm cells (the box's faces 6 and 3 cells across) is the
+# case 0.02, on cells of 10 mm the softer core's starts ended above it (module docstring).
+@pytest.mark.parametrize("cell", [0.02, pytest.param(0.01, marks=pytest.mark.slow)])
+def test_a_softer_core_ends_at_or_below_a_stiffer_core_s_mode(cell):
+    stiff = build_section(_box(1e11, cell), MPI.COMM_WORLD, SolverSpec())
+    soft = build_section(_box(3e10, cell), MPI.COMM_WORLD, SolverSpec())
     try:
         stiff_solution = solve_foundation(stiff.cored)
         soft_springs = soft.cored.contact.stiffness
@@ -67,7 +70,7 @@ def test_a_softer_core_ends_at_or_below_a_stiffer_core_s_mode():
     finally:
         stiff.destroy()
         soft.destroy()
-    with solve_section(_box(3e10), MPI.COMM_WORLD) as analysis:  # the section's route
+    with solve_section(_box(3e10, cell), MPI.COMM_WORLD) as analysis:  # the section's route
         load = analysis.result.critical_load_Pa
         assert analysis.result.free_load_Pa <= load
     assert load <= bound * (1.0 + 1e-9), (load, bound)
