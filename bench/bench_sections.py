@@ -68,23 +68,30 @@ LEVEL_COLUMNS = (
 
 
 def section_parameters(
-    shape: str, size: float, corner_cell: float | None = None, geometric: str = "full"
+    shape: str,
+    size: float,
+    corner_cell: float | None = None,
+    geometric: str = "full",
+    tube: dict | None = None,
 ) -> SectionParameters:
     """The benchmark's box or tube with a rigid core on cells of ``size`` (m).
 
     ``geometric``: the geometric stiffness's components
     (:data:`~unibuckle_fenicsx.model.shell.section.GEOMETRIC`; the package's default
-    "full", or "donnell" as the rows measured before it was the default).
+    "full", or "donnell" as the rows measured before it was the default). ``tube``: the
+    tube's fields that differ from the benchmark's (``diameter``, ``thickness``,
+    ``length``, ``core_span``, ``ends``).
     """
     from unibuckle_fenicsx.model.shell.section import SectionParameters
 
-    geometry = (
+    geometry: dict = (
         {"width": 0.2, "depth": 0.2, "thickness": 0.002, "length": 0.6}
         if shape == "box"
-        else {"diameter": 0.2, "thickness": 0.001, "length": 0.1}
+        else {"diameter": 0.2, "thickness": 0.001, "length": 0.1} | (tube or {})
     )
+    geometry.setdefault("ends", "simply_supported")
     return SectionParameters(
-        shape, E=2.1e11, nu=0.3, mesh_size=size, ends="simply_supported", core=True,
+        shape, E=2.1e11, nu=0.3, mesh_size=size, core=True,
         corner_cell=corner_cell if shape == "box" else None, geometric=geometric, **geometry,
     )  # fmt: skip
 
@@ -127,6 +134,14 @@ def _fine_links(details: object) -> list[dict]:
     return [msgspec.to_builtins(link) for link in levels[-1].links] if levels else []
 
 
+def _keep_turns(keep: bool) -> None:
+    """Without ``keep``: every section built from now on has no turns (all seeds run)."""
+    from unibuckle_fenicsx.model.shell import section as section_module
+
+    if not keep:
+        section_module._symmetries = lambda *args: ()  # type: ignore[assignment]
+
+
 def run(
     shape: str,
     size: float,
@@ -137,6 +152,8 @@ def run(
     geometric: str = "full",
     release_steps: int | None = None,
     chain: dict | None = None,
+    tube: dict | None = None,
+    symmetries: bool = True,
 ) -> dict:
     """One section: set-up, free solve, unilateral solve, certificate.
 
@@ -148,7 +165,10 @@ def run(
     :attr:`~unibuckle_fenicsx.algorithms.chain.ChainOptions.release_steps` for this run
     (None: the package's :data:`~unibuckle_fenicsx.algorithms.section_levels.CHAIN_OPTIONS`).
     ``chain``: other fields of those options for this run (``--escape-either``,
-    ``--quick-descent``, ``--max-steps``), by name.
+    ``--quick-descent``, ``--max-steps``), by name. ``tube``: as
+    :func:`section_parameters`. ``symmetries``: False runs every seed of the active set,
+    as if no turn left the section alike (the section's turns dropped, to measure what
+    leaving out their images saves).
     """
     from mpi4py import MPI
     from petsc4py import PETSc
@@ -164,6 +184,8 @@ def run(
     from unibuckle_fenicsx.la.eigen import GEPSolver
     from unibuckle_fenicsx.model.shell.section import build_section
     from unibuckle_fenicsx.spec import SolverSpec
+
+    _keep_turns(symmetries)
 
     # Each level's factorisations: the count before and after it (in order, coarsest first).
     per_level: list[int] = []
@@ -200,7 +222,7 @@ def run(
         lambda args, out: int(args[0].matrix.getSize()[0]),
     )
 
-    params = section_parameters(shape, size, corner_cell, geometric)
+    params = section_parameters(shape, size, corner_cell, geometric, tube)
     PETSc.Log.begin()  # the factorisations' counts
     t0 = time.perf_counter()
     with build_section(params, MPI.COMM_WORLD) as section:
@@ -295,6 +317,7 @@ def run(
             "ratio": unilateral / min(times),
             "certify_s": certify_s,
             "process_ratio": (unilateral + certify_s) / (setup + min(times)),
+            "eigensolves": solution.eigensolves,
             "eigensolves_fine": levels_log[-1]["eigensolves"],
             "eigensolves_coarse": coarse,
             "factorisations": factorisations,
@@ -306,7 +329,14 @@ def run(
             "quick_descent": options.quick_descent,
             "max_steps": options.max_steps,
             "fine_links": fine_links,
+            "tube": tube,
+            "symmetries": symmetries,
         }
+
+
+def _given(args: argparse.Namespace, names: tuple[str, ...]) -> dict:
+    """The options of ``names`` given on the command line (not None), by name."""
+    return {name: getattr(args, name) for name in names if getattr(args, name) is not None}
 
 
 def main() -> None:
@@ -342,6 +372,17 @@ def main() -> None:
         "--max-steps", type=int, default=None,
         help="Newton steps per run on the sections (default: the package's)",
     )  # fmt: skip
+    parser.add_argument(
+        "--symmetries", action=argparse.BooleanOptionalAction, default=True,
+        help="leave out the active set's seeds that a turn of the section maps onto another's",
+    )  # fmt: skip
+    parser.add_argument("--diameter", type=float, default=None, help="tube: 2R (m), 0.2")
+    parser.add_argument("--thickness", type=float, default=None, help="tube: t (m), 0.001")
+    parser.add_argument("--length", type=float, default=None, help="tube: L (m), 0.1")
+    parser.add_argument("--ends", choices=("simply_supported", "clamped"), default=None)
+    parser.add_argument(
+        "--core-span", type=float, nargs=2, default=None, help="tube: the core's x0 x1 (m)"
+    )
     parser.add_argument("--links", action="store_true", help="print the finest section's links too")
     parser.add_argument(
         "--progress", action="store_true", help="the route's progress lines on stderr"
@@ -354,18 +395,13 @@ def main() -> None:
         logging.basicConfig(format="%(asctime)s %(message)s", level=logging.WARNING)
         logging.getLogger("unibuckle_fenicsx.progress").setLevel(logging.INFO)
     route = "active-set" if args.route == "levels" else args.route
-    chain = {
-        name: value
-        for name, value in (
-            ("escape_either", args.escape_either),
-            ("quick_descent", args.quick_descent),
-            ("max_steps", args.max_steps),
-        )
-        if value is not None
-    }
+    chain = _given(args, ("escape_either", "quick_descent", "max_steps"))
+    tube = _given(args, ("diameter", "thickness", "length", "ends", "core_span"))
+    if "core_span" in tube:
+        tube["core_span"] = tuple(tube["core_span"])
     row = run(
         args.shape, args.size, args.levels, args.repeat, args.corner_cell, route,
-        args.geometric, args.release_steps, chain,
+        args.geometric, args.release_steps, chain, tube or None, args.symmetries,
     )  # fmt: skip
     print_header("Sections with a core (one rank)", COLUMNS)
     cells = []
@@ -381,7 +417,7 @@ def main() -> None:
             "| " + " | ".join(f"{v:.6g}" if isinstance(v, float) else str(v) for v in cells) + " |"
         )
     print(f"per level (steps / factorisations / eigen solves): {row['per_level']}")
-    print(f"core load {row['core_load_Pa']!r} Pa", flush=True)
+    print(f"core load {row['core_load_Pa']!r} Pa, {row['eigensolves']} eigen solves", flush=True)
     if args.links:
         print()
         print_header("The finest section's links", LINK_COLUMNS)

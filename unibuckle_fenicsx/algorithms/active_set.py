@@ -122,14 +122,17 @@ def _seeds(
     free_values: npt.NDArray[np.float64],
     tau: float,
     names: tuple[str, ...] = SEED_NAMES,
-) -> list[tuple[str, npt.NDArray[np.int64]]]:
+) -> list[tuple[str, npt.NDArray[np.int64], str | None]]:
     """Seed contact sets (deduplicated, in the order of ``names``, a part of :data:`SEED_NAMES`).
 
-    A seed whose set is the image of an earlier one's under a symmetry of the problem
-    (``problem.contact.symmetries``: a square box's quarter turns, where the free mode's
-    two sign patterns are such images) is left out too: its run is that one's image, and
-    its KKT point has the same load (rounding may break a tie otherwise in either run, which
-    then ends at another image; :doc:`/verification/sections_cost_symmetry`).
+    Each as (name, set, image_of). A seed whose set is the image of an earlier one's
+    under a symmetry of the problem (``problem.contact.symmetries``: a square box's
+    quarter turns, a tube's turns about its axis, where the free mode's two sign
+    patterns are such images) has that one's name as ``image_of`` (else None): its run
+    is that one's image, and its KKT point has the same load, so it runs only where that
+    one reaches no KKT point (:func:`multi_seed`). Only up to rounding: a tie may break
+    otherwise in either run, which then ends at another image of the same load, or
+    stalls where the other does not (:doc:`/verification/sections_cost_symmetry`).
     """
     xy = problem.contact.coordinates
     plate = problem.spec.plate
@@ -145,7 +148,7 @@ def _seeds(
     n = problem.num_constrained
     scale = np.abs(free_values).max() if free_values.size else 1.0
     images = problem.contact.symmetries
-    out: list[tuple[str, npt.NDArray[np.int64]]] = []
+    out: list[tuple[str, npt.NDArray[np.int64], str | None]] = []
     seen: set[bytes] = set()
     for name in names:
         if name == "free+":
@@ -168,12 +171,18 @@ def _seeds(
         z = z.astype(np.int64)
         if z.tobytes() in seen:
             continue
-        image = next((e for e, y in out for p in images if np.array_equal(np.sort(p[y]), z)), None)
-        if image is not None:
-            logger.info("active set: seed %s, the image of %s by symmetry: not run", name, image)
-            continue
         seen.add(z.tobytes())
-        out.append((name, z))
+        image = next(
+            (
+                e
+                for e, y, of in out
+                if of is None
+                for p in images
+                if np.array_equal(np.sort(p[y]), z)
+            ),
+            None,
+        )
+        out.append((name, z, image))
     return out
 
 
@@ -186,14 +195,21 @@ def multi_seed(
     """Run the iteration from every seed of ``seeds``, starting from the free mode.
 
     The seeds of ``more_seeds`` run after them only if none of theirs reached a KKT point.
+    A seed whose set is the image of an earlier seed's under a symmetry of the problem
+    (:func:`_seeds`) runs only if that seed's run reached no KKT point.
     """
     free = problem.solve_free().function.x.petsc_vec
     values = problem.contact.values(free)
     runs: list[Run] = []
     # The greedy seeds come last.
-    for name, z in _seeds(problem, values, problem.tau, seeds + more_seeds):
+    for name, z, image_of in _seeds(problem, values, problem.tau, seeds + more_seeds):
         if name in more_seeds and any(r.status is RunStatus.KKT for r in runs if r.seed in seeds):
             break
+        if image_of is not None and any(
+            r.status is RunStatus.KKT for r in runs if r.seed == image_of
+        ):
+            logger.info("active set: seed %s, the image of %s by symmetry: not run", name, image_of)
+            continue
         greedy = name.startswith("greedy")
         capped = greedy and any(r.status is RunStatus.KKT for r in runs)
         budget = min(max_iterations, GREEDY_ITERATIONS) if capped else max_iterations

@@ -381,7 +381,7 @@ class ContactSetManager:
         symmetries: Permutations ``perm`` of the constrained nodes (node k to
             ``perm[k]``) under which the whole problem is invariant, so that a contact
             set and its image have the same KKT points' loads: empty for a plate; a
-            square box's quarter turns
+            square box's quarter turns, a tube's turns about its axis
             (:class:`~unibuckle_fenicsx.model.shell.problem.SectionContact`).
 
     Note:

@@ -439,3 +439,88 @@ def test_a_box_that_a_quarter_turn_changes_has_no_symmetries(changes):
         assert sec.problem.contact.symmetries == ()
     finally:
         sec.destroy()
+
+
+#: Two tubes with a core (R/t = 50, 40 facets): the first's seed "free+" alone stalls
+#: (the active set's iteration, then the penalty continuation) where "free-" reaches
+#: a KKT point; the second's both reach one.
+TUBES = [
+    {"diameter": 0.1, "thickness": 0.001, "length": 0.05, "mesh_size": 0.008},
+    {"diameter": 0.1, "thickness": 0.001, "length": 0.04, "mesh_size": 0.008, "ends": "clamped"},
+]
+
+
+@pytest.mark.parametrize("changes", TUBES)
+def test_a_tube_s_turns_leave_its_pencil_alike_and_skip_a_seed_only_after_a_kkt_point(changes):
+    # A tube of n equal facets with a core under uniform compression is the same after a
+    # turn by 2 pi k/n about its axis: n - 1 turns. The independent check of the turns
+    # found from the mesh: the pencil's free mode (an eigen solve that knows nothing of
+    # them) is cos(m theta + phi) around, so the half-turn maps it onto (-1)^m times itself
+    # at the constrained directions, and some turn (by pi/m) maps its one sign pattern onto
+    # the other. The answer with the turns equals the answer of the same problem with
+    # them dropped (every seed run): the same load to rounding, fewer eigen solves where
+    # the first pattern reaches a KKT point; where it stalls, its image runs too, as with
+    # the turns dropped (the same count).
+    from unibuckle_fenicsx.algorithms.section_levels import SEEDS
+
+    sec = build_section(_parameters("tube", **changes), MPI.COMM_WORLD)
+    try:
+        n = sec.mesh.cells_around
+        turns = sec.problem.contact.symmetries
+        assert n == 40 and len(turns) == n - 1
+        v = sec.problem.contact.values(sec.problem.solve_free().function.x.petsc_vec)
+        v = v / np.abs(v).max()
+        half = turns[n // 2 - 1]
+        assert min(np.abs(v[half] - v).max(), np.abs(v[half] + v).max()) < 1e-8
+        plus, minus = np.flatnonzero(v > 1e-3), np.flatnonzero(v < -1e-3)
+        assert any(np.array_equal(np.sort(t[plus]), minus) for t in turns)
+        kept = solve_active_set(sec.problem, multilevel=False, bound_budget=0, seeds=SEEDS)
+        sec.problem.contact.symmetries = ()
+        every = solve_active_set(sec.problem, multilevel=False, bound_budget=0, seeds=SEEDS)
+        assert kept.candidate.kkt and every.candidate.kkt
+        assert kept.load == pytest.approx(every.load, rel=1e-9)
+        assert [run.seed for run in every.details.runs] == list(SEEDS)
+        first_kkt = every.details.runs[0].kkt
+        if first_kkt:
+            assert [run.seed for run in kept.details.runs] == [SEEDS[0]]
+            assert kept.eigensolves < every.eigensolves
+        else:
+            assert [run.seed for run in kept.details.runs] == list(SEEDS)
+            assert kept.eigensolves == every.eigensolves
+        assert first_kkt == ("ends" in changes)  # the cases TUBES describes
+    finally:
+        sec.destroy()
+
+
+def test_a_tube_s_route_gives_the_answer_of_every_seed_with_fewer_eigen_solves(monkeypatch):
+    # The active set's whole route (its seeds on the coarser section, the set carried to
+    # the given one and polished, the seeds run there too) on the clamped tube of TUBES,
+    # then again with the section's turns dropped (every seed run): the same load to
+    # 1e-9 relative (docs/verification/sections_cost_symmetry.md: the image's run ends at
+    # the same load up to rounding), fewer eigen solves.
+    from unibuckle_fenicsx.model.shell import section as section_module
+
+    params = _parameters("tube", **TUBES[1])
+    fine, kept = solve_levels(params, route="active-set", levels=1)
+    fine.destroy()
+    monkeypatch.setattr(section_module, "_symmetries", lambda *args: ())
+    fine, every = solve_levels(params, route="active-set", levels=1)
+    fine.destroy()
+    assert kept.candidate.kkt and every.candidate.kkt
+    assert kept.load == pytest.approx(every.load, rel=1e-9)
+    assert kept.eigensolves < every.eigensolves
+
+
+@pytest.mark.parametrize(
+    "changes, turns",
+    [({"bending_stress": 0.5}, 0), ({"core_span": (0.05, 0.15)}, 21)],
+)
+def test_a_tube_s_turns_keep_its_stress_and_core(changes, turns):
+    # A bending stress varies around the tube, so no turn leaves its prestress alike; a
+    # core over part of the length is the same after every turn (21 on 22 facets).
+    sec = build_section(_parameters("tube", mesh_size=0.03, **changes), MPI.COMM_WORLD)
+    try:
+        assert sec.mesh.cells_around == 22
+        assert len(sec.problem.contact.symmetries) == turns
+    finally:
+        sec.destroy()

@@ -44,6 +44,7 @@ from unibuckle_fenicsx.tolerances import GEOMETRY_RTOL
 
 __all__ = [
     "CoreConstraints",
+    "axis_turns",
     "change_of_basis",
     "core_constraints",
     "core_springs",
@@ -188,27 +189,61 @@ def quarter_turns(constraints: CoreConstraints) -> tuple[npt.NDArray[np.int64], 
     to decide (:func:`~unibuckle_fenicsx.model.shell.section.build_section`); this
     checks the mesh. The same on every rank (the constraints are).
     """
+    turns = (_turn(constraints, 0.5 * math.pi * k) for k in (1, 2, 3))
+    return tuple(perm for perm in turns if perm is not None)
+
+
+def axis_turns(
+    constraints: CoreConstraints, cells_around: int
+) -> tuple[npt.NDArray[np.int64], ...]:
+    r"""The constrained directions' permutations under a tube's turns about its axis.
+
+    A tube meshed with ``cells_around`` equal facets is the same after a turn by
+    :math:`2\pi k/n` (n = ``cells_around``, k = 1, ..., n - 1) about its axis. The turn
+    by :math:`2\pi/n` is checked on the mesh as :func:`quarter_turns` checks a box's
+    (every constrained direction mapped onto one); its powers are the others, each as
+    the array ``perm`` (direction ``k`` to ``perm[k]``). None if that turn maps some
+    direction onto none (a mesh that is no such polygon swept along x). Whether the
+    pencil is invariant under them (a load the same all around) is the caller's to
+    decide (:func:`~unibuckle_fenicsx.model.shell.section.build_section`). The same on
+    every rank (the constraints are).
+    """
+    if cells_around < 2:
+        raise InputError(f"cells_around must be an integer >= 2, got {cells_around}")
+    step = _turn(constraints, 2.0 * math.pi / cells_around)
+    if step is None:
+        return ()
+    turns = [step]
+    for _ in range(cells_around - 2):
+        turns.append(step[turns[-1]])  # one step more: k -> step[perm[k]]
+    return tuple(turns)
+
+
+def _turn(constraints: CoreConstraints, theta: float) -> npt.NDArray[np.int64] | None:
+    """The permutation of the constrained directions under a turn by ``theta`` about x.
+
+    None where the turn maps some direction (node and normal) onto none, to
+    :data:`~unibuckle_fenicsx.tolerances.GEOMETRY_RTOL` of the section's size.
+    """
     from scipy.spatial import cKDTree
 
     points = np.hstack([constraints.coordinates, constraints.normals])
     n = points.shape[0]
     if n == 0:
-        return ()
+        return None
     size = float(np.abs(constraints.coordinates).max())
     scale = np.array([size] * 3 + [1.0] * 3)
     tree = cKDTree(points / scale)
-    turns = []
-    for k in (1, 2, 3):
-        c, s = (0.0, 1.0) if k == 1 else (-1.0, 0.0) if k == 2 else (0.0, -1.0)
-        image = points.copy()
-        for j in (0, 3):  # the node, then its normal
-            y, z = points[:, j + 1], points[:, j + 2]
-            image[:, j + 1] = c * y - s * z
-            image[:, j + 2] = s * y + c * z
-        dist, perm = tree.query(image / scale)
-        if np.all(dist <= GEOMETRY_RTOL) and np.unique(perm).size == n:
-            turns.append(perm.astype(np.int64))
-    return tuple(turns)
+    c, s = math.cos(theta), math.sin(theta)
+    image = points.copy()
+    for j in (0, 3):  # the node, then its normal
+        y, z = points[:, j + 1], points[:, j + 2]
+        image[:, j + 1] = c * y - s * z
+        image[:, j + 2] = s * y + c * z
+    dist, perm = tree.query(image / scale)
+    if np.all(dist <= GEOMETRY_RTOL) and np.unique(perm).size == n:
+        return perm.astype(np.int64)
+    return None
 
 
 def _directions(

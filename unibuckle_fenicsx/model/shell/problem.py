@@ -208,7 +208,8 @@ def section_problem(
             load times it; 1 for a uniform unit compression.
         symmetries: Permutations of the constrained directions under which the rotated
             pencil is invariant (the contact manager's ``symmetries``): a square box's
-            quarter turns (:func:`~unibuckle_fenicsx.model.shell.core.quarter_turns`).
+            quarter turns (:func:`~unibuckle_fenicsx.model.shell.core.quarter_turns`), a
+            tube's turns about its axis (:func:`~unibuckle_fenicsx.model.shell.core.axis_turns`).
 
     Returns:
         A :class:`CoredSectionProblem` with a core, else a :class:`SectionProblem`; the

@@ -34,6 +34,7 @@ from unibuckle_fenicsx.model.materials import bending_stiffness
 from unibuckle_fenicsx.model.problem import Candidate
 from unibuckle_fenicsx.model.shell.core import (
     CoreConstraints,
+    axis_turns,
     change_of_basis,
     core_constraints,
     core_springs,
@@ -408,7 +409,8 @@ def build_section(
         springs = core_springs(model, constraints, p.foundation_stiffness, p.core_span)
     problem = section_problem(
         model, prestress, constraints, T, material, solver, springs=springs,
-        compression=p.compression(), symmetries=_symmetries(p, constraints, springs),
+        compression=p.compression(),
+        symmetries=_symmetries(p, constraints, springs, msh.cells_around),
     )  # fmt: skip
     return Section(p, msh, prestress, model, constraints, problem)
 
@@ -417,20 +419,32 @@ def _symmetries(
     p: SectionParameters,
     constraints: CoreConstraints | None,
     springs: npt.NDArray[np.float64] | None,
+    cells_around: int,
 ) -> tuple[npt.NDArray[np.int64], ...]:
-    """The quarter turns under which the section's pencil and core are invariant.
+    """The turns about its axis under which the section's pencil and core are invariant.
 
     A square box (width = depth) under a load the same on every face (no bending
     stress): its walls, supports, core span and prestress are the same after a quarter
     turn about its axis, and so are its pencil's eigenvalues and the normal components of
-    its modes. The turns that map its mesh's constrained directions onto themselves
-    (:func:`~unibuckle_fenicsx.model.shell.core.quarter_turns`) and a foundation's
-    springs onto equal springs; none for any other section.
+    its modes. A tube under a load the same all around (no bending stress) likewise
+    after a turn by a whole number of its ``cells_around`` facets: its mesh is that
+    polygon swept along the axis, the core's span runs along the axis, and the supports
+    of its ends are the same all around (a simply supported end's one node held along
+    the axis holds the rigid axial motion only, which neither energy sees). The turns
+    that map the mesh's constrained directions onto themselves
+    (:func:`~unibuckle_fenicsx.model.shell.core.quarter_turns`,
+    :func:`~unibuckle_fenicsx.model.shell.core.axis_turns`) and a foundation's springs
+    onto equal springs; none for any other section (a bending stress varies around it,
+    and a turn changes it).
     """
-    square = p.shape == "box" and p.width == p.depth and p.bending_stress == 0.0
-    if constraints is None or not square:
+    if constraints is None or p.bending_stress != 0.0:
         return ()
-    turns = quarter_turns(constraints)
+    if p.shape == "box" and p.width == p.depth:
+        turns = quarter_turns(constraints)
+    elif p.shape == "tube":
+        turns = axis_turns(constraints, cells_around)
+    else:
+        return ()
     if springs is not None:
         turns = tuple(t for t in turns if np.allclose(springs[t], springs, rtol=1e-12, atol=0.0))
     return turns
