@@ -493,18 +493,32 @@ def _table(data: object, path: Path) -> dict[str, Any]:
     return data
 
 
-def _refuse_empty(data: Mapping[str, object], path: Path) -> None:
-    """Refuse a problem file that holds no key: empty, or comments only.
+#: The file's top-level keys that are not tables (the schema's ``name`` and ``units``):
+#: they name the problem and its units, but no plate or section.
+TOP_LEVEL_SCALARS = ("name", "units")
 
-    Every key has a default, so an empty file would solve the default plate in silence
-    (a file emptied by mistake, the wrong path): it names no problem.
+
+def _refuse_empty(data: Mapping[str, object], path: Path) -> None:
+    """Refuse a problem file that holds no table: empty, comments only, or only top-level keys.
+
+    Every key has a default, so a file without a table would solve the default plate in
+    silence (a file emptied by mistake, the wrong path, the tables left out): it names no
+    plate or section. Unknown top-level keys, and a wrong name or units, are left to the
+    schema's message.
     """
+    needs = (
+        "a problem file needs at least one table, e.g. [plate] (the plate's corners or "
+        "outline, thickness) or [section] (a section); the keys it leaves out take their "
+        "defaults"
+    )
     if not data:
         raise InputError(
-            f"{path}: holds no table or key (an empty file, comments only, or {{}}): a problem "
-            "file needs at least one table, e.g. [plate] (the plate's corners or outline, "
-            "thickness) or [section] (a section); the keys it leaves out take their defaults"
+            f"{path}: holds no table or key (an empty file, comments only, or {{}}): {needs}"
         )
+    valid = isinstance(data.get("name", ""), str) and data.get("units", "SI") in tuple(UNITS)
+    if set(data) <= set(TOP_LEVEL_SCALARS) and valid:
+        given = ", ".join(f"{key} = {data[key]!r}" for key in TOP_LEVEL_SCALARS if key in data)
+        raise InputError(f"{path}: holds no table, only the top-level key(s) {given}: {needs}")
 
 
 def load_problem(path: str | Path) -> ProblemSpec | SectionProblemSpec:

@@ -332,16 +332,35 @@ def test_the_petsc_eps_tol_is_the_solver_eps_tol_it_overrides(tmp_path):
 
 
 @pytest.mark.parametrize(
-    ("name", "text"), [("empty.toml", ""), ("comments.toml", "# a plate\n\n"), ("p.json", "{}")]
+    ("name", "text", "start"),
+    [
+        ("empty.toml", "", "holds no table or key"),
+        ("comments.toml", "# a plate\n\n", "holds no table or key"),
+        ("p.json", "{}", "holds no table or key"),
+        # Top-level keys alone (name, units: the schema's only keys that are no table).
+        ("units.toml", 'units = "SI"\n', "holds no table, only the top-level key(s) units = 'SI':"),
+        (
+            "named.toml",
+            '# a plate\nname = "x"\nunits = "mm-N-MPa"\n',
+            "holds no table, only the top-level key(s) name = 'x', units = 'mm-N-MPa':",
+        ),
+        (
+            "units.json",
+            '{"units": "SI"}',
+            "holds no table, only the top-level key(s) units = 'SI':",
+        ),
+    ],
 )
 @pytest.mark.parametrize("command", ["solve", "sweep", "nonlinear"])
-def test_an_empty_problem_file_is_refused_at_read(tmp_path, capsys, nothing_built, name, text,
-                                                  command):  # fmt: skip
-    """A problem file with no table, empty or comments only, is refused: exit 2, no solve.
+def test_a_problem_file_without_a_table_is_refused_at_read(tmp_path, capsys, nothing_built, name,
+                                                           text, start, command):  # fmt: skip
+    """A problem file with no table is refused: exit 2, no solve.
 
-    Every key has a default: before, such a file solved the default plate (the paper's
-    0.2 x 0.1 m, exit 0) in silence. Expected: the message names the file and says what
-    is missing (a table: [plate] or [section]), before any mesh.
+    Empty, comments only, or only the top-level ``name`` and ``units``: every key has a
+    default, and before, such a file solved the default plate (the paper's 0.2 x 0.1 m,
+    exit 0) in silence. Expected: the
+    message names the file, the keys it holds, and what is missing (a table: [plate] or
+    [section]), before any mesh.
     """
     path = tmp_path / name
     path.write_text(text)
@@ -353,8 +372,35 @@ def test_an_empty_problem_file_is_refused_at_read(tmp_path, capsys, nothing_buil
     assert main([*args, "--config", str(path)]) == EXIT_BAD_INPUT
     captured = capsys.readouterr()
     assert captured.out == ""
-    assert captured.err.startswith(f"unibuckle: error: {path}: holds no table or key"), captured.err
+    assert captured.err.startswith(f"unibuckle: error: {path}: {start}"), captured.err
     assert "needs at least one table, e.g. [plate]" in captured.err and "[section]" in captured.err
+
+
+def test_the_top_level_scalars_are_the_schemas():
+    """The keys the refusal above allows alone are the schema's top-level non-table keys.
+
+    Read from ``schema/unibuckle-problem.schema.json``: the top-level properties of a plate's
+    and a section's problem that are neither a table (``$ref``, object) nor an array.
+    """
+    import json
+    from pathlib import Path
+
+    from unibuckle_fenicsx.spec.files import TOP_LEVEL_SCALARS
+
+    root = Path(__file__).resolve().parents[3]
+    schema = json.loads((root / "schema" / "unibuckle-problem.schema.json").read_text())
+
+    def is_table(prop):
+        kinds = [prop, *prop.get("anyOf", [])]
+        return any("$ref" in k or k.get("type") in ("object", "array") for k in kinds)
+
+    scalars = {
+        key
+        for spec in ("ProblemSpec", "SectionProblemSpec")
+        for key, prop in schema["$defs"][spec]["properties"].items()
+        if not is_table(prop)
+    }
+    assert scalars == set(TOP_LEVEL_SCALARS) == {"name", "units"}
 
 
 def test_set_reads_a_string_as_toml_writes_it():
