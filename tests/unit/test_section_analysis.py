@@ -15,6 +15,7 @@ import dataclasses
 import json
 import logging
 import math
+import re
 
 from mpi4py import MPI
 
@@ -108,6 +109,17 @@ def test_tube_without_a_core_is_its_free_load():
             "corner_cell = 0.005 grades a box's faces at its corners; a tube has no corners",
         ),
         (lambda: _box(corner_cell=0.1), InputError, r"corner_cell = 0.1 m must be < mesh_size"),
+        # corner_cell is SectionParameters' argument alone, no file key: a message naming
+        # section.corner_cell sent the reader to a [section] key that does not exist.
+        *(
+            (
+                lambda v=v: _box(corner_cell=v),
+                InputError,
+                r"^corner_cell \(an argument of SectionParameters, not a file key\) must be a "
+                rf"finite number > 0 \(m\), got {re.escape(repr(v))}$",
+            )
+            for v in (-0.01, 0.0, math.nan)
+        ),
     ],
 )
 def test_bad_section_input_is_refused_before_any_mesh(call, error, words):

@@ -150,7 +150,13 @@ class SectionParameters:
                     f"corner_cell = {self.corner_cell!r} grades a box's faces at its corners; "
                     "a tube has no corners (its facets are uniform): leave it None"
                 )
-            _positive("corner_cell", self.corner_cell)
+            cell = self.corner_cell
+            if not (isinstance(cell, int | float) and math.isfinite(cell) and cell > 0.0):
+                # Not a file key (a section's [mesh] has none): named as the argument it is.
+                raise InputError(
+                    "corner_cell (an argument of SectionParameters, not a file key) must be "
+                    f"a finite number > 0 (m), got {cell!r}"
+                )
             if self.corner_cell >= self.mesh_size:
                 raise InputError(
                     f"corner_cell = {self.corner_cell:g} m must be < mesh_size = "
