@@ -272,7 +272,13 @@ def _sweep_parser(sub: Any, common: argparse.ArgumentParser) -> None:
         epilog=SWEEP_EPILOG,
         formatter_class=Formatter,
     )
-    w.add_argument("--config", metavar="FILE", required=True, help="the base problem (TOML)")
+    w.add_argument(
+        "--config",
+        metavar="FILE",
+        required=True,
+        help="the base problem: a TOML file (its keys: unibuckle schema --keys), or a "
+        "result JSON (its input)",
+    )
     w.add_argument(
         "--vary",
         metavar="PATH=VALUES",
@@ -367,7 +373,7 @@ def solve_flags(s: argparse.ArgumentParser) -> None:
     s.add_argument(
         "--tau",
         type=float,
-        help="relative feasibility tolerance, in (0, 0.01] " + _solver_default("tau"),
+        help="relative feasibility tolerance, in [1e-12, 0.01] " + _solver_default("tau"),
     )
     s.add_argument(
         "--candidate-parallel",

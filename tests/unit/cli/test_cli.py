@@ -685,6 +685,40 @@ def test_options_that_auto_does_not_use_are_named(capsys):
     assert "warning" not in capsys.readouterr().err
 
 
+def test_the_help_states_the_schemas_ranges_and_inputs():
+    """The solver flags' ranges in the help are the schema's; sweep reads a result JSON too.
+
+    ``--tau``'s help said (0, 0.01], while ``solver.tau`` (``--tau`` sets it) allows
+    [1e-12, 0.01] (``schema/unibuckle-problem.schema.json``: minimum 1e-12, inclusive) and
+    refuses 1e-13. ``sweep --config`` said "(TOML)" while it reads a result JSON's input,
+    as ``solve --config`` does (``load_problem``).
+    """
+    import json
+
+    schema = json.loads((ROOT / "schema" / "unibuckle-problem.schema.json").read_text())
+    solver = schema["$defs"]["SolverSpec"]["properties"]
+    _, commands = build_parser()
+    helps = {
+        a.option_strings[0]: " ".join(a.help.split())
+        for a in commands["solve"]._actions
+        if a.option_strings and a.help
+    }
+    ranges = {  # flag: its key, and the range its help states
+        "--tau": ("tau", r"in \[(\S+), (\S+)\]"),
+        "--penalty": ("penalty", r"(\S+) to (\S+) \("),
+    }
+    for flag, (key, pattern) in ranges.items():
+        stated = re.search(pattern, helps[flag])
+        assert stated, helps[flag]
+        bounds = (solver[key]["minimum"], solver[key]["maximum"])
+        assert tuple(map(float, stated.groups())) == bounds, flag
+    for flag, key in (("--max-candidates", "max_candidates"), ("--bound-budget", "bound_budget"),
+                      ("--max-iterations", "max_iterations")):  # fmt: skip
+        assert f"N >= {solver[key]['minimum']}" in helps[flag], flag
+    sweep = {a.option_strings[0]: a.help for a in commands["sweep"]._actions if a.option_strings}
+    assert "result JSON" in sweep["--config"] and "TOML" in sweep["--config"]
+
+
 def test_nonlinear_help_names_only_its_own_flags(capsys):
     """The nonlinear help names no --output (it writes no fields).
 
