@@ -24,6 +24,7 @@ __all__ = [
     "DIVISION_FLOOR",
     "ENERGY_TIE_RTOL",
     "EXHAUSTED_NORM",
+    "FREE_CHECK_RESOLUTION",
     "GEOMETRY_RTOL",
     "KNEE_RTOL",
     "LOAD_TIE_RTOL",
@@ -113,6 +114,13 @@ BRACKET_GAP = 1e-3
 #: The smallest-eigenvalue check looks below lambda (1 - SMALLEST_RTOL_FACTOR eps_tol):
 #: a thousand eigen tolerances keep the computed load itself out of the count.
 SMALLEST_RTOL_FACTOR = 1e3
+#: The smallest-eigenvalue check refuses a free load that double precision fixes more
+#: loosely than this (its ``load_resolution``, relative): below the load by less than the
+#: rounding, the inertia count says nothing, and its margin widened to the rounding would
+#: prove the load the smallest only more loosely than the bracket the certificate still
+#: calls "bracketed". Below it the margin is widened to twice the resolution (the computed
+#: load and the factorised pencil are each off by up to one).
+FREE_CHECK_RESOLUTION = BRACKET_GAP
 
 # -- the problem's set-up ---------------------------------------------------------------
 

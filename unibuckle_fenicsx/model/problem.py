@@ -43,7 +43,7 @@ from unibuckle_fenicsx.model.materials import reference_bending_stiffness
 from unibuckle_fenicsx.model.prestress import Prestress
 from unibuckle_fenicsx.model.structure import StructuralModel
 from unibuckle_fenicsx.spec import ProblemSpec, temperature_field
-from unibuckle_fenicsx.tolerances import SMALLEST_RTOL_FACTOR
+from unibuckle_fenicsx.tolerances import FREE_CHECK_RESOLUTION, SMALLEST_RTOL_FACTOR
 
 __all__ = ["Candidate", "Mode", "Problem", "SetUp", "UnilateralProblem", "require_obstacle"]
 
@@ -283,10 +283,15 @@ class Problem(Owner):
         :math:`LDL^T` through the shared factorisation), counts the eigenvalues in
         :math:`(0, \sigma)` (Sylvester's law, A SPD): there must be none. A free pair
         that its shifted solve proved the smallest (``free_proof``) needs nothing
-        more.
+        more. A count within rounding of the load says nothing, and which way it falls
+        depends on the partition: the margin is widened to twice the load's
+        :meth:`load_resolution` where that is larger, and a load fixed more loosely
+        than ``FREE_CHECK_RESOLUTION`` (:mod:`~unibuckle_fenicsx.tolerances`) is
+        refused before the count, alike on any number of ranks.
 
         Raises:
-            EigenSolveError: An eigenvalue lies below the free load.
+            EigenSolveError: An eigenvalue lies below the free load, or the load's
+                rounding bound exceeds what the check resolves (a plate too thin).
 
         Note:
             Collective.
@@ -294,29 +299,33 @@ class Problem(Owner):
         free = self.solve_free()
         if self._free_verified:
             return
-        sigma = free.load * (1.0 - SMALLEST_RTOL_FACTOR * self.spec.solver.eps_tol)
+        # A plate so thin against its width that double precision fixes its load more
+        # loosely than the count's margin (b/t of about 1e6) makes the count rounding,
+        # which differs with the partition: the rounding bound, not the count, decides
+        # (the same on any number of ranks), before the count.
+        resolution = self.load_resolution(free.function.x.petsc_vec, free.load)
+        if resolution > FREE_CHECK_RESOLUTION:
+            thicken = float(np.sqrt(resolution / FREE_CHECK_RESOLUTION))  # (b/t)^2
+            raise EigenSolveError(
+                "the free load cannot be checked the pencil's smallest: double precision "
+                f"fixes it only to {resolution:.2g} of it "
+                f"(load_resolution), above the {FREE_CHECK_RESOLUTION:g} the inertia check "
+                f"resolves: the plate (plate.thickness = {self.spec.plate.thickness:g} m; "
+                "a section's wall, section.thickness) is too thin against its width for "
+                f"its stiffness to keep the digits; make it about {thicken:.2g} times "
+                "thicker (the bound grows as (b/t)^2)"
+            )
+        margin = max(SMALLEST_RTOL_FACTOR * self.spec.solver.eps_tol, 2.0 * resolution)
+        sigma = free.load * (1.0 - margin)
         # Negative pivots only (the reduced pencils' check in the certificate reads the
         # inertia alike).
         below = self.eigensolver.count_below(sigma)
         if below:
-            # A count within rounding of the load says nothing: a plate so thin against
-            # its width that double precision fixes its load more loosely than sigma's
-            # margin (b/t of about 1e6) is not the eigen solver's fault.
-            resolution = self.load_resolution(free.function.x.petsc_vec, free.load)
-            why = (
-                "the eigen solver stopped on a higher pair; its options "
-                "(-unibuckle_eps_tol, -unibuckle_eps_ncv, ...) are too loose"
-            )
-            if resolution > 1.0 - sigma / free.load:
-                why = (
-                    f"double precision fixes that load only to {resolution:.2g} of it "
-                    f"(load_resolution), beyond the count's margin {1.0 - sigma / free.load:.2g}: "
-                    "the plate (plate.thickness; a section's wall, section.thickness) is "
-                    "too thin against its width for its stiffness to keep the digits"
-                )
             raise EigenSolveError(
                 f"the free eigen solve returned lambda = {free.load!r}, but {below} "
-                f"eigenvalue(s) of the pencil lie below it (inertia of A - sigma B): {why}"
+                f"eigenvalue(s) of the pencil lie below it (inertia of A - sigma B, sigma "
+                f"{margin:.2g} below it): the eigen solver stopped on a higher pair; its "
+                "options (-unibuckle_eps_tol, -unibuckle_eps_ncv, ...) are too loose"
             )
         self._free_verified = True
 

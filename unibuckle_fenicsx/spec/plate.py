@@ -60,7 +60,8 @@ MAX_THICKNESS_RATIO = 0.5
 #: deflection is about :math:`(t/b)^2`, which at 1e-8 lies below the double precision's
 #: unit round-off (1.1e-16): no digit of the load is left (SLEPc returned a negative
 #: load at t/b = 1e-8). Between this and about 1e-5 the load is computed with the
-#: digits it keeps (the ``load_resolution`` warning says how many).
+#: digits it keeps (the ``load_resolution`` warning says how many), or refused where
+#: the free pair's check cannot resolve it (``FREE_CHECK_RESOLUTION``).
 MIN_THICKNESS_RATIO = 1e-7
 #: Plate sides and corner coordinates accepted (m): from a micro-machined membrane to
 #: far beyond a bridge deck; beyond, lengths to the fourth power (the bending stiffness
