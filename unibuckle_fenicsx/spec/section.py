@@ -134,16 +134,15 @@ def cells_along(length: float, size: float) -> int:
     return max(1, math.ceil(length / size - _ROUNDING))
 
 
-def face_cells(extent: float, size: float) -> int:
-    """The cells of about ``size`` (m) a box's uniform face of width ``extent`` (m) gets.
+def face_cells(extent: float, size: float, even: bool = True, least: int = 2) -> int:
+    """The cells of about ``size`` (m) across a width ``extent`` (m) of a section's mesh.
 
-    ceil(extent/size) made even (a node at the middle of the face), at least 2.
-    :mod:`~unibuckle_fenicsx.model.shell.geometry` meshes a box's faces with it (and the
-    uniform middle part of a graded face); the checks of a file's ``[mesh]`` read it
-    before any mesh is made.
+    ceil(extent/size), at least ``least``, made even if ``even`` (a box's face: a node at
+    its middle; a tube's facets, at least 8). :mod:`~unibuckle_fenicsx.model.shell.geometry`
+    meshes with it; the checks of a file's ``[mesh]`` read it before any mesh is made.
     """
-    n = max(2, math.ceil(extent / size - _ROUNDING))
-    return n + n % 2
+    n = max(least, math.ceil(extent / size - _ROUNDING))
+    return n + n % 2 if even else n
 
 
 #: The fewest cells across a box's narrowest face a core (rigid or elastic) is solved on.

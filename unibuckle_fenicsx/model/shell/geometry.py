@@ -137,12 +137,6 @@ class SectionMesh:
         return out
 
 
-def _cells_for(extent: float, size: float, even: bool = True, least: int = 2) -> int:
-    """Cells across ``extent`` of about ``size`` each (even if asked, at least ``least``)."""
-    n = max(least, math.ceil(extent / size - 1e-9))
-    return n + (n % 2) if even else n
-
-
 def _cells_along(length: float, size: float) -> int:
     """Cells along x of every section mesh: ceil(L/size), at least one.
 
@@ -154,7 +148,7 @@ def _cells_along(length: float, size: float) -> int:
 
 def _facets(diameter: float, size: float) -> int:
     """A tube's facets around: an even number of chords of about ``size``, at least 8."""
-    return _cells_for(math.pi * diameter, size, least=8)
+    return face_cells(math.pi * diameter, size, least=8)
 
 
 #: Growth ratio of neighbouring cells across a graded face (:func:`_face_fractions`).
@@ -373,7 +367,7 @@ def flat_face_mesh(
         if size is None:
             raise InputError("flat_face_mesh needs size or cells")
         _positive(size=size)
-        nx, ny = _cells_along(length, size), _cells_for(width, size, False, 1)
+        nx, ny = _cells_along(length, size), face_cells(width, size, False, 1)
     else:
         nx, ny = cells
     ring = np.stack([np.linspace(0.0, width, ny + 1), np.zeros(ny + 1)], axis=1)
@@ -398,7 +392,7 @@ def grid_nodes(
     if shape == "tube":
         return _facets(across[0], size), along
     if shape == "flat":
-        return _cells_for(across[0], size, even=False, least=1) + 1, along
+        return face_cells(across[0], size, even=False, least=1) + 1, along
     b, d = across
     return sum(_face_cells(e, size, corner) for e in (d, b, d, b)), along
 
